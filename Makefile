@@ -1,0 +1,136 @@
+# grainkit - the only build. `make help` lists the targets.
+#
+# Every program under tests/, examples/, bench/ and tools/ is one C file that
+# defines GK_IMPLEMENTATION itself, so each builds with a single compiler call.
+# Variables you may override: CC, CXX, OPT, ARCH, OMP, PREFIX, BUILD.
+
+CC      ?= cc
+CXX     ?= c++
+OPT     ?= -O2
+ARCH    ?= -march=native
+OMP     ?= -fopenmp
+BUILD   ?= build
+PREFIX  ?= /usr/local
+
+WARN    := -std=c99 -pedantic -Wall -Wextra -Werror
+# determinism: no FMA contraction, never -ffast-math (DESIGN.md principle 3)
+FPFLAGS := -ffp-contract=off -fno-fast-math
+CFLAGS  := $(WARN) $(OPT) $(ARCH) $(FPFLAGS) $(OMP) -Iinclude -Itests
+LDLIBS  := -lm
+
+HEADERS  := $(wildcard include/gk_*.h)
+TEST_SRC := $(wildcard tests/test_*.c)
+EX_SRC   := $(wildcard examples/*.c)
+BENCH_SRC:= $(filter-out bench/%_part.c,$(wildcard bench/*.c))
+TOOL_SRC := $(wildcard tools/*.c)
+
+TESTS    := $(patsubst tests/%.c,$(BUILD)/%,$(TEST_SRC))
+EXAMPLES := $(patsubst examples/%.c,$(BUILD)/%,$(EX_SRC))
+BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
+TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
+
+.PHONY: all test check bench bench-peers run install uninstall format format-check clean help \
+        check-headers check-asan check-nosimd
+
+all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
+
+help:
+	@echo "make            build tests, examples, benchmarks and tools into $(BUILD)/"
+	@echo "make run        the main job (see README.md)"
+	@echo "make test       build and run every test; ends with 'N passed, N failed'"
+	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability"
+	@echo "make bench      performance programs (2 cores)"
+	@echo "make bench-peers  the same workloads in LAMMPS / LIGGGHTS / YADE when installed"
+	@echo "make install PREFIX=dir   headers + pkg-config file"
+	@echo "make format / format-check   clang-format"
+
+$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr:
+	@mkdir -p $@
+
+$(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
+	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
+
+$(BUILD)/%: examples/%.c $(HEADERS) | $(BUILD)
+	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
+
+$(BUILD)/bench_%: bench/%.c $(HEADERS) $(wildcard bench/*_part.c) | $(BUILD)
+	$(CC) $(CFLAGS) -Ibench -o $@ $< $(LDLIBS)
+
+$(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
+	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
+
+test: $(TESTS)
+	@tests/run_tests.sh $(TESTS)
+
+# ---------------------------------------------------------------- check
+SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+ASAN_TESTS   := $(patsubst tests/%.c,$(BUILD)/asan/%,$(TEST_SRC))
+NOSIMD_TESTS := $(patsubst tests/%.c,$(BUILD)/nosimd/%,$(TEST_SRC))
+
+$(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/asan
+	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -Itests -DGK_TEST_QUICK -o $@ $< $(LDLIBS)
+
+$(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/nosimd
+	$(CC) $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude -Itests -o $@ $< $(LDLIBS)
+
+check-asan: $(ASAN_TESTS)
+	@echo "== tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+	@ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 tests/run_tests.sh $(ASAN_TESTS)
+
+check-nosimd: $(NOSIMD_TESTS)
+	@echo "== tests built without SIMD (GK_NO_SIMD, no -march)"
+	@tests/run_tests.sh $(NOSIMD_TESTS)
+
+# every header alone, declarations and implementation, as C99 with gcc and
+# clang, as C++ with g++ and clang++, double and float
+check-headers: | $(BUILD)/hdr
+	@echo "== header portability"
+	@set -e; for h in $(notdir $(HEADERS)); do \
+	  for cc in gcc clang; do \
+	    for def in "" "-DGK_IMPLEMENTATION" "-DGK_IMPLEMENTATION -DGK_REAL_FLOAT" "-DGK_IMPLEMENTATION -DGK_NO_SIMD"; do \
+	      printf '#include "%s"\nint gk__dummy;\n' $$h | $$cc -std=c99 -pedantic -Wall -Wextra -Werror -Wshadow $(ARCH) $$def -Iinclude -x c -c - -o $(BUILD)/hdr/x.o \
+	        || { echo "FAILED: $$cc $$def $$h"; exit 1; }; \
+	    done; \
+	  done; \
+	  for cxx in g++ clang++; do \
+	    for def in "" "-DGK_IMPLEMENTATION"; do \
+	      printf '#include "%s"\nint gk__dummy;\n' $$h | $$cxx -std=c++11 -Wall -Wextra -Werror $(ARCH) $$def -Iinclude -x c++ -c - -o $(BUILD)/hdr/x.o \
+	        || { echo "FAILED: $$cxx $$def $$h"; exit 1; }; \
+	    done; \
+	  done; \
+	  echo "ok   $$h (gcc, clang: c99 -pedantic; g++, clang++: c++11; float; no-SIMD)"; \
+	done
+
+check: check-headers check-nosimd check-asan
+
+# ---------------------------------------------------------------- run / bench
+run: $(BUILD)/rve_path
+	$(BUILD)/rve_path --packing examples/data/rve400.txt --dH "0 0.001 0 0" --increments 50 \
+	  --steps-per-increment 100 --out $(BUILD)/rve_path.csv
+
+bench: $(BENCHES)
+	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
+
+bench-peers: $(BUILD)/bench_dem_step
+	@bench/peers/run_peers.sh
+
+# ---------------------------------------------------------------- install
+install:
+	@mkdir -p $(DESTDIR)$(PREFIX)/include/grainkit $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	cp $(HEADERS) $(DESTDIR)$(PREFIX)/include/grainkit/
+	@printf 'prefix=%s\nincludedir=$${prefix}/include/grainkit\n\nName: grainkit\nDescription: header-only C99 kernels for two-scale granular mechanics (FEMxDEM, MPMxDEM)\nVersion: %s\nCflags: -I$${includedir} -ffp-contract=off\nLibs: -lm\n' \
+	  "$(PREFIX)" "$$(sed -n 's/^#define GK_VERSION_STRING "\(.*\)"/\1/p' include/gk_base.h)" \
+	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/grainkit.pc
+	@echo "installed headers in $(DESTDIR)$(PREFIX)/include/grainkit, pkg-config file grainkit.pc"
+
+uninstall:
+	rm -rf $(DESTDIR)$(PREFIX)/include/grainkit $(DESTDIR)$(PREFIX)/lib/pkgconfig/grainkit.pc
+
+FORMAT_SRC := $(HEADERS) $(TEST_SRC) tests/gk_test.h $(EX_SRC) $(wildcard bench/*.c bench/*.h) $(TOOL_SRC)
+format:
+	clang-format -i $(FORMAT_SRC)
+format-check:
+	clang-format --dry-run --Werror $(FORMAT_SRC)
+
+clean:
+	rm -rf $(BUILD)
