@@ -140,6 +140,7 @@ typedef enum gk_result {
     GK_ERR_STATE,       /* call not valid in the object's current state        */
     GK_ERR_MESH,        /* invalid mesh: inverted/degenerate element, bad ids  */
     GK_ERR_UNSUPPORTED, /* valid request this build or module does not do    */
+    GK_ERR_NOCONVERGE,  /* an iteration stopped at its cap without converging */
     GK_RESULT_COUNT
 } gk_result;
 
@@ -482,6 +483,7 @@ GKDEF const char *gk_result_string(gk_result r) {
     case GK_ERR_STATE: return "invalid state for this call";
     case GK_ERR_MESH: return "invalid mesh";
     case GK_ERR_UNSUPPORTED: return "unsupported";
+    case GK_ERR_NOCONVERGE: return "did not converge";
     default: return "unknown result code";
     }
 }

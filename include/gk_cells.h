@@ -1,0 +1,350 @@
+/* gk_cells.h - contact detection with cell lists for grainkit.   (grainkit v0.1)
+ *
+ * Bins particles of a periodic (possibly sheared or rotated) cell by a
+ * counting sort in reduced coordinates and lists candidate pairs: every pair
+ * (i, j), i < j, whose nearest-image distance is below r_i + r_j + skin.
+ *
+ * DO THIS: #define GK_IMPLEMENTATION (or GK_CELLS_IMPLEMENTATION) in one file.
+ *
+ * WHY REDUCED COORDINATES. Two particles closer than c differ in reduced
+ * coordinate k by at most c / w_k, where w_k is the perpendicular width of
+ * the cell across axis k (gk_pcell_widths). Bins of reduced width >= c / w_k
+ * therefore make the 3^dim neighbouring bins exact in any skewed cell; there
+ * is no special case for Lees-Edwards shear.
+ *
+ * ORDER (documented and fixed): pairs are sorted by i, then by j, with i < j.
+ * The order depends only on which pairs are candidates, never on the binning,
+ * the thread count or the SIMD width. gk_dem.h relies on it for its
+ * fixed-order force reduction and to carry contact history across rebuilds
+ * by a linear merge.
+ *
+ * POLYDISPERSITY. The bin size is set by the largest pair cutoff
+ * (2 r_max + skin); per-pair cutoffs r_i + r_j + skin are tested exactly, so a
+ * size ratio of 10 is correct (small particles share bins; it costs time,
+ * not accuracy).
+ *
+ * VERLET SKIN. gk_cells_skin_ok tells whether a list built at reduced
+ * positions s0 in cell h0 still contains every touching pair: it bounds the
+ * change of any pair distance by the affine map A = h h0^-1 (through its
+ * smallest singular value) plus twice the largest non-affine displacement.
+ *
+ * LICENCE: MIT (see gk_base.h).
+ */
+#ifndef GK_CELLS_H
+#define GK_CELLS_H
+
+#include "gk_base.h"
+
+typedef struct gk_cells {
+    int dim, n;
+    int nbin[3];
+    int nbins;
+    int32_t *bin_start; /* nbins + 1: particles of bin b are order[bin_start[b] .. bin_start[b+1]) */
+    int32_t *order;     /* particle indices sorted by bin, ascending inside a bin */
+    int32_t *bin_of;    /* bin of each particle */
+    int32_t *buf;       /* scratch for one particle's candidates */
+    size_t cap_bins, cap_n, cap_buf;
+    gk_allocator alloc;
+} gk_cells;
+
+/* Candidate pair list, sorted by (i, j), i < j; start[p] .. start[p+1] are
+ * the pairs whose first particle is p (CSR by i). */
+typedef struct gk_pairlist {
+    int n;          /* number of pairs */
+    int np;         /* number of particles the CSR covers */
+    int32_t *i, *j; /* n each */
+    int32_t *start; /* np + 1 */
+    size_t cap, cap_np;
+    gk_allocator alloc;
+} gk_pairlist;
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+GKDEF void gk_cells_init(gk_cells *c, const gk_allocator *alloc);
+GKDEF void gk_cells_free(gk_cells *c);
+/* Bins n particles with reduced coordinates s[0..dim-1][n] (any real values;
+ * they are wrapped into [0,1) for binning) in cell h with bin size >= cutoff.
+ * GK_ERR_CELL if cutoff >= half the smallest cell width (minimum image would
+ * be ambiguous). */
+GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3], double cutoff,
+                             gk_err *err);
+/* After gk_cells_bin: all pairs with nearest-image distance < r_i + r_j + skin. */
+GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *const s[3], const gk_real *r,
+                               double skin, gk_pairlist *out, gk_err *err);
+
+GKDEF void gk_pairlist_init(gk_pairlist *p, const gk_allocator *alloc);
+GKDEF void gk_pairlist_free(gk_pairlist *p);
+GKDEF gk_result gk_pairlist_reserve(gk_pairlist *p, size_t npairs, size_t np);
+
+/* Verlet criterion: 1 if a list built at s0 in cell h0 (with this skin and
+ * largest radius rmax) is still complete at s in cell h. dispmax2 receives
+ * the largest squared non-affine displacement |h (s - s0)|^2. */
+GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n, const double *const s0[3],
+                           const double *const s[3], double skin, double rmax, double *dispmax2);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* GK_CELLS_H */
+
+/* ======================================================== IMPLEMENTATION */
+#if (defined(GK_IMPLEMENTATION) || defined(GK_CELLS_IMPLEMENTATION)) && !defined(GK_CELLS_IMPL_ONCE)
+#define GK_CELLS_IMPL_ONCE
+
+GKDEF void gk_cells_init(gk_cells *c, const gk_allocator *alloc) {
+    c->dim = c->n = c->nbins = 0;
+    c->nbin[0] = c->nbin[1] = c->nbin[2] = 0;
+    c->bin_start = c->order = c->bin_of = c->buf = NULL;
+    c->cap_bins = c->cap_n = c->cap_buf = 0;
+    if (alloc)
+        c->alloc = *alloc;
+    else {
+        c->alloc.alloc = NULL;
+        c->alloc.free = NULL;
+        c->alloc.user = NULL;
+    }
+}
+
+GKDEF void gk_cells_free(gk_cells *c) {
+    gk_free(&c->alloc, c->bin_start);
+    gk_free(&c->alloc, c->order);
+    gk_free(&c->alloc, c->bin_of);
+    gk_free(&c->alloc, c->buf);
+    gk_cells_init(c, &c->alloc);
+}
+
+GKDEF void gk_pairlist_init(gk_pairlist *p, const gk_allocator *alloc) {
+    p->n = p->np = 0;
+    p->i = p->j = p->start = NULL;
+    p->cap = p->cap_np = 0;
+    if (alloc)
+        p->alloc = *alloc;
+    else {
+        p->alloc.alloc = NULL;
+        p->alloc.free = NULL;
+        p->alloc.user = NULL;
+    }
+}
+
+GKDEF void gk_pairlist_free(gk_pairlist *p) {
+    gk_free(&p->alloc, p->i);
+    gk_free(&p->alloc, p->j);
+    gk_free(&p->alloc, p->start);
+    gk_pairlist_init(p, &p->alloc);
+}
+
+GKDEF gk_result gk_pairlist_reserve(gk_pairlist *p, size_t npairs, size_t np) {
+    if (npairs > p->cap) {
+        size_t cap = p->cap ? p->cap : 64;
+        while (cap < npairs) cap *= 2;
+        if (gk_realloc(&p->alloc, (void **)&p->i, (size_t)p->n, cap, sizeof(int32_t))) return GK_ERR_ALLOC;
+        if (gk_realloc(&p->alloc, (void **)&p->j, (size_t)p->n, cap, sizeof(int32_t))) return GK_ERR_ALLOC;
+        p->cap = cap;
+    }
+    if (np + 1 > p->cap_np) {
+        if (gk_realloc(&p->alloc, (void **)&p->start, 0, np + 1, sizeof(int32_t))) return GK_ERR_ALLOC;
+        p->cap_np = np + 1;
+    }
+    return GK_OK;
+}
+
+static gk_result gk__cells_grow(gk_cells *c, int32_t **arr, size_t *cap, size_t need) {
+    if (need <= *cap) return GK_OK;
+    if (gk_realloc(&c->alloc, (void **)arr, 0, need, sizeof(int32_t))) return GK_ERR_ALLOC;
+    *cap = need;
+    return GK_OK;
+}
+
+GK_INLINE int gk__wrap_bin(double s, int nb) {
+    double f = s - floor(s);
+    int b = (int)(f * (double)nb);
+    return b >= nb ? nb - 1 : (b < 0 ? 0 : b);
+}
+
+GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3], double cutoff,
+                             gk_err *err) {
+    double hinv[9], w[3];
+    long total = 1;
+    int k, p;
+    if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
+    if (n < 0) return gk_err_set(err, GK_ERR_ARG, "particle count %d < 0", n);
+    if (!(cutoff > 0.0) || !isfinite(cutoff)) return gk_err_set(err, GK_ERR_ARG, "cutoff %g must be > 0", cutoff);
+    if (!(gk_m3_inverse(h, hinv) > 0.0)) return gk_err_set(err, GK_ERR_CELL, "cell matrix is singular or inverted");
+    for (k = 0; k < dim; ++k) {
+        const double *row = hinv + 3 * k;
+        w[k] = 1.0 / sqrt(row[0] * row[0] + row[1] * row[1] + (dim == 3 ? row[2] * row[2] : 0.0));
+        if (!(cutoff < 0.5 * w[k]))
+            return gk_err_set(err, GK_ERR_CELL,
+                              "cell width %g across axis %d is less than twice the interaction distance %g: "
+                              "nearest image ambiguous (use a larger cell)",
+                              w[k], k, cutoff);
+        c->nbin[k] = (int)(w[k] / cutoff);
+        if (c->nbin[k] < 1) c->nbin[k] = 1;
+    }
+    if (dim == 2) c->nbin[2] = 1;
+    /* keep the grid at most ~2n + 27 bins (dilute or huge cells) */
+    for (;;) {
+        total = (long)c->nbin[0] * c->nbin[1] * c->nbin[2];
+        if (total <= 2L * n + 27) break;
+        for (k = 0; k < dim; ++k)
+            if (c->nbin[k] > 3) c->nbin[k] = c->nbin[k] * 3 / 4 > 3 ? c->nbin[k] * 3 / 4 : 3;
+        if (c->nbin[0] <= 3 && c->nbin[1] <= 3 && c->nbin[2] <= 3) break;
+    }
+    c->nbins = (int)total;
+    if (gk__cells_grow(c, &c->bin_start, &c->cap_bins, (size_t)total + 1))
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %ld cell-list bins", total);
+    if ((size_t)n + 1 > c->cap_n) { /* order and bin_of share one capacity */
+        size_t cap = (size_t)n + 1;
+        if (gk_realloc(&c->alloc, (void **)&c->order, 0, cap, sizeof(int32_t)) ||
+            gk_realloc(&c->alloc, (void **)&c->bin_of, 0, cap, sizeof(int32_t)))
+            return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d particles in the cell list", n);
+        c->cap_n = cap;
+    }
+    c->dim = dim;
+    c->n = n;
+    for (k = 0; k <= c->nbins; ++k) c->bin_start[k] = 0;
+    for (p = 0; p < n; ++p) {
+        int b = gk__wrap_bin(s[0][p], c->nbin[0]) +
+                c->nbin[0] * (gk__wrap_bin(s[1][p], c->nbin[1]) +
+                              c->nbin[1] * (dim == 3 ? gk__wrap_bin(s[2][p], c->nbin[2]) : 0));
+        c->bin_of[p] = b;
+        ++c->bin_start[b + 1];
+    }
+    for (k = 0; k < c->nbins; ++k) c->bin_start[k + 1] += c->bin_start[k];
+    /* stable scatter: ascending particle index inside each bin */
+    for (p = 0; p < n; ++p) {
+        int b = c->bin_of[p];
+        c->order[c->bin_start[b]++] = p;
+    }
+    for (k = c->nbins; k > 0; --k) c->bin_start[k] = c->bin_start[k - 1];
+    c->bin_start[0] = 0;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *const s[3], const gk_real *r,
+                               double skin, gk_pairlist *out, gk_err *err) {
+    int off[3][3], noff[3], k, p, dim = c->dim, n = c->n;
+    if (gk_pairlist_reserve(out, out->cap ? out->cap : (size_t)4 * n + 16, (size_t)n))
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the pair list");
+    for (k = 0; k < 3; ++k) {
+        int nb = c->nbin[k];
+        if (k >= dim || nb == 1) {
+            noff[k] = 1;
+            off[k][0] = 0;
+        } else if (nb == 2) { /* bins -1 and +1 coincide: visit each once */
+            noff[k] = 2;
+            off[k][0] = 0;
+            off[k][1] = 1;
+        } else {
+            noff[k] = 3;
+            off[k][0] = -1;
+            off[k][1] = 0;
+            off[k][2] = 1;
+        }
+    }
+    if (gk__cells_grow(c, &c->buf, &c->cap_buf, 256))
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the pair buffer");
+    out->n = 0;
+    out->np = n;
+    for (p = 0; p < n; ++p) {
+        int b = c->bin_of[p];
+        int bx = b % c->nbin[0], by = (b / c->nbin[0]) % c->nbin[1], bz = b / (c->nbin[0] * c->nbin[1]);
+        int a0, a1, a2, cnt = 0, q;
+        double spx = s[0][p], spy = s[1][p], spz = dim == 3 ? s[2][p] : 0.0;
+        double rp = (double)r[p];
+        out->start[p] = out->n;
+        for (a2 = 0; a2 < noff[2]; ++a2)
+            for (a1 = 0; a1 < noff[1]; ++a1)
+                for (a0 = 0; a0 < noff[0]; ++a0) {
+                    int cx = (bx + off[0][a0] + c->nbin[0]) % c->nbin[0];
+                    int cy = (by + off[1][a1] + c->nbin[1]) % c->nbin[1];
+                    int cz = (bz + off[2][a2] + c->nbin[2]) % c->nbin[2];
+                    int nb = cx + c->nbin[0] * (cy + c->nbin[1] * cz), e;
+                    for (e = c->bin_start[nb]; e < c->bin_start[nb + 1]; ++e) {
+                        int q2 = c->order[e];
+                        double dx, dy, dz, ex, ey, ez, cut;
+                        if (q2 <= p) continue;
+                        dx = s[0][q2] - spx;
+                        dy = s[1][q2] - spy;
+                        dz = dim == 3 ? s[2][q2] - spz : 0.0;
+                        dx -= rint(dx);
+                        dy -= rint(dy);
+                        dz -= rint(dz);
+                        ex = h[0] * dx + h[1] * dy + h[2] * dz;
+                        ey = h[3] * dx + h[4] * dy + h[5] * dz;
+                        ez = h[6] * dx + h[7] * dy + h[8] * dz;
+                        if (dim == 2) ez = 0.0;
+                        cut = rp + (double)r[q2] + skin;
+                        if (ex * ex + ey * ey + ez * ez < cut * cut) {
+                            if ((size_t)cnt >= c->cap_buf &&
+                                gk__cells_grow(c, &c->buf, &c->cap_buf, c->cap_buf * 2))
+                                return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the pair buffer");
+                            c->buf[cnt++] = q2;
+                        }
+                    }
+                }
+        /* insertion sort: lists are short (a few to a few tens) */
+        for (q = 1; q < cnt; ++q) {
+            int32_t v = c->buf[q];
+            int t = q - 1;
+            while (t >= 0 && c->buf[t] > v) {
+                c->buf[t + 1] = c->buf[t];
+                --t;
+            }
+            c->buf[t + 1] = v;
+        }
+        if ((size_t)(out->n + cnt) > out->cap) {
+            size_t want = out->cap * 2 > (size_t)(out->n + cnt) ? out->cap * 2 : (size_t)(out->n + cnt);
+            if (gk_pairlist_reserve(out, want, (size_t)n))
+                return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d pairs", out->n + cnt);
+        }
+        for (q = 0; q < cnt; ++q) {
+            out->i[out->n] = p;
+            out->j[out->n] = c->buf[q];
+            ++out->n;
+        }
+    }
+    out->start[n] = out->n;
+    return GK_OK;
+}
+
+/* smallest singular value of a 3x3 (dim x dim block) */
+static double gk__sigma_min(int dim, const double A[9]) {
+    double AtA[9], At[9], val[3], vec[9];
+    gk_m3_transpose(A, At);
+    gk_m3_mul(At, A, AtA);
+    if (dim == 2) {
+        double a = AtA[0], b = AtA[1], d = AtA[4];
+        double tr = a + d, disc = sqrt(0.25 * (a - d) * (a - d) + b * b);
+        double lmin = 0.5 * tr - disc;
+        return lmin > 0.0 ? sqrt(lmin) : 0.0;
+    }
+    gk_m3_sym_eigen(AtA, val, vec);
+    return val[0] > 0.0 ? sqrt(val[0]) : 0.0;
+}
+
+GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n, const double *const s0[3],
+                           const double *const s[3], double skin, double rmax, double *dispmax2) {
+    double h0i[9], A[9], smin, m2 = 0.0, margin;
+    int p;
+    if (!(gk_m3_inverse(h0, h0i) > 0.0)) return 0;
+    gk_m3_mul(h, h0i, A);
+    smin = gk__sigma_min(dim, A);
+    for (p = 0; p < n; ++p) {
+        double dx = s[0][p] - s0[0][p], dy = s[1][p] - s0[1][p], dz = dim == 3 ? s[2][p] - s0[2][p] : 0.0;
+        double ex = h[0] * dx + h[1] * dy + h[2] * dz;
+        double ey = h[3] * dx + h[4] * dy + h[5] * dz;
+        double ez = dim == 3 ? h[6] * dx + h[7] * dy + h[8] * dz : 0.0;
+        double d2 = ex * ex + ey * ey + ez * ez;
+        if (d2 > m2) m2 = d2;
+    }
+    if (dispmax2) *dispmax2 = m2;
+    /* a pair listed out had |d0| >= R + skin; now |d| >= smin (R + skin) - 2 disp.
+     * It stays apart (|d| > R) for every R <= 2 rmax if this margin is positive. */
+    margin = smin * skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rmax : 0.0) - 2.0 * sqrt(m2);
+    return margin > 0.0;
+}
+
+#endif /* GK_CELLS implementation */

@@ -1,0 +1,3474 @@
+/* gk_dem.h - the periodic DEM RVE as a unit of work.             (grainkit v0.1)
+ *
+ * A gk_rve is a periodic packing of disks (2D) or spheres (3D) in a
+ * deformable cell: give it a displacement-gradient increment and a number of
+ * steps, get back the homogenised stress (and, through gk_homog.h, the
+ * tangent). It is a plain struct the caller can keep in an array of
+ * thousands (one per Gauss or material point).
+ *
+ * DO THIS in one C/C++ file:   #define GK_IMPLEMENTATION
+ *                              #include "gk_dem.h"
+ *
+ *   gk_packing pk;  gk_err e;  gk_rve rve;
+ *   gk_rve_def def = gk_rve_def_default();          // seed 000 material
+ *   gk_packing_read("rve400.txt", &pk, NULL, &e);
+ *   gk_rve_create(&rve, &def, &pk);
+ *   double dH[9] = {0, 1e-3, 0,  0, 0, 0,  0, 0, 0};  // H01 = du_x/dy
+ *   gk_rve_deform(&rve, dH, 100);                   // 100 DEM steps
+ *   double sig[9]; gk_rve_stress(&rve, sig);        // Love stress, tension +
+ *   gk_rve_destroy(&rve); gk_packing_free(&pk);
+ *
+ * THE RVE CONTRACT (DESIGN.md principle 6)
+ *   gk_rve_deform(rve, dH, n)  cell map I + dH over n steps; stress after
+ *   gk_rve_stress / gk_homog_tangent (gk_homog.h)
+ *   gk_rve_save / gk_rve_restore  the full state (positions, velocities,
+ *     spins, cell, pair list with contact history) to and from caller
+ *     memory, so an implicit driver can retry an increment bit for bit.
+ *
+ * KINEMATICS. Positions are stored as reduced coordinates s (double, also in
+ * the float build) and x = h s; velocities v and spins w are the
+ * FLUCTUATIONS about the affine field of the cell (translational L x and
+ * rotational = spin of L). Per step with incremental cell map E (h <- E h):
+ *   1. forces at (s_n, h_n) with v_{n-1/2}; the relative velocity of a pair
+ *      includes the affine part G d, G = (E - I)/dt, and particles spin with
+ *      the cell's spin plus their own fluctuation;
+ *   2. h_{n+1} = E h_n (lattice reduction when too skewed);
+ *   3. leap-frog: v += dt F/m (after local damping), s += h_{n+1}^-1 v dt.
+ * The inertial term -m L v of the SLLOD equations is neglected (it is of
+ * order I^2 in the quasi-static regime this code is for), as in YADE.
+ *
+ * LOCAL (NON-VISCOUS) DAMPING, factor alpha in [0, 1):
+ *   GK_DAMP_COMPONENT (default; YADE, PFC, the seed 000 data): per component
+ *     a_k <- a_k (1 - alpha sign(a_k (v_k + a_k dt/2)))   (YADE cundallDamp2nd)
+ *   GK_DAMP_VECTOR (seed 000 eq 18): F_damp = -alpha |F| v/|v|, with the same
+ *     mid-step velocity estimate v + a dt/2.
+ *   Applied to the fluctuating velocity and spin.
+ *
+ * TIME STEP. gk_rve_dt_critical() is seed 000 eq 19, dt_cr = sqrt(m_min /
+ * k_n,max) (Hertz: k_n at twice the current largest overlap, at least 1e-3
+ * r_min). dt = 0 in the def means 0.5 dt_cr; a dt above dt_cr is an error.
+ *
+ * MASSES. 3D spheres: m = rho 4/3 pi r^3, I = 2/5 m r^2. 2D disks, default
+ * GK_MASS_CYLINDER: cylinders of thickness t (seed 000: 0.1 m),
+ * m = rho t pi r^2, I = m r^2 / 2, stress volume = cell area x t;
+ * GK_MASS_SPHERE: sphere masses for the disks (as LAMMPS in 2D), stress volume
+ * = area x t (t = 1 if 0: stress in N/m).
+ *
+ * ORDER AND DETERMINISM. Pairs are kept sorted by (i, j) (gk_cells.h). Each
+ * step first computes every pair force (no write conflicts, SIMD), then sums
+ * per particle in a fixed order: for particle p, the pairs where p is j in
+ * ascending pair order, then the pairs where p is i. The result is identical
+ * whatever the thread count, the SIMD width, or when the list is rebuilt.
+ * Particles are stored in cell-list order for locality; gk_rve.id[] holds
+ * each one's index in the input packing and output packings use input order.
+ *
+ * ERRORS are values: every call returns gk_result; gk_rve_error(rve) gives
+ * the message. Bad input leaves the caller's data unchanged. A step that
+ * produces a non-finite value returns GK_ERR_DIVERGED and marks the RVE
+ * (restore a saved state to continue).
+ *
+ * CONFIG: GK_REAL_FLOAT (see gk_base.h), GK_DEM_PAR_MIN (pairs below which
+ * one RVE never uses threads, default 20000).
+ *
+ * LICENCE: MIT (see gk_base.h).
+ */
+#ifndef GK_DEM_H
+#define GK_DEM_H
+
+#include "gk_base.h"
+#include "gk_cells.h"
+#include "gk_contact.h"
+#include "gk_pcell.h"
+
+#ifndef GK_DEM_PAR_MIN
+#define GK_DEM_PAR_MIN 20000
+#endif
+
+/* ------------------------------------------------------------- packing */
+/* A packing: particles in a periodic cell, in the format of shared/data:
+ *   line 1:  "2 N Lx Ly" or "3 N Lx Ly Lz"
+ *   lines starting with '#': comments; grainkit writes and reads an optional
+ *            "# cell h00 h01 ... " line holding the full (skewed) cell matrix
+ *   N lines: "x y r" or "x y z r" (SI units), positions in the cell. */
+typedef struct gk_packing {
+    int dim, n;
+    double h[9];     /* cell matrix (a box is diag(Lx, Ly, Lz)); 2D: h22 = 1 */
+    double *x, *y, *z, *r;
+    gk_allocator alloc;
+} gk_packing;
+
+typedef enum gk_psd_kind { GK_PSD_UNIFORM = 0, GK_PSD_TABLE_NUMBER = 1, GK_PSD_TABLE_MASS = 2 } gk_psd_kind;
+
+/* Random loose packing (no overlaps) to be consolidated by gk_rve_consolidate. */
+typedef struct gk_gen_def {
+    int dim, n;
+    gk_psd_kind psd;
+    double r_min, r_max;      /* GK_PSD_UNIFORM: radii uniform in [r_min, r_max]     */
+    int ntable;               /* table kinds: ntable points (radius, cumulative     */
+    const double *table_r;    /*   fraction passing, by number or by mass), radii   */
+    const double *table_cum;  /*   increasing, cum from 0 to 1                       */
+    double packing_fraction;  /* of the initial cloud; 0 -> 0.5 (2D), 0.3 (3D)      */
+    double aspect[3];         /* cell edge ratios; 0 -> cube/square                  */
+    uint64_t seed;
+} gk_gen_def;
+
+/* ------------------------------------------------------------- RVE def */
+typedef enum gk_damp_form { GK_DAMP_COMPONENT = 0, GK_DAMP_VECTOR = 1 } gk_damp_form;
+typedef enum gk_mass_model { GK_MASS_CYLINDER = 0, GK_MASS_SPHERE = 1 } gk_mass_model;
+
+#define GK_RVE_NO_ROTATION 1u /* particles do not rotate (spin with the cell only) */
+#define GK_RVE_SCALAR 2u      /* always use the scalar reference kernels          */
+#define GK_RVE_WRAP 4u        /* accept positions outside the cell (wrap them)    */
+#define GK_RVE_DEF_COOKIE 0x52564531
+
+typedef struct gk_rve_def {
+    int cookie;               /* set by gk_rve_def_default()                        */
+    gk_material mat;
+    double dt;                /* time step [s]; 0 -> dt_factor x critical           */
+    double dt_factor;         /* used when dt = 0; 0 -> 0.5                          */
+    double skin;              /* Verlet skin [m]; 0 -> 0.1 x mean radius            */
+    double thickness;         /* 2D: disk thickness [m] (seed 000: 0.1)             */
+    gk_mass_model mass2d;
+    double damping;           /* local non-viscous damping alpha in [0, 1)          */
+    gk_damp_form damping_form;
+    gk_path_kind path;        /* how gk_rve_deform splits I + dH over the steps     */
+    unsigned flags;           /* GK_RVE_*                                           */
+    int threads;              /* threads inside this RVE; <= 1: serial              */
+    gk_allocator alloc;
+} gk_rve_def;
+
+typedef struct gk_rve {
+    int dim, n;
+    gk_rve_def def;
+    gk_law_consts K;
+    unsigned phys;            /* GK_PHYS_* in use                                   */
+    double dt, time, dt_crit;
+    long step, rebuilds;
+    gk_pcell cell;
+    double L[9];              /* prescribed velocity gradient for gk_rve_step      */
+    double G[9];              /* affine velocity gradient of the last step (E-I)/dt */
+    double volume_factor;     /* stress volume = det h x this (2D thickness)       */
+    /* particles: n each, stored in cell-list order */
+    double *s[3];             /* reduced positions                                  */
+    double *s0[3];            /* reduced positions at the last list build           */
+    gk_real *v[3];            /* fluctuating velocity [m/s]                         */
+    gk_real *w[3];            /* fluctuating spin [rad/s] (2D: w[2] only)           */
+    gk_real *f[3];            /* contact force sum of the last step [N]             */
+    gk_real *t[3];            /* contact torque sum of the last step (2D: t[2])     */
+    gk_real *r, *minv, *Iinv;
+    double *theta;            /* 2D: accumulated rotation [rad] (incl. cell spin)   */
+    int32_t *id;              /* index in the input packing                         */
+    double rmin, rmax, mmin, solid_volume, mass_total;
+    /* pairs, sorted by (i, j) */
+    gk_pairlist pl;
+    gk_real *ft[3];           /* tangential history (2D: ft[0] along t = (-ny, nx)) */
+    gk_real *mr[3];           /* rolling history (2D: mr[2])                        */
+    unsigned char *cs;        /* GK_CS_* state bits                                 */
+    gk_real *fc[3];           /* force on j of each pair, last step                 */
+    gk_real *tci[3], *tcj[3]; /* torques on i and on j, last step                   */
+    int32_t *jstart, *jlist;  /* pairs where p is j: jlist[jstart[p] .. jstart[p+1])*/
+    size_t pcap;              /* capacity of the per-pair arrays                    */
+    gk_cells cells;
+    double h0[9];             /* cell at the last build                             */
+    double skin;
+    int need_rebuild, diverged;
+    /* results of the last step that computed them (the last step of each call) */
+    double stress[9];         /* Love stress, tension-positive [Pa]                 */
+    double stiff[3];          /* Voigt stiffness D_kkkk estimate [Pa]               */
+    int ncontacts;
+    double fc_mean;           /* mean |F| over contacts                             */
+    int servo_on;
+    gk_servo servo;
+    gk_err err;
+} gk_rve;
+
+/* a growable buffer for gk_rve_save / gk_rve_restore */
+typedef struct gk_rve_state {
+    unsigned char *buf;
+    size_t size, cap;
+    gk_allocator alloc;
+} gk_rve_state;
+
+typedef struct gk_consolidate_def {
+    double pressure;          /* target isotropic stress, compression-positive [Pa] (> 0) */
+    double friction;          /* Coulomb coefficient while consolidating (0 = dense)      */
+    double stress_tol;        /* relative tolerance on every sigma_kk; 0 -> 1e-3           */
+    double unbalanced_tol;    /* unbalanced force ratio to reach; 0 -> 1e-3                */
+    double max_strain_rate;   /* [1/s]; 0 -> inertial number 1e-2 at the target pressure   */
+    long max_steps;           /* 0 -> 2 000 000                                            */
+} gk_consolidate_def;
+
+typedef struct gk_consolidate_report {
+    long steps;
+    double stress[9], unbalanced, void_ratio;
+} gk_consolidate_report;
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* packing */
+GKDEF gk_result gk_packing_alloc(gk_packing *pk, int dim, int n, const gk_allocator *alloc, gk_err *err);
+GKDEF void gk_packing_free(gk_packing *pk);
+GKDEF gk_result gk_packing_read(const char *path, gk_packing *pk, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *pk, const gk_allocator *alloc,
+                                 gk_err *err);
+GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const char *comment, gk_err *err);
+GKDEF gk_result gk_packing_generate(gk_packing *pk, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err);
+
+/* RVE */
+GKDEF gk_rve_def gk_rve_def_default(void);
+GKDEF gk_result gk_rve_create(gk_rve *rve, const gk_rve_def *def, const gk_packing *pk);
+GKDEF void gk_rve_destroy(gk_rve *rve);
+GKDEF const char *gk_rve_error(const gk_rve *rve);
+GKDEF double gk_rve_dt_critical(const gk_rve *rve);
+GKDEF gk_result gk_rve_set_dt(gk_rve *rve, double dt);
+GKDEF gk_result gk_rve_set_friction(gk_rve *rve, double mu);
+GKDEF gk_result gk_rve_set_damping(gk_rve *rve, double alpha, gk_damp_form form);
+/* constant velocity gradient used by gk_rve_step (diagonal overridden by a servo) */
+GKDEF gk_result gk_rve_set_velocity_gradient(gk_rve *rve, const double L[9]);
+GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *servo); /* NULL switches it off */
+GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps);
+GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps);
+GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk_consolidate_report *rep);
+/* Love stress of the last step (seed 000 eq 5), tension-positive, 3x3 */
+GKDEF void gk_rve_stress(const gk_rve *rve, double sigma[9]);
+/* recompute forces at the current positions without advancing (zero-length
+ * step: history and positions unchanged), then stress etc. are current */
+GKDEF gk_result gk_rve_refresh(gk_rve *rve);
+GKDEF double gk_rve_volume(const gk_rve *rve);     /* stress volume                */
+GKDEF double gk_rve_kinetic_energy(const gk_rve *rve); /* of the fluctuations     */
+GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]);
+GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *pk, const gk_allocator *alloc, gk_err *err);
+
+/* state */
+GKDEF size_t gk_rve_state_size(const gk_rve *rve);
+GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *written);
+GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size);
+GKDEF void gk_rve_state_init(gk_rve_state *st, const gk_allocator *alloc);
+GKDEF void gk_rve_state_free(gk_rve_state *st);
+GKDEF gk_result gk_rve_state_save(gk_rve_state *st, const gk_rve *rve);
+GKDEF gk_result gk_rve_state_restore(const gk_rve_state *st, gk_rve *rve);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* GK_DEM_H */
+
+/* ======================================================== IMPLEMENTATION */
+#if (defined(GK_IMPLEMENTATION) || defined(GK_DEM_IMPLEMENTATION)) && !defined(GK_DEM_IMPL_ONCE)
+#define GK_DEM_IMPL_ONCE
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ================================================================ packing */
+GKDEF gk_result gk_packing_alloc(gk_packing *pk, int dim, int n, const gk_allocator *alloc, gk_err *err) {
+    gk_packing p;
+    if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
+    if (n < 1) return gk_err_set(err, GK_ERR_ARG, "particle count %d (must be >= 1)", n);
+    memset(&p, 0, sizeof p);
+    if (alloc) p.alloc = *alloc;
+    p.dim = dim;
+    p.n = n;
+    gk_m3_identity(p.h);
+    p.x = (double *)gk_alloc(&p.alloc, (size_t)n * sizeof(double));
+    p.y = (double *)gk_alloc(&p.alloc, (size_t)n * sizeof(double));
+    p.z = (double *)gk_alloc(&p.alloc, (size_t)n * sizeof(double));
+    p.r = (double *)gk_alloc(&p.alloc, (size_t)n * sizeof(double));
+    if (!p.x || !p.y || !p.z || !p.r) {
+        gk_packing_free(&p);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d particles", n);
+    }
+    memset(p.z, 0, (size_t)n * sizeof(double));
+    *pk = p;
+    return GK_OK;
+}
+
+GKDEF void gk_packing_free(gk_packing *pk) {
+    gk_free(&pk->alloc, pk->x);
+    gk_free(&pk->alloc, pk->y);
+    gk_free(&pk->alloc, pk->z);
+    gk_free(&pk->alloc, pk->r);
+    pk->x = pk->y = pk->z = pk->r = NULL;
+    pk->n = 0;
+}
+
+/* line reader over a memory buffer */
+typedef struct gk__lines {
+    const char *p, *end;
+    long lineno;
+    char line[1024];
+} gk__lines;
+
+static int gk__next_line(gk__lines *L) {
+    size_t k = 0;
+    if (L->p >= L->end) return 0;
+    while (L->p < L->end && *L->p != '\n') {
+        if (k + 1 < sizeof L->line) L->line[k++] = *L->p;
+        ++L->p;
+    }
+    if (L->p < L->end) ++L->p;
+    L->line[k] = '\0';
+    ++L->lineno;
+    return 1;
+}
+
+static int gk__blank(const char *s) {
+    while (*s == ' ' || *s == '\t' || *s == '\r') ++s;
+    return *s == '\0';
+}
+
+/* parse up to max doubles; returns the count; sets *bad if a token is not a number */
+static int gk__parse_doubles(const char *s, double *out, int max, int *bad) {
+    int k = 0;
+    char *e;
+    *bad = 0;
+    for (;;) {
+        double v;
+        while (*s == ' ' || *s == '\t' || *s == '\r' || *s == ',') ++s;
+        if (*s == '\0' || *s == '#') break;
+        v = strtod(s, &e);
+        if (e == s) {
+            *bad = 1;
+            break;
+        }
+        if (k < max) out[k] = v;
+        ++k;
+        s = e;
+    }
+    return k;
+}
+
+GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, const gk_allocator *alloc,
+                                 gk_err *err) {
+    gk__lines L;
+    double hd[5], h[9], vals[8];
+    int nh, bad, dim, n, k = 0;
+    gk_packing pk;
+    gk_result r;
+    L.p = text;
+    L.end = text + len;
+    L.lineno = 0;
+    do {
+        if (!gk__next_line(&L)) return gk_err_set(err, GK_ERR_FORMAT, "empty packing: no header line");
+    } while (gk__blank(L.line));
+    nh = gk__parse_doubles(L.line, hd, 5, &bad);
+    if (bad || nh < 4) return gk_err_set(err, GK_ERR_FORMAT, "line %ld: header must be 'dim N Lx Ly [Lz]'", L.lineno);
+    if (hd[0] != 2.0 && hd[0] != 3.0)
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: dimension %g (must be 2 or 3)", L.lineno, hd[0]);
+    dim = (int)hd[0];
+    if (nh != dim + 2)
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: a %dD header has %d numbers, found %d", L.lineno, dim,
+                          dim + 2, nh);
+    if (!(hd[1] >= 1 && hd[1] <= 2e9) || (double)(int)hd[1] != hd[1])
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: particle count %g invalid", L.lineno, hd[1]);
+    n = (int)hd[1];
+    gk_m3_identity(h);
+    for (k = 0; k < dim; ++k) {
+        if (!(hd[2 + k] > 0.0) || !isfinite(hd[2 + k]))
+            return gk_err_set(err, GK_ERR_CELL, "line %ld: cell length %g must be > 0", L.lineno, hd[2 + k]);
+        h[4 * k] = hd[2 + k];
+    }
+    r = gk_packing_alloc(&pk, dim, n, alloc, err);
+    if (r) return r;
+    k = 0;
+    while (gk__next_line(&L)) {
+        const char *s = L.line;
+        int nv;
+        while (*s == ' ' || *s == '\t') ++s;
+        if (*s == '#') {
+            if (strncmp(s, "# cell ", 7) == 0) {
+                double hc[9];
+                int nc = gk__parse_doubles(s + 7, hc, 9, &bad), a, b;
+                if (bad || nc != dim * dim) {
+                    gk_packing_free(&pk);
+                    return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno, dim * dim);
+                }
+                gk_m3_identity(h);
+                for (a = 0; a < dim; ++a)
+                    for (b = 0; b < dim; ++b) h[3 * a + b] = hc[dim * a + b];
+            }
+            continue;
+        }
+        if (gk__blank(s)) continue;
+        nv = gk__parse_doubles(s, vals, 8, &bad);
+        if (bad || nv != dim + 1) {
+            gk_packing_free(&pk);
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: expected %d numbers (%s r), found %s", L.lineno, dim + 1,
+                              dim == 2 ? "x y" : "x y z", bad ? "a non-number" : "a different count");
+        }
+        if (k >= n) {
+            gk_packing_free(&pk);
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced", L.lineno, n);
+        }
+        for (nv = 0; nv <= dim; ++nv)
+            if (!isfinite(vals[nv])) {
+                gk_packing_free(&pk);
+                return gk_err_set(err, GK_ERR_NAN, "line %ld: particle %d has a non-finite value", L.lineno, k);
+            }
+        if (!(vals[dim] > 0.0)) {
+            gk_packing_free(&pk);
+            return gk_err_set(err, GK_ERR_RADIUS, "line %ld: particle %d has radius %g <= 0", L.lineno, k, vals[dim]);
+        }
+        pk.x[k] = vals[0];
+        pk.y[k] = vals[1];
+        pk.z[k] = dim == 3 ? vals[2] : 0.0;
+        pk.r[k] = vals[dim];
+        ++k;
+    }
+    if (k != n) {
+        gk_packing_free(&pk);
+        return gk_err_set(err, GK_ERR_FORMAT, "packing announces %d particles but lists %d", n, k);
+    }
+    if (!(gk_m3_det(h) > 0.0)) {
+        gk_packing_free(&pk);
+        return gk_err_set(err, GK_ERR_CELL, "cell matrix has det <= 0");
+    }
+    gk_m3_copy(h, pk.h);
+    *out = pk;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_packing_read(const char *path, gk_packing *pk, const gk_allocator *alloc, gk_err *err) {
+    FILE *fp;
+    long len;
+    char *buf;
+    gk_allocator a;
+    gk_result r;
+    if (alloc)
+        a = *alloc;
+    else
+        memset(&a, 0, sizeof a);
+    if (!path) return gk_err_set(err, GK_ERR_ARG, "no packing path given");
+    fp = fopen(path, "rb");
+    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open packing '%s'", path);
+    if (fseek(fp, 0, SEEK_END) != 0 || (len = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0) {
+        fclose(fp);
+        return gk_err_set(err, GK_ERR_IO, "cannot size packing '%s'", path);
+    }
+    buf = (char *)gk_alloc(&a, (size_t)len + 1);
+    if (!buf) {
+        fclose(fp);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory reading '%s'", path);
+    }
+    if (fread(buf, 1, (size_t)len, fp) != (size_t)len) {
+        fclose(fp);
+        gk_free(&a, buf);
+        return gk_err_set(err, GK_ERR_IO, "cannot read packing '%s'", path);
+    }
+    fclose(fp);
+    buf[len] = '\0';
+    r = gk_packing_parse(buf, (size_t)len, pk, alloc, err);
+    gk_free(&a, buf);
+    if (r && err) {
+        char msg[GK_ERR_MSG_LEN];
+        memcpy(msg, err->msg, sizeof msg);
+        gk_err_set(err, r, "%s: %s", path, msg);
+    }
+    return r;
+}
+
+GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const char *comment, gk_err *err) {
+    FILE *fp;
+    int k, skew = 0, a, b;
+    if (!pk || !pk->x || pk->n < 1) return gk_err_set(err, GK_ERR_ARG, "empty packing");
+    for (a = 0; a < pk->dim; ++a)
+        for (b = 0; b < pk->dim; ++b)
+            if (a != b && pk->h[3 * a + b] != 0.0) skew = 1;
+    fp = fopen(path, "w");
+    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot write packing '%s'", path);
+    if (pk->dim == 2)
+        fprintf(fp, "2 %d %.17g %.17g\n", pk->n, pk->h[0], pk->h[4]);
+    else
+        fprintf(fp, "3 %d %.17g %.17g %.17g\n", pk->n, pk->h[0], pk->h[4], pk->h[8]);
+    fprintf(fp, "# written by grainkit %s\n", GK_VERSION_STRING);
+    if (comment && comment[0]) {
+        const char *c = comment;
+        fputs("# ", fp);
+        for (; *c; ++c) {
+            fputc(*c, fp);
+            if (*c == '\n' && c[1]) fputs("# ", fp);
+        }
+        if (c[-1] != '\n') fputc('\n', fp);
+    }
+    if (skew) {
+        fputs("# cell", fp);
+        for (a = 0; a < pk->dim; ++a)
+            for (b = 0; b < pk->dim; ++b) fprintf(fp, " %.17g", pk->h[3 * a + b]);
+        fputc('\n', fp);
+    }
+    for (k = 0; k < pk->n; ++k) {
+        if (pk->dim == 2)
+            fprintf(fp, "%.17g %.17g %.17g\n", pk->x[k], pk->y[k], pk->r[k]);
+        else
+            fprintf(fp, "%.17g %.17g %.17g %.17g\n", pk->x[k], pk->y[k], pk->z[k], pk->r[k]);
+    }
+    if (fclose(fp) != 0) return gk_err_set(err, GK_ERR_IO, "error writing '%s'", path);
+    return GK_OK;
+}
+
+static double gk__particle_volume(int dim, double r) { return dim == 2 ? GK_PI * r * r : 4.0 / 3.0 * GK_PI * r * r * r; }
+
+GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err) {
+    gk_packing pk;
+    gk_rng rng;
+    double vs = 0.0, phi, side, asp[3], V, *rr;
+    int k, dim = def->dim, n = def->n;
+    gk_result res;
+    if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
+    if (n < 1) return gk_err_set(err, GK_ERR_ARG, "particle count %d (must be >= 1)", n);
+    phi = def->packing_fraction > 0 ? def->packing_fraction : (dim == 2 ? 0.5 : 0.3);
+    if (!(phi < (dim == 2 ? 0.7 : 0.45)))
+        return gk_err_set(err, GK_ERR_ARG, "initial packing fraction %g too dense for random addition", phi);
+    if (def->psd == GK_PSD_UNIFORM) {
+        if (!(def->r_min > 0.0) || !(def->r_max >= def->r_min) || !isfinite(def->r_max))
+            return gk_err_set(err, GK_ERR_RADIUS, "radius range [%g, %g] invalid", def->r_min, def->r_max);
+    } else if (def->psd == GK_PSD_TABLE_NUMBER || def->psd == GK_PSD_TABLE_MASS) {
+        if (def->ntable < 2 || !def->table_r || !def->table_cum)
+            return gk_err_set(err, GK_ERR_ARG, "size-distribution table needs >= 2 points");
+        for (k = 0; k < def->ntable; ++k) {
+            if (!(def->table_r[k] > 0.0) || (k && !(def->table_r[k] > def->table_r[k - 1])))
+                return gk_err_set(err, GK_ERR_RADIUS, "table radius %d (%g) must be > 0 and increasing", k,
+                                  def->table_r[k]);
+            if (!(def->table_cum[k] >= 0.0 && def->table_cum[k] <= 1.0) ||
+                (k && def->table_cum[k] < def->table_cum[k - 1]))
+                return gk_err_set(err, GK_ERR_ARG, "table cumulative fraction %d (%g) must rise from 0 to 1", k,
+                                  def->table_cum[k]);
+        }
+        if (def->table_cum[0] != 0.0 || def->table_cum[def->ntable - 1] != 1.0)
+            return gk_err_set(err, GK_ERR_ARG, "table cumulative fractions must start at 0 and end at 1");
+    } else {
+        return gk_err_set(err, GK_ERR_ARG, "unknown size-distribution kind %d", (int)def->psd);
+    }
+    res = gk_packing_alloc(&pk, dim, n, alloc, err);
+    if (res) return res;
+    gk_rng_seed(&rng, def->seed);
+    rr = pk.r;
+    if (def->psd == GK_PSD_UNIFORM) {
+        for (k = 0; k < n; ++k) rr[k] = def->r_min + (def->r_max - def->r_min) * gk_rng_uniform(&rng);
+    } else {
+        /* number fractions per table interval (radii uniform inside an interval) */
+        double w[256], tot = 0.0;
+        int nt = def->ntable, b;
+        if (nt > 257) nt = 257;
+        for (b = 0; b + 1 < nt; ++b) {
+            double frac = def->table_cum[b + 1] - def->table_cum[b];
+            if (def->psd == GK_PSD_TABLE_MASS) { /* number ~ mass / mean particle volume */
+                double r0 = def->table_r[b], r1 = def->table_r[b + 1], mv;
+                mv = dim == 2 ? GK_PI * (r1 * r1 + r0 * r1 + r0 * r0) / 3.0
+                              : GK_PI * (r1 + r0) * (r1 * r1 + r0 * r0) / 3.0; /* mean of r^dim volume */
+                frac = frac / mv;
+            }
+            w[b] = frac;
+            tot += frac;
+        }
+        for (k = 0; k < n; ++k) {
+            double u = gk_rng_uniform(&rng) * tot, acc = 0.0;
+            for (b = 0; b + 2 < nt; ++b) {
+                acc += w[b];
+                if (u < acc) break;
+            }
+            rr[k] = def->table_r[b] + (def->table_r[b + 1] - def->table_r[b]) * gk_rng_uniform(&rng);
+        }
+    }
+    /* largest first for random sequential addition */
+    for (k = 1; k < n; ++k) {
+        double v = rr[k];
+        int t = k - 1;
+        while (t >= 0 && rr[t] < v) {
+            rr[t + 1] = rr[t];
+            --t;
+        }
+        rr[t + 1] = v;
+    }
+    for (k = 0; k < n; ++k) vs += gk__particle_volume(dim, rr[k]);
+    for (k = 0; k < 3; ++k) asp[k] = def->aspect[k] > 0 ? def->aspect[k] : 1.0;
+    V = vs / phi;
+    side = pow(V / (asp[0] * asp[1] * (dim == 3 ? asp[2] : 1.0)), 1.0 / dim);
+    gk_m3_identity(pk.h);
+    for (k = 0; k < dim; ++k) pk.h[4 * k] = side * asp[k];
+    /* random sequential addition with a linked-cell grid updated as particles land */
+    {
+        double *sx = (double *)gk_alloc(alloc, (size_t)n * sizeof(double));
+        double *sy = (double *)gk_alloc(alloc, (size_t)n * sizeof(double));
+        double *sz = (double *)gk_alloc(alloc, (size_t)n * sizeof(double));
+        int placed = 0, nbin[3], b;
+        int32_t *head = NULL, *next = NULL;
+        double cut = 2.0 * rr[0];
+        for (k = 0; k < 3; ++k) {
+            nbin[k] = k < dim ? (int)(pk.h[4 * k] / cut) : 1;
+            if (nbin[k] < 1) nbin[k] = 1;
+            if (nbin[k] > 1024) nbin[k] = 1024;
+        }
+        head = (int32_t *)gk_alloc(alloc, (size_t)nbin[0] * nbin[1] * nbin[2] * sizeof(int32_t));
+        next = (int32_t *)gk_alloc(alloc, (size_t)n * sizeof(int32_t));
+        res = (sx && sy && sz && head && next) ? GK_OK : GK_ERR_ALLOC;
+        if (res) gk_err_set(err, res, "out of memory generating %d particles", n);
+        for (b = 0; !res && b < nbin[0] * nbin[1] * nbin[2]; ++b) head[b] = -1;
+        while (!res && placed < n) {
+            int attempt, ok = 0;
+            for (attempt = 0; attempt < 20000 && !ok; ++attempt) {
+                double s[3];
+                int bi[3], o0, o1, o2, clash = 0;
+                for (k = 0; k < 3; ++k) s[k] = k < dim ? gk_rng_uniform(&rng) : 0.0;
+                for (k = 0; k < 3; ++k) bi[k] = (int)(s[k] * nbin[k]) % nbin[k];
+                for (o2 = (dim == 3 ? -1 : 0); o2 <= (dim == 3 ? 1 : 0) && !clash; ++o2)
+                    for (o1 = -1; o1 <= 1 && !clash; ++o1)
+                        for (o0 = -1; o0 <= 1 && !clash; ++o0) {
+                            int cx = (bi[0] + o0 + nbin[0]) % nbin[0], cy = (bi[1] + o1 + nbin[1]) % nbin[1];
+                            int cz = (bi[2] + o2 + nbin[2]) % nbin[2], q;
+                            for (q = head[cx + nbin[0] * (cy + nbin[1] * cz)]; q >= 0 && !clash; q = next[q]) {
+                                double ds[3], d[3], R = rr[q] + rr[placed];
+                                ds[0] = sx[q] - s[0];
+                                ds[1] = sy[q] - s[1];
+                                ds[2] = dim == 3 ? sz[q] - s[2] : 0.0;
+                                for (k = 0; k < 3; ++k) ds[k] -= rint(ds[k]);
+                                gk_m3_matvec(pk.h, ds, d);
+                                if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < R * R) clash = 1;
+                            }
+                            /* with few bins the same bin can be visited twice: harmless */
+                        }
+                if (!clash) {
+                    int bb = bi[0] + nbin[0] * (bi[1] + nbin[1] * bi[2]);
+                    sx[placed] = s[0];
+                    sy[placed] = s[1];
+                    sz[placed] = s[2];
+                    next[placed] = head[bb];
+                    head[bb] = placed;
+                    ok = 1;
+                }
+            }
+            if (!ok) {
+                res = gk_err_set(err, GK_ERR_ARG,
+                                 "could not place particle %d of %d without overlap: lower packing_fraction (%g)",
+                                 placed, n, phi);
+                break;
+            }
+            ++placed;
+        }
+        if (!res)
+            for (k = 0; k < n; ++k) {
+                double s[3], x[3];
+                s[0] = sx[k];
+                s[1] = sy[k];
+                s[2] = sz[k];
+                gk_m3_matvec(pk.h, s, x);
+                pk.x[k] = x[0];
+                pk.y[k] = x[1];
+                pk.z[k] = dim == 3 ? x[2] : 0.0;
+            }
+        gk_free(alloc, sx);
+        gk_free(alloc, sy);
+        gk_free(alloc, sz);
+        gk_free(alloc, head);
+        gk_free(alloc, next);
+    }
+    if (res) {
+        gk_packing_free(&pk);
+        return res;
+    }
+    *out = pk;
+    return GK_OK;
+}
+
+/* ================================================================ RVE */
+GKDEF gk_rve_def gk_rve_def_default(void) {
+    gk_rve_def d;
+    memset(&d, 0, sizeof d);
+    d.cookie = GK_RVE_DEF_COOKIE;
+    d.mat = gk_material_default();
+    d.dt = 0.0;
+    d.dt_factor = 0.5;
+    d.skin = 0.0;
+    d.thickness = 0.1;
+    d.mass2d = GK_MASS_CYLINDER;
+    d.damping = 0.1;
+    d.damping_form = GK_DAMP_COMPONENT;
+    d.path = GK_PATH_CONSTANT_L;
+    d.flags = 0;
+    d.threads = 1;
+    return d;
+}
+
+GKDEF const char *gk_rve_error(const gk_rve *rve) { return rve->err.msg; }
+
+static void gk__rve_free_arrays(gk_rve *rve) {
+    const gk_allocator *a = &rve->def.alloc;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        gk_free(a, rve->s[k]);
+        gk_free(a, rve->s0[k]);
+        gk_free(a, rve->v[k]);
+        gk_free(a, rve->w[k]);
+        gk_free(a, rve->f[k]);
+        gk_free(a, rve->t[k]);
+        gk_free(a, rve->ft[k]);
+        gk_free(a, rve->mr[k]);
+        gk_free(a, rve->fc[k]);
+        gk_free(a, rve->tci[k]);
+        gk_free(a, rve->tcj[k]);
+        rve->s[k] = rve->s0[k] = NULL;
+        rve->v[k] = rve->w[k] = rve->f[k] = rve->t[k] = NULL;
+        rve->ft[k] = rve->mr[k] = rve->fc[k] = rve->tci[k] = rve->tcj[k] = NULL;
+    }
+    gk_free(a, rve->r);
+    gk_free(a, rve->minv);
+    gk_free(a, rve->Iinv);
+    gk_free(a, rve->theta);
+    gk_free(a, rve->id);
+    gk_free(a, rve->cs);
+    gk_free(a, rve->jstart);
+    gk_free(a, rve->jlist);
+    rve->r = rve->minv = rve->Iinv = NULL;
+    rve->theta = NULL;
+    rve->id = rve->jstart = rve->jlist = NULL;
+    rve->cs = NULL;
+    gk_pairlist_free(&rve->pl);
+    gk_cells_free(&rve->cells);
+}
+
+GKDEF void gk_rve_destroy(gk_rve *rve) {
+    gk__rve_free_arrays(rve);
+    rve->n = 0;
+}
+
+/* which per-pair arrays exist */
+#define GK__HAS_ROT(rve) (((rve)->phys & GK_PHYS_ROTATION) != 0)
+#define GK__HAS_ROLL(rve) (((rve)->phys & GK_PHYS_ROLLING) != 0)
+
+/* allocate per-pair arrays for cap pairs, copying the first ncopy */
+static gk_result gk__pairs_reserve(gk_rve *rve, size_t cap, size_t ncopy) {
+    const gk_allocator *a = &rve->def.alloc;
+    int dim = rve->dim, k, nft = dim == 2 ? 1 : 3;
+    size_t sz = sizeof(gk_real);
+    if (cap <= rve->pcap) return GK_OK;
+    {
+        size_t c = rve->pcap ? rve->pcap : 64;
+        while (c < cap) c *= 2;
+        cap = c;
+    }
+    for (k = 0; k < 3; ++k) {
+        if (k < nft && gk_realloc(a, (void **)&rve->ft[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
+        if (k < dim && gk_realloc(a, (void **)&rve->fc[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
+        if (GK__HAS_ROT(rve) && (dim == 3 || k == 2)) {
+            if (gk_realloc(a, (void **)&rve->tci[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
+            if (gk_realloc(a, (void **)&rve->tcj[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
+        }
+        if (GK__HAS_ROLL(rve) && (dim == 3 || k == 2) && gk_realloc(a, (void **)&rve->mr[k], ncopy, cap, sz))
+            return GK_ERR_ALLOC;
+    }
+    if (gk_realloc(a, (void **)&rve->cs, ncopy, cap, 1)) return GK_ERR_ALLOC;
+    if (gk_realloc(a, (void **)&rve->jlist, 0, cap, sizeof(int32_t))) return GK_ERR_ALLOC;
+    rve->pcap = cap;
+    return GK_OK;
+}
+
+/* critical time step, seed 000 eq 19 */
+static double gk__dt_critical(const gk_rve *rve) {
+    double knmax;
+    const gk_material *m = &rve->def.mat;
+    if (m->law == GK_LAW_LINEAR) {
+        knmax = m->kn > 0 ? m->kn : m->young * rve->rmax; /* r* <= r_max */
+    } else {
+        double dmax = 1e-3 * rve->rmin, G = m->young / (2.0 * (1.0 + m->poisson));
+        int c;
+        for (c = 0; c < rve->pl.n; ++c) { /* current largest overlap, from the stored forces */
+            if (rve->cs && (rve->cs[c] & GK_CS_CONTACT)) {
+                int i = rve->pl.i[c], j = rve->pl.j[c], k;
+                double ds[3], d[3], dd;
+                for (k = 0; k < 3; ++k) ds[k] = k < rve->dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
+                gk_pcell_min_image(&rve->cell, ds, d);
+                dd = (double)rve->r[i] + (double)rve->r[j] - sqrt(gk_v3_dot(d, d));
+                if (2.0 * dd > dmax) dmax = 2.0 * dd;
+            }
+        }
+        knmax = G / (1.0 - m->poisson) * sqrt(2.0 * rve->rmax * dmax);
+    }
+    return sqrt(rve->mmin / knmax);
+}
+
+GKDEF double gk_rve_dt_critical(const gk_rve *rve) { return gk__dt_critical(rve); }
+
+static gk_result gk__rve_rebuild(gk_rve *rve);
+
+GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_packing *pk) {
+    gk_rve R;
+    gk_err *err = &rve_out->err;
+    gk_result res;
+    int dim, n, p, k;
+    double hpk[9], rsum = 0.0, w[3], cutoff, dtc;
+    int32_t *perm = NULL;
+    memset(&R, 0, sizeof R);
+    gk_err_clear(err);
+    if (!def || def->cookie != GK_RVE_DEF_COOKIE)
+        return gk_err_set(err, GK_ERR_ARG, "gk_rve_def not initialised with gk_rve_def_default()");
+    if (!pk || !pk->x || !pk->y || !pk->r) return gk_err_set(err, GK_ERR_ARG, "no packing given");
+    res = gk_material_check(&def->mat, err);
+    if (res) return res;
+    dim = pk->dim;
+    n = pk->n;
+    if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
+    if (n < 1) return gk_err_set(err, GK_ERR_ARG, "packing has %d particles", n);
+    if (!(def->damping >= 0.0 && def->damping < 1.0))
+        return gk_err_set(err, GK_ERR_ARG, "local damping %g outside [0, 1)", def->damping);
+    if (def->damping_form != GK_DAMP_COMPONENT && def->damping_form != GK_DAMP_VECTOR)
+        return gk_err_set(err, GK_ERR_ARG, "unknown damping form %d", (int)def->damping_form);
+    if (def->path != GK_PATH_CONSTANT_L && def->path != GK_PATH_OBJECTIVE)
+        return gk_err_set(err, GK_ERR_ARG, "unknown deformation path %d", (int)def->path);
+    if (dim == 2 && def->mass2d == GK_MASS_CYLINDER && !(def->thickness > 0.0))
+        return gk_err_set(err, GK_ERR_ARG, "2D cylinder masses need thickness > 0 (got %g)", def->thickness);
+    if (!(def->dt >= 0.0) || !isfinite(def->dt)) return gk_err_set(err, GK_ERR_DT, "time step %g invalid", def->dt);
+    if (!(def->skin >= 0.0) || !isfinite(def->skin)) return gk_err_set(err, GK_ERR_ARG, "skin %g invalid", def->skin);
+    if (!(def->dt_factor >= 0.0 && def->dt_factor <= 1.0))
+        return gk_err_set(err, GK_ERR_DT, "dt_factor %g outside (0, 1]", def->dt_factor);
+    gk_m3_copy(pk->h, hpk);
+    if (dim == 2) {
+        hpk[2] = hpk[5] = hpk[6] = hpk[7] = 0.0;
+        hpk[8] = 1.0;
+    }
+    res = gk_pcell_init(&R.cell, dim, hpk, err);
+    if (res) return res;
+    for (p = 0; p < n; ++p) {
+        double rp = pk->r[p];
+        if (!isfinite(pk->x[p]) || !isfinite(pk->y[p]) || (dim == 3 && (!pk->z || !isfinite(pk->z[p]))))
+            return gk_err_set(err, GK_ERR_NAN, "particle %d has a NaN or infinite position", p);
+        if (!(rp > 0.0) || !isfinite(rp)) return gk_err_set(err, GK_ERR_RADIUS, "particle %d has radius %g", p, rp);
+        if (!(def->flags & GK_RVE_WRAP)) {
+            double x[3], s[3];
+            x[0] = pk->x[p];
+            x[1] = pk->y[p];
+            x[2] = dim == 3 ? pk->z[p] : 0.0;
+            gk_m3_matvec(R.cell.hinv, x, s);
+            for (k = 0; k < dim; ++k)
+                if (s[k] < -1e-9 || s[k] >= 1.0 + 1e-9)
+                    return gk_err_set(err, GK_ERR_OUTSIDE,
+                                      "particle %d at (%g, %g, %g) is outside the cell (set GK_RVE_WRAP to wrap)", p,
+                                      x[0], x[1], x[2]);
+        }
+    }
+    R.dim = dim;
+    R.n = n;
+    R.def = *def;
+    gk_law_consts_make(&def->mat, &R.K);
+    R.phys = gk_material_flags(&def->mat);
+    if (!(def->flags & GK_RVE_NO_ROTATION) && (R.phys & (GK_PHYS_TANGENT | GK_PHYS_ROLLING)))
+        R.phys |= GK_PHYS_ROTATION;
+    if ((R.phys & GK_PHYS_ROLLING) && !(R.phys & GK_PHYS_ROTATION))
+        return gk_err_set(err, GK_ERR_ARG, "rolling resistance needs rotating particles (GK_RVE_NO_ROTATION is set)");
+    R.volume_factor = dim == 2 ? (def->thickness > 0.0 ? def->thickness : 1.0) : 1.0;
+    /* particle order: cell-list order for locality */
+    {
+        double *tmp[3];
+        gk_cells cl;
+        double rmax = 0.0;
+        for (p = 0; p < n; ++p)
+            if (pk->r[p] > rmax) rmax = pk->r[p];
+        for (k = 0; k < 3; ++k) tmp[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
+        perm = (int32_t *)gk_alloc(&def->alloc, (size_t)n * sizeof(int32_t));
+        gk_cells_init(&cl, &def->alloc);
+        res = (tmp[0] && tmp[1] && tmp[2] && perm) ? GK_OK : GK_ERR_ALLOC;
+        if (!res) {
+            for (p = 0; p < n; ++p) {
+                double x[3], s[3];
+                x[0] = pk->x[p];
+                x[1] = pk->y[p];
+                x[2] = dim == 3 ? pk->z[p] : 0.0;
+                gk_m3_matvec(R.cell.hinv, x, s);
+                for (k = 0; k < 3; ++k) tmp[k][p] = k < dim ? s[k] - floor(s[k]) : 0.0;
+            }
+            {
+                double wmin, wd[3];
+                gk_pcell_widths(&R.cell, wd);
+                wmin = wd[0] < wd[1] ? wd[0] : wd[1];
+                if (dim == 3 && wd[2] < wmin) wmin = wd[2];
+                /* binning for ordering only: any bin size below half the cell works */
+                cutoff = 2.0 * rmax < 0.49 * wmin ? 2.0 * rmax : 0.49 * wmin;
+            }
+            res = gk_cells_bin(&cl, dim, R.cell.h, n, (const double *const *)tmp, cutoff, NULL);
+            if (!res) memcpy(perm, cl.order, (size_t)n * sizeof(int32_t));
+        }
+        gk_cells_free(&cl);
+        if (res) {
+            for (k = 0; k < 3; ++k) gk_free(&def->alloc, tmp[k]);
+            gk_free(&def->alloc, perm);
+            return gk_err_set(err, res == GK_ERR_ALLOC ? GK_ERR_ALLOC : res, "could not order %d particles", n);
+        }
+        /* allocate */
+        for (k = 0; k < 3; ++k) {
+            if (k < dim) {
+                R.s[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
+                R.s0[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
+                R.v[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+                R.f[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+                if (!R.s[k] || !R.s0[k] || !R.v[k] || !R.f[k]) res = GK_ERR_ALLOC;
+            }
+            if (GK__HAS_ROT(&R) && (dim == 3 || k == 2)) {
+                R.w[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+                R.t[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+                if (!R.w[k] || !R.t[k]) res = GK_ERR_ALLOC;
+            }
+        }
+        R.r = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+        R.minv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+        R.Iinv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+        R.id = (int32_t *)gk_alloc(&def->alloc, (size_t)n * sizeof(int32_t));
+        R.jstart = (int32_t *)gk_alloc(&def->alloc, ((size_t)n + 1) * sizeof(int32_t));
+        if (dim == 2) R.theta = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
+        if (!R.r || !R.minv || !R.Iinv || !R.id || !R.jstart || (dim == 2 && !R.theta)) res = GK_ERR_ALLOC;
+        gk_pairlist_init(&R.pl, &def->alloc);
+        gk_cells_init(&R.cells, &def->alloc);
+        if (!res) {
+            R.rmin = 1e300;
+            R.rmax = 0.0;
+            R.mmin = 1e300;
+            for (p = 0; p < n; ++p) {
+                int q = perm[p];
+                double rq = pk->r[q], m, I;
+                for (k = 0; k < dim; ++k) {
+                    R.s[k][p] = tmp[k][q];
+                    R.s0[k][p] = tmp[k][q];
+                    R.v[k][p] = 0;
+                    R.f[k][p] = 0;
+                }
+                for (k = 0; k < 3; ++k)
+                    if (R.w[k]) R.w[k][p] = R.t[k][p] = 0;
+                if (dim == 3) {
+                    m = def->mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
+                    I = 0.4 * m * rq * rq;
+                } else if (def->mass2d == GK_MASS_CYLINDER) {
+                    m = def->mat.density * def->thickness * GK_PI * rq * rq;
+                    I = 0.5 * m * rq * rq;
+                } else {
+                    m = def->mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
+                    I = 0.4 * m * rq * rq;
+                }
+                R.r[p] = (gk_real)rq;
+                R.minv[p] = (gk_real)(1.0 / m);
+                R.Iinv[p] = (gk_real)(1.0 / I);
+                R.id[p] = q;
+                if (R.theta) R.theta[p] = 0.0;
+                if (rq < R.rmin) R.rmin = rq;
+                if (rq > R.rmax) R.rmax = rq;
+                if (m < R.mmin) R.mmin = m;
+                R.mass_total += m;
+                rsum += rq;
+                R.solid_volume += gk__particle_volume(dim, rq) * (dim == 2 ? R.volume_factor : 1.0);
+            }
+        }
+        for (k = 0; k < 3; ++k) gk_free(&def->alloc, tmp[k]);
+        gk_free(&def->alloc, perm);
+        if (res) {
+            gk__rve_free_arrays(&R);
+            return gk_err_set(err, GK_ERR_ALLOC, "out of memory for an RVE of %d particles", n);
+        }
+    }
+    R.skin = def->skin > 0.0 ? def->skin : 0.1 * rsum / n;
+    if (R.phys & GK_PHYS_COHESION) { /* a bond may stretch to coh_n / k_n before breaking */
+        double knmin = def->mat.kn > 0 ? def->mat.kn : def->mat.young * R.rmin;
+        if (R.skin < 2.0 * def->mat.coh_n / knmin) R.skin = 2.0 * def->mat.coh_n / knmin;
+    }
+    gk_pcell_widths(&R.cell, w);
+    cutoff = 2.0 * R.rmax + R.skin;
+    for (k = 0; k < dim; ++k)
+        if (!(2.0 * cutoff < w[k])) {
+            gk__rve_free_arrays(&R);
+            return gk_err_set(err, GK_ERR_CELL,
+                              "cell width %g is below twice the interaction distance %g (2 r_max + skin): "
+                              "use more particles or a smaller skin",
+                              w[k], cutoff);
+        }
+    R.dt_crit = gk__dt_critical(&R);
+    dtc = R.dt_crit;
+    if (def->dt > 0.0) {
+        if (def->dt > dtc) {
+            gk__rve_free_arrays(&R);
+            return gk_err_set(err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)", def->dt,
+                              dtc);
+        }
+        R.dt = def->dt;
+    } else {
+        R.dt = (def->dt_factor > 0.0 ? def->dt_factor : 0.5) * dtc;
+    }
+    gk_m3_zero(R.L);
+    gk_m3_zero(R.G);
+    R.need_rebuild = 1;
+    R.err = rve_out->err;
+    res = gk__rve_rebuild(&R);
+    if (res) {
+        gk_err e = R.err;
+        gk__rve_free_arrays(&R);
+        rve_out->err = e;
+        return res;
+    }
+    *rve_out = R;
+    return GK_OK;
+}
+
+/* rebuild the pair list at the current positions, carrying history over by merge */
+static gk_result gk__rve_rebuild(gk_rve *rve) {
+    gk_pairlist nl;
+    int dim = rve->dim, n = rve->n, k, p, c, oc, nft = dim == 2 ? 1 : 3;
+    double w[3];
+    gk_result res;
+    const double *sp[3];
+    /* cell too thin for the nearest image: try a lattice reduction first */
+    gk_pcell_widths(&rve->cell, w);
+    for (k = 0; k < dim; ++k)
+        if (!(2.0 * (2.0 * rve->rmax + rve->skin) < w[k]))
+            return gk_err_set(&rve->err, GK_ERR_CELL,
+                              "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
+                              "too far for this many particles)",
+                              w[k], 2.0 * rve->rmax + rve->skin);
+    /* wrap positions into [0,1): the nearest image is unaffected */
+    for (k = 0; k < dim; ++k)
+        for (p = 0; p < n; ++p) {
+            double s = rve->s[k][p];
+            if (s < 0.0 || s >= 1.0) {
+                s -= floor(s);
+                if (s >= 1.0) s = 0.0;
+                rve->s[k][p] = s;
+            }
+        }
+    for (k = 0; k < 3; ++k) sp[k] = rve->s[k < dim ? k : 0];
+    res = gk_cells_bin(&rve->cells, dim, rve->cell.h, n, sp, 2.0 * rve->rmax + rve->skin, &rve->err);
+    if (res) return res;
+    gk_pairlist_init(&nl, &rve->def.alloc);
+    res = gk_cells_pairs(&rve->cells, rve->cell.h, sp, rve->r, rve->skin, &nl, &rve->err);
+    if (res) {
+        gk_pairlist_free(&nl);
+        return res;
+    }
+    {
+        /* new per-pair arrays, filled by a merge with the old list (both sorted by (i, j)) */
+        gk_rve tmp;
+        memset(&tmp, 0, sizeof tmp);
+        tmp.dim = dim;
+        tmp.phys = rve->phys;
+        tmp.def.alloc = rve->def.alloc;
+        res = gk__pairs_reserve(&tmp, (size_t)nl.n + 1, 0);
+        if (res) {
+            for (k = 0; k < 3; ++k) {
+                gk_free(&rve->def.alloc, tmp.ft[k]);
+                gk_free(&rve->def.alloc, tmp.fc[k]);
+                gk_free(&rve->def.alloc, tmp.tci[k]);
+                gk_free(&rve->def.alloc, tmp.tcj[k]);
+                gk_free(&rve->def.alloc, tmp.mr[k]);
+            }
+            gk_free(&rve->def.alloc, tmp.cs);
+            gk_free(&rve->def.alloc, tmp.jlist);
+            gk_pairlist_free(&nl);
+            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", nl.n);
+        }
+        oc = 0;
+        for (c = 0; c < nl.n; ++c) {
+            int32_t ni = nl.i[c], nj = nl.j[c];
+            while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj))) ++oc;
+            if (oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj) {
+                for (k = 0; k < nft; ++k) tmp.ft[k][c] = rve->ft[k][oc];
+                for (k = 0; k < dim; ++k) tmp.fc[k][c] = rve->fc[k][oc];
+                for (k = 0; k < 3; ++k) {
+                    if (tmp.tci[k]) {
+                        tmp.tci[k][c] = rve->tci[k][oc];
+                        tmp.tcj[k][c] = rve->tcj[k][oc];
+                    }
+                    if (tmp.mr[k]) tmp.mr[k][c] = rve->mr[k][oc];
+                }
+                tmp.cs[c] = rve->cs[oc];
+            } else {
+                for (k = 0; k < nft; ++k) tmp.ft[k][c] = 0;
+                for (k = 0; k < dim; ++k) tmp.fc[k][c] = 0;
+                for (k = 0; k < 3; ++k) {
+                    if (tmp.tci[k]) tmp.tci[k][c] = tmp.tcj[k][c] = 0;
+                    if (tmp.mr[k]) tmp.mr[k][c] = 0;
+                }
+                tmp.cs[c] = 0;
+            }
+        }
+        /* swap in */
+        for (k = 0; k < 3; ++k) {
+            gk_free(&rve->def.alloc, rve->ft[k]);
+            gk_free(&rve->def.alloc, rve->fc[k]);
+            gk_free(&rve->def.alloc, rve->tci[k]);
+            gk_free(&rve->def.alloc, rve->tcj[k]);
+            gk_free(&rve->def.alloc, rve->mr[k]);
+            rve->ft[k] = tmp.ft[k];
+            rve->fc[k] = tmp.fc[k];
+            rve->tci[k] = tmp.tci[k];
+            rve->tcj[k] = tmp.tcj[k];
+            rve->mr[k] = tmp.mr[k];
+        }
+        gk_free(&rve->def.alloc, rve->cs);
+        gk_free(&rve->def.alloc, rve->jlist);
+        rve->cs = tmp.cs;
+        rve->jlist = tmp.jlist;
+        rve->pcap = tmp.pcap;
+        gk_pairlist_free(&rve->pl);
+        rve->pl = nl;
+    }
+    /* pairs where p is j, ascending pair index (counting sort by j) */
+    for (p = 0; p <= n; ++p) rve->jstart[p] = 0;
+    for (c = 0; c < rve->pl.n; ++c) ++rve->jstart[rve->pl.j[c] + 1];
+    for (p = 0; p < n; ++p) rve->jstart[p + 1] += rve->jstart[p];
+    for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
+    for (p = n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
+    rve->jstart[0] = 0;
+    for (k = 0; k < dim; ++k) memcpy(rve->s0[k], rve->s[k], (size_t)n * sizeof(double));
+    gk_m3_copy(rve->cell.h, rve->h0);
+    rve->need_rebuild = 0;
+    ++rve->rebuilds;
+    return GK_OK;
+}
+
+/* ---------------------------------------------------------------- forces */
+typedef struct gk__stepctx {
+    gk_real h[9];   /* unused by the double-position path; kept for kernels */
+    double hd[9];   /* cell matrix (positions are double)                  */
+    gk_real G[9];   /* affine velocity gradient of this step                */
+    gk_real wa[3];  /* affine spin (2D: wa[2])                              */
+    gk_real dt;
+} gk__stepctx;
+
+/* pair forces, scalar reference: writes fc, tci, tcj, ft, mr, cs for pairs [c0, c1) */
+GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+    const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
+    const double *sx = rve->s[0], *sy = rve->s[1];
+    const gk_real *vx = rve->v[0], *vy = rve->v[1], *r = rve->r, *minv = rve->minv;
+    const gk_real *wz = rve->w[2];
+    gk_real *ft = rve->ft[0], *mr = rve->mr[2], *fcx = rve->fc[0], *fcy = rve->fc[1];
+    gk_real *tci = rve->tci[2], *tcj = rve->tcj[2];
+    unsigned char *cs = rve->cs;
+    gk_real dummy = 0;
+    int c;
+    for (c = c0; c < c1; ++c) {
+        int i = pi[c], j = pj[c];
+        double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i];
+        gk_real dx, dy, rvx, rvy, wi, wj;
+        gk_contact_out o;
+        dsx -= rint(dsx);
+        dsy -= rint(dsy);
+        dx = (gk_real)(x->hd[0] * dsx + x->hd[1] * dsy);
+        dy = (gk_real)(x->hd[3] * dsx + x->hd[4] * dsy);
+        rvx = (vx[j] - vx[i]) + (x->G[0] * dx + x->G[1] * dy);
+        rvy = (vy[j] - vy[i]) + (x->G[3] * dx + x->G[4] * dy);
+        wi = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[i] : x->wa[2];
+        wj = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[j] : x->wa[2];
+        gk_contact_2d(&rve->K, law, fl, dx, dy, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], rvx, rvy, wi,
+                      wj, x->dt, ft + c, (fl & GK_PHYS_ROLLING) ? mr + c : &dummy, cs + c, &o);
+        fcx[c] = o.f[0];
+        fcy[c] = o.f[1];
+        if (fl & GK_PHYS_ROTATION) {
+            tci[c] = o.ti[2];
+            tcj[c] = o.tj[2];
+        }
+    }
+}
+
+GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+    const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
+    const gk_real *r = rve->r, *minv = rve->minv;
+    gk_real dummy[3] = {0, 0, 0};
+    int c, k;
+    for (c = c0; c < c1; ++c) {
+        int i = pi[c], j = pj[c];
+        double ds[3];
+        gk_real d[3], vr[3], wi[3], wj[3], hist[3], mh[3];
+        gk_contact_out o;
+        for (k = 0; k < 3; ++k) {
+            ds[k] = rve->s[k][j] - rve->s[k][i];
+            ds[k] -= rint(ds[k]);
+        }
+        for (k = 0; k < 3; ++k) d[k] = (gk_real)(x->hd[3 * k] * ds[0] + x->hd[3 * k + 1] * ds[1] + x->hd[3 * k + 2] * ds[2]);
+        for (k = 0; k < 3; ++k)
+            vr[k] = (rve->v[k][j] - rve->v[k][i]) + (x->G[3 * k] * d[0] + x->G[3 * k + 1] * d[1] + x->G[3 * k + 2] * d[2]);
+        for (k = 0; k < 3; ++k) {
+            wi[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][i] : x->wa[k];
+            wj[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][j] : x->wa[k];
+            hist[k] = rve->ft[k][c];
+            mh[k] = (fl & GK_PHYS_ROLLING) ? rve->mr[k][c] : dummy[k];
+        }
+        gk_contact_3d(&rve->K, law, fl, d, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], vr, wi, wj, x->dt,
+                      hist, mh, rve->cs + c, &o);
+        for (k = 0; k < 3; ++k) {
+            rve->ft[k][c] = hist[k];
+            if (fl & GK_PHYS_ROLLING) rve->mr[k][c] = mh[k];
+            rve->fc[k][c] = o.f[k];
+            if (fl & GK_PHYS_ROTATION) {
+                rve->tci[k][c] = o.ti[k];
+                rve->tcj[k][c] = o.tj[k];
+            }
+        }
+    }
+}
+
+/* instantiate the kernel with constant law and flags (pay only for what is on) */
+#define GK__DISPATCH(fn, rve, x, c0, c1)                                                                              \
+    do {                                                                                                               \
+        unsigned fl_ = (rve)->phys;                                                                                    \
+        gk_law law_ = (rve)->def.mat.law;                                                                              \
+        if (law_ == GK_LAW_LINEAR) {                                                                                   \
+            if (fl_ == 0u)                                                                                             \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, 0u);                                                                 \
+            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT);                                                    \
+            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                 \
+            else                                                                                                       \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, fl_);                                                                \
+        } else {                                                                                                       \
+            if (fl_ == 0u)                                                                                             \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, 0u);                                                                  \
+            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT);                                                     \
+            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                  \
+            else                                                                                                       \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, fl_);                                                                 \
+        }                                                                                                              \
+    } while (0)
+
+static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
+    if (rve->dim == 2)
+        GK__DISPATCH(gk__forces_ref_2d, rve, x, c0, c1);
+    else
+        GK__DISPATCH(gk__forces_ref_3d, rve, x, c0, c1);
+}
+
+static void gk__forces(gk_rve *rve, const gk__stepctx *x) {
+    int nc = rve->pl.n;
+    int nth = rve->def.threads > 1 && nc >= GK_DEM_PAR_MIN ? rve->def.threads : 1;
+    if (nth <= 1) {
+        gk__forces_range(rve, x, 0, nc);
+    } else {
+        int b;
+        GK_OMP(parallel for num_threads(nth) schedule(static))
+        for (b = 0; b < nth * 4; ++b) {
+            long c0 = (long)nc * b / (nth * 4), c1 = (long)nc * (b + 1) / (nth * 4);
+            gk__forces_range(rve, x, (int)c0, (int)c1);
+        }
+    }
+}
+
+/* ---------------------------------------------------------------- integration */
+GK_FORCE_INLINE gk_real gk__damp_component(gk_real a, gk_real v, gk_real dt, gk_real alpha) {
+    gk_real sgn = a * (v + (gk_real)0.5 * dt * a);
+    if (sgn > 0) return a * ((gk_real)1 - alpha);
+    if (sgn < 0) return a * ((gk_real)1 + alpha);
+    return a;
+}
+
+/* sum pair forces per particle (fixed order), damp, leap-frog; particles [p0, p1).
+ * Returns the largest squared non-affine displacement since the last build;
+ * *bad set if a non-finite value appeared. */
+static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int p0,
+                                  int p1, int *bad) {
+    const int dim = rve->dim, rot = GK__HAS_ROT(rve);
+    const gk_real dt = x->dt, alpha = (gk_real)rve->def.damping;
+    const int vec = rve->def.damping_form == GK_DAMP_VECTOR;
+    const int32_t *start = rve->pl.start, *jst = rve->jstart, *jl = rve->jlist;
+    double m2 = 0.0, chk = 0.0;
+    int p, k, e;
+    for (p = p0; p < p1; ++p) {
+        gk_real f[3] = {0, 0, 0}, tq[3] = {0, 0, 0}, a[3], aw[3];
+        for (e = jst[p]; e < jst[p + 1]; ++e) {
+            int c = jl[e];
+            for (k = 0; k < dim; ++k) f[k] += rve->fc[k][c];
+            if (rot) {
+                if (dim == 2)
+                    tq[2] += rve->tcj[2][c];
+                else
+                    for (k = 0; k < 3; ++k) tq[k] += rve->tcj[k][c];
+            }
+        }
+        for (e = start[p]; e < start[p + 1]; ++e) {
+            for (k = 0; k < dim; ++k) f[k] -= rve->fc[k][e];
+            if (rot) {
+                if (dim == 2)
+                    tq[2] += rve->tci[2][e];
+                else
+                    for (k = 0; k < 3; ++k) tq[k] += rve->tci[k][e];
+            }
+        }
+        for (k = 0; k < dim; ++k) {
+            rve->f[k][p] = f[k];
+            a[k] = f[k] * rve->minv[p];
+        }
+        if (alpha > 0) {
+            if (!vec) {
+                for (k = 0; k < dim; ++k) a[k] = gk__damp_component(a[k], rve->v[k][p], dt, alpha);
+            } else {
+                gk_real ve[3] = {0, 0, 0}, vv = 0, aa = 0;
+                for (k = 0; k < dim; ++k) {
+                    ve[k] = rve->v[k][p] + (gk_real)0.5 * dt * a[k];
+                    vv += ve[k] * ve[k];
+                    aa += a[k] * a[k];
+                }
+                if (vv > 0) {
+                    gk_real sc = alpha * (gk_real)sqrt(aa) / (gk_real)sqrt(vv);
+                    for (k = 0; k < dim; ++k) a[k] = a[k] - sc * ve[k];
+                }
+            }
+        }
+        {
+            gk_real dd[3] = {0, 0, 0};
+            for (k = 0; k < dim; ++k) {
+                gk_real vn = rve->v[k][p] + dt * a[k];
+                rve->v[k][p] = vn;
+                dd[k] = vn * dt;
+                chk += (double)(vn < 0 ? -vn : vn);
+            }
+            if (dim == 2) {
+                double ex, ey, ux, uy;
+                rve->s[0][p] += hinv[0] * (double)dd[0] + hinv[1] * (double)dd[1];
+                rve->s[1][p] += hinv[3] * (double)dd[0] + hinv[4] * (double)dd[1];
+                ex = rve->s[0][p] - rve->s0[0][p];
+                ey = rve->s[1][p] - rve->s0[1][p];
+                ux = hnew[0] * ex + hnew[1] * ey;
+                uy = hnew[3] * ex + hnew[4] * ey;
+                if (ux * ux + uy * uy > m2) m2 = ux * ux + uy * uy;
+            } else {
+                double ex[3], u[3], u2;
+                for (k = 0; k < 3; ++k)
+                    rve->s[k][p] += hinv[3 * k] * (double)dd[0] + hinv[3 * k + 1] * (double)dd[1] +
+                                    hinv[3 * k + 2] * (double)dd[2];
+                for (k = 0; k < 3; ++k) ex[k] = rve->s[k][p] - rve->s0[k][p];
+                gk_m3_matvec(hnew, ex, u);
+                u2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+                if (u2 > m2) m2 = u2;
+            }
+        }
+        if (rot) {
+            int k0 = dim == 2 ? 2 : 0;
+            for (k = k0; k < 3; ++k) {
+                rve->t[k][p] = tq[k];
+                aw[k] = tq[k] * rve->Iinv[p];
+            }
+            if (alpha > 0) {
+                if (!vec || dim == 2) {
+                    for (k = k0; k < 3; ++k) aw[k] = gk__damp_component(aw[k], rve->w[k][p], dt, alpha);
+                } else {
+                    gk_real ve[3], vv = 0, aa = 0;
+                    for (k = 0; k < 3; ++k) {
+                        ve[k] = rve->w[k][p] + (gk_real)0.5 * dt * aw[k];
+                        vv += ve[k] * ve[k];
+                        aa += aw[k] * aw[k];
+                    }
+                    if (vv > 0) {
+                        gk_real sc = alpha * (gk_real)sqrt(aa) / (gk_real)sqrt(vv);
+                        for (k = 0; k < 3; ++k) aw[k] = aw[k] - sc * ve[k];
+                    }
+                }
+            }
+            for (k = k0; k < 3; ++k) {
+                rve->w[k][p] = rve->w[k][p] + dt * aw[k];
+                chk += (double)(rve->w[k][p] < 0 ? -rve->w[k][p] : rve->w[k][p]);
+            }
+            if (dim == 2) rve->theta[p] += ((double)x->wa[2] + (double)rve->w[2][p]) * (double)dt;
+        } else if (dim == 2) {
+            rve->theta[p] += (double)x->wa[2] * (double)dt;
+        }
+    }
+    if (!isfinite(chk) || !isfinite(m2)) *bad = 1;
+    return m2;
+}
+
+static double gk__integrate(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int *bad) {
+    int n = rve->n;
+    int nth = rve->def.threads > 1 && rve->pl.n >= GK_DEM_PAR_MIN ? rve->def.threads : 1;
+    double m2 = 0.0;
+    if (nth <= 1) return gk__integrate_range(rve, x, hinv, hnew, 0, n, bad);
+    {
+        int b, badl = 0;
+        GK_OMP(parallel for num_threads(nth) schedule(static) reduction(max : m2) reduction(| : badl))
+        for (b = 0; b < nth * 4; ++b) {
+            long p0 = (long)n * b / (nth * 4), p1 = (long)n * (b + 1) / (nth * 4);
+            int bb = 0;
+            double mm = gk__integrate_range(rve, x, hinv, hnew, (int)p0, (int)p1, &bb);
+            if (mm > m2) m2 = mm;
+            badl |= bb;
+        }
+        if (badl) *bad = 1;
+    }
+    return m2;
+}
+
+/* ---------------------------------------------------------------- stress */
+/* Love stress sigma = -(1/V) sum F (x) d (seed 000 eq 5; F on j, d = x_j - x_i),
+ * the Voigt stiffness diagonal and contact statistics, in pair order. */
+static void gk__stress_pass(gk_rve *rve) {
+    int dim = rve->dim, c, k, l, nc = 0;
+    double S[9], st[3] = {0, 0, 0}, V = gk_rve_volume(rve), fsum = 0.0;
+    gk_m3_zero(S);
+    for (c = 0; c < rve->pl.n; ++c) {
+        int i, j;
+        double ds[3], d[3], F[3], dd, R, delta;
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        i = rve->pl.i[c];
+        j = rve->pl.j[c];
+        for (k = 0; k < 3; ++k) {
+            ds[k] = k < dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
+            F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
+        }
+        gk_pcell_min_image(&rve->cell, ds, d);
+        if (dim == 2) d[2] = 0.0;
+        for (k = 0; k < 3; ++k)
+            for (l = 0; l < 3; ++l) S[3 * k + l] += F[k] * d[l];
+        dd = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        R = (double)rve->r[i] + (double)rve->r[j];
+        delta = R - dd;
+        if (dd > 0.0) {
+            gk_real kn, fn, kt;
+            gk_contact_stiffness(&rve->K, rve->def.mat.law, rve->r[i], rve->r[j], (gk_real)(delta > 0 ? delta : 0), &kn,
+                                 &fn, &kt);
+            for (k = 0; k < dim; ++k) st[k] += (double)kn * d[k] * d[k] * d[k] * d[k] / (dd * dd);
+        }
+        fsum += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
+        ++nc;
+    }
+    for (k = 0; k < 9; ++k) rve->stress[k] = -S[k] / V;
+    for (k = 0; k < 3; ++k) rve->stiff[k] = st[k] / V;
+    rve->ncontacts = nc;
+    rve->fc_mean = nc ? fsum / nc : 0.0;
+}
+
+GKDEF double gk_rve_volume(const gk_rve *rve) { return gk_pcell_volume(&rve->cell) * rve->volume_factor; }
+
+GKDEF void gk_rve_stress(const gk_rve *rve, double sigma[9]) { gk_m3_copy(rve->stress, sigma); }
+
+/* ---------------------------------------------------------------- one step */
+static void gk__ctx_make(const gk_rve *rve, const double E[9], gk__stepctx *x) {
+    double G[9];
+    int k;
+    for (k = 0; k < 9; ++k) G[k] = (E[k] - (k % 4 == 0 ? 1.0 : 0.0)) / rve->dt;
+    if (rve->dim == 2) G[2] = G[5] = G[6] = G[7] = G[8] = 0.0;
+    for (k = 0; k < 9; ++k) {
+        x->G[k] = (gk_real)G[k];
+        x->hd[k] = rve->cell.h[k];
+        x->h[k] = (gk_real)rve->cell.h[k];
+    }
+    x->wa[0] = (gk_real)(0.5 * (G[7] - G[5]));
+    x->wa[1] = (gk_real)(0.5 * (G[2] - G[6]));
+    x->wa[2] = (gk_real)(0.5 * (G[3] - G[1]));
+    x->dt = (gk_real)rve->dt;
+}
+
+static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) {
+    gk__stepctx x;
+    double M[9], dispmax2;
+    int bad = 0, k;
+    gk_result res;
+    if (rve->need_rebuild) {
+        res = gk__rve_rebuild(rve);
+        if (res) return res;
+    }
+    gk__ctx_make(rve, E, &x);
+    for (k = 0; k < 9; ++k) rve->G[k] = (double)x.G[k];
+    gk__forces(rve, &x);
+    if (want_stress) gk__stress_pass(rve);
+    res = gk_pcell_advance(&rve->cell, E, &rve->err);
+    if (res) return res;
+    if (gk_pcell_reduce(&rve->cell, M)) {
+        /* same lattice, new basis: s' = M^-1 s for positions and build references */
+        double Mi[9];
+        int p;
+        gk_m3_inverse(M, Mi);
+        gk_pcell_apply_basis(&rve->cell, M);
+        for (p = 0; p < rve->n; ++p) {
+            double a[3], b[3], a0[3], b0[3];
+            for (k = 0; k < 3; ++k) {
+                a[k] = k < rve->dim ? rve->s[k][p] : 0.0;
+                a0[k] = k < rve->dim ? rve->s0[k][p] : 0.0;
+            }
+            gk_m3_matvec(Mi, a, b);
+            gk_m3_matvec(Mi, a0, b0);
+            for (k = 0; k < rve->dim; ++k) {
+                rve->s[k][p] = b[k];
+                rve->s0[k][p] = b0[k];
+            }
+        }
+        {
+            double h0n[9];
+            gk_m3_mul(rve->h0, M, h0n);
+            gk_m3_copy(h0n, rve->h0);
+        }
+        rve->need_rebuild = 1;
+    }
+    dispmax2 = gk__integrate(rve, &x, rve->cell.hinv, rve->cell.h, &bad);
+    rve->time += rve->dt;
+    ++rve->step;
+    if (bad) {
+        rve->diverged = 1;
+        return gk_err_set(&rve->err, GK_ERR_DIVERGED,
+                          "non-finite velocity or position at step %ld (time step too large or unstable input?)",
+                          rve->step);
+    }
+    if (!rve->need_rebuild) {
+        double h0i[9], A[9], smin, margin, At[9], AtA[9];
+        gk_m3_inverse(rve->h0, h0i);
+        gk_m3_mul(rve->cell.h, h0i, A);
+        gk_m3_transpose(A, At);
+        gk_m3_mul(At, A, AtA);
+        if (rve->dim == 2) {
+            double a = AtA[0], b = AtA[1], d = AtA[4];
+            double lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
+            smin = lmin > 0.0 ? sqrt(lmin) : 0.0;
+        } else {
+            double val[3], vec[9];
+            gk_m3_sym_eigen(AtA, val, vec);
+            smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
+        }
+        margin = smin * rve->skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
+        if (!(margin > 0.0)) rve->need_rebuild = 1;
+    }
+    return GK_OK;
+}
+
+static gk_result gk__rve_ready(gk_rve *rve) {
+    if (rve->n < 1 || !rve->s[0]) return gk_err_set(&rve->err, GK_ERR_STATE, "RVE not created");
+    if (rve->diverged)
+        return gk_err_set(&rve->err, GK_ERR_STATE, "RVE diverged at step %ld; restore a saved state", rve->step);
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_velocity_gradient(gk_rve *rve, const double L[9]) {
+    if (!gk_m3_isfinite(L)) return gk_err_set(&rve->err, GK_ERR_NAN, "velocity gradient has a NaN entry");
+    if (rve->dim == 2 && (L[2] != 0 || L[5] != 0 || L[6] != 0 || L[7] != 0 || L[8] != 0))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "2D velocity gradient must have zero third row and column");
+    gk_m3_copy(L, rve->L);
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *s) {
+    int k;
+    if (!s) {
+        rve->servo_on = 0;
+        return GK_OK;
+    }
+    for (k = 0; k < rve->dim; ++k) {
+        if (s->mode[k] != GK_SERVO_STRAIN && s->mode[k] != GK_SERVO_STRESS)
+            return gk_err_set(&rve->err, GK_ERR_ARG, "servo axis %d: unknown mode %d", k, (int)s->mode[k]);
+        if (!isfinite(s->target[k]) || !isfinite(s->rate[k]))
+            return gk_err_set(&rve->err, GK_ERR_NAN, "servo axis %d: non-finite target or rate", k);
+    }
+    if (!(s->max_rate > 0.0) || !isfinite(s->max_rate))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "servo max_rate %g must be > 0", s->max_rate);
+    if (!(s->gain >= 0.0 && s->gain <= 1.0))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "servo gain %g outside [0, 1]", s->gain);
+    rve->servo = *s;
+    rve->servo_on = 1;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
+    double E[9], A[9], Lcur[9];
+    long st;
+    int k, have = 0;
+    gk_result res = gk__rve_ready(rve);
+    if (res) return res;
+    if (nsteps < 0) return gk_err_set(&rve->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
+    gk_m3_copy(rve->L, Lcur);
+    for (st = 0; st < nsteps; ++st) {
+        if (rve->servo_on) {
+            if (st == 0 && rve->step == 0) gk_rve_refresh(rve);
+            gk_servo_rates(&rve->servo, rve->dim, rve->stress, rve->stiff, rve->dt, Lcur);
+            have = 0;
+        }
+        if (!have) {
+            for (k = 0; k < 9; ++k) A[k] = Lcur[k] * rve->dt;
+            gk_m3_exp(A, E);
+            have = 1;
+        }
+        res = gk__step_once(rve, E, rve->servo_on || st == nsteps - 1);
+        if (res) return res;
+    }
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
+    gk_path path;
+    double E[9];
+    int k;
+    gk_result res = gk__rve_ready(rve);
+    if (res) return res;
+    if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
+    res = gk_path_init(&path, rve->dim, rve->def.path, dH, nsteps, &rve->err);
+    if (res) return res;
+    for (k = 1; k <= nsteps; ++k) {
+        gk_path_step(&path, k, E);
+        res = gk__step_once(rve, E, k == nsteps);
+        if (res) return res;
+    }
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_refresh(gk_rve *rve) {
+    /* Forces at the current positions as a zero-length step: with dt = 0 and
+     * E = I every history increment vanishes. The tangential and rolling
+     * history is copied back afterwards so that a refresh never changes the
+     * future (a 3D projection or a cap could otherwise touch it). */
+    gk__stepctx x;
+    double I[9], dtsave = rve->dt;
+    gk_result res = gk__rve_ready(rve);
+    int k;
+    size_t np;
+    gk_real *save[6] = {NULL, NULL, NULL, NULL, NULL, NULL};
+    if (res) return res;
+    if (rve->need_rebuild) {
+        res = gk__rve_rebuild(rve);
+        if (res) return res;
+    }
+    np = (size_t)rve->pl.n;
+    for (k = 0; k < 3; ++k) {
+        if (rve->ft[k] && !(save[k] = (gk_real *)gk_alloc(&rve->def.alloc, (np + 1) * sizeof(gk_real)))) res = GK_ERR_ALLOC;
+        if (rve->mr[k] && !(save[3 + k] = (gk_real *)gk_alloc(&rve->def.alloc, (np + 1) * sizeof(gk_real))))
+            res = GK_ERR_ALLOC;
+    }
+    if (!res) {
+        for (k = 0; k < 3; ++k) {
+            if (save[k]) memcpy(save[k], rve->ft[k], np * sizeof(gk_real));
+            if (save[3 + k]) memcpy(save[3 + k], rve->mr[k], np * sizeof(gk_real));
+        }
+        gk_m3_identity(I);
+        rve->dt = 1.0; /* G = (E - I)/dt = 0 */
+        gk__ctx_make(rve, I, &x);
+        rve->dt = dtsave;
+        x.dt = 0;
+        gk__forces(rve, &x);
+        gk__stress_pass(rve);
+        for (k = 0; k < 3; ++k) {
+            if (save[k]) memcpy(rve->ft[k], save[k], np * sizeof(gk_real));
+            if (save[3 + k]) memcpy(rve->mr[k], save[3 + k], np * sizeof(gk_real));
+        }
+    }
+    for (k = 0; k < 6; ++k) gk_free(&rve->def.alloc, save[k]);
+    if (res) return gk_err_set(&rve->err, res, "out of memory refreshing forces");
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_dt(gk_rve *rve, double dt);
+GKDEF gk_result gk_rve_set_friction(gk_rve *rve, double mu);
+GKDEF gk_result gk_rve_set_damping(gk_rve *rve, double alpha, gk_damp_form form);
+/* constant velocity gradient used by gk_rve_step (diagonal overridden by a servo) */
+GKDEF gk_result gk_rve_set_velocity_gradient(gk_rve *rve, const double L[9]);
+GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *servo); /* NULL switches it off */
+GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps);
+GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps);
+GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk_consolidate_report *rep);
+/* Love stress of the last step (seed 000 eq 5), tension-positive, 3x3 */
+GKDEF void gk_rve_stress(const gk_rve *rve, double sigma[9]);
+/* recompute forces at the current positions without advancing (zero-length
+ * step: history and positions unchanged), then stress etc. are current */
+GKDEF gk_result gk_rve_refresh(gk_rve *rve);
+GKDEF double gk_rve_volume(const gk_rve *rve);     /* stress volume                */
+GKDEF double gk_rve_kinetic_energy(const gk_rve *rve); /* of the fluctuations     */
+GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]);
+GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *pk, const gk_allocator *alloc, gk_err *err);
+
+/* state */
+GKDEF size_t gk_rve_state_size(const gk_rve *rve);
+GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *written);
+GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size);
+GKDEF void gk_rve_state_init(gk_rve_state *st, const gk_allocator *alloc);
+GKDEF void gk_rve_state_free(gk_rve_state *st);
+GKDEF gk_result gk_rve_state_save(gk_rve_state *st, const gk_rve *rve);
+GKDEF gk_result gk_rve_state_restore(const gk_rve_state *st, gk_rve *rve);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* GK_DEM_H */
+
+/* ======================================================== IMPLEMENTATION */
+#if (defined(GK_IMPLEMENTATION) || defined(GK_DEM_IMPLEMENTATION)) && !defined(GK_DEM_IMPL_ONCE)
+#define GK_DEM_IMPL_ONCE
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ================================================================ packing */
+GKDEF gk_result gk_packing_alloc(gk_packing *pk, int dim, int n, const gk_allocator *alloc, gk_err *err) {
+    gk_packing p;
+    if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
+    if (n < 1) return gk_err_set(err, GK_ERR_ARG, "particle count %d (must be >= 1)", n);
+    memset(&p, 0, sizeof p);
+    if (alloc) p.alloc = *alloc;
+    p.dim = dim;
+    p.n = n;
+    gk_m3_identity(p.h);
+    p.x = (double *)gk_alloc(&p.alloc, (size_t)n * sizeof(double));
+    p.y = (double *)gk_alloc(&p.alloc, (size_t)n * sizeof(double));
+    p.z = (double *)gk_alloc(&p.alloc, (size_t)n * sizeof(double));
+    p.r = (double *)gk_alloc(&p.alloc, (size_t)n * sizeof(double));
+    if (!p.x || !p.y || !p.z || !p.r) {
+        gk_packing_free(&p);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d particles", n);
+    }
+    memset(p.z, 0, (size_t)n * sizeof(double));
+    *pk = p;
+    return GK_OK;
+}
+
+GKDEF void gk_packing_free(gk_packing *pk) {
+    gk_free(&pk->alloc, pk->x);
+    gk_free(&pk->alloc, pk->y);
+    gk_free(&pk->alloc, pk->z);
+    gk_free(&pk->alloc, pk->r);
+    pk->x = pk->y = pk->z = pk->r = NULL;
+    pk->n = 0;
+}
+
+/* line reader over a memory buffer */
+typedef struct gk__lines {
+    const char *p, *end;
+    long lineno;
+    char line[1024];
+} gk__lines;
+
+static int gk__next_line(gk__lines *L) {
+    size_t k = 0;
+    if (L->p >= L->end) return 0;
+    while (L->p < L->end && *L->p != '\n') {
+        if (k + 1 < sizeof L->line) L->line[k++] = *L->p;
+        ++L->p;
+    }
+    if (L->p < L->end) ++L->p;
+    L->line[k] = '\0';
+    ++L->lineno;
+    return 1;
+}
+
+static int gk__blank(const char *s) {
+    while (*s == ' ' || *s == '\t' || *s == '\r') ++s;
+    return *s == '\0';
+}
+
+/* parse up to max doubles; returns the count; sets *bad if a token is not a number */
+static int gk__parse_doubles(const char *s, double *out, int max, int *bad) {
+    int k = 0;
+    char *e;
+    *bad = 0;
+    for (;;) {
+        double v;
+        while (*s == ' ' || *s == '\t' || *s == '\r' || *s == ',') ++s;
+        if (*s == '\0' || *s == '#') break;
+        v = strtod(s, &e);
+        if (e == s) {
+            *bad = 1;
+            break;
+        }
+        if (k < max) out[k] = v;
+        ++k;
+        s = e;
+    }
+    return k;
+}
+
+GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, const gk_allocator *alloc,
+                                 gk_err *err) {
+    gk__lines L;
+    double hd[5], h[9], vals[8];
+    int nh, bad, dim, n, k = 0;
+    gk_packing pk;
+    gk_result r;
+    L.p = text;
+    L.end = text + len;
+    L.lineno = 0;
+    do {
+        if (!gk__next_line(&L)) return gk_err_set(err, GK_ERR_FORMAT, "empty packing: no header line");
+    } while (gk__blank(L.line));
+    nh = gk__parse_doubles(L.line, hd, 5, &bad);
+    if (bad || nh < 4) return gk_err_set(err, GK_ERR_FORMAT, "line %ld: header must be 'dim N Lx Ly [Lz]'", L.lineno);
+    if (hd[0] != 2.0 && hd[0] != 3.0)
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: dimension %g (must be 2 or 3)", L.lineno, hd[0]);
+    dim = (int)hd[0];
+    if (nh != dim + 2)
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: a %dD header has %d numbers, found %d", L.lineno, dim,
+                          dim + 2, nh);
+    if (!(hd[1] >= 1 && hd[1] <= 2e9) || (double)(int)hd[1] != hd[1])
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: particle count %g invalid", L.lineno, hd[1]);
+    n = (int)hd[1];
+    gk_m3_identity(h);
+    for (k = 0; k < dim; ++k) {
+        if (!(hd[2 + k] > 0.0) || !isfinite(hd[2 + k]))
+            return gk_err_set(err, GK_ERR_CELL, "line %ld: cell length %g must be > 0", L.lineno, hd[2 + k]);
+        h[4 * k] = hd[2 + k];
+    }
+    r = gk_packing_alloc(&pk, dim, n, alloc, err);
+    if (r) return r;
+    k = 0;
+    while (gk__next_line(&L)) {
+        const char *s = L.line;
+        int nv;
+        while (*s == ' ' || *s == '\t') ++s;
+        if (*s == '#') {
+            if (strncmp(s, "# cell ", 7) == 0) {
+                double hc[9];
+                int nc = gk__parse_doubles(s + 7, hc, 9, &bad), a, b;
+                if (bad || nc != dim * dim) {
+                    gk_packing_free(&pk);
+                    return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno, dim * dim);
+                }
+                gk_m3_identity(h);
+                for (a = 0; a < dim; ++a)
+                    for (b = 0; b < dim; ++b) h[3 * a + b] = hc[dim * a + b];
+            }
+            continue;
+        }
+        if (gk__blank(s)) continue;
+        nv = gk__parse_doubles(s, vals, 8, &bad);
+        if (bad || nv != dim + 1) {
+            gk_packing_free(&pk);
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: expected %d numbers (%s r), found %s", L.lineno, dim + 1,
+                              dim == 2 ? "x y" : "x y z", bad ? "a non-number" : "a different count");
+        }
+        if (k >= n) {
+            gk_packing_free(&pk);
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced", L.lineno, n);
+        }
+        for (nv = 0; nv <= dim; ++nv)
+            if (!isfinite(vals[nv])) {
+                gk_packing_free(&pk);
+                return gk_err_set(err, GK_ERR_NAN, "line %ld: particle %d has a non-finite value", L.lineno, k);
+            }
+        if (!(vals[dim] > 0.0)) {
+            gk_packing_free(&pk);
+            return gk_err_set(err, GK_ERR_RADIUS, "line %ld: particle %d has radius %g <= 0", L.lineno, k, vals[dim]);
+        }
+        pk.x[k] = vals[0];
+        pk.y[k] = vals[1];
+        pk.z[k] = dim == 3 ? vals[2] : 0.0;
+        pk.r[k] = vals[dim];
+        ++k;
+    }
+    if (k != n) {
+        gk_packing_free(&pk);
+        return gk_err_set(err, GK_ERR_FORMAT, "packing announces %d particles but lists %d", n, k);
+    }
+    if (!(gk_m3_det(h) > 0.0)) {
+        gk_packing_free(&pk);
+        return gk_err_set(err, GK_ERR_CELL, "cell matrix has det <= 0");
+    }
+    gk_m3_copy(h, pk.h);
+    *out = pk;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_packing_read(const char *path, gk_packing *pk, const gk_allocator *alloc, gk_err *err) {
+    FILE *fp;
+    long len;
+    char *buf;
+    gk_allocator a;
+    gk_result r;
+    if (alloc)
+        a = *alloc;
+    else
+        memset(&a, 0, sizeof a);
+    if (!path) return gk_err_set(err, GK_ERR_ARG, "no packing path given");
+    fp = fopen(path, "rb");
+    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open packing '%s'", path);
+    if (fseek(fp, 0, SEEK_END) != 0 || (len = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0) {
+        fclose(fp);
+        return gk_err_set(err, GK_ERR_IO, "cannot size packing '%s'", path);
+    }
+    buf = (char *)gk_alloc(&a, (size_t)len + 1);
+    if (!buf) {
+        fclose(fp);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory reading '%s'", path);
+    }
+    if (fread(buf, 1, (size_t)len, fp) != (size_t)len) {
+        fclose(fp);
+        gk_free(&a, buf);
+        return gk_err_set(err, GK_ERR_IO, "cannot read packing '%s'", path);
+    }
+    fclose(fp);
+    buf[len] = '\0';
+    r = gk_packing_parse(buf, (size_t)len, pk, alloc, err);
+    gk_free(&a, buf);
+    if (r && err) {
+        char msg[GK_ERR_MSG_LEN];
+        memcpy(msg, err->msg, sizeof msg);
+        gk_err_set(err, r, "%s: %s", path, msg);
+    }
+    return r;
+}
+
+GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const char *comment, gk_err *err) {
+    FILE *fp;
+    int k, skew = 0, a, b;
+    if (!pk || !pk->x || pk->n < 1) return gk_err_set(err, GK_ERR_ARG, "empty packing");
+    for (a = 0; a < pk->dim; ++a)
+        for (b = 0; b < pk->dim; ++b)
+            if (a != b && pk->h[3 * a + b] != 0.0) skew = 1;
+    fp = fopen(path, "w");
+    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot write packing '%s'", path);
+    if (pk->dim == 2)
+        fprintf(fp, "2 %d %.17g %.17g\n", pk->n, pk->h[0], pk->h[4]);
+    else
+        fprintf(fp, "3 %d %.17g %.17g %.17g\n", pk->n, pk->h[0], pk->h[4], pk->h[8]);
+    fprintf(fp, "# written by grainkit %s\n", GK_VERSION_STRING);
+    if (comment && comment[0]) {
+        const char *c = comment;
+        fputs("# ", fp);
+        for (; *c; ++c) {
+            fputc(*c, fp);
+            if (*c == '\n' && c[1]) fputs("# ", fp);
+        }
+        if (c[-1] != '\n') fputc('\n', fp);
+    }
+    if (skew) {
+        fputs("# cell", fp);
+        for (a = 0; a < pk->dim; ++a)
+            for (b = 0; b < pk->dim; ++b) fprintf(fp, " %.17g", pk->h[3 * a + b]);
+        fputc('\n', fp);
+    }
+    for (k = 0; k < pk->n; ++k) {
+        if (pk->dim == 2)
+            fprintf(fp, "%.17g %.17g %.17g\n", pk->x[k], pk->y[k], pk->r[k]);
+        else
+            fprintf(fp, "%.17g %.17g %.17g %.17g\n", pk->x[k], pk->y[k], pk->z[k], pk->r[k]);
+    }
+    if (fclose(fp) != 0) return gk_err_set(err, GK_ERR_IO, "error writing '%s'", path);
+    return GK_OK;
+}
+
+static double gk__particle_volume(int dim, double r) { return dim == 2 ? GK_PI * r * r : 4.0 / 3.0 * GK_PI * r * r * r; }
+
+GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err) {
+    gk_packing pk;
+    gk_rng rng;
+    double vs = 0.0, phi, side, asp[3], V, *rr;
+    int k, dim = def->dim, n = def->n;
+    gk_result res;
+    if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
+    if (n < 1) return gk_err_set(err, GK_ERR_ARG, "particle count %d (must be >= 1)", n);
+    phi = def->packing_fraction > 0 ? def->packing_fraction : (dim == 2 ? 0.5 : 0.3);
+    if (!(phi < (dim == 2 ? 0.7 : 0.45)))
+        return gk_err_set(err, GK_ERR_ARG, "initial packing fraction %g too dense for random addition", phi);
+    if (def->psd == GK_PSD_UNIFORM) {
+        if (!(def->r_min > 0.0) || !(def->r_max >= def->r_min) || !isfinite(def->r_max))
+            return gk_err_set(err, GK_ERR_RADIUS, "radius range [%g, %g] invalid", def->r_min, def->r_max);
+    } else if (def->psd == GK_PSD_TABLE_NUMBER || def->psd == GK_PSD_TABLE_MASS) {
+        if (def->ntable < 2 || !def->table_r || !def->table_cum)
+            return gk_err_set(err, GK_ERR_ARG, "size-distribution table needs >= 2 points");
+        for (k = 0; k < def->ntable; ++k) {
+            if (!(def->table_r[k] > 0.0) || (k && !(def->table_r[k] > def->table_r[k - 1])))
+                return gk_err_set(err, GK_ERR_RADIUS, "table radius %d (%g) must be > 0 and increasing", k,
+                                  def->table_r[k]);
+            if (!(def->table_cum[k] >= 0.0 && def->table_cum[k] <= 1.0) ||
+                (k && def->table_cum[k] < def->table_cum[k - 1]))
+                return gk_err_set(err, GK_ERR_ARG, "table cumulative fraction %d (%g) must rise from 0 to 1", k,
+                                  def->table_cum[k]);
+        }
+        if (def->table_cum[0] != 0.0 || def->table_cum[def->ntable - 1] != 1.0)
+            return gk_err_set(err, GK_ERR_ARG, "table cumulative fractions must start at 0 and end at 1");
+    } else {
+        return gk_err_set(err, GK_ERR_ARG, "unknown size-distribution kind %d", (int)def->psd);
+    }
+    res = gk_packing_alloc(&pk, dim, n, alloc, err);
+    if (res) return res;
+    gk_rng_seed(&rng, def->seed);
+    rr = pk.r;
+    if (def->psd == GK_PSD_UNIFORM) {
+        for (k = 0; k < n; ++k) rr[k] = def->r_min + (def->r_max - def->r_min) * gk_rng_uniform(&rng);
+    } else {
+        /* number fractions per table interval (radii uniform inside an interval) */
+        double w[256], tot = 0.0;
+        int nt = def->ntable, b;
+        if (nt > 257) nt = 257;
+        for (b = 0; b + 1 < nt; ++b) {
+            double frac = def->table_cum[b + 1] - def->table_cum[b];
+            if (def->psd == GK_PSD_TABLE_MASS) { /* number ~ mass / mean particle volume */
+                double r0 = def->table_r[b], r1 = def->table_r[b + 1], mv;
+                mv = dim == 2 ? GK_PI * (r1 * r1 + r0 * r1 + r0 * r0) / 3.0
+                              : GK_PI * (r1 + r0) * (r1 * r1 + r0 * r0) / 3.0; /* mean of r^dim volume */
+                frac = frac / mv;
+            }
+            w[b] = frac;
+            tot += frac;
+        }
+        for (k = 0; k < n; ++k) {
+            double u = gk_rng_uniform(&rng) * tot, acc = 0.0;
+            for (b = 0; b + 2 < nt; ++b) {
+                acc += w[b];
+                if (u < acc) break;
+            }
+            rr[k] = def->table_r[b] + (def->table_r[b + 1] - def->table_r[b]) * gk_rng_uniform(&rng);
+        }
+    }
+    /* largest first for random sequential addition */
+    for (k = 1; k < n; ++k) {
+        double v = rr[k];
+        int t = k - 1;
+        while (t >= 0 && rr[t] < v) {
+            rr[t + 1] = rr[t];
+            --t;
+        }
+        rr[t + 1] = v;
+    }
+    for (k = 0; k < n; ++k) vs += gk__particle_volume(dim, rr[k]);
+    for (k = 0; k < 3; ++k) asp[k] = def->aspect[k] > 0 ? def->aspect[k] : 1.0;
+    V = vs / phi;
+    side = pow(V / (asp[0] * asp[1] * (dim == 3 ? asp[2] : 1.0)), 1.0 / dim);
+    gk_m3_identity(pk.h);
+    for (k = 0; k < dim; ++k) pk.h[4 * k] = side * asp[k];
+    /* random sequential addition with a linked-cell grid updated as particles land */
+    {
+        double *sx = (double *)gk_alloc(alloc, (size_t)n * sizeof(double));
+        double *sy = (double *)gk_alloc(alloc, (size_t)n * sizeof(double));
+        double *sz = (double *)gk_alloc(alloc, (size_t)n * sizeof(double));
+        int placed = 0, nbin[3], b;
+        int32_t *head = NULL, *next = NULL;
+        double cut = 2.0 * rr[0];
+        for (k = 0; k < 3; ++k) {
+            nbin[k] = k < dim ? (int)(pk.h[4 * k] / cut) : 1;
+            if (nbin[k] < 1) nbin[k] = 1;
+            if (nbin[k] > 1024) nbin[k] = 1024;
+        }
+        head = (int32_t *)gk_alloc(alloc, (size_t)nbin[0] * nbin[1] * nbin[2] * sizeof(int32_t));
+        next = (int32_t *)gk_alloc(alloc, (size_t)n * sizeof(int32_t));
+        res = (sx && sy && sz && head && next) ? GK_OK : GK_ERR_ALLOC;
+        if (res) gk_err_set(err, res, "out of memory generating %d particles", n);
+        for (b = 0; !res && b < nbin[0] * nbin[1] * nbin[2]; ++b) head[b] = -1;
+        while (!res && placed < n) {
+            int attempt, ok = 0;
+            for (attempt = 0; attempt < 20000 && !ok; ++attempt) {
+                double s[3];
+                int bi[3], o0, o1, o2, clash = 0;
+                for (k = 0; k < 3; ++k) s[k] = k < dim ? gk_rng_uniform(&rng) : 0.0;
+                for (k = 0; k < 3; ++k) bi[k] = (int)(s[k] * nbin[k]) % nbin[k];
+                for (o2 = (dim == 3 ? -1 : 0); o2 <= (dim == 3 ? 1 : 0) && !clash; ++o2)
+                    for (o1 = -1; o1 <= 1 && !clash; ++o1)
+                        for (o0 = -1; o0 <= 1 && !clash; ++o0) {
+                            int cx = (bi[0] + o0 + nbin[0]) % nbin[0], cy = (bi[1] + o1 + nbin[1]) % nbin[1];
+                            int cz = (bi[2] + o2 + nbin[2]) % nbin[2], q;
+                            for (q = head[cx + nbin[0] * (cy + nbin[1] * cz)]; q >= 0 && !clash; q = next[q]) {
+                                double ds[3], d[3], R = rr[q] + rr[placed];
+                                ds[0] = sx[q] - s[0];
+                                ds[1] = sy[q] - s[1];
+                                ds[2] = dim == 3 ? sz[q] - s[2] : 0.0;
+                                for (k = 0; k < 3; ++k) ds[k] -= rint(ds[k]);
+                                gk_m3_matvec(pk.h, ds, d);
+                                if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < R * R) clash = 1;
+                            }
+                            /* with few bins the same bin can be visited twice: harmless */
+                        }
+                if (!clash) {
+                    int bb = bi[0] + nbin[0] * (bi[1] + nbin[1] * bi[2]);
+                    sx[placed] = s[0];
+                    sy[placed] = s[1];
+                    sz[placed] = s[2];
+                    next[placed] = head[bb];
+                    head[bb] = placed;
+                    ok = 1;
+                }
+            }
+            if (!ok) {
+                res = gk_err_set(err, GK_ERR_ARG,
+                                 "could not place particle %d of %d without overlap: lower packing_fraction (%g)",
+                                 placed, n, phi);
+                break;
+            }
+            ++placed;
+        }
+        if (!res)
+            for (k = 0; k < n; ++k) {
+                double s[3], x[3];
+                s[0] = sx[k];
+                s[1] = sy[k];
+                s[2] = sz[k];
+                gk_m3_matvec(pk.h, s, x);
+                pk.x[k] = x[0];
+                pk.y[k] = x[1];
+                pk.z[k] = dim == 3 ? x[2] : 0.0;
+            }
+        gk_free(alloc, sx);
+        gk_free(alloc, sy);
+        gk_free(alloc, sz);
+        gk_free(alloc, head);
+        gk_free(alloc, next);
+    }
+    if (res) {
+        gk_packing_free(&pk);
+        return res;
+    }
+    *out = pk;
+    return GK_OK;
+}
+
+/* ================================================================ RVE */
+GKDEF gk_rve_def gk_rve_def_default(void) {
+    gk_rve_def d;
+    memset(&d, 0, sizeof d);
+    d.cookie = GK_RVE_DEF_COOKIE;
+    d.mat = gk_material_default();
+    d.dt = 0.0;
+    d.dt_factor = 0.5;
+    d.skin = 0.0;
+    d.thickness = 0.1;
+    d.mass2d = GK_MASS_CYLINDER;
+    d.damping = 0.1;
+    d.damping_form = GK_DAMP_COMPONENT;
+    d.path = GK_PATH_CONSTANT_L;
+    d.flags = 0;
+    d.threads = 1;
+    return d;
+}
+
+GKDEF const char *gk_rve_error(const gk_rve *rve) { return rve->err.msg; }
+
+static void gk__rve_free_arrays(gk_rve *rve) {
+    const gk_allocator *a = &rve->def.alloc;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        gk_free(a, rve->s[k]);
+        gk_free(a, rve->s0[k]);
+        gk_free(a, rve->v[k]);
+        gk_free(a, rve->w[k]);
+        gk_free(a, rve->f[k]);
+        gk_free(a, rve->t[k]);
+        gk_free(a, rve->ft[k]);
+        gk_free(a, rve->mr[k]);
+        gk_free(a, rve->fc[k]);
+        gk_free(a, rve->tci[k]);
+        gk_free(a, rve->tcj[k]);
+        rve->s[k] = rve->s0[k] = NULL;
+        rve->v[k] = rve->w[k] = rve->f[k] = rve->t[k] = NULL;
+        rve->ft[k] = rve->mr[k] = rve->fc[k] = rve->tci[k] = rve->tcj[k] = NULL;
+    }
+    gk_free(a, rve->r);
+    gk_free(a, rve->minv);
+    gk_free(a, rve->Iinv);
+    gk_free(a, rve->theta);
+    gk_free(a, rve->id);
+    gk_free(a, rve->cs);
+    gk_free(a, rve->jstart);
+    gk_free(a, rve->jlist);
+    rve->r = rve->minv = rve->Iinv = NULL;
+    rve->theta = NULL;
+    rve->id = rve->jstart = rve->jlist = NULL;
+    rve->cs = NULL;
+    gk_pairlist_free(&rve->pl);
+    gk_cells_free(&rve->cells);
+}
+
+GKDEF void gk_rve_destroy(gk_rve *rve) {
+    gk__rve_free_arrays(rve);
+    rve->n = 0;
+}
+
+/* which per-pair arrays exist */
+#define GK__HAS_ROT(rve) (((rve)->phys & GK_PHYS_ROTATION) != 0)
+#define GK__HAS_ROLL(rve) (((rve)->phys & GK_PHYS_ROLLING) != 0)
+
+/* allocate per-pair arrays for cap pairs, copying the first ncopy */
+static gk_result gk__pairs_reserve(gk_rve *rve, size_t cap, size_t ncopy) {
+    const gk_allocator *a = &rve->def.alloc;
+    int dim = rve->dim, k, nft = dim == 2 ? 1 : 3;
+    size_t sz = sizeof(gk_real);
+    if (cap <= rve->pcap) return GK_OK;
+    {
+        size_t c = rve->pcap ? rve->pcap : 64;
+        while (c < cap) c *= 2;
+        cap = c;
+    }
+    for (k = 0; k < 3; ++k) {
+        if (k < nft && gk_realloc(a, (void **)&rve->ft[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
+        if (k < dim && gk_realloc(a, (void **)&rve->fc[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
+        if (GK__HAS_ROT(rve) && (dim == 3 || k == 2)) {
+            if (gk_realloc(a, (void **)&rve->tci[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
+            if (gk_realloc(a, (void **)&rve->tcj[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
+        }
+        if (GK__HAS_ROLL(rve) && (dim == 3 || k == 2) && gk_realloc(a, (void **)&rve->mr[k], ncopy, cap, sz))
+            return GK_ERR_ALLOC;
+    }
+    if (gk_realloc(a, (void **)&rve->cs, ncopy, cap, 1)) return GK_ERR_ALLOC;
+    if (gk_realloc(a, (void **)&rve->jlist, 0, cap, sizeof(int32_t))) return GK_ERR_ALLOC;
+    rve->pcap = cap;
+    return GK_OK;
+}
+
+/* critical time step, seed 000 eq 19 */
+static double gk__dt_critical(const gk_rve *rve) {
+    double knmax;
+    const gk_material *m = &rve->def.mat;
+    if (m->law == GK_LAW_LINEAR) {
+        knmax = m->kn > 0 ? m->kn : m->young * rve->rmax; /* r* <= r_max */
+    } else {
+        double dmax = 1e-3 * rve->rmin, G = m->young / (2.0 * (1.0 + m->poisson));
+        int c;
+        for (c = 0; c < rve->pl.n; ++c) { /* current largest overlap, from the stored forces */
+            if (rve->cs && (rve->cs[c] & GK_CS_CONTACT)) {
+                int i = rve->pl.i[c], j = rve->pl.j[c], k;
+                double ds[3], d[3], dd;
+                for (k = 0; k < 3; ++k) ds[k] = k < rve->dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
+                gk_pcell_min_image(&rve->cell, ds, d);
+                dd = (double)rve->r[i] + (double)rve->r[j] - sqrt(gk_v3_dot(d, d));
+                if (2.0 * dd > dmax) dmax = 2.0 * dd;
+            }
+        }
+        knmax = G / (1.0 - m->poisson) * sqrt(2.0 * rve->rmax * dmax);
+    }
+    return sqrt(rve->mmin / knmax);
+}
+
+GKDEF double gk_rve_dt_critical(const gk_rve *rve) { return gk__dt_critical(rve); }
+
+static gk_result gk__rve_rebuild(gk_rve *rve);
+
+GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_packing *pk) {
+    gk_rve R;
+    gk_err *err = &rve_out->err;
+    gk_result res;
+    int dim, n, p, k;
+    double hpk[9], rsum = 0.0, w[3], cutoff, dtc;
+    int32_t *perm = NULL;
+    memset(&R, 0, sizeof R);
+    gk_err_clear(err);
+    if (!def || def->cookie != GK_RVE_DEF_COOKIE)
+        return gk_err_set(err, GK_ERR_ARG, "gk_rve_def not initialised with gk_rve_def_default()");
+    if (!pk || !pk->x || !pk->y || !pk->r) return gk_err_set(err, GK_ERR_ARG, "no packing given");
+    res = gk_material_check(&def->mat, err);
+    if (res) return res;
+    dim = pk->dim;
+    n = pk->n;
+    if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
+    if (n < 1) return gk_err_set(err, GK_ERR_ARG, "packing has %d particles", n);
+    if (!(def->damping >= 0.0 && def->damping < 1.0))
+        return gk_err_set(err, GK_ERR_ARG, "local damping %g outside [0, 1)", def->damping);
+    if (def->damping_form != GK_DAMP_COMPONENT && def->damping_form != GK_DAMP_VECTOR)
+        return gk_err_set(err, GK_ERR_ARG, "unknown damping form %d", (int)def->damping_form);
+    if (def->path != GK_PATH_CONSTANT_L && def->path != GK_PATH_OBJECTIVE)
+        return gk_err_set(err, GK_ERR_ARG, "unknown deformation path %d", (int)def->path);
+    if (dim == 2 && def->mass2d == GK_MASS_CYLINDER && !(def->thickness > 0.0))
+        return gk_err_set(err, GK_ERR_ARG, "2D cylinder masses need thickness > 0 (got %g)", def->thickness);
+    if (!(def->dt >= 0.0) || !isfinite(def->dt)) return gk_err_set(err, GK_ERR_DT, "time step %g invalid", def->dt);
+    if (!(def->skin >= 0.0) || !isfinite(def->skin)) return gk_err_set(err, GK_ERR_ARG, "skin %g invalid", def->skin);
+    if (!(def->dt_factor >= 0.0 && def->dt_factor <= 1.0))
+        return gk_err_set(err, GK_ERR_DT, "dt_factor %g outside (0, 1]", def->dt_factor);
+    gk_m3_copy(pk->h, hpk);
+    if (dim == 2) {
+        hpk[2] = hpk[5] = hpk[6] = hpk[7] = 0.0;
+        hpk[8] = 1.0;
+    }
+    res = gk_pcell_init(&R.cell, dim, hpk, err);
+    if (res) return res;
+    for (p = 0; p < n; ++p) {
+        double rp = pk->r[p];
+        if (!isfinite(pk->x[p]) || !isfinite(pk->y[p]) || (dim == 3 && (!pk->z || !isfinite(pk->z[p]))))
+            return gk_err_set(err, GK_ERR_NAN, "particle %d has a NaN or infinite position", p);
+        if (!(rp > 0.0) || !isfinite(rp)) return gk_err_set(err, GK_ERR_RADIUS, "particle %d has radius %g", p, rp);
+        if (!(def->flags & GK_RVE_WRAP)) {
+            double x[3], s[3];
+            x[0] = pk->x[p];
+            x[1] = pk->y[p];
+            x[2] = dim == 3 ? pk->z[p] : 0.0;
+            gk_m3_matvec(R.cell.hinv, x, s);
+            for (k = 0; k < dim; ++k)
+                if (s[k] < -1e-9 || s[k] >= 1.0 + 1e-9)
+                    return gk_err_set(err, GK_ERR_OUTSIDE,
+                                      "particle %d at (%g, %g, %g) is outside the cell (set GK_RVE_WRAP to wrap)", p,
+                                      x[0], x[1], x[2]);
+        }
+    }
+    R.dim = dim;
+    R.n = n;
+    R.def = *def;
+    gk_law_consts_make(&def->mat, &R.K);
+    R.phys = gk_material_flags(&def->mat);
+    if (!(def->flags & GK_RVE_NO_ROTATION) && (R.phys & (GK_PHYS_TANGENT | GK_PHYS_ROLLING)))
+        R.phys |= GK_PHYS_ROTATION;
+    if ((R.phys & GK_PHYS_ROLLING) && !(R.phys & GK_PHYS_ROTATION))
+        return gk_err_set(err, GK_ERR_ARG, "rolling resistance needs rotating particles (GK_RVE_NO_ROTATION is set)");
+    R.volume_factor = dim == 2 ? (def->thickness > 0.0 ? def->thickness : 1.0) : 1.0;
+    /* particle order: cell-list order for locality */
+    {
+        double *tmp[3];
+        gk_cells cl;
+        double rmax = 0.0;
+        for (p = 0; p < n; ++p)
+            if (pk->r[p] > rmax) rmax = pk->r[p];
+        for (k = 0; k < 3; ++k) tmp[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
+        perm = (int32_t *)gk_alloc(&def->alloc, (size_t)n * sizeof(int32_t));
+        gk_cells_init(&cl, &def->alloc);
+        res = (tmp[0] && tmp[1] && tmp[2] && perm) ? GK_OK : GK_ERR_ALLOC;
+        if (!res) {
+            for (p = 0; p < n; ++p) {
+                double x[3], s[3];
+                x[0] = pk->x[p];
+                x[1] = pk->y[p];
+                x[2] = dim == 3 ? pk->z[p] : 0.0;
+                gk_m3_matvec(R.cell.hinv, x, s);
+                for (k = 0; k < 3; ++k) tmp[k][p] = k < dim ? s[k] - floor(s[k]) : 0.0;
+            }
+            {
+                double wmin, wd[3];
+                gk_pcell_widths(&R.cell, wd);
+                wmin = wd[0] < wd[1] ? wd[0] : wd[1];
+                if (dim == 3 && wd[2] < wmin) wmin = wd[2];
+                /* binning for ordering only: any bin size below half the cell works */
+                cutoff = 2.0 * rmax < 0.49 * wmin ? 2.0 * rmax : 0.49 * wmin;
+            }
+            res = gk_cells_bin(&cl, dim, R.cell.h, n, (const double *const *)tmp, cutoff, NULL);
+            if (!res) memcpy(perm, cl.order, (size_t)n * sizeof(int32_t));
+        }
+        gk_cells_free(&cl);
+        if (res) {
+            for (k = 0; k < 3; ++k) gk_free(&def->alloc, tmp[k]);
+            gk_free(&def->alloc, perm);
+            return gk_err_set(err, res == GK_ERR_ALLOC ? GK_ERR_ALLOC : res, "could not order %d particles", n);
+        }
+        /* allocate */
+        for (k = 0; k < 3; ++k) {
+            if (k < dim) {
+                R.s[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
+                R.s0[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
+                R.v[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+                R.f[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+                if (!R.s[k] || !R.s0[k] || !R.v[k] || !R.f[k]) res = GK_ERR_ALLOC;
+            }
+            if (GK__HAS_ROT(&R) && (dim == 3 || k == 2)) {
+                R.w[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+                R.t[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+                if (!R.w[k] || !R.t[k]) res = GK_ERR_ALLOC;
+            }
+        }
+        R.r = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+        R.minv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+        R.Iinv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
+        R.id = (int32_t *)gk_alloc(&def->alloc, (size_t)n * sizeof(int32_t));
+        R.jstart = (int32_t *)gk_alloc(&def->alloc, ((size_t)n + 1) * sizeof(int32_t));
+        if (dim == 2) R.theta = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
+        if (!R.r || !R.minv || !R.Iinv || !R.id || !R.jstart || (dim == 2 && !R.theta)) res = GK_ERR_ALLOC;
+        gk_pairlist_init(&R.pl, &def->alloc);
+        gk_cells_init(&R.cells, &def->alloc);
+        if (!res) {
+            R.rmin = 1e300;
+            R.rmax = 0.0;
+            R.mmin = 1e300;
+            for (p = 0; p < n; ++p) {
+                int q = perm[p];
+                double rq = pk->r[q], m, I;
+                for (k = 0; k < dim; ++k) {
+                    R.s[k][p] = tmp[k][q];
+                    R.s0[k][p] = tmp[k][q];
+                    R.v[k][p] = 0;
+                    R.f[k][p] = 0;
+                }
+                for (k = 0; k < 3; ++k)
+                    if (R.w[k]) R.w[k][p] = R.t[k][p] = 0;
+                if (dim == 3) {
+                    m = def->mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
+                    I = 0.4 * m * rq * rq;
+                } else if (def->mass2d == GK_MASS_CYLINDER) {
+                    m = def->mat.density * def->thickness * GK_PI * rq * rq;
+                    I = 0.5 * m * rq * rq;
+                } else {
+                    m = def->mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
+                    I = 0.4 * m * rq * rq;
+                }
+                R.r[p] = (gk_real)rq;
+                R.minv[p] = (gk_real)(1.0 / m);
+                R.Iinv[p] = (gk_real)(1.0 / I);
+                R.id[p] = q;
+                if (R.theta) R.theta[p] = 0.0;
+                if (rq < R.rmin) R.rmin = rq;
+                if (rq > R.rmax) R.rmax = rq;
+                if (m < R.mmin) R.mmin = m;
+                R.mass_total += m;
+                rsum += rq;
+                R.solid_volume += gk__particle_volume(dim, rq) * (dim == 2 ? R.volume_factor : 1.0);
+            }
+        }
+        for (k = 0; k < 3; ++k) gk_free(&def->alloc, tmp[k]);
+        gk_free(&def->alloc, perm);
+        if (res) {
+            gk__rve_free_arrays(&R);
+            return gk_err_set(err, GK_ERR_ALLOC, "out of memory for an RVE of %d particles", n);
+        }
+    }
+    R.skin = def->skin > 0.0 ? def->skin : 0.1 * rsum / n;
+    if (R.phys & GK_PHYS_COHESION) { /* a bond may stretch to coh_n / k_n before breaking */
+        double knmin = def->mat.kn > 0 ? def->mat.kn : def->mat.young * R.rmin;
+        if (R.skin < 2.0 * def->mat.coh_n / knmin) R.skin = 2.0 * def->mat.coh_n / knmin;
+    }
+    gk_pcell_widths(&R.cell, w);
+    cutoff = 2.0 * R.rmax + R.skin;
+    for (k = 0; k < dim; ++k)
+        if (!(2.0 * cutoff < w[k])) {
+            gk__rve_free_arrays(&R);
+            return gk_err_set(err, GK_ERR_CELL,
+                              "cell width %g is below twice the interaction distance %g (2 r_max + skin): "
+                              "use more particles or a smaller skin",
+                              w[k], cutoff);
+        }
+    R.dt_crit = gk__dt_critical(&R);
+    dtc = R.dt_crit;
+    if (def->dt > 0.0) {
+        if (def->dt > dtc) {
+            gk__rve_free_arrays(&R);
+            return gk_err_set(err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)", def->dt,
+                              dtc);
+        }
+        R.dt = def->dt;
+    } else {
+        R.dt = (def->dt_factor > 0.0 ? def->dt_factor : 0.5) * dtc;
+    }
+    gk_m3_zero(R.L);
+    gk_m3_zero(R.G);
+    R.need_rebuild = 1;
+    R.err = rve_out->err;
+    res = gk__rve_rebuild(&R);
+    if (res) {
+        gk_err e = R.err;
+        gk__rve_free_arrays(&R);
+        rve_out->err = e;
+        return res;
+    }
+    *rve_out = R;
+    return GK_OK;
+}
+
+/* rebuild the pair list at the current positions, carrying history over by merge */
+static gk_result gk__rve_rebuild(gk_rve *rve) {
+    gk_pairlist nl;
+    int dim = rve->dim, n = rve->n, k, p, c, oc, nft = dim == 2 ? 1 : 3;
+    double w[3];
+    gk_result res;
+    const double *sp[3];
+    /* cell too thin for the nearest image: try a lattice reduction first */
+    gk_pcell_widths(&rve->cell, w);
+    for (k = 0; k < dim; ++k)
+        if (!(2.0 * (2.0 * rve->rmax + rve->skin) < w[k]))
+            return gk_err_set(&rve->err, GK_ERR_CELL,
+                              "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
+                              "too far for this many particles)",
+                              w[k], 2.0 * rve->rmax + rve->skin);
+    /* wrap positions into [0,1): the nearest image is unaffected */
+    for (k = 0; k < dim; ++k)
+        for (p = 0; p < n; ++p) {
+            double s = rve->s[k][p];
+            if (s < 0.0 || s >= 1.0) {
+                s -= floor(s);
+                if (s >= 1.0) s = 0.0;
+                rve->s[k][p] = s;
+            }
+        }
+    for (k = 0; k < 3; ++k) sp[k] = rve->s[k < dim ? k : 0];
+    res = gk_cells_bin(&rve->cells, dim, rve->cell.h, n, sp, 2.0 * rve->rmax + rve->skin, &rve->err);
+    if (res) return res;
+    gk_pairlist_init(&nl, &rve->def.alloc);
+    res = gk_cells_pairs(&rve->cells, rve->cell.h, sp, rve->r, rve->skin, &nl, &rve->err);
+    if (res) {
+        gk_pairlist_free(&nl);
+        return res;
+    }
+    {
+        /* new per-pair arrays, filled by a merge with the old list (both sorted by (i, j)) */
+        gk_rve tmp;
+        memset(&tmp, 0, sizeof tmp);
+        tmp.dim = dim;
+        tmp.phys = rve->phys;
+        tmp.def.alloc = rve->def.alloc;
+        res = gk__pairs_reserve(&tmp, (size_t)nl.n + 1, 0);
+        if (res) {
+            for (k = 0; k < 3; ++k) {
+                gk_free(&rve->def.alloc, tmp.ft[k]);
+                gk_free(&rve->def.alloc, tmp.fc[k]);
+                gk_free(&rve->def.alloc, tmp.tci[k]);
+                gk_free(&rve->def.alloc, tmp.tcj[k]);
+                gk_free(&rve->def.alloc, tmp.mr[k]);
+            }
+            gk_free(&rve->def.alloc, tmp.cs);
+            gk_free(&rve->def.alloc, tmp.jlist);
+            gk_pairlist_free(&nl);
+            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", nl.n);
+        }
+        oc = 0;
+        for (c = 0; c < nl.n; ++c) {
+            int32_t ni = nl.i[c], nj = nl.j[c];
+            while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj))) ++oc;
+            if (oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj) {
+                for (k = 0; k < nft; ++k) tmp.ft[k][c] = rve->ft[k][oc];
+                for (k = 0; k < dim; ++k) tmp.fc[k][c] = rve->fc[k][oc];
+                for (k = 0; k < 3; ++k) {
+                    if (tmp.tci[k]) {
+                        tmp.tci[k][c] = rve->tci[k][oc];
+                        tmp.tcj[k][c] = rve->tcj[k][oc];
+                    }
+                    if (tmp.mr[k]) tmp.mr[k][c] = rve->mr[k][oc];
+                }
+                tmp.cs[c] = rve->cs[oc];
+            } else {
+                for (k = 0; k < nft; ++k) tmp.ft[k][c] = 0;
+                for (k = 0; k < dim; ++k) tmp.fc[k][c] = 0;
+                for (k = 0; k < 3; ++k) {
+                    if (tmp.tci[k]) tmp.tci[k][c] = tmp.tcj[k][c] = 0;
+                    if (tmp.mr[k]) tmp.mr[k][c] = 0;
+                }
+                tmp.cs[c] = 0;
+            }
+        }
+        /* swap in */
+        for (k = 0; k < 3; ++k) {
+            gk_free(&rve->def.alloc, rve->ft[k]);
+            gk_free(&rve->def.alloc, rve->fc[k]);
+            gk_free(&rve->def.alloc, rve->tci[k]);
+            gk_free(&rve->def.alloc, rve->tcj[k]);
+            gk_free(&rve->def.alloc, rve->mr[k]);
+            rve->ft[k] = tmp.ft[k];
+            rve->fc[k] = tmp.fc[k];
+            rve->tci[k] = tmp.tci[k];
+            rve->tcj[k] = tmp.tcj[k];
+            rve->mr[k] = tmp.mr[k];
+        }
+        gk_free(&rve->def.alloc, rve->cs);
+        gk_free(&rve->def.alloc, rve->jlist);
+        rve->cs = tmp.cs;
+        rve->jlist = tmp.jlist;
+        rve->pcap = tmp.pcap;
+        gk_pairlist_free(&rve->pl);
+        rve->pl = nl;
+    }
+    /* pairs where p is j, ascending pair index (counting sort by j) */
+    for (p = 0; p <= n; ++p) rve->jstart[p] = 0;
+    for (c = 0; c < rve->pl.n; ++c) ++rve->jstart[rve->pl.j[c] + 1];
+    for (p = 0; p < n; ++p) rve->jstart[p + 1] += rve->jstart[p];
+    for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
+    for (p = n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
+    rve->jstart[0] = 0;
+    for (k = 0; k < dim; ++k) memcpy(rve->s0[k], rve->s[k], (size_t)n * sizeof(double));
+    gk_m3_copy(rve->cell.h, rve->h0);
+    rve->need_rebuild = 0;
+    ++rve->rebuilds;
+    return GK_OK;
+}
+
+/* ---------------------------------------------------------------- forces */
+typedef struct gk__stepctx {
+    gk_real h[9];   /* unused by the double-position path; kept for kernels */
+    double hd[9];   /* cell matrix (positions are double)                  */
+    gk_real G[9];   /* affine velocity gradient of this step                */
+    gk_real wa[3];  /* affine spin (2D: wa[2])                              */
+    gk_real dt;
+} gk__stepctx;
+
+/* pair forces, scalar reference: writes fc, tci, tcj, ft, mr, cs for pairs [c0, c1) */
+GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+    const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
+    const double *sx = rve->s[0], *sy = rve->s[1];
+    const gk_real *vx = rve->v[0], *vy = rve->v[1], *r = rve->r, *minv = rve->minv;
+    const gk_real *wz = rve->w[2];
+    gk_real *ft = rve->ft[0], *mr = rve->mr[2], *fcx = rve->fc[0], *fcy = rve->fc[1];
+    gk_real *tci = rve->tci[2], *tcj = rve->tcj[2];
+    unsigned char *cs = rve->cs;
+    gk_real dummy = 0;
+    int c;
+    for (c = c0; c < c1; ++c) {
+        int i = pi[c], j = pj[c];
+        double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i];
+        gk_real dx, dy, rvx, rvy, wi, wj;
+        gk_contact_out o;
+        dsx -= rint(dsx);
+        dsy -= rint(dsy);
+        dx = (gk_real)(x->hd[0] * dsx + x->hd[1] * dsy);
+        dy = (gk_real)(x->hd[3] * dsx + x->hd[4] * dsy);
+        rvx = (vx[j] - vx[i]) + (x->G[0] * dx + x->G[1] * dy);
+        rvy = (vy[j] - vy[i]) + (x->G[3] * dx + x->G[4] * dy);
+        wi = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[i] : x->wa[2];
+        wj = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[j] : x->wa[2];
+        gk_contact_2d(&rve->K, law, fl, dx, dy, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], rvx, rvy, wi,
+                      wj, x->dt, ft + c, (fl & GK_PHYS_ROLLING) ? mr + c : &dummy, cs + c, &o);
+        fcx[c] = o.f[0];
+        fcy[c] = o.f[1];
+        if (fl & GK_PHYS_ROTATION) {
+            tci[c] = o.ti[2];
+            tcj[c] = o.tj[2];
+        }
+    }
+}
+
+GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+    const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
+    const gk_real *r = rve->r, *minv = rve->minv;
+    gk_real dummy[3] = {0, 0, 0};
+    int c, k;
+    for (c = c0; c < c1; ++c) {
+        int i = pi[c], j = pj[c];
+        double ds[3];
+        gk_real d[3], vr[3], wi[3], wj[3], hist[3], mh[3];
+        gk_contact_out o;
+        for (k = 0; k < 3; ++k) {
+            ds[k] = rve->s[k][j] - rve->s[k][i];
+            ds[k] -= rint(ds[k]);
+        }
+        for (k = 0; k < 3; ++k) d[k] = (gk_real)(x->hd[3 * k] * ds[0] + x->hd[3 * k + 1] * ds[1] + x->hd[3 * k + 2] * ds[2]);
+        for (k = 0; k < 3; ++k)
+            vr[k] = (rve->v[k][j] - rve->v[k][i]) + (x->G[3 * k] * d[0] + x->G[3 * k + 1] * d[1] + x->G[3 * k + 2] * d[2]);
+        for (k = 0; k < 3; ++k) {
+            wi[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][i] : x->wa[k];
+            wj[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][j] : x->wa[k];
+            hist[k] = rve->ft[k][c];
+            mh[k] = (fl & GK_PHYS_ROLLING) ? rve->mr[k][c] : dummy[k];
+        }
+        gk_contact_3d(&rve->K, law, fl, d, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], vr, wi, wj, x->dt,
+                      hist, mh, rve->cs + c, &o);
+        for (k = 0; k < 3; ++k) {
+            rve->ft[k][c] = hist[k];
+            if (fl & GK_PHYS_ROLLING) rve->mr[k][c] = mh[k];
+            rve->fc[k][c] = o.f[k];
+            if (fl & GK_PHYS_ROTATION) {
+                rve->tci[k][c] = o.ti[k];
+                rve->tcj[k][c] = o.tj[k];
+            }
+        }
+    }
+}
+
+/* instantiate the kernel with constant law and flags (pay only for what is on) */
+#define GK__DISPATCH(fn, rve, x, c0, c1)                                                                              \
+    do {                                                                                                               \
+        unsigned fl_ = (rve)->phys;                                                                                    \
+        gk_law law_ = (rve)->def.mat.law;                                                                              \
+        if (law_ == GK_LAW_LINEAR) {                                                                                   \
+            if (fl_ == 0u)                                                                                             \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, 0u);                                                                 \
+            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT);                                                    \
+            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                 \
+            else                                                                                                       \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, fl_);                                                                \
+        } else {                                                                                                       \
+            if (fl_ == 0u)                                                                                             \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, 0u);                                                                  \
+            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT);                                                     \
+            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                  \
+            else                                                                                                       \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, fl_);                                                                 \
+        }                                                                                                              \
+    } while (0)
+
+static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
+    if (rve->dim == 2)
+        GK__DISPATCH(gk__forces_ref_2d, rve, x, c0, c1);
+    else
+        GK__DISPATCH(gk__forces_ref_3d, rve, x, c0, c1);
+}
+
+static void gk__forces(gk_rve *rve, const gk__stepctx *x) {
+    int nc = rve->pl.n;
+    int nth = rve->def.threads > 1 && nc >= GK_DEM_PAR_MIN ? rve->def.threads : 1;
+    if (nth <= 1) {
+        gk__forces_range(rve, x, 0, nc);
+    } else {
+        int b;
+        GK_OMP(parallel for num_threads(nth) schedule(static))
+        for (b = 0; b < nth * 4; ++b) {
+            long c0 = (long)nc * b / (nth * 4), c1 = (long)nc * (b + 1) / (nth * 4);
+            gk__forces_range(rve, x, (int)c0, (int)c1);
+        }
+    }
+}
+
+/* ---------------------------------------------------------------- integration */
+GK_FORCE_INLINE gk_real gk__damp_component(gk_real a, gk_real v, gk_real dt, gk_real alpha) {
+    gk_real sgn = a * (v + (gk_real)0.5 * dt * a);
+    if (sgn > 0) return a * ((gk_real)1 - alpha);
+    if (sgn < 0) return a * ((gk_real)1 + alpha);
+    return a;
+}
+
+/* sum pair forces per particle (fixed order), damp, leap-frog; particles [p0, p1).
+ * Returns the largest squared non-affine displacement since the last build;
+ * *bad set if a non-finite value appeared. */
+static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int p0,
+                                  int p1, int *bad) {
+    const int dim = rve->dim, rot = GK__HAS_ROT(rve);
+    const gk_real dt = x->dt, alpha = (gk_real)rve->def.damping;
+    const int vec = rve->def.damping_form == GK_DAMP_VECTOR;
+    const int32_t *start = rve->pl.start, *jst = rve->jstart, *jl = rve->jlist;
+    double m2 = 0.0, chk = 0.0;
+    int p, k, e;
+    for (p = p0; p < p1; ++p) {
+        gk_real f[3] = {0, 0, 0}, tq[3] = {0, 0, 0}, a[3], aw[3];
+        for (e = jst[p]; e < jst[p + 1]; ++e) {
+            int c = jl[e];
+            for (k = 0; k < dim; ++k) f[k] += rve->fc[k][c];
+            if (rot) {
+                if (dim == 2)
+                    tq[2] += rve->tcj[2][c];
+                else
+                    for (k = 0; k < 3; ++k) tq[k] += rve->tcj[k][c];
+            }
+        }
+        for (e = start[p]; e < start[p + 1]; ++e) {
+            for (k = 0; k < dim; ++k) f[k] -= rve->fc[k][e];
+            if (rot) {
+                if (dim == 2)
+                    tq[2] += rve->tci[2][e];
+                else
+                    for (k = 0; k < 3; ++k) tq[k] += rve->tci[k][e];
+            }
+        }
+        for (k = 0; k < dim; ++k) {
+            rve->f[k][p] = f[k];
+            a[k] = f[k] * rve->minv[p];
+        }
+        if (alpha > 0) {
+            if (!vec) {
+                for (k = 0; k < dim; ++k) a[k] = gk__damp_component(a[k], rve->v[k][p], dt, alpha);
+            } else {
+                gk_real ve[3] = {0, 0, 0}, vv = 0, aa = 0;
+                for (k = 0; k < dim; ++k) {
+                    ve[k] = rve->v[k][p] + (gk_real)0.5 * dt * a[k];
+                    vv += ve[k] * ve[k];
+                    aa += a[k] * a[k];
+                }
+                if (vv > 0) {
+                    gk_real sc = alpha * (gk_real)sqrt(aa) / (gk_real)sqrt(vv);
+                    for (k = 0; k < dim; ++k) a[k] = a[k] - sc * ve[k];
+                }
+            }
+        }
+        {
+            gk_real dd[3] = {0, 0, 0};
+            for (k = 0; k < dim; ++k) {
+                gk_real vn = rve->v[k][p] + dt * a[k];
+                rve->v[k][p] = vn;
+                dd[k] = vn * dt;
+                chk += (double)(vn < 0 ? -vn : vn);
+            }
+            if (dim == 2) {
+                double ex, ey, ux, uy;
+                rve->s[0][p] += hinv[0] * (double)dd[0] + hinv[1] * (double)dd[1];
+                rve->s[1][p] += hinv[3] * (double)dd[0] + hinv[4] * (double)dd[1];
+                ex = rve->s[0][p] - rve->s0[0][p];
+                ey = rve->s[1][p] - rve->s0[1][p];
+                ux = hnew[0] * ex + hnew[1] * ey;
+                uy = hnew[3] * ex + hnew[4] * ey;
+                if (ux * ux + uy * uy > m2) m2 = ux * ux + uy * uy;
+            } else {
+                double ex[3], u[3], u2;
+                for (k = 0; k < 3; ++k)
+                    rve->s[k][p] += hinv[3 * k] * (double)dd[0] + hinv[3 * k + 1] * (double)dd[1] +
+                                    hinv[3 * k + 2] * (double)dd[2];
+                for (k = 0; k < 3; ++k) ex[k] = rve->s[k][p] - rve->s0[k][p];
+                gk_m3_matvec(hnew, ex, u);
+                u2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+                if (u2 > m2) m2 = u2;
+            }
+        }
+        if (rot) {
+            int k0 = dim == 2 ? 2 : 0;
+            for (k = k0; k < 3; ++k) {
+                rve->t[k][p] = tq[k];
+                aw[k] = tq[k] * rve->Iinv[p];
+            }
+            if (alpha > 0) {
+                if (!vec || dim == 2) {
+                    for (k = k0; k < 3; ++k) aw[k] = gk__damp_component(aw[k], rve->w[k][p], dt, alpha);
+                } else {
+                    gk_real ve[3], vv = 0, aa = 0;
+                    for (k = 0; k < 3; ++k) {
+                        ve[k] = rve->w[k][p] + (gk_real)0.5 * dt * aw[k];
+                        vv += ve[k] * ve[k];
+                        aa += aw[k] * aw[k];
+                    }
+                    if (vv > 0) {
+                        gk_real sc = alpha * (gk_real)sqrt(aa) / (gk_real)sqrt(vv);
+                        for (k = 0; k < 3; ++k) aw[k] = aw[k] - sc * ve[k];
+                    }
+                }
+            }
+            for (k = k0; k < 3; ++k) {
+                rve->w[k][p] = rve->w[k][p] + dt * aw[k];
+                chk += (double)(rve->w[k][p] < 0 ? -rve->w[k][p] : rve->w[k][p]);
+            }
+            if (dim == 2) rve->theta[p] += ((double)x->wa[2] + (double)rve->w[2][p]) * (double)dt;
+        } else if (dim == 2) {
+            rve->theta[p] += (double)x->wa[2] * (double)dt;
+        }
+    }
+    if (!isfinite(chk) || !isfinite(m2)) *bad = 1;
+    return m2;
+}
+
+static double gk__integrate(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int *bad) {
+    int n = rve->n;
+    int nth = rve->def.threads > 1 && rve->pl.n >= GK_DEM_PAR_MIN ? rve->def.threads : 1;
+    double m2 = 0.0;
+    if (nth <= 1) return gk__integrate_range(rve, x, hinv, hnew, 0, n, bad);
+    {
+        int b, badl = 0;
+        GK_OMP(parallel for num_threads(nth) schedule(static) reduction(max : m2) reduction(| : badl))
+        for (b = 0; b < nth * 4; ++b) {
+            long p0 = (long)n * b / (nth * 4), p1 = (long)n * (b + 1) / (nth * 4);
+            int bb = 0;
+            double mm = gk__integrate_range(rve, x, hinv, hnew, (int)p0, (int)p1, &bb);
+            if (mm > m2) m2 = mm;
+            badl |= bb;
+        }
+        if (badl) *bad = 1;
+    }
+    return m2;
+}
+
+/* ---------------------------------------------------------------- stress */
+/* Love stress sigma = -(1/V) sum F (x) d (seed 000 eq 5; F on j, d = x_j - x_i),
+ * the Voigt stiffness diagonal and contact statistics, in pair order. */
+static void gk__stress_pass(gk_rve *rve) {
+    int dim = rve->dim, c, k, l, nc = 0;
+    double S[9], st[3] = {0, 0, 0}, V = gk_rve_volume(rve), fsum = 0.0;
+    gk_m3_zero(S);
+    for (c = 0; c < rve->pl.n; ++c) {
+        int i, j;
+        double ds[3], d[3], F[3], dd, R, delta;
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        i = rve->pl.i[c];
+        j = rve->pl.j[c];
+        for (k = 0; k < 3; ++k) {
+            ds[k] = k < dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
+            F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
+        }
+        gk_pcell_min_image(&rve->cell, ds, d);
+        if (dim == 2) d[2] = 0.0;
+        for (k = 0; k < 3; ++k)
+            for (l = 0; l < 3; ++l) S[3 * k + l] += F[k] * d[l];
+        dd = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        R = (double)rve->r[i] + (double)rve->r[j];
+        delta = R - dd;
+        if (dd > 0.0) {
+            gk_real kn, fn, kt;
+            gk_contact_stiffness(&rve->K, rve->def.mat.law, rve->r[i], rve->r[j], (gk_real)(delta > 0 ? delta : 0), &kn,
+                                 &fn, &kt);
+            for (k = 0; k < dim; ++k) st[k] += (double)kn * d[k] * d[k] * d[k] * d[k] / (dd * dd);
+        }
+        fsum += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
+        ++nc;
+    }
+    for (k = 0; k < 9; ++k) rve->stress[k] = -S[k] / V;
+    for (k = 0; k < 3; ++k) rve->stiff[k] = st[k] / V;
+    rve->ncontacts = nc;
+    rve->fc_mean = nc ? fsum / nc : 0.0;
+}
+
+GKDEF double gk_rve_volume(const gk_rve *rve) { return gk_pcell_volume(&rve->cell) * rve->volume_factor; }
+
+GKDEF void gk_rve_stress(const gk_rve *rve, double sigma[9]) { gk_m3_copy(rve->stress, sigma); }
+
+/* ---------------------------------------------------------------- one step */
+static void gk__ctx_make(const gk_rve *rve, const double E[9], gk__stepctx *x) {
+    double G[9];
+    int k;
+    for (k = 0; k < 9; ++k) G[k] = (E[k] - (k % 4 == 0 ? 1.0 : 0.0)) / rve->dt;
+    if (rve->dim == 2) G[2] = G[5] = G[6] = G[7] = G[8] = 0.0;
+    for (k = 0; k < 9; ++k) {
+        x->G[k] = (gk_real)G[k];
+        x->hd[k] = rve->cell.h[k];
+        x->h[k] = (gk_real)rve->cell.h[k];
+    }
+    x->wa[0] = (gk_real)(0.5 * (G[7] - G[5]));
+    x->wa[1] = (gk_real)(0.5 * (G[2] - G[6]));
+    x->wa[2] = (gk_real)(0.5 * (G[3] - G[1]));
+    x->dt = (gk_real)rve->dt;
+}
+
+static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) {
+    gk__stepctx x;
+    double M[9], dispmax2;
+    int bad = 0, k;
+    gk_result res;
+    if (rve->need_rebuild) {
+        res = gk__rve_rebuild(rve);
+        if (res) return res;
+    }
+    gk__ctx_make(rve, E, &x);
+    for (k = 0; k < 9; ++k) rve->G[k] = (double)x.G[k];
+    gk__forces(rve, &x);
+    if (want_stress) gk__stress_pass(rve);
+    res = gk_pcell_advance(&rve->cell, E, &rve->err);
+    if (res) return res;
+    if (gk_pcell_reduce(&rve->cell, M)) {
+        /* same lattice, new basis: s' = M^-1 s for positions and build references */
+        double Mi[9];
+        int p;
+        gk_m3_inverse(M, Mi);
+        gk_pcell_apply_basis(&rve->cell, M);
+        for (p = 0; p < rve->n; ++p) {
+            double a[3], b[3], a0[3], b0[3];
+            for (k = 0; k < 3; ++k) {
+                a[k] = k < rve->dim ? rve->s[k][p] : 0.0;
+                a0[k] = k < rve->dim ? rve->s0[k][p] : 0.0;
+            }
+            gk_m3_matvec(Mi, a, b);
+            gk_m3_matvec(Mi, a0, b0);
+            for (k = 0; k < rve->dim; ++k) {
+                rve->s[k][p] = b[k];
+                rve->s0[k][p] = b0[k];
+            }
+        }
+        {
+            double h0n[9];
+            gk_m3_mul(rve->h0, M, h0n);
+            gk_m3_copy(h0n, rve->h0);
+        }
+        rve->need_rebuild = 1;
+    }
+    dispmax2 = gk__integrate(rve, &x, rve->cell.hinv, rve->cell.h, &bad);
+    rve->time += rve->dt;
+    ++rve->step;
+    if (bad) {
+        rve->diverged = 1;
+        return gk_err_set(&rve->err, GK_ERR_DIVERGED,
+                          "non-finite velocity or position at step %ld (time step too large or unstable input?)",
+                          rve->step);
+    }
+    if (!rve->need_rebuild) {
+        double h0i[9], A[9], smin, margin, At[9], AtA[9];
+        gk_m3_inverse(rve->h0, h0i);
+        gk_m3_mul(rve->cell.h, h0i, A);
+        gk_m3_transpose(A, At);
+        gk_m3_mul(At, A, AtA);
+        if (rve->dim == 2) {
+            double a = AtA[0], b = AtA[1], d = AtA[4];
+            double lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
+            smin = lmin > 0.0 ? sqrt(lmin) : 0.0;
+        } else {
+            double val[3], vec[9];
+            gk_m3_sym_eigen(AtA, val, vec);
+            smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
+        }
+        margin = smin * rve->skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
+        if (!(margin > 0.0)) rve->need_rebuild = 1;
+    }
+    return GK_OK;
+}
+
+static gk_result gk__rve_ready(gk_rve *rve) {
+    if (rve->n < 1 || !rve->s[0]) return gk_err_set(&rve->err, GK_ERR_STATE, "RVE not created");
+    if (rve->diverged)
+        return gk_err_set(&rve->err, GK_ERR_STATE, "RVE diverged at step %ld; restore a saved state", rve->step);
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_velocity_gradient(gk_rve *rve, const double L[9]) {
+    if (!gk_m3_isfinite(L)) return gk_err_set(&rve->err, GK_ERR_NAN, "velocity gradient has a NaN entry");
+    if (rve->dim == 2 && (L[2] != 0 || L[5] != 0 || L[6] != 0 || L[7] != 0 || L[8] != 0))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "2D velocity gradient must have zero third row and column");
+    gk_m3_copy(L, rve->L);
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *s) {
+    int k;
+    if (!s) {
+        rve->servo_on = 0;
+        return GK_OK;
+    }
+    for (k = 0; k < rve->dim; ++k) {
+        if (s->mode[k] != GK_SERVO_STRAIN && s->mode[k] != GK_SERVO_STRESS)
+            return gk_err_set(&rve->err, GK_ERR_ARG, "servo axis %d: unknown mode %d", k, (int)s->mode[k]);
+        if (!isfinite(s->target[k]) || !isfinite(s->rate[k]))
+            return gk_err_set(&rve->err, GK_ERR_NAN, "servo axis %d: non-finite target or rate", k);
+    }
+    if (!(s->max_rate > 0.0) || !isfinite(s->max_rate))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "servo max_rate %g must be > 0", s->max_rate);
+    if (!(s->gain >= 0.0 && s->gain <= 1.0))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "servo gain %g outside [0, 1]", s->gain);
+    rve->servo = *s;
+    rve->servo_on = 1;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
+    double E[9], A[9], Lcur[9];
+    long st;
+    int k, have = 0;
+    gk_result res = gk__rve_ready(rve);
+    if (res) return res;
+    if (nsteps < 0) return gk_err_set(&rve->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
+    gk_m3_copy(rve->L, Lcur);
+    for (st = 0; st < nsteps; ++st) {
+        if (rve->servo_on) {
+            if (st == 0 && rve->step == 0) gk_rve_refresh(rve);
+            gk_servo_rates(&rve->servo, rve->dim, rve->stress, rve->stiff, rve->dt, Lcur);
+            have = 0;
+        }
+        if (!have) {
+            for (k = 0; k < 9; ++k) A[k] = Lcur[k] * rve->dt;
+            gk_m3_exp(A, E);
+            have = 1;
+        }
+        res = gk__step_once(rve, E, rve->servo_on || st == nsteps - 1);
+        if (res) return res;
+    }
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
+    gk_path path;
+    double E[9];
+    int k;
+    gk_result res = gk__rve_ready(rve);
+    if (res) return res;
+    if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
+    res = gk_path_init(&path, rve->dim, rve->def.path, dH, nsteps, &rve->err);
+    if (res) return res;
+    for (k = 1; k <= nsteps; ++k) {
+        gk_path_step(&path, k, E);
+        res = gk__step_once(rve, E, k == nsteps);
+        if (res) return res;
+    }
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_refresh(gk_rve *rve) {
+    /* forces at the current positions with a zero-length step: the tangential
+     * increments vanish (dt -> 0 in the increments), history is kept */
+    gk__stepctx x;
+    double I[9], dtsave = rve->dt;
+    gk_result res = gk__rve_ready(rve);
+    unsigned char *cs_save = NULL;
+    int k;
+    gk_real *ft_save[3] = {NULL, NULL, NULL}, *mr_save[3] = {NULL, NULL, NULL};
+    if (res) return res;
+    if (rve->need_rebuild) {
+        res = gk__rve_rebuild(rve);
+        if (res) return res;
+    }
+    /* keep history bit-identical: evaluate with dt = 0 on copies, restore history after */
+    {
+        size_t np = (size_t)rve->pl.n + 1;
+        cs_save = (unsigned char *)gk_alloc(&rve->def.alloc, np);
+        for (k = 0; k < 3; ++k) {
+            if (rve->ft[k]) ft_save[k] = (gk_real *)gk_alloc(&rve->def.alloc, np * sizeof(gk_real));
+            if (rve->mr[k]) mr_save[k] = (gk_real *)gk_alloc(&rve->def.alloc, np * sizeof(gk_real));
+        }
+        if (!cs_save || (rve->ft[0] && !ft_save[0])) res = GK_ERR_ALLOC;
+        for (k = 0; k < 3 && !res; ++k)
+            if ((rve->ft[k] && !ft_save[k]) || (rve->mr[k] && !mr_save[k])) res = GK_ERR_ALLOC;
+        if (!res) {
+            memcpy(cs_save, rve->cs, np - 1);
+            for (k = 0; k < 3; ++k) {
+                if (ft_save[k]) memcpy(ft_save[k], rve->ft[k], (np - 1) * sizeof(gk_real));
+                if (mr_save[k]) memcpy(mr_save[k], rve->mr[k], (np - 1) * sizeof(gk_real));
+            }
+            gk_m3_identity(I);
+            rve->dt = 1.0; /* G = 0 with E = I; dt only scales increments, which are zero */
+            gk__ctx_make(rve, I, &x);
+            x.dt = 0;
+            gk__forces(rve, &x);
+            gk__stress_pass(rve);
+            rve->dt = dtsave;
+            memcpy(rve->cs, cs_save, np - 1);
+            for (k = 0; k < 3; ++k) {
+                if (ft_save[k]) memcpy(rve->ft[k], ft_save[k], (np - 1) * sizeof(gk_real));
+                if (mr_save[k]) memcpy(rve->mr[k], mr_save[k], (np - 1) * sizeof(gk_real));
+            }
+        }
+        gk_free(&rve->def.alloc, cs_save);
+        for (k = 0; k < 3; ++k) {
+            gk_free(&rve->def.alloc, ft_save[k]);
+            gk_free(&rve->def.alloc, mr_save[k]);
+        }
+    }
+    if (res) return gk_err_set(&rve->err, res, "out of memory refreshing forces");
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_dt(gk_rve *rve, double dt) {
+    double dtc = gk__dt_critical(rve);
+    if (!(dt > 0.0) || !isfinite(dt)) return gk_err_set(&rve->err, GK_ERR_DT, "time step %g must be > 0", dt);
+    if (dt > dtc)
+        return gk_err_set(&rve->err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)", dt, dtc);
+    rve->dt = dt;
+    rve->dt_crit = dtc;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_friction(gk_rve *rve, double mu) {
+    gk_material m = rve->def.mat;
+    unsigned phys;
+    gk_result res;
+    m.friction = mu;
+    res = gk_material_check(&m, &rve->err);
+    if (res) return res;
+    phys = gk_material_flags(&m) | (rve->phys & GK_PHYS_ROTATION);
+    if ((phys & GK_PHYS_TANGENT) && !(rve->phys & GK_PHYS_TANGENT))
+        return gk_err_set(&rve->err, GK_ERR_STATE,
+                          "RVE was created frictionless: create it with the friction it will use "
+                          "(gk_rve_consolidate switches friction off and on itself)");
+    rve->def.mat = m;
+    rve->K.mu = (gk_real)mu;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_damping(gk_rve *rve, double alpha, gk_damp_form form) {
+    if (!(alpha >= 0.0 && alpha < 1.0)) return gk_err_set(&rve->err, GK_ERR_ARG, "damping %g outside [0, 1)", alpha);
+    if (form != GK_DAMP_COMPONENT && form != GK_DAMP_VECTOR)
+        return gk_err_set(&rve->err, GK_ERR_ARG, "unknown damping form %d", (int)form);
+    rve->def.damping = alpha;
+    rve->def.damping_form = form;
+    return GK_OK;
+}
+
+GKDEF double gk_rve_kinetic_energy(const gk_rve *rve) {
+    double e = 0.0;
+    int p, k;
+    for (p = 0; p < rve->n; ++p) {
+        double m = 1.0 / (double)rve->minv[p], I = 1.0 / (double)rve->Iinv[p];
+        for (k = 0; k < rve->dim; ++k) e += 0.5 * m * (double)rve->v[k][p] * (double)rve->v[k][p];
+        for (k = 0; k < 3; ++k)
+            if (rve->w[k]) e += 0.5 * I * (double)rve->w[k][p] * (double)rve->w[k][p];
+    }
+    return e;
+}
+
+GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]) {
+    double s[3];
+    int k;
+    for (k = 0; k < 3; ++k) s[k] = k < rve->dim ? rve->s[k][p] : 0.0;
+    gk_m3_matvec(rve->cell.h, s, x);
+    if (rve->dim == 2) x[2] = 0.0;
+}
+
+GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *out, const gk_allocator *alloc, gk_err *err) {
+    gk_packing pk;
+    int p, k;
+    gk_result res = gk_packing_alloc(&pk, rve->dim, rve->n, alloc, err);
+    if (res) return res;
+    gk_m3_copy(rve->cell.h, pk.h);
+    for (p = 0; p < rve->n; ++p) {
+        double s[3], x[3];
+        int q = rve->id[p];
+        for (k = 0; k < 3; ++k) s[k] = k < rve->dim ? rve->s[k][p] - floor(rve->s[k][p]) : 0.0;
+        gk_m3_matvec(rve->cell.h, s, x);
+        pk.x[q] = x[0];
+        pk.y[q] = x[1];
+        pk.z[q] = rve->dim == 3 ? x[2] : 0.0;
+        pk.r[q] = (double)rve->r[p];
+    }
+    *out = pk;
+    return GK_OK;
+}
+
+/* ---------------------------------------------------------------- consolidation */
+GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk_consolidate_report *rep) {
+    gk_servo sv;
+    double mu_final = rve->def.mat.friction, rmean = 0.0, tol, utol, rate;
+    long maxs, st = 0, calm = 0;
+    int k, p;
+    gk_result res = gk__rve_ready(rve);
+    if (res) return res;
+    if (!cd || !(cd->pressure > 0.0) || !isfinite(cd->pressure))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "consolidation pressure must be > 0");
+    if (!(cd->friction >= 0.0) || !isfinite(cd->friction))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "consolidation friction %g invalid", cd->friction);
+    if (cd->friction > 0.0 && !(rve->phys & GK_PHYS_TANGENT))
+        return gk_err_set(&rve->err, GK_ERR_STATE,
+                          "consolidating with friction needs an RVE created with friction > 0");
+    tol = cd->stress_tol > 0 ? cd->stress_tol : 1e-3;
+    utol = cd->unbalanced_tol > 0 ? cd->unbalanced_tol : 1e-3;
+    maxs = cd->max_steps > 0 ? cd->max_steps : 2000000;
+    for (p = 0; p < rve->n; ++p) rmean += (double)rve->r[p];
+    rmean /= rve->n;
+    /* inertial number I = 2 rate r sqrt(rho/p) (seed 000 eq 20) kept at 1e-2 */
+    rate = cd->max_strain_rate > 0 ? cd->max_strain_rate
+                                   : 1e-2 * sqrt(cd->pressure / rve->def.mat.density) / (2.0 * rmean);
+    memset(&sv, 0, sizeof sv);
+    for (k = 0; k < 3; ++k) {
+        sv.mode[k] = GK_SERVO_STRESS;
+        sv.target[k] = -cd->pressure;
+    }
+    sv.max_rate = rate;
+    sv.gain = 0.02;
+    rve->K.mu = (gk_real)cd->friction;
+    gk_m3_zero(rve->L);
+    res = gk_rve_set_servo(rve, &sv);
+    if (res) return res;
+    while (st < maxs) {
+        double un, errmax = 0.0, fsum = 0.0;
+        res = gk_rve_step(rve, 100);
+        st += 100;
+        if (res) break;
+        for (k = 0; k < rve->dim; ++k) {
+            double e = fabs(rve->stress[4 * k] + cd->pressure) / cd->pressure;
+            if (e > errmax) errmax = e;
+        }
+        for (p = 0; p < rve->n; ++p) {
+            double f2 = 0.0;
+            for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
+            fsum += sqrt(f2);
+        }
+        un = rve->fc_mean > 0 ? fsum / rve->n / rve->fc_mean : 1.0;
+        if (errmax < tol && un < utol) {
+            if (++calm >= 3) break;
+        } else {
+            calm = 0;
+        }
+    }
+    rve->servo_on = 0;
+    gk_m3_zero(rve->L);
+    rve->K.mu = (gk_real)mu_final;
+    /* friction is switched on with zero tangential history (YADE setContactFriction) */
+    if (!res && rve->ft[0]) {
+        int c;
+        for (k = 0; k < 3; ++k)
+            if (rve->ft[k])
+                for (c = 0; c < rve->pl.n; ++c) rve->ft[k][c] = 0;
+    }
+    if (rep) {
+        double fsum = 0.0;
+        rep->steps = st;
+        gk_m3_copy(rve->stress, rep->stress);
+        for (p = 0; p < rve->n; ++p) {
+            double f2 = 0.0;
+            for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
+            fsum += sqrt(f2);
+        }
+        rep->unbalanced = rve->fc_mean > 0 ? fsum / rve->n / rve->fc_mean : 1.0;
+        rep->void_ratio = gk_rve_volume(rve) / rve->solid_volume - 1.0;
+    }
+    if (res) return res;
+    if (st >= maxs)
+        return gk_err_set(&rve->err, GK_ERR_NOCONVERGE,
+                          "consolidation to %g Pa did not converge in %ld steps (stress %g %g, see report)",
+                          cd->pressure, st, -rve->stress[0], -rve->stress[4]);
+    return GK_OK;
+}
+
+/* ---------------------------------------------------------------- save / restore */
+#define GK__STATE_MAGIC "GKRVE\001\000\000"
+#define GK__STATE_VERSION 1
+
+typedef struct gk__state_hdr {
+    char magic[8];
+    int32_t version, dim, n, npairs, real_size, phys, endian, rot, roll, pad;
+    double dt, time, dt_crit, skin;
+    int64_t step, rebuilds, flips;
+    double h[9], F[9], h0[9], L[9], G[9], stress[9], stiff[3], fc_mean;
+    int32_t ncontacts, need_rebuild, servo_on, pad2;
+    gk_servo servo;
+    double mu;
+} gk__state_hdr;
+
+static size_t gk__state_bytes(const gk_rve *rve, int npairs) {
+    int dim = rve->dim, nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0, nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
+    size_t n = (size_t)rve->n, np = (size_t)npairs, R = sizeof(gk_real), b = sizeof(gk__state_hdr);
+    b += n * (2 * dim * sizeof(double)); /* s, s0 */
+    b += n * R * (2 * dim + 2 * nr);      /* v, f, w, t */
+    b += dim == 2 ? n * sizeof(double) : 0; /* theta */
+    b += np * (2 * sizeof(int32_t) + 1);   /* i, j, cs */
+    b += np * R * ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll); /* ft, fc, tci, tcj, mr */
+    return b;
+}
+
+GKDEF size_t gk_rve_state_size(const gk_rve *rve) { return gk__state_bytes(rve, rve->pl.n); }
+
+#define GK__PUT(ptr, bytes)                 \
+    do {                                    \
+        memcpy(o + off, (ptr), (bytes));    \
+        off += (bytes);                     \
+    } while (0)
+#define GK__GET(ptr, bytes)                 \
+    do {                                    \
+        memcpy((ptr), in + off, (bytes));   \
+        off += (bytes);                     \
+    } while (0)
+
+GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *written) {
+    gk__state_hdr hd;
+    unsigned char *o = (unsigned char *)buf;
+    size_t off = 0, need = gk_rve_state_size(rve), n = (size_t)rve->n, np = (size_t)rve->pl.n, R = sizeof(gk_real);
+    int k, dim = rve->dim;
+    if (written) *written = need;
+    if (!buf || cap < need) return GK_ERR_ARG;
+    memset(&hd, 0, sizeof hd);
+    memcpy(hd.magic, GK__STATE_MAGIC, 8);
+    hd.version = GK__STATE_VERSION;
+    hd.dim = dim;
+    hd.n = rve->n;
+    hd.npairs = rve->pl.n;
+    hd.real_size = (int32_t)R;
+    hd.phys = (int32_t)rve->phys;
+    hd.endian = 0x01020304;
+    hd.rot = GK__HAS_ROT(rve);
+    hd.roll = GK__HAS_ROLL(rve);
+    hd.dt = rve->dt;
+    hd.time = rve->time;
+    hd.dt_crit = rve->dt_crit;
+    hd.skin = rve->skin;
+    hd.step = rve->step;
+    hd.rebuilds = rve->rebuilds;
+    hd.flips = rve->cell.flips;
+    gk_m3_copy(rve->cell.h, hd.h);
+    gk_m3_copy(rve->cell.F, hd.F);
+    gk_m3_copy(rve->h0, hd.h0);
+    gk_m3_copy(rve->L, hd.L);
+    gk_m3_copy(rve->G, hd.G);
+    gk_m3_copy(rve->stress, hd.stress);
+    for (k = 0; k < 3; ++k) hd.stiff[k] = rve->stiff[k];
+    hd.fc_mean = rve->fc_mean;
+    hd.ncontacts = rve->ncontacts;
+    hd.need_rebuild = rve->need_rebuild;
+    hd.servo_on = rve->servo_on;
+    hd.servo = rve->servo;
+    hd.mu = (double)rve->K.mu;
+    GK__PUT(&hd, sizeof hd);
+    for (k = 0; k < dim; ++k) GK__PUT(rve->s[k], n * sizeof(double));
+    for (k = 0; k < dim; ++k) GK__PUT(rve->s0[k], n * sizeof(double));
+    for (k = 0; k < dim; ++k) GK__PUT(rve->v[k], n * R);
+    for (k = 0; k < dim; ++k) GK__PUT(rve->f[k], n * R);
+    for (k = 0; k < 3; ++k)
+        if (rve->w[k]) {
+            GK__PUT(rve->w[k], n * R);
+            GK__PUT(rve->t[k], n * R);
+        }
+    if (dim == 2) GK__PUT(rve->theta, n * sizeof(double));
+    GK__PUT(rve->pl.i, np * sizeof(int32_t));
+    GK__PUT(rve->pl.j, np * sizeof(int32_t));
+    GK__PUT(rve->cs, np);
+    for (k = 0; k < (dim == 2 ? 1 : 3); ++k) GK__PUT(rve->ft[k], np * R);
+    for (k = 0; k < dim; ++k) GK__PUT(rve->fc[k], np * R);
+    for (k = 0; k < 3; ++k)
+        if (rve->tci[k]) {
+            GK__PUT(rve->tci[k], np * R);
+            GK__PUT(rve->tcj[k], np * R);
+        }
+    for (k = 0; k < 3; ++k)
+        if (rve->mr[k]) GK__PUT(rve->mr[k], np * R);
+    GK_ASSERT(off == need);
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
+    gk__state_hdr hd;
+    const unsigned char *in = (const unsigned char *)buf;
+    size_t off = 0, n, np, R = sizeof(gk_real);
+    int k, dim = rve->dim, p, c;
+    if (!buf || size < sizeof hd) return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state buffer too small");
+    memcpy(&hd, buf, sizeof hd);
+    if (memcmp(hd.magic, GK__STATE_MAGIC, 8) != 0 || hd.endian != 0x01020304)
+        return gk_err_set(&rve->err, GK_ERR_FORMAT, "not a grainkit RVE state (bad magic or byte order)");
+    if (hd.version != GK__STATE_VERSION)
+        return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state version %d (this build reads %d)", hd.version,
+                          GK__STATE_VERSION);
+    if (hd.dim != rve->dim || hd.n != rve->n || hd.real_size != (int32_t)R || hd.phys != (int32_t)rve->phys)
+        return gk_err_set(&rve->err, GK_ERR_FORMAT,
+                          "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
+                          hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
+    if (hd.npairs < 0 || size != gk__state_bytes(rve, hd.npairs))
+        return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state has the wrong size");
+    n = (size_t)rve->n;
+    np = (size_t)hd.npairs;
+    /* capacity first, so a failure changes nothing observable */
+    if (gk__pairs_reserve(rve, np + 1, (size_t)rve->pl.n) || gk_pairlist_reserve(&rve->pl, np + 1, n))
+        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory restoring %d pairs", hd.npairs);
+    /* validate pair indices before touching anything */
+    {
+        size_t base = sizeof hd + n * (2 * dim * sizeof(double)) +
+                      n * R * (2 * dim + 2 * (GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0)) +
+                      (dim == 2 ? n * sizeof(double) : 0);
+        for (c = 0; c < (int)np; ++c) {
+            int32_t a, b;
+            memcpy(&a, in + base + (size_t)c * 4, 4);
+            memcpy(&b, in + base + np * 4 + (size_t)c * 4, 4);
+            if (a < 0 || b <= a || b >= rve->n)
+                return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state pair %d has invalid particles (%d, %d)", c, a,
+                                  b);
+        }
+    }
+    off = sizeof hd;
+    for (k = 0; k < dim; ++k) GK__GET(rve->s[k], n * sizeof(double));
+    for (k = 0; k < dim; ++k) GK__GET(rve->s0[k], n * sizeof(double));
+    for (k = 0; k < dim; ++k) GK__GET(rve->v[k], n * R);
+    for (k = 0; k < dim; ++k) GK__GET(rve->f[k], n * R);
+    for (k = 0; k < 3; ++k)
+        if (rve->w[k]) {
+            GK__GET(rve->w[k], n * R);
+            GK__GET(rve->t[k], n * R);
+        }
+    if (dim == 2) GK__GET(rve->theta, n * sizeof(double));
+    GK__GET(rve->pl.i, np * sizeof(int32_t));
+    GK__GET(rve->pl.j, np * sizeof(int32_t));
+    GK__GET(rve->cs, np);
+    for (k = 0; k < (dim == 2 ? 1 : 3); ++k) GK__GET(rve->ft[k], np * R);
+    for (k = 0; k < dim; ++k) GK__GET(rve->fc[k], np * R);
+    for (k = 0; k < 3; ++k)
+        if (rve->tci[k]) {
+            GK__GET(rve->tci[k], np * R);
+            GK__GET(rve->tcj[k], np * R);
+        }
+    for (k = 0; k < 3; ++k)
+        if (rve->mr[k]) GK__GET(rve->mr[k], np * R);
+    rve->pl.n = hd.npairs;
+    rve->pl.np = rve->n;
+    /* CSR by i and the j index are functions of the pair list */
+    for (p = 0; p <= rve->n; ++p) rve->pl.start[p] = 0;
+    for (c = 0; c < rve->pl.n; ++c) ++rve->pl.start[rve->pl.i[c] + 1];
+    for (p = 0; p < rve->n; ++p) rve->pl.start[p + 1] += rve->pl.start[p];
+    for (p = 0; p <= rve->n; ++p) rve->jstart[p] = 0;
+    for (c = 0; c < rve->pl.n; ++c) ++rve->jstart[rve->pl.j[c] + 1];
+    for (p = 0; p < rve->n; ++p) rve->jstart[p + 1] += rve->jstart[p];
+    for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
+    for (p = rve->n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
+    rve->jstart[0] = 0;
+    rve->dt = hd.dt;
+    rve->time = hd.time;
+    rve->dt_crit = hd.dt_crit;
+    rve->skin = hd.skin;
+    rve->step = hd.step;
+    rve->rebuilds = hd.rebuilds;
+    gk_m3_copy(hd.h, rve->cell.h);
+    gk_m3_inverse(rve->cell.h, rve->cell.hinv);
+    gk_m3_copy(hd.F, rve->cell.F);
+    rve->cell.flips = hd.flips;
+    gk_m3_copy(hd.h0, rve->h0);
+    gk_m3_copy(hd.L, rve->L);
+    gk_m3_copy(hd.G, rve->G);
+    gk_m3_copy(hd.stress, rve->stress);
+    for (k = 0; k < 3; ++k) rve->stiff[k] = hd.stiff[k];
+    rve->fc_mean = hd.fc_mean;
+    rve->ncontacts = hd.ncontacts;
+    rve->need_rebuild = hd.need_rebuild;
+    rve->servo_on = hd.servo_on;
+    rve->servo = hd.servo;
+    rve->K.mu = (gk_real)hd.mu;
+    rve->def.mat.friction = hd.mu;
+    rve->diverged = 0;
+    return GK_OK;
+}
+
+GKDEF void gk_rve_state_init(gk_rve_state *st, const gk_allocator *alloc) {
+    st->buf = NULL;
+    st->size = st->cap = 0;
+    if (alloc)
+        st->alloc = *alloc;
+    else
+        memset(&st->alloc, 0, sizeof st->alloc);
+}
+GKDEF void gk_rve_state_free(gk_rve_state *st) {
+    gk_free(&st->alloc, st->buf);
+    gk_rve_state_init(st, &st->alloc);
+}
+GKDEF gk_result gk_rve_state_save(gk_rve_state *st, const gk_rve *rve) {
+    size_t need = gk_rve_state_size(rve);
+    if (need > st->cap) {
+        unsigned char *b = (unsigned char *)gk_alloc(&st->alloc, need + need / 4);
+        if (!b) return GK_ERR_ALLOC;
+        gk_free(&st->alloc, st->buf);
+        st->buf = b;
+        st->cap = need + need / 4;
+    }
+    st->size = need;
+    return gk_rve_save(rve, st->buf, st->cap, NULL);
+}
+GKDEF gk_result gk_rve_state_restore(const gk_rve_state *st, gk_rve *rve) {
+    return gk_rve_restore(rve, st->buf, st->size);
+}
+
+#endif /* GK_DEM implementation */

@@ -1,0 +1,350 @@
+/* gk_homog.h - micro to macro: tangent, fabric, state variables.  (grainkit v0.1)
+ *
+ * Homogenised quantities of a gk_rve (gk_dem.h) and tensor invariants.
+ *
+ * DO THIS: #define GK_IMPLEMENTATION (or GK_HOMOG_IMPLEMENTATION) in one file.
+ *
+ * WHAT IS HERE (seed equations in brackets)
+ *   gk_rve_stress (gk_dem.h)   Love-Weber stress  sigma = -(1/V) sum F (x) d
+ *                              [seed 000 eq 5, seed 003 eq 30, seed 004 eq 44b]
+ *   gk_homog_tangent           Taylor (Voigt) tangent [seed 000 eq 9]:
+ *        D_ijkl = (1/V) sum_c [k_n n_i n_k + k_t (delta_ik - n_i n_k)] d_j d_l
+ *     (in 2D delta_ik - n_i n_k = t_i t_k, exactly eq 9; in 3D the whole
+ *     tangent plane instead of YADE's single shear-force direction).
+ *     k_n = dF_n/d delta, k_t = tangential stiffness (Hertz: at the current
+ *     overlap). Options:
+ *       GK_TANGENT_SLIDING_KEEP  sliding contacts keep k_t (YADE). Default:
+ *                                a contact on its Coulomb cap gets k_t = 0
+ *                                (the softest consistent choice: further
+ *                                shear in the slip direction adds no force).
+ *       GK_TANGENT_GEOMETRIC     add the initial-stress terms, so that D is
+ *                                the exact derivative of the Love stress
+ *                                under an affine, no-slip, no-spin map:
+ *         + (1/V) sum [-(F_n/|d|)(delta_ik - n_i n_k) + n_i F_t,k/|d|] d_j d_l
+ *         + sigma_il delta_jk - sigma_ij delta_kl
+ *       GK_TANGENT_RAW           skip the minor symmetrisation. Default: D is
+ *                                symmetrised in (i,j) and in (k,l) as YADE's
+ *                                Voigt form, so D:W = 0 for a spin W.
+ *     Layout: D[((i*dim + j)*dim + k)*dim + l], d sigma_ij = D_ijkl dH_kl,
+ *     tension-positive, [Pa]. No contacts -> D = 0 (never NaN).
+ *   gk_homog_fabric            phi = (1/N_c) sum n (x) n; 2D anisotropy
+ *                              F_a = 4 dev phi, |F_a| = sqrt(F_a:F_a / 2)
+ *                              [seed 000 eqs 22-25, seed 003 eqs 41-43];
+ *                              3D: F_a = 15/2 dev phi, |F_a| = sqrt(3/2 F_a:F_a)
+ *   gk_homog_coordination      Z = 2 N_c / N_p; YADE's avgNumInteractions
+ *                              (skipFree=True) = (2 N_c - N_1)/(N_p - N_0 - N_1)
+ *                              (N_k: particles with k contacts); mechanical Z_m after
+ *                              removing rattlers (< dim + 1 contacts) iteratively
+ *   gk_homog_void_ratio        e = (V_cell - V_solid) / V_solid (2D: areas)
+ *   gk_homog_unbalanced        mean |sum F_p| / mean |F_c| (YADE), and the
+ *                              RMS ratio I_uf of seed 004 eq 57
+ *   gk_homog_mean_rotation     2D mean particle rotation (incl. cell spin)
+ *   gk_stress_p, gk_stress_q   p = -tr sigma / dim (compression-positive);
+ *                              2D q = sqrt(s:s / 2) [seed 000 eq 7];
+ *                              3D q = sqrt(3/2 s:s)
+ *   gk_strain_v, gk_strain_q   eps_v = tr eps (tension-positive: dilation > 0;
+ *                              the seeds flip it); 2D eps_q = sqrt(2 e:e)
+ *                              [seed 000 eq 13]; 3D eps_q = sqrt(2/3 e:e)
+ *   gk_rotation_angle          rotation of the polar decomposition of F
+ *                              [seed 003 eqs 36-40], radians (2D: signed)
+ *   gk_inertial_number         I = 2 gdot r_mean sqrt(rho / p),
+ *                              gdot = sqrt(rate:rate) [seed 000 eq 20];
+ *                              p <= 0 -> +inf (not NaN)
+ *   gk_tangent_voigt           D -> Voigt matrix (3x3 in 2D, 6x6 in 3D), with
+ *                              engineering shear strain columns
+ *
+ * LICENCE: MIT (see gk_base.h).
+ */
+#ifndef GK_HOMOG_H
+#define GK_HOMOG_H
+
+#include "gk_dem.h"
+
+#define GK_TANGENT_SLIDING_KEEP 1u
+#define GK_TANGENT_GEOMETRIC 2u
+#define GK_TANGENT_RAW 4u
+
+typedef struct gk_coordination {
+    double z;          /* 2 N_c / N_p                                 */
+    double z_nofree;   /* YADE avgNumInteractions(skipFree=True): (2C - N1)/(N - N0 - N1),
+                          N0, N1 = particles with 0 and 1 contacts       */
+    double z_mech;     /* after iterative removal of rattlers          */
+    int contacts, rattlers, free_particles;
+} gk_coordination;
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D);
+GKDEF double gk_homog_fabric(const gk_rve *rve, double phi[9], double Fa[9]);
+GKDEF gk_result gk_homog_coordination(const gk_rve *rve, gk_coordination *out);
+GKDEF double gk_homog_void_ratio(const gk_rve *rve);
+GKDEF void gk_homog_unbalanced(const gk_rve *rve, double *mean_ratio, double *rms_ratio);
+GKDEF double gk_homog_mean_rotation(const gk_rve *rve);
+GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p);
+GKDEF double gk_rotation_angle(const double F[9], int dim);
+GKDEF void gk_tangent_voigt(const double *D, int dim, double *V);
+
+#ifdef __cplusplus
+}
+#endif
+
+GK_INLINE double gk_stress_p(const double s[9], int dim) {
+    return -(s[0] + s[4] + (dim == 3 ? s[8] : 0.0)) / dim;
+}
+GK_INLINE double gk_stress_q(const double s[9], int dim) {
+    double m = (s[0] + s[4] + (dim == 3 ? s[8] : 0.0)) / dim, ss = 0.0, d;
+    int i, j;
+    for (i = 0; i < dim; ++i)
+        for (j = 0; j < dim; ++j) {
+            d = 0.5 * (s[3 * i + j] + s[3 * j + i]) - (i == j ? m : 0.0);
+            ss += d * d;
+        }
+    return dim == 2 ? sqrt(0.5 * ss) : sqrt(1.5 * ss);
+}
+GK_INLINE double gk_strain_v(const double e[9], int dim) { return e[0] + e[4] + (dim == 3 ? e[8] : 0.0); }
+GK_INLINE double gk_strain_q(const double e[9], int dim) {
+    double m = gk_strain_v(e, dim) / dim, ee = 0.0, d;
+    int i, j;
+    for (i = 0; i < dim; ++i)
+        for (j = 0; j < dim; ++j) {
+            d = 0.5 * (e[3 * i + j] + e[3 * j + i]) - (i == j ? m : 0.0);
+            ee += d * d;
+        }
+    return dim == 2 ? sqrt(2.0 * ee) : sqrt(2.0 / 3.0 * ee);
+}
+
+#endif /* GK_HOMOG_H */
+
+/* ======================================================== IMPLEMENTATION */
+#if (defined(GK_IMPLEMENTATION) || defined(GK_HOMOG_IMPLEMENTATION)) && !defined(GK_HOMOG_IMPL_ONCE)
+#define GK_HOMOG_IMPL_ONCE
+
+#include <string.h>
+
+/* geometry of pair c at the current positions: branch d, |d| */
+static double gk__pair_branch(const gk_rve *rve, int c, double d[3]) {
+    int i = rve->pl.i[c], j = rve->pl.j[c], k;
+    double ds[3];
+    for (k = 0; k < 3; ++k) ds[k] = k < rve->dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
+    gk_pcell_min_image(&rve->cell, ds, d);
+    if (rve->dim == 2) d[2] = 0.0;
+    return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
+GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
+    int dim = rve->dim, n4 = dim * dim * dim * dim, c, i, j, k, l;
+    double V = gk_rve_volume(rve);
+    for (k = 0; k < n4; ++k) D[k] = 0.0;
+    if (!(V > 0.0)) return GK_ERR_CELL;
+    for (c = 0; c < rve->pl.n; ++c) {
+        double d[3], n[3], dd, delta, A[9], F[3], Fn = 0.0, Ft[3] = {0, 0, 0};
+        gk_real kn, fn, kt;
+        int a = rve->pl.i[c], b = rve->pl.j[c];
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        dd = gk__pair_branch(rve, c, d);
+        if (!(dd > 0.0)) continue;
+        for (k = 0; k < 3; ++k) n[k] = d[k] / dd;
+        delta = (double)rve->r[a] + (double)rve->r[b] - dd;
+        gk_contact_stiffness(&rve->K, rve->def.mat.law, rve->r[a], rve->r[b], (gk_real)(delta > 0 ? delta : 0), &kn,
+                             &fn, &kt);
+        if (!(rve->phys & GK_PHYS_TANGENT)) kt = 0;
+        if ((rve->cs[c] & GK_CS_SLIDING) && !(opts & GK_TANGENT_SLIDING_KEEP)) kt = 0;
+        for (k = 0; k < 3; ++k) F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
+        if (opts & GK_TANGENT_GEOMETRIC) {
+            Fn = F[0] * n[0] + F[1] * n[1] + F[2] * n[2];
+            for (k = 0; k < 3; ++k) Ft[k] = F[k] - Fn * n[k];
+        }
+        /* A_ik = kn n_i n_k + kt (delta_ik - n_i n_k) [+ geometric]; D_ijkl += A_ik d_j d_l / V */
+        for (i = 0; i < dim; ++i)
+            for (k = 0; k < dim; ++k) {
+                double P = (i == k ? 1.0 : 0.0) - n[i] * n[k];
+                A[3 * i + k] = (double)kn * n[i] * n[k] + (double)kt * P;
+                if (opts & GK_TANGENT_GEOMETRIC) A[3 * i + k] += -(Fn / dd) * P + n[i] * Ft[k] / dd;
+            }
+        for (i = 0; i < dim; ++i)
+            for (j = 0; j < dim; ++j)
+                for (k = 0; k < dim; ++k)
+                    for (l = 0; l < dim; ++l) D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
+    }
+    for (k = 0; k < n4; ++k) D[k] /= V;
+    if (opts & GK_TANGENT_GEOMETRIC) {
+        const double *s = rve->stress;
+        for (i = 0; i < dim; ++i)
+            for (j = 0; j < dim; ++j)
+                for (k = 0; k < dim; ++k)
+                    for (l = 0; l < dim; ++l)
+                        D[((i * dim + j) * dim + k) * dim + l] +=
+                            (j == k ? s[3 * i + l] : 0.0) - (k == l ? s[3 * i + j] : 0.0);
+    }
+    if (!(opts & GK_TANGENT_RAW)) {
+        double *T = (double *)gk_alloc(&rve->def.alloc, (size_t)n4 * sizeof(double));
+        if (!T) return GK_ERR_ALLOC;
+        for (i = 0; i < dim; ++i)
+            for (j = 0; j < dim; ++j)
+                for (k = 0; k < dim; ++k)
+                    for (l = 0; l < dim; ++l) {
+#define GK__DI(a, b, c2, d2) D[(((a)*dim + (b)) * dim + (c2)) * dim + (d2)]
+                        T[((i * dim + j) * dim + k) * dim + l] =
+                            0.25 * (GK__DI(i, j, k, l) + GK__DI(j, i, k, l) + GK__DI(i, j, l, k) + GK__DI(j, i, l, k));
+#undef GK__DI
+                    }
+        memcpy(D, T, (size_t)n4 * sizeof(double));
+        gk_free(&rve->def.alloc, T);
+    }
+    return GK_OK;
+}
+
+GKDEF double gk_homog_fabric(const gk_rve *rve, double phi[9], double Fa[9]) {
+    int dim = rve->dim, c, k, l, nc = 0;
+    double dev[9], ss = 0.0, f = dim == 2 ? 4.0 : 7.5;
+    gk_m3_zero(phi);
+    for (c = 0; c < rve->pl.n; ++c) {
+        double d[3], dd;
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        dd = gk__pair_branch(rve, c, d);
+        if (!(dd > 0.0)) continue;
+        for (k = 0; k < 3; ++k)
+            for (l = 0; l < 3; ++l) phi[3 * k + l] += d[k] * d[l] / (dd * dd);
+        ++nc;
+    }
+    if (nc) {
+        for (k = 0; k < 9; ++k) phi[k] /= nc;
+    }
+    for (k = 0; k < 9; ++k) dev[k] = 0.0;
+    if (nc)
+        for (k = 0; k < dim; ++k)
+            for (l = 0; l < dim; ++l) dev[3 * k + l] = f * (phi[3 * k + l] - (k == l ? 1.0 / dim : 0.0));
+    if (Fa) gk_m3_copy(dev, Fa);
+    for (k = 0; k < 9; ++k) ss += dev[k] * dev[k];
+    return dim == 2 ? sqrt(0.5 * ss) : sqrt(1.5 * ss);
+}
+
+GKDEF gk_result gk_homog_coordination(const gk_rve *rve, gk_coordination *out) {
+    int n = rve->n, c, p, nc = 0, changed, alive, links, nfree = 0, n1 = 0;
+    int *cnt = (int *)gk_alloc(&rve->def.alloc, (size_t)n * sizeof(int));
+    unsigned char *dead = (unsigned char *)gk_alloc(&rve->def.alloc, (size_t)n);
+    if (!cnt || !dead) {
+        gk_free(&rve->def.alloc, cnt);
+        gk_free(&rve->def.alloc, dead);
+        return GK_ERR_ALLOC;
+    }
+    for (p = 0; p < n; ++p) {
+        cnt[p] = 0;
+        dead[p] = 0;
+    }
+    for (c = 0; c < rve->pl.n; ++c)
+        if (rve->cs[c] & GK_CS_CONTACT) {
+            ++cnt[rve->pl.i[c]];
+            ++cnt[rve->pl.j[c]];
+            ++nc;
+        }
+    for (p = 0; p < n; ++p) {
+        if (cnt[p] == 0) ++nfree;
+        if (cnt[p] == 1) ++n1;
+    }
+    out->contacts = nc;
+    out->free_particles = nfree;
+    out->z = n ? 2.0 * nc / n : 0.0;
+    out->z_nofree = n - nfree - n1 > 0 ? (2.0 * nc - n1) / (n - nfree - n1) : 0.0;
+    /* rattlers: fewer than dim + 1 contacts, removed until none is left */
+    do {
+        changed = 0;
+        for (p = 0; p < n; ++p)
+            if (!dead[p] && cnt[p] < rve->dim + 1) {
+                dead[p] = 1;
+                changed = 1;
+                for (c = rve->pl.start[p]; c < rve->pl.start[p + 1]; ++c)
+                    if ((rve->cs[c] & GK_CS_CONTACT) && !dead[rve->pl.j[c]]) --cnt[rve->pl.j[c]];
+                for (c = rve->jstart[p]; c < rve->jstart[p + 1]; ++c) {
+                    int e = rve->jlist[c];
+                    if ((rve->cs[e] & GK_CS_CONTACT) && !dead[rve->pl.i[e]]) --cnt[rve->pl.i[e]];
+                }
+            }
+    } while (changed);
+    alive = 0;
+    links = 0;
+    for (p = 0; p < n; ++p)
+        if (!dead[p]) {
+            ++alive;
+            links += cnt[p];
+        }
+    out->rattlers = n - alive;
+    out->z_mech = alive ? (double)links / alive : 0.0;
+    gk_free(&rve->def.alloc, cnt);
+    gk_free(&rve->def.alloc, dead);
+    return GK_OK;
+}
+
+GKDEF double gk_homog_void_ratio(const gk_rve *rve) { return gk_rve_volume(rve) / rve->solid_volume - 1.0; }
+
+GKDEF void gk_homog_unbalanced(const gk_rve *rve, double *mean_ratio, double *rms_ratio) {
+    double fp = 0.0, fp2 = 0.0, fc = 0.0, fc2 = 0.0;
+    int p, c, k, nc = 0;
+    for (p = 0; p < rve->n; ++p) {
+        double f2 = 0.0;
+        for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
+        fp += sqrt(f2);
+        fp2 += f2;
+    }
+    for (c = 0; c < rve->pl.n; ++c) {
+        double f2 = 0.0;
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        for (k = 0; k < rve->dim; ++k) f2 += (double)rve->fc[k][c] * (double)rve->fc[k][c];
+        fc += sqrt(f2);
+        fc2 += f2;
+        ++nc;
+    }
+    /* no contacts: nothing to balance; report 0 (not NaN) */
+    if (mean_ratio) *mean_ratio = (nc && fc > 0.0) ? (fp / rve->n) / (fc / nc) : 0.0;
+    if (rms_ratio) *rms_ratio = (nc && fc2 > 0.0) ? sqrt(fp2 / rve->n) / sqrt(fc2 / nc) : 0.0;
+}
+
+GKDEF double gk_homog_mean_rotation(const gk_rve *rve) {
+    double s = 0.0;
+    int p;
+    if (rve->dim != 2 || !rve->theta) return 0.0;
+    for (p = 0; p < rve->n; ++p) s += rve->theta[p];
+    return s / rve->n;
+}
+
+GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p) {
+    double g = 0.0;
+    int i, j;
+    for (i = 0; i < dim; ++i)
+        for (j = 0; j < dim; ++j) {
+            double e = 0.5 * (rate[3 * i + j] + rate[3 * j + i]);
+            g += e * e;
+        }
+    g = sqrt(g);
+    if (g == 0.0) return 0.0;
+    if (!(p > 0.0)) return HUGE_VAL;
+    return 2.0 * g * r_mean * sqrt(density / p);
+}
+
+GKDEF double gk_rotation_angle(const double F[9], int dim) {
+    double R[9], U[9], w[3];
+    if (gk_m3_polar(F, dim, R, U) != GK_OK) return 0.0;
+    if (dim == 2) return atan2(R[3], R[0]);
+    gk_m3_rotation_vector(R, w);
+    return sqrt(gk_v3_dot(w, w));
+}
+
+GKDEF void gk_tangent_voigt(const double *D, int dim, double *V) {
+    static const int v2[3][2] = {{0, 0}, {1, 1}, {0, 1}};
+    static const int v3[6][2] = {{0, 0}, {1, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}};
+    int nv = dim == 2 ? 3 : 6, a, b;
+    for (a = 0; a < nv; ++a)
+        for (b = 0; b < nv; ++b) {
+            int i = dim == 2 ? v2[a][0] : v3[a][0], j = dim == 2 ? v2[a][1] : v3[a][1];
+            int k = dim == 2 ? v2[b][0] : v3[b][0], l = dim == 2 ? v2[b][1] : v3[b][1];
+            /* sigma_a = sum_b V_ab eps_b with engineering shear gamma = 2 eps_kl:
+             * D_ijkl eps_kl + D_ijlk eps_lk = (D_ijkl + D_ijlk)/2 gamma; rows use sigma_ij */
+            double x = k == l ? D[((i * dim + j) * dim + k) * dim + l]
+                              : 0.5 * (D[((i * dim + j) * dim + k) * dim + l] + D[((i * dim + j) * dim + l) * dim + k]);
+            V[a * nv + b] = x;
+        }
+}
+
+#endif /* GK_HOMOG implementation */
