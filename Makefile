@@ -59,7 +59,7 @@ $(BUILD)/bench_%: bench/%.c $(HEADERS) $(wildcard bench/*_part.c) | $(BUILD)
 $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
-test: $(TESTS)
+test: $(TESTS) $(EXAMPLES) $(TOOLS)
 	@tests/run_tests.sh $(TESTS)
 
 # ---------------------------------------------------------------- check
@@ -73,11 +73,11 @@ $(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/asan
 $(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/nosimd
 	$(CC) $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude -Itests -o $@ $< $(LDLIBS)
 
-check-asan: $(ASAN_TESTS)
+check-asan: $(ASAN_TESTS) $(EXAMPLES) $(TOOLS)
 	@echo "== tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 	@ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 tests/run_tests.sh $(ASAN_TESTS)
 
-check-nosimd: $(NOSIMD_TESTS)
+check-nosimd: $(NOSIMD_TESTS) $(EXAMPLES) $(TOOLS)
 	@echo "== tests built without SIMD (GK_NO_SIMD, no -march)"
 	@tests/run_tests.sh $(NOSIMD_TESTS)
 
