@@ -53,8 +53,14 @@ $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
 $(BUILD)/%: examples/%.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
-$(BUILD)/bench_%: bench/%.c $(HEADERS) $(wildcard bench/*_part.c) | $(BUILD)
+$(BUILD)/bench_%: bench/%.c $(HEADERS) $(wildcard bench/*_part.c bench/*.h) | $(BUILD)
 	$(CC) $(CFLAGS) -Ibench -o $@ $< $(LDLIBS)
+
+# one program, two copies of grainkit (double and float), all static
+$(BUILD)/bench_dem_step: bench/dem_step.c bench/dem_step_part.c bench/dem_step.h $(HEADERS) | $(BUILD)
+	$(CC) $(CFLAGS) -Ibench -c bench/dem_step_part.c -o $(BUILD)/dem_step_double.o
+	$(CC) $(CFLAGS) -Ibench -DGK_REAL_FLOAT -c bench/dem_step_part.c -o $(BUILD)/dem_step_float.o
+	$(CC) $(CFLAGS) -Ibench -o $@ bench/dem_step.c $(BUILD)/dem_step_double.o $(BUILD)/dem_step_float.o $(LDLIBS)
 
 $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)

@@ -26,6 +26,7 @@
  *                                  a double copy of grainkit side by side)
  *   GK_NO_SIMD        undefined    wide type has one lane (scalar build)
  *   GK_SIMD_WIDTH     auto         force 512, 256, 128 or 0 (bits)
+ *   GK_HW_GATHER      undefined    use vgather instructions (default: loads)
  *   GK_ASSERT(c)      assert(c)    internal invariant checks
  *   GK_MALLOC/GK_FREE malloc/free  default allocator behind gk_allocator
  *
@@ -63,7 +64,11 @@
 
 /* ---------------------------------------------------------------- linkage */
 #ifdef GK_STATIC
+#if defined(__GNUC__) || defined(__clang__)
+#define GKDEF static __attribute__((unused)) /* a program may use only some */
+#else
 #define GKDEF static
+#endif
 #else
 #ifdef __cplusplus
 #define GKDEF extern "C"
@@ -337,8 +342,60 @@ GK_FORCE_INLINE gk_vdm gk_vdm_not(gk_vdm a) { return (gk_vdm)(~a); }
 GK_FORCE_INLINE int gk_vdm_any(gk_vdm a) { return a != 0; }
 /* select: lanes of a where m is set, b elsewhere */
 GK_FORCE_INLINE gk_vd gk_vd_select(gk_vdm m, gk_vd a, gk_vd b) { return _mm512_mask_blend_pd(m, b, a); }
+/* gathers are plain loads + inserts: on the AMD EPYC this was tuned on they are
+ * 2.5x faster than vgatherdpd (1.75 vs 4.4 ns per 8 doubles); define
+ * GK_HW_GATHER to use the gather instructions instead */
 GK_FORCE_INLINE gk_vd gk_vd_gather(const double *base, const int32_t *idx) {
+#ifdef GK_HW_GATHER
     return _mm512_i32gather_pd(_mm256_loadu_si256((const __m256i *)(const void *)idx), base, 8);
+#else
+    return _mm512_set_pd(base[idx[7]], base[idx[6]], base[idx[5]], base[idx[4]], base[idx[3]], base[idx[2]],
+                         base[idx[1]], base[idx[0]]);
+#endif
+}
+GK_FORCE_INLINE unsigned gk_vdm_bits(gk_vdm m) { return (unsigned)m; }
+GK_FORCE_INLINE gk_vd gk_vd_xorsign(gk_vd a) { /* -a, exactly */
+    return _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(a), _mm512_set1_epi64((long long)0x8000000000000000ull)));
+}
+GK_FORCE_INLINE gk_vd gk_vd_abs(gk_vd a) { return _mm512_abs_pd(a); }
+GK_FORCE_INLINE gk_vf gk_vf_zero(void) { return _mm512_setzero_ps(); }
+GK_FORCE_INLINE gk_vf gk_vf_set1(float a) { return _mm512_set1_ps(a); }
+GK_FORCE_INLINE gk_vf gk_vf_load(const float *p) { return _mm512_load_ps(p); }
+GK_FORCE_INLINE gk_vf gk_vf_loadu(const float *p) { return _mm512_loadu_ps(p); }
+GK_FORCE_INLINE void gk_vf_store(float *p, gk_vf a) { _mm512_store_ps(p, a); }
+GK_FORCE_INLINE void gk_vf_storeu(float *p, gk_vf a) { _mm512_storeu_ps(p, a); }
+GK_FORCE_INLINE gk_vf gk_vf_add(gk_vf a, gk_vf b) { return _mm512_add_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_sub(gk_vf a, gk_vf b) { return _mm512_sub_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_mul(gk_vf a, gk_vf b) { return _mm512_mul_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_div(gk_vf a, gk_vf b) { return _mm512_div_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_sqrt(gk_vf a) { return _mm512_sqrt_ps(a); }
+GK_FORCE_INLINE gk_vf gk_vf_min(gk_vf a, gk_vf b) { return _mm512_min_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_max(gk_vf a, gk_vf b) { return _mm512_max_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_abs(gk_vf a) { return _mm512_abs_ps(a); }
+GK_FORCE_INLINE gk_vf gk_vf_xorsign(gk_vf a) {
+    return _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(a), _mm512_set1_epi32((int)0x80000000u)));
+}
+GK_FORCE_INLINE gk_vfm gk_vf_lt(gk_vf a, gk_vf b) { return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ); }
+GK_FORCE_INLINE gk_vfm gk_vf_le(gk_vf a, gk_vf b) { return _mm512_cmp_ps_mask(a, b, _CMP_LE_OQ); }
+GK_FORCE_INLINE gk_vfm gk_vf_gt(gk_vf a, gk_vf b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }
+GK_FORCE_INLINE gk_vfm gk_vfm_and(gk_vfm a, gk_vfm b) { return (gk_vfm)(a & b); }
+GK_FORCE_INLINE gk_vfm gk_vfm_or(gk_vfm a, gk_vfm b) { return (gk_vfm)(a | b); }
+GK_FORCE_INLINE gk_vfm gk_vfm_not(gk_vfm a) { return (gk_vfm)(~a); }
+GK_FORCE_INLINE int gk_vfm_any(gk_vfm a) { return a != 0; }
+GK_FORCE_INLINE unsigned gk_vfm_bits(gk_vfm m) { return (unsigned)m; }
+GK_FORCE_INLINE gk_vf gk_vf_select(gk_vfm m, gk_vf a, gk_vf b) { return _mm512_mask_blend_ps(m, b, a); }
+GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) {
+#ifdef GK_HW_GATHER
+    return _mm512_i32gather_ps(_mm512_loadu_si512((const void *)idx), base, 4);
+#else
+    return _mm512_set_ps(base[idx[15]], base[idx[14]], base[idx[13]], base[idx[12]], base[idx[11]], base[idx[10]],
+                         base[idx[9]], base[idx[8]], base[idx[7]], base[idx[6]], base[idx[5]], base[idx[4]],
+                         base[idx[3]], base[idx[2]], base[idx[1]], base[idx[0]]);
+#endif
+}
+/* two double vectors (lanes 0..7, 8..15) rounded to one float vector */
+GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) {
+    return _mm512_insertf32x8(_mm512_castps256_ps512(_mm512_cvtpd_ps(lo)), _mm512_cvtpd_ps(hi), 1);
 }
 #elif GK_SIMD_WIDTH == 256
 #include <immintrin.h>
@@ -376,7 +433,49 @@ GK_FORCE_INLINE gk_vdm gk_vdm_not(gk_vdm a) {
 GK_FORCE_INLINE int gk_vdm_any(gk_vdm a) { return _mm256_movemask_pd(a) != 0; }
 GK_FORCE_INLINE gk_vd gk_vd_select(gk_vdm m, gk_vd a, gk_vd b) { return _mm256_blendv_pd(b, a, m); }
 GK_FORCE_INLINE gk_vd gk_vd_gather(const double *base, const int32_t *idx) {
+#ifdef GK_HW_GATHER
     return _mm256_i32gather_pd(base, _mm_loadu_si128((const __m128i *)(const void *)idx), 8);
+#else
+    return _mm256_set_pd(base[idx[3]], base[idx[2]], base[idx[1]], base[idx[0]]);
+#endif
+}
+GK_FORCE_INLINE unsigned gk_vdm_bits(gk_vdm m) { return (unsigned)_mm256_movemask_pd(m); }
+GK_FORCE_INLINE gk_vd gk_vd_xorsign(gk_vd a) { return _mm256_xor_pd(a, _mm256_set1_pd(-0.0)); }
+GK_FORCE_INLINE gk_vd gk_vd_abs(gk_vd a) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), a); }
+GK_FORCE_INLINE gk_vf gk_vf_zero(void) { return _mm256_setzero_ps(); }
+GK_FORCE_INLINE gk_vf gk_vf_set1(float a) { return _mm256_set1_ps(a); }
+GK_FORCE_INLINE gk_vf gk_vf_load(const float *p) { return _mm256_load_ps(p); }
+GK_FORCE_INLINE gk_vf gk_vf_loadu(const float *p) { return _mm256_loadu_ps(p); }
+GK_FORCE_INLINE void gk_vf_store(float *p, gk_vf a) { _mm256_store_ps(p, a); }
+GK_FORCE_INLINE void gk_vf_storeu(float *p, gk_vf a) { _mm256_storeu_ps(p, a); }
+GK_FORCE_INLINE gk_vf gk_vf_add(gk_vf a, gk_vf b) { return _mm256_add_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_sub(gk_vf a, gk_vf b) { return _mm256_sub_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_mul(gk_vf a, gk_vf b) { return _mm256_mul_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_div(gk_vf a, gk_vf b) { return _mm256_div_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_sqrt(gk_vf a) { return _mm256_sqrt_ps(a); }
+GK_FORCE_INLINE gk_vf gk_vf_min(gk_vf a, gk_vf b) { return _mm256_min_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_max(gk_vf a, gk_vf b) { return _mm256_max_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_abs(gk_vf a) { return _mm256_andnot_ps(_mm256_set1_ps(-0.0f), a); }
+GK_FORCE_INLINE gk_vf gk_vf_xorsign(gk_vf a) { return _mm256_xor_ps(a, _mm256_set1_ps(-0.0f)); }
+GK_FORCE_INLINE gk_vfm gk_vf_lt(gk_vf a, gk_vf b) { return _mm256_cmp_ps(a, b, _CMP_LT_OQ); }
+GK_FORCE_INLINE gk_vfm gk_vf_le(gk_vf a, gk_vf b) { return _mm256_cmp_ps(a, b, _CMP_LE_OQ); }
+GK_FORCE_INLINE gk_vfm gk_vf_gt(gk_vf a, gk_vf b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
+GK_FORCE_INLINE gk_vfm gk_vfm_and(gk_vfm a, gk_vfm b) { return _mm256_and_ps(a, b); }
+GK_FORCE_INLINE gk_vfm gk_vfm_or(gk_vfm a, gk_vfm b) { return _mm256_or_ps(a, b); }
+GK_FORCE_INLINE gk_vfm gk_vfm_not(gk_vfm a) { return _mm256_xor_ps(a, _mm256_castsi256_ps(_mm256_set1_epi32(-1))); }
+GK_FORCE_INLINE int gk_vfm_any(gk_vfm a) { return _mm256_movemask_ps(a) != 0; }
+GK_FORCE_INLINE unsigned gk_vfm_bits(gk_vfm m) { return (unsigned)_mm256_movemask_ps(m); }
+GK_FORCE_INLINE gk_vf gk_vf_select(gk_vfm m, gk_vf a, gk_vf b) { return _mm256_blendv_ps(b, a, m); }
+GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) {
+#ifdef GK_HW_GATHER
+    return _mm256_i32gather_ps(base, _mm256_loadu_si256((const __m256i *)(const void *)idx), 4);
+#else
+    return _mm256_set_ps(base[idx[7]], base[idx[6]], base[idx[5]], base[idx[4]], base[idx[3]], base[idx[2]],
+                         base[idx[1]], base[idx[0]]);
+#endif
+}
+GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm256_cvtpd_ps(lo)), _mm256_cvtpd_ps(hi), 1);
 }
 #elif GK_SIMD_WIDTH == 128
 #include <smmintrin.h>
@@ -414,6 +513,37 @@ GK_FORCE_INLINE gk_vd gk_vd_select(gk_vdm m, gk_vd a, gk_vd b) { return _mm_blen
 GK_FORCE_INLINE gk_vd gk_vd_gather(const double *base, const int32_t *idx) {
     return _mm_set_pd(base[idx[1]], base[idx[0]]);
 }
+GK_FORCE_INLINE unsigned gk_vdm_bits(gk_vdm m) { return (unsigned)_mm_movemask_pd(m); }
+GK_FORCE_INLINE gk_vd gk_vd_xorsign(gk_vd a) { return _mm_xor_pd(a, _mm_set1_pd(-0.0)); }
+GK_FORCE_INLINE gk_vd gk_vd_abs(gk_vd a) { return _mm_andnot_pd(_mm_set1_pd(-0.0), a); }
+GK_FORCE_INLINE gk_vf gk_vf_zero(void) { return _mm_setzero_ps(); }
+GK_FORCE_INLINE gk_vf gk_vf_set1(float a) { return _mm_set1_ps(a); }
+GK_FORCE_INLINE gk_vf gk_vf_load(const float *p) { return _mm_load_ps(p); }
+GK_FORCE_INLINE gk_vf gk_vf_loadu(const float *p) { return _mm_loadu_ps(p); }
+GK_FORCE_INLINE void gk_vf_store(float *p, gk_vf a) { _mm_store_ps(p, a); }
+GK_FORCE_INLINE void gk_vf_storeu(float *p, gk_vf a) { _mm_storeu_ps(p, a); }
+GK_FORCE_INLINE gk_vf gk_vf_add(gk_vf a, gk_vf b) { return _mm_add_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_sub(gk_vf a, gk_vf b) { return _mm_sub_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_mul(gk_vf a, gk_vf b) { return _mm_mul_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_div(gk_vf a, gk_vf b) { return _mm_div_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_sqrt(gk_vf a) { return _mm_sqrt_ps(a); }
+GK_FORCE_INLINE gk_vf gk_vf_min(gk_vf a, gk_vf b) { return _mm_min_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_max(gk_vf a, gk_vf b) { return _mm_max_ps(a, b); }
+GK_FORCE_INLINE gk_vf gk_vf_abs(gk_vf a) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), a); }
+GK_FORCE_INLINE gk_vf gk_vf_xorsign(gk_vf a) { return _mm_xor_ps(a, _mm_set1_ps(-0.0f)); }
+GK_FORCE_INLINE gk_vfm gk_vf_lt(gk_vf a, gk_vf b) { return _mm_cmplt_ps(a, b); }
+GK_FORCE_INLINE gk_vfm gk_vf_le(gk_vf a, gk_vf b) { return _mm_cmple_ps(a, b); }
+GK_FORCE_INLINE gk_vfm gk_vf_gt(gk_vf a, gk_vf b) { return _mm_cmpgt_ps(a, b); }
+GK_FORCE_INLINE gk_vfm gk_vfm_and(gk_vfm a, gk_vfm b) { return _mm_and_ps(a, b); }
+GK_FORCE_INLINE gk_vfm gk_vfm_or(gk_vfm a, gk_vfm b) { return _mm_or_ps(a, b); }
+GK_FORCE_INLINE gk_vfm gk_vfm_not(gk_vfm a) { return _mm_xor_ps(a, _mm_castsi128_ps(_mm_set1_epi32(-1))); }
+GK_FORCE_INLINE int gk_vfm_any(gk_vfm a) { return _mm_movemask_ps(a) != 0; }
+GK_FORCE_INLINE unsigned gk_vfm_bits(gk_vfm m) { return (unsigned)_mm_movemask_ps(m); }
+GK_FORCE_INLINE gk_vf gk_vf_select(gk_vfm m, gk_vf a, gk_vf b) { return _mm_blendv_ps(b, a, m); }
+GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) {
+    return _mm_set_ps(base[idx[3]], base[idx[2]], base[idx[1]], base[idx[0]]);
+}
+GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) { return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi)); }
 #else
 #define GK_SIMD_NAME "scalar"
 #define GK_VD_W 1
@@ -446,6 +576,103 @@ GK_FORCE_INLINE gk_vdm gk_vdm_not(gk_vdm a) { return !a; }
 GK_FORCE_INLINE int gk_vdm_any(gk_vdm a) { return a; }
 GK_FORCE_INLINE gk_vd gk_vd_select(gk_vdm m, gk_vd a, gk_vd b) { return m ? a : b; }
 GK_FORCE_INLINE gk_vd gk_vd_gather(const double *base, const int32_t *idx) { return base[idx[0]]; }
+GK_FORCE_INLINE unsigned gk_vdm_bits(gk_vdm m) { return (unsigned)(m != 0); }
+GK_FORCE_INLINE gk_vd gk_vd_xorsign(gk_vd a) { return -a; }
+GK_FORCE_INLINE gk_vd gk_vd_abs(gk_vd a) { return fabs(a); }
+GK_FORCE_INLINE gk_vf gk_vf_zero(void) { return 0.0f; }
+GK_FORCE_INLINE gk_vf gk_vf_set1(float a) { return a; }
+GK_FORCE_INLINE gk_vf gk_vf_load(const float *p) { return *p; }
+GK_FORCE_INLINE gk_vf gk_vf_loadu(const float *p) { return *p; }
+GK_FORCE_INLINE void gk_vf_store(float *p, gk_vf a) { *p = a; }
+GK_FORCE_INLINE void gk_vf_storeu(float *p, gk_vf a) { *p = a; }
+GK_FORCE_INLINE gk_vf gk_vf_add(gk_vf a, gk_vf b) { return a + b; }
+GK_FORCE_INLINE gk_vf gk_vf_sub(gk_vf a, gk_vf b) { return a - b; }
+GK_FORCE_INLINE gk_vf gk_vf_mul(gk_vf a, gk_vf b) { return a * b; }
+GK_FORCE_INLINE gk_vf gk_vf_div(gk_vf a, gk_vf b) { return a / b; }
+GK_FORCE_INLINE gk_vf gk_vf_sqrt(gk_vf a) { return (float)sqrt((double)a); }
+GK_FORCE_INLINE gk_vf gk_vf_min(gk_vf a, gk_vf b) { return a < b ? a : b; }
+GK_FORCE_INLINE gk_vf gk_vf_max(gk_vf a, gk_vf b) { return a > b ? a : b; }
+GK_FORCE_INLINE gk_vf gk_vf_abs(gk_vf a) { return (float)fabs((double)a); }
+GK_FORCE_INLINE gk_vf gk_vf_xorsign(gk_vf a) { return -a; }
+GK_FORCE_INLINE gk_vfm gk_vf_lt(gk_vf a, gk_vf b) { return a < b; }
+GK_FORCE_INLINE gk_vfm gk_vf_le(gk_vf a, gk_vf b) { return a <= b; }
+GK_FORCE_INLINE gk_vfm gk_vf_gt(gk_vf a, gk_vf b) { return a > b; }
+GK_FORCE_INLINE gk_vfm gk_vfm_and(gk_vfm a, gk_vfm b) { return a && b; }
+GK_FORCE_INLINE gk_vfm gk_vfm_or(gk_vfm a, gk_vfm b) { return a || b; }
+GK_FORCE_INLINE gk_vfm gk_vfm_not(gk_vfm a) { return !a; }
+GK_FORCE_INLINE int gk_vfm_any(gk_vfm a) { return a; }
+GK_FORCE_INLINE unsigned gk_vfm_bits(gk_vfm m) { return (unsigned)(m != 0); }
+GK_FORCE_INLINE gk_vf gk_vf_select(gk_vfm m, gk_vf a, gk_vf b) { return m ? a : b; }
+GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) { return base[idx[0]]; }
+/* the scalar build has one float lane and one double lane: only `lo` is used */
+GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) {
+    (void)hi;
+    return (float)lo;
+}
+#endif
+
+/* The working-precision wide type gk_vr (GK_VR_W lanes of gk_real) used by
+ * the DEM kernels; positions stay double (gk_vd). */
+#ifdef GK_REAL_FLOAT
+typedef gk_vf gk_vr;
+typedef gk_vfm gk_vrm;
+#define GK_VR_W GK_VF_W
+#define GK_VR_DHALVES (GK_VF_W == 1 ? 1 : 2) /* double vectors per gk_vr */
+#define gk_vr_zero gk_vf_zero
+#define gk_vr_set1 gk_vf_set1
+#define gk_vr_load gk_vf_load
+#define gk_vr_loadu gk_vf_loadu
+#define gk_vr_store gk_vf_store
+#define gk_vr_storeu gk_vf_storeu
+#define gk_vr_add gk_vf_add
+#define gk_vr_sub gk_vf_sub
+#define gk_vr_mul gk_vf_mul
+#define gk_vr_div gk_vf_div
+#define gk_vr_sqrt gk_vf_sqrt
+#define gk_vr_min gk_vf_min
+#define gk_vr_max gk_vf_max
+#define gk_vr_abs gk_vf_abs
+#define gk_vr_neg gk_vf_xorsign
+#define gk_vr_lt gk_vf_lt
+#define gk_vr_le gk_vf_le
+#define gk_vr_gt gk_vf_gt
+#define gk_vrm_and gk_vfm_and
+#define gk_vrm_or gk_vfm_or
+#define gk_vrm_not gk_vfm_not
+#define gk_vrm_any gk_vfm_any
+#define gk_vrm_bits gk_vfm_bits
+#define gk_vr_select gk_vf_select
+#define gk_vr_gather gk_vf_gather
+#else
+typedef gk_vd gk_vr;
+typedef gk_vdm gk_vrm;
+#define GK_VR_W GK_VD_W
+#define GK_VR_DHALVES 1
+#define gk_vr_zero gk_vd_zero
+#define gk_vr_set1 gk_vd_set1
+#define gk_vr_load gk_vd_load
+#define gk_vr_loadu gk_vd_loadu
+#define gk_vr_store gk_vd_store
+#define gk_vr_storeu gk_vd_storeu
+#define gk_vr_add gk_vd_add
+#define gk_vr_sub gk_vd_sub
+#define gk_vr_mul gk_vd_mul
+#define gk_vr_div gk_vd_div
+#define gk_vr_sqrt gk_vd_sqrt
+#define gk_vr_min gk_vd_min
+#define gk_vr_max gk_vd_max
+#define gk_vr_abs gk_vd_abs
+#define gk_vr_neg gk_vd_xorsign
+#define gk_vr_lt gk_vd_lt
+#define gk_vr_le gk_vd_le
+#define gk_vr_gt gk_vd_gt
+#define gk_vrm_and gk_vdm_and
+#define gk_vrm_or gk_vdm_or
+#define gk_vrm_not gk_vdm_not
+#define gk_vrm_any gk_vdm_any
+#define gk_vrm_bits gk_vdm_bits
+#define gk_vr_select gk_vd_select
+#define gk_vr_gather gk_vd_gather
 #endif
 
 #endif /* GK_BASE_H */

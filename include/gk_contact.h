@@ -235,7 +235,7 @@ GK_FORCE_INLINE int gk_contact_2d(const gk_law_consts *K, gk_law law, unsigned f
                 }
                 if (fabs(ftot) > cap) {
                     ftot = ftot > 0 ? cap : -cap;
-                    f = ftot + gt * vt;
+                    f = (flags & GK_PHYS_VISCOUS) ? ftot + gt * vt : ftot;
                     s |= GK_CS_SLIDING;
                 }
             }
@@ -368,7 +368,7 @@ GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned f
                     gk_real sc = cap / (gk_real)sqrt(m2);
                     for (k = 0; k < 3; ++k) {
                         tot[k] = tot[k] * sc;
-                        f[k] = tot[k] + gt * vt[k];
+                        f[k] = (flags & GK_PHYS_VISCOUS) ? tot[k] + gt * vt[k] : tot[k];
                     }
                     s |= GK_CS_SLIDING;
                 }

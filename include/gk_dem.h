@@ -1124,11 +1124,12 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
 
 /* ---------------------------------------------------------------- forces */
 typedef struct gk__stepctx {
-    gk_real h[9];   /* unused by the double-position path; kept for kernels */
-    double hd[9];   /* cell matrix (positions are double)                  */
-    gk_real G[9];   /* affine velocity gradient of this step                */
-    gk_real wa[3];  /* affine spin (2D: wa[2])                              */
+    double hd[9];   /* cell matrix (positions are double)                   */
+    gk_real G[9];   /* affine velocity gradient of this step                 */
+    gk_real wa[3];  /* affine spin (2D: wa[2])                               */
     gk_real dt;
+    int scatter;    /* add pair forces to the particles in the force loop    */
+    int store;      /* keep per-pair forces and torques (stress, threads)    */
 } gk__stepctx;
 
 /* pair forces, scalar reference: writes fc, tci, tcj, ft, mr, cs for pairs [c0, c1) */
@@ -1157,11 +1158,23 @@ GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0
         wj = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[j] : x->wa[2];
         gk_contact_2d(&rve->K, law, fl, dx, dy, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], rvx, rvy, wi,
                       wj, x->dt, ft + c, (fl & GK_PHYS_ROLLING) ? mr + c : &dummy, cs + c, &o);
-        fcx[c] = o.f[0];
-        fcy[c] = o.f[1];
-        if (fl & GK_PHYS_ROTATION) {
-            tci[c] = o.ti[2];
-            tcj[c] = o.tj[2];
+        if (x->store) {
+            fcx[c] = o.f[0];
+            fcy[c] = o.f[1];
+            if (fl & GK_PHYS_ROTATION) {
+                tci[c] = o.ti[2];
+                tcj[c] = o.tj[2];
+            }
+        }
+        if (x->scatter) { /* pair order: same sums as gk__reduce_kernel */
+            rve->f[0][j] += o.f[0];
+            rve->f[1][j] += o.f[1];
+            rve->f[0][i] -= o.f[0];
+            rve->f[1][i] -= o.f[1];
+            if (fl & GK_PHYS_ROTATION) {
+                rve->t[2][j] += o.tj[2];
+                rve->t[2][i] += o.ti[2];
+            }
         }
     }
 }
@@ -1194,14 +1207,401 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
         for (k = 0; k < 3; ++k) {
             rve->ft[k][c] = hist[k];
             if (fl & GK_PHYS_ROLLING) rve->mr[k][c] = mh[k];
-            rve->fc[k][c] = o.f[k];
-            if (fl & GK_PHYS_ROTATION) {
-                rve->tci[k][c] = o.ti[k];
-                rve->tcj[k][c] = o.tj[k];
+            if (x->store) {
+                rve->fc[k][c] = o.f[k];
+                if (fl & GK_PHYS_ROTATION) {
+                    rve->tci[k][c] = o.ti[k];
+                    rve->tcj[k][c] = o.tj[k];
+                }
+            }
+        }
+        if (x->scatter)
+            for (k = 0; k < 3; ++k) {
+                rve->f[k][j] += o.f[k];
+                rve->f[k][i] -= o.f[k];
+                if (fl & GK_PHYS_ROTATION) {
+                    rve->t[k][j] += o.tj[k];
+                    rve->t[k][i] += o.ti[k];
+                }
+            }
+    }
+}
+
+/* ---------------------------------------------------------------- SIMD forces
+ * The same law as gk_contact_2d/3d, GK_VR_W pairs at a time, every operation
+ * in the same order (no FMA, correctly rounded sqrt and division, exact
+ * negation), so each lane is bit-identical to the scalar reference. The
+ * remainder of a range (fewer than GK_VR_W pairs) and cohesive contacts go
+ * through the scalar reference. */
+#if GK_VR_W > 1
+/* branch vectors d = h (ds - round(ds)) of GK_VR_W pairs, from double positions */
+GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk__stepctx *x, const int32_t *ii, const int32_t *jj,
+                                     int dim, gk_vr d[3]) {
+    gk_vd dd[2][3];
+    int hf, k;
+    for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
+        gk_vd ds[3];
+        for (k = 0; k < dim; ++k) {
+            ds[k] = gk_vd_sub(gk_vd_gather(rve->s[k], jj + hf * GK_VD_W), gk_vd_gather(rve->s[k], ii + hf * GK_VD_W));
+            ds[k] = gk_vd_sub(ds[k], gk_vd_round(ds[k]));
+        }
+        for (k = 0; k < dim; ++k) {
+            gk_vd a = gk_vd_add(gk_vd_mul(gk_vd_set1(x->hd[3 * k]), ds[0]), gk_vd_mul(gk_vd_set1(x->hd[3 * k + 1]), ds[1]));
+            if (dim == 3) a = gk_vd_add(a, gk_vd_mul(gk_vd_set1(x->hd[3 * k + 2]), ds[2]));
+            dd[hf][k] = a;
+        }
+    }
+    for (k = 0; k < dim; ++k) {
+#ifdef GK_REAL_FLOAT
+        d[k] = gk_vf_from_vd2(dd[0][k], dd[GK_VR_DHALVES - 1][k]);
+#else
+        d[k] = dd[0][k];
+#endif
+    }
+}
+
+/* stiffness of GK_VR_W contacts (gk_contact_stiffness) */
+GK_FORCE_INLINE void gk__simd_stiffness(const gk_law_consts *K, gk_law law, gk_vr ri, gk_vr rj, gk_vr delta, gk_vr *kn,
+                                        gk_vr *fn, gk_vr *kt) {
+    gk_vr rr = gk_vr_mul(ri, rj), rs = gk_vr_div(gk_vr_add(rr, rr), gk_vr_add(ri, rj));
+    if (law == GK_LAW_LINEAR) {
+        gk_vr k = K->kn_const > 0 ? gk_vr_set1(K->kn_const) : gk_vr_mul(gk_vr_set1(K->young), rs);
+        *kn = k;
+        *fn = gk_vr_mul(k, delta);
+        *kt = gk_vr_mul(gk_vr_set1(K->kt_ratio), k);
+    } else {
+        gk_vr a = gk_vr_mul(gk_vr_add(rs, rs), delta);
+        gk_vr sq = gk_vr_select(gk_vr_gt(a, gk_vr_zero()), gk_vr_sqrt(a), gk_vr_zero());
+        gk_vr k = gk_vr_mul(gk_vr_set1(K->hn), sq);
+        *kn = k;
+        *fn = gk_vr_mul(gk_vr_set1((gk_real)(2.0 / 3.0)), gk_vr_mul(k, delta));
+        *kt = gk_vr_mul(gk_vr_set1(K->ht), sq);
+    }
+}
+
+GK_FORCE_INLINE void gk__simd_state(unsigned char *cs, gk_vrm in, gk_vrm slide) {
+    unsigned bi = gk_vrm_bits(in), bs = gk_vrm_bits(gk_vrm_and(in, slide));
+    int l;
+    for (l = 0; l < GK_VR_W; ++l)
+        cs[l] = (unsigned char)(((bi >> l) & 1u) * GK_CS_CONTACT | ((bs >> l) & 1u) * GK_CS_SLIDING);
+}
+
+GK_FORCE_INLINE void gk__scatter_buf_2d(gk_rve *rve, const int32_t *ii, const int32_t *jj, const gk_real *bx,
+                                        const gk_real *by, const gk_real *bi, const gk_real *bj, unsigned rot) {
+    gk_real *f0 = rve->f[0], *f1 = rve->f[1], *t2 = rve->t[2];
+    int l;
+    for (l = 0; l < GK_VR_W; ++l) {
+        int i = ii[l], j = jj[l];
+        f0[j] += bx[l];
+        f1[j] += by[l];
+        f0[i] -= bx[l];
+        f1[i] -= by[l];
+        if (rot) {
+            t2[j] += bj[l];
+            t2[i] += bi[l];
+        }
+    }
+}
+
+GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const int32_t *jj, gk_real bF[3][GK_VR_W],
+                                        gk_real bI[3][GK_VR_W], gk_real bJ[3][GK_VR_W], unsigned rot) {
+    int l, k;
+    for (l = 0; l < GK_VR_W; ++l) {
+        int i = ii[l], j = jj[l];
+        for (k = 0; k < 3; ++k) {
+            rve->f[k][j] += bF[k][l];
+            rve->f[k][i] -= bF[k][l];
+            if (rot) {
+                rve->t[k][j] += bJ[k][l];
+                rve->t[k][i] += bI[k][l];
             }
         }
     }
 }
+
+GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+    const gk_law_consts *K = &rve->K;
+    const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5), dt = gk_vr_set1(x->dt);
+    const gk_vr G0 = gk_vr_set1(x->G[0]), G1 = gk_vr_set1(x->G[1]), G3 = gk_vr_set1(x->G[3]), G4 = gk_vr_set1(x->G[4]);
+    const gk_vr wa = gk_vr_set1(x->wa[2]), mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
+    const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta);
+    gk_real bx[GK_VR_W], by[GK_VR_W], bi[GK_VR_W], bj[GK_VR_W];
+    int c = c0, pend = -1;
+    for (; c + GK_VR_W <= c1; c += GK_VR_W) {
+        const int32_t *ii = pi + c, *jj = pj + c;
+        gk_vr d[3], ri, rj, R, d2, dist, inv, nx, ny, delta, kn, fn, kt, vx, vy, vn, mstar = zero, li, lj, hd;
+        gk_vr fx, fy, ti = zero, tj = zero, wi = wa, wj = wa, fnp = zero, ftot = zero, fh = zero, m = zero;
+        gk_vrm in, slide = gk_vr_lt(one, zero);
+        gk__simd_branch(rve, x, ii, jj, 2, d);
+        ri = gk_vr_gather(rve->r, ii);
+        rj = gk_vr_gather(rve->r, jj);
+        R = gk_vr_add(ri, rj);
+        d2 = gk_vr_add(gk_vr_mul(d[0], d[0]), gk_vr_mul(d[1], d[1]));
+        in = gk_vr_lt(d2, gk_vr_mul(R, R));
+        dist = gk_vr_sqrt(d2);
+        inv = gk_vr_div(one, dist);
+        nx = gk_vr_mul(d[0], inv);
+        ny = gk_vr_mul(d[1], inv);
+        delta = gk_vr_sub(R, dist);
+        gk__simd_stiffness(K, law, ri, rj, delta, &kn, &fn, &kt);
+        vx = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[0], jj), gk_vr_gather(rve->v[0], ii)),
+                       gk_vr_add(gk_vr_mul(G0, d[0]), gk_vr_mul(G1, d[1])));
+        vy = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[1], jj), gk_vr_gather(rve->v[1], ii)),
+                       gk_vr_add(gk_vr_mul(G3, d[0]), gk_vr_mul(G4, d[1])));
+        vn = gk_vr_add(gk_vr_mul(vx, nx), gk_vr_mul(vy, ny));
+        if (fl & GK_PHYS_VISCOUS) {
+            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)), mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
+            mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
+            fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(zn2, gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
+        }
+        hd = gk_vr_mul(half, delta);
+        li = gk_vr_sub(ri, hd);
+        lj = gk_vr_sub(rj, hd);
+        if (fl & GK_PHYS_ROTATION) {
+            wi = gk_vr_add(wa, gk_vr_gather(rve->w[2], ii));
+            wj = gk_vr_add(wa, gk_vr_gather(rve->w[2], jj));
+        }
+        if (fl & GK_PHYS_TANGENT) {
+            gk_vr tx = gk_vr_neg(ny), ty = nx, vt, f, cap, gt = zero;
+            vt = gk_vr_sub(gk_vr_add(gk_vr_mul(vx, tx), gk_vr_mul(vy, ty)),
+                           gk_vr_add(gk_vr_mul(li, wi), gk_vr_mul(lj, wj)));
+            f = gk_vr_sub(gk_vr_load(rve->ft[0] + c), gk_vr_mul(gk_vr_mul(kt, vt), dt));
+            ftot = f;
+            if (fl & GK_PHYS_VISCOUS) {
+                gt = gk_vr_mul(zt2, gk_vr_sqrt(gk_vr_mul(mstar, kt)));
+                ftot = gk_vr_sub(f, gk_vr_mul(gt, vt));
+            }
+            fnp = gk_vr_max(fn, zero);
+            cap = gk_vr_mul(mu, fnp);
+            slide = gk_vr_gt(gk_vr_abs(ftot), cap);
+            ftot = gk_vr_select(slide, gk_vr_select(gk_vr_gt(ftot, zero), cap, gk_vr_neg(cap)), ftot);
+            if (fl & GK_PHYS_VISCOUS)
+                f = gk_vr_select(slide, gk_vr_add(ftot, gk_vr_mul(gt, vt)), f);
+            else
+                f = gk_vr_select(slide, ftot, f);
+            fh = f;
+            fx = gk_vr_add(gk_vr_mul(fn, nx), gk_vr_mul(ftot, tx));
+            fy = gk_vr_add(gk_vr_mul(fn, ny), gk_vr_mul(ftot, ty));
+            ti = gk_vr_mul(gk_vr_neg(li), ftot);
+            tj = gk_vr_mul(gk_vr_neg(lj), ftot);
+        } else {
+            fx = gk_vr_mul(fn, nx);
+            fy = gk_vr_mul(fn, ny);
+        }
+        if (fl & GK_PHYS_ROLLING) {
+            gk_vr kr = gk_vr_mul(gk_vr_mul(beta, kt), gk_vr_mul(ri, rj)), capr;
+            gk_vrm over;
+            m = gk_vr_sub(gk_vr_load(rve->mr[2] + c), gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wj, wi)), dt));
+            fnp = gk_vr_max(fn, zero);
+            capr = gk_vr_mul(gk_vr_mul(eta, gk_vr_min(ri, rj)), fnp);
+            over = gk_vr_gt(gk_vr_abs(m), capr);
+            m = gk_vr_select(over, gk_vr_select(gk_vr_gt(m, zero), capr, gk_vr_neg(capr)), m);
+            ti = gk_vr_sub(ti, m);
+            tj = gk_vr_add(tj, m);
+        }
+        fx = gk_vr_select(in, fx, zero);
+        fy = gk_vr_select(in, fy, zero);
+        ti = gk_vr_select(in, ti, zero);
+        tj = gk_vr_select(in, tj, zero);
+        if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[0] + c, gk_vr_select(in, fh, zero));
+        if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[2] + c, gk_vr_select(in, m, zero));
+        gk__simd_state(rve->cs + c, in, slide);
+        if (x->store) {
+            gk_vr_store(rve->fc[0] + c, fx);
+            gk_vr_store(rve->fc[1] + c, fy);
+            if (fl & GK_PHYS_ROTATION) {
+                gk_vr_store(rve->tci[2] + c, ti);
+                gk_vr_store(rve->tcj[2] + c, tj);
+            }
+        }
+        if (x->scatter) {
+            /* scatter the previous block now (its buffer stores have retired: no
+             * store-forwarding stall) and buffer this one; pair order is kept */
+            if (pend >= 0) gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
+            gk_vr_storeu(bx, fx);
+            gk_vr_storeu(by, fy);
+            if (fl & GK_PHYS_ROTATION) {
+                gk_vr_storeu(bi, ti);
+                gk_vr_storeu(bj, tj);
+            }
+            pend = c;
+        }
+    }
+    if (pend >= 0) gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
+    gk__forces_ref_2d(rve, x, c, c1, law, fl);
+}
+
+/* gk_contact_rotate_history on GK_VR_W lanes */
+GK_FORCE_INLINE void gk__simd_rotate(const gk_vr n[3], gk_vr a, gk_vr h[3]) {
+    const gk_vr zero = gk_vr_zero();
+    gk_vr m2, p[3], dn, p2, sc;
+    gk_vrm has, pos;
+    int k;
+    m2 = gk_vr_add(gk_vr_add(gk_vr_mul(h[0], h[0]), gk_vr_mul(h[1], h[1])), gk_vr_mul(h[2], h[2]));
+    p[0] = gk_vr_add(h[0], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[1], h[2]), gk_vr_mul(n[2], h[1]))));
+    p[1] = gk_vr_add(h[1], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[2], h[0]), gk_vr_mul(n[0], h[2]))));
+    p[2] = gk_vr_add(h[2], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[0], h[1]), gk_vr_mul(n[1], h[0]))));
+    dn = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], n[0]), gk_vr_mul(p[1], n[1])), gk_vr_mul(p[2], n[2]));
+    for (k = 0; k < 3; ++k) p[k] = gk_vr_sub(p[k], gk_vr_mul(dn, n[k]));
+    p2 = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], p[0]), gk_vr_mul(p[1], p[1])), gk_vr_mul(p[2], p[2]));
+    sc = gk_vr_sqrt(gk_vr_div(m2, p2));
+    has = gk_vr_gt(m2, zero);
+    pos = gk_vr_gt(p2, zero);
+    for (k = 0; k < 3; ++k) h[k] = gk_vr_select(has, gk_vr_select(pos, gk_vr_mul(p[k], sc), zero), h[k]);
+}
+
+GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+    const gk_law_consts *K = &rve->K;
+    const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5), dt = gk_vr_set1(x->dt);
+    const gk_vr mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
+    const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta), halfdt = gk_vr_mul(half, dt);
+    gk_vr G[9], wa[3];
+    gk_real bF[3][GK_VR_W], bI[3][GK_VR_W], bJ[3][GK_VR_W];
+    int c = c0, k, pend = -1;
+    for (k = 0; k < 9; ++k) G[k] = gk_vr_set1(x->G[k]);
+    for (k = 0; k < 3; ++k) wa[k] = gk_vr_set1(x->wa[k]);
+    for (; c + GK_VR_W <= c1; c += GK_VR_W) {
+        const int32_t *ii = pi + c, *jj = pj + c;
+        gk_vr d[3], n[3], v[3], wi[3], wj[3], F[3], ti[3], tj[3], fh[3], mh[3];
+        gk_vr ri, rj, R, d2, dist, inv, delta, kn, fn, kt, vn, mstar = zero, hd, li, lj, twist = zero, fnp;
+        gk_vrm in, slide = gk_vr_lt(one, zero);
+        gk__simd_branch(rve, x, ii, jj, 3, d);
+        ri = gk_vr_gather(rve->r, ii);
+        rj = gk_vr_gather(rve->r, jj);
+        R = gk_vr_add(ri, rj);
+        d2 = gk_vr_add(gk_vr_add(gk_vr_mul(d[0], d[0]), gk_vr_mul(d[1], d[1])), gk_vr_mul(d[2], d[2]));
+        in = gk_vr_lt(d2, gk_vr_mul(R, R));
+        dist = gk_vr_sqrt(d2);
+        inv = gk_vr_div(one, dist);
+        for (k = 0; k < 3; ++k) n[k] = gk_vr_mul(d[k], inv);
+        delta = gk_vr_sub(R, dist);
+        gk__simd_stiffness(K, law, ri, rj, delta, &kn, &fn, &kt);
+        for (k = 0; k < 3; ++k)
+            v[k] = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[k], jj), gk_vr_gather(rve->v[k], ii)),
+                             gk_vr_add(gk_vr_add(gk_vr_mul(G[3 * k], d[0]), gk_vr_mul(G[3 * k + 1], d[1])),
+                                       gk_vr_mul(G[3 * k + 2], d[2])));
+        for (k = 0; k < 3; ++k) {
+            wi[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather(rve->w[k], ii)) : wa[k];
+            wj[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather(rve->w[k], jj)) : wa[k];
+            ti[k] = tj[k] = zero;
+        }
+        vn = gk_vr_add(gk_vr_add(gk_vr_mul(v[0], n[0]), gk_vr_mul(v[1], n[1])), gk_vr_mul(v[2], n[2]));
+        if (fl & GK_PHYS_VISCOUS) {
+            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)), mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
+            mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
+            fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(zn2, gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
+        }
+        hd = gk_vr_mul(half, delta);
+        li = gk_vr_sub(ri, hd);
+        lj = gk_vr_sub(rj, hd);
+        if (fl & (GK_PHYS_TANGENT | GK_PHYS_ROLLING))
+            twist = gk_vr_mul(halfdt, gk_vr_add(gk_vr_add(gk_vr_mul(gk_vr_add(wi[0], wj[0]), n[0]),
+                                                          gk_vr_mul(gk_vr_add(wi[1], wj[1]), n[1])),
+                                                gk_vr_mul(gk_vr_add(wi[2], wj[2]), n[2])));
+        if (fl & GK_PHYS_TANGENT) {
+            gk_vr sw[3], vc[3], vcn, vt[3], f[3], tot[3], cc[3], cap, gt = zero, m2;
+            for (k = 0; k < 3; ++k) sw[k] = gk_vr_add(gk_vr_mul(li, wi[k]), gk_vr_mul(lj, wj[k]));
+            vc[0] = gk_vr_sub(v[0], gk_vr_sub(gk_vr_mul(sw[1], n[2]), gk_vr_mul(sw[2], n[1])));
+            vc[1] = gk_vr_sub(v[1], gk_vr_sub(gk_vr_mul(sw[2], n[0]), gk_vr_mul(sw[0], n[2])));
+            vc[2] = gk_vr_sub(v[2], gk_vr_sub(gk_vr_mul(sw[0], n[1]), gk_vr_mul(sw[1], n[0])));
+            vcn = gk_vr_add(gk_vr_add(gk_vr_mul(vc[0], n[0]), gk_vr_mul(vc[1], n[1])), gk_vr_mul(vc[2], n[2]));
+            for (k = 0; k < 3; ++k) {
+                vt[k] = gk_vr_sub(vc[k], gk_vr_mul(vcn, n[k]));
+                fh[k] = gk_vr_load(rve->ft[k] + c);
+            }
+            gk__simd_rotate(n, twist, fh);
+            for (k = 0; k < 3; ++k) {
+                f[k] = gk_vr_sub(fh[k], gk_vr_mul(gk_vr_mul(kt, vt[k]), dt));
+                tot[k] = f[k];
+            }
+            if (fl & GK_PHYS_VISCOUS) {
+                gt = gk_vr_mul(zt2, gk_vr_sqrt(gk_vr_mul(mstar, kt)));
+                for (k = 0; k < 3; ++k) tot[k] = gk_vr_sub(f[k], gk_vr_mul(gt, vt[k]));
+            }
+            fnp = gk_vr_max(fn, zero);
+            cap = gk_vr_mul(mu, fnp);
+            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(tot[0], tot[0]), gk_vr_mul(tot[1], tot[1])), gk_vr_mul(tot[2], tot[2]));
+            slide = gk_vr_gt(m2, gk_vr_mul(cap, cap));
+            if (gk_vrm_any(slide)) {
+                gk_vr sc = gk_vr_div(cap, gk_vr_sqrt(m2));
+                for (k = 0; k < 3; ++k) {
+                    gk_vr t = gk_vr_mul(tot[k], sc);
+                    tot[k] = gk_vr_select(slide, t, tot[k]);
+                    f[k] = gk_vr_select(slide, (fl & GK_PHYS_VISCOUS) ? gk_vr_add(tot[k], gk_vr_mul(gt, vt[k])) : tot[k],
+                                        f[k]);
+                }
+            }
+            for (k = 0; k < 3; ++k) {
+                fh[k] = f[k];
+                F[k] = gk_vr_add(gk_vr_mul(fn, n[k]), tot[k]);
+            }
+            cc[0] = gk_vr_sub(gk_vr_mul(n[1], tot[2]), gk_vr_mul(n[2], tot[1]));
+            cc[1] = gk_vr_sub(gk_vr_mul(n[2], tot[0]), gk_vr_mul(n[0], tot[2]));
+            cc[2] = gk_vr_sub(gk_vr_mul(n[0], tot[1]), gk_vr_mul(n[1], tot[0]));
+            for (k = 0; k < 3; ++k) {
+                ti[k] = gk_vr_mul(gk_vr_neg(li), cc[k]);
+                tj[k] = gk_vr_mul(gk_vr_neg(lj), cc[k]);
+            }
+        } else {
+            for (k = 0; k < 3; ++k) F[k] = gk_vr_mul(fn, n[k]);
+        }
+        if (fl & GK_PHYS_ROLLING) {
+            gk_vr wr[3], wrn, kr = gk_vr_mul(gk_vr_mul(beta, kt), gk_vr_mul(ri, rj)), capr, m2;
+            gk_vrm over;
+            fnp = gk_vr_max(fn, zero);
+            capr = gk_vr_mul(gk_vr_mul(eta, gk_vr_min(ri, rj)), fnp);
+            for (k = 0; k < 3; ++k) {
+                wr[k] = gk_vr_sub(wj[k], wi[k]);
+                mh[k] = gk_vr_load(rve->mr[k] + c);
+            }
+            wrn = gk_vr_add(gk_vr_add(gk_vr_mul(wr[0], n[0]), gk_vr_mul(wr[1], n[1])), gk_vr_mul(wr[2], n[2]));
+            gk__simd_rotate(n, twist, mh);
+            for (k = 0; k < 3; ++k)
+                mh[k] = gk_vr_sub(mh[k], gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wr[k], gk_vr_mul(wrn, n[k]))), dt));
+            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(mh[0], mh[0]), gk_vr_mul(mh[1], mh[1])), gk_vr_mul(mh[2], mh[2]));
+            over = gk_vr_gt(m2, gk_vr_mul(capr, capr));
+            if (gk_vrm_any(over)) {
+                gk_vr sc = gk_vr_div(capr, gk_vr_sqrt(m2));
+                for (k = 0; k < 3; ++k) mh[k] = gk_vr_select(over, gk_vr_mul(mh[k], sc), mh[k]);
+            }
+            for (k = 0; k < 3; ++k) {
+                ti[k] = gk_vr_sub(ti[k], mh[k]);
+                tj[k] = gk_vr_add(tj[k], mh[k]);
+            }
+        }
+        for (k = 0; k < 3; ++k) {
+            F[k] = gk_vr_select(in, F[k], zero);
+            ti[k] = gk_vr_select(in, ti[k], zero);
+            tj[k] = gk_vr_select(in, tj[k], zero);
+            if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[k] + c, gk_vr_select(in, fh[k], zero));
+            if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[k] + c, gk_vr_select(in, mh[k], zero));
+            if (x->store) {
+                gk_vr_store(rve->fc[k] + c, F[k]);
+                if (fl & GK_PHYS_ROTATION) {
+                    gk_vr_store(rve->tci[k] + c, ti[k]);
+                    gk_vr_store(rve->tcj[k] + c, tj[k]);
+                }
+            }
+        }
+        gk__simd_state(rve->cs + c, in, slide);
+        if (x->scatter) { /* pipelined as in 2D */
+            if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, bF, bI, bJ, fl & GK_PHYS_ROTATION);
+            for (k = 0; k < 3; ++k) {
+                gk_vr_storeu(bF[k], F[k]);
+                if (fl & GK_PHYS_ROTATION) {
+                    gk_vr_storeu(bI[k], ti[k]);
+                    gk_vr_storeu(bJ[k], tj[k]);
+                }
+            }
+            pend = c;
+        }
+    }
+    if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, bF, bI, bJ, fl & GK_PHYS_ROTATION);
+    gk__forces_ref_3d(rve, x, c, c1, law, fl);
+}
+#endif /* GK_VR_W > 1 */
 
 /* instantiate the kernel with constant law and flags (pay only for what is on) */
 #define GK__DISPATCH(fn, rve, x, c0, c1)                                                                              \
@@ -1230,128 +1630,214 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
     } while (0)
 
 static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
+#if GK_VR_W > 1
+    if (!(rve->def.flags & GK_RVE_SCALAR) && !(rve->phys & GK_PHYS_COHESION)) {
+        if (rve->dim == 2)
+            GK__DISPATCH(gk__forces_simd_2d, rve, x, c0, c1);
+        else
+            GK__DISPATCH(gk__forces_simd_3d, rve, x, c0, c1);
+        return;
+    }
+#endif
     if (rve->dim == 2)
         GK__DISPATCH(gk__forces_ref_2d, rve, x, c0, c1);
     else
         GK__DISPATCH(gk__forces_ref_3d, rve, x, c0, c1);
 }
 
-static void gk__forces(gk_rve *rve, const gk__stepctx *x) {
-    int nc = rve->pl.n;
-    int nth = rve->def.threads > 1 && nc >= GK_DEM_PAR_MIN ? rve->def.threads : 1;
+static int gk__nthreads(const gk_rve *rve);
+
+static void gk__reduce_range(gk_rve *rve, int p0, int p1);
+
+/* pair forces and their per-particle sums (f, t) for this step. A single
+ * thread scatters in the force loop; threads store per-pair forces and
+ * gather. want_store keeps per-pair forces and torques (stress, tangent). */
+static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
+    int nc = rve->pl.n, nth = gk__nthreads(rve), k;
     if (nth <= 1) {
+        x->scatter = 1;
+        x->store = want_store;
+        for (k = 0; k < 3; ++k) {
+            if (rve->f[k]) memset(rve->f[k], 0, (size_t)rve->n * sizeof(gk_real));
+            if (rve->t[k]) memset(rve->t[k], 0, (size_t)rve->n * sizeof(gk_real));
+        }
         gk__forces_range(rve, x, 0, nc);
     } else {
-        int b;
+        int b, n = rve->n;
+        x->scatter = 0;
+        x->store = 1;
         GK_OMP(parallel for num_threads(nth) schedule(static))
         for (b = 0; b < nth * 4; ++b) {
-            long c0 = (long)nc * b / (nth * 4), c1 = (long)nc * (b + 1) / (nth * 4);
+            /* chunk starts on a multiple of 16 pairs: aligned SIMD loads, same lanes as serial */
+            long c0 = ((long)nc * b / (nth * 4)) & ~15L, c1 = b + 1 == nth * 4 ? nc : ((long)nc * (b + 1) / (nth * 4)) & ~15L;
             gk__forces_range(rve, x, (int)c0, (int)c1);
+        }
+        GK_OMP(parallel for num_threads(nth) schedule(static))
+        for (b = 0; b < nth * 4; ++b) {
+            long p0 = (long)n * b / (nth * 4), p1 = (long)n * (b + 1) / (nth * 4);
+            gk__reduce_range(rve, (int)p0, (int)p1);
         }
     }
 }
 
-/* ---------------------------------------------------------------- integration */
-GK_FORCE_INLINE gk_real gk__damp_component(gk_real a, gk_real v, gk_real dt, gk_real alpha) {
-    gk_real sgn = a * (v + (gk_real)0.5 * dt * a);
-    if (sgn > 0) return a * ((gk_real)1 - alpha);
-    if (sgn < 0) return a * ((gk_real)1 + alpha);
-    return a;
-}
-
-/* sum pair forces per particle (fixed order), damp, leap-frog; particles [p0, p1).
- * Returns the largest squared non-affine displacement since the last build;
- * *bad set if a non-finite value appeared. */
-static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int p0,
-                                  int p1, int *bad) {
-    const int dim = rve->dim, rot = GK__HAS_ROT(rve);
-    const gk_real dt = x->dt, alpha = (gk_real)rve->def.damping;
-    const int vec = rve->def.damping_form == GK_DAMP_VECTOR;
-    const int32_t *start = rve->pl.start, *jst = rve->jstart, *jl = rve->jlist;
-    double m2 = 0.0, chk = 0.0;
-    int p, k, e;
+/* ---------------------------------------------------------------- sums and integration */
+/* Per-particle sums of the pair forces in the fixed order (pairs where p is j,
+ * ascending; then pairs where p is i, ascending), by gathering: used with
+ * threads. A single thread scatters inside the force loop instead
+ * (gk__scatter_*), in pair order, which is the same order and so gives the
+ * same bits. */
+GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int dim, const int rot) {
+    const int32_t *GK_RESTRICT start = rve->pl.start, *GK_RESTRICT jst = rve->jstart, *GK_RESTRICT jl = rve->jlist;
+    const gk_real *fc0 = rve->fc[0], *fc1 = rve->fc[1], *fc2 = dim == 3 ? rve->fc[2] : NULL;
+    gk_real *f0 = rve->f[0], *f1 = rve->f[1], *f2 = dim == 3 ? rve->f[2] : NULL;
+    int p, e, k;
     for (p = p0; p < p1; ++p) {
-        gk_real f[3] = {0, 0, 0}, tq[3] = {0, 0, 0}, a[3], aw[3];
+        gk_real a0 = 0, a1 = 0, a2 = 0, t[3] = {0, 0, 0};
         for (e = jst[p]; e < jst[p + 1]; ++e) {
             int c = jl[e];
-            for (k = 0; k < dim; ++k) f[k] += rve->fc[k][c];
+            a0 += fc0[c];
+            a1 += fc1[c];
+            if (dim == 3) a2 += fc2[c];
             if (rot) {
                 if (dim == 2)
-                    tq[2] += rve->tcj[2][c];
+                    t[2] += rve->tcj[2][c];
                 else
-                    for (k = 0; k < 3; ++k) tq[k] += rve->tcj[k][c];
+                    for (k = 0; k < 3; ++k) t[k] += rve->tcj[k][c];
             }
         }
         for (e = start[p]; e < start[p + 1]; ++e) {
-            for (k = 0; k < dim; ++k) f[k] -= rve->fc[k][e];
+            a0 -= fc0[e];
+            a1 -= fc1[e];
+            if (dim == 3) a2 -= fc2[e];
             if (rot) {
                 if (dim == 2)
-                    tq[2] += rve->tci[2][e];
+                    t[2] += rve->tci[2][e];
                 else
-                    for (k = 0; k < 3; ++k) tq[k] += rve->tci[k][e];
+                    for (k = 0; k < 3; ++k) t[k] += rve->tci[k][e];
             }
         }
-        for (k = 0; k < dim; ++k) {
-            rve->f[k][p] = f[k];
-            a[k] = f[k] * rve->minv[p];
+        f0[p] = a0;
+        f1[p] = a1;
+        if (dim == 3) f2[p] = a2;
+        if (rot) {
+            if (dim == 2)
+                rve->t[2][p] = t[2];
+            else
+                for (k = 0; k < 3; ++k) rve->t[k][p] = t[k];
         }
-        if (alpha > 0) {
-            if (!vec) {
-                for (k = 0; k < dim; ++k) a[k] = gk__damp_component(a[k], rve->v[k][p], dt, alpha);
-            } else {
-                gk_real ve[3] = {0, 0, 0}, vv = 0, aa = 0;
-                for (k = 0; k < dim; ++k) {
-                    ve[k] = rve->v[k][p] + (gk_real)0.5 * dt * a[k];
-                    vv += ve[k] * ve[k];
-                    aa += a[k] * a[k];
-                }
-                if (vv > 0) {
-                    gk_real sc = alpha * (gk_real)sqrt(aa) / (gk_real)sqrt(vv);
-                    for (k = 0; k < dim; ++k) a[k] = a[k] - sc * ve[k];
-                }
+    }
+}
+
+static void gk__reduce_range(gk_rve *rve, int p0, int p1) {
+    int rot = GK__HAS_ROT(rve);
+    if (rve->dim == 2) {
+        if (rot)
+            gk__reduce_kernel(rve, p0, p1, 2, 1);
+        else
+            gk__reduce_kernel(rve, p0, p1, 2, 0);
+    } else {
+        if (rot)
+            gk__reduce_kernel(rve, p0, p1, 3, 1);
+        else
+            gk__reduce_kernel(rve, p0, p1, 3, 0);
+    }
+}
+
+/* local damping, YADE/PFC component form: a <- a (1 - alpha sign(a (v + a dt/2))).
+ * Branch-free (the sign is random: a branch would mispredict half the time);
+ * 1 - alpha * s with s in {-1, 0, 1} gives exactly 1 + alpha, 1, 1 - alpha. */
+GK_FORCE_INLINE gk_real gk__damp_component(gk_real a, gk_real v, gk_real dt, gk_real alpha) {
+    gk_real x = a * (v + (gk_real)0.5 * dt * a);
+    gk_real sg = (gk_real)(x > 0) - (gk_real)(x < 0);
+    return a * ((gk_real)1 - alpha * sg);
+}
+
+/* leap-frog for particles [p0, p1) with the force sums in f, t; returns the
+ * largest squared non-affine displacement since the last build; *bad if a
+ * non-finite value appeared. damp: 0 none, 1 component, 2 vector. */
+GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, const double *hinv, const double *hnew,
+                                            int p0, int p1, int *bad, const int dim, const int rot, const int damp) {
+    const gk_real dt = x->dt, alpha = (gk_real)rve->def.damping, hdt = (gk_real)0.5 * dt;
+    const gk_real *GK_RESTRICT minv = rve->minv, *GK_RESTRICT Iinv = rve->Iinv;
+    double *GK_RESTRICT s0 = rve->s[0], *GK_RESTRICT s1 = rve->s[1], *GK_RESTRICT s2 = dim == 3 ? rve->s[2] : NULL;
+    const double *GK_RESTRICT r0 = rve->s0[0], *GK_RESTRICT r1 = rve->s0[1], *GK_RESTRICT r2 = dim == 3 ? rve->s0[2] : NULL;
+    gk_real *GK_RESTRICT v0 = rve->v[0], *GK_RESTRICT v1 = rve->v[1], *GK_RESTRICT v2 = dim == 3 ? rve->v[2] : NULL;
+    const gk_real *GK_RESTRICT f0 = rve->f[0], *GK_RESTRICT f1 = rve->f[1], *GK_RESTRICT f2 = dim == 3 ? rve->f[2] : NULL;
+    const double h00 = hinv[0], h01 = hinv[1], h02 = hinv[2], h10 = hinv[3], h11 = hinv[4], h12 = hinv[5], h20 = hinv[6],
+                 h21 = hinv[7], h22 = hinv[8];
+    const double g00 = hnew[0], g01 = hnew[1], g02 = hnew[2], g10 = hnew[3], g11 = hnew[4], g12 = hnew[5], g20 = hnew[6],
+                 g21 = hnew[7], g22 = hnew[8];
+    double m2 = 0.0, chk = 0.0;
+    int p;
+    for (p = p0; p < p1; ++p) {
+        gk_real a0 = f0[p] * minv[p], a1 = f1[p] * minv[p], a2 = dim == 3 ? f2[p] * minv[p] : 0;
+        gk_real n0, n1, n2 = 0;
+        double e0, e1, e2 = 0.0, u0, u1, u2 = 0.0, u2sum;
+        if (damp == 1) {
+            a0 = gk__damp_component(a0, v0[p], dt, alpha);
+            a1 = gk__damp_component(a1, v1[p], dt, alpha);
+            if (dim == 3) a2 = gk__damp_component(a2, v2[p], dt, alpha);
+        } else if (damp == 2) {
+            gk_real w0 = v0[p] + hdt * a0, w1 = v1[p] + hdt * a1, w2 = dim == 3 ? v2[p] + hdt * a2 : 0;
+            gk_real vv = w0 * w0 + w1 * w1 + (dim == 3 ? w2 * w2 : 0), aa = a0 * a0 + a1 * a1 + (dim == 3 ? a2 * a2 : 0);
+            if (vv > 0) {
+                gk_real sc = alpha * (gk_real)sqrt(aa) / (gk_real)sqrt(vv);
+                a0 = a0 - sc * w0;
+                a1 = a1 - sc * w1;
+                if (dim == 3) a2 = a2 - sc * w2;
             }
         }
+        n0 = v0[p] + dt * a0;
+        n1 = v1[p] + dt * a1;
+        v0[p] = n0;
+        v1[p] = n1;
+        if (dim == 3) {
+            n2 = v2[p] + dt * a2;
+            v2[p] = n2;
+        }
+        chk += (double)(n0 < 0 ? -n0 : n0) + (double)(n1 < 0 ? -n1 : n1) + (double)(n2 < 0 ? -n2 : n2);
         {
-            gk_real dd[3] = {0, 0, 0};
-            for (k = 0; k < dim; ++k) {
-                gk_real vn = rve->v[k][p] + dt * a[k];
-                rve->v[k][p] = vn;
-                dd[k] = vn * dt;
-                chk += (double)(vn < 0 ? -vn : vn);
-            }
+            double d0 = (double)(n0 * dt), d1 = (double)(n1 * dt), d2 = (double)(n2 * dt);
             if (dim == 2) {
-                double ex, ey, ux, uy;
-                rve->s[0][p] += hinv[0] * (double)dd[0] + hinv[1] * (double)dd[1];
-                rve->s[1][p] += hinv[3] * (double)dd[0] + hinv[4] * (double)dd[1];
-                ex = rve->s[0][p] - rve->s0[0][p];
-                ey = rve->s[1][p] - rve->s0[1][p];
-                ux = hnew[0] * ex + hnew[1] * ey;
-                uy = hnew[3] * ex + hnew[4] * ey;
-                if (ux * ux + uy * uy > m2) m2 = ux * ux + uy * uy;
+                s0[p] += h00 * d0 + h01 * d1;
+                s1[p] += h10 * d0 + h11 * d1;
+                e0 = s0[p] - r0[p];
+                e1 = s1[p] - r1[p];
+                u0 = g00 * e0 + g01 * e1;
+                u1 = g10 * e0 + g11 * e1;
+                u2sum = u0 * u0 + u1 * u1;
             } else {
-                double ex[3], u[3], u2;
-                for (k = 0; k < 3; ++k)
-                    rve->s[k][p] += hinv[3 * k] * (double)dd[0] + hinv[3 * k + 1] * (double)dd[1] +
-                                    hinv[3 * k + 2] * (double)dd[2];
-                for (k = 0; k < 3; ++k) ex[k] = rve->s[k][p] - rve->s0[k][p];
-                gk_m3_matvec(hnew, ex, u);
-                u2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-                if (u2 > m2) m2 = u2;
+                s0[p] += h00 * d0 + h01 * d1 + h02 * d2;
+                s1[p] += h10 * d0 + h11 * d1 + h12 * d2;
+                s2[p] += h20 * d0 + h21 * d1 + h22 * d2;
+                e0 = s0[p] - r0[p];
+                e1 = s1[p] - r1[p];
+                e2 = s2[p] - r2[p];
+                u0 = g00 * e0 + g01 * e1 + g02 * e2;
+                u1 = g10 * e0 + g11 * e1 + g12 * e2;
+                u2 = g20 * e0 + g21 * e1 + g22 * e2;
+                u2sum = u0 * u0 + u1 * u1 + u2 * u2;
             }
+            m2 = u2sum > m2 ? u2sum : m2;
         }
         if (rot) {
-            int k0 = dim == 2 ? 2 : 0;
-            for (k = k0; k < 3; ++k) {
-                rve->t[k][p] = tq[k];
-                aw[k] = tq[k] * rve->Iinv[p];
-            }
-            if (alpha > 0) {
-                if (!vec || dim == 2) {
-                    for (k = k0; k < 3; ++k) aw[k] = gk__damp_component(aw[k], rve->w[k][p], dt, alpha);
-                } else {
+            if (dim == 2) {
+                gk_real aw = rve->t[2][p] * Iinv[p], wn;
+                if (damp) aw = gk__damp_component(aw, rve->w[2][p], dt, alpha); /* 2D: one component */
+                wn = rve->w[2][p] + dt * aw;
+                rve->w[2][p] = wn;
+                chk += (double)(wn < 0 ? -wn : wn);
+                rve->theta[p] += ((double)x->wa[2] + (double)wn) * (double)dt;
+            } else {
+                gk_real aw[3], wn;
+                int k;
+                for (k = 0; k < 3; ++k) aw[k] = rve->t[k][p] * Iinv[p];
+                if (damp == 1) {
+                    for (k = 0; k < 3; ++k) aw[k] = gk__damp_component(aw[k], rve->w[k][p], dt, alpha);
+                } else if (damp == 2) {
                     gk_real ve[3], vv = 0, aa = 0;
                     for (k = 0; k < 3; ++k) {
-                        ve[k] = rve->w[k][p] + (gk_real)0.5 * dt * aw[k];
+                        ve[k] = rve->w[k][p] + hdt * aw[k];
                         vv += ve[k] * ve[k];
                         aa += aw[k] * aw[k];
                     }
@@ -1360,12 +1846,12 @@ static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const doubl
                         for (k = 0; k < 3; ++k) aw[k] = aw[k] - sc * ve[k];
                     }
                 }
+                for (k = 0; k < 3; ++k) {
+                    wn = rve->w[k][p] + dt * aw[k];
+                    rve->w[k][p] = wn;
+                    chk += (double)(wn < 0 ? -wn : wn);
+                }
             }
-            for (k = k0; k < 3; ++k) {
-                rve->w[k][p] = rve->w[k][p] + dt * aw[k];
-                chk += (double)(rve->w[k][p] < 0 ? -rve->w[k][p] : rve->w[k][p]);
-            }
-            if (dim == 2) rve->theta[p] += ((double)x->wa[2] + (double)rve->w[2][p]) * (double)dt;
         } else if (dim == 2) {
             rve->theta[p] += (double)x->wa[2] * (double)dt;
         }
@@ -1374,9 +1860,155 @@ static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const doubl
     return m2;
 }
 
+#if GK_VR_W > 1 && !defined(GK_REAL_FLOAT)
+/* gk__integrate_kernel on GK_VD_W particles at a time (double build): same
+ * arithmetic per lane, selects instead of branches. */
+GK_FORCE_INLINE gk_vd gk__damp_v(gk_vd a, gk_vd v, gk_vd hdt, gk_vd alpha) {
+    const gk_vd one = gk_vd_set1(1.0), zero = gk_vd_zero();
+    gk_vd xx = gk_vd_mul(a, gk_vd_add(v, gk_vd_mul(hdt, a)));
+    gk_vd sg = gk_vd_sub(gk_vd_select(gk_vd_gt(xx, zero), one, zero), gk_vd_select(gk_vd_lt(xx, zero), one, zero));
+    return gk_vd_mul(a, gk_vd_sub(one, gk_vd_mul(alpha, sg)));
+}
+
+GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, const double *hinv, const double *hnew,
+                                          int p0, int p1, int *bad, const int dim, const int rot, const int damp) {
+    const gk_vd dt = gk_vd_set1(x->dt), alpha = gk_vd_set1(rve->def.damping), hdt = gk_vd_set1(0.5 * x->dt),
+                zero = gk_vd_zero();
+    const gk_vd wa = gk_vd_set1((double)x->wa[2]);
+    gk_vd H[9], Gn[9], vm2 = zero, vchk = zero;
+    double m2 = 0.0, chk = 0.0, buf[2 * GK_VD_W];
+    int p = p0, k, l;
+    for (k = 0; k < 9; ++k) {
+        H[k] = gk_vd_set1(hinv[k]);
+        Gn[k] = gk_vd_set1(hnew[k]);
+    }
+    for (; p + GK_VD_W <= p1; p += GK_VD_W) {
+        gk_vd minv = gk_vd_loadu(rve->minv + p), a[3], v[3], nv[3], d[3], e[3], u[3], sp[3], u2;
+        for (k = 0; k < dim; ++k) {
+            a[k] = gk_vd_mul(gk_vd_loadu(rve->f[k] + p), minv);
+            v[k] = gk_vd_loadu(rve->v[k] + p);
+        }
+        if (damp == 1) {
+            for (k = 0; k < dim; ++k) a[k] = gk__damp_v(a[k], v[k], hdt, alpha);
+        } else if (damp == 2) {
+            gk_vd w[3], vv, aa, sc;
+            gk_vdm pos;
+            for (k = 0; k < dim; ++k) w[k] = gk_vd_add(v[k], gk_vd_mul(hdt, a[k]));
+            vv = gk_vd_add(gk_vd_mul(w[0], w[0]), gk_vd_mul(w[1], w[1]));
+            aa = gk_vd_add(gk_vd_mul(a[0], a[0]), gk_vd_mul(a[1], a[1]));
+            if (dim == 3) {
+                vv = gk_vd_add(vv, gk_vd_mul(w[2], w[2]));
+                aa = gk_vd_add(aa, gk_vd_mul(a[2], a[2]));
+            }
+            pos = gk_vd_gt(vv, zero);
+            sc = gk_vd_div(gk_vd_mul(alpha, gk_vd_sqrt(aa)), gk_vd_sqrt(vv));
+            for (k = 0; k < dim; ++k) a[k] = gk_vd_select(pos, gk_vd_sub(a[k], gk_vd_mul(sc, w[k])), a[k]);
+        }
+        for (k = 0; k < dim; ++k) {
+            nv[k] = gk_vd_add(v[k], gk_vd_mul(dt, a[k]));
+            gk_vd_storeu(rve->v[k] + p, nv[k]);
+            vchk = gk_vd_add(vchk, gk_vd_abs(nv[k]));
+            d[k] = gk_vd_mul(nv[k], dt);
+        }
+        for (k = 0; k < dim; ++k) {
+            gk_vd inc = gk_vd_add(gk_vd_mul(H[3 * k], d[0]), gk_vd_mul(H[3 * k + 1], d[1]));
+            if (dim == 3) inc = gk_vd_add(inc, gk_vd_mul(H[3 * k + 2], d[2]));
+            sp[k] = gk_vd_add(gk_vd_loadu(rve->s[k] + p), inc);
+            gk_vd_storeu(rve->s[k] + p, sp[k]);
+            e[k] = gk_vd_sub(sp[k], gk_vd_loadu(rve->s0[k] + p));
+        }
+        for (k = 0; k < dim; ++k) {
+            u[k] = gk_vd_add(gk_vd_mul(Gn[3 * k], e[0]), gk_vd_mul(Gn[3 * k + 1], e[1]));
+            if (dim == 3) u[k] = gk_vd_add(u[k], gk_vd_mul(Gn[3 * k + 2], e[2]));
+        }
+        u2 = gk_vd_add(gk_vd_mul(u[0], u[0]), gk_vd_mul(u[1], u[1]));
+        if (dim == 3) u2 = gk_vd_add(u2, gk_vd_mul(u[2], u[2]));
+        vm2 = gk_vd_max(u2, vm2);
+        if (rot && dim == 2) {
+            gk_vd aw = gk_vd_mul(gk_vd_loadu(rve->t[2] + p), gk_vd_loadu(rve->Iinv + p)), w = gk_vd_loadu(rve->w[2] + p);
+            if (damp) aw = gk__damp_v(aw, w, hdt, alpha);
+            w = gk_vd_add(w, gk_vd_mul(dt, aw));
+            gk_vd_storeu(rve->w[2] + p, w);
+            vchk = gk_vd_add(vchk, gk_vd_abs(w));
+            gk_vd_storeu(rve->theta + p, gk_vd_add(gk_vd_loadu(rve->theta + p), gk_vd_mul(gk_vd_add(wa, w), dt)));
+        } else if (rot) {
+            gk_vd iinv = gk_vd_loadu(rve->Iinv + p), aw[3], w[3];
+            for (k = 0; k < 3; ++k) {
+                aw[k] = gk_vd_mul(gk_vd_loadu(rve->t[k] + p), iinv);
+                w[k] = gk_vd_loadu(rve->w[k] + p);
+            }
+            if (damp == 1) {
+                for (k = 0; k < 3; ++k) aw[k] = gk__damp_v(aw[k], w[k], hdt, alpha);
+            } else if (damp == 2) {
+                gk_vd ve[3], vv, aa, sc;
+                gk_vdm pos;
+                for (k = 0; k < 3; ++k) ve[k] = gk_vd_add(w[k], gk_vd_mul(hdt, aw[k]));
+                vv = gk_vd_add(gk_vd_add(gk_vd_mul(ve[0], ve[0]), gk_vd_mul(ve[1], ve[1])), gk_vd_mul(ve[2], ve[2]));
+                aa = gk_vd_add(gk_vd_add(gk_vd_mul(aw[0], aw[0]), gk_vd_mul(aw[1], aw[1])), gk_vd_mul(aw[2], aw[2]));
+                pos = gk_vd_gt(vv, zero);
+                sc = gk_vd_div(gk_vd_mul(alpha, gk_vd_sqrt(aa)), gk_vd_sqrt(vv));
+                for (k = 0; k < 3; ++k) aw[k] = gk_vd_select(pos, gk_vd_sub(aw[k], gk_vd_mul(sc, ve[k])), aw[k]);
+            }
+            for (k = 0; k < 3; ++k) {
+                w[k] = gk_vd_add(w[k], gk_vd_mul(dt, aw[k]));
+                gk_vd_storeu(rve->w[k] + p, w[k]);
+                vchk = gk_vd_add(vchk, gk_vd_abs(w[k]));
+            }
+        } else if (dim == 2) {
+            gk_vd_storeu(rve->theta + p, gk_vd_add(gk_vd_loadu(rve->theta + p), gk_vd_mul(wa, dt)));
+        }
+    }
+    gk_vd_storeu(buf, vm2);
+    gk_vd_storeu(buf + GK_VD_W, vchk);
+    for (l = 0; l < GK_VD_W; ++l) {
+        if (buf[l] > m2) m2 = buf[l];
+        chk += buf[GK_VD_W + l];
+    }
+    if (!isfinite(chk) || !isfinite(m2)) *bad = 1;
+    if (p < p1) {
+        double mt = gk__integrate_kernel(rve, x, hinv, hnew, p, p1, bad, dim, rot, damp);
+        if (mt > m2) m2 = mt;
+    }
+    return m2;
+}
+#define GK__INTEGRATE_FAST gk__integrate_simd
+#else
+#define GK__INTEGRATE_FAST gk__integrate_kernel
+#endif
+
+static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int p0,
+                                  int p1, int *bad) {
+    int rot = GK__HAS_ROT(rve), damp = rve->def.damping > 0 ? (rve->def.damping_form == GK_DAMP_VECTOR ? 2 : 1) : 0;
+#define GK__INT(D, R, M)                                                                                               \
+    return (rve->def.flags & GK_RVE_SCALAR) ? gk__integrate_kernel(rve, x, hinv, hnew, p0, p1, bad, D, R, M)          \
+                                            : GK__INTEGRATE_FAST(rve, x, hinv, hnew, p0, p1, bad, D, R, M)
+    if (rve->dim == 2) {
+        if (rot) {
+            if (damp == 1) GK__INT(2, 1, 1);
+            if (damp == 2) GK__INT(2, 1, 2);
+            GK__INT(2, 1, 0);
+        }
+        if (damp == 1) GK__INT(2, 0, 1);
+        if (damp == 2) GK__INT(2, 0, 2);
+        GK__INT(2, 0, 0);
+    }
+    if (rot) {
+        if (damp == 1) GK__INT(3, 1, 1);
+        if (damp == 2) GK__INT(3, 1, 2);
+        GK__INT(3, 1, 0);
+    }
+    if (damp == 1) GK__INT(3, 0, 1);
+    if (damp == 2) GK__INT(3, 0, 2);
+    GK__INT(3, 0, 0);
+#undef GK__INT
+}
+
+static int gk__nthreads(const gk_rve *rve) {
+    return rve->def.threads > 1 && rve->pl.n >= GK_DEM_PAR_MIN ? rve->def.threads : 1;
+}
+
 static double gk__integrate(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int *bad) {
-    int n = rve->n;
-    int nth = rve->def.threads > 1 && rve->pl.n >= GK_DEM_PAR_MIN ? rve->def.threads : 1;
+    int n = rve->n, nth = gk__nthreads(rve);
     double m2 = 0.0;
     if (nth <= 1) return gk__integrate_range(rve, x, hinv, hnew, 0, n, bad);
     {
@@ -1446,8 +2078,9 @@ static void gk__ctx_make(const gk_rve *rve, const double E[9], gk__stepctx *x) {
     for (k = 0; k < 9; ++k) {
         x->G[k] = (gk_real)G[k];
         x->hd[k] = rve->cell.h[k];
-        x->h[k] = (gk_real)rve->cell.h[k];
     }
+    x->scatter = 0;
+    x->store = 1;
     x->wa[0] = (gk_real)(0.5 * (G[7] - G[5]));
     x->wa[1] = (gk_real)(0.5 * (G[2] - G[6]));
     x->wa[2] = (gk_real)(0.5 * (G[3] - G[1]));
@@ -1465,7 +2098,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
     }
     gk__ctx_make(rve, E, &x);
     for (k = 0; k < 9; ++k) rve->G[k] = (double)x.G[k];
-    gk__forces(rve, &x);
+    gk__forces(rve, &x, want_stress);
     if (want_stress) gk__stress_pass(rve);
     res = gk_pcell_advance(&rve->cell, E, &rve->err);
     if (res) return res;
@@ -1649,7 +2282,7 @@ GKDEF gk_result gk_rve_refresh(gk_rve *rve) {
         gk__ctx_make(rve, I, &x);
         rve->dt = dtsave;
         x.dt = 0;
-        gk__forces(rve, &x);
+        gk__forces(rve, &x, 1);
         gk__stress_pass(rve);
         for (k = 0; k < 3; ++k) {
             if (save[k]) memcpy(rve->ft[k], save[k], np * sizeof(gk_real));

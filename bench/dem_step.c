@@ -1,0 +1,116 @@
+/* bench_dem_step - the DEM step at the speed limit of this CPU.
+ *
+ *   build/bench_dem_step                      the whole suite (make bench)
+ *   build/bench_dem_step --case NAME [--threads T] [--steps S] [--law linear|hertz]
+ *                        [--real double|float] [--scalar] [--repeats R]
+ *                        [--packing FILE] [--write-packing FILE]
+ *
+ * Cases: rve400 (the seed 000 400-disk RVE, its own material, simple shear at
+ * 1e-5 per step), 2d_10k and 2d_100k (bench/data/bench2d_10k.txt, tiled 5x2),
+ * 3d_1k (bench/data/bench3d_1k.txt), 3d_10k (bench/data/bench3d_20k.txt:
+ * 20 000 spheres, the packing the peers were measured on) and 3d_100k (that,
+ * tiled 5x), all under slow Lees-Edwards shear with the peers' parameters:
+ * linear law, constant kn = 2e5 N/m, kt = 0.5 kn, mu = 0.5, no damping,
+ * rho = 2650 (sphere masses also in 2D), dt = 2.7e-6 s, shear rate 1.5 /s,
+ * skin 0.5 mm. --law hertz: Hertz-Mindlin (E 5e9, nu 0.3) + rolling
+ * resistance (beta 1, eta 0.1) at dt 1e-6 s. Each run: warm-up, then R
+ * repeats of S steps; rates are medians over the repeats. One line per run:
+ * BENCH case=... dim=... n=... threads=... law=... real=... simd=... steps=...
+ *       particle_steps_per_s=... contact_steps_per_s=... contacts_per_particle=... */
+#include "dem_step.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void usage(FILE *fp) {
+    fprintf(fp, "usage: bench_dem_step [--case rve400|2d_10k|2d_100k|3d_1k|3d_10k|3d_100k] [--threads T]\n"
+                "                      [--steps S] [--law linear|hertz] [--real double|float] [--scalar]\n"
+                "                      [--repeats R] [--packing FILE] [--write-packing FILE]\n"
+                "with no --case, runs the whole suite (1 and 2 threads, both laws, double and float,\n"
+                "SIMD and scalar) and prints a table.\n");
+}
+
+static int run_one(const bench_case *c, int use_float, int quiet_header) {
+    bench_out o;
+    int rc = use_float ? bench_run_float(c, &o) : bench_run_double(c, &o);
+    (void)quiet_header;
+    if (rc) {
+        fprintf(stderr, "bench_dem_step: %s: %s\n", c->name, o.err);
+        return rc;
+    }
+    printf("%-8s %dD %7d  %2d  %-6s %-6s %-6s %8.2f %9.2f %6.2f %6.2f\n", c->name, o.dim, o.n, c->threads,
+           c->hertz ? "hertz" : "linear", o.real, o.simd, o.particle_steps_per_s / 1e6, o.contact_steps_per_s / 1e6,
+           o.contacts_per_particle, o.pairs_per_particle);
+    printf("BENCH case=%s dim=%d n=%d threads=%d law=%s real=%s simd=%s steps=%ld particle_steps_per_s=%.4g "
+           "contact_steps_per_s=%.4g contacts_per_particle=%.3f pairs_per_particle=%.3f seconds_median=%.4g "
+           "sxx=%.6g syy=%.6g sxy=%.6g\n",
+           c->name, o.dim, o.n, c->threads, c->hertz ? "hertz" : "linear", o.real, o.simd, o.steps,
+           o.particle_steps_per_s, o.contact_steps_per_s, o.contacts_per_particle, o.pairs_per_particle,
+           o.seconds_median, o.sigma[0], o.sigma[4], o.sigma[1]);
+    fflush(stdout);
+    return 0;
+}
+
+static void header(void) {
+    printf("%-8s %2s %7s  %2s  %-6s %-6s %-6s %8s %9s %6s %6s\n", "case", "", "n", "th", "law", "real", "simd",
+           "Mpart/s", "Mcont/s", "Z/2", "pairs");
+}
+
+int main(int argc, char **argv) {
+    bench_case c;
+    int i, use_float = 0, rc = 0;
+    const char *cname = NULL;
+    memset(&c, 0, sizeof c);
+    c.threads = 1;
+    for (i = 1; i < argc; ++i) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout);
+            return 0;
+        }
+        if (!strcmp(a, "--scalar")) {
+            c.scalar = 1;
+            continue;
+        }
+        if (!v) {
+            fprintf(stderr, "bench_dem_step: %s needs a value\n", a);
+            return 2;
+        }
+        if (!strcmp(a, "--case")) cname = v;
+        else if (!strcmp(a, "--threads")) c.threads = atoi(v);
+        else if (!strcmp(a, "--steps")) c.steps = atol(v);
+        else if (!strcmp(a, "--repeats")) c.repeats = atoi(v);
+        else if (!strcmp(a, "--law")) c.hertz = !strcmp(v, "hertz");
+        else if (!strcmp(a, "--real")) use_float = !strcmp(v, "float");
+        else if (!strcmp(a, "--packing")) c.packing = v;
+        else if (!strcmp(a, "--write-packing")) c.write_packing = v;
+        else {
+            fprintf(stderr, "bench_dem_step: unknown option %s (see --help)\n", a);
+            return 2;
+        }
+        ++i;
+    }
+    if (cname) {
+        c.name = cname;
+        header();
+        return run_one(&c, use_float, 0);
+    }
+    {
+        static const char *cases[] = {"rve400", "2d_10k", "2d_100k", "3d_1k", "3d_10k", "3d_100k"};
+        int k, law, fl, sc, th;
+        header();
+        for (k = 0; k < 6; ++k)
+            for (law = 0; law < 2; ++law)
+                for (fl = 0; fl < 2; ++fl)
+                    for (th = 1; th <= 2; ++th)
+                        for (sc = 0; sc < (th == 1 ? 2 : 1); ++sc) {
+                            bench_case b = c;
+                            b.name = cases[k];
+                            b.hertz = law;
+                            b.scalar = sc;
+                            b.threads = th;
+                            if (run_one(&b, fl, 1)) rc = 1;
+                        }
+    }
+    return rc;
+}

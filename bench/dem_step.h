@@ -1,0 +1,30 @@
+/* dem_step.h - interface between bench/dem_step.c and bench/dem_step_part.c,
+ * which is compiled twice (double and float grainkit, GK_STATIC) into one
+ * program. Plain C types only. */
+#ifndef BENCH_DEM_STEP_H
+#define BENCH_DEM_STEP_H
+
+typedef struct bench_case {
+    const char *name;          /* rve400, 2d_10k, 2d_100k, 3d_1k, 3d_10k, 3d_100k */
+    const char *packing;       /* NULL: the case's default packing                 */
+    const char *write_packing; /* write the exact starting packing here            */
+    int threads, hertz, scalar, repeats;
+    long steps;                /* timed steps per repeat; 0: case default          */
+} bench_case;
+
+typedef struct bench_out {
+    int dim, n;
+    long steps;                  /* per repeat */
+    double particle_steps_per_s; /* median over repeats */
+    double contact_steps_per_s;  /* median */
+    double contacts_per_particle;
+    double pairs_per_particle;
+    double seconds_min, seconds_median;
+    double sigma[9];             /* final Love stress (tension +) */
+    char simd[16], real[8], err[256];
+} bench_out;
+
+int bench_run_double(const bench_case *c, bench_out *o);
+int bench_run_float(const bench_case *c, bench_out *o);
+
+#endif

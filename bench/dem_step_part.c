@@ -1,0 +1,169 @@
+/* dem_step_part.c - one benchmark case, compiled once per precision (see
+ * Makefile: -DGK_REAL_FLOAT for the float copy). Every grainkit function is
+ * static here (GK_STATIC), so both copies live in one program. */
+#define _POSIX_C_SOURCE 200809L
+#define GK_STATIC
+#define GK_IMPLEMENTATION
+#include "gk_homog.h"
+#include "gk_io.h"
+#include "dem_step.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef GK_REAL_FLOAT
+#define BENCH_RUN bench_run_float
+#else
+#define BENCH_RUN bench_run_double
+#endif
+
+/* tile a periodic packing nx x ny x nz times (still periodic and dense) */
+static int tile(const gk_packing *in, int nx, int ny, int nz, gk_packing *out, gk_err *e) {
+    int a, b, c, p, q = 0, n = in->n * nx * ny * nz;
+    if (gk_packing_alloc(out, in->dim, n, NULL, e)) return 1;
+    gk_m3_identity(out->h);
+    out->h[0] = in->h[0] * nx;
+    out->h[4] = in->h[4] * ny;
+    if (in->dim == 3) out->h[8] = in->h[8] * nz;
+    for (c = 0; c < nz; ++c)
+        for (b = 0; b < ny; ++b)
+            for (a = 0; a < nx; ++a)
+                for (p = 0; p < in->n; ++p) {
+                    out->x[q] = in->x[p] + a * in->h[0];
+                    out->y[q] = in->y[p] + b * in->h[4];
+                    out->z[q] = in->dim == 3 ? in->z[p] + c * in->h[8] : 0.0;
+                    out->r[q] = in->r[p];
+                    ++q;
+                }
+    return 0;
+}
+
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+int BENCH_RUN(const bench_case *bc, bench_out *o) {
+    gk_packing base, pk;
+    gk_err e;
+    gk_rve rve;
+    gk_rve_def def = gk_rve_def_default();
+    const char *path = bc->packing;
+    int tx = 1, ty = 1, tz = 1, rve400 = !strcmp(bc->name, "rve400"), dim_want, r, nrep;
+    double L[9], secs[64], rate;
+    long steps = bc->steps;
+    memset(o, 0, sizeof *o);
+    snprintf(o->simd, sizeof o->simd, "%s", bc->scalar ? "scalar" : GK_SIMD_NAME);
+    snprintf(o->real, sizeof o->real, "%s", GK_REAL_NAME);
+    if (rve400) {
+        dim_want = 2;
+        if (!path) path = "examples/data/rve400.txt";
+        if (!steps) steps = 20000;
+    } else if (!strcmp(bc->name, "2d_10k") || !strcmp(bc->name, "2d_100k")) {
+        dim_want = 2;
+        if (!path) {
+            path = "bench/data/bench2d_10k.txt";
+            if (!strcmp(bc->name, "2d_100k")) tx = 5, ty = 2;
+        }
+        if (!steps) steps = tx * ty > 1 ? 60 : 600;
+    } else if (!strcmp(bc->name, "3d_1k") || !strcmp(bc->name, "3d_10k") || !strcmp(bc->name, "3d_100k")) {
+        dim_want = 3;
+        if (!path) {
+            if (!strcmp(bc->name, "3d_1k")) path = "bench/data/bench3d_1k.txt";
+            else path = "bench/data/bench3d_20k.txt";
+            if (!strcmp(bc->name, "3d_100k")) tx = 5;
+        }
+        if (!steps) steps = !strcmp(bc->name, "3d_1k") ? 4000 : (tx > 1 ? 30 : 150);
+    } else {
+        snprintf(o->err, sizeof o->err, "unknown case '%s' (rve400, 2d_10k, 2d_100k, 3d_1k, 3d_10k, 3d_100k)", bc->name);
+        return 2;
+    }
+    if (gk_packing_read(path, &base, NULL, &e)) {
+        snprintf(o->err, sizeof o->err, "%s", e.msg);
+        return 1;
+    }
+    if (base.dim != dim_want) {
+        snprintf(o->err, sizeof o->err, "case %s is %dD but %s is %dD", bc->name, dim_want, path, base.dim);
+        gk_packing_free(&base);
+        return 2;
+    }
+    if (tx * ty * tz > 1) {
+        if (tile(&base, tx, ty, tz, &pk, &e)) {
+            snprintf(o->err, sizeof o->err, "%s", e.msg);
+            return 1;
+        }
+        gk_packing_free(&base);
+    } else {
+        pk = base;
+    }
+    if (bc->write_packing && gk_packing_write(bc->write_packing, &pk, "grainkit bench_dem_step starting packing", &e)) {
+        snprintf(o->err, sizeof o->err, "%s", e.msg);
+        return 1;
+    }
+    if (rve400) { /* the seed 000 RVE and material (YADE FEMxDEM prepareRVE.py) */
+        def.mat.young = 6e8;
+        def.mat.kt_ratio = 0.8;
+        def.mat.friction = tan(0.5);
+        def.damping = 0.1;
+        def.thickness = 0.1;
+        def.dt = bc->hertz ? 0 : 3.1602315723728926e-05; /* YADE's PWaveTimeStep for this packing */
+    } else { /* the parameters the peer codes ran with (bench/data/README.md) */
+        def.mat.kn = 2e5;
+        def.mat.kt_ratio = 0.5;
+        def.mat.friction = 0.5;
+        def.mass2d = GK_MASS_SPHERE;
+        def.thickness = 0;
+        def.damping = 0.0;
+        def.dt = 2.7e-6;
+        def.skin = 5e-4;
+    }
+    if (bc->hertz) { /* Hertz-Mindlin + rolling resistance, k_n comparable at these overlaps */
+        def.mat.law = GK_LAW_HERTZ;
+        def.mat.kn = 0;
+        def.mat.young = rve400 ? 6e8 : 5e9;
+        def.mat.poisson = 0.3;
+        def.mat.roll_beta = 1.0;
+        def.mat.roll_eta = 0.1;
+        if (!rve400) def.dt = 1.0e-6;
+    }
+    def.threads = bc->threads;
+    if (bc->scalar) def.flags |= GK_RVE_SCALAR;
+    if (gk_rve_create(&rve, &def, &pk)) {
+        snprintf(o->err, sizeof o->err, "%s", gk_rve_error(&rve));
+        gk_packing_free(&pk);
+        return 1;
+    }
+    gk_packing_free(&pk);
+    /* slow simple shear (Lees-Edwards): the seed's 1e-5 strain per step for the
+     * RVE, the peers' 1.5 /s for the large packings */
+    gk_m3_zero(L);
+    rate = rve400 ? 1e-5 / rve.dt : 1.5;
+    L[1] = rate;
+    gk_rve_set_velocity_gradient(&rve, L);
+    if (gk_rve_step(&rve, steps / 10 + 10)) { /* warm-up */
+        snprintf(o->err, sizeof o->err, "%s", gk_rve_error(&rve));
+        return 1;
+    }
+    nrep = bc->repeats > 0 ? (bc->repeats > 64 ? 64 : bc->repeats) : 3;
+    for (r = 0; r < nrep; ++r) {
+        double t0 = gk_wtime();
+        if (gk_rve_step(&rve, steps)) {
+            snprintf(o->err, sizeof o->err, "%s", gk_rve_error(&rve));
+            return 1;
+        }
+        secs[r] = gk_wtime() - t0;
+    }
+    qsort(secs, (size_t)nrep, sizeof secs[0], cmp_double);
+    o->dim = rve.dim;
+    o->n = rve.n;
+    o->steps = steps;
+    o->seconds_min = secs[0];
+    o->seconds_median = nrep % 2 ? secs[nrep / 2] : 0.5 * (secs[nrep / 2 - 1] + secs[nrep / 2]);
+    o->particle_steps_per_s = (double)rve.n * steps / o->seconds_median;
+    o->contacts_per_particle = (double)rve.ncontacts / rve.n;
+    o->pairs_per_particle = (double)rve.pl.n / rve.n;
+    o->contact_steps_per_s = (double)rve.ncontacts * steps / o->seconds_median;
+    gk_rve_stress(&rve, o->sigma);
+    gk_rve_destroy(&rve);
+    return 0;
+}
