@@ -333,6 +333,7 @@ GK_FORCE_INLINE gk_vd gk_vd_max(gk_vd a, gk_vd b) { return _mm512_max_pd(a, b); 
 GK_FORCE_INLINE gk_vd gk_vd_round(gk_vd a) {
     return _mm512_roundscale_pd(a, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
 }
+GK_FORCE_INLINE gk_vd gk_vd_floor(gk_vd a) { return _mm512_roundscale_pd(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
 GK_FORCE_INLINE gk_vdm gk_vd_lt(gk_vd a, gk_vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
 GK_FORCE_INLINE gk_vdm gk_vd_le(gk_vd a, gk_vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LE_OQ); }
 GK_FORCE_INLINE gk_vdm gk_vd_gt(gk_vd a, gk_vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ); }
@@ -422,6 +423,7 @@ GK_FORCE_INLINE gk_vd gk_vd_max(gk_vd a, gk_vd b) { return _mm256_max_pd(a, b); 
 GK_FORCE_INLINE gk_vd gk_vd_round(gk_vd a) {
     return _mm256_round_pd(a, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
 }
+GK_FORCE_INLINE gk_vd gk_vd_floor(gk_vd a) { return _mm256_floor_pd(a); }
 GK_FORCE_INLINE gk_vdm gk_vd_lt(gk_vd a, gk_vd b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
 GK_FORCE_INLINE gk_vdm gk_vd_le(gk_vd a, gk_vd b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
 GK_FORCE_INLINE gk_vdm gk_vd_gt(gk_vd a, gk_vd b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
@@ -502,6 +504,7 @@ GK_FORCE_INLINE gk_vd gk_vd_max(gk_vd a, gk_vd b) { return _mm_max_pd(a, b); }
 GK_FORCE_INLINE gk_vd gk_vd_round(gk_vd a) {
     return _mm_round_pd(a, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
 }
+GK_FORCE_INLINE gk_vd gk_vd_floor(gk_vd a) { return _mm_floor_pd(a); }
 GK_FORCE_INLINE gk_vdm gk_vd_lt(gk_vd a, gk_vd b) { return _mm_cmplt_pd(a, b); }
 GK_FORCE_INLINE gk_vdm gk_vd_le(gk_vd a, gk_vd b) { return _mm_cmple_pd(a, b); }
 GK_FORCE_INLINE gk_vdm gk_vd_gt(gk_vd a, gk_vd b) { return _mm_cmpgt_pd(a, b); }
@@ -567,6 +570,7 @@ GK_FORCE_INLINE gk_vd gk_vd_sqrt(gk_vd a) { return sqrt(a); }
 GK_FORCE_INLINE gk_vd gk_vd_min(gk_vd a, gk_vd b) { return a < b ? a : b; }
 GK_FORCE_INLINE gk_vd gk_vd_max(gk_vd a, gk_vd b) { return a > b ? a : b; }
 GK_FORCE_INLINE gk_vd gk_vd_round(gk_vd a) { return rint(a); }
+GK_FORCE_INLINE gk_vd gk_vd_floor(gk_vd a) { return floor(a); }
 GK_FORCE_INLINE gk_vdm gk_vd_lt(gk_vd a, gk_vd b) { return a < b; }
 GK_FORCE_INLINE gk_vdm gk_vd_le(gk_vd a, gk_vd b) { return a <= b; }
 GK_FORCE_INLINE gk_vdm gk_vd_gt(gk_vd a, gk_vd b) { return a > b; }

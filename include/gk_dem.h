@@ -54,6 +54,14 @@
  * GK_MASS_SPHERE: sphere masses for the disks (as LAMMPS in 2D), stress volume
  * = area x t (t = 1 if 0: stress in N/m).
  *
+ * TWO-LEVEL VERLET LISTS. The skin of the def builds the outer candidate list
+ * from the cell grid; the kernels run over an inner list filtered from it
+ * with a quarter of that skin (the whole skin with cohesion), so they do not
+ * spend their time on pairs that are far from touching. Each list has its
+ * own rebuild test (gk_cells.h); history moves between inner lists by pair.
+ * Which pairs a list holds never changes a result (a pair outside contact
+ * adds exactly zero), only the speed.
+ *
  * ORDER AND DETERMINISM. Pairs are kept sorted by (i, j) (gk_cells.h). Each
  * step first computes every pair force (no write conflicts, SIMD), then sums
  * per particle in a fixed order: for particle p, the pairs where p is j in
@@ -168,9 +176,20 @@ typedef struct gk_rve {
     gk_real *tci[3], *tcj[3]; /* torques on i and on j, last step                   */
     int32_t *jstart, *jlist;  /* pairs where p is j: jlist[jstart[p] .. jstart[p+1])*/
     size_t pcap;              /* capacity of the per-pair arrays                    */
+    struct {                  /* second set of per-pair arrays: rebuilds fill it and swap */
+        gk_real *ft[3], *mr[3], *fc[3], *tci[3], *tcj[3];
+        unsigned char *cs;
+        size_t cap;
+        gk_pairlist pl;
+    } spare;
     gk_cells cells;
-    double h0[9];             /* cell at the last build                             */
-    double skin;
+    double h0[9];             /* cell at the last (inner) build                     */
+    double skin;              /* Verlet skin of the outer list [m]                  */
+    double skin_in;           /* skin of the inner list the kernels run over        */
+    gk_pairlist outer;        /* candidates within skin, from the cell grid          */
+    double *o0[3];            /* reduced positions at the outer build               */
+    double ho0[9];            /* cell at the outer build                            */
+    int outer_valid;
     int need_rebuild, diverged;
     /* results of the last step that computed them (the last step of each call) */
     double stress[9];         /* Love stress, tension-positive [Pa]                 */
@@ -726,7 +745,23 @@ static void gk__rve_free_arrays(gk_rve *rve) {
     rve->theta = NULL;
     rve->id = rve->jstart = rve->jlist = NULL;
     rve->cs = NULL;
+    for (k = 0; k < 3; ++k) {
+        gk_free(a, rve->o0[k]);
+        gk_free(a, rve->spare.ft[k]);
+        gk_free(a, rve->spare.mr[k]);
+        gk_free(a, rve->spare.fc[k]);
+        gk_free(a, rve->spare.tci[k]);
+        gk_free(a, rve->spare.tcj[k]);
+        rve->o0[k] = NULL;
+        rve->spare.ft[k] = rve->spare.mr[k] = rve->spare.fc[k] = NULL;
+        rve->spare.tci[k] = rve->spare.tcj[k] = NULL;
+    }
+    gk_free(a, rve->spare.cs);
+    rve->spare.cs = NULL;
+    rve->spare.cap = 0;
+    gk_pairlist_free(&rve->spare.pl);
     gk_pairlist_free(&rve->pl);
+    gk_pairlist_free(&rve->outer);
     gk_cells_free(&rve->cells);
 }
 
@@ -763,6 +798,32 @@ static gk_result gk__pairs_reserve(gk_rve *rve, size_t cap, size_t ncopy) {
     if (gk_realloc(a, (void **)&rve->cs, ncopy, cap, 1)) return GK_ERR_ALLOC;
     if (gk_realloc(a, (void **)&rve->jlist, 0, cap, sizeof(int32_t))) return GK_ERR_ALLOC;
     rve->pcap = cap;
+    return GK_OK;
+}
+
+/* the spare per-pair arrays (same set as the current ones) for cap pairs */
+static gk_result gk__spare_reserve(gk_rve *rve, size_t cap) {
+    const gk_allocator *a = &rve->def.alloc;
+    int dim = rve->dim, k, nft = dim == 2 ? 1 : 3;
+    size_t sz = sizeof(gk_real);
+    if (cap <= rve->spare.cap) return GK_OK;
+    {
+        size_t c = rve->spare.cap ? rve->spare.cap : 64;
+        while (c < cap) c *= 2;
+        cap = c;
+    }
+    for (k = 0; k < 3; ++k) {
+        if (k < nft && gk_realloc(a, (void **)&rve->spare.ft[k], 0, cap, sz)) return GK_ERR_ALLOC;
+        if (k < dim && gk_realloc(a, (void **)&rve->spare.fc[k], 0, cap, sz)) return GK_ERR_ALLOC;
+        if (GK__HAS_ROT(rve) && (dim == 3 || k == 2)) {
+            if (gk_realloc(a, (void **)&rve->spare.tci[k], 0, cap, sz)) return GK_ERR_ALLOC;
+            if (gk_realloc(a, (void **)&rve->spare.tcj[k], 0, cap, sz)) return GK_ERR_ALLOC;
+        }
+        if (GK__HAS_ROLL(rve) && (dim == 3 || k == 2) && gk_realloc(a, (void **)&rve->spare.mr[k], 0, cap, sz))
+            return GK_ERR_ALLOC;
+    }
+    if (gk_realloc(a, (void **)&rve->spare.cs, 0, cap, 1)) return GK_ERR_ALLOC;
+    rve->spare.cap = cap;
     return GK_OK;
 }
 
@@ -901,9 +962,10 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
             if (k < dim) {
                 R.s[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
                 R.s0[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
+                R.o0[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
                 R.v[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
                 R.f[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-                if (!R.s[k] || !R.s0[k] || !R.v[k] || !R.f[k]) res = GK_ERR_ALLOC;
+                if (!R.s[k] || !R.s0[k] || !R.o0[k] || !R.v[k] || !R.f[k]) res = GK_ERR_ALLOC;
             }
             if (GK__HAS_ROT(&R) && (dim == 3 || k == 2)) {
                 R.w[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
@@ -919,6 +981,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         if (dim == 2) R.theta = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
         if (!R.r || !R.minv || !R.Iinv || !R.id || !R.jstart || (dim == 2 && !R.theta)) res = GK_ERR_ALLOC;
         gk_pairlist_init(&R.pl, &def->alloc);
+        gk_pairlist_init(&R.outer, &def->alloc);
+        gk_pairlist_init(&R.spare.pl, &def->alloc);
         gk_cells_init(&R.cells, &def->alloc);
         if (!res) {
             R.rmin = 1e300;
@@ -966,10 +1030,13 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         }
     }
     R.skin = def->skin > 0.0 ? def->skin : 0.1 * rsum / n;
+    R.skin_in = 0.25 * R.skin;
     if (R.phys & GK_PHYS_COHESION) { /* a bond may stretch to coh_n / k_n before breaking */
         double knmin = def->mat.kn > 0 ? def->mat.kn : def->mat.young * R.rmin;
         if (R.skin < 2.0 * def->mat.coh_n / knmin) R.skin = 2.0 * def->mat.coh_n / knmin;
+        R.skin_in = R.skin;
     }
+    R.outer_valid = 0;
     gk_pcell_widths(&R.cell, w);
     cutoff = 2.0 * R.rmax + R.skin;
     for (k = 0; k < dim; ++k)
@@ -1007,6 +1074,36 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     return GK_OK;
 }
 
+/* Verlet margin of a list built at (href, sref): a pair listed out was at least
+ * r_i + r_j + skin apart; it is now at least r_i + r_j + margin apart
+ * (smallest singular value of the affine map and largest non-affine
+ * displacement, as gk_cells_skin_ok). */
+static double gk__list_margin(const gk_rve *rve, const double href[9], double *const sref[3], double skin) {
+    double hi[9], A[9], At[9], AtA[9], smin, m2 = 0.0;
+    const double *h = rve->cell.h;
+    int p, dim = rve->dim;
+    if (!(gk_m3_inverse(href, hi) > 0.0)) return -1.0;
+    gk_m3_mul(h, hi, A);
+    gk_m3_transpose(A, At);
+    gk_m3_mul(At, A, AtA);
+    if (dim == 2) {
+        double a = AtA[0], b = AtA[1], d = AtA[4], lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
+        smin = lmin > 0.0 ? sqrt(lmin) : 0.0;
+    } else {
+        double val[3], vec[9];
+        gk_m3_sym_eigen(AtA, val, vec);
+        smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
+    }
+    for (p = 0; p < rve->n; ++p) {
+        double e0 = rve->s[0][p] - sref[0][p], e1 = rve->s[1][p] - sref[1][p], e2 = dim == 3 ? rve->s[2][p] - sref[2][p] : 0;
+        double u0 = h[0] * e0 + h[1] * e1 + h[2] * e2, u1 = h[3] * e0 + h[4] * e1 + h[5] * e2;
+        double u2 = dim == 3 ? h[6] * e0 + h[7] * e1 + h[8] * e2 : 0.0, d2 = u0 * u0 + u1 * u1 + u2 * u2;
+        if (d2 > m2) m2 = d2;
+    }
+    if (!isfinite(m2)) return -1.0;
+    return smin * skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(m2);
+}
+
 /* rebuild the pair list at the current positions, carrying history over by merge */
 static gk_result gk__rve_rebuild(gk_rve *rve) {
     gk_pairlist nl;
@@ -1022,91 +1119,123 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
                               "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
                               "too far for this many particles)",
                               w[k], 2.0 * rve->rmax + rve->skin);
-    /* wrap positions into [0,1): the nearest image is unaffected */
-    for (k = 0; k < dim; ++k)
-        for (p = 0; p < n; ++p) {
-            double s = rve->s[k][p];
-            if (s < 0.0 || s >= 1.0) {
-                s -= floor(s);
-                if (s >= 1.0) s = 0.0;
-                rve->s[k][p] = s;
-            }
-        }
-    for (k = 0; k < 3; ++k) sp[k] = rve->s[k < dim ? k : 0];
-    res = gk_cells_bin(&rve->cells, dim, rve->cell.h, n, sp, 2.0 * rve->rmax + rve->skin, &rve->err);
-    if (res) return res;
-    gk_pairlist_init(&nl, &rve->def.alloc);
-    res = gk_cells_pairs(&rve->cells, rve->cell.h, sp, rve->r, rve->skin, &nl, &rve->err);
-    if (res) {
-        gk_pairlist_free(&nl);
-        return res;
-    }
-    {
-        /* new per-pair arrays, filled by a merge with the old list (both sorted by (i, j)) */
-        gk_rve tmp;
-        memset(&tmp, 0, sizeof tmp);
-        tmp.dim = dim;
-        tmp.phys = rve->phys;
-        tmp.def.alloc = rve->def.alloc;
-        res = gk__pairs_reserve(&tmp, (size_t)nl.n + 1, 0);
+    if (!rve->outer_valid || gk__list_margin(rve, rve->ho0, rve->o0, rve->skin) <= rve->skin_in) {
+        /* outer list from the cell grid (positions are in [0,1): gk__wrap) */
+        for (k = 0; k < 3; ++k) sp[k] = rve->s[k < dim ? k : 0];
+        res = gk_cells_bin(&rve->cells, dim, rve->cell.h, n, sp, 2.0 * rve->rmax + rve->skin, &rve->err);
+        if (res) return res;
+        res = gk_cells_pairs(&rve->cells, rve->cell.h, sp, rve->r, rve->skin, &rve->outer, &rve->err);
         if (res) {
+            rve->outer_valid = 0;
+            return res;
+        }
+        for (k = 0; k < dim; ++k) memcpy(rve->o0[k], rve->s[k], (size_t)n * sizeof(double));
+        gk_m3_copy(rve->cell.h, rve->ho0);
+        rve->outer_valid = 1;
+    }
+    /* inner list: outer pairs closer than r_i + r_j + skin_in, in outer order,
+     * written into the spare list and spare per-pair arrays */
+    nl = rve->spare.pl;
+    if (gk_pairlist_reserve(&nl, (size_t)rve->outer.n + 1, (size_t)n) ||
+        gk__spare_reserve(rve, (size_t)rve->outer.n + 1) || gk__pairs_reserve(rve, (size_t)rve->outer.n + 1, (size_t)rve->pl.n)) {
+        rve->spare.pl = nl;
+        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", rve->outer.n);
+    }
+    nl.np = n;
+    nl.n = 0;
+    for (p = 0; p <= n; ++p) nl.start[p] = 0;
+    {
+        const double *h = rve->cell.h, skin = rve->skin_in;
+        const int32_t *oi = rve->outer.i, *oj = rve->outer.j;
+        const gk_real *r = rve->r;
+        int no = rve->outer.n;
+        if (dim == 2) {
+            const double *sx = rve->s[0], *sy = rve->s[1];
+            for (c = 0; c < no; ++c) {
+                int i = oi[c], j = oj[c];
+                double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i], dx, dy, cut = (double)r[i] + (double)r[j] + skin;
+                dsx -= rint(dsx);
+                dsy -= rint(dsy);
+                dx = h[0] * dsx + h[1] * dsy;
+                dy = h[3] * dsx + h[4] * dsy;
+                if (dx * dx + dy * dy < cut * cut) {
+                    nl.i[nl.n] = i;
+                    nl.j[nl.n] = j;
+                    ++nl.n;
+                    ++nl.start[i + 1];
+                }
+            }
+        } else {
+            const double *sx = rve->s[0], *sy = rve->s[1], *sz = rve->s[2];
+            for (c = 0; c < no; ++c) {
+                int i = oi[c], j = oj[c];
+                double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i], dsz = sz[j] - sz[i], dx, dy, dz;
+                double cut = (double)r[i] + (double)r[j] + skin;
+                dsx -= rint(dsx);
+                dsy -= rint(dsy);
+                dsz -= rint(dsz);
+                dx = h[0] * dsx + h[1] * dsy + h[2] * dsz;
+                dy = h[3] * dsx + h[4] * dsy + h[5] * dsz;
+                dz = h[6] * dsx + h[7] * dsy + h[8] * dsz;
+                if (dx * dx + dy * dy + dz * dz < cut * cut) {
+                    nl.i[nl.n] = i;
+                    nl.j[nl.n] = j;
+                    ++nl.n;
+                    ++nl.start[i + 1];
+                }
+            }
+        }
+    }
+    for (p = 0; p < n; ++p) nl.start[p + 1] += nl.start[p];
+    /* history into the spare arrays by a merge with the current list (both sorted by (i, j)) */
+    oc = 0;
+    for (c = 0; c < nl.n; ++c) {
+        int32_t ni = nl.i[c], nj = nl.j[c];
+        while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj))) ++oc;
+        if (oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj) {
+            for (k = 0; k < nft; ++k) rve->spare.ft[k][c] = rve->ft[k][oc];
+            for (k = 0; k < dim; ++k) rve->spare.fc[k][c] = rve->fc[k][oc];
             for (k = 0; k < 3; ++k) {
-                gk_free(&rve->def.alloc, tmp.ft[k]);
-                gk_free(&rve->def.alloc, tmp.fc[k]);
-                gk_free(&rve->def.alloc, tmp.tci[k]);
-                gk_free(&rve->def.alloc, tmp.tcj[k]);
-                gk_free(&rve->def.alloc, tmp.mr[k]);
-            }
-            gk_free(&rve->def.alloc, tmp.cs);
-            gk_free(&rve->def.alloc, tmp.jlist);
-            gk_pairlist_free(&nl);
-            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", nl.n);
-        }
-        oc = 0;
-        for (c = 0; c < nl.n; ++c) {
-            int32_t ni = nl.i[c], nj = nl.j[c];
-            while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj))) ++oc;
-            if (oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj) {
-                for (k = 0; k < nft; ++k) tmp.ft[k][c] = rve->ft[k][oc];
-                for (k = 0; k < dim; ++k) tmp.fc[k][c] = rve->fc[k][oc];
-                for (k = 0; k < 3; ++k) {
-                    if (tmp.tci[k]) {
-                        tmp.tci[k][c] = rve->tci[k][oc];
-                        tmp.tcj[k][c] = rve->tcj[k][oc];
-                    }
-                    if (tmp.mr[k]) tmp.mr[k][c] = rve->mr[k][oc];
+                if (rve->spare.tci[k]) {
+                    rve->spare.tci[k][c] = rve->tci[k][oc];
+                    rve->spare.tcj[k][c] = rve->tcj[k][oc];
                 }
-                tmp.cs[c] = rve->cs[oc];
-            } else {
-                for (k = 0; k < nft; ++k) tmp.ft[k][c] = 0;
-                for (k = 0; k < dim; ++k) tmp.fc[k][c] = 0;
-                for (k = 0; k < 3; ++k) {
-                    if (tmp.tci[k]) tmp.tci[k][c] = tmp.tcj[k][c] = 0;
-                    if (tmp.mr[k]) tmp.mr[k][c] = 0;
-                }
-                tmp.cs[c] = 0;
+                if (rve->spare.mr[k]) rve->spare.mr[k][c] = rve->mr[k][oc];
             }
+            rve->spare.cs[c] = rve->cs[oc];
+        } else {
+            for (k = 0; k < nft; ++k) rve->spare.ft[k][c] = 0;
+            for (k = 0; k < dim; ++k) rve->spare.fc[k][c] = 0;
+            for (k = 0; k < 3; ++k) {
+                if (rve->spare.tci[k]) rve->spare.tci[k][c] = rve->spare.tcj[k][c] = 0;
+                if (rve->spare.mr[k]) rve->spare.mr[k][c] = 0;
+            }
+            rve->spare.cs[c] = 0;
         }
-        /* swap in */
+    }
+    /* swap the spare set in */
+    {
+        gk_pairlist t = rve->pl;
+        size_t cap = rve->pcap;
+        unsigned char *cs = rve->cs;
         for (k = 0; k < 3; ++k) {
-            gk_free(&rve->def.alloc, rve->ft[k]);
-            gk_free(&rve->def.alloc, rve->fc[k]);
-            gk_free(&rve->def.alloc, rve->tci[k]);
-            gk_free(&rve->def.alloc, rve->tcj[k]);
-            gk_free(&rve->def.alloc, rve->mr[k]);
-            rve->ft[k] = tmp.ft[k];
-            rve->fc[k] = tmp.fc[k];
-            rve->tci[k] = tmp.tci[k];
-            rve->tcj[k] = tmp.tcj[k];
-            rve->mr[k] = tmp.mr[k];
+            gk_real *x;
+#define GK__SWAP(f) x = rve->f[k], rve->f[k] = rve->spare.f[k], rve->spare.f[k] = x
+            GK__SWAP(ft);
+            GK__SWAP(mr);
+            GK__SWAP(fc);
+            GK__SWAP(tci);
+            GK__SWAP(tcj);
+#undef GK__SWAP
         }
-        gk_free(&rve->def.alloc, rve->cs);
-        gk_free(&rve->def.alloc, rve->jlist);
-        rve->cs = tmp.cs;
-        rve->jlist = tmp.jlist;
-        rve->pcap = tmp.pcap;
-        gk_pairlist_free(&rve->pl);
+        rve->cs = rve->spare.cs;
+        rve->spare.cs = cs;
+        rve->pcap = rve->spare.cap;
+        rve->spare.cap = cap;
         rve->pl = nl;
+        rve->spare.pl = t;
+        if (rve->pcap > cap && gk_realloc(&rve->def.alloc, (void **)&rve->jlist, 0, rve->pcap, sizeof(int32_t)))
+            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", nl.n);
     }
     /* pairs where p is j, ascending pair index (counting sort by j) */
     for (p = 0; p <= n; ++p) rve->jstart[p] = 0;
@@ -1234,8 +1363,9 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
  * remainder of a range (fewer than GK_VR_W pairs) and cohesive contacts go
  * through the scalar reference. */
 #if GK_VR_W > 1
-/* branch vectors d = h (ds - round(ds)) of GK_VR_W pairs, from double positions */
-GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk__stepctx *x, const int32_t *ii, const int32_t *jj,
+/* branch vectors d = h (ds - round(ds)) of GK_VR_W pairs, from double
+ * positions; H = the cell matrix broadcast once per call */
+GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const int32_t *ii, const int32_t *jj,
                                      int dim, gk_vr d[3]) {
     gk_vd dd[2][3];
     int hf, k;
@@ -1246,8 +1376,8 @@ GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk__stepctx *x, co
             ds[k] = gk_vd_sub(ds[k], gk_vd_round(ds[k]));
         }
         for (k = 0; k < dim; ++k) {
-            gk_vd a = gk_vd_add(gk_vd_mul(gk_vd_set1(x->hd[3 * k]), ds[0]), gk_vd_mul(gk_vd_set1(x->hd[3 * k + 1]), ds[1]));
-            if (dim == 3) a = gk_vd_add(a, gk_vd_mul(gk_vd_set1(x->hd[3 * k + 2]), ds[2]));
+            gk_vd a = gk_vd_add(gk_vd_mul(H[3 * k], ds[0]), gk_vd_mul(H[3 * k + 1], ds[1]));
+            if (dim == 3) a = gk_vd_add(a, gk_vd_mul(H[3 * k + 2], ds[2]));
             dd[hf][k] = a;
         }
     }
@@ -1279,11 +1409,32 @@ GK_FORCE_INLINE void gk__simd_stiffness(const gk_law_consts *K, gk_law law, gk_v
     }
 }
 
-GK_FORCE_INLINE void gk__simd_state(unsigned char *cs, gk_vrm in, gk_vrm slide) {
+/* 8 mask bits -> 8 bytes of 0/1 (bit l -> byte l): a constant table */
+#define GK__E(b)                                                                                                        \
+    ((uint64_t)((b) >> 0 & 1) | (uint64_t)((b) >> 1 & 1) << 8 | (uint64_t)((b) >> 2 & 1) << 16 |                       \
+     (uint64_t)((b) >> 3 & 1) << 24 | (uint64_t)((b) >> 4 & 1) << 32 | (uint64_t)((b) >> 5 & 1) << 40 |                \
+     (uint64_t)((b) >> 6 & 1) << 48 | (uint64_t)((b) >> 7 & 1) << 56)
+#define GK__R4(b) GK__E(b), GK__E((b) + 1), GK__E((b) + 2), GK__E((b) + 3)
+#define GK__R16(b) GK__R4(b), GK__R4((b) + 4), GK__R4((b) + 8), GK__R4((b) + 12)
+#define GK__R64(b) GK__R16(b), GK__R16((b) + 16), GK__R16((b) + 32), GK__R16((b) + 48)
+static const uint64_t gk__bitbytes[256] = {GK__R64(0), GK__R64(64), GK__R64(128), GK__R64(192)};
+#undef GK__R64
+#undef GK__R16
+#undef GK__R4
+#undef GK__E
+
+/* contact state bytes of GK_VR_W lanes: CONTACT where in, SLIDING where also slide */
+GK_FORCE_INLINE void gk__simd_state(unsigned char *cs, gk_vrm in, gk_vrm slide, const uint64_t *lut) {
     unsigned bi = gk_vrm_bits(in), bs = gk_vrm_bits(gk_vrm_and(in, slide));
     int l;
-    for (l = 0; l < GK_VR_W; ++l)
-        cs[l] = (unsigned char)(((bi >> l) & 1u) * GK_CS_CONTACT | ((bs >> l) & 1u) * GK_CS_SLIDING);
+    for (l = 0; l < GK_VR_W; l += 8) {
+        uint64_t v = lut[(bi >> l) & 0xffu] * GK_CS_CONTACT | lut[(bs >> l) & 0xffu] * GK_CS_SLIDING;
+        int m, nb = GK_VR_W - l < 8 ? GK_VR_W - l : 8;
+        if (nb == 8)
+            memcpy(cs + l, &v, 8);
+        else
+            for (m = 0; m < nb; ++m) cs[l + m] = (unsigned char)(v >> (8 * m));
+    }
 }
 
 GK_FORCE_INLINE void gk__scatter_buf_2d(gk_rve *rve, const int32_t *ii, const int32_t *jj, const gk_real *bx,
@@ -1327,13 +1478,16 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
     const gk_vr wa = gk_vr_set1(x->wa[2]), mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
     const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta);
     gk_real bx[GK_VR_W], by[GK_VR_W], bi[GK_VR_W], bj[GK_VR_W];
-    int c = c0, pend = -1;
+    gk_vd H[9];
+    const uint64_t *lut = gk__bitbytes;
+    int c = c0, pend = -1, k;
+    for (k = 0; k < 9; ++k) H[k] = gk_vd_set1(x->hd[k]); /* hoisted: stores to doubles could alias x->hd */
     for (; c + GK_VR_W <= c1; c += GK_VR_W) {
         const int32_t *ii = pi + c, *jj = pj + c;
         gk_vr d[3], ri, rj, R, d2, dist, inv, nx, ny, delta, kn, fn, kt, vx, vy, vn, mstar = zero, li, lj, hd;
         gk_vr fx, fy, ti = zero, tj = zero, wi = wa, wj = wa, fnp = zero, ftot = zero, fh = zero, m = zero;
         gk_vrm in, slide = gk_vr_lt(one, zero);
-        gk__simd_branch(rve, x, ii, jj, 2, d);
+        gk__simd_branch(rve, H, ii, jj, 2, d);
         ri = gk_vr_gather(rve->r, ii);
         rj = gk_vr_gather(rve->r, jj);
         R = gk_vr_add(ri, rj);
@@ -1406,7 +1560,7 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
         tj = gk_vr_select(in, tj, zero);
         if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[0] + c, gk_vr_select(in, fh, zero));
         if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[2] + c, gk_vr_select(in, m, zero));
-        gk__simd_state(rve->cs + c, in, slide);
+        gk__simd_state(rve->cs + c, in, slide, lut);
         if (x->store) {
             gk_vr_store(rve->fc[0] + c, fx);
             gk_vr_store(rve->fc[1] + c, fy);
@@ -1458,16 +1612,21 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
     const gk_vr mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
     const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta), halfdt = gk_vr_mul(half, dt);
     gk_vr G[9], wa[3];
+    gk_vd H[9];
     gk_real bF[3][GK_VR_W], bI[3][GK_VR_W], bJ[3][GK_VR_W];
+    const uint64_t *lut = gk__bitbytes;
     int c = c0, k, pend = -1;
-    for (k = 0; k < 9; ++k) G[k] = gk_vr_set1(x->G[k]);
+    for (k = 0; k < 9; ++k) {
+        G[k] = gk_vr_set1(x->G[k]);
+        H[k] = gk_vd_set1(x->hd[k]);
+    }
     for (k = 0; k < 3; ++k) wa[k] = gk_vr_set1(x->wa[k]);
     for (; c + GK_VR_W <= c1; c += GK_VR_W) {
         const int32_t *ii = pi + c, *jj = pj + c;
         gk_vr d[3], n[3], v[3], wi[3], wj[3], F[3], ti[3], tj[3], fh[3], mh[3];
         gk_vr ri, rj, R, d2, dist, inv, delta, kn, fn, kt, vn, mstar = zero, hd, li, lj, twist = zero, fnp;
         gk_vrm in, slide = gk_vr_lt(one, zero);
-        gk__simd_branch(rve, x, ii, jj, 3, d);
+        gk__simd_branch(rve, H, ii, jj, 3, d);
         ri = gk_vr_gather(rve->r, ii);
         rj = gk_vr_gather(rve->r, jj);
         R = gk_vr_add(ri, rj);
@@ -1585,7 +1744,7 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
                 }
             }
         }
-        gk__simd_state(rve->cs + c, in, slide);
+        gk__simd_state(rve->cs + c, in, slide, lut);
         if (x->scatter) { /* pipelined as in 2D */
             if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, bF, bI, bJ, fl & GK_PHYS_ROTATION);
             for (k = 0; k < 3; ++k) {
@@ -1752,6 +1911,16 @@ GK_FORCE_INLINE gk_real gk__damp_component(gk_real a, gk_real v, gk_real dt, gk_
     return a * ((gk_real)1 - alpha * sg);
 }
 
+/* Keep s in [0, 1) every step, shifting the list references by the same whole
+ * period, so that when a position wraps depends on the dynamics only, never
+ * on when a list is rebuilt (s_j - s_i rounds differently after a wrap). */
+GK_FORCE_INLINE void gk__wrap(gk_rve *rve, int p, int k) {
+    double fl = floor(rve->s[k][p]);
+    rve->s[k][p] -= fl;
+    rve->s0[k][p] -= fl;
+    rve->o0[k][p] -= fl;
+}
+
 /* leap-frog for particles [p0, p1) with the force sums in f, t; returns the
  * largest squared non-affine displacement since the last build; *bad if a
  * non-finite value appeared. damp: 0 none, 1 component, 2 vector. */
@@ -1759,8 +1928,8 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
                                             int p0, int p1, int *bad, const int dim, const int rot, const int damp) {
     const gk_real dt = x->dt, alpha = (gk_real)rve->def.damping, hdt = (gk_real)0.5 * dt;
     const gk_real *GK_RESTRICT minv = rve->minv, *GK_RESTRICT Iinv = rve->Iinv;
-    double *GK_RESTRICT s0 = rve->s[0], *GK_RESTRICT s1 = rve->s[1], *GK_RESTRICT s2 = dim == 3 ? rve->s[2] : NULL;
-    const double *GK_RESTRICT r0 = rve->s0[0], *GK_RESTRICT r1 = rve->s0[1], *GK_RESTRICT r2 = dim == 3 ? rve->s0[2] : NULL;
+    double *s0 = rve->s[0], *s1 = rve->s[1], *s2 = dim == 3 ? rve->s[2] : NULL;
+    const double *r0 = rve->s0[0], *r1 = rve->s0[1], *r2 = dim == 3 ? rve->s0[2] : NULL;
     gk_real *GK_RESTRICT v0 = rve->v[0], *GK_RESTRICT v1 = rve->v[1], *GK_RESTRICT v2 = dim == 3 ? rve->v[2] : NULL;
     const gk_real *GK_RESTRICT f0 = rve->f[0], *GK_RESTRICT f1 = rve->f[1], *GK_RESTRICT f2 = dim == 3 ? rve->f[2] : NULL;
     const double h00 = hinv[0], h01 = hinv[1], h02 = hinv[2], h10 = hinv[3], h11 = hinv[4], h12 = hinv[5], h20 = hinv[6],
@@ -1801,6 +1970,8 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
             if (dim == 2) {
                 s0[p] += h00 * d0 + h01 * d1;
                 s1[p] += h10 * d0 + h11 * d1;
+                gk__wrap(rve, p, 0);
+                gk__wrap(rve, p, 1);
                 e0 = s0[p] - r0[p];
                 e1 = s1[p] - r1[p];
                 u0 = g00 * e0 + g01 * e1;
@@ -1810,6 +1981,9 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
                 s0[p] += h00 * d0 + h01 * d1 + h02 * d2;
                 s1[p] += h10 * d0 + h11 * d1 + h12 * d2;
                 s2[p] += h20 * d0 + h21 * d1 + h22 * d2;
+                gk__wrap(rve, p, 0);
+                gk__wrap(rve, p, 1);
+                gk__wrap(rve, p, 2);
                 e0 = s0[p] - r0[p];
                 e1 = s1[p] - r1[p];
                 e2 = s2[p] - r2[p];
@@ -1914,8 +2088,14 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
             gk_vd inc = gk_vd_add(gk_vd_mul(H[3 * k], d[0]), gk_vd_mul(H[3 * k + 1], d[1]));
             if (dim == 3) inc = gk_vd_add(inc, gk_vd_mul(H[3 * k + 2], d[2]));
             sp[k] = gk_vd_add(gk_vd_loadu(rve->s[k] + p), inc);
-            gk_vd_storeu(rve->s[k] + p, sp[k]);
-            e[k] = gk_vd_sub(sp[k], gk_vd_loadu(rve->s0[k] + p));
+            {   /* gk__wrap */
+                gk_vd fl = gk_vd_floor(sp[k]), r0 = gk_vd_sub(gk_vd_loadu(rve->s0[k] + p), fl);
+                sp[k] = gk_vd_sub(sp[k], fl);
+                gk_vd_storeu(rve->s0[k] + p, r0);
+                gk_vd_storeu(rve->o0[k] + p, gk_vd_sub(gk_vd_loadu(rve->o0[k] + p), fl));
+                gk_vd_storeu(rve->s[k] + p, sp[k]);
+                e[k] = gk_vd_sub(sp[k], r0);
+            }
         }
         for (k = 0; k < dim; ++k) {
             u[k] = gk_vd_add(gk_vd_mul(Gn[3 * k], e[0]), gk_vd_mul(Gn[3 * k + 1], e[1]));
@@ -2119,6 +2299,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
             for (k = 0; k < rve->dim; ++k) {
                 rve->s[k][p] = b[k];
                 rve->s0[k][p] = b0[k];
+                gk__wrap(rve, p, k);
             }
         }
         {
@@ -2127,6 +2308,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
             gk_m3_copy(h0n, rve->h0);
         }
         rve->need_rebuild = 1;
+        rve->outer_valid = 0;
     }
     dispmax2 = gk__integrate(rve, &x, rve->cell.hinv, rve->cell.h, &bad);
     rve->time += rve->dt;
@@ -2152,7 +2334,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
             gk_m3_sym_eigen(AtA, val, vec);
             smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
         }
-        margin = smin * rve->skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
+        margin = smin * rve->skin_in - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
         if (!(margin > 0.0)) rve->need_rebuild = 1;
     }
     return GK_OK;
@@ -2179,6 +2361,8 @@ GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *s) {
         rve->servo_on = 0;
         return GK_OK;
     }
+    if (s->shear && !(isfinite(s->shear_target[0]) && isfinite(s->shear_target[1]) && isfinite(s->shear_target[2])))
+        return gk_err_set(&rve->err, GK_ERR_NAN, "servo: non-finite shear target");
     for (k = 0; k < rve->dim; ++k) {
         if (s->mode[k] != GK_SERVO_STRAIN && s->mode[k] != GK_SERVO_STRESS)
             return gk_err_set(&rve->err, GK_ERR_ARG, "servo axis %d: unknown mode %d", k, (int)s->mode[k]);
@@ -2402,6 +2586,7 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
     }
     sv.max_rate = rate;
     sv.gain = 0.1; /* of the Taylor stiffness, which overestimates the packing's own */
+    sv.shear = 1;  /* isotropic: the shear stresses go to zero as well */
     rve->K.mu = (gk_real)cd->friction;
     if (cd->damping > 0.0) rve->def.damping = cd->damping;
     gk_m3_zero(rve->L);
@@ -2414,7 +2599,12 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
         if (res) break;
         for (k = 0; k < rve->dim; ++k) {
             double e = fabs(rve->stress[4 * k] + cd->pressure) / cd->pressure;
+            int l;
             if (e > errmax) errmax = e;
+            for (l = k + 1; l < rve->dim; ++l) {
+                e = fabs(0.5 * (rve->stress[3 * k + l] + rve->stress[3 * l + k])) / cd->pressure;
+                if (e > errmax) errmax = e;
+            }
         }
         for (p = 0; p < rve->n; ++p) {
             double f2 = 0.0;
@@ -2472,9 +2662,11 @@ typedef struct gk__state_hdr {
     int32_t ncontacts, need_rebuild, servo_on, pad2;
     gk_servo servo;
     double mu;
+    int32_t nouter, outer_valid;
+    double ho0[9], skin_in;
 } gk__state_hdr;
 
-static size_t gk__state_bytes(const gk_rve *rve, int npairs) {
+static size_t gk__state_bytes(const gk_rve *rve, int npairs, int nouter) {
     int dim = rve->dim, nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0, nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
     size_t n = (size_t)rve->n, np = (size_t)npairs, R = sizeof(gk_real), b = sizeof(gk__state_hdr);
     b += n * (2 * dim * sizeof(double)); /* s, s0 */
@@ -2482,10 +2674,11 @@ static size_t gk__state_bytes(const gk_rve *rve, int npairs) {
     b += dim == 2 ? n * sizeof(double) : 0; /* theta */
     b += np * (2 * sizeof(int32_t) + 1);   /* i, j, cs */
     b += np * R * ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll); /* ft, fc, tci, tcj, mr */
+    b += (size_t)nouter * 2 * sizeof(int32_t) + n * dim * sizeof(double); /* outer list, o0 */
     return b;
 }
 
-GKDEF size_t gk_rve_state_size(const gk_rve *rve) { return gk__state_bytes(rve, rve->pl.n); }
+GKDEF size_t gk_rve_state_size(const gk_rve *rve) { return gk__state_bytes(rve, rve->pl.n, rve->outer.n); }
 
 #define GK__PUT(ptr, bytes)                 \
     do {                                    \
@@ -2536,6 +2729,10 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
     hd.servo_on = rve->servo_on;
     hd.servo = rve->servo;
     hd.mu = (double)rve->K.mu;
+    hd.nouter = rve->outer.n;
+    hd.outer_valid = rve->outer_valid;
+    gk_m3_copy(rve->ho0, hd.ho0);
+    hd.skin_in = rve->skin_in;
     GK__PUT(&hd, sizeof hd);
     for (k = 0; k < dim; ++k) GK__PUT(rve->s[k], n * sizeof(double));
     for (k = 0; k < dim; ++k) GK__PUT(rve->s0[k], n * sizeof(double));
@@ -2559,6 +2756,9 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
         }
     for (k = 0; k < 3; ++k)
         if (rve->mr[k]) GK__PUT(rve->mr[k], np * R);
+    GK__PUT(rve->outer.i, (size_t)rve->outer.n * sizeof(int32_t));
+    GK__PUT(rve->outer.j, (size_t)rve->outer.n * sizeof(int32_t));
+    for (k = 0; k < dim; ++k) GK__PUT(rve->o0[k], n * sizeof(double));
     GK_ASSERT(off == need);
     return GK_OK;
 }
@@ -2579,13 +2779,25 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         return gk_err_set(&rve->err, GK_ERR_FORMAT,
                           "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
                           hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
-    if (hd.npairs < 0 || size != gk__state_bytes(rve, hd.npairs))
+    if (hd.npairs < 0 || hd.nouter < 0 || size != gk__state_bytes(rve, hd.npairs, hd.nouter))
         return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state has the wrong size");
     n = (size_t)rve->n;
     np = (size_t)hd.npairs;
     /* capacity first, so a failure changes nothing observable */
-    if (gk__pairs_reserve(rve, np + 1, (size_t)rve->pl.n) || gk_pairlist_reserve(&rve->pl, np + 1, n))
+    if (gk__pairs_reserve(rve, np + 1, (size_t)rve->pl.n) || gk_pairlist_reserve(&rve->pl, np + 1, n) ||
+        gk_pairlist_reserve(&rve->outer, (size_t)hd.nouter + 1, n))
         return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory restoring %d pairs", hd.npairs);
+    {   /* outer list indices */
+        size_t ob = size - (size_t)hd.nouter * 8 - n * (size_t)dim * sizeof(double);
+        for (c = 0; c < hd.nouter; ++c) {
+            int32_t a, b;
+            memcpy(&a, in + ob + (size_t)c * 4, 4);
+            memcpy(&b, in + ob + (size_t)hd.nouter * 4 + (size_t)c * 4, 4);
+            if (a < 0 || b <= a || b >= rve->n)
+                return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid particles (%d, %d)", c,
+                                  a, b);
+        }
+    }
     /* validate pair indices before touching anything */
     {
         size_t base = sizeof hd + n * (2 * dim * sizeof(double)) +
@@ -2623,6 +2835,14 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         }
     for (k = 0; k < 3; ++k)
         if (rve->mr[k]) GK__GET(rve->mr[k], np * R);
+    GK__GET(rve->outer.i, (size_t)hd.nouter * sizeof(int32_t));
+    GK__GET(rve->outer.j, (size_t)hd.nouter * sizeof(int32_t));
+    for (k = 0; k < dim; ++k) GK__GET(rve->o0[k], n * sizeof(double));
+    rve->outer.n = hd.nouter;
+    rve->outer.np = rve->n;
+    rve->outer_valid = hd.outer_valid;
+    gk_m3_copy(hd.ho0, rve->ho0);
+    rve->skin_in = hd.skin_in;
     rve->pl.n = hd.npairs;
     rve->pl.np = rve->n;
     /* CSR by i and the j index are functions of the pair list */

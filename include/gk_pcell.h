@@ -85,6 +85,8 @@ typedef struct gk_servo {
     double rate[3];    /* prescribed L_kk for strain-controlled axes [1/s]       */
     double max_rate;   /* cap on |L_kk| for stress-controlled axes [1/s] (> 0)   */
     double gain;       /* fraction of the stress error corrected per step; 0 -> 0.02 */
+    int shear;         /* 1: also drive the shear stresses sigma_kl (k < l) to    */
+    double shear_target[3]; /* these targets (xy, xz, yz) with a symmetric L_kl = L_lk */
 } gk_servo;
 
 #ifdef __cplusplus
@@ -113,7 +115,10 @@ GKDEF void gk_path_map(const gk_path *p, int k, double M[9]);
 
 /* Servo: writes L_kk for k < dim from the current stress sigma (tension-
  * positive) and per-axis stiffness estimates stiff[k] [Pa] (e.g. the Taylor
- * tangent's D_kkkk; <= 0 means unknown: move at max_rate). */
+ * tangent's D_kkkk; <= 0 means unknown: move at max_rate). With shear = 1
+ * it also writes the symmetric off-diagonal rates L_kl = L_lk that drive
+ * sigma_kl to shear_target, using half the mean of stiff[k] and stiff[l] as
+ * the shear stiffness (a pure shear rate eps_kl changes sigma_kl by 2 G). */
 GKDEF void gk_servo_rates(const gk_servo *s, int dim, const double sigma[9], const double stiff[3], double dt,
                           double L[9]);
 
@@ -351,6 +356,22 @@ GKDEF void gk_servo_rates(const gk_servo *s, int dim, const double sigma[9], con
             L[4 * k] = gk_clamp(rate, -s->max_rate, s->max_rate);
         } else {
             L[4 * k] = s->rate[k];
+        }
+    }
+    if (s->shear) {
+        static const int pk[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+        int q;
+        for (q = 0; q < (dim == 3 ? 3 : 1); ++q) {
+            int a = pk[q][0], b = pk[q][1];
+            double sig = 0.5 * (sigma[3 * a + b] + sigma[3 * b + a]), err = s->shear_target[q] - sig;
+            double G = 0.25 * (stiff[a] + stiff[b]), rate; /* half the mean normal stiffness */
+            if (G > 0.0 && dt > 0.0)
+                rate = gain * err / (2.0 * G * dt);
+            else
+                rate = err > 0.0 ? s->max_rate : (err < 0.0 ? -s->max_rate : 0.0);
+            rate = gk_clamp(rate, -s->max_rate, s->max_rate);
+            L[3 * a + b] = rate;
+            L[3 * b + a] = rate;
         }
     }
 }
