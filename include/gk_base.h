@@ -394,6 +394,10 @@ GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) {
                          base[idx[3]], base[idx[2]], base[idx[1]], base[idx[0]]);
 #endif
 }
+/* float lanes 0..7 (half 0) or 8..15 (half 1) widened to double, exactly */
+GK_FORCE_INLINE gk_vd gk_vd_from_vf(gk_vf a, int half) {
+    return half ? _mm512_cvtps_pd(_mm512_extractf32x8_ps(a, 1)) : _mm512_cvtps_pd(_mm512_castps512_ps256(a));
+}
 /* two double vectors (lanes 0..7, 8..15) rounded to one float vector */
 GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) {
     return _mm512_insertf32x8(_mm512_castps256_ps512(_mm512_cvtpd_ps(lo)), _mm512_cvtpd_ps(hi), 1);
@@ -479,6 +483,9 @@ GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) {
 GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) {
     return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm256_cvtpd_ps(lo)), _mm256_cvtpd_ps(hi), 1);
 }
+GK_FORCE_INLINE gk_vd gk_vd_from_vf(gk_vf a, int half) {
+    return half ? _mm256_cvtps_pd(_mm256_extractf128_ps(a, 1)) : _mm256_cvtps_pd(_mm256_castps256_ps128(a));
+}
 #elif GK_SIMD_WIDTH == 128
 #include <smmintrin.h>
 #define GK_SIMD_NAME "sse4"
@@ -547,6 +554,7 @@ GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) {
     return _mm_set_ps(base[idx[3]], base[idx[2]], base[idx[1]], base[idx[0]]);
 }
 GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) { return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi)); }
+GK_FORCE_INLINE gk_vd gk_vd_from_vf(gk_vf a, int half) { return _mm_cvtps_pd(half ? _mm_movehl_ps(a, a) : a); }
 #else
 #define GK_SIMD_NAME "scalar"
 #define GK_VD_W 1
@@ -612,6 +620,10 @@ GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) { retu
 GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) {
     (void)hi;
     return (float)lo;
+}
+GK_FORCE_INLINE gk_vd gk_vd_from_vf(gk_vf a, int half) {
+    (void)half;
+    return (double)a;
 }
 #endif
 

@@ -2034,116 +2034,139 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
     return m2;
 }
 
-#if GK_VR_W > 1 && !defined(GK_REAL_FLOAT)
-/* gk__integrate_kernel on GK_VD_W particles at a time (double build): same
- * arithmetic per lane, selects instead of branches. */
-GK_FORCE_INLINE gk_vd gk__damp_v(gk_vd a, gk_vd v, gk_vd hdt, gk_vd alpha) {
-    const gk_vd one = gk_vd_set1(1.0), zero = gk_vd_zero();
-    gk_vd xx = gk_vd_mul(a, gk_vd_add(v, gk_vd_mul(hdt, a)));
-    gk_vd sg = gk_vd_sub(gk_vd_select(gk_vd_gt(xx, zero), one, zero), gk_vd_select(gk_vd_lt(xx, zero), one, zero));
-    return gk_vd_mul(a, gk_vd_sub(one, gk_vd_mul(alpha, sg)));
+#if GK_VR_W > 1
+/* gk__integrate_kernel on GK_VR_W particles at a time: the same arithmetic
+ * per lane, selects instead of branches. Velocities in the working precision,
+ * positions in double (in the float build, two double vectors per group). */
+GK_FORCE_INLINE gk_vr gk__damp_v(gk_vr a, gk_vr v, gk_vr hdt, gk_vr alpha) {
+    const gk_vr one = gk_vr_set1(1), zero = gk_vr_zero();
+    gk_vr xx = gk_vr_mul(a, gk_vr_add(v, gk_vr_mul(hdt, a)));
+    gk_vr sg = gk_vr_sub(gk_vr_select(gk_vr_gt(xx, zero), one, zero), gk_vr_select(gk_vr_lt(xx, zero), one, zero));
+    return gk_vr_mul(a, gk_vr_sub(one, gk_vr_mul(alpha, sg)));
+}
+
+/* double lanes of half hf of a working-precision vector (exact widening) */
+GK_FORCE_INLINE gk_vd gk__vr_half(gk_vr a, int hf) {
+#ifdef GK_REAL_FLOAT
+    return gk_vd_from_vf(a, hf);
+#else
+    (void)hf;
+    return a;
+#endif
 }
 
 GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, const double *hinv, const double *hnew,
                                           int p0, int p1, int *bad, const int dim, const int rot, const int damp) {
-    const gk_vd dt = gk_vd_set1(x->dt), alpha = gk_vd_set1(rve->def.damping), hdt = gk_vd_set1(0.5 * x->dt),
-                zero = gk_vd_zero();
-    const gk_vd wa = gk_vd_set1((double)x->wa[2]);
-    gk_vd H[9], Gn[9], vm2 = zero, vchk = zero;
-    double m2 = 0.0, chk = 0.0, buf[2 * GK_VD_W];
-    int p = p0, k, l;
+    const gk_vr dt = gk_vr_set1(x->dt), alpha = gk_vr_set1((gk_real)rve->def.damping),
+                hdt = gk_vr_set1((gk_real)0.5 * x->dt), zero = gk_vr_zero();
+    const gk_vd dtd = gk_vd_set1((double)x->dt), wad = gk_vd_set1((double)x->wa[2]);
+    gk_vd H[9], Gn[9], vm2 = gk_vd_zero();
+    gk_vr vchk = zero;
+    double m2 = 0.0, chk = 0.0, buf[GK_VD_W];
+    gk_real bufr[GK_VR_W];
+    int p = p0, k, l, hf;
     for (k = 0; k < 9; ++k) {
         H[k] = gk_vd_set1(hinv[k]);
         Gn[k] = gk_vd_set1(hnew[k]);
     }
-    for (; p + GK_VD_W <= p1; p += GK_VD_W) {
-        gk_vd minv = gk_vd_loadu(rve->minv + p), a[3], v[3], nv[3], d[3], e[3], u[3], sp[3], u2;
+    for (; p + GK_VR_W <= p1; p += GK_VR_W) {
+        gk_vr minv = gk_vr_loadu(rve->minv + p), a[3], v[3], nv[3], d[3];
         for (k = 0; k < dim; ++k) {
-            a[k] = gk_vd_mul(gk_vd_loadu(rve->f[k] + p), minv);
-            v[k] = gk_vd_loadu(rve->v[k] + p);
+            a[k] = gk_vr_mul(gk_vr_loadu(rve->f[k] + p), minv);
+            v[k] = gk_vr_loadu(rve->v[k] + p);
         }
         if (damp == 1) {
             for (k = 0; k < dim; ++k) a[k] = gk__damp_v(a[k], v[k], hdt, alpha);
         } else if (damp == 2) {
-            gk_vd w[3], vv, aa, sc;
-            gk_vdm pos;
-            for (k = 0; k < dim; ++k) w[k] = gk_vd_add(v[k], gk_vd_mul(hdt, a[k]));
-            vv = gk_vd_add(gk_vd_mul(w[0], w[0]), gk_vd_mul(w[1], w[1]));
-            aa = gk_vd_add(gk_vd_mul(a[0], a[0]), gk_vd_mul(a[1], a[1]));
+            gk_vr w[3], vv, aa, sc;
+            gk_vrm pos;
+            for (k = 0; k < dim; ++k) w[k] = gk_vr_add(v[k], gk_vr_mul(hdt, a[k]));
+            vv = gk_vr_add(gk_vr_mul(w[0], w[0]), gk_vr_mul(w[1], w[1]));
+            aa = gk_vr_add(gk_vr_mul(a[0], a[0]), gk_vr_mul(a[1], a[1]));
             if (dim == 3) {
-                vv = gk_vd_add(vv, gk_vd_mul(w[2], w[2]));
-                aa = gk_vd_add(aa, gk_vd_mul(a[2], a[2]));
+                vv = gk_vr_add(vv, gk_vr_mul(w[2], w[2]));
+                aa = gk_vr_add(aa, gk_vr_mul(a[2], a[2]));
             }
-            pos = gk_vd_gt(vv, zero);
-            sc = gk_vd_div(gk_vd_mul(alpha, gk_vd_sqrt(aa)), gk_vd_sqrt(vv));
-            for (k = 0; k < dim; ++k) a[k] = gk_vd_select(pos, gk_vd_sub(a[k], gk_vd_mul(sc, w[k])), a[k]);
+            pos = gk_vr_gt(vv, zero);
+            sc = gk_vr_div(gk_vr_mul(alpha, gk_vr_sqrt(aa)), gk_vr_sqrt(vv));
+            for (k = 0; k < dim; ++k) a[k] = gk_vr_select(pos, gk_vr_sub(a[k], gk_vr_mul(sc, w[k])), a[k]);
         }
         for (k = 0; k < dim; ++k) {
-            nv[k] = gk_vd_add(v[k], gk_vd_mul(dt, a[k]));
-            gk_vd_storeu(rve->v[k] + p, nv[k]);
-            vchk = gk_vd_add(vchk, gk_vd_abs(nv[k]));
-            d[k] = gk_vd_mul(nv[k], dt);
+            nv[k] = gk_vr_add(v[k], gk_vr_mul(dt, a[k]));
+            gk_vr_storeu(rve->v[k] + p, nv[k]);
+            vchk = gk_vr_add(vchk, gk_vr_abs(nv[k]));
+            d[k] = gk_vr_mul(nv[k], dt);
         }
-        for (k = 0; k < dim; ++k) {
-            gk_vd inc = gk_vd_add(gk_vd_mul(H[3 * k], d[0]), gk_vd_mul(H[3 * k + 1], d[1]));
-            if (dim == 3) inc = gk_vd_add(inc, gk_vd_mul(H[3 * k + 2], d[2]));
-            sp[k] = gk_vd_add(gk_vd_loadu(rve->s[k] + p), inc);
-            {   /* gk__wrap */
-                gk_vd fl = gk_vd_floor(sp[k]), r0 = gk_vd_sub(gk_vd_loadu(rve->s0[k] + p), fl);
+        for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
+            int q = p + hf * GK_VD_W;
+            gk_vd dd[3], sp[3], e[3], u[3], u2;
+            for (k = 0; k < dim; ++k) dd[k] = gk__vr_half(d[k], hf);
+            for (k = 0; k < dim; ++k) {
+                gk_vd inc = gk_vd_add(gk_vd_mul(H[3 * k], dd[0]), gk_vd_mul(H[3 * k + 1], dd[1])), fl, r0;
+                if (dim == 3) inc = gk_vd_add(inc, gk_vd_mul(H[3 * k + 2], dd[2]));
+                sp[k] = gk_vd_add(gk_vd_loadu(rve->s[k] + q), inc);
+                /* gk__wrap */
+                fl = gk_vd_floor(sp[k]);
+                r0 = gk_vd_sub(gk_vd_loadu(rve->s0[k] + q), fl);
                 sp[k] = gk_vd_sub(sp[k], fl);
-                gk_vd_storeu(rve->s0[k] + p, r0);
-                gk_vd_storeu(rve->o0[k] + p, gk_vd_sub(gk_vd_loadu(rve->o0[k] + p), fl));
-                gk_vd_storeu(rve->s[k] + p, sp[k]);
+                gk_vd_storeu(rve->s0[k] + q, r0);
+                gk_vd_storeu(rve->o0[k] + q, gk_vd_sub(gk_vd_loadu(rve->o0[k] + q), fl));
+                gk_vd_storeu(rve->s[k] + q, sp[k]);
                 e[k] = gk_vd_sub(sp[k], r0);
             }
+            for (k = 0; k < dim; ++k) {
+                u[k] = gk_vd_add(gk_vd_mul(Gn[3 * k], e[0]), gk_vd_mul(Gn[3 * k + 1], e[1]));
+                if (dim == 3) u[k] = gk_vd_add(u[k], gk_vd_mul(Gn[3 * k + 2], e[2]));
+            }
+            u2 = gk_vd_add(gk_vd_mul(u[0], u[0]), gk_vd_mul(u[1], u[1]));
+            if (dim == 3) u2 = gk_vd_add(u2, gk_vd_mul(u[2], u[2]));
+            vm2 = gk_vd_max(u2, vm2);
         }
-        for (k = 0; k < dim; ++k) {
-            u[k] = gk_vd_add(gk_vd_mul(Gn[3 * k], e[0]), gk_vd_mul(Gn[3 * k + 1], e[1]));
-            if (dim == 3) u[k] = gk_vd_add(u[k], gk_vd_mul(Gn[3 * k + 2], e[2]));
-        }
-        u2 = gk_vd_add(gk_vd_mul(u[0], u[0]), gk_vd_mul(u[1], u[1]));
-        if (dim == 3) u2 = gk_vd_add(u2, gk_vd_mul(u[2], u[2]));
-        vm2 = gk_vd_max(u2, vm2);
         if (rot && dim == 2) {
-            gk_vd aw = gk_vd_mul(gk_vd_loadu(rve->t[2] + p), gk_vd_loadu(rve->Iinv + p)), w = gk_vd_loadu(rve->w[2] + p);
+            gk_vr aw = gk_vr_mul(gk_vr_loadu(rve->t[2] + p), gk_vr_loadu(rve->Iinv + p)), w = gk_vr_loadu(rve->w[2] + p);
             if (damp) aw = gk__damp_v(aw, w, hdt, alpha);
-            w = gk_vd_add(w, gk_vd_mul(dt, aw));
-            gk_vd_storeu(rve->w[2] + p, w);
-            vchk = gk_vd_add(vchk, gk_vd_abs(w));
-            gk_vd_storeu(rve->theta + p, gk_vd_add(gk_vd_loadu(rve->theta + p), gk_vd_mul(gk_vd_add(wa, w), dt)));
+            w = gk_vr_add(w, gk_vr_mul(dt, aw));
+            gk_vr_storeu(rve->w[2] + p, w);
+            vchk = gk_vr_add(vchk, gk_vr_abs(w));
+            for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
+                double *th = rve->theta + p + hf * GK_VD_W;
+                gk_vd_storeu(th, gk_vd_add(gk_vd_loadu(th), gk_vd_mul(gk_vd_add(wad, gk__vr_half(w, hf)), dtd)));
+            }
         } else if (rot) {
-            gk_vd iinv = gk_vd_loadu(rve->Iinv + p), aw[3], w[3];
+            gk_vr iinv = gk_vr_loadu(rve->Iinv + p), aw[3], w[3];
             for (k = 0; k < 3; ++k) {
-                aw[k] = gk_vd_mul(gk_vd_loadu(rve->t[k] + p), iinv);
-                w[k] = gk_vd_loadu(rve->w[k] + p);
+                aw[k] = gk_vr_mul(gk_vr_loadu(rve->t[k] + p), iinv);
+                w[k] = gk_vr_loadu(rve->w[k] + p);
             }
             if (damp == 1) {
                 for (k = 0; k < 3; ++k) aw[k] = gk__damp_v(aw[k], w[k], hdt, alpha);
             } else if (damp == 2) {
-                gk_vd ve[3], vv, aa, sc;
-                gk_vdm pos;
-                for (k = 0; k < 3; ++k) ve[k] = gk_vd_add(w[k], gk_vd_mul(hdt, aw[k]));
-                vv = gk_vd_add(gk_vd_add(gk_vd_mul(ve[0], ve[0]), gk_vd_mul(ve[1], ve[1])), gk_vd_mul(ve[2], ve[2]));
-                aa = gk_vd_add(gk_vd_add(gk_vd_mul(aw[0], aw[0]), gk_vd_mul(aw[1], aw[1])), gk_vd_mul(aw[2], aw[2]));
-                pos = gk_vd_gt(vv, zero);
-                sc = gk_vd_div(gk_vd_mul(alpha, gk_vd_sqrt(aa)), gk_vd_sqrt(vv));
-                for (k = 0; k < 3; ++k) aw[k] = gk_vd_select(pos, gk_vd_sub(aw[k], gk_vd_mul(sc, ve[k])), aw[k]);
+                gk_vr ve[3], vv, aa, sc;
+                gk_vrm pos;
+                for (k = 0; k < 3; ++k) ve[k] = gk_vr_add(w[k], gk_vr_mul(hdt, aw[k]));
+                vv = gk_vr_add(gk_vr_add(gk_vr_mul(ve[0], ve[0]), gk_vr_mul(ve[1], ve[1])), gk_vr_mul(ve[2], ve[2]));
+                aa = gk_vr_add(gk_vr_add(gk_vr_mul(aw[0], aw[0]), gk_vr_mul(aw[1], aw[1])), gk_vr_mul(aw[2], aw[2]));
+                pos = gk_vr_gt(vv, zero);
+                sc = gk_vr_div(gk_vr_mul(alpha, gk_vr_sqrt(aa)), gk_vr_sqrt(vv));
+                for (k = 0; k < 3; ++k) aw[k] = gk_vr_select(pos, gk_vr_sub(aw[k], gk_vr_mul(sc, ve[k])), aw[k]);
             }
             for (k = 0; k < 3; ++k) {
-                w[k] = gk_vd_add(w[k], gk_vd_mul(dt, aw[k]));
-                gk_vd_storeu(rve->w[k] + p, w[k]);
-                vchk = gk_vd_add(vchk, gk_vd_abs(w[k]));
+                w[k] = gk_vr_add(w[k], gk_vr_mul(dt, aw[k]));
+                gk_vr_storeu(rve->w[k] + p, w[k]);
+                vchk = gk_vr_add(vchk, gk_vr_abs(w[k]));
             }
         } else if (dim == 2) {
-            gk_vd_storeu(rve->theta + p, gk_vd_add(gk_vd_loadu(rve->theta + p), gk_vd_mul(wa, dt)));
+            for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
+                double *th = rve->theta + p + hf * GK_VD_W;
+                gk_vd_storeu(th, gk_vd_add(gk_vd_loadu(th), gk_vd_mul(wad, dtd)));
+            }
         }
     }
     gk_vd_storeu(buf, vm2);
-    gk_vd_storeu(buf + GK_VD_W, vchk);
-    for (l = 0; l < GK_VD_W; ++l) {
+    gk_vr_storeu(bufr, vchk);
+    for (l = 0; l < GK_VD_W; ++l)
         if (buf[l] > m2) m2 = buf[l];
-        chk += buf[GK_VD_W + l];
-    }
+    for (l = 0; l < GK_VR_W; ++l) chk += (double)bufr[l];
     if (!isfinite(chk) || !isfinite(m2)) *bad = 1;
     if (p < p1) {
         double mt = gk__integrate_kernel(rve, x, hinv, hnew, p, p1, bad, dim, rot, damp);
