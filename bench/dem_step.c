@@ -18,6 +18,7 @@
  * BENCH case=... dim=... n=... threads=... law=... real=... simd=... steps=...
  *       particle_steps_per_s=... contact_steps_per_s=... contacts_per_particle=... */
 #include "dem_step.h"
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +27,8 @@ static void usage(FILE *fp) {
     fprintf(fp, "usage: bench_dem_step [--case rve400|2d_10k|2d_100k|3d_1k|3d_10k|3d_100k] [--threads T]\n"
                 "                      [--steps S] [--law linear|hertz] [--real double|float] [--scalar]\n"
                 "                      [--repeats R] [--packing FILE] [--write-packing FILE]\n"
+                "                      [--physics norot,frictionless,rolling,viscous,cohesion]\n"
+                "       bench_dem_step --float-error   q/p along the rve_path shear, float vs double\n"
                 "with no --case, runs the whole suite (1 and 2 threads, both laws, double and float,\n"
                 "SIMD and scalar) and prints a table.\n");
 }
@@ -38,27 +41,28 @@ static int run_one(const bench_case *c, int use_float, int quiet_header) {
         fprintf(stderr, "bench_dem_step: %s: %s\n", c->name, o.err);
         return rc;
     }
-    printf("%-8s %dD %7d  %2d  %-6s %-6s %-6s %8.2f %9.2f %6.2f %6.2f\n", c->name, o.dim, o.n, c->threads,
+    printf("%-8s %dD %7d  %2d  %-6s %-6s %-6s %8.2f %9.2f %6.2f %6.2f %s\n", c->name, o.dim, o.n, c->threads,
            c->hertz ? "hertz" : "linear", o.real, o.simd, o.particle_steps_per_s / 1e6, o.contact_steps_per_s / 1e6,
-           o.contacts_per_particle, o.pairs_per_particle);
+           2.0 * o.contacts_per_particle, o.pairs_per_particle, c->physics ? c->physics : "");
     printf("BENCH case=%s dim=%d n=%d threads=%d law=%s real=%s simd=%s steps=%ld particle_steps_per_s=%.4g "
-           "contact_steps_per_s=%.4g contacts_per_particle=%.3f pairs_per_particle=%.3f seconds_median=%.4g "
-           "sxx=%.6g syy=%.6g sxy=%.6g\n",
+           "contact_steps_per_s=%.4g contacts_per_particle=%.3f coordination=%.3f pairs_per_particle=%.3f "
+           "seconds_median=%.4g physics=%s sxx=%.6g syy=%.6g sxy=%.6g\n",
            c->name, o.dim, o.n, c->threads, c->hertz ? "hertz" : "linear", o.real, o.simd, o.steps,
-           o.particle_steps_per_s, o.contact_steps_per_s, o.contacts_per_particle, o.pairs_per_particle,
-           o.seconds_median, o.sigma[0], o.sigma[4], o.sigma[1]);
+           o.particle_steps_per_s, o.contact_steps_per_s, o.contacts_per_particle, 2.0 * o.contacts_per_particle,
+           o.pairs_per_particle, o.seconds_median, c->physics ? c->physics : "default", o.sigma[0], o.sigma[4],
+           o.sigma[1]);
     fflush(stdout);
     return 0;
 }
 
 static void header(void) {
     printf("%-8s %2s %7s  %2s  %-6s %-6s %-6s %8s %9s %6s %6s\n", "case", "", "n", "th", "law", "real", "simd",
-           "Mpart/s", "Mcont/s", "Z/2", "pairs");
+           "Mpart/s", "Mcont/s", "Z", "pairs");
 }
 
 int main(int argc, char **argv) {
     bench_case c;
-    int i, use_float = 0, rc = 0;
+    int i, use_float = 0, rc = 0, float_error = 0;
     const char *cname = NULL;
     memset(&c, 0, sizeof c);
     c.threads = 1;
@@ -70,6 +74,10 @@ int main(int argc, char **argv) {
         }
         if (!strcmp(a, "--scalar")) {
             c.scalar = 1;
+            continue;
+        }
+        if (!strcmp(a, "--float-error")) {
+            float_error = 1;
             continue;
         }
         if (!v) {
@@ -84,6 +92,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(a, "--real")) use_float = !strcmp(v, "float");
         else if (!strcmp(a, "--packing")) c.packing = v;
         else if (!strcmp(a, "--write-packing")) c.write_packing = v;
+        else if (!strcmp(a, "--physics")) c.physics = v;
         else {
             fprintf(stderr, "bench_dem_step: unknown option %s (see --help)\n", a);
             return 2;
@@ -94,6 +103,26 @@ int main(int argc, char **argv) {
         c.name = cname;
         header();
         return run_one(&c, use_float, 0);
+    }
+    if (float_error) {
+        enum { NI = 50 };
+        double pd[NI], qd[NI], pf[NI], qf[NI], emax = 0, erat = 0;
+        int k;
+        if (bench_path_double(NI, pd, qd) || bench_path_float(NI, pf, qf)) {
+            fprintf(stderr, "bench_dem_step: float-error path failed\n");
+            return 1;
+        }
+        for (k = 0; k < NI; ++k) {
+            double e = fabs(pf[k] - pd[k]) / pd[k], r = fabs(qf[k] / pf[k] - qd[k] / pd[k]);
+            if (e > emax) emax = e;
+            if (r > erat) erat = r;
+        }
+        printf("float vs double along the seed-000 RVE shear path (50 x dH01 = 1e-3, 100 steps each):\n"
+               "  largest relative difference in p: %.3g; largest difference in q/p: %.3g (q/p at the end %.4f)\n",
+               emax, erat, qd[NI - 1] / pd[NI - 1]);
+        printf("BENCH case=float_error increments=%d max_rel_p=%.4g max_abs_q_over_p=%.4g final_q_over_p=%.4f\n", NI,
+               emax, erat, qd[NI - 1] / pd[NI - 1]);
+        return 0;
     }
     {
         static const char *cases[] = {"rve400", "2d_10k", "2d_100k", "3d_1k", "3d_10k", "3d_100k"};

@@ -9,6 +9,7 @@ typedef struct bench_case {
     const char *packing;       /* NULL: the case's default packing                 */
     const char *write_packing; /* write the exact starting packing here            */
     int threads, hertz, scalar, repeats;
+    const char *physics;       /* comma list: norot, frictionless, rolling, viscous, cohesion */
     long steps;                /* timed steps per repeat; 0: case default          */
 } bench_case;
 
@@ -26,5 +27,10 @@ typedef struct bench_out {
 
 int bench_run_double(const bench_case *c, bench_out *o);
 int bench_run_float(const bench_case *c, bench_out *o);
+
+/* the seed 000 RVE sheared along the rve_path loading (nincr increments of
+ * dH01 = 1e-3 over 100 steps): compression-positive p and q after each */
+int bench_path_double(int nincr, double *p, double *q);
+int bench_path_float(int nincr, double *p, double *q);
 
 #endif

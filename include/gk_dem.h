@@ -47,6 +47,9 @@
  * TIME STEP. gk_rve_dt_critical() is seed 000 eq 19, dt_cr = sqrt(m_min /
  * k_n,max) (Hertz: k_n at twice the current largest overlap, at least 1e-3
  * r_min). dt = 0 in the def means 0.5 dt_cr; a dt above dt_cr is an error.
+ * Hertz contacts stiffen with load, so the RVE re-checks dt_cr at every
+ * list rebuild and stops with GK_ERR_DT when dt has become too large; for
+ * loading that raises the stress several-fold choose dt_factor ~ 0.2.
  *
  * MASSES. 3D spheres: m = rho 4/3 pi r^3, I = 2/5 m r^2. 2D disks, default
  * GK_MASS_CYLINDER: cylinders of thickness t (seed 000: 0.1 m),
@@ -836,15 +839,14 @@ static double gk__dt_critical(const gk_rve *rve) {
     } else {
         double dmax = 1e-3 * rve->rmin, G = m->young / (2.0 * (1.0 + m->poisson));
         int c;
-        for (c = 0; c < rve->pl.n; ++c) { /* current largest overlap, from the stored forces */
-            if (rve->cs && (rve->cs[c] & GK_CS_CONTACT)) {
-                int i = rve->pl.i[c], j = rve->pl.j[c], k;
-                double ds[3], d[3], dd;
-                for (k = 0; k < 3; ++k) ds[k] = k < rve->dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
-                gk_pcell_min_image(&rve->cell, ds, d);
-                dd = (double)rve->r[i] + (double)rve->r[j] - sqrt(gk_v3_dot(d, d));
-                if (2.0 * dd > dmax) dmax = 2.0 * dd;
-            }
+        for (c = 0; c < rve->pl.n; ++c) { /* current largest overlap, from the geometry */
+            int i = rve->pl.i[c], j = rve->pl.j[c], k;
+            double ds[3], d[3], dd;
+            for (k = 0; k < 3; ++k) ds[k] = k < rve->dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
+            gk_pcell_min_image(&rve->cell, ds, d);
+            if (rve->dim == 2) d[2] = 0.0;
+            dd = (double)rve->r[i] + (double)rve->r[j] - sqrt(gk_v3_dot(d, d));
+            if (2.0 * dd > dmax) dmax = 2.0 * dd;
         }
         knmax = G / (1.0 - m->poisson) * sqrt(2.0 * rve->rmax * dmax);
     }
@@ -1047,23 +1049,24 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                               "use more particles or a smaller skin",
                               w[k], cutoff);
         }
-    R.dt_crit = gk__dt_critical(&R);
-    dtc = R.dt_crit;
-    if (def->dt > 0.0) {
-        if (def->dt > dtc) {
-            gk__rve_free_arrays(&R);
-            return gk_err_set(err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)", def->dt,
-                              dtc);
-        }
-        R.dt = def->dt;
-    } else {
-        R.dt = (def->dt_factor > 0.0 ? def->dt_factor : 0.5) * dtc;
-    }
     gk_m3_zero(R.L);
     gk_m3_zero(R.G);
     R.need_rebuild = 1;
     R.err = rve_out->err;
+    R.dt = 0.0; /* set below, from the pairs (Hertz stiffness depends on the overlaps) */
     res = gk__rve_rebuild(&R);
+    if (!res) {
+        R.dt_crit = gk__dt_critical(&R);
+        dtc = R.dt_crit;
+        if (def->dt > 0.0) {
+            if (def->dt > dtc)
+                res = gk_err_set(&R.err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)",
+                                 def->dt, dtc);
+            R.dt = def->dt;
+        } else {
+            R.dt = (def->dt_factor > 0.0 ? def->dt_factor : 0.5) * dtc;
+        }
+    }
     if (res) {
         gk_err e = R.err;
         gk__rve_free_arrays(&R);
@@ -1107,6 +1110,16 @@ static double gk__list_margin(const gk_rve *rve, const double href[9], double *c
 /* rebuild the pair list at the current positions, carrying history over by merge */
 static gk_result gk__rve_rebuild(gk_rve *rve) {
     gk_pairlist nl;
+    if (rve->def.mat.law == GK_LAW_HERTZ && rve->pl.n > 0) {
+        /* Hertz stiffens with load: the critical step shrinks as overlaps grow */
+        double dtc = gk__dt_critical(rve);
+        if (rve->dt > dtc)
+            return gk_err_set(&rve->err, GK_ERR_DT,
+                              "time step %g s now exceeds the critical %g s at the current overlaps (Hertz stiffens "
+                              "with load): restore a saved state and use a smaller dt",
+                              rve->dt, dtc);
+        rve->dt_crit = dtc;
+    }
     int dim = rve->dim, n = rve->n, k, p, c, oc, nft = dim == 2 ? 1 : 3;
     double w[3];
     gk_result res;
