@@ -1,0 +1,1237 @@
+/* gk_fem.h - finite elements for the macro scale of FEMxDEM.   (grainkit v0.1)
+ *
+ * Small-strain / updated-Lagrangian continuum elements whose material is a
+ * tangent D and a stress sigma handed in per Gauss point (e.g. from a DEM RVE
+ * through gk_homog.h), sparse assembly, boundary conditions and a
+ * dependency-free linear solver. Seed 000 (Guo & Zhao 2014) eqs 1-4, 21.
+ *
+ * DO THIS: #define GK_IMPLEMENTATION (or GK_FEM_IMPLEMENTATION) in one file.
+ *
+ * ELEMENTS (node order = Gmsh = VTK)
+ *   GK_Q4    4-node bilinear quad, plane strain. Corners counter-clockwise
+ *            from (-1,-1). Gauss 2x2 (default) or 1, 3.
+ *   GK_Q8    8-node serendipity quad: corners as Q4, then mid-side nodes of
+ *            edges 0-1, 1-2, 2-3, 3-0. Gauss 2x2 (reduced; the seed 000
+ *            authors' escript setting: 4 RVEs per element) or 3x3 (full).
+ *   GK_HEX8  8-node trilinear hexahedron: the Q4 corners at zeta = -1, then at
+ *            zeta = +1. Gauss 2x2x2, or 1 point with gk_fem_hex8_hourglass
+ *            (Flanagan-Belytschko stiffness-form hourglass control) for
+ *            explicit runs.
+ *
+ * WHAT IS HERE
+ *   gk_quad_rule            tensor Gauss-Legendre rule (1, 2 or 3 per direction)
+ *   gk_fem_shape            N and dN/dxi of an element at a reference point
+ *   gk_fem_jacobian         dN/dx and det J at a point of a mesh element;
+ *                           det J <= 0 -> GK_ERR_MESH (inverted/degenerate)
+ *   gk_fem_grad             H_ij = du_i/dx_j at a point (seed 000 eq 10 input)
+ *   gk_fem_elem_stiffness   K_e = int B^T D B dV with D a full 4th-order
+ *                           tangent D_ijkl (NOT assumed symmetric), layout
+ *                           D[((i*dim+j)*dim+k)*dim+l] as gk_homog_tangent:
+ *                           K_(a i)(b k) = int dN_a/dx_j D_ijkl dN_b/dx_l [eq 3]
+ *   gk_fem_elem_force       f_(a i) = int sigma_ij dN_a/dx_j dV        [eq 4]
+ *   gk_fem_assemble         all elements into a CSR matrix and/or a force
+ *                           vector, in element order (deterministic)
+ *   gk_fem_elastic_tangent  isotropic D_ijkl = lambda d_ij d_kl + mu (d_ik d_jl
+ *                           + d_il d_jk); 2D = plane strain
+ *   gk_fem_lumped_mass      HRZ-lumped nodal masses (positive for Q8 too)
+ *   gk_fem_face_load        consistent nodal forces of a traction on an edge
+ *                           (2 or 3 nodes) or a quad face (4 nodes)
+ *   gk_mesh_faces_on_plane  boundary edges/faces lying on x_axis = value
+ *   gk_mesh_nodes_on_plane  nodes lying on x_axis = value
+ *   gk_mesh_structured      nx x ny (x nz) mesh of a box, any element type
+ *   gk_mesh_read_gmsh       Gmsh .msh ASCII v2.2 and v4.1: quad4/quad8/hex8
+ *   gk_mesh_check           every element has det J > 0 at every Gauss point
+ *   gk_mesh_update          updated-Lagrangian node update x += u
+ *   gk_csr_from_mesh        sparsity of the nodal-dof graph (dof = dim*node+c)
+ *   gk_fem_dirichlet        prescribed dofs by symmetric elimination: row and
+ *                           column zeroed, the known values moved to the right-
+ *                           hand side, the diagonal KEPT (scaling unchanged)
+ *                           and rhs = diag * value, so the solve returns the
+ *                           prescribed value exactly.
+ *   gk_solver_factor/solve  direct: reverse Cuthill-McKee ordering, then a
+ *                           banded LU with partial pivoting (robust for the
+ *                           non-symmetric perturbation tangent). A pivot below
+ *                           1e-12 x max|A| -> GK_ERR_SINGULAR naming the dof
+ *                           (typically an unconstrained rigid-body mode).
+ *   gk_pcg                  Jacobi-preconditioned conjugate gradients for large
+ *                           symmetric positive definite systems.
+ *
+ * Units and signs as gk_base.h: SI, tension-positive stress. 2D is plane
+ * strain per unit thickness (forces are N/m).
+ *
+ * LICENCE: MIT (see gk_base.h).
+ */
+#ifndef GK_FEM_H
+#define GK_FEM_H
+
+#include "gk_base.h"
+
+typedef enum gk_elem_type { GK_Q4 = 0, GK_Q8 = 1, GK_HEX8 = 2 } gk_elem_type;
+
+#define GK_FEM_MAX_NPE 8 /* nodes per element          */
+#define GK_FEM_MAX_GP 27 /* Gauss points per element   */
+
+typedef struct gk_mesh {
+    int dim;           /* 2 or 3                                         */
+    gk_elem_type type; /* element type (one per mesh)                   */
+    int npe;           /* nodes per element                             */
+    int nnode, nelem;
+    double *x;    /* nnode x dim node coordinates                         */
+    int *conn;    /* nelem x npe node ids (0-based)                       */
+    int *tag;     /* nelem physical tags (Gmsh) or 0                      */
+    gk_allocator alloc;
+} gk_mesh;
+
+typedef struct gk_quad {
+    int n;                       /* number of points                   */
+    double xi[GK_FEM_MAX_GP][3]; /* reference coordinates              */
+    double w[GK_FEM_MAX_GP];     /* weights                            */
+} gk_quad;
+
+typedef struct gk_csr {
+    int n, nnz;
+    int *rowptr; /* n + 1                     */
+    int *col;    /* nnz, sorted within a row  */
+    double *val; /* nnz                       */
+    gk_allocator alloc;
+} gk_csr;
+
+typedef struct gk_solver {
+    int n, kl, ku, w; /* band: kl below, ku above (+kl fill from pivoting)  */
+    int *perm;        /* perm[new] = old dof (reverse Cuthill-McKee)        */
+    int *ipiv;        /* row interchanges                                   */
+    double *ab;       /* n x w row-band: A(i,j) at ab[i*w + j - i + kl]     */
+    double *tmp;      /* n                                                  */
+    gk_allocator alloc;
+} gk_solver;
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+GKDEF int gk_fem_npe(gk_elem_type t);
+GKDEF int gk_fem_dim(gk_elem_type t);
+GKDEF gk_result gk_quad_rule(gk_quad *q, gk_elem_type t, int per_dir, gk_err *err);
+GKDEF void gk_fem_shape(gk_elem_type t, const double *xi, double *N, double *dN);
+GKDEF gk_result gk_fem_jacobian(const gk_mesh *m, int e, const double *xi, double *N, double *dNdx, double *detJ,
+                                gk_err *err);
+GKDEF void gk_fem_grad(const gk_mesh *m, int e, const double *dNdx, const double *u, double H[9]);
+GKDEF gk_result gk_fem_elem_stiffness(const gk_mesh *m, int e, const gk_quad *q, const double *D, double *Ke,
+                                      gk_err *err);
+GKDEF gk_result gk_fem_elem_force(const gk_mesh *m, int e, const gk_quad *q, const double *sigma, double *fe,
+                                  gk_err *err);
+GKDEF gk_result gk_fem_assemble(const gk_mesh *m, const gk_quad *q, const double *D, const double *sigma, gk_csr *K,
+                                double *fint, gk_err *err);
+GKDEF void gk_fem_elastic_tangent(int dim, double E, double nu, double *D);
+GKDEF gk_result gk_fem_lumped_mass(const gk_mesh *m, const gk_quad *q, double density, double *mass, gk_err *err);
+GKDEF gk_result gk_fem_face_load(const gk_mesh *m, int nfn, const int *face, const double traction[3], double *f,
+                                 gk_err *err);
+GKDEF void gk_fem_hex8_hourglass(const double *xe, const double *ue, double k, double *f);
+
+GKDEF gk_result gk_mesh_structured(gk_mesh *m, gk_elem_type t, const int n[3], const double origin[3],
+                                   const double len[3], const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *m, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_mesh_check(const gk_mesh *m, const gk_quad *q, gk_err *err);
+GKDEF void gk_mesh_free(gk_mesh *m);
+GKDEF void gk_mesh_update(gk_mesh *m, const double *u);
+GKDEF int gk_mesh_nodes_on_plane(const gk_mesh *m, int axis, double value, double tol, int *out);
+GKDEF int gk_mesh_faces_on_plane(const gk_mesh *m, int axis, double value, double tol, int *faces, int *nfn);
+GKDEF void gk_mesh_point(const gk_mesh *m, int e, const double *xi, double x[3]);
+
+GKDEF gk_result gk_csr_from_mesh(gk_csr *A, const gk_mesh *m, const gk_allocator *alloc, gk_err *err);
+GKDEF void gk_csr_free(gk_csr *A);
+GKDEF void gk_csr_zero(gk_csr *A);
+GKDEF double *gk_csr_at(gk_csr *A, int i, int j); /* NULL outside the pattern */
+GKDEF void gk_csr_matvec(const gk_csr *A, const double *x, double *y);
+GKDEF gk_result gk_fem_dirichlet(gk_csr *A, double *rhs, int nfix, const int *dofs, const double *vals, gk_err *err);
+
+GKDEF gk_result gk_solver_factor(gk_solver *s, const gk_csr *A, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x);
+GKDEF void gk_solver_free(gk_solver *s);
+GKDEF gk_result gk_rcm_order(const gk_csr *A, int *perm, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol, int maxit, int *iters,
+                       const gk_allocator *alloc, gk_err *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* GK_FEM_H */
+
+/* ======================================================== IMPLEMENTATION */
+#if (defined(GK_IMPLEMENTATION) || defined(GK_FEM_IMPLEMENTATION)) && !defined(GK_FEM_IMPL_ONCE)
+#define GK_FEM_IMPL_ONCE
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+GKDEF int gk_fem_npe(gk_elem_type t) { return t == GK_Q4 ? 4 : 8; }
+GKDEF int gk_fem_dim(gk_elem_type t) { return t == GK_HEX8 ? 3 : 2; }
+
+GKDEF gk_result gk_quad_rule(gk_quad *q, gk_elem_type t, int per_dir, gk_err *err) {
+    static const double g1[1] = {0.0}, w1[1] = {2.0};
+    static const double g2[2] = {-0.57735026918962576451, 0.57735026918962576451}, w2[2] = {1.0, 1.0};
+    static const double g3[3] = {-0.77459666924148337704, 0.0, 0.77459666924148337704};
+    static const double w3[3] = {0.55555555555555555556, 0.88888888888888888889, 0.55555555555555555556};
+    const double *g, *w;
+    int dim, i, j, k, n = 0;
+    if (t != GK_Q4 && t != GK_Q8 && t != GK_HEX8) return gk_err_set(err, GK_ERR_ARG, "unknown element type %d", (int)t);
+    if (per_dir < 1 || per_dir > 3)
+        return gk_err_set(err, GK_ERR_ARG, "Gauss rule with %d points per direction (1, 2 or 3)", per_dir);
+    g = per_dir == 1 ? g1 : per_dir == 2 ? g2 : g3;
+    w = per_dir == 1 ? w1 : per_dir == 2 ? w2 : w3;
+    dim = gk_fem_dim(t);
+    for (k = 0; k < (dim == 3 ? per_dir : 1); ++k)
+        for (j = 0; j < per_dir; ++j)
+            for (i = 0; i < per_dir; ++i) {
+                q->xi[n][0] = g[i];
+                q->xi[n][1] = g[j];
+                q->xi[n][2] = dim == 3 ? g[k] : 0.0;
+                q->w[n] = w[i] * w[j] * (dim == 3 ? w[k] : 1.0);
+                ++n;
+            }
+    q->n = n;
+    return GK_OK;
+}
+
+/* reference corner coordinates (Q4 / Hex8 corners, Q8 all nodes) */
+static const double gk__q8_xi[8][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}, {0, -1}, {1, 0}, {0, 1}, {-1, 0}};
+static const double gk__h8_xi[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                                       {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+
+GKDEF void gk_fem_shape(gk_elem_type t, const double *xi, double *N, double *dN) {
+    int a;
+    double x = xi[0], y = xi[1];
+    if (t == GK_Q4) {
+        for (a = 0; a < 4; ++a) {
+            double xa = gk__q8_xi[a][0], ya = gk__q8_xi[a][1];
+            N[a] = 0.25 * (1 + x * xa) * (1 + y * ya);
+            dN[2 * a] = 0.25 * xa * (1 + y * ya);
+            dN[2 * a + 1] = 0.25 * ya * (1 + x * xa);
+        }
+    } else if (t == GK_Q8) {
+        for (a = 0; a < 8; ++a) {
+            double xa = gk__q8_xi[a][0], ya = gk__q8_xi[a][1];
+            if (a < 4) {
+                N[a] = 0.25 * (1 + x * xa) * (1 + y * ya) * (x * xa + y * ya - 1);
+                dN[2 * a] = 0.25 * xa * (1 + y * ya) * (2 * x * xa + y * ya);
+                dN[2 * a + 1] = 0.25 * ya * (1 + x * xa) * (x * xa + 2 * y * ya);
+            } else if (xa == 0.0) {
+                N[a] = 0.5 * (1 - x * x) * (1 + y * ya);
+                dN[2 * a] = -x * (1 + y * ya);
+                dN[2 * a + 1] = 0.5 * ya * (1 - x * x);
+            } else {
+                N[a] = 0.5 * (1 + x * xa) * (1 - y * y);
+                dN[2 * a] = 0.5 * xa * (1 - y * y);
+                dN[2 * a + 1] = -y * (1 + x * xa);
+            }
+        }
+    } else {
+        double z = xi[2];
+        for (a = 0; a < 8; ++a) {
+            double xa = gk__h8_xi[a][0], ya = gk__h8_xi[a][1], za = gk__h8_xi[a][2];
+            N[a] = 0.125 * (1 + x * xa) * (1 + y * ya) * (1 + z * za);
+            dN[3 * a] = 0.125 * xa * (1 + y * ya) * (1 + z * za);
+            dN[3 * a + 1] = 0.125 * ya * (1 + x * xa) * (1 + z * za);
+            dN[3 * a + 2] = 0.125 * za * (1 + x * xa) * (1 + y * ya);
+        }
+    }
+}
+
+GKDEF gk_result gk_fem_jacobian(const gk_mesh *m, int e, const double *xi, double *N, double *dNdx, double *detJ,
+                                gk_err *err) {
+    double Nl[GK_FEM_MAX_NPE], dN[3 * GK_FEM_MAX_NPE], J[9], Ji[9], det;
+    int a, i, j, dim = m->dim, npe = m->npe;
+    const int *c = m->conn + (size_t)e * npe;
+    gk_fem_shape(m->type, xi, Nl, dN);
+    gk_m3_identity(J);
+    for (i = 0; i < dim; ++i)
+        for (j = 0; j < dim; ++j) {
+            double s = 0.0;
+            for (a = 0; a < npe; ++a) s += m->x[(size_t)c[a] * dim + i] * dN[dim * a + j];
+            J[3 * i + j] = s; /* J_ij = dx_i / dxi_j */
+        }
+    det = gk_m3_det(J);
+    if (!(det > 0.0) || !(det < HUGE_VAL))
+        return gk_err_set(err, GK_ERR_MESH, "element %d has det J = %g at (%g, %g%s): inverted or degenerate", e, det,
+                          xi[0], xi[1], dim == 3 ? ", ..." : "");
+    gk_m3_inverse(J, Ji);
+    if (N)
+        for (a = 0; a < npe; ++a) N[a] = Nl[a];
+    for (a = 0; a < npe; ++a)
+        for (j = 0; j < dim; ++j) { /* dN/dx_j = dN/dxi_k dxi_k/dx_j */
+            double s = 0.0;
+            for (i = 0; i < dim; ++i) s += dN[dim * a + i] * Ji[3 * i + j];
+            dNdx[dim * a + j] = s;
+        }
+    *detJ = det;
+    return GK_OK;
+}
+
+GKDEF void gk_fem_grad(const gk_mesh *m, int e, const double *dNdx, const double *u, double H[9]) {
+    int a, i, j, dim = m->dim;
+    const int *c = m->conn + (size_t)e * m->npe;
+    gk_m3_zero(H);
+    for (a = 0; a < m->npe; ++a)
+        for (i = 0; i < dim; ++i)
+            for (j = 0; j < dim; ++j) H[3 * i + j] += u[(size_t)c[a] * dim + i] * dNdx[dim * a + j];
+}
+
+GKDEF gk_result gk_fem_elem_stiffness(const gk_mesh *m, int e, const gk_quad *q, const double *D, double *Ke,
+                                      gk_err *err) {
+    int dim = m->dim, npe = m->npe, nd = dim * npe, n4 = dim * dim * dim * dim, g, a, b, i, j, k, l;
+    double dNdx[3 * GK_FEM_MAX_NPE], detJ;
+    for (k = 0; k < nd * nd; ++k) Ke[k] = 0.0;
+    for (g = 0; g < q->n; ++g) {
+        const double *Dg = D + (size_t)g * n4;
+        double DB[81 * GK_FEM_MAX_NPE / 3]; /* (i j) x (b k): dim^2 x nd */
+        gk_result r = gk_fem_jacobian(m, e, q->xi[g], NULL, dNdx, &detJ, err);
+        if (r) return r;
+        /* DB_(ij),(bk) = D_ijkl dN_b/dx_l */
+        for (i = 0; i < dim; ++i)
+            for (j = 0; j < dim; ++j)
+                for (b = 0; b < npe; ++b)
+                    for (k = 0; k < dim; ++k) {
+                        double s = 0.0;
+                        for (l = 0; l < dim; ++l) s += Dg[((i * dim + j) * dim + k) * dim + l] * dNdx[dim * b + l];
+                        DB[(i * dim + j) * nd + dim * b + k] = s;
+                    }
+        for (a = 0; a < npe; ++a)
+            for (i = 0; i < dim; ++i) {
+                double *row = Ke + (size_t)(dim * a + i) * nd;
+                for (j = 0; j < dim; ++j) {
+                    double c = q->w[g] * detJ * dNdx[dim * a + j];
+                    const double *src = DB + (i * dim + j) * nd;
+                    for (k = 0; k < nd; ++k) row[k] += c * src[k];
+                }
+            }
+    }
+    return GK_OK;
+}
+
+GKDEF gk_result gk_fem_elem_force(const gk_mesh *m, int e, const gk_quad *q, const double *sigma, double *fe,
+                                  gk_err *err) {
+    int dim = m->dim, npe = m->npe, g, a, i, j;
+    double dNdx[3 * GK_FEM_MAX_NPE], detJ;
+    for (a = 0; a < dim * npe; ++a) fe[a] = 0.0;
+    for (g = 0; g < q->n; ++g) {
+        const double *s = sigma + 9 * (size_t)g;
+        gk_result r = gk_fem_jacobian(m, e, q->xi[g], NULL, dNdx, &detJ, err);
+        if (r) return r;
+        for (a = 0; a < npe; ++a)
+            for (i = 0; i < dim; ++i) {
+                double acc = 0.0;
+                for (j = 0; j < dim; ++j) acc += s[3 * i + j] * dNdx[dim * a + j];
+                fe[dim * a + i] += q->w[g] * detJ * acc;
+            }
+    }
+    return GK_OK;
+}
+
+GKDEF gk_result gk_fem_assemble(const gk_mesh *m, const gk_quad *q, const double *D, const double *sigma, gk_csr *K,
+                                double *fint, gk_err *err) {
+    int dim = m->dim, npe = m->npe, nd = dim * npe, n4 = dim * dim * dim * dim, e, a, b, i, k;
+    double Ke[24 * 24], fe[24];
+    if (K) {
+        if (K->n != dim * m->nnode)
+            return gk_err_set(err, GK_ERR_ARG, "matrix has %d rows, mesh %d dofs", K->n, dim * m->nnode);
+        if (!D) return gk_err_set(err, GK_ERR_ARG, "a matrix needs tangents D");
+        size_t t, nt = (size_t)m->nelem * q->n * n4;
+        for (t = 0; t < nt; ++t)
+            if (!(fabs(D[t]) < HUGE_VAL))
+                return gk_err_set(err, GK_ERR_NAN, "tangent of element %d, Gauss point %d is not finite",
+                                  (int)(t / ((size_t)q->n * n4)), (int)(t / n4) % q->n);
+        gk_csr_zero(K);
+    }
+    if (fint) {
+        if (!sigma) return gk_err_set(err, GK_ERR_ARG, "an internal force needs stresses");
+        for (k = 0; k < m->nelem * q->n * 9; ++k)
+            if (!(fabs(sigma[k]) < HUGE_VAL))
+                return gk_err_set(err, GK_ERR_NAN, "stress of element %d, Gauss point %d is not finite",
+                                  k / (q->n * 9), (k / 9) % q->n);
+        for (k = 0; k < dim * m->nnode; ++k) fint[k] = 0.0;
+    }
+    for (e = 0; e < m->nelem; ++e) {
+        const int *c = m->conn + (size_t)e * npe;
+        gk_result r;
+        if (K) {
+            r = gk_fem_elem_stiffness(m, e, q, D + (size_t)e * q->n * n4, Ke, err);
+            if (r) return r;
+            for (a = 0; a < npe; ++a)
+                for (i = 0; i < dim; ++i) {
+                    int row = dim * c[a] + i, p0 = K->rowptr[row], p1 = K->rowptr[row + 1];
+                    for (b = 0; b < npe; ++b)
+                        for (k = 0; k < dim; ++k) { /* binary search of the column in the sorted row */
+                            int col = dim * c[b] + k, lo = p0, hi = p1 - 1;
+                            while (lo < hi) {
+                                int mid = (lo + hi) >> 1;
+                                if (K->col[mid] < col)
+                                    lo = mid + 1;
+                                else
+                                    hi = mid;
+                            }
+                            K->val[lo] += Ke[(dim * a + i) * nd + dim * b + k];
+                        }
+                }
+        }
+        if (fint) {
+            r = gk_fem_elem_force(m, e, q, sigma + (size_t)e * q->n * 9, fe, err);
+            if (r) return r;
+            for (a = 0; a < npe; ++a)
+                for (i = 0; i < dim; ++i) fint[dim * c[a] + i] += fe[dim * a + i];
+        }
+    }
+    return GK_OK;
+}
+
+GKDEF void gk_fem_elastic_tangent(int dim, double E, double nu, double *D) {
+    double lam = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
+    int i, j, k, l;
+    for (i = 0; i < dim; ++i)
+        for (j = 0; j < dim; ++j)
+            for (k = 0; k < dim; ++k)
+                for (l = 0; l < dim; ++l)
+                    D[((i * dim + j) * dim + k) * dim + l] = lam * (i == j && k == l) +
+                                                             mu * ((i == k && j == l) + (i == l && j == k));
+}
+
+GKDEF gk_result gk_fem_lumped_mass(const gk_mesh *m, const gk_quad *q, double density, double *mass, gk_err *err) {
+    int e, g, a, npe = m->npe;
+    double N[GK_FEM_MAX_NPE], dNdx[3 * GK_FEM_MAX_NPE], detJ;
+    if (!(density > 0.0) || !(density < HUGE_VAL)) return gk_err_set(err, GK_ERR_MASS, "density %g", density);
+    for (a = 0; a < m->nnode; ++a) mass[a] = 0.0;
+    for (e = 0; e < m->nelem; ++e) {
+        double diag[GK_FEM_MAX_NPE] = {0}, total = 0.0, sd = 0.0;
+        const int *c = m->conn + (size_t)e * npe;
+        for (g = 0; g < q->n; ++g) {
+            gk_result r = gk_fem_jacobian(m, e, q->xi[g], N, dNdx, &detJ, err);
+            if (r) return r;
+            total += q->w[g] * detJ * density;
+            for (a = 0; a < npe; ++a) diag[a] += q->w[g] * detJ * density * N[a] * N[a];
+        }
+        for (a = 0; a < npe; ++a) sd += diag[a];
+        for (a = 0; a < npe; ++a) mass[c[a]] += diag[a] * total / sd; /* Hinton-Rock-Zienkiewicz */
+    }
+    return GK_OK;
+}
+
+GKDEF gk_result gk_fem_face_load(const gk_mesh *m, int nfn, const int *face, const double traction[3], double *f,
+                                 gk_err *err) {
+    static const double g3[3] = {-0.77459666924148337704, 0.0, 0.77459666924148337704};
+    static const double w3[3] = {0.55555555555555555556, 0.88888888888888888889, 0.55555555555555555556};
+    int dim = m->dim, a, i, gi, gj;
+    for (a = 0; a < nfn; ++a)
+        if (face[a] < 0 || face[a] >= m->nnode) return gk_err_set(err, GK_ERR_ARG, "face node %d out of range", face[a]);
+    for (i = 0; i < dim; ++i)
+        if (!(fabs(traction[i]) < HUGE_VAL)) return gk_err_set(err, GK_ERR_NAN, "traction is not finite");
+    if (dim == 2 && (nfn == 2 || nfn == 3)) {
+        for (gi = 0; gi < 3; ++gi) { /* line: nodes (end, end[, mid]) */
+            double s = g3[gi], N[3], dN[3], t[2] = {0, 0}, len;
+            if (nfn == 2) {
+                N[0] = 0.5 * (1 - s), N[1] = 0.5 * (1 + s), dN[0] = -0.5, dN[1] = 0.5;
+            } else {
+                N[0] = 0.5 * s * (s - 1), N[1] = 0.5 * s * (s + 1), N[2] = 1 - s * s;
+                dN[0] = s - 0.5, dN[1] = s + 0.5, dN[2] = -2 * s;
+            }
+            for (a = 0; a < nfn; ++a)
+                for (i = 0; i < 2; ++i) t[i] += dN[a] * m->x[2 * (size_t)face[a] + i];
+            len = sqrt(t[0] * t[0] + t[1] * t[1]);
+            for (a = 0; a < nfn; ++a)
+                for (i = 0; i < 2; ++i) f[2 * face[a] + i] += w3[gi] * len * N[a] * traction[i];
+        }
+        return GK_OK;
+    }
+    if (dim == 3 && nfn == 4) {
+        for (gi = 0; gi < 3; ++gi)
+            for (gj = 0; gj < 3; ++gj) {
+                double xi[2], N[4], dN[8], t1[3] = {0, 0, 0}, t2[3] = {0, 0, 0}, n[3], area;
+                xi[0] = g3[gi], xi[1] = g3[gj];
+                gk_fem_shape(GK_Q4, xi, N, dN);
+                for (a = 0; a < 4; ++a)
+                    for (i = 0; i < 3; ++i) {
+                        t1[i] += dN[2 * a] * m->x[3 * (size_t)face[a] + i];
+                        t2[i] += dN[2 * a + 1] * m->x[3 * (size_t)face[a] + i];
+                    }
+                gk_v3_cross(t1, t2, n);
+                area = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                for (a = 0; a < 4; ++a)
+                    for (i = 0; i < 3; ++i) f[3 * face[a] + i] += w3[gi] * w3[gj] * area * N[a] * traction[i];
+            }
+        return GK_OK;
+    }
+    return gk_err_set(err, GK_ERR_ARG, "a %dD face with %d nodes (2D: 2 or 3; 3D: 4)", dim, nfn);
+}
+
+/* Flanagan & Belytschko (1981) hourglass control for the 1-point Hex8:
+ * gamma_a^alpha = h_a^alpha - (h^alpha . x_i) b_ai with b_ai = dN_a/dx_i at the
+ * centre; f_ai = -k sum_alpha gamma_a^alpha (gamma^alpha . u_i). Zero for any
+ * linear field, so it never stiffens a patch test. */
+GKDEF void gk_fem_hex8_hourglass(const double *xe, const double *ue, double k, double *f) {
+    double N[8], dN[24], J[9], Ji[9], b[24], h[4][8], g[4][8];
+    double zero[3] = {0, 0, 0};
+    int a, i, j, al;
+    gk_fem_shape(GK_HEX8, zero, N, dN);
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) {
+            double s = 0.0;
+            for (a = 0; a < 8; ++a) s += xe[3 * a + i] * dN[3 * a + j];
+            J[3 * i + j] = s;
+        }
+    gk_m3_inverse(J, Ji);
+    for (a = 0; a < 8; ++a)
+        for (j = 0; j < 3; ++j) b[3 * a + j] = dN[3 * a] * Ji[j] + dN[3 * a + 1] * Ji[3 + j] + dN[3 * a + 2] * Ji[6 + j];
+    for (a = 0; a < 8; ++a) {
+        const double *r = gk__h8_xi[a];
+        h[0][a] = r[1] * r[2], h[1][a] = r[0] * r[2], h[2][a] = r[0] * r[1], h[3][a] = r[0] * r[1] * r[2];
+    }
+    for (al = 0; al < 4; ++al) {
+        double hx[3] = {0, 0, 0};
+        for (a = 0; a < 8; ++a)
+            for (i = 0; i < 3; ++i) hx[i] += h[al][a] * xe[3 * a + i];
+        for (a = 0; a < 8; ++a) g[al][a] = h[al][a] - (hx[0] * b[3 * a] + hx[1] * b[3 * a + 1] + hx[2] * b[3 * a + 2]);
+    }
+    for (a = 0; a < 24; ++a) f[a] = 0.0;
+    for (al = 0; al < 4; ++al)
+        for (i = 0; i < 3; ++i) {
+            double qv = 0.0;
+            for (a = 0; a < 8; ++a) qv += g[al][a] * ue[3 * a + i];
+            for (a = 0; a < 8; ++a) f[3 * a + i] -= k * g[al][a] * qv;
+        }
+}
+
+/* ------------------------------------------------------------------ mesh */
+static gk_result gk__mesh_alloc(gk_mesh *m, gk_elem_type t, int nnode, int nelem, const gk_allocator *alloc,
+                                gk_err *err) {
+    gk_mesh z;
+    memset(&z, 0, sizeof z);
+    if (alloc) z.alloc = *alloc;
+    z.type = t, z.dim = gk_fem_dim(t), z.npe = gk_fem_npe(t), z.nnode = nnode, z.nelem = nelem;
+    z.x = (double *)gk_alloc(&z.alloc, (size_t)nnode * z.dim * sizeof(double));
+    z.conn = (int *)gk_alloc(&z.alloc, (size_t)nelem * z.npe * sizeof(int));
+    z.tag = (int *)gk_alloc(&z.alloc, (size_t)nelem * sizeof(int) + 1);
+    if (!z.x || !z.conn || !z.tag) {
+        gk_free(&z.alloc, z.x), gk_free(&z.alloc, z.conn), gk_free(&z.alloc, z.tag);
+        return gk_err_set(err, GK_ERR_ALLOC, "mesh of %d nodes, %d elements", nnode, nelem);
+    }
+    memset(z.tag, 0, (size_t)nelem * sizeof(int));
+    *m = z;
+    return GK_OK;
+}
+
+GKDEF void gk_mesh_free(gk_mesh *m) {
+    gk_free(&m->alloc, m->x);
+    gk_free(&m->alloc, m->conn);
+    gk_free(&m->alloc, m->tag);
+    memset(m, 0, sizeof *m);
+}
+
+GKDEF gk_result gk_mesh_structured(gk_mesh *m, gk_elem_type t, const int n[3], const double origin[3],
+                                   const double len[3], const gk_allocator *alloc, gk_err *err) {
+    int dim, i, j, k, e = 0, nx, ny, nz;
+    gk_mesh z;
+    gk_result r;
+    if (t != GK_Q4 && t != GK_Q8 && t != GK_HEX8) return gk_err_set(err, GK_ERR_ARG, "unknown element type %d", (int)t);
+    dim = gk_fem_dim(t);
+    for (k = 0; k < dim; ++k) {
+        if (n[k] < 1 || n[k] > 100000) return gk_err_set(err, GK_ERR_ARG, "%d elements along axis %d", n[k], k);
+        if (!(len[k] > 0.0) || !(len[k] < HUGE_VAL) || !(fabs(origin[k]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_ARG, "box length %g / origin %g along axis %d", len[k], origin[k], k);
+    }
+    nx = n[0], ny = n[1], nz = dim == 3 ? n[2] : 1;
+    if (t == GK_Q4 || t == GK_HEX8) {
+        int nn = (nx + 1) * (ny + 1) * (dim == 3 ? nz + 1 : 1);
+        r = gk__mesh_alloc(&z, t, nn, nx * ny * nz, alloc, err);
+        if (r) return r;
+        for (k = 0; k < (dim == 3 ? nz + 1 : 1); ++k)
+            for (j = 0; j <= ny; ++j)
+                for (i = 0; i <= nx; ++i) {
+                    int id = (k * (ny + 1) + j) * (nx + 1) + i;
+                    z.x[dim * id] = origin[0] + len[0] * i / nx;
+                    z.x[dim * id + 1] = origin[1] + len[1] * j / ny;
+                    if (dim == 3) z.x[dim * id + 2] = origin[2] + len[2] * k / nz;
+                }
+        for (k = 0; k < nz; ++k)
+            for (j = 0; j < ny; ++j)
+                for (i = 0; i < nx; ++i, ++e) {
+                    int *c = z.conn + (size_t)e * z.npe, s = (nx + 1) * (ny + 1);
+                    int b = (k * (ny + 1) + j) * (nx + 1) + i;
+                    c[0] = b, c[1] = b + 1, c[2] = b + nx + 2, c[3] = b + nx + 1;
+                    if (dim == 3) c[4] = c[0] + s, c[5] = c[1] + s, c[6] = c[2] + s, c[7] = c[3] + s;
+                }
+    } else { /* Q8: a (2nx+1) x (2ny+1) lattice without the element centres */
+        int W = 2 * nx + 1, H = 2 * ny + 1, *id, cnt = 0;
+        r = gk__mesh_alloc(&z, t, W * H - nx * ny, nx * ny, alloc, err);
+        if (r) return r;
+        id = (int *)gk_alloc(&z.alloc, (size_t)W * H * sizeof(int));
+        if (!id) {
+            gk_mesh_free(&z);
+            return gk_err_set(err, GK_ERR_ALLOC, "Q8 node map");
+        }
+        for (j = 0; j < H; ++j)
+            for (i = 0; i < W; ++i) {
+                if ((i & 1) && (j & 1)) {
+                    id[j * W + i] = -1;
+                    continue;
+                }
+                id[j * W + i] = cnt;
+                z.x[2 * cnt] = origin[0] + len[0] * i / (2.0 * nx);
+                z.x[2 * cnt + 1] = origin[1] + len[1] * j / (2.0 * ny);
+                ++cnt;
+            }
+        for (j = 0; j < ny; ++j)
+            for (i = 0; i < nx; ++i, ++e) {
+                int *c = z.conn + (size_t)e * 8, I = 2 * i, J = 2 * j;
+                c[0] = id[J * W + I], c[1] = id[J * W + I + 2], c[2] = id[(J + 2) * W + I + 2], c[3] = id[(J + 2) * W + I];
+                c[4] = id[J * W + I + 1], c[5] = id[(J + 1) * W + I + 2], c[6] = id[(J + 2) * W + I + 1];
+                c[7] = id[(J + 1) * W + I];
+            }
+        gk_free(&z.alloc, id);
+    }
+    *m = z;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_mesh_check(const gk_mesh *m, const gk_quad *q, gk_err *err) {
+    int e, g, a;
+    double dNdx[3 * GK_FEM_MAX_NPE], detJ = 0.0, dmax = 0.0;
+    for (a = 0; a < m->nnode * m->dim; ++a)
+        if (!(fabs(m->x[a]) < HUGE_VAL)) return gk_err_set(err, GK_ERR_NAN, "node %d has a non-finite coordinate", a / m->dim);
+    for (e = 0; e < m->nelem; ++e) {
+        for (a = 0; a < m->npe; ++a) {
+            int b, id = m->conn[(size_t)e * m->npe + a];
+            if (id < 0 || id >= m->nnode) return gk_err_set(err, GK_ERR_MESH, "element %d: node id %d out of range", e, id);
+            for (b = 0; b < a; ++b)
+                if (m->conn[(size_t)e * m->npe + b] == id)
+                    return gk_err_set(err, GK_ERR_MESH, "element %d uses node %d twice (degenerate)", e, id);
+        }
+        for (g = 0; g < q->n; ++g) {
+            gk_result r = gk_fem_jacobian(m, e, q->xi[g], NULL, dNdx, &detJ, err);
+            if (r) return r;
+            if (g == 0 || detJ > dmax) dmax = detJ;
+        }
+        /* corners too: a quad collapsed to a triangle still has det J > 0 at
+         * its Gauss points, but 0 at the collapsed corner */
+        for (a = 0; a < (m->dim == 3 ? 8 : 4); ++a) {
+            double xi[3];
+            xi[0] = gk__h8_xi[a][0], xi[1] = gk__h8_xi[a][1], xi[2] = gk__h8_xi[a][2];
+            if (gk_fem_jacobian(m, e, xi, NULL, dNdx, &detJ, NULL) || !(detJ > 1e-8 * dmax))
+                return gk_err_set(err, GK_ERR_MESH, "element %d is degenerate or inverted at its corner %d (det J %g)", e,
+                                  a, detJ);
+        }
+    }
+    return GK_OK;
+}
+
+GKDEF void gk_mesh_update(gk_mesh *m, const double *u) {
+    int k;
+    for (k = 0; k < m->nnode * m->dim; ++k) m->x[k] += u[k];
+}
+
+GKDEF void gk_mesh_point(const gk_mesh *m, int e, const double *xi, double x[3]) {
+    double N[GK_FEM_MAX_NPE], dN[3 * GK_FEM_MAX_NPE];
+    int a, i;
+    gk_fem_shape(m->type, xi, N, dN);
+    x[0] = x[1] = x[2] = 0.0;
+    for (a = 0; a < m->npe; ++a)
+        for (i = 0; i < m->dim; ++i) x[i] += N[a] * m->x[(size_t)m->conn[(size_t)e * m->npe + a] * m->dim + i];
+}
+
+GKDEF int gk_mesh_nodes_on_plane(const gk_mesh *m, int axis, double value, double tol, int *out) {
+    int a, n = 0;
+    for (a = 0; a < m->nnode; ++a)
+        if (fabs(m->x[(size_t)a * m->dim + axis] - value) <= tol) {
+            if (out) out[n] = a;
+            ++n;
+        }
+    return n;
+}
+
+/* local faces: Q4 edges (2 nodes), Q8 edges (end, end, mid), Hex8 quads */
+static const int gk__q4_edges[4][3] = {{0, 1, 4}, {1, 2, 5}, {2, 3, 6}, {3, 0, 7}};
+static const int gk__h8_faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+
+GKDEF int gk_mesh_faces_on_plane(const gk_mesh *m, int axis, double value, double tol, int *faces, int *nfn_out) {
+    int e, f, a, n = 0, nf = m->type == GK_HEX8 ? 6 : 4;
+    int nfn = m->type == GK_HEX8 ? 4 : m->type == GK_Q8 ? 3 : 2;
+    if (nfn_out) *nfn_out = nfn;
+    for (e = 0; e < m->nelem; ++e)
+        for (f = 0; f < nf; ++f) {
+            int nodes[4], on = 1;
+            for (a = 0; a < nfn; ++a) {
+                int loc = m->type == GK_HEX8 ? gk__h8_faces[f][a] : gk__q4_edges[f][a];
+                nodes[a] = m->conn[(size_t)e * m->npe + loc];
+                if (fabs(m->x[(size_t)nodes[a] * m->dim + axis] - value) > tol) on = 0;
+            }
+            if (!on) continue;
+            if (faces)
+                for (a = 0; a < nfn; ++a) faces[n * nfn + a] = nodes[a];
+            ++n;
+        }
+    return n;
+}
+
+/* ------------------------------------------------------------------ gmsh */
+typedef struct gk__rd {
+    const char *p, *end;
+} gk__rd;
+
+static int gk__rd_line(gk__rd *r, char *buf, size_t cap) {
+    size_t n = 0;
+    if (r->p >= r->end) return 0;
+    while (r->p < r->end && *r->p != '\n') {
+        if (n + 1 < cap) buf[n++] = *r->p;
+        ++r->p;
+    }
+    if (r->p < r->end) ++r->p;
+    while (n && (buf[n - 1] == '\r' || buf[n - 1] == ' ')) --n;
+    buf[n] = 0;
+    return 1;
+}
+
+static int gk__rd_find(gk__rd *r, const char *section) {
+    char line[256];
+    while (gk__rd_line(r, line, sizeof line))
+        if (!strcmp(line, section)) return 1;
+    return 0;
+}
+
+static int gk__gmsh_npe(int type) { return type == 3 ? 4 : type == 16 ? 8 : type == 5 ? 8 : -1; }
+
+GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_allocator *alloc, gk_err *err) {
+    FILE *fp = fopen(path, "rb");
+    char *text = NULL, line[1024];
+    long len;
+    gk__rd r;
+    double version = 0.0, *nx = NULL;
+    long *ntag = NULL, nnodes_file = 0, maxtag = 0, k;
+    int *map = NULL, *econn = NULL, *etag = NULL, etype = -1, nel = 0, cap = 0, nused = 0, i;
+    gk_allocator A;
+    gk_result res = GK_OK;
+    gk_mesh m;
+    memset(&A, 0, sizeof A);
+    if (alloc) A = *alloc;
+    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open %s", path);
+    if (fseek(fp, 0, SEEK_END) || (len = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET)) {
+        fclose(fp);
+        return gk_err_set(err, GK_ERR_IO, "cannot size %s", path);
+    }
+    text = (char *)gk_alloc(&A, (size_t)len + 1);
+    if (!text) {
+        fclose(fp);
+        return gk_err_set(err, GK_ERR_ALLOC, "%ld bytes for %s", len, path);
+    }
+    if (fread(text, 1, (size_t)len, fp) != (size_t)len) {
+        fclose(fp);
+        gk_free(&A, text);
+        return gk_err_set(err, GK_ERR_IO, "cannot read %s", path);
+    }
+    fclose(fp);
+    text[len] = 0;
+#define GK__GFAIL(code, ...)                                                                                          \
+    do {                                                                                                              \
+        res = gk_err_set(err, code, __VA_ARGS__);                                                                     \
+        goto done;                                                                                                    \
+    } while (0)
+    r.p = text, r.end = text + len;
+    if (!gk__rd_find(&r, "$MeshFormat") || !gk__rd_line(&r, line, sizeof line) || sscanf(line, "%lf", &version) != 1)
+        GK__GFAIL(GK_ERR_FORMAT, "%s: no $MeshFormat section", path);
+    if (strstr(line, " 1 ")) GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: binary Gmsh files are not supported (ASCII only)", path);
+    if (!(version >= 2.0 && version < 3.0) && !(version >= 4.0 && version < 5.0))
+        GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: Gmsh format %g (2.x and 4.x ASCII are read)", path, version);
+    /* ---- nodes: tags and coordinates */
+    r.p = text;
+    if (!gk__rd_find(&r, "$Nodes") || !gk__rd_line(&r, line, sizeof line))
+        GK__GFAIL(GK_ERR_FORMAT, "%s: no $Nodes section", path);
+    if (version < 3.0) {
+        if (sscanf(line, "%ld", &nnodes_file) != 1 || nnodes_file <= 0) GK__GFAIL(GK_ERR_FORMAT, "%s: bad node count", path);
+        ntag = (long *)gk_alloc(&A, (size_t)nnodes_file * sizeof(long));
+        nx = (double *)gk_alloc(&A, (size_t)nnodes_file * 3 * sizeof(double));
+        if (!ntag || !nx) GK__GFAIL(GK_ERR_ALLOC, "%s: node arrays", path);
+        for (k = 0; k < nnodes_file; ++k) {
+            if (!gk__rd_line(&r, line, sizeof line) ||
+                sscanf(line, "%ld %lf %lf %lf", &ntag[k], &nx[3 * k], &nx[3 * k + 1], &nx[3 * k + 2]) != 4)
+                GK__GFAIL(GK_ERR_FORMAT, "%s: bad node line %ld", path, k + 1);
+        }
+    } else {
+        long nblocks, minT, maxT, b, got = 0;
+        if (sscanf(line, "%ld %ld %ld %ld", &nblocks, &nnodes_file, &minT, &maxT) != 4 || nnodes_file <= 0)
+            GK__GFAIL(GK_ERR_FORMAT, "%s: bad $Nodes header", path);
+        ntag = (long *)gk_alloc(&A, (size_t)nnodes_file * sizeof(long));
+        nx = (double *)gk_alloc(&A, (size_t)nnodes_file * 3 * sizeof(double));
+        if (!ntag || !nx) GK__GFAIL(GK_ERR_ALLOC, "%s: node arrays", path);
+        for (b = 0; b < nblocks; ++b) {
+            int edim, etg, par;
+            long nin;
+            if (!gk__rd_line(&r, line, sizeof line) || sscanf(line, "%d %d %d %ld", &edim, &etg, &par, &nin) != 4 ||
+                nin < 0 || got + nin > nnodes_file)
+                GK__GFAIL(GK_ERR_FORMAT, "%s: bad node block %ld", path, b);
+            if (par) GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: parametric node coordinates", path);
+            for (k = 0; k < nin; ++k)
+                if (!gk__rd_line(&r, line, sizeof line) || sscanf(line, "%ld", &ntag[got + k]) != 1)
+                    GK__GFAIL(GK_ERR_FORMAT, "%s: bad node tag in block %ld", path, b);
+            for (k = 0; k < nin; ++k) {
+                double *c = nx + 3 * (got + k);
+                if (!gk__rd_line(&r, line, sizeof line) || sscanf(line, "%lf %lf %lf", &c[0], &c[1], &c[2]) != 3)
+                    GK__GFAIL(GK_ERR_FORMAT, "%s: bad node coordinates in block %ld", path, b);
+            }
+            got += nin;
+        }
+        if (got != nnodes_file) GK__GFAIL(GK_ERR_FORMAT, "%s: %ld nodes listed, %ld read", path, nnodes_file, got);
+    }
+    for (k = 0; k < nnodes_file; ++k) {
+        if (ntag[k] <= 0 || ntag[k] > 100000000L) GK__GFAIL(GK_ERR_FORMAT, "%s: node tag %ld", path, ntag[k]);
+        if (ntag[k] > maxtag) maxtag = ntag[k];
+    }
+    map = (int *)gk_alloc(&A, (size_t)(maxtag + 1) * sizeof(int));
+    if (!map) GK__GFAIL(GK_ERR_ALLOC, "%s: node map", path);
+    for (k = 0; k <= maxtag; ++k) map[k] = -1;
+    for (k = 0; k < nnodes_file; ++k) map[ntag[k]] = (int)k; /* file index; renumbered to used nodes below */
+    /* ---- elements: keep the highest-dimensional supported type */
+    r.p = text;
+    if (!gk__rd_find(&r, "$Elements") || !gk__rd_line(&r, line, sizeof line))
+        GK__GFAIL(GK_ERR_FORMAT, "%s: no $Elements section", path);
+    {
+        long nblocks = 1, nelem_file, b, e;
+        if (version < 3.0) {
+            if (sscanf(line, "%ld", &nelem_file) != 1) GK__GFAIL(GK_ERR_FORMAT, "%s: bad element count", path);
+        } else {
+            long a1, a2;
+            if (sscanf(line, "%ld %ld %ld %ld", &nblocks, &nelem_file, &a1, &a2) != 4)
+                GK__GFAIL(GK_ERR_FORMAT, "%s: bad $Elements header", path);
+        }
+        for (b = 0; b < nblocks; ++b) {
+            long nin = nelem_file;
+            int btype = -1, bphys = 0;
+            if (version >= 3.0) {
+                int edim;
+                if (!gk__rd_line(&r, line, sizeof line) || sscanf(line, "%d %d %d %ld", &edim, &bphys, &btype, &nin) != 4)
+                    GK__GFAIL(GK_ERR_FORMAT, "%s: bad element block %ld", path, b);
+            }
+            for (e = 0; e < nin; ++e) {
+                long v[64];
+                int nv = 0, off, type, ntg = 0, np, tagv = bphys;
+                char *s = line, *q;
+                if (!gk__rd_line(&r, line, sizeof line)) GK__GFAIL(GK_ERR_FORMAT, "%s: truncated $Elements", path);
+                while (nv < 64) {
+                    long x = strtol(s, &q, 10);
+                    if (q == s) break;
+                    v[nv++] = x, s = q;
+                }
+                if (version < 3.0) {
+                    if (nv < 3) GK__GFAIL(GK_ERR_FORMAT, "%s: bad element line", path);
+                    type = (int)v[1], ntg = (int)v[2], off = 3 + ntg;
+                    tagv = ntg > 0 ? (int)v[3] : 0;
+                } else {
+                    type = btype, off = 1;
+                }
+                np = gk__gmsh_npe(type);
+                if (np < 0) continue; /* points, lines, triangles...: not volume elements of this module */
+                if (nv < off + np) GK__GFAIL(GK_ERR_FORMAT, "%s: element with too few nodes", path);
+                if (etype >= 0 && type != etype) {
+                    if ((type == 5) == (etype == 5))
+                        GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: mixed element types %d and %d", path, etype, type);
+                    if (etype == 5) continue; /* 3D mesh: skip boundary quads */
+                    nel = 0;                  /* a hex appears after quads: restart with hexes */
+                }
+                etype = type;
+                if (nel == cap) {
+                    int nc = cap ? 2 * cap : 256;
+                    if (gk_realloc(&A, (void **)&econn, (size_t)cap * 8, (size_t)nc * 8, sizeof(int)) ||
+                        gk_realloc(&A, (void **)&etag, (size_t)cap, (size_t)nc, sizeof(int)))
+                        GK__GFAIL(GK_ERR_ALLOC, "%s: elements", path);
+                    cap = nc;
+                }
+                for (i = 0; i < np; ++i) {
+                    long t = v[off + i];
+                    if (t <= 0 || t > maxtag || map[t] < 0)
+                        GK__GFAIL(GK_ERR_FORMAT, "%s: element refers to unknown node %ld", path, t);
+                    econn[nel * 8 + i] = map[t];
+                }
+                etag[nel++] = tagv;
+            }
+        }
+    }
+    if (etype < 0 || nel == 0) GK__GFAIL(GK_ERR_MESH, "%s: no quad4, quad8 or hex8 elements", path);
+    {   /* keep only the nodes the elements use, in file order */
+        gk_elem_type t = etype == 3 ? GK_Q4 : etype == 16 ? GK_Q8 : GK_HEX8;
+        int npe = gk_fem_npe(t), dim = gk_fem_dim(t), *used;
+        used = (int *)gk_alloc(&A, (size_t)nnodes_file * sizeof(int));
+        if (!used) GK__GFAIL(GK_ERR_ALLOC, "%s: node renumbering", path);
+        for (k = 0; k < nnodes_file; ++k) used[k] = -1;
+        for (k = 0; k < (long)nel * npe; ++k) used[econn[(k / npe) * 8 + k % npe]] = 0;
+        for (k = 0; k < nnodes_file; ++k)
+            if (!used[k]) used[k] = nused++;
+        res = gk__mesh_alloc(&m, t, nused, nel, &A, err);
+        if (res) {
+            gk_free(&A, used);
+            goto done;
+        }
+        for (k = 0; k < nnodes_file; ++k)
+            if (used[k] >= 0)
+                for (i = 0; i < dim; ++i) m.x[(size_t)used[k] * dim + i] = nx[3 * k + i];
+        for (k = 0; k < nel; ++k) {
+            for (i = 0; i < npe; ++i) m.conn[k * npe + i] = used[econn[k * 8 + i]];
+            m.tag[k] = etag[k];
+        }
+        gk_free(&A, used);
+        *out = m;
+    }
+done:
+#undef GK__GFAIL
+    gk_free(&A, text), gk_free(&A, nx), gk_free(&A, ntag), gk_free(&A, map), gk_free(&A, econn), gk_free(&A, etag);
+    return res;
+}
+
+/* ------------------------------------------------------------------- CSR */
+GKDEF gk_result gk_csr_from_mesh(gk_csr *A, const gk_mesh *m, const gk_allocator *alloc, gk_err *err) {
+    /* node-to-node adjacency through elements, then expanded to dofs */
+    int nn = m->nnode, dim = m->dim, npe = m->npe, e, a, b, i, k, *cnt = NULL, *adj = NULL, *start = NULL, *mark = NULL;
+    gk_csr z;
+    size_t cap;
+    memset(&z, 0, sizeof z);
+    if (alloc) z.alloc = *alloc;
+    cap = (size_t)m->nelem * npe * npe;
+    cnt = (int *)gk_alloc(&z.alloc, ((size_t)nn + 1) * sizeof(int));
+    start = (int *)gk_alloc(&z.alloc, ((size_t)nn + 1) * sizeof(int));
+    mark = (int *)gk_alloc(&z.alloc, (size_t)nn * sizeof(int));
+    adj = (int *)gk_alloc(&z.alloc, cap * sizeof(int) + 1);
+    if (!cnt || !start || !mark || !adj) goto oom;
+    /* upper bound per node: sum over its elements of npe, then deduplicate */
+    memset(cnt, 0, ((size_t)nn + 1) * sizeof(int));
+    for (e = 0; e < m->nelem; ++e)
+        for (a = 0; a < npe; ++a) {
+            int id = m->conn[(size_t)e * npe + a];
+            if (id < 0 || id >= nn) {
+                gk_free(&z.alloc, cnt), gk_free(&z.alloc, start), gk_free(&z.alloc, mark), gk_free(&z.alloc, adj);
+                return gk_err_set(err, GK_ERR_MESH, "element %d: node id %d out of range", e, id);
+            }
+            cnt[id] += npe;
+        }
+    start[0] = 0;
+    for (a = 0; a < nn; ++a) start[a + 1] = start[a] + cnt[a], cnt[a] = 0, mark[a] = -1;
+    for (e = 0; e < m->nelem; ++e)
+        for (a = 0; a < npe; ++a) {
+            int ia = m->conn[(size_t)e * npe + a];
+            for (b = 0; b < npe; ++b) adj[start[ia] + cnt[ia]++] = m->conn[(size_t)e * npe + b];
+        }
+    z.n = dim * nn;
+    z.rowptr = (int *)gk_alloc(&z.alloc, ((size_t)z.n + 1) * sizeof(int));
+    if (!z.rowptr) goto oom;
+    /* deduplicate and sort each node's neighbour list (insertion sort: short lists) */
+    for (a = 0; a < nn; ++a) {
+        int *L = adj + start[a], n = 0;
+        for (k = 0; k < cnt[a]; ++k)
+            if (mark[L[k]] != a) mark[L[k]] = a, L[n++] = L[k];
+        for (k = 1; k < n; ++k) {
+            int v = L[k], j = k - 1;
+            while (j >= 0 && L[j] > v) L[j + 1] = L[j], --j;
+            L[j + 1] = v;
+        }
+        cnt[a] = n;
+    }
+    z.rowptr[0] = 0;
+    for (a = 0; a < nn; ++a)
+        for (i = 0; i < dim; ++i) z.rowptr[dim * a + i + 1] = z.rowptr[dim * a + i] + dim * cnt[a];
+    z.nnz = z.rowptr[z.n];
+    z.col = (int *)gk_alloc(&z.alloc, (size_t)z.nnz * sizeof(int) + 1);
+    z.val = (double *)gk_alloc(&z.alloc, (size_t)z.nnz * sizeof(double) + 1);
+    if (!z.col || !z.val) goto oom;
+    for (a = 0; a < nn; ++a)
+        for (i = 0; i < dim; ++i) {
+            int p = z.rowptr[dim * a + i];
+            for (k = 0; k < cnt[a]; ++k)
+                for (b = 0; b < dim; ++b) z.col[p++] = dim * adj[start[a] + k] + b;
+        }
+    memset(z.val, 0, (size_t)z.nnz * sizeof(double));
+    gk_free(&z.alloc, cnt), gk_free(&z.alloc, start), gk_free(&z.alloc, mark), gk_free(&z.alloc, adj);
+    *A = z;
+    return GK_OK;
+oom:
+    gk_free(&z.alloc, cnt), gk_free(&z.alloc, start), gk_free(&z.alloc, mark), gk_free(&z.alloc, adj);
+    gk_free(&z.alloc, z.rowptr), gk_free(&z.alloc, z.col), gk_free(&z.alloc, z.val);
+    return gk_err_set(err, GK_ERR_ALLOC, "sparse matrix for %d nodes", nn);
+}
+
+GKDEF void gk_csr_free(gk_csr *A) {
+    gk_free(&A->alloc, A->rowptr), gk_free(&A->alloc, A->col), gk_free(&A->alloc, A->val);
+    memset(A, 0, sizeof *A);
+}
+
+GKDEF void gk_csr_zero(gk_csr *A) { memset(A->val, 0, (size_t)A->nnz * sizeof(double)); }
+
+GKDEF double *gk_csr_at(gk_csr *A, int i, int j) {
+    int lo = A->rowptr[i], hi = A->rowptr[i + 1] - 1;
+    while (lo <= hi) {
+        int mid = (lo + hi) >> 1;
+        if (A->col[mid] == j) return A->val + mid;
+        if (A->col[mid] < j)
+            lo = mid + 1;
+        else
+            hi = mid - 1;
+    }
+    return NULL;
+}
+
+GKDEF void gk_csr_matvec(const gk_csr *A, const double *x, double *y) {
+    int i, p;
+    for (i = 0; i < A->n; ++i) {
+        double s = 0.0;
+        for (p = A->rowptr[i]; p < A->rowptr[i + 1]; ++p) s += A->val[p] * x[A->col[p]];
+        y[i] = s;
+    }
+}
+
+GKDEF gk_result gk_fem_dirichlet(gk_csr *A, double *rhs, int nfix, const int *dofs, const double *vals, gk_err *err) {
+    double *fixv;
+    int k, i, p;
+    for (k = 0; k < nfix; ++k) {
+        if (dofs[k] < 0 || dofs[k] >= A->n) return gk_err_set(err, GK_ERR_ARG, "prescribed dof %d out of range", dofs[k]);
+        if (!(fabs(vals[k]) < HUGE_VAL)) return gk_err_set(err, GK_ERR_NAN, "prescribed value of dof %d", dofs[k]);
+    }
+    fixv = (double *)gk_alloc(&A->alloc, (size_t)A->n * sizeof(double) + 1);
+    if (!fixv) return gk_err_set(err, GK_ERR_ALLOC, "Dirichlet work array");
+    /* NaN marks a free dof (prescribed values were checked finite above) */
+    for (i = 0; i < A->n; ++i) fixv[i] = NAN;
+    for (k = 0; k < nfix; ++k) fixv[dofs[k]] = vals[k];
+    for (i = 0; i < A->n; ++i) {
+        if (fixv[i] == fixv[i]) {
+            double d = 0.0;
+            for (p = A->rowptr[i]; p < A->rowptr[i + 1]; ++p) {
+                if (A->col[p] == i) d = A->val[p];
+                A->val[p] = 0.0;
+            }
+            if (!(fabs(d) > 0.0)) d = 1.0;
+            for (p = A->rowptr[i]; p < A->rowptr[i + 1]; ++p)
+                if (A->col[p] == i) A->val[p] = d;
+            rhs[i] = d * fixv[i];
+        } else {
+            for (p = A->rowptr[i]; p < A->rowptr[i + 1]; ++p)
+                if (fixv[A->col[p]] == fixv[A->col[p]]) {
+                    rhs[i] -= A->val[p] * fixv[A->col[p]];
+                    A->val[p] = 0.0;
+                }
+        }
+    }
+    gk_free(&A->alloc, fixv);
+    return GK_OK;
+}
+
+/* ---------------------------------------------------------------- solvers */
+GKDEF gk_result gk_rcm_order(const gk_csr *A, int *perm, const gk_allocator *alloc, gk_err *err) {
+    int n = A->n, *deg, *lvl, *queue, head, tail, nout = 0, i, p, it;
+    gk_allocator al;
+    memset(&al, 0, sizeof al);
+    if (alloc) al = *alloc;
+    deg = (int *)gk_alloc(&al, (size_t)n * sizeof(int) + 1);
+    lvl = (int *)gk_alloc(&al, (size_t)n * sizeof(int) + 1);
+    queue = (int *)gk_alloc(&al, (size_t)n * sizeof(int) + 1);
+    if (!deg || !lvl || !queue) {
+        gk_free(&al, deg), gk_free(&al, lvl), gk_free(&al, queue);
+        return gk_err_set(err, GK_ERR_ALLOC, "RCM work arrays");
+    }
+    for (i = 0; i < n; ++i) deg[i] = A->rowptr[i + 1] - A->rowptr[i], lvl[i] = -1;
+    while (nout < n) {
+        /* start: lowest-degree unvisited vertex, refined twice towards a
+         * pseudo-peripheral one (last vertex of a BFS, lowest degree) */
+        int s = -1, last;
+        for (i = 0; i < n; ++i)
+            if (lvl[i] < 0 && (s < 0 || deg[i] < deg[s])) s = i;
+        for (it = 0; it < 2; ++it) {
+            int maxl;
+            head = tail = 0, queue[tail++] = s, lvl[s] = 0;
+            while (head < tail) {
+                int v = queue[head++];
+                for (p = A->rowptr[v]; p < A->rowptr[v + 1]; ++p)
+                    if (lvl[A->col[p]] < 0) lvl[A->col[p]] = lvl[v] + 1, queue[tail++] = A->col[p];
+            }
+            maxl = lvl[queue[tail - 1]];
+            last = queue[tail - 1];
+            for (i = 0; i < tail; ++i)
+                if (lvl[queue[i]] == maxl && deg[queue[i]] < deg[last]) last = queue[i];
+            for (i = 0; i < tail; ++i) lvl[queue[i]] = -1;
+            s = last;
+        }
+        /* Cuthill-McKee BFS from s, neighbours by increasing degree */
+        head = tail = 0, queue[tail++] = s, lvl[s] = 0;
+        while (head < tail) {
+            int v = queue[head++], t0 = tail, a, b;
+            perm[nout++] = v;
+            for (p = A->rowptr[v]; p < A->rowptr[v + 1]; ++p)
+                if (lvl[A->col[p]] < 0) lvl[A->col[p]] = 0, queue[tail++] = A->col[p];
+            for (a = t0 + 1; a < tail; ++a) { /* insertion sort by degree (ties: index) */
+                int x = queue[a];
+                b = a - 1;
+                while (b >= t0 && (deg[queue[b]] > deg[x] || (deg[queue[b]] == deg[x] && queue[b] > x)))
+                    queue[b + 1] = queue[b], --b;
+                queue[b + 1] = x;
+            }
+        }
+    }
+    for (i = 0; i < n / 2; ++i) { /* reverse */
+        int t = perm[i];
+        perm[i] = perm[n - 1 - i], perm[n - 1 - i] = t;
+    }
+    gk_free(&al, deg), gk_free(&al, lvl), gk_free(&al, queue);
+    return GK_OK;
+}
+
+GKDEF void gk_solver_free(gk_solver *s) {
+    gk_free(&s->alloc, s->perm), gk_free(&s->alloc, s->ipiv), gk_free(&s->alloc, s->ab), gk_free(&s->alloc, s->tmp);
+    memset(s, 0, sizeof *s);
+}
+
+GKDEF gk_result gk_solver_factor(gk_solver *s, const gk_csr *A, const gk_allocator *alloc, gk_err *err) {
+    gk_solver z;
+    int n = A->n, i, p, k, *inv = NULL, kl = 0, ku = 0;
+    double amax = 0.0, tiny;
+    gk_result res;
+    memset(&z, 0, sizeof z);
+    if (alloc) z.alloc = *alloc;
+    if (n < 1) return gk_err_set(err, GK_ERR_ARG, "empty system");
+    for (p = 0; p < A->nnz; ++p) {
+        if (!(fabs(A->val[p]) < HUGE_VAL)) return gk_err_set(err, GK_ERR_NAN, "matrix entry %d is not finite", p);
+        if (fabs(A->val[p]) > amax) amax = fabs(A->val[p]);
+    }
+    if (!(amax > 0.0)) return gk_err_set(err, GK_ERR_SINGULAR, "matrix is zero");
+    z.n = n;
+    z.perm = (int *)gk_alloc(&z.alloc, (size_t)n * sizeof(int));
+    z.ipiv = (int *)gk_alloc(&z.alloc, (size_t)n * sizeof(int));
+    z.tmp = (double *)gk_alloc(&z.alloc, (size_t)n * sizeof(double));
+    inv = (int *)gk_alloc(&z.alloc, (size_t)n * sizeof(int));
+    if (!z.perm || !z.ipiv || !z.tmp || !inv) {
+        res = gk_err_set(err, GK_ERR_ALLOC, "solver arrays for %d unknowns", n);
+        goto fail;
+    }
+    res = gk_rcm_order(A, z.perm, &z.alloc, err);
+    if (res) goto fail;
+    for (i = 0; i < n; ++i) inv[z.perm[i]] = i;
+    for (i = 0; i < n; ++i)
+        for (p = A->rowptr[i]; p < A->rowptr[i + 1]; ++p) {
+            int d = inv[A->col[p]] - inv[i];
+            if (A->val[p] == 0.0) continue;
+            if (-d > kl) kl = -d;
+            if (d > ku) ku = d;
+        }
+    z.kl = kl, z.ku = ku, z.w = 2 * kl + ku + 1;
+    z.ab = (double *)gk_alloc(&z.alloc, (size_t)n * z.w * sizeof(double));
+    if (!z.ab) {
+        res = gk_err_set(err, GK_ERR_ALLOC, "band of %d x %d for the direct solver", n, z.w);
+        goto fail;
+    }
+    memset(z.ab, 0, (size_t)n * z.w * sizeof(double));
+#define GK__AB(r, c) z.ab[(size_t)(r)*z.w + (c) - (r) + kl]
+    for (i = 0; i < n; ++i)
+        for (p = A->rowptr[i]; p < A->rowptr[i + 1]; ++p)
+            if (A->val[p] != 0.0) GK__AB(inv[i], inv[A->col[p]]) = A->val[p];
+    tiny = 1e-12 * amax;
+    for (k = 0; k < n; ++k) { /* LU with partial pivoting within the band (LAPACK dgbtf2) */
+        int pr = k, last = k + kl < n - 1 ? k + kl : n - 1, jend = k + ku + kl < n - 1 ? k + ku + kl : n - 1, j;
+        double piv;
+        for (i = k + 1; i <= last; ++i)
+            if (fabs(GK__AB(i, k)) > fabs(GK__AB(pr, k))) pr = i;
+        z.ipiv[k] = pr;
+        if (!(fabs(GK__AB(pr, k)) > tiny)) {
+            res = gk_err_set(err, GK_ERR_SINGULAR,
+                             "singular system: pivot %g at unknown %d (dof %d) below 1e-12 x max|A| = %g; "
+                             "is every rigid-body mode constrained?",
+                             GK__AB(pr, k), k, z.perm[k], amax);
+            goto fail;
+        }
+        if (pr != k)
+            for (j = k; j <= jend; ++j) {
+                double t = GK__AB(k, j);
+                GK__AB(k, j) = GK__AB(pr, j), GK__AB(pr, j) = t;
+            }
+        piv = GK__AB(k, k);
+        for (i = k + 1; i <= last; ++i) {
+            double l = GK__AB(i, k) / piv;
+            GK__AB(i, k) = l;
+            if (l != 0.0)
+                for (j = k + 1; j <= jend; ++j) GK__AB(i, j) -= l * GK__AB(k, j);
+        }
+    }
+#undef GK__AB
+    gk_free(&z.alloc, inv);
+    gk_solver_free(s);
+    *s = z;
+    return GK_OK;
+fail:
+    gk_free(&z.alloc, inv);
+    gk_solver_free(&z);
+    return res;
+}
+
+GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x) {
+    int n = s->n, kl = s->kl, k, i, j;
+    double *y = s->tmp;
+    if (!s->ab) return GK_ERR_STATE;
+#define GK__AB(r, c) s->ab[(size_t)(r)*s->w + (c) - (r) + kl]
+    for (i = 0; i < n; ++i) y[i] = b[s->perm[i]];
+    for (k = 0; k < n; ++k) {
+        int last = k + kl < n - 1 ? k + kl : n - 1;
+        if (s->ipiv[k] != k) {
+            double t = y[k];
+            y[k] = y[s->ipiv[k]], y[s->ipiv[k]] = t;
+        }
+        for (i = k + 1; i <= last; ++i) y[i] -= GK__AB(i, k) * y[k];
+    }
+    for (k = n - 1; k >= 0; --k) {
+        int jend = k + s->ku + kl < n - 1 ? k + s->ku + kl : n - 1;
+        double acc = y[k];
+        for (j = k + 1; j <= jend; ++j) acc -= GK__AB(k, j) * y[j];
+        y[k] = acc / GK__AB(k, k);
+    }
+#undef GK__AB
+    for (i = 0; i < n; ++i) x[s->perm[i]] = y[i];
+    return GK_OK;
+}
+
+GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol, int maxit, int *iters,
+                       const gk_allocator *alloc, gk_err *err) {
+    int n = A->n, i, it, p;
+    double *r, *z, *d, *q, *Mi, rz, bn = 0.0;
+    gk_allocator al;
+    memset(&al, 0, sizeof al);
+    if (alloc) al = *alloc;
+    if (!(rtol > 0.0) || maxit < 1) return gk_err_set(err, GK_ERR_ARG, "PCG tolerance %g, max iterations %d", rtol, maxit);
+    r = (double *)gk_alloc(&al, 5 * (size_t)n * sizeof(double));
+    if (!r) return gk_err_set(err, GK_ERR_ALLOC, "PCG work arrays");
+    z = r + n, d = z + n, q = d + n, Mi = q + n;
+    for (i = 0; i < n; ++i) {
+        double dg = 0.0;
+        for (p = A->rowptr[i]; p < A->rowptr[i + 1]; ++p)
+            if (A->col[p] == i) dg = A->val[p];
+        if (!(dg > 0.0)) {
+            gk_free(&al, r);
+            return gk_err_set(err, GK_ERR_SINGULAR, "PCG needs a positive diagonal; row %d has %g", i, dg);
+        }
+        Mi[i] = 1.0 / dg;
+        bn += b[i] * b[i];
+    }
+    bn = sqrt(bn);
+    gk_csr_matvec(A, x, q);
+    rz = 0.0;
+    for (i = 0; i < n; ++i) r[i] = b[i] - q[i], z[i] = Mi[i] * r[i], d[i] = z[i], rz += r[i] * z[i];
+    for (it = 0; it < maxit; ++it) {
+        double rn = 0.0, dq = 0.0, alpha, rz1 = 0.0, beta;
+        for (i = 0; i < n; ++i) rn += r[i] * r[i];
+        if (sqrt(rn) <= rtol * bn) break;
+        gk_csr_matvec(A, d, q);
+        for (i = 0; i < n; ++i) dq += d[i] * q[i];
+        if (!(dq > 0.0)) {
+            gk_free(&al, r);
+            return gk_err_set(err, GK_ERR_SINGULAR, "PCG: matrix not positive definite (d.Ad = %g)", dq);
+        }
+        alpha = rz / dq;
+        for (i = 0; i < n; ++i) x[i] += alpha * d[i], r[i] -= alpha * q[i], z[i] = Mi[i] * r[i], rz1 += r[i] * z[i];
+        beta = rz1 / rz, rz = rz1;
+        for (i = 0; i < n; ++i) d[i] = z[i] + beta * d[i];
+    }
+    gk_free(&al, r);
+    if (iters) *iters = it;
+    if (it == maxit) return gk_err_set(err, GK_ERR_NOCONVERGE, "PCG did not reach %g in %d iterations", rtol, maxit);
+    return GK_OK;
+}
+
+#endif /* GK_FEM implementation */
