@@ -251,7 +251,7 @@ typedef struct gk_mpm_def {
     double alpha;         /* PIC fraction of the PIC/FLIP blend, [0, 1]           */
     double gravity[3];    /* body force per unit mass [m/s^2]                     */
     double damping;       /* local non-viscous grid damping, [0, 1)               */
-    double mass_min;      /* node mass threshold; <= 0: 1e-10 x smallest point mass */
+    double mass_min;      /* node mass threshold; <= 0: 1e-14 x smallest point mass */
     int threads;          /* OpenMP threads for P2G/G2P/update; <= 1 serial       */
 } gk_mpm_def;
 
@@ -862,7 +862,7 @@ static gk_result gk__mpm_bin(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mp
     for (p = 0; p < n; ++p) g->order[g->bstart[g->bid[p]]++] = p;
     for (s = g->nblock; s > 0; --s) g->bstart[s] = g->bstart[s - 1];
     g->bstart[0] = 0;
-    *mmin = d->mass_min > 0.0 ? d->mass_min : (n > 0 ? 1e-10 * mlow : 0.0);
+    *mmin = d->mass_min > 0.0 ? d->mass_min : (n > 0 ? 1e-14 * mlow : 0.0);
     return GK_OK;
 }
 
@@ -933,8 +933,19 @@ GK_INLINE void gk__mpm_wall(double u[3], const double nrm[3], double mu, int fri
     }
 }
 
+/* velocity the node would have had without grid damping (reactions measure
+ * the undamped load: damping must not leak into a footing force) */
+static void gk__mpm_undamped(const gk_mpm_grid *g, size_t I, double dt, double damp, double u0[3]) {
+    int k;
+    if (!(damp > 0.0)) return;
+    for (k = 0; k < g->dim; ++k) {
+        double f = g->fint[k][I] + g->fext[k][I], vk = g->v[k][I];
+        if (vk != 0.0) u0[k] += dt * damp * fabs(f) * (vk > 0.0 ? 1.0 : -1.0) / g->m[I];
+    }
+}
+
 /* apply faces and bodies to velocity arrays vel; with dt > 0 record reactions */
-static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt) {
+static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt, double damp) {
     int f, bi, k, dim = g->dim, i, j, l, lo[3], hi[3];
     for (f = 0; f < 2 * dim; ++f) {
         gk_mpm_face *F = &g->face[f];
@@ -958,6 +969,7 @@ static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt) {
                     double u[3], u0[3];
                     if (!(g->m[I] > g->mass_min)) continue;
                     for (k = 0; k < 3; ++k) u[k] = u0[k] = k < dim ? vel[k][I] : 0.0;
+                    if (dt > 0.0) gk__mpm_undamped(g, I, dt, damp, u0);
                     if (F->kind == GK_MPM_BC_FIXED)
                         u[0] = u[1] = u[2] = 0.0;
                     else if (F->kind == GK_MPM_BC_ROLLER)
@@ -995,6 +1007,7 @@ static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt) {
                     }
                     if (B->contact == GK_MPM_CONTACT_STICK) {
                         for (k = 0; k < 3; ++k) u[k] = vb[k];
+                        if (dt > 0.0) gk__mpm_undamped(g, I, dt, damp, u0);
                     } else {
                         double nrm[3] = {0.0, 0.0, 0.0}, xI[3];
                         int fc = B->face - 1;
@@ -1015,6 +1028,7 @@ static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt) {
                         for (k = 0; k < 3; ++k) u[k] = u0[k] - vb[k];
                         gk__mpm_wall(u, nrm, B->mu, B->contact == GK_MPM_CONTACT_FRICTION);
                         for (k = 0; k < 3; ++k) u[k] += vb[k];
+                        if (dt > 0.0) gk__mpm_undamped(g, I, dt, damp, u0);
                     }
                     for (k = 0; k < dim; ++k) {
                         vel[k][I] = u[k];
@@ -1069,7 +1083,13 @@ GKDEF gk_result gk_mpm_p2g(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mpm_
             double m = g->m[I];
             for (q = 0; q < dim; ++q) g->v[q][I] = m > mmin ? g->p[q][I] / m : 0.0;
         }
-        gk__mpm_apply_bc(g, g->v, 0.0);
+        gk__mpm_apply_bc(g, g->v, 0.0, 0.0);
+        /* the constrained velocity is the grid state: p = m v */
+        GK_OMP(parallel for num_threads(nth) schedule(static) if (nth > 1))
+        for (I = 0; I < nn; ++I) {
+            int q;
+            for (q = 0; q < dim; ++q) g->p[q][I] = g->m[I] > mmin ? g->m[I] * g->v[q][I] : 0.0;
+        }
     }
     return GK_OK;
 }
@@ -1101,7 +1121,7 @@ GKDEF gk_result gk_mpm_grid_update(gk_mpm_grid *g, const gk_mpm_def *d, double d
             g->vn[q][I] = u;
         }
     }
-    gk__mpm_apply_bc(g, g->vn, dt);
+    gk__mpm_apply_bc(g, g->vn, dt, damp);
     if (bad) return gk_err_set(err, GK_ERR_DIVERGED, "a node velocity became NaN or infinite");
     return GK_OK;
 }
