@@ -1,0 +1,1041 @@
+/* femdem_biaxial - the seed 000 FEMxDEM two-scale biaxial test (Guo & Zhao 2014).
+ *
+ *   build/femdem_biaxial --nx 8 --ny 16 --element q8 --steps 100 --threads 2 --out DIR
+ *                        [--tangent taylor|yade|perturbation] [--restart DIR] [--test biaxial|single]
+ *
+ * A 2D plane-strain mesh (Q4 or Q8) of a 50 x 100 mm specimen with a
+ * periodic 400-disk RVE (examples/data/rve400.txt, the seed authors' own) at
+ * every Gauss point. Smooth top and bottom platens, bottom-centre node pinned
+ * in x, 100 kPa confining traction on both sides, top displaced by 0.1 % of
+ * the height per load step. Per Newton iteration every Gauss point receives
+ * the whole-step displacement gradient dH (stretch and spin, seed 000 eq 10),
+ * re-runs its RVE from the last converged state over n_s DEM steps, and
+ * returns its total Love stress (eq 5) and tangent (eq 9, or eq 8 by
+ * perturbation); the macro solve is full Newton-Raphson (sec 2.3) with the
+ * displacement criterion E_d < 0.01 (eq 21).
+ *
+ * ROBUSTNESS (what the authors' script lacks; see README "Convergence")
+ *   - tangent 'taylor' (default) drops the tangential stiffness of sliding
+ *     contacts (consistent with the Coulomb cap); 'yade' keeps it (the
+ *     authors' Shop::getStressAndTangent); 'perturbation' = eq 8 with xi.
+ *   - Aitken relaxation: the approximate (affine) tangent makes Newton
+ *     converge linearly with a nearly constant ratio; the correction d_k is
+ *     scaled by w_k = -w_(k-1) d_(k-1).(d_k - d_(k-1)) / |d_k - d_(k-1)|^2
+ *     (Irons & Tuck 1969), clamped to [0.25, 4]; --relaxation none turns it off.
+ *   - line search: when the residual norm grows by > 25 % the correction is halved
+ *     once and the RVEs re-run (counted as an iteration).
+ *   - cut-back: a step that does not converge in --max-iter iterations, or
+ *     whose RVEs fail, restarts from the converged state with half the load
+ *     increment (down to 1/16), and the increment regrows x2 per converged
+ *     sub-step; a cut-back increment keeps the full increment's DEM step
+ *     count (slower ramp, less DEM noise). If it still fails the driver writes a checkpoint of the last
+ *     converged state, says so, and exits with status 3.
+ *   - a Gauss point that lost its contacts (p -> 0) returns zero stress; its
+ *     tangent gets a floor of 1e-4 x the mesh-mean stiffness so K stays
+ *     invertible (reported as failed points).
+ *
+ * OUTPUTS in DIR
+ *   biaxial.csv   step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds,E_d,E_f,increment,failed_gp
+ *                 stresses [Pa] from the boundary reactions (top force / current
+ *                 width, side force / current height), COMPRESSION POSITIVE;
+ *                 strains compression positive (eps_v = -(A - A0)/A0).
+ *   gp_NNNN.vtk   Gauss-point fields per step (eps_q, eps_v, void_ratio,
+ *                 rotation_deg, spin_deg, p, q, fabric_anisotropy, coordination,
+ *                 dem_steps), mesh_NNNN.vtk the deformed mesh with displacement
+ *   biaxial_stress.svg, biaxial_volume.svg, eps_q_field.svg (final eps_q)
+ *   single_element.csv/svg (--test single: FEM element vs the RVE alone)
+ *   checkpoint.bin every --checkpoint K steps and at the end
+ * and prints per step a progress line with ETA and finally
+ *   RESULT peak_sigma_yy=… eps_at_peak=… band_angle_deg=… band_width_mm=… total_seconds=…
+ */
+#define _POSIX_C_SOURCE 200809L
+#define GK_IMPLEMENTATION
+#include "gk_fem.h"
+#include "gk_homog.h"
+#include "gk_io.h"
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
+#define SEED_DT 3.1602315723728926e-05 /* the seed authors' YADE time step (PWaveTimeStep of rve400) */
+
+typedef struct opts {
+    int nx, ny, steps, threads, quad, max_iter, checkpoint, verbose, vtk_every, dem_min, dem_max, aitken;
+    gk_elem_type elem;
+    const char *out, *restart, *packing, *tangent, *test;
+    double width, height, pressure, inc, tol, dt, dem_strain, xi;
+} opts;
+
+typedef struct curve_row {
+    double eps, syy, sxx, ev, secs, Ed, Ef, inc;
+    int iters, failed;
+} curve_row;
+
+typedef struct model {
+    opts o;
+    gk_mesh mesh;
+    gk_quad q;
+    int ngp, npe, ndof, tmode;
+    gk_rve *rve;
+    gk_rve_state *st;
+    double *sig, *sig_n, *D, *D_n, *Hacc, *Hit, *dNdx, *detJ;
+    int *nsteps_gp, *failed;
+    gk_csr K;
+    double *u, *du, *dprev, *fint, *fext, *R, *rhs, *utot, *A0x;
+    int *fix, nfix, *fixtop, *top, ntop, *right, nright, *lface, nlf, *rface, nrf, nfn;
+    double area0, eps_done, scale;
+    int step;
+    curve_row *curve;
+    int ncurve, cap;
+} model;
+
+static void usage(FILE *fp) {
+    fprintf(fp,
+            "usage: femdem_biaxial [--nx 8] [--ny 16] [--element q8|q4] [--steps 100] [--threads 2] [--out DIR]\n"
+            "                      [--tangent taylor|yade|perturbation] [--restart DIR] [--test biaxial|single]\n"
+            "\n"
+            "  --nx, --ny N           elements across the width and the height (8 x 16: the authors' mesh)\n"
+            "  --element q8|q4        8-node serendipity (default) or 4-node bilinear quad\n"
+            "  --quad 2|3             Gauss points per direction (default 2: Q8 reduced as in the authors'\n"
+            "                         script, 4 RVEs per element; 3: Q8 full integration, 9 RVEs)\n"
+            "  --steps N              load steps (default 100: 10 %% axial strain at 0.1 %% per step)\n"
+            "  --increment F          axial strain per load step (default 0.001)\n"
+            "  --threads T            OpenMP threads over the RVEs (results identical for any T)\n"
+            "  --out DIR              output directory (created; default femdem_out)\n"
+            "  --tangent KIND         taylor (eq 9, sliding contacts k_t = 0, default), yade (eq 9 keeping\n"
+            "                         k_t of sliding contacts, as the authors' code), perturbation (eq 8)\n"
+            "  --xi X                 perturbation size of eq 8 (default 5e-5, seed Fig 6)\n"
+            "  --restart DIR          continue from DIR/checkpoint.bin (same mesh options) to --steps\n"
+            "  --checkpoint K         write DIR/checkpoint.bin every K steps (default 10; always at the end)\n"
+            "  --test biaxial|single  biaxial (default) or the single-element test of seed sec 3.3: one Q4\n"
+            "                         element, 4 Gauss points, compared with the RVE alone under the same\n"
+            "                         drained path (writes single_element.csv and .svg)\n"
+            "  --packing FILE         RVE at every Gauss point (default examples/data/rve400.txt)\n"
+            "  --width, --height M    specimen size [m] (0.05 x 0.1)\n"
+            "  --pressure P           confining pressure [Pa] (1e5)\n"
+            "  --tol T                Newton tolerance on E_d (eq 21; default 0.01)\n"
+            "  --max-iter N           iterations before a load step is cut back (default 12)\n"
+            "  --dt DT                DEM time step (default 3.16e-5 s, the authors')\n"
+            "  --dem-strain S         DEM steps per RVE run n_s = max|dH| / S (default 1e-5: the\n"
+            "                         authors' rule, 100 steps per 0.1 %%), clamped to [--dem-min, --dem-max]\n"
+            "  --dem-min, --dem-max   bounds of n_s (2, 20000)\n"
+            "  --vtk-every K          VTK files every K steps (default 1; 0: none)\n"
+            "  --relaxation KIND      aitken (default): Newton corrections scaled by the Aitken factor of the\n"
+            "                         last two corrections (in [0.25, 4]); none: plain Newton\n"
+            "  --verbose              print E_d, E_f and time of every Newton iteration\n");
+}
+
+static int mkdir_p(const char *d) {
+    if (mkdir(d, 0777) == 0 || errno == EEXIST) return 0;
+    return -1;
+}
+
+static double norm(const double *v, int n) {
+    double s = 0.0;
+    int k;
+    for (k = 0; k < n; ++k) s += v[k] * v[k];
+    return sqrt(s);
+}
+
+/* ------------------------------------------------------------ RVE runs */
+static int dem_steps_for(const model *M, const double H[9]) {
+    double mx = 0.0;
+    int k;
+    for (k = 0; k < 9; ++k)
+        if (fabs(H[k]) > mx) mx = fabs(H[k]);
+    {
+        /* a cut-back increment keeps the DEM step count of the full one (a slower,
+         * more quasi-static ramp) instead of fewer, noisier steps */
+        double n = ceil(mx / (M->o.dem_strain * M->scale));
+        if (n < M->o.dem_min) n = M->o.dem_min;
+        if (n > M->o.dem_max) n = M->o.dem_max;
+        return (int)n;
+    }
+}
+
+/* every Gauss point: restore the converged state, deform by dH = grad u over
+ * n_s steps, read stress and tangent. Returns the number of failed RVEs. */
+static int eval_rves(model *M, const double *u) {
+    int g, nbad = 0, n4 = 16;
+    GK_OMP(parallel for num_threads(M->o.threads) schedule(dynamic, 1) reduction(+ : nbad))
+    for (g = 0; g < M->ngp; ++g) {
+        int e = g / M->q.n, a, i, j, ns;
+        double H[9];
+        gk_rve *r = &M->rve[g];
+        const int *c = M->mesh.conn + (size_t)e * M->npe;
+        gk_m3_zero(H);
+        for (a = 0; a < M->npe; ++a)
+            for (i = 0; i < 2; ++i)
+                for (j = 0; j < 2; ++j) H[3 * i + j] += u[2 * c[a] + i] * M->dNdx[(size_t)g * 16 + 2 * a + j];
+        memcpy(M->Hit + 9 * (size_t)g, H, sizeof H);
+        ns = dem_steps_for(M, H);
+        M->nsteps_gp[g] = ns;
+        if (M->tmode == 2) { /* perturbation tangent (eq 8): 4 extra runs, then the trial run last */
+            double s0[9], s1[9], Hp[9];
+            int k, l;
+            if (gk_rve_state_restore(&M->st[g], r) || gk_rve_deform(r, H, ns)) {
+                ++nbad;
+                continue;
+            }
+            gk_rve_stress(r, s0);
+            for (k = 0; k < 2; ++k)
+                for (l = 0; l < 2; ++l) {
+                    memcpy(Hp, H, sizeof H);
+                    Hp[3 * k + l] += M->o.xi;
+                    if (gk_rve_state_restore(&M->st[g], r) || gk_rve_deform(r, Hp, ns)) {
+                        ++nbad;
+                        continue;
+                    }
+                    gk_rve_stress(r, s1);
+                    for (i = 0; i < 2; ++i)
+                        for (j = 0; j < 2; ++j)
+                            M->D[(size_t)g * n4 + ((i * 2 + j) * 2 + k) * 2 + l] = (s1[3 * i + j] - s0[3 * i + j]) / M->o.xi;
+                }
+        }
+        if (gk_rve_state_restore(&M->st[g], r) || gk_rve_deform(r, H, ns)) {
+            ++nbad;
+            continue;
+        }
+        gk_rve_stress(r, M->sig + 9 * (size_t)g);
+        if (M->tmode != 2 &&
+            gk_homog_tangent(r, M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u, M->D + (size_t)g * n4))
+            ++nbad;
+    }
+    return nbad;
+}
+
+/* a Gauss point without contacts has D = 0; give it a small floor so that K
+ * stays invertible. Returns the number of such points. */
+static int floor_tangents(model *M, double *D) {
+    double mean = 0.0;
+    int g, nf = 0, k;
+    for (g = 0; g < M->ngp; ++g) mean += D[16 * g] + D[16 * g + 15];
+    mean /= 2.0 * M->ngp;
+    for (g = 0; g < M->ngp; ++g) {
+        M->failed[g] = M->rve[g].ncontacts < M->rve[g].n / 2;
+        if (D[16 * g] + D[16 * g + 15] < 2e-3 * mean) {
+            double Df[16];
+            gk_fem_elastic_tangent(2, 1e-4 * mean, 0.2, Df);
+            for (k = 0; k < 16; ++k) D[16 * g + k] += Df[k];
+            ++nf;
+        }
+    }
+    return nf;
+}
+
+/* ------------------------------------------------------------- setup */
+static int setup(model *M, gk_err *err) {
+    opts *o = &M->o;
+    int n[3], g, e, a, per = o->quad, k;
+    double org[3] = {0, 0, 0}, len[3];
+    gk_packing pk;
+    gk_rve_def def = gk_rve_def_default();
+    n[0] = o->nx, n[1] = o->ny, n[2] = 1;
+    len[0] = o->width, len[1] = o->height, len[2] = 1;
+    if (gk_mesh_structured(&M->mesh, o->elem, n, org, len, NULL, err)) return 1;
+    if (gk_quad_rule(&M->q, o->elem, per, err)) return 1;
+    if (gk_mesh_check(&M->mesh, &M->q, err)) return 1;
+    M->npe = M->mesh.npe;
+    M->ngp = M->mesh.nelem * M->q.n;
+    M->ndof = 2 * M->mesh.nnode;
+    M->tmode = !strcmp(o->tangent, "yade") ? 1 : !strcmp(o->tangent, "perturbation") ? 2 : 0;
+    if (gk_csr_from_mesh(&M->K, &M->mesh, NULL, err)) return 1;
+#define ALLOC(p, n)                                                                                                    \
+    do {                                                                                                              \
+        (p) = calloc((size_t)(n) + 1, sizeof *(p));                                                                   \
+        if (!(p)) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;                                          \
+    } while (0)
+    ALLOC(M->rve, M->ngp);
+    ALLOC(M->st, M->ngp);
+    ALLOC(M->sig, 9 * M->ngp);
+    ALLOC(M->sig_n, 9 * M->ngp);
+    ALLOC(M->D, 16 * M->ngp);
+    ALLOC(M->D_n, 16 * M->ngp);
+    ALLOC(M->Hacc, 9 * M->ngp);
+    ALLOC(M->Hit, 9 * M->ngp);
+    ALLOC(M->dNdx, 16 * M->ngp);
+    ALLOC(M->detJ, M->ngp);
+    ALLOC(M->nsteps_gp, M->ngp);
+    ALLOC(M->failed, M->ngp);
+    ALLOC(M->u, M->ndof);
+    ALLOC(M->du, M->ndof);
+    ALLOC(M->dprev, M->ndof);
+    ALLOC(M->fint, M->ndof);
+    ALLOC(M->fext, M->ndof);
+    ALLOC(M->R, M->ndof);
+    ALLOC(M->rhs, M->ndof);
+    ALLOC(M->utot, M->ndof);
+    ALLOC(M->A0x, M->ndof);
+    ALLOC(M->fix, M->ndof);
+    ALLOC(M->fixtop, M->ndof);
+    ALLOC(M->top, M->mesh.nnode);
+    ALLOC(M->right, M->mesh.nnode);
+    ALLOC(M->lface, 3 * M->mesh.nelem);
+    ALLOC(M->rface, 3 * M->mesh.nelem);
+    memcpy(M->A0x, M->mesh.x, (size_t)M->ndof * sizeof(double));
+    /* boundary sets, fixed for the whole run (node ids persist) */
+    {
+        double tol = 1e-9 * o->height, best = 1e30;
+        int nb, *bot, centre = -1;
+        ALLOC(bot, M->mesh.nnode);
+        nb = gk_mesh_nodes_on_plane(&M->mesh, 1, 0.0, tol, bot);
+        M->ntop = gk_mesh_nodes_on_plane(&M->mesh, 1, o->height, tol, M->top);
+        M->nright = gk_mesh_nodes_on_plane(&M->mesh, 0, o->width, tol, M->right);
+        M->nlf = gk_mesh_faces_on_plane(&M->mesh, 0, 0.0, tol, M->lface, &M->nfn);
+        M->nrf = gk_mesh_faces_on_plane(&M->mesh, 0, o->width, tol, M->rface, &M->nfn);
+        M->nfix = 0;
+        for (a = 0; a < nb; ++a) {
+            double dx = fabs(M->mesh.x[2 * bot[a]] - 0.5 * o->width);
+            M->fix[M->nfix] = 2 * bot[a] + 1, M->fixtop[M->nfix++] = 0;
+            if (dx < best - tol) best = dx, centre = bot[a];
+        }
+        for (a = 0; a < M->ntop; ++a) M->fix[M->nfix] = 2 * M->top[a] + 1, M->fixtop[M->nfix++] = 1;
+        M->fix[M->nfix] = 2 * centre, M->fixtop[M->nfix++] = 0;
+        free(bot);
+    }
+    M->area0 = o->width * o->height;
+    /* RVEs: the same packing everywhere (seed 000: uniform RVE, no imperfection) */
+    if (gk_packing_read(o->packing, &pk, NULL, err)) return 1;
+    if (pk.dim != 2) return gk_err_set(err, GK_ERR_ARG, "%s is a %dD packing; this driver is 2D", o->packing, pk.dim), 1;
+    def.dt = o->dt;
+    for (g = 0; g < M->ngp; ++g) {
+        if (gk_rve_create(&M->rve[g], &def, &pk)) {
+            gk_err_set(err, GK_ERR_ARG, "RVE: %s", gk_rve_error(&M->rve[g]));
+            gk_packing_free(&pk);
+            return 1;
+        }
+        if (g == 0 && gk_rve_refresh(&M->rve[g])) return gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&M->rve[0])), 1;
+        if (g > 0) { /* identical copies: clone the refreshed state of the first */
+            if (gk_rve_state_restore(&M->st[0], &M->rve[g])) return gk_err_set(err, GK_ERR_STATE, "clone"), 1;
+        } else {
+            gk_rve_state_init(&M->st[0], NULL);
+            if (gk_rve_state_save(&M->st[0], &M->rve[0])) return gk_err_set(err, GK_ERR_ALLOC, "RVE state"), 1;
+        }
+        if (g > 0) {
+            gk_rve_state_init(&M->st[g], NULL);
+            if (gk_rve_state_save(&M->st[g], &M->rve[g])) return gk_err_set(err, GK_ERR_ALLOC, "RVE state"), 1;
+        }
+        gk_rve_stress(&M->rve[g], M->sig_n + 9 * (size_t)g);
+        if (M->tmode == 2) { /* first tangent: Taylor (no trial state yet) */
+            if (gk_homog_tangent(&M->rve[g], 0u, M->D_n + 16 * (size_t)g)) return 1;
+        } else if (gk_homog_tangent(&M->rve[g], M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u, M->D_n + 16 * (size_t)g))
+            return gk_err_set(err, GK_ERR_STATE, "tangent"), 1;
+    }
+    gk_packing_free(&pk);
+    M->scale = 1.0;
+    (void)e, (void)k;
+    return 0;
+}
+
+static void precompute_gradients(model *M) {
+    int e, g;
+    for (e = 0; e < M->mesh.nelem; ++e)
+        for (g = 0; g < M->q.n; ++g) {
+            int id = e * M->q.n + g;
+            gk_fem_jacobian(&M->mesh, e, M->q.xi[g], NULL, M->dNdx + 16 * (size_t)id, &M->detJ[id], NULL);
+        }
+}
+
+static int external_force(model *M, gk_err *err) {
+    double tl[3] = {M->o.pressure, 0, 0}, tr[3] = {-M->o.pressure, 0, 0};
+    int f;
+    memset(M->fext, 0, (size_t)M->ndof * sizeof(double));
+    for (f = 0; f < M->nlf; ++f)
+        if (gk_fem_face_load(&M->mesh, M->nfn, M->lface + f * M->nfn, tl, M->fext, err)) return 1;
+    for (f = 0; f < M->nrf; ++f)
+        if (gk_fem_face_load(&M->mesh, M->nfn, M->rface + f * M->nfn, tr, M->fext, err)) return 1;
+    return 0;
+}
+
+/* K from tangents D, rhs with Dirichlet values; solve into x */
+static int solve(model *M, const double *D, const double *rhs_in, double top_value, double *x, gk_err *err) {
+    gk_solver s;
+    double vals[4096], *vp = vals;
+    int k, r = 0;
+    memset(&s, 0, sizeof s);
+    if (M->nfix > 4096) vp = (double *)malloc((size_t)M->nfix * sizeof(double));
+    for (k = 0; k < M->nfix; ++k) vp[k] = M->fixtop[k] ? top_value : 0.0;
+    memcpy(M->rhs, rhs_in, (size_t)M->ndof * sizeof(double));
+    if (gk_fem_assemble(&M->mesh, &M->q, D, NULL, &M->K, NULL, err) ||
+        gk_fem_dirichlet(&M->K, M->rhs, M->nfix, M->fix, vp, err) || gk_solver_factor(&s, &M->K, NULL, err) ||
+        gk_solver_solve(&s, M->rhs, x))
+        r = 1;
+    gk_solver_free(&s);
+    if (vp != vals) free(vp);
+    return r;
+}
+
+/* residual R = f_int(sig) - f_ext, zero at prescribed dofs; returns E_f */
+static double residual(model *M, const double *sig, gk_err *err) {
+    int k;
+    double nf;
+    if (gk_fem_assemble(&M->mesh, &M->q, NULL, sig, NULL, M->fint, err)) return HUGE_VAL;
+    for (k = 0; k < M->ndof; ++k) M->R[k] = M->fint[k] - M->fext[k];
+    nf = norm(M->fint, M->ndof);
+    for (k = 0; k < M->nfix; ++k) M->R[M->fix[k]] = 0.0;
+    return nf > 0 ? norm(M->R, M->ndof) / nf : 0.0;
+}
+
+/* one load (sub)step of axial strain inc; 0 = converged, 1 = not converged,
+ * 2 = hard error */
+static int load_step(model *M, double inc, int *iters, double *Ed_out, double *Ef_out, gk_err *err) {
+    int it, k, nbad, have_prev = 0;
+    double Ed = 1.0, Ef = 0.0, Rprev = HUGE_VAL, top = -inc * M->o.height, omega = 1.0;
+    precompute_gradients(M);
+    if (external_force(M, err)) return 2;
+    /* predictor: K(D_n) u = f_ext - f_int(sig_n) with the prescribed increment */
+    residual(M, M->sig_n, err);
+    for (k = 0; k < M->ndof; ++k) M->du[k] = -M->R[k];
+    if (solve(M, M->D_n, M->du, top, M->u, err)) return 1;
+    for (it = 1; it <= M->o.max_iter; ++it) {
+        double t0 = gk_wtime(), Rn;
+        nbad = eval_rves(M, M->u);
+        if (nbad) {
+            if (M->o.verbose) fprintf(stderr, "    iter %2d: %d RVEs failed -> cut back\n", it, nbad);
+            *iters = it;
+            return 1;
+        }
+        Ef = residual(M, M->sig, err);
+        Rn = norm(M->R, M->ndof);
+        if (M->o.verbose)
+            fprintf(stderr, "    iter %2d: E_d %.3e  E_f %.3e  max n_s %d  %.2f s\n", it, Ed, Ef,
+                    M->nsteps_gp[0] > 0 ? M->nsteps_gp[0] : 0, gk_wtime() - t0);
+        if (it > 1 && Ed < M->o.tol) {
+            *iters = it, *Ed_out = Ed, *Ef_out = Ef;
+            return 0;
+        }
+        if (it >= M->o.max_iter) break;
+        if (it > 2 && Rn > 1.25 * Rprev) { /* line search: the last correction overshot; take back half */
+            for (k = 0; k < M->ndof; ++k) M->du[k] *= 0.5, M->u[k] -= M->du[k];
+            Ed = norm(M->du, M->ndof) / (norm(M->u, M->ndof) + 1e-300);
+            Rprev = HUGE_VAL; /* accept whatever the halved step gives */
+            have_prev = 0, omega = 1.0;
+            if (M->o.verbose) fprintf(stderr, "    iter %2d: residual grew, correction halved\n", it);
+            continue;
+        }
+        Rprev = Rn;
+        floor_tangents(M, M->D);
+        for (k = 0; k < M->ndof; ++k) M->R[k] = -M->R[k];
+        if (solve(M, M->D, M->R, 0.0, M->du, err)) return 1;
+        if (M->o.aitken) { /* Aitken (Irons-Tuck) relaxation of the Newton correction d_k */
+            if (have_prev) {
+                double num = 0.0, den = 0.0;
+                for (k = 0; k < M->ndof; ++k) {
+                    double dd = M->du[k] - M->dprev[k];
+                    num += M->dprev[k] * dd, den += dd * dd;
+                }
+                if (den > 0.0) omega = -omega * num / den;
+                if (!(omega >= 0.25)) omega = 0.25; /* also catches NaN */
+                if (omega > 4.0) omega = 4.0;
+            }
+            memcpy(M->dprev, M->du, (size_t)M->ndof * sizeof(double));
+            have_prev = 1;
+            for (k = 0; k < M->ndof; ++k) M->du[k] *= omega;
+        }
+        for (k = 0; k < M->ndof; ++k) M->u[k] += M->du[k];
+        Ed = norm(M->du, M->ndof) / (norm(M->u, M->ndof) + 1e-300);
+    }
+    *iters = M->o.max_iter, *Ed_out = Ed, *Ef_out = Ef;
+    return 1;
+}
+
+static void commit(model *M) {
+    int g, k;
+    for (g = 0; g < M->ngp; ++g) {
+        gk_rve_state_save(&M->st[g], &M->rve[g]);
+        for (k = 0; k < 9; ++k) M->Hacc[9 * g + k] += M->Hit[9 * g + k];
+    }
+    memcpy(M->sig_n, M->sig, (size_t)M->ngp * 9 * sizeof(double));
+    memcpy(M->D_n, M->D, (size_t)M->ngp * 16 * sizeof(double));
+    floor_tangents(M, M->D_n);
+    gk_mesh_update(&M->mesh, M->u);
+    for (k = 0; k < M->ndof; ++k) M->utot[k] += M->u[k];
+}
+
+/* boundary stresses (compression positive) and volumetric strain */
+static void macro_state(const model *M, double *syy, double *sxx, double *ev) {
+    double fy = 0, fx = 0, w, h, area = 0.0;
+    int a, e, g;
+    for (a = 0; a < M->ntop; ++a) fy += M->fint[2 * M->top[a] + 1];
+    for (a = 0; a < M->nright; ++a) fx += M->fint[2 * M->right[a]];
+    /* current width and height: mean over the top and right node sets */
+    {
+        double xr = 0, xl = 0, yt = 0;
+        int nl = 0;
+        for (a = 0; a < M->nright; ++a) xr += M->mesh.x[2 * M->right[a]];
+        for (a = 0; a < M->mesh.nnode; ++a)
+            if (fabs(M->A0x[2 * a]) < 1e-12) xl += M->mesh.x[2 * a], ++nl;
+        for (a = 0; a < M->ntop; ++a) yt += M->mesh.x[2 * M->top[a] + 1];
+        w = xr / M->nright - xl / nl;
+        h = yt / M->ntop;
+    }
+    *syy = -fy / w;
+    *sxx = -fx / h;
+    for (e = 0; e < M->mesh.nelem; ++e)
+        for (g = 0; g < M->q.n; ++g) {
+            double dN[16], dJ;
+            gk_fem_jacobian(&M->mesh, e, M->q.xi[g], NULL, dN, &dJ, NULL);
+            area += M->q.w[g] * dJ;
+        }
+    *ev = -(area - M->area0) / M->area0;
+}
+
+/* ------------------------------------------------------------- outputs */
+static void gp_fields(const model *M, int g, double *f) {
+    const gk_rve *r = &M->rve[g];
+    double s[9], F[9], phi[9], Fa[9], eps[9];
+    const double *H = M->Hacc + 9 * (size_t)g;
+    int k;
+    for (k = 0; k < 9; ++k) eps[k] = 0.5 * (H[k] + H[3 * (k % 3) + k / 3]);
+    gk_m3_identity(F);
+    for (k = 0; k < 9; ++k) F[k] += H[k];
+    gk_rve_stress(r, s);
+    f[0] = gk_strain_q(eps, 2);
+    f[1] = -gk_strain_v(eps, 2); /* compression positive, as the seed */
+    f[2] = gk_homog_void_ratio(r);
+    f[3] = gk_homog_mean_rotation(r) * 180.0 / 3.14159265358979323846;
+    f[4] = gk_rotation_angle(F, 2) * 180.0 / 3.14159265358979323846;
+    f[5] = gk_stress_p(s, 2);
+    f[6] = gk_stress_q(s, 2);
+    f[7] = gk_homog_fabric(r, phi, Fa);
+    f[8] = r->n > 0 ? 2.0 * r->ncontacts / r->n : 0.0;
+    f[9] = M->nsteps_gp[g];
+}
+
+#define NFIELD 10
+static const char *field_names[NFIELD] = {"eps_q",    "eps_v", "void_ratio", "rotation_deg",      "spin_deg",
+                                          "p",        "q",     "fabric_anisotropy", "coordination", "dem_steps"};
+
+static void write_vtk(const model *M, int step) {
+    char path[1200];
+    gk_vtk v;
+    double *xyz = (double *)malloc((size_t)(M->ngp > M->mesh.nnode ? M->ngp : M->mesh.nnode) * 3 * sizeof(double));
+    double *val = (double *)malloc((size_t)M->ngp * sizeof(double)), *all;
+    int *conn, g, k, a;
+    all = (double *)malloc((size_t)M->ngp * NFIELD * sizeof(double));
+    conn = (int *)malloc((size_t)(M->ngp > M->mesh.nelem * 8 ? M->ngp : M->mesh.nelem * 8) * sizeof(int));
+    if (!xyz || !val || !all || !conn) goto out;
+    for (g = 0; g < M->ngp; ++g) {
+        gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], xyz + 3 * g);
+        conn[g] = g;
+        gp_fields(M, g, all + NFIELD * g);
+    }
+    snprintf(path, sizeof path, "%s/gp_%04d.vtk", M->o.out, step);
+    if (gk_vtk_open(&v, path, "grainkit femdem_biaxial Gauss points") == GK_OK) {
+        gk_vtk_points(&v, M->ngp, xyz);
+        gk_vtk_cells(&v, M->ngp, 1, conn, GK_VTK_VERTEX);
+        for (k = 0; k < NFIELD; ++k) {
+            for (g = 0; g < M->ngp; ++g) val[g] = all[NFIELD * g + k];
+            gk_vtk_point_scalar(&v, field_names[k], val);
+        }
+        gk_vtk_close(&v);
+    }
+    for (a = 0; a < M->mesh.nnode; ++a) {
+        xyz[3 * a] = M->mesh.x[2 * a], xyz[3 * a + 1] = M->mesh.x[2 * a + 1], xyz[3 * a + 2] = 0.0;
+    }
+    snprintf(path, sizeof path, "%s/mesh_%04d.vtk", M->o.out, step);
+    if (gk_vtk_open(&v, path, "grainkit femdem_biaxial mesh") == GK_OK) {
+        double *d3 = (double *)malloc((size_t)M->mesh.nnode * 3 * sizeof(double));
+        gk_vtk_points(&v, M->mesh.nnode, xyz);
+        gk_vtk_cells(&v, M->mesh.nelem, M->npe, M->mesh.conn, M->npe == 8 ? GK_VTK_QUAD8 : GK_VTK_QUAD);
+        if (d3) {
+            for (a = 0; a < M->mesh.nnode; ++a)
+                d3[3 * a] = M->utot[2 * a], d3[3 * a + 1] = M->utot[2 * a + 1], d3[3 * a + 2] = 0.0;
+            gk_vtk_point_vector(&v, "displacement", d3);
+            free(d3);
+        }
+        gk_vtk_close(&v);
+    }
+out:
+    free(xyz), free(val), free(all), free(conn);
+}
+
+static void write_csv(const model *M) {
+    char path[1200];
+    FILE *fp;
+    int k;
+    snprintf(path, sizeof path, "%s/biaxial.csv", M->o.out);
+    fp = fopen(path, "w");
+    if (!fp) return;
+    fprintf(fp, "step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds,E_d,E_f,increment,failed_gp\n");
+    for (k = 0; k < M->ncurve; ++k) {
+        const curve_row *c = &M->curve[k];
+        fprintf(fp, "%d,%.9g,%.9g,%.9g,%.9g,%d,%.4f,%.4g,%.4g,%.6g,%d\n", k, c->eps, c->syy, c->sxx, c->ev, c->iters,
+                c->secs, c->Ed, c->Ef, c->inc, c->failed);
+    }
+    fclose(fp);
+}
+
+static void write_plots(const model *M) {
+    char path[1200];
+    gk_plot pl;
+    gk_err err;
+    double *x = (double *)malloc((size_t)M->ncurve * sizeof(double)), *y1 = (double *)malloc((size_t)M->ncurve * sizeof(double)),
+           *y2 = (double *)malloc((size_t)M->ncurve * sizeof(double));
+    int k;
+    if (!x || !y1 || !y2) goto out;
+    for (k = 0; k < M->ncurve; ++k)
+        x[k] = 100 * M->curve[k].eps, y1[k] = M->curve[k].syy / 1e3, y2[k] = M->curve[k].sxx / 1e3;
+    gk_plot_init(&pl, "FEMxDEM biaxial test (seed 000)", "axial strain [%]", "stress [kPa] (compression positive)");
+    gk_plot_add(&pl, x, y1, M->ncurve, "sigma_yy (top reaction / width)");
+    gk_plot_add(&pl, x, y2, M->ncurve, "sigma_xx (side reaction / height)");
+    snprintf(path, sizeof path, "%s/biaxial_stress.svg", M->o.out);
+    gk_plot_svg(&pl, path, &err);
+    for (k = 0; k < M->ncurve; ++k) y1[k] = 100 * M->curve[k].ev;
+    gk_plot_init(&pl, "FEMxDEM biaxial test: volume", "axial strain [%]", "volumetric strain [%] (contraction positive)");
+    gk_plot_add(&pl, x, y1, M->ncurve, NULL);
+    snprintf(path, sizeof path, "%s/biaxial_volume.svg", M->o.out);
+    gk_plot_svg(&pl, path, &err);
+out:
+    free(x), free(y1), free(y2);
+}
+
+/* eps_q map: each Gauss point owns the sub-quad of its element around it */
+static void write_field_svg(const model *M) {
+    int per = M->o.quad, e, i, j, c, g = 0;
+    double *xy = (double *)malloc((size_t)M->ngp * 8 * sizeof(double)), *val = (double *)malloc((size_t)M->ngp * sizeof(double));
+    char path[1200], title[200];
+    gk_err err;
+    if (!xy || !val) goto out;
+    for (e = 0; e < M->mesh.nelem; ++e)
+        for (j = 0; j < per; ++j)
+            for (i = 0; i < per; ++i, ++g) {
+                static const int ci[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+                double f[NFIELD];
+                for (c = 0; c < 4; ++c) {
+                    double xi[3], x[3];
+                    xi[0] = -1 + 2.0 * (i + ci[c][0]) / per, xi[1] = -1 + 2.0 * (j + ci[c][1]) / per, xi[2] = 0;
+                    gk_mesh_point(&M->mesh, e, xi, x);
+                    xy[8 * g + 2 * c] = x[0] * 1e3, xy[8 * g + 2 * c + 1] = x[1] * 1e3;
+                }
+                gp_fields(M, g, f);
+                val[g] = f[0];
+            }
+    snprintf(title, sizeof title, "eps_q at axial strain %.2f %% (x, y in mm)", 100 * M->eps_done);
+    snprintf(path, sizeof path, "%s/eps_q_field.svg", M->o.out);
+    gk_svg_field(path, title, "eps_q", M->ngp, 4, xy, val, 0.0, &err);
+out:
+    free(xy), free(val);
+}
+
+/* shear band from the eps_q field: points above the median + half the range;
+ * angle of their principal axis from the horizontal (weighted by excess eps_q),
+ * width = sqrt(12 var) of the perpendicular distances (a uniform band of width
+ * W has variance W^2/12). No band if max eps_q < 1.5 x median. */
+static int cmp_d(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static void band(const model *M, double *angle, double *width) {
+    double *v = (double *)malloc((size_t)M->ngp * sizeof(double)), *s = (double *)malloc((size_t)M->ngp * sizeof(double));
+    double med, mx, thr, sw = 0, cx = 0, cy = 0, sxx = 0, syy = 0, sxy = 0, th, nx, ny, var = 0, f[NFIELD];
+    int g;
+    *angle = *width = NAN;
+    if (!v || !s) goto out;
+    for (g = 0; g < M->ngp; ++g) gp_fields(M, g, f), v[g] = s[g] = f[0];
+    qsort(s, (size_t)M->ngp, sizeof(double), cmp_d);
+    med = s[M->ngp / 2], mx = s[M->ngp - 1];
+    if (M->ngp < 8 || !(mx > 1.5 * med)) goto out;
+    thr = med + 0.5 * (mx - med);
+    for (g = 0; g < M->ngp; ++g) {
+        double x[3], w = v[g] - thr;
+        if (w <= 0) continue;
+        gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], x);
+        sw += w, cx += w * x[0], cy += w * x[1];
+    }
+    cx /= sw, cy /= sw;
+    for (g = 0; g < M->ngp; ++g) {
+        double x[3], w = v[g] - thr;
+        if (w <= 0) continue;
+        gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], x);
+        sxx += w * (x[0] - cx) * (x[0] - cx), syy += w * (x[1] - cy) * (x[1] - cy), sxy += w * (x[0] - cx) * (x[1] - cy);
+    }
+    th = 0.5 * atan2(2 * sxy, sxx - syy); /* major axis */
+    nx = -sin(th), ny = cos(th);
+    for (g = 0; g < M->ngp; ++g) {
+        double x[3], w = v[g] - thr, d;
+        if (w <= 0) continue;
+        gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], x);
+        d = (x[0] - cx) * nx + (x[1] - cy) * ny;
+        var += w * d * d;
+    }
+    *angle = fabs(th * 180.0 / 3.14159265358979323846);
+    if (*angle > 90) *angle = 180 - *angle;
+    *width = sqrt(12.0 * var / sw);
+out:
+    free(v), free(s);
+}
+
+/* ---------------------------------------------------------- checkpoint */
+#define CK_MAGIC "GKFEMDEM1"
+static int write_checkpoint(const model *M, const char *dir) {
+    char path[1200], tmp[1300];
+    FILE *fp;
+    int g, ok = 1;
+    size_t cap = 0;
+    void *buf = NULL;
+    snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    fp = fopen(tmp, "wb");
+    if (!fp) return 1;
+    ok &= fwrite(CK_MAGIC, 1, 9, fp) == 9;
+    ok &= fwrite(&M->o.nx, sizeof(int), 1, fp) == 1 && fwrite(&M->o.ny, sizeof(int), 1, fp) == 1;
+    ok &= fwrite(&M->o.elem, sizeof(M->o.elem), 1, fp) == 1 && fwrite(&M->o.quad, sizeof(int), 1, fp) == 1;
+    ok &= fwrite(&M->step, sizeof(int), 1, fp) == 1 && fwrite(&M->eps_done, sizeof(double), 1, fp) == 1;
+    ok &= fwrite(&M->scale, sizeof(double), 1, fp) == 1 && fwrite(&M->ncurve, sizeof(int), 1, fp) == 1;
+    ok &= fwrite(M->curve, sizeof(curve_row), (size_t)M->ncurve, fp) == (size_t)M->ncurve;
+    ok &= fwrite(M->mesh.x, sizeof(double), (size_t)M->ndof, fp) == (size_t)M->ndof;
+    ok &= fwrite(M->utot, sizeof(double), (size_t)M->ndof, fp) == (size_t)M->ndof;
+    ok &= fwrite(M->Hacc, sizeof(double), 9 * (size_t)M->ngp, fp) == 9 * (size_t)M->ngp;
+    ok &= fwrite(M->sig_n, sizeof(double), 9 * (size_t)M->ngp, fp) == 9 * (size_t)M->ngp;
+    ok &= fwrite(M->D_n, sizeof(double), 16 * (size_t)M->ngp, fp) == 16 * (size_t)M->ngp;
+    ok &= fwrite(M->nsteps_gp, sizeof(int), (size_t)M->ngp, fp) == (size_t)M->ngp;
+    for (g = 0; g < M->ngp && ok; ++g) { /* the converged state, not the trial one */
+        size_t n;
+        gk_rve *r = &M->rve[g];
+        if (gk_rve_state_restore(&M->st[g], r)) ok = 0;
+        n = gk_rve_state_size(r);
+        if (n > cap) {
+            free(buf);
+            cap = n;
+            buf = malloc(cap);
+            if (!buf) ok = 0;
+        }
+        if (ok && gk_rve_save(r, buf, cap, &n)) ok = 0;
+        ok &= fwrite(&n, sizeof n, 1, fp) == 1 && fwrite(buf, 1, n, fp) == n;
+    }
+    free(buf);
+    ok &= fclose(fp) == 0;
+    if (!ok || rename(tmp, path)) return 1;
+    return 0;
+}
+
+static int read_checkpoint(model *M, const char *dir, gk_err *err) {
+    char path[1200], magic[9];
+    FILE *fp;
+    int nx, ny, quad, g, ok = 1;
+    gk_elem_type el;
+    snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
+    fp = fopen(path, "rb");
+    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open %s", path), 1;
+    ok &= fread(magic, 1, 9, fp) == 9 && !memcmp(magic, CK_MAGIC, 9);
+    ok &= fread(&nx, sizeof(int), 1, fp) == 1 && fread(&ny, sizeof(int), 1, fp) == 1;
+    ok &= fread(&el, sizeof el, 1, fp) == 1 && fread(&quad, sizeof(int), 1, fp) == 1;
+    if (!ok || nx != M->o.nx || ny != M->o.ny || el != M->o.elem || quad != M->o.quad) {
+        fclose(fp);
+        return gk_err_set(err, GK_ERR_FORMAT, "%s: not a checkpoint of this mesh (%dx%d, element, quad must match)", path,
+                          nx, ny),
+               1;
+    }
+    ok &= fread(&M->step, sizeof(int), 1, fp) == 1 && fread(&M->eps_done, sizeof(double), 1, fp) == 1;
+    ok &= fread(&M->scale, sizeof(double), 1, fp) == 1 && fread(&M->ncurve, sizeof(int), 1, fp) == 1;
+    if (ok && (M->ncurve < 0 || M->ncurve > 10000000)) ok = 0;
+    if (ok) {
+        M->cap = M->ncurve + 16;
+        M->curve = (curve_row *)realloc(M->curve, (size_t)M->cap * sizeof(curve_row));
+        ok &= M->curve && fread(M->curve, sizeof(curve_row), (size_t)M->ncurve, fp) == (size_t)M->ncurve;
+    }
+    ok &= fread(M->mesh.x, sizeof(double), (size_t)M->ndof, fp) == (size_t)M->ndof;
+    ok &= fread(M->utot, sizeof(double), (size_t)M->ndof, fp) == (size_t)M->ndof;
+    ok &= fread(M->Hacc, sizeof(double), 9 * (size_t)M->ngp, fp) == 9 * (size_t)M->ngp;
+    ok &= fread(M->sig_n, sizeof(double), 9 * (size_t)M->ngp, fp) == 9 * (size_t)M->ngp;
+    ok &= fread(M->D_n, sizeof(double), 16 * (size_t)M->ngp, fp) == 16 * (size_t)M->ngp;
+    ok &= fread(M->nsteps_gp, sizeof(int), (size_t)M->ngp, fp) == (size_t)M->ngp;
+    for (g = 0; g < M->ngp && ok; ++g) {
+        size_t n;
+        void *buf;
+        ok &= fread(&n, sizeof n, 1, fp) == 1 && n < ((size_t)1 << 31);
+        if (!ok) break;
+        buf = malloc(n);
+        ok &= buf && fread(buf, 1, n, fp) == n && gk_rve_restore(&M->rve[g], buf, n) == GK_OK &&
+              gk_rve_state_save(&M->st[g], &M->rve[g]) == GK_OK;
+        free(buf);
+    }
+    fclose(fp);
+    if (!ok) return gk_err_set(err, GK_ERR_FORMAT, "%s: truncated or corrupt", path), 1;
+    return 0;
+}
+
+/* ------------------------------------------------- single-element test */
+/* the same RVE alone under the drained biaxial path: sigma_xx servo-held at
+ * -p, axial strain rate as the FEM run, sampled after every increment */
+static int single_rve_reference(const model *M, double *eps, double *syy, double *ev, int n, gk_err *err) {
+    gk_rve r;
+    gk_servo s;
+    gk_packing pk;
+    gk_rve_def def = gk_rve_def_default();
+    double sig[9], V0;
+    int k, ns = (int)ceil(M->o.inc / M->o.dem_strain);
+    if (gk_packing_read(M->o.packing, &pk, NULL, err)) return 1;
+    def.dt = M->o.dt;
+    if (gk_rve_create(&r, &def, &pk)) {
+        gk_packing_free(&pk);
+        return gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&r)), 1;
+    }
+    gk_packing_free(&pk);
+    gk_rve_refresh(&r);
+    V0 = gk_rve_volume(&r);
+    memset(&s, 0, sizeof s);
+    s.mode[0] = GK_SERVO_STRESS, s.target[0] = -M->o.pressure;
+    s.mode[1] = GK_SERVO_STRAIN, s.rate[1] = -M->o.inc / (ns * r.dt);
+    s.mode[2] = GK_SERVO_STRAIN;
+    s.max_rate = 10 * M->o.inc / (ns * r.dt);
+    s.gain = 0.02;
+    if (gk_rve_set_servo(&r, &s)) return gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&r)), 1;
+    for (k = 0; k < n; ++k) {
+        if (k > 0 && gk_rve_step(&r, ns)) return gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&r)), 1;
+        gk_rve_stress(&r, sig);
+        eps[k] = M->o.inc * k, syy[k] = -sig[4], ev[k] = -(gk_rve_volume(&r) - V0) / V0;
+    }
+    gk_rve_destroy(&r);
+    return 0;
+}
+
+/* ------------------------------------------------------------------ main */
+int main(int argc, char **argv) {
+    model M;
+    opts *o = &M.o;
+    gk_err err;
+    int i, status = 0;
+    double t_start, t_prev_total = 0.0;
+    memset(&M, 0, sizeof M);
+    o->nx = 8, o->ny = 16, o->steps = 100, o->threads = 2, o->quad = 2, o->max_iter = 12, o->checkpoint = 10;
+    o->vtk_every = 1, o->aitken = 1, o->dem_min = 2, o->dem_max = 20000, o->elem = GK_Q8;
+    o->out = "femdem_out", o->packing = "examples/data/rve400.txt", o->tangent = "taylor", o->test = "biaxial";
+    o->width = 0.05, o->height = 0.1, o->pressure = 1e5, o->inc = 1e-3, o->tol = 0.01, o->dt = SEED_DT;
+    o->dem_strain = 1e-5, o->xi = 5e-5;
+    for (i = 1; i < argc; ++i) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout);
+            return 0;
+        }
+        if (!strcmp(a, "--verbose")) {
+            o->verbose = 1;
+            continue;
+        }
+        if (!v) {
+            fprintf(stderr, "femdem_biaxial: %s needs a value (see --help)\n", a);
+            return 2;
+        }
+        if (!strcmp(a, "--nx")) o->nx = atoi(v);
+        else if (!strcmp(a, "--ny")) o->ny = atoi(v);
+        else if (!strcmp(a, "--element")) {
+            if (!strcmp(v, "q8")) o->elem = GK_Q8;
+            else if (!strcmp(v, "q4")) o->elem = GK_Q4;
+            else {
+                fprintf(stderr, "femdem_biaxial: --element must be q4 or q8\n");
+                return 2;
+            }
+        } else if (!strcmp(a, "--quad")) o->quad = atoi(v);
+        else if (!strcmp(a, "--steps")) o->steps = atoi(v);
+        else if (!strcmp(a, "--increment")) o->inc = atof(v);
+        else if (!strcmp(a, "--threads")) o->threads = atoi(v);
+        else if (!strcmp(a, "--out")) o->out = v;
+        else if (!strcmp(a, "--tangent")) o->tangent = v;
+        else if (!strcmp(a, "--xi")) o->xi = atof(v);
+        else if (!strcmp(a, "--restart")) o->restart = v;
+        else if (!strcmp(a, "--checkpoint")) o->checkpoint = atoi(v);
+        else if (!strcmp(a, "--test")) o->test = v;
+        else if (!strcmp(a, "--packing")) o->packing = v;
+        else if (!strcmp(a, "--width")) o->width = atof(v);
+        else if (!strcmp(a, "--height")) o->height = atof(v);
+        else if (!strcmp(a, "--pressure")) o->pressure = atof(v);
+        else if (!strcmp(a, "--tol")) o->tol = atof(v);
+        else if (!strcmp(a, "--max-iter")) o->max_iter = atoi(v);
+        else if (!strcmp(a, "--dt")) o->dt = atof(v);
+        else if (!strcmp(a, "--dem-strain")) o->dem_strain = atof(v);
+        else if (!strcmp(a, "--dem-min")) o->dem_min = atoi(v);
+        else if (!strcmp(a, "--dem-max")) o->dem_max = atoi(v);
+        else if (!strcmp(a, "--vtk-every")) o->vtk_every = atoi(v);
+        else if (!strcmp(a, "--relaxation")) {
+            if (!strcmp(v, "aitken")) o->aitken = 1;
+            else if (!strcmp(v, "none")) o->aitken = 0;
+            else {
+                fprintf(stderr, "femdem_biaxial: --relaxation must be aitken or none\n");
+                return 2;
+            }
+        }
+        else {
+            fprintf(stderr, "femdem_biaxial: unknown option %s (see --help)\n", a);
+            return 2;
+        }
+        ++i;
+    }
+    if (!strcmp(o->test, "single")) o->nx = 1, o->ny = 1, o->elem = GK_Q4, o->quad = 2;
+    else if (strcmp(o->test, "biaxial")) {
+        fprintf(stderr, "femdem_biaxial: --test must be biaxial or single\n");
+        return 2;
+    }
+    if (o->nx < 1 || o->ny < 1 || o->nx > 1000 || o->ny > 1000 || o->steps < 1 || o->threads < 1 || o->quad < 1 ||
+        o->quad > 3 || o->max_iter < 2 || !(o->inc > 0 && o->inc < 0.1) || !(o->tol > 0) || !(o->width > 0) ||
+        !(o->height > 0) || !(o->pressure >= 0) || !(o->dt > 0) || !(o->dem_strain > 0) || o->dem_min < 1 ||
+        o->dem_max < o->dem_min || !(o->xi > 0) || o->checkpoint < 0 || o->vtk_every < 0) {
+        fprintf(stderr, "femdem_biaxial: an option is out of range (see --help)\n");
+        return 2;
+    }
+    if (strcmp(o->tangent, "taylor") && strcmp(o->tangent, "yade") && strcmp(o->tangent, "perturbation")) {
+        fprintf(stderr, "femdem_biaxial: --tangent must be taylor, yade or perturbation\n");
+        return 2;
+    }
+    if (mkdir_p(o->out)) {
+        fprintf(stderr, "femdem_biaxial: cannot create %s\n", o->out);
+        return 1;
+    }
+    if (setup(&M, &err)) {
+        fprintf(stderr, "femdem_biaxial: %s\n", err.msg);
+        return 1;
+    }
+    M.cap = o->steps + 16;
+    M.curve = (curve_row *)calloc((size_t)M.cap, sizeof(curve_row));
+    if (!M.curve) return 1;
+    if (o->restart) {
+        if (read_checkpoint(&M, o->restart, &err)) {
+            fprintf(stderr, "femdem_biaxial: %s\n", err.msg);
+            return 1;
+        }
+        for (i = 0; i < M.ncurve; ++i) t_prev_total += M.curve[i].secs;
+        fprintf(stderr, "femdem_biaxial: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n",
+                o->restart, M.step, 100 * M.eps_done);
+    } else {
+        double syy, sxx, ev;
+        external_force(&M, &err);
+        residual(&M, M.sig_n, &err);
+        macro_state(&M, &syy, &sxx, &ev);
+        M.curve[0].syy = syy, M.curve[0].sxx = sxx, M.curve[0].inc = 0;
+        M.ncurve = 1;
+    }
+    printf("femdem_biaxial: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n", o->test,
+           o->nx, o->ny, o->elem == GK_Q8 ? "Q8" : "Q4", M.ngp, M.rve[0].n, o->tangent, o->threads);
+    fflush(stdout);
+    t_start = gk_wtime();
+    {
+        double target = o->steps * o->inc;
+        int good_in_row = 0;
+        while (M.eps_done < target - 1e-12 * target) {
+            double inc = o->inc * M.scale, t0 = gk_wtime(), Ed = 0, Ef = 0, syy, sxx, ev;
+            int iters = 0, r, g, nf = 0;
+            char what[200];
+            if (M.eps_done + inc > target) inc = target - M.eps_done;
+            r = load_step(&M, inc, &iters, &Ed, &Ef, &err);
+            if (r == 2) {
+                fprintf(stderr, "femdem_biaxial: %s\n", err.msg);
+                status = 1;
+                break;
+            }
+            if (r == 1) {
+                M.scale *= 0.5;
+                good_in_row = 0;
+                fprintf(stderr, "femdem_biaxial: step at %.3f %% did not converge in %d iterations (E_d %.3g)%s%s; "
+                                "increment cut to %.4g %%\n",
+                        100 * M.eps_done, iters, Ed, err.msg[0] ? ": " : "", err.msg, 100 * o->inc * M.scale);
+                err.msg[0] = 0;
+                if (M.scale < 1.0 / 16) {
+                    fprintf(stderr, "femdem_biaxial: giving up at axial strain %.3f %%; last converged state in %s/checkpoint.bin\n",
+                            100 * M.eps_done, o->out);
+                    write_checkpoint(&M, o->out);
+                    status = 3;
+                    break;
+                }
+                continue;
+            }
+            commit(&M);
+            M.eps_done += inc;
+            ++M.step;
+            residual(&M, M.sig_n, &err);
+            macro_state(&M, &syy, &sxx, &ev);
+            for (g = 0; g < M.ngp; ++g) nf += M.failed[g];
+            if (M.ncurve == M.cap) {
+                M.cap *= 2;
+                M.curve = (curve_row *)realloc(M.curve, (size_t)M.cap * sizeof(curve_row));
+                if (!M.curve) return 1;
+            }
+            {
+                curve_row *c = &M.curve[M.ncurve++];
+                c->eps = M.eps_done, c->syy = syy, c->sxx = sxx, c->ev = ev, c->iters = iters;
+                c->secs = gk_wtime() - t0, c->Ed = Ed, c->Ef = Ef, c->inc = inc, c->failed = nf;
+            }
+            if (++good_in_row >= 2 && M.scale < 1.0) M.scale *= 2, good_in_row = 0;
+            write_csv(&M);
+            if (o->vtk_every && M.step % o->vtk_every == 0) write_vtk(&M, M.step);
+            if (o->checkpoint && M.step % o->checkpoint == 0) write_checkpoint(&M, o->out);
+            snprintf(what, sizeof what, "eps %.2f %%  sigma_yy %.1f kPa  sigma_xx %.1f kPa  eps_v %.3f %%  %d iter  %.2f s",
+                     100 * M.eps_done, syy / 1e3, sxx / 1e3, 100 * ev, iters, gk_wtime() - t0);
+            gk_progress(stderr, (long)floor(M.eps_done / o->inc + 0.5), o->steps, t_start - 0.0, what);
+        }
+    }
+    write_csv(&M);
+    write_plots(&M);
+    write_field_svg(&M);
+    if (status != 3) write_checkpoint(&M, o->out);
+    if (!strcmp(o->test, "single") && M.ncurve > 1) {
+        int n = M.ncurve, k, kpk = 0;
+        double *e = (double *)malloc((size_t)n * sizeof(double)), *s = (double *)malloc((size_t)n * sizeof(double)),
+               *v = (double *)malloc((size_t)n * sizeof(double)), *x = (double *)malloc((size_t)n * sizeof(double)),
+               *y = (double *)malloc((size_t)n * sizeof(double)), maxdiff = 0, *yr = (double *)malloc((size_t)n * sizeof(double));
+        char path[1200];
+        FILE *fp;
+        if (e && s && v && x && y && yr && !single_rve_reference(&M, e, s, v, n, &err)) {
+            for (k = 0; k < n; ++k)
+                if (M.curve[k].syy > M.curve[kpk].syy) kpk = k;
+            snprintf(path, sizeof path, "%s/single_element.csv", o->out);
+            fp = fopen(path, "w");
+            if (fp) {
+                fprintf(fp, "eps_axial,sigma_yy_fem,sigma_yy_rve,eps_v_fem,eps_v_rve\n");
+                for (k = 0; k < n; ++k)
+                    fprintf(fp, "%.6g,%.9g,%.9g,%.9g,%.9g\n", M.curve[k].eps, M.curve[k].syy, s[k], M.curve[k].ev, v[k]);
+                fclose(fp);
+            }
+            for (k = 0; k <= kpk; ++k) {
+                double d = fabs(M.curve[k].syy - s[k]) / s[k];
+                if (d > maxdiff) maxdiff = d;
+            }
+            for (k = 0; k < n; ++k) x[k] = 100 * e[k], y[k] = M.curve[k].syy / 1e3, yr[k] = s[k] / 1e3;
+            {
+                gk_plot pl;
+                gk_plot_init(&pl, "Single-element test vs the RVE alone (seed 000 Fig 6)", "axial strain [%]",
+                             "sigma_yy [kPa]");
+                gk_plot_add(&pl, x, y, n, "FEM, 1 Q4 element, 4 RVEs");
+                gk_plot_add(&pl, x, yr, n, "RVE alone, servo-held sigma_xx");
+                snprintf(path, sizeof path, "%s/single_element.svg", o->out);
+                gk_plot_svg(&pl, path, &err);
+            }
+            printf("single element vs RVE alone: max relative difference of sigma_yy up to the peak (%.2f %%) = %.4f\n",
+                   100 * M.curve[kpk].eps, maxdiff);
+            printf("SINGLE max_rel_diff_to_peak=%.5f peak_fem=%.6g peak_rve=%.6g\n", maxdiff, M.curve[kpk].syy, s[kpk]);
+        }
+        free(e), free(s), free(v), free(x), free(y), free(yr);
+    }
+    {
+        double peak = 0, epk = 0, ang, wid, tot;
+        int k, itmax = 0;
+        for (k = 0; k < M.ncurve; ++k) {
+            if (M.curve[k].syy > peak) peak = M.curve[k].syy, epk = M.curve[k].eps;
+            if (M.curve[k].iters > itmax) itmax = M.curve[k].iters;
+        }
+        tot = 0;
+        for (k = 1; k < M.ncurve; ++k) tot += M.curve[k].secs;
+        band(&M, &ang, &wid);
+        printf("wrote %s/biaxial.csv, %s/gp_*.vtk and mesh_*.vtk (ParaView), %s/biaxial_stress.svg, "
+               "biaxial_volume.svg, eps_q_field.svg, checkpoint.bin\n",
+               o->out, o->out, o->out);
+        if (ang == ang)
+            printf("shear band: angle %.1f deg from the horizontal, width %.1f mm\n", ang, 1e3 * wid);
+        else
+            printf("shear band: none (max eps_q < 1.5 x median)\n");
+        printf("RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g band_angle_deg=%.3g band_width_mm=%.3g max_iterations=%d "
+               "steps=%d seconds_per_step=%.3f total_seconds=%.2f\n",
+               peak, epk, ang, 1e3 * wid, itmax, M.ncurve - 1, M.ncurve > 1 ? tot / (M.ncurve - 1) : 0.0, tot);
+    }
+    for (i = 0; i < M.ngp; ++i) {
+        gk_rve_destroy(&M.rve[i]);
+        gk_rve_state_free(&M.st[i]);
+    }
+    gk_csr_free(&M.K);
+    gk_mesh_free(&M.mesh);
+    return status;
+}
