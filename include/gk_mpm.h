@@ -1040,7 +1040,7 @@ static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt, double d
 
 GKDEF gk_result gk_mpm_p2g(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mpm_def *d, int what, gk_err *err) {
     gk_result r;
-    double mmin;
+    double mmin = 0.0;
     long nn = (long)g->nnode, I;
     int nth, c, k, dim = g->dim, bi;
     if (!P) return gk_err_set(err, GK_ERR_ARG, "NULL points");
