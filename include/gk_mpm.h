@@ -776,6 +776,24 @@ static int gk__mpm_nthreads(const gk_mpm_def *d) {
 #endif
 }
 
+static gk_result gk__mpm_check_bodies(const gk_mpm_grid *g, gk_err *err) {
+    int bi, k;
+    if (g->nbody < 0 || (g->nbody > 0 && !g->body))
+        return gk_err_set(err, GK_ERR_ARG, "%d rigid bodies with body array %p", g->nbody, (const void *)g->body);
+    for (bi = 0; bi < g->nbody; ++bi) {
+        const gk_mpm_body *B = &g->body[bi];
+        for (k = 0; k < g->dim; ++k)
+            if (!isfinite(B->lo[k]) || !isfinite(B->hi[k]) || !isfinite(B->v[k]) || !isfinite(B->mu))
+                return gk_err_set(err, GK_ERR_NAN, "rigid body %d has a NaN or infinite entry", bi);
+        if ((int)B->contact < 0 || (int)B->contact > (int)GK_MPM_CONTACT_SMOOTH)
+            return gk_err_set(err, GK_ERR_ARG, "rigid body %d: unknown contact kind %d", bi, (int)B->contact);
+        if (B->mu < 0.0) return gk_err_set(err, GK_ERR_ARG, "rigid body %d: friction coefficient %g < 0", bi, B->mu);
+        if (B->face < 0 || B->face > 2 * g->dim)
+            return gk_err_set(err, GK_ERR_ARG, "rigid body %d: face %d (0 = nearest, 1..%d)", bi, B->face, 2 * g->dim);
+    }
+    return GK_OK;
+}
+
 static gk_result gk__mpm_check_def(const gk_mpm_def *d, gk_err *err) {
     int k;
     if (!d) return gk_err_set(err, GK_ERR_ARG, "NULL gk_mpm_def");
@@ -1042,17 +1060,13 @@ GKDEF gk_result gk_mpm_p2g(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mpm_
     gk_result r;
     double mmin = 0.0;
     long nn = (long)g->nnode, I;
-    int nth, c, k, dim = g->dim, bi;
+    int nth, c, k, dim = g->dim;
     if (!P) return gk_err_set(err, GK_ERR_ARG, "NULL points");
     r = gk__mpm_check_def(d, err);
     if (r) return r;
     if (what < 1 || what > 3) return gk_err_set(err, GK_ERR_ARG, "P2G flags %d (MOMENTUM and/or FORCE)", what);
-    for (bi = 0; bi < g->nbody; ++bi) {
-        const gk_mpm_body *B = &g->body[bi];
-        for (k = 0; k < dim; ++k)
-            if (!isfinite(B->lo[k]) || !isfinite(B->hi[k]) || !isfinite(B->v[k]) || !isfinite(B->mu))
-                return gk_err_set(err, GK_ERR_NAN, "rigid body %d has a NaN or infinite entry", bi);
-    }
+    r = gk__mpm_check_bodies(g, err);
+    if (r) return r;
     r = gk__mpm_bin(g, P, d, what, &mmin, err);
     if (r) return r;
     nth = gk__mpm_nthreads(d);
@@ -1102,6 +1116,8 @@ GKDEF gk_result gk_mpm_grid_update(gk_mpm_grid *g, const gk_mpm_def *d, double d
     if (r) return r;
     if (!isfinite(dt)) return gk_err_set(err, GK_ERR_NAN, "time step is NaN or infinite");
     if (!(dt > 0.0)) return gk_err_set(err, GK_ERR_DT, "time step %g (must be > 0)", dt);
+    r = gk__mpm_check_bodies(g, err);
+    if (r) return r;
     nth = gk__mpm_nthreads(d);
     (void)nth; /* unused without OpenMP */
     damp = d->damping;

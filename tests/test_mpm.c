@@ -254,7 +254,8 @@ TEST(elastic_bar_first_mode_frequency) {
     int sc;
     law.K = 6e5;
     law.G = 4e5;
-    for (sc = 0; sc < 3; ++sc) {
+    /* runs 0-2: linear in USF, USL, MUSL; 3-5: uGIMP, quadratic, cubic B-spline in MUSL */
+    for (sc = 0; sc < 6; ++sc) {
         gk_mpm_grid g = make_grid(2, 0.0, 0.0, 0.0, h, 27, 6, 1);
         gk_mpm_points P;
         gk_mpm_def d = gk_mpm_def_default();
@@ -267,7 +268,8 @@ TEST(elastic_bar_first_mode_frequency) {
         gk_mpm_grid_set_bc(&g, 0, GK_MPM_BC_ROLLER, 0, 3, &e);
         gk_mpm_grid_set_bc(&g, 2, GK_MPM_BC_ROLLER, 0, 3, &e);
         gk_mpm_grid_set_bc(&g, 3, GK_MPM_BC_ROLLER, 0, 3, &e);
-        d.scheme = (gk_mpm_scheme)sc;
+        d.scheme = sc < 3 ? (gk_mpm_scheme)sc : GK_MPM_MUSL;
+        d.basis = sc < 3 ? GK_MPM_LINEAR : all_bases[sc - 2];
         d.alpha = 0.0;
         gk_mpm_points_totals(&P, NULL, mom0, NULL);
         prev = mom0[0];
@@ -286,10 +288,13 @@ TEST(elastic_bar_first_mode_frequency) {
         }
         CHECK_EQ_INT(ncross, 2);
         if (ncross == 2) {
-            if (fabs(2 * (cross[1] - cross[0]) / T - 1) > 0.005)
-                printf("    scheme %d: period %.5f s, analytic %.5f s\n", sc, 2 * (cross[1] - cross[0]), T);
-            CHECK_REL(2 * (cross[1] - cross[0]), T, 0.01);
-            CHECK_REL(cross[0], T / 4, 0.01);
+            if (fabs(2 * (cross[1] - cross[0]) / T - 1) > 0.03)
+                printf("    run %d: period %.5f s, analytic %.5f s\n", sc, 2 * (cross[1] - cross[0]), T);
+            /* uniform B-splines (no boundary-modified splines) smear the free
+             * end over about h/2: effective length ~ L + h/2, period +2.5 % */
+            double tol = sc >= 4 ? 0.03 : 0.01;
+            CHECK_REL(2 * (cross[1] - cross[0]), T, tol);
+            CHECK_REL(cross[0], T / 4, tol);
         }
         gk_mpm_points_destroy(&P);
         gk_mpm_grid_destroy(&g);
@@ -450,6 +455,64 @@ TEST(rigid_plate_reaction_matches_confined_compression) {
     CHECK_REL(g.face[2].force[1], -favg, 0.03);
     gk_mpm_points_destroy(&P);
     gk_mpm_grid_destroy(&g);
+}
+
+/* Node-level contact laws, checked on hand-set node states (m = 2, no
+ * force): Coulomb wall removes the approaching normal velocity dv_n and
+ * cuts the tangential speed by mu dv_n (or sticks); separating nodes are
+ * free; roller zeroes the normal component both ways; fixed zeroes all.
+ * Rigid body: the same laws on the velocity relative to the body; the
+ * reported force is sum m dv / dt. */
+TEST(wall_and_body_contact_laws) {
+    const double dt = 0.5, m = 2.0;
+    int kind;
+    for (kind = 0; kind < 4; ++kind) { /* body: stick, friction, smooth, friction with explicit face */
+        gk_mpm_grid g = make_grid(2, 0.0, 0.0, 0.0, 1.0, 6, 6, 1);
+        gk_mpm_def d = gk_mpm_def_default();
+        gk_mpm_body body;
+        gk_err e;
+        int nodes[7][2] = {{2, 0}, {3, 0}, {4, 0}, {0, 2}, {0, 3}, {5, 3}, {2, 3}};
+        double vel[7][2] = {{3, -1}, {0.2, -1}, {1, 1}, {-1, 0.5}, {1, 0.5}, {1, 2}, {1, 0}};
+        double want[7][2] = {{2.5, 0}, {0, 0}, {1, 1}, {0, 0.5}, {0, 0.5}, {0, 0}, {0, 0}};
+        int q;
+        memset(&body, 0, sizeof body);
+        body.lo[0] = 1.4; /* node (2,3): nearest face is y- (0.5 away; x- is 0.6) */
+        body.lo[1] = 2.5;
+        body.hi[0] = 3.5;
+        body.hi[1] = 10;
+        body.v[1] = -1;
+        body.mu = 0.5;
+        body.contact = kind == 0 ? GK_MPM_CONTACT_STICK : kind == 2 ? GK_MPM_CONTACT_SMOOTH : GK_MPM_CONTACT_FRICTION;
+        body.face = kind == 3 ? 3 : 0;
+        /* relative velocity (1, 1) into the body face y- (outward normal -y) */
+        want[6][0] = kind == 0 ? 0.0 : kind == 2 ? 1.0 : 0.5;
+        want[6][1] = -1.0;
+        g.body = &body;
+        g.nbody = 1;
+        CHECK_EQ_INT(gk_mpm_grid_set_bc(&g, 2, GK_MPM_BC_FRICTION, 0.5, 1, &e), GK_OK);
+        CHECK_EQ_INT(gk_mpm_grid_set_bc(&g, 0, GK_MPM_BC_ROLLER, 0, 1, &e), GK_OK);
+        CHECK_EQ_INT(gk_mpm_grid_set_bc(&g, 1, GK_MPM_BC_FIXED, 0, 1, &e), GK_OK);
+        for (q = 0; q < 7; ++q) {
+            size_t I = (size_t)(nodes[q][0] + 6 * nodes[q][1]);
+            g.m[I] = m;
+            g.v[0][I] = vel[q][0];
+            g.v[1][I] = vel[q][1];
+            g.p[0][I] = m * vel[q][0];
+            g.p[1][I] = m * vel[q][1];
+        }
+        CHECK_EQ_INT(gk_mpm_grid_update(&g, &d, dt, &e), GK_OK);
+        for (q = 0; q < 7; ++q) {
+            size_t I = (size_t)(nodes[q][0] + 6 * nodes[q][1]);
+            CHECK_NEAR(g.vn[0][I], want[q][0], 1e-15);
+            CHECK_NEAR(g.vn[1][I], want[q][1], 1e-15);
+        }
+        /* y- face acts on nodes 0..2: reaction m dv / dt */
+        CHECK_NEAR(g.face[2].force[0], m * ((2.5 - 3) + (0 - 0.2)) / dt, 1e-13);
+        CHECK_NEAR(g.face[2].force[1], m * (1 + 1) / dt, 1e-13);
+        CHECK_NEAR(body.force[0], m * (want[6][0] - 1) / dt, 1e-13);
+        CHECK_NEAR(body.force[1], m * (want[6][1] - 0) / dt, 1e-13);
+        gk_mpm_grid_destroy(&g);
+    }
 }
 
 /* Drucker-Prager [seed 002 eqs 5-6, return map of its Sec 2.2]: an elastic
@@ -739,6 +802,7 @@ int main(int argc, char **argv) {
     RUN(column_settles_to_geostatic_stress);
     RUN(block_on_frictional_floor_decelerates_at_mu_g);
     RUN(rigid_plate_reaction_matches_confined_compression);
+    RUN(wall_and_body_contact_laws);
     RUN(drucker_prager_return_map);
     RUN(drucker_prager_update_spin_and_critical_state);
     RUN(threads_give_identical_bits);
