@@ -20,6 +20,8 @@
  *   gk_mpm_grid_set_bc            fixed / roller / Coulomb-friction face
  *   gk_mpm_points_create/_destroy material points (struct of arrays)
  *   gk_mpm_points_create_box      points filling a box, ppd^dim per cell
+ *   gk_mpm_points_totals          mass, momentum, kinetic energy
+ *   gk_mpm_grid_node_position     position of a node
  *   gk_mpm_kernel_1d              1D weight and derivative of each basis
  *   gk_mpm_shape                  nodes, weights, gradients of one point
  *   gk_mpm_p2g                    mass, momentum (PIC/FLIP or APIC), v = p/m,
@@ -29,7 +31,11 @@
  *                                 rigid bodies and their reaction forces
  *   gk_mpm_g2p                    velocity (PIC/FLIP blend or APIC), position,
  *                                 velocity gradient L, F, volume [eqs 16-19]
+ *   gk_mpm_def_default            options: basis, transfer, scheme, alpha,
+ *                                 gravity, damping, mass threshold, threads
  *   gk_mpm_step                   one step in USF, USL or MUSL order
+ *   gk_mpm_bodies_advance         move rigid bodies by v dt
+ *   gk_mpm_wave_speed             P-wave speed, for the time step
  *   gk_mpm_point_dH               dH = dt L, what an RVE receives [seed 003 (b)]
  *   gk_mpm_point_polar            F = R U via gk_m3_polar [seed 003 eqs 36-40]
  *   gk_mpm_elastic_update         hypoelastic increment (objective rotation)
@@ -78,9 +84,9 @@
  *        g2p(GRADIENT_OLD) -> stress
  *   Rigid bodies then move by v dt (gk_mpm_bodies_advance).
  *
- * BOUNDARY CONDITIONS act on the node velocity after the forces (and on the
- * P2G velocity v, without counting a reaction), faces in the order x-, x+,
- * y-, y+, z-, z+, then rigid bodies in array order:
+ * BOUNDARY CONDITIONS act on the node velocity after the forces, and on the
+ * P2G velocity v (then p = m v; no reaction is counted there), faces in the
+ * order x-, x+, y-, y+, z-, z+, then rigid bodies in array order:
  *   FIXED     v = 0
  *   ROLLER    normal component v_a = 0 (both directions)
  *   FRICTION  unilateral Coulomb wall: a node moving into the wall loses its
@@ -92,8 +98,11 @@
  * FRICTION as the wall above on the velocity relative to the body, normal =
  * outward normal of a chosen face of the box or of the nearest face. Each
  * face and body records force = sum m_I (v_after - v_before) / dt over the
- * last grid update: the force it exerted ON the material. The load on a
- * footing is -force.
+ * last grid update (v_before without grid damping, so damping never leaks
+ * into a load): the force it exerted ON the material. The load on a
+ * footing is -force. Nodes with m <= mass_min are inactive (velocity 0, no
+ * constraint); the default threshold is 1e-14 x the smallest point mass, so
+ * B-spline nodes at the edge of a support (weights ~1e-12) stay active.
  *
  * DAMPING (optional, def.damping in [0,1)): Cundall local non-viscous
  * damping on the grid, f_k -= damping |f_k| sign(v_k) per node (the form of
@@ -131,6 +140,12 @@
  *   |de_p| [eq 8], |.| Frobenius.
  *   K and G are the moduli of the dimension: 2D plane K (p = K tr eps),
  *   P-wave modulus M = K + G (2D), K + 4G/3 (3D).
+ *
+ * CHOICES. Options are a plain struct with gk_mpm_def_default() (zero also
+ * works: linear, pure FLIP, USF). Point tensors are stored 9 per point
+ * (array of 3x3 blocks inside the struct of arrays) rather than 9 arrays:
+ * they go whole to gk_m3_* and to an RVE, and G2P writes them together.
+ * The caller owns the rigid-body array (g->body, g->nbody).
  *
  * CONVENTIONS: SI units (2D: per unit thickness, volumes are areas, forces
  * N/m); stress tension-positive; L_ij = dv_i/dx_j, H_ij = du_i/dx_j;
