@@ -347,7 +347,7 @@ GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def
 GKDEF void gk_mpm_bodies_advance(gk_mpm_body *body, int nbody, double dt);
 
 /* F = R U of point p [seed 003 eqs 36-40]; GK_ERR_SINGULAR if det F <= 0 */
-GKDEF gk_result gk_mpm_point_polar(const gk_mpm_points *pts, int p, double R[9], double U[9]);
+GKDEF gk_result gk_mpm_point_polar(const gk_mpm_points *pts, int p, double R[9], double U[9], gk_err *err);
 
 /* hypoelastic update: sigma <- R sigma R^T + K tr(de) I + 2G dev(de) */
 GKDEF gk_result gk_mpm_elastic_update(double K, double G, int dim, const double dH[9], double sigma[9], gk_err *err);
@@ -1314,9 +1314,13 @@ GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_def *
     return GK_OK;
 }
 
-GKDEF gk_result gk_mpm_point_polar(const gk_mpm_points *pts, int p, double R[9], double U[9]) {
-    if (p < 0 || p >= pts->n) return GK_ERR_ARG;
-    return gk_m3_polar(pts->F + 9 * p, pts->dim, R, U);
+GKDEF gk_result gk_mpm_point_polar(const gk_mpm_points *pts, int p, double R[9], double U[9], gk_err *err) {
+    if (p < 0 || p >= pts->n) return gk_err_set(err, GK_ERR_ARG, "point %d (there are %d)", p, pts->n);
+    if (!gk_m3_isfinite(pts->F + 9 * p))
+        return gk_err_set(err, GK_ERR_NAN, "point %d: F has a NaN or infinite entry", p);
+    if (gk_m3_polar(pts->F + 9 * p, pts->dim, R, U) != GK_OK)
+        return gk_err_set(err, GK_ERR_SINGULAR, "point %d: det F = %g <= 0", p, gk_m3_det(pts->F + 9 * p));
+    return GK_OK;
 }
 
 /* ---- constitutive updates */

@@ -660,6 +660,9 @@ TEST(threads_give_identical_bits) {
         same &= memcmp(A.C, B.C, 9 * n * sizeof(double)) == 0;
         same &= memcmp(g1.face[2].force, g2.face[2].force, sizeof g1.face[2].force) == 0;
         CHECK(same);
+#ifndef _OPENMP
+        if (dim == 2) printf("    (built without OpenMP: both runs are serial)\n");
+#endif
         gk_mpm_points_destroy(&A);
         gk_mpm_points_destroy(&B);
         gk_mpm_grid_destroy(&g1);
@@ -696,9 +699,13 @@ TEST(velocity_gradient_F_and_polar) {
     P.F[0] = P.F[4] = cos(0.3);
     P.F[1] = -sin(0.3);
     P.F[3] = sin(0.3);
-    CHECK_EQ_INT(gk_mpm_point_polar(&P, 0, R, U), GK_OK);
+    CHECK_EQ_INT(gk_mpm_point_polar(&P, 0, R, U, &e), GK_OK);
     CHECK_NEAR(atan2(R[3], R[0]), 0.3, 1e-14);
     CHECK_NEAR(U[0], 1.0, 1e-14);
+    P.F[0] = -P.F[0]; /* det F < 0: refused */
+    P.F[1] = -P.F[1];
+    CHECK_EQ_INT(gk_mpm_point_polar(&P, 0, R, U, &e), GK_ERR_SINGULAR);
+    CHECK_EQ_INT(gk_mpm_point_polar(&P, P.n, R, U, &e), GK_ERR_ARG);
     gk_mpm_points_destroy(&P);
     gk_mpm_grid_destroy(&g);
 }
