@@ -189,55 +189,55 @@ typedef enum gk_mpm_bc_kind {
 
 typedef enum gk_mpm_contact {
     GK_MPM_CONTACT_STICK = 0,    /* rough: covered nodes move with the body */
-    GK_MPM_CONTACT_FRICTION = 1, /* Coulomb with mu, unilateral             */
-    GK_MPM_CONTACT_SMOOTH = 2    /* frictionless, unilateral                */
+    GK_MPM_CONTACT_FRICTION = 1, /* Coulomb with mu, unilateral */
+    GK_MPM_CONTACT_SMOOTH = 2    /* frictionless, unilateral */
 } gk_mpm_contact;
 
 /* face index: 0 x-, 1 x+, 2 y-, 3 y+, 4 z-, 5 z+ */
 typedef struct gk_mpm_face {
     gk_mpm_bc_kind kind;
-    double mu;       /* FRICTION: Coulomb coefficient (>= 0)                    */
+    double mu;       /* FRICTION: Coulomb coefficient (>= 0) */
     int layers;      /* node layers the BC acts on, counted from the face (>= 1) */
-    double force[3]; /* out: force on the material in the last grid update      */
+    double force[3]; /* out: force on the material in the last grid update */
 } gk_mpm_face;
 
 /* A prescribed-velocity rigid body: an axis-aligned box (a footing, a plate).
  * Zero-initialised except lo, hi: a stick body at rest. */
 typedef struct gk_mpm_body {
     double lo[3], hi[3]; /* box corners [m]; nodes with lo <= x_I <= hi are covered */
-    double v[3];         /* prescribed velocity [m/s]                               */
+    double v[3];         /* prescribed velocity [m/s] */
     gk_mpm_contact contact;
-    double mu;           /* FRICTION: Coulomb coefficient                           */
-    int face;            /* contact normal for SMOOTH/FRICTION: 0 = outward normal
-                            of the box face nearest to each node, 1..6 = that of
-                            face x-, x+, y-, y+, z-, z+ for every node             */
-    double force[3];     /* out: force on the material in the last grid update     */
+    double mu;       /* FRICTION: Coulomb coefficient */
+    int face;        /* contact normal for SMOOTH/FRICTION: 0 = outward normal
+                        of the box face nearest to each node, 1..6 = that of
+                        face x-, x+, y-, y+, z-, z+ for every node */
+    double force[3]; /* out: force on the material in the last grid update */
 } gk_mpm_body;
 
 typedef struct gk_mpm_grid {
-    int dim;           /* 2 or 3                                                  */
-    int n[3];          /* nodes per axis (n[2] = 1 in 2D)                         */
+    int dim;  /* 2 or 3 */
+    int n[3]; /* nodes per axis (n[2] = 1 in 2D) */
     size_t nnode;
-    double origin[3];  /* position of node (0,0,0) [m]                           */
-    double h, inv_h;   /* spacing [m]                                            */
-    /* node arrays, nnode each; index i + n0 (j + n1 k); [2] NULL in 2D          */
-    double *m;         /* mass [kg]                                              */
-    double *p[3];      /* momentum from P2G [kg m/s]                             */
-    double *v[3];      /* P2G velocity p/m (BCs applied)                          */
-    double *vn[3];     /* updated velocity (after forces and BCs)                */
-    double *fint[3];   /* internal force -sum V sigma.grad N [N]                  */
-    double *fext[3];   /* external force sum N (m g + f_p) [N]; the caller may add
-                          nodal loads between gk_mpm_p2g and gk_mpm_grid_update  */
+    double origin[3]; /* position of node (0,0,0) [m] */
+    double h, inv_h;  /* spacing [m] */
+    /* node arrays, nnode each; index i + n0 (j + n1 k); [2] NULL in 2D */
+    double *m;       /* mass [kg] */
+    double *p[3];    /* momentum from P2G [kg m/s] */
+    double *v[3];    /* P2G velocity p/m (BCs applied) */
+    double *vn[3];   /* updated velocity (after forces and BCs) */
+    double *fint[3]; /* internal force -sum V sigma.grad N [N] */
+    double *fext[3]; /* external force sum N (m g + f_p) [N]; the caller may add
+                        nodal loads between gk_mpm_p2g and gk_mpm_grid_update */
     gk_mpm_face face[6];
-    gk_mpm_body *body; /* caller-owned array of rigid bodies (may be NULL)       */
+    gk_mpm_body *body; /* caller-owned array of rigid bodies (may be NULL) */
     int nbody;
-    double mass_min;   /* nodes with m <= mass_min are inactive (set by P2G)     */
+    double mass_min; /* nodes with m <= mass_min are inactive (set by P2G) */
     /* private: coloured block sort of the points */
     int nb[3], nblock, colour_start[9];
-    int32_t *slot;     /* block -> position in colour-major order                */
-    int32_t *bstart;   /* nblock + 1                                             */
+    int32_t *slot;   /* block -> position in colour-major order */
+    int32_t *bstart; /* nblock + 1 */
     int32_t *order, *bid;
-    int cap;           /* capacity of order and bid                              */
+    int cap; /* capacity of order and bid */
     gk_allocator alloc;
 } gk_mpm_grid;
 
@@ -245,29 +245,29 @@ typedef struct gk_mpm_grid {
  * row-major 3x3 tensors stored 9 per point. */
 typedef struct gk_mpm_points {
     int dim, n;
-    double *x[3];    /* position [m]                                              */
-    double *v[3];    /* velocity [m/s]                                            */
-    double *fext[3]; /* external point force (traction x area, N or N/m)          */
-    double *m;       /* mass [kg]                                                 */
-    double *vol0;    /* initial volume [m^3] (2D: area)                           */
-    double *vol;     /* current volume det(F) vol0                                */
-    double *lp;      /* uGIMP half-size [m] (constant; <= h/2)                    */
-    double *F;       /* deformation gradient, 9 per point                        */
-    double *L;       /* velocity gradient of the last G2P [1/s], 9 per point     */
-    double *sigma;   /* Cauchy stress, tension-positive [Pa], 9 per point        */
-    double *C;       /* APIC affine velocity B D^-1 [1/s], 9 per point           */
+    double *x[3];    /* position [m] */
+    double *v[3];    /* velocity [m/s] */
+    double *fext[3]; /* external point force (traction x area, N or N/m) */
+    double *m;       /* mass [kg] */
+    double *vol0;    /* initial volume [m^3] (2D: area) */
+    double *vol;     /* current volume det(F) vol0 */
+    double *lp;      /* uGIMP half-size [m] (constant; <= h/2) */
+    double *F;       /* deformation gradient, 9 per point */
+    double *L;       /* velocity gradient of the last G2P [1/s], 9 per point */
+    double *sigma;   /* Cauchy stress, tension-positive [Pa], 9 per point */
+    double *C;       /* APIC affine velocity B D^-1 [1/s], 9 per point */
     gk_allocator alloc;
 } gk_mpm_points;
 
 typedef struct gk_mpm_def {
     gk_mpm_basis basis;
     gk_mpm_transfer transfer;
-    gk_mpm_scheme scheme; /* for gk_mpm_step                                     */
-    double alpha;         /* PIC fraction of the PIC/FLIP blend, [0, 1]           */
-    double gravity[3];    /* body force per unit mass [m/s^2]                     */
-    double damping;       /* local non-viscous grid damping, [0, 1)               */
+    gk_mpm_scheme scheme; /* for gk_mpm_step */
+    double alpha;         /* PIC fraction of the PIC/FLIP blend, [0, 1] */
+    double gravity[3];    /* body force per unit mass [m/s^2] */
+    double damping;       /* local non-viscous grid damping, [0, 1) */
     double mass_min;      /* node mass threshold; <= 0: 1e-14 x smallest point mass */
-    int threads;          /* OpenMP threads for P2G/G2P/update; <= 1 serial       */
+    int threads;          /* OpenMP threads for P2G/G2P/update; <= 1 serial */
 } gk_mpm_def;
 
 /* one point's stencil: s^dim nodes (zero weights included) */
@@ -275,32 +275,32 @@ typedef struct gk_mpm_stencil {
     int n;
     int32_t node[GK_MPM_MAX_STENCIL];
     double w[GK_MPM_MAX_STENCIL];
-    double dw[GK_MPM_MAX_STENCIL][3]; /* grad N [1/m]                            */
+    double dw[GK_MPM_MAX_STENCIL][3]; /* grad N [1/m] */
 } gk_mpm_stencil;
 
 /* flags for gk_mpm_p2g and gk_mpm_g2p */
-#define GK_MPM_P2G_MOMENTUM 1     /* m, p, v = p/m (+ BCs on v)                    */
-#define GK_MPM_P2G_FORCE 2        /* fint, fext                                   */
-#define GK_MPM_G2P_VELOCITY 1     /* v_p (and C for APIC) from v, vn              */
-#define GK_MPM_G2P_POSITION 2     /* x_p += dt sum N vn                           */
-#define GK_MPM_G2P_GRADIENT_NEW 4 /* L from vn, then F, vol                       */
-#define GK_MPM_G2P_GRADIENT_OLD 8 /* L from v (the P2G velocity), then F, vol     */
+#define GK_MPM_P2G_MOMENTUM 1     /* m, p, v = p/m (+ BCs on v) */
+#define GK_MPM_P2G_FORCE 2        /* fint, fext */
+#define GK_MPM_G2P_VELOCITY 1     /* v_p (and C for APIC) from v, vn */
+#define GK_MPM_G2P_POSITION 2     /* x_p += dt sum N vn */
+#define GK_MPM_G2P_GRADIENT_NEW 4 /* L from vn, then F, vol */
+#define GK_MPM_G2P_GRADIENT_OLD 8 /* L from v (the P2G velocity), then F, vol */
 
 typedef struct gk_mpm_dp {
-    double K, G;       /* bulk and shear moduli of the dimension [Pa] (> 0)       */
-    double eta;        /* friction coefficient of f (2D: sin phi)                 */
-    double etabar;     /* dilatancy coefficient of g (2D: sin psi)                */
-    double zeta;       /* cohesion factor (2D: cos phi)                           */
-    double c;          /* cohesion [Pa] (>= 0)                                    */
+    double K, G;   /* bulk and shear moduli of the dimension [Pa] (> 0) */
+    double eta;    /* friction coefficient of f (2D: sin phi) */
+    double etabar; /* dilatancy coefficient of g (2D: sin psi) */
+    double zeta;   /* cohesion factor (2D: cos phi) */
+    double c;      /* cohesion [Pa] (>= 0) */
     /* critical-state softening [seed 002 eqs 7-8]; off when chi <= 0 */
     double tan_phi_cs, Phi_cs, chi, xi;
 } gk_mpm_dp;
 
 typedef struct gk_mpm_dp_info {
-    int status;        /* 0 elastic, 1 return to the cone, 2 return to the apex   */
-    double f_trial;    /* yield function of the trial stress [Pa]                 */
-    double dlambda;    /* plastic multiplier (cone return)                        */
-    double deps_p[9];  /* plastic strain increment                                */
+    int status;       /* 0 elastic, 1 return to the cone, 2 return to the apex */
+    double f_trial;   /* yield function of the trial stress [Pa] */
+    double dlambda;   /* plastic multiplier (cone return) */
+    double deps_p[9]; /* plastic strain increment */
 } gk_mpm_dp_info;
 
 /* user stress update called by gk_mpm_step once L (and F, vol) are known */
@@ -321,12 +321,14 @@ GKDEF gk_result gk_mpm_grid_set_bc(gk_mpm_grid *g, int face, gk_mpm_bc_kind kind
 GKDEF void gk_mpm_grid_node_position(const gk_mpm_grid *g, size_t node, double x[3]);
 
 /* n points, zeroed, F = I, lp = 0 */
-GKDEF gk_result gk_mpm_points_create(gk_mpm_points *pts, int dim, int n, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_mpm_points_create(gk_mpm_points *pts, int dim, int n, const gk_allocator *alloc,
+                                     gk_err *err);
 /* points filling the box [lo, hi] whose edges are whole multiples of h,
  * ppd points per cell edge (ppd^dim per cell) at the sub-cell centres,
  * density rho, velocity 0, vol0 = (h/ppd)^dim, lp = h / (2 ppd) */
-GKDEF gk_result gk_mpm_points_create_box(gk_mpm_points *pts, int dim, const double lo[3], const double hi[3], double h,
-                                         int ppd, double rho, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_mpm_points_create_box(gk_mpm_points *pts, int dim, const double lo[3], const double hi[3],
+                                         double h, int ppd, double rho, const gk_allocator *alloc,
+                                         gk_err *err);
 GKDEF void gk_mpm_points_destroy(gk_mpm_points *pts);
 /* total mass, momentum and kinetic energy of the points (serial, fixed order) */
 GKDEF void gk_mpm_points_totals(const gk_mpm_points *pts, double *mass, double mom[3], double *kinetic);
@@ -337,10 +339,11 @@ GKDEF gk_result gk_mpm_shape(const gk_mpm_grid *g, gk_mpm_basis basis, const dou
 
 GKDEF gk_mpm_def gk_mpm_def_default(void); /* linear, PIC/FLIP alpha 0.1, USF, 1 thread */
 
-GKDEF gk_result gk_mpm_p2g(gk_mpm_grid *g, const gk_mpm_points *pts, const gk_mpm_def *def, int what, gk_err *err);
-GKDEF gk_result gk_mpm_grid_update(gk_mpm_grid *g, const gk_mpm_def *def, double dt, gk_err *err);
-GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def *def, double dt, int what,
+GKDEF gk_result gk_mpm_p2g(gk_mpm_grid *g, const gk_mpm_points *pts, const gk_mpm_def *def, int what,
                            gk_err *err);
+GKDEF gk_result gk_mpm_grid_update(gk_mpm_grid *g, const gk_mpm_def *def, double dt, gk_err *err);
+GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def *def, double dt,
+                           int what, gk_err *err);
 /* one explicit step in def->scheme order; stress may be NULL (sigma kept) */
 GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def *def, double dt,
                             gk_mpm_stress_fn stress, void *user, gk_err *err);
@@ -350,7 +353,8 @@ GKDEF void gk_mpm_bodies_advance(gk_mpm_body *body, int nbody, double dt);
 GKDEF gk_result gk_mpm_point_polar(const gk_mpm_points *pts, int p, double R[9], double U[9], gk_err *err);
 
 /* hypoelastic update: sigma <- R sigma R^T + K tr(de) I + 2G dev(de) */
-GKDEF gk_result gk_mpm_elastic_update(double K, double G, int dim, const double dH[9], double sigma[9], gk_err *err);
+GKDEF gk_result gk_mpm_elastic_update(double K, double G, int dim, const double dH[9], double sigma[9],
+                                      gk_err *err);
 /* Drucker-Prager from Mohr-Coulomb angles [rad] (see the top comment) */
 GKDEF gk_result gk_mpm_dp_init(gk_mpm_dp *dp, int dim, double K, double G, double phi, double psi, double c,
                                gk_err *err);
@@ -360,8 +364,8 @@ GKDEF gk_result gk_mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_
                                  gk_mpm_dp_info *info, gk_err *err);
 /* rotate, elastic trial from dH, return map; Phi (packing fraction) updated
  * by eq 8 and used by eq 7 when dp->chi > 0 (Phi may be NULL otherwise) */
-GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9], double *Phi,
-                                 gk_mpm_dp_info *info, gk_err *err);
+GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9],
+                                 double *Phi, gk_mpm_dp_info *info, gk_err *err);
 
 #ifdef __cplusplus
 }
@@ -460,8 +464,8 @@ static void gk__mpm_grid_free_arrays(gk_mpm_grid *g) {
     gk_free(&g->alloc, g->bid);
 }
 
-GKDEF gk_result gk_mpm_grid_create(gk_mpm_grid *g_out, int dim, const double origin[3], double h, const int n[3],
-                                   const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_mpm_grid_create(gk_mpm_grid *g_out, int dim, const double origin[3], double h,
+                                   const int n[3], const gk_allocator *alloc, gk_err *err) {
     gk_mpm_grid g;
     int k, bad = 0, c, b;
     size_t nn = 1;
@@ -471,7 +475,8 @@ GKDEF gk_result gk_mpm_grid_create(gk_mpm_grid *g_out, int dim, const double ori
     if (!(h > 0.0)) return gk_err_set(err, GK_ERR_ARG, "grid spacing h = %g (must be > 0)", h);
     for (k = 0; k < dim; ++k) {
         if (!isfinite(origin[k])) return gk_err_set(err, GK_ERR_NAN, "grid origin[%d] is NaN or infinite", k);
-        if (n[k] < 2) return gk_err_set(err, GK_ERR_ARG, "grid has %d nodes along axis %d (need >= 2)", n[k], k);
+        if (n[k] < 2)
+            return gk_err_set(err, GK_ERR_ARG, "grid has %d nodes along axis %d (need >= 2)", n[k], k);
         if (nn > (size_t)INT32_MAX / (size_t)n[k]) bad = 1;
         nn *= (size_t)n[k];
     }
@@ -536,13 +541,15 @@ GKDEF void gk_mpm_grid_destroy(gk_mpm_grid *g) {
 GKDEF gk_result gk_mpm_grid_set_bc(gk_mpm_grid *g, int face, gk_mpm_bc_kind kind, double mu, int layers,
                                    gk_err *err) {
     if (face < 0 || face >= 2 * g->dim)
-        return gk_err_set(err, GK_ERR_ARG, "face %d (must be 0..%d: x-, x+, y-, y+[, z-, z+])", face, 2 * g->dim - 1);
+        return gk_err_set(err, GK_ERR_ARG, "face %d (must be 0..%d: x-, x+, y-, y+[, z-, z+])", face,
+                          2 * g->dim - 1);
     if ((int)kind < 0 || (int)kind > (int)GK_MPM_BC_FRICTION)
         return gk_err_set(err, GK_ERR_ARG, "unknown boundary condition kind %d", (int)kind);
     if (!isfinite(mu)) return gk_err_set(err, GK_ERR_NAN, "friction coefficient is NaN or infinite");
     if (mu < 0.0) return gk_err_set(err, GK_ERR_ARG, "friction coefficient %g < 0", mu);
     if (layers < 1 || layers > g->n[face / 2])
-        return gk_err_set(err, GK_ERR_ARG, "%d node layers on face %d (must be 1..%d)", layers, face, g->n[face / 2]);
+        return gk_err_set(err, GK_ERR_ARG, "%d node layers on face %d (must be 1..%d)", layers, face,
+                          g->n[face / 2]);
     g->face[face].kind = kind;
     g->face[face].mu = mu;
     g->face[face].layers = layers;
@@ -575,13 +582,15 @@ static void gk__mpm_points_free_arrays(gk_mpm_points *P) {
     gk_free(&P->alloc, P->C);
 }
 
-GKDEF gk_result gk_mpm_points_create(gk_mpm_points *out, int dim, int n, const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_mpm_points_create(gk_mpm_points *out, int dim, int n, const gk_allocator *alloc,
+                                     gk_err *err) {
     gk_mpm_points P;
     int k, bad = 0, p;
     size_t nn = (size_t)(n > 0 ? n : 1);
     if (!out) return gk_err_set(err, GK_ERR_ARG, "NULL points");
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
-    if (n < 0 || n > INT32_MAX / 9) return gk_err_set(err, GK_ERR_ARG, "%d points (must be 0..%d)", n, INT32_MAX / 9);
+    if (n < 0 || n > INT32_MAX / 9)
+        return gk_err_set(err, GK_ERR_ARG, "%d points (must be 0..%d)", n, INT32_MAX / 9);
     memset(&P, 0, sizeof P);
     if (alloc) P.alloc = *alloc;
     P.dim = dim;
@@ -621,8 +630,9 @@ GKDEF gk_result gk_mpm_points_create(gk_mpm_points *out, int dim, int n, const g
     return GK_OK;
 }
 
-GKDEF gk_result gk_mpm_points_create_box(gk_mpm_points *pts, int dim, const double lo[3], const double hi[3], double h,
-                                         int ppd, double rho, const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_mpm_points_create_box(gk_mpm_points *pts, int dim, const double lo[3], const double hi[3],
+                                         double h, int ppd, double rho, const gk_allocator *alloc,
+                                         gk_err *err) {
     int nc[3] = {1, 1, 1}, k, i, j, l, p = 0, ns[3];
     long total = 1;
     double d, v0;
@@ -631,15 +641,16 @@ GKDEF gk_result gk_mpm_points_create_box(gk_mpm_points *pts, int dim, const doub
     if (!isfinite(h) || !isfinite(rho)) return gk_err_set(err, GK_ERR_NAN, "spacing or density is NaN");
     if (!(h > 0.0)) return gk_err_set(err, GK_ERR_ARG, "spacing h = %g (must be > 0)", h);
     if (!(rho > 0.0)) return gk_err_set(err, GK_ERR_MASS, "density %g (must be > 0)", rho);
-    if (ppd < 1 || ppd > 16) return gk_err_set(err, GK_ERR_ARG, "%d points per cell edge (must be 1..16)", ppd);
+    if (ppd < 1 || ppd > 16)
+        return gk_err_set(err, GK_ERR_ARG, "%d points per cell edge (must be 1..16)", ppd);
     for (k = 0; k < dim; ++k) {
         double c;
         if (!isfinite(lo[k]) || !isfinite(hi[k])) return gk_err_set(err, GK_ERR_NAN, "box corner is NaN");
         c = (hi[k] - lo[k]) / h;
         nc[k] = (int)floor(c + 0.5);
         if (nc[k] < 1 || fabs(c - nc[k]) > 1e-9 * (c > 1.0 ? c : 1.0) || nc[k] > 1000000)
-            return gk_err_set(err, GK_ERR_ARG, "box edge %d of %g cells is not a positive whole number of cells",
-                              k, c);
+            return gk_err_set(err, GK_ERR_ARG,
+                              "box edge %d of %g cells is not a positive whole number of cells", k, c);
         total *= (long)nc[k] * ppd;
         if (total > INT32_MAX / 9) return gk_err_set(err, GK_ERR_ARG, "box holds too many points");
     }
@@ -765,14 +776,16 @@ GKDEF gk_result gk_mpm_shape(const gk_mpm_grid *g, gk_mpm_basis basis, const dou
     if (basis == GK_MPM_UGIMP && !(l > 0.0 && l <= 0.5))
         return gk_err_set(err, GK_ERR_ARG, "uGIMP half-size lp = %g (must be in (0, h/2], h = %g)", lp, g->h);
     if (!gk__mpm_inside(g, basis, xx, l))
-        return gk_err_set(err, GK_ERR_OUTSIDE, "point (%g, %g, %g): its support leaves the grid", xx[0], xx[1], xx[2]);
+        return gk_err_set(err, GK_ERR_OUTSIDE, "point (%g, %g, %g): its support leaves the grid", xx[0],
+                          xx[1], xx[2]);
     gk__mpm_weights(g, basis, xx, l, &W);
     s = W.s;
     sz = g->dim == 3 ? s : 1;
     for (c = 0; c < sz; ++c)
         for (b = 0; b < s; ++b)
             for (a = 0; a < s; ++a, ++q) {
-                st->node[q] = (int32_t)((W.base[0] + a) + g->n[0] * ((W.base[1] + b) + g->n[1] * (W.base[2] + c)));
+                st->node[q] =
+                    (int32_t)((W.base[0] + a) + g->n[0] * ((W.base[1] + b) + g->n[1] * (W.base[2] + c)));
                 st->w[q] = W.w[0][a] * W.w[1][b] * W.w[2][c];
                 st->dw[q][0] = W.dw[0][a] * W.w[1][b] * W.w[2][c];
                 st->dw[q][1] = W.w[0][a] * W.dw[1][b] * W.w[2][c];
@@ -794,7 +807,8 @@ static int gk__mpm_nthreads(const gk_mpm_def *d) {
 static gk_result gk__mpm_check_bodies(const gk_mpm_grid *g, gk_err *err) {
     int bi, k;
     if (g->nbody < 0 || (g->nbody > 0 && !g->body))
-        return gk_err_set(err, GK_ERR_ARG, "%d rigid bodies with body array %p", g->nbody, (const void *)g->body);
+        return gk_err_set(err, GK_ERR_ARG, "%d rigid bodies with body array %p", g->nbody,
+                          (const void *)g->body);
     for (bi = 0; bi < g->nbody; ++bi) {
         const gk_mpm_body *B = &g->body[bi];
         for (k = 0; k < g->dim; ++k)
@@ -802,9 +816,11 @@ static gk_result gk__mpm_check_bodies(const gk_mpm_grid *g, gk_err *err) {
                 return gk_err_set(err, GK_ERR_NAN, "rigid body %d has a NaN or infinite entry", bi);
         if ((int)B->contact < 0 || (int)B->contact > (int)GK_MPM_CONTACT_SMOOTH)
             return gk_err_set(err, GK_ERR_ARG, "rigid body %d: unknown contact kind %d", bi, (int)B->contact);
-        if (B->mu < 0.0) return gk_err_set(err, GK_ERR_ARG, "rigid body %d: friction coefficient %g < 0", bi, B->mu);
+        if (B->mu < 0.0)
+            return gk_err_set(err, GK_ERR_ARG, "rigid body %d: friction coefficient %g < 0", bi, B->mu);
         if (B->face < 0 || B->face > 2 * g->dim)
-            return gk_err_set(err, GK_ERR_ARG, "rigid body %d: face %d (0 = nearest, 1..%d)", bi, B->face, 2 * g->dim);
+            return gk_err_set(err, GK_ERR_ARG, "rigid body %d: face %d (0 = nearest, 1..%d)", bi, B->face,
+                              2 * g->dim);
     }
     return GK_OK;
 }
@@ -830,12 +846,11 @@ static gk_result gk__mpm_check_def(const gk_mpm_def *d, gk_err *err) {
 
 /* Validate every point (nothing written on failure), then counting-sort the
  * points into colour-major blocks (stable: ascending index inside a block). */
-static gk_result gk__mpm_bin(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mpm_def *d, int what, double *mmin,
-                             gk_err *err) {
+static gk_result gk__mpm_bin(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mpm_def *d, int what,
+                             double *mmin, gk_err *err) {
     int n = P->n, p, k, s;
     double mlow = HUGE_VAL;
-    if (P->dim != g->dim)
-        return gk_err_set(err, GK_ERR_ARG, "points are %dD, grid is %dD", P->dim, g->dim);
+    if (P->dim != g->dim) return gk_err_set(err, GK_ERR_ARG, "points are %dD, grid is %dD", P->dim, g->dim);
     for (p = 0; p < n; ++p) {
         double x[3] = {0.0, 0.0, 0.0}, l = d->basis == GK_MPM_UGIMP ? P->lp[p] * g->inv_h : 0.0;
         for (k = 0; k < g->dim; ++k) {
@@ -846,11 +861,12 @@ static gk_result gk__mpm_bin(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mp
         if (!(P->m[p] > 0.0) || !isfinite(P->m[p]))
             return gk_err_set(err, GK_ERR_MASS, "point %d: mass %g (must be > 0)", p, P->m[p]);
         if (d->basis == GK_MPM_UGIMP && !(l > 0.0 && l <= 0.5))
-            return gk_err_set(err, GK_ERR_ARG, "point %d: uGIMP half-size lp = %g (must be in (0, h/2], h = %g)", p,
-                              P->lp[p], g->h);
+            return gk_err_set(err, GK_ERR_ARG,
+                              "point %d: uGIMP half-size lp = %g (must be in (0, h/2], h = %g)", p, P->lp[p],
+                              g->h);
         if (!gk__mpm_inside(g, d->basis, x, l))
-            return gk_err_set(err, GK_ERR_OUTSIDE, "point %d at (%g, %g, %g): its support leaves the grid", p, x[0],
-                              x[1], x[2]);
+            return gk_err_set(err, GK_ERR_OUTSIDE, "point %d at (%g, %g, %g): its support leaves the grid", p,
+                              x[0], x[1], x[2]);
         if (d->transfer == GK_MPM_APIC && !gk_m3_isfinite(P->C + 9 * p))
             return gk_err_set(err, GK_ERR_NAN, "point %d: APIC matrix C has a NaN", p);
         if (what & GK_MPM_P2G_FORCE) {
@@ -920,8 +936,9 @@ static void gk__mpm_p2g_point(gk_mpm_grid *g, const gk_mpm_points *P, const gk_m
     for (c = 0; c < sz; ++c)
         for (b = 0; b < s; ++b)
             for (a = 0; a < s; ++a) {
-                size_t I = (size_t)(W.base[0] + a) +
-                           (size_t)g->n[0] * ((size_t)(W.base[1] + b) + (size_t)g->n[1] * (size_t)(W.base[2] + c));
+                size_t I =
+                    (size_t)(W.base[0] + a) +
+                    (size_t)g->n[0] * ((size_t)(W.base[1] + b) + (size_t)g->n[1] * (size_t)(W.base[2] + c));
                 double wyz = W.w[1][b] * W.w[2][c], w = W.w[0][a] * wyz, gr[3];
                 if (what & GK_MPM_P2G_MOMENTUM) {
                     double dx[3];
@@ -1071,7 +1088,8 @@ static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt, double d
     }
 }
 
-GKDEF gk_result gk_mpm_p2g(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mpm_def *d, int what, gk_err *err) {
+GKDEF gk_result gk_mpm_p2g(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mpm_def *d, int what,
+                           gk_err *err) {
     gk_result r;
     double mmin = 0.0;
     long nn = (long)g->nnode, I;
@@ -1079,7 +1097,8 @@ GKDEF gk_result gk_mpm_p2g(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mpm_
     if (!P) return gk_err_set(err, GK_ERR_ARG, "NULL points");
     r = gk__mpm_check_def(d, err);
     if (r) return r;
-    if (what < 1 || what > 3) return gk_err_set(err, GK_ERR_ARG, "P2G flags %d (MOMENTUM and/or FORCE)", what);
+    if (what < 1 || what > 3)
+        return gk_err_set(err, GK_ERR_ARG, "P2G flags %d (MOMENTUM and/or FORCE)", what);
     r = gk__mpm_check_bodies(g, err);
     if (r) return r;
     r = gk__mpm_bin(g, P, d, what, &mmin, err);
@@ -1177,8 +1196,9 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
     for (c = 0; c < sz; ++c)
         for (b = 0; b < s; ++b)
             for (a = 0; a < s; ++a) {
-                size_t I = (size_t)(W.base[0] + a) +
-                           (size_t)g->n[0] * ((size_t)(W.base[1] + b) + (size_t)g->n[1] * (size_t)(W.base[2] + c));
+                size_t I =
+                    (size_t)(W.base[0] + a) +
+                    (size_t)g->n[0] * ((size_t)(W.base[1] + b) + (size_t)g->n[1] * (size_t)(W.base[2] + c));
                 double wyz = W.w[1][b] * W.w[2][c], w = W.w[0][a] * wyz, gr[3], dx[3];
                 gr[0] = W.dw[0][a] * wyz;
                 gr[1] = W.w[0][a] * W.dw[1][b] * W.w[2][c];
@@ -1200,7 +1220,8 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
             }
     if (want_v) {
         if (apic) {
-            double Dinv = d->basis == GK_MPM_QUADRATIC ? 4.0 * g->inv_h * g->inv_h : 3.0 * g->inv_h * g->inv_h;
+            double Dinv =
+                d->basis == GK_MPM_QUADRATIC ? 4.0 * g->inv_h * g->inv_h : 3.0 * g->inv_h * g->inv_h;
             for (k = 0; k < dim; ++k) P->v[k][p] = vpic[k];
             for (k = 0; k < 9; ++k) P->C[9 * p + k] = apic_b ? Bm[k] * Dinv : Bm[k];
         } else {
@@ -1238,8 +1259,7 @@ GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_
     if (r) return r;
     if (!P) return gk_err_set(err, GK_ERR_ARG, "NULL points");
     if (P->dim != g->dim) return gk_err_set(err, GK_ERR_ARG, "points are %dD, grid is %dD", P->dim, g->dim);
-    if (what < 1 || what > 15 ||
-        ((what & GK_MPM_G2P_GRADIENT_NEW) && (what & GK_MPM_G2P_GRADIENT_OLD)))
+    if (what < 1 || what > 15 || ((what & GK_MPM_G2P_GRADIENT_NEW) && (what & GK_MPM_G2P_GRADIENT_OLD)))
         return gk_err_set(err, GK_ERR_ARG, "G2P flags %d (at most one GRADIENT flag)", what);
     if (!isfinite(dt)) return gk_err_set(err, GK_ERR_NAN, "time step is NaN or infinite");
     if (!(dt > 0.0)) return gk_err_set(err, GK_ERR_DT, "time step %g (must be > 0)", dt);
@@ -1255,8 +1275,8 @@ GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_
             return gk_err_set(err, GK_ERR_ARG, "point %d: uGIMP half-size lp = %g (must be in (0, h/2])", p,
                               P->lp[p]);
         if (!gk__mpm_inside(g, d->basis, x, l))
-            return gk_err_set(err, GK_ERR_OUTSIDE, "point %d at (%g, %g, %g): its support leaves the grid", p, x[0],
-                              x[1], x[2]);
+            return gk_err_set(err, GK_ERR_OUTSIDE, "point %d at (%g, %g, %g): its support leaves the grid", p,
+                              x[0], x[1], x[2]);
     }
     nth = gk__mpm_nthreads(d);
     (void)nth; /* unused without OpenMP */
@@ -1279,8 +1299,8 @@ GKDEF void gk_mpm_bodies_advance(gk_mpm_body *body, int nbody, double dt) {
         }
 }
 
-GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_def *d, double dt, gk_mpm_stress_fn stress,
-                            void *user, gk_err *err) {
+GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_def *d, double dt,
+                            gk_mpm_stress_fn stress, void *user, gk_err *err) {
     gk_result r = gk__mpm_check_def(d, err);
     if (r) return r;
     if (!isfinite(dt)) return gk_err_set(err, GK_ERR_NAN, "time step is NaN or infinite");
@@ -1297,7 +1317,8 @@ GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_def *
     case GK_MPM_USL:
         if ((r = gk_mpm_p2g(g, P, d, GK_MPM_P2G_MOMENTUM | GK_MPM_P2G_FORCE, err))) return r;
         if ((r = gk_mpm_grid_update(g, d, dt, err))) return r;
-        if ((r = gk_mpm_g2p(g, P, d, dt, GK_MPM_G2P_GRADIENT_NEW | GK_MPM_G2P_VELOCITY | GK_MPM_G2P_POSITION, err)))
+        if ((r = gk_mpm_g2p(g, P, d, dt, GK_MPM_G2P_GRADIENT_NEW | GK_MPM_G2P_VELOCITY | GK_MPM_G2P_POSITION,
+                            err)))
             return r;
         if (stress && (r = stress(P, dt, user, err))) return r;
         break;
@@ -1354,7 +1375,8 @@ static void gk__mpm_elastic_add(double K, double G, int dim, const double dH[9],
             sigma[3 * i + j] += 2.0 * G * e[3 * i + j] + (i == j ? (K - 2.0 * G / dim) * tr : 0.0);
 }
 
-GKDEF gk_result gk_mpm_elastic_update(double K, double G, int dim, const double dH[9], double sigma[9], gk_err *err) {
+GKDEF gk_result gk_mpm_elastic_update(double K, double G, int dim, const double dH[9], double sigma[9],
+                                      gk_err *err) {
     gk_result r = gk__mpm_check_dH(dim, dH, sigma, err);
     if (r) return r;
     if (!(K > 0.0) || !(G >= 0.0) || !isfinite(K) || !isfinite(G))
@@ -1367,14 +1389,15 @@ GKDEF gk_result gk_mpm_elastic_update(double K, double G, int dim, const double 
 static gk_result gk__mpm_dp_check(const gk_mpm_dp *dp, int dim, gk_err *err) {
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
     if (!dp) return gk_err_set(err, GK_ERR_ARG, "NULL Drucker-Prager parameters");
-    if (!isfinite(dp->K) || !isfinite(dp->G) || !isfinite(dp->eta) || !isfinite(dp->etabar) || !isfinite(dp->zeta) ||
-        !isfinite(dp->c))
+    if (!isfinite(dp->K) || !isfinite(dp->G) || !isfinite(dp->eta) || !isfinite(dp->etabar) ||
+        !isfinite(dp->zeta) || !isfinite(dp->c))
         return gk_err_set(err, GK_ERR_NAN, "Drucker-Prager parameter is NaN or infinite");
     if (!(dp->K > 0.0) || !(dp->G > 0.0))
-        return gk_err_set(err, GK_ERR_ARG, "Drucker-Prager moduli K = %g, G = %g (must be > 0)", dp->K, dp->G);
+        return gk_err_set(err, GK_ERR_ARG, "Drucker-Prager moduli K = %g, G = %g (must be > 0)", dp->K,
+                          dp->G);
     if (dp->eta < 0.0 || dp->c < 0.0 || dp->zeta < 0.0)
-        return gk_err_set(err, GK_ERR_ARG, "Drucker-Prager eta = %g, zeta = %g, c = %g (must be >= 0)", dp->eta,
-                          dp->zeta, dp->c);
+        return gk_err_set(err, GK_ERR_ARG, "Drucker-Prager eta = %g, zeta = %g, c = %g (must be >= 0)",
+                          dp->eta, dp->zeta, dp->c);
     if (dp->eta == 0.0 && dp->etabar != 0.0)
         return gk_err_set(err, GK_ERR_ARG, "Drucker-Prager etabar = %g with eta = 0", dp->etabar);
     return GK_OK;
@@ -1398,10 +1421,11 @@ GKDEF gk_result gk_mpm_dp_init(gk_mpm_dp *dp, int dim, double K, double G, doubl
     gk_mpm_dp t;
     gk_result r;
     memset(&t, 0, sizeof t);
-    if (!isfinite(phi) || !isfinite(psi)) return gk_err_set(err, GK_ERR_NAN, "friction or dilatancy angle is NaN");
+    if (!isfinite(phi) || !isfinite(psi))
+        return gk_err_set(err, GK_ERR_NAN, "friction or dilatancy angle is NaN");
     if (!(phi >= 0.0 && phi < 0.5 * GK_PI) || !(psi > -0.5 * GK_PI && psi <= phi))
-        return gk_err_set(err, GK_ERR_ARG, "angles phi = %g, psi = %g rad (need 0 <= phi < pi/2, psi <= phi)", phi,
-                          psi);
+        return gk_err_set(err, GK_ERR_ARG, "angles phi = %g, psi = %g rad (need 0 <= phi < pi/2, psi <= phi)",
+                          phi, psi);
     t.K = K;
     t.G = G;
     t.c = c;
@@ -1439,7 +1463,8 @@ GKDEF gk_result gk_mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_
     int i, j, status = 0;
     gk_result r = gk__mpm_dp_check(dp, dim, err);
     if (r) return r;
-    if (!gk_m3_isfinite(sig_trial)) return gk_err_set(err, GK_ERR_NAN, "trial stress has a NaN or infinite entry");
+    if (!gk_m3_isfinite(sig_trial))
+        return gk_err_set(err, GK_ERR_NAN, "trial stress has a NaN or infinite entry");
     p = gk__mpm_pq(dim, sig_trial, s, &q);
     f = q + dp->eta * p - dp->zeta * dp->c;
     gk_m3_copy(sig_trial, out);
@@ -1472,8 +1497,8 @@ GKDEF gk_result gk_mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_
     return GK_OK;
 }
 
-GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp_in, int dim, const double dH[9], double sigma[9], double *Phi,
-                                 gk_mpm_dp_info *info_out, gk_err *err) {
+GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp_in, int dim, const double dH[9], double sigma[9],
+                                 double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
     gk_mpm_dp dp;
     gk_mpm_dp_info info;
     double trial[9];
@@ -1485,7 +1510,8 @@ GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp_in, int dim, const double d
     if (dp.chi > 0.0) {
         double tphi, tpsi;
         if (!Phi || !isfinite(*Phi) || !isfinite(dp.tan_phi_cs) || !isfinite(dp.Phi_cs) || !isfinite(dp.xi))
-            return gk_err_set(err, GK_ERR_ARG, "critical-state Drucker-Prager needs a finite packing fraction");
+            return gk_err_set(err, GK_ERR_ARG,
+                              "critical-state Drucker-Prager needs a finite packing fraction");
         tpsi = (*Phi - dp.Phi_cs) * dp.chi; /* eq 7 */
         tphi = dp.tan_phi_cs + tpsi;
         if (tphi < 0.0) tphi = 0.0;

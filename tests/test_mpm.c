@@ -52,7 +52,8 @@ static gk_mpm_grid make_grid(int dim, double ox, double oy, double oz, double h,
 }
 
 /* random points whose support (any basis, lp = h/4) is inside the grid */
-static void random_points(gk_mpm_points *P, const gk_mpm_grid *g, int n, uint64_t seed) { /* in [1.5h, (n-2.5)h] */
+static void random_points(gk_mpm_points *P, const gk_mpm_grid *g, int n,
+                          uint64_t seed) { /* in [1.5h, (n-2.5)h] */
     gk_rng rng;
     int p, k;
     gk_err e;
@@ -89,13 +90,15 @@ TEST(shape_partition_of_unity) {
                 gk_err e;
                 double x[3] = {0, 0, 0}, sw = 0, sg[3] = {0, 0, 0}, sx[3] = {0, 0, 0}, cx[9];
                 int k, q, i, j;
-                for (k = 0; k < dim; ++k) x[k] = g.origin[k] + g.h * (1.0 + (g.n[k] - 3.0) * gk_rng_uniform(&rng));
+                for (k = 0; k < dim; ++k)
+                    x[k] = g.origin[k] + g.h * (1.0 + (g.n[k] - 3.0) * gk_rng_uniform(&rng));
                 if (t == 0)
                     for (k = 0; k < dim; ++k) x[k] = g.origin[k] + g.h * 3.0; /* exactly on a node */
                 CHECK_EQ_INT(gk_mpm_shape(&g, all_bases[bi], x, 0.3 * g.h, &st, &e), GK_OK);
-                CHECK_EQ_INT(st.n, dim == 3 ? gk_mpm_basis_width(all_bases[bi]) * gk_mpm_basis_width(all_bases[bi]) *
-                                                  gk_mpm_basis_width(all_bases[bi])
-                                            : gk_mpm_basis_width(all_bases[bi]) * gk_mpm_basis_width(all_bases[bi]));
+                CHECK_EQ_INT(
+                    st.n, dim == 3 ? gk_mpm_basis_width(all_bases[bi]) * gk_mpm_basis_width(all_bases[bi]) *
+                                         gk_mpm_basis_width(all_bases[bi])
+                                   : gk_mpm_basis_width(all_bases[bi]) * gk_mpm_basis_width(all_bases[bi]));
                 for (i = 0; i < 9; ++i) cx[i] = 0;
                 for (q = 0; q < st.n; ++q) {
                     double xI[3];
@@ -112,11 +115,13 @@ TEST(shape_partition_of_unity) {
                     if (fabs(sg[i]) * g.h > worst_g) worst_g = fabs(sg[i]) * g.h;
                     if (fabs(sx[i] - x[i]) > worst_x) worst_x = fabs(sx[i] - x[i]);
                     for (j = 0; j < dim; ++j)
-                        if (fabs(cx[3 * i + j] - (i == j)) > worst_c) worst_c = fabs(cx[3 * i + j] - (i == j));
+                        if (fabs(cx[3 * i + j] - (i == j)) > worst_c)
+                            worst_c = fabs(cx[3 * i + j] - (i == j));
                 }
             }
             if (worst_w > 1e-14 || worst_g > 1e-13 || worst_x > 1e-13 || worst_c > 1e-12)
-                printf("    %dD %s: |sum N - 1| %.2e, |sum grad N| h %.2e, |sum N x - x| %.2e, |sum x grad N - I| %.2e\n",
+                printf("    %dD %s: |sum N - 1| %.2e, |sum grad N| h %.2e, |sum N x - x| %.2e, |sum x grad N "
+                       "- I| %.2e\n",
                        dim, basis_name[bi], worst_w, worst_g, worst_x, worst_c);
             CHECK(worst_w <= 1e-14);
             CHECK(worst_g <= 1e-13);
@@ -235,7 +240,8 @@ TEST(apic_preserves_rigid_rotation) {
                     }
                     if (fabs(P.v[i][p] - ve) > errv) errv = fabs(P.v[i][p] - ve);
                 }
-            if (errv > 1e-13 || errc > 1e-12) printf("    %dD %s: |dv| %.2e |dC| %.2e\n", dim, basis_name[bi], errv, errc);
+            if (errv > 1e-13 || errc > 1e-12)
+                printf("    %dD %s: |dv| %.2e |dC| %.2e\n", dim, basis_name[bi], errv, errc);
             CHECK(errv <= 1e-13);
             CHECK(errc <= 1e-12);
             gk_mpm_points_destroy(&P);
@@ -260,7 +266,8 @@ TEST(elastic_bar_first_mode_frequency) {
         gk_mpm_points P;
         gk_mpm_def d = gk_mpm_def_default();
         gk_err e;
-        double lo[3] = {2 * h, 2 * h, 0}, hi[3] = {2 * h + Lb, 3 * h, 0}, c = gk_mpm_wave_speed(law.K, law.G, rho, 2);
+        double lo[3] = {2 * h, 2 * h, 0}, hi[3] = {2 * h + Lb, 3 * h, 0},
+               c = gk_mpm_wave_speed(law.K, law.G, rho, 2);
         double T = 4 * Lb / c, dt = 0.1 * h / c, t = 0, prev, mom0[3], cross[2] = {0, 0};
         int p, ncross = 0, step;
         CHECK_EQ_INT(gk_mpm_points_create_box(&P, 2, lo, hi, h, 2, rho, NULL, &e), GK_OK);
@@ -312,7 +319,8 @@ TEST(column_settles_to_geostatic_stress) {
     gk_mpm_def d = gk_mpm_def_default();
     gk_err e;
     elastic_law law;
-    double lo[3] = {2 * h, 2 * h, 0}, hi[3] = {4 * h, 2 * h + H, 0}, *Y, c, dt, worst = 0, ke = 0, mean_err = 0;
+    double lo[3] = {2 * h, 2 * h, 0}, hi[3] = {4 * h, 2 * h + H, 0}, *Y, c, dt, worst = 0, ke = 0,
+           mean_err = 0;
     int p, step, nsteps;
     law.K = 6e6; /* settlement 0.1 %: small against the cell size */
     law.G = 4e6;
@@ -343,7 +351,8 @@ TEST(column_settles_to_geostatic_stress) {
     gk_mpm_points_totals(&P, NULL, NULL, &ke);
     /* piecewise-linear velocity: stress is constant per cell, so a point may
      * be off by up to rho g h / 4 from the pointwise line */
-    if (worst > 0.3 * rho * grav * h) printf("    worst sigma_yy error %.1f Pa (rho g h = %.1f)\n", worst, rho * grav * h);
+    if (worst > 0.3 * rho * grav * h)
+        printf("    worst sigma_yy error %.1f Pa (rho g h = %.1f)\n", worst, rho * grav * h);
     CHECK(worst <= 0.3 * rho * grav * h);
     CHECK_NEAR(mean_err, 0.0, 0.005 * rho * grav * H);
     CHECK_REL(g.face[2].force[1], rho * grav * H * 2 * h, 1e-3);
@@ -393,7 +402,7 @@ TEST(block_on_frictional_floor_decelerates_at_mu_g) {
             CHECK_REL(mom[0] / M, v0 - mus[c] * grav * t, 0.01);
             /* the floor's impulses: tangential = mu x normal where sliding */
             CHECK(fx <= 0 && -fx <= mus[c] * fy * (1 + 1e-12)); /* Coulomb: |T| <= mu N */
-            CHECK(-fx >= 0.95 * mus[c] * fy);                  /* sliding nearly everywhere */
+            CHECK(-fx >= 0.95 * mus[c] * fy);                   /* sliding nearly everywhere */
             CHECK_REL(fy, M * grav * t, 0.01);
         } else {
             CHECK_REL(mom[0] / M, v0, 1e-9);
@@ -482,7 +491,9 @@ TEST(wall_and_body_contact_laws) {
         body.hi[1] = 10;
         body.v[1] = -1;
         body.mu = 0.5;
-        body.contact = kind == 0 ? GK_MPM_CONTACT_STICK : kind == 2 ? GK_MPM_CONTACT_SMOOTH : GK_MPM_CONTACT_FRICTION;
+        body.contact = kind == 0   ? GK_MPM_CONTACT_STICK
+                       : kind == 2 ? GK_MPM_CONTACT_SMOOTH
+                                   : GK_MPM_CONTACT_FRICTION;
         body.face = kind == 3 ? 3 : 0;
         /* relative velocity (1, 1) into the body face y- (outward normal -y) */
         want[6][0] = kind == 0 ? 0.0 : kind == 2 ? 1.0 : 0.5;
@@ -619,7 +630,8 @@ TEST(drucker_prager_update_spin_and_critical_state) {
 TEST(threads_give_identical_bits) {
     int dim;
     for (dim = 2; dim <= 3; ++dim) {
-        gk_mpm_grid g1 = make_grid(dim, 0.0, 0.0, 0.0, 0.1, 22, 21, 20), g2 = make_grid(dim, 0.0, 0.0, 0.0, 0.1, 22, 21, 20);
+        gk_mpm_grid g1 = make_grid(dim, 0.0, 0.0, 0.0, 0.1, 22, 21, 20),
+                    g2 = make_grid(dim, 0.0, 0.0, 0.0, 0.1, 22, 21, 20);
         gk_mpm_points A, B;
         gk_mpm_def d = gk_mpm_def_default();
         elastic_law law;
@@ -632,7 +644,8 @@ TEST(threads_give_identical_bits) {
         random_points(&B, &g2, n, 99);
         for (p = 0; p < n; ++p)
             for (k = 0; k < 9; ++k) {
-                A.sigma[9 * p + k] = B.sigma[9 * p + k] = (k % 3 < dim && k / 3 < dim) ? 100.0 * cos(p + 2.0 * k) : 0;
+                A.sigma[9 * p + k] = B.sigma[9 * p + k] =
+                    (k % 3 < dim && k / 3 < dim) ? 100.0 * cos(p + 2.0 * k) : 0;
                 A.C[9 * p + k] = B.C[9 * p + k] = (k % 3 < dim && k / 3 < dim) ? sin(p + 3.0 * k) : 0;
             }
         d.basis = dim == 2 ? GK_MPM_QUADRATIC : GK_MPM_CUBIC;
