@@ -22,7 +22,8 @@
 # Environment:
 #   PEERS_CASES    cases to run ("3d_10k 3d_1k 2d_10k rve400")
 #   PEERS_STEPS    timed steps per repeat for every case (default per case:
-#                  3d_10k 400, 3d_1k 2000, 2d_10k 500, rve400 5000)
+#                  3d_10k 200, 3d_1k 1000, 2d_10k 300, rve400 2500: YADE,
+#                  at ~0.8 M particle-steps/s, sets the pace; about 3 min)
 #   PEERS_REPEATS  timed repeats (3)
 #   PEERS_LIST     codes to run ("grainkit lammps liggghts yade")
 #   PEERS_WORK     scratch directory (build/peers)
@@ -58,7 +59,7 @@ wants() { case " $LIST " in *" $1 "*) return 0 ;; esac; return 1; }
 steps_for() {
     if [ -n "${PEERS_STEPS:-}" ]; then echo "$PEERS_STEPS"; return; fi
     case $1 in
-    3d_10k) echo 400 ;; 3d_1k) echo 2000 ;; 2d_10k) echo 500 ;; rve400) echo 5000 ;;
+    3d_10k) echo 200 ;; 3d_1k) echo 1000 ;; 2d_10k) echo 300 ;; rve400) echo 2500 ;;
     *) echo 200 ;;
     esac
 }
@@ -104,7 +105,8 @@ parse_lmp() {
         tee -a "$RES"
 }
 
-echo "run_peers: $(date -u '+%Y-%m-%d %H:%M UTC'), $(uname -m), $(nproc 2>/dev/null || echo '?') cores; cases: $CASES; repeats $REPS"
+loadavg() { cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo '?'; }
+echo "run_peers: $(date -u '+%Y-%m-%d %H:%M UTC'), $(uname -m), $(nproc 2>/dev/null || echo '?') cores, load average $(loadavg); cases: $CASES; repeats $REPS"
 have python3 || echo "run_peers: python3 not found: LAMMPS and LIGGGHTS (need the data-file converter) will be skipped"
 MPI_FLAGS=""
 if have "$MPIRUN" && "$MPIRUN" --version 2>&1 | grep -q 'Open MPI'; then
@@ -252,5 +254,6 @@ awk '/^PEER/ {
     }
   }' "$RES"
 echo
-echo "run_peers: PEER lines kept in $RES, logs in $WORK/"
+echo "run_peers: load average at the end $(loadavg) (a load above the core count means other jobs shared the"
+echo "cores: multi-thread/rank rates are then the first to suffer). PEER lines kept in $RES, logs in $WORK/"
 exit 0
