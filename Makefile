@@ -29,14 +29,15 @@ EXAMPLES := $(patsubst examples/%.c,$(BUILD)/%,$(EX_SRC))
 BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
 TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
 
-.PHONY: all test check bench bench-peers run install uninstall format format-check clean help \
+.PHONY: all test check bench bench-peers run run-rve install uninstall format format-check clean help \
         check-headers check-asan check-nosimd
 
 all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
 
 help:
 	@echo "make            build tests, examples, benchmarks and tools into $(BUILD)/"
-	@echo "make run        the main job (see README.md)"
+	@echo "make run        the main job: FEMxDEM biaxial test (see README.md)"
+	@echo "make run-rve    one RVE along a shear path"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability"
 	@echo "make bench      performance programs (2 cores)"
@@ -110,7 +111,13 @@ check-headers: | $(BUILD)/hdr
 check: check-headers check-nosimd check-asan
 
 # ---------------------------------------------------------------- run / bench
-run: $(BUILD)/rve_path
+# the seed 000 FEMxDEM biaxial test at a size that runs in about a minute on
+# 2 cores (4 x 8 Q8, 128 RVEs, through the peak); the paper's mesh is
+# --nx 8 --ny 16 --steps 100
+run: $(BUILD)/femdem_biaxial
+	$(BUILD)/femdem_biaxial --nx 4 --ny 8 --element q8 --steps 30 --threads 2 --out $(BUILD)/biaxial
+
+run-rve: $(BUILD)/rve_path
 	$(BUILD)/rve_path --packing examples/data/rve400.txt --dH "0 0.001 0 0" --increments 50 \
 	  --steps-per-increment 100 --out $(BUILD)/rve_path.csv
 

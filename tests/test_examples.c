@@ -78,9 +78,102 @@ TEST(gk_pack_makes_a_consolidated_packing) {
     gk_packing_free(&pk);
 }
 
+/* the first `ncol` columns of every data row of two CSV files are identical */
+static int csv_same(const char *a, const char *b, int ncol) {
+    FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
+    char la[2048], lb[2048];
+    int same = fa && fb, rows = 0;
+    while (same) {
+        char *pa = fgets(la, sizeof la, fa), *pb = fgets(lb, sizeof lb, fb);
+        int k, c = 0;
+        if (!pa || !pb) {
+            same = !pa && !pb;
+            break;
+        }
+        for (k = 0; la[k] && lb[k] && c < ncol; ++k) {
+            if (la[k] != lb[k]) same = 0;
+            if (la[k] == ',') ++c;
+        }
+        ++rows;
+    }
+    if (fa) fclose(fa);
+    if (fb) fclose(fb);
+    return same && rows > 1;
+}
+
+/* femdem_biaxial (seed 000): documented CSV header and RESULT line, VTK and
+ * SVG outputs; the same result for 1 and 2 threads; a restart from a
+ * checkpoint continues to the identical curve; the initial state carries the
+ * confining pressure (sigma_xx = sigma_yy = 100 kPa from the reactions of
+ * the seed RVE, whose p = 99976 Pa) */
+TEST(femdem_biaxial_runs_restarts_and_is_thread_independent) {
+    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 1 ";
+    char cmd[1024];
+    FILE *fp;
+    char line[1024];
+    snprintf(cmd, sizeof cmd, "%s --steps 4 --threads 2 --out build/t_fdA > build/t_fdA.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    snprintf(cmd, sizeof cmd, "%s --steps 4 --threads 1 --out build/t_fd1 > build/t_fd1.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 2 --out build/t_fdB > build/t_fdB.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    snprintf(cmd, sizeof cmd, "%s --steps 4 --threads 2 --out build/t_fdB --restart build/t_fdB > build/t_fdB2.out 2>&1",
+             base);
+    CHECK(system(cmd) == 0);
+    fp = fopen("build/t_fdA/biaxial.csv", "r");
+    CHECK(fp != NULL);
+    if (!fp) return;
+    CHECK(fgets(line, sizeof line, fp) != NULL);
+    CHECK(strncmp(line, "step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds", 57) == 0);
+    CHECK(fgets(line, sizeof line, fp) != NULL);
+    {
+        double v[5];
+        CHECK(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4]) == 5);
+        CHECK_NEAR(v[2], 1e5, 500.0); /* sigma_yy [Pa] at step 0 */
+        CHECK_NEAR(v[3], 1e5, 500.0); /* sigma_xx */
+    }
+    fclose(fp);
+    CHECK_EQ_INT(count_lines("build/t_fdA/biaxial.csv"), 6);
+    CHECK(file_has("build/t_fdA.out", "RESULT peak_sigma_yy="));
+    CHECK(file_has("build/t_fdA.out", "total_seconds="));
+    CHECK(file_has("build/t_fdA/gp_0004.vtk", "eps_q"));
+    CHECK(file_has("build/t_fdA/gp_0004.vtk", "fabric_anisotropy"));
+    CHECK(file_has("build/t_fdA/mesh_0004.vtk", "displacement"));
+    CHECK(file_has("build/t_fdA/biaxial_stress.svg", "<svg"));
+    CHECK(file_has("build/t_fdA/eps_q_field.svg", "<svg"));
+    /* columns step..iterations identical (seconds differ) */
+    CHECK(csv_same("build/t_fdA/biaxial.csv", "build/t_fd1/biaxial.csv", 6));
+    CHECK(csv_same("build/t_fdA/biaxial.csv", "build/t_fdB/biaxial.csv", 6));
+    CHECK(file_has("build/t_fdB2.out", "restarted from"));
+    /* bad input: a message and status 2 */
+    CHECK(system("build/femdem_biaxial --element q9 > build/t_bad.out 2>&1") != 0);
+    CHECK(file_has("build/t_bad.out", "q4 or q8"));
+    CHECK(system("build/femdem_biaxial --help > build/t_bad.out 2>&1") == 0);
+    CHECK(file_has("build/t_bad.out", "--restart"));
+}
+
+/* single-element test (seed 000 sec 3.3, Fig 6): one Q4 element with 4
+ * identical RVEs follows the RVE loaded alone under the same drained path */
+TEST(femdem_single_element_matches_rve_alone) {
+    double d = 1.0;
+    FILE *fp;
+    char line[1024];
+    CHECK(system("build/femdem_biaxial --test single --steps 6 --threads 2 --vtk-every 0 --out build/t_fds "
+                 "> build/t_fds.out 2>&1") == 0);
+    fp = fopen("build/t_fds.out", "r");
+    while (fp && fgets(line, sizeof line, fp))
+        if (!strncmp(line, "SINGLE max_rel_diff_to_peak=", 28)) d = atof(line + 28);
+    if (fp) fclose(fp);
+    printf("    max relative difference of sigma_yy, FEM element vs RVE alone: %.4f\n", d);
+    CHECK(d < 0.01); /* before the peak the curves agree (seed Fig 6) */
+    CHECK(file_has("build/t_fds/single_element.csv", "sigma_yy_fem,sigma_yy_rve"));
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(rve_path_writes_csv_and_svg);
     RUN(gk_pack_makes_a_consolidated_packing);
+    RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
+    RUN(femdem_single_element_matches_rve_alone);
     return gk_test_done();
 }
