@@ -66,7 +66,7 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
-#define AND_M 5 /* Anderson memory */
+#define AND_M 5                        /* Anderson memory */
 #define SEED_DT 3.1602315723728926e-05 /* the seed authors' YADE time step (PWaveTimeStep of rve400) */
 
 typedef struct opts {
@@ -100,42 +100,43 @@ typedef struct model {
 } model;
 
 static void usage(FILE *fp) {
-    fprintf(fp,
-            "usage: femdem_biaxial [--nx 8] [--ny 16] [--element q8|q4] [--steps 100] [--threads 2] [--out DIR]\n"
-            "                      [--tangent taylor|yade|perturbation] [--restart DIR] [--test biaxial|single]\n"
-            "\n"
-            "  --nx, --ny N           elements across the width and the height (8 x 16: the authors' mesh)\n"
-            "  --element q8|q4        8-node serendipity (default) or 4-node bilinear quad\n"
-            "  --quad 2|3             Gauss points per direction (default 2: Q8 reduced as in the authors'\n"
-            "                         script, 4 RVEs per element; 3: Q8 full integration, 9 RVEs)\n"
-            "  --steps N              load steps (default 100: 10 %% axial strain at 0.1 %% per step)\n"
-            "  --increment F          axial strain per load step (default 0.001)\n"
-            "  --threads T            OpenMP threads over the RVEs (results identical for any T)\n"
-            "  --out DIR              output directory (created; default femdem_out)\n"
-            "  --tangent KIND         taylor (eq 9, sliding contacts k_t = 0, default), yade (eq 9 keeping\n"
-            "                         k_t of sliding contacts, as the authors' code), perturbation (eq 8)\n"
-            "  --xi X                 perturbation size of eq 8 (default 5e-5, seed Fig 6)\n"
-            "  --restart DIR          continue from DIR/checkpoint.bin (same mesh options) to --steps\n"
-            "  --checkpoint K         write DIR/checkpoint.bin every K steps (default 10; always at the end)\n"
-            "  --test biaxial|single  biaxial (default) or the single-element test of seed sec 3.3: one Q4\n"
-            "                         element, 4 Gauss points, compared with the RVE alone under the same\n"
-            "                         drained path (writes single_element.csv and .svg)\n"
-            "  --packing FILE         RVE at every Gauss point (default examples/data/rve400.txt)\n"
-            "  --width, --height M    specimen size [m] (0.05 x 0.1)\n"
-            "  --pressure P           confining pressure [Pa] (1e5)\n"
-            "  --tol T                Newton tolerance on E_d = |du|/|u| (eq 21; default 0.01)\n"
-            "  --ftol F               a step also converges when E_f = |R_free|/|f_int| < F (default 0.003;\n"
-            "                         0: eq 21 alone). Near the peak the DEM noise keeps E_d from settling\n"
-            "                         while equilibrium already holds (see README)\n"
-            "  --max-iter N           iterations before a load step is cut back (default 20)\n"
-            "  --dt DT                DEM time step (default 3.16e-5 s, the authors')\n"
-            "  --dem-strain S         DEM steps per RVE run n_s = max|dH| / S (default 1e-5: the\n"
-            "                         authors' rule, 100 steps per 0.1 %%), clamped to [--dem-min, --dem-max]\n"
-            "  --dem-min, --dem-max   bounds of n_s (2, 20000)\n"
-            "  --vtk-every K          VTK files every K steps (default 1; 0: none)\n"
-            "  --relaxation KIND      aitken (default): Newton corrections scaled by the Aitken factor of the\n"
-            "                         last two corrections (in [0.25, 4]); none: plain Newton\n"
-            "  --verbose              print E_d, E_f and time of every Newton iteration\n");
+    fprintf(
+        fp,
+        "usage: femdem_biaxial [--nx 8] [--ny 16] [--element q8|q4] [--steps 100] [--threads 2] [--out DIR]\n"
+        "                      [--tangent taylor|yade|perturbation] [--restart DIR] [--test biaxial|single]\n"
+        "\n"
+        "  --nx, --ny N           elements across the width and the height (8 x 16: the authors' mesh)\n"
+        "  --element q8|q4        8-node serendipity (default) or 4-node bilinear quad\n"
+        "  --quad 2|3             Gauss points per direction (default 2: Q8 reduced as in the authors'\n"
+        "                         script, 4 RVEs per element; 3: Q8 full integration, 9 RVEs)\n"
+        "  --steps N              load steps (default 100: 10 %% axial strain at 0.1 %% per step)\n"
+        "  --increment F          axial strain per load step (default 0.001)\n"
+        "  --threads T            OpenMP threads over the RVEs (results identical for any T)\n"
+        "  --out DIR              output directory (created; default femdem_out)\n"
+        "  --tangent KIND         taylor (eq 9, sliding contacts k_t = 0, default), yade (eq 9 keeping\n"
+        "                         k_t of sliding contacts, as the authors' code), perturbation (eq 8)\n"
+        "  --xi X                 perturbation size of eq 8 (default 5e-5, seed Fig 6)\n"
+        "  --restart DIR          continue from DIR/checkpoint.bin (same mesh options) to --steps\n"
+        "  --checkpoint K         write DIR/checkpoint.bin every K steps (default 10; always at the end)\n"
+        "  --test biaxial|single  biaxial (default) or the single-element test of seed sec 3.3: one Q4\n"
+        "                         element, 4 Gauss points, compared with the RVE alone under the same\n"
+        "                         drained path (writes single_element.csv and .svg)\n"
+        "  --packing FILE         RVE at every Gauss point (default examples/data/rve400.txt)\n"
+        "  --width, --height M    specimen size [m] (0.05 x 0.1)\n"
+        "  --pressure P           confining pressure [Pa] (1e5)\n"
+        "  --tol T                Newton tolerance on E_d = |du|/|u| (eq 21; default 0.01)\n"
+        "  --ftol F               a step also converges when E_f = |R_free|/|f_int| < F (default 0.003;\n"
+        "                         0: eq 21 alone). Near the peak the DEM noise keeps E_d from settling\n"
+        "                         while equilibrium already holds (see README)\n"
+        "  --max-iter N           iterations before a load step is cut back (default 20)\n"
+        "  --dt DT                DEM time step (default 3.16e-5 s, the authors')\n"
+        "  --dem-strain S         DEM steps per RVE run n_s = max|dH| / S (default 1e-5: the\n"
+        "                         authors' rule, 100 steps per 0.1 %%), clamped to [--dem-min, --dem-max]\n"
+        "  --dem-min, --dem-max   bounds of n_s (2, 20000)\n"
+        "  --vtk-every K          VTK files every K steps (default 1; 0: none)\n"
+        "  --relaxation KIND      aitken (default): Newton corrections scaled by the Aitken factor of the\n"
+        "                         last two corrections (in [0.25, 4]); none: plain Newton\n"
+        "  --verbose              print E_d, E_f and time of every Newton iteration\n");
 }
 
 static int mkdir_p(const char *d) {
@@ -172,8 +173,8 @@ static int eval_rves(model *M, const double *u) {
     int g, nbad = 0, n4 = 16;
     GK_OMP(parallel for num_threads(M->o.threads) schedule(dynamic, 1) reduction(+ : nbad))
     for (g = 0; g < M->ngp; ++g) {
-        int e = g / M->q.n, a, i, j, ns;
-        double H[9];
+        int e = g / M->q.n, a, i, j, k, ns;
+        double H[9], s0[9], sp[4][9];
         gk_rve *r = &M->rve[g];
         const int *c = M->mesh.conn + (size_t)e * M->npe;
         gk_m3_zero(H);
@@ -183,35 +184,27 @@ static int eval_rves(model *M, const double *u) {
         memcpy(M->Hit + 9 * (size_t)g, H, sizeof H);
         ns = dem_steps_for(M, H);
         M->nsteps_gp[g] = ns;
-        if (M->tmode == 2) { /* perturbation tangent (eq 8): 4 extra runs, then the trial run last */
-            double s0[9], s1[9], Hp[9];
-            int k, l;
-            if (gk_rve_state_restore(&M->st[g], r) || gk_rve_deform(r, H, ns)) {
-                ++nbad;
-                continue;
+        if (M->tmode == 2) /* perturbation tangent (eq 8): the 4 perturbed runs first, the trial run last */
+            for (k = 0; k < 4; ++k) {
+                double Hp[9];
+                memcpy(Hp, H, sizeof H);
+                Hp[3 * (k / 2) + k % 2] += M->o.xi;
+                if (gk_rve_state_restore(&M->st[g], r) || gk_rve_deform(r, Hp, ns)) ++nbad;
+                gk_rve_stress(r, sp[k]);
             }
-            gk_rve_stress(r, s0);
-            for (k = 0; k < 2; ++k)
-                for (l = 0; l < 2; ++l) {
-                    memcpy(Hp, H, sizeof H);
-                    Hp[3 * k + l] += M->o.xi;
-                    if (gk_rve_state_restore(&M->st[g], r) || gk_rve_deform(r, Hp, ns)) {
-                        ++nbad;
-                        continue;
-                    }
-                    gk_rve_stress(r, s1);
-                    for (i = 0; i < 2; ++i)
-                        for (j = 0; j < 2; ++j)
-                            M->D[(size_t)g * n4 + ((i * 2 + j) * 2 + k) * 2 + l] = (s1[3 * i + j] - s0[3 * i + j]) / M->o.xi;
-                }
-        }
         if (gk_rve_state_restore(&M->st[g], r) || gk_rve_deform(r, H, ns)) {
             ++nbad;
             continue;
         }
-        gk_rve_stress(r, M->sig + 9 * (size_t)g);
-        if (M->tmode != 2 &&
-            gk_homog_tangent(r, M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u, M->D + (size_t)g * n4))
+        gk_rve_stress(r, s0);
+        memcpy(M->sig + 9 * (size_t)g, s0, sizeof s0);
+        if (M->tmode == 2) {
+            for (i = 0; i < 2; ++i)
+                for (j = 0; j < 2; ++j)
+                    for (k = 0; k < 4; ++k) /* k = 2 kk + ll */
+                        M->D[(size_t)g * n4 + (i * 2 + j) * 4 + k] =
+                            (sp[k][3 * i + j] - s0[3 * i + j]) / M->o.xi;
+        } else if (gk_homog_tangent(r, M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u, M->D + (size_t)g * n4))
             ++nbad;
     }
     return nbad;
@@ -239,7 +232,7 @@ static int floor_tangents(model *M, double *D) {
 /* ------------------------------------------------------------- setup */
 static int setup(model *M, gk_err *err) {
     opts *o = &M->o;
-    int n[3], g, e, a, per = o->quad, k;
+    int n[3], g, a, per = o->quad;
     double org[3] = {0, 0, 0}, len[3];
     gk_packing pk;
     gk_rve_def def = gk_rve_def_default();
@@ -253,10 +246,10 @@ static int setup(model *M, gk_err *err) {
     M->ndof = 2 * M->mesh.nnode;
     M->tmode = !strcmp(o->tangent, "yade") ? 1 : !strcmp(o->tangent, "perturbation") ? 2 : 0;
     if (gk_csr_from_mesh(&M->K, &M->mesh, NULL, err)) return 1;
-#define ALLOC(p, n)                                                                                                    \
-    do {                                                                                                              \
-        (p) = calloc((size_t)(n) + 1, sizeof *(p));                                                                   \
-        if (!(p)) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;                                          \
+#define ALLOC(p, n)                                                         \
+    do {                                                                    \
+        (p) = calloc((size_t)(n) + 1, sizeof *(p));                         \
+        if (!(p)) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1; \
     } while (0)
     ALLOC(M->rve, M->ngp);
     ALLOC(M->st, M->ngp);
@@ -313,7 +306,8 @@ static int setup(model *M, gk_err *err) {
     M->area0 = o->width * o->height;
     /* RVEs: the same packing everywhere (seed 000: uniform RVE, no imperfection) */
     if (gk_packing_read(o->packing, &pk, NULL, err)) return 1;
-    if (pk.dim != 2) return gk_err_set(err, GK_ERR_ARG, "%s is a %dD packing; this driver is 2D", o->packing, pk.dim), 1;
+    if (pk.dim != 2)
+        return gk_err_set(err, GK_ERR_ARG, "%s is a %dD packing; this driver is 2D", o->packing, pk.dim), 1;
     def.dt = o->dt;
     for (g = 0; g < M->ngp; ++g) {
         if (gk_rve_create(&M->rve[g], &def, &pk)) {
@@ -321,26 +315,29 @@ static int setup(model *M, gk_err *err) {
             gk_packing_free(&pk);
             return 1;
         }
-        if (g == 0 && gk_rve_refresh(&M->rve[g])) return gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&M->rve[0])), 1;
+        if (g == 0 && gk_rve_refresh(&M->rve[g]))
+            return gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&M->rve[0])), 1;
         if (g > 0) { /* identical copies: clone the refreshed state of the first */
             if (gk_rve_state_restore(&M->st[0], &M->rve[g])) return gk_err_set(err, GK_ERR_STATE, "clone"), 1;
         } else {
             gk_rve_state_init(&M->st[0], NULL);
-            if (gk_rve_state_save(&M->st[0], &M->rve[0])) return gk_err_set(err, GK_ERR_ALLOC, "RVE state"), 1;
+            if (gk_rve_state_save(&M->st[0], &M->rve[0]))
+                return gk_err_set(err, GK_ERR_ALLOC, "RVE state"), 1;
         }
         if (g > 0) {
             gk_rve_state_init(&M->st[g], NULL);
-            if (gk_rve_state_save(&M->st[g], &M->rve[g])) return gk_err_set(err, GK_ERR_ALLOC, "RVE state"), 1;
+            if (gk_rve_state_save(&M->st[g], &M->rve[g]))
+                return gk_err_set(err, GK_ERR_ALLOC, "RVE state"), 1;
         }
         gk_rve_stress(&M->rve[g], M->sig_n + 9 * (size_t)g);
         if (M->tmode == 2) { /* first tangent: Taylor (no trial state yet) */
             if (gk_homog_tangent(&M->rve[g], 0u, M->D_n + 16 * (size_t)g)) return 1;
-        } else if (gk_homog_tangent(&M->rve[g], M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u, M->D_n + 16 * (size_t)g))
+        } else if (gk_homog_tangent(&M->rve[g], M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u,
+                                    M->D_n + 16 * (size_t)g))
             return gk_err_set(err, GK_ERR_STATE, "tangent"), 1;
     }
     gk_packing_free(&pk);
     M->scale = 1.0;
-    (void)e, (void)k;
     return 0;
 }
 
@@ -414,15 +411,20 @@ static int load_step(model *M, double inc, int *iters, double *Ed_out, double *E
         }
         Ef = residual(M, M->sig, err);
         Rn = norm(M->R, M->ndof);
-        if (M->o.verbose)
-            fprintf(stderr, "    iter %2d: E_d %.3e  E_f %.3e  max n_s %d  %.2f s\n", it, Ed, Ef,
-                    M->nsteps_gp[0] > 0 ? M->nsteps_gp[0] : 0, gk_wtime() - t0);
+        if (M->o.verbose) {
+            int g, nmax = 0;
+            for (g = 0; g < M->ngp; ++g)
+                if (M->nsteps_gp[g] > nmax) nmax = M->nsteps_gp[g];
+            fprintf(stderr, "    iter %2d: E_d %.3e  E_f %.3e  max n_s %d  %.2f s\n", it, Ed, Ef, nmax,
+                    gk_wtime() - t0);
+        }
         if (it > 1 && (Ed < M->o.tol || Ef < M->o.ftol)) {
             *iters = it, *Ed_out = Ed, *Ef_out = Ef;
             return 0;
         }
         if (it >= M->o.max_iter) break;
-        if (M->o.aitken != 2 && it > 2 && Rn > 1.25 * Rprev) { /* line search: the last correction overshot; take back half */
+        if (M->o.aitken != 2 && it > 2 &&
+            Rn > 1.25 * Rprev) { /* line search: the last correction overshot; take back half */
             for (k = 0; k < M->ndof; ++k) M->du[k] *= 0.5, M->u[k] -= M->du[k];
             Ed = norm(M->du, M->ndof) / (norm(M->u, M->ndof) + 1e-300);
             Rprev = HUGE_VAL; /* accept whatever the halved step gives */
@@ -570,13 +572,14 @@ static void gp_fields(const model *M, int g, double *f) {
 }
 
 #define NFIELD 10
-static const char *field_names[NFIELD] = {"eps_q",    "eps_v", "void_ratio", "rotation_deg",      "spin_deg",
-                                          "p",        "q",     "fabric_anisotropy", "coordination", "dem_steps"};
+static const char *field_names[NFIELD] = {"eps_q", "eps_v", "void_ratio",        "rotation_deg", "spin_deg",
+                                          "p",     "q",     "fabric_anisotropy", "coordination", "dem_steps"};
 
 static void write_vtk(const model *M, int step) {
     char path[1200];
     gk_vtk v;
-    double *xyz = (double *)malloc((size_t)(M->ngp > M->mesh.nnode ? M->ngp : M->mesh.nnode) * 3 * sizeof(double));
+    double *xyz =
+        (double *)malloc((size_t)(M->ngp > M->mesh.nnode ? M->ngp : M->mesh.nnode) * 3 * sizeof(double));
     double *val = (double *)malloc((size_t)M->ngp * sizeof(double)), *all;
     int *conn, g, k, a;
     all = (double *)malloc((size_t)M->ngp * NFIELD * sizeof(double));
@@ -627,8 +630,8 @@ static void write_csv(const model *M) {
     fprintf(fp, "step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds,E_d,E_f,increment,failed_gp\n");
     for (k = 0; k < M->ncurve; ++k) {
         const curve_row *c = &M->curve[k];
-        fprintf(fp, "%d,%.9g,%.9g,%.9g,%.9g,%d,%.4f,%.4g,%.4g,%.6g,%d\n", k, c->eps, c->syy, c->sxx, c->ev, c->iters,
-                c->secs, c->Ed, c->Ef, c->inc, c->failed);
+        fprintf(fp, "%d,%.9g,%.9g,%.9g,%.9g,%d,%.4f,%.4g,%.4g,%.6g,%d\n", k, c->eps, c->syy, c->sxx, c->ev,
+                c->iters, c->secs, c->Ed, c->Ef, c->inc, c->failed);
     }
     fclose(fp);
 }
@@ -637,19 +640,22 @@ static void write_plots(const model *M) {
     char path[1200];
     gk_plot pl;
     gk_err err;
-    double *x = (double *)malloc((size_t)M->ncurve * sizeof(double)), *y1 = (double *)malloc((size_t)M->ncurve * sizeof(double)),
+    double *x = (double *)malloc((size_t)M->ncurve * sizeof(double)),
+           *y1 = (double *)malloc((size_t)M->ncurve * sizeof(double)),
            *y2 = (double *)malloc((size_t)M->ncurve * sizeof(double));
     int k;
     if (!x || !y1 || !y2) goto out;
     for (k = 0; k < M->ncurve; ++k)
         x[k] = 100 * M->curve[k].eps, y1[k] = M->curve[k].syy / 1e3, y2[k] = M->curve[k].sxx / 1e3;
-    gk_plot_init(&pl, "FEMxDEM biaxial test (seed 000)", "axial strain [%]", "stress [kPa] (compression positive)");
+    gk_plot_init(&pl, "FEMxDEM biaxial test (seed 000)", "axial strain [%]",
+                 "stress [kPa] (compression positive)");
     gk_plot_add(&pl, x, y1, M->ncurve, "sigma_yy (top reaction / width)");
     gk_plot_add(&pl, x, y2, M->ncurve, "sigma_xx (side reaction / height)");
     snprintf(path, sizeof path, "%s/biaxial_stress.svg", M->o.out);
     gk_plot_svg(&pl, path, &err);
     for (k = 0; k < M->ncurve; ++k) y1[k] = 100 * M->curve[k].ev;
-    gk_plot_init(&pl, "FEMxDEM biaxial test: volume", "axial strain [%]", "volumetric strain [%] (contraction positive)");
+    gk_plot_init(&pl, "FEMxDEM biaxial test: volume", "axial strain [%]",
+                 "volumetric strain [%] (contraction positive)");
     gk_plot_add(&pl, x, y1, M->ncurve, NULL);
     snprintf(path, sizeof path, "%s/biaxial_volume.svg", M->o.out);
     gk_plot_svg(&pl, path, &err);
@@ -660,7 +666,8 @@ out:
 /* eps_q map: each Gauss point owns the sub-quad of its element around it */
 static void write_field_svg(const model *M) {
     int per = M->o.quad, e, i, j, c, g = 0;
-    double *xy = (double *)malloc((size_t)M->ngp * 8 * sizeof(double)), *val = (double *)malloc((size_t)M->ngp * sizeof(double));
+    double *xy = (double *)malloc((size_t)M->ngp * 8 * sizeof(double)),
+           *val = (double *)malloc((size_t)M->ngp * sizeof(double));
     char path[1200], title[200];
     gk_err err;
     if (!xy || !val) goto out;
@@ -671,7 +678,8 @@ static void write_field_svg(const model *M) {
                 double f[NFIELD];
                 for (c = 0; c < 4; ++c) {
                     double xi[3], x[3];
-                    xi[0] = -1 + 2.0 * (i + ci[c][0]) / per, xi[1] = -1 + 2.0 * (j + ci[c][1]) / per, xi[2] = 0;
+                    xi[0] = -1 + 2.0 * (i + ci[c][0]) / per, xi[1] = -1 + 2.0 * (j + ci[c][1]) / per,
+                    xi[2] = 0;
                     gk_mesh_point(&M->mesh, e, xi, x);
                     xy[8 * g + 2 * c] = x[0] * 1e3, xy[8 * g + 2 * c + 1] = x[1] * 1e3;
                 }
@@ -695,7 +703,8 @@ static int cmp_d(const void *a, const void *b) {
 }
 
 static void band(const model *M, double *angle, double *width) {
-    double *v = (double *)malloc((size_t)M->ngp * sizeof(double)), *s = (double *)malloc((size_t)M->ngp * sizeof(double));
+    double *v = (double *)malloc((size_t)M->ngp * sizeof(double)),
+           *s = (double *)malloc((size_t)M->ngp * sizeof(double));
     double med, mx, thr, sw = 0, cx = 0, cy = 0, sxx = 0, syy = 0, sxy = 0, th, nx, ny, var = 0, f[NFIELD];
     int g;
     *angle = *width = NAN;
@@ -716,7 +725,8 @@ static void band(const model *M, double *angle, double *width) {
         double x[3], w = v[g] - thr;
         if (w <= 0) continue;
         gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], x);
-        sxx += w * (x[0] - cx) * (x[0] - cx), syy += w * (x[1] - cy) * (x[1] - cy), sxy += w * (x[0] - cx) * (x[1] - cy);
+        sxx += w * (x[0] - cx) * (x[0] - cx), syy += w * (x[1] - cy) * (x[1] - cy),
+            sxy += w * (x[0] - cx) * (x[1] - cy);
     }
     th = 0.5 * atan2(2 * sxy, sxx - syy); /* major axis */
     nx = -sin(th), ny = cos(th);
@@ -791,8 +801,9 @@ static int read_checkpoint(model *M, const char *dir, gk_err *err) {
     ok &= fread(&el, sizeof el, 1, fp) == 1 && fread(&quad, sizeof(int), 1, fp) == 1;
     if (!ok || nx != M->o.nx || ny != M->o.ny || el != M->o.elem || quad != M->o.quad) {
         fclose(fp);
-        return gk_err_set(err, GK_ERR_FORMAT, "%s: not a checkpoint of this mesh (%dx%d, element, quad must match)", path,
-                          nx, ny),
+        return gk_err_set(err, GK_ERR_FORMAT,
+                          "%s: not a checkpoint of this mesh (%dx%d, element, quad must match)", path, nx,
+                          ny),
                1;
     }
     ok &= fread(&M->step, sizeof(int), 1, fp) == 1 && fread(&M->eps_done, sizeof(double), 1, fp) == 1;
@@ -827,9 +838,10 @@ static int read_checkpoint(model *M, const char *dir, gk_err *err) {
 /* ------------------------------------------------- single-element test */
 /* the same RVE alone under the same drained biaxial path: per increment the
  * axial strain is prescribed and the lateral strain h is found by Newton on
- * sigma_xx = -p (tangent D_xxxx of eq 9), each trial re-run from the
+ * sigma_xx = -p (the xx-xx component of the eq 9 tangent), each trial re-run from the
  * increment's start state - the single-Gauss-point version of the FEM loop. */
-static int single_rve_reference(const model *M, double *eps, double *syy, double *sxx, double *ev, int n, gk_err *err) {
+static int single_rve_reference(const model *M, double *eps, double *syy, double *sxx, double *ev, int n,
+                                gk_err *err) {
     gk_rve r;
     gk_rve_state st;
     gk_packing pk;
@@ -875,12 +887,14 @@ int main(int argc, char **argv) {
     opts *o = &M.o;
     gk_err err;
     int i, status = 0;
-    double t_start, t_prev_total = 0.0;
+    double t_start;
     memset(&M, 0, sizeof M);
     o->nx = 8, o->ny = 16, o->steps = 100, o->threads = 2, o->quad = 2, o->max_iter = 20, o->checkpoint = 10;
     o->vtk_every = 1, o->aitken = 1, o->dem_min = 2, o->dem_max = 20000, o->elem = GK_Q8;
-    o->out = "femdem_out", o->packing = "examples/data/rve400.txt", o->tangent = "taylor", o->test = "biaxial";
-    o->width = 0.05, o->height = 0.1, o->pressure = 1e5, o->inc = 1e-3, o->tol = 0.01, o->ftol = 3e-3, o->dt = SEED_DT;
+    o->out = "femdem_out", o->packing = "examples/data/rve400.txt", o->tangent = "taylor",
+    o->test = "biaxial";
+    o->width = 0.05, o->height = 0.1, o->pressure = 1e5, o->inc = 1e-3, o->tol = 0.01, o->ftol = 3e-3,
+    o->dt = SEED_DT;
     o->dem_strain = 1e-5, o->xi = 5e-5;
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -896,61 +910,91 @@ int main(int argc, char **argv) {
             fprintf(stderr, "femdem_biaxial: %s needs a value (see --help)\n", a);
             return 2;
         }
-        if (!strcmp(a, "--nx")) o->nx = atoi(v);
-        else if (!strcmp(a, "--ny")) o->ny = atoi(v);
+        if (!strcmp(a, "--nx"))
+            o->nx = atoi(v);
+        else if (!strcmp(a, "--ny"))
+            o->ny = atoi(v);
         else if (!strcmp(a, "--element")) {
-            if (!strcmp(v, "q8")) o->elem = GK_Q8;
-            else if (!strcmp(v, "q4")) o->elem = GK_Q4;
+            if (!strcmp(v, "q8"))
+                o->elem = GK_Q8;
+            else if (!strcmp(v, "q4"))
+                o->elem = GK_Q4;
             else {
                 fprintf(stderr, "femdem_biaxial: --element must be q4 or q8\n");
                 return 2;
             }
-        } else if (!strcmp(a, "--quad")) o->quad = atoi(v);
-        else if (!strcmp(a, "--steps")) o->steps = atoi(v);
-        else if (!strcmp(a, "--increment")) o->inc = atof(v);
-        else if (!strcmp(a, "--threads")) o->threads = atoi(v);
-        else if (!strcmp(a, "--out")) o->out = v;
-        else if (!strcmp(a, "--tangent")) o->tangent = v;
-        else if (!strcmp(a, "--xi")) o->xi = atof(v);
-        else if (!strcmp(a, "--restart")) o->restart = v;
-        else if (!strcmp(a, "--checkpoint")) o->checkpoint = atoi(v);
-        else if (!strcmp(a, "--test")) o->test = v;
-        else if (!strcmp(a, "--packing")) o->packing = v;
-        else if (!strcmp(a, "--width")) o->width = atof(v);
-        else if (!strcmp(a, "--height")) o->height = atof(v);
-        else if (!strcmp(a, "--pressure")) o->pressure = atof(v);
-        else if (!strcmp(a, "--tol")) o->tol = atof(v);
-        else if (!strcmp(a, "--ftol")) o->ftol = atof(v);
-        else if (!strcmp(a, "--max-iter")) o->max_iter = atoi(v);
-        else if (!strcmp(a, "--dt")) o->dt = atof(v);
-        else if (!strcmp(a, "--dem-strain")) o->dem_strain = atof(v);
-        else if (!strcmp(a, "--dem-min")) o->dem_min = atoi(v);
-        else if (!strcmp(a, "--dem-max")) o->dem_max = atoi(v);
-        else if (!strcmp(a, "--vtk-every")) o->vtk_every = atoi(v);
+        } else if (!strcmp(a, "--quad"))
+            o->quad = atoi(v);
+        else if (!strcmp(a, "--steps"))
+            o->steps = atoi(v);
+        else if (!strcmp(a, "--increment"))
+            o->inc = atof(v);
+        else if (!strcmp(a, "--threads"))
+            o->threads = atoi(v);
+        else if (!strcmp(a, "--out"))
+            o->out = v;
+        else if (!strcmp(a, "--tangent"))
+            o->tangent = v;
+        else if (!strcmp(a, "--xi"))
+            o->xi = atof(v);
+        else if (!strcmp(a, "--restart"))
+            o->restart = v;
+        else if (!strcmp(a, "--checkpoint"))
+            o->checkpoint = atoi(v);
+        else if (!strcmp(a, "--test"))
+            o->test = v;
+        else if (!strcmp(a, "--packing"))
+            o->packing = v;
+        else if (!strcmp(a, "--width"))
+            o->width = atof(v);
+        else if (!strcmp(a, "--height"))
+            o->height = atof(v);
+        else if (!strcmp(a, "--pressure"))
+            o->pressure = atof(v);
+        else if (!strcmp(a, "--tol"))
+            o->tol = atof(v);
+        else if (!strcmp(a, "--ftol"))
+            o->ftol = atof(v);
+        else if (!strcmp(a, "--max-iter"))
+            o->max_iter = atoi(v);
+        else if (!strcmp(a, "--dt"))
+            o->dt = atof(v);
+        else if (!strcmp(a, "--dem-strain"))
+            o->dem_strain = atof(v);
+        else if (!strcmp(a, "--dem-min"))
+            o->dem_min = atoi(v);
+        else if (!strcmp(a, "--dem-max"))
+            o->dem_max = atoi(v);
+        else if (!strcmp(a, "--vtk-every"))
+            o->vtk_every = atoi(v);
         else if (!strcmp(a, "--relaxation")) {
-            if (!strcmp(v, "aitken")) o->aitken = 1;
-            else if (!strcmp(v, "anderson")) o->aitken = 2;
-            else if (!strcmp(v, "none")) o->aitken = 0;
+            if (!strcmp(v, "aitken"))
+                o->aitken = 1;
+            else if (!strcmp(v, "anderson"))
+                o->aitken = 2;
+            else if (!strcmp(v, "none"))
+                o->aitken = 0;
             else {
                 fprintf(stderr, "femdem_biaxial: --relaxation must be aitken or none\n");
                 return 2;
             }
-        }
-        else {
+        } else {
             fprintf(stderr, "femdem_biaxial: unknown option %s (see --help)\n", a);
             return 2;
         }
         ++i;
     }
-    if (!strcmp(o->test, "single")) o->nx = 1, o->ny = 1, o->elem = GK_Q4, o->quad = 2;
+    if (!strcmp(o->test, "single"))
+        o->nx = 1, o->ny = 1, o->elem = GK_Q4, o->quad = 2;
     else if (strcmp(o->test, "biaxial")) {
         fprintf(stderr, "femdem_biaxial: --test must be biaxial or single\n");
         return 2;
     }
-    if (o->nx < 1 || o->ny < 1 || o->nx > 1000 || o->ny > 1000 || o->steps < 1 || o->threads < 1 || o->quad < 1 ||
-        o->quad > 3 || o->max_iter < 2 || !(o->inc > 0 && o->inc < 0.1) || !(o->tol > 0) || !(o->ftol >= 0) || !(o->width > 0) ||
-        !(o->height > 0) || !(o->pressure >= 0) || !(o->dt > 0) || !(o->dem_strain > 0) || o->dem_min < 1 ||
-        o->dem_max < o->dem_min || !(o->xi > 0) || o->checkpoint < 0 || o->vtk_every < 0) {
+    if (o->nx < 1 || o->ny < 1 || o->nx > 1000 || o->ny > 1000 || o->steps < 1 || o->threads < 1 ||
+        o->quad < 1 || o->quad > 3 || o->max_iter < 2 || !(o->inc > 0 && o->inc < 0.1) || !(o->tol > 0) ||
+        !(o->ftol >= 0) || !(o->width > 0) || !(o->height > 0) || !(o->pressure >= 0) || !(o->dt > 0) ||
+        !(o->dem_strain > 0) || o->dem_min < 1 || o->dem_max < o->dem_min || !(o->xi > 0) ||
+        o->checkpoint < 0 || o->vtk_every < 0) {
         fprintf(stderr, "femdem_biaxial: an option is out of range (see --help)\n");
         return 2;
     }
@@ -974,8 +1018,8 @@ int main(int argc, char **argv) {
             fprintf(stderr, "femdem_biaxial: %s\n", err.msg);
             return 1;
         }
-        for (i = 0; i < M.ncurve; ++i) t_prev_total += M.curve[i].secs;
-        fprintf(stderr, "femdem_biaxial: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n",
+        fprintf(stderr,
+                "femdem_biaxial: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n",
                 o->restart, M.step, 100 * M.eps_done);
     } else {
         double syy, sxx, ev;
@@ -985,8 +1029,9 @@ int main(int argc, char **argv) {
         M.curve[0].syy = syy, M.curve[0].sxx = sxx, M.curve[0].inc = 0;
         M.ncurve = 1;
     }
-    printf("femdem_biaxial: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n", o->test,
-           o->nx, o->ny, o->elem == GK_Q8 ? "Q8" : "Q4", M.ngp, M.rve[0].n, o->tangent, o->threads);
+    printf(
+        "femdem_biaxial: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n",
+        o->test, o->nx, o->ny, o->elem == GK_Q8 ? "Q8" : "Q4", M.ngp, M.rve[0].n, o->tangent, o->threads);
     fflush(stdout);
     t_start = gk_wtime();
     {
@@ -1006,12 +1051,15 @@ int main(int argc, char **argv) {
             if (r == 1) {
                 M.scale *= 0.5;
                 good_in_row = 0;
-                fprintf(stderr, "femdem_biaxial: step at %.3f %% did not converge in %d iterations (E_d %.3g)%s%s; "
-                                "increment cut to %.4g %%\n",
+                fprintf(stderr,
+                        "femdem_biaxial: step at %.3f %% did not converge in %d iterations (E_d %.3g)%s%s; "
+                        "increment cut to %.4g %%\n",
                         100 * M.eps_done, iters, Ed, err.msg[0] ? ": " : "", err.msg, 100 * o->inc * M.scale);
                 err.msg[0] = 0;
                 if (M.scale < 1.0 / 16) {
-                    fprintf(stderr, "femdem_biaxial: giving up at axial strain %.3f %%; last converged state in %s/checkpoint.bin\n",
+                    fprintf(stderr,
+                            "femdem_biaxial: giving up at axial strain %.3f %%; last converged state in "
+                            "%s/checkpoint.bin\n",
                             100 * M.eps_done, o->out);
                     write_checkpoint(&M, o->out);
                     status = 3;
@@ -1039,7 +1087,8 @@ int main(int argc, char **argv) {
             write_csv(&M);
             if (o->vtk_every && M.step % o->vtk_every == 0) write_vtk(&M, M.step);
             if (o->checkpoint && M.step % o->checkpoint == 0) write_checkpoint(&M, o->out);
-            snprintf(what, sizeof what, "eps %.2f %%  sigma_yy %.1f kPa  sigma_xx %.1f kPa  eps_v %.3f %%  %d iter  %.2f s",
+            snprintf(what, sizeof what,
+                     "eps %.2f %%  sigma_yy %.1f kPa  sigma_xx %.1f kPa  eps_v %.3f %%  %d iter  %.2f s",
                      100 * M.eps_done, syy / 1e3, sxx / 1e3, 100 * ev, iters, gk_wtime() - t0);
             gk_progress(stderr, (long)floor(M.eps_done / o->inc + 0.5), o->steps, t_start - 0.0, what);
         }
@@ -1050,9 +1099,12 @@ int main(int argc, char **argv) {
     if (status != 3) write_checkpoint(&M, o->out);
     if (!strcmp(o->test, "single") && M.ncurve > 1) {
         int n = M.ncurve, k, kpk = 0;
-        double *e = (double *)malloc((size_t)n * sizeof(double)), *s = (double *)malloc((size_t)n * sizeof(double)),
-               *v = (double *)malloc((size_t)n * sizeof(double)), *x = (double *)malloc((size_t)n * sizeof(double)),
-               *y = (double *)malloc((size_t)n * sizeof(double)), maxdiff = 0, *yr = (double *)malloc((size_t)n * sizeof(double)),
+        double *e = (double *)malloc((size_t)n * sizeof(double)),
+               *s = (double *)malloc((size_t)n * sizeof(double)),
+               *v = (double *)malloc((size_t)n * sizeof(double)),
+               *x = (double *)malloc((size_t)n * sizeof(double)),
+               *y = (double *)malloc((size_t)n * sizeof(double)), maxdiff = 0,
+               *yr = (double *)malloc((size_t)n * sizeof(double)),
                *sx = (double *)malloc((size_t)n * sizeof(double));
         char path[1200];
         FILE *fp;
@@ -1062,10 +1114,12 @@ int main(int argc, char **argv) {
             snprintf(path, sizeof path, "%s/single_element.csv", o->out);
             fp = fopen(path, "w");
             if (fp) {
-                fprintf(fp, "eps_axial,sigma_yy_fem,sigma_yy_rve,sigma_xx_fem,sigma_xx_rve,eps_v_fem,eps_v_rve\n");
+                fprintf(
+                    fp,
+                    "eps_axial,sigma_yy_fem,sigma_yy_rve,sigma_xx_fem,sigma_xx_rve,eps_v_fem,eps_v_rve\n");
                 for (k = 0; k < n; ++k)
-                    fprintf(fp, "%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", M.curve[k].eps, M.curve[k].syy, s[k], M.curve[k].sxx,
-                            sx[k], M.curve[k].ev, v[k]);
+                    fprintf(fp, "%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", M.curve[k].eps, M.curve[k].syy, s[k],
+                            M.curve[k].sxx, sx[k], M.curve[k].ev, v[k]);
                 fclose(fp);
             }
             for (k = 0; k <= kpk; ++k) { /* stress ratio: removes the 0.1 % lateral-stress tolerance */
@@ -1082,9 +1136,11 @@ int main(int argc, char **argv) {
                 snprintf(path, sizeof path, "%s/single_element.svg", o->out);
                 gk_plot_svg(&pl, path, &err);
             }
-            printf("single element vs RVE alone: max relative difference of sigma_yy/sigma_xx up to the peak (%.2f %%) = %.4f\n",
+            printf("single element vs RVE alone: max relative difference of sigma_yy/sigma_xx up to the peak "
+                   "(%.2f %%) = %.4f\n",
                    100 * M.curve[kpk].eps, maxdiff);
-            printf("SINGLE max_rel_diff_to_peak=%.5f peak_fem=%.6g peak_rve=%.6g\n", maxdiff, M.curve[kpk].syy, s[kpk]);
+            printf("SINGLE max_rel_diff_to_peak=%.5f peak_fem=%.6g peak_rve=%.6g\n", maxdiff,
+                   M.curve[kpk].syy, s[kpk]);
         }
         free(e), free(s), free(v), free(x), free(y), free(yr), free(sx);
     }
@@ -1105,9 +1161,11 @@ int main(int argc, char **argv) {
             printf("shear band: angle %.1f deg from the horizontal, width %.1f mm\n", ang, 1e3 * wid);
         else
             printf("shear band: none (max eps_q < 1.5 x median)\n");
-        printf("RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g band_angle_deg=%.3g band_width_mm=%.3g max_iterations=%d "
+        printf("RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g band_angle_deg=%.3g band_width_mm=%.3g "
+               "max_iterations=%d "
                "steps=%d seconds_per_step=%.3f total_seconds=%.2f\n",
-               peak, epk, ang, 1e3 * wid, itmax, M.ncurve - 1, M.ncurve > 1 ? tot / (M.ncurve - 1) : 0.0, tot);
+               peak, epk, ang, 1e3 * wid, itmax, M.ncurve - 1, M.ncurve > 1 ? tot / (M.ncurve - 1) : 0.0,
+               tot);
     }
     for (i = 0; i < M.ngp; ++i) {
         gk_rve_destroy(&M.rve[i]);

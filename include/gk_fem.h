@@ -76,9 +76,9 @@ typedef struct gk_mesh {
     gk_elem_type type; /* element type (one per mesh)                   */
     int npe;           /* nodes per element                             */
     int nnode, nelem;
-    double *x;    /* nnode x dim node coordinates                         */
-    int *conn;    /* nelem x npe node ids (0-based)                       */
-    int *tag;     /* nelem physical tags (Gmsh) or 0                      */
+    double *x; /* nnode x dim node coordinates                         */
+    int *conn; /* nelem x npe node ids (0-based)                       */
+    int *tag;  /* nelem physical tags (Gmsh) or 0                      */
     gk_allocator alloc;
 } gk_mesh;
 
@@ -113,19 +113,20 @@ GKDEF int gk_fem_npe(gk_elem_type t);
 GKDEF int gk_fem_dim(gk_elem_type t);
 GKDEF gk_result gk_quad_rule(gk_quad *q, gk_elem_type t, int per_dir, gk_err *err);
 GKDEF void gk_fem_shape(gk_elem_type t, const double *xi, double *N, double *dN);
-GKDEF gk_result gk_fem_jacobian(const gk_mesh *m, int e, const double *xi, double *N, double *dNdx, double *detJ,
-                                gk_err *err);
+GKDEF gk_result gk_fem_jacobian(const gk_mesh *m, int e, const double *xi, double *N, double *dNdx,
+                                double *detJ, gk_err *err);
 GKDEF void gk_fem_grad(const gk_mesh *m, int e, const double *dNdx, const double *u, double H[9]);
 GKDEF gk_result gk_fem_elem_stiffness(const gk_mesh *m, int e, const gk_quad *q, const double *D, double *Ke,
                                       gk_err *err);
 GKDEF gk_result gk_fem_elem_force(const gk_mesh *m, int e, const gk_quad *q, const double *sigma, double *fe,
                                   gk_err *err);
-GKDEF gk_result gk_fem_assemble(const gk_mesh *m, const gk_quad *q, const double *D, const double *sigma, gk_csr *K,
-                                double *fint, gk_err *err);
+GKDEF gk_result gk_fem_assemble(const gk_mesh *m, const gk_quad *q, const double *D, const double *sigma,
+                                gk_csr *K, double *fint, gk_err *err);
 GKDEF void gk_fem_elastic_tangent(int dim, double E, double nu, double *D);
-GKDEF gk_result gk_fem_lumped_mass(const gk_mesh *m, const gk_quad *q, double density, double *mass, gk_err *err);
-GKDEF gk_result gk_fem_face_load(const gk_mesh *m, int nfn, const int *face, const double traction[3], double *f,
-                                 gk_err *err);
+GKDEF gk_result gk_fem_lumped_mass(const gk_mesh *m, const gk_quad *q, double density, double *mass,
+                                   gk_err *err);
+GKDEF gk_result gk_fem_face_load(const gk_mesh *m, int nfn, const int *face, const double traction[3],
+                                 double *f, gk_err *err);
 GKDEF void gk_fem_hex8_hourglass(const double *xe, const double *ue, double k, double *f);
 
 GKDEF gk_result gk_mesh_structured(gk_mesh *m, gk_elem_type t, const int n[3], const double origin[3],
@@ -143,7 +144,8 @@ GKDEF void gk_csr_free(gk_csr *A);
 GKDEF void gk_csr_zero(gk_csr *A);
 GKDEF double *gk_csr_at(gk_csr *A, int i, int j); /* NULL outside the pattern */
 GKDEF void gk_csr_matvec(const gk_csr *A, const double *x, double *y);
-GKDEF gk_result gk_fem_dirichlet(gk_csr *A, double *rhs, int nfix, const int *dofs, const double *vals, gk_err *err);
+GKDEF gk_result gk_fem_dirichlet(gk_csr *A, double *rhs, int nfix, const int *dofs, const double *vals,
+                                 gk_err *err);
 
 GKDEF gk_result gk_solver_factor(gk_solver *s, const gk_csr *A, const gk_allocator *alloc, gk_err *err);
 GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x);
@@ -176,7 +178,8 @@ GKDEF gk_result gk_quad_rule(gk_quad *q, gk_elem_type t, int per_dir, gk_err *er
     static const double w3[3] = {0.55555555555555555556, 0.88888888888888888889, 0.55555555555555555556};
     const double *g, *w;
     int dim, i, j, k, n = 0;
-    if (t != GK_Q4 && t != GK_Q8 && t != GK_HEX8) return gk_err_set(err, GK_ERR_ARG, "unknown element type %d", (int)t);
+    if (t != GK_Q4 && t != GK_Q8 && t != GK_HEX8)
+        return gk_err_set(err, GK_ERR_ARG, "unknown element type %d", (int)t);
     if (per_dir < 1 || per_dir > 3)
         return gk_err_set(err, GK_ERR_ARG, "Gauss rule with %d points per direction (1, 2 or 3)", per_dir);
     g = per_dir == 1 ? g1 : per_dir == 2 ? g2 : g3;
@@ -239,8 +242,8 @@ GKDEF void gk_fem_shape(gk_elem_type t, const double *xi, double *N, double *dN)
     }
 }
 
-GKDEF gk_result gk_fem_jacobian(const gk_mesh *m, int e, const double *xi, double *N, double *dNdx, double *detJ,
-                                gk_err *err) {
+GKDEF gk_result gk_fem_jacobian(const gk_mesh *m, int e, const double *xi, double *N, double *dNdx,
+                                double *detJ, gk_err *err) {
     double Nl[GK_FEM_MAX_NPE], dN[3 * GK_FEM_MAX_NPE], J[9], Ji[9], det;
     int a, i, j, dim = m->dim, npe = m->npe;
     const int *c = m->conn + (size_t)e * npe;
@@ -254,8 +257,8 @@ GKDEF gk_result gk_fem_jacobian(const gk_mesh *m, int e, const double *xi, doubl
         }
     det = gk_m3_det(J);
     if (!(det > 0.0) || !(det < HUGE_VAL))
-        return gk_err_set(err, GK_ERR_MESH, "element %d has det J = %g at (%g, %g%s): inverted or degenerate", e, det,
-                          xi[0], xi[1], dim == 3 ? ", ..." : "");
+        return gk_err_set(err, GK_ERR_MESH, "element %d has det J = %g at (%g, %g%s): inverted or degenerate",
+                          e, det, xi[0], xi[1], dim == 3 ? ", ..." : "");
     gk_m3_inverse(J, Ji);
     if (N)
         for (a = 0; a < npe; ++a) N[a] = Nl[a];
@@ -294,7 +297,8 @@ GKDEF gk_result gk_fem_elem_stiffness(const gk_mesh *m, int e, const gk_quad *q,
                 for (b = 0; b < npe; ++b)
                     for (k = 0; k < dim; ++k) {
                         double s = 0.0;
-                        for (l = 0; l < dim; ++l) s += Dg[((i * dim + j) * dim + k) * dim + l] * dNdx[dim * b + l];
+                        for (l = 0; l < dim; ++l)
+                            s += Dg[((i * dim + j) * dim + k) * dim + l] * dNdx[dim * b + l];
                         DB[(i * dim + j) * nd + dim * b + k] = s;
                     }
         for (a = 0; a < npe; ++a)
@@ -329,8 +333,8 @@ GKDEF gk_result gk_fem_elem_force(const gk_mesh *m, int e, const gk_quad *q, con
     return GK_OK;
 }
 
-GKDEF gk_result gk_fem_assemble(const gk_mesh *m, const gk_quad *q, const double *D, const double *sigma, gk_csr *K,
-                                double *fint, gk_err *err) {
+GKDEF gk_result gk_fem_assemble(const gk_mesh *m, const gk_quad *q, const double *D, const double *sigma,
+                                gk_csr *K, double *fint, gk_err *err) {
     int dim = m->dim, npe = m->npe, nd = dim * npe, n4 = dim * dim * dim * dim, e, a, b, i, k;
     double Ke[24 * 24], fe[24];
     if (K) {
@@ -360,19 +364,10 @@ GKDEF gk_result gk_fem_assemble(const gk_mesh *m, const gk_quad *q, const double
             if (r) return r;
             for (a = 0; a < npe; ++a)
                 for (i = 0; i < dim; ++i) {
-                    int row = dim * c[a] + i, p0 = K->rowptr[row], p1 = K->rowptr[row + 1];
-                    for (b = 0; b < npe; ++b)
-                        for (k = 0; k < dim; ++k) { /* binary search of the column in the sorted row */
-                            int col = dim * c[b] + k, lo = p0, hi = p1 - 1;
-                            while (lo < hi) {
-                                int mid = (lo + hi) >> 1;
-                                if (K->col[mid] < col)
-                                    lo = mid + 1;
-                                else
-                                    hi = mid;
-                            }
-                            K->val[lo] += Ke[(dim * a + i) * nd + dim * b + k];
-                        }
+                    int row = dim * c[a] + i;
+                    for (b = 0; b < npe; ++b) /* the pattern came from this mesh: every entry exists */
+                        for (k = 0; k < dim; ++k)
+                            *gk_csr_at(K, row, dim * c[b] + k) += Ke[(dim * a + i) * nd + dim * b + k];
                 }
         }
         if (fint) {
@@ -392,11 +387,12 @@ GKDEF void gk_fem_elastic_tangent(int dim, double E, double nu, double *D) {
         for (j = 0; j < dim; ++j)
             for (k = 0; k < dim; ++k)
                 for (l = 0; l < dim; ++l)
-                    D[((i * dim + j) * dim + k) * dim + l] = lam * (i == j && k == l) +
-                                                             mu * ((i == k && j == l) + (i == l && j == k));
+                    D[((i * dim + j) * dim + k) * dim + l] =
+                        lam * (i == j && k == l) + mu * ((i == k && j == l) + (i == l && j == k));
 }
 
-GKDEF gk_result gk_fem_lumped_mass(const gk_mesh *m, const gk_quad *q, double density, double *mass, gk_err *err) {
+GKDEF gk_result gk_fem_lumped_mass(const gk_mesh *m, const gk_quad *q, double density, double *mass,
+                                   gk_err *err) {
     int e, g, a, npe = m->npe;
     double N[GK_FEM_MAX_NPE], dNdx[3 * GK_FEM_MAX_NPE], detJ;
     if (!(density > 0.0) || !(density < HUGE_VAL)) return gk_err_set(err, GK_ERR_MASS, "density %g", density);
@@ -416,13 +412,14 @@ GKDEF gk_result gk_fem_lumped_mass(const gk_mesh *m, const gk_quad *q, double de
     return GK_OK;
 }
 
-GKDEF gk_result gk_fem_face_load(const gk_mesh *m, int nfn, const int *face, const double traction[3], double *f,
-                                 gk_err *err) {
+GKDEF gk_result gk_fem_face_load(const gk_mesh *m, int nfn, const int *face, const double traction[3],
+                                 double *f, gk_err *err) {
     static const double g3[3] = {-0.77459666924148337704, 0.0, 0.77459666924148337704};
     static const double w3[3] = {0.55555555555555555556, 0.88888888888888888889, 0.55555555555555555556};
     int dim = m->dim, a, i, gi, gj;
     for (a = 0; a < nfn; ++a)
-        if (face[a] < 0 || face[a] >= m->nnode) return gk_err_set(err, GK_ERR_ARG, "face node %d out of range", face[a]);
+        if (face[a] < 0 || face[a] >= m->nnode)
+            return gk_err_set(err, GK_ERR_ARG, "face node %d out of range", face[a]);
     for (i = 0; i < dim; ++i)
         if (!(fabs(traction[i]) < HUGE_VAL)) return gk_err_set(err, GK_ERR_NAN, "traction is not finite");
     if (dim == 2 && (nfn == 2 || nfn == 3)) {
@@ -480,7 +477,8 @@ GKDEF void gk_fem_hex8_hourglass(const double *xe, const double *ue, double k, d
         }
     gk_m3_inverse(J, Ji);
     for (a = 0; a < 8; ++a)
-        for (j = 0; j < 3; ++j) b[3 * a + j] = dN[3 * a] * Ji[j] + dN[3 * a + 1] * Ji[3 + j] + dN[3 * a + 2] * Ji[6 + j];
+        for (j = 0; j < 3; ++j)
+            b[3 * a + j] = dN[3 * a] * Ji[j] + dN[3 * a + 1] * Ji[3 + j] + dN[3 * a + 2] * Ji[6 + j];
     for (a = 0; a < 8; ++a) {
         const double *r = gk__h8_xi[a];
         h[0][a] = r[1] * r[2], h[1][a] = r[0] * r[2], h[2][a] = r[0] * r[1], h[3][a] = r[0] * r[1] * r[2];
@@ -489,7 +487,8 @@ GKDEF void gk_fem_hex8_hourglass(const double *xe, const double *ue, double k, d
         double hx[3] = {0, 0, 0};
         for (a = 0; a < 8; ++a)
             for (i = 0; i < 3; ++i) hx[i] += h[al][a] * xe[3 * a + i];
-        for (a = 0; a < 8; ++a) g[al][a] = h[al][a] - (hx[0] * b[3 * a] + hx[1] * b[3 * a + 1] + hx[2] * b[3 * a + 2]);
+        for (a = 0; a < 8; ++a)
+            g[al][a] = h[al][a] - (hx[0] * b[3 * a] + hx[1] * b[3 * a + 1] + hx[2] * b[3 * a + 2]);
     }
     for (a = 0; a < 24; ++a) f[a] = 0.0;
     for (al = 0; al < 4; ++al)
@@ -531,12 +530,15 @@ GKDEF gk_result gk_mesh_structured(gk_mesh *m, gk_elem_type t, const int n[3], c
     int dim, i, j, k, e = 0, nx, ny, nz;
     gk_mesh z;
     gk_result r;
-    if (t != GK_Q4 && t != GK_Q8 && t != GK_HEX8) return gk_err_set(err, GK_ERR_ARG, "unknown element type %d", (int)t);
+    if (t != GK_Q4 && t != GK_Q8 && t != GK_HEX8)
+        return gk_err_set(err, GK_ERR_ARG, "unknown element type %d", (int)t);
     dim = gk_fem_dim(t);
     for (k = 0; k < dim; ++k) {
-        if (n[k] < 1 || n[k] > 100000) return gk_err_set(err, GK_ERR_ARG, "%d elements along axis %d", n[k], k);
+        if (n[k] < 1 || n[k] > 100000)
+            return gk_err_set(err, GK_ERR_ARG, "%d elements along axis %d", n[k], k);
         if (!(len[k] > 0.0) || !(len[k] < HUGE_VAL) || !(fabs(origin[k]) < HUGE_VAL))
-            return gk_err_set(err, GK_ERR_ARG, "box length %g / origin %g along axis %d", len[k], origin[k], k);
+            return gk_err_set(err, GK_ERR_ARG, "box length %g / origin %g along axis %d", len[k], origin[k],
+                              k);
     }
     nx = n[0], ny = n[1], nz = dim == 3 ? n[2] : 1;
     if (t == GK_Q4 || t == GK_HEX8) {
@@ -582,7 +584,8 @@ GKDEF gk_result gk_mesh_structured(gk_mesh *m, gk_elem_type t, const int n[3], c
         for (j = 0; j < ny; ++j)
             for (i = 0; i < nx; ++i, ++e) {
                 int *c = z.conn + (size_t)e * 8, I = 2 * i, J = 2 * j;
-                c[0] = id[J * W + I], c[1] = id[J * W + I + 2], c[2] = id[(J + 2) * W + I + 2], c[3] = id[(J + 2) * W + I];
+                c[0] = id[J * W + I], c[1] = id[J * W + I + 2], c[2] = id[(J + 2) * W + I + 2],
+                c[3] = id[(J + 2) * W + I];
                 c[4] = id[J * W + I + 1], c[5] = id[(J + 1) * W + I + 2], c[6] = id[(J + 2) * W + I + 1];
                 c[7] = id[(J + 1) * W + I];
             }
@@ -596,11 +599,13 @@ GKDEF gk_result gk_mesh_check(const gk_mesh *m, const gk_quad *q, gk_err *err) {
     int e, g, a;
     double dNdx[3 * GK_FEM_MAX_NPE], detJ = 0.0, dmax = 0.0;
     for (a = 0; a < m->nnode * m->dim; ++a)
-        if (!(fabs(m->x[a]) < HUGE_VAL)) return gk_err_set(err, GK_ERR_NAN, "node %d has a non-finite coordinate", a / m->dim);
+        if (!(fabs(m->x[a]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_NAN, "node %d has a non-finite coordinate", a / m->dim);
     for (e = 0; e < m->nelem; ++e) {
         for (a = 0; a < m->npe; ++a) {
             int b, id = m->conn[(size_t)e * m->npe + a];
-            if (id < 0 || id >= m->nnode) return gk_err_set(err, GK_ERR_MESH, "element %d: node id %d out of range", e, id);
+            if (id < 0 || id >= m->nnode)
+                return gk_err_set(err, GK_ERR_MESH, "element %d: node id %d out of range", e, id);
             for (b = 0; b < a; ++b)
                 if (m->conn[(size_t)e * m->npe + b] == id)
                     return gk_err_set(err, GK_ERR_MESH, "element %d uses node %d twice (degenerate)", e, id);
@@ -616,8 +621,9 @@ GKDEF gk_result gk_mesh_check(const gk_mesh *m, const gk_quad *q, gk_err *err) {
             double xi[3];
             xi[0] = gk__h8_xi[a][0], xi[1] = gk__h8_xi[a][1], xi[2] = gk__h8_xi[a][2];
             if (gk_fem_jacobian(m, e, xi, NULL, dNdx, &detJ, NULL) || !(detJ > 1e-8 * dmax))
-                return gk_err_set(err, GK_ERR_MESH, "element %d is degenerate or inverted at its corner %d (det J %g)", e,
-                                  a, detJ);
+                return gk_err_set(err, GK_ERR_MESH,
+                                  "element %d is degenerate or inverted at its corner %d (det J %g)", e, a,
+                                  detJ);
         }
     }
     return GK_OK;
@@ -634,7 +640,8 @@ GKDEF void gk_mesh_point(const gk_mesh *m, int e, const double *xi, double x[3])
     gk_fem_shape(m->type, xi, N, dN);
     x[0] = x[1] = x[2] = 0.0;
     for (a = 0; a < m->npe; ++a)
-        for (i = 0; i < m->dim; ++i) x[i] += N[a] * m->x[(size_t)m->conn[(size_t)e * m->npe + a] * m->dim + i];
+        for (i = 0; i < m->dim; ++i)
+            x[i] += N[a] * m->x[(size_t)m->conn[(size_t)e * m->npe + a] * m->dim + i];
 }
 
 GKDEF int gk_mesh_nodes_on_plane(const gk_mesh *m, int axis, double value, double tol, int *out) {
@@ -649,9 +656,11 @@ GKDEF int gk_mesh_nodes_on_plane(const gk_mesh *m, int axis, double value, doubl
 
 /* local faces: Q4 edges (2 nodes), Q8 edges (end, end, mid), Hex8 quads */
 static const int gk__q4_edges[4][3] = {{0, 1, 4}, {1, 2, 5}, {2, 3, 6}, {3, 0, 7}};
-static const int gk__h8_faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+static const int gk__h8_faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                       {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
 
-GKDEF int gk_mesh_faces_on_plane(const gk_mesh *m, int axis, double value, double tol, int *faces, int *nfn_out) {
+GKDEF int gk_mesh_faces_on_plane(const gk_mesh *m, int axis, double value, double tol, int *faces,
+                                 int *nfn_out) {
     int e, f, a, n = 0, nf = m->type == GK_HEX8 ? 6 : 4;
     int nfn = m->type == GK_HEX8 ? 4 : m->type == GK_Q8 ? 3 : 2;
     if (nfn_out) *nfn_out = nfn;
@@ -728,15 +737,17 @@ GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_alloc
     }
     fclose(fp);
     text[len] = 0;
-#define GK__GFAIL(code, ...)                                                                                          \
-    do {                                                                                                              \
-        res = gk_err_set(err, code, __VA_ARGS__);                                                                     \
-        goto done;                                                                                                    \
+#define GK__GFAIL(code, ...)                      \
+    do {                                          \
+        res = gk_err_set(err, code, __VA_ARGS__); \
+        goto done;                                \
     } while (0)
     r.p = text, r.end = text + len;
-    if (!gk__rd_find(&r, "$MeshFormat") || !gk__rd_line(&r, line, sizeof line) || sscanf(line, "%lf", &version) != 1)
+    if (!gk__rd_find(&r, "$MeshFormat") || !gk__rd_line(&r, line, sizeof line) ||
+        sscanf(line, "%lf", &version) != 1)
         GK__GFAIL(GK_ERR_FORMAT, "%s: no $MeshFormat section", path);
-    if (strstr(line, " 1 ")) GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: binary Gmsh files are not supported (ASCII only)", path);
+    if (strstr(line, " 1 "))
+        GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: binary Gmsh files are not supported (ASCII only)", path);
     if (!(version >= 2.0 && version < 3.0) && !(version >= 4.0 && version < 5.0))
         GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: Gmsh format %g (2.x and 4.x ASCII are read)", path, version);
     /* ---- nodes: tags and coordinates */
@@ -744,7 +755,8 @@ GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_alloc
     if (!gk__rd_find(&r, "$Nodes") || !gk__rd_line(&r, line, sizeof line))
         GK__GFAIL(GK_ERR_FORMAT, "%s: no $Nodes section", path);
     if (version < 3.0) {
-        if (sscanf(line, "%ld", &nnodes_file) != 1 || nnodes_file <= 0) GK__GFAIL(GK_ERR_FORMAT, "%s: bad node count", path);
+        if (sscanf(line, "%ld", &nnodes_file) != 1 || nnodes_file <= 0)
+            GK__GFAIL(GK_ERR_FORMAT, "%s: bad node count", path);
         ntag = (long *)gk_alloc(&A, (size_t)nnodes_file * sizeof(long));
         nx = (double *)gk_alloc(&A, (size_t)nnodes_file * 3 * sizeof(double));
         if (!ntag || !nx) GK__GFAIL(GK_ERR_ALLOC, "%s: node arrays", path);
@@ -763,8 +775,9 @@ GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_alloc
         for (b = 0; b < nblocks; ++b) {
             int edim, etg, par;
             long nin;
-            if (!gk__rd_line(&r, line, sizeof line) || sscanf(line, "%d %d %d %ld", &edim, &etg, &par, &nin) != 4 ||
-                nin < 0 || got + nin > nnodes_file)
+            if (!gk__rd_line(&r, line, sizeof line) ||
+                sscanf(line, "%d %d %d %ld", &edim, &etg, &par, &nin) != 4 || nin < 0 ||
+                got + nin > nnodes_file)
                 GK__GFAIL(GK_ERR_FORMAT, "%s: bad node block %ld", path, b);
             if (par) GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: parametric node coordinates", path);
             for (k = 0; k < nin; ++k)
@@ -772,12 +785,14 @@ GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_alloc
                     GK__GFAIL(GK_ERR_FORMAT, "%s: bad node tag in block %ld", path, b);
             for (k = 0; k < nin; ++k) {
                 double *c = nx + 3 * (got + k);
-                if (!gk__rd_line(&r, line, sizeof line) || sscanf(line, "%lf %lf %lf", &c[0], &c[1], &c[2]) != 3)
+                if (!gk__rd_line(&r, line, sizeof line) ||
+                    sscanf(line, "%lf %lf %lf", &c[0], &c[1], &c[2]) != 3)
                     GK__GFAIL(GK_ERR_FORMAT, "%s: bad node coordinates in block %ld", path, b);
             }
             got += nin;
         }
-        if (got != nnodes_file) GK__GFAIL(GK_ERR_FORMAT, "%s: %ld nodes listed, %ld read", path, nnodes_file, got);
+        if (got != nnodes_file)
+            GK__GFAIL(GK_ERR_FORMAT, "%s: %ld nodes listed, %ld read", path, nnodes_file, got);
     }
     for (k = 0; k < nnodes_file; ++k) {
         if (ntag[k] <= 0 || ntag[k] > 100000000L) GK__GFAIL(GK_ERR_FORMAT, "%s: node tag %ld", path, ntag[k]);
@@ -794,7 +809,8 @@ GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_alloc
     {
         long nblocks = 1, nelem_file, b, e;
         if (version < 3.0) {
-            if (sscanf(line, "%ld", &nelem_file) != 1) GK__GFAIL(GK_ERR_FORMAT, "%s: bad element count", path);
+            if (sscanf(line, "%ld", &nelem_file) != 1)
+                GK__GFAIL(GK_ERR_FORMAT, "%s: bad element count", path);
         } else {
             long a1, a2;
             if (sscanf(line, "%ld %ld %ld %ld", &nblocks, &nelem_file, &a1, &a2) != 4)
@@ -805,14 +821,16 @@ GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_alloc
             int btype = -1, bphys = 0;
             if (version >= 3.0) {
                 int edim;
-                if (!gk__rd_line(&r, line, sizeof line) || sscanf(line, "%d %d %d %ld", &edim, &bphys, &btype, &nin) != 4)
+                if (!gk__rd_line(&r, line, sizeof line) ||
+                    sscanf(line, "%d %d %d %ld", &edim, &bphys, &btype, &nin) != 4)
                     GK__GFAIL(GK_ERR_FORMAT, "%s: bad element block %ld", path, b);
             }
             for (e = 0; e < nin; ++e) {
                 long v[64];
                 int nv = 0, off, type, ntg = 0, np, tagv = bphys;
                 char *s = line, *q;
-                if (!gk__rd_line(&r, line, sizeof line)) GK__GFAIL(GK_ERR_FORMAT, "%s: truncated $Elements", path);
+                if (!gk__rd_line(&r, line, sizeof line))
+                    GK__GFAIL(GK_ERR_FORMAT, "%s: truncated $Elements", path);
                 while (nv < 64) {
                     long x = strtol(s, &q, 10);
                     if (q == s) break;
@@ -853,7 +871,7 @@ GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_alloc
         }
     }
     if (etype < 0 || nel == 0) GK__GFAIL(GK_ERR_MESH, "%s: no quad4, quad8 or hex8 elements", path);
-    {   /* keep only the nodes the elements use, in file order */
+    { /* keep only the nodes the elements use, in file order */
         gk_elem_type t = etype == 3 ? GK_Q4 : etype == 16 ? GK_Q8 : GK_HEX8;
         int npe = gk_fem_npe(t), dim = gk_fem_dim(t), *used;
         used = (int *)gk_alloc(&A, (size_t)nnodes_file * sizeof(int));
@@ -879,14 +897,16 @@ GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_alloc
     }
 done:
 #undef GK__GFAIL
-    gk_free(&A, text), gk_free(&A, nx), gk_free(&A, ntag), gk_free(&A, map), gk_free(&A, econn), gk_free(&A, etag);
+    gk_free(&A, text), gk_free(&A, nx), gk_free(&A, ntag), gk_free(&A, map), gk_free(&A, econn),
+        gk_free(&A, etag);
     return res;
 }
 
 /* ------------------------------------------------------------------- CSR */
 GKDEF gk_result gk_csr_from_mesh(gk_csr *A, const gk_mesh *m, const gk_allocator *alloc, gk_err *err) {
     /* node-to-node adjacency through elements, then expanded to dofs */
-    int nn = m->nnode, dim = m->dim, npe = m->npe, e, a, b, i, k, *cnt = NULL, *adj = NULL, *start = NULL, *mark = NULL;
+    int nn = m->nnode, dim = m->dim, npe = m->npe, e, a, b, i, k, *cnt = NULL, *adj = NULL, *start = NULL,
+        *mark = NULL;
     gk_csr z;
     size_t cap;
     memset(&z, 0, sizeof z);
@@ -903,7 +923,8 @@ GKDEF gk_result gk_csr_from_mesh(gk_csr *A, const gk_mesh *m, const gk_allocator
         for (a = 0; a < npe; ++a) {
             int id = m->conn[(size_t)e * npe + a];
             if (id < 0 || id >= nn) {
-                gk_free(&z.alloc, cnt), gk_free(&z.alloc, start), gk_free(&z.alloc, mark), gk_free(&z.alloc, adj);
+                gk_free(&z.alloc, cnt), gk_free(&z.alloc, start), gk_free(&z.alloc, mark),
+                    gk_free(&z.alloc, adj);
                 return gk_err_set(err, GK_ERR_MESH, "element %d: node id %d out of range", e, id);
             }
             cnt[id] += npe;
@@ -982,12 +1003,15 @@ GKDEF void gk_csr_matvec(const gk_csr *A, const double *x, double *y) {
     }
 }
 
-GKDEF gk_result gk_fem_dirichlet(gk_csr *A, double *rhs, int nfix, const int *dofs, const double *vals, gk_err *err) {
+GKDEF gk_result gk_fem_dirichlet(gk_csr *A, double *rhs, int nfix, const int *dofs, const double *vals,
+                                 gk_err *err) {
     double *fixv;
     int k, i, p;
     for (k = 0; k < nfix; ++k) {
-        if (dofs[k] < 0 || dofs[k] >= A->n) return gk_err_set(err, GK_ERR_ARG, "prescribed dof %d out of range", dofs[k]);
-        if (!(fabs(vals[k]) < HUGE_VAL)) return gk_err_set(err, GK_ERR_NAN, "prescribed value of dof %d", dofs[k]);
+        if (dofs[k] < 0 || dofs[k] >= A->n)
+            return gk_err_set(err, GK_ERR_ARG, "prescribed dof %d out of range", dofs[k]);
+        if (!(fabs(vals[k]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_NAN, "prescribed value of dof %d", dofs[k]);
     }
     fixv = (double *)gk_alloc(&A->alloc, (size_t)A->n * sizeof(double) + 1);
     if (!fixv) return gk_err_set(err, GK_ERR_ALLOC, "Dirichlet work array");
@@ -1077,7 +1101,8 @@ GKDEF gk_result gk_rcm_order(const gk_csr *A, int *perm, const gk_allocator *all
 }
 
 GKDEF void gk_solver_free(gk_solver *s) {
-    gk_free(&s->alloc, s->perm), gk_free(&s->alloc, s->ipiv), gk_free(&s->alloc, s->ab), gk_free(&s->alloc, s->tmp);
+    gk_free(&s->alloc, s->perm), gk_free(&s->alloc, s->ipiv), gk_free(&s->alloc, s->ab),
+        gk_free(&s->alloc, s->tmp);
     memset(s, 0, sizeof *s);
 }
 
@@ -1090,7 +1115,8 @@ GKDEF gk_result gk_solver_factor(gk_solver *s, const gk_csr *A, const gk_allocat
     if (alloc) z.alloc = *alloc;
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "empty system");
     for (p = 0; p < A->nnz; ++p) {
-        if (!(fabs(A->val[p]) < HUGE_VAL)) return gk_err_set(err, GK_ERR_NAN, "matrix entry %d is not finite", p);
+        if (!(fabs(A->val[p]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_NAN, "matrix entry %d is not finite", p);
         if (fabs(A->val[p]) > amax) amax = fabs(A->val[p]);
     }
     if (!(amax > 0.0)) return gk_err_set(err, GK_ERR_SINGULAR, "matrix is zero");
@@ -1126,7 +1152,8 @@ GKDEF gk_result gk_solver_factor(gk_solver *s, const gk_csr *A, const gk_allocat
             if (A->val[p] != 0.0) GK__AB(inv[i], inv[A->col[p]]) = A->val[p];
     tiny = 1e-12 * amax;
     for (k = 0; k < n; ++k) { /* LU with partial pivoting within the band (LAPACK dgbtf2) */
-        int pr = k, last = k + kl < n - 1 ? k + kl : n - 1, jend = k + ku + kl < n - 1 ? k + ku + kl : n - 1, j;
+        int pr = k, last = k + kl < n - 1 ? k + kl : n - 1, jend = k + ku + kl < n - 1 ? k + ku + kl : n - 1,
+            j;
         double piv;
         for (i = k + 1; i <= last; ++i)
             if (fabs(GK__AB(i, k)) > fabs(GK__AB(pr, k))) pr = i;
@@ -1194,7 +1221,8 @@ GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol,
     gk_allocator al;
     memset(&al, 0, sizeof al);
     if (alloc) al = *alloc;
-    if (!(rtol > 0.0) || maxit < 1) return gk_err_set(err, GK_ERR_ARG, "PCG tolerance %g, max iterations %d", rtol, maxit);
+    if (!(rtol > 0.0) || maxit < 1)
+        return gk_err_set(err, GK_ERR_ARG, "PCG tolerance %g, max iterations %d", rtol, maxit);
     r = (double *)gk_alloc(&al, 5 * (size_t)n * sizeof(double));
     if (!r) return gk_err_set(err, GK_ERR_ALLOC, "PCG work arrays");
     z = r + n, d = z + n, q = d + n, Mi = q + n;
@@ -1224,13 +1252,15 @@ GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol,
             return gk_err_set(err, GK_ERR_SINGULAR, "PCG: matrix not positive definite (d.Ad = %g)", dq);
         }
         alpha = rz / dq;
-        for (i = 0; i < n; ++i) x[i] += alpha * d[i], r[i] -= alpha * q[i], z[i] = Mi[i] * r[i], rz1 += r[i] * z[i];
+        for (i = 0; i < n; ++i)
+            x[i] += alpha * d[i], r[i] -= alpha * q[i], z[i] = Mi[i] * r[i], rz1 += r[i] * z[i];
         beta = rz1 / rz, rz = rz1;
         for (i = 0; i < n; ++i) d[i] = z[i] + beta * d[i];
     }
     gk_free(&al, r);
     if (iters) *iters = it;
-    if (it == maxit) return gk_err_set(err, GK_ERR_NOCONVERGE, "PCG did not reach %g in %d iterations", rtol, maxit);
+    if (it == maxit)
+        return gk_err_set(err, GK_ERR_NOCONVERGE, "PCG did not reach %g in %d iterations", rtol, maxit);
     return GK_OK;
 }
 

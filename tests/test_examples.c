@@ -46,8 +46,8 @@ TEST(rve_path_writes_csv_and_svg) {
     CHECK(fgets(line, sizeof line, fp) != NULL);
     {
         double v[12];
-        CHECK(sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
-                     &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) == 12);
+        CHECK(sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3],
+                     &v[4], &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) == 12);
         p0 = v[8];
         CHECK_NEAR(v[5], 100028.513620, 1e-3); /* compression-positive */
         CHECK_NEAR(v[11], 4.16, 1e-9);
@@ -58,7 +58,8 @@ TEST(rve_path_writes_csv_and_svg) {
     CHECK(file_has("build/t_rve_path.svg", "<svg"));
     CHECK(file_has("build/t_rve_path.out", "RESULT p="));
     /* bad arguments: a message and a non-zero status */
-    CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 1\" > build/t_bad.out 2>&1") != 0);
+    CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 1\" > build/t_bad.out 2>&1") !=
+          0);
     CHECK(file_has("build/t_bad.out", "needs 4 numbers"));
     CHECK(system("build/rve_path --packing no_such_file --dH \"0 0 0 0\" > build/t_bad.out 2>&1") != 0);
     CHECK(file_has("build/t_bad.out", "no_such_file"));
@@ -70,7 +71,10 @@ TEST(rve_path_writes_csv_and_svg) {
 TEST(gk_pack_makes_a_consolidated_packing) {
     gk_packing pk;
     gk_err e;
-    CHECK(system("build/gk_pack --dim 2 --n 120 --pressure 1e5 --out build/t_pack.txt > build/t_pack.out 2>&1") == 0);
+    CHECK(
+        system(
+            "build/gk_pack --dim 2 --n 120 --pressure 1e5 --out build/t_pack.txt > build/t_pack.out 2>&1") ==
+        0);
     CHECK(file_has("build/t_pack.out", "RESULT void_ratio="));
     CHECK(gk_packing_read("build/t_pack.txt", &pk, NULL, &e) == GK_OK);
     CHECK(pk.n == 120 && pk.dim == 2);
@@ -117,7 +121,8 @@ TEST(femdem_biaxial_runs_restarts_and_is_thread_independent) {
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 2 --out build/t_fdB > build/t_fdB.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --steps 4 --threads 2 --out build/t_fdB --restart build/t_fdB > build/t_fdB2.out 2>&1",
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 4 --threads 2 --out build/t_fdB --restart build/t_fdB > build/t_fdB2.out 2>&1",
              base);
     CHECK(system(cmd) == 0);
     fp = fopen("build/t_fdA/biaxial.csv", "r");

@@ -76,7 +76,8 @@ TEST(patch_test_q4_q8_hex8_reproduce_linear_field) {
     for (t = 0; t < 3; ++t) {
         gk_elem_type ty = all_types[t];
         int dim = gk_fem_dim(ty), n[3] = {3, 3, 2}, nfix = 0, a, i, e, g, *fix;
-        double o[3] = {0, 0, 0}, L[3] = {1.0, 1.2, 0.9}, G[9] = {1e-3, 2e-4, -3e-4, -5e-4, 2e-3, 1e-4, 3e-4, -2e-4, 7e-4};
+        double o[3] = {0, 0, 0}, L[3] = {1.0, 1.2, 0.9},
+               G[9] = {1e-3, 2e-4, -3e-4, -5e-4, 2e-3, 1e-4, 3e-4, -2e-4, 7e-4};
         double D[81], *Dall, *rhs, *u, *vals, maxerr = 0, lo[3] = {0, 0, 0};
         gk_mesh m;
         gk_quad q;
@@ -90,7 +91,8 @@ TEST(patch_test_q4_q8_hex8_reproduce_linear_field) {
         CHECK(gk_mesh_check(&m, &q, &err) == GK_OK);
         gk_fem_elastic_tangent(dim, 1e7, 0.3, D);
         Dall = (double *)malloc((size_t)m.nelem * q.n * 81 * sizeof(double));
-        for (e = 0; e < m.nelem * q.n; ++e) memcpy(Dall + (size_t)e * dim * dim * dim * dim, D, sizeof(double) * dim * dim * dim * dim);
+        for (e = 0; e < m.nelem * q.n; ++e)
+            memcpy(Dall + (size_t)e * dim * dim * dim * dim, D, sizeof(double) * dim * dim * dim * dim);
         CHECK(gk_csr_from_mesh(&K, &m, NULL, &err) == GK_OK);
         CHECK(gk_fem_assemble(&m, &q, Dall, NULL, &K, NULL, &err) == GK_OK);
         rhs = (double *)calloc((size_t)K.n, sizeof(double));
@@ -130,7 +132,11 @@ TEST(patch_test_q4_q8_hex8_reproduce_linear_field) {
                 for (i = 0; i < dim; ++i)
                     for (j = 0; j < dim; ++j) CHECK_NEAR(H[3 * i + j], G[3 * i + j], 1e-12);
             }
-        printf("    %s patch: max nodal error %.2e\n", ty == GK_Q4 ? "Q4" : ty == GK_Q8 ? "Q8" : "Hex8", maxerr);
+        printf("    %s patch: max nodal error %.2e\n",
+               ty == GK_Q4   ? "Q4"
+               : ty == GK_Q8 ? "Q8"
+                             : "Hex8",
+               maxerr);
         free(Dall), free(rhs), free(u), free(fix), free(vals);
         gk_solver_free(&s), gk_csr_free(&K), gk_mesh_free(&m);
     }
@@ -144,7 +150,7 @@ TEST(constant_stress_balances_and_stiffness_matches_force) {
     int t;
     for (t = 0; t < 3; ++t) {
         gk_elem_type ty = all_types[t];
-        int dim = gk_fem_dim(ty), n[3] = {2, 3, 2}, e, g, a, i, j, k, l, n4 = dim * dim * dim * dim;
+        int dim = gk_fem_dim(ty), n[3] = {2, 3, 2}, e, a, i, j, k, l, n4 = dim * dim * dim * dim;
         double o[3] = {0, 0, 0}, L[3] = {1, 1, 1}, sig[9] = {3, 1, 0.5, 1, -2, 0.2, 0.5, 0.2, 1};
         double *S, *f, D[81], *Dall, *u, *Ku, H[9], s2[9], *f2, lo = 0, hi = 1;
         gk_rng rng;
@@ -176,7 +182,8 @@ TEST(constant_stress_balances_and_stiffness_matches_force) {
         for (i = 0; i < dim; ++i)
             for (j = 0; j < dim; ++j)
                 for (k = 0; k < dim; ++k)
-                    for (l = 0; l < dim; ++l) s2[3 * i + j] += D[((i * dim + j) * dim + k) * dim + l] * H[3 * k + l];
+                    for (l = 0; l < dim; ++l)
+                        s2[3 * i + j] += D[((i * dim + j) * dim + k) * dim + l] * H[3 * k + l];
         for (e = 0; e < m.nelem * q.n; ++e) memcpy(S + 9 * e, s2, sizeof s2);
         u = (double *)malloc((size_t)m.nnode * dim * sizeof(double));
         Ku = (double *)malloc((size_t)m.nnode * dim * sizeof(double));
@@ -190,7 +197,6 @@ TEST(constant_stress_balances_and_stiffness_matches_force) {
         CHECK(gk_fem_assemble(&m, &q, Dall, S, &K, f2, &err) == GK_OK);
         gk_csr_matvec(&K, u, Ku);
         for (k = 0; k < m.nnode * dim; ++k) CHECK_NEAR(Ku[k], f2[k], 1e-12 * (1 + fabs(f2[k])));
-        (void)g;
         free(S), free(f), free(Dall), free(u), free(Ku), free(f2);
         gk_csr_free(&K), gk_mesh_free(&m);
     }
@@ -200,15 +206,18 @@ TEST(constant_stress_balances_and_stiffness_matches_force) {
  * sec. 21; plane strain via E' = E/(1-nu^2), nu' = nu/(1-nu)) prescribed on
  * the whole boundary: the L2 displacement error falls as h^2 for Q4 and h^3
  * for Q8 (standard a-priori estimates, p + 1 for degree p). */
-static void cantilever_exact(const double *x, double E, double nu, double P, double Lb, double Dh, double *u) {
-    double Ep = E / (1 - nu * nu), nup = nu / (1 - nu), I = Dh * Dh * Dh / 12.0, X = x[0], Y = x[1] - 0.5 * Dh;
+static void cantilever_exact(const double *x, double E, double nu, double P, double Lb, double Dh,
+                             double *u) {
+    double Ep = E / (1 - nu * nu), nup = nu / (1 - nu), I = Dh * Dh * Dh / 12.0, X = x[0],
+           Y = x[1] - 0.5 * Dh;
     u[0] = -P * Y / (6 * Ep * I) * ((6 * Lb - 3 * X) * X + (2 + nup) * (Y * Y - Dh * Dh / 4));
-    u[1] = P / (6 * Ep * I) * (3 * nup * Y * Y * (Lb - X) + (4 + 5 * nup) * Dh * Dh * X / 4 + (3 * Lb - X) * X * X);
+    u[1] = P / (6 * Ep * I) *
+           (3 * nup * Y * Y * (Lb - X) + (4 + 5 * nup) * Dh * Dh * X / 4 + (3 * Lb - X) * X * X);
 }
 
 static double cantilever_error(gk_elem_type ty, int nx, int ny) {
-    double E = 1e3, nu = 0.25, P = 1.0, Lb = 4.0, Dh = 1.0, o[3] = {0, 0, 0}, L[3] = {4.0, 1.0, 0}, D[16], *Dall, *rhs, *u,
-           *vals, err2 = 0, norm2 = 0;
+    double E = 1e3, nu = 0.25, P = 1.0, Lb = 4.0, Dh = 1.0, o[3] = {0, 0, 0}, L[3] = {4.0, 1.0, 0}, D[16],
+           *Dall, *rhs, *u, *vals, err2 = 0, norm2 = 0;
     int n[3], nfix = 0, a, i, e, g, *fix;
     gk_mesh m;
     gk_quad q, q3;
@@ -232,7 +241,8 @@ static double cantilever_error(gk_elem_type ty, int nx, int ny) {
     for (a = 0; a < m.nnode; ++a) {
         const double *xa = m.x + 2 * a;
         double ue[2];
-        if (!(fabs(xa[0]) < 1e-12 || fabs(xa[0] - Lb) < 1e-12 || fabs(xa[1]) < 1e-12 || fabs(xa[1] - Dh) < 1e-12))
+        if (!(fabs(xa[0]) < 1e-12 || fabs(xa[0] - Lb) < 1e-12 || fabs(xa[1]) < 1e-12 ||
+              fabs(xa[1] - Dh) < 1e-12))
             continue;
         cantilever_exact(xa, E, nu, P, Lb, Dh, ue);
         for (i = 0; i < 2; ++i) fix[nfix] = 2 * a + i, vals[nfix++] = ue[i];
@@ -248,7 +258,9 @@ static double cantilever_error(gk_elem_type ty, int nx, int ny) {
                 for (i = 0; i < 2; ++i) uh[i] += N[a] * u[2 * m.conn[e * m.npe + a] + i];
             gk_mesh_point(&m, e, q3.xi[g], x);
             cantilever_exact(x, E, nu, P, Lb, Dh, ue);
-            for (i = 0; i < 2; ++i) err2 += q3.w[g] * dJ * (uh[i] - ue[i]) * (uh[i] - ue[i]), norm2 += q3.w[g] * dJ * ue[i] * ue[i];
+            for (i = 0; i < 2; ++i)
+                err2 += q3.w[g] * dJ * (uh[i] - ue[i]) * (uh[i] - ue[i]),
+                    norm2 += q3.w[g] * dJ * ue[i] * ue[i];
         }
     free(Dall), free(rhs), free(u), free(fix), free(vals);
     gk_solver_free(&s), gk_csr_free(&K), gk_mesh_free(&m);
@@ -259,10 +271,11 @@ TEST(cantilever_converges_at_expected_rate) {
     int t;
     for (t = 0; t < 2; ++t) {
         gk_elem_type ty = all_types[t];
-        double e1 = cantilever_error(ty, 4, 1), e2 = cantilever_error(ty, 8, 2), e3 = cantilever_error(ty, 16, 4);
+        double e1 = cantilever_error(ty, 4, 1), e2 = cantilever_error(ty, 8, 2),
+               e3 = cantilever_error(ty, 16, 4);
         double r1 = log(e1 / e2) / log(2.0), r2 = log(e2 / e3) / log(2.0), expect = ty == GK_Q4 ? 2.0 : 3.0;
-        printf("    %s: L2 errors %.3e %.3e %.3e, rates %.2f %.2f (expected %.0f)\n", ty == GK_Q4 ? "Q4" : "Q8", e1, e2, e3,
-               r1, r2, expect);
+        printf("    %s: L2 errors %.3e %.3e %.3e, rates %.2f %.2f (expected %.0f)\n",
+               ty == GK_Q4 ? "Q4" : "Q8", e1, e2, e3, r1, r2, expect);
         CHECK(e3 < e2 && e2 < e1);
         CHECK(fabs(r2 - expect) < 0.25);
     }
@@ -459,13 +472,15 @@ TEST(hex8_hourglass_zero_for_linear_field) {
     gk_mesh m;
     gk_err err;
     int n[3] = {1, 1, 1}, a, i;
-    double o[3] = {0.1, 0.2, 0.3}, L[3] = {1.0, 0.8, 1.3}, xe[24], ue[24], f[24], G[9] = {1, 2, 3, -1, 0.5, 0.2, 0.3, -0.4, 2},
-           fu = 0, fmax = 0;
+    double o[3] = {0.1, 0.2, 0.3}, L[3] = {1.0, 0.8, 1.3}, xe[24], ue[24], f[24],
+           G[9] = {1, 2, 3, -1, 0.5, 0.2, 0.3, -0.4, 2}, fu = 0, fmax = 0;
     gk_mesh_structured(&m, GK_HEX8, n, o, L, NULL, &err);
     for (a = 0; a < 8; ++a)
         for (i = 0; i < 3; ++i) xe[3 * a + i] = m.x[3 * m.conn[a] + i] + (a == 6 ? 0.05 * (i + 1) : 0.0);
     for (a = 0; a < 8; ++a)
-        for (i = 0; i < 3; ++i) ue[3 * a + i] = 0.01 + G[3 * i] * xe[3 * a] + G[3 * i + 1] * xe[3 * a + 1] + G[3 * i + 2] * xe[3 * a + 2];
+        for (i = 0; i < 3; ++i)
+            ue[3 * a + i] =
+                0.01 + G[3 * i] * xe[3 * a] + G[3 * i + 1] * xe[3 * a + 1] + G[3 * i + 2] * xe[3 * a + 2];
     gk_fem_hex8_hourglass(xe, ue, 1e3, f);
     for (a = 0; a < 24; ++a)
         if (fabs(f[a]) > fmax) fmax = fabs(f[a]);
@@ -489,13 +504,16 @@ static int write_text(const char *path, const char *text) {
 /* the same 2 x 1 Q4 mesh written as Gmsh v2.2 and v4.1 (with a point and
  * line elements to skip and unused node tags) reads identically */
 TEST(gmsh_v2_and_v4_read) {
-    const char *v2 = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n7\n"
-                     "1 0 0 0\n2 1 0 0\n3 2 0 0\n4 0 1 0\n5 1 1 0\n6 2 1 0\n9 5 5 0\n$EndNodes\n"
-                     "$Elements\n4\n1 15 2 0 1 1\n2 1 2 0 1 1 2\n3 3 2 7 1 1 2 5 4\n4 3 2 7 1 2 3 6 5\n$EndElements\n";
+    const char *v2 =
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n7\n"
+        "1 0 0 0\n2 1 0 0\n3 2 0 0\n4 0 1 0\n5 1 1 0\n6 2 1 0\n9 5 5 0\n$EndNodes\n"
+        "$Elements\n4\n1 15 2 0 1 1\n2 1 2 0 1 1 2\n3 3 2 7 1 1 2 5 4\n4 3 2 7 1 2 3 6 5\n$EndElements\n";
     const char *v4 = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"
-                     "$Nodes\n2 6 1 6\n0 1 0 1\n1\n0 0 0\n2 1 0 5\n2\n3\n4\n5\n6\n1 0 0\n2 0 0\n0 1 0\n1 1 0\n2 1 0\n$EndNodes\n"
+                     "$Nodes\n2 6 1 6\n0 1 0 1\n1\n0 0 0\n2 1 0 5\n2\n3\n4\n5\n6\n1 0 0\n2 0 0\n0 1 0\n1 1 "
+                     "0\n2 1 0\n$EndNodes\n"
                      "$Elements\n2 3 1 3\n1 5 1 1\n1 1 2\n2 1 3 2\n2 1 2 5 4\n3 2 3 6 5\n$EndElements\n";
-    const char *bad = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 0 0\n$EndNodes\n$Elements\n1\n1 3 0 1 2 3 4\n$EndElements\n";
+    const char *bad = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n1\n1 0 0 0\n$EndNodes\n$Elements\n1\n1 "
+                      "3 0 1 2 3 4\n$EndElements\n";
     gk_mesh a, b;
     gk_err err;
     int k;

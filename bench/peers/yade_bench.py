@@ -28,6 +28,9 @@ import time
 
 from yade import utils
 from yade.wrapper import *  # noqa: F401,F403 (engines, materials)
+import os
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x sets argv[0] to this script
+from pack2lammps import read_packing  # noqa: E402
 try:
     from yade.minieigenHP import Matrix3
 except ImportError:  # older YADE
@@ -36,29 +39,8 @@ except ImportError:  # older YADE
 path, warm, steps, reps = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
 KN, KT_RATIO, MU, RHO, DT, RATE, SKIN = 2e5, 0.5, 0.5, 2650.0, 2.7e-6, 1.5, 5e-4
 
-with open(path) as f:
-    lines = f.read().splitlines()
-head = lines[0].split()
-dim, n = int(head[0]), int(head[1])
-h = [[0.0] * 3 for _ in range(3)]
-for a in range(dim):
-    h[a][a] = float(head[2 + a])
-pts = []
-for ln in lines[1:]:
-    s = ln.strip()
-    if not s:
-        continue
-    if s.startswith('#'):
-        w = s[1:].split()
-        if w and w[0] == 'cell':
-            v = [float(t) for t in w[1:]]
-            for a in range(dim):
-                for b in range(dim):
-                    h[a][b] = v[dim * a + b]
-        continue
-    v = [float(t) for t in s.split()]
-    pts.append((v[0], v[1], 0.0, v[2]) if dim == 2 else tuple(v[:4]))
-assert len(pts) == n, 'packing lists %d particles, announces %d' % (len(pts), n)
+dim, h, pts = read_packing(path)  # one reader for every peer script (pack2lammps.py)
+n = len(pts)
 rmax = max(p[3] for p in pts)
 if dim == 2:
     h[2][2] = 8.0 * rmax
