@@ -51,7 +51,7 @@ $(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr:
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
-$(BUILD)/%: examples/%.c $(HEADERS) | $(BUILD)
+$(BUILD)/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
 $(BUILD)/bench_%: bench/%.c $(HEADERS) $(wildcard bench/*_part.c bench/*.h) | $(BUILD)
@@ -139,7 +139,7 @@ install:
 uninstall:
 	rm -rf $(DESTDIR)$(PREFIX)/include/grainkit $(DESTDIR)$(PREFIX)/lib/pkgconfig/grainkit.pc
 
-FORMAT_SRC := $(HEADERS) $(TEST_SRC) tests/gk_test.h $(EX_SRC) $(wildcard bench/*.c bench/*.h) $(TOOL_SRC)
+FORMAT_SRC := $(HEADERS) $(TEST_SRC) tests/gk_test.h $(EX_SRC) $(wildcard examples/*.h) $(wildcard bench/*.c bench/*.h) $(TOOL_SRC)
 format:
 	clang-format -i $(FORMAT_SRC)
 format-check:
