@@ -12,6 +12,7 @@
 #define GK_TEST_H
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -80,6 +81,36 @@ static void gk__t_run(const char *name, void (*fn)(void)) {
     fflush(stdout);
 }
 #define RUN(name) gk__t_run(#name, name)
+
+/* ---- for smoke tests of the example drivers: #define GK_TEST_DRIVERS
+ * before including this file */
+#ifdef GK_TEST_DRIVERS
+/* 1 if the file exists and some line contains needle */
+static int gk_test_file_has(const char *path, const char *needle) {
+    FILE *fp = fopen(path, "r");
+    char buf[4096];
+    int found = 0;
+    if (!fp) return 0;
+    while (!found && fgets(buf, sizeof buf, fp))
+        if (strstr(buf, needle)) found = 1;
+    fclose(fp);
+    return found;
+}
+/* value of "key=" on the last line of path starting with "RESULT ", or NAN */
+static double gk_test_result(const char *path, const char *key) {
+    FILE *fp = fopen(path, "r");
+    char buf[4096], last[4096], pat[128];
+    const char *q;
+    last[0] = 0;
+    if (!fp) return NAN;
+    while (fgets(buf, sizeof buf, fp))
+        if (!strncmp(buf, "RESULT ", 7)) memcpy(last, buf, sizeof buf);
+    fclose(fp);
+    snprintf(pat, sizeof pat, " %s=", key);
+    q = strstr(last, pat);
+    return q ? atof(q + strlen(pat)) : NAN;
+}
+#endif
 
 static void gk_test_init(int argc, char **argv) {
     const char *p;
