@@ -363,6 +363,59 @@ static gk_result mpd_stress(gk_mpm_points *pts, double dt, void *user, gk_err *e
     return GK_OK;
 }
 
+/* ------------------------------------------------------ the MPM step */
+/* A pressure on the boundary edge of a point (a follower load: it turns and
+ * stretches with the point). In the reference configuration the edge has
+ * its midpoint at x_p + off and the vector e (oriented so that the outward
+ * normal is (e_y, -e_x) / |e|); now at x_p + F off and F e, and it receives
+ * f = -pressure ((F e)_y, -(F e)_x): the pressure times the current length,
+ * along the current normal. The force goes to the grid nodes with the weights
+ * of the EDGE midpoint (the tent for linear/uGIMP), not of the point centre:
+ * applied at the centre, half of it would land one node inside the body
+ * (uGIMP at a cell centre splits 1/2-1/2) and the uniform initial state
+ * would not be in equilibrium - the nodal loads here are the consistent ones
+ * of a uniform pressure, matching the internal forces of a uniform stress. */
+typedef struct mpd_edge {
+    int p;           /* point index */
+    double off[2];   /* reference offset centre -> edge midpoint [m] */
+    double e[2];     /* reference edge vector [m] */
+    double pressure; /* [Pa], compression positive */
+} mpd_edge;
+
+/* One USF step (seed 003 Sec 2.3; the sequence gk_mpm_step runs) with the
+ * edge loads added to the nodal external forces after P2G, then the rigid
+ * bodies advance by v dt. The RVEs update in mpd_stress. */
+static gk_result mpd_step(gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def *def, double dt, mpd_rves *f,
+                          const mpd_edge *edge, int nedge, gk_err *err) {
+    gk_mpm_basis lb = def->basis == GK_MPM_UGIMP ? GK_MPM_LINEAR : def->basis;
+    gk_result r;
+    int k, a;
+    if (def->scheme != GK_MPM_USF) return gk_err_set(err, GK_ERR_ARG, "mpd_step runs USF only");
+    if ((r = gk_mpm_p2g(g, pts, def, GK_MPM_P2G_MOMENTUM, err))) return r;
+    if ((r = gk_mpm_g2p(g, pts, def, dt, GK_MPM_G2P_GRADIENT_OLD, err))) return r;
+    if ((r = mpd_stress(pts, dt, f, err))) return r;
+    if ((r = gk_mpm_p2g(g, pts, def, GK_MPM_P2G_FORCE, err))) return r;
+    for (k = 0; k < nedge; ++k) {
+        const mpd_edge *E = &edge[k];
+        const double *F = pts->F + 9 * (size_t)E->p;
+        double x[3], fe[2];
+        gk_mpm_stencil st;
+        x[0] = pts->x[0][E->p] + F[0] * E->off[0] + F[1] * E->off[1];
+        x[1] = pts->x[1][E->p] + F[3] * E->off[0] + F[4] * E->off[1];
+        x[2] = 0.0;
+        fe[0] = F[0] * E->e[0] + F[1] * E->e[1], fe[1] = F[3] * E->e[0] + F[4] * E->e[1];
+        if ((r = gk_mpm_shape(g, lb, x, 0.0, &st, err))) return r;
+        for (a = 0; a < st.n; ++a) {
+            g->fext[0][st.node[a]] += -E->pressure * fe[1] * st.w[a];
+            g->fext[1][st.node[a]] += E->pressure * fe[0] * st.w[a];
+        }
+    }
+    if ((r = gk_mpm_grid_update(g, def, dt, err))) return r;
+    if ((r = gk_mpm_g2p(g, pts, def, dt, GK_MPM_G2P_VELOCITY | GK_MPM_G2P_POSITION, err))) return r;
+    gk_mpm_bodies_advance(g->body, g->nbody, dt);
+    return GK_OK;
+}
+
 /* ------------------------------------------------------------- fields */
 #define MPD_NFIELD 9
 static const char *mpd_field_names[MPD_NFIELD] = {

@@ -12,11 +12,10 @@
  * Model. Points fill the specimen (ppc^2 per cell, h = width / nx); the grid
  * is padded by ghost layers and by room for the bulge. The base and the top
  * plate are rigid STICK bodies (rough; the base at rest): their reactions
- * are the axial loads. The lateral pressure is a follower load on the points
- * of the outer columns: a point's right/left edge is the image F e_y (h/ppd)
- * of its initial vertical edge, so it receives f = -/+ sigma_3 (h/ppd)
- * (F_11, -F_01), the pressure on its current edge (normal and length exact for
- * the point's homogeneous F). Every point's RVE starts from the packing
+ * are the axial loads. The lateral pressure is a follower load on the outer
+ * edges of the points of the outer columns (mpd_edge in mpmdem.h: the edge
+ * turns and stretches with the point's F, and its load goes to the nodes
+ * with the weights of the edge, so the initial state is in equilibrium). Every point's RVE starts from the packing
  * (default: the seed 000 authors' 400 disks, consolidated to 100 kPa, e =
  * 0.177 as seed 003 states) and receives dH = dt L each MPM step (USF,
  * mpmdem.h). sigma_yy = -(plate reaction)/width (the rough plate keeps the
@@ -133,6 +132,45 @@ static void stage_fields(const char *out, const char *tag, const mpd_rves *f, co
     mpd_svg_field(path, title, f, pts, 0, dot);
 }
 
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* the dominant shear band: the points whose eps_q exceeds twice the median,
+ * their principal axis (largest eigenvector of the covariance of their
+ * positions, weighted by eps_q) -> angle from the horizontal in [0, 90] deg.
+ * NaN when no point stands out (no localisation yet). */
+static double band_angle(const mpd_rves *f, const gk_mpm_points *pts) {
+    int n = pts->n, p, m = 0;
+    double *e = (double *)malloc((size_t)n * sizeof *e), *s = (double *)malloc((size_t)n * sizeof *s), med,
+           w = 0, mx = 0, my = 0, cxx = 0, cyy = 0, cxy = 0, ang = NAN;
+    if (e && s) {
+        for (p = 0; p < n; ++p) {
+            double v[MPD_NFIELD];
+            mpd_fields(f, pts, p, v);
+            e[p] = s[p] = v[0];
+        }
+        qsort(s, (size_t)n, sizeof *s, cmp_double);
+        med = s[n / 2];
+        for (p = 0; p < n; ++p)
+            if (e[p] > 2 * med) ++m, w += e[p], mx += e[p] * pts->x[0][p], my += e[p] * pts->x[1][p];
+        if (m >= 3 && w > 0) {
+            mx /= w, my /= w;
+            for (p = 0; p < n; ++p)
+                if (e[p] > 2 * med) {
+                    double dx = pts->x[0][p] - mx, dy = pts->x[1][p] - my;
+                    cxx += e[p] * dx * dx, cyy += e[p] * dy * dy, cxy += e[p] * dx * dy;
+                }
+            ang = 0.5 * atan2(2 * cxy, cxx - cyy) * 180.0 / MPD_PI; /* principal direction */
+            ang = fabs(ang);
+            if (ang > 90) ang = 180 - ang;
+        }
+    }
+    free(e), free(s);
+    return ang;
+}
+
 int main(int argc, char **argv) {
     mpd_opts o, od;
     bx_opts b = {8, 16, 1.0, 2.0, 1e5, 0.02, 0.5, 0.03, 0.001};
@@ -144,9 +182,11 @@ int main(int argc, char **argv) {
     gk_mpm_def def;
     bx_state S;
     bx_row *rows = NULL;
-    int nrows = 0, caprows = 0, i, *side = NULL, status = 0;
+    int nrows = 0, caprows = 0, i, nedge = 0, status = 0;
+    mpd_edge *edge = NULL;
     double h, dt, c, lo[3], hi[3], org[3], vol0 = 0, t0, t_start, stages[3] = {0.015, 0.02, 0.03};
     long nsteps_total, step0;
+    long long dem0;
     gk_err err;
     char buf[64], what[300], path[1200];
     int n[3];
@@ -217,12 +257,17 @@ int main(int argc, char **argv) {
         return fprintf(stderr, "mpmdem_biaxial: %s\n", err.msg), 1;
     if (mpd_rves_create(&F, pts.n, &P, &st0, NULL, NULL, &o, &err))
         return fprintf(stderr, "mpmdem_biaxial: %s\n", err.msg), 1;
-    side = (int *)calloc((size_t)pts.n, sizeof *side);
-    if (!side) return fprintf(stderr, "mpmdem_biaxial: out of memory\n"), 1;
-    for (i = 0; i < pts.n; ++i) {
+    edge = (mpd_edge *)calloc((size_t)pts.n, sizeof *edge);
+    if (!edge) return fprintf(stderr, "mpmdem_biaxial: out of memory\n"), 1;
+    for (i = 0; i < pts.n; ++i) { /* the lateral pressure on the outer columns' outer edges */
+        double a = 0.5 * h / o.ppc, side = pts.x[0][i] < 2 * a ? -1 : pts.x[0][i] > b.width - 2 * a ? 1 : 0;
         mpd_rve_sigma(&F.rve[i], pts.sigma + 9 * (size_t)i);
         vol0 += pts.vol0[i];
-        side[i] = pts.x[0][i] < h / o.ppc ? -1 : pts.x[0][i] > b.width - h / o.ppc ? 1 : 0;
+        if (side == 0) continue;
+        edge[nedge].p = i, edge[nedge].pressure = b.pressure;
+        edge[nedge].off[0] = side * a, edge[nedge].off[1] = 0;
+        edge[nedge].e[0] = 0, edge[nedge].e[1] = side * 2 * a;
+        ++nedge;
     }
     def = mpd_mpm_def(&o);
     memset(&S, 0, sizeof S);
@@ -257,24 +302,18 @@ int main(int argc, char **argv) {
     }
     t_start = gk_wtime();
     t0 = t_start;
-    step0 = S.step;
+    step0 = S.step, dem0 = F.dem_steps;
     {
         while (S.disp < b.strain * b.height * (1 - 1e-12)) {
             double vplate = b.velocity * (b.ramp > 0 && S.t < b.ramp ? (S.t + 0.5 * dt) / b.ramp : 1.0), ek,
                    m, mom[3];
-            for (i = 0; i < pts.n; ++i) { /* follower pressure on the outer columns */
-                const double *Fp = pts.F + 9 * (size_t)i;
-                double s = -side[i] * b.pressure * h / o.ppc;
-                pts.fext[0][i] = s * Fp[4], pts.fext[1][i] = -s * Fp[1];
-            }
             S.body[1].v[1] = -vplate;
-            if (gk_mpm_step(&g, &pts, &def, dt, mpd_stress, &F, &err)) {
+            if (mpd_step(&g, &pts, &def, dt, &F, edge, nedge, &err)) {
                 fprintf(stderr, "mpmdem_biaxial: step %ld (axial strain %.3f %%): %s\n", S.step,
                         100 * S.disp / b.height, err.msg);
                 status = 3;
                 break;
             }
-            gk_mpm_bodies_advance(S.body, 2, dt);
             S.t += dt, S.disp += vplate * dt, ++S.step;
             S.acc_top += -S.body[1].force[1] * dt, S.acc_base += S.body[0].force[1] * dt, S.acc_dt += dt;
             gk_mpm_points_totals(&pts, &m, mom, &ek);
@@ -327,7 +366,7 @@ int main(int argc, char **argv) {
         }
     }
     {
-        double secs = gk_wtime() - t_start, peak = 0, epk = 0, rmax = 0;
+        double secs = gk_wtime() - t_start, peak = 0, epk = 0, rmax = 0, ang = band_angle(&F, &pts);
         long steps_run = S.step - step0;
         void *blob[2];
         size_t size[2];
@@ -352,19 +391,27 @@ int main(int argc, char **argv) {
         printf("seed 003 (mesh M4, its RVE): peak sigma_yy ~ 280 kPa at 1.6 %%; here %.1f kPa at %.2f %% "
                "(sigma_1/sigma_3 = %.2f; seed ~2.8)\n",
                peak / 1e3, 100 * epk, b.pressure > 0 ? peak / b.pressure : 0.0);
+        if (ang == ang)
+            printf("shear band: %.1f deg from the horizontal (principal axis of the points with eps_q > 2 x "
+                   "median; "
+                   "seed 003: first band ~60 deg)\n",
+                   ang);
+        else
+            printf("shear band: none yet (no point with eps_q > 2 x median)\n");
         printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step)\n",
-               mpd_duration(secs, buf, sizeof buf), steps_run, F.dem_steps,
-               steps_run ? (double)F.dem_steps / steps_run / pts.n : 0.0);
+               mpd_duration(secs, buf, sizeof buf), steps_run, F.dem_steps - dem0,
+               steps_run ? (double)(F.dem_steps - dem0) / steps_run / pts.n : 0.0);
         printf(
             "RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g sigma_yy_end=%.6g eps_end=%.5g max_rotation_deg=%.3g "
+            "band_angle_deg=%.3g "
             "n_rves=%d mpm_steps=%ld dt=%.4g seconds_per_step=%.4g seconds_per_step_per_1000_rves=%.4g "
             "total_seconds=%.2f\n",
-            peak, epk, nrows ? rows[nrows - 1].syy_top : 0.0, nrows ? rows[nrows - 1].eps : 0.0, rmax, pts.n,
-            steps_run, dt, steps_run ? secs / steps_run : 0.0,
+            peak, epk, nrows ? rows[nrows - 1].syy_top : 0.0, nrows ? rows[nrows - 1].eps : 0.0, rmax, ang,
+            pts.n, steps_run, dt, steps_run ? secs / steps_run : 0.0,
             steps_run ? secs / steps_run * 1000.0 / pts.n : 0.0, secs);
     }
     free(rows);
-    free(side);
+    free(edge);
     mpd_rves_free(&F);
     gk_rve_state_free(&st0);
     mpd_proto_close(&P);
