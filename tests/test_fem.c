@@ -581,6 +581,304 @@ TEST(bad_meshes_and_unconstrained_system_errors) {
     gk_csr_free(&K), gk_mesh_free(&m);
 }
 
+/* K u = f with tied dofs and prescribed dofs: condense, restrict (with the
+ * jumps), Dirichlet on the reduced system, solve, expand */
+static gk_result solve_tied(const gk_mesh *m, const gk_quad *q, const double *D, const gk_dofmap *dm,
+                            const double *f, int nfix, const int *fix, const double *vals, double *u,
+                            gk_err *err) {
+    gk_csr K, Kr;
+    gk_solver s;
+    int nr = 0, *rfix = (int *)malloc((size_t)nfix * sizeof(int) + 1);
+    double *fr = (double *)calloc((size_t)dm->nred, sizeof(double)),
+           *ur = (double *)calloc((size_t)dm->nred, sizeof(double)),
+           *rv = (double *)malloc((size_t)nfix * sizeof(double) + 1);
+    gk_result r;
+    memset(&s, 0, sizeof s);
+    memset(&K, 0, sizeof K), memset(&Kr, 0, sizeof Kr);
+    r = gk_csr_from_mesh(&K, m, NULL, err);
+    if (!r) r = gk_fem_assemble(m, q, D, NULL, &K, NULL, err);
+    if (!r) r = gk_dofmap_csr(dm, &K, &Kr, NULL, err);
+    if (!r) r = gk_dofmap_condense(dm, &K, &Kr, err);
+    if (!r) r = gk_dofmap_restrict(dm, &K, f, fr, err);
+    if (!r) r = gk_dofmap_dirichlet(dm, nfix, fix, vals, rfix, rv, &nr, err);
+    if (!r) r = gk_fem_dirichlet(&Kr, fr, nr, rfix, rv, err);
+    if (!r) r = gk_solver_factor(&s, &Kr, NULL, err);
+    if (!r) r = gk_solver_solve(&s, fr, ur);
+    if (!r) gk_dofmap_expand(dm, ur, 1, u);
+    gk_solver_free(&s), gk_csr_free(&K), gk_csr_free(&Kr);
+    free(rfix), free(fr), free(ur), free(rv);
+    return r;
+}
+
+static double *uniform_tangent(const gk_mesh *m, const gk_quad *q, double E, double nu) {
+    int dim = m->dim, n4 = dim * dim * dim * dim, e;
+    double D[81], *Dall = (double *)malloc((size_t)m->nelem * q->n * n4 * sizeof(double));
+    gk_fem_elastic_tangent(dim, E, nu, D);
+    for (e = 0; e < m->nelem * q->n; ++e) memcpy(Dall + (size_t)e * n4, D, (size_t)n4 * sizeof(double));
+    return Dall;
+}
+
+/* Periodic simple shear (seed 000 sec 5 boundary conditions): left/right
+ * tied, bottom fixed, top moved by gamma H with u_y = 0. On a distorted mesh
+ * the solution is the homogeneous simple shear u_x = gamma y, u_y = 0 to
+ * round-off, and the top reaction is mu gamma W. With free sides instead the
+ * field is not homogeneous (so the check can fail). Corner nodes are both
+ * tied and prescribed (same value: merged). */
+TEST(periodic_simple_shear_patch_test) {
+    int t;
+    for (t = 0; t < 2; ++t) {
+        gk_elem_type ty = all_types[t];
+        int n[3] = {4, 3, 1}, a, nfix = 0, *fix, e, g, nright;
+        double o[3] = {0, 0, 0}, L[3] = {2.0, 1.0, 1}, gam = 0.01, E = 1e7, nu = 0.3, mu = E / (2 * (1 + nu));
+        double *D, *u, *f, *vals, err_tied = 0, err_free = 0, ftop = 0;
+        gk_mesh m;
+        gk_quad q;
+        gk_dofmap dm, id;
+        gk_err err;
+        CHECK(gk_mesh_structured(&m, ty, n, o, L, NULL, &err) == GK_OK);
+        distort(&m, ty == GK_Q8 ? 0.03 : 0.08, 21u + (unsigned)t);
+        gk_quad_rule(&q, ty, 2, &err);
+        D = uniform_tangent(&m, &q, E, nu);
+        u = (double *)calloc((size_t)2 * m.nnode, sizeof(double));
+        f = (double *)calloc((size_t)2 * m.nnode, sizeof(double));
+        fix = (int *)malloc((size_t)2 * m.nnode * sizeof(int));
+        vals = (double *)malloc((size_t)2 * m.nnode * sizeof(double));
+        for (a = 0; a < m.nnode; ++a) {
+            double y = m.x[2 * a + 1];
+            if (fabs(y) < 1e-12 || fabs(y - L[1]) < 1e-12) {
+                fix[nfix] = 2 * a, vals[nfix++] = y > 0.5 ? gam * L[1] : 0.0;
+                fix[nfix] = 2 * a + 1, vals[nfix++] = 0.0;
+            }
+        }
+        CHECK(gk_dofmap_periodic(&dm, &m, 1u, NULL, 1e-9, NULL, &err) == GK_OK);
+        nright = gk_mesh_nodes_on_plane(&m, 0, L[0], 1e-9, NULL);
+        CHECK_EQ_INT(dm.nred, 2 * (m.nnode - nright));
+        CHECK(dm.off == NULL);
+        CHECK(solve_tied(&m, &q, D, &dm, f, nfix, fix, vals, u, &err) == GK_OK);
+        for (a = 0; a < m.nnode; ++a) {
+            double ex = fabs(u[2 * a] - gam * m.x[2 * a + 1]), ey = fabs(u[2 * a + 1]);
+            if (ex > err_tied) err_tied = ex;
+            if (ey > err_tied) err_tied = ey;
+        }
+        CHECK(err_tied < 1e-15);
+        for (e = 0; e < m.nelem; ++e)
+            for (g = 0; g < q.n; ++g) {
+                double dNdx[16], dJ, H[9];
+                gk_fem_jacobian(&m, e, q.xi[g], NULL, dNdx, &dJ, &err);
+                gk_fem_grad(&m, e, dNdx, u, H);
+                CHECK_NEAR(H[1], gam, 1e-13);
+                CHECK_NEAR(H[0], 0.0, 1e-13);
+                CHECK_NEAR(H[4], 0.0, 1e-13);
+            }
+        { /* top reaction from the internal force of the uniform stress */
+            double *S = (double *)calloc((size_t)m.nelem * q.n * 9, sizeof(double)), *fi = f;
+            for (e = 0; e < m.nelem * q.n; ++e) S[9 * e + 1] = S[9 * e + 3] = mu * gam;
+            CHECK(gk_fem_assemble(&m, &q, NULL, S, NULL, fi, &err) == GK_OK);
+            for (a = 0; a < m.nnode; ++a)
+                if (fabs(m.x[2 * a + 1] - L[1]) < 1e-12) ftop += fi[2 * a];
+            CHECK_REL(ftop, mu * gam * L[0], 1e-12);
+            memset(f, 0, (size_t)2 * m.nnode * sizeof(double));
+            free(S);
+        }
+        /* the same problem without the ties (free sides): not homogeneous */
+        CHECK(gk_dofmap_ties(&id, 2 * m.nnode, 0, NULL, NULL, NULL, NULL, &err) == GK_OK);
+        CHECK_EQ_INT(id.nred, 2 * m.nnode);
+        CHECK(solve_tied(&m, &q, D, &id, f, nfix, fix, vals, u, &err) == GK_OK);
+        for (a = 0; a < m.nnode; ++a)
+            if (fabs(u[2 * a + 1]) > err_free) err_free = fabs(u[2 * a + 1]);
+        CHECK(err_free > 1e-5 * gam);
+        printf(
+            "    %s: periodic max error %.1e; free sides max |u_y| %.1e; top force %.6g (mu gamma W %.6g)\n",
+            ty == GK_Q4 ? "Q4" : "Q8", err_tied, err_free, ftop, mu * gam * L[0]);
+        gk_dofmap_free(&dm), gk_dofmap_free(&id);
+        free(D), free(u), free(f), free(fix), free(vals);
+        gk_mesh_free(&m);
+    }
+}
+
+/* Fully periodic mesh with a macro gradient in the jumps, u_s = u_m + G
+ * (x_s - x_m), one node pinned: the solution is u = G x to round-off (a
+ * periodic patch test). The corner/edge nodes of the Hex8 mesh are tied
+ * through chains of up to three ties. */
+TEST(periodic_jump_patch_test_with_chains) {
+    int t;
+    for (t = 0; t < 3; ++t) {
+        gk_elem_type ty = all_types[t];
+        int dim = gk_fem_dim(ty), n[3] = {3, 2, 2}, a, i, j, fix[3], nint = 0, k;
+        double o[3] = {0, 0, 0}, L[3] = {1.5, 1.0, 0.8},
+               G[9] = {1e-3, 4e-3, -2e-3, -1e-3, 2e-3, 1e-3, 3e-3, -2e-3, 5e-4};
+        double *D, *u, *f, vals[3] = {0, 0, 0}, maxerr = 0;
+        gk_mesh m;
+        gk_quad q;
+        gk_dofmap dm;
+        gk_err err;
+        CHECK(gk_mesh_structured(&m, ty, n, o, L, NULL, &err) == GK_OK);
+        distort(&m, ty == GK_Q8 ? 0.02 : 0.05, 31u + (unsigned)t);
+        gk_quad_rule(&q, ty, 2, &err);
+        D = uniform_tangent(&m, &q, 5e6, 0.25);
+        u = (double *)calloc((size_t)dim * m.nnode, sizeof(double));
+        f = (double *)calloc((size_t)dim * m.nnode, sizeof(double));
+        CHECK(gk_dofmap_periodic(&dm, &m, dim == 3 ? 7u : 3u, G, 1e-9, NULL, &err) == GK_OK);
+        for (a = 0; a < m.nnode; ++a) { /* independent nodes: on no hi face */
+            int hi = 0;
+            for (i = 0; i < dim; ++i)
+                if (fabs(m.x[dim * a + i] - L[i]) < 1e-9) hi = 1;
+            nint += !hi;
+        }
+        CHECK_EQ_INT(dm.nred, dim * nint);
+        for (i = 0; i < dim; ++i) fix[i] = i; /* node 0 sits at the origin */
+        CHECK(solve_tied(&m, &q, D, &dm, f, dim, fix, vals, u, &err) == GK_OK);
+        for (a = 0; a < m.nnode; ++a)
+            for (i = 0; i < dim; ++i) {
+                double v = 0;
+                for (j = 0; j < dim; ++j) v += G[3 * i + j] * m.x[dim * a + j];
+                if (fabs(u[dim * a + i] - v) > maxerr) maxerr = fabs(u[dim * a + i] - v);
+            }
+        CHECK(maxerr < 1e-14);
+        /* the far corner is tied through dim ties; its jump is G L */
+        for (a = 0; a < m.nnode; ++a) {
+            int corner = 1;
+            for (i = 0; i < dim; ++i)
+                if (fabs(m.x[dim * a + i] - L[i]) > 1e-9) corner = 0;
+            if (corner)
+                for (i = 0; i < dim; ++i) {
+                    double v = 0;
+                    for (k = 0; k < dim; ++k) v += G[3 * i + k] * L[k];
+                    CHECK_EQ_INT(dm.red[dim * a + i], i);
+                    CHECK_NEAR(dm.off[dim * a + i], v, 1e-15);
+                }
+        }
+        printf("    %s: fully periodic, %d -> %d dofs, max |u - G x| %.1e\n",
+               ty == GK_Q4   ? "Q4"
+               : ty == GK_Q8 ? "Q8"
+                             : "Hex8",
+               dm.n, dm.nred, maxerr);
+        gk_dofmap_free(&dm);
+        free(D), free(u), free(f);
+        gk_mesh_free(&m);
+    }
+}
+
+/* Stress control by a rough platen: every top x dof tied to one, the shear
+ * force F applied there, sides periodic (the ties combined with
+ * gk_mesh_periodic_pairs; the top-right corner is tied twice identically,
+ * which is accepted). Exact: u_x = F / (mu W) y. */
+TEST(tied_platen_under_shear_force) {
+    int n[3] = {3, 2, 1}, np, a, k, nt = 0, nfix = 0, *ps, *pm, *sl, *ms, *fix, master = -1;
+    double o[3] = {0, 0, 0}, L[3] = {1.0, 0.5, 1}, E = 2e7, nu = 0.2, mu = E / (2 * (1 + nu)), F = 300.0, *D,
+           *u, *f, *vals, maxerr = 0;
+    gk_mesh m;
+    gk_quad q;
+    gk_dofmap dm;
+    gk_err err;
+    CHECK(gk_mesh_structured(&m, GK_Q8, n, o, L, NULL, &err) == GK_OK);
+    distort(&m, 0.02, 41u);
+    gk_quad_rule(&q, GK_Q8, 2, &err);
+    D = uniform_tangent(&m, &q, E, nu);
+    ps = (int *)malloc((size_t)m.nnode * sizeof(int)), pm = (int *)malloc((size_t)m.nnode * sizeof(int));
+    sl = (int *)malloc((size_t)4 * m.nnode * sizeof(int)),
+    ms = (int *)malloc((size_t)4 * m.nnode * sizeof(int));
+    fix = (int *)malloc((size_t)2 * m.nnode * sizeof(int));
+    vals = (double *)calloc((size_t)2 * m.nnode, sizeof(double));
+    u = (double *)calloc((size_t)2 * m.nnode, sizeof(double));
+    f = (double *)calloc((size_t)2 * m.nnode, sizeof(double));
+    CHECK(gk_mesh_periodic_pairs(&m, 0, 0.0, L[0], 1e-9, ps, pm, &np, &err) == GK_OK);
+    CHECK_EQ_INT(np, 2 * n[1] + 1);
+    for (k = 0; k < np; ++k)
+        for (a = 0; a < 2; ++a) sl[nt] = 2 * ps[k] + a, ms[nt++] = 2 * pm[k] + a;
+    for (a = 0; a < m.nnode; ++a)
+        if (fabs(m.x[2 * a + 1] - L[1]) < 1e-12 && fabs(m.x[2 * a]) < 1e-12) master = a;
+    CHECK(master >= 0);
+    for (a = 0; a < m.nnode; ++a) {
+        double y = m.x[2 * a + 1];
+        if (fabs(y - L[1]) < 1e-12) {
+            if (a != master) sl[nt] = 2 * a, ms[nt++] = 2 * master;
+            fix[nfix++] = 2 * a + 1;
+        } else if (fabs(y) < 1e-12)
+            fix[nfix++] = 2 * a, fix[nfix++] = 2 * a + 1;
+    }
+    CHECK(gk_dofmap_ties(&dm, 2 * m.nnode, nt, sl, ms, NULL, NULL, &err) == GK_OK);
+    f[2 * master] = F;
+    CHECK(solve_tied(&m, &q, D, &dm, f, nfix, fix, vals, u, &err) == GK_OK);
+    for (a = 0; a < m.nnode; ++a) {
+        double ex = fabs(u[2 * a] - F / (mu * L[0]) * m.x[2 * a + 1]);
+        if (ex > maxerr) maxerr = ex;
+        if (fabs(u[2 * a + 1]) > maxerr) maxerr = fabs(u[2 * a + 1]);
+    }
+    printf("    platen displacement %.6g (exact %.6g), max error %.1e\n", u[2 * master], F / mu * L[1] / L[0],
+           maxerr);
+    CHECK(maxerr < 1e-15);
+    gk_dofmap_free(&dm);
+    free(D), free(u), free(f), free(vals), free(fix), free(ps), free(pm), free(sl), free(ms);
+    gk_mesh_free(&m);
+}
+
+/* bad ties, non-periodic meshes and inconsistent prescribed values give
+ * clear errors and change nothing */
+TEST(bad_ties_give_clear_errors) {
+    gk_dofmap dm, keep;
+    gk_err err;
+    gk_mesh m;
+    gk_csr K, Kr, Kr2;
+    int n[3] = {2, 2, 1}, s1[3] = {0, 1, 2}, m1[3] = {1, 2, 0}, rd[4] = {-7, -7, -7, -7}, nr = -7, np = -7;
+    int fx[2] = {1, 3}, ps[8], pm[8];
+    double o[3] = {0, 0, 0}, L[3] = {1, 1, 1}, j1[3] = {0, NAN, 0}, fv[2] = {0.0, 1.0},
+           rv[4] = {-7, -7, -7, -7};
+    double fr[20];
+    memset(&dm, 0x5a, sizeof dm);
+    keep = dm;
+    CHECK(gk_dofmap_ties(&dm, 4, 1, s1, (const int[]){7}, NULL, NULL, &err) == GK_ERR_ARG);
+    printf("    out of range: %s\n", err.msg);
+    CHECK(gk_dofmap_ties(&dm, 4, 1, s1, s1, NULL, NULL, &err) == GK_ERR_ARG);
+    printf("    self: %s\n", err.msg);
+    CHECK(gk_dofmap_ties(&dm, 4, 2, (const int[]){3, 3}, (const int[]){0, 1}, NULL, NULL, &err) ==
+          GK_ERR_ARG);
+    printf("    twice: %s\n", err.msg);
+    CHECK(strstr(err.msg, "tied twice") != NULL);
+    CHECK(gk_dofmap_ties(&dm, 4, 3, s1, m1, NULL, NULL, &err) == GK_ERR_ARG);
+    printf("    cycle: %s\n", err.msg);
+    CHECK(strstr(err.msg, "cycle") != NULL);
+    CHECK(gk_dofmap_ties(&dm, 4, 2, s1, m1, j1, NULL, &err) == GK_ERR_NAN);
+    CHECK(gk_dofmap_ties(&dm, 0, 0, NULL, NULL, NULL, NULL, &err) == GK_ERR_ARG);
+    CHECK(memcmp(&dm, &keep, sizeof dm) == 0);
+    /* a mesh whose right side does not match its left side */
+    gk_mesh_structured(&m, GK_Q4, n, o, L, NULL, &err);
+    m.x[2 * 5 + 1] += 0.01; /* node 5 = (1, 0.5) */
+    CHECK(gk_dofmap_periodic(&dm, &m, 1u, NULL, 1e-9, NULL, &err) == GK_ERR_MESH);
+    printf("    not periodic: %s\n", err.msg);
+    CHECK(strstr(err.msg, "node 5") != NULL);
+    CHECK(gk_mesh_periodic_pairs(&m, 0, 0.0, 1.0, 1e-9, ps, pm, &np, &err) == GK_ERR_MESH && np == -7);
+    CHECK(gk_dofmap_periodic(&dm, &m, 4u, NULL, 1e-9, NULL, &err) == GK_ERR_ARG); /* z in 2D */
+    CHECK(memcmp(&dm, &keep, sizeof dm) == 0);
+    m.x[2 * 5 + 1] -= 0.01;
+    /* tied dofs prescribed inconsistently */
+    CHECK(gk_dofmap_ties(&dm, 4, 1, (const int[]){3}, (const int[]){1}, NULL, NULL, &err) == GK_OK);
+    CHECK(gk_dofmap_dirichlet(&dm, 2, fx, fv, rd, rv, &nr, &err) == GK_ERR_ARG);
+    printf("    inconsistent: %s\n", err.msg);
+    CHECK(nr == -7 && rd[0] == -7 && rv[0] == -7);
+    fv[1] = 0.0; /* consistent: merged into one reduced dof */
+    CHECK(gk_dofmap_dirichlet(&dm, 2, fx, fv, rd, rv, &nr, &err) == GK_OK);
+    CHECK(nr == 1 && rd[0] == 1 && rv[0] == 0.0);
+    gk_dofmap_free(&dm);
+    /* condensing into a matrix of the wrong pattern, restricting with the wrong size */
+    CHECK(gk_dofmap_periodic(&dm, &m, 1u, NULL, 1e-9, NULL, &err) == GK_OK);
+    gk_csr_from_mesh(&K, &m, NULL, &err);
+    CHECK(gk_dofmap_csr(&dm, &K, &Kr, NULL, &err) == GK_OK);
+    CHECK(Kr.n == dm.nred && Kr.n == 12);
+    gk_csr_from_mesh(&Kr2, &m, NULL, &err);
+    CHECK(gk_dofmap_condense(&dm, &K, &Kr2, &err) == GK_ERR_ARG);
+    Kr2.n = Kr.n; /* the right size, a different pattern */
+    Kr2.val[0] = 42.0;
+    CHECK(gk_dofmap_condense(&dm, &K, &Kr2, &err) == GK_ERR_ARG);
+    printf("    wrong pattern: %s\n", err.msg);
+    CHECK(Kr2.val[0] == 42.0);
+    CHECK(gk_dofmap_restrict(&dm, &Kr, fr, fr, &err) == GK_ERR_ARG);
+    Kr2.n = K.n;
+    gk_csr_free(&K), gk_csr_free(&Kr), gk_csr_free(&Kr2);
+    gk_dofmap_free(&dm);
+    gk_mesh_free(&m);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(shape_functions_partition_of_unity_and_kronecker);
@@ -594,5 +892,9 @@ int main(int argc, char **argv) {
     RUN(hex8_hourglass_zero_for_linear_field);
     RUN(gmsh_v2_and_v4_read);
     RUN(bad_meshes_and_unconstrained_system_errors);
+    RUN(periodic_simple_shear_patch_test);
+    RUN(periodic_jump_patch_test_with_chains);
+    RUN(tied_platen_under_shear_force);
+    RUN(bad_ties_give_clear_errors);
     return gk_test_done();
 }
