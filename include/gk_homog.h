@@ -50,6 +50,18 @@
  *   gk_inertial_number         I = 2 gdot r_mean sqrt(rho / p),
  *                              gdot = sqrt(rate:rate) [seed 000 eq 20];
  *                              p <= 0 -> +inf (not NaN)
+ *   gk_rve_deform_adaptive     gk_rve_deform with the step count chosen by
+ *                              the physics instead of fixed (issue 6):
+ *       n = ceil(I_1 / I_max) clamped to [n_min, n_max], I_1 the inertial
+ *       number (eq 20) of dH applied in one step at the RVE's current
+ *       pressure (p <= 0: n_max), so the deformation runs at I <= I_max;
+ *       then, if the unbalanced force ratio (mean, as YADE) exceeds
+ *       uf_max, relaxation steps at fixed cell (L = 0) in chunks of
+ *       `every` until it does not or the total reaches n_max (reported as
+ *       capped). Quasi-static by construction; more steps where p is
+ *       low (near liquefaction), fewer where it is high. The report gives
+ *       the steps used, the final I and ratio. Bad input (NaN dH, bounds
+ *       <= 0, n_min > n_max) -> GK_ERR_ARG before anything runs.
  *   gk_tangent_voigt           D -> Voigt matrix (3x3 in 2D, 6x6 in 3D), with
  *                              engineering shear strain columns
  *
@@ -65,10 +77,10 @@
 #define GK_TANGENT_RAW 4u
 
 typedef struct gk_coordination {
-    double z;          /* 2 N_c / N_p                                 */
-    double z_nofree;   /* YADE avgNumInteractions(skipFree=True): (2C - N1)/(N - N0 - N1),
+    double z;        /* 2 N_c / N_p                                 */
+    double z_nofree; /* YADE avgNumInteractions(skipFree=True): (2C - N1)/(N - N0 - N1),
                           N0, N1 = particles with 0 and 1 contacts       */
-    double z_mech;     /* after iterative removal of rattlers          */
+    double z_mech;   /* after iterative removal of rattlers          */
     int contacts, rattlers, free_particles;
 } gk_coordination;
 
@@ -85,6 +97,23 @@ GKDEF double gk_homog_mean_rotation(const gk_rve *rve);
 GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p);
 GKDEF double gk_rotation_angle(const double F[9], int dim);
 GKDEF void gk_tangent_voigt(const double *D, int dim, double *V);
+
+typedef struct gk_adapt_def {
+    double inertial_max;   /* I bound of the deformation (seed 000 eq 20); 0 -> 5e-4   */
+    double unbalanced_max; /* unbalanced force ratio to reach after it; 0 -> 5e-3     */
+    int n_min, n_max;      /* bounds on the total DEM steps; 0 -> 10 and 5000          */
+    int every;             /* relaxation steps between checks; 0 -> 20                 */
+} gk_adapt_def;
+
+typedef struct gk_adapt_report {
+    int n_deform, n_relax; /* steps of the deformation and of the relaxation         */
+    double inertial;       /* I of the deformation (at the pressure before it)       */
+    double unbalanced;     /* mean unbalanced force ratio at the end                  */
+    int capped;            /* 1 if n_max stopped the relaxation above uf_max          */
+} gk_adapt_report;
+
+GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk_adapt_def *ad,
+                                       gk_adapt_report *rep);
 
 #ifdef __cplusplus
 }
@@ -147,8 +176,8 @@ GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
         if (!(dd > 0.0)) continue;
         for (k = 0; k < 3; ++k) n[k] = d[k] / dd;
         delta = (double)rve->r[a] + (double)rve->r[b] - dd;
-        gk_contact_stiffness(&rve->K, rve->def.mat.law, rve->r[a], rve->r[b], (gk_real)(delta > 0 ? delta : 0), &kn,
-                             &fn, &kt);
+        gk_contact_stiffness(&rve->K, rve->def.mat.law, rve->r[a], rve->r[b],
+                             (gk_real)(delta > 0 ? delta : 0), &kn, &fn, &kt);
         if (!(rve->phys & GK_PHYS_TANGENT)) kt = 0;
         if ((rve->cs[c] & GK_CS_SLIDING) && !(opts & GK_TANGENT_SLIDING_KEEP)) kt = 0;
         for (k = 0; k < 3; ++k) F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
@@ -166,7 +195,8 @@ GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
         for (i = 0; i < dim; ++i)
             for (j = 0; j < dim; ++j)
                 for (k = 0; k < dim; ++k)
-                    for (l = 0; l < dim; ++l) D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
+                    for (l = 0; l < dim; ++l)
+                        D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
     }
     for (k = 0; k < n4; ++k) D[k] /= V;
     if (opts & GK_TANGENT_GEOMETRIC) {
@@ -187,7 +217,8 @@ GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
                     for (l = 0; l < dim; ++l) {
 #define GK__DI(a, b, c2, d2) D[(((a)*dim + (b)) * dim + (c2)) * dim + (d2)]
                         T[((i * dim + j) * dim + k) * dim + l] =
-                            0.25 * (GK__DI(i, j, k, l) + GK__DI(j, i, k, l) + GK__DI(i, j, l, k) + GK__DI(j, i, l, k));
+                            0.25 * (GK__DI(i, j, k, l) + GK__DI(j, i, k, l) + GK__DI(i, j, l, k) +
+                                    GK__DI(j, i, l, k));
 #undef GK__DI
                     }
         memcpy(D, T, (size_t)n4 * sizeof(double));
@@ -341,10 +372,67 @@ GKDEF void gk_tangent_voigt(const double *D, int dim, double *V) {
             int k = dim == 2 ? v2[b][0] : v3[b][0], l = dim == 2 ? v2[b][1] : v3[b][1];
             /* sigma_a = sum_b V_ab eps_b with engineering shear gamma = 2 eps_kl:
              * D_ijkl eps_kl + D_ijlk eps_lk = (D_ijkl + D_ijlk)/2 gamma; rows use sigma_ij */
-            double x = k == l ? D[((i * dim + j) * dim + k) * dim + l]
-                              : 0.5 * (D[((i * dim + j) * dim + k) * dim + l] + D[((i * dim + j) * dim + l) * dim + k]);
+            double x =
+                k == l
+                    ? D[((i * dim + j) * dim + k) * dim + l]
+                    : 0.5 * (D[((i * dim + j) * dim + k) * dim + l] + D[((i * dim + j) * dim + l) * dim + k]);
             V[a * nv + b] = x;
         }
+}
+
+GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk_adapt_def *ad_in,
+                                       gk_adapt_report *rep) {
+    gk_adapt_def ad;
+    gk_adapt_report R;
+    double rate[9], s[9], p, rmean = 0.0, I1, L0[9], Lsave[9], n;
+    int k;
+    gk_result res;
+    memset(&ad, 0, sizeof ad);
+    if (ad_in) ad = *ad_in;
+    if (ad.inertial_max == 0.0) ad.inertial_max = 5e-4;
+    if (ad.unbalanced_max == 0.0) ad.unbalanced_max = 5e-3;
+    if (ad.n_min == 0) ad.n_min = 10;
+    if (ad.n_max == 0) ad.n_max = 5000;
+    if (ad.every == 0) ad.every = 20;
+    if (!gk_m3_isfinite(dH)) return gk_err_set(&rve->err, GK_ERR_ARG, "dH has a NaN or infinite entry");
+    if (!(ad.inertial_max > 0.0) || !(ad.unbalanced_max > 0.0) || ad.n_min < 1 || ad.n_max < ad.n_min ||
+        ad.every < 1)
+        return gk_err_set(&rve->err, GK_ERR_ARG,
+                          "adaptive bounds: I_max %g, uf_max %g (> 0), n_min %d <= n_max %d, every %d (>= 1)",
+                          ad.inertial_max, ad.unbalanced_max, ad.n_min, ad.n_max, ad.every);
+    memset(&R, 0, sizeof R);
+    for (k = 0; k < rve->n; ++k) rmean += (double)rve->r[k];
+    rmean /= rve->n > 0 ? rve->n : 1;
+    gk_rve_stress(rve, s);
+    p = gk_stress_p(s, rve->dim);
+    for (k = 0; k < 9; ++k) rate[k] = dH[k] / rve->dt;
+    I1 = gk_inertial_number(rate, rve->dim, rmean, rve->def.mat.density, p);
+    n = isfinite(I1) ? ceil(I1 / ad.inertial_max) : (double)ad.n_max;
+    if (n < ad.n_min) n = ad.n_min;
+    if (n > ad.n_max) n = ad.n_max;
+    R.n_deform = (int)n;
+    R.inertial = isfinite(I1) ? I1 / n : I1;
+    res = gk_rve_deform(rve, dH, R.n_deform);
+    if (res) return res;
+    gk_homog_unbalanced(rve, &R.unbalanced, NULL);
+    if (R.unbalanced > ad.unbalanced_max && R.n_deform < ad.n_max) {
+        gk_m3_copy(rve->L, Lsave);
+        gk_m3_zero(L0);
+        gk_rve_set_velocity_gradient(rve, L0);
+        while (R.unbalanced > ad.unbalanced_max && R.n_deform + R.n_relax < ad.n_max) {
+            int m = ad.every;
+            if (R.n_deform + R.n_relax + m > ad.n_max) m = ad.n_max - R.n_deform - R.n_relax;
+            res = gk_rve_step(rve, m);
+            if (res) break;
+            R.n_relax += m;
+            gk_homog_unbalanced(rve, &R.unbalanced, NULL);
+        }
+        gk_rve_set_velocity_gradient(rve, Lsave);
+        if (res) return res;
+    }
+    R.capped = R.unbalanced > ad.unbalanced_max;
+    if (rep) *rep = R;
+    return GK_OK;
 }
 
 #endif /* GK_HOMOG implementation */

@@ -194,7 +194,9 @@ static double contract(const double *D, int dim, const double H[9], int i, int j
 TEST(taylor_tangent_is_fd_tangent_at_vanishing_preload) {
     gk_rve rve;
     gk_rve_def def = gk_rve_def_default();
-    double D[16], Hs[3][9] = {{1, 0, 0, 0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 1, 0, 0, 0, 0}, {0, 0.5, 0, 0.5, 0, 0, 0, 0, 0}};
+    double D[16], Hs[3][9] = {{1, 0, 0, 0, 0, 0, 0, 0, 0},
+                              {0, 0, 0, 0, 1, 0, 0, 0, 0},
+                              {0, 0.5, 0, 0.5, 0, 0, 0, 0, 0}};
     int c, i, j;
     def.mat.density = 1e20; /* particles do not move within one step */
     def.dt = 1e-6;          /* (an automatic dt would grow with sqrt(m)) */
@@ -220,10 +222,11 @@ TEST(taylor_tangent_is_fd_tangent_at_vanishing_preload) {
 TEST(full_tangent_is_fd_tangent_prestressed) {
     gk_rve rve;
     gk_rve_def def = gk_rve_def_default();
-    double D[16], De[16], Hs[4][9] = {{1, 0, 0, 0, 0, 0, 0, 0, 0},
-                                      {0, 0, 0, 0, 1, 0, 0, 0, 0},
-                                      {0, 1, 0, 1, 0, 0, 0, 0, 0},
-                                      {0.3, -0.7, 0, -0.7, -1.1, 0, 0, 0, 0}};
+    double D[16], De[16],
+        Hs[4][9] = {{1, 0, 0, 0, 0, 0, 0, 0, 0},
+                    {0, 0, 0, 0, 1, 0, 0, 0, 0},
+                    {0, 1, 0, 1, 0, 0, 0, 0, 0},
+                    {0.3, -0.7, 0, -0.7, -1.1, 0, 0, 0, 0}};
     double maxerr = 0, maxerr_e = 0, scale;
     int c, i, j;
     def.mat.density = 1e20; /* no particle motion in one step of 1 us */
@@ -291,7 +294,8 @@ static int same_physics(const gk_rve *a, const gk_rve *b) {
     int k, p;
     for (k = 0; k < 3; ++k)
         for (p = 0; p < a->n; ++p) {
-            if (k < a->dim && (a->s[k][p] != b->s[k][p] || a->v[k][p] != b->v[k][p] || a->f[k][p] != b->f[k][p]))
+            if (k < a->dim &&
+                (a->s[k][p] != b->s[k][p] || a->v[k][p] != b->v[k][p] || a->f[k][p] != b->f[k][p]))
                 return 0;
             if (a->w[k] && (a->w[k][p] != b->w[k][p] || a->t[k][p] != b->t[k][p])) return 0;
         }
@@ -439,8 +443,8 @@ TEST(consolidation_reaches_target_stress) {
     CHECK(fabs(rl.stress[1]) < 0.01 * 1e5);
     CHECK(rd.unbalanced < 2e-3);
     CHECK(rl.void_ratio > rd.void_ratio + 0.01);
-    printf("    dense e = %.4f (%ld steps), loose e = %.4f (%ld steps)\n", rd.void_ratio, rd.steps, rl.void_ratio,
-           rl.steps);
+    printf("    dense e = %.4f (%ld steps), loose e = %.4f (%ld steps)\n", rd.void_ratio, rd.steps,
+           rl.void_ratio, rl.steps);
     gk_rve_destroy(&dense);
     gk_rve_destroy(&loose);
 }
@@ -524,8 +528,8 @@ TEST(dt_at_0_9_critical_stays_bounded) {
 TEST(rve_without_contacts_is_zero_not_nan) {
     gk_rve rve;
     gk_rve_def def = gk_rve_def_default();
-    double dH[9] = {0.05, 0, 0, 0, 0.05, 0, 0, 0, 0}, back[9] = {-0.055, 0, 0, 0, -0.055, 0, 0, 0, 0}, s[9], D[16], phi[9],
-           um, ur;
+    double dH[9] = {0.05, 0, 0, 0, 0.05, 0, 0, 0, 0}, back[9] = {-0.055, 0, 0, 0, -0.055, 0, 0, 0, 0}, s[9],
+           D[16], phi[9], um, ur;
     int k;
     if (load_rve(&rve, &def, RVE400)) {
         CHECK(0);
@@ -892,6 +896,71 @@ TEST(hertz_rolling_rve_runs) {
     gk_rve_destroy(&rve);
 }
 
+/* gk_rve_deform_adaptive (gk_homog.h): the deformation runs n = ceil(I_1 /
+ * I_max) steps, I_1 = 2 |sym dH / dt| r_mean sqrt(rho / p) (seed 000 eq 20)
+ * of the whole dH in one step, so n doubles with |dH| and with 1/sqrt(p);
+ * then relaxation at fixed cell until the unbalanced ratio is below uf_max
+ * (which it must then be) or n_max is reached (then reported as capped). */
+TEST(adaptive_deform_follows_the_inertial_number) {
+    gk_rve a, b;
+    gk_rve_def def = gk_rve_def_default();
+    gk_adapt_def ad;
+    gk_adapt_report ra, rb;
+    double dH[9] = {0}, rate[9] = {0}, s[9], rmean = 0, I1, ub;
+    int k;
+    def.dt = 3.16e-5;
+    if (load_rve(&a, &def, RVE400) || load_rve(&b, &def, RVE400)) {
+        CHECK(0);
+        return;
+    }
+    gk_rve_refresh(&a);
+    gk_rve_refresh(&b);
+    for (k = 0; k < a.n; ++k) rmean += a.r[k];
+    rmean /= a.n;
+    gk_rve_stress(&a, s);
+    dH[4] = -2e-4;
+    rate[4] = dH[4] / a.dt;
+    I1 = gk_inertial_number(rate, 2, rmean, a.def.mat.density, gk_stress_p(s, 2));
+    memset(&ad, 0, sizeof ad);
+    ad.inertial_max = 2e-4, ad.unbalanced_max = 1.0, ad.n_min = 1, ad.n_max = 100000;
+    CHECK(gk_rve_deform_adaptive(&a, dH, &ad, &ra) == GK_OK);
+    CHECK_EQ_INT(ra.n_deform, (long)ceil(I1 / 2e-4));
+    CHECK_EQ_INT(ra.n_relax, 0);
+    CHECK(ra.inertial <= 2e-4 && ra.inertial > 1e-4);
+    dH[4] = -4e-4; /* twice the increment: twice the steps (to the rounding) */
+    CHECK(gk_rve_deform_adaptive(&b, dH, &ad, &rb) == GK_OK);
+    CHECK(abs(rb.n_deform - 2 * ra.n_deform) <= 1);
+    /* relaxation: a strict bound is reached, or the cap is reported */
+    ad.unbalanced_max = 2e-4, ad.n_max = ra.n_deform + 2000;
+    dH[4] = -2e-4;
+    CHECK(gk_rve_deform_adaptive(&a, dH, &ad, &ra) == GK_OK);
+    gk_homog_unbalanced(&a, &ub, NULL);
+    CHECK_NEAR(ub, ra.unbalanced, 0);
+    CHECK(ra.n_relax > 0);
+    CHECK(ra.capped ? ra.n_deform + ra.n_relax == ad.n_max : ra.unbalanced <= 2e-4);
+    /* bad input: an error, and the RVE is untouched */
+    {
+        gk_rve_state st;
+        gk_rve c;
+        gk_rve_state_init(&st, NULL);
+        CHECK(gk_rve_state_save(&st, &a) == GK_OK);
+        dH[4] = NAN;
+        CHECK(gk_rve_deform_adaptive(&a, dH, &ad, &ra) == GK_ERR_ARG);
+        dH[4] = -1e-4;
+        ad.n_min = 10, ad.n_max = 5;
+        CHECK(gk_rve_deform_adaptive(&a, dH, &ad, &ra) == GK_ERR_ARG);
+        CHECK(strstr(gk_rve_error(&a), "n_min") != NULL);
+        if (load_rve(&c, &def, RVE400) == GK_OK) {
+            CHECK(gk_rve_state_restore(&st, &c) == GK_OK);
+            CHECK(same_state(&a, &c));
+            gk_rve_destroy(&c);
+        }
+        gk_rve_state_free(&st);
+    }
+    gk_rve_destroy(&a);
+    gk_rve_destroy(&b);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(seed_packing_reproduces_yade);
@@ -916,5 +985,6 @@ int main(int argc, char **argv) {
     RUN(packing_roundtrip_and_input_order);
     RUN(generate_from_size_table);
     RUN(hertz_rolling_rve_runs);
+    RUN(adaptive_deform_follows_the_inertial_number);
     return gk_test_done();
 }
