@@ -16,16 +16,20 @@
  *   mpd_write_vtk / mpd_svg_field   material points for ParaView / an SVG
  *   mpd_ck_write / mpd_ck_read      checkpoints (every RVE, every point)
  *
- * THE DEM STEPS PER MPM STEP (the paper leaves it unstated). A point whose
- * RVE receives dH runs
- *     n_s = clamp(ceil(max|dH_ij| / dem_strain), dem_min, dem_max)
- * DEM steps: the RVE strain per DEM step stays below dem_strain (1e-5 by
- * default, the bound seed 000's drivers use), which keeps the RVE's inertial
- * number (seed 000 eq 20) I = gdot d sqrt(rho/p) below ~1e-3 at 100 kPa: a
- * quasi-static RVE. Points that barely deform run dem_min steps so their
- * RVE keeps relaxing. dem_max caps the cost; the collapse driver sets it to
- * the real-time count dt_MPM / dt_DEM (a flowing point cannot be more
- * quasi-static than the flow), the quasi-static drivers leave it large.
+ * THE DEM STEPS PER MPM STEP (the paper leaves it unstated; it says the DEM
+ * runs "until a quasi-static state"). Default (--dem-rule adaptive):
+ * gk_rve_deform_adaptive (gk_homog.h) - the point's dH is applied over
+ *     n = clamp(ceil(I_1 / I_max), dem_min, dem_max)
+ * steps, I_1 the inertial number (seed 000 eq 20) of dH in one DEM step at
+ * the RVE's current pressure, so the RVE deforms at I <= I_max (5e-4: at
+ * 100 kPa the same count as the 1e-5-strain-per-step rule of seed 000's
+ * scripts; more steps where p is low), then relaxes at fixed cell while its
+ * unbalanced force ratio exceeds --dem-unbalanced (5e-3), within dem_max
+ * steps in all. --dem-rule strain: n_s = clamp(ceil(max|dH_ij| /
+ * dem_strain), dem_min, dem_max), no relaxation. dem_max caps the cost; the
+ * collapse driver sets it to the real-time count dt_MPM / dt_DEM (a flowing
+ * point cannot be more quasi-static than the flow), the quasi-static
+ * drivers leave it large.
  *
  * THE MPM TIME STEP: dt = cfl h / c, c = sqrt(M / rho) with M = max(D_xxxx,
  * D_yyyy) of the Taylor (affine, eq 9 of seed 000) tangent of the prepared
@@ -49,9 +53,11 @@ typedef struct mpd_opts {
     const char *out, *packing, *restart;
     int threads, ppc;
     gk_mpm_basis basis;
-    double alpha;      /* PIC fraction (seed 003: 0.1)                          */
-    double cfl;        /* dt = cfl h / c                                        */
-    double dem_strain; /* RVE strain per DEM step bound                         */
+    double alpha;                        /* PIC fraction (seed 003: 0.1)                          */
+    double cfl;                          /* dt = cfl h / c                                        */
+    int dem_adaptive;                    /* 1: gk_rve_deform_adaptive, 0: the strain rule         */
+    double dem_inertial, dem_unbalanced; /* bounds of the adaptive rule        */
+    double dem_strain;                   /* RVE strain per DEM step bound (strain rule)           */
     int dem_min, dem_max;
     double dem_dt; /* DEM time step [s]; 0 -> 0.5 x critical                */
     double young, kt_ratio, friction_deg, roll_beta, roll_eta, dem_damping;
@@ -70,6 +76,9 @@ static void mpd_opts_default(mpd_opts *o, const char *out) {
     o->basis = GK_MPM_UGIMP;
     o->alpha = 0.1;
     o->cfl = 0.4;
+    o->dem_adaptive = 1;
+    o->dem_inertial = 5e-4;
+    o->dem_unbalanced = 5e-3;
     o->dem_strain = 1e-5;
     o->dem_min = 1;
     o->dem_max = 1000;
@@ -93,7 +102,11 @@ static void mpd_usage_common(FILE *fp, const mpd_opts *d) {
         "  --alpha A              PIC fraction of the PIC/FLIP blend, eq 19 (default %g)\n"
         "  --cfl C                MPM step = C h / c, c from the RVE's Taylor tangent (default %g)\n"
         "  --packing FILE         RVE packing every point starts from (default %s)\n"
-        "  --dem-strain S         RVE strain per DEM step bound (default %g)\n"
+        "  --dem-rule R           adaptive | strain: DEM steps per MPM step from the inertial number and\n"
+        "                         the unbalanced force (default), or from the strain per DEM step\n"
+        "  --dem-inertial I       adaptive: inertial number bound of the RVE deformation (default %g)\n"
+        "  --dem-unbalanced U     adaptive: relax until the unbalanced force ratio < U (default %g)\n"
+        "  --dem-strain S         strain rule: RVE strain per DEM step bound (default %g)\n"
         "  --dem-min N --dem-max N  bounds of the DEM steps per MPM step (default %d, %d)\n"
         "  --dem-dt DT            DEM time step [s] (default %g)\n"
         "  --young E --kt-ratio R --friction-deg PHI --roll-beta B --roll-eta ETA\n"
@@ -103,8 +116,9 @@ static void mpd_usage_common(FILE *fp, const mpd_opts *d) {
         "  --checkpoint N         checkpoint every N MPM steps into DIR/checkpoint.bin (0: at the end)\n"
         "  --restart DIR          continue from DIR/checkpoint.bin (same flags) to the same result\n"
         "  --quiet                no progress lines\n",
-        d->out, d->threads, d->ppc, d->alpha, d->cfl, d->packing, d->dem_strain, d->dem_min, d->dem_max,
-        d->dem_dt, d->young, d->kt_ratio, d->friction_deg, d->roll_beta, d->roll_eta, d->dem_damping);
+        d->out, d->threads, d->ppc, d->alpha, d->cfl, d->packing, d->dem_inertial, d->dem_unbalanced,
+        d->dem_strain, d->dem_min, d->dem_max, d->dem_dt, d->young, d->kt_ratio, d->friction_deg,
+        d->roll_beta, d->roll_eta, d->dem_damping);
 }
 
 /* numbers on the command line: the whole string must parse and be finite */
@@ -135,6 +149,15 @@ static int mpd_parse_common(mpd_opts *o, int argc, char **argv, int *i) {
     if (!strcmp(a, "--out")) return o->out = val, 1;
     if (!strcmp(a, "--packing")) return o->packing = val, 1;
     if (!strcmp(a, "--restart")) return o->restart = val, 1;
+    if (!strcmp(a, "--dem-rule")) {
+        if (!strcmp(val, "adaptive"))
+            o->dem_adaptive = 1;
+        else if (!strcmp(val, "strain"))
+            o->dem_adaptive = 0;
+        else
+            return fprintf(stderr, "error: --dem-rule %s: use adaptive or strain\n", val), -1;
+        return 1;
+    }
     if (!strcmp(a, "--basis")) {
         if (!strcmp(val, "linear"))
             o->basis = GK_MPM_LINEAR;
@@ -169,6 +192,8 @@ static int mpd_parse_common(mpd_opts *o, int argc, char **argv, int *i) {
     MPD_REAL("--alpha", alpha, v >= 0.0 && v <= 1.0, "a value in [0, 1]")
     MPD_REAL("--cfl", cfl, v > 0.0 && v <= 1.0, "a value in (0, 1]")
     MPD_REAL("--dem-strain", dem_strain, v > 0.0, "a positive value")
+    MPD_REAL("--dem-inertial", dem_inertial, v > 0.0, "a positive value")
+    MPD_REAL("--dem-unbalanced", dem_unbalanced, v > 0.0, "a positive value")
     MPD_REAL("--dem-dt", dem_dt, v >= 0.0, "a value >= 0")
     MPD_REAL("--young", young, v > 0.0, "a positive modulus")
     MPD_REAL("--kt-ratio", kt_ratio, v >= 0.0 && v <= 1.0, "a value in [0, 1]")
@@ -347,10 +372,21 @@ static gk_result mpd_stress(gk_mpm_points *pts, double dt, void *user, gk_err *e
         int k, ns;
         gk_mpm_point_dH(pts, p, dt, dH);
         dH[2] = dH[5] = dH[6] = dH[7] = dH[8] = 0.0; /* plane */
-        ns = mpd_dem_steps(f->o, dH);
+        if (f->o->dem_adaptive) {
+            gk_adapt_def ad;
+            gk_adapt_report rep;
+            memset(&ad, 0, sizeof ad);
+            ad.inertial_max = f->o->dem_inertial, ad.unbalanced_max = f->o->dem_unbalanced;
+            ad.n_min = f->o->dem_min, ad.n_max = f->o->dem_max;
+            memset(&rep, 0, sizeof rep);
+            f->status[p] = (int)gk_rve_deform_adaptive(&f->rve[p], dH, &ad, &rep);
+            ns = rep.n_deform + rep.n_relax;
+        } else {
+            ns = mpd_dem_steps(f->o, dH);
+            f->status[p] = (int)gk_rve_deform(&f->rve[p], dH, ns);
+        }
         f->nsub[p] = ns;
         total += ns;
-        f->status[p] = (int)gk_rve_deform(&f->rve[p], dH, ns);
         if (f->status[p]) continue;
         mpd_rve_sigma(&f->rve[p], pts->sigma + 9 * (size_t)p);
         for (k = 0; k < 9; ++k) f->eps[9 * (size_t)p + k] += 0.5 * (dH[k] + dH[3 * (k % 3) + k / 3]);
