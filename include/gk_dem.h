@@ -103,7 +103,7 @@
  *   N lines: "x y r" or "x y z r" (SI units), positions in the cell. */
 typedef struct gk_packing {
     int dim, n;
-    double h[9]; /* cell matrix (a box is diag(Lx, Ly, Lz)); 2D: h22 = 1 */
+    double h[9];     /* cell matrix (a box is diag(Lx, Ly, Lz)); 2D: h22 = 1 */
     double *x, *y, *z, *r;
     gk_allocator alloc;
 } gk_packing;
@@ -114,12 +114,12 @@ typedef enum gk_psd_kind { GK_PSD_UNIFORM = 0, GK_PSD_TABLE_NUMBER = 1, GK_PSD_T
 typedef struct gk_gen_def {
     int dim, n;
     gk_psd_kind psd;
-    double r_min, r_max;     /* GK_PSD_UNIFORM: radii uniform in [r_min, r_max]     */
-    int ntable;              /* table kinds: ntable points (radius, cumulative     */
-    const double *table_r;   /*   fraction passing, by number or by mass), radii   */
-    const double *table_cum; /*   increasing, cum from 0 to 1                       */
-    double packing_fraction; /* of the initial cloud; 0 -> 0.5 (2D), 0.3 (3D)      */
-    double aspect[3];        /* cell edge ratios; 0 -> cube/square                  */
+    double r_min, r_max;      /* GK_PSD_UNIFORM: radii uniform in [r_min, r_max]     */
+    int ntable;               /* table kinds: ntable points (radius, cumulative     */
+    const double *table_r;    /*   fraction passing, by number or by mass), radii   */
+    const double *table_cum;  /*   increasing, cum from 0 to 1                       */
+    double packing_fraction;  /* of the initial cloud; 0 -> 0.5 (2D), 0.3 (3D)      */
+    double aspect[3];         /* cell edge ratios; 0 -> cube/square                  */
     uint64_t seed;
 } gk_gen_def;
 
@@ -133,18 +133,18 @@ typedef enum gk_mass_model { GK_MASS_CYLINDER = 0, GK_MASS_SPHERE = 1 } gk_mass_
 #define GK_RVE_DEF_COOKIE 0x52564531
 
 typedef struct gk_rve_def {
-    int cookie; /* set by gk_rve_def_default()                        */
+    int cookie;               /* set by gk_rve_def_default()                        */
     gk_material mat;
-    double dt;        /* time step [s]; 0 -> dt_factor x critical           */
-    double dt_factor; /* used when dt = 0; 0 -> 0.5                          */
-    double skin;      /* Verlet skin [m]; 0 -> 0.1 x mean radius            */
-    double thickness; /* 2D: disk thickness [m] (seed 000: 0.1)             */
+    double dt;                /* time step [s]; 0 -> dt_factor x critical           */
+    double dt_factor;         /* used when dt = 0; 0 -> 0.5                          */
+    double skin;              /* Verlet skin [m]; 0 -> 0.1 x mean radius            */
+    double thickness;         /* 2D: disk thickness [m] (seed 000: 0.1)             */
     gk_mass_model mass2d;
-    double damping; /* local non-viscous damping alpha in [0, 1)          */
+    double damping;           /* local non-viscous damping alpha in [0, 1)          */
     gk_damp_form damping_form;
-    gk_path_kind path; /* how gk_rve_deform splits I + dH over the steps     */
-    unsigned flags;    /* GK_RVE_*                                           */
-    int threads;       /* threads inside this RVE; <= 1: serial              */
+    gk_path_kind path;        /* how gk_rve_deform splits I + dH over the steps     */
+    unsigned flags;           /* GK_RVE_*                                           */
+    int threads;              /* threads inside this RVE; <= 1: serial              */
     gk_allocator alloc;
 } gk_rve_def;
 
@@ -152,23 +152,23 @@ typedef struct gk_rve {
     int dim, n;
     gk_rve_def def;
     gk_law_consts K;
-    unsigned phys; /* GK_PHYS_* in use                                   */
+    unsigned phys;            /* GK_PHYS_* in use                                   */
     double dt, time, dt_crit;
     long step, rebuilds;
     gk_pcell cell;
-    double L[9];          /* prescribed velocity gradient for gk_rve_step      */
-    double G[9];          /* affine velocity gradient of the last step (E-I)/dt */
-    double volume_factor; /* stress volume = det h x this (2D thickness)       */
+    double L[9];              /* prescribed velocity gradient for gk_rve_step      */
+    double G[9];              /* affine velocity gradient of the last step (E-I)/dt */
+    double volume_factor;     /* stress volume = det h x this (2D thickness)       */
     /* particles: n each, stored in cell-list order */
-    double *s[3];  /* reduced positions                                  */
-    double *s0[3]; /* reduced positions at the last list build           */
-    gk_real *v[3]; /* fluctuating velocity [m/s]                         */
-    gk_real *w[3]; /* fluctuating spin [rad/s] (2D: w[2] only)           */
-    gk_real *f[3]; /* contact force sum of the last step [N]             */
-    gk_real *t[3]; /* contact torque sum of the last step (2D: t[2])     */
+    double *s[3];             /* reduced positions                                  */
+    double *s0[3];            /* reduced positions at the last list build           */
+    gk_real *v[3];            /* fluctuating velocity [m/s]                         */
+    gk_real *w[3];            /* fluctuating spin [rad/s] (2D: w[2] only)           */
+    gk_real *f[3];            /* contact force sum of the last step [N]             */
+    gk_real *t[3];            /* contact torque sum of the last step (2D: t[2])     */
     gk_real *r, *minv, *Iinv;
-    double *theta; /* 2D: accumulated rotation [rad] (incl. cell spin)   */
-    int32_t *id;   /* index in the input packing                         */
+    double *theta;            /* 2D: accumulated rotation [rad] (incl. cell spin)   */
+    int32_t *id;              /* index in the input packing                         */
     double rmin, rmax, mmin, solid_volume, mass_total;
     /* pairs, sorted by (i, j) */
     gk_pairlist pl;
@@ -186,19 +186,19 @@ typedef struct gk_rve {
         gk_pairlist pl;
     } spare;
     gk_cells cells;
-    double h0[9];      /* cell at the last (inner) build                     */
-    double skin;       /* Verlet skin of the outer list [m]                  */
-    double skin_in;    /* skin of the inner list the kernels run over        */
-    gk_pairlist outer; /* candidates within skin, from the cell grid          */
-    double *o0[3];     /* reduced positions at the outer build               */
-    double ho0[9];     /* cell at the outer build                            */
+    double h0[9];             /* cell at the last (inner) build                     */
+    double skin;              /* Verlet skin of the outer list [m]                  */
+    double skin_in;           /* skin of the inner list the kernels run over        */
+    gk_pairlist outer;        /* candidates within skin, from the cell grid          */
+    double *o0[3];            /* reduced positions at the outer build               */
+    double ho0[9];            /* cell at the outer build                            */
     int outer_valid;
     int need_rebuild, diverged;
     /* results of the last step that computed them (the last step of each call) */
-    double stress[9]; /* Love stress, tension-positive [Pa]                 */
-    double stiff[3];  /* Voigt stiffness D_kkkk estimate [Pa]               */
+    double stress[9];         /* Love stress, tension-positive [Pa]                 */
+    double stiff[3];          /* Voigt stiffness D_kkkk estimate [Pa]               */
     int ncontacts;
-    double fc_mean; /* mean |F| over contacts                             */
+    double fc_mean;           /* mean |F| over contacts                             */
     int servo_on;
     gk_servo servo;
     gk_err err;
@@ -212,13 +212,13 @@ typedef struct gk_rve_state {
 } gk_rve_state;
 
 typedef struct gk_consolidate_def {
-    double pressure;        /* target isotropic stress, compression-positive [Pa] (> 0) */
-    double friction;        /* Coulomb coefficient while consolidating (0 = dense)      */
-    double stress_tol;      /* relative tolerance on every sigma_kk; 0 -> 1e-3           */
-    double unbalanced_tol;  /* unbalanced force ratio to reach; 0 -> 1e-3                */
-    double max_strain_rate; /* [1/s]; 0 -> inertial number 1e-2 at the target pressure   */
-    long max_steps;         /* 0 -> 2 000 000                                            */
-    double damping;         /* local damping while consolidating; 0 -> the RVE's own     */
+    double pressure;          /* target isotropic stress, compression-positive [Pa] (> 0) */
+    double friction;          /* Coulomb coefficient while consolidating (0 = dense)      */
+    double stress_tol;        /* relative tolerance on every sigma_kk; 0 -> 1e-3           */
+    double unbalanced_tol;    /* unbalanced force ratio to reach; 0 -> 1e-3                */
+    double max_strain_rate;   /* [1/s]; 0 -> inertial number 1e-2 at the target pressure   */
+    long max_steps;           /* 0 -> 2 000 000                                            */
+    double damping;           /* local damping while consolidating; 0 -> the RVE's own     */
 } gk_consolidate_def;
 
 typedef struct gk_consolidate_report {
@@ -237,8 +237,7 @@ GKDEF gk_result gk_packing_read(const char *path, gk_packing *pk, const gk_alloc
 GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *pk, const gk_allocator *alloc,
                                  gk_err *err);
 GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const char *comment, gk_err *err);
-GKDEF gk_result gk_packing_generate(gk_packing *pk, const gk_gen_def *def, const gk_allocator *alloc,
-                                    gk_err *err);
+GKDEF gk_result gk_packing_generate(gk_packing *pk, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err);
 
 /* RVE */
 GKDEF gk_rve_def gk_rve_def_default(void);
@@ -260,7 +259,7 @@ GKDEF void gk_rve_stress(const gk_rve *rve, double sigma[9]);
 /* recompute forces at the current positions without advancing (zero-length
  * step: history and positions unchanged), then stress etc. are current */
 GKDEF gk_result gk_rve_refresh(gk_rve *rve);
-GKDEF double gk_rve_volume(const gk_rve *rve);         /* stress volume                */
+GKDEF double gk_rve_volume(const gk_rve *rve);     /* stress volume                */
 GKDEF double gk_rve_kinetic_energy(const gk_rve *rve); /* of the fluctuations     */
 GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]);
 GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *pk, const gk_allocator *alloc, gk_err *err);
@@ -379,14 +378,13 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
         if (!gk__next_line(&L)) return gk_err_set(err, GK_ERR_FORMAT, "empty packing: no header line");
     } while (gk__blank(L.line));
     nh = gk__parse_doubles(L.line, hd, 5, &bad);
-    if (bad || nh < 4)
-        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: header must be 'dim N Lx Ly [Lz]'", L.lineno);
+    if (bad || nh < 4) return gk_err_set(err, GK_ERR_FORMAT, "line %ld: header must be 'dim N Lx Ly [Lz]'", L.lineno);
     if (hd[0] != 2.0 && hd[0] != 3.0)
         return gk_err_set(err, GK_ERR_FORMAT, "line %ld: dimension %g (must be 2 or 3)", L.lineno, hd[0]);
     dim = (int)hd[0];
     if (nh != dim + 2)
-        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: a %dD header has %d numbers, found %d", L.lineno,
-                          dim, dim + 2, nh);
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: a %dD header has %d numbers, found %d", L.lineno, dim,
+                          dim + 2, nh);
     if (!(hd[1] >= 1 && hd[1] <= 2e9) || (double)(int)hd[1] != hd[1])
         return gk_err_set(err, GK_ERR_FORMAT, "line %ld: particle count %g invalid", L.lineno, hd[1]);
     n = (int)hd[1];
@@ -409,8 +407,7 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
                 int nc = gk__parse_doubles(s + 7, hc, 9, &bad), a, b;
                 if (bad || nc != dim * dim) {
                     gk_packing_free(&pk);
-                    return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno,
-                                      dim * dim);
+                    return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno, dim * dim);
                 }
                 gk_m3_identity(h);
                 for (a = 0; a < dim; ++a)
@@ -422,25 +419,21 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
         nv = gk__parse_doubles(s, vals, 8, &bad);
         if (bad || nv != dim + 1) {
             gk_packing_free(&pk);
-            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: expected %d numbers (%s r), found %s", L.lineno,
-                              dim + 1, dim == 2 ? "x y" : "x y z",
-                              bad ? "a non-number" : "a different count");
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: expected %d numbers (%s r), found %s", L.lineno, dim + 1,
+                              dim == 2 ? "x y" : "x y z", bad ? "a non-number" : "a different count");
         }
         if (k >= n) {
             gk_packing_free(&pk);
-            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced",
-                              L.lineno, n);
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced", L.lineno, n);
         }
         for (nv = 0; nv <= dim; ++nv)
             if (!isfinite(vals[nv])) {
                 gk_packing_free(&pk);
-                return gk_err_set(err, GK_ERR_NAN, "line %ld: particle %d has a non-finite value", L.lineno,
-                                  k);
+                return gk_err_set(err, GK_ERR_NAN, "line %ld: particle %d has a non-finite value", L.lineno, k);
             }
         if (!(vals[dim] > 0.0)) {
             gk_packing_free(&pk);
-            return gk_err_set(err, GK_ERR_RADIUS, "line %ld: particle %d has radius %g <= 0", L.lineno, k,
-                              vals[dim]);
+            return gk_err_set(err, GK_ERR_RADIUS, "line %ld: particle %d has radius %g <= 0", L.lineno, k, vals[dim]);
         }
         pk.x[k] = vals[0];
         pk.y[k] = vals[1];
@@ -539,12 +532,9 @@ GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const c
     return GK_OK;
 }
 
-static double gk__particle_volume(int dim, double r) {
-    return dim == 2 ? GK_PI * r * r : 4.0 / 3.0 * GK_PI * r * r * r;
-}
+static double gk__particle_volume(int dim, double r) { return dim == 2 ? GK_PI * r * r : 4.0 / 3.0 * GK_PI * r * r * r; }
 
-GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, const gk_allocator *alloc,
-                                    gk_err *err) {
+GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err) {
     gk_packing pk;
     gk_rng rng;
     double vs = 0.0, phi, side, asp[3], V, *rr;
@@ -567,8 +557,8 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
                                   def->table_r[k]);
             if (!(def->table_cum[k] >= 0.0 && def->table_cum[k] <= 1.0) ||
                 (k && def->table_cum[k] < def->table_cum[k - 1]))
-                return gk_err_set(err, GK_ERR_ARG, "table cumulative fraction %d (%g) must rise from 0 to 1",
-                                  k, def->table_cum[k]);
+                return gk_err_set(err, GK_ERR_ARG, "table cumulative fraction %d (%g) must rise from 0 to 1", k,
+                                  def->table_cum[k]);
         }
         if (def->table_cum[0] != 0.0 || def->table_cum[def->ntable - 1] != 1.0)
             return gk_err_set(err, GK_ERR_ARG, "table cumulative fractions must start at 0 and end at 1");
@@ -652,8 +642,7 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
                         for (o0 = -1; o0 <= 1 && !clash; ++o0) {
                             int cx = (bi[0] + o0 + nbin[0]) % nbin[0], cy = (bi[1] + o1 + nbin[1]) % nbin[1];
                             int cz = (bi[2] + o2 + nbin[2]) % nbin[2], q;
-                            for (q = head[cx + nbin[0] * (cy + nbin[1] * cz)]; q >= 0 && !clash;
-                                 q = next[q]) {
+                            for (q = head[cx + nbin[0] * (cy + nbin[1] * cz)]; q >= 0 && !clash; q = next[q]) {
                                 double ds[3], d[3], R = rr[q] + rr[placed];
                                 ds[0] = sx[q] - s[0];
                                 ds[1] = sy[q] - s[1];
@@ -675,10 +664,9 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
                 }
             }
             if (!ok) {
-                res = gk_err_set(
-                    err, GK_ERR_ARG,
-                    "could not place particle %d of %d without overlap: lower packing_fraction (%g)", placed,
-                    n, phi);
+                res = gk_err_set(err, GK_ERR_ARG,
+                                 "could not place particle %d of %d without overlap: lower packing_fraction (%g)",
+                                 placed, n, phi);
                 break;
             }
             ++placed;
@@ -834,8 +822,7 @@ static gk_result gk__spare_reserve(gk_rve *rve, size_t cap) {
             if (gk_realloc(a, (void **)&rve->spare.tci[k], 0, cap, sz)) return GK_ERR_ALLOC;
             if (gk_realloc(a, (void **)&rve->spare.tcj[k], 0, cap, sz)) return GK_ERR_ALLOC;
         }
-        if (GK__HAS_ROLL(rve) && (dim == 3 || k == 2) &&
-            gk_realloc(a, (void **)&rve->spare.mr[k], 0, cap, sz))
+        if (GK__HAS_ROLL(rve) && (dim == 3 || k == 2) && gk_realloc(a, (void **)&rve->spare.mr[k], 0, cap, sz))
             return GK_ERR_ALLOC;
     }
     if (gk_realloc(a, (void **)&rve->spare.cs, 0, cap, 1)) return GK_ERR_ALLOC;
@@ -886,8 +873,7 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     if (res) return res;
     dim = pk->dim;
     n = pk->n;
-    if (dim != 2 && dim != 3)
-        return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
+    if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "packing has %d particles", n);
     if (!(def->damping >= 0.0 && def->damping < 1.0))
         return gk_err_set(err, GK_ERR_ARG, "local damping %g outside [0, 1)", def->damping);
@@ -897,10 +883,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         return gk_err_set(err, GK_ERR_ARG, "unknown deformation path %d", (int)def->path);
     if (dim == 2 && def->mass2d == GK_MASS_CYLINDER && !(def->thickness > 0.0))
         return gk_err_set(err, GK_ERR_ARG, "2D cylinder masses need thickness > 0 (got %g)", def->thickness);
-    if (!(def->dt >= 0.0) || !isfinite(def->dt))
-        return gk_err_set(err, GK_ERR_DT, "time step %g invalid", def->dt);
-    if (!(def->skin >= 0.0) || !isfinite(def->skin))
-        return gk_err_set(err, GK_ERR_ARG, "skin %g invalid", def->skin);
+    if (!(def->dt >= 0.0) || !isfinite(def->dt)) return gk_err_set(err, GK_ERR_DT, "time step %g invalid", def->dt);
+    if (!(def->skin >= 0.0) || !isfinite(def->skin)) return gk_err_set(err, GK_ERR_ARG, "skin %g invalid", def->skin);
     if (!(def->dt_factor >= 0.0 && def->dt_factor <= 1.0))
         return gk_err_set(err, GK_ERR_DT, "dt_factor %g outside (0, 1]", def->dt_factor);
     gk_m3_copy(pk->h, hpk);
@@ -914,8 +898,7 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         double rp = pk->r[p];
         if (!isfinite(pk->x[p]) || !isfinite(pk->y[p]) || (dim == 3 && (!pk->z || !isfinite(pk->z[p]))))
             return gk_err_set(err, GK_ERR_NAN, "particle %d has a NaN or infinite position", p);
-        if (!(rp > 0.0) || !isfinite(rp))
-            return gk_err_set(err, GK_ERR_RADIUS, "particle %d has radius %g", p, rp);
+        if (!(rp > 0.0) || !isfinite(rp)) return gk_err_set(err, GK_ERR_RADIUS, "particle %d has radius %g", p, rp);
         if (!(def->flags & GK_RVE_WRAP)) {
             double x[3], s[3];
             x[0] = pk->x[p];
@@ -924,10 +907,9 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
             gk_m3_matvec(R.cell.hinv, x, s);
             for (k = 0; k < dim; ++k)
                 if (s[k] < -1e-9 || s[k] >= 1.0 + 1e-9)
-                    return gk_err_set(
-                        err, GK_ERR_OUTSIDE,
-                        "particle %d at (%g, %g, %g) is outside the cell (set GK_RVE_WRAP to wrap)", p, x[0],
-                        x[1], x[2]);
+                    return gk_err_set(err, GK_ERR_OUTSIDE,
+                                      "particle %d at (%g, %g, %g) is outside the cell (set GK_RVE_WRAP to wrap)", p,
+                                      x[0], x[1], x[2]);
         }
     }
     R.dim = dim;
@@ -938,8 +920,7 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     if (!(def->flags & GK_RVE_NO_ROTATION) && (R.phys & (GK_PHYS_TANGENT | GK_PHYS_ROLLING)))
         R.phys |= GK_PHYS_ROTATION;
     if ((R.phys & GK_PHYS_ROLLING) && !(R.phys & GK_PHYS_ROTATION))
-        return gk_err_set(err, GK_ERR_ARG,
-                          "rolling resistance needs rotating particles (GK_RVE_NO_ROTATION is set)");
+        return gk_err_set(err, GK_ERR_ARG, "rolling resistance needs rotating particles (GK_RVE_NO_ROTATION is set)");
     R.volume_factor = dim == 2 ? (def->thickness > 0.0 ? def->thickness : 1.0) : 1.0;
     /* particle order: cell-list order for locality */
     {
@@ -976,8 +957,7 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         if (res) {
             for (k = 0; k < 3; ++k) gk_free(&def->alloc, tmp[k]);
             gk_free(&def->alloc, perm);
-            return gk_err_set(err, res == GK_ERR_ALLOC ? GK_ERR_ALLOC : res, "could not order %d particles",
-                              n);
+            return gk_err_set(err, res == GK_ERR_ALLOC ? GK_ERR_ALLOC : res, "could not order %d particles", n);
         }
         /* allocate */
         for (k = 0; k < 3; ++k) {
@@ -1080,8 +1060,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         dtc = R.dt_crit;
         if (def->dt > 0.0) {
             if (def->dt > dtc)
-                res = gk_err_set(&R.err, GK_ERR_DT,
-                                 "time step %g s is above the critical %g s (seed 000 eq 19)", def->dt, dtc);
+                res = gk_err_set(&R.err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)",
+                                 def->dt, dtc);
             R.dt = def->dt;
         } else {
             R.dt = (def->dt_factor > 0.0 ? def->dt_factor : 0.5) * dtc;
@@ -1110,8 +1090,7 @@ static double gk__list_margin(const gk_rve *rve, const double href[9], double *c
     gk_m3_transpose(A, At);
     gk_m3_mul(At, A, AtA);
     if (dim == 2) {
-        double a = AtA[0], b = AtA[1], d = AtA[4],
-               lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
+        double a = AtA[0], b = AtA[1], d = AtA[4], lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
         smin = lmin > 0.0 ? sqrt(lmin) : 0.0;
     } else {
         double val[3], vec[9];
@@ -1119,8 +1098,7 @@ static double gk__list_margin(const gk_rve *rve, const double href[9], double *c
         smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
     }
     for (p = 0; p < rve->n; ++p) {
-        double e0 = rve->s[0][p] - sref[0][p], e1 = rve->s[1][p] - sref[1][p],
-               e2 = dim == 3 ? rve->s[2][p] - sref[2][p] : 0;
+        double e0 = rve->s[0][p] - sref[0][p], e1 = rve->s[1][p] - sref[1][p], e2 = dim == 3 ? rve->s[2][p] - sref[2][p] : 0;
         double u0 = h[0] * e0 + h[1] * e1 + h[2] * e2, u1 = h[3] * e0 + h[4] * e1 + h[5] * e2;
         double u2 = dim == 3 ? h[6] * e0 + h[7] * e1 + h[8] * e2 : 0.0, d2 = u0 * u0 + u1 * u1 + u2 * u2;
         if (d2 > m2) m2 = d2;
@@ -1136,11 +1114,10 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         /* Hertz stiffens with load: the critical step shrinks as overlaps grow */
         double dtc = gk__dt_critical(rve);
         if (rve->dt > dtc)
-            return gk_err_set(
-                &rve->err, GK_ERR_DT,
-                "time step %g s now exceeds the critical %g s at the current overlaps (Hertz stiffens "
-                "with load): restore a saved state and use a smaller dt",
-                rve->dt, dtc);
+            return gk_err_set(&rve->err, GK_ERR_DT,
+                              "time step %g s now exceeds the critical %g s at the current overlaps (Hertz stiffens "
+                              "with load): restore a saved state and use a smaller dt",
+                              rve->dt, dtc);
         rve->dt_crit = dtc;
     }
     int dim = rve->dim, n = rve->n, k, p, c, oc, nft = dim == 2 ? 1 : 3;
@@ -1151,11 +1128,10 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
     gk_pcell_widths(&rve->cell, w);
     for (k = 0; k < dim; ++k)
         if (!(2.0 * (2.0 * rve->rmax + rve->skin) < w[k]))
-            return gk_err_set(
-                &rve->err, GK_ERR_CELL,
-                "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
-                "too far for this many particles)",
-                w[k], 2.0 * rve->rmax + rve->skin);
+            return gk_err_set(&rve->err, GK_ERR_CELL,
+                              "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
+                              "too far for this many particles)",
+                              w[k], 2.0 * rve->rmax + rve->skin);
     if (!rve->outer_valid || gk__list_margin(rve, rve->ho0, rve->o0, rve->skin) <= rve->skin_in) {
         /* outer list from the cell grid (positions are in [0,1): gk__wrap) */
         for (k = 0; k < 3; ++k) sp[k] = rve->s[k < dim ? k : 0];
@@ -1174,8 +1150,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
      * written into the spare list and spare per-pair arrays */
     nl = rve->spare.pl;
     if (gk_pairlist_reserve(&nl, (size_t)rve->outer.n + 1, (size_t)n) ||
-        gk__spare_reserve(rve, (size_t)rve->outer.n + 1) ||
-        gk__pairs_reserve(rve, (size_t)rve->outer.n + 1, (size_t)rve->pl.n)) {
+        gk__spare_reserve(rve, (size_t)rve->outer.n + 1) || gk__pairs_reserve(rve, (size_t)rve->outer.n + 1, (size_t)rve->pl.n)) {
         rve->spare.pl = nl;
         return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", rve->outer.n);
     }
@@ -1191,8 +1166,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
             const double *sx = rve->s[0], *sy = rve->s[1];
             for (c = 0; c < no; ++c) {
                 int i = oi[c], j = oj[c];
-                double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i], dx, dy,
-                       cut = (double)r[i] + (double)r[j] + skin;
+                double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i], dx, dy, cut = (double)r[i] + (double)r[j] + skin;
                 dsx -= rint(dsx);
                 dsy -= rint(dsy);
                 dx = h[0] * dsx + h[1] * dsy;
@@ -1273,8 +1247,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         rve->spare.cap = cap;
         rve->pl = nl;
         rve->spare.pl = t;
-        if (rve->pcap > cap &&
-            gk_realloc(&rve->def.alloc, (void **)&rve->jlist, 0, rve->pcap, sizeof(int32_t)))
+        if (rve->pcap > cap && gk_realloc(&rve->def.alloc, (void **)&rve->jlist, 0, rve->pcap, sizeof(int32_t)))
             return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", nl.n);
     }
     /* pairs where p is j, ascending pair index (counting sort by j) */
@@ -1293,17 +1266,16 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
 
 /* ---------------------------------------------------------------- forces */
 typedef struct gk__stepctx {
-    double hd[9];  /* cell matrix (positions are double)                   */
-    gk_real G[9];  /* affine velocity gradient of this step                 */
-    gk_real wa[3]; /* affine spin (2D: wa[2])                               */
+    double hd[9];   /* cell matrix (positions are double)                   */
+    gk_real G[9];   /* affine velocity gradient of this step                 */
+    gk_real wa[3];  /* affine spin (2D: wa[2])                               */
     gk_real dt;
-    int scatter; /* add pair forces to the particles in the force loop    */
-    int store;   /* keep per-pair forces and torques (stress, threads)    */
+    int scatter;    /* add pair forces to the particles in the force loop    */
+    int store;      /* keep per-pair forces and torques (stress, threads)    */
 } gk__stepctx;
 
 /* pair forces, scalar reference: writes fc, tci, tcj, ft, mr, cs for pairs [c0, c1) */
-GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
-                                       unsigned fl) {
+GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
     const double *sx = rve->s[0], *sy = rve->s[1];
     const gk_real *vx = rve->v[0], *vy = rve->v[1], *r = rve->r, *minv = rve->minv;
@@ -1326,8 +1298,8 @@ GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0
         rvy = (vy[j] - vy[i]) + (x->G[3] * dx + x->G[4] * dy);
         wi = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[i] : x->wa[2];
         wj = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[j] : x->wa[2];
-        gk_contact_2d(&rve->K, law, fl, dx, dy, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], rvx,
-                      rvy, wi, wj, x->dt, ft + c, (fl & GK_PHYS_ROLLING) ? mr + c : &dummy, cs + c, &o);
+        gk_contact_2d(&rve->K, law, fl, dx, dy, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], rvx, rvy, wi,
+                      wj, x->dt, ft + c, (fl & GK_PHYS_ROLLING) ? mr + c : &dummy, cs + c, &o);
         if (x->store) {
             fcx[c] = o.f[0];
             fcy[c] = o.f[1];
@@ -1349,8 +1321,7 @@ GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0
     }
 }
 
-GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
-                                       unsigned fl) {
+GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
     const gk_real *r = rve->r, *minv = rve->minv;
     gk_real dummy[3] = {0, 0, 0};
@@ -1364,19 +1335,17 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
             ds[k] = rve->s[k][j] - rve->s[k][i];
             ds[k] -= rint(ds[k]);
         }
+        for (k = 0; k < 3; ++k) d[k] = (gk_real)(x->hd[3 * k] * ds[0] + x->hd[3 * k + 1] * ds[1] + x->hd[3 * k + 2] * ds[2]);
         for (k = 0; k < 3; ++k)
-            d[k] = (gk_real)(x->hd[3 * k] * ds[0] + x->hd[3 * k + 1] * ds[1] + x->hd[3 * k + 2] * ds[2]);
-        for (k = 0; k < 3; ++k)
-            vr[k] = (rve->v[k][j] - rve->v[k][i]) +
-                    (x->G[3 * k] * d[0] + x->G[3 * k + 1] * d[1] + x->G[3 * k + 2] * d[2]);
+            vr[k] = (rve->v[k][j] - rve->v[k][i]) + (x->G[3 * k] * d[0] + x->G[3 * k + 1] * d[1] + x->G[3 * k + 2] * d[2]);
         for (k = 0; k < 3; ++k) {
             wi[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][i] : x->wa[k];
             wj[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][j] : x->wa[k];
             hist[k] = rve->ft[k][c];
             mh[k] = (fl & GK_PHYS_ROLLING) ? rve->mr[k][c] : dummy[k];
         }
-        gk_contact_3d(&rve->K, law, fl, d, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], vr, wi, wj,
-                      x->dt, hist, mh, rve->cs + c, &o);
+        gk_contact_3d(&rve->K, law, fl, d, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], vr, wi, wj, x->dt,
+                      hist, mh, rve->cs + c, &o);
         for (k = 0; k < 3; ++k) {
             rve->ft[k][c] = hist[k];
             if (fl & GK_PHYS_ROLLING) rve->mr[k][c] = mh[k];
@@ -1409,15 +1378,14 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
 #if GK_VR_W > 1
 /* branch vectors d = h (ds - round(ds)) of GK_VR_W pairs, from double
  * positions; H = the cell matrix broadcast once per call */
-GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const int32_t *ii,
-                                     const int32_t *jj, int dim, gk_vr d[3]) {
+GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const int32_t *ii, const int32_t *jj,
+                                     int dim, gk_vr d[3]) {
     gk_vd dd[2][3];
     int hf, k;
     for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
         gk_vd ds[3];
         for (k = 0; k < dim; ++k) {
-            ds[k] = gk_vd_sub(gk_vd_gather(rve->s[k], jj + hf * GK_VD_W),
-                              gk_vd_gather(rve->s[k], ii + hf * GK_VD_W));
+            ds[k] = gk_vd_sub(gk_vd_gather(rve->s[k], jj + hf * GK_VD_W), gk_vd_gather(rve->s[k], ii + hf * GK_VD_W));
             ds[k] = gk_vd_sub(ds[k], gk_vd_round(ds[k]));
         }
         for (k = 0; k < dim; ++k) {
@@ -1436,8 +1404,8 @@ GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const 
 }
 
 /* stiffness of GK_VR_W contacts (gk_contact_stiffness) */
-GK_FORCE_INLINE void gk__simd_stiffness(const gk_law_consts *K, gk_law law, gk_vr ri, gk_vr rj, gk_vr delta,
-                                        gk_vr *kn, gk_vr *fn, gk_vr *kt) {
+GK_FORCE_INLINE void gk__simd_stiffness(const gk_law_consts *K, gk_law law, gk_vr ri, gk_vr rj, gk_vr delta, gk_vr *kn,
+                                        gk_vr *fn, gk_vr *kt) {
     gk_vr rr = gk_vr_mul(ri, rj), rs = gk_vr_div(gk_vr_add(rr, rr), gk_vr_add(ri, rj));
     if (law == GK_LAW_LINEAR) {
         gk_vr k = K->kn_const > 0 ? gk_vr_set1(K->kn_const) : gk_vr_mul(gk_vr_set1(K->young), rs);
@@ -1455,9 +1423,9 @@ GK_FORCE_INLINE void gk__simd_stiffness(const gk_law_consts *K, gk_law law, gk_v
 }
 
 /* 8 mask bits -> 8 bytes of 0/1 (bit l -> byte l): a constant table */
-#define GK__E(b)                                                                                        \
-    ((uint64_t)((b) >> 0 & 1) | (uint64_t)((b) >> 1 & 1) << 8 | (uint64_t)((b) >> 2 & 1) << 16 |        \
-     (uint64_t)((b) >> 3 & 1) << 24 | (uint64_t)((b) >> 4 & 1) << 32 | (uint64_t)((b) >> 5 & 1) << 40 | \
+#define GK__E(b)                                                                                                        \
+    ((uint64_t)((b) >> 0 & 1) | (uint64_t)((b) >> 1 & 1) << 8 | (uint64_t)((b) >> 2 & 1) << 16 |                       \
+     (uint64_t)((b) >> 3 & 1) << 24 | (uint64_t)((b) >> 4 & 1) << 32 | (uint64_t)((b) >> 5 & 1) << 40 |                \
      (uint64_t)((b) >> 6 & 1) << 48 | (uint64_t)((b) >> 7 & 1) << 56)
 #define GK__R4(b) GK__E(b), GK__E((b) + 1), GK__E((b) + 2), GK__E((b) + 3)
 #define GK__R16(b) GK__R4(b), GK__R4((b) + 4), GK__R4((b) + 8), GK__R4((b) + 12)
@@ -1483,8 +1451,7 @@ GK_FORCE_INLINE void gk__simd_state(unsigned char *cs, gk_vrm in, gk_vrm slide, 
 }
 
 GK_FORCE_INLINE void gk__scatter_buf_2d(gk_rve *rve, const int32_t *ii, const int32_t *jj, const gk_real *bx,
-                                        const gk_real *by, const gk_real *bi, const gk_real *bj,
-                                        unsigned rot) {
+                                        const gk_real *by, const gk_real *bi, const gk_real *bj, unsigned rot) {
     gk_real *f0 = rve->f[0], *f1 = rve->f[1], *t2 = rve->t[2];
     int l;
     for (l = 0; l < GK_VR_W; ++l) {
@@ -1500,9 +1467,8 @@ GK_FORCE_INLINE void gk__scatter_buf_2d(gk_rve *rve, const int32_t *ii, const in
     }
 }
 
-GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const int32_t *jj,
-                                        gk_real bF[3][GK_VR_W], gk_real bI[3][GK_VR_W],
-                                        gk_real bJ[3][GK_VR_W], unsigned rot) {
+GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const int32_t *jj, gk_real bF[3][GK_VR_W],
+                                        gk_real bI[3][GK_VR_W], gk_real bJ[3][GK_VR_W], unsigned rot) {
     int l, k;
     for (l = 0; l < GK_VR_W; ++l) {
         int i = ii[l], j = jj[l];
@@ -1517,16 +1483,12 @@ GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const in
     }
 }
 
-GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
-                                        unsigned fl) {
+GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
     const gk_law_consts *K = &rve->K;
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
-    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5),
-                dt = gk_vr_set1(x->dt);
-    const gk_vr G0 = gk_vr_set1(x->G[0]), G1 = gk_vr_set1(x->G[1]), G3 = gk_vr_set1(x->G[3]),
-                G4 = gk_vr_set1(x->G[4]);
-    const gk_vr wa = gk_vr_set1(x->wa[2]), mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2),
-                zt2 = gk_vr_set1(K->zt2);
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5), dt = gk_vr_set1(x->dt);
+    const gk_vr G0 = gk_vr_set1(x->G[0]), G1 = gk_vr_set1(x->G[1]), G3 = gk_vr_set1(x->G[3]), G4 = gk_vr_set1(x->G[4]);
+    const gk_vr wa = gk_vr_set1(x->wa[2]), mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
     const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta);
     gk_real bx[GK_VR_W], by[GK_VR_W], bi[GK_VR_W], bj[GK_VR_W];
     gk_vd H[9];
@@ -1556,8 +1518,7 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
                        gk_vr_add(gk_vr_mul(G3, d[0]), gk_vr_mul(G4, d[1])));
         vn = gk_vr_add(gk_vr_mul(vx, nx), gk_vr_mul(vy, ny));
         if (fl & GK_PHYS_VISCOUS) {
-            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)),
-                  mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
+            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)), mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
             mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
             fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(zn2, gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
         }
@@ -1624,8 +1585,7 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
         if (x->scatter) {
             /* scatter the previous block now (its buffer stores have retired: no
              * store-forwarding stall) and buffer this one; pair order is kept */
-            if (pend >= 0)
-                gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
+            if (pend >= 0) gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
             gk_vr_storeu(bx, fx);
             gk_vr_storeu(by, fy);
             if (fl & GK_PHYS_ROTATION) {
@@ -1658,12 +1618,10 @@ GK_FORCE_INLINE void gk__simd_rotate(const gk_vr n[3], gk_vr a, gk_vr h[3]) {
     for (k = 0; k < 3; ++k) h[k] = gk_vr_select(has, gk_vr_select(pos, gk_vr_mul(p[k], sc), zero), h[k]);
 }
 
-GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
-                                        unsigned fl) {
+GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
     const gk_law_consts *K = &rve->K;
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
-    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5),
-                dt = gk_vr_set1(x->dt);
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5), dt = gk_vr_set1(x->dt);
     const gk_vr mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
     const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta), halfdt = gk_vr_mul(half, dt);
     gk_vr G[9], wa[3];
@@ -1703,8 +1661,7 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
         }
         vn = gk_vr_add(gk_vr_add(gk_vr_mul(v[0], n[0]), gk_vr_mul(v[1], n[1])), gk_vr_mul(v[2], n[2]));
         if (fl & GK_PHYS_VISCOUS) {
-            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)),
-                  mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
+            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)), mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
             mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
             fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(zn2, gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
         }
@@ -1721,8 +1678,7 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
             vc[0] = gk_vr_sub(v[0], gk_vr_sub(gk_vr_mul(sw[1], n[2]), gk_vr_mul(sw[2], n[1])));
             vc[1] = gk_vr_sub(v[1], gk_vr_sub(gk_vr_mul(sw[2], n[0]), gk_vr_mul(sw[0], n[2])));
             vc[2] = gk_vr_sub(v[2], gk_vr_sub(gk_vr_mul(sw[0], n[1]), gk_vr_mul(sw[1], n[0])));
-            vcn =
-                gk_vr_add(gk_vr_add(gk_vr_mul(vc[0], n[0]), gk_vr_mul(vc[1], n[1])), gk_vr_mul(vc[2], n[2]));
+            vcn = gk_vr_add(gk_vr_add(gk_vr_mul(vc[0], n[0]), gk_vr_mul(vc[1], n[1])), gk_vr_mul(vc[2], n[2]));
             for (k = 0; k < 3; ++k) {
                 vt[k] = gk_vr_sub(vc[k], gk_vr_mul(vcn, n[k]));
                 fh[k] = gk_vr_load(rve->ft[k] + c);
@@ -1738,17 +1694,15 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
             }
             fnp = gk_vr_max(fn, zero);
             cap = gk_vr_mul(mu, fnp);
-            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(tot[0], tot[0]), gk_vr_mul(tot[1], tot[1])),
-                           gk_vr_mul(tot[2], tot[2]));
+            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(tot[0], tot[0]), gk_vr_mul(tot[1], tot[1])), gk_vr_mul(tot[2], tot[2]));
             slide = gk_vr_gt(m2, gk_vr_mul(cap, cap));
             if (gk_vrm_any(slide)) {
                 gk_vr sc = gk_vr_div(cap, gk_vr_sqrt(m2));
                 for (k = 0; k < 3; ++k) {
                     gk_vr t = gk_vr_mul(tot[k], sc);
                     tot[k] = gk_vr_select(slide, t, tot[k]);
-                    f[k] = gk_vr_select(
-                        slide, (fl & GK_PHYS_VISCOUS) ? gk_vr_add(tot[k], gk_vr_mul(gt, vt[k])) : tot[k],
-                        f[k]);
+                    f[k] = gk_vr_select(slide, (fl & GK_PHYS_VISCOUS) ? gk_vr_add(tot[k], gk_vr_mul(gt, vt[k])) : tot[k],
+                                        f[k]);
                 }
             }
             for (k = 0; k < 3; ++k) {
@@ -1774,14 +1728,11 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
                 wr[k] = gk_vr_sub(wj[k], wi[k]);
                 mh[k] = gk_vr_load(rve->mr[k] + c);
             }
-            wrn =
-                gk_vr_add(gk_vr_add(gk_vr_mul(wr[0], n[0]), gk_vr_mul(wr[1], n[1])), gk_vr_mul(wr[2], n[2]));
+            wrn = gk_vr_add(gk_vr_add(gk_vr_mul(wr[0], n[0]), gk_vr_mul(wr[1], n[1])), gk_vr_mul(wr[2], n[2]));
             gk__simd_rotate(n, twist, mh);
             for (k = 0; k < 3; ++k)
-                mh[k] =
-                    gk_vr_sub(mh[k], gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wr[k], gk_vr_mul(wrn, n[k]))), dt));
-            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(mh[0], mh[0]), gk_vr_mul(mh[1], mh[1])),
-                           gk_vr_mul(mh[2], mh[2]));
+                mh[k] = gk_vr_sub(mh[k], gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wr[k], gk_vr_mul(wrn, n[k]))), dt));
+            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(mh[0], mh[0]), gk_vr_mul(mh[1], mh[1])), gk_vr_mul(mh[2], mh[2]));
             over = gk_vr_gt(m2, gk_vr_mul(capr, capr));
             if (gk_vrm_any(over)) {
                 gk_vr sc = gk_vr_div(capr, gk_vr_sqrt(m2));
@@ -1825,29 +1776,29 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
 #endif /* GK_VR_W > 1 */
 
 /* instantiate the kernel with constant law and flags (pay only for what is on) */
-#define GK__DISPATCH(fn, rve, x, c0, c1)                                               \
-    do {                                                                               \
-        unsigned fl_ = (rve)->phys;                                                    \
-        gk_law law_ = (rve)->def.mat.law;                                              \
-        if (law_ == GK_LAW_LINEAR) {                                                   \
-            if (fl_ == 0u)                                                             \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, 0u);                                 \
-            else if (fl_ == GK_PHYS_TANGENT)                                           \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT);                    \
-            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                      \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION); \
-            else                                                                       \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, fl_);                                \
-        } else {                                                                       \
-            if (fl_ == 0u)                                                             \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, 0u);                                  \
-            else if (fl_ == GK_PHYS_TANGENT)                                           \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT);                     \
-            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                      \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT | GK_PHYS_ROTATION);  \
-            else                                                                       \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, fl_);                                 \
-        }                                                                              \
+#define GK__DISPATCH(fn, rve, x, c0, c1)                                                                              \
+    do {                                                                                                               \
+        unsigned fl_ = (rve)->phys;                                                                                    \
+        gk_law law_ = (rve)->def.mat.law;                                                                              \
+        if (law_ == GK_LAW_LINEAR) {                                                                                   \
+            if (fl_ == 0u)                                                                                             \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, 0u);                                                                 \
+            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT);                                                    \
+            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                 \
+            else                                                                                                       \
+                fn(rve, x, c0, c1, GK_LAW_LINEAR, fl_);                                                                \
+        } else {                                                                                                       \
+            if (fl_ == 0u)                                                                                             \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, 0u);                                                                  \
+            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT);                                                     \
+            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                  \
+            else                                                                                                       \
+                fn(rve, x, c0, c1, GK_LAW_HERTZ, fl_);                                                                 \
+        }                                                                                                              \
     } while (0)
 
 static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
@@ -1890,8 +1841,7 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
         GK_OMP(parallel for num_threads(nth) schedule(static))
         for (b = 0; b < nth * 4; ++b) {
             /* chunk starts on a multiple of 16 pairs: aligned SIMD loads, same lanes as serial */
-            long c0 = ((long)nc * b / (nth * 4)) & ~15L,
-                 c1 = b + 1 == nth * 4 ? nc : ((long)nc * (b + 1) / (nth * 4)) & ~15L;
+            long c0 = ((long)nc * b / (nth * 4)) & ~15L, c1 = b + 1 == nth * 4 ? nc : ((long)nc * (b + 1) / (nth * 4)) & ~15L;
             gk__forces_range(rve, x, (int)c0, (int)c1);
         }
         GK_OMP(parallel for num_threads(nth) schedule(static))
@@ -1909,8 +1859,7 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
  * (gk__scatter_*), in pair order, which is the same order and so gives the
  * same bits. */
 GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int dim, const int rot) {
-    const int32_t *GK_RESTRICT start = rve->pl.start, *GK_RESTRICT jst = rve->jstart,
-                               *GK_RESTRICT jl = rve->jlist;
+    const int32_t *GK_RESTRICT start = rve->pl.start, *GK_RESTRICT jst = rve->jstart, *GK_RESTRICT jl = rve->jlist;
     const gk_real *fc0 = rve->fc[0], *fc1 = rve->fc[1], *fc2 = dim == 3 ? rve->fc[2] : NULL;
     gk_real *f0 = rve->f[0], *f1 = rve->f[1], *f2 = dim == 3 ? rve->f[2] : NULL;
     int p, e, k;
@@ -1988,21 +1937,18 @@ GK_FORCE_INLINE void gk__wrap(gk_rve *rve, int p, int k) {
 /* leap-frog for particles [p0, p1) with the force sums in f, t; returns the
  * largest squared non-affine displacement since the last build; *bad if a
  * non-finite value appeared. damp: 0 none, 1 component, 2 vector. */
-GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, const double *hinv,
-                                            const double *hnew, int p0, int p1, int *bad, const int dim,
-                                            const int rot, const int damp) {
+GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, const double *hinv, const double *hnew,
+                                            int p0, int p1, int *bad, const int dim, const int rot, const int damp) {
     const gk_real dt = x->dt, alpha = (gk_real)rve->def.damping, hdt = (gk_real)0.5 * dt;
     const gk_real *GK_RESTRICT minv = rve->minv, *GK_RESTRICT Iinv = rve->Iinv;
     double *s0 = rve->s[0], *s1 = rve->s[1], *s2 = dim == 3 ? rve->s[2] : NULL;
     const double *r0 = rve->s0[0], *r1 = rve->s0[1], *r2 = dim == 3 ? rve->s0[2] : NULL;
-    gk_real *GK_RESTRICT v0 = rve->v[0], *GK_RESTRICT v1 = rve->v[1],
-                         *GK_RESTRICT v2 = dim == 3 ? rve->v[2] : NULL;
-    const gk_real *GK_RESTRICT f0 = rve->f[0], *GK_RESTRICT f1 = rve->f[1],
-                               *GK_RESTRICT f2 = dim == 3 ? rve->f[2] : NULL;
-    const double h00 = hinv[0], h01 = hinv[1], h02 = hinv[2], h10 = hinv[3], h11 = hinv[4], h12 = hinv[5],
-                 h20 = hinv[6], h21 = hinv[7], h22 = hinv[8];
-    const double g00 = hnew[0], g01 = hnew[1], g02 = hnew[2], g10 = hnew[3], g11 = hnew[4], g12 = hnew[5],
-                 g20 = hnew[6], g21 = hnew[7], g22 = hnew[8];
+    gk_real *GK_RESTRICT v0 = rve->v[0], *GK_RESTRICT v1 = rve->v[1], *GK_RESTRICT v2 = dim == 3 ? rve->v[2] : NULL;
+    const gk_real *GK_RESTRICT f0 = rve->f[0], *GK_RESTRICT f1 = rve->f[1], *GK_RESTRICT f2 = dim == 3 ? rve->f[2] : NULL;
+    const double h00 = hinv[0], h01 = hinv[1], h02 = hinv[2], h10 = hinv[3], h11 = hinv[4], h12 = hinv[5], h20 = hinv[6],
+                 h21 = hinv[7], h22 = hinv[8];
+    const double g00 = hnew[0], g01 = hnew[1], g02 = hnew[2], g10 = hnew[3], g11 = hnew[4], g12 = hnew[5], g20 = hnew[6],
+                 g21 = hnew[7], g22 = hnew[8];
     double m2 = 0.0, chk = 0.0;
     int p;
     for (p = p0; p < p1; ++p) {
@@ -2015,8 +1961,7 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
             if (dim == 3) a2 = gk__damp_component(a2, v2[p], dt, alpha);
         } else if (damp == 2) {
             gk_real w0 = v0[p] + hdt * a0, w1 = v1[p] + hdt * a1, w2 = dim == 3 ? v2[p] + hdt * a2 : 0;
-            gk_real vv = w0 * w0 + w1 * w1 + (dim == 3 ? w2 * w2 : 0),
-                    aa = a0 * a0 + a1 * a1 + (dim == 3 ? a2 * a2 : 0);
+            gk_real vv = w0 * w0 + w1 * w1 + (dim == 3 ? w2 * w2 : 0), aa = a0 * a0 + a1 * a1 + (dim == 3 ? a2 * a2 : 0);
             if (vv > 0) {
                 gk_real sc = alpha * (gk_real)sqrt(aa) / (gk_real)sqrt(vv);
                 a0 = a0 - sc * w0;
@@ -2109,8 +2054,7 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
 GK_FORCE_INLINE gk_vr gk__damp_v(gk_vr a, gk_vr v, gk_vr hdt, gk_vr alpha) {
     const gk_vr one = gk_vr_set1(1), zero = gk_vr_zero();
     gk_vr xx = gk_vr_mul(a, gk_vr_add(v, gk_vr_mul(hdt, a)));
-    gk_vr sg =
-        gk_vr_sub(gk_vr_select(gk_vr_gt(xx, zero), one, zero), gk_vr_select(gk_vr_lt(xx, zero), one, zero));
+    gk_vr sg = gk_vr_sub(gk_vr_select(gk_vr_gt(xx, zero), one, zero), gk_vr_select(gk_vr_lt(xx, zero), one, zero));
     return gk_vr_mul(a, gk_vr_sub(one, gk_vr_mul(alpha, sg)));
 }
 
@@ -2124,9 +2068,8 @@ GK_FORCE_INLINE gk_vd gk__vr_half(gk_vr a, int hf) {
 #endif
 }
 
-GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, const double *hinv,
-                                          const double *hnew, int p0, int p1, int *bad, const int dim,
-                                          const int rot, const int damp) {
+GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, const double *hinv, const double *hnew,
+                                          int p0, int p1, int *bad, const int dim, const int rot, const int damp) {
     const gk_vr dt = gk_vr_set1(x->dt), alpha = gk_vr_set1((gk_real)rve->def.damping),
                 hdt = gk_vr_set1((gk_real)0.5 * x->dt), zero = gk_vr_zero();
     const gk_vd dtd = gk_vd_set1((double)x->dt), wad = gk_vd_set1((double)x->wa[2]);
@@ -2193,16 +2136,14 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
             vm2 = gk_vd_max(u2, vm2);
         }
         if (rot && dim == 2) {
-            gk_vr aw = gk_vr_mul(gk_vr_loadu(rve->t[2] + p), gk_vr_loadu(rve->Iinv + p)),
-                  w = gk_vr_loadu(rve->w[2] + p);
+            gk_vr aw = gk_vr_mul(gk_vr_loadu(rve->t[2] + p), gk_vr_loadu(rve->Iinv + p)), w = gk_vr_loadu(rve->w[2] + p);
             if (damp) aw = gk__damp_v(aw, w, hdt, alpha);
             w = gk_vr_add(w, gk_vr_mul(dt, aw));
             gk_vr_storeu(rve->w[2] + p, w);
             vchk = gk_vr_add(vchk, gk_vr_abs(w));
             for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
                 double *th = rve->theta + p + hf * GK_VD_W;
-                gk_vd_storeu(th,
-                             gk_vd_add(gk_vd_loadu(th), gk_vd_mul(gk_vd_add(wad, gk__vr_half(w, hf)), dtd)));
+                gk_vd_storeu(th, gk_vd_add(gk_vd_loadu(th), gk_vd_mul(gk_vd_add(wad, gk__vr_half(w, hf)), dtd)));
             }
         } else if (rot) {
             gk_vr iinv = gk_vr_loadu(rve->Iinv + p), aw[3], w[3];
@@ -2216,14 +2157,11 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
                 gk_vr ve[3], vv, aa, sc;
                 gk_vrm pos;
                 for (k = 0; k < 3; ++k) ve[k] = gk_vr_add(w[k], gk_vr_mul(hdt, aw[k]));
-                vv = gk_vr_add(gk_vr_add(gk_vr_mul(ve[0], ve[0]), gk_vr_mul(ve[1], ve[1])),
-                               gk_vr_mul(ve[2], ve[2]));
-                aa = gk_vr_add(gk_vr_add(gk_vr_mul(aw[0], aw[0]), gk_vr_mul(aw[1], aw[1])),
-                               gk_vr_mul(aw[2], aw[2]));
+                vv = gk_vr_add(gk_vr_add(gk_vr_mul(ve[0], ve[0]), gk_vr_mul(ve[1], ve[1])), gk_vr_mul(ve[2], ve[2]));
+                aa = gk_vr_add(gk_vr_add(gk_vr_mul(aw[0], aw[0]), gk_vr_mul(aw[1], aw[1])), gk_vr_mul(aw[2], aw[2]));
                 pos = gk_vr_gt(vv, zero);
                 sc = gk_vr_div(gk_vr_mul(alpha, gk_vr_sqrt(aa)), gk_vr_sqrt(vv));
-                for (k = 0; k < 3; ++k)
-                    aw[k] = gk_vr_select(pos, gk_vr_sub(aw[k], gk_vr_mul(sc, ve[k])), aw[k]);
+                for (k = 0; k < 3; ++k) aw[k] = gk_vr_select(pos, gk_vr_sub(aw[k], gk_vr_mul(sc, ve[k])), aw[k]);
             }
             for (k = 0; k < 3; ++k) {
                 w[k] = gk_vr_add(w[k], gk_vr_mul(dt, aw[k]));
@@ -2254,12 +2192,11 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
 #define GK__INTEGRATE_FAST gk__integrate_kernel
 #endif
 
-static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const double hinv[9],
-                                  const double hnew[9], int p0, int p1, int *bad) {
-    int rot = GK__HAS_ROT(rve),
-        damp = rve->def.damping > 0 ? (rve->def.damping_form == GK_DAMP_VECTOR ? 2 : 1) : 0;
-#define GK__INT(D, R, M)                                                                                     \
-    return (rve->def.flags & GK_RVE_SCALAR) ? gk__integrate_kernel(rve, x, hinv, hnew, p0, p1, bad, D, R, M) \
+static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int p0,
+                                  int p1, int *bad) {
+    int rot = GK__HAS_ROT(rve), damp = rve->def.damping > 0 ? (rve->def.damping_form == GK_DAMP_VECTOR ? 2 : 1) : 0;
+#define GK__INT(D, R, M)                                                                                               \
+    return (rve->def.flags & GK_RVE_SCALAR) ? gk__integrate_kernel(rve, x, hinv, hnew, p0, p1, bad, D, R, M)          \
                                             : GK__INTEGRATE_FAST(rve, x, hinv, hnew, p0, p1, bad, D, R, M)
     if (rve->dim == 2) {
         if (rot) {
@@ -2286,8 +2223,7 @@ static int gk__nthreads(const gk_rve *rve) {
     return rve->def.threads > 1 && rve->pl.n >= GK_DEM_PAR_MIN ? rve->def.threads : 1;
 }
 
-static double gk__integrate(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9],
-                            int *bad) {
+static double gk__integrate(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int *bad) {
     int n = rve->n, nth = gk__nthreads(rve);
     double m2 = 0.0;
     if (nth <= 1) return gk__integrate_range(rve, x, hinv, hnew, 0, n, bad);
@@ -2457,10 +2393,9 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
     ++rve->step;
     if (bad) {
         rve->diverged = 1;
-        return gk_err_set(
-            &rve->err, GK_ERR_DIVERGED,
-            "non-finite velocity or position at step %ld (time step too large or unstable input?)",
-            rve->step);
+        return gk_err_set(&rve->err, GK_ERR_DIVERGED,
+                          "non-finite velocity or position at step %ld (time step too large or unstable input?)",
+                          rve->step);
     }
     if (!rve->need_rebuild) {
         double h0i[9], A[9], smin, margin, At[9], AtA[9];
@@ -2477,8 +2412,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
             gk_m3_sym_eigen(AtA, val, vec);
             smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
         }
-        margin =
-            smin * rve->skin_in - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
+        margin = smin * rve->skin_in - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
         if (!(margin > 0.0)) rve->need_rebuild = 1;
     }
     return GK_OK;
@@ -2487,8 +2421,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
 static gk_result gk__rve_ready(gk_rve *rve) {
     if (rve->n < 1 || !rve->s[0]) return gk_err_set(&rve->err, GK_ERR_STATE, "RVE not created");
     if (rve->diverged)
-        return gk_err_set(&rve->err, GK_ERR_STATE, "RVE diverged at step %ld; restore a saved state",
-                          rve->step);
+        return gk_err_set(&rve->err, GK_ERR_STATE, "RVE diverged at step %ld; restore a saved state", rve->step);
     return GK_OK;
 }
 
@@ -2506,8 +2439,7 @@ GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *s) {
         rve->servo_on = 0;
         return GK_OK;
     }
-    if (s->shear &&
-        !(isfinite(s->shear_target[0]) && isfinite(s->shear_target[1]) && isfinite(s->shear_target[2])))
+    if (s->shear && !(isfinite(s->shear_target[0]) && isfinite(s->shear_target[1]) && isfinite(s->shear_target[2])))
         return gk_err_set(&rve->err, GK_ERR_NAN, "servo: non-finite shear target");
     for (k = 0; k < rve->dim; ++k) {
         if (s->mode[k] != GK_SERVO_STRAIN && s->mode[k] != GK_SERVO_STRESS)
@@ -2556,11 +2488,10 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     int k;
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
-    if (rve->servo_on)
-        return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
+    if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
     res = gk_path_init(&path, rve->dim, rve->def.path, dH, nsteps, &rve->err);
     if (res) return res;
-    { /* refuse up front a map that leaves the cell too thin for the nearest image */
+    {   /* refuse up front a map that leaves the cell too thin for the nearest image */
         gk_pcell end = rve->cell;
         double Mend[9], B[9], w[3];
         gk_path_map(&path, nsteps, Mend);
@@ -2571,8 +2502,8 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
         for (k = 0; k < rve->dim; ++k)
             if (!(2.0 * (2.0 * rve->rmax + rve->skin) < w[k]))
                 return gk_err_set(&rve->err, GK_ERR_CELL,
-                                  "dH would leave a cell %g wide, below twice the interaction distance %g",
-                                  w[k], 2.0 * rve->rmax + rve->skin);
+                                  "dH would leave a cell %g wide, below twice the interaction distance %g", w[k],
+                                  2.0 * rve->rmax + rve->skin);
     }
     for (k = 1; k <= nsteps; ++k) {
         gk_path_step(&path, k, E);
@@ -2600,8 +2531,7 @@ GKDEF gk_result gk_rve_refresh(gk_rve *rve) {
     }
     np = (size_t)rve->pl.n;
     for (k = 0; k < 3; ++k) {
-        if (rve->ft[k] && !(save[k] = (gk_real *)gk_alloc(&rve->def.alloc, (np + 1) * sizeof(gk_real))))
-            res = GK_ERR_ALLOC;
+        if (rve->ft[k] && !(save[k] = (gk_real *)gk_alloc(&rve->def.alloc, (np + 1) * sizeof(gk_real)))) res = GK_ERR_ALLOC;
         if (rve->mr[k] && !(save[3 + k] = (gk_real *)gk_alloc(&rve->def.alloc, (np + 1) * sizeof(gk_real))))
             res = GK_ERR_ALLOC;
     }
@@ -2631,8 +2561,7 @@ GKDEF gk_result gk_rve_set_dt(gk_rve *rve, double dt) {
     double dtc = gk__dt_critical(rve);
     if (!(dt > 0.0) || !isfinite(dt)) return gk_err_set(&rve->err, GK_ERR_DT, "time step %g must be > 0", dt);
     if (dt > dtc)
-        return gk_err_set(&rve->err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)",
-                          dt, dtc);
+        return gk_err_set(&rve->err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)", dt, dtc);
     rve->dt = dt;
     rve->dt_crit = dtc;
     return GK_OK;
@@ -2656,8 +2585,7 @@ GKDEF gk_result gk_rve_set_friction(gk_rve *rve, double mu) {
 }
 
 GKDEF gk_result gk_rve_set_damping(gk_rve *rve, double alpha, gk_damp_form form) {
-    if (!(alpha >= 0.0 && alpha < 1.0))
-        return gk_err_set(&rve->err, GK_ERR_ARG, "damping %g outside [0, 1)", alpha);
+    if (!(alpha >= 0.0 && alpha < 1.0)) return gk_err_set(&rve->err, GK_ERR_ARG, "damping %g outside [0, 1)", alpha);
     if (form != GK_DAMP_COMPONENT && form != GK_DAMP_VECTOR)
         return gk_err_set(&rve->err, GK_ERR_ARG, "unknown damping form %d", (int)form);
     rve->def.damping = alpha;
@@ -2685,8 +2613,7 @@ GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]) {
     if (rve->dim == 2) x[2] = 0.0;
 }
 
-GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *out, const gk_allocator *alloc,
-                                  gk_err *err) {
+GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *out, const gk_allocator *alloc, gk_err *err) {
     gk_packing pk;
     int p, k;
     gk_result res = gk_packing_alloc(&pk, rve->dim, rve->n, alloc, err);
@@ -2819,36 +2746,34 @@ typedef struct gk__state_hdr {
 } gk__state_hdr;
 
 static size_t gk__state_bytes(const gk_rve *rve, int npairs, int nouter) {
-    int dim = rve->dim, nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0,
-        nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
+    int dim = rve->dim, nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0, nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
     size_t n = (size_t)rve->n, np = (size_t)npairs, R = sizeof(gk_real), b = sizeof(gk__state_hdr);
-    b += n * (2 * dim * sizeof(double));                                  /* s, s0 */
-    b += n * R * (2 * dim + 2 * nr);                                      /* v, f, w, t */
-    b += dim == 2 ? n * sizeof(double) : 0;                               /* theta */
-    b += np * (2 * sizeof(int32_t) + 1);                                  /* i, j, cs */
-    b += np * R * ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll);            /* ft, fc, tci, tcj, mr */
+    b += n * (2 * dim * sizeof(double)); /* s, s0 */
+    b += n * R * (2 * dim + 2 * nr);      /* v, f, w, t */
+    b += dim == 2 ? n * sizeof(double) : 0; /* theta */
+    b += np * (2 * sizeof(int32_t) + 1);   /* i, j, cs */
+    b += np * R * ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll); /* ft, fc, tci, tcj, mr */
     b += (size_t)nouter * 2 * sizeof(int32_t) + n * dim * sizeof(double); /* outer list, o0 */
     return b;
 }
 
 GKDEF size_t gk_rve_state_size(const gk_rve *rve) { return gk__state_bytes(rve, rve->pl.n, rve->outer.n); }
 
-#define GK__PUT(ptr, bytes)              \
-    do {                                 \
-        memcpy(o + off, (ptr), (bytes)); \
-        off += (bytes);                  \
+#define GK__PUT(ptr, bytes)                 \
+    do {                                    \
+        memcpy(o + off, (ptr), (bytes));    \
+        off += (bytes);                     \
     } while (0)
-#define GK__GET(ptr, bytes)               \
-    do {                                  \
-        memcpy((ptr), in + off, (bytes)); \
-        off += (bytes);                   \
+#define GK__GET(ptr, bytes)                 \
+    do {                                    \
+        memcpy((ptr), in + off, (bytes));   \
+        off += (bytes);                     \
     } while (0)
 
 GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *written) {
     gk__state_hdr hd;
     unsigned char *o = (unsigned char *)buf;
-    size_t off = 0, need = gk_rve_state_size(rve), n = (size_t)rve->n, np = (size_t)rve->pl.n,
-           R = sizeof(gk_real);
+    size_t off = 0, need = gk_rve_state_size(rve), n = (size_t)rve->n, np = (size_t)rve->pl.n, R = sizeof(gk_real);
     int k, dim = rve->dim;
     if (written) *written = need;
     if (!buf || cap < need) return GK_ERR_ARG;
@@ -2930,10 +2855,9 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state version %d (this build reads %d)", hd.version,
                           GK__STATE_VERSION);
     if (hd.dim != rve->dim || hd.n != rve->n || hd.real_size != (int32_t)R || hd.phys != (int32_t)rve->phys)
-        return gk_err_set(
-            &rve->err, GK_ERR_FORMAT,
-            "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
-            hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
+        return gk_err_set(&rve->err, GK_ERR_FORMAT,
+                          "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
+                          hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
     if (hd.npairs < 0 || hd.nouter < 0 || size != gk__state_bytes(rve, hd.npairs, hd.nouter))
         return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state has the wrong size");
     n = (size_t)rve->n;
@@ -2942,15 +2866,15 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     if (gk__pairs_reserve(rve, np + 1, (size_t)rve->pl.n) || gk_pairlist_reserve(&rve->pl, np + 1, n) ||
         gk_pairlist_reserve(&rve->outer, (size_t)hd.nouter + 1, n))
         return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory restoring %d pairs", hd.npairs);
-    { /* outer list indices */
+    {   /* outer list indices */
         size_t ob = size - (size_t)hd.nouter * 8 - n * (size_t)dim * sizeof(double);
         for (c = 0; c < hd.nouter; ++c) {
             int32_t a, b;
             memcpy(&a, in + ob + (size_t)c * 4, 4);
             memcpy(&b, in + ob + (size_t)hd.nouter * 4 + (size_t)c * 4, 4);
             if (a < 0 || b <= a || b >= rve->n)
-                return gk_err_set(&rve->err, GK_ERR_FORMAT,
-                                  "RVE state outer pair %d has invalid particles (%d, %d)", c, a, b);
+                return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid particles (%d, %d)", c,
+                                  a, b);
         }
     }
     /* validate pair indices before touching anything */
@@ -2963,8 +2887,8 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
             memcpy(&a, in + base + (size_t)c * 4, 4);
             memcpy(&b, in + base + np * 4 + (size_t)c * 4, 4);
             if (a < 0 || b <= a || b >= rve->n)
-                return gk_err_set(&rve->err, GK_ERR_FORMAT,
-                                  "RVE state pair %d has invalid particles (%d, %d)", c, a, b);
+                return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state pair %d has invalid particles (%d, %d)", c, a,
+                                  b);
         }
     }
     off = sizeof hd;
