@@ -2,6 +2,8 @@
  *
  *   build/femdem_biaxial --nx 8 --ny 16 --element q8 --steps 100 --threads 2 --out DIR
  *                        [--tangent taylor|yade|perturbation] [--restart DIR] [--test biaxial|single]
+ *   build/femdem_biaxial --test cyclic-strain|cyclic-stress [--nx 15 --ny 10] [--amplitude 0.01 |
+ *                        --tau-amplitude 3e4] [--cycles 20] --out DIR
  *
  * A 2D plane-strain mesh (Q4 or Q8) of a 50 x 100 mm specimen with a
  * periodic 400-disk RVE (examples/data/rve400.txt, the seed authors' own) at
@@ -53,6 +55,43 @@
  *   checkpoint.bin every --checkpoint K steps and at the end
  * and prints per step a progress line with ETA and finally
  *   RESULT peak_sigma_yy=… eps_at_peak=… band_angle_deg=… band_width_mm=… total_seconds=…
+ *
+ * CYCLIC SIMPLE SHEAR (seed 000 sec 5; --test cyclic-strain | cyclic-stress)
+ *   A 100 x 50 mm specimen (the seed's mesh: --nx 15 --ny 10, Q8, 600 Gauss
+ *   points), bottom fixed, the top moved horizontally by a rough platen whose
+ *   vertical displacement is held, left and right sides PERIODIC (every right
+ *   node tied to the left node at the same height through a gk_dofmap; the
+ *   Newton system is condensed, K_r = T^T K T). Height and width are fixed,
+ *   so the specimen volume is constant: the "undrained" test of dry sand.
+ *   The load step is a platen displacement d gamma x H (the Newton loop, the
+ *   RVE runs, relaxation and cut-back are the biaxial ones, except that a
+ *   predictor already in equilibrium, E_f < --ftol, is accepted at the first
+ *   iteration: under displacement-driven shear of a uniform specimen it often
+ *   is, until the RVEs drift apart).
+ *   - cyclic-strain: gamma = u_top / H goes 0 -> +A -> -A -> +A ... in steps
+ *     of --increment (A = --amplitude, default 1 %).
+ *   - cyclic-stress: the platen moves until the shear stress on the top
+ *     reaches +-tau_A (--tau-amplitude, default 30 kPa), then reverses. The
+ *     step landing on tau_A is repeated with a secant-corrected increment
+ *     until |tau - tau_A| < 2 % tau_A (Newton on the platen displacement);
+ *     other steps are sized from the last secant modulus so that a quarter
+ *     cycle takes about --stress-steps steps (at most --increment).
+ *   Liquefaction: p' (mean stress of the volume-averaged RVE stress) below
+ *   --liq-ratio (0.1) x its initial value. cyclic-strain stops there;
+ *   cyclic-stress stops when |gamma| reaches --gamma-limit (5 %, the seed's
+ *   criterion) and also reports when p' first collapsed. Both stop after
+ *   --cycles cycles. A cycle is 0 -> +A -> 0 -> -A -> 0 (fractional values
+ *   interpolate within the current loading branch).
+ *   cyclic.csv    step,cycle,gamma,tau,sigma_yy,sigma_xx,p,q,eps_v_rve,top_uy,iterations,seconds,
+ *                 E_d,E_f,increment,failed_gp - tau = sigma_xy from the top reaction [Pa]
+ *                 (positive with gamma), sigma_yy from the top reaction, sigma_xx, p, q (seed
+ *                 eq 7) from the volume-averaged RVE stress, normal stresses COMPRESSION
+ *                 POSITIVE; eps_v_rve the area-weighted mean RVE volume change (contraction
+ *                 positive, ~0 at constant volume); top_uy the mean platen lift (0)
+ *   cyclic_stress_path.svg (tau vs sigma_yy and q vs p), cyclic_stress_strain.svg (tau vs
+ *   gamma), cyclic_pressure.svg (p and sigma_yy vs cycles), void_ratio_field.svg, gp/mesh VTK
+ *   RESULT test=… liquefied=… cycles=… cycles_to_liquefaction=… cycles_to_gamma_limit=… p0=…
+ *          p_final=… sigma_yy_final=… tau_final=… gamma_final=… e_min=… e_max=… … total_seconds=…
  */
 #define _POSIX_C_SOURCE 200809L
 #define GK_IMPLEMENTATION
@@ -74,7 +113,23 @@ typedef struct opts {
     gk_elem_type elem;
     const char *out, *restart, *packing, *tangent, *test;
     double width, height, pressure, inc, tol, ftol, dt, dem_strain, xi;
+    /* cyclic simple shear: cyclic = 1 strain-, 2 stress-controlled */
+    int cyclic, stress_steps;
+    double amp, tau_amp, cycles, gamma_stop, liq_ratio;
 } opts;
+
+/* cyclic: what a row of cyclic.csv has besides curve_row (eps = gamma, syy =
+ * sigma_yy, sxx = sigma_xx, ev = eps_v_rve) */
+typedef struct cyc_extra {
+    double cycle, tau, p, q, top_uy;
+} cyc_extra;
+
+/* cyclic: loading branch 0 = 0 -> +A, then -A, +A, ...; state at its start */
+typedef struct cyc_state {
+    int dir, branch, good, bsteps; /* bsteps: steps done in this branch */
+    double gamma, g_start, t_start, tau, h, p0, cyc_liq, cyc_gamma;
+    double G0, Gu; /* stress control: secant moduli of the first step and of the last unloading */
+} cyc_state;
 
 typedef struct curve_row {
     double eps, syy, sxx, ev, secs, Ed, Ef, inc;
@@ -97,6 +152,13 @@ typedef struct model {
     int step;
     curve_row *curve;
     int ncurve, cap;
+    /* cyclic: periodic ties, condensed matrix, reduced work arrays */
+    gk_dofmap dm;
+    gk_csr Kr;
+    int *rfix;
+    double *rvals, *rr, *ur, v0;
+    cyc_extra *cx;
+    cyc_state cs;
 } model;
 
 static void usage(FILE *fp) {
@@ -104,6 +166,8 @@ static void usage(FILE *fp) {
         fp,
         "usage: femdem_biaxial [--nx 8] [--ny 16] [--element q8|q4] [--steps 100] [--threads 2] [--out DIR]\n"
         "                      [--tangent taylor|yade|perturbation] [--restart DIR] [--test biaxial|single]\n"
+        "       femdem_biaxial --test cyclic-strain|cyclic-stress [--amplitude 0.01 | --tau-amplitude 3e4]\n"
+        "                      [--cycles 20] [--nx 2 --ny 2] [--threads 2] [--out DIR]\n"
         "\n"
         "  --nx, --ny N           elements across the width and the height (8 x 16: the authors' mesh)\n"
         "  --element q8|q4        8-node serendipity (default) or 4-node bilinear quad\n"
@@ -117,10 +181,12 @@ static void usage(FILE *fp) {
         "                         k_t of sliding contacts, as the authors' code), perturbation (eq 8)\n"
         "  --xi X                 perturbation size of eq 8 (default 5e-5, seed Fig 6)\n"
         "  --restart DIR          continue from DIR/checkpoint.bin (same mesh options) to --steps\n"
+        "                         (cyclic: to --cycles or the stop criterion)\n"
         "  --checkpoint K         write DIR/checkpoint.bin every K steps (default 10; always at the end)\n"
-        "  --test biaxial|single  biaxial (default) or the single-element test of seed sec 3.3: one Q4\n"
-        "                         element, 4 Gauss points, compared with the RVE alone under the same\n"
-        "                         drained path (writes single_element.csv and .svg)\n"
+        "  --test KIND            biaxial (default); single: the single-element test of seed sec 3.3, one\n"
+        "                         Q4 element, 4 Gauss points, compared with the RVE alone under the same\n"
+        "                         drained path (writes single_element.csv and .svg); cyclic-strain,\n"
+        "                         cyclic-stress: constant-volume cyclic simple shear of seed sec 5 (below)\n"
         "  --packing FILE         RVE at every Gauss point (default examples/data/rve400.txt)\n"
         "  --width, --height M    specimen size [m] (0.05 x 0.1)\n"
         "  --pressure P           confining pressure [Pa] (1e5)\n"
@@ -137,6 +203,25 @@ static void usage(FILE *fp) {
         "  --relaxation KIND      aitken (default): Newton corrections scaled by the Aitken factor of the\n"
         "                         last two corrections (in [0.25, 4]); none: plain Newton\n"
         "  --verbose              print E_d, E_f and time of every Newton iteration\n");
+    fprintf(
+        fp,
+        "\n"
+        "cyclic simple shear (--test cyclic-strain|cyclic-stress): 100 x 50 mm, bottom fixed, rough top\n"
+        "platen moved horizontally with its vertical displacement held, left/right sides periodic.\n"
+        "Defaults differ from the biaxial ones: --nx 2 --ny 2 (Q8, 16 RVEs; the seed's mesh is --nx 15\n"
+        "--ny 10, 600 RVEs), --width 0.1 --height 0.05, --increment 0.001 (shear strain per step),\n"
+        "--vtk-every 0 (VTK of the final state only), --packing examples/data/rve400_e0223.txt\n"
+        "(cyclic-strain) or rve400_e0209.txt (cyclic-stress), the seed's void ratios.\n"
+        "  --amplitude A          cyclic-strain: shear strain amplitude gamma_A (default 0.01 = 1 %%)\n"
+        "  --tau-amplitude T      cyclic-stress: shear stress amplitude [Pa] (default 3e4)\n"
+        "  --stress-steps N       cyclic-stress: about N steps per quarter cycle (default 6); the\n"
+        "                         strain increment is then at most --increment and at least 1/64 of it\n"
+        "  --cycles N             stop after N cycles (default 20)\n"
+        "  --liq-ratio R          liquefaction when p' < R x p'_0 (default 0.1); cyclic-strain stops there\n"
+        "  --gamma-limit G        cyclic-stress: stop when |gamma| >= G (default 0.05, the seed's 5 %%)\n"
+        "  --pressure P           initial isotropic stress [Pa]: when it differs from the packing's own by\n"
+        "                         more than 0.5 %% the RVE is first re-consolidated to P with its contact\n"
+        "                         friction (default: the packing as it is, 100 kPa for the shipped ones)\n");
 }
 
 static int mkdir_p(const char *d) {
@@ -294,14 +379,34 @@ static int setup(model *M, gk_err *err) {
         M->nlf = gk_mesh_faces_on_plane(&M->mesh, 0, 0.0, tol, M->lface, &M->nfn);
         M->nrf = gk_mesh_faces_on_plane(&M->mesh, 0, o->width, tol, M->rface, &M->nfn);
         M->nfix = 0;
-        for (a = 0; a < nb; ++a) {
-            double dx = fabs(M->mesh.x[2 * bot[a]] - 0.5 * o->width);
-            M->fix[M->nfix] = 2 * bot[a] + 1, M->fixtop[M->nfix++] = 0;
-            if (dx < best - tol) best = dx, centre = bot[a];
+        if (o->cyclic) { /* simple shear: bottom fixed; top u_x = platen (fixtop), u_y = 0 */
+            for (a = 0; a < nb; ++a) {
+                M->fix[M->nfix] = 2 * bot[a], M->fixtop[M->nfix++] = 0;
+                M->fix[M->nfix] = 2 * bot[a] + 1, M->fixtop[M->nfix++] = 0;
+            }
+            for (a = 0; a < M->ntop; ++a) {
+                M->fix[M->nfix] = 2 * M->top[a], M->fixtop[M->nfix++] = 1;
+                M->fix[M->nfix] = 2 * M->top[a] + 1, M->fixtop[M->nfix++] = 0;
+            }
+        } else {
+            for (a = 0; a < nb; ++a) {
+                double dx = fabs(M->mesh.x[2 * bot[a]] - 0.5 * o->width);
+                M->fix[M->nfix] = 2 * bot[a] + 1, M->fixtop[M->nfix++] = 0;
+                if (dx < best - tol) best = dx, centre = bot[a];
+            }
+            for (a = 0; a < M->ntop; ++a) M->fix[M->nfix] = 2 * M->top[a] + 1, M->fixtop[M->nfix++] = 1;
+            M->fix[M->nfix] = 2 * centre, M->fixtop[M->nfix++] = 0;
         }
-        for (a = 0; a < M->ntop; ++a) M->fix[M->nfix] = 2 * M->top[a] + 1, M->fixtop[M->nfix++] = 1;
-        M->fix[M->nfix] = 2 * centre, M->fixtop[M->nfix++] = 0;
         free(bot);
+        if (o->cyclic) { /* left/right periodic: u(right node) = u(left node at the same height) */
+            if (gk_dofmap_periodic(&M->dm, &M->mesh, 1u, NULL, tol, NULL, err) ||
+                gk_dofmap_csr(&M->dm, &M->K, &M->Kr, NULL, err))
+                return 1;
+            ALLOC(M->rfix, M->nfix);
+            ALLOC(M->rvals, M->nfix);
+            ALLOC(M->rr, M->dm.nred);
+            ALLOC(M->ur, M->dm.nred);
+        }
     }
     M->area0 = o->width * o->height;
     /* RVEs: the same packing everywhere (seed 000: uniform RVE, no imperfection) */
@@ -317,6 +422,25 @@ static int setup(model *M, gk_err *err) {
         }
         if (g == 0 && gk_rve_refresh(&M->rve[g]))
             return gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&M->rve[0])), 1;
+        if (g == 0 && o->cyclic && o->pressure > 0) { /* initial stress other than the packing's own */
+            double s0[9], p0;
+            gk_rve_stress(&M->rve[0], s0);
+            p0 = -0.5 * (s0[0] + s0[4]);
+            if (fabs(p0 - o->pressure) > 5e-3 * o->pressure) {
+                gk_consolidate_def cd;
+                gk_consolidate_report rep;
+                memset(&cd, 0, sizeof cd);
+                cd.pressure = o->pressure;
+                cd.friction = M->rve[0].def.mat.friction; /* keep the fabric: no frictionless re-packing */
+                if (gk_rve_consolidate(&M->rve[0], &cd, &rep) || gk_rve_refresh(&M->rve[0]))
+                    return gk_err_set(err, GK_ERR_STATE, "consolidation to %g Pa: %s", o->pressure,
+                                      gk_rve_error(&M->rve[0])),
+                           1;
+                printf("femdem_biaxial: RVE consolidated from p = %.1f kPa to %.1f kPa (void ratio %.4f)\n",
+                       p0 / 1e3, o->pressure / 1e3, rep.void_ratio);
+            }
+        }
+        if (g == 0) M->v0 = gk_rve_volume(&M->rve[0]);
         if (g > 0) { /* identical copies: clone the refreshed state of the first */
             if (gk_rve_state_restore(&M->st[0], &M->rve[g])) return gk_err_set(err, GK_ERR_STATE, "clone"), 1;
         } else {
@@ -354,6 +478,7 @@ static int external_force(model *M, gk_err *err) {
     double tl[3] = {M->o.pressure, 0, 0}, tr[3] = {-M->o.pressure, 0, 0};
     int f;
     memset(M->fext, 0, (size_t)M->ndof * sizeof(double));
+    if (M->o.cyclic) return 0; /* simple shear: displacement-driven, no traction */
     for (f = 0; f < M->nlf; ++f)
         if (gk_fem_face_load(&M->mesh, M->nfn, M->lface + f * M->nfn, tl, M->fext, err)) return 1;
     for (f = 0; f < M->nrf; ++f)
@@ -370,9 +495,20 @@ static int solve(model *M, const double *D, const double *rhs_in, double top_val
     if (M->nfix > 4096) vp = (double *)malloc((size_t)M->nfix * sizeof(double));
     for (k = 0; k < M->nfix; ++k) vp[k] = M->fixtop[k] ? top_value : 0.0;
     memcpy(M->rhs, rhs_in, (size_t)M->ndof * sizeof(double));
-    if (gk_fem_assemble(&M->mesh, &M->q, D, NULL, &M->K, NULL, err) ||
-        gk_fem_dirichlet(&M->K, M->rhs, M->nfix, M->fix, vp, err) || gk_solver_factor(&s, &M->K, NULL, err) ||
-        gk_solver_solve(&s, M->rhs, x))
+    if (M->dm.n) { /* tied (periodic) dofs: solve K_r = T^T K T for the independent dofs */
+        int nr = 0;
+        if (gk_fem_assemble(&M->mesh, &M->q, D, NULL, &M->K, NULL, err) ||
+            gk_dofmap_condense(&M->dm, &M->K, &M->Kr, err) ||
+            gk_dofmap_restrict(&M->dm, NULL, M->rhs, M->rr, err) ||
+            gk_dofmap_dirichlet(&M->dm, M->nfix, M->fix, vp, M->rfix, M->rvals, &nr, err) ||
+            gk_fem_dirichlet(&M->Kr, M->rr, nr, M->rfix, M->rvals, err) ||
+            gk_solver_factor(&s, &M->Kr, NULL, err) || gk_solver_solve(&s, M->rr, M->ur))
+            r = 1;
+        else
+            gk_dofmap_expand(&M->dm, M->ur, 0, x);
+    } else if (gk_fem_assemble(&M->mesh, &M->q, D, NULL, &M->K, NULL, err) ||
+               gk_fem_dirichlet(&M->K, M->rhs, M->nfix, M->fix, vp, err) ||
+               gk_solver_factor(&s, &M->K, NULL, err) || gk_solver_solve(&s, M->rhs, x))
         r = 1;
     gk_solver_free(&s);
     if (vp != vals) free(vp);
@@ -386,7 +522,13 @@ static double residual(model *M, const double *sig, gk_err *err) {
     if (gk_fem_assemble(&M->mesh, &M->q, NULL, sig, NULL, M->fint, err)) return HUGE_VAL;
     for (k = 0; k < M->ndof; ++k) M->R[k] = M->fint[k] - M->fext[k];
     nf = norm(M->fint, M->ndof);
-    for (k = 0; k < M->nfix; ++k) M->R[M->fix[k]] = 0.0;
+    if (M->dm.n) { /* tied dofs: R_r = T^T R, kept at the independent dof of each reduced one */
+        const gk_dofmap *dm = &M->dm;
+        gk_dofmap_restrict(dm, NULL, M->R, M->rr, err);
+        for (k = 0; k < M->nfix; ++k) M->rr[dm->red[M->fix[k]]] = 0.0;
+        for (k = 0; k < M->ndof; ++k) M->R[k] = dm->rep[dm->red[k]] == k ? M->rr[dm->red[k]] : 0.0;
+    } else
+        for (k = 0; k < M->nfix; ++k) M->R[M->fix[k]] = 0.0;
     return nf > 0 ? norm(M->R, M->ndof) / nf : 0.0;
 }
 
@@ -394,7 +536,8 @@ static double residual(model *M, const double *sig, gk_err *err) {
  * 2 = hard error */
 static int load_step(model *M, double inc, int *iters, double *Ed_out, double *Ef_out, gk_err *err) {
     int it, k, nbad, have_prev = 0, hist = 0, it_and = 0;
-    double Ed = 1.0, Ef = 0.0, Rprev = HUGE_VAL, top = -inc * M->o.height, omega = 1.0;
+    /* prescribed platen displacement: biaxial top u_y = -inc H, cyclic top u_x = inc H (inc = d gamma) */
+    double Ed = 1.0, Ef = 0.0, Rprev = HUGE_VAL, top = (M->o.cyclic ? inc : -inc) * M->o.height, omega = 1.0;
     precompute_gradients(M);
     if (external_force(M, err)) return 2;
     /* predictor: K(D_n) u = f_ext - f_int(sig_n) with the prescribed increment */
@@ -418,7 +561,9 @@ static int load_step(model *M, double inc, int *iters, double *Ed_out, double *E
             fprintf(stderr, "    iter %2d: E_d %.3e  E_f %.3e  max n_s %d  %.2f s\n", it, Ed, Ef, nmax,
                     gk_wtime() - t0);
         }
-        if (it > 1 && (Ed < M->o.tol || Ef < M->o.ftol)) {
+        /* cyclic: a predictor already in equilibrium is accepted at the first iteration (displacement-
+         * driven shear of a uniform specimen: the predictor is exact until the RVEs drift apart) */
+        if ((it > 1 || M->o.cyclic) && (Ed < M->o.tol || Ef < M->o.ftol)) {
             *iters = it, *Ed_out = Ed, *Ef_out = Ef;
             return 0;
         }
@@ -549,6 +694,98 @@ static void macro_state(const model *M, double *syy, double *sxx, double *ev) {
     *ev = -(area - M->area0) / M->area0;
 }
 
+/* ------------------------------------------------------ cyclic simple shear */
+/* shear stress on the top platen from the internal force in M->fint (the
+ * reaction), positive in the direction of positive gamma */
+static double top_tau(const model *M) {
+    double fx = 0.0;
+    int a;
+    for (a = 0; a < M->ntop; ++a) fx += M->fint[2 * M->top[a]];
+    return fx / M->o.width;
+}
+
+/* state after a committed step (M->fint from residual(sig_n)): the top
+ * reaction, the volume average of the RVE stresses (compression positive), the
+ * area-weighted mean RVE volume change and the mean platen lift */
+static void cyclic_state(const model *M, curve_row *c, cyc_extra *x) {
+    double fy = 0, uy = 0, area = 0, sa[3] = {0, 0, 0}, ev = 0, sxx, syy, sxy;
+    int a, e, g;
+    for (a = 0; a < M->ntop; ++a) fy += M->fint[2 * M->top[a] + 1], uy += M->utot[2 * M->top[a] + 1];
+    for (e = 0; e < M->mesh.nelem; ++e)
+        for (g = 0; g < M->q.n; ++g) {
+            double dN[16], dJ, w;
+            int id = e * M->q.n + g;
+            gk_fem_jacobian(&M->mesh, e, M->q.xi[g], NULL, dN, &dJ, NULL);
+            w = M->q.w[g] * dJ;
+            sa[0] += w * M->sig_n[9 * id], sa[1] += w * M->sig_n[9 * id + 4],
+                sa[2] += w * M->sig_n[9 * id + 1];
+            ev += w * (1.0 - gk_rve_volume(&M->rve[id]) / M->v0);
+            area += w;
+        }
+    sxx = -sa[0] / area, syy = -sa[1] / area, sxy = sa[2] / area;
+    c->eps = M->cs.gamma, c->syy = -fy / M->o.width, c->sxx = sxx, c->ev = ev / area;
+    x->tau = top_tau(M), x->p = 0.5 * (sxx + syy);
+    x->q = sqrt(0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy); /* seed eq 7 */
+    x->top_uy = uy / M->ntop;
+}
+
+/* cycles so far: branch 0 (0 -> +A) is the first quarter, every later branch
+ * (+A -> -A or back) a half; within a branch, progress in gamma (strain
+ * control) or tau (stress control) */
+static double cycles_at(const model *M, double gamma, double tau) {
+    const cyc_state *c = &M->cs;
+    double f, q0 = c->branch == 0 ? 0.0 : 2.0 * c->branch - 1, ql = c->branch == 0 ? 1.0 : 2.0;
+    if (M->o.cyclic == 1)
+        f = (gamma - c->g_start) / (c->dir * M->o.amp - c->g_start);
+    else
+        f = (tau - c->t_start) / (c->dir * M->o.tau_amp - c->t_start);
+    if (!(f > 0.0)) f = 0.0;
+    if (f > 1.0) f = 1.0;
+    return (q0 + f * ql) / 4.0;
+}
+
+static void write_cyclic_plots(const model *M) {
+    char path[1200], title[200];
+    gk_plot pl;
+    gk_err err;
+    int n = M->ncurve, k;
+    double *g = (double *)malloc((size_t)n * sizeof(double)),
+           *t = (double *)malloc((size_t)n * sizeof(double)),
+           *sy = (double *)malloc((size_t)n * sizeof(double)),
+           *p = (double *)malloc((size_t)n * sizeof(double)),
+           *q = (double *)malloc((size_t)n * sizeof(double)),
+           *cy = (double *)malloc((size_t)n * sizeof(double));
+    if (!g || !t || !sy || !p || !q || !cy) goto out;
+    for (k = 0; k < n; ++k) {
+        g[k] = 100 * M->curve[k].eps, t[k] = M->cx[k].tau / 1e3, sy[k] = M->curve[k].syy / 1e3;
+        p[k] = M->cx[k].p / 1e3, q[k] = M->cx[k].q / 1e3, cy[k] = M->cx[k].cycle;
+    }
+    if (M->o.cyclic == 1)
+        snprintf(title, sizeof title,
+                 "Cyclic simple shear, constant volume, gamma = +-%.2g %% (seed 000 Fig 20)", 100 * M->o.amp);
+    else
+        snprintf(title, sizeof title,
+                 "Cyclic simple shear, constant volume, tau = +-%.3g kPa (seed 000 Fig 22)",
+                 M->o.tau_amp / 1e3);
+    gk_plot_init(&pl, title, "sigma_yy or p [kPa] (compression positive)", "tau or q [kPa]");
+    gk_plot_add(&pl, sy, t, n, "tau vs sigma_yy (top platen reaction)");
+    gk_plot_add(&pl, p, q, n, "q vs p (volume-averaged RVE stress)");
+    snprintf(path, sizeof path, "%s/cyclic_stress_path.svg", M->o.out);
+    gk_plot_svg(&pl, path, &err);
+    gk_plot_init(&pl, title, "shear strain gamma [%]", "tau = sigma_xy [kPa]");
+    gk_plot_add(&pl, g, t, n, NULL);
+    snprintf(path, sizeof path, "%s/cyclic_stress_strain.svg", M->o.out);
+    gk_plot_svg(&pl, path, &err);
+    gk_plot_init(&pl, title, "cycles", "stress [kPa] (compression positive)");
+    gk_plot_add(&pl, cy, p, n, "p (volume average)");
+    gk_plot_add(&pl, cy, sy, n, "sigma_yy (top platen)");
+    gk_plot_add(&pl, cy, t, n, "tau (top platen)");
+    snprintf(path, sizeof path, "%s/cyclic_pressure.svg", M->o.out);
+    gk_plot_svg(&pl, path, &err);
+out:
+    free(g), free(t), free(sy), free(p), free(q), free(cy);
+}
+
 /* ------------------------------------------------------------- outputs */
 static void gp_fields(const model *M, int g, double *f) {
     const gk_rve *r = &M->rve[g];
@@ -624,14 +861,25 @@ static void write_csv(const model *M) {
     char path[1200];
     FILE *fp;
     int k;
-    snprintf(path, sizeof path, "%s/biaxial.csv", M->o.out);
+    snprintf(path, sizeof path, "%s/%s.csv", M->o.out, M->o.cyclic ? "cyclic" : "biaxial");
     fp = fopen(path, "w");
     if (!fp) return;
-    fprintf(fp, "step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds,E_d,E_f,increment,failed_gp\n");
+    if (M->o.cyclic)
+        fprintf(fp, "step,cycle,gamma,tau,sigma_yy,sigma_xx,p,q,eps_v_rve,top_uy,iterations,seconds,E_d,E_f,"
+                    "increment,failed_gp\n");
+    else
+        fprintf(fp,
+                "step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds,E_d,E_f,increment,failed_gp\n");
     for (k = 0; k < M->ncurve; ++k) {
         const curve_row *c = &M->curve[k];
-        fprintf(fp, "%d,%.9g,%.9g,%.9g,%.9g,%d,%.4f,%.4g,%.4g,%.6g,%d\n", k, c->eps, c->syy, c->sxx, c->ev,
-                c->iters, c->secs, c->Ed, c->Ef, c->inc, c->failed);
+        if (M->o.cyclic) {
+            const cyc_extra *x = &M->cx[k];
+            fprintf(fp, "%d,%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.3g,%d,%.4f,%.4g,%.4g,%.6g,%d\n", k,
+                    x->cycle, c->eps, x->tau, c->syy, c->sxx, x->p, x->q, c->ev, x->top_uy, c->iters, c->secs,
+                    c->Ed, c->Ef, c->inc, c->failed);
+        } else
+            fprintf(fp, "%d,%.9g,%.9g,%.9g,%.9g,%d,%.4f,%.4g,%.4g,%.6g,%d\n", k, c->eps, c->syy, c->sxx,
+                    c->ev, c->iters, c->secs, c->Ed, c->Ef, c->inc, c->failed);
     }
     fclose(fp);
 }
@@ -663,12 +911,13 @@ out:
     free(x), free(y1), free(y2);
 }
 
-/* eps_q map: each Gauss point owns the sub-quad of its element around it */
-static void write_field_svg(const model *M) {
+/* a Gauss-point field (gp_fields index) as a map: each Gauss point owns the
+ * sub-quad of its element around it */
+static void write_field_svg(const model *M, int field, const char *file, const char *title) {
     int per = M->o.quad, e, i, j, c, g = 0;
     double *xy = (double *)malloc((size_t)M->ngp * 8 * sizeof(double)),
            *val = (double *)malloc((size_t)M->ngp * sizeof(double));
-    char path[1200], title[200];
+    char path[1200];
     gk_err err;
     if (!xy || !val) goto out;
     for (e = 0; e < M->mesh.nelem; ++e)
@@ -684,11 +933,10 @@ static void write_field_svg(const model *M) {
                     xy[8 * g + 2 * c] = x[0] * 1e3, xy[8 * g + 2 * c + 1] = x[1] * 1e3;
                 }
                 gp_fields(M, g, f);
-                val[g] = f[0];
+                val[g] = f[field];
             }
-    snprintf(title, sizeof title, "eps_q at axial strain %.2f %% (x, y in mm)", 100 * M->eps_done);
-    snprintf(path, sizeof path, "%s/eps_q_field.svg", M->o.out);
-    gk_svg_field(path, title, "eps_q", M->ngp, 4, xy, val, 0.0, &err);
+    snprintf(path, sizeof path, "%s/%s", M->o.out, file);
+    gk_svg_field(path, title, field_names[field], M->ngp, 4, xy, val, 0.0, &err);
 out:
     free(xy), free(val);
 }
@@ -746,6 +994,10 @@ out:
 
 /* ---------------------------------------------------------- checkpoint */
 #define CK_MAGIC "GKFEMDEM1"
+/* cyclic: "GKFEMCYC1" (strain control) or "GKFEMCYC2" (stress control); the cyclic state and rows at the end */
+static const char *ck_magic(const model *M) {
+    return M->o.cyclic == 1 ? "GKFEMCYC1" : M->o.cyclic == 2 ? "GKFEMCYC2" : CK_MAGIC;
+}
 static int write_checkpoint(const model *M, const char *dir) {
     char path[1200], tmp[1300];
     FILE *fp;
@@ -756,7 +1008,7 @@ static int write_checkpoint(const model *M, const char *dir) {
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     fp = fopen(tmp, "wb");
     if (!fp) return 1;
-    ok &= fwrite(CK_MAGIC, 1, 9, fp) == 9;
+    ok &= fwrite(ck_magic(M), 1, 9, fp) == 9;
     ok &= fwrite(&M->o.nx, sizeof(int), 1, fp) == 1 && fwrite(&M->o.ny, sizeof(int), 1, fp) == 1;
     ok &= fwrite(&M->o.elem, sizeof(M->o.elem), 1, fp) == 1 && fwrite(&M->o.quad, sizeof(int), 1, fp) == 1;
     ok &= fwrite(&M->step, sizeof(int), 1, fp) == 1 && fwrite(&M->eps_done, sizeof(double), 1, fp) == 1;
@@ -783,6 +1035,10 @@ static int write_checkpoint(const model *M, const char *dir) {
         ok &= fwrite(&n, sizeof n, 1, fp) == 1 && fwrite(buf, 1, n, fp) == n;
     }
     free(buf);
+    if (M->o.cyclic) {
+        ok &= fwrite(&M->cs, sizeof M->cs, 1, fp) == 1;
+        ok &= fwrite(M->cx, sizeof(cyc_extra), (size_t)M->ncurve, fp) == (size_t)M->ncurve;
+    }
     ok &= fclose(fp) == 0;
     if (!ok || rename(tmp, path)) return 1;
     return 0;
@@ -796,14 +1052,14 @@ static int read_checkpoint(model *M, const char *dir, gk_err *err) {
     snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
     fp = fopen(path, "rb");
     if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open %s", path), 1;
-    ok &= fread(magic, 1, 9, fp) == 9 && !memcmp(magic, CK_MAGIC, 9);
+    ok &= fread(magic, 1, 9, fp) == 9 && !memcmp(magic, ck_magic(M), 9);
     ok &= fread(&nx, sizeof(int), 1, fp) == 1 && fread(&ny, sizeof(int), 1, fp) == 1;
     ok &= fread(&el, sizeof el, 1, fp) == 1 && fread(&quad, sizeof(int), 1, fp) == 1;
     if (!ok || nx != M->o.nx || ny != M->o.ny || el != M->o.elem || quad != M->o.quad) {
         fclose(fp);
         return gk_err_set(err, GK_ERR_FORMAT,
-                          "%s: not a checkpoint of this mesh (%dx%d, element, quad must match)", path, nx,
-                          ny),
+                          "%s: not a checkpoint of this test and mesh (%dx%d, element, quad must match)",
+                          path, nx, ny),
                1;
     }
     ok &= fread(&M->step, sizeof(int), 1, fp) == 1 && fread(&M->eps_done, sizeof(double), 1, fp) == 1;
@@ -813,6 +1069,10 @@ static int read_checkpoint(model *M, const char *dir, gk_err *err) {
         M->cap = M->ncurve + 16;
         M->curve = (curve_row *)realloc(M->curve, (size_t)M->cap * sizeof(curve_row));
         ok &= M->curve && fread(M->curve, sizeof(curve_row), (size_t)M->ncurve, fp) == (size_t)M->ncurve;
+        if (M->o.cyclic) {
+            M->cx = (cyc_extra *)realloc(M->cx, (size_t)M->cap * sizeof(cyc_extra));
+            ok &= M->cx != NULL;
+        }
     }
     ok &= fread(M->mesh.x, sizeof(double), (size_t)M->ndof, fp) == (size_t)M->ndof;
     ok &= fread(M->utot, sizeof(double), (size_t)M->ndof, fp) == (size_t)M->ndof;
@@ -830,9 +1090,194 @@ static int read_checkpoint(model *M, const char *dir, gk_err *err) {
               gk_rve_state_save(&M->st[g], &M->rve[g]) == GK_OK;
         free(buf);
     }
+    if (ok && M->o.cyclic) {
+        ok &= fread(&M->cs, sizeof M->cs, 1, fp) == 1;
+        ok &= fread(M->cx, sizeof(cyc_extra), (size_t)M->ncurve, fp) == (size_t)M->ncurve;
+    }
     fclose(fp);
     if (!ok) return gk_err_set(err, GK_ERR_FORMAT, "%s: truncated or corrupt", path), 1;
     return 0;
+}
+
+/* a load step that did not converge: halve the increment (the caller retries);
+ * below 1/16 of it give up, with the last converged state in checkpoint.bin.
+ * Returns 1 when giving up. */
+static int cut_back(model *M, const char *what, double strain, double nominal, int iters, double Ed,
+                    gk_err *err) {
+    M->scale *= 0.5;
+    fprintf(stderr,
+            "femdem_biaxial: step at %.3f %% did not converge in %d iterations (E_d %.3g)%s%s; "
+            "increment cut to %.4g %%\n",
+            100 * strain, iters, Ed, err->msg[0] ? ": " : "", err->msg, 100 * nominal * M->scale);
+    err->msg[0] = 0;
+    if (M->scale >= 1.0 / 16) return 0;
+    fprintf(stderr, "femdem_biaxial: giving up at %s %.3f %%; last converged state in %s/checkpoint.bin\n",
+            what, 100 * strain, M->o.out);
+    write_checkpoint(M, M->o.out);
+    return 1;
+}
+
+/* stress control: strain increment for a shear-stress change of tau_A /
+ * stress_steps at secant modulus G, within [inc / 64, inc] */
+static double stress_increment(const model *M, double G, double h) {
+    double hn = G > 0.0 ? M->o.tau_amp / M->o.stress_steps / G : 2.0 * h;
+    if (hn > 2.0 * h) hn = 2.0 * h;
+    if (hn > M->o.inc) hn = M->o.inc;
+    if (!(hn >= M->o.inc / 64)) hn = M->o.inc / 64;
+    return hn;
+}
+
+/* the cyclic loading loop (seed 000 sec 5); returns the exit status */
+static int run_cyclic(model *M, double t_start, gk_err *err) {
+    opts *o = &M->o;
+    cyc_state *c = &M->cs;
+    int tries = 0;
+    double forced = 0.0; /* stress control: the increment of a repeated step */
+    while (cycles_at(M, c->gamma, c->tau) < o->cycles - 1e-9) {
+        double inc, t0 = gk_wtime(), Ed = 0, Ef = 0, cyc;
+        int iters = 0, r, g, nf = 0, reversed = 0;
+        curve_row *row;
+        cyc_extra *x;
+        if (o->cyclic == 1) { /* the next increment; the last one of a branch lands on the amplitude */
+            double target = c->dir * o->amp;
+            inc = c->dir * o->inc * M->scale;
+            if (c->dir * (c->gamma + inc - target) > -1e-9 * o->amp) inc = target - c->gamma;
+        } else
+            inc = forced != 0.0 ? forced : c->dir * c->h * M->scale;
+        r = load_step(M, inc, &iters, &Ed, &Ef, err);
+        if (r == 2) {
+            fprintf(stderr, "femdem_biaxial: %s\n", err->msg);
+            return 1;
+        }
+        if (r == 1) {
+            forced = 0.0, tries = 0, c->good = 0;
+            if (cut_back(M, "shear strain", c->gamma, o->cyclic == 1 ? o->inc : c->h, iters, Ed, err))
+                return 3;
+            continue;
+        }
+        if (o->cyclic == 2) { /* overshoot of the amplitude: repeat with the secant increment */
+            double tt = top_tau(M), goal = c->dir * o->tau_amp;
+            if (c->dir * tt > 1.02 * o->tau_amp && tries < 4) {
+                double ratio = (goal - c->tau) / (tt - c->tau);
+                if (!(ratio > 0.05 && ratio < 1.0)) ratio = 0.5;
+                if (o->verbose)
+                    fprintf(stderr,
+                            "    tau %.2f kPa overshoots %.2f kPa: step repeated with %.3g x the increment\n",
+                            tt / 1e3, goal / 1e3, ratio);
+                forced = inc * ratio, ++tries;
+                continue;
+            }
+        }
+        forced = 0.0, tries = 0;
+        commit(M);
+        c->gamma += inc;
+        ++M->step;
+        residual(M, M->sig_n, err);
+        for (g = 0; g < M->ngp; ++g) nf += M->failed[g];
+        if (M->ncurve == M->cap) {
+            M->cap *= 2;
+            M->curve = (curve_row *)realloc(M->curve, (size_t)M->cap * sizeof(curve_row));
+            M->cx = (cyc_extra *)realloc(M->cx, (size_t)M->cap * sizeof(cyc_extra));
+            if (!M->curve || !M->cx) return 1;
+        }
+        row = &M->curve[M->ncurve], x = &M->cx[M->ncurve++];
+        cyclic_state(M, row, x);
+        row->iters = iters, row->secs = gk_wtime() - t0, row->Ed = Ed, row->Ef = Ef, row->inc = inc;
+        row->failed = nf;
+        x->cycle = cyc = cycles_at(M, c->gamma, x->tau);
+        ++c->bsteps;
+        if (o->cyclic == 2) { /* next increment from the secant modulus of this step */
+            double G = (x->tau - c->tau) / inc;
+            if (!(c->G0 > 0.0) && G > 0.0) c->G0 = G;
+            if (c->branch > 0 && c->bsteps == 1 && G > 0.0) c->Gu = G;
+            c->h = stress_increment(M, G, c->h);
+        }
+        c->tau = x->tau;
+        if (o->cyclic == 1 ? fabs(c->gamma - c->dir * o->amp) <= 1e-9 * o->amp
+                           : c->dir * x->tau >= 0.98 * o->tau_amp) {
+            if (o->cyclic == 1) c->gamma = c->dir * o->amp; /* no drift of the turning points */
+            c->dir = -c->dir, ++c->branch, c->bsteps = 0, c->g_start = c->gamma, c->t_start = x->tau,
+            reversed = 1;
+            if (o->cyclic ==
+                2) /* unloading: as stiff as the last unloading (the first time: the first step) */
+                c->h = stress_increment(M, c->Gu > 0.0 ? c->Gu : c->G0, o->inc);
+        }
+        if (c->cyc_liq < 0 && x->p <= o->liq_ratio * c->p0) c->cyc_liq = cyc;
+        if (o->cyclic == 2 && c->cyc_gamma < 0 && fabs(c->gamma) >= o->gamma_stop) c->cyc_gamma = cyc;
+        if (++c->good >= 2 && M->scale < 1.0) M->scale *= 2, c->good = 0;
+        write_csv(M);
+        if (o->vtk_every && M->step % o->vtk_every == 0) write_vtk(M, M->step);
+        if (o->checkpoint && M->step % o->checkpoint == 0) write_checkpoint(M, o->out);
+        fprintf(stderr,
+                "step %d  cycle %.2f  gamma %.3f %%  tau %.2f kPa  sigma_yy %.2f kPa  p %.2f kPa  %d iter  "
+                "%.2f s%s | "
+                "%.1f s elapsed\n",
+                M->step, cyc, 100 * c->gamma, x->tau / 1e3, row->syy / 1e3, x->p / 1e3, iters, row->secs,
+                reversed ? "  (reversal)" : "", gk_wtime() - t_start);
+        if (o->cyclic == 1 && c->cyc_liq >= 0) {
+            fprintf(stderr, "femdem_biaxial: liquefied (p < %.3g x p0) after %.2f cycles\n", o->liq_ratio,
+                    cyc);
+            break;
+        }
+        if (o->cyclic == 2 && c->cyc_gamma >= 0) {
+            fprintf(stderr, "femdem_biaxial: |gamma| reached %.3g %% after %.2f cycles\n",
+                    100 * o->gamma_stop, cyc);
+            break;
+        }
+    }
+    return 0;
+}
+
+/* cyclic: final outputs, a summary and the RESULT line */
+static void cyclic_summary(model *M, int status) {
+    const opts *o = &M->o;
+    const cyc_state *c = &M->cs;
+    const curve_row *last = &M->curve[M->ncurve - 1];
+    const cyc_extra *xl = &M->cx[M->ncurve - 1];
+    double emin = HUGE_VAL, emax = -HUGE_VAL, tot = 0, evmax = 0, uymax = 0, pmin = HUGE_VAL;
+    int g, k, itmax = 0, itsum = 0, n = M->ncurve - 1;
+    char title[200];
+    for (g = 0; g < M->ngp; ++g) {
+        double e = gk_homog_void_ratio(&M->rve[g]);
+        if (e < emin) emin = e;
+        if (e > emax) emax = e;
+    }
+    for (k = 0; k < M->ncurve; ++k) {
+        if (fabs(M->curve[k].ev) > evmax) evmax = fabs(M->curve[k].ev);
+        if (fabs(M->cx[k].top_uy) > uymax) uymax = fabs(M->cx[k].top_uy);
+        if (M->cx[k].p < pmin) pmin = M->cx[k].p;
+        if (k == 0) continue;
+        tot += M->curve[k].secs, itsum += M->curve[k].iters;
+        if (M->curve[k].iters > itmax) itmax = M->curve[k].iters;
+    }
+    write_csv(M);
+    write_cyclic_plots(M);
+    snprintf(title, sizeof title, "void ratio after %.2f cycles, gamma = %.2f %% (x, y in mm)", xl->cycle,
+             100 * c->gamma);
+    write_field_svg(M, 2, "void_ratio_field.svg", title);
+    if (!o->vtk_every || M->step % o->vtk_every) write_vtk(M, M->step);
+    if (status != 3) write_checkpoint(M, o->out);
+    printf("wrote %s/cyclic.csv, cyclic_stress_path.svg, cyclic_stress_strain.svg, cyclic_pressure.svg, "
+           "void_ratio_field.svg, gp_%04d.vtk and mesh_%04d.vtk (ParaView), checkpoint.bin\n",
+           o->out, M->step, M->step);
+    if (c->cyc_liq >= 0)
+        printf("liquefaction (p < %.3g x p0 = %.2f kPa) after %.2f cycles\n", o->liq_ratio,
+               o->liq_ratio * c->p0 / 1e3, c->cyc_liq);
+    else
+        printf("no liquefaction: p from %.2f kPa to %.2f kPa (lowest %.2f kPa) in %.2f cycles\n", c->p0 / 1e3,
+               xl->p / 1e3, pmin / 1e3, xl->cycle);
+    if (o->cyclic == 2)
+        printf("|gamma| %s %.3g %%%s\n", c->cyc_gamma >= 0 ? "reached" : "stayed below", 100 * o->gamma_stop,
+               c->cyc_gamma >= 0 ? "" : " (cycle limit)");
+    printf("local void ratio %.4f - %.4f; max |mean RVE eps_v| %.2e; max |top u_y| %.1e m\n", emin, emax,
+           evmax, uymax);
+    printf("RESULT test=%s liquefied=%d cycles=%.3f cycles_to_liquefaction=%.3f cycles_to_gamma_limit=%.3f "
+           "p0=%.6g p_final=%.6g p_min=%.6g sigma_yy_final=%.6g tau_final=%.6g gamma_final=%.6g e_min=%.5f "
+           "e_max=%.5f max_eps_v_rve=%.3g max_iterations=%d mean_iterations=%.2f steps=%d "
+           "seconds_per_step=%.3f total_seconds=%.2f\n",
+           o->test, c->cyc_liq >= 0, xl->cycle, c->cyc_liq, c->cyc_gamma, c->p0, xl->p, pmin, last->syy,
+           xl->tau, c->gamma, emin, emax, evmax, itmax, n > 0 ? (double)itsum / n : 0.0, n,
+           n > 0 ? tot / n : 0.0, tot);
 }
 
 /* ------------------------------------------------- single-element test */
@@ -889,13 +1334,15 @@ int main(int argc, char **argv) {
     int i, status = 0;
     double t_start;
     memset(&M, 0, sizeof M);
-    o->nx = 8, o->ny = 16, o->steps = 100, o->threads = 2, o->quad = 2, o->max_iter = 20, o->checkpoint = 10;
-    o->vtk_every = 1, o->aitken = 1, o->dem_min = 2, o->dem_max = 20000, o->elem = GK_Q8;
-    o->out = "femdem_out", o->packing = "examples/data/rve400.txt", o->tangent = "taylor",
-    o->test = "biaxial";
-    o->width = 0.05, o->height = 0.1, o->pressure = 1e5, o->inc = 1e-3, o->tol = 0.01, o->ftol = 3e-3,
+    /* -1 / NAN / NULL: a default that depends on --test, set after parsing */
+    o->nx = -1, o->ny = -1, o->steps = 100, o->threads = 2, o->quad = 2, o->max_iter = 20, o->checkpoint = 10;
+    o->vtk_every = -1, o->aitken = 1, o->dem_min = 2, o->dem_max = 20000, o->elem = GK_Q8;
+    o->out = "femdem_out", o->packing = NULL, o->tangent = "taylor", o->test = "biaxial";
+    o->width = NAN, o->height = NAN, o->pressure = NAN, o->inc = 1e-3, o->tol = 0.01, o->ftol = 3e-3,
     o->dt = SEED_DT;
     o->dem_strain = 1e-5, o->xi = 5e-5;
+    o->amp = 0.01, o->tau_amp = 3e4, o->stress_steps = 6, o->cycles = 20, o->gamma_stop = 0.05,
+    o->liq_ratio = 0.1;
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -967,6 +1414,18 @@ int main(int argc, char **argv) {
             o->dem_max = atoi(v);
         else if (!strcmp(a, "--vtk-every"))
             o->vtk_every = atoi(v);
+        else if (!strcmp(a, "--amplitude"))
+            o->amp = atof(v);
+        else if (!strcmp(a, "--tau-amplitude"))
+            o->tau_amp = atof(v);
+        else if (!strcmp(a, "--stress-steps"))
+            o->stress_steps = atoi(v);
+        else if (!strcmp(a, "--cycles"))
+            o->cycles = atof(v);
+        else if (!strcmp(a, "--liq-ratio"))
+            o->liq_ratio = atof(v);
+        else if (!strcmp(a, "--gamma-limit"))
+            o->gamma_stop = atof(v);
         else if (!strcmp(a, "--relaxation")) {
             if (!strcmp(v, "aitken"))
                 o->aitken = 1;
@@ -984,10 +1443,27 @@ int main(int argc, char **argv) {
         }
         ++i;
     }
+    o->cyclic = !strcmp(o->test, "cyclic-strain") ? 1 : !strcmp(o->test, "cyclic-stress") ? 2 : 0;
     if (!strcmp(o->test, "single"))
         o->nx = 1, o->ny = 1, o->elem = GK_Q4, o->quad = 2;
-    else if (strcmp(o->test, "biaxial")) {
-        fprintf(stderr, "femdem_biaxial: --test must be biaxial or single\n");
+    else if (!o->cyclic && strcmp(o->test, "biaxial")) {
+        fprintf(stderr, "femdem_biaxial: --test must be biaxial, single, cyclic-strain or cyclic-stress\n");
+        return 2;
+    }
+    if (o->nx == -1) o->nx = o->cyclic ? 2 : 8;
+    if (o->ny == -1) o->ny = o->cyclic ? 2 : 16;
+    if (o->width != o->width) o->width = o->cyclic ? 0.1 : 0.05;
+    if (o->height != o->height) o->height = o->cyclic ? 0.05 : 0.1;
+    if (o->pressure != o->pressure) o->pressure = o->cyclic ? 0.0 : 1e5; /* cyclic 0: the packing's own */
+    if (o->vtk_every == -1) o->vtk_every = o->cyclic ? 0 : 1;
+    if (!o->packing)
+        o->packing = o->cyclic == 1   ? "examples/data/rve400_e0223.txt"
+                     : o->cyclic == 2 ? "examples/data/rve400_e0209.txt"
+                                      : "examples/data/rve400.txt";
+    if (o->cyclic && (!(o->amp > 0 && o->amp < 0.5) || !(o->tau_amp > 0) || o->stress_steps < 1 ||
+                      !(o->cycles > 0 && o->cycles <= 1e5) || !(o->liq_ratio > 0 && o->liq_ratio < 1) ||
+                      !(o->gamma_stop > 0))) {
+        fprintf(stderr, "femdem_biaxial: a cyclic option is out of range (see --help)\n");
         return 2;
     }
     if (o->nx < 1 || o->ny < 1 || o->nx > 1000 || o->ny > 1000 || o->steps < 1 || o->threads < 1 ||
@@ -1013,14 +1489,34 @@ int main(int argc, char **argv) {
     M.cap = o->steps + 16;
     M.curve = (curve_row *)calloc((size_t)M.cap, sizeof(curve_row));
     if (!M.curve) return 1;
+    if (o->cyclic) {
+        M.cx = (cyc_extra *)calloc((size_t)M.cap, sizeof(cyc_extra));
+        if (!M.cx) return 1;
+    }
     if (o->restart) {
         if (read_checkpoint(&M, o->restart, &err)) {
             fprintf(stderr, "femdem_biaxial: %s\n", err.msg);
             return 1;
         }
-        fprintf(stderr,
-                "femdem_biaxial: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n",
-                o->restart, M.step, 100 * M.eps_done);
+        if (o->cyclic)
+            fprintf(stderr,
+                    "femdem_biaxial: restarted from %s/checkpoint.bin at step %d (shear strain %.3f %%, %.2f "
+                    "cycles)\n",
+                    o->restart, M.step, 100 * M.cs.gamma, M.cx[M.ncurve - 1].cycle);
+        else
+            fprintf(stderr,
+                    "femdem_biaxial: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n",
+                    o->restart, M.step, 100 * M.eps_done);
+    } else if (o->cyclic) { /* initial state: the consolidated RVEs under the platens */
+        cyc_state *c = &M.cs;
+        external_force(&M, &err);
+        residual(&M, M.sig_n, &err);
+        cyclic_state(&M, &M.curve[0], &M.cx[0]);
+        M.ncurve = 1;
+        c->dir = 1, c->branch = 0, c->good = 0, c->bsteps = 0, c->gamma = c->g_start = 0.0,
+        c->G0 = c->Gu = 0.0;
+        c->tau = c->t_start = M.cx[0].tau, c->p0 = M.cx[0].p, c->h = o->inc / 8;
+        c->cyc_liq = c->cyc_gamma = -1.0;
     } else {
         double syy, sxx, ev;
         external_force(&M, &err);
@@ -1032,8 +1528,20 @@ int main(int argc, char **argv) {
     printf(
         "femdem_biaxial: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n",
         o->test, o->nx, o->ny, o->elem == GK_Q8 ? "Q8" : "Q4", M.ngp, M.rve[0].n, o->tangent, o->threads);
+    if (o->cyclic)
+        printf("femdem_biaxial: %s, void ratio %.4f, p0 = %.2f kPa, sigma_yy0 = %.2f kPa; left/right "
+               "periodic: %d "
+               "-> %d dofs; %s amplitude %.4g%s, at most %.4g cycles\n",
+               o->packing, gk_homog_void_ratio(&M.rve[0]), M.cs.p0 / 1e3, M.curve[0].syy / 1e3, M.dm.n,
+               M.dm.nred, o->cyclic == 1 ? "shear strain" : "shear stress",
+               o->cyclic == 1 ? 100 * o->amp : o->tau_amp / 1e3, o->cyclic == 1 ? " %" : " kPa", o->cycles);
     fflush(stdout);
     t_start = gk_wtime();
+    if (o->cyclic) {
+        status = run_cyclic(&M, t_start, &err);
+        cyclic_summary(&M, status);
+        goto done;
+    }
     {
         double target = o->steps * o->inc;
         int good_in_row = 0;
@@ -1049,19 +1557,8 @@ int main(int argc, char **argv) {
                 break;
             }
             if (r == 1) {
-                M.scale *= 0.5;
                 good_in_row = 0;
-                fprintf(stderr,
-                        "femdem_biaxial: step at %.3f %% did not converge in %d iterations (E_d %.3g)%s%s; "
-                        "increment cut to %.4g %%\n",
-                        100 * M.eps_done, iters, Ed, err.msg[0] ? ": " : "", err.msg, 100 * o->inc * M.scale);
-                err.msg[0] = 0;
-                if (M.scale < 1.0 / 16) {
-                    fprintf(stderr,
-                            "femdem_biaxial: giving up at axial strain %.3f %%; last converged state in "
-                            "%s/checkpoint.bin\n",
-                            100 * M.eps_done, o->out);
-                    write_checkpoint(&M, o->out);
+                if (cut_back(&M, "axial strain", M.eps_done, o->inc, iters, Ed, &err)) {
                     status = 3;
                     break;
                 }
@@ -1095,7 +1592,11 @@ int main(int argc, char **argv) {
     }
     write_csv(&M);
     write_plots(&M);
-    write_field_svg(&M);
+    {
+        char title[200];
+        snprintf(title, sizeof title, "eps_q at axial strain %.2f %% (x, y in mm)", 100 * M.eps_done);
+        write_field_svg(&M, 0, "eps_q_field.svg", title);
+    }
     if (status != 3) write_checkpoint(&M, o->out);
     if (!strcmp(o->test, "single") && M.ncurve > 1) {
         int n = M.ncurve, k, kpk = 0;
@@ -1167,10 +1668,13 @@ int main(int argc, char **argv) {
                peak, epk, ang, 1e3 * wid, itmax, M.ncurve - 1, M.ncurve > 1 ? tot / (M.ncurve - 1) : 0.0,
                tot);
     }
+done:
     for (i = 0; i < M.ngp; ++i) {
         gk_rve_destroy(&M.rve[i]);
         gk_rve_state_free(&M.st[i]);
     }
+    gk_dofmap_free(&M.dm);
+    gk_csr_free(&M.Kr);
     gk_csr_free(&M.K);
     gk_mesh_free(&M.mesh);
     return status;

@@ -2,20 +2,10 @@
  * exit 0, and write the documented outputs with sane values. Needs the
  * binaries in build/ (`make test` builds them first). */
 #define GK_IMPLEMENTATION
+#define GK_TEST_DRIVERS
 #include "gk_dem.h"
 #include "gk_test.h"
 #include <stdlib.h>
-
-static int file_has(const char *path, const char *needle) {
-    FILE *fp = fopen(path, "r");
-    char buf[4096];
-    int found = 0;
-    if (!fp) return 0;
-    while (!found && fgets(buf, sizeof buf, fp))
-        if (strstr(buf, needle)) found = 1;
-    fclose(fp);
-    return found;
-}
 
 static int count_lines(const char *path) {
     FILE *fp = fopen(path, "r");
@@ -55,16 +45,16 @@ TEST(rve_path_writes_csv_and_svg) {
     CHECK_NEAR(p0, 99976.3847, 1e-3);
     fclose(fp);
     CHECK_EQ_INT(count_lines("build/t_rve_path.csv"), 7);
-    CHECK(file_has("build/t_rve_path.svg", "<svg"));
-    CHECK(file_has("build/t_rve_path.out", "RESULT p="));
+    CHECK(gk_test_file_has("build/t_rve_path.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_rve_path.out", "RESULT p="));
     /* bad arguments: a message and a non-zero status */
     CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 1\" > build/t_bad.out 2>&1") !=
           0);
-    CHECK(file_has("build/t_bad.out", "needs 4 numbers"));
+    CHECK(gk_test_file_has("build/t_bad.out", "needs 4 numbers"));
     CHECK(system("build/rve_path --packing no_such_file --dH \"0 0 0 0\" > build/t_bad.out 2>&1") != 0);
-    CHECK(file_has("build/t_bad.out", "no_such_file"));
+    CHECK(gk_test_file_has("build/t_bad.out", "no_such_file"));
     CHECK(system("build/rve_path --help > build/t_bad.out 2>&1") == 0);
-    CHECK(file_has("build/t_bad.out", "--steps-per-increment"));
+    CHECK(gk_test_file_has("build/t_bad.out", "--steps-per-increment"));
 }
 
 /* gk_pack: a small packing, consolidated to 100 kPa, readable back */
@@ -75,10 +65,10 @@ TEST(gk_pack_makes_a_consolidated_packing) {
         system(
             "build/gk_pack --dim 2 --n 120 --pressure 1e5 --out build/t_pack.txt > build/t_pack.out 2>&1") ==
         0);
-    CHECK(file_has("build/t_pack.out", "RESULT void_ratio="));
+    CHECK(gk_test_file_has("build/t_pack.out", "RESULT void_ratio="));
     CHECK(gk_packing_read("build/t_pack.txt", &pk, NULL, &e) == GK_OK);
     CHECK(pk.n == 120 && pk.dim == 2);
-    CHECK(file_has("build/t_pack.txt", "RVE state: stress"));
+    CHECK(gk_test_file_has("build/t_pack.txt", "RVE state: stress"));
     gk_packing_free(&pk);
 }
 
@@ -105,26 +95,46 @@ static int csv_same(const char *a, const char *b, int ncol) {
     return same && rows > 1;
 }
 
+/* a driver run `base full` with 2 and with 1 thread (build/<tag>A, <tag>1),
+ * and `base part` continued by a restart to `full` (build/<tag>B); 1 when
+ * every run exits 0 */
+static int run_threads_and_restart(const char *base, const char *full, const char *part, const char *tag) {
+    char cmd[1024];
+    int ok = 1;
+    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/%sA > build/%sA.out 2>&1", base, full, tag, tag);
+    ok &= system(cmd) == 0;
+    snprintf(cmd, sizeof cmd, "%s %s --threads 1 --out build/%s1 > build/%s1.out 2>&1", base, full, tag, tag);
+    ok &= system(cmd) == 0;
+    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/%sB > build/%sB.out 2>&1", base, part, tag, tag);
+    ok &= system(cmd) == 0;
+    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/%sB --restart build/%sB > build/%sB2.out 2>&1",
+             base, full, tag, tag, tag);
+    ok &= system(cmd) == 0;
+    return ok;
+}
+
+/* ... and their CSVs agree in the first ncol columns (the seconds differ) */
+static void check_threads_and_restart(const char *tag, const char *csv, int ncol) {
+    char a[256], b[256];
+    snprintf(a, sizeof a, "build/%sA/%s", tag, csv);
+    snprintf(b, sizeof b, "build/%s1/%s", tag, csv);
+    CHECK(csv_same(a, b, ncol));
+    snprintf(b, sizeof b, "build/%sB/%s", tag, csv);
+    CHECK(csv_same(a, b, ncol));
+    snprintf(b, sizeof b, "build/%sB2.out", tag);
+    CHECK(gk_test_file_has(b, "restarted from"));
+}
+
 /* femdem_biaxial (seed 000): documented CSV header and RESULT line, VTK and
  * SVG outputs; the same result for 1 and 2 threads; a restart from a
  * checkpoint continues to the identical curve; the initial state carries the
  * confining pressure (sigma_xx = sigma_yy = 100 kPa from the reactions of
  * the seed RVE, whose p = 99976 Pa) */
 TEST(femdem_biaxial_runs_restarts_and_is_thread_independent) {
-    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 1 ";
-    char cmd[1024];
     FILE *fp;
     char line[1024];
-    snprintf(cmd, sizeof cmd, "%s --steps 4 --threads 2 --out build/t_fdA > build/t_fdA.out 2>&1", base);
-    CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --steps 4 --threads 1 --out build/t_fd1 > build/t_fd1.out 2>&1", base);
-    CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 2 --out build/t_fdB > build/t_fdB.out 2>&1", base);
-    CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd,
-             "%s --steps 4 --threads 2 --out build/t_fdB --restart build/t_fdB > build/t_fdB2.out 2>&1",
-             base);
-    CHECK(system(cmd) == 0);
+    CHECK(run_threads_and_restart("build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 1",
+                                  "--steps 4", "--steps 2", "t_fd"));
     fp = fopen("build/t_fdA/biaxial.csv", "r");
     CHECK(fp != NULL);
     if (!fp) return;
@@ -139,22 +149,19 @@ TEST(femdem_biaxial_runs_restarts_and_is_thread_independent) {
     }
     fclose(fp);
     CHECK_EQ_INT(count_lines("build/t_fdA/biaxial.csv"), 6);
-    CHECK(file_has("build/t_fdA.out", "RESULT peak_sigma_yy="));
-    CHECK(file_has("build/t_fdA.out", "total_seconds="));
-    CHECK(file_has("build/t_fdA/gp_0004.vtk", "eps_q"));
-    CHECK(file_has("build/t_fdA/gp_0004.vtk", "fabric_anisotropy"));
-    CHECK(file_has("build/t_fdA/mesh_0004.vtk", "displacement"));
-    CHECK(file_has("build/t_fdA/biaxial_stress.svg", "<svg"));
-    CHECK(file_has("build/t_fdA/eps_q_field.svg", "<svg"));
-    /* columns step..iterations identical (seconds differ) */
-    CHECK(csv_same("build/t_fdA/biaxial.csv", "build/t_fd1/biaxial.csv", 6));
-    CHECK(csv_same("build/t_fdA/biaxial.csv", "build/t_fdB/biaxial.csv", 6));
-    CHECK(file_has("build/t_fdB2.out", "restarted from"));
+    CHECK(gk_test_file_has("build/t_fdA.out", "RESULT peak_sigma_yy="));
+    CHECK(gk_test_file_has("build/t_fdA.out", "total_seconds="));
+    CHECK(gk_test_file_has("build/t_fdA/gp_0004.vtk", "eps_q"));
+    CHECK(gk_test_file_has("build/t_fdA/gp_0004.vtk", "fabric_anisotropy"));
+    CHECK(gk_test_file_has("build/t_fdA/mesh_0004.vtk", "displacement"));
+    CHECK(gk_test_file_has("build/t_fdA/biaxial_stress.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_fdA/eps_q_field.svg", "<svg"));
+    check_threads_and_restart("t_fd", "biaxial.csv", 6); /* columns step..iterations */
     /* bad input: a message and status 2 */
     CHECK(system("build/femdem_biaxial --element q9 > build/t_bad.out 2>&1") != 0);
-    CHECK(file_has("build/t_bad.out", "q4 or q8"));
+    CHECK(gk_test_file_has("build/t_bad.out", "q4 or q8"));
     CHECK(system("build/femdem_biaxial --help > build/t_bad.out 2>&1") == 0);
-    CHECK(file_has("build/t_bad.out", "--restart"));
+    CHECK(gk_test_file_has("build/t_bad.out", "--restart"));
 }
 
 /* single-element test (seed 000 sec 3.3, Fig 6): one Q4 element with 4
@@ -171,7 +178,129 @@ TEST(femdem_single_element_matches_rve_alone) {
     if (fp) fclose(fp);
     printf("    max relative difference of sigma_yy, FEM element vs RVE alone: %.4f\n", d);
     CHECK(d < 0.01); /* before the peak the curves agree (seed Fig 6) */
-    CHECK(file_has("build/t_fds/single_element.csv", "sigma_yy_fem,sigma_yy_rve"));
+    CHECK(gk_test_file_has("build/t_fds/single_element.csv", "sigma_yy_fem,sigma_yy_rve"));
+}
+
+/* data rows of a CSV file with ncol numeric columns into v[row * ncol + col];
+ * the header line into header. Returns the number of rows (-1: no file). */
+static int read_csv(const char *path, int ncol, double *v, int maxrows, char *header, size_t hlen) {
+    FILE *fp = fopen(path, "r");
+    char line[4096];
+    int n = 0;
+    if (!fp) return -1;
+    if (!fgets(header, (int)hlen, fp)) header[0] = 0;
+    while (n < maxrows && fgets(line, sizeof line, fp)) {
+        char *p = line;
+        int k;
+        for (k = 0; k < ncol; ++k) {
+            v[n * ncol + k] = strtod(p, &p);
+            if (*p == ',') ++p;
+        }
+        ++n;
+    }
+    fclose(fp);
+    return n;
+}
+
+#define CYC_HEADER                                                                                      \
+    "step,cycle,gamma,tau,sigma_yy,sigma_xx,p,q,eps_v_rve,top_uy,iterations,seconds,E_d,E_f,increment," \
+    "failed_gp\n"
+enum { C_STEP, C_CYCLE, C_GAMMA, C_TAU, C_SYY, C_SXX, C_P, C_Q, C_EVR, C_UY, C_ITER, C_NCOL = 16 };
+
+/* cyclic simple shear, strain control (seed 000 sec 5): documented CSV and
+ * RESULT line; constant volume (platen lift 0, mean RVE volume change ~0:
+ * the periodic ties keep the width); tau has the sign of gamma at the turning
+ * points; the loose packing loses mean stress over a cycle (contractive); the
+ * same curve for 1 and 2 threads and across a restart */
+TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
+    char header[512];
+    double v[64 * C_NCOL], evmax = 0, uymax = 0, tau_pos = 0, tau_neg = 0;
+    int n, k, turns = 0;
+    CHECK(run_threads_and_restart("build/femdem_biaxial --test cyclic-strain --nx 2 --ny 1 --element q4 "
+                                  "--increment 0.002",
+                                  "--cycles 1", "--cycles 0.5", "t_fc"));
+    n = read_csv("build/t_fcA/cyclic.csv", C_NCOL, v, 64, header, sizeof header);
+    CHECK(strcmp(header, CYC_HEADER) == 0);
+    CHECK_EQ_INT(n, 21); /* the initial state and 1 cycle of 4 x 1 % in steps of 0.2 % */
+    if (n != 21) return;
+    for (k = 0; k < n; ++k) {
+        const double *r = v + k * C_NCOL;
+        if (fabs(r[C_EVR]) > evmax) evmax = fabs(r[C_EVR]);
+        if (fabs(r[C_UY]) > uymax) uymax = fabs(r[C_UY]);
+        if (fabs(r[C_GAMMA] - 0.01) < 1e-12) tau_pos = r[C_TAU], ++turns;
+        if (fabs(r[C_GAMMA] + 0.01) < 1e-12) tau_neg = r[C_TAU], ++turns;
+    }
+    printf("    constant volume: max |top u_y| %.1e m, max |mean RVE eps_v| %.1e; tau at +-1 %%: %.0f / %.0f "
+           "Pa; "
+           "p %.0f -> %.0f Pa\n",
+           uymax, evmax, tau_pos, tau_neg, v[C_P], v[20 * C_NCOL + C_P]);
+    CHECK(uymax == 0.0);
+    CHECK(evmax < 1e-6);
+    CHECK_EQ_INT(turns, 2);
+    CHECK(tau_pos > 5e3 && tau_neg < -5e3);
+    CHECK_NEAR(v[C_P], 1e5, 100.0);              /* the packing's own 100 kPa */
+    CHECK(v[20 * C_NCOL + C_P] < 0.97 * v[C_P]); /* contractive: p' falls over a cycle */
+    CHECK_NEAR(v[20 * C_NCOL + C_CYCLE], 1.0, 1e-9);
+    CHECK_NEAR(v[20 * C_NCOL + C_GAMMA], 0.0, 1e-12);
+    CHECK_NEAR(gk_test_result("build/t_fcA.out", "cycles"), 1.0, 1e-9);
+    CHECK(gk_test_result("build/t_fcA.out", "liquefied") == 0.0);
+    CHECK_REL(gk_test_result("build/t_fcA.out", "p_final"), v[20 * C_NCOL + C_P], 1e-5);
+    CHECK(gk_test_result("build/t_fcA.out", "total_seconds") > 0);
+    CHECK(gk_test_file_has("build/t_fcA/cyclic_stress_path.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_fcA/cyclic_stress_strain.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_fcA/void_ratio_field.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_fcA/gp_0020.vtk", "void_ratio"));
+    check_threads_and_restart("t_fc", "cyclic.csv", 11); /* columns step..iterations */
+    /* bad input: a message and status 2; a checkpoint of the other control mode is refused */
+    CHECK(system("build/femdem_biaxial --test cyclic-foo > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "cyclic-strain or cyclic-stress"));
+    CHECK(system("build/femdem_biaxial --test cyclic-strain --amplitude 0 > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "out of range"));
+    CHECK(system("build/femdem_biaxial --test cyclic-stress --nx 2 --ny 1 --element q4 --restart build/t_fcA "
+                 "--out build/t_fcC > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "not a checkpoint"));
+    CHECK(system("build/femdem_biaxial --help > build/t_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "--tau-amplitude"));
+}
+
+/* stress control: the platen turns when |tau| reaches the amplitude (the
+ * overshooting step is repeated with a secant increment, so every turning
+ * point is within 2 % of it and no |tau| exceeds it by more); with a
+ * --gamma-limit the run stops at the first step beyond it */
+TEST(femdem_cyclic_stress_turns_at_the_amplitude) {
+    const char *base =
+        "build/femdem_biaxial --test cyclic-stress --nx 2 --ny 1 --element q4 --tau-amplitude 1.5e4 "
+        "--stress-steps 2 --threads 2";
+    char cmd[1024], header[512];
+    double v[128 * C_NCOL], tmax = 0, amp = 1.5e4, g_lim = 0.002;
+    int n, k, turns = 0;
+    snprintf(cmd, sizeof cmd, "%s --cycles 1.5 --out build/t_fcS > build/t_fcS.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    n = read_csv("build/t_fcS/cyclic.csv", C_NCOL, v, 128, header, sizeof header);
+    CHECK(strcmp(header, CYC_HEADER) == 0);
+    for (k = 1; k < n; ++k) {
+        const double *r = v + k * C_NCOL;
+        if (fabs(r[C_TAU]) > tmax) tmax = fabs(r[C_TAU]);
+        if (k + 1 < n && (r[C_GAMMA] - r[C_GAMMA - C_NCOL]) * (r[C_GAMMA + C_NCOL] - r[C_GAMMA]) < 0) {
+            ++turns;
+            CHECK(fabs(r[C_TAU]) >= 0.98 * amp && fabs(r[C_TAU]) <= 1.02 * amp);
+            CHECK(r[C_TAU] * r[C_GAMMA] > 0); /* turning at +tau_A with gamma > 0 and vice versa */
+        }
+    }
+    printf("    %d turning points, max |tau| %.0f Pa (amplitude %.0f) in %.2f cycles\n", turns, tmax, amp,
+           n > 0 ? v[(n - 1) * C_NCOL + C_CYCLE] : 0.0);
+    CHECK_EQ_INT(turns, 3);
+    CHECK(tmax <= 1.02 * amp);
+    CHECK(gk_test_file_has("build/t_fcS.out", "RESULT test=cyclic-stress"));
+    snprintf(cmd, sizeof cmd, "%s --gamma-limit %g --out build/t_fcG > build/t_fcG.out 2>&1", base, g_lim);
+    CHECK(system(cmd) == 0);
+    n = read_csv("build/t_fcG/cyclic.csv", C_NCOL, v, 128, header, sizeof header);
+    CHECK(n > 2);
+    if (n <= 2) return;
+    for (k = 0; k + 1 < n; ++k) CHECK(fabs(v[k * C_NCOL + C_GAMMA]) < g_lim);
+    CHECK(fabs(v[(n - 1) * C_NCOL + C_GAMMA]) >= g_lim);
+    CHECK_NEAR(gk_test_result("build/t_fcG.out", "cycles_to_gamma_limit"), v[(n - 1) * C_NCOL + C_CYCLE],
+               1e-3);
 }
 
 int main(int argc, char **argv) {
@@ -180,5 +309,7 @@ int main(int argc, char **argv) {
     RUN(gk_pack_makes_a_consolidated_packing);
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
     RUN(femdem_single_element_matches_rve_alone);
+    RUN(femdem_cyclic_strain_constant_volume_and_contractive);
+    RUN(femdem_cyclic_stress_turns_at_the_amplitude);
     return gk_test_done();
 }
