@@ -22,15 +22,20 @@
  * the resolution b/h and the domain size in footing widths do.
  *
  * BOUNDARIES. Left (x = 0): roller (symmetry plane). Right: smooth rigid
- * wall = roller. Base: fixed. Top: the surcharge q_s as a follower load on
- * the top row of points outside the footing: a point's top edge is the image
- * F e_x l of its initial edge (l = h/ppc), so it receives f = q_s l frac
- * (F_10, -F_00), the pressure on its current edge (frac = the part of the
- * initial edge beyond x = b: 1 when b is a multiple of h). The footing is a
- * gk_mpm_body box x <= b, y >= top (its ghost part too), STICK contact
- * (rough base and side), prescribed velocity -v ramped up linearly over
- * --ramp seconds; load = -force_y (the reaction, per unit length of the half
- * model), averaged over each output interval.
+ * wall = roller. Base: fixed. Top: the surcharge q_s as a follower load
+ * (mpd_edge, mpmdem.h: the edge turns and stretches with F, its load goes
+ * to the nodes with the weights of the edge) on the top edges of the top row
+ * of points beyond the footing edge x = b. The footing is a gk_mpm_body box
+ * (its ghost part too), STICK contact (rough base and side), prescribed
+ * velocity -v ramped up linearly over --ramp seconds; load = -force_y (the
+ * reaction, per unit length of the half model), averaged over each output
+ * interval. FOOTING EDGE: a nodal rigid body covering the nodes x <= x_k
+ * carries a uniform stress over x <= x_k + h/2 (each node's tributary
+ * width), so the body covers x <= B/2 - h/2 and b = x_k + h/2 = B/2 exactly
+ * when B/2 = (k + 1/2) h (the default h = 0.2 and the paper's h = 1/9 m
+ * are; otherwise b is the nearest such width below B/2, printed, and q =
+ * load / b). Covering x <= B/2 instead makes the footing half a cell wider
+ * than b: +25 % load at b = 2 h.
  *
  * INITIAL STATE. Weightless soil under a uniform 20 kPa surface load is at
  * sigma = -20 kPa I everywhere (roller walls, fixed base): every RVE is the
@@ -49,14 +54,20 @@
  * RVE per confining pressure (--phi-pressures, default 10, 20, 30 kPa; the
  * seed used 10..30 kPa): prepared at sigma_3 like the footing's RVEs, then a
  * drained biaxial test with gk_rve_set_servo (axis 0 stress-controlled at
- * -sigma_3, axis 1 compressed at the strain per DEM step the MPM coupling
- * uses, --dem-strain, so both see the same inertial number) to past its
- * peak. Peak = maximum of the mobilised sin phi = (s1 - s3)/(s1 + s3) after
- * a centred moving average over +-0.1 % axial strain (a 400-disk RVE is
- * noisy). phi per test = asin of that; the Mohr-Coulomb envelope through
- * the origin tangent (least squares) to the peak circles, sin phi =
- * sum(c r) / sum(c^2) (c, r = centre and radius), is the phi used (the
+ * -sigma_3, axis 1 compressed at constant rate: the inertial number
+ * --dem-inertial at sigma_3 with the adaptive DEM rule, --dem-strain per DEM
+ * step with the strain rule, i.e. as the MPM's RVEs deform) to
+ * --phi-strain. Peak = maximum of the mobilised sin phi = (s1 - s3)/(s1 +
+ * s3) after a centred moving average over +-0.1 % axial strain (a 400-disk
+ * RVE is noisy). phi per test = asin of that; the Mohr-Coulomb envelope
+ * through the origin tangent (least squares) to the peak circles, sin phi
+ * = sum(c r) / sum(c^2) (c, r = centre and radius), is the phi used (the
  * regression r = c sin phi + c' cos phi with a cohesion c' is printed too).
+ * The same fit of the means over the last 2 % of strain gives phi_res (the
+ * softened end of the tests, not yet a critical state at 8 %): the dense
+ * RVE peaks at ~0.7 % and loses ~7 deg, and a footing on it fails
+ * progressively, so its N_q lies between eq 46 of phi_res and of phi; the
+ * output also gives the phi whose eq 46 is the computed N_q.
  * Nothing is cached: every run measures (or --phi-deg X skips it).
  *
  * ULTIMATE LOAD (Vesic's rule, as the seed: the first point where the slope
@@ -74,17 +85,26 @@
  * the last row (RESULT ultimate_reached=0).
  *
  * TIME STEP, DEM STEPS: mpmdem.h (dt = cfl h / c from the RVE's Taylor
- * tangent; n_s = max|dH| / dem_strain DEM steps per MPM step).
+ * tangent; DEM steps per MPM step by its --dem-rule, default adaptive).
+ *
+ * RATE. The PIC part of the PIC/FLIP blend damps like a viscosity: its
+ * shear stress is of order rho alpha c v / cfl (~6 kPa at alpha 0.1, 0.1
+ * m/s here), not small next to the strength of a soil at 20 kPa, so N_q
+ * grows with alpha v (measured with --dem-rule strain on the 18 x 12 grid:
+ * 12.8 at 0.1 m/s, 15.2 at 0.25 m/s, 11.9 at 0.25 m/s with alpha 0; on a
+ * 24 x 16 grid 1 m/s gave ~1.5 x the 0.25 m/s value). The default keeps
+ * the seed's alpha = 0.1 and 0.1 m/s.
  *
  * SIZE AND COST. The paper's grid (--paper: 12 x 8 m, 108 x 72 cells, h =
  * 0.111 m, 1 point per cell = 7776 RVEs x 400 disks, 0.1 m/s to d/B = 1.5)
  * takes hours. The default is a reduced problem that finishes in about a
- * minute on 2 cores and still reaches the ultimate load (see --help for its
- * values): a 6 x 4 m domain (the Prandtl mechanism of phi <= 30 deg reaches
- * 4.8 B from the axis and ~1.5 B deep), h = 0.25 m (b = 2 cells), footing
- * speed 1 m/s, to d/B = 0.35. The run prints its memory (VmHWM, per RVE)
- * and projects the paper-size memory and wall time; --max-steps N stops
- * early (e.g. a 5-step run at the paper's size to measure both there).
+ * minute on 2 idle cores and still reaches the ultimate load: a 6 x 3 m
+ * domain (the Prandtl mechanism of phi <= 32 deg reaches 5.3 B from the
+ * axis and ~1.5 B deep), h = 0.2 m (b = 2.5 cells, 450 RVEs), the seed's
+ * 0.1 m/s, to d/B = 0.14 (the dense footing peaks at d/B ~ 0.06). The run
+ * prints its memory (VmHWM, per RVE) and projects the paper-size memory and
+ * wall time; --max-steps N stops early (e.g. a 5-step run at the paper's
+ * size to measure both there).
  *
  * Outputs in --out DIR: footing.csv (load-settlement), footing_load.svg,
  * rve_biaxial.svg and rve_mohr.svg (phi measurement), eps_q_dB*.svg (stages)
@@ -212,12 +232,12 @@ static void usage(FILE *fp, const mpd_opts *d, const ft_opts *f) {
         "  dem_steps_per_point,seconds), footing_load.svg, rve_biaxial.svg, rve_mohr.svg, eps_q_dB*.svg,\n"
         "  eps_q_end.svg, rotation_end.svg, void_ratio_end.svg, displacement_end.svg, points_*.vtk,\n"
         "  checkpoint.bin\n"
-        "ends with: RESULT Nq=... Nq_analytic=... Nq_analytic_local=... phi_deg=... q_ult=... "
-        "d_ult_over_B=...\n"
-        "           phi_res_deg=... Nq_analytic_res=... ultimate_reached=... n_rves=... mpm_steps=... "
-        "dt=...\n"
-        "           seconds_per_step=...\n"
-        "           seconds_per_step_per_1000_rves=... mem_per_rve_kb=... vmhwm_mb=... total_seconds=...\n");
+        "ends with: RESULT Nq=... Nq_analytic=... Nq_analytic_local=... phi_deg=... phi_res_deg=...\n"
+        "           Nq_analytic_res=... phi_mobilised_deg=... q_ult=... d_ult_over_B=... "
+        "ultimate_reached=...\n"
+        "           n_rves=... mpm_steps=... dt=... seconds_per_step=... seconds_per_step_per_1000_rves=...\n"
+        "           seconds_per_step_per_1000_rves_after_first=... mem_per_rve_kb=... vmhwm_mb=... "
+        "total_seconds=...\n");
 }
 
 /* kB of a /proc/self/status line ("VmHWM", "VmRSS"); -1 if unavailable */
@@ -241,6 +261,21 @@ static double nq_prandtl(double phi_deg) {
     double p = phi_deg * MPD_PI / 180.0, t = tan(MPD_PI / 4 + p / 2);
     return t * t * exp(MPD_PI * tan(p));
 }
+/* the angle whose eq 46 gives N_q (bisection; N_q < 1 has none) [deg] */
+static double phi_of_nq(double nq) {
+    double lo = 0.0, hi = 60.0;
+    int k;
+    if (!(nq >= 1.0) || nq > nq_prandtl(hi)) return NAN;
+    for (k = 0; k < 60; ++k) {
+        double m = 0.5 * (lo + hi);
+        if (nq_prandtl(m) < nq)
+            lo = m;
+        else
+            hi = m;
+    }
+    return 0.5 * (lo + hi);
+}
+
 /* Terzaghi's reduced angle for local / punching failure, eq 47 [deg] */
 static double phi_reduced(double phi_deg) {
     return atan(2.0 / 3.0 * tan(phi_deg * MPD_PI / 180.0)) * 180.0 / MPD_PI;
@@ -584,7 +619,8 @@ int main(int argc, char **argv) {
     double phi_res = NAN, phi_rc = NAN, coh_r = NAN;
     double rss_before, rss_after, stages[FT_NSTAGE] = {0.1, 0.25, 0.5, 1.0, 1.5};
     long nsteps_total, step0;
-    long long dem0;
+    long long dem0, dem_first = 0;
+    double t_first = 0;
     gk_err err;
     char buf[64], what[300], path[1200];
     int n[3];
@@ -872,6 +908,7 @@ int main(int argc, char **argv) {
             break;
         }
         S.t += dt, S.disp += vf * dt, ++S.step;
+        if (S.step == 1) t_first = gk_wtime() - t_start, dem_first = F.dem_steps - dem0; /* fresh runs only */
         S.acc_load += -S.body.force[1] * dt, S.acc_dt += dt;
         gk_mpm_points_totals(&pts, &m, mom, &ek);
         S.acc_ek += ek, ++S.nacc;
@@ -929,6 +966,10 @@ int main(int argc, char **argv) {
         double nq46 = nq_prandtl(phi), nq47 = nq_prandtl(phi_reduced(phi)), hwm, per_rve, ck_mb = 0;
         long steps_run = S.step - step0;
         long long dems = F.dem_steps - dem0;
+        int excl = step0 == 0 && steps_run > 1; /* leave out the first step's one-off relaxation */
+        double per_step_rve = steps_run ? (secs - (excl ? t_first : 0)) / (steps_run - excl) / pts.n : 0.0;
+        double dem_after_first =
+            steps_run ? (double)(dems - (excl ? dem_first : 0)) / (steps_run - excl) / pts.n : 0.0;
         int ku = -1, reached = 0, k;
         const char *mode = "not reached";
         void *blob[2];
@@ -981,6 +1022,8 @@ int main(int argc, char **argv) {
             "N_q: MPMxDEM %.2f; eq 46 (general shear, phi = %.2f deg) %.2f; eq 47 (local/punching, phi_r = "
             "%.2f deg) %.2f; ratio %.3f to eq 46\n",
             nq, phi, nq46, phi_reduced(phi), nq47, nq / nq46);
+        printf("the MPMxDEM N_q is eq 46 of phi = %.2f deg (the angle the footing mobilises)\n",
+               phi_of_nq(nq));
         if (measured)
             printf("N_q of eq 46 with the residual angle phi_res = %.2f deg (the softened end of the RVE "
                    "tests): "
@@ -1001,30 +1044,30 @@ int main(int argc, char **argv) {
                "states\n",
                hwm / 1024, per_rve, ck_mb);
         {
-            /* the paper's size: 7776 RVEs, h = 12/108, 0.1 m/s to d/B = 1.5 with a 0.5 s ramp */
+            /* the paper's size: 7776 RVEs, h = 12/108, 0.1 m/s to d/B = 1.5 with a 0.5 s ramp; cost per
+             * RVE per MPM step of this run without its first step (the one-off relaxation of every RVE) */
             double hp = 12.0 / 108.0, dtp = o.cfl * hp / c, stepsp = (1.5 * f.B / 0.1 + 0.25) / dtp;
             double base = hwm > 0 && isfinite(per_rve) ? hwm - per_rve * pts.n : NAN;
-            double us = dems ? secs / (double)dems : 0.0;                        /* s per RVE DEM step */
-            double extra = (double)dems - (double)o.dem_min * steps_run * pts.n; /* above the minimum */
-            double scale = S.disp > 0 ? (h / hp) * (h / hp) * (1.5 * f.B / S.disp) : 0.0;
-            double tp = us * (7776.0 * o.dem_min * stepsp + (extra > 0 ? extra : 0.0) * scale);
-            printf(
-                "paper size projection (7776 RVEs, h = %.4g m, dt = %.3g s, %.0f MPM steps at 0.1 m/s to d/B "
-                "= "
-                "1.5): memory ~ %.2f GB, checkpoint file %.2f GB; wall ~ %s on these cores "
-                "(%.3g s/step at 1 DEM step per RVE + this run's extra DEM steps scaled by points per area "
-                "and settlement)\n",
-                hp, dtp, stepsp, (base + 7776.0 * per_rve) / 1048576.0, 7776.0 * ck_mb / pts.n / 1024.0,
-                mpd_duration(tp, buf, sizeof buf), us * 7776.0 * o.dem_min);
+            double tp = per_step_rve * 7776.0 * stepsp;
+            printf("paper size projection (7776 RVEs, h = %.4g m, dt = %.3g s, %.0f MPM steps at 0.1 m/s to "
+                   "d/B = "
+                   "1.5): memory ~ %.2f GB, checkpoint file %.2f GB; wall ~ %s on these cores at this run's "
+                   "%.3g ms "
+                   "per RVE per MPM step (first step excluded; %.1f DEM steps per RVE per MPM step here)\n",
+                   hp, dtp, stepsp, (base + 7776.0 * per_rve) / 1048576.0, 7776.0 * ck_mb / pts.n / 1024.0,
+                   mpd_duration(tp, buf, sizeof buf), 1e3 * per_step_rve, dem_after_first);
         }
         printf("RESULT Nq=%.5g Nq_analytic=%.5g Nq_analytic_local=%.5g phi_deg=%.4g phi_res_deg=%.4g "
-               "Nq_analytic_res=%.5g q_ult=%.6g d_ult_over_B=%.4g ultimate_reached=%d n_rves=%d "
+               "Nq_analytic_res=%.5g phi_mobilised_deg=%.4g q_ult=%.6g d_ult_over_B=%.4g ultimate_reached=%d "
+               "n_rves=%d "
                "mpm_steps=%ld dt=%.4g "
-               "seconds_per_step=%.4g seconds_per_step_per_1000_rves=%.4g mem_per_rve_kb=%.4g vmhwm_mb=%.5g "
+               "seconds_per_step=%.4g seconds_per_step_per_1000_rves=%.4g "
+               "seconds_per_step_per_1000_rves_after_first=%.4g mem_per_rve_kb=%.4g vmhwm_mb=%.5g "
                "total_seconds=%.2f\n",
-               nq, nq46, nq47, phi, phi_res, measured ? nq_prandtl(phi_res) : NAN, qu, du, reached, pts.n,
-               steps_run, dt, steps_run ? secs / steps_run : 0.0,
-               steps_run ? secs / steps_run * 1000.0 / pts.n : 0.0, per_rve, hwm / 1024, secs);
+               nq, nq46, nq47, phi, phi_res, measured ? nq_prandtl(phi_res) : NAN, phi_of_nq(nq), qu, du,
+               reached, pts.n, steps_run, dt, steps_run ? secs / steps_run : 0.0,
+               steps_run ? secs / steps_run * 1000.0 / pts.n : 0.0, 1000.0 * per_step_rve, per_rve,
+               hwm / 1024, secs);
         free(x), free(q), free(qsm);
     }
 done : {
