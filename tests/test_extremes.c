@@ -232,10 +232,15 @@ TEST(dt_0_1_to_0_95_critical_seed_packing) {
  *       friction and rotation (I = m r^2/2): all disks spinning alike slip
  *         2 r w at every contact, torque 2 k_t r^2 theta per contact:
  *         omega^2 = 4 Z k_t / m = 19.2 k/m              -> dt* = 0.456 sqrt(m/k)
+ *     and for the face-centred cubic lattice of equal spheres (Z = 12,
+ *     I = 2/5 m r^2) with friction and rotation, the same mode with the
+ *     slip 2 r w |e x n| (e: spin axis; mean |e x n|^2 = 2/3):
+ *         omega^2 = (10/3) Z k_t / m = 32 k/m           -> dt* = 0.354 sqrt(m/k)
  *     From a 1e-9 J velocity perturbation, at 0.97 dt* the kinetic energy
  *     stays at the perturbation's level (leap-frog's shadow energy allows
  *     at most 1/(1 - 0.97^2) = 17x), at 1.03 dt* it grows by
- *     more than 1e3 within 2000 steps. Either way the state stays finite.
+ *     more than 1e3 within 2000 steps (1000 for fcc). Either way the state
+ *     stays finite.
  *
  *     KNOWN LIMITATION (found by this suite, issue 6): on this lattice
  *     gk_rve_dt_critical() is exactly sqrt(m/k), so the API accepts (GK_OK)
@@ -244,25 +249,57 @@ TEST(dt_0_1_to_0_95_critical_seed_packing) {
  *     not flagged (no GK_ERR_*, no NaN); its energy is the symptom. The seed
  *     packing (polydisperse, Z ~ 4) is stable to 0.9 dt_cr, see (a). If
  *     dt_cr becomes a true bound, the last CHECK below flips. */
-static double hex_energy_growth(double f, int friction, int rotation, int nsteps, int *finite) {
+/* face-centred cubic lattice of equal spheres, n^3 cells, spacing 2r - delta (12 contacts each) */
+static gk_result fcc_lattice(gk_rve *rve, const gk_rve_def *def, int n, double r, double delta) {
+    double basis[4][3] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}},
+           a = (2 * r - delta) * sqrt(2.0);
+    gk_packing pk;
+    gk_err e;
+    gk_result res;
+    int i, j, k, b, p = 0;
+    res = gk_packing_alloc(&pk, 3, 4 * n * n * n, NULL, &e);
+    if (res) return res;
+    pk.h[0] = pk.h[4] = pk.h[8] = n * a;
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j)
+            for (k = 0; k < n; ++k)
+                for (b = 0; b < 4; ++b) {
+                    pk.x[p] = (i + basis[b][0] + 0.25) * a;
+                    pk.y[p] = (j + basis[b][1] + 0.25) * a;
+                    pk.z[p] = (k + basis[b][2] + 0.25) * a;
+                    pk.r[p] = r;
+                    ++p;
+                }
+    res = gk_rve_create(rve, def, &pk);
+    gk_packing_free(&pk);
+    return res;
+}
+
+/* lattice 0: 2D hexagonal (64 disks), 1: 3D face-centred cubic (256 spheres) */
+static double lattice_energy_growth(int lattice, double f, int friction, int rotation, int nsteps,
+                                    int *finite) {
     gk_rve rve;
     gk_rve_def def = gk_rve_def_default();
     double ke0, ke_max = 0.0, m, k;
-    int p, st;
+    int p, st, q;
     def.damping = 0.0;
     def.mat.friction = friction ? 0.5 : 0.0;
     if (!rotation) def.flags |= GK_RVE_NO_ROTATION;
-    if (hex_lattice(&rve, &def, 8, 8, 0.005, 1e-5)) return -1.0;
+    if ((lattice == 0 ? hex_lattice(&rve, &def, 8, 8, 0.005, 1e-5)
+                      : fcc_lattice(&rve, &def, 4, 0.005, 1e-5)) != GK_OK)
+        return -1.0;
+    CHECK(gk_rve_refresh(&rve) == GK_OK);
+    CHECK_EQ_INT(rve.ncontacts, (lattice == 0 ? 3 : 6) * rve.n);
     m = 1.0 / (double)rve.minv[0];
     k = def.mat.young * 0.005;
     CHECK_REL(gk_rve_dt_critical(&rve), sqrt(m / k), 1e-12); /* eq 19 */
     CHECK(gk_rve_set_dt(&rve, f * sqrt(m / k)) == GK_OK);
     srand(7);
-    for (p = 0; p < rve.n; ++p) {
-        rve.v[0][p] = (gk_real)(1e-4 * (rand() / (double)RAND_MAX - 0.5));
-        rve.v[1][p] = (gk_real)(1e-4 * (rand() / (double)RAND_MAX - 0.5));
-        if (rve.w[2]) rve.w[2][p] = (gk_real)(1e-2 * (rand() / (double)RAND_MAX - 0.5));
-    }
+    for (p = 0; p < rve.n; ++p)
+        for (q = 0; q < 3; ++q) {
+            if (q < rve.dim) rve.v[q][p] = (gk_real)(1e-4 * (rand() / (double)RAND_MAX - 0.5));
+            if (rve.w[q]) rve.w[q][p] = (gk_real)(1e-2 * (rand() / (double)RAND_MAX - 0.5));
+        }
     ke0 = gk_rve_kinetic_energy(&rve);
     for (st = 0; st < nsteps; st += 10) {
         double ke;
@@ -275,18 +312,18 @@ static double hex_energy_growth(double f, int friction, int rotation, int nsteps
     return ke_max / ke0;
 }
 
-TEST(dt_stability_limit_hexagonal_lattice) {
-    /* frictionless, friction without rotation, friction with rotation */
-    double lim[3] = {2.0 / sqrt(6.0), 2.0 / sqrt(4.5 * 1.8), 2.0 / sqrt(4.0 * 6.0 * 0.8)};
-    int c, n = 2000;
-    for (c = 0; c < 3; ++c) {
-        int fin1 = 0, fin2 = 0;
-        double g1 = hex_energy_growth(0.97 * lim[c], c > 0, c == 2, n, &fin1);
-        double g2 = hex_energy_growth(1.03 * lim[c], c > 0, c == 2, n, &fin2);
-        printf("    %-22s dt* = %.3f sqrt(m/k): KE growth %.1e at 0.97 dt*, %.1e at 1.03 dt*\n",
-               c == 0   ? "frictionless"
-               : c == 1 ? "friction, no rotation"
-                        : "friction and rotation",
+TEST(dt_stability_limit_lattices) {
+    /* hexagonal: frictionless, friction without rotation, friction with rotation; fcc: friction with rotation */
+    double lim[4] = {2.0 / sqrt(6.0), 2.0 / sqrt(4.5 * 1.8), 2.0 / sqrt(4.0 * 6.0 * 0.8),
+                     2.0 / sqrt(10.0 / 3.0 * 12.0 * 0.8)};
+    const char *what[4] = {"hex, frictionless", "hex, friction, no rotation", "hex, friction and rotation",
+                           "fcc, friction and rotation"};
+    int c;
+    for (c = 0; c < 4; ++c) {
+        int fin1 = 0, fin2 = 0, lat = c == 3, n = c == 3 ? 1000 : 2000;
+        double g1 = lattice_energy_growth(lat, 0.97 * lim[c], c > 0, c >= 2, n, &fin1);
+        double g2 = lattice_energy_growth(lat, 1.03 * lim[c], c > 0, c >= 2, n, &fin2);
+        printf("    %-27s dt* = %.3f sqrt(m/k): KE growth %.1e at 0.97 dt*, %.1e at 1.03 dt*\n", what[c],
                lim[c], g1, g2);
         CHECK(g1 > 0 && g1 < 20.0); /* shadow energy: <= 1/(1 - 0.97^2) = 17 */
         CHECK(g2 > 1e3);
@@ -544,7 +581,7 @@ TEST(friction_0_and_10) {
  * same r_max), and the default dt is 0.5 dt_cr. The shear response at the
  * default dt equals (1 %) the one at dt = 0.25 dt_cr, at the same strain
  * rate: the default step is converged -
- * KNOWN LIMITATION (issue 6, see dt_stability_limit_hexagonal_lattice)
+ * KNOWN LIMITATION (issue 6, see dt_stability_limit_lattices)
  * except at ratio 1: equal frictional disks crystallise (Z up to 6), their
  * rotational mode is unstable at 0.5 dt_cr: the kinetic energy is 400x the
  * converged run's and sigma_xy 11 % high (measured with these 150 disks;
@@ -1314,7 +1351,7 @@ TEST(newton_divergence_is_cut_back) {
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN_DOUBLE(dt_0_1_to_0_95_critical_seed_packing);
-    RUN_DOUBLE(dt_stability_limit_hexagonal_lattice);
+    RUN_DOUBLE(dt_stability_limit_lattices);
     RUN_DOUBLE(dt_beyond_critical_is_refused_or_reported);
     RUN_DOUBLE(stiffness_ratio_kt_kn_0_to_1);
     RUN_DOUBLE(friction_0_and_10);
