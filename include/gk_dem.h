@@ -50,6 +50,17 @@
  * Hertz contacts stiffen with load, so the RVE re-checks dt_cr at every
  * list rebuild and stops with GK_ERR_DT when dt has become too large; for
  * loading that raises the stress several-fold choose dt_factor ~ 0.2.
+ * Eq 19 is a one-contact estimate, NOT the stability limit of leap-frog on
+ * a packing: with Z contacts per particle and rotation the limit is lower.
+ * Equal disks on a hexagonal lattice (Z = 6, k_t = 0.8 k_n): 0.816 dt_cr
+ * frictionless, 0.703 with friction and no rotation, 0.456 with rotation
+ * (every disk spinning alike, omega^2 = 4 Z k_t / m) - so the default 0.5
+ * is unstable there, and a consolidated packing of equal frictional disks
+ * at 0.5 dt_cr shears 11 % stiff with 400x the kinetic energy; nothing
+ * flags it (tests/test_extremes.c). The polydisperse seed packing (Z ~ 4)
+ * is stable to 0.9 dt_cr. Equal spheres, face-centred cubic (Z = 12,
+ * omega^2 = (10/3) Z k_t / m): 0.354 dt_cr. For equal or nearly equal
+ * particles use dt_factor <= 0.4 (2D disks), <= 0.3 (dense 3D packings).
  *
  * MASSES. 3D spheres: m = rho 4/3 pi r^3, I = 2/5 m r^2. 2D disks, default
  * GK_MASS_CYLINDER: cylinders of thickness t (seed 000: 0.1 m),
