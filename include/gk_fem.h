@@ -65,8 +65,13 @@
  *                           masters, a cycle, an index out of range ->
  *                           GK_ERR_ARG naming the dof (nothing is changed)
  *   gk_dofmap_periodic      every component of every node of the hi faces of
- *                           the mesh box tied to its lo-face partner along the
- *                           chosen axes, jump g = G (x_s - x_m)
+ *                           the mesh's bounding box tied to its partner on the
+ *                           lo face, along the axes in a bit mask (1 x, 2 y,
+ *                           4 z), jump g = G (x_s - x_m) (G NULL: no jump).
+ *                           A node on several hi faces is tied along its
+ *                           first axis only; the chain does the rest. Node
+ *                           ids, not coordinates, are kept: build the map once
+ *                           and keep it through gk_mesh_update.
  *   gk_dofmap_csr           the sparsity of T^T A T (once)
  *   gk_dofmap_condense      its values Ar = T^T A T (deterministic order)
  *   gk_dofmap_restrict      fr = T^T f, or T^T (f - A g) with A
@@ -78,7 +83,10 @@
  *   Typical Newton step: gk_fem_assemble(K) ; gk_dofmap_condense(K -> Kr) ;
  *   gk_dofmap_restrict(R -> Rr) ; gk_dofmap_dirichlet ; gk_fem_dirichlet(Kr) ;
  *   gk_solver_factor/solve(Kr) ; gk_dofmap_expand(dur -> du, no jump).
+ *   Used by femdem_biaxial --test cyclic-strain|cyclic-stress (periodic
+ *   simple shear); tests/test_fem.c has periodic patch tests.
  *
+ * SOLVERS
  *   gk_solver_factor/solve  direct: reverse Cuthill-McKee ordering, then a
  *                           banded LU with partial pivoting (robust for the
  *                           non-symmetric perturbation tangent). A pivot below
