@@ -37,8 +37,12 @@
  * per MPM step are capped by default at the REAL-TIME count
  * dem_max = ceil(dt / dt_DEM): an RVE never runs more DEM time than the MPM
  * step lasts (a flowing point cannot be more quasi-static than the flow).
- * Points that barely deform run fewer (the dem-strain rule of mpmdem.h, at
- * least dem_min). --dem-max overrides the cap.
+ * Below the cap the rule of mpmdem.h decides (--dem-rule adaptive, the
+ * default: the RVE deforms at inertial number <= --dem-inertial and relaxes
+ * while unbalanced; at the low pressures of the column, 1-20 kPa, flowing
+ * points hit the cap, i.e. their RVEs run exactly in real time, and the
+ * dead zone runs few steps; --dem-rule strain: <= --dem-strain per step).
+ * --dem-max overrides the cap.
  *
  * Measures (every --every seconds, CSV row):
  *   front: the points connected to the deposit are found by a flood fill
@@ -70,15 +74,18 @@
  *
  * RVE cells that get too thin. gk_rve_deform refuses (GK_ERR_CELL) a dH
  * that would leave the periodic cell narrower than twice the interaction
- * distance 2 (2 r_max + skin), ~6x thinner than the 400-disk cell. It
- * happens at the flow front, where points slide along the base stretched
- * ~6x and squeezed to a few centimetres; their RVEs have (almost) no
- * contacts by then. --thin-cell freeze (default): that RVE skips the
- * increment (no DEM steps, its last stress kept; the MPM strain still
- * accumulates) and takes the next dH that fits; every newly frozen point
- * is named on stderr with its F, pressure and contacts, and counted
- * (frozen_rves, thin_points in RESULT). --thin-cell stop ends the run at the
- * first refusal, naming the point (mpd_stress's behaviour).
+ * distance 2 (2 r_max + skin) = 0.029 m for the 400-disk cell of 0.198 m.
+ * The points at the flow front slide along the base stretched ~8x and
+ * squeezed to a few centimetres (F_yy ~ 0.17); their RVEs have almost no
+ * contacts by then. In the default run the thinnest cell comes to 0.032 m,
+ * 10 % above the limit (with a Verlet skin of 0.4 mean radii, limit 0.032 m,
+ * the front point's RVE was refused at t = 1.12 s). --thin-cell freeze
+ * (default): that RVE skips the increment (no DEM steps, its last stress
+ * kept; the MPM strain still accumulates) and takes the next dH that fits;
+ * every newly frozen point is named on stderr with its F, pressure and
+ * contacts, and counted (frozen_rves, thin_points in RESULT). --thin-cell
+ * stop ends the run at the first refusal, naming the point (mpd_step /
+ * mpd_stress of mpmdem.h, which this option uses).
  *
  * Outputs in --out DIR: collapse.csv, collapse_energy.svg, collapse_front.svg,
  * eps_q_T.svg and velocity_T.svg at the --snapshots times and at the end,
@@ -96,6 +103,13 @@
 
 #define CL_MAX_LEVELS 64
 #define CL_MAX_SNAP 16
+/* main's error exit after the first allocation: message, status 1, cleanup */
+#define CL_FAIL(...)                  \
+    do {                              \
+        fprintf(stderr, __VA_ARGS__); \
+        status = 1;                   \
+        goto done;                    \
+    } while (0)
 
 typedef struct cl_opts {
     int nx, levels, stop_at_rest, thin_freeze;
@@ -214,8 +228,19 @@ static gk_result cl_stress(gk_mpm_points *pts, double dt, void *user, gk_err *er
         int k, ns;
         gk_mpm_point_dH(pts, p, dt, dH);
         dH[2] = dH[5] = dH[6] = dH[7] = dH[8] = 0.0; /* plane */
-        ns = mpd_dem_steps(f->o, dH);
-        f->status[p] = (int)gk_rve_deform(&f->rve[p], dH, ns);
+        if (f->o->dem_adaptive) {                    /* as mpd_stress */
+            gk_adapt_def ad;
+            gk_adapt_report rep;
+            memset(&ad, 0, sizeof ad);
+            ad.inertial_max = f->o->dem_inertial, ad.unbalanced_max = f->o->dem_unbalanced;
+            ad.n_min = f->o->dem_min, ad.n_max = f->o->dem_max;
+            memset(&rep, 0, sizeof rep);
+            f->status[p] = (int)gk_rve_deform_adaptive(&f->rve[p], dH, &ad, &rep);
+            ns = rep.n_deform + rep.n_relax;
+        } else {
+            ns = mpd_dem_steps(f->o, dH);
+            f->status[p] = (int)gk_rve_deform(&f->rve[p], dH, ns);
+        }
         if (f->status[p] == GK_ERR_CELL) ns = 0; /* refused up front: the RVE is unchanged */
         f->nsub[p] = ns;
         total += ns;
@@ -442,9 +467,12 @@ int main(int argc, char **argv) {
     double h, c, Mmax = 0, rho_ref, lo[3], hi[3], org[3], t_start, t0, l0, prep_secs;
     long nsteps_total, step0;
     gk_err err;
-    char buf[64], buf2[64], path[1200], tag[32];
+    gk_result res;
+    char buf[64], buf2[64], path[1200], tag[32], rule[96];
     int n[3];
 
+    memset(&P, 0, sizeof P), memset(&F, 0, sizeof F), memset(&g, 0, sizeof g), memset(&pts, 0, sizeof pts);
+    for (k = 0; k < CL_MAX_LEVELS; ++k) gk_rve_state_init(&st[k], NULL);
     mpd_opts_default(&od, "build/mpmdem_collapse");
     od.alpha = 5e-4;
     o = od;
@@ -554,14 +582,12 @@ int main(int argc, char **argv) {
 
     /* ---- the RVEs: bulk density of the packing, then one state per level */
     t0 = gk_wtime();
-    if (mpd_proto_open(&P, &o, &err)) return fprintf(stderr, "mpmdem_collapse: %s\n", err.msg), 1;
-    gk_rve_state_init(&st[0], NULL);
-    if (mpd_prepare_rve(&P, 0.0, &st[0], &err)) return fprintf(stderr, "mpmdem_collapse: %s\n", err.msg), 1;
+    if (mpd_proto_open(&P, &o, &err)) CL_FAIL("mpmdem_collapse: %s\n", err.msg);
+    if (mpd_prepare_rve(&P, 0.0, &st[0], &err)) CL_FAIL("mpmdem_collapse: %s\n", err.msg);
     rho_ref = P.rho;
     for (k = 0; k < b.levels; ++k) {
         double z = b.height * (k + 0.5) / b.levels;
         lev_p[k] = rho_ref * b.gravity * (z > 0.5 * h ? z : 0.5 * h);
-        if (k) gk_rve_state_init(&st[k], NULL);
     }
     {
         int bad = 0;
@@ -579,7 +605,7 @@ int main(int argc, char **argv) {
             }
             lev_rho[k] = Pk.rho, lev_e[k] = Pk.e0, lev_M[k] = Pk.M, lev_pa[k] = Pk.p0;
         }
-        if (bad) return fprintf(stderr, "mpmdem_collapse: %s\n", msg), 1;
+        if (bad) CL_FAIL("mpmdem_collapse: %s\n", msg);
     }
     for (k = 0; k < b.levels; ++k)
         if (lev_M[k] > Mmax) Mmax = lev_M[k];
@@ -593,17 +619,17 @@ int main(int argc, char **argv) {
         if (gk_mpm_grid_create(&g, 2, org, h, n, NULL, &err) ||
             gk_mpm_grid_set_bc(&g, 0, GK_MPM_BC_ROLLER, 0.0, gl + 1, &err) ||
             gk_mpm_grid_set_bc(&g, 2, GK_MPM_BC_FRICTION, b.mu, gl + 1, &err))
-            return fprintf(stderr, "mpmdem_collapse: %s\n", err.msg), 1;
+            CL_FAIL("mpmdem_collapse: %s\n", err.msg);
     }
     lo[0] = 0, lo[1] = 0, lo[2] = 0, hi[0] = b.width, hi[1] = b.height, hi[2] = 0;
     if (gk_mpm_points_create_box(&pts, 2, lo, hi, h, o.ppc, rho_ref, NULL, &err))
-        return fprintf(stderr, "mpmdem_collapse: %s\n", err.msg), 1;
+        CL_FAIL("mpmdem_collapse: %s\n", err.msg);
     pk.pts = &pts, pk.height = b.height, pk.levels = b.levels;
     if (mpd_rves_create(&F, pts.n, &P, st, pick_level, &pk, &o, &err))
-        return fprintf(stderr, "mpmdem_collapse: %s\n", err.msg), 1;
+        CL_FAIL("mpmdem_collapse: %s\n", err.msg);
     thin = (int *)calloc((size_t)pts.n, sizeof *thin);
     work = (int *)malloc((size_t)pts.n * sizeof *work);
-    if (!thin || !work) return fprintf(stderr, "mpmdem_collapse: out of memory\n"), 1;
+    if (!thin || !work) CL_FAIL("mpmdem_collapse: out of memory\n");
     memset(&S, 0, sizeof S);
     for (i = 0; i < pts.n; ++i) {
         pts.m[i] = lev_rho[level_of(&pk, pts.x[1][i])] * pts.vol0[i];
@@ -622,13 +648,18 @@ int main(int argc, char **argv) {
         size_t size[3] = {sizeof S, (size_t)pts.n * sizeof *thin, 0};
         cl_row *rr = NULL;
         blob[0] = &S, blob[1] = thin, blob[2] = &rr;
-        if (mpd_ck_read(o.restart, "collapse", blob, size, 3, &pts, &F, &err))
-            return fprintf(stderr, "mpmdem_collapse: %s\n", err.msg), 1;
-        rows = rr, nrows = caprows = (int)(size[2] / sizeof *rows);
+        res = mpd_ck_read(o.restart, "collapse", blob, size, 3, &pts, &F, &err);
+        rows = rr; /* freed at the end whatever happened */
+        if (res) CL_FAIL("mpmdem_collapse: %s\n", err.msg);
+        nrows = caprows = (int)(size[2] / sizeof *rows);
+        if (nrows < 1) CL_FAIL("mpmdem_collapse: %s/checkpoint.bin holds no rows\n", o.restart);
         printf("restarted from %s/checkpoint.bin at t = %.4f s (step %ld)\n", o.restart, S.t, S.step);
     }
     o.dem_max = S.dem_max;
-    if (mpd_check_opts(&o)) return 2;
+    if (mpd_check_opts(&o)) {
+        status = 2;
+        goto done;
+    }
     C.f = &F, C.thin = thin, C.thin_step = 0, C.warned = 0, C.t = 0;
     nsteps_total = (long)ceil(b.t_end / S.dt - 1e-9);
 
@@ -645,10 +676,14 @@ int main(int argc, char **argv) {
                "= %.4g MPa\n",
                k, b.height * k / b.levels, b.height * (k + 1) / b.levels, lev_p[k] / 1e3, lev_pa[k] / 1e3,
                lev_e[k], lev_rho[k], lev_M[k] / 1e6);
+    if (o.dem_adaptive)
+        snprintf(rule, sizeof rule, "adaptive, I <= %g, unbalanced <= %g", o.dem_inertial, o.dem_unbalanced);
+    else
+        snprintf(rule, sizeof rule, "strain, <= %g per DEM step", o.dem_strain);
     printf("MPM dt = %.4g s (cfl %.2f, c = %.1f m/s from M = %.4g MPa); DEM dt = %.3g s; DEM steps per MPM "
-           "step %d..%d (%s), <= %g strain per DEM step\n",
+           "step %d..%d (%s), rule: %s\n",
            S.dt, o.cfl, c, Mmax / 1e6, F.rve[0].dt, o.dem_min, S.dem_max,
-           dem_max_given ? "--dem-max" : "cap = real-time count ceil(dt/dt_DEM)", o.dem_strain);
+           dem_max_given ? "--dem-max" : "cap = real-time count ceil(dt/dt_DEM)", rule);
     printf("about %ld MPM steps to t = %g s (stops at rest: %s); E_p0 = %.6g J/m\n", nsteps_total, b.t_end,
            b.stop_at_rest ? "yes" : "no", S.Ep0);
     t_start = gk_wtime();
@@ -657,9 +692,9 @@ int main(int argc, char **argv) {
         snprintf(path, sizeof path, "%s/points_%06ld.vtk", o.out, 0L);
         mpd_write_vtk(path, &F, &pts);
         if (make_row(&r, &S, &pts, &F, &g, l0, &b, t_start, work))
-            return fprintf(stderr, "mpmdem_collapse: out of memory\n"), 1;
+            CL_FAIL("mpmdem_collapse: out of memory\n");
         rows = (cl_row *)malloc(64 * sizeof *rows);
-        if (!rows) return fprintf(stderr, "mpmdem_collapse: out of memory\n"), 1;
+        if (!rows) CL_FAIL("mpmdem_collapse: out of memory\n");
         caprows = 64;
         rows[nrows++] = r;
         if (S.nsnap < b.nsnap && b.snap[S.nsnap] <= 0) {
@@ -669,7 +704,6 @@ int main(int argc, char **argv) {
     }
     step0 = S.step;
     while (S.t < b.t_end - 0.5 * S.dt) {
-        gk_result res;
         C.t = S.t;
         res = b.thin_freeze ? gk_mpm_step(&g, &pts, &def, S.dt, cl_stress, &C, &err)
                             : mpd_step(&g, &pts, &def, S.dt, &F, NULL, 0, &err);
@@ -691,13 +725,14 @@ int main(int argc, char **argv) {
         if (S.t >= S.next_out - 1e-9 * S.dt) {
             cl_row r;
             if (make_row(&r, &S, &pts, &F, &g, l0, &b, t_start, work))
-                return fprintf(stderr, "mpmdem_collapse: out of memory\n"), 1;
+                CL_FAIL("mpmdem_collapse: out of memory\n");
             S.acc_dem = 0, S.nacc = 0;
             while (S.next_out <= S.t + 1e-9 * S.dt) S.next_out += b.every;
             if (nrows == caprows) {
                 caprows = caprows ? 2 * caprows : 64;
-                rows = (cl_row *)realloc(rows, (size_t)caprows * sizeof *rows);
-                if (!rows) return fprintf(stderr, "mpmdem_collapse: out of memory\n"), 1;
+                cl_row *nr = (cl_row *)realloc(rows, (size_t)caprows * sizeof *rows);
+                if (!nr) CL_FAIL("mpmdem_collapse: out of memory\n");
+                rows = nr;
             }
             rows[nrows++] = r;
             write_csv(o.out, rows, nrows, b.width);
@@ -740,11 +775,12 @@ int main(int argc, char **argv) {
         if (rows[nrows - 1].t < S.t - 0.5 * S.dt) { /* the end, off the row schedule: not checkpointed */
             cl_row r;
             if (make_row(&r, &S, &pts, &F, &g, l0, &b, t_start, work))
-                return fprintf(stderr, "mpmdem_collapse: out of memory\n"), 1;
+                CL_FAIL("mpmdem_collapse: out of memory\n");
             if (nrows == caprows) {
-                caprows = 2 * caprows;
-                rows = (cl_row *)realloc(rows, (size_t)caprows * sizeof *rows);
-                if (!rows) return fprintf(stderr, "mpmdem_collapse: out of memory\n"), 1;
+                caprows = caprows ? 2 * caprows : 64;
+                cl_row *nr = (cl_row *)realloc(rows, (size_t)caprows * sizeof *rows);
+                if (!nr) CL_FAIL("mpmdem_collapse: out of memory\n");
+                rows = nr;
             }
             rows[nrows++] = r;
         }
@@ -784,11 +820,12 @@ int main(int argc, char **argv) {
             S.dem_max, nthin, steps_run ? secs / steps_run : 0.0,
             steps_run ? secs / steps_run * 1000.0 / pts.n : 0.0, secs);
     }
+done:
     free(rows);
     free(thin);
     free(work);
     mpd_rves_free(&F);
-    for (k = 0; k < b.levels; ++k) gk_rve_state_free(&st[k]);
+    for (k = 0; k < CL_MAX_LEVELS; ++k) gk_rve_state_free(&st[k]);
     mpd_proto_close(&P);
     gk_mpm_points_destroy(&pts);
     gk_mpm_grid_destroy(&g);
