@@ -46,8 +46,8 @@
  * MATERIAL = seed 003 Table 2 (--material dense | medium | soft): E, kt/kn
  * (the table's nu), interparticle friction, rolling beta and eta, local
  * damping 0.1. "Medium dense" differs from "dense" only by e0 (0.2314 vs
- * 0.1874): give it a looser packing with --packing (the shipped one is
- * dense: e ~ 0.18 at 20 kPa). DEM step: 3.16e-5 s sqrt(6e8 / E), the same
+ * 0.1874): give it a looser packing with --packing (the default one is
+ * dense: e ~ 0.18 at 20 kPa; examples/data/rve400_e0223.txt is looser). DEM step: 3.16e-5 s sqrt(6e8 / E), the same
  * fraction of the critical step as seed 000's 3.16e-5 s at E = 600 MPa.
  *
  * FRICTION ANGLE (what eq 46 needs). Before the footing, the driver runs one
@@ -57,7 +57,8 @@
  * -sigma_3, axis 1 compressed at constant rate: the inertial number
  * --dem-inertial at sigma_3 with the adaptive DEM rule, --dem-strain per DEM
  * step with the strain rule, i.e. as the MPM's RVEs deform) to
- * --phi-strain. Peak = maximum of the mobilised sin phi = (s1 - s3)/(s1 +
+ * --phi-strain and on until the peak lies 1 % of strain behind (a hardening
+ * RVE, e.g. a loose one, that has not peaked by 25 % uses its maximum). Peak = maximum of the mobilised sin phi = (s1 - s3)/(s1 +
  * s3) after a centred moving average over +-0.1 % axial strain (a 400-disk
  * RVE is noisy). phi per test = asin of that; the Mohr-Coulomb envelope
  * through the origin tangent (least squares) to the peak circles, sin phi
@@ -158,7 +159,7 @@ typedef struct ft_phi_test {
     double s1, s3m, eps_peak, phi; /* smoothed peak: s1, s3 [Pa], strain, phi [deg] */
     double r1, r3, phi_res;        /* residual: means over the last 2 % of axial strain */
     double eps_end;
-    int nsamp;
+    int nsamp, nopeak;   /* nopeak: no peak by FT_PHI_STRAIN_MAX (the maximum is used) */
     double *eps, *ratio; /* sampled curve: axial strain, s1/s3 (for the plot) */
     int status;
     char msg[400];
@@ -199,7 +200,7 @@ static void usage(FILE *fp, const mpd_opts *d, const ft_opts *f) {
         "                         W/nx must equal D/ny\n"
         "  --paper                the paper's size: 12 x 8 m, 108 x 72 cells (7776 RVEs), 0.1 m/s, ramp 0.5 "
         "s,\n"
-        "                         to d/B = 1.5, rows every 0.01 (later flags override it)\n"
+        "                         to d/B = 1.5, rows every 0.01 (other flags given override it)\n"
         "  --B W                  FULL footing width [m] (default %g: the seed's 1 m x 2 m footing); the\n"
         "                         half model carries b = B/2; q = load / b\n"
         "  --footing-height H     footing height above the ground [m] (default %g)\n"
@@ -216,7 +217,9 @@ static void usage(FILE *fp, const mpd_opts *d, const ft_opts *f) {
         "  --phi-deg X            friction angle for eq 46 [deg]; skips the RVE biaxial measurement\n"
         "  --phi-pressures LIST   confining pressures of the measurement [kPa], comma-separated, at most %d\n"
         "                         (default 10,20,30; the seed used 10,15,20,25,30)\n"
-        "  --phi-strain E         largest axial strain of a measurement test (default %g)\n"
+        "  --phi-strain E         axial strain a measurement test runs to at least; then on until its peak "
+        "lies\n"
+        "                         1 %% behind, at most 25 %% (default %g)\n"
         "  --grid-damping A       local non-viscous damping on the grid nodes in [0, 1) (default %g: none,\n"
         "                         as the seed; reactions never include it)\n"
         "  --max-steps N          stop after N MPM steps (timing / memory probe; default: no limit)\n"
@@ -296,6 +299,23 @@ static void smooth_curve(const double *x, const double *y, int n, double w, doub
 }
 
 /* ------------------------------------------------- friction angle of the RVE */
+#define FT_PHI_STRAIN_MAX 0.25 /* a test that has not peaked by then uses its maximum */
+
+/* index of the largest smoothed sin phi_mob = (s1 - s3)/(s1 + s3) (means
+ * over +-0.1 % of axial strain); the smoothed s1, s3 there */
+static int smoothed_peak(const double *eps, const double *s1, const double *s3, int n, double *a, double *b,
+                         double *a_pk, double *b_pk) {
+    int k, kb = 0;
+    double best = -2.0;
+    smooth_curve(eps, s1, n, 0.002, a);
+    smooth_curve(eps, s3, n, 0.002, b);
+    for (k = 0; k < n; ++k) {
+        double sn = a[k] + b[k] > 0 ? (a[k] - b[k]) / (a[k] + b[k]) : -1.0;
+        if (sn > best) best = sn, kb = k;
+    }
+    *a_pk = a[kb], *b_pk = b[kb];
+    return kb;
+}
 /* one drained biaxial test (see the top comment); 0 or 1 with out->msg */
 static int phi_test(const mpd_proto *P0, const mpd_opts *o, double max_strain, ft_phi_test *out) {
     mpd_proto P = *P0; /* mpd_prepare_rve writes rho, M, p0, e0: keep the caller's */
@@ -303,7 +323,7 @@ static int phi_test(const mpd_proto *P0, const mpd_opts *o, double max_strain, f
     gk_rve r;
     gk_servo sv;
     gk_err err;
-    double rate, L[9], *s1 = NULL, *s3 = NULL;
+    double rate, L[9], *s1 = NULL, *s3 = NULL, *wa = NULL, *wb = NULL;
     int chunk, cap, n = 0, k, bad = 0;
     gk_rve_state_init(&st, NULL);
     if (mpd_prepare_rve(&P, out->s3, &st, &err)) {
@@ -337,13 +357,14 @@ static int phi_test(const mpd_proto *P0, const mpd_opts *o, double max_strain, f
     gk_m3_zero(L);
     out->rate = rate;
     chunk = (int)ceil(1e-4 / (rate * r.dt)); /* a sample every 1e-4 of axial strain */
-    cap = (int)ceil(1.5 * max_strain / (chunk * rate * r.dt)) +
-          10; /* the lateral servo changes F_11 a little */
+    cap = (int)ceil(1.5 * FT_PHI_STRAIN_MAX / (chunk * rate * r.dt)) + 10; /* the servo moves F_11 a little */
     out->eps = (double *)malloc((size_t)cap * sizeof(double));
     out->ratio = (double *)malloc((size_t)cap * sizeof(double));
     s1 = (double *)malloc((size_t)cap * sizeof(double));
     s3 = (double *)malloc((size_t)cap * sizeof(double));
-    if (!out->eps || !out->ratio || !s1 || !s3) {
+    wa = (double *)malloc((size_t)cap * sizeof(double));
+    wb = (double *)malloc((size_t)cap * sizeof(double));
+    if (!out->eps || !out->ratio || !s1 || !s3 || !wa || !wb) {
         snprintf(out->msg, sizeof out->msg, "out of memory");
         bad = 1;
     }
@@ -351,6 +372,7 @@ static int phi_test(const mpd_proto *P0, const mpd_opts *o, double max_strain, f
         snprintf(out->msg, sizeof out->msg, "servo: %s", gk_rve_error(&r));
         bad = 1;
     }
+    /* to --phi-strain, then on until the peak lies 1 % of strain behind (a hardening RVE) */
     while (!bad && n < cap) {
         double e;
         if (gk_rve_step(&r, chunk)) {
@@ -362,44 +384,31 @@ static int phi_test(const mpd_proto *P0, const mpd_opts *o, double max_strain, f
         out->eps[n] = e, s1[n] = -r.stress[4], s3[n] = -r.stress[0];
         out->ratio[n] = s3[n] > 0 ? s1[n] / s3[n] : 0.0;
         ++n;
-        if (e >= max_strain) break;
+        if (e >= FT_PHI_STRAIN_MAX) {
+            out->nopeak = 1;
+            break;
+        }
+        if (e >= max_strain && n % 50 == 0) {
+            double u, v;
+            if (out->eps[smoothed_peak(out->eps, s1, s3, n, wa, wb, &u, &v)] <= e - 0.01) break;
+        }
     }
     out->nsamp = n;
-    if (!bad) { /* smoothed peak of sin phi_mob */
-        double *a = (double *)malloc((size_t)n * sizeof(double)),
-               *b = (double *)malloc((size_t)n * sizeof(double));
-        double best = -1.0;
-        if (!a || !b) {
-            snprintf(out->msg, sizeof out->msg, "out of memory");
-            bad = 1;
-        } else {
-            smooth_curve(out->eps, s1, n, 0.002, a);
-            smooth_curve(out->eps, s3, n, 0.002, b);
-            for (k = 0; k < n; ++k) {
-                double sn = a[k] + b[k] > 0 ? (a[k] - b[k]) / (a[k] + b[k]) : -1.0;
-                if (sn > best) best = sn, out->s1 = a[k], out->s3m = b[k], out->eps_peak = out->eps[k];
-            }
-            out->phi = best > 0 ? asin(best) * 180.0 / MPD_PI : 0.0;
-            out->eps_end = n ? out->eps[n - 1] : 0.0;
-            {
-                int c = 0;
-                out->r1 = out->r3 = 0;
-                for (k = 0; k < n; ++k)
-                    if (out->eps[k] >= out->eps_end - 0.02) out->r1 += s1[k], out->r3 += s3[k], ++c;
-                if (c) out->r1 /= c, out->r3 /= c;
-                out->phi_res = out->r1 > out->r3 && out->r3 > 0
-                                   ? asin((out->r1 - out->r3) / (out->r1 + out->r3)) * 180.0 / MPD_PI
-                                   : 0.0;
-            }
-            if (out->eps_peak > out->eps_end - 0.01) {
-                snprintf(out->msg, sizeof out->msg,
-                         "peak at %.2f %% is within 1 %% of the test's end (%.2f %%): raise --phi-strain",
-                         100 * out->eps_peak, 100 * out->eps_end);
-                bad = 1;
-            }
-        }
-        free(a), free(b);
+    if (!bad && n > 0) {
+        int kp = smoothed_peak(out->eps, s1, s3, n, wa, wb, &out->s1, &out->s3m), c = 0;
+        double sn = (out->s1 - out->s3m) / (out->s1 + out->s3m);
+        out->eps_peak = out->eps[kp];
+        out->phi = sn > 0 ? asin(sn) * 180.0 / MPD_PI : 0.0;
+        out->eps_end = out->eps[n - 1];
+        out->r1 = out->r3 = 0;
+        for (k = 0; k < n; ++k)
+            if (out->eps[k] >= out->eps_end - 0.02) out->r1 += s1[k], out->r3 += s3[k], ++c;
+        if (c) out->r1 /= c, out->r3 /= c;
+        out->phi_res = out->r1 > out->r3 && out->r3 > 0
+                           ? asin((out->r1 - out->r3) / (out->r1 + out->r3)) * 180.0 / MPD_PI
+                           : 0.0;
     }
+    free(wa), free(wb);
     free(s1), free(s3);
     gk_rve_destroy(&r);
     return out->status = bad;
@@ -723,8 +732,8 @@ int main(int argc, char **argv) {
     if (f.nx < 1 || f.ny < 1 || f.nx > 4000 || f.ny > 4000 || !(f.width > 0) || !(f.depth > 0) ||
         !(f.B > 0) || !(f.foot_height > 0) || !(f.surcharge > 0) || !(f.velocity > 0) || !(f.ramp >= 0) ||
         !(f.final_dB > 0 && f.final_dB <= 3) || !(f.every > 0 && f.every <= f.final_dB) || !(f.smooth > 0) ||
-        !(f.phi_strain > 0.01 && f.phi_strain < 0.5) || !(f.grid_damping >= 0 && f.grid_damping < 1) ||
-        mpd_check_opts(&o))
+        !(f.phi_strain >= 0.01 && f.phi_strain <= FT_PHI_STRAIN_MAX) ||
+        !(f.grid_damping >= 0 && f.grid_damping < 1) || mpd_check_opts(&o))
         return fprintf(stderr, "mpmdem_footing: an option is out of range (see --help)\n"), 2;
     h = f.width / f.nx;
     /* the footing covers the nodes x <= b - h/2; their tributary width (the
@@ -767,7 +776,7 @@ int main(int argc, char **argv) {
     if (f.material == 1 && !strcmp(o.packing, od.packing))
         printf(
             "note: 'medium' has Table 2's dense contact law; with the shipped dense packing it is the dense "
-            "soil (give a looser --packing for e0 = 0.2314)\n");
+            "soil (give a looser --packing for e0 = 0.2314, e.g. examples/data/rve400_e0223.txt)\n");
     if (f.phi_deg > 0) {
         phi = f.phi_deg;
         printf("friction angle: phi = %g deg given (--phi-deg), no measurement\n", phi);
@@ -795,6 +804,9 @@ int main(int argc, char **argv) {
                    "strain -> phi = %.2f deg; residual (mean over %.1f-%.1f %%) %.2f deg\n",
                    T[k].s3 / 1e3, T[k].rate, T[k].e0, T[k].s1 / 1e3, T[k].s3m / 1e3, 100 * T[k].eps_peak,
                    T[k].phi, fmax(0.0, 100 * T[k].eps_end - 2), 100 * T[k].eps_end, T[k].phi_res);
+            if (T[k].nopeak)
+                printf("    (no peak by %.0f %% axial strain: the maximum is used, a hardening RVE)\n",
+                       100 * FT_PHI_STRAIN_MAX);
         }
         if (nbad) {
             status = 1;
