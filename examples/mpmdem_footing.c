@@ -122,7 +122,7 @@
 #include "mpmdem.h"
 
 #define FT_MAXPHI 6
-#define FT_NSTAGE 5
+#define FT_NSTAGE 6
 #define FT_DEM_DT_REF 3.16e-5 /* seed 000's DEM step at E = 600 MPa */
 
 typedef struct ft_opts {
@@ -626,7 +626,7 @@ int main(int argc, char **argv) {
     mpd_edge *edge = NULL;
     double h, b, bnode, dt, c, lo[3], hi[3], org[3], t_start, phi, phi_c = NAN, coh = NAN, *x0 = NULL;
     double phi_res = NAN, phi_rc = NAN, coh_r = NAN;
-    double rss_before, rss_after, stages[FT_NSTAGE] = {0.1, 0.25, 0.5, 1.0, 1.5};
+    double rss_before, rss_after, stages[FT_NSTAGE] = {0.05, 0.1, 0.25, 0.5, 1.0, 1.5};
     long nsteps_total, step0;
     long long dem0, dem_first = 0;
     double t_first = 0;
