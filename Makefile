@@ -29,7 +29,7 @@ EXAMPLES := $(patsubst examples/%.c,$(BUILD)/%,$(EX_SRC))
 BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
 TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
 
-.PHONY: all test check bench bench-peers run run-rve install uninstall format format-check clean help \
+.PHONY: all test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
         check-headers check-asan check-nosimd
 
 all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
@@ -38,6 +38,7 @@ help:
 	@echo "make            build tests, examples, benchmarks and tools into $(BUILD)/"
 	@echo "make run        the main job: FEMxDEM biaxial test (see README.md)"
 	@echo "make run-rve    one RVE along a shear path"
+	@echo "make run-mpm | run-footing | run-collapse   seed 003's MPMxDEM biaxial, footing, column collapse"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability"
 	@echo "make bench      performance programs (2 cores)"
@@ -116,6 +117,15 @@ check: check-headers check-nosimd check-asan
 # --nx 8 --ny 16 --steps 100
 run: $(BUILD)/femdem_biaxial
 	$(BUILD)/femdem_biaxial --nx 4 --ny 8 --element q8 --steps 30 --threads 2 --out $(BUILD)/biaxial
+
+# seed 003's MPMxDEM systems at default sizes of about a minute each on 2
+# cores (128-400 RVEs); every driver's --help gives the paper's sizes
+run-mpm: $(BUILD)/mpmdem_biaxial
+	$(BUILD)/mpmdem_biaxial --threads 2 --out $(BUILD)/mpm_biaxial
+run-footing: $(BUILD)/mpmdem_footing
+	$(BUILD)/mpmdem_footing --threads 2 --out $(BUILD)/mpm_footing
+run-collapse: $(BUILD)/mpmdem_collapse
+	$(BUILD)/mpmdem_collapse --threads 2 --out $(BUILD)/mpm_collapse
 
 run-rve: $(BUILD)/rve_path
 	$(BUILD)/rve_path --packing examples/data/rve400.txt --dH "0 0.001 0 0" --increments 50 \
