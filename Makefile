@@ -30,7 +30,7 @@ BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
 TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
 
 .PHONY: all test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
-        check-headers check-asan check-nosimd
+        check-headers check-asan check-nosimd tradeoff
 
 all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
 
@@ -42,6 +42,7 @@ help:
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability"
 	@echo "make bench      performance programs (2 cores)"
+	@echo "make tradeoff   accuracy against cost of the drivers, the whole sweep (10-15 min; build/tradeoff/)"
 	@echo "make bench-peers  the same workloads in LAMMPS / LIGGGHTS / YADE when installed"
 	@echo "make install PREFIX=dir   headers + pkg-config file"
 	@echo "make format / format-check   clang-format"
@@ -63,6 +64,13 @@ $(BUILD)/bench_dem_step: bench/dem_step.c bench/dem_step_part.c bench/dem_step.h
 	$(CC) $(CFLAGS) -Ibench -c bench/dem_step_part.c -o $(BUILD)/dem_step_double.o
 	$(CC) $(CFLAGS) -Ibench -DGK_REAL_FLOAT -c bench/dem_step_part.c -o $(BUILD)/dem_step_float.o
 	$(CC) $(CFLAGS) -Ibench -o $@ bench/dem_step.c $(BUILD)/dem_step_double.o $(BUILD)/dem_step_float.o $(LDLIBS)
+
+# the FEMxDEM driver with float reals, for bench_tradeoff's precision sweep
+$(BUILD)/femdem_biaxial_float: examples/femdem_biaxial.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
+	$(CC) $(CFLAGS) -DGK_REAL_FLOAT -o $@ $< $(LDLIBS)
+
+# bench_tradeoff runs these drivers as child processes
+$(BUILD)/bench_tradeoff: | $(BUILD)/femdem_biaxial $(BUILD)/femdem_biaxial_float $(BUILD)/mpmdem_biaxial
 
 $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
@@ -133,6 +141,11 @@ run-rve: $(BUILD)/rve_path
 
 bench: $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
+
+# issue 6: error against cost over RVE size, DEM steps, float, tangent, mesh,
+# element and MPM points per cell (make bench runs the short version)
+tradeoff: $(BUILD)/bench_tradeoff
+	$(BUILD)/bench_tradeoff --full
 
 bench-peers: $(BUILD)/bench_dem_step
 	@bench/peers/run_peers.sh
