@@ -292,8 +292,15 @@ int main(int argc, char **argv) {
            b.nx, b.ny, h, pts.n, F.rve[0].n, (int)o.basis, o.alpha);
     printf("RVE: p0 = %.4g kPa, e0 = %.4f, rho = %.1f kg/m3, M (Taylor) = %.4g MPa -> c = %.1f m/s; MPM dt = "
            "%.4g s "
-           "(cfl %.2f); DEM dt = %.3g s, <= %g strain per DEM step\n",
-           P.p0 / 1e3, P.e0, P.rho, P.M / 1e6, c, dt, o.cfl, F.rve[0].dt, o.dem_strain);
+           "(cfl %.2f); DEM dt = %.3g s\n",
+           P.p0 / 1e3, P.e0, P.rho, P.M / 1e6, c, dt, o.cfl, F.rve[0].dt);
+    if (o.dem_adaptive)
+        printf("DEM steps per MPM step: adaptive, I <= %g then relaxation to an unbalanced force ratio < %g, "
+               "%d..%d steps\n",
+               o.dem_inertial, o.dem_unbalanced, o.dem_min, o.dem_max);
+    else
+        printf("DEM steps per MPM step: <= %g strain per DEM step, %d..%d steps\n", o.dem_strain, o.dem_min,
+               o.dem_max);
     printf("about %ld MPM steps to %.1f %% axial strain at %g m/s\n", nsteps_total, 100 * b.strain,
            b.velocity);
     if (!o.restart) {
