@@ -160,7 +160,16 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
     FILE *fp;
     int W = p->width > 0 ? p->width : 640, H = p->height > 0 ? p->height : 420;
     double ml = 78, mr = 20, mt = 36, mb = 52, x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300, sx, sy, t, st;
+    double lx, lw = 0.0; /* legend: left edge and width (text at ~0.55 em per character) */
     int k, i, nleg = 0;
+    for (k = 0; k < p->ns; ++k)
+        if (p->s[k].label) {
+            double w = 30.0 + 6.6 * (double)strlen(p->s[k].label);
+            if (w > lw) lw = w;
+            ++nleg;
+        }
+    lx = W - mr - 8 - lw;
+    if (lx < ml + 8) lx = ml + 8;
     for (k = 0; k < p->ns; ++k)
         for (i = 0; i < p->s[k].n; ++i) {
             double x = p->s[k].x[i], y = p->s[k].y[i];
@@ -234,11 +243,20 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
         if (p->s[k].n == 1 && isfinite(p->s[k].x[0]) && isfinite(p->s[k].y[0]))
             fprintf(fp, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"3\" fill=\"%s\"/>\n", GK__X(p->s[k].x[0]),
                     GK__Y(p->s[k].y[0]), col);
+    }
+    if (nleg > 0) /* legend over the curves: a box, then a line and the label per series */
+        fprintf(fp,
+                "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"white\" fill-opacity=\"0.85\" "
+                "stroke=\"#ccc\"/>\n",
+                lx - 6, mt + 4, lw + 10, 16.0 * nleg + 6);
+    nleg = 0;
+    for (k = 0; k < p->ns; ++k) {
+        const char *col = p->s[k].color ? p->s[k].color : gk__cycle[k % GK_PLOT_MAX];
         if (p->s[k].label) {
             double ly = mt + 14 + 16 * nleg++;
             fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" stroke-width=\"2\"%s/>\n",
-                    W - mr - 150, ly - 4, W - mr - 126, ly - 4, col, p->s[k].dashed ? " stroke-dasharray=\"6,4\"" : "");
-            fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\">", W - mr - 120, ly);
+                    lx, ly - 4, lx + 24, ly - 4, col, p->s[k].dashed ? " stroke-dasharray=\"6,4\"" : "");
+            fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\">", lx + 30, ly);
             gk__xml_text(fp, p->s[k].label);
             fprintf(fp, "</text>\n");
         }
