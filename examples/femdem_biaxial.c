@@ -172,7 +172,7 @@ typedef struct opts {
     const char *out, *restart, *packing, *tangent, *test;
     double width, height, pressure, inc, tol, ftol, dt, dem_strain, xi;
     /* DEM steps per RVE run: 1 adaptive (gk_rve_deform_adaptive), 0 the strain rule; tangent reuse bound */
-    int dem_adaptive, dem_freeze;
+    int dem_adaptive;
     double dem_inertial, dem_unbalanced, tangent_reuse;
     /* cyclic simple shear: cyclic = 1 strain-, 2 stress-controlled */
     int cyclic, stress_steps;
@@ -218,9 +218,8 @@ typedef struct model {
     gk_rve_state *st;
     double *sig, *sig_n, *D, *D_n, *Hacc, *Hit, *dNdx, *detJ;
     int *nsteps_gp, *failed;
-    int *nd_gp, *nr_gp, frozen; /* adaptive rule: counts of the first iteration, kept for the step */
-    double *D_ref;              /* tangent reuse: the last computed tangent of each Gauss point */
-    net_ref *nref;              /* ... and the contact network it was computed at */
+    double *D_ref; /* tangent reuse: the last computed tangent of each Gauss point */
+    net_ref *nref; /* ... and the contact network it was computed at */
     long long pend_dem, pend_reused, pend_computed; /* work since the last converged step */
     gk_csr K;
     double *u, *du, *dprev, *fint, *fext, *R, *rhs, *utot, *A0x, *andF, *andG, *fprev, *Gprev;
@@ -490,15 +489,12 @@ static int eval_rves(model *M, const double *u) {
                 steps += nd;
             }
         }
-        if (M->frozen) nd = M->nd_gp[g], nr = M->nr_gp[g];
-        if (gk_rve_state_restore(&M->st[g], r) ||
-            (M->frozen ? rve_replay(r, H, nd, nr) : rve_run(o, M->scale, r, H, &nd, &nr))) {
+        if (gk_rve_state_restore(&M->st[g], r) || rve_run(o, M->scale, r, H, &nd, &nr)) {
             ++nbad;
             continue;
         }
         steps += nd + nr;
         M->nsteps_gp[g] = nd + nr;
-        M->nd_gp[g] = nd, M->nr_gp[g] = nr;
         gk_rve_stress(r, s0);
         memcpy(M->sig + 9 * (size_t)g, s0, sizeof s0);
         if (o->tangent_reuse > 0) {
@@ -546,7 +542,6 @@ static int eval_rves(model *M, const double *u) {
         }
     }
     M->pend_dem += steps, M->pend_reused += reused, M->pend_computed += computed;
-    if (o->dem_adaptive && o->dem_freeze) M->frozen = 1;
     return nbad;
 }
 
@@ -621,8 +616,6 @@ static int setup(model *M, gk_err *err) {
     ALLOC(M->dNdx, 16 * M->ngp);
     ALLOC(M->detJ, M->ngp);
     ALLOC(M->nsteps_gp, M->ngp);
-    ALLOC(M->nd_gp, M->ngp);
-    ALLOC(M->nr_gp, M->ngp);
     ALLOC(M->D_ref, 16 * M->ngp);
     ALLOC(M->nref, M->ngp);
     ALLOC(M->failed, M->ngp);
@@ -817,7 +810,6 @@ static int load_step(model *M, double inc, int *iters, double *Ed_out, double *E
     /* prescribed platen displacement: biaxial top u_y = -inc H, cyclic top u_x = inc H (inc = d gamma) */
     double Ed = 1.0, Ef = 0.0, Rprev = HUGE_VAL, top = (M->o.cyclic ? inc : -inc) * M->o.height, omega = 1.0;
     precompute_gradients(M);
-    M->frozen = 0; /* the first RVE runs of this attempt choose the DEM step counts */
     if (external_force(M, err)) return 2;
     /* predictor: K(D_n) u = f_ext - f_int(sig_n) with the prescribed increment */
     residual(M, M->sig_n, err);

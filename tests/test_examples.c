@@ -204,7 +204,7 @@ static int read_csv(const char *path, int ncol, double *v, int maxrows, char *he
 
 #define CYC_HEADER                                                                                      \
     "step,cycle,gamma,tau,sigma_yy,sigma_xx,p,q,eps_v_rve,top_uy,iterations,seconds,E_d,E_f,increment," \
-    "failed_gp\n"
+    "failed_gp,dem_steps_mean,dem_steps_max,dem_steps,tangents_reused,tangents_computed\n"
 enum { C_STEP, C_CYCLE, C_GAMMA, C_TAU, C_SYY, C_SXX, C_P, C_Q, C_EVR, C_UY, C_ITER, C_NCOL = 16 };
 
 /* cyclic simple shear, strain control (seed 000 sec 5): documented CSV and
@@ -303,12 +303,132 @@ TEST(femdem_cyclic_stress_turns_at_the_amplitude) {
                1e-3);
 }
 
+/* biaxial.csv columns (the header is checked in the test below) */
+#define FD_HEADER                                                                                           \
+    "step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds,E_d,E_f,increment,failed_gp,dem_steps_mean," \
+    "dem_steps_max,dem_steps,tangents_reused,tangents_computed\n"
+enum { F_SYY = 2, F_ITER = 5, F_DMEAN = 11, F_DMAX, F_DALL, F_REUSED, F_COMP, F_NCOL };
+
+/* a bad value of a flag: status != 0, the message, and no output directory */
+static int fd_refused(const char *flags, const char *msg) {
+    char cmd[512];
+    FILE *fp;
+    int ok;
+    system("rm -rf build/t_fdbad");
+    snprintf(cmd, sizeof cmd, "build/femdem_biaxial %s --out build/t_fdbad > build/t_bad.out 2>&1", flags);
+    ok = system(cmd) != 0 && gk_test_file_has("build/t_bad.out", msg);
+    fp = fopen("build/t_fdbad/biaxial.csv", "r");
+    if (fp) fclose(fp), ok = 0;
+    if (!ok) printf("    not refused as expected: %s\n", flags);
+    return ok;
+}
+
+/* issue 6: the DEM step rule (adaptive by default) and tangent reuse in femdem_biaxial. 2 x 2 Q4, 16
+ * RVEs, a few 0.1 % steps. */
+TEST(femdem_dem_rule_and_tangent_reuse) {
+    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2";
+    char cmd[1024], header[512];
+    double a[8 * F_NCOL], b[8 * F_NCOL], c[8 * F_NCOL], dmax = 0;
+    int n, k, exact = 1, nfix = 37;
+    /* the adaptive rule is the default and reports its steps: per point (mean <= max), in all */
+    snprintf(cmd, sizeof cmd, "%s --steps 4 --vtk-every 4 --out build/t_fdr > build/t_fdr.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    n = read_csv("build/t_fdr/biaxial.csv", F_NCOL, a, 8, header, sizeof header);
+    CHECK(strcmp(header, FD_HEADER) == 0);
+    CHECK_EQ_INT(n, 5);
+    if (n != 5) return;
+    CHECK(gk_test_file_has("build/t_fdr.out", "dem_rule=adaptive"));
+    CHECK(gk_test_file_has("build/t_fdr/gp_0004.vtk", "dem_steps"));
+    for (k = 1; k < n; ++k) {
+        const double *r = a + k * F_NCOL;
+        CHECK(r[F_DMEAN] > 50 && r[F_DMEAN] <= r[F_DMAX]);
+        /* every iteration runs all 16 RVEs at least as long as the accepted one's shortest run */
+        CHECK(r[F_DALL] >= 16 * r[F_ITER] * 2 && r[F_COMP] == 16 * r[F_ITER] && r[F_REUSED] == 0);
+        dmax += r[F_DALL];
+    }
+    CHECK_NEAR(gk_test_result("build/t_fdr.out", "dem_steps_total"), dmax, 0.5);
+    /* a 4x larger inertial-number bound: about 4x fewer deformation steps */
+    snprintf(cmd, sizeof cmd, "%s --steps 4 --dem-inertial 2e-3 --out build/t_fdr2 > build/t_fdr2.out 2>&1",
+             base);
+    CHECK(system(cmd) == 0);
+    CHECK_EQ_INT(read_csv("build/t_fdr2/biaxial.csv", F_NCOL, b, 8, header, sizeof header), 5);
+    printf(
+        "    adaptive rule: DEM steps per RVE at step 1: %.1f (I_max 5e-4), %.1f (2e-3); all: %.0f, %.0f\n",
+        a[F_NCOL + F_DMEAN], b[F_NCOL + F_DMEAN], gk_test_result("build/t_fdr.out", "dem_steps_total"),
+        gk_test_result("build/t_fdr2.out", "dem_steps_total"));
+    CHECK(b[F_NCOL + F_DMEAN] < 0.4 * a[F_NCOL + F_DMEAN]);
+    CHECK(gk_test_result("build/t_fdr2.out", "dem_steps_total") <
+          0.5 * gk_test_result("build/t_fdr.out", "dem_steps_total"));
+    /* the strain rule with --dem-min N --dem-max N: exactly N steps per RVE run, every run */
+    snprintf(
+        cmd, sizeof cmd,
+        "%s --steps 3 --dem-rule strain --dem-min %d --dem-max %d --out build/t_fdn > build/t_fdn.out 2>&1",
+        base, nfix, nfix);
+    CHECK(system(cmd) == 0);
+    n = read_csv("build/t_fdn/biaxial.csv", F_NCOL, c, 8, header, sizeof header);
+    CHECK_EQ_INT(n, 4);
+    for (k = 1; k < n; ++k) {
+        const double *r = c + k * F_NCOL;
+        exact &= r[F_DMEAN] == nfix && r[F_DMAX] == nfix && r[F_DALL] == 16.0 * nfix * r[F_ITER];
+    }
+    CHECK(exact);
+    CHECK(gk_test_file_has("build/t_fdn.out", "dem_rule=strain"));
+    /* tangent reuse: the same converged curve within the Newton tolerance - both runs stop at E_f <
+     * --ftol = 0.3 % of the internal force, so two converged states may differ by a few tenths of a
+     * percent in the reactions; 1 % allows that and no more - and it does reuse */
+    snprintf(cmd, sizeof cmd, "%s --steps 4 --tangent-reuse 0.3 --out build/t_fdt > build/t_fdt.out 2>&1",
+             base);
+    CHECK(system(cmd) == 0);
+    n = read_csv("build/t_fdt/biaxial.csv", F_NCOL, b, 8, header, sizeof header);
+    CHECK_EQ_INT(n, 5);
+    if (n != 5) return;
+    for (k = 1; k < n; ++k) CHECK_REL(b[k * F_NCOL + F_SYY], a[k * F_NCOL + F_SYY], 0.01);
+    printf("    tangent reuse 0.3: %.0f reused, %.0f computed; sigma_yy at 0.4 %%: %.0f Pa (no reuse %.0f)\n",
+           gk_test_result("build/t_fdt.out", "tangents_reused"),
+           gk_test_result("build/t_fdt.out", "tangents_computed"), b[4 * F_NCOL + F_SYY],
+           a[4 * F_NCOL + F_SYY]);
+    CHECK(gk_test_result("build/t_fdt.out", "tangents_reused") > 0);
+    /* ... thread-independent and restart-safe: with X = 0.3 tangents are kept across load steps, so the
+     * restart needs the stored tangents and networks of the checkpoint (without them it diverges) */
+    CHECK(run_threads_and_restart(base, "--steps 4 --tangent-reuse 0.3", "--steps 2 --tangent-reuse 0.3",
+                                  "t_fdq"));
+    check_threads_and_restart("t_fdq", "biaxial.csv", 6);
+    CHECK(gk_test_result("build/t_fdqB2.out", "tangents_reused") ==
+          gk_test_result("build/t_fdqA.out", "tangents_reused"));
+    CHECK(gk_test_result("build/t_fdq1.out", "dem_steps_total") ==
+          gk_test_result("build/t_fdqA.out", "dem_steps_total"));
+    CHECK(gk_test_result("build/t_fdqB2.out", "dem_steps_total") ==
+          gk_test_result("build/t_fdqA.out", "dem_steps_total"));
+    /* eq 8 with the adaptive rule (trial run first, perturbed runs with its counts): the same for 1 and 2
+     * threads, and at least 5 RVE runs per tangent */
+    CHECK(run_threads_and_restart(base, "--steps 2 --tangent perturbation",
+                                  "--steps 1 --tangent perturbation", "t_fdp"));
+    check_threads_and_restart("t_fdp", "biaxial.csv", 6);
+    n = read_csv("build/t_fdpA/biaxial.csv", F_NCOL, c, 8, header, sizeof header);
+    CHECK_EQ_INT(n, 3);
+    if (n == 3) /* DEM steps per tangent at step 1: 6 runs (trial, 4 perturbed, trial again) vs 1 */
+        CHECK(c[F_NCOL + F_DALL] / c[F_NCOL + F_COMP] > 5.5 * a[F_NCOL + F_DALL] / a[F_NCOL + F_COMP]);
+    /* bad values: refused with a message, nothing written */
+    CHECK(fd_refused("--dem-rule fast", "use adaptive or strain"));
+    CHECK(fd_refused("--dem-inertial 0", "needs a positive number"));
+    CHECK(fd_refused("--dem-unbalanced -1e-3", "needs a positive number"));
+    CHECK(fd_refused("--dem-strain 1e-5x", "needs a positive number"));
+    CHECK(fd_refused("--dem-min 2.5", "whole number"));
+    CHECK(fd_refused("--dem-min 50 --dem-max 40", "exceeds"));
+    CHECK(fd_refused("--tangent-reuse 1", "0 <= X < 1"));
+    CHECK(fd_refused("--tangent-reuse nan", "0 <= X < 1"));
+    CHECK(system("build/femdem_biaxial --help > build/t_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "--dem-unbalanced"));
+    CHECK(gk_test_file_has("build/t_bad.out", "--tangent-reuse"));
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(rve_path_writes_csv_and_svg);
     RUN(gk_pack_makes_a_consolidated_packing);
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
     RUN(femdem_single_element_matches_rve_alone);
+    RUN(femdem_dem_rule_and_tangent_reuse);
     RUN(femdem_cyclic_strain_constant_volume_and_contractive);
     RUN(femdem_cyclic_stress_turns_at_the_amplitude);
     return gk_test_done();
