@@ -34,19 +34,31 @@
  *            discretisation error, same RVE and DEM steps; after the peak the
  *            strain localises and no mesh is "converged").
  *            sweep  mesh  2x4 Q4, 2x4 Q8, 4x8 Q4, 4x8 Q8
- *   mpm      mpmdem_biaxial, 4 x 8 cells to 10 % strain [2 x 4 cells], default
- *            (adaptive) DEM rule. reference: 3 x 3 points per cell [2 x 2].
- *            sweep  mpm_ppc  1, 2 [1]
+ *   mpm      mpmdem_biaxial, 4 x 8 cells (1 x 2 m), to 3 % axial strain, default
+ *            (adaptive) DEM rule [short: not run; --sweep mpm without --full: 2 x 4
+ *            cells]. After the peak the adaptive rule needs tens to hundreds of DEM
+ *            steps per point per MPM step (measured on 2 x 4 cells, 2 x 2 points:
+ *            5-8 at 2-3 %, 300+ at 9 %), hence 3 %, past the peak (about 2 %).
+ *            reference: 3 x 3 points per cell (288 RVEs).
+ *            sweep  mpm_ppc  1 and 2 points per cell edge (32, 128 RVEs)
+ *
+ * The short version runs the single-element group only (about a minute on 2
+ * idle cores); --sweep biaxial or --sweep mpm adds a group to it.
  *
  * Error metrics (each row against its group's reference; NaN when the run did
  * not reach the strain the metric needs):
  *   err_peak   |R - R_ref| / R_ref, R = max over the curve of sigma_yy / sigma_xx
  *              (MPM: sigma_yy / the applied lateral pressure)
- *   err_s5     |sigma_yy(5 %) - ref| / ref,   err_s10 the same at 10 %
+ *   err_sa     |sigma_yy(5 %) - ref| / ref,   err_sb the same at 10 %
  *   ev_rms     RMS over the reference's rows (0 < eps_axial <= the shorter curve's
  *              end) of eps_v - eps_v_ref, both interpolated at eps_axial
  *              (strain units); err_ev = ev_rms / max |eps_v_ref|
- *   err_max    max(err_peak, err_s5, err_s10, err_ev): the y axis of the Pareto plot
+ *   err_max    max(err_peak, err_sa, err_sb, err_ev): the y axis of the Pareto plot
+ *   err_twin   (single group; CSV err_max_vs_100_steps_double_taylor_same_rve) err_max
+ *              against the run with the same packing, 100 DEM steps, double and Taylor:
+ *              the swept factor alone, without the RVE-sample difference. For float it
+ *              measures how far round-off alone moves a chaotic DEM curve, i.e. the
+ *              noise floor of single-run comparisons.
  * Cost: wall seconds of the child process (start-up, packing read and output
  * included) and the total Newton iterations (sum of the CSV's iterations
  * column, converged steps and sub-steps; none for the explicit MPM, which
@@ -61,7 +73,7 @@
  * (error against seconds, log axes, Pareto front of each group), OUT/runs/ID
  * (each child's output and log), a table on stdout and one line per row:
  *   BENCH case=tradeoff group=... sweep=... config=... completed=... seconds=...
- *         newton_iterations=... err_peak=... err_s5=... err_s10=... ev_rms=... err_max=... */
+ *         newton_iterations=... err_peak=... err_sa=... err_sb=... ev_rms=... err_max=... */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -104,7 +116,9 @@ typedef struct cfg {
     double seconds;
     long newton, mpm_steps;
     curve c;
-    double err_peak, err_s5, err_s10, ev_rms, err_ev, err_max;
+    double eps_a, eps_b; /* axial strains of the two stress points (5 and 10 %; MPM 1 and 3 %) */
+    double err_peak, err_sa, err_sb, ev_rms, err_ev, err_max;
+    double err_base; /* err_max against the same RVE with 100 DEM steps, double, Taylor */
 } cfg;
 
 typedef struct opts {
@@ -238,16 +252,16 @@ static void compute_errors(cfg *r, const cfg *ref) {
     const curve *a = &r->c, *b = &ref->c;
     double ea, eb, Ra, Rb, end, s = 0.0, evmax = 0.0, m;
     int k, n = 0;
-    r->err_peak = r->err_s5 = r->err_s10 = r->ev_rms = r->err_ev = r->err_max = NAN;
+    r->err_peak = r->err_sa = r->err_sb = r->ev_rms = r->err_ev = r->err_max = NAN;
     if (a->n < 2 || b->n < 2) return;
     Ra = peak_ratio(a, &ea);
     Rb = peak_ratio(b, &eb);
     /* a peak means something only when the run got past the reference's peak */
     if (a->eps[a->n - 1] >= eb && Rb > 0) r->err_peak = fabs(Ra - Rb) / Rb;
-    m = interp(b, b->syy, 0.05);
-    r->err_s5 = fabs(interp(a, a->syy, 0.05) - m) / m;
-    m = interp(b, b->syy, 0.10);
-    r->err_s10 = fabs(interp(a, a->syy, 0.10) - m) / m;
+    m = interp(b, b->syy, r->eps_a);
+    r->err_sa = fabs(interp(a, a->syy, r->eps_a) - m) / m;
+    m = interp(b, b->syy, r->eps_b);
+    r->err_sb = fabs(interp(a, a->syy, r->eps_b) - m) / m;
     end = a->eps[a->n - 1] < b->eps[b->n - 1] ? a->eps[a->n - 1] : b->eps[b->n - 1];
     for (k = 0; k < b->n; ++k) {
         if (fabs(b->ev[k]) > evmax) evmax = fabs(b->ev[k]);
@@ -260,7 +274,7 @@ static void compute_errors(cfg *r, const cfg *ref) {
     if (evmax > 0) r->err_ev = r->ev_rms / evmax;
     {
         double e[4];
-        e[0] = r->err_peak, e[1] = r->err_s5, e[2] = r->err_s10, e[3] = r->err_ev;
+        e[0] = r->err_peak, e[1] = r->err_sa, e[2] = r->err_sb, e[3] = r->err_ev;
         r->err_max = 0.0;
         for (k = 0; k < 4; ++k) r->err_max = e[k] != e[k] || r->err_max != r->err_max ? NAN : e[k] > r->err_max ? e[k] : r->err_max;
     }
@@ -277,7 +291,7 @@ static cfg *add(cfg *list, int *n, const char *group, const char *sweep, kind_t 
     memset(c, 0, sizeof *c);
     c->group = group, c->sweep = sweep, c->kind = kind;
     c->dem_steps = 100, c->tangent = "taylor", c->element = "q4", c->nx = c->ny = 1, c->steps = 100;
-    c->same_as = -1;
+    c->same_as = -1, c->eps_a = 0.05, c->eps_b = 0.10;
     return c;
 }
 
@@ -358,20 +372,22 @@ static int build_list(cfg *L, const opts *o) {
             snprintf(c->label, sizeof c->label, "%dx%d %s", c->nx, c->ny, c->element);
         }
     }
-    if (wanted(o, "mpm", "mpm_ppc")) {
-        int top = o->full ? 3 : 2;
+    if ((o->full || o->only) && wanted(o, "mpm", "mpm_ppc")) { /* short: only when asked */
+        int top = 3;
         for (k = top; k >= 1; --k) {
             cfg *c = add(L, &n, "mpm", k == top ? "reference" : "mpm_ppc", K_MPM);
             set_packing(c, o, 0);
             c->nx = o->full ? 4 : 2, c->ny = 2 * c->nx, c->ppc = k, c->is_ref = k == top;
-            c->strain = 0.1005; /* a little past 10 %: the 10 % point lies inside the curve */
+            c->strain = 0.0305; /* a little past 3 %: the 3 % point lies inside the curve */
+            c->eps_a = 0.01, c->eps_b = 0.03;
             c->dem_steps = 0;
             snprintf(c->label, sizeof c->label, "%dx%d ppc%d", c->nx, c->ny, k);
         }
     }
     for (k = 0; k < n; ++k) {
         snprintf(L[k].id, sizeof L[k].id, "%02d_%s_%s", k, L[k].group, L[k].sweep);
-        if (o->steps) L[k].steps = o->steps, L[k].strain = INC * (o->steps + 0.5);
+        if (o->steps && L[k].kind != K_MPM) L[k].steps = o->steps;
+        if (o->steps && L[k].kind == K_MPM && INC * (o->steps + 0.5) < L[k].strain) L[k].strain = INC * (o->steps + 0.5);
     }
     return n;
 }
@@ -499,14 +515,15 @@ static void marker(FILE *fp, kind_t k, double x, double y, const char *col) {
 
 static int write_svg(const char *path, cfg *L, int n) {
     FILE *fp = fopen(path, "w");
-    const double W = 960, H = 640, x0 = 80, x1 = 700, y0 = 50, y1 = 570;
-    double lx0 = 1e300, lx1 = -1e300, ly0 = 1e300, ly1 = -1e300, d;
+    const double W = 1180, H = 660, x0 = 80, x1 = 680, y0 = 50, y1 = 570;
+    double lx0 = 1e300, lx1 = -1e300, ly0 = 1e300, ly1 = -1e300, d, ky;
     int k, j, ng = 0;
-    const char *groups[3] = {"single", "biaxial", "mpm"}, *sweeps[6] = {"rve_size", "dem_steps", "real", "tangent", "mesh", "mpm_ppc"};
+    const char *groups[3] = {"single", "biaxial", "mpm"};
+    const char *sweeps[6] = {"rve_size", "dem_steps", "real", "tangent", "mesh", "mpm_ppc"};
     if (!fp) return -1;
     for (k = 0; k < n; ++k)
         if (L[k].ran && L[k].seconds > 0) {
-            double lx = log10(L[k].seconds), ly = L[k].err_max > 0 ? log10(L[k].err_max) : NAN;
+            double lx = log10(L[k].seconds), ly = !L[k].is_ref && L[k].err_max > 0 ? log10(L[k].err_max) : NAN;
             if (lx < lx0) lx0 = lx;
             if (lx > lx1) lx1 = lx;
             if (ly == ly && ly < ly0) ly0 = ly;
@@ -514,7 +531,7 @@ static int write_svg(const char *path, cfg *L, int n) {
         }
     if (lx0 > lx1) lx0 = -1, lx1 = 1;
     if (ly0 > ly1) ly0 = -3, ly1 = 0;
-    lx0 = floor(lx0), lx1 = ceil(lx1 + 1e-9), ly0 = floor(ly0) - 1, ly1 = ceil(ly1 + 1e-9);
+    lx0 = floor(lx0), lx1 = ceil(lx1 + 1e-9), ly0 = floor(ly0 - 0.3), ly1 = ceil(ly1 + 1e-9);
 #define PX(v) (x0 + (log10(v) - lx0) / (lx1 - lx0) * (x1 - x0))
 #define PY(v) (y1 - (log10(v) - ly0) / (ly1 - ly0) * (y1 - y0))
     fprintf(fp, "<svg xmlns='http://www.w3.org/2000/svg' width='%g' height='%g' font-family='sans-serif' font-size='12'>\n",
@@ -522,27 +539,39 @@ static int write_svg(const char *path, cfg *L, int n) {
     fprintf(fp, "<rect width='100%%' height='100%%' fill='white'/>\n");
     fprintf(fp, "<text x='%g' y='25' font-size='15' text-anchor='middle'>grainkit trade-off: error against wall time "
                 "(each group against its own reference)</text>\n", (x0 + x1) / 2);
-    for (d = lx0; d <= lx1 + 1e-9; d += 1) {
-        double x = x0 + (d - lx0) / (lx1 - lx0) * (x1 - x0);
-        fprintf(fp, "<line x1='%.1f' y1='%g' x2='%.1f' y2='%g' stroke='#ddd'/>\n", x, y0, x, y1);
-        fprintf(fp, "<text x='%.1f' y='%g' text-anchor='middle'>%g</text>\n", x, y1 + 16, pow(10, d));
+    for (d = lx0; d <= lx1 + 1e-9; d += 1) { /* decades, with 2 and 5 in between */
+        int m;
+        for (m = 1; m <= 5; m += m == 1 ? 1 : 3) {
+            double v = log10(m) + d, x = x0 + (v - lx0) / (lx1 - lx0) * (x1 - x0);
+            if (v > lx1 + 1e-9) break;
+            fprintf(fp, "<line x1='%.1f' y1='%g' x2='%.1f' y2='%g' stroke='%s'/>\n", x, y0, x, y1, m == 1 ? "#ccc" : "#eee");
+            fprintf(fp, "<text x='%.1f' y='%g' text-anchor='middle'>%g</text>\n", x, y1 + 16, pow(10, v));
+        }
     }
     for (d = ly0; d <= ly1 + 1e-9; d += 1) {
-        double y = y1 - (d - ly0) / (ly1 - ly0) * (y1 - y0);
-        fprintf(fp, "<line x1='%g' y1='%.1f' x2='%g' y2='%.1f' stroke='#ddd'/>\n", x0, y, x1, y);
-        fprintf(fp, "<text x='%g' y='%.1f' text-anchor='end'>%g %%</text>\n", x0 - 5, y + 4, 100 * pow(10, d));
+        int m;
+        for (m = 1; m <= 5; m += m == 1 ? 1 : 3) {
+            double v = log10(m) + d, y = y1 - (v - ly0) / (ly1 - ly0) * (y1 - y0);
+            if (v > ly1 + 1e-9) break;
+            fprintf(fp, "<line x1='%g' y1='%.1f' x2='%g' y2='%.1f' stroke='%s'/>\n", x0, y, x1, y, m == 1 ? "#ccc" : "#eee");
+            fprintf(fp, "<text x='%g' y='%.1f' text-anchor='end'>%g %%</text>\n", x0 - 5, y + 4, 100 * pow(10, v));
+        }
     }
     fprintf(fp, "<rect x='%g' y='%g' width='%g' height='%g' fill='none' stroke='black'/>\n", x0, y0, x1 - x0, y1 - y0);
-    fprintf(fp, "<text x='%g' y='%g' text-anchor='middle'>wall seconds (2 cores, one run each)</text>\n", (x0 + x1) / 2,
-            y1 + 36);
-    fprintf(fp, "<text transform='translate(22 %g) rotate(-90)' text-anchor='middle'>err_max = max(peak ratio, "
-                "sigma_yy at 5 %% and 10 %%, eps_v RMS) relative error</text>\n", (y0 + y1) / 2);
+    fprintf(fp, "<text x='%g' y='%g' text-anchor='middle'>wall seconds per run (2 cores, one run each)</text>\n",
+            (x0 + x1) / 2, y1 + 36);
+    fprintf(fp, "<text transform='translate(22 %g) rotate(-90)' text-anchor='middle'>err_max: largest relative error "
+                "of peak ratio, sigma_yy at eps_a and eps_b, eps_v</text>\n", (y0 + y1) / 2);
+    fprintf(fp, "<text x='%g' y='%g' font-size='10' fill='#555'>numbers: run ids (table order, build/tradeoff/runs/NN_*); references "
+                "on the bottom edge; single runs of chaotic DEM: differences of a few %% after the peak are noise</text>\n",
+            x0, y1 + 56);
     /* Pareto front per group: points no cheaper point beats */
     for (j = 0; j < 3; ++j) {
         int idx[MAXCFG], m = 0, a, b;
         double best = 1e300;
         for (k = 0; k < n; ++k)
-            if (!strcmp(L[k].group, groups[j]) && L[k].ran && L[k].completed && !L[k].is_ref && L[k].err_max > 0 && L[k].same_as < 0)
+            if (!strcmp(L[k].group, groups[j]) && L[k].ran && L[k].completed && !L[k].is_ref && L[k].err_max > 0 &&
+                L[k].same_as < 0)
                 idx[m++] = k;
         for (a = 1; a < m; ++a)
             for (b = a; b > 0 && L[idx[b]].seconds < L[idx[b - 1]].seconds; --b) {
@@ -565,54 +594,44 @@ static int write_svg(const char *path, cfg *L, int n) {
         double x, y;
         if (!c->ran || c->same_as >= 0 || !(c->seconds > 0)) continue;
         x = PX(c->seconds);
-        if (c->is_ref) {
-            y = y1 - 8;
-            fprintf(fp, "<text x='%.1f' y='%.1f' font-size='10' text-anchor='middle'>ref %s</text>\n", x, y - 8,
-                    c->group);
-            marker(fp, c->kind, x, y, "#000");
+        if (c->is_ref)
+            y = y1 - 8, marker(fp, c->kind, x, y, "#000");
+        else if (c->err_max > 0)
+            y = PY(c->err_max), marker(fp, c->kind, x, y, sweep_color(c->sweep));
+        else
             continue;
-        }
-        if (!(c->err_max > 0)) continue;
-        y = PY(c->err_max);
-        marker(fp, c->kind, x, y, sweep_color(c->sweep));
-        fprintf(fp, "<text x='%.1f' y='%.1f' font-size='9' fill='#333'>%s</text>\n", x + 6, y - 4, c->label);
+        fprintf(fp, "<text x='%.1f' y='%.1f' font-size='9' fill='#333'>%d</text>\n", x + 5, y - 4, k);
     }
     /* legend */
-    {
-        double y = y0 + 10;
-        fprintf(fp, "<text x='720' y='%.1f' font-weight='bold'>sweep</text>\n", y);
-        for (j = 0; j < 6; ++j) {
-            y += 18;
-            fprintf(fp, "<rect x='720' y='%.1f' width='12' height='12' fill='%s'/><text x='738' y='%.1f'>%s</text>\n",
-                    y - 10, sweep_color(sweeps[j]), y, sweeps[j]);
-        }
-        y += 28;
-        fprintf(fp, "<text x='720' y='%.1f' font-weight='bold'>test (marker)</text>\n", y);
-        y += 18, marker(fp, K_SINGLE, 726, y - 4, "#777");
-        fprintf(fp, "<text x='738' y='%.1f'>single element</text>\n", y);
-        y += 18, marker(fp, K_BIAXIAL, 726, y - 4, "#777");
-        fprintf(fp, "<text x='738' y='%.1f'>FEMxDEM biaxial</text>\n", y);
-        y += 18, marker(fp, K_MPM, 726, y - 4, "#777");
-        fprintf(fp, "<text x='738' y='%.1f'>MPMxDEM biaxial</text>\n", y);
-        y += 28;
-        fprintf(fp, "<line x1='720' y1='%.1f' x2='750' y2='%.1f' stroke='#555' stroke-dasharray='5,4'/>"
-                    "<text x='756' y='%.1f'>Pareto front (%d groups)</text>\n", y - 4, y - 4, y, ng);
-        y += 28;
-        fprintf(fp, "<text x='720' y='%.1f' font-weight='bold'>references</text>\n", y);
-        for (k = 0; k < n; ++k)
-            if (L[k].is_ref && L[k].ran) {
-                y += 16;
-                fprintf(fp, "<text x='720' y='%.1f' font-size='10'>%s: %s%s</text>\n", y, L[k].group, L[k].label,
-                        L[k].completed ? "" : " (FAILED)");
-            }
-        y += 28;
-        fprintf(fp, "<text x='720' y='%.1f' font-weight='bold'>not plotted</text>\n", y);
-        for (k = 0; k < n; ++k)
-            if (!L[k].is_ref && (L[k].skipped || (L[k].ran && L[k].same_as < 0 && !(L[k].err_max > 0)))) {
-                y += 14;
-                fprintf(fp, "<text x='720' y='%.1f' font-size='10'>%s %s: %s</text>\n", y, L[k].group, L[k].label,
-                        L[k].skipped ? "skipped" : L[k].completed ? "error NaN or 0" : "failed");
-            }
+    ky = y0 + 10;
+    fprintf(fp, "<text x='700' y='%.1f' font-weight='bold'>sweep</text>\n", ky);
+    for (j = 0; j < 6; ++j) {
+        ky += 17;
+        fprintf(fp, "<rect x='700' y='%.1f' width='11' height='11' fill='%s'/><text x='716' y='%.1f'>%s</text>\n",
+                ky - 10, sweep_color(sweeps[j]), ky, sweeps[j]);
+    }
+    ky += 26;
+    fprintf(fp, "<text x='700' y='%.1f' font-weight='bold'>test (marker)</text>\n", ky);
+    ky += 17, marker(fp, K_SINGLE, 706, ky - 4, "#777");
+    fprintf(fp, "<text x='716' y='%.1f'>single element</text>\n", ky);
+    ky += 17, marker(fp, K_BIAXIAL, 706, ky - 4, "#777");
+    fprintf(fp, "<text x='716' y='%.1f'>FEMxDEM biaxial</text>\n", ky);
+    ky += 17, marker(fp, K_MPM, 706, ky - 4, "#777");
+    fprintf(fp, "<text x='716' y='%.1f'>MPMxDEM biaxial</text>\n", ky);
+    ky += 26;
+    fprintf(fp, "<line x1='700' y1='%.1f' x2='730' y2='%.1f' stroke='#555' stroke-dasharray='5,4'/>"
+                "<text x='736' y='%.1f'>Pareto front of each group (%d)</text>\n", ky - 4, ky - 4, ky, ng);
+    /* key: row number, group, configuration; two columns */
+    ky = y0 + 10;
+    fprintf(fp, "<text x='900' y='%.1f' font-weight='bold'>rows</text>\n", ky);
+    for (k = 0, j = 0; k < n; ++k) {
+        const cfg *c = &L[k];
+        double x = j < 34 ? 900 : 1040, y = y0 + 26 + 15 * (j < 34 ? j : j - 34);
+        const char *state = c->skipped ? " (skipped)" : !c->ran ? " (not run)" : c->same_as >= 0 ? " (=row)"
+                            : !c->completed ? " (FAILED)" : c->is_ref ? " REF" : !(c->err_max > 0) ? " (NaN)" : "";
+        fprintf(fp, "<text x='%.0f' y='%.1f' font-size='10'>%d %s %s%s</text>\n", x, y, k,
+                c->kind == K_SINGLE ? "S" : c->kind == K_BIAXIAL ? "B" : "M", c->label, state);
+        ++j;
     }
     fprintf(fp, "</svg>\n");
 #undef PX
@@ -624,8 +643,8 @@ static void usage(FILE *fp) {
     fprintf(fp,
             "usage: bench_tradeoff [--full] [--threads T] [--bin DIR] [--data DIR] [--out DIR]\n"
             "                      [--sweep NAME,...] [--steps N] [--dry-run]\n"
-            "  (no option)     short version, about a minute on 2 cores (make bench)\n"
-            "  --full          the whole sweep of issue 6 (make tradeoff), about 10-15 minutes\n"
+            "  (no option)     short version: the single-element group, about a minute on 2 cores (make bench)\n"
+            "  --full          the whole sweep of issue 6 (make tradeoff), about 10-15 minutes on 2 idle cores\n"
             "  --threads T     threads given to every driver run (2)\n"
             "  --bin DIR       where the driver binaries are (build)\n"
             "  --data DIR      packings rveN.txt of the RVE-size series (bench/data/tradeoff)\n"
@@ -750,8 +769,23 @@ int main(int argc, char **argv) {
         int ref = -1;
         for (k = 0; k < n; ++k)
             if (L[k].is_ref && !strcmp(L[k].group, L[i].group)) ref = k;
-        L[i].err_peak = L[i].err_s5 = L[i].err_s10 = L[i].ev_rms = L[i].err_ev = L[i].err_max = NAN;
+        L[i].err_peak = L[i].err_sa = L[i].err_sb = L[i].ev_rms = L[i].err_ev = L[i].err_max = NAN;
         if (ref >= 0 && L[ref].ran && L[ref].c.n > 1 && L[i].ran && L[i].c.n > 1) compute_errors(&L[i], &L[ref]);
+        if (L[i].is_ref && L[i].ran && L[i].c.n > 1) /* exactly zero, not an interpolation round-off */
+            L[i].err_peak = L[i].err_sa = L[i].err_sb = L[i].ev_rms = L[i].err_ev = L[i].err_max = 0.0;
+    }
+    /* the swept factor alone: against the twin with the same RVE and 100 DEM steps, double, Taylor */
+    for (i = 0; i < n; ++i) {
+        L[i].err_base = NAN;
+        if (L[i].kind != K_SINGLE || !L[i].ran || L[i].c.n < 2) continue;
+        for (k = 0; k < n; ++k)
+            if (L[k].kind == K_SINGLE && L[k].ran && L[k].c.n > 1 && !strcmp(L[k].packing, L[i].packing) &&
+                L[k].dem_steps == 100 && !L[k].use_float && !strcmp(L[k].tangent, "taylor")) {
+                cfg tmp = L[i];
+                compute_errors(&tmp, &L[k]);
+                L[i].err_base = k == i || L[k].c.eps == L[i].c.eps ? 0.0 : tmp.err_max;
+                break;
+            }
     }
     snprintf(path, sizeof path, "%s/tradeoff.csv", o.out);
     fp = fopen(path, "w");
@@ -760,31 +794,32 @@ int main(int argc, char **argv) {
         return 1;
     }
     fprintf(fp, "group,sweep,config,test,disks,packing,dem_steps_per_increment,real,tangent,nx,ny,element,ppc,threads,"
-                "completed,seconds,newton_iterations,mpm_steps,end_strain,peak_ratio,eps_at_peak,err_peak,err_s5,"
-                "err_s10,ev_rms,err_ev,err_max,reference,run_dir\n");
-    printf("\n%-8s %-10s %-26s %3s %8s %7s %8s %8s %8s %9s %8s\n", "group", "sweep", "config", "ok", "seconds", "newton",
-           "peak%", "s5%", "s10%", "ev_rms", "max%");
+                "completed,seconds,newton_iterations,mpm_steps,end_strain,peak_ratio,eps_at_peak,err_peak,eps_a,err_sa,"
+                "eps_b,err_sb,ev_rms,err_ev,err_max,err_max_vs_100_steps_double_taylor_same_rve,reference,run_dir\n");
+    printf("\n%-8s %-10s %-26s %3s %8s %7s %8s %8s %8s %9s %8s %8s\n", "group", "sweep", "config", "ok", "seconds",
+           "newton", "peak%", "sA%", "sB%", "ev_rms", "max%", "twin%");
     for (i = 0; i < n; ++i) {
         cfg *c = &L[i];
         char b[6][32], refl[64] = "";
         double ep = NAN, R = c->c.n > 1 ? peak_ratio(&c->c, &ep) : NAN;
         for (k = 0; k < n; ++k)
             if (L[k].is_ref && !strcmp(L[k].group, c->group)) snprintf(refl, sizeof refl, "%s", L[k].label);
-        fprintf(fp, "%s,%s,%s,%s,%d,%s,%s%d,%s,%s,%d,%d,%s,%d,%d,%s,%.3f,%ld,%ld,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,"
-                    "%.6g,%s,%s/runs/%s\n",
+        fprintf(fp, "%s,%s,%s,%s,%d,%s,%s%d,%s,%s,%d,%d,%s,%d,%d,%s,%.3f,%ld,%ld,%.6g,%.6g,%.6g,%.6g,%g,%.6g,%g,%.6g,%.6g,"
+                    "%.6g,%.6g,%.6g,%s,%s/runs/%s\n",
                 c->group, c->sweep, c->label, c->kind == K_SINGLE ? "single" : c->kind == K_BIAXIAL ? "biaxial" : "mpm",
                 c->disks ? c->disks : 400, c->packing, c->dem_steps ? "" : "adaptive", c->dem_steps,
                 c->use_float ? "float" : "double", c->tangent, c->nx, c->ny, c->kind == K_MPM ? "" : c->element, c->ppc,
                 o.threads, c->skipped ? "skipped" : c->completed ? "yes" : "no", c->seconds, c->newton, c->mpm_steps,
-                c->c.n ? c->c.eps[c->c.n - 1] : NAN, R, ep, c->err_peak, c->err_s5, c->err_s10, c->ev_rms, c->err_ev,
-                c->err_max, refl, o.out, c->same_as >= 0 ? L[c->same_as].id : c->id);
+                c->c.n ? c->c.eps[c->c.n - 1] : NAN, R, ep, c->err_peak, c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_ev,
+                c->err_max, c->err_base, refl, o.out, c->same_as >= 0 ? L[c->same_as].id : c->id);
         fmt(b[0], 32, c->err_peak, 100, "%.2f");
-        fmt(b[1], 32, c->err_s5, 100, "%.2f");
-        fmt(b[2], 32, c->err_s10, 100, "%.2f");
+        fmt(b[1], 32, c->err_sa, 100, "%.2f");
+        fmt(b[2], 32, c->err_sb, 100, "%.2f");
         fmt(b[3], 32, c->ev_rms, 1, "%.2e");
         fmt(b[4], 32, c->err_max, 100, "%.2f");
-        printf("%-8s %-10s %-26s %3s %8.1f %7ld %8s %8s %8s %9s %8s%s\n", c->group, c->sweep, c->label,
-               c->skipped ? "skp" : c->completed ? "yes" : "NO", c->seconds, c->newton, b[0], b[1], b[2], b[3], b[4],
+        fmt(b[5], 32, c->err_base, 100, "%.2f");
+        printf("%-8s %-10s %-26s %3s %8.1f %7ld %8s %8s %8s %9s %8s %8s%s\n", c->group, c->sweep, c->label,
+               c->skipped ? "skp" : c->completed ? "yes" : "NO", c->seconds, c->newton, b[0], b[1], b[2], b[3], b[4], b[5],
                c->is_ref ? "  (reference)" : c->same_as >= 0 ? "  (same run as above)" : "");
     }
     fclose(fp);
@@ -792,10 +827,10 @@ int main(int argc, char **argv) {
     for (i = 0; i < n; ++i) {
         cfg *c = &L[i];
         printf("BENCH case=tradeoff group=%s sweep=%s config=\"%s\" completed=%d skipped=%d seconds=%.3f "
-               "newton_iterations=%ld mpm_steps=%ld err_peak=%.4g err_s5=%.4g err_s10=%.4g ev_rms=%.4g err_max=%.4g "
-               "reference=%d\n",
+               "newton_iterations=%ld mpm_steps=%ld err_peak=%.4g eps_a=%g err_sa=%.4g eps_b=%g err_sb=%.4g ev_rms=%.4g err_max=%.4g "
+               "err_twin=%.4g reference=%d\n",
                c->group, c->sweep, c->label, c->completed, c->skipped, c->seconds, c->newton, c->mpm_steps, c->err_peak,
-               c->err_s5, c->err_s10, c->ev_rms, c->err_max, c->is_ref);
+               c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_max, c->err_base, c->is_ref);
     }
     snprintf(path, sizeof path, "%s/tradeoff.svg", o.out);
     if (write_svg(path, L, n)) fprintf(stderr, "bench_tradeoff: cannot write %s\n", path);
