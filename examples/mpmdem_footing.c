@@ -1034,8 +1034,14 @@ int main(int argc, char **argv) {
             "N_q: MPMxDEM %.2f; eq 46 (general shear, phi = %.2f deg) %.2f; eq 47 (local/punching, phi_r = "
             "%.2f deg) %.2f; ratio %.3f to eq 46\n",
             nq, phi, nq46, phi_reduced(phi), nq47, nq / nq46);
-        printf("the MPMxDEM N_q is eq 46 of phi = %.2f deg (the angle the footing mobilises)\n",
-               phi_of_nq(nq));
+        if (isnan(phi_of_nq(nq)))
+            printf(
+                "no angle's eq 46 gives the MPMxDEM N_q %.3g (eq 46 spans %.3g at 0 deg to %.4g at 60 deg; "
+                "RESULT phi_mobilised_deg=nan)\n",
+                nq, nq_prandtl(0.0), nq_prandtl(60.0));
+        else
+            printf("the MPMxDEM N_q is eq 46 of phi = %.2f deg (the angle the footing mobilises)\n",
+                   phi_of_nq(nq));
         if (measured)
             printf("N_q of eq 46 with the residual angle phi_res = %.2f deg (the softened end of the RVE "
                    "tests): "
