@@ -77,6 +77,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -474,6 +475,11 @@ static void run_one(cfg *L, int i, const opts *o) {
     t0 = now();
     rc = system(c->cmd);
     c->seconds = now() - t0;
+    if (rc != -1 && ((WIFSIGNALED(rc) && (WTERMSIG(rc) == SIGINT || WTERMSIG(rc) == SIGQUIT)) ||
+                     (WIFEXITED(rc) && WEXITSTATUS(rc) == 128 + SIGINT))) { /* ^C: stop the sweep */
+        fprintf(stderr, "\nbench_tradeoff: interrupted\n");
+        exit(130);
+    }
     c->ran = 1;
     c->completed = rc != -1 && WIFEXITED(rc) && WEXITSTATUS(rc) == 0;
     snprintf(path, sizeof path, "%s/biaxial.csv", dir);
