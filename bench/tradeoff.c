@@ -806,16 +806,18 @@ int main(int argc, char **argv) {
            "newton", "peak%", "sA%", "sB%", "ev_rms", "max%", "twin%");
     for (i = 0; i < n; ++i) {
         cfg *c = &L[i];
-        char b[6][32], refl[64] = "";
+        char b[6][32], refl[64] = "", nit[24] = "", nmpm[24] = ""; /* empty: not applicable */
         double ep = NAN, R = c->c.n > 1 ? peak_ratio(&c->c, &ep) : NAN;
         for (k = 0; k < n; ++k)
             if (L[k].is_ref && !strcmp(L[k].group, c->group)) snprintf(refl, sizeof refl, "%s", L[k].label);
-        fprintf(fp, "%s,%s,%s,%s,%d,%s,%s%d,%s,%s,%d,%d,%s,%d,%d,%s,%.3f,%ld,%ld,%.6g,%.6g,%.6g,%.6g,%g,%.6g,%g,%.6g,%.6g,"
+        if (c->newton >= 0) snprintf(nit, sizeof nit, "%ld", c->newton);
+        if (c->mpm_steps >= 0) snprintf(nmpm, sizeof nmpm, "%ld", c->mpm_steps);
+        fprintf(fp, "%s,%s,%s,%s,%d,%s,%s%d,%s,%s,%d,%d,%s,%d,%d,%s,%.3f,%s,%s,%.6g,%.6g,%.6g,%.6g,%g,%.6g,%g,%.6g,%.6g,"
                     "%.6g,%.6g,%.6g,%s,%s/runs/%s\n",
                 c->group, c->sweep, c->label, c->kind == K_SINGLE ? "single" : c->kind == K_BIAXIAL ? "biaxial" : "mpm",
                 c->disks ? c->disks : 400, c->packing, c->dem_steps ? "" : "adaptive", c->dem_steps,
                 c->use_float ? "float" : "double", c->tangent, c->nx, c->ny, c->kind == K_MPM ? "" : c->element, c->ppc,
-                o.threads, c->skipped ? "skipped" : c->completed ? "yes" : "no", c->seconds, c->newton, c->mpm_steps,
+                o.threads, c->skipped ? "skipped" : c->completed ? "yes" : "no", c->seconds, nit, nmpm,
                 c->c.n ? c->c.eps[c->c.n - 1] : NAN, R, ep, c->err_peak, c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_ev,
                 c->err_max, c->err_base, refl, o.out, c->same_as >= 0 ? L[c->same_as].id : c->id);
         fmt(b[0], 32, c->err_peak, 100, "%.2f");
@@ -842,6 +844,13 @@ int main(int argc, char **argv) {
     if (write_svg(path, L, n)) fprintf(stderr, "bench_tradeoff: cannot write %s\n", path);
     printf("wrote %s/tradeoff.csv and %s/tradeoff.svg (runs in %s/runs/); %.0f s in all\n", o.out, o.out, o.out,
            now() - t0);
-    for (i = 0; i < n; ++i) curve_free(&L[i].c);
-    return 0;
+    k = 0;
+    for (i = 0; i < n; ++i) {
+        if (L[i].is_ref && !L[i].completed) {
+            fprintf(stderr, "bench_tradeoff: reference run %s failed: no errors for its group\n", L[i].id);
+            k = 1;
+        }
+        curve_free(&L[i].c);
+    }
+    return k; /* a failed configuration is a result; a failed reference is not */
 }
