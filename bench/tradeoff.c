@@ -26,8 +26,9 @@
  *                   dem_steps 25 50 100 200 400 fixed steps per increment and the
  *                             adaptive rule, on 400 and 1600 disks [25 50 adaptive, 400 disks]
  *                   real      float build (femdem_biaxial_float), 400 and 1600 disks [400]
- *                   tangent   yade and perturbation (eq 8) vs taylor, 400 and 1600 disks
- *                             [yade, 400]
+ *                   tangent   yade, perturbation (eq 8), and perturbation with
+ *                             --tangent-reuse 0.1 (when the driver has it), vs taylor,
+ *                             400 and 1600 disks [yade, 400]
  *   biaxial  femdem_biaxial biaxial test, the authors' 400-disk RVE, 100 DEM
  *            steps per increment, to 10 % [short: not run].
  *            reference: the finest of the sweep, 4 x 8 Q8 (a mesh/element
@@ -105,6 +106,7 @@ typedef struct cfg {
     int dem_steps;    /* fixed steps per increment; 0: adaptive rule */
     int use_float;
     const char *tangent;
+    double reuse;     /* --tangent-reuse X (0: off) */
     int nx, ny;
     const char *element;
     int ppc;
@@ -123,7 +125,7 @@ typedef struct cfg {
 } cfg;
 
 typedef struct opts {
-    int full, threads, dry, has_dem_rule, steps;
+    int full, threads, dry, has_dem_rule, has_reuse, steps;
     const char *bin, *data, *out, *only;
 } opts;
 
@@ -305,10 +307,10 @@ static void set_packing(cfg *c, const opts *o, int disks) {
 }
 
 static void single(cfg *L, int *n, const opts *o, const char *sweep, int disks, int steps, int use_float,
-                   const char *tangent, int is_ref) {
+                   const char *tangent, double reuse, int is_ref) {
     cfg *c = add(L, n, "single", sweep, K_SINGLE);
     set_packing(c, o, disks);
-    c->dem_steps = steps, c->use_float = use_float, c->tangent = tangent, c->is_ref = is_ref;
+    c->dem_steps = steps, c->use_float = use_float, c->tangent = tangent, c->reuse = reuse, c->is_ref = is_ref;
     if (disks)
         snprintf(c->label, sizeof c->label, "%dd ", disks);
     else
@@ -319,6 +321,7 @@ static void single(cfg *L, int *n, const opts *o, const char *sweep, int disks, 
         snprintf(c->label + strlen(c->label), sizeof c->label - strlen(c->label), "adaptive");
     if (use_float) strcat(c->label, " float");
     if (strcmp(tangent, "taylor")) snprintf(c->label + strlen(c->label), sizeof c->label - strlen(c->label), " %s", tangent);
+    if (reuse > 0) snprintf(c->label + strlen(c->label), sizeof c->label - strlen(c->label), " reuse%g", reuse);
 }
 
 static int wanted(const opts *o, const char *group, const char *sweep) {
@@ -345,22 +348,23 @@ static int build_list(cfg *L, const opts *o) {
     if (wanted(o, "single", "rve_size") || wanted(o, "single", "dem_steps") || wanted(o, "single", "real") ||
         wanted(o, "single", "tangent")) {
         if (o->full)
-            single(L, &n, o, "reference", 1600, 400, 0, "taylor", 1);
+            single(L, &n, o, "reference", 1600, 400, 0, "taylor", 0, 1);
         else
-            single(L, &n, o, "reference", 800, 200, 0, "taylor", 1);
+            single(L, &n, o, "reference", 800, 200, 0, "taylor", 0, 1);
         if (wanted(o, "single", "rve_size")) {
-            for (k = 0; k < nsz; ++k) single(L, &n, o, "rve_size", sz[k], 100, 0, "taylor", 0);
-            if (o->full) single(L, &n, o, "rve_size", 0, 100, 0, "taylor", 0);
+            for (k = 0; k < nsz; ++k) single(L, &n, o, "rve_size", sz[k], 100, 0, "taylor", 0, 0);
+            if (o->full) single(L, &n, o, "rve_size", 0, 100, 0, "taylor", 0, 0);
         }
         if (wanted(o, "single", "dem_steps"))
             for (j = 0; j < ndk; ++j)
-                for (k = 0; k < nst; ++k) single(L, &n, o, "dem_steps", dk[j], st[k], 0, "taylor", 0);
+                for (k = 0; k < nst; ++k) single(L, &n, o, "dem_steps", dk[j], st[k], 0, "taylor", 0, 0);
         if (wanted(o, "single", "real"))
-            for (j = 0; j < ndk; ++j) single(L, &n, o, "real", dk[j], 100, 1, "taylor", 0);
+            for (j = 0; j < ndk; ++j) single(L, &n, o, "real", dk[j], 100, 1, "taylor", 0, 0);
         if (wanted(o, "single", "tangent"))
             for (j = 0; j < ndk; ++j) {
-                single(L, &n, o, "tangent", dk[j], 100, 0, "yade", 0);
-                if (o->full) single(L, &n, o, "tangent", dk[j], 100, 0, "perturbation", 0);
+                single(L, &n, o, "tangent", dk[j], 100, 0, "yade", 0, 0);
+                if (o->full) single(L, &n, o, "tangent", dk[j], 100, 0, "perturbation", 0, 0);
+                if (o->full) single(L, &n, o, "tangent", dk[j], 100, 0, "perturbation", 0.1, 0);
             }
     }
     if ((o->full || o->only) && wanted(o, "biaxial", "mesh")) { /* short: only when asked */
@@ -411,6 +415,8 @@ static int make_cmd(cfg *c, const opts *o, const char *dir) {
                      o->has_dem_rule ? "--dem-rule strain " : "", S, c->dem_steps, c->dem_steps);
     } else
         w = snprintf(dem, sizeof dem, "--dem-rule adaptive");
+    if (c->reuse > 0)
+        snprintf(dem + strlen(dem), sizeof dem - strlen(dem), " --tangent-reuse %g", c->reuse);
     w = snprintf(c->cmd, sizeof c->cmd,
              "%s/%s --test %s --nx %d --ny %d --element %s --steps %d --threads %d --tangent %s --packing %s %s "
              "--vtk-every 0 --checkpoint 1000000 --out %s > %s/log.txt 2>&1",
@@ -448,9 +454,14 @@ static void run_one(cfg *L, int i, const opts *o) {
         printf("skip %-34s %s/femdem_biaxial has no --dem-rule (adaptive rule not there yet)\n", c->id, o->bin);
         return;
     }
+    if (c->reuse > 0 && !o->has_reuse) {
+        c->skipped = 1;
+        printf("skip %-34s %s/femdem_biaxial has no --tangent-reuse\n", c->id, o->bin);
+        return;
+    }
     for (k = 0; k < i; ++k) /* same command line (up to the directory): reuse that run */
         if (L[k].ran && !strcmp(L[k].packing, c->packing) && L[k].kind == c->kind && L[k].dem_steps == c->dem_steps &&
-            L[k].use_float == c->use_float && !strcmp(L[k].tangent, c->tangent) && L[k].nx == c->nx &&
+            L[k].use_float == c->use_float && !strcmp(L[k].tangent, c->tangent) && L[k].reuse == c->reuse && L[k].nx == c->nx &&
             L[k].ny == c->ny && !strcmp(L[k].element, c->element) && L[k].ppc == c->ppc && L[k].steps == c->steps &&
             L[k].strain == c->strain) {
             c->same_as = k;
@@ -632,7 +643,7 @@ static int write_svg(const char *path, cfg *L, int n) {
     fprintf(fp, "<text x='900' y='%.1f' font-weight='bold'>rows</text>\n", ky);
     for (k = 0, j = 0; k < n; ++k) {
         const cfg *c = &L[k];
-        double x = j < 34 ? 900 : 1040, y = y0 + 26 + 15 * (j < 34 ? j : j - 34);
+        double x = j < 36 ? 900 : 1040, y = y0 + 26 + 15 * (j < 36 ? j : j - 36);
         const char *state = c->skipped ? " (skipped)" : !c->ran ? " (not run)" : c->same_as >= 0 ? " (=row)"
                             : !c->completed ? " (FAILED)" : c->is_ref ? " REF" : !(c->err_max > 0) ? " (NaN)" : "";
         fprintf(fp, "<text x='%.0f' y='%.1f' font-size='10'>%d %s %s%s</text>\n", x, y, k,
@@ -756,8 +767,10 @@ int main(int argc, char **argv) {
         snprintf(path, sizeof path, "%s/femdem_biaxial --help 2>&1", o.bin);
         fp = popen(path, "r");
         if (fp) {
-            while (fgets(line, sizeof line, fp))
+            while (fgets(line, sizeof line, fp)) {
                 if (strstr(line, "--dem-rule")) o.has_dem_rule = 1;
+                if (strstr(line, "--tangent-reuse")) o.has_reuse = 1;
+            }
             pclose(fp);
         }
     }
@@ -786,7 +799,7 @@ int main(int argc, char **argv) {
         if (L[i].kind != K_SINGLE || !L[i].ran || L[i].c.n < 2) continue;
         for (k = 0; k < n; ++k)
             if (L[k].kind == K_SINGLE && L[k].ran && L[k].c.n > 1 && !strcmp(L[k].packing, L[i].packing) &&
-                L[k].dem_steps == 100 && !L[k].use_float && !strcmp(L[k].tangent, "taylor")) {
+                L[k].dem_steps == 100 && !L[k].use_float && !strcmp(L[k].tangent, "taylor") && L[k].reuse == 0) {
                 cfg tmp = L[i];
                 compute_errors(&tmp, &L[k]);
                 L[i].err_base = k == i || L[k].c.eps == L[i].c.eps ? 0.0 : tmp.err_max;
@@ -799,10 +812,10 @@ int main(int argc, char **argv) {
         fprintf(stderr, "bench_tradeoff: cannot write %s\n", path);
         return 1;
     }
-    fprintf(fp, "group,sweep,config,test,disks,packing,dem_steps_per_increment,real,tangent,nx,ny,element,ppc,threads,"
+    fprintf(fp, "group,sweep,config,test,disks,packing,dem_steps_per_increment,real,tangent,tangent_reuse,nx,ny,element,ppc,threads,"
                 "completed,seconds,newton_iterations,mpm_steps,end_strain,peak_ratio,eps_at_peak,err_peak,eps_a,err_sa,"
                 "eps_b,err_sb,ev_rms,err_ev,err_max,err_max_vs_100_steps_double_taylor_same_rve,reference,run_dir\n");
-    printf("\n%-8s %-10s %-26s %3s %8s %7s %8s %8s %8s %9s %8s %8s\n", "group", "sweep", "config", "ok", "seconds",
+    printf("\n%-8s %-10s %-34s %3s %8s %7s %8s %8s %8s %9s %8s %8s\n", "group", "sweep", "config", "ok", "seconds",
            "newton", "peak%", "sA%", "sB%", "ev_rms", "max%", "twin%");
     for (i = 0; i < n; ++i) {
         cfg *c = &L[i];
@@ -812,11 +825,11 @@ int main(int argc, char **argv) {
             if (L[k].is_ref && !strcmp(L[k].group, c->group)) snprintf(refl, sizeof refl, "%s", L[k].label);
         if (c->newton >= 0) snprintf(nit, sizeof nit, "%ld", c->newton);
         if (c->mpm_steps >= 0) snprintf(nmpm, sizeof nmpm, "%ld", c->mpm_steps);
-        fprintf(fp, "%s,%s,%s,%s,%d,%s,%s%d,%s,%s,%d,%d,%s,%d,%d,%s,%.3f,%s,%s,%.6g,%.6g,%.6g,%.6g,%g,%.6g,%g,%.6g,%.6g,"
+        fprintf(fp, "%s,%s,%s,%s,%d,%s,%s%d,%s,%s,%g,%d,%d,%s,%d,%d,%s,%.3f,%s,%s,%.6g,%.6g,%.6g,%.6g,%g,%.6g,%g,%.6g,%.6g,"
                     "%.6g,%.6g,%.6g,%s,%s/runs/%s\n",
                 c->group, c->sweep, c->label, c->kind == K_SINGLE ? "single" : c->kind == K_BIAXIAL ? "biaxial" : "mpm",
                 c->disks ? c->disks : 400, c->packing, c->dem_steps ? "" : "adaptive", c->dem_steps,
-                c->use_float ? "float" : "double", c->tangent, c->nx, c->ny, c->kind == K_MPM ? "" : c->element, c->ppc,
+                c->use_float ? "float" : "double", c->tangent, c->reuse, c->nx, c->ny, c->kind == K_MPM ? "" : c->element, c->ppc,
                 o.threads, c->skipped ? "skipped" : c->completed ? "yes" : "no", c->seconds, nit, nmpm,
                 c->c.n ? c->c.eps[c->c.n - 1] : NAN, R, ep, c->err_peak, c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_ev,
                 c->err_max, c->err_base, refl, o.out, c->same_as >= 0 ? L[c->same_as].id : c->id);
@@ -826,7 +839,7 @@ int main(int argc, char **argv) {
         fmt(b[3], 32, c->ev_rms, 1, "%.2e");
         fmt(b[4], 32, c->err_max, 100, "%.2f");
         fmt(b[5], 32, c->err_base, 100, "%.2f");
-        printf("%-8s %-10s %-26s %3s %8.1f %7ld %8s %8s %8s %9s %8s %8s%s\n", c->group, c->sweep, c->label,
+        printf("%-8s %-10s %-34s %3s %8.1f %7ld %8s %8s %8s %9s %8s %8s%s\n", c->group, c->sweep, c->label,
                c->skipped ? "skp" : c->completed ? "yes" : "NO", c->seconds, c->newton, b[0], b[1], b[2], b[3], b[4], b[5],
                c->is_ref ? "  (reference)" : c->same_as >= 0 ? "  (same run as above)" : "");
     }
