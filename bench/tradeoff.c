@@ -102,16 +102,16 @@ typedef struct cfg {
     char label[64], id[48];
     kind_t kind;
     char packing[256];
-    int disks;        /* 0: the authors' rve400.txt */
-    int dem_steps;    /* fixed steps per increment; 0: adaptive rule */
+    int disks;     /* 0: the authors' rve400.txt */
+    int dem_steps; /* fixed steps per increment; 0: adaptive rule */
     int use_float;
     const char *tangent;
-    double reuse;     /* --tangent-reuse X (0: off) */
+    double reuse; /* --tangent-reuse X (0: off) */
     int nx, ny;
     const char *element;
     int ppc;
-    int steps;        /* FEM load steps */
-    double strain;    /* MPM final strain */
+    int steps;     /* FEM load steps */
+    double strain; /* MPM final strain */
     int is_ref;
     char cmd[4096];
     /* results */
@@ -279,7 +279,10 @@ static void compute_errors(cfg *r, const cfg *ref) {
         double e[4];
         e[0] = r->err_peak, e[1] = r->err_sa, e[2] = r->err_sb, e[3] = r->err_ev;
         r->err_max = 0.0;
-        for (k = 0; k < 4; ++k) r->err_max = e[k] != e[k] || r->err_max != r->err_max ? NAN : e[k] > r->err_max ? e[k] : r->err_max;
+        for (k = 0; k < 4; ++k)
+            r->err_max = e[k] != e[k] || r->err_max != r->err_max ? NAN
+                         : e[k] > r->err_max                      ? e[k]
+                                                                  : r->err_max;
     }
 }
 
@@ -310,7 +313,8 @@ static void single(cfg *L, int *n, const opts *o, const char *sweep, int disks, 
                    const char *tangent, double reuse, int is_ref) {
     cfg *c = add(L, n, "single", sweep, K_SINGLE);
     set_packing(c, o, disks);
-    c->dem_steps = steps, c->use_float = use_float, c->tangent = tangent, c->reuse = reuse, c->is_ref = is_ref;
+    c->dem_steps = steps, c->use_float = use_float, c->tangent = tangent, c->reuse = reuse,
+    c->is_ref = is_ref;
     if (disks)
         snprintf(c->label, sizeof c->label, "%dd ", disks);
     else
@@ -320,8 +324,10 @@ static void single(cfg *L, int *n, const opts *o, const char *sweep, int disks, 
     else
         snprintf(c->label + strlen(c->label), sizeof c->label - strlen(c->label), "adaptive");
     if (use_float) strcat(c->label, " float");
-    if (strcmp(tangent, "taylor")) snprintf(c->label + strlen(c->label), sizeof c->label - strlen(c->label), " %s", tangent);
-    if (reuse > 0) snprintf(c->label + strlen(c->label), sizeof c->label - strlen(c->label), " reuse%g", reuse);
+    if (strcmp(tangent, "taylor"))
+        snprintf(c->label + strlen(c->label), sizeof c->label - strlen(c->label), " %s", tangent);
+    if (reuse > 0)
+        snprintf(c->label + strlen(c->label), sizeof c->label - strlen(c->label), " reuse%g", reuse);
 }
 
 static int wanted(const opts *o, const char *group, const char *sweep) {
@@ -392,7 +398,8 @@ static int build_list(cfg *L, const opts *o) {
     for (k = 0; k < n; ++k) {
         snprintf(L[k].id, sizeof L[k].id, "%02d_%s_%s", k, L[k].group, L[k].sweep);
         if (o->steps && L[k].kind != K_MPM) L[k].steps = o->steps;
-        if (o->steps && L[k].kind == K_MPM && INC * (o->steps + 0.5) < L[k].strain) L[k].strain = INC * (o->steps + 0.5);
+        if (o->steps && L[k].kind == K_MPM && INC * (o->steps + 0.5) < L[k].strain)
+            L[k].strain = INC * (o->steps + 0.5);
     }
     return n;
 }
@@ -401,10 +408,11 @@ static int make_cmd(cfg *c, const opts *o, const char *dir) {
     char dem[160] = "";
     int w = 0;
     if (c->kind == K_MPM) {
-        w = snprintf(c->cmd, sizeof c->cmd,
-                 "%s/mpmdem_biaxial --nx %d --ny %d --ppc %d --strain %g --threads %d --packing %s --quiet "
-                 "--out %s > %s/log.txt 2>&1",
-                 o->bin, c->nx, c->ny, c->ppc, c->strain, o->threads, c->packing, dir, dir);
+        w = snprintf(
+            c->cmd, sizeof c->cmd,
+            "%s/mpmdem_biaxial --nx %d --ny %d --ppc %d --strain %g --threads %d --packing %s --quiet "
+            "--out %s > %s/log.txt 2>&1",
+            o->bin, c->nx, c->ny, c->ppc, c->strain, o->threads, c->packing, dir, dir);
         return w < 0 || w >= (int)sizeof c->cmd;
     }
     if (c->dem_steps > 0) {
@@ -415,14 +423,14 @@ static int make_cmd(cfg *c, const opts *o, const char *dir) {
                      o->has_dem_rule ? "--dem-rule strain " : "", S, c->dem_steps, c->dem_steps);
     } else
         w = snprintf(dem, sizeof dem, "--dem-rule adaptive");
-    if (c->reuse > 0)
-        snprintf(dem + strlen(dem), sizeof dem - strlen(dem), " --tangent-reuse %g", c->reuse);
-    w = snprintf(c->cmd, sizeof c->cmd,
-             "%s/%s --test %s --nx %d --ny %d --element %s --steps %d --threads %d --tangent %s --packing %s %s "
-             "--vtk-every 0 --checkpoint 1000000 --out %s > %s/log.txt 2>&1",
-             o->bin, c->use_float ? "femdem_biaxial_float" : "femdem_biaxial",
-             c->kind == K_SINGLE ? "single" : "biaxial", c->nx, c->ny, c->element, c->steps, o->threads, c->tangent,
-             c->packing, dem, dir, dir);
+    if (c->reuse > 0) snprintf(dem + strlen(dem), sizeof dem - strlen(dem), " --tangent-reuse %g", c->reuse);
+    w = snprintf(
+        c->cmd, sizeof c->cmd,
+        "%s/%s --test %s --nx %d --ny %d --element %s --steps %d --threads %d --tangent %s --packing %s %s "
+        "--vtk-every 0 --checkpoint 1000000 --out %s > %s/log.txt 2>&1",
+        o->bin, c->use_float ? "femdem_biaxial_float" : "femdem_biaxial",
+        c->kind == K_SINGLE ? "single" : "biaxial", c->nx, c->ny, c->element, c->steps, o->threads,
+        c->tangent, c->packing, dem, dir, dir);
     return w < 0 || w >= (int)sizeof c->cmd;
 }
 
@@ -451,7 +459,8 @@ static void run_one(cfg *L, int i, const opts *o) {
     c->newton = -1, c->mpm_steps = -1;
     if (c->kind != K_MPM && c->dem_steps == 0 && !o->has_dem_rule) {
         c->skipped = 1;
-        printf("skip %-34s %s/femdem_biaxial has no --dem-rule (adaptive rule not there yet)\n", c->id, o->bin);
+        printf("skip %-34s %s/femdem_biaxial has no --dem-rule (adaptive rule not there yet)\n", c->id,
+               o->bin);
         return;
     }
     if (c->reuse > 0 && !o->has_reuse) {
@@ -460,10 +469,11 @@ static void run_one(cfg *L, int i, const opts *o) {
         return;
     }
     for (k = 0; k < i; ++k) /* same command line (up to the directory): reuse that run */
-        if (L[k].ran && !strcmp(L[k].packing, c->packing) && L[k].kind == c->kind && L[k].dem_steps == c->dem_steps &&
-            L[k].use_float == c->use_float && !strcmp(L[k].tangent, c->tangent) && L[k].reuse == c->reuse && L[k].nx == c->nx &&
-            L[k].ny == c->ny && !strcmp(L[k].element, c->element) && L[k].ppc == c->ppc && L[k].steps == c->steps &&
-            L[k].strain == c->strain) {
+        if (L[k].ran && !strcmp(L[k].packing, c->packing) && L[k].kind == c->kind &&
+            L[k].dem_steps == c->dem_steps && L[k].use_float == c->use_float &&
+            !strcmp(L[k].tangent, c->tangent) && L[k].reuse == c->reuse && L[k].nx == c->nx &&
+            L[k].ny == c->ny && !strcmp(L[k].element, c->element) && L[k].ppc == c->ppc &&
+            L[k].steps == c->steps && L[k].strain == c->strain) {
             c->same_as = k;
             c->ran = 1, c->completed = L[k].completed, c->seconds = L[k].seconds, c->newton = L[k].newton;
             c->mpm_steps = L[k].mpm_steps;
@@ -524,8 +534,8 @@ static void marker(FILE *fp, kind_t k, double x, double y, const char *col) {
     if (k == K_SINGLE)
         fprintf(fp, "<circle cx='%.1f' cy='%.1f' r='4.5' fill='%s' fill-opacity='0.8'/>\n", x, y, col);
     else if (k == K_BIAXIAL)
-        fprintf(fp, "<rect x='%.1f' y='%.1f' width='9' height='9' fill='%s' fill-opacity='0.8'/>\n", x - 4.5, y - 4.5,
-                col);
+        fprintf(fp, "<rect x='%.1f' y='%.1f' width='9' height='9' fill='%s' fill-opacity='0.8'/>\n", x - 4.5,
+                y - 4.5, col);
     else
         fprintf(fp, "<path d='M%.1f %.1f l5 9 h-10 z' fill='%s' fill-opacity='0.8'/>\n", x, y - 5.5, col);
 }
@@ -540,7 +550,8 @@ static int write_svg(const char *path, cfg *L, int n) {
     if (!fp) return -1;
     for (k = 0; k < n; ++k)
         if (L[k].ran && L[k].seconds > 0) {
-            double lx = log10(L[k].seconds), ly = !L[k].is_ref && L[k].err_max > 0 ? log10(L[k].err_max) : NAN;
+            double lx = log10(L[k].seconds),
+                   ly = !L[k].is_ref && L[k].err_max > 0 ? log10(L[k].err_max) : NAN;
             if (lx < lx0) lx0 = lx;
             if (lx > lx1) lx1 = lx;
             if (ly == ly && ly < ly0) ly0 = ly;
@@ -551,17 +562,23 @@ static int write_svg(const char *path, cfg *L, int n) {
     lx0 = floor(lx0), lx1 = ceil(lx1 + 1e-9), ly0 = floor(ly0 - 0.3), ly1 = ceil(ly1 + 1e-9);
 #define PX(v) (x0 + (log10(v) - lx0) / (lx1 - lx0) * (x1 - x0))
 #define PY(v) (y1 - (log10(v) - ly0) / (ly1 - ly0) * (y1 - y0))
-    fprintf(fp, "<svg xmlns='http://www.w3.org/2000/svg' width='%g' height='%g' font-family='sans-serif' font-size='12'>\n",
+    fprintf(fp,
+            "<svg xmlns='http://www.w3.org/2000/svg' width='%g' height='%g' font-family='sans-serif' "
+            "font-size='12'>\n",
             W, H);
     fprintf(fp, "<rect width='100%%' height='100%%' fill='white'/>\n");
-    fprintf(fp, "<text x='%g' y='25' font-size='15' text-anchor='middle'>grainkit trade-off: error against wall time "
-                "(each group against its own reference)</text>\n", (x0 + x1) / 2);
+    fprintf(
+        fp,
+        "<text x='%g' y='25' font-size='15' text-anchor='middle'>grainkit trade-off: error against wall time "
+        "(each group against its own reference)</text>\n",
+        (x0 + x1) / 2);
     for (d = lx0; d <= lx1 + 1e-9; d += 1) { /* decades, with 2 and 5 in between */
         int m;
         for (m = 1; m <= 5; m += m == 1 ? 1 : 3) {
             double v = log10(m) + d, x = x0 + (v - lx0) / (lx1 - lx0) * (x1 - x0);
             if (v > lx1 + 1e-9) break;
-            fprintf(fp, "<line x1='%.1f' y1='%g' x2='%.1f' y2='%g' stroke='%s'/>\n", x, y0, x, y1, m == 1 ? "#ccc" : "#eee");
+            fprintf(fp, "<line x1='%.1f' y1='%g' x2='%.1f' y2='%g' stroke='%s'/>\n", x, y0, x, y1,
+                    m == 1 ? "#ccc" : "#eee");
             fprintf(fp, "<text x='%.1f' y='%g' text-anchor='middle'>%g</text>\n", x, y1 + 16, pow(10, v));
         }
     }
@@ -570,25 +587,35 @@ static int write_svg(const char *path, cfg *L, int n) {
         for (m = 1; m <= 5; m += m == 1 ? 1 : 3) {
             double v = log10(m) + d, y = y1 - (v - ly0) / (ly1 - ly0) * (y1 - y0);
             if (v > ly1 + 1e-9) break;
-            fprintf(fp, "<line x1='%g' y1='%.1f' x2='%g' y2='%.1f' stroke='%s'/>\n", x0, y, x1, y, m == 1 ? "#ccc" : "#eee");
-            fprintf(fp, "<text x='%g' y='%.1f' text-anchor='end'>%g %%</text>\n", x0 - 5, y + 4, 100 * pow(10, v));
+            fprintf(fp, "<line x1='%g' y1='%.1f' x2='%g' y2='%.1f' stroke='%s'/>\n", x0, y, x1, y,
+                    m == 1 ? "#ccc" : "#eee");
+            fprintf(fp, "<text x='%g' y='%.1f' text-anchor='end'>%g %%</text>\n", x0 - 5, y + 4,
+                    100 * pow(10, v));
         }
     }
-    fprintf(fp, "<rect x='%g' y='%g' width='%g' height='%g' fill='none' stroke='black'/>\n", x0, y0, x1 - x0, y1 - y0);
-    fprintf(fp, "<text x='%g' y='%g' text-anchor='middle'>wall seconds per run (2 cores, one run each)</text>\n",
+    fprintf(fp, "<rect x='%g' y='%g' width='%g' height='%g' fill='none' stroke='black'/>\n", x0, y0, x1 - x0,
+            y1 - y0);
+    fprintf(fp,
+            "<text x='%g' y='%g' text-anchor='middle'>wall seconds per run (2 cores, one run each)</text>\n",
             (x0 + x1) / 2, y1 + 36);
-    fprintf(fp, "<text transform='translate(22 %g) rotate(-90)' text-anchor='middle'>err_max: largest relative error "
-                "of peak ratio, sigma_yy at eps_a and eps_b, eps_v</text>\n", (y0 + y1) / 2);
-    fprintf(fp, "<text x='%g' y='%g' font-size='10' fill='#555'>numbers: run ids (table order, build/tradeoff/runs/NN_*); references "
-                "on the bottom edge; single runs of chaotic DEM: differences of a few %% after the peak are noise</text>\n",
+    fprintf(
+        fp,
+        "<text transform='translate(22 %g) rotate(-90)' text-anchor='middle'>err_max: largest relative error "
+        "of peak ratio, sigma_yy at eps_a and eps_b, eps_v</text>\n",
+        (y0 + y1) / 2);
+    fprintf(fp,
+            "<text x='%g' y='%g' font-size='10' fill='#555'>numbers: run ids (table order, "
+            "build/tradeoff/runs/NN_*); references "
+            "on the bottom edge; single runs of chaotic DEM: differences of a few %% after the peak are "
+            "noise</text>\n",
             x0, y1 + 56);
     /* Pareto front per group: points no cheaper point beats */
     for (j = 0; j < 3; ++j) {
         int idx[MAXCFG], m = 0, a, b;
         double best = 1e300;
         for (k = 0; k < n; ++k)
-            if (!strcmp(L[k].group, groups[j]) && L[k].ran && L[k].completed && !L[k].is_ref && L[k].err_max > 0 &&
-                L[k].same_as < 0)
+            if (!strcmp(L[k].group, groups[j]) && L[k].ran && L[k].completed && !L[k].is_ref &&
+                L[k].err_max > 0 && L[k].same_as < 0)
                 idx[m++] = k;
         for (a = 1; a < m; ++a)
             for (b = a; b > 0 && L[idx[b]].seconds < L[idx[b - 1]].seconds; --b) {
@@ -624,7 +651,8 @@ static int write_svg(const char *path, cfg *L, int n) {
     fprintf(fp, "<text x='700' y='%.1f' font-weight='bold'>sweep</text>\n", ky);
     for (j = 0; j < 6; ++j) {
         ky += 17;
-        fprintf(fp, "<rect x='700' y='%.1f' width='11' height='11' fill='%s'/><text x='716' y='%.1f'>%s</text>\n",
+        fprintf(fp,
+                "<rect x='700' y='%.1f' width='11' height='11' fill='%s'/><text x='716' y='%.1f'>%s</text>\n",
                 ky - 10, sweep_color(sweeps[j]), ky, sweeps[j]);
     }
     ky += 26;
@@ -636,18 +664,28 @@ static int write_svg(const char *path, cfg *L, int n) {
     ky += 17, marker(fp, K_MPM, 706, ky - 4, "#777");
     fprintf(fp, "<text x='716' y='%.1f'>MPMxDEM biaxial</text>\n", ky);
     ky += 26;
-    fprintf(fp, "<line x1='700' y1='%.1f' x2='730' y2='%.1f' stroke='#555' stroke-dasharray='5,4'/>"
-                "<text x='736' y='%.1f'>Pareto front of each group (%d)</text>\n", ky - 4, ky - 4, ky, ng);
+    fprintf(fp,
+            "<line x1='700' y1='%.1f' x2='730' y2='%.1f' stroke='#555' stroke-dasharray='5,4'/>"
+            "<text x='736' y='%.1f'>Pareto front of each group (%d)</text>\n",
+            ky - 4, ky - 4, ky, ng);
     /* key: row number, group, configuration; two columns */
     ky = y0 + 10;
     fprintf(fp, "<text x='900' y='%.1f' font-weight='bold'>rows</text>\n", ky);
     for (k = 0, j = 0; k < n; ++k) {
         const cfg *c = &L[k];
         double x = j < 36 ? 900 : 1040, y = y0 + 26 + 15 * (j < 36 ? j : j - 36);
-        const char *state = c->skipped ? " (skipped)" : !c->ran ? " (not run)" : c->same_as >= 0 ? " (=row)"
-                            : !c->completed ? " (FAILED)" : c->is_ref ? " REF" : !(c->err_max > 0) ? " (NaN)" : "";
+        const char *state = c->skipped          ? " (skipped)"
+                            : !c->ran           ? " (not run)"
+                            : c->same_as >= 0   ? " (=row)"
+                            : !c->completed     ? " (FAILED)"
+                            : c->is_ref         ? " REF"
+                            : !(c->err_max > 0) ? " (NaN)"
+                                                : "";
         fprintf(fp, "<text x='%.0f' y='%.1f' font-size='10'>%d %s %s%s</text>\n", x, y, k,
-                c->kind == K_SINGLE ? "S" : c->kind == K_BIAXIAL ? "B" : "M", c->label, state);
+                c->kind == K_SINGLE    ? "S"
+                : c->kind == K_BIAXIAL ? "B"
+                                       : "M",
+                c->label, state);
         ++j;
     }
     fprintf(fp, "</svg>\n");
@@ -657,20 +695,21 @@ static int write_svg(const char *path, cfg *L, int n) {
 }
 
 static void usage(FILE *fp) {
-    fprintf(fp,
-            "usage: bench_tradeoff [--full] [--threads T] [--bin DIR] [--data DIR] [--out DIR]\n"
-            "                      [--sweep NAME,...] [--steps N] [--dry-run]\n"
-            "  (no option)     short version: the single-element group, about a minute on 2 cores (make bench)\n"
-            "  --full          the whole sweep of issue 6 (make tradeoff), about 10-15 minutes on 2 idle cores\n"
-            "  --threads T     threads given to every driver run (2)\n"
-            "  --bin DIR       where the driver binaries are (build)\n"
-            "  --data DIR      packings rveN.txt of the RVE-size series (bench/data/tradeoff)\n"
-            "  --out DIR       output directory (build/tradeoff)\n"
-            "  --sweep LIST    only these groups or sweeps: single, biaxial, mpm, rve_size, dem_steps,\n"
-            "                  real, tangent, mesh, mpm_ppc (a group's reference always runs)\n"
-            "  --steps N       quick check of the machinery: every run stops at N x 0.1 %% strain\n"
-            "                  (metrics past that are NaN; default 100 = 10 %%)\n"
-            "  --dry-run       print the command lines, run nothing\n");
+    fprintf(
+        fp,
+        "usage: bench_tradeoff [--full] [--threads T] [--bin DIR] [--data DIR] [--out DIR]\n"
+        "                      [--sweep NAME,...] [--steps N] [--dry-run]\n"
+        "  (no option)     short version: the single-element group, about a minute on 2 cores (make bench)\n"
+        "  --full          the whole sweep of issue 6 (make tradeoff), about 10-15 minutes on 2 idle cores\n"
+        "  --threads T     threads given to every driver run (2)\n"
+        "  --bin DIR       where the driver binaries are (build)\n"
+        "  --data DIR      packings rveN.txt of the RVE-size series (bench/data/tradeoff)\n"
+        "  --out DIR       output directory (build/tradeoff)\n"
+        "  --sweep LIST    only these groups or sweeps: single, biaxial, mpm, rve_size, dem_steps,\n"
+        "                  real, tangent, mesh, mpm_ppc (a group's reference always runs)\n"
+        "  --steps N       quick check of the machinery: every run stops at N x 0.1 %% strain\n"
+        "                  (metrics past that are NaN; default 100 = 10 %%)\n"
+        "  --dry-run       print the command lines, run nothing\n");
 }
 
 int main(int argc, char **argv) {
@@ -691,8 +730,8 @@ int main(int argc, char **argv) {
             o.full = 1;
         else if (!strcmp(a, "--dry-run"))
             o.dry = 1;
-        else if (!strcmp(a, "--threads") || !strcmp(a, "--bin") || !strcmp(a, "--data") || !strcmp(a, "--out") ||
-                 !strcmp(a, "--sweep") || !strcmp(a, "--steps")) {
+        else if (!strcmp(a, "--threads") || !strcmp(a, "--bin") || !strcmp(a, "--data") ||
+                 !strcmp(a, "--out") || !strcmp(a, "--sweep") || !strcmp(a, "--steps")) {
             if (!v) {
                 fprintf(stderr, "bench_tradeoff: %s needs a value\n", a);
                 return 2;
@@ -701,7 +740,8 @@ int main(int argc, char **argv) {
                 char *end;
                 long t = strtol(v, &end, 10);
                 if (*end || t < 1 || t > 256) {
-                    fprintf(stderr, "bench_tradeoff: --threads must be an integer in [1, 256], got '%s'\n", v);
+                    fprintf(stderr, "bench_tradeoff: --threads must be an integer in [1, 256], got '%s'\n",
+                            v);
                     return 2;
                 }
                 o.threads = (int)t;
@@ -720,7 +760,8 @@ int main(int argc, char **argv) {
             else if (!strcmp(a, "--out"))
                 o.out = v;
             else {
-                const char *names = ",single,biaxial,mpm,rve_size,dem_steps,real,tangent,mesh,mpm_ppc,", *p = v;
+                const char *names = ",single,biaxial,mpm,rve_size,dem_steps,real,tangent,mesh,mpm_ppc,",
+                           *p = v;
                 while (*p) {
                     size_t l = strcspn(p, ",");
                     char buf[64];
@@ -750,14 +791,17 @@ int main(int argc, char **argv) {
         for (k = 0; k < 3; ++k) {
             snprintf(path, sizeof path, "%s/%s", o.bin, need[k]);
             if (!file_exists(path)) {
-                fprintf(stderr, "bench_tradeoff: %s not found (make %s; run from the repository root)\n", path, path);
+                fprintf(stderr, "bench_tradeoff: %s not found (make %s; run from the repository root)\n",
+                        path, path);
                 return 1;
             }
         }
         snprintf(path, sizeof path, "%s/rve100.txt", o.data);
         if (!file_exists(path) || !file_exists("examples/data/rve400.txt")) {
-            fprintf(stderr, "bench_tradeoff: packings not found (%s, examples/data/rve400.txt); run from the "
-                            "repository root or give --data\n", path);
+            fprintf(stderr,
+                    "bench_tradeoff: packings not found (%s, examples/data/rve400.txt); run from the "
+                    "repository root or give --data\n",
+                    path);
             return 1;
         }
     }
@@ -775,8 +819,9 @@ int main(int argc, char **argv) {
         }
     }
     n = build_list(L, &o);
-    printf("bench_tradeoff: %s version, %d configurations, %d threads per run; femdem_biaxial %s --dem-rule\n",
-           o.full ? "full" : "short", n, o.threads, o.has_dem_rule ? "has" : "has no");
+    printf(
+        "bench_tradeoff: %s version, %d configurations, %d threads per run; femdem_biaxial %s --dem-rule\n",
+        o.full ? "full" : "short", n, o.threads, o.has_dem_rule ? "has" : "has no");
     if (!o.dry && mkdirs(o.out)) {
         fprintf(stderr, "bench_tradeoff: cannot create %s\n", o.out);
         return 1;
@@ -789,7 +834,8 @@ int main(int argc, char **argv) {
         for (k = 0; k < n; ++k)
             if (L[k].is_ref && !strcmp(L[k].group, L[i].group)) ref = k;
         L[i].err_peak = L[i].err_sa = L[i].err_sb = L[i].ev_rms = L[i].err_ev = L[i].err_max = NAN;
-        if (ref >= 0 && L[ref].ran && L[ref].c.n > 1 && L[i].ran && L[i].c.n > 1) compute_errors(&L[i], &L[ref]);
+        if (ref >= 0 && L[ref].ran && L[ref].c.n > 1 && L[i].ran && L[i].c.n > 1)
+            compute_errors(&L[i], &L[ref]);
         if (L[i].is_ref && L[i].ran && L[i].c.n > 1) /* exactly zero, not an interpolation round-off */
             L[i].err_peak = L[i].err_sa = L[i].err_sb = L[i].ev_rms = L[i].err_ev = L[i].err_max = 0.0;
     }
@@ -799,7 +845,8 @@ int main(int argc, char **argv) {
         if (L[i].kind != K_SINGLE || !L[i].ran || L[i].c.n < 2) continue;
         for (k = 0; k < n; ++k)
             if (L[k].kind == K_SINGLE && L[k].ran && L[k].c.n > 1 && !strcmp(L[k].packing, L[i].packing) &&
-                L[k].dem_steps == 100 && !L[k].use_float && !strcmp(L[k].tangent, "taylor") && L[k].reuse == 0) {
+                L[k].dem_steps == 100 && !L[k].use_float && !strcmp(L[k].tangent, "taylor") &&
+                L[k].reuse == 0) {
                 cfg tmp = L[i];
                 compute_errors(&tmp, &L[k]);
                 L[i].err_base = k == i || L[k].c.eps == L[i].c.eps ? 0.0 : tmp.err_max;
@@ -812,11 +859,15 @@ int main(int argc, char **argv) {
         fprintf(stderr, "bench_tradeoff: cannot write %s\n", path);
         return 1;
     }
-    fprintf(fp, "group,sweep,config,test,disks,packing,dem_steps_per_increment,real,tangent,tangent_reuse,nx,ny,element,ppc,threads,"
-                "completed,seconds,newton_iterations,mpm_steps,end_strain,peak_ratio,eps_at_peak,err_peak,eps_a,err_sa,"
-                "eps_b,err_sb,ev_rms,err_ev,err_max,err_max_vs_100_steps_double_taylor_same_rve,reference,run_dir\n");
-    printf("\n%-8s %-10s %-34s %3s %8s %7s %8s %8s %8s %9s %8s %8s\n", "group", "sweep", "config", "ok", "seconds",
-           "newton", "peak%", "sA%", "sB%", "ev_rms", "max%", "twin%");
+    fprintf(
+        fp,
+        "group,sweep,config,test,disks,packing,dem_steps_per_increment,real,tangent,tangent_reuse,nx,ny,"
+        "element,ppc,threads,"
+        "completed,seconds,newton_iterations,mpm_steps,end_strain,peak_ratio,eps_at_peak,err_peak,eps_a,err_"
+        "sa,"
+        "eps_b,err_sb,ev_rms,err_ev,err_max,err_max_vs_100_steps_double_taylor_same_rve,reference,run_dir\n");
+    printf("\n%-8s %-10s %-34s %3s %8s %7s %8s %8s %8s %9s %8s %8s\n", "group", "sweep", "config", "ok",
+           "seconds", "newton", "peak%", "sA%", "sB%", "ev_rms", "max%", "twin%");
     for (i = 0; i < n; ++i) {
         cfg *c = &L[i];
         char b[6][32], refl[64] = "", nit[24] = "", nmpm[24] = ""; /* empty: not applicable */
@@ -825,14 +876,23 @@ int main(int argc, char **argv) {
             if (L[k].is_ref && !strcmp(L[k].group, c->group)) snprintf(refl, sizeof refl, "%s", L[k].label);
         if (c->newton >= 0) snprintf(nit, sizeof nit, "%ld", c->newton);
         if (c->mpm_steps >= 0) snprintf(nmpm, sizeof nmpm, "%ld", c->mpm_steps);
-        fprintf(fp, "%s,%s,%s,%s,%d,%s,%s%d,%s,%s,%g,%d,%d,%s,%d,%d,%s,%.3f,%s,%s,%.6g,%.6g,%.6g,%.6g,%g,%.6g,%g,%.6g,%.6g,"
-                    "%.6g,%.6g,%.6g,%s,%s/runs/%s\n",
-                c->group, c->sweep, c->label, c->kind == K_SINGLE ? "single" : c->kind == K_BIAXIAL ? "biaxial" : "mpm",
+        fprintf(fp,
+                "%s,%s,%s,%s,%d,%s,%s%d,%s,%s,%g,%d,%d,%s,%d,%d,%s,%.3f,%s,%s,%.6g,%.6g,%.6g,%.6g,%g,%.6g,%g,"
+                "%.6g,%.6g,"
+                "%.6g,%.6g,%.6g,%s,%s/runs/%s\n",
+                c->group, c->sweep, c->label,
+                c->kind == K_SINGLE    ? "single"
+                : c->kind == K_BIAXIAL ? "biaxial"
+                                       : "mpm",
                 c->disks ? c->disks : 400, c->packing, c->dem_steps ? "" : "adaptive", c->dem_steps,
-                c->use_float ? "float" : "double", c->tangent, c->reuse, c->nx, c->ny, c->kind == K_MPM ? "" : c->element, c->ppc,
-                o.threads, c->skipped ? "skipped" : c->completed ? "yes" : "no", c->seconds, nit, nmpm,
-                c->c.n ? c->c.eps[c->c.n - 1] : NAN, R, ep, c->err_peak, c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_ev,
-                c->err_max, c->err_base, refl, o.out, c->same_as >= 0 ? L[c->same_as].id : c->id);
+                c->use_float ? "float" : "double", c->tangent, c->reuse, c->nx, c->ny,
+                c->kind == K_MPM ? "" : c->element, c->ppc, o.threads,
+                c->skipped     ? "skipped"
+                : c->completed ? "yes"
+                               : "no",
+                c->seconds, nit, nmpm, c->c.n ? c->c.eps[c->c.n - 1] : NAN, R, ep, c->err_peak, c->eps_a,
+                c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_ev, c->err_max, c->err_base, refl, o.out,
+                c->same_as >= 0 ? L[c->same_as].id : c->id);
         fmt(b[0], 32, c->err_peak, 100, "%.2f");
         fmt(b[1], 32, c->err_sa, 100, "%.2f");
         fmt(b[2], 32, c->err_sb, 100, "%.2f");
@@ -840,23 +900,30 @@ int main(int argc, char **argv) {
         fmt(b[4], 32, c->err_max, 100, "%.2f");
         fmt(b[5], 32, c->err_base, 100, "%.2f");
         printf("%-8s %-10s %-34s %3s %8.1f %7ld %8s %8s %8s %9s %8s %8s%s\n", c->group, c->sweep, c->label,
-               c->skipped ? "skp" : c->completed ? "yes" : "NO", c->seconds, c->newton, b[0], b[1], b[2], b[3], b[4], b[5],
-               c->is_ref ? "  (reference)" : c->same_as >= 0 ? "  (same run as above)" : "");
+               c->skipped     ? "skp"
+               : c->completed ? "yes"
+                              : "NO",
+               c->seconds, c->newton, b[0], b[1], b[2], b[3], b[4], b[5],
+               c->is_ref         ? "  (reference)"
+               : c->same_as >= 0 ? "  (same run as above)"
+                                 : "");
     }
     fclose(fp);
     printf("\n");
     for (i = 0; i < n; ++i) {
         cfg *c = &L[i];
         printf("BENCH case=tradeoff group=%s sweep=%s config=\"%s\" completed=%d skipped=%d seconds=%.3f "
-               "newton_iterations=%ld mpm_steps=%ld err_peak=%.4g eps_a=%g err_sa=%.4g eps_b=%g err_sb=%.4g ev_rms=%.4g err_max=%.4g "
+               "newton_iterations=%ld mpm_steps=%ld err_peak=%.4g eps_a=%g err_sa=%.4g eps_b=%g err_sb=%.4g "
+               "ev_rms=%.4g err_max=%.4g "
                "err_twin=%.4g reference=%d\n",
-               c->group, c->sweep, c->label, c->completed, c->skipped, c->seconds, c->newton, c->mpm_steps, c->err_peak,
-               c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_max, c->err_base, c->is_ref);
+               c->group, c->sweep, c->label, c->completed, c->skipped, c->seconds, c->newton, c->mpm_steps,
+               c->err_peak, c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_max, c->err_base,
+               c->is_ref);
     }
     snprintf(path, sizeof path, "%s/tradeoff.svg", o.out);
     if (write_svg(path, L, n)) fprintf(stderr, "bench_tradeoff: cannot write %s\n", path);
-    printf("wrote %s/tradeoff.csv and %s/tradeoff.svg (runs in %s/runs/); %.0f s in all\n", o.out, o.out, o.out,
-           now() - t0);
+    printf("wrote %s/tradeoff.csv and %s/tradeoff.svg (runs in %s/runs/); %.0f s in all\n", o.out, o.out,
+           o.out, now() - t0);
     k = 0;
     for (i = 0; i < n; ++i) {
         if (L[i].is_ref && !L[i].completed) {
