@@ -10,9 +10,10 @@
  * curve with the reference run of its group at equal axial strain (linear
  * interpolation). Every configuration runs once: a trade table, not a timing
  * benchmark, so no repeats and no median. Wall times mean something only on
- * otherwise idle cores: with another 2-thread OpenMP job on the same 2 cores
- * the spinning barriers slow a run several-fold (seen while writing this: the
- * 4 x 8 cells, 2 x 2 points MPM run took 182 s, the 3 x 3 one 117 s).
+ * otherwise idle cores: with other 2-thread jobs on the same 2 cores a run
+ * can be several-fold slower, probably OpenMP threads spinning at barriers
+ * (not verified; seen while writing this: the 4 x 8 cells, 2 x 2 points MPM
+ * run took 182 s, the 3 x 3 one 117 s, with about 4 other busy threads).
  *
  * Groups, references and sweeps (--full; the short version in brackets):
  *
