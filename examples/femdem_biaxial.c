@@ -274,7 +274,8 @@ static void usage(FILE *fp) {
         "  --dt DT                DEM time step (default 3.16e-5 s, the authors')\n"
         "  --vtk-every K          VTK files every K steps (default 1; 0: none)\n"
         "  --relaxation KIND      aitken (default): Newton corrections scaled by the Aitken factor of the\n"
-        "                         last two corrections (in [0.25, 4]); none: plain Newton\n"
+        "                         last two corrections (in [0.25, 4]); anderson: Anderson mixing of the\n"
+        "                         Newton map u + d(u) over the last iterates; none: plain Newton\n"
         "  --verbose              print E_d, E_f, the DEM steps per RVE (mean, max) and the time of every\n"
         "                         Newton iteration\n"
         "\n"
@@ -1781,7 +1782,7 @@ int main(int argc, char **argv) {
             else if (!strcmp(v, "none"))
                 o->aitken = 0;
             else {
-                fprintf(stderr, "femdem_biaxial: --relaxation must be aitken or none\n");
+                fprintf(stderr, "femdem_biaxial: --relaxation must be aitken, anderson or none\n");
                 return 2;
             }
         } else {
