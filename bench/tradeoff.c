@@ -551,10 +551,10 @@ static int write_svg(const char *path, cfg *L, int n) {
     const char *groups[3] = {"single", "biaxial", "mpm"};
     const char *sweeps[6] = {"rve_size", "dem_steps", "real", "tangent", "mesh", "mpm_ppc"};
     if (!fp) return -1;
-    for (k = 0; k < n; ++k)
+    for (k = 0; k < n; ++k) /* the range of what is plotted: repeats of a run (same_as) are not */
         if (L[k].ran && L[k].seconds > 0) {
             double lx = log10(L[k].seconds),
-                   ly = !L[k].is_ref && L[k].err_max > 0 ? log10(L[k].err_max) : NAN;
+                   ly = !L[k].is_ref && L[k].same_as < 0 && L[k].err_max > 0 ? log10(L[k].err_max) : NAN;
             if (lx < lx0) lx0 = lx;
             if (lx > lx1) lx1 = lx;
             if (ly == ly && ly < ly0) ly0 = ly;
