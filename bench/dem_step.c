@@ -1,6 +1,7 @@
 /* bench_dem_step - the DEM step at the speed limit of this CPU.
  *
- *   build/bench_dem_step                      the whole suite (make bench)
+ *   build/bench_dem_step                      the whole suite (make bench), the physics-switch
+ *                                             table (rve400) and the float-error report
  *   build/bench_dem_step --case NAME [--threads T] [--steps S] [--law linear|hertz]
  *                        [--real double|float] [--scalar] [--repeats R]
  *                        [--packing FILE] [--write-packing FILE]
@@ -30,7 +31,8 @@ static void usage(FILE *fp) {
                 "                      [--physics norot,frictionless,rolling,viscous,cohesion]\n"
                 "       bench_dem_step --float-error   q/p along the rve_path shear, float vs double\n"
                 "with no --case, runs the whole suite (1 and 2 threads, both laws, double and float,\n"
-                "SIMD and scalar) and prints a table.\n");
+                "SIMD and scalar) and prints a table, then the cost of each physics switch on rve400\n"
+                "and the float-error report.\n");
 }
 
 static int run_one(const bench_case *c, int use_float, int quiet_header) {
@@ -58,6 +60,28 @@ static int run_one(const bench_case *c, int use_float, int quiet_header) {
 static void header(void) {
     printf("%-8s %2s %7s  %2s  %-6s %-6s %-6s %8s %9s %6s %6s\n", "case", "", "n", "th", "law", "real", "simd",
            "Mpart/s", "Mcont/s", "Z", "pairs");
+}
+
+/* float against double along the seed-000 RVE shear path: what float costs in accuracy */
+static int float_error_report(void) {
+    enum { NI = 50 };
+    double pd[NI], qd[NI], pf[NI], qf[NI], emax = 0, erat = 0;
+    int k;
+    if (bench_path_double(NI, pd, qd) || bench_path_float(NI, pf, qf)) {
+        fprintf(stderr, "bench_dem_step: float-error path failed\n");
+        return 1;
+    }
+    for (k = 0; k < NI; ++k) {
+        double e = fabs(pf[k] - pd[k]) / pd[k], r = fabs(qf[k] / pf[k] - qd[k] / pd[k]);
+        if (e > emax) emax = e;
+        if (r > erat) erat = r;
+    }
+    printf("float vs double along the seed-000 RVE shear path (50 x dH01 = 1e-3, 100 steps each):\n"
+           "  largest relative difference in p: %.3g; largest difference in q/p: %.3g (q/p at the end %.4f)\n",
+           emax, erat, qd[NI - 1] / pd[NI - 1]);
+    printf("BENCH case=float_error increments=%d max_rel_p=%.4g max_abs_q_over_p=%.4g final_q_over_p=%.4f\n", NI,
+           emax, erat, qd[NI - 1] / pd[NI - 1]);
+    return 0;
 }
 
 int main(int argc, char **argv) {
@@ -104,26 +128,7 @@ int main(int argc, char **argv) {
         header();
         return run_one(&c, use_float, 0);
     }
-    if (float_error) {
-        enum { NI = 50 };
-        double pd[NI], qd[NI], pf[NI], qf[NI], emax = 0, erat = 0;
-        int k;
-        if (bench_path_double(NI, pd, qd) || bench_path_float(NI, pf, qf)) {
-            fprintf(stderr, "bench_dem_step: float-error path failed\n");
-            return 1;
-        }
-        for (k = 0; k < NI; ++k) {
-            double e = fabs(pf[k] - pd[k]) / pd[k], r = fabs(qf[k] / pf[k] - qd[k] / pd[k]);
-            if (e > emax) emax = e;
-            if (r > erat) erat = r;
-        }
-        printf("float vs double along the seed-000 RVE shear path (50 x dH01 = 1e-3, 100 steps each):\n"
-               "  largest relative difference in p: %.3g; largest difference in q/p: %.3g (q/p at the end %.4f)\n",
-               emax, erat, qd[NI - 1] / pd[NI - 1]);
-        printf("BENCH case=float_error increments=%d max_rel_p=%.4g max_abs_q_over_p=%.4g final_q_over_p=%.4f\n", NI,
-               emax, erat, qd[NI - 1] / pd[NI - 1]);
-        return 0;
-    }
+    if (float_error) return float_error_report();
     {
         static const char *cases[] = {"rve400", "2d_10k", "2d_100k", "3d_1k", "3d_10k", "3d_100k"};
         int k, law, fl, sc, th;
@@ -141,5 +146,26 @@ int main(int argc, char **argv) {
                             if (run_one(&b, fl, 1)) rc = 1;
                         }
     }
+    { /* what each optional physics switch costs, on the 400-disk RVE (1 thread, double) */
+        static const char *phys[] = {NULL, "norot", "frictionless", "rolling", "viscous", "cohesion"};
+        int k, law;
+        printf("\nphysics switches, rve400, 1 thread, double (linear default: rotation on, Coulomb friction, no\n"
+               "rolling resistance, local damping only, no cohesion; the hertz case has rolling resistance, so\n"
+               "no 'norot', and cohesion is linear-only):\n");
+        header();
+        for (law = 0; law < 2; ++law)
+            for (k = 0; k < 6; ++k) {
+                bench_case b = c;
+                if (law == 1 && (k == 1 || k == 3 || k == 5)) continue;
+                b.name = "rve400";
+                b.hertz = law;
+                b.threads = 1;
+                b.physics = phys[k];
+                if (run_one(&b, 0, 1)) rc = 1;
+            }
+    }
+    printf("\n");
+    fflush(stdout);
+    if (float_error_report()) rc = 1;
     return rc;
 }
