@@ -177,6 +177,7 @@ typedef struct opts {
     /* cyclic simple shear: cyclic = 1 strain-, 2 stress-controlled */
     int cyclic, stress_steps;
     double amp, tau_amp, cycles, gamma_stop, liq_ratio;
+    unsigned long packing_seed; /* --packing A,B,...: seed of the per-Gauss-point draw */
 } opts;
 
 /* cyclic: what a row of cyclic.csv has besides curve_row (eps = gamma, syy =
@@ -232,7 +233,7 @@ typedef struct model {
     gk_dofmap dm;
     gk_csr Kr;
     int *rfix;
-    double *rvals, *rr, *ur, v0;
+    double *rvals, *rr, *ur, *v0; /* v0: initial volume of each RVE */
     cyc_extra *cx;
     cyc_state cs;
 } model;
@@ -263,7 +264,12 @@ static void usage(FILE *fp) {
         "                         Q4 element, 4 Gauss points, compared with the RVE alone under the same\n"
         "                         drained path (writes single_element.csv and .svg); cyclic-strain,\n"
         "                         cyclic-stress: constant-volume cyclic simple shear of seed sec 5 (below)\n"
-        "  --packing FILE         RVE at every Gauss point (default examples/data/rve400.txt)\n"
+        "  --packing FILE[,FILE]  RVE at every Gauss point (default examples/data/rve400.txt). A comma-\n"
+        "                         separated list seeds heterogeneity: each Gauss point draws one of the\n"
+        "                         files (uniformly, in Gauss-point order, from --packing-seed; the counts\n"
+        "                         are printed; at most 64 files; not with --test single)\n"
+        "  --packing-seed S       seed of that draw (default 1): the same list and seed give the same\n"
+        "                         assignment on every run and restart\n"
         "  --width, --height M    specimen size [m] (0.05 x 0.1)\n"
         "  --pressure P           confining pressure [Pa] (1e5)\n"
         "  --tol T                Newton tolerance on E_d = |du|/|u| (eq 21; default 0.01)\n"
@@ -585,11 +591,13 @@ static int floor_tangents(model *M, double *D) {
 }
 
 /* ------------------------------------------------------------- setup */
+#define MAX_PACKINGS 64
 static int setup(model *M, gk_err *err) {
     opts *o = &M->o;
     int n[3], g, a, per = o->quad;
     double org[3] = {0, 0, 0}, len[3];
-    gk_packing pk;
+    gk_packing pks[MAX_PACKINGS];
+    int npk = 0, *pick;
     gk_rve_def def = gk_rve_def_default();
     n[0] = o->nx, n[1] = o->ny, n[2] = 1;
     len[0] = o->width, len[1] = o->height, len[2] = 1;
@@ -681,18 +689,53 @@ static int setup(model *M, gk_err *err) {
         }
     }
     M->area0 = o->width * o->height;
-    /* RVEs: the same packing everywhere (seed 000: uniform RVE, no imperfection) */
-    if (gk_packing_read(o->packing, &pk, NULL, err)) return 1;
-    if (pk.dim != 2)
-        return gk_err_set(err, GK_ERR_ARG, "%s is a %dD packing; this driver is 2D", o->packing, pk.dim), 1;
+    /* RVEs: the same packing everywhere (seed 000: uniform RVE, no imperfection), or with
+     * --packing A,B,... each Gauss point draws one of the files: xoshiro256** seeded by
+     * --packing-seed, drawn in Gauss-point order, so every run (and restart) gets the same
+     * assignment whatever the thread count */
+    ALLOC(M->v0, M->ngp);
+    ALLOC(pick, M->ngp);
+    {
+        char *list = (char *)malloc(strlen(o->packing) + 1), *name, *save = NULL;
+        int k, cnt[MAX_PACKINGS];
+        gk_rng rng;
+        if (!list) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+        strcpy(list, o->packing);
+        for (name = strtok_r(list, ",", &save); name; name = strtok_r(NULL, ",", &save)) {
+            if (npk == MAX_PACKINGS || gk_packing_read(name, &pks[npk], NULL, err)) {
+                if (npk == MAX_PACKINGS) gk_err_set(err, GK_ERR_ARG, "more than %d packings", MAX_PACKINGS);
+                for (k = 0; k < npk; ++k) gk_packing_free(&pks[k]);
+                free(list);
+                return 1;
+            }
+            if (pks[npk++].dim != 2) {
+                gk_err_set(err, GK_ERR_ARG, "%s is a %dD packing; this driver is 2D", name, pks[npk - 1].dim);
+                for (k = 0; k < npk; ++k) gk_packing_free(&pks[k]);
+                free(list);
+                return 1;
+            }
+        }
+        free(list);
+        if (npk == 0) return gk_err_set(err, GK_ERR_ARG, "--packing names no file"), 1;
+        gk_rng_seed(&rng, (uint64_t)o->packing_seed);
+        for (k = 0; k < npk; ++k) cnt[k] = 0;
+        for (g = 0; g < M->ngp; ++g) ++cnt[pick[g] = npk > 1 ? (int)(gk_rng_u64(&rng) % (uint64_t)npk) : 0];
+        if (npk > 1) {
+            printf("femdem_biaxial: %d packings drawn over %d Gauss points (--packing-seed %lu):", npk,
+                   M->ngp, o->packing_seed);
+            for (k = 0; k < npk; ++k) printf(" %d", cnt[k]);
+            printf("\n");
+        }
+    }
     def.dt = o->dt;
     for (g = 0; g < M->ngp; ++g) {
-        if (gk_rve_create(&M->rve[g], &def, &pk)) {
+        if (gk_rve_create(&M->rve[g], &def, &pks[pick[g]])) {
             gk_err_set(err, GK_ERR_ARG, "RVE: %s", gk_rve_error(&M->rve[g]));
-            gk_packing_free(&pk);
+            for (a = 0; a < npk; ++a) gk_packing_free(&pks[a]);
+            free(pick);
             return 1;
         }
-        if (g == 0 && gk_rve_refresh(&M->rve[g]))
+        if ((g == 0 || npk > 1) && gk_rve_refresh(&M->rve[g]))
             return gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&M->rve[0])), 1;
         if (g == 0 && o->cyclic && o->pressure > 0) { /* initial stress other than the packing's own */
             double s0[9], p0;
@@ -712,14 +755,14 @@ static int setup(model *M, gk_err *err) {
                        p0 / 1e3, o->pressure / 1e3, rep.void_ratio);
             }
         }
-        if (g == 0) M->v0 = gk_rve_volume(&M->rve[0]);
-        if (g > 0) { /* identical copies: clone the refreshed state of the first */
+        if (g > 0 && npk == 1) { /* identical copies: clone the refreshed state of the first */
             if (gk_rve_state_restore(&M->st[0], &M->rve[g])) return gk_err_set(err, GK_ERR_STATE, "clone"), 1;
-        } else {
+        } else if (g == 0) {
             gk_rve_state_init(&M->st[0], NULL);
             if (gk_rve_state_save(&M->st[0], &M->rve[0]))
                 return gk_err_set(err, GK_ERR_ALLOC, "RVE state"), 1;
         }
+        M->v0[g] = gk_rve_volume(&M->rve[g]);
         if (g > 0) {
             gk_rve_state_init(&M->st[g], NULL);
             if (gk_rve_state_save(&M->st[g], &M->rve[g]))
@@ -732,7 +775,8 @@ static int setup(model *M, gk_err *err) {
                                     M->D_n + 16 * (size_t)g))
             return gk_err_set(err, GK_ERR_STATE, "tangent"), 1;
     }
-    gk_packing_free(&pk);
+    for (a = 0; a < npk; ++a) gk_packing_free(&pks[a]);
+    free(pick);
     M->scale = 1.0;
     return 0;
 }
@@ -991,7 +1035,7 @@ static void cyclic_state(const model *M, curve_row *c, cyc_extra *x) {
             w = M->q.w[g] * dJ;
             sa[0] += w * M->sig_n[9 * id], sa[1] += w * M->sig_n[9 * id + 4],
                 sa[2] += w * M->sig_n[9 * id + 1];
-            ev += w * (1.0 - gk_rve_volume(&M->rve[id]) / M->v0);
+            ev += w * (1.0 - gk_rve_volume(&M->rve[id]) / M->v0[id]);
             area += w;
         }
     sxx = -sa[0] / area, syy = -sa[1] / area, sxy = sa[2] / area;
@@ -1661,7 +1705,7 @@ int main(int argc, char **argv) {
     o->dt = SEED_DT;
     o->dem_strain = DEF_DEM_STRAIN, o->xi = 5e-5;
     o->amp = 0.01, o->tau_amp = 3e4, o->stress_steps = 6, o->cycles = 20, o->gamma_stop = 0.05,
-    o->liq_ratio = 0.1;
+    o->liq_ratio = 0.1, o->packing_seed = 1;
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -1711,7 +1755,16 @@ int main(int argc, char **argv) {
             o->test = v;
         else if (!strcmp(a, "--packing"))
             o->packing = v;
-        else if (!strcmp(a, "--width"))
+        else if (!strcmp(a, "--packing-seed")) {
+            char *end;
+            errno = 0;
+            o->packing_seed = strtoul(v, &end, 10);
+            if (errno || end == v || *end || v[0] == '-') {
+                fprintf(stderr, "femdem_biaxial: --packing-seed must be a non-negative integer, not '%s'\n",
+                        v);
+                return 2;
+            }
+        } else if (!strcmp(a, "--width"))
             o->width = atof(v);
         else if (!strcmp(a, "--height"))
             o->height = atof(v);
@@ -1808,6 +1861,16 @@ int main(int argc, char **argv) {
         o->packing = o->cyclic == 1   ? "examples/data/rve400_e0223.txt"
                      : o->cyclic == 2 ? "examples/data/rve400_e0209.txt"
                                       : "examples/data/rve400.txt";
+    if (strchr(o->packing, ',') && !strcmp(o->test, "single")) {
+        fprintf(stderr,
+                "femdem_biaxial: --test single compares the mesh with one RVE alone: give one --packing\n");
+        return 2;
+    }
+    if (strchr(o->packing, ',') && o->cyclic && o->pressure > 0) {
+        fprintf(stderr, "femdem_biaxial: --pressure re-consolidates one packing; with a list of packings "
+                        "give them at their own stress\n");
+        return 2;
+    }
     if (o->cyclic && (!(o->amp > 0 && o->amp < 0.5) || !(o->tau_amp > 0) || o->stress_steps < 1 ||
                       !(o->cycles > 0 && o->cycles <= 1e5) || !(o->liq_ratio > 0 && o->liq_ratio < 1) ||
                       !(o->gamma_stop > 0))) {
