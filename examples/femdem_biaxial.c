@@ -222,6 +222,8 @@ typedef struct model {
     double *D_ref; /* tangent reuse: the last computed tangent of each Gauss point */
     net_ref *nref; /* ... and the contact network it was computed at */
     long long pend_dem, pend_reused, pend_computed; /* work since the last converged step */
+    int bad_g;         /* the lowest Gauss point whose RVE run failed in the last evaluation (-1: none) */
+    char bad_msg[300]; /* ... and its RVE's message */
     gk_csr K;
     double *u, *du, *dprev, *fint, *fext, *R, *rhs, *utot, *A0x, *andF, *andG, *fprev, *Gprev;
     int *fix, nfix, *fixtop, *top, ntop, *right, nright, *lface, nlf, *rface, nrf, nfn;
@@ -466,10 +468,20 @@ static double net_change(const net_ref *nr) {
 /* every Gauss point: restore the converged state, deform by dH = grad u with the DEM step rule, read
  * stress and tangent (or keep the stored tangent, --tangent-reuse). Returns the number of failed RVEs.
  * Counts the DEM steps and tangents into M->pend_*. */
+/* a failed RVE run at Gauss point g: keep the lowest g's message (the same whatever the thread count) */
+static void note_bad(model *M, int g, const gk_rve *r) {
+    GK_OMP(critical(femdem_bad))
+    if (M->bad_g < 0 || g < M->bad_g) {
+        M->bad_g = g;
+        snprintf(M->bad_msg, sizeof M->bad_msg, "%s", gk_rve_error(r));
+    }
+}
+
 static int eval_rves(model *M, const double *u) {
     int g, nbad = 0, n4 = 16;
     long long steps = 0, reused = 0, computed = 0;
     const opts *o = &M->o;
+    M->bad_g = -1, M->bad_msg[0] = 0;
     GK_OMP(parallel for num_threads(o->threads) schedule(dynamic, 1) reduction(+ : nbad, steps, reused, computed))
     for (g = 0; g < M->ngp; ++g) {
         int e = g / M->q.n, a, i, j, k, nd = 0, nr = 0, reuse = 0, keys = 0, bad_t = 0;
@@ -491,13 +503,13 @@ static int eval_rves(model *M, const double *u) {
                 double Hp[9];
                 memcpy(Hp, H, sizeof H);
                 Hp[3 * (k / 2) + k % 2] += o->xi;
-                if (gk_rve_state_restore(&M->st[g], r) || gk_rve_deform(r, Hp, nd)) ++nbad;
+                if (gk_rve_state_restore(&M->st[g], r) || gk_rve_deform(r, Hp, nd)) ++nbad, note_bad(M, g, r);
                 gk_rve_stress(r, sp[k]);
                 steps += nd;
             }
         }
         if (gk_rve_state_restore(&M->st[g], r) || rve_run(o, M->scale, r, H, &nd, &nr)) {
-            ++nbad;
+            ++nbad, note_bad(M, g, r);
             continue;
         }
         steps += nd + nr;
@@ -523,13 +535,14 @@ static int eval_rves(model *M, const double *u) {
                     double Hp[9];
                     memcpy(Hp, H, sizeof H);
                     Hp[3 * (k / 2) + k % 2] += o->xi;
-                    if (gk_rve_state_restore(&M->st[g], r) || rve_replay(r, Hp, nd, nr)) ++nbad;
+                    if (gk_rve_state_restore(&M->st[g], r) || rve_replay(r, Hp, nd, nr))
+                        ++nbad, note_bad(M, g, r);
                     gk_rve_stress(r, sp[k]);
                     steps += nd + nr;
                 }
                 /* the trial state again (the same run: bit-identical) */
                 if (gk_rve_state_restore(&M->st[g], r) || rve_replay(r, H, nd, nr)) {
-                    ++nbad;
+                    ++nbad, note_bad(M, g, r);
                     continue;
                 }
                 steps += nd + nr;
@@ -540,7 +553,7 @@ static int eval_rves(model *M, const double *u) {
                         M->D[(size_t)g * n4 + (i * 2 + j) * 4 + k] =
                             (sp[k][3 * i + j] - s0[3 * i + j]) / o->xi;
         } else if (gk_homog_tangent(r, M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u, M->D + (size_t)g * n4))
-            ++nbad, bad_t = 1;
+            ++nbad, bad_t = 1, note_bad(M, g, r);
         if (keys && !bad_t) { /* this tangent and its network become the reference */
             unsigned long long *t = nf->key;
             memcpy(M->D_ref + (size_t)g * n4, M->D + (size_t)g * n4, (size_t)n4 * sizeof(double));
@@ -865,7 +878,9 @@ static int load_step(model *M, double inc, int *iters, double *Ed_out, double *E
         nbad = eval_rves(M, M->u);
         if (nbad) {
             if (M->o.verbose) fprintf(stderr, "    iter %2d: %d RVEs failed -> cut back\n", it, nbad);
-            *iters = it;
+            gk_err_set(err, GK_ERR_STATE, "%d RVE run(s) failed at iteration %d; Gauss point %d: %s", nbad,
+                       it, M->bad_g, M->bad_msg);
+            *iters = it, *Ed_out = Ed, *Ef_out = Ef;
             return 1;
         }
         Ef = residual(M, M->sig, err);
