@@ -422,17 +422,22 @@ static int cmp_u64(const void *a, const void *b) {
     unsigned long long x = *(const unsigned long long *)a, y = *(const unsigned long long *)b;
     return x < y ? -1 : x > y;
 }
+/* room for cap keys in both lists of nr; 0, or -1 when out of memory */
+static int net_reserve(net_ref *nr, int cap) {
+    unsigned long long *k;
+    if (cap <= nr->cap) return 0;
+    k = (unsigned long long *)realloc(nr->key, (size_t)cap * sizeof *k);
+    if (!k) return -1;
+    nr->key = k;
+    k = (unsigned long long *)realloc(nr->cur, (size_t)cap * sizeof *k);
+    if (!k) return -1;
+    nr->cur = k, nr->cap = cap;
+    return 0;
+}
+
 static int net_keys(const gk_rve *r, net_ref *nr) {
     int c, n = 0;
-    if (r->pl.n > nr->cap) {
-        int cap = r->pl.n + r->pl.n / 4 + 16;
-        unsigned long long *k1 = (unsigned long long *)realloc(nr->key, (size_t)cap * sizeof *k1), *k2;
-        if (!k1) return -1;
-        nr->key = k1;
-        k2 = (unsigned long long *)realloc(nr->cur, (size_t)cap * sizeof *k2);
-        if (!k2) return -1;
-        nr->cur = k2, nr->cap = cap;
-    }
+    if (r->pl.n > nr->cap && net_reserve(nr, r->pl.n + r->pl.n / 4 + 16)) return -1;
     for (c = 0; c < r->pl.n; ++c) {
         unsigned long long a, b;
         if (!(r->cs[c] & GK_CS_CONTACT)) continue;
@@ -465,9 +470,6 @@ static double net_change(const net_ref *nr) {
     return (double)ch / (nr->n > 0 ? nr->n : 1);
 }
 
-/* every Gauss point: restore the converged state, deform by dH = grad u with the DEM step rule, read
- * stress and tangent (or keep the stored tangent, --tangent-reuse). Returns the number of failed RVEs.
- * Counts the DEM steps and tangents into M->pend_*. */
 /* a failed RVE run at Gauss point g: keep the lowest g's message (the same whatever the thread count) */
 static void note_bad(model *M, int g, const gk_rve *r) {
     GK_OMP(critical(femdem_bad))
@@ -477,6 +479,9 @@ static void note_bad(model *M, int g, const gk_rve *r) {
     }
 }
 
+/* every Gauss point: restore the converged state, deform by dH = grad u with the DEM step rule, read
+ * stress and tangent (or keep the stored tangent, --tangent-reuse). Returns the number of failed RVEs.
+ * Counts the DEM steps and tangents into M->pend_*. */
 static int eval_rves(model *M, const double *u) {
     int g, nbad = 0, n4 = 16;
     long long steps = 0, reused = 0, computed = 0;
@@ -582,6 +587,19 @@ static void row_work(model *M, curve_row *c) {
     dem_stats(M, &c->dem_mean, &c->dem_max);
     c->dem_total = M->pend_dem, c->t_reused = M->pend_reused, c->t_computed = M->pend_computed;
     M->pend_dem = M->pend_reused = M->pend_computed = 0;
+}
+
+/* the closing keys of both RESULT lines: the DEM rule and the work of the whole run, summed over the
+ * rows (so a restart, which reads the rows back, reports the whole run) */
+static void print_work_totals(const model *M) {
+    long long dtot = 0, reu = 0, comp = 0;
+    int k, dmax = 0;
+    for (k = 0; k < M->ncurve; ++k) {
+        dtot += M->curve[k].dem_total, reu += M->curve[k].t_reused, comp += M->curve[k].t_computed;
+        if (M->curve[k].dem_max > dmax) dmax = M->curve[k].dem_max;
+    }
+    printf(" dem_rule=%s dem_steps_total=%lld dem_steps_max=%d tangents_reused=%lld tangents_computed=%lld\n",
+           M->o.dem_adaptive ? "adaptive" : "strain", dtot, dmax, reu, comp);
 }
 
 /* a Gauss point without contacts has D = 0; give it a small floor so that K
@@ -1447,16 +1465,8 @@ static int read_checkpoint(model *M, const char *dir, gk_err *err) {
         int nk;
         ok &= fread(&nk, sizeof nk, 1, fp) == 1 && nk >= -1 && nk < (1 << 28);
         if (!ok || nk < 0) continue;
-        if (nk > nf->cap) {
-            unsigned long long *k1 = (unsigned long long *)realloc(nf->key, (size_t)nk * sizeof *k1), *k2;
-            ok &= k1 != NULL;
-            if (!ok) break;
-            nf->key = k1;
-            k2 = (unsigned long long *)realloc(nf->cur, (size_t)nk * sizeof *k2);
-            ok &= k2 != NULL;
-            if (!ok) break;
-            nf->cur = k2, nf->cap = nk;
-        }
+        ok &= net_reserve(nf, nk) == 0;
+        if (!ok) break;
         ok &= fread(M->D_ref + 16 * (size_t)g, sizeof(double), 16, fp) == 16 &&
               fread(nf->key, sizeof *nf->key, (size_t)nk, fp) == (size_t)nk;
         nf->n = nk, nf->valid = ok;
@@ -1606,8 +1616,7 @@ static void cyclic_summary(model *M, int status) {
     const curve_row *last = &M->curve[M->ncurve - 1];
     const cyc_extra *xl = &M->cx[M->ncurve - 1];
     double emin = HUGE_VAL, emax = -HUGE_VAL, tot = 0, evmax = 0, uymax = 0, pmin = HUGE_VAL;
-    int g, k, itmax = 0, itsum = 0, n = M->ncurve - 1, dmax = 0;
-    long long dtot = 0, reu = 0, comp = 0;
+    int g, k, itmax = 0, itsum = 0, n = M->ncurve - 1;
     char title[200];
     for (g = 0; g < M->ngp; ++g) {
         double e = gk_homog_void_ratio(&M->rve[g]);
@@ -1618,8 +1627,6 @@ static void cyclic_summary(model *M, int status) {
         if (fabs(M->curve[k].ev) > evmax) evmax = fabs(M->curve[k].ev);
         if (fabs(M->cx[k].top_uy) > uymax) uymax = fabs(M->cx[k].top_uy);
         if (M->cx[k].p < pmin) pmin = M->cx[k].p;
-        dtot += M->curve[k].dem_total, reu += M->curve[k].t_reused, comp += M->curve[k].t_computed;
-        if (M->curve[k].dem_max > dmax) dmax = M->curve[k].dem_max;
         if (k == 0) continue;
         tot += M->curve[k].secs, itsum += M->curve[k].iters;
         if (M->curve[k].iters > itmax) itmax = M->curve[k].iters;
@@ -1648,11 +1655,11 @@ static void cyclic_summary(model *M, int status) {
     printf("RESULT test=%s liquefied=%d cycles=%.3f cycles_to_liquefaction=%.3f cycles_to_gamma_limit=%.3f "
            "p0=%.6g p_final=%.6g p_min=%.6g sigma_yy_final=%.6g tau_final=%.6g gamma_final=%.6g e_min=%.5f "
            "e_max=%.5f max_eps_v_rve=%.3g max_iterations=%d mean_iterations=%.2f steps=%d "
-           "seconds_per_step=%.3f total_seconds=%.2f dem_rule=%s dem_steps_total=%lld dem_steps_max=%d "
-           "tangents_reused=%lld tangents_computed=%lld\n",
+           "seconds_per_step=%.3f total_seconds=%.2f",
            o->test, c->cyc_liq >= 0, xl->cycle, c->cyc_liq, c->cyc_gamma, c->p0, xl->p, pmin, last->syy,
            xl->tau, c->gamma, emin, emax, evmax, itmax, n > 0 ? (double)itsum / n : 0.0, n,
-           n > 0 ? tot / n : 0.0, tot, o->dem_adaptive ? "adaptive" : "strain", dtot, dmax, reu, comp);
+           n > 0 ? tot / n : 0.0, tot);
+    print_work_totals(M);
 }
 
 /* ------------------------------------------------- single-element test */
@@ -2087,14 +2094,11 @@ int main(int argc, char **argv) {
     }
     {
         double peak = 0, epk = 0, ang, wid, tot;
-        int k, itmax = 0, itsum = 0, dmax = 0;
-        long long dtot = 0, reu = 0, comp = 0;
+        int k, itmax = 0, itsum = 0;
         for (k = 0; k < M.ncurve; ++k) {
             if (M.curve[k].syy > peak) peak = M.curve[k].syy, epk = M.curve[k].eps;
             if (M.curve[k].iters > itmax) itmax = M.curve[k].iters;
-            if (M.curve[k].dem_max > dmax) dmax = M.curve[k].dem_max;
             if (k > 0) itsum += M.curve[k].iters;
-            dtot += M.curve[k].dem_total, reu += M.curve[k].t_reused, comp += M.curve[k].t_computed;
         }
         tot = 0;
         for (k = 1; k < M.ncurve; ++k) tot += M.curve[k].secs;
@@ -2108,11 +2112,10 @@ int main(int argc, char **argv) {
             printf("shear band: none (max eps_q < 1.5 x median)\n");
         printf("RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g band_angle_deg=%.3g band_width_mm=%.3g "
                "max_iterations=%d "
-               "steps=%d seconds_per_step=%.3f total_seconds=%.2f mean_iterations=%.2f dem_rule=%s "
-               "dem_steps_total=%lld dem_steps_max=%d tangents_reused=%lld tangents_computed=%lld\n",
+               "steps=%d seconds_per_step=%.3f total_seconds=%.2f mean_iterations=%.2f",
                peak, epk, ang, 1e3 * wid, itmax, M.ncurve - 1, M.ncurve > 1 ? tot / (M.ncurve - 1) : 0.0, tot,
-               M.ncurve > 1 ? (double)itsum / (M.ncurve - 1) : 0.0, o->dem_adaptive ? "adaptive" : "strain",
-               dtot, dmax, reu, comp);
+               M.ncurve > 1 ? (double)itsum / (M.ncurve - 1) : 0.0);
+        print_work_totals(&M);
     }
 done:
     for (i = 0; i < M.ngp; ++i) {
