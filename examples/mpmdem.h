@@ -91,6 +91,18 @@ static void mpd_opts_default(mpd_opts *o, const char *out) {
     o->checkpoint_every = 0;
 }
 
+/* the DEM-step rule in force, as the quasi-static drivers print it at start (the collapse prints its
+ * real-time cap with it); inline: a driver that does not call it gets no unused-function warning */
+GK_INLINE void mpd_print_dem_rule(const mpd_opts *o) {
+    if (o->dem_adaptive)
+        printf("DEM steps per MPM step: adaptive, I <= %g then relaxation to an unbalanced force ratio < %g, "
+               "%d..%d steps\n",
+               o->dem_inertial, o->dem_unbalanced, o->dem_min, o->dem_max);
+    else
+        printf("DEM steps per MPM step: <= %g strain per DEM step, %d..%d steps\n", o->dem_strain, o->dem_min,
+               o->dem_max);
+}
+
 static void mpd_usage_common(FILE *fp, const mpd_opts *d) {
     fprintf(
         fp,
@@ -134,11 +146,11 @@ static int mpd_num(const char *s, double *v) {
 static int mpd_parse_common(mpd_opts *o, int argc, char **argv, int *i) {
     const char *a = argv[*i], *val = *i + 1 < argc ? argv[*i + 1] : NULL;
     double v = 0.0;
-    static const char *with_value[] = {"--out",         "--threads",      "--ppc",        "--basis",
-                                       "--alpha",       "--cfl",          "--packing",    "--dem-strain",
-                                       "--dem-min",     "--dem-max",      "--dem-dt",     "--young",
-                                       "--kt-ratio",    "--friction-deg", "--roll-beta",  "--roll-eta",
-                                       "--dem-damping", "--vtk-every",    "--checkpoint", "--restart"};
+    static const char *with_value[] = {
+        "--out",        "--threads",      "--ppc",       "--basis",        "--alpha",         "--cfl",
+        "--packing",    "--dem-strain",   "--dem-min",   "--dem-max",      "--dem-dt",        "--young",
+        "--kt-ratio",   "--friction-deg", "--roll-beta", "--roll-eta",     "--dem-damping",   "--vtk-every",
+        "--checkpoint", "--restart",      "--dem-rule",  "--dem-inertial", "--dem-unbalanced"};
     size_t k;
     if (!strcmp(a, "--quiet")) return o->quiet = 1, 1;
     for (k = 0; k < sizeof with_value / sizeof *with_value; ++k)

@@ -294,13 +294,7 @@ int main(int argc, char **argv) {
            "%.4g s "
            "(cfl %.2f); DEM dt = %.3g s\n",
            P.p0 / 1e3, P.e0, P.rho, P.M / 1e6, c, dt, o.cfl, F.rve[0].dt);
-    if (o.dem_adaptive)
-        printf("DEM steps per MPM step: adaptive, I <= %g then relaxation to an unbalanced force ratio < %g, "
-               "%d..%d steps\n",
-               o.dem_inertial, o.dem_unbalanced, o.dem_min, o.dem_max);
-    else
-        printf("DEM steps per MPM step: <= %g strain per DEM step, %d..%d steps\n", o.dem_strain, o.dem_min,
-               o.dem_max);
+    mpd_print_dem_rule(&o);
     printf("about %ld MPM steps to %.1f %% axial strain at %g m/s\n", nsteps_total, 100 * b.strain,
            b.velocity);
     if (!o.restart) {

@@ -891,14 +891,7 @@ int main(int argc, char **argv) {
            "c = "
            "%.1f m/s; MPM dt = %.4g s (cfl %.2f)\n",
            P.p0 / 1e3, P.e0, table2_e0[f.material], P.rho, P.M / 1e6, c, dt, o.cfl);
-    if (o.dem_adaptive)
-        printf("DEM steps per MPM step: adaptive, I <= %g then relaxation to an unbalanced force ratio < %g, "
-               "%d..%d "
-               "steps\n",
-               o.dem_inertial, o.dem_unbalanced, o.dem_min, o.dem_max);
-    else
-        printf("DEM steps per MPM step: <= %g strain per DEM step, %d..%d steps\n", o.dem_strain, o.dem_min,
-               o.dem_max);
+    mpd_print_dem_rule(&o);
     printf("memory: %.1f kB per RVE (RSS growth over creating %d RVEs)\n",
            rss_after > 0 && rss_before > 0 ? (rss_after - rss_before) / pts.n : -1.0, pts.n);
     printf("footing at %g m/s (ramp %g s) to d/B = %g: about %ld MPM steps%s\n", f.velocity, f.ramp,

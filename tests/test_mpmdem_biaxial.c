@@ -53,7 +53,8 @@ TEST(biaxial_runs_and_loads) {
     CHECK(gk_test_file_has("build/t_mpmbx/rotation_end.svg", "<svg"));
     CHECK(gk_test_file_has("build/t_mpmbx/points_000000.vtk", "SCALARS eps_q"));
     CHECK_NEAR(gk_test_result("build/t_mpmbx.out", "n_rves"), 8, 0);
-    CHECK_REL(gk_test_result("build/t_mpmbx.out", "peak_sigma_yy"), r[n - 1][2], 1e-5); /* printed with 6 digits */
+    CHECK_REL(gk_test_result("build/t_mpmbx.out", "peak_sigma_yy"), r[n - 1][2],
+              1e-5); /* printed with 6 digits */
 }
 
 /* RVEs run in parallel: one thread gives the same curve to the last digit */
@@ -96,6 +97,19 @@ TEST(biaxial_bad_arguments) {
     CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "cannot open"));
     CHECK(system("build/mpmdem_biaxial --help > build/t_mpmbx_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--dem-strain"));
+    /* the DEM-rule flags of mpmdem.h are taken (they were listed in --help but refused), bad ones not */
+    CHECK(system("build/mpmdem_biaxial --dem-rule foo > build/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "use adaptive or strain"));
+    CHECK(system("build/mpmdem_biaxial --dem-inertial -1 > build/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--dem-inertial"));
+    CHECK(system(BX "--strain 0.0005 --dem-rule strain --dem-strain 2e-5 --out build/t_mpmbx_rule "
+                    "> build/t_mpmbx_rule.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_rule.out", "DEM steps per MPM step: <= 2e-05 strain per DEM step"));
+    CHECK(system(BX "--strain 0.0005 --dem-inertial 1e-3 --dem-unbalanced 1e-2 --out build/t_mpmbx_rule "
+                    "> build/t_mpmbx_rule.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_rule.out",
+                           "adaptive, I <= 0.001 then relaxation to an unbalanced force "
+                           "ratio < 0.01"));
 }
 
 int main(int argc, char **argv) {
