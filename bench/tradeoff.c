@@ -68,10 +68,8 @@
  * column, converged steps and sub-steps; none for the explicit MPM, which
  * reports its step count instead).
  *
- * Fixed DEM step counts N are asked as --dem-strain inc/N --dem-min N --dem-max N
- * (plus --dem-rule strain when the driver has --dem-rule); the adaptive rows
- * need --dem-rule in femdem_biaxial --help and are skipped (with a note) when it
- * is not there.
+ * Fixed DEM step counts N are asked as --dem-rule strain --dem-strain inc/N
+ * --dem-min N --dem-max N; the adaptive rows as --dem-rule adaptive.
  *
  * Output: OUT/tradeoff.csv (one row per configuration), OUT/tradeoff.svg
  * (error against seconds, log axes, Pareto front of each group), OUT/runs/ID
@@ -118,7 +116,7 @@ typedef struct cfg {
     int is_ref;
     char cmd[4096];
     /* results */
-    int ran, skipped, completed, same_as;
+    int ran, completed, same_as;
     double seconds;
     long newton, mpm_steps;
     curve c;
@@ -128,7 +126,7 @@ typedef struct cfg {
 } cfg;
 
 typedef struct opts {
-    int full, threads, dry, has_dem_rule, has_reuse, steps;
+    int full, threads, dry, steps;
     const char *bin, *data, *out, *only;
 } opts;
 
@@ -422,8 +420,8 @@ static int make_cmd(cfg *c, const opts *o, const char *dir) {
         /* n_s = ceil(|dH| / S) clamped to [N, N]; S a hair above inc/N so that the
          * single test's RVE-alone check, ceil(inc / S), is also N */
         double S = INC / c->dem_steps * (1.0 + 1e-6);
-        w = snprintf(dem, sizeof dem, "%s--dem-strain %.9g --dem-min %d --dem-max %d",
-                     o->has_dem_rule ? "--dem-rule strain " : "", S, c->dem_steps, c->dem_steps);
+        w = snprintf(dem, sizeof dem, "--dem-rule strain --dem-strain %.9g --dem-min %d --dem-max %d", S,
+                     c->dem_steps, c->dem_steps);
     } else
         w = snprintf(dem, sizeof dem, "--dem-rule adaptive");
     if (c->reuse > 0) snprintf(dem + strlen(dem), sizeof dem - strlen(dem), " --tangent-reuse %g", c->reuse);
@@ -460,17 +458,6 @@ static void run_one(cfg *L, int i, const opts *o) {
         return;
     }
     c->newton = -1, c->mpm_steps = -1;
-    if (c->kind != K_MPM && c->dem_steps == 0 && !o->has_dem_rule) {
-        c->skipped = 1;
-        printf("skip %-34s %s/femdem_biaxial has no --dem-rule (adaptive rule not there yet)\n", c->id,
-               o->bin);
-        return;
-    }
-    if (c->reuse > 0 && !o->has_reuse) {
-        c->skipped = 1;
-        printf("skip %-34s %s/femdem_biaxial has no --tangent-reuse\n", c->id, o->bin);
-        return;
-    }
     for (k = 0; k < i; ++k) /* same command line (up to the directory): reuse that run */
         if (L[k].ran && !strcmp(L[k].packing, c->packing) && L[k].kind == c->kind &&
             L[k].dem_steps == c->dem_steps && L[k].use_float == c->use_float &&
@@ -677,8 +664,7 @@ static int write_svg(const char *path, cfg *L, int n) {
     for (k = 0, j = 0; k < n; ++k) {
         const cfg *c = &L[k];
         double x = j < 36 ? 900 : 1040, y = y0 + 26 + 15 * (j < 36 ? j : j - 36);
-        const char *state = c->skipped          ? " (skipped)"
-                            : !c->ran           ? " (not run)"
+        const char *state = !c->ran             ? " (not run)"
                             : c->same_as >= 0   ? " (=row)"
                             : !c->completed     ? " (FAILED)"
                             : c->is_ref         ? " REF"
@@ -808,23 +794,9 @@ int main(int argc, char **argv) {
             return 1;
         }
     }
-    /* does femdem_biaxial know --dem-rule (adaptive rule)? */
-    {
-        char line[1024];
-        snprintf(path, sizeof path, "%s/femdem_biaxial --help 2>&1", o.bin);
-        fp = popen(path, "r");
-        if (fp) {
-            while (fgets(line, sizeof line, fp)) {
-                if (strstr(line, "--dem-rule")) o.has_dem_rule = 1;
-                if (strstr(line, "--tangent-reuse")) o.has_reuse = 1;
-            }
-            pclose(fp);
-        }
-    }
     n = build_list(L, &o);
-    printf(
-        "bench_tradeoff: %s version, %d configurations, %d threads per run; femdem_biaxial %s --dem-rule\n",
-        o.full ? "full" : "short", n, o.threads, o.has_dem_rule ? "has" : "has no");
+    printf("bench_tradeoff: %s version, %d configurations, %d threads per run\n", o.full ? "full" : "short",
+           n, o.threads);
     if (!o.dry && mkdirs(o.out)) {
         fprintf(stderr, "bench_tradeoff: cannot create %s\n", o.out);
         return 1;
@@ -889,10 +861,7 @@ int main(int argc, char **argv) {
                                        : "mpm",
                 c->disks ? c->disks : 400, c->packing, c->dem_steps ? "" : "adaptive", c->dem_steps,
                 c->use_float ? "float" : "double", c->tangent, c->reuse, c->nx, c->ny,
-                c->kind == K_MPM ? "" : c->element, c->ppc, o.threads,
-                c->skipped     ? "skipped"
-                : c->completed ? "yes"
-                               : "no",
+                c->kind == K_MPM ? "" : c->element, c->ppc, o.threads, c->completed ? "yes" : "no",
                 c->seconds, nit, nmpm, c->c.n ? c->c.eps[c->c.n - 1] : NAN, R, ep, c->err_peak, c->eps_a,
                 c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_ev, c->err_max, c->err_base, refl, o.out,
                 c->same_as >= 0 ? L[c->same_as].id : c->id);
@@ -903,10 +872,7 @@ int main(int argc, char **argv) {
         fmt(b[4], 32, c->err_max, 100, "%.2f");
         fmt(b[5], 32, c->err_base, 100, "%.2f");
         printf("%-8s %-10s %-34s %3s %8.1f %7ld %8s %8s %8s %9s %8s %8s%s\n", c->group, c->sweep, c->label,
-               c->skipped     ? "skp"
-               : c->completed ? "yes"
-                              : "NO",
-               c->seconds, c->newton, b[0], b[1], b[2], b[3], b[4], b[5],
+               c->completed ? "yes" : "NO", c->seconds, c->newton, b[0], b[1], b[2], b[3], b[4], b[5],
                c->is_ref         ? "  (reference)"
                : c->same_as >= 0 ? "  (same run as above)"
                                  : "");
@@ -915,13 +881,12 @@ int main(int argc, char **argv) {
     printf("\n");
     for (i = 0; i < n; ++i) {
         cfg *c = &L[i];
-        printf("BENCH case=tradeoff group=%s sweep=%s config=\"%s\" completed=%d skipped=%d seconds=%.3f "
+        printf("BENCH case=tradeoff group=%s sweep=%s config=\"%s\" completed=%d seconds=%.3f "
                "newton_iterations=%ld mpm_steps=%ld err_peak=%.4g eps_a=%g err_sa=%.4g eps_b=%g err_sb=%.4g "
                "ev_rms=%.4g err_max=%.4g "
                "err_twin=%.4g reference=%d\n",
-               c->group, c->sweep, c->label, c->completed, c->skipped, c->seconds, c->newton, c->mpm_steps,
-               c->err_peak, c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_max, c->err_base,
-               c->is_ref);
+               c->group, c->sweep, c->label, c->completed, c->seconds, c->newton, c->mpm_steps, c->err_peak,
+               c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_max, c->err_base, c->is_ref);
     }
     snprintf(path, sizeof path, "%s/tradeoff.svg", o.out);
     if (write_svg(path, L, n)) fprintf(stderr, "bench_tradeoff: cannot write %s\n", path);
