@@ -151,6 +151,7 @@
 #include "gk_homog.h"
 #include "gk_io.h"
 #include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -342,6 +343,27 @@ static int num_arg(const char *s, double *v) {
     errno = 0;
     *v = strtod(s, &end);
     return end == s || *end || errno == ERANGE || !isfinite(*v);
+}
+
+/* a whole-number or real option value, strictly ('12x', '', '1e999' are refused with a message); 0 or 1 */
+static int int_opt(const char *a, const char *v, int *out) {
+    char *end;
+    long x;
+    errno = 0;
+    x = strtol(v, &end, 10);
+    if (end == v || *end || errno == ERANGE || x < INT_MIN || x > INT_MAX) {
+        fprintf(stderr, "femdem_biaxial: %s '%s' is not a whole number\n", a, v);
+        return 1;
+    }
+    *out = (int)x;
+    return 0;
+}
+static int dbl_opt(const char *a, const char *v, double *out) {
+    if (num_arg(v, out)) {
+        fprintf(stderr, "femdem_biaxial: %s '%s' is not a finite number\n", a, v);
+        return 1;
+    }
+    return 0;
 }
 
 static int mkdir_p(const char *d) {
@@ -1730,6 +1752,7 @@ int main(int argc, char **argv) {
     o->liq_ratio = 0.1, o->packing_seed = 1;
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int bad = 0;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             usage(stdout);
             return 0;
@@ -1743,9 +1766,9 @@ int main(int argc, char **argv) {
             return 2;
         }
         if (!strcmp(a, "--nx"))
-            o->nx = atoi(v);
+            bad = int_opt(a, v, &o->nx);
         else if (!strcmp(a, "--ny"))
-            o->ny = atoi(v);
+            bad = int_opt(a, v, &o->ny);
         else if (!strcmp(a, "--element")) {
             if (!strcmp(v, "q8"))
                 o->elem = GK_Q8;
@@ -1756,23 +1779,23 @@ int main(int argc, char **argv) {
                 return 2;
             }
         } else if (!strcmp(a, "--quad"))
-            o->quad = atoi(v);
+            bad = int_opt(a, v, &o->quad);
         else if (!strcmp(a, "--steps"))
-            o->steps = atoi(v);
+            bad = int_opt(a, v, &o->steps);
         else if (!strcmp(a, "--increment"))
-            o->inc = atof(v);
+            bad = dbl_opt(a, v, &o->inc);
         else if (!strcmp(a, "--threads"))
-            o->threads = atoi(v);
+            bad = int_opt(a, v, &o->threads);
         else if (!strcmp(a, "--out"))
             o->out = v;
         else if (!strcmp(a, "--tangent"))
             o->tangent = v;
         else if (!strcmp(a, "--xi"))
-            o->xi = atof(v);
+            bad = dbl_opt(a, v, &o->xi);
         else if (!strcmp(a, "--restart"))
             o->restart = v;
         else if (!strcmp(a, "--checkpoint"))
-            o->checkpoint = atoi(v);
+            bad = int_opt(a, v, &o->checkpoint);
         else if (!strcmp(a, "--test"))
             o->test = v;
         else if (!strcmp(a, "--packing"))
@@ -1787,19 +1810,19 @@ int main(int argc, char **argv) {
                 return 2;
             }
         } else if (!strcmp(a, "--width"))
-            o->width = atof(v);
+            bad = dbl_opt(a, v, &o->width);
         else if (!strcmp(a, "--height"))
-            o->height = atof(v);
+            bad = dbl_opt(a, v, &o->height);
         else if (!strcmp(a, "--pressure"))
-            o->pressure = atof(v);
+            bad = dbl_opt(a, v, &o->pressure);
         else if (!strcmp(a, "--tol"))
-            o->tol = atof(v);
+            bad = dbl_opt(a, v, &o->tol);
         else if (!strcmp(a, "--ftol"))
-            o->ftol = atof(v);
+            bad = dbl_opt(a, v, &o->ftol);
         else if (!strcmp(a, "--max-iter"))
-            o->max_iter = atoi(v);
+            bad = int_opt(a, v, &o->max_iter);
         else if (!strcmp(a, "--dt"))
-            o->dt = atof(v);
+            bad = dbl_opt(a, v, &o->dt);
         else if (!strcmp(a, "--dem-rule")) {
             if (!strcmp(v, "adaptive"))
                 o->dem_adaptive = 1;
@@ -1836,19 +1859,19 @@ int main(int argc, char **argv) {
             }
             *(!strcmp(a, "--dem-min") ? &o->dem_min : &o->dem_max) = (int)x;
         } else if (!strcmp(a, "--vtk-every"))
-            o->vtk_every = atoi(v);
+            bad = int_opt(a, v, &o->vtk_every);
         else if (!strcmp(a, "--amplitude"))
-            o->amp = atof(v);
+            bad = dbl_opt(a, v, &o->amp);
         else if (!strcmp(a, "--tau-amplitude"))
-            o->tau_amp = atof(v);
+            bad = dbl_opt(a, v, &o->tau_amp);
         else if (!strcmp(a, "--stress-steps"))
-            o->stress_steps = atoi(v);
+            bad = int_opt(a, v, &o->stress_steps);
         else if (!strcmp(a, "--cycles"))
-            o->cycles = atof(v);
+            bad = dbl_opt(a, v, &o->cycles);
         else if (!strcmp(a, "--liq-ratio"))
-            o->liq_ratio = atof(v);
+            bad = dbl_opt(a, v, &o->liq_ratio);
         else if (!strcmp(a, "--gamma-limit"))
-            o->gamma_stop = atof(v);
+            bad = dbl_opt(a, v, &o->gamma_stop);
         else if (!strcmp(a, "--relaxation")) {
             if (!strcmp(v, "aitken"))
                 o->aitken = 1;
@@ -1864,6 +1887,7 @@ int main(int argc, char **argv) {
             fprintf(stderr, "femdem_biaxial: unknown option %s (see --help)\n", a);
             return 2;
         }
+        if (bad) return 2;
         ++i;
     }
     o->cyclic = !strcmp(o->test, "cyclic-strain") ? 1 : !strcmp(o->test, "cyclic-stress") ? 2 : 0;

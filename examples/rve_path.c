@@ -23,6 +23,8 @@
 #define GK_IMPLEMENTATION
 #include "gk_homog.h"
 #include "gk_io.h"
+#include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -64,12 +66,34 @@ static int parse_numbers(const char *s, double *out, int max) {
         while (*s == ' ' || *s == ',' || *s == '\t') ++s;
         if (!*s) break;
         v = strtod(s, &e);
-        if (e == s) return -1;
+        if (e == s || !isfinite(v)) return -1;
         if (n < max) out[n] = v;
         ++n;
         s = e;
     }
     return n;
+}
+
+/* a real or whole-number option value, strictly ('1e9x', '', 'nan', out of range: refused by name) */
+static int real_opt(const char *a, const char *v, double *out) {
+    char *e;
+    errno = 0;
+    *out = strtod(v, &e);
+    if (e == v || *e || errno == ERANGE || !isfinite(*out)) {
+        fprintf(stderr, "rve_path: %s '%s' is not a finite number\n", a, v);
+        return 1;
+    }
+    return 0;
+}
+static int long_opt(const char *a, const char *v, long *out) {
+    char *e;
+    errno = 0;
+    *out = strtol(v, &e, 10);
+    if (e == v || *e || errno == ERANGE) {
+        fprintf(stderr, "rve_path: %s '%s' is not a whole number\n", a, v);
+        return 1;
+    }
+    return 0;
 }
 
 int main(int argc, char **argv) {
@@ -89,6 +113,7 @@ int main(int argc, char **argv) {
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int bad = 0;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             usage(stdout);
             return 0;
@@ -99,26 +124,35 @@ int main(int argc, char **argv) {
         }
         if (!strcmp(a, "--packing")) packing = v;
         else if (!strcmp(a, "--dH")) dhs = v;
-        else if (!strcmp(a, "--increments")) ninc = atol(v);
-        else if (!strcmp(a, "--steps-per-increment")) nsteps = atol(v);
-        else if (!strcmp(a, "--E")) E = atof(v);
-        else if (!strcmp(a, "--kt-ratio")) ktr = atof(v);
-        else if (!strcmp(a, "--friction-angle")) phi = atof(v);
-        else if (!strcmp(a, "--density")) rho = atof(v);
-        else if (!strcmp(a, "--thickness")) thick = atof(v);
-        else if (!strcmp(a, "--damping")) damp = atof(v);
+        else if (!strcmp(a, "--increments")) bad = long_opt(a, v, &ninc);
+        else if (!strcmp(a, "--steps-per-increment")) bad = long_opt(a, v, &nsteps);
+        else if (!strcmp(a, "--E")) bad = real_opt(a, v, &E);
+        else if (!strcmp(a, "--kt-ratio")) bad = real_opt(a, v, &ktr);
+        else if (!strcmp(a, "--friction-angle")) bad = real_opt(a, v, &phi);
+        else if (!strcmp(a, "--density")) bad = real_opt(a, v, &rho);
+        else if (!strcmp(a, "--thickness")) bad = real_opt(a, v, &thick);
+        else if (!strcmp(a, "--damping")) bad = real_opt(a, v, &damp);
         else if (!strcmp(a, "--damping-form")) form = v;
-        else if (!strcmp(a, "--dt")) dt = atof(v);
+        else if (!strcmp(a, "--dt")) bad = real_opt(a, v, &dt);
         else if (!strcmp(a, "--law")) law = v;
-        else if (!strcmp(a, "--poisson")) poisson = atof(v);
+        else if (!strcmp(a, "--poisson")) bad = real_opt(a, v, &poisson);
         else if (!strcmp(a, "--path")) path = v;
-        else if (!strcmp(a, "--threads")) threads = atoi(v);
+        else if (!strcmp(a, "--threads")) {
+            long t = 0;
+            bad = long_opt(a, v, &t);
+            if (!bad && (t < 1 || t > 4096)) {
+                fprintf(stderr, "rve_path: --threads %ld: needs 1 to 4096\n", t);
+                bad = 1;
+            }
+            threads = (int)t;
+        }
         else if (!strcmp(a, "--out")) out = v;
         else if (!strcmp(a, "--svg")) svg = v;
         else {
             fprintf(stderr, "rve_path: unknown option %s (see --help)\n", a);
             return 2;
         }
+        if (bad) return 2;
         ++i;
     }
     if (!packing || !dhs) {
@@ -135,6 +169,10 @@ int main(int argc, char **argv) {
     }
     dim = pk.dim;
     nd = parse_numbers(dhs, dHin, 9);
+    if (nd < 0) {
+        fprintf(stderr, "rve_path: --dH '%s' is not a list of finite numbers\n", dhs);
+        return 2;
+    }
     if (nd != dim * dim) {
         fprintf(stderr, "rve_path: --dH needs %d numbers for a %dD packing, got %d\n", dim * dim, dim, nd);
         return 2;

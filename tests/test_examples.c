@@ -53,6 +53,16 @@ TEST(rve_path_writes_csv_and_svg) {
     CHECK(gk_test_file_has("build/t_bad.out", "needs 4 numbers"));
     CHECK(system("build/rve_path --packing no_such_file --dH \"0 0 0 0\" > build/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_bad.out", "no_such_file"));
+    /* numbers are parsed strictly (atof took '6e8x' as 6e8) */
+    CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --E 6e8x "
+                 "> build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "--E '6e8x' is not a finite number"));
+    CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 5.5 "
+                 "> build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "--increments '5.5' is not a whole number"));
+    CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 nan 0 0\" "
+                 "> build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "is not a list of finite numbers"));
     CHECK(system("build/rve_path --help > build/t_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/t_bad.out", "--steps-per-increment"));
 }
@@ -323,6 +333,21 @@ static int fd_refused(const char *flags, const char *msg) {
     return ok;
 }
 
+/* every numeric flag is parsed strictly: a value with trailing text, an empty one, one out of the
+ * type's range or not finite is refused by name (atoi/atof took '8x' as 8 and 'abc' as 0) */
+TEST(femdem_refuses_malformed_numbers) {
+    CHECK(fd_refused("--nx 8x", "--nx '8x' is not a whole number"));
+    CHECK(fd_refused("--ny 2.5", "--ny '2.5' is not a whole number"));
+    CHECK(fd_refused("--steps ''", "--steps '' is not a whole number"));
+    CHECK(fd_refused("--threads 99999999999", "is not a whole number"));
+    CHECK(fd_refused("--max-iter ten", "--max-iter 'ten' is not a whole number"));
+    CHECK(fd_refused("--tol abc", "--tol 'abc' is not a finite number"));
+    CHECK(fd_refused("--pressure 1e5Pa", "--pressure '1e5Pa' is not a finite number"));
+    CHECK(fd_refused("--increment 1e999", "is not a finite number"));
+    CHECK(fd_refused("--test cyclic-strain --amplitude nan", "--amplitude 'nan' is not a finite number"));
+    CHECK(fd_refused("--nx 0", "out of range")); /* well-formed but out of range: the range check */
+}
+
 /* issue 6: the DEM step rule (adaptive by default) and tangent reuse in femdem_biaxial. 2 x 2 Q4, 16
  * RVEs, a few 0.1 % steps. */
 TEST(femdem_dem_rule_and_tangent_reuse) {
@@ -505,6 +530,7 @@ int main(int argc, char **argv) {
     RUN(gk_pack_makes_a_consolidated_packing);
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
     RUN(femdem_single_element_matches_rve_alone);
+    RUN(femdem_refuses_malformed_numbers);
     RUN(femdem_dem_rule_and_tangent_reuse);
     RUN(femdem_heterogeneous_packings);
     RUN(femdem_cyclic_strain_constant_volume_and_contractive);
