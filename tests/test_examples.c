@@ -71,6 +71,7 @@ TEST(rve_path_writes_csv_and_svg) {
 TEST(gk_pack_makes_a_consolidated_packing) {
     gk_packing pk;
     gk_err e;
+    FILE *fp;
     CHECK(
         system(
             "build/gk_pack --dim 2 --n 120 --pressure 1e5 --out build/t_pack.txt > build/t_pack.out 2>&1") ==
@@ -80,6 +81,18 @@ TEST(gk_pack_makes_a_consolidated_packing) {
     CHECK(pk.n == 120 && pk.dim == 2);
     CHECK(gk_test_file_has("build/t_pack.txt", "RVE state: stress"));
     gk_packing_free(&pk);
+    /* numbers are parsed strictly, and nothing is written for a refused one */
+    remove("build/t_pack_bad.txt");
+    CHECK(system("build/gk_pack --dim 2 --n 120x --out build/t_pack_bad.txt > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "--n '120x' is not a whole number"));
+    CHECK(system("build/gk_pack --dim 2 --pressure 1e5Pa --out build/t_pack_bad.txt "
+                 "> build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "--pressure '1e5Pa' is not a finite number"));
+    CHECK(system("build/gk_pack --dim 2 --seed -1 --out build/t_pack_bad.txt > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "--seed '-1' is not a non-negative whole number"));
+    fp = fopen("build/t_pack_bad.txt", "r");
+    CHECK(!fp);
+    if (fp) fclose(fp);
 }
 
 /* the first `ncol` columns of every data row of two CSV files are identical */

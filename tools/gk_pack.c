@@ -15,6 +15,9 @@
 #define GK_IMPLEMENTATION
 #include "gk_homog.h"
 #include "gk_io.h"
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -65,6 +68,30 @@ static gk_result consolidate_once(const opts *o, const gk_packing *cloud, double
     return r;
 }
 
+/* a real or whole-number option value, strictly ('1e5x', '', 'nan', out of range: refused by name) */
+static int real_opt(const char *a, const char *v, double *out) {
+    char *e;
+    errno = 0;
+    *out = strtod(v, &e);
+    if (e == v || *e || errno == ERANGE || !isfinite(*out)) {
+        fprintf(stderr, "gk_pack: %s '%s' is not a finite number\n", a, v);
+        return 1;
+    }
+    return 0;
+}
+static int int_opt(const char *a, const char *v, int *out) {
+    char *e;
+    long x;
+    errno = 0;
+    x = strtol(v, &e, 10);
+    if (e == v || *e || errno == ERANGE || x < INT_MIN || x > INT_MAX) {
+        fprintf(stderr, "gk_pack: %s '%s' is not a whole number\n", a, v);
+        return 1;
+    }
+    *out = (int)x;
+    return 0;
+}
+
 int main(int argc, char **argv) {
     opts o;
     gk_gen_def g;
@@ -93,6 +120,7 @@ int main(int argc, char **argv) {
     o.psd_by = "mass";
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int bad = 0;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             usage(stdout);
             return 0;
@@ -101,28 +129,37 @@ int main(int argc, char **argv) {
             fprintf(stderr, "gk_pack: %s needs a value\n", a);
             return 2;
         }
-        if (!strcmp(a, "--dim")) o.dim = atoi(v);
-        else if (!strcmp(a, "--n")) o.n = atoi(v);
-        else if (!strcmp(a, "--rmin")) o.rmin = atof(v);
-        else if (!strcmp(a, "--rmax")) o.rmax = atof(v);
+        if (!strcmp(a, "--dim")) bad = int_opt(a, v, &o.dim);
+        else if (!strcmp(a, "--n")) bad = int_opt(a, v, &o.n);
+        else if (!strcmp(a, "--rmin")) bad = real_opt(a, v, &o.rmin);
+        else if (!strcmp(a, "--rmax")) bad = real_opt(a, v, &o.rmax);
         else if (!strcmp(a, "--psd")) o.psd = v;
         else if (!strcmp(a, "--psd-by")) o.psd_by = v;
-        else if (!strcmp(a, "--pressure")) o.pressure = atof(v);
-        else if (!strcmp(a, "--consolidation-friction")) o.mu_cons = atof(v);
-        else if (!strcmp(a, "--target-void-ratio")) o.target_e = atof(v);
-        else if (!strcmp(a, "--friction-angle")) o.phi = atof(v);
-        else if (!strcmp(a, "--E")) o.E = atof(v);
-        else if (!strcmp(a, "--kt-ratio")) o.ktr = atof(v);
-        else if (!strcmp(a, "--density")) o.rho = atof(v);
-        else if (!strcmp(a, "--thickness")) o.thick = atof(v);
-        else if (!strcmp(a, "--damping")) o.damp = atof(v);
-        else if (!strcmp(a, "--seed")) o.seed = strtoul(v, NULL, 10);
-        else if (!strcmp(a, "--tol")) o.tol = atof(v);
+        else if (!strcmp(a, "--pressure")) bad = real_opt(a, v, &o.pressure);
+        else if (!strcmp(a, "--consolidation-friction")) bad = real_opt(a, v, &o.mu_cons);
+        else if (!strcmp(a, "--target-void-ratio")) bad = real_opt(a, v, &o.target_e);
+        else if (!strcmp(a, "--friction-angle")) bad = real_opt(a, v, &o.phi);
+        else if (!strcmp(a, "--E")) bad = real_opt(a, v, &o.E);
+        else if (!strcmp(a, "--kt-ratio")) bad = real_opt(a, v, &o.ktr);
+        else if (!strcmp(a, "--density")) bad = real_opt(a, v, &o.rho);
+        else if (!strcmp(a, "--thickness")) bad = real_opt(a, v, &o.thick);
+        else if (!strcmp(a, "--damping")) bad = real_opt(a, v, &o.damp);
+        else if (!strcmp(a, "--seed")) {
+            char *e;
+            errno = 0;
+            o.seed = strtoul(v, &e, 10);
+            if (e == v || *e || errno == ERANGE || v[0] == '-') {
+                fprintf(stderr, "gk_pack: --seed '%s' is not a non-negative whole number\n", v);
+                bad = 1;
+            }
+        }
+        else if (!strcmp(a, "--tol")) bad = real_opt(a, v, &o.tol);
         else if (!strcmp(a, "--out")) o.out = v;
         else {
             fprintf(stderr, "gk_pack: unknown option %s (see --help)\n", a);
             return 2;
         }
+        if (bad) return 2;
         ++i;
     }
     if (!o.out) {
