@@ -177,6 +177,7 @@ typedef struct opts {
     double dem_inertial, dem_unbalanced, tangent_reuse;
     /* cyclic simple shear: cyclic = 1 strain-, 2 stress-controlled */
     int cyclic, stress_steps;
+    int noise_probe; /* diagnostic: at this Newton iteration, the residual's sensitivity to u (0: off) */
     double amp, tau_amp, cycles, gamma_stop, liq_ratio;
     unsigned long packing_seed; /* --packing A,B,...: seed of the per-Gauss-point draw */
 } opts;
@@ -286,7 +287,15 @@ static void usage(FILE *fp) {
         "                         last two corrections (in [0.25, 4]); anderson: Anderson mixing of the\n"
         "                         Newton map u + d(u) over the last iterates; none: plain Newton\n"
         "  --verbose              print E_d, E_f, the DEM steps per RVE (mean, max) and the time of every\n"
-        "                         Newton iteration\n"
+        "                         Newton iteration\n");
+    fprintf(
+        fp,
+        "  --noise-probe K        diagnostic: at Newton iteration K of every step, re-run all RVEs at\n"
+        "                         u (1 + eps), eps = 1e-6 ... 1e-2, and print the change of the residual\n"
+        "                         |R(u (1+eps)) - R(u)| / |f_int| next to E_f: a residual far above\n"
+        "                         that floor is not DEM noise. The iterate is then evaluated at u again\n"
+        "                         (same result; the probe's DEM steps are not counted). Not with\n"
+        "                         --tangent-reuse (the probe would move its reference)\n"
         "\n"
         "biaxial.csv (and cyclic.csv) end with dem_steps_mean,dem_steps_max (per Gauss point, accepted\n"
         "iterate), dem_steps (all DEM steps of the step: every iteration, perturbed run and cut-back\n"
@@ -901,6 +910,42 @@ static double residual(model *M, const double *sig, gk_err *err) {
     return nf > 0 ? norm(M->R, M->ndof) / nf : 0.0;
 }
 
+/* --noise-probe: the change of the residual under u -> u (1 + eps), relative to |f_int|, for eps =
+ * 1e-6 ... 1e-2, printed next to E_f; then the iterate at u again (deterministic: the same stresses and
+ * tangents), the probe's DEM work uncounted. The RVE map is smooth on the scale where the change grows
+ * with eps; its floor at tiny eps is the DEM noise. Returns the number of failed RVE runs. */
+static int noise_probe(model *M, int it, double Ef, gk_err *err) {
+    double *R0 = (double *)malloc((size_t)M->ndof * sizeof(double)),
+           *u0 = (double *)malloc((size_t)M->ndof * sizeof(double)), eps;
+    long long pd = M->pend_dem, pr = M->pend_reused, pc = M->pend_computed;
+    int k, nbad = 0;
+    if (!R0 || !u0) {
+        free(R0), free(u0);
+        fprintf(stderr, "    noise probe: out of memory, skipped\n");
+        return 0;
+    }
+    memcpy(R0, M->R, (size_t)M->ndof * sizeof(double));
+    memcpy(u0, M->u, (size_t)M->ndof * sizeof(double));
+    fprintf(stderr, "    noise probe at iteration %d (E_f %.3e): |R(u(1+eps)) - R(u)| / |f_int| =", it, Ef);
+    for (eps = 1e-6; eps < 2e-2 && !nbad; eps *= 10) {
+        double d = 0.0, fn;
+        for (k = 0; k < M->ndof; ++k) M->u[k] = u0[k] * (1.0 + eps);
+        nbad = eval_rves(M, M->u);
+        if (nbad) break;
+        residual(M, M->sig, err);
+        fn = norm(M->fint, M->ndof);
+        for (k = 0; k < M->ndof; ++k) d += (M->R[k] - R0[k]) * (M->R[k] - R0[k]);
+        fprintf(stderr, " %.0e: %.2e", eps, fn > 0 ? sqrt(d) / fn : 0.0);
+    }
+    fprintf(stderr, nbad ? " (an RVE run failed)\n" : "\n");
+    memcpy(M->u, u0, (size_t)M->ndof * sizeof(double));
+    nbad = eval_rves(M, M->u);
+    if (!nbad) residual(M, M->sig, err);
+    M->pend_dem = pd, M->pend_reused = pr, M->pend_computed = pc;
+    free(R0), free(u0);
+    return nbad;
+}
+
 /* one load (sub)step of axial strain inc; 0 = converged, 1 = not converged,
  * 2 = hard error */
 static int load_step(model *M, double inc, int *iters, double *Ed_out, double *Ef_out, gk_err *err) {
@@ -925,6 +970,11 @@ static int load_step(model *M, double inc, int *iters, double *Ed_out, double *E
         }
         Ef = residual(M, M->sig, err);
         Rn = norm(M->R, M->ndof);
+        if (it == M->o.noise_probe && noise_probe(M, it, Ef, err)) {
+            gk_err_set(err, GK_ERR_STATE, "an RVE run failed again at the iterate after the noise probe");
+            *iters = it, *Ed_out = Ed, *Ef_out = Ef;
+            return 1;
+        }
         if (M->o.verbose) {
             double nmean;
             int nmax;
@@ -1872,6 +1922,8 @@ int main(int argc, char **argv) {
             bad = dbl_opt(a, v, &o->liq_ratio);
         else if (!strcmp(a, "--gamma-limit"))
             bad = dbl_opt(a, v, &o->gamma_stop);
+        else if (!strcmp(a, "--noise-probe"))
+            bad = int_opt(a, v, &o->noise_probe);
         else if (!strcmp(a, "--relaxation")) {
             if (!strcmp(v, "aitken"))
                 o->aitken = 1;
@@ -1937,8 +1989,13 @@ int main(int argc, char **argv) {
         o->quad < 1 || o->quad > 3 || o->max_iter < 2 || !(o->inc > 0 && o->inc < 0.1) || !(o->tol > 0) ||
         !(o->ftol >= 0) || !(o->width > 0) || !(o->height > 0) || !(o->pressure >= 0) || !(o->dt > 0) ||
         !(o->dem_strain > 0) || o->dem_min < 1 || o->dem_max < o->dem_min || !(o->xi > 0) ||
-        o->checkpoint < 0 || o->vtk_every < 0) {
+        o->checkpoint < 0 || o->vtk_every < 0 || o->noise_probe < 0) {
         fprintf(stderr, "femdem_biaxial: an option is out of range (see --help)\n");
+        return 2;
+    }
+    if (o->noise_probe > 0 && o->tangent_reuse > 0) {
+        fprintf(stderr, "femdem_biaxial: --noise-probe re-runs the RVEs and would move the reference of "
+                        "--tangent-reuse: use one of them\n");
         return 2;
     }
     if (strcmp(o->tangent, "taylor") && strcmp(o->tangent, "yade") && strcmp(o->tangent, "perturbation")) {

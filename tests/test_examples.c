@@ -361,6 +361,33 @@ TEST(femdem_refuses_malformed_numbers) {
     CHECK(fd_refused("--nx 0", "out of range")); /* well-formed but out of range: the range check */
 }
 
+/* --noise-probe: a line of residual changes per step for the 5 values of eps, and the run itself is
+ * unchanged (every CSV column but the seconds, DEM work counts included); refused with tangent reuse */
+TEST(femdem_noise_probe_leaves_the_run_unchanged) {
+    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
+    char cmd[512], header[512];
+    double a[4 * F_NCOL], b[4 * F_NCOL];
+    int na, nb, r, k, same = 1;
+    snprintf(cmd, sizeof cmd, "%s --out build/t_fnp0 > build/t_fnp0.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    snprintf(cmd, sizeof cmd, "%s --noise-probe 2 --out build/t_fnp1 > build/t_fnp1.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    CHECK(gk_test_file_has("build/t_fnp1.out", "noise probe at iteration 2 (E_f "));
+    CHECK(gk_test_file_has("build/t_fnp1.out", " 1e-06: "));
+    CHECK(gk_test_file_has("build/t_fnp1.out", " 1e-02: "));
+    CHECK(!gk_test_file_has("build/t_fnp0.out", "noise probe"));
+    na = read_csv("build/t_fnp0/biaxial.csv", F_NCOL, a, 4, header, sizeof header);
+    nb = read_csv("build/t_fnp1/biaxial.csv", F_NCOL, b, 4, header, sizeof header);
+    CHECK_EQ_INT(na, 4);
+    CHECK_EQ_INT(nb, 4);
+    for (r = 0; r < 4 && na == 4 && nb == 4; ++r)
+        for (k = 0; k < F_NCOL; ++k)
+            if (k != 6 && a[r * F_NCOL + k] != b[r * F_NCOL + k]) same = 0; /* column 6: seconds */
+    CHECK(same);
+    CHECK(fd_refused("--noise-probe 2 --tangent-reuse 0.1", "use one of them"));
+    CHECK(fd_refused("--noise-probe -1", "out of range"));
+}
+
 /* issue 6: the DEM step rule (adaptive by default) and tangent reuse in femdem_biaxial. 2 x 2 Q4, 16
  * RVEs, a few 0.1 % steps. */
 TEST(femdem_dem_rule_and_tangent_reuse) {
@@ -544,6 +571,7 @@ int main(int argc, char **argv) {
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
     RUN(femdem_single_element_matches_rve_alone);
     RUN(femdem_refuses_malformed_numbers);
+    RUN(femdem_noise_probe_leaves_the_run_unchanged);
     RUN(femdem_dem_rule_and_tangent_reuse);
     RUN(femdem_heterogeneous_packings);
     RUN(femdem_cyclic_strain_constant_volume_and_contractive);
