@@ -70,9 +70,10 @@
  *     seed; both are the seed's footnote's pairs of displacement and force
  *     criteria). Both E_d and E_f of the accepted iterate are in the CSV;
  *     --ftol 0 restores the pure eq 21 criterion. --noise-probe measures
- *     the RVE noise floor of the residual: on the 8 x 16 mesh it is 5e-6 to
- *     2e-5 of |f_int| while the iterates' E_f is 2e-3 to 1e-2, so what slows
- *     Newton near and after the peak is the affine tangent, not DEM noise.
+ *     how much DEM noise moves the residual: on the 8 x 16 mesh at most
+ *     3e-4 of |f_int| (u scaled by up to 1 + 1e-3) while the iterates' E_f
+ *     is 2e-3 to 1e-2, so what slows Newton near and after the peak is the
+ *     affine tangent, not DEM noise.
  *   - Aitken relaxation: the approximate (affine) tangent makes Newton
  *     converge linearly with a nearly constant ratio; the correction d_k is
  *     scaled by w_k = -w_(k-1) d_(k-1).(d_k - d_(k-1)) / |d_k - d_(k-1)|^2
