@@ -914,8 +914,9 @@ static double residual(model *M, const double *sig, gk_err *err) {
 
 /* --noise-probe: the change of the residual under u -> u (1 + eps), relative to |f_int|, for eps =
  * 1e-6 ... 1e-2, printed next to E_f; then the iterate at u again (deterministic: the same stresses and
- * tangents), the probe's DEM work uncounted. The RVE map is smooth on the scale where the change grows
- * with eps; its floor at tiny eps is the DEM noise. Returns the number of failed RVE runs. */
+ * tangents), the probe's DEM work uncounted. Where the change grows in proportion to eps it is the RVE
+ * map's response; where it grows much more slowly (tiny eps) it is DEM noise. Returns the number of
+ * failed RVE runs. */
 static int noise_probe(model *M, int it, double Ef, gk_err *err) {
     double *R0 = (double *)malloc((size_t)M->ndof * sizeof(double)),
            *u0 = (double *)malloc((size_t)M->ndof * sizeof(double)), eps;
