@@ -181,6 +181,7 @@ typedef struct opts {
     /* cyclic simple shear: cyclic = 1 strain-, 2 stress-controlled */
     int cyclic, stress_steps;
     int noise_probe; /* diagnostic: at this Newton iteration, the residual's sensitivity to u (0: off) */
+    int ed_newton;   /* E_d from the Newton correction before relaxation (1) or the step taken (0, eq 21) */
     double amp, tau_amp, cycles, gamma_stop, liq_ratio;
     unsigned long packing_seed; /* --packing A,B,...: seed of the per-Gauss-point draw */
 } opts;
@@ -282,6 +283,10 @@ static void usage(FILE *fp) {
         "  --tol T                Newton tolerance on E_d = |du|/|u| (eq 21; default 0.01)\n"
         "  --ftol F               a step also converges when E_f = |R_free|/|f_int| < F (default 0.003;\n"
         "                         0: eq 21 alone; see README \"Convergence\")\n"
+        "  --ed step|newton       what E_d measures: step (default; eq 21 as written: the change of the\n"
+        "                         iterate, so after an Aitken factor below 1 or a halving it is smaller\n"
+        "                         than the Newton correction) or newton (the Newton correction before\n"
+        "                         relaxation; a halving is not one)\n"
         "  --max-iter N           iterations before a load step is cut back (default 20)\n"
         "  --dt DT                DEM time step (default 3.16e-5 s, the authors')\n"
         "  --vtk-every K          VTK files every K steps (default 1; 0: none)\n"
@@ -954,7 +959,8 @@ static int noise_probe(model *M, int it, double Ef, gk_err *err) {
 static int load_step(model *M, double inc, int *iters, double *Ed_out, double *Ef_out, gk_err *err) {
     int it, k, nbad, have_prev = 0, hist = 0, it_and = 0;
     /* prescribed platen displacement: biaxial top u_y = -inc H, cyclic top u_x = inc H (inc = d gamma) */
-    double Ed = 1.0, Ef = 0.0, Rprev = HUGE_VAL, top = (M->o.cyclic ? inc : -inc) * M->o.height, omega = 1.0;
+    double Ed = 1.0, Ef = 0.0, Rprev = HUGE_VAL, top = (M->o.cyclic ? inc : -inc) * M->o.height, omega = 1.0,
+           dnewton = 0.0;
     precompute_gradients(M);
     if (external_force(M, err)) return 2;
     /* predictor: K(D_n) u = f_ext - f_int(sig_n) with the prescribed increment */
@@ -995,7 +1001,8 @@ static int load_step(model *M, double inc, int *iters, double *Ed_out, double *E
         if (M->o.aitken != 2 && it > 2 &&
             Rn > 1.25 * Rprev) { /* line search: the last correction overshot; take back half */
             for (k = 0; k < M->ndof; ++k) M->du[k] *= 0.5, M->u[k] -= M->du[k];
-            Ed = norm(M->du, M->ndof) / (norm(M->u, M->ndof) + 1e-300);
+            /* --ed newton: a backtrack is not a Newton correction; no E_d acceptance before the next one */
+            Ed = M->o.ed_newton ? 1.0 : norm(M->du, M->ndof) / (norm(M->u, M->ndof) + 1e-300);
             Rprev = HUGE_VAL; /* accept whatever the halved step gives */
             have_prev = 0, omega = 1.0;
             if (M->o.verbose) fprintf(stderr, "    iter %2d: residual grew, correction halved\n", it);
@@ -1005,7 +1012,8 @@ static int load_step(model *M, double inc, int *iters, double *Ed_out, double *E
         floor_tangents(M, M->D);
         for (k = 0; k < M->ndof; ++k) M->R[k] = -M->R[k];
         if (solve(M, M->D, M->R, 0.0, M->du, err)) return 1;
-        if (M->o.aitken == 2) { /* Anderson mixing of the Newton map G(u) = u + d(u) */
+        dnewton = norm(M->du, M->ndof); /* the Newton correction before relaxation */
+        if (M->o.aitken == 2) {         /* Anderson mixing of the Newton map G(u) = u + d(u) */
             int n = M->ndof, mm = hist < AND_M ? hist : AND_M, a, b;
             double *G = M->rhs; /* free here: solve() is done */
             for (k = 0; k < n; ++k) G[k] = M->u[k] + M->du[k];
@@ -1071,7 +1079,7 @@ static int load_step(model *M, double inc, int *iters, double *Ed_out, double *E
             for (k = 0; k < M->ndof; ++k) M->du[k] *= omega;
         }
         for (k = 0; k < M->ndof; ++k) M->u[k] += M->du[k];
-        Ed = norm(M->du, M->ndof) / (norm(M->u, M->ndof) + 1e-300);
+        Ed = (M->o.ed_newton ? dnewton : norm(M->du, M->ndof)) / (norm(M->u, M->ndof) + 1e-300);
     }
     *iters = M->o.max_iter, *Ed_out = Ed, *Ef_out = Ef;
     return 1;
@@ -1925,7 +1933,16 @@ int main(int argc, char **argv) {
             bad = dbl_opt(a, v, &o->liq_ratio);
         else if (!strcmp(a, "--gamma-limit"))
             bad = dbl_opt(a, v, &o->gamma_stop);
-        else if (!strcmp(a, "--noise-probe"))
+        else if (!strcmp(a, "--ed")) {
+            if (!strcmp(v, "step"))
+                o->ed_newton = 0;
+            else if (!strcmp(v, "newton"))
+                o->ed_newton = 1;
+            else {
+                fprintf(stderr, "femdem_biaxial: --ed must be step or newton\n");
+                return 2;
+            }
+        } else if (!strcmp(a, "--noise-probe"))
             bad = int_opt(a, v, &o->noise_probe);
         else if (!strcmp(a, "--relaxation")) {
             if (!strcmp(v, "aitken"))

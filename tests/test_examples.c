@@ -385,7 +385,23 @@ TEST(femdem_noise_probe_leaves_the_run_unchanged) {
             if (k != 6 && a[r * F_NCOL + k] != b[r * F_NCOL + k]) same = 0; /* column 6: seconds */
     CHECK(same);
     CHECK(fd_refused("--noise-probe 2 --tangent-reuse 0.1", "use one of them"));
+    CHECK(fd_refused("--ed raw", "--ed must be step or newton"));
     CHECK(fd_refused("--noise-probe -1", "out of range"));
+}
+
+/* --ed newton: E_d is the Newton correction before relaxation; every accepted row of the CSV meets
+ * E_d < 0.01 or E_f < 0.003 (columns 7 and 8) */
+TEST(femdem_ed_newton_accepts_by_the_criterion) {
+    char header[512];
+    double a[4 * F_NCOL];
+    int n, r;
+    CHECK(
+        system(
+            "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3 --ed newton "
+            "--out build/t_fed > build/t_fed.out 2>&1") == 0);
+    n = read_csv("build/t_fed/biaxial.csv", F_NCOL, a, 4, header, sizeof header);
+    CHECK_EQ_INT(n, 4);
+    for (r = 1; r < n; ++r) CHECK(a[r * F_NCOL + 7] < 0.01 || a[r * F_NCOL + 8] < 0.003);
 }
 
 /* issue 6: the DEM step rule (adaptive by default) and tangent reuse in femdem_biaxial. 2 x 2 Q4, 16
@@ -572,6 +588,7 @@ int main(int argc, char **argv) {
     RUN(femdem_single_element_matches_rve_alone);
     RUN(femdem_refuses_malformed_numbers);
     RUN(femdem_noise_probe_leaves_the_run_unchanged);
+    RUN(femdem_ed_newton_accepts_by_the_criterion);
     RUN(femdem_dem_rule_and_tangent_reuse);
     RUN(femdem_heterogeneous_packings);
     RUN(femdem_cyclic_strain_constant_volume_and_contractive);
