@@ -666,7 +666,7 @@ static int setup(model *M, gk_err *err) {
     int n[3], g, a, per = o->quad;
     double org[3] = {0, 0, 0}, len[3];
     gk_packing pks[MAX_PACKINGS];
-    int npk = 0, *pick;
+    int npk = 0, *pick, status = 1;
     gk_rve_def def = gk_rve_def_default();
     n[0] = o->nx, n[1] = o->ny, n[2] = 1;
     len[0] = o->width, len[1] = o->height, len[2] = 1;
@@ -768,24 +768,25 @@ static int setup(model *M, gk_err *err) {
         char *list = (char *)malloc(strlen(o->packing) + 1), *name, *save = NULL;
         int k, cnt[MAX_PACKINGS];
         gk_rng rng;
-        if (!list) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+        if (!list) {
+            gk_err_set(err, GK_ERR_ALLOC, "out of memory");
+            goto out;
+        }
         strcpy(list, o->packing);
         for (name = strtok_r(list, ",", &save); name; name = strtok_r(NULL, ",", &save)) {
-            if (npk == MAX_PACKINGS || gk_packing_read(name, &pks[npk], NULL, err)) {
-                if (npk == MAX_PACKINGS) gk_err_set(err, GK_ERR_ARG, "more than %d packings", MAX_PACKINGS);
-                for (k = 0; k < npk; ++k) gk_packing_free(&pks[k]);
-                free(list);
-                return 1;
+            if (npk == MAX_PACKINGS) {
+                gk_err_set(err, GK_ERR_ARG, "more than %d packings", MAX_PACKINGS);
+                break;
             }
+            if (gk_packing_read(name, &pks[npk], NULL, err)) break;
             if (pks[npk++].dim != 2) {
                 gk_err_set(err, GK_ERR_ARG, "%s is a %dD packing; this driver is 2D", name, pks[npk - 1].dim);
-                for (k = 0; k < npk; ++k) gk_packing_free(&pks[k]);
-                free(list);
-                return 1;
+                break;
             }
         }
-        free(list);
-        if (npk == 0) return gk_err_set(err, GK_ERR_ARG, "--packing names no file"), 1;
+        free(list); /* name != NULL: the loop stopped at an error */
+        if (!name && npk == 0) gk_err_set(err, GK_ERR_ARG, "--packing names no file");
+        if (name || npk == 0) goto out;
         gk_rng_seed(&rng, (uint64_t)o->packing_seed);
         for (k = 0; k < npk; ++k) cnt[k] = 0;
         for (g = 0; g < M->ngp; ++g) ++cnt[pick[g] = npk > 1 ? (int)(gk_rng_u64(&rng) % (uint64_t)npk) : 0];
@@ -800,12 +801,12 @@ static int setup(model *M, gk_err *err) {
     for (g = 0; g < M->ngp; ++g) {
         if (gk_rve_create(&M->rve[g], &def, &pks[pick[g]])) {
             gk_err_set(err, GK_ERR_ARG, "RVE: %s", gk_rve_error(&M->rve[g]));
-            for (a = 0; a < npk; ++a) gk_packing_free(&pks[a]);
-            free(pick);
-            return 1;
+            goto out;
         }
-        if ((g == 0 || npk > 1) && gk_rve_refresh(&M->rve[g]))
-            return gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&M->rve[0])), 1;
+        if ((g == 0 || npk > 1) && gk_rve_refresh(&M->rve[g])) {
+            gk_err_set(err, GK_ERR_STATE, "%s", gk_rve_error(&M->rve[g]));
+            goto out;
+        }
         if (g == 0 && o->cyclic && o->pressure > 0) { /* initial stress other than the packing's own */
             double s0[9], p0;
             gk_rve_stress(&M->rve[0], s0);
@@ -816,38 +817,49 @@ static int setup(model *M, gk_err *err) {
                 memset(&cd, 0, sizeof cd);
                 cd.pressure = o->pressure;
                 cd.friction = M->rve[0].def.mat.friction; /* keep the fabric: no frictionless re-packing */
-                if (gk_rve_consolidate(&M->rve[0], &cd, &rep) || gk_rve_refresh(&M->rve[0]))
-                    return gk_err_set(err, GK_ERR_STATE, "consolidation to %g Pa: %s", o->pressure,
-                                      gk_rve_error(&M->rve[0])),
-                           1;
+                if (gk_rve_consolidate(&M->rve[0], &cd, &rep) || gk_rve_refresh(&M->rve[0])) {
+                    gk_err_set(err, GK_ERR_STATE, "consolidation to %g Pa: %s", o->pressure,
+                               gk_rve_error(&M->rve[0]));
+                    goto out;
+                }
                 printf("femdem_biaxial: RVE consolidated from p = %.1f kPa to %.1f kPa (void ratio %.4f)\n",
                        p0 / 1e3, o->pressure / 1e3, rep.void_ratio);
             }
         }
         if (g > 0 && npk == 1) { /* identical copies: clone the refreshed state of the first */
-            if (gk_rve_state_restore(&M->st[0], &M->rve[g])) return gk_err_set(err, GK_ERR_STATE, "clone"), 1;
+            if (gk_rve_state_restore(&M->st[0], &M->rve[g])) {
+                gk_err_set(err, GK_ERR_STATE, "clone");
+                goto out;
+            }
         } else if (g == 0) {
             gk_rve_state_init(&M->st[0], NULL);
-            if (gk_rve_state_save(&M->st[0], &M->rve[0]))
-                return gk_err_set(err, GK_ERR_ALLOC, "RVE state"), 1;
+            if (gk_rve_state_save(&M->st[0], &M->rve[0])) {
+                gk_err_set(err, GK_ERR_ALLOC, "RVE state");
+                goto out;
+            }
         }
         M->v0[g] = gk_rve_volume(&M->rve[g]);
         if (g > 0) {
             gk_rve_state_init(&M->st[g], NULL);
-            if (gk_rve_state_save(&M->st[g], &M->rve[g]))
-                return gk_err_set(err, GK_ERR_ALLOC, "RVE state"), 1;
+            if (gk_rve_state_save(&M->st[g], &M->rve[g])) {
+                gk_err_set(err, GK_ERR_ALLOC, "RVE state");
+                goto out;
+            }
         }
         gk_rve_stress(&M->rve[g], M->sig_n + 9 * (size_t)g);
-        if (M->tmode == 2) { /* first tangent: Taylor (no trial state yet) */
-            if (gk_homog_tangent(&M->rve[g], 0u, M->D_n + 16 * (size_t)g)) return 1;
-        } else if (gk_homog_tangent(&M->rve[g], M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u,
-                                    M->D_n + 16 * (size_t)g))
-            return gk_err_set(err, GK_ERR_STATE, "tangent"), 1;
+        /* first tangent: Taylor (eq 8 has no trial state yet), keeping sliding contacts for 'yade' */
+        if (gk_homog_tangent(&M->rve[g], M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u,
+                             M->D_n + 16 * (size_t)g)) {
+            gk_err_set(err, GK_ERR_STATE, "tangent");
+            goto out;
+        }
     }
+    M->scale = 1.0;
+    status = 0;
+out: /* the packings and the draw are needed only here */
     for (a = 0; a < npk; ++a) gk_packing_free(&pks[a]);
     free(pick);
-    M->scale = 1.0;
-    return 0;
+    return status;
 }
 
 static void precompute_gradients(model *M) {

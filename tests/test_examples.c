@@ -385,12 +385,11 @@ TEST(femdem_noise_probe_leaves_the_run_unchanged) {
             if (k != 6 && a[r * F_NCOL + k] != b[r * F_NCOL + k]) same = 0; /* column 6: seconds */
     CHECK(same);
     CHECK(fd_refused("--noise-probe 2 --tangent-reuse 0.1", "use one of them"));
-    CHECK(fd_refused("--ed raw", "--ed must be step or newton"));
     CHECK(fd_refused("--noise-probe -1", "out of range"));
 }
 
 /* --ed newton: E_d is the Newton correction before relaxation; every accepted row of the CSV meets
- * E_d < 0.01 or E_f < 0.003 (columns 7 and 8) */
+ * E_d < 0.01 or E_f < 0.003 (columns 7 and 8); a value other than step or newton is refused */
 TEST(femdem_ed_newton_accepts_by_the_criterion) {
     char header[512];
     double a[4 * F_NCOL];
@@ -402,6 +401,7 @@ TEST(femdem_ed_newton_accepts_by_the_criterion) {
     n = read_csv("build/t_fed/biaxial.csv", F_NCOL, a, 4, header, sizeof header);
     CHECK_EQ_INT(n, 4);
     for (r = 1; r < n; ++r) CHECK(a[r * F_NCOL + 7] < 0.01 || a[r * F_NCOL + 8] < 0.003);
+    CHECK(fd_refused("--ed raw", "--ed must be step or newton"));
 }
 
 /* issue 6: the DEM step rule (adaptive by default) and tangent reuse in femdem_biaxial. 2 x 2 Q4, 16
