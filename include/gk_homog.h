@@ -25,6 +25,30 @@
  *       GK_TANGENT_RAW           skip the minor symmetrisation. Default: D is
  *                                symmetrised in (i,j) and in (k,l) as YADE's
  *                                Voigt form, so D:W = 0 for a spin W.
+ *       GK_TANGENT_RELAXED       the particles relax: the contact network of
+ *                                the current state (the same springs A as eq 9,
+ *                                sliding ones by the rule above) with every
+ *                                particle's translation and rotation free to
+ *                                minimise the spring energy at the imposed dH:
+ *         D = (1/V) (K_EE - K_Ef K_ff^-1 K_fE)
+ *                                (static condensation; K_EE / V is eq 9).
+ *                                Always between 0 and eq 9 (H:D:H of both, any
+ *                                H), and equal to eq 9 for a Bravais lattice.
+ *                                It is the quasi-static response of the RVE
+ *                                to a small dH without slip (tested against
+ *                                the DEM relaxed to equilibrium), softer
+ *                                where the network is close to a mechanism,
+ *                                which the affine eq 9 does not see. Cost: a
+ *                                banded Cholesky of the particle system in
+ *                                reverse Cuthill-McKee order, O(n b^2) for n
+ *                                unknowns (dim + rotations per particle with a
+ *                                contact) and band b: far more than eq 9.
+ *                                Exact mechanisms (rigid translation, one-
+ *                                contact particles, free spins) are pinned by
+ *                                a diagonal shift of 1e-10 x the largest
+ *                                diagonal entry. Rolling springs are not
+ *                                included; not with GK_TANGENT_GEOMETRIC
+ *                                (-> GK_ERR_ARG).
  *     Layout: D[((i*dim + j)*dim + k)*dim + l], d sigma_ij = D_ijkl dH_kl,
  *     tension-positive, [Pa]. No contacts -> D = 0 (never NaN).
  *   gk_homog_fabric            phi = (1/N_c) sum n (x) n; 2D anisotropy
@@ -75,6 +99,7 @@
 #define GK_TANGENT_SLIDING_KEEP 1u
 #define GK_TANGENT_GEOMETRIC 2u
 #define GK_TANGENT_RAW 4u
+#define GK_TANGENT_RELAXED 8u
 
 typedef struct gk_coordination {
     double z;        /* 2 N_c / N_p                                 */
@@ -162,43 +187,268 @@ static double gk__pair_branch(const gk_rve *rve, int c, double d[3]) {
     return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 }
 
+/* contact springs of eq 9 for pair c: A (dim x dim, row-major in 3 x 3), branch d; 0 = no contact */
+static int gk__contact_spring(const gk_rve *rve, int c, unsigned opts, double A[9], double d[3], double n[3],
+                              double *dd_out) {
+    int dim = rve->dim, a = rve->pl.i[c], b = rve->pl.j[c], i, k;
+    double dd, delta;
+    gk_real kn, fn, kt;
+    if (!(rve->cs[c] & GK_CS_CONTACT)) return 0;
+    dd = gk__pair_branch(rve, c, d);
+    if (!(dd > 0.0)) return 0;
+    for (k = 0; k < 3; ++k) n[k] = d[k] / dd;
+    delta = (double)rve->r[a] + (double)rve->r[b] - dd;
+    gk_contact_stiffness(&rve->K, rve->def.mat.law, rve->r[a], rve->r[b], (gk_real)(delta > 0 ? delta : 0),
+                         &kn, &fn, &kt);
+    if (!(rve->phys & GK_PHYS_TANGENT)) kt = 0;
+    if ((rve->cs[c] & GK_CS_SLIDING) && !(opts & GK_TANGENT_SLIDING_KEEP)) kt = 0;
+    for (i = 0; i < dim; ++i)
+        for (k = 0; k < dim; ++k)
+            A[3 * i + k] = (double)kn * n[i] * n[k] + (double)kt * ((i == k ? 1.0 : 0.0) - n[i] * n[k]);
+    *dd_out = dd;
+    return 1;
+}
+
+/* reverse Cuthill-McKee order of the nodes with neighbours of an undirected
+ * graph (xadj/adj); pos[node] = place, -1 for isolated nodes; returns count */
+static int gk__rcm(int nv, const int *xadj, const int *adj, int *pos, int *order, int *lev) {
+    int cnt = 0, v, q, i;
+    for (v = 0; v < nv; ++v) pos[v] = -1;
+    for (;;) {
+        int start = -1, head, tail, pass;
+        for (v = 0; v < nv; ++v) /* unplaced node of least degree starts a component */
+            if (pos[v] < 0 && xadj[v + 1] > xadj[v] &&
+                (start < 0 || xadj[v + 1] - xadj[v] < xadj[start + 1] - xadj[start]))
+                start = v;
+        if (start < 0) break;
+        for (pass = 0; pass < 2; ++pass) { /* pseudo-peripheral: least-degree node of the last BFS level */
+            int best = start, last = 0;
+            for (i = 0; i < nv; ++i) lev[i] = -1;
+            lev[start] = 0, order[cnt] = start, head = cnt, tail = cnt + 1;
+            while (head < tail) {
+                int u = order[head++];
+                for (q = xadj[u]; q < xadj[u + 1]; ++q)
+                    if (lev[adj[q]] < 0) lev[adj[q]] = lev[u] + 1, order[tail++] = adj[q];
+            }
+            for (i = cnt; i < tail; ++i) last = lev[order[i]] > last ? lev[order[i]] : last;
+            for (i = cnt; i < tail; ++i)
+                if (lev[order[i]] == last &&
+                    xadj[order[i] + 1] - xadj[order[i]] < xadj[best + 1] - xadj[best])
+                    best = order[i];
+            start = best;
+        }
+        order[cnt] = start, pos[start] = cnt, head = cnt, tail = cnt + 1; /* Cuthill-McKee */
+        while (head < tail) {
+            int u = order[head++], first = tail;
+            for (q = xadj[u]; q < xadj[u + 1]; ++q)
+                if (pos[adj[q]] < 0) pos[adj[q]] = tail, order[tail++] = adj[q];
+            for (i = first + 1; i < tail; ++i) { /* new neighbours by increasing degree */
+                int w = order[i], dw = xadj[w + 1] - xadj[w], m = i;
+                while (m > first && xadj[order[m - 1] + 1] - xadj[order[m - 1]] > dw)
+                    order[m] = order[m - 1], --m;
+                order[m] = w;
+            }
+            for (i = first; i < tail; ++i) pos[order[i]] = i;
+        }
+        cnt = tail;
+    }
+    for (i = 0; i < cnt; ++i) pos[order[i]] = cnt - 1 - i; /* reversed */
+    return cnt;
+}
+
+/* GK_TANGENT_RELAXED: D = (K_EE - K_Ef K_ff^-1 K_fE) / V over the fluctuations
+ * q = (u, r_mean theta) of every particle with a contact. Relative displacement
+ * at contact c (particles a -> b, branch d, normal n):
+ *   delta = dH d + u_b - u_a + r_a n x theta_a + r_b n x theta_b = G dH + B q,
+ * spring force A delta, energy (1/2) sum delta.A.delta. */
+static gk_result gk__tangent_relaxed(const gk_rve *rve, unsigned opts, double V, double *D) {
+    const gk_allocator *al = &rve->def.alloc;
+    int dim = rve->dim, np = rve->n, nr = (rve->phys & GK_PHYS_ROTATION) ? (dim == 2 ? 1 : 3) : 0,
+        nq = dim + nr, ne = dim * dim, nc = 0, nv, ndof, bw = 0, w, c, p, i, j, k, e, x, y;
+    int *ca = NULL, *xadj = NULL, *adj = NULL, *pos = NULL, *order = NULL, *lev = NULL;
+    double *cA = NULL, *cd = NULL, *cB = NULL, *L = NULL, *F = NULL, rmean = 0.0, dmax = 0.0, reg;
+    gk_result res = GK_OK;
+    size_t sz = (size_t)(rve->pl.n > 0 ? rve->pl.n : 1);
+    ca = (int *)gk_alloc(al, 2 * sz * sizeof(int));
+    cA = (double *)gk_alloc(al, 9 * sz * sizeof(double));
+    cd = (double *)gk_alloc(al, 3 * sz * sizeof(double));
+    cB = (double *)gk_alloc(al, 2 * 3 * 6 * sz * sizeof(double)); /* B_a, B_b: dim x nq each */
+    xadj = (int *)gk_alloc(al, ((size_t)np + 1) * sizeof(int));
+    adj = (int *)gk_alloc(al, 2 * sz * sizeof(int));
+    pos = (int *)gk_alloc(al, (size_t)np * sizeof(int));
+    order = (int *)gk_alloc(al, (size_t)np * sizeof(int));
+    lev = (int *)gk_alloc(al, (size_t)np * sizeof(int));
+    if (!ca || !cA || !cd || !cB || !xadj || !adj || !pos || !order || !lev) {
+        res = GK_ERR_ALLOC;
+        goto done;
+    }
+    for (p = 0; p < np; ++p) rmean += (double)rve->r[p] / np;
+    for (p = 0; p <= np; ++p) xadj[p] = 0;
+    for (c = 0; c < rve->pl.n; ++c) { /* the springs, and the contact graph */
+        double n[3], dd, N[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, *Ba = cB + 36 * (size_t)nc, *Bb = Ba + 18;
+        int a = rve->pl.i[c], b = rve->pl.j[c];
+        if (!gk__contact_spring(rve, c, opts, cA + 9 * (size_t)nc, cd + 3 * (size_t)nc, n, &dd)) continue;
+        if (dim == 2) /* n x (theta e_z) = theta (n_y, -n_x) */
+            N[0] = n[1], N[3] = -n[0];
+        else /* n x theta = N theta */
+            N[1] = -n[2], N[2] = n[1], N[3] = n[2], N[5] = -n[0], N[6] = -n[1], N[7] = n[0];
+        for (i = 0; i < dim; ++i) /* B row i: [-e_i | r_a/rm N_i] and [e_i | r_b/rm N_i] */
+            for (k = 0; k < nq; ++k) {
+                double rot = k >= dim ? N[3 * i + (k - dim)] / rmean : 0.0;
+                Ba[6 * i + k] = k < dim ? -(i == k ? 1.0 : 0.0) : (double)rve->r[a] * rot;
+                Bb[6 * i + k] = k < dim ? (i == k ? 1.0 : 0.0) : (double)rve->r[b] * rot;
+            }
+        ca[2 * nc] = a, ca[2 * nc + 1] = b;
+        if (a != b) ++xadj[a + 1], ++xadj[b + 1];
+        ++nc;
+    }
+    if (nc == 0) goto done; /* no contacts: D = 0 as eq 9 */
+    for (p = 0; p < np; ++p) xadj[p + 1] += xadj[p];
+    for (p = 0; p < np; ++p) lev[p] = xadj[p];
+    for (c = 0; c < nc; ++c)
+        if (ca[2 * c] != ca[2 * c + 1])
+            adj[lev[ca[2 * c]]++] = ca[2 * c + 1], adj[lev[ca[2 * c + 1]]++] = ca[2 * c];
+    nv = gk__rcm(np, xadj, adj, pos, order, lev);
+    for (c = 0; c < nc; ++c) {
+        int da = pos[ca[2 * c]] - pos[ca[2 * c + 1]];
+        if (da < 0) da = -da;
+        if (da > bw) bw = da;
+    }
+    ndof = nv * nq, bw = (bw + 1) * nq - 1, w = bw + 1;
+    L = (double *)gk_alloc(al, (size_t)ndof * w * sizeof(double));
+    F = (double *)gk_alloc(al, (size_t)ndof * ne * sizeof(double));
+    if (!L || !F) {
+        res = GK_ERR_ALLOC;
+        goto done;
+    }
+    memset(L, 0, (size_t)ndof * w * sizeof(double));
+    memset(F, 0, (size_t)ndof * ne * sizeof(double));
+#define GK__L(r, s) L[(size_t)(r)*w + (s) - (r) + bw]
+    for (c = 0; c < nc; ++c) { /* K_ff (lower band) += B^T A B; F = -K_fE */
+        const double *A = cA + 9 * (size_t)c, *d = cd + 3 * (size_t)c;
+        for (x = 0; x < 2; ++x) {
+            const double *Bx = cB + 36 * (size_t)c + 18 * x;
+            int px = pos[ca[2 * c + x]];
+            double AB[3 * 6]; /* A B_y, then reused: (B_x^T A)_k i */
+            for (y = 0; y < 2; ++y) {
+                const double *By = cB + 36 * (size_t)c + 18 * y;
+                int py = pos[ca[2 * c + y]];
+                for (i = 0; i < dim; ++i)
+                    for (k = 0; k < nq; ++k) {
+                        double s = 0.0;
+                        for (j = 0; j < dim; ++j) s += A[3 * i + j] * By[6 * j + k];
+                        AB[6 * i + k] = s;
+                    }
+                for (k = 0; k < nq; ++k)
+                    for (j = 0; j < nq; ++j) {
+                        int I = px * nq + k, J = py * nq + j;
+                        double s = 0.0;
+                        if (I < J) continue;
+                        for (i = 0; i < dim; ++i) s += Bx[6 * i + k] * AB[6 * i + j];
+                        GK__L(I, J) += s;
+                    }
+            }
+            for (k = 0; k < nq; ++k) /* unit dH = e_m (x) e_l: (A G)_i = A_im d_l */
+                for (e = 0; e < ne; ++e) {
+                    int m = e / dim, l = e % dim;
+                    double s = 0.0;
+                    for (i = 0; i < dim; ++i) s += Bx[6 * i + k] * A[3 * i + m] * d[l];
+                    F[(size_t)(px * nq + k) * ne + e] -= s;
+                }
+        }
+    }
+    for (i = 0; i < ndof; ++i) dmax = GK__L(i, i) > dmax ? GK__L(i, i) : dmax;
+    /* a shift far below any contact stiffness pins the exact mechanisms (rigid translation,
+     * one-contact particles, free spins), whose right-hand sides are zero */
+    reg = 1e-10 * dmax;
+    for (i = 0; i < ndof; ++i) GK__L(i, i) += reg;
+    for (i = 0; i < ndof; ++i) { /* banded Cholesky, L L^T */
+        int j0 = i - bw > 0 ? i - bw : 0, m;
+        for (j = j0; j <= i; ++j) {
+            int m0 = j - bw > j0 ? j - bw : j0;
+            double s = GK__L(i, j);
+            for (m = m0; m < j; ++m) s -= GK__L(i, m) * GK__L(j, m);
+            if (j < i)
+                GK__L(i, j) = s / GK__L(j, j);
+            else if (s > 0.0)
+                GK__L(i, i) = sqrt(s);
+            else {
+                res = GK_ERR_SINGULAR;
+                goto done;
+            }
+        }
+    }
+    for (e = 0; e < ne; ++e) { /* q_e = K_ff^-1 F_e, in place */
+        int m;
+        for (i = 0; i < ndof; ++i) {
+            double s = F[(size_t)i * ne + e];
+            for (m = i - bw > 0 ? i - bw : 0; m < i; ++m) s -= GK__L(i, m) * F[(size_t)m * ne + e];
+            F[(size_t)i * ne + e] = s / GK__L(i, i);
+        }
+        for (i = ndof - 1; i >= 0; --i) {
+            double s = F[(size_t)i * ne + e];
+            for (m = i + 1; m <= i + bw && m < ndof; ++m) s -= GK__L(m, i) * F[(size_t)m * ne + e];
+            F[(size_t)i * ne + e] = s / GK__L(i, i);
+        }
+    }
+#undef GK__L
+    for (c = 0; c < nc; ++c) { /* D_ij,e = (1/V) sum (A (G e + B q_e))_i d_j */
+        const double *A = cA + 9 * (size_t)c, *d = cd + 3 * (size_t)c;
+        for (e = 0; e < ne; ++e) {
+            double del[3] = {0, 0, 0};
+            del[e / dim] = d[e % dim];
+            for (x = 0; x < 2; ++x) {
+                const double *Bx = cB + 36 * (size_t)c + 18 * x;
+                const double *q = F + (size_t)pos[ca[2 * c + x]] * nq * ne + e;
+                for (i = 0; i < dim; ++i)
+                    for (k = 0; k < nq; ++k) del[i] += Bx[6 * i + k] * q[(size_t)k * ne];
+            }
+            for (i = 0; i < dim; ++i) {
+                double f = 0.0;
+                for (k = 0; k < dim; ++k) f += A[3 * i + k] * del[k];
+                for (j = 0; j < dim; ++j) D[(i * dim + j) * ne + e] += f * d[j] / V;
+            }
+        }
+    }
+done:
+    gk_free(al, ca), gk_free(al, cA), gk_free(al, cd), gk_free(al, cB), gk_free(al, xadj), gk_free(al, adj);
+    gk_free(al, pos), gk_free(al, order), gk_free(al, lev), gk_free(al, L), gk_free(al, F);
+    return res;
+}
+
 GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
     int dim = rve->dim, n4 = dim * dim * dim * dim, c, i, j, k, l;
     double V = gk_rve_volume(rve);
     for (k = 0; k < n4; ++k) D[k] = 0.0;
     if (!(V > 0.0)) return GK_ERR_CELL;
-    for (c = 0; c < rve->pl.n; ++c) {
-        double d[3], n[3], dd, delta, A[9], F[3], Fn = 0.0, Ft[3] = {0, 0, 0};
-        gk_real kn, fn, kt;
-        int a = rve->pl.i[c], b = rve->pl.j[c];
-        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
-        dd = gk__pair_branch(rve, c, d);
-        if (!(dd > 0.0)) continue;
-        for (k = 0; k < 3; ++k) n[k] = d[k] / dd;
-        delta = (double)rve->r[a] + (double)rve->r[b] - dd;
-        gk_contact_stiffness(&rve->K, rve->def.mat.law, rve->r[a], rve->r[b],
-                             (gk_real)(delta > 0 ? delta : 0), &kn, &fn, &kt);
-        if (!(rve->phys & GK_PHYS_TANGENT)) kt = 0;
-        if ((rve->cs[c] & GK_CS_SLIDING) && !(opts & GK_TANGENT_SLIDING_KEEP)) kt = 0;
-        for (k = 0; k < 3; ++k) F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
-        if (opts & GK_TANGENT_GEOMETRIC) {
+    if (opts & GK_TANGENT_RELAXED) {
+        gk_result res = (opts & GK_TANGENT_GEOMETRIC) ? GK_ERR_ARG : gk__tangent_relaxed(rve, opts, V, D);
+        if (res) {
+            for (k = 0; k < n4; ++k) D[k] = 0.0;
+            return res;
+        }
+    }
+    for (c = 0; !(opts & GK_TANGENT_RELAXED) && c < rve->pl.n; ++c) {
+        double d[3], n[3], dd, A[9];
+        if (!gk__contact_spring(rve, c, opts, A, d, n, &dd)) continue;
+        if (opts & GK_TANGENT_GEOMETRIC) { /* A_ik += -(F_n/|d|)(delta_ik - n_i n_k) + n_i F_t,k / |d| */
+            double F[3], Fn, Ft[3];
+            for (k = 0; k < 3; ++k) F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
             Fn = F[0] * n[0] + F[1] * n[1] + F[2] * n[2];
             for (k = 0; k < 3; ++k) Ft[k] = F[k] - Fn * n[k];
+            for (i = 0; i < dim; ++i)
+                for (k = 0; k < dim; ++k)
+                    A[3 * i + k] += -(Fn / dd) * ((i == k ? 1.0 : 0.0) - n[i] * n[k]) + n[i] * Ft[k] / dd;
         }
         /* A_ik = kn n_i n_k + kt (delta_ik - n_i n_k) [+ geometric]; D_ijkl += A_ik d_j d_l / V */
-        for (i = 0; i < dim; ++i)
-            for (k = 0; k < dim; ++k) {
-                double P = (i == k ? 1.0 : 0.0) - n[i] * n[k];
-                A[3 * i + k] = (double)kn * n[i] * n[k] + (double)kt * P;
-                if (opts & GK_TANGENT_GEOMETRIC) A[3 * i + k] += -(Fn / dd) * P + n[i] * Ft[k] / dd;
-            }
         for (i = 0; i < dim; ++i)
             for (j = 0; j < dim; ++j)
                 for (k = 0; k < dim; ++k)
                     for (l = 0; l < dim; ++l)
                         D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
     }
-    for (k = 0; k < n4; ++k) D[k] /= V;
+    if (!(opts & GK_TANGENT_RELAXED))
+        for (k = 0; k < n4; ++k) D[k] /= V;
     if (opts & GK_TANGENT_GEOMETRIC) {
         const double *s = rve->stress;
         for (i = 0; i < dim; ++i)

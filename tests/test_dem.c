@@ -260,6 +260,141 @@ TEST(full_tangent_is_fd_tangent_prestressed) {
     gk_rve_destroy(&rve);
 }
 
+static double h_d_h(const double *D, int dim, const double H[9]) {
+    double s = 0;
+    int i, j, k, l;
+    for (i = 0; i < dim; ++i)
+        for (j = 0; j < dim; ++j)
+            for (k = 0; k < dim; ++k)
+                for (l = 0; l < dim; ++l)
+                    s += H[3 * i + j] * D[((i * dim + j) * dim + k) * dim + l] * H[3 * k + l];
+    return s;
+}
+
+/* the relaxed tangent against the DEM: from equilibrium (L = 0, damped steps),
+ * an affine dH = 1e-7 H without slip, then damped steps at a fixed cell until
+ * the particles are in equilibrium again: d sigma : H / 1e-7 vs H:D:H */
+static void relaxed_vs_dem(gk_rve *rve, int nh, const double (*Hs)[9], double rtol) {
+    gk_rve_state st;
+    double Dt[81], Dr[81], s0[9], s1[9], L0[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    int c, k, dim = rve->dim;
+    CHECK(gk_rve_set_friction(rve, 1e3) == GK_OK); /* no slip */
+    CHECK(gk_rve_set_velocity_gradient(rve, L0) == GK_OK);
+    CHECK(gk_rve_step(rve, 2000) == GK_OK);
+    CHECK(gk_rve_refresh(rve) == GK_OK);
+    CHECK(gk_homog_tangent(rve, 0, Dt) == GK_OK);
+    CHECK(gk_homog_tangent(rve, GK_TANGENT_RELAXED, Dr) == GK_OK);
+    gk_rve_stress(rve, s0);
+    gk_rve_state_init(&st, NULL);
+    CHECK(gk_rve_state_save(&st, rve) == GK_OK);
+    for (c = 0; c < nh; ++c) {
+        double dH[9], dem = 0.0, um, ur;
+        for (k = 0; k < 9; ++k) dH[k] = 1e-7 * Hs[c][k];
+        CHECK(gk_rve_state_restore(&st, rve) == GK_OK);
+        CHECK(gk_rve_deform(rve, dH, 1) == GK_OK);
+        CHECK(gk_rve_set_velocity_gradient(rve, L0) == GK_OK);
+        CHECK(gk_rve_step(rve, 2000) == GK_OK);
+        CHECK(gk_rve_refresh(rve) == GK_OK);
+        gk_homog_unbalanced(rve, &um, &ur);
+        gk_rve_stress(rve, s1);
+        for (k = 0; k < 9; ++k) dem += (s1[k] - s0[k]) / 1e-7 * Hs[c][k];
+        printf("    %dD H%d: d sigma:H / 1e-7 DEM %.4e, relaxed %.4e, eq 9 %.4e Pa (unbalanced %.1e)\n", dim,
+               c, dem, h_d_h(Dr, dim, Hs[c]), h_d_h(Dt, dim, Hs[c]), um);
+        CHECK(um < 1e-9);
+        CHECK_REL(h_d_h(Dr, dim, Hs[c]), dem, rtol);
+        CHECK(h_d_h(Dt, dim, Hs[c]) > 1.1 * dem);
+        CHECK(h_d_h(Dr, dim, Hs[c]) > 0.0 && h_d_h(Dr, dim, Hs[c]) < h_d_h(Dt, dim, Hs[c]));
+    }
+    gk_rve_state_free(&st);
+}
+
+/* GK_TANGENT_RELAXED on a Bravais lattice (one particle per primitive cell):
+ * every particle sees the same surroundings, the affine map is already in
+ * equilibrium and the relaxed tangent is eq 9 itself. */
+TEST(relaxed_tangent_of_a_bravais_lattice_is_taylor) {
+    gk_rve rve;
+    gk_rve_def def = gk_rve_def_default();
+    double Dt[16], Dr[16];
+    int k;
+    def.mat.friction = 0.5;
+    CHECK(hex_lattice(&rve, &def, 8, 8, 0.005, 0.005e-3) == GK_OK);
+    CHECK(gk_rve_refresh(&rve) == GK_OK);
+    CHECK(gk_homog_tangent(&rve, 0, Dt) == GK_OK);
+    CHECK(gk_homog_tangent(&rve, GK_TANGENT_RELAXED, Dr) == GK_OK);
+    for (k = 0; k < 16; ++k) CHECK_NEAR(Dr[k], Dt[k], 1e-8 * Dt[0]);
+    CHECK(gk_homog_tangent(&rve, GK_TANGENT_RELAXED | GK_TANGENT_GEOMETRIC, Dr) == GK_ERR_ARG);
+    for (k = 0; k < 16; ++k) CHECK(Dr[k] == 0.0);
+    gk_rve_destroy(&rve);
+}
+
+/* A chain of disks along x (radii a, a, b repeated 4 times; no contact in y):
+ * under dH_xx the springs are in series, so the relaxed D_xxxx is
+ *   L^2 / (V sum_c 1/k_c)   (L the chain length, V the cell volume)
+ * while eq 9 gives sum_c k_c l_c^2 / V (Cauchy-Schwarz: larger unless every
+ * k_c l_c is the same). Under shear the chain rolls: the relaxed D_xyxy is 0. */
+TEST(relaxed_tangent_of_a_chain_is_springs_in_series) {
+    gk_rve rve;
+    gk_rve_def def = gk_rve_def_default();
+    gk_packing pk;
+    gk_err e;
+    double ra = 0.005, rb = 0.008, ov = 1e-5, x = 0.0, L, V, flex = 0.0, taylor = 0.0, Dt[16], Dr[16];
+    double rad[12], len[12];
+    int p;
+    def.mat.friction = 0.5;
+    for (p = 0; p < 12; ++p) rad[p] = p % 3 == 2 ? rb : ra;
+    CHECK(gk_packing_alloc(&pk, 2, 12, NULL, &e) == GK_OK);
+    for (p = 0; p < 12; ++p) {
+        len[p] = rad[p] + rad[(p + 1) % 12] - ov; /* contact p -> p + 1 */
+        pk.x[p] = x, pk.y[p] = 0.025, pk.r[p] = rad[p];
+        x += len[p];
+    }
+    L = x;
+    gk_m3_identity(pk.h);
+    pk.h[0] = L, pk.h[4] = 0.05;
+    CHECK(gk_rve_create(&rve, &def, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    CHECK(gk_rve_refresh(&rve) == GK_OK);
+    CHECK_EQ_INT(rve.ncontacts, 12);
+    V = gk_rve_volume(&rve);
+    for (p = 0; p < 12; ++p) {
+        gk_real kn, fn, kt;
+        gk_contact_stiffness(&rve.K, rve.def.mat.law, (gk_real)rad[p], (gk_real)rad[(p + 1) % 12],
+                             (gk_real)ov, &kn, &fn, &kt);
+        flex += 1.0 / kn, taylor += kn * len[p] * len[p];
+    }
+    CHECK(gk_homog_tangent(&rve, 0, Dt) == GK_OK);
+    CHECK(gk_homog_tangent(&rve, GK_TANGENT_RELAXED, Dr) == GK_OK);
+    printf("    D_xxxx: eq 9 %.6e, relaxed %.6e, springs in series %.6e Pa\n", Dt[0], Dr[0],
+           L * L / (V * flex));
+    CHECK_REL(Dt[0], taylor / V, 1e-6);
+    CHECK_REL(Dr[0], L * L / (V * flex), 1e-6);
+    CHECK(Dr[0] < 0.97 * Dt[0]);       /* the two differ by 4 % here */
+    CHECK(Dt[5] > 0.1 * Dt[0]);        /* eq 9 resists shear with k_t ... */
+    CHECK(fabs(Dr[5]) < 1e-6 * Dt[5]); /* ... the relaxed chain rolls */
+    gk_rve_destroy(&rve);
+}
+
+/* GK_TANGENT_RELAXED is the quasi-static response of the seed packing
+ * (relaxed_vs_dem) to the initial-stress terms (order sigma / D_xxxx ~ 1e-3,
+ * not in the spring model). Eq 9 is 14-35 % stiffer; the relaxed tangent lies
+ * between 0 and it (H:D:H, a Schur complement of a positive semi-definite
+ * energy). */
+TEST(relaxed_tangent_is_the_quasistatic_dem_response) {
+    gk_rve rve;
+    gk_rve_def def = gk_rve_def_default();
+    const double Hs[4][9] = {{1, 0, 0, 0, -1, 0, 0, 0, 0},
+                             {0, 1, 0, 1, 0, 0, 0, 0, 0},
+                             {1, 0, 0, 0, 1, 0, 0, 0, 0},
+                             {0.3, -0.7, 0, -0.7, -1.1, 0, 0, 0, 0}};
+    def.damping = 0.7;
+    if (load_rve(&rve, &def, RVE400)) {
+        CHECK(0);
+        return;
+    }
+    relaxed_vs_dem(&rve, 4, Hs, 1.5e-2);
+    gk_rve_destroy(&rve);
+}
+
 /* save -> run -> restore -> run gives bit-identical states (friction, history,
  * rebuilds and cell flips included) */
 TEST(save_restore_is_bitwise) {
@@ -471,6 +606,23 @@ TEST(rve_3d_pipeline) {
     gk_rve_stress(&a, s2);
     for (k = 0; k < 9; ++k) CHECK(s1[k] == s2[k]);
     gk_rve_state_free(&st);
+    gk_rve_destroy(&a);
+}
+
+/* 3D (three rotations per particle): the relaxed tangent of a consolidated
+ * 150-sphere packing is its quasi-static DEM response (relaxed_vs_dem) */
+TEST(relaxed_tangent_3d_is_the_quasistatic_dem_response) {
+    gk_rve a;
+    gk_consolidate_report rep;
+    const double Hs[3][9] = {{1, 0, 0, 0, -0.5, 0, 0, 0, -0.5},
+                             {0, 0.5, 0, 0.5, 0, 0, 0, 0, 0},
+                             {0.2, 0.1, -0.4, 0.1, 0.5, 0.3, -0.4, 0.3, -0.6}};
+    if (gen_consolidate(&a, 3, 150, 0.0, 0.5, 7, &rep) != GK_OK) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_rve_set_damping(&a, 0.7, a.def.damping_form) == GK_OK);
+    relaxed_vs_dem(&a, 3, Hs, 1.5e-2);
     gk_rve_destroy(&a);
 }
 
@@ -968,12 +1120,16 @@ int main(int argc, char **argv) {
     RUN(love_stress_cubic_lattice_3d);
     RUN(taylor_tangent_is_fd_tangent_at_vanishing_preload);
     RUN(full_tangent_is_fd_tangent_prestressed);
+    RUN(relaxed_tangent_of_a_bravais_lattice_is_taylor);
+    RUN(relaxed_tangent_of_a_chain_is_springs_in_series);
+    RUN(relaxed_tangent_is_the_quasistatic_dem_response);
     RUN(save_restore_is_bitwise);
     RUN(restore_rejects_bad_buffers);
     RUN(skin_does_not_change_results);
     RUN(threads_do_not_change_results);
     RUN(consolidation_reaches_target_stress);
     RUN(rve_3d_pipeline);
+    RUN(relaxed_tangent_3d_is_the_quasistatic_dem_response);
     RUN(dt_at_0_9_critical_stays_bounded);
     RUN(rve_without_contacts_is_zero_not_nan);
     RUN(extreme_stiffness_scales);
