@@ -1,7 +1,8 @@
 /* femdem_biaxial - the seed 000 FEMxDEM two-scale biaxial test (Guo & Zhao 2014).
  *
  *   build/femdem_biaxial --nx 8 --ny 16 --element q8 --steps 100 --threads 2 --out DIR
- *                        [--tangent taylor|yade|perturbation] [--restart DIR] [--test biaxial|single]
+ *                        [--tangent taylor|yade|relaxed|perturbation] [--restart DIR]
+ *                        [--test biaxial|single]
  *   build/femdem_biaxial --test cyclic-strain|cyclic-stress [--nx 15 --ny 10] [--amplitude 0.01 |
  *                        --tau-amplitude 3e4] [--cycles 20] --out DIR
  *
@@ -64,7 +65,9 @@
  * ROBUSTNESS (what the authors' script lacks; see README "Convergence")
  *   - tangent 'taylor' (default) drops the tangential stiffness of sliding
  *     contacts (consistent with the Coulomb cap); 'yade' keeps it (the
- *     authors' Shop::getStressAndTangent); 'perturbation' = eq 8 with xi.
+ *     authors' Shop::getStressAndTangent); 'relaxed' = the contact network
+ *     with every particle relaxed (GK_TANGENT_RELAXED: softer than eq 9 where
+ *     the network is near a mechanism); 'perturbation' = eq 8 with xi.
  *   - convergence: E_d < --tol (eq 21), or E_f < --ftol (default 0.003, a
  *     force criterion stricter than the ABAQUS/ANSYS 0.005 quoted by the
  *     seed; both are the seed's footnote's pairs of displacement and force
@@ -250,7 +253,8 @@ static void usage(FILE *fp) {
     fprintf(
         fp,
         "usage: femdem_biaxial [--nx 8] [--ny 16] [--element q8|q4] [--steps 100] [--threads 2] [--out DIR]\n"
-        "                      [--tangent taylor|yade|perturbation] [--restart DIR] [--test biaxial|single]\n"
+        "                      [--tangent taylor|yade|relaxed|perturbation] [--restart DIR]\n"
+        "                      [--test biaxial|single]\n"
         "       femdem_biaxial --test cyclic-strain|cyclic-stress [--amplitude 0.01 | --tau-amplitude 3e4]\n"
         "                      [--cycles 20] [--nx 2 --ny 2] [--threads 2] [--out DIR]\n"
         "\n"
@@ -263,7 +267,10 @@ static void usage(FILE *fp) {
         "  --threads T            OpenMP threads over the RVEs (results identical for any T)\n"
         "  --out DIR              output directory (created; default femdem_out)\n"
         "  --tangent KIND         taylor (eq 9, sliding contacts k_t = 0, default), yade (eq 9 keeping\n"
-        "                         k_t of sliding contacts, as the authors' code), perturbation (eq 8)\n"
+        "                         k_t of sliding contacts, as the authors' code), relaxed (the\n"
+        "                         RVE's contact network with the particles relaxed, GK_TANGENT_RELAXED:\n"
+        "                         its quasi-static response without slip; an iteration takes about\n"
+        "                         10 x as long), perturbation (eq 8)\n"
         "  --xi X                 perturbation size of eq 8 (default 5e-5, seed Fig 6)\n"
         "  --restart DIR          continue from DIR/checkpoint.bin (same mesh options) to --steps\n"
         "                         (cyclic: to --cycles or the stop criterion)\n"
@@ -517,6 +524,11 @@ static void note_bad(model *M, int g, const gk_rve *r) {
     }
 }
 
+/* gk_homog_tangent options of --tangent (perturbation: Taylor where eq 8 is not run) */
+static unsigned tangent_flags(const model *M) {
+    return M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : M->tmode == 3 ? GK_TANGENT_RELAXED : 0u;
+}
+
 /* every Gauss point: restore the converged state, deform by dH = grad u with the DEM step rule, read
  * stress and tangent (or keep the stored tangent, --tangent-reuse). Returns the number of failed RVEs.
  * Counts the DEM steps and tangents into M->pend_*. */
@@ -595,7 +607,7 @@ static int eval_rves(model *M, const double *u) {
                     for (k = 0; k < 4; ++k) /* k = 2 kk + ll */
                         M->D[(size_t)g * n4 + (i * 2 + j) * 4 + k] =
                             (sp[k][3 * i + j] - s0[3 * i + j]) / o->xi;
-        } else if (gk_homog_tangent(r, M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u, M->D + (size_t)g * n4))
+        } else if (gk_homog_tangent(r, tangent_flags(M), M->D + (size_t)g * n4))
             ++nbad, bad_t = 1, note_bad(M, g, r);
         if (keys && !bad_t) { /* this tangent and its network become the reference */
             unsigned long long *t = nf->key;
@@ -676,7 +688,10 @@ static int setup(model *M, gk_err *err) {
     M->npe = M->mesh.npe;
     M->ngp = M->mesh.nelem * M->q.n;
     M->ndof = 2 * M->mesh.nnode;
-    M->tmode = !strcmp(o->tangent, "yade") ? 1 : !strcmp(o->tangent, "perturbation") ? 2 : 0;
+    M->tmode = !strcmp(o->tangent, "yade")           ? 1
+               : !strcmp(o->tangent, "perturbation") ? 2
+               : !strcmp(o->tangent, "relaxed")      ? 3
+                                                     : 0;
     if (gk_csr_from_mesh(&M->K, &M->mesh, NULL, err)) return 1;
 #define ALLOC(p, n)                                                         \
     do {                                                                    \
@@ -847,9 +862,8 @@ static int setup(model *M, gk_err *err) {
             }
         }
         gk_rve_stress(&M->rve[g], M->sig_n + 9 * (size_t)g);
-        /* first tangent: Taylor (eq 8 has no trial state yet), keeping sliding contacts for 'yade' */
-        if (gk_homog_tangent(&M->rve[g], M->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : 0u,
-                             M->D_n + 16 * (size_t)g)) {
+        /* first tangent: Taylor for eq 8 (no trial state yet), else the chosen one */
+        if (gk_homog_tangent(&M->rve[g], tangent_flags(M), M->D_n + 16 * (size_t)g)) {
             gk_err_set(err, GK_ERR_STATE, "tangent");
             goto out;
         }
@@ -2030,8 +2044,9 @@ int main(int argc, char **argv) {
                         "--tangent-reuse: use one of them\n");
         return 2;
     }
-    if (strcmp(o->tangent, "taylor") && strcmp(o->tangent, "yade") && strcmp(o->tangent, "perturbation")) {
-        fprintf(stderr, "femdem_biaxial: --tangent must be taylor, yade or perturbation\n");
+    if (strcmp(o->tangent, "taylor") && strcmp(o->tangent, "yade") && strcmp(o->tangent, "perturbation") &&
+        strcmp(o->tangent, "relaxed")) {
+        fprintf(stderr, "femdem_biaxial: --tangent must be taylor, yade, relaxed or perturbation\n");
         return 2;
     }
     if (mkdir_p(o->out)) {

@@ -404,6 +404,33 @@ TEST(femdem_ed_newton_accepts_by_the_criterion) {
     CHECK(fd_refused("--ed raw", "--ed must be step or newton"));
 }
 
+/* --tangent relaxed (GK_TANGENT_RELAXED at every Gauss point): the same for 1 and 2 threads and
+ * across a restart; the converged curve is the Taylor run's within the Newton tolerance (both stop at
+ * E_f < --ftol = 0.3 % of the internal force; 1 % allows that and no more), a different tangent does
+ * not change the equilibrium it converges to. 2 x 2 Q4, 16 RVEs. */
+TEST(femdem_relaxed_tangent_converges_to_the_same_curve) {
+    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0";
+    char cmd[512], header[512];
+    double a[8 * F_NCOL], b[8 * F_NCOL];
+    int k, n;
+    CHECK(
+        run_threads_and_restart(base, "--steps 3 --tangent relaxed", "--steps 2 --tangent relaxed", "t_fdx"));
+    check_threads_and_restart("t_fdx", "biaxial.csv", 6);
+    CHECK(gk_test_file_has("build/t_fdxA.out", "tangent relaxed"));
+    snprintf(cmd, sizeof cmd, "%s --steps 3 --threads 2 --out build/t_fdxT > build/t_fdxT.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    n = read_csv("build/t_fdxA/biaxial.csv", F_NCOL, a, 8, header, sizeof header);
+    CHECK_EQ_INT(n, 4);
+    CHECK_EQ_INT(read_csv("build/t_fdxT/biaxial.csv", F_NCOL, b, 8, header, sizeof header), 4);
+    if (n != 4) return;
+    for (k = 1; k < n; ++k) {
+        printf("    step %d: sigma_yy relaxed %.0f Pa (%.0f iterations), Taylor %.0f Pa (%.0f)\n", k,
+               a[k * F_NCOL + F_SYY], a[k * F_NCOL + F_ITER], b[k * F_NCOL + F_SYY], b[k * F_NCOL + F_ITER]);
+        CHECK_REL(a[k * F_NCOL + F_SYY], b[k * F_NCOL + F_SYY], 0.01);
+    }
+    CHECK(fd_refused("--tangent voigt", "taylor, yade, relaxed or perturbation"));
+}
+
 /* issue 6: the DEM step rule (adaptive by default) and tangent reuse in femdem_biaxial. 2 x 2 Q4, 16
  * RVEs, a few 0.1 % steps. */
 TEST(femdem_dem_rule_and_tangent_reuse) {
@@ -590,6 +617,7 @@ int main(int argc, char **argv) {
     RUN(femdem_noise_probe_leaves_the_run_unchanged);
     RUN(femdem_ed_newton_accepts_by_the_criterion);
     RUN(femdem_dem_rule_and_tangent_reuse);
+    RUN(femdem_relaxed_tangent_converges_to_the_same_curve);
     RUN(femdem_heterogeneous_packings);
     RUN(femdem_cyclic_strain_constant_volume_and_contractive);
     RUN(femdem_cyclic_stress_turns_at_the_amplitude);
