@@ -270,7 +270,9 @@ static void usage(FILE *fp) {
         "                         k_t of sliding contacts, as the authors' code), relaxed (the\n"
         "                         RVE's contact network with the particles relaxed, GK_TANGENT_RELAXED:\n"
         "                         its quasi-static response without slip; 8 x 16 mesh: fewer iterations\n"
-        "                         before the peak, 10 x the time per step), perturbation (eq 8)\n"
+        "                         before the peak, 10 x the time per step), perturbation (eq 8)\n");
+    fprintf(
+        fp,
         "  --xi X                 perturbation size of eq 8 (default 5e-5, seed Fig 6)\n"
         "  --restart DIR          continue from DIR/checkpoint.bin (same mesh options) to --steps\n"
         "                         (cyclic: to --cycles or the stop criterion)\n"
