@@ -329,7 +329,7 @@ static gk_result gk__tangent_relaxed(const gk_rve *rve, unsigned opts, double V,
         for (x = 0; x < 2; ++x) {
             const double *Bx = cB + 36 * (size_t)c + 18 * x;
             int px = pos[ca[2 * c + x]];
-            double AB[3 * 6]; /* A B_y, then reused: (B_x^T A)_k i */
+            double AB[3 * 6]; /* A B_y */
             for (y = 0; y < 2; ++y) {
                 const double *By = cB + 36 * (size_t)c + 18 * y;
                 int py = pos[ca[2 * c + y]];
