@@ -225,6 +225,29 @@ static int read_csv(const char *path, int ncol, double *v, int maxrows, char *he
     return n;
 }
 
+/* the reference of the single-element test, the RVE alone with its lateral
+ * stress held at the confinement: through and after the peak (to 3 %) every
+ * row holds sigma_xx = p to the control's 1e-3 p, within the documented
+ * bound on the RVE runs per increment (the Taylor D_xxxx alone, capped at
+ * 12 iterations, missed it by up to 5.5e-3 p after the peak) */
+TEST(femdem_single_reference_holds_the_lateral_stress) {
+    double v[31 * 8];
+    char header[512];
+    int n, k, runs = 0;
+    CHECK(
+        system("build/femdem_biaxial --test single --steps 30 --threads 2 --vtk-every 0 --out build/t_fds30 "
+               "> build/t_fds30.out 2>&1") == 0);
+    n = read_csv("build/t_fds30/single_element.csv", 8, v, 31, header, sizeof header);
+    CHECK(n == 31);
+    CHECK(strstr(header, "eps_v_rve,rve_runs") != NULL);
+    for (k = 1; k < n; ++k) {
+        CHECK(fabs(v[8 * k + 4] - 1e5) <= 1e-3 * 1e5);
+        CHECK(v[8 * k + 7] >= 1 && v[8 * k + 7] <= 40);
+        runs += (int)v[8 * k + 7];
+    }
+    printf("    RVE alone: %d runs for 30 increments, sigma_xx held to 1e-3 p\n", runs);
+}
+
 #define CYC_HEADER                                                                                      \
     "step,cycle,gamma,tau,sigma_yy,sigma_xx,p,q,eps_v_rve,top_uy,iterations,seconds,E_d,E_f,increment," \
     "failed_gp,dem_steps_mean,dem_steps_max,dem_steps,tangents_reused,tangents_computed\n"
@@ -613,6 +636,7 @@ int main(int argc, char **argv) {
     RUN(gk_pack_makes_a_consolidated_packing);
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
     RUN(femdem_single_element_matches_rve_alone);
+    RUN(femdem_single_reference_holds_the_lateral_stress);
     RUN(femdem_refuses_malformed_numbers);
     RUN(femdem_noise_probe_leaves_the_run_unchanged);
     RUN(femdem_ed_newton_accepts_by_the_criterion);
