@@ -411,6 +411,60 @@ TEST(femdem_noise_probe_leaves_the_run_unchanged) {
     CHECK(fd_refused("--noise-probe -1", "out of range"));
 }
 
+/* --krylov-probe: GMRES with the RVEs' own responses at one iterate. Its model residual is the GMRES
+ * minimum over a growing Krylov space, so it is in [0, 1] and does not grow with the number of
+ * directions (a Givens or orthogonalisation error breaks that); before the peak the RVE map is smooth,
+ * so three directions nearly remove the residual, in the model and in the E_f found (a wrong finite-
+ * difference step or sign breaks that); the probe's RVE runs leave the run itself unchanged (the
+ * iterate is re-evaluated at u: the same CSV, bit for bit); bad values are refused */
+TEST(femdem_krylov_probe_leaves_the_run_unchanged) {
+    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
+    char cmd[512], header[512], line[256];
+    double a[4 * F_NCOL], b[4 * F_NCOL], prev = 1.0 + 1e-12, ef0 = 0.0, worst3 = 0.0;
+    int na, nb, r, k, same = 1, lines = 0, monotone = 1;
+    FILE *fp;
+    snprintf(cmd, sizeof cmd, "%s --out build/t_fkp0 > build/t_fkp0.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    snprintf(cmd, sizeof cmd,
+             "%s --krylov-probe 2 --krylov-scale 0.02 --out build/t_fkp1 > build/t_fkp1.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    CHECK(gk_test_file_has("build/t_fkp1.out", "krylov probe at iteration 2 (E_f "));
+    fp = fopen("build/t_fkp1.out", "r");
+    while (fp && fgets(line, sizeof line, fp)) {
+        int m;
+        double model, ef;
+        const char *h = strstr(line, "(E_f ");
+        if (strstr(line, "krylov probe at") && h) prev = 1.0 + 1e-12, ef0 = atof(h + 5); /* each step anew */
+        if (sscanf(line, " m %d: %lf E_f %lf", &m, &model, &ef) == 3) {
+            ++lines;
+            if (!(model >= 0.0 && model <= prev + 1e-12 && ef >= 0.0)) monotone = 0;
+            prev = model;
+            if (m == 3 && model > worst3) worst3 = model;
+            if (m == 3 && !(ef < 0.1 * ef0)) worst3 = 1.0;
+        }
+    }
+    if (fp) fclose(fp);
+    printf("    %d probe lines over 3 steps; with 3 directions the model keeps at most %.1e of |R|\n", lines,
+           worst3);
+    CHECK(lines >= 3);
+    CHECK(monotone);
+    /* hardening specimen: the RVE map is locally linear, 3 directions remove 99 % of the modelled
+     * residual and the E_f found there is below a tenth of the iterate's */
+    CHECK(worst3 < 0.01);
+    na = read_csv("build/t_fkp0/biaxial.csv", F_NCOL, a, 4, header, sizeof header);
+    nb = read_csv("build/t_fkp1/biaxial.csv", F_NCOL, b, 4, header, sizeof header);
+    CHECK_EQ_INT(na, 4);
+    CHECK_EQ_INT(nb, 4);
+    for (r = 0; r < 4 && na == 4 && nb == 4; ++r)
+        for (k = 0; k < F_NCOL; ++k)
+            if (k != 6 && a[r * F_NCOL + k] != b[r * F_NCOL + k]) same = 0; /* column 6: seconds */
+    CHECK(same);
+    CHECK(fd_refused("--krylov-probe 2 --tangent-reuse 0.1", "use one of them"));
+    CHECK(fd_refused("--krylov-probe -1", "out of range"));
+    CHECK(fd_refused("--krylov-probe 2 --krylov-scale 0", "out of range"));
+    CHECK(fd_refused("--krylov-probe 2 --krylov-scale 1.5", "out of range"));
+}
+
 /* --ed newton: E_d is the Newton correction before relaxation; every accepted row of the CSV meets
  * E_d < 0.01 or E_f < 0.003 (columns 7 and 8); a value other than step or newton is refused */
 TEST(femdem_ed_newton_accepts_by_the_criterion) {
@@ -639,6 +693,7 @@ int main(int argc, char **argv) {
     RUN(femdem_single_reference_holds_the_lateral_stress);
     RUN(femdem_refuses_malformed_numbers);
     RUN(femdem_noise_probe_leaves_the_run_unchanged);
+    RUN(femdem_krylov_probe_leaves_the_run_unchanged);
     RUN(femdem_ed_newton_accepts_by_the_criterion);
     RUN(femdem_dem_rule_and_tangent_reuse);
     RUN(femdem_relaxed_tangent_converges_to_the_same_curve);
