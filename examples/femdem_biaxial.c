@@ -190,7 +190,8 @@ typedef struct opts {
     int noise_probe;     /* diagnostic: at this Newton iteration, the residual's sensitivity to u (0: off) */
     int krylov_probe;    /* diagnostic: at this Newton iteration, GMRES with the RVEs' responses (0: off) */
     double krylov_scale; /* ... its finite-difference step, a fraction of |u| */
-    int ed_newton; /* E_d from the Newton correction before relaxation (1) or the step taken (0, eq 21) */
+    int ed_newton;   /* E_d from the Newton correction before relaxation (1) or the step taken (0, eq 21) */
+    int extrapolate; /* predictor: the last converged increment, scaled (1), or the tangent solve (0) */
     double amp, tau_amp, cycles, gamma_stop, liq_ratio;
     unsigned long packing_seed; /* --packing A,B,...: seed of the per-Gauss-point draw */
 } opts;
@@ -243,6 +244,7 @@ typedef struct model {
     double *u, *du, *dprev, *fint, *fext, *R, *rhs, *utot, *A0x, *andF, *andG, *fprev, *Gprev;
     int *fix, nfix, *fixtop, *top, ntop, *right, nright, *lface, nlf, *rface, nrf, nfn;
     double area0, eps_done, scale;
+    double *ulast, inclast; /* --predictor extrapolate: the last converged increment and its axial strain */
     int step;
     curve_row *curve;
     int ncurve, cap;
@@ -280,6 +282,10 @@ static void usage(FILE *fp) {
     fprintf(
         fp,
         "  --xi X                 perturbation size of eq 8 (default 5e-5, seed Fig 6)\n"
+        "  --predictor KIND       first iterate of a load step: tangent (default; K(D_n) u = f_ext -\n"
+        "                         f_int with the platen's increment) or extrapolate (the last converged\n"
+        "                         increment scaled to this one, as ABAQUS does by default; a shear band,\n"
+        "                         once formed, is carried into the next step). Not with the cyclic tests\n"
         "  --restart DIR          continue from DIR/checkpoint.bin (same mesh options) to --steps\n"
         "                         (cyclic: to --cycles or the stop criterion)\n"
         "  --checkpoint K         write DIR/checkpoint.bin every K steps (default 10; always at the end)\n"
@@ -739,6 +745,7 @@ static int setup(model *M, gk_err *err) {
     ALLOC(M->R, M->ndof);
     ALLOC(M->rhs, M->ndof);
     ALLOC(M->utot, M->ndof);
+    ALLOC(M->ulast, M->ndof);
     ALLOC(M->A0x, M->ndof);
     ALLOC(M->fix, M->ndof);
     ALLOC(M->fixtop, M->ndof);
@@ -1090,10 +1097,15 @@ static int load_step(model *M, double inc, int *iters, double *Ed_out, double *E
            dnewton = 0.0;
     precompute_gradients(M);
     if (external_force(M, err)) return 2;
-    /* predictor: K(D_n) u = f_ext - f_int(sig_n) with the prescribed increment */
-    residual(M, M->sig_n, err);
-    for (k = 0; k < M->ndof; ++k) M->du[k] = -M->R[k];
-    if (solve(M, M->D_n, M->du, top, M->u, err)) return 1;
+    if (M->o.extrapolate && M->inclast != 0.0) { /* predictor: the last converged increment, scaled */
+        double f = inc / M->inclast;
+        for (k = 0; k < M->ndof; ++k) M->u[k] = f * M->ulast[k];
+        if (M->o.verbose) fprintf(stderr, "    predictor: the last increment x %.4g\n", f);
+    } else { /* predictor: K(D_n) u = f_ext - f_int(sig_n) with the prescribed increment */
+        residual(M, M->sig_n, err);
+        for (k = 0; k < M->ndof; ++k) M->du[k] = -M->R[k];
+        if (solve(M, M->D_n, M->du, top, M->u, err)) return 1;
+    }
     for (it = 1; it <= M->o.max_iter; ++it) {
         double t0 = gk_wtime(), Rn;
         nbad = eval_rves(M, M->u);
@@ -1567,7 +1579,7 @@ out:
 /* version 2 (rows with the DEM steps and tangent counts, and the tangent-reuse references after the
  * RVEs); cyclic: "GKFEMCYC3" (strain control) or "GKFEMCYC4" (stress control), the cyclic state and
  * rows at the end. Version 1 files ("GKFEMDEM1", "GKFEMCYC1/2") are refused as not matching. */
-#define CK_MAGIC "GKFEMDEM2"
+#define CK_MAGIC "GKFEMDEM3"
 static const char *ck_magic(const model *M) {
     return M->o.cyclic == 1 ? "GKFEMCYC3" : M->o.cyclic == 2 ? "GKFEMCYC4" : CK_MAGIC;
 }
@@ -1621,7 +1633,9 @@ static int write_checkpoint(const model *M, const char *dir) {
     if (M->o.cyclic) {
         ok &= fwrite(&M->cs, sizeof M->cs, 1, fp) == 1;
         ok &= fwrite(M->cx, sizeof(cyc_extra), (size_t)M->ncurve, fp) == (size_t)M->ncurve;
-    }
+    } else /* the extrapolated predictor's last increment (written whatever the predictor) */
+        ok &= fwrite(&M->inclast, sizeof(double), 1, fp) == 1 &&
+              fwrite(M->ulast, sizeof(double), (size_t)M->ndof, fp) == (size_t)M->ndof;
     ok &= fclose(fp) == 0;
     if (!ok || rename(tmp, path)) return 1;
     return 0;
@@ -1689,7 +1703,9 @@ static int read_checkpoint(model *M, const char *dir, gk_err *err) {
     if (ok && M->o.cyclic) {
         ok &= fread(&M->cs, sizeof M->cs, 1, fp) == 1;
         ok &= fread(M->cx, sizeof(cyc_extra), (size_t)M->ncurve, fp) == (size_t)M->ncurve;
-    }
+    } else if (ok)
+        ok &= fread(&M->inclast, sizeof(double), 1, fp) == 1 &&
+              fread(M->ulast, sizeof(double), (size_t)M->ndof, fp) == (size_t)M->ndof;
     fclose(fp);
     if (!ok) return gk_err_set(err, GK_ERR_FORMAT, "%s: truncated or corrupt", path), 1;
     return 0;
@@ -2111,7 +2127,16 @@ int main(int argc, char **argv) {
             }
         } else if (!strcmp(a, "--noise-probe"))
             bad = int_opt(a, v, &o->noise_probe);
-        else if (!strcmp(a, "--krylov-probe"))
+        else if (!strcmp(a, "--predictor")) {
+            if (!strcmp(v, "tangent"))
+                o->extrapolate = 0;
+            else if (!strcmp(v, "extrapolate"))
+                o->extrapolate = 1;
+            else {
+                fprintf(stderr, "femdem_biaxial: --predictor must be tangent or extrapolate\n");
+                return 2;
+            }
+        } else if (!strcmp(a, "--krylov-probe"))
             bad = int_opt(a, v, &o->krylov_probe);
         else if (!strcmp(a, "--krylov-scale"))
             bad = dbl_opt(a, v, &o->krylov_scale);
@@ -2138,6 +2163,12 @@ int main(int argc, char **argv) {
         o->nx = 1, o->ny = 1, o->elem = GK_Q4, o->quad = 2;
     else if (!o->cyclic && strcmp(o->test, "biaxial")) {
         fprintf(stderr, "femdem_biaxial: --test must be biaxial, single, cyclic-strain or cyclic-stress\n");
+        return 2;
+    }
+    if (o->cyclic && o->extrapolate) {
+        fprintf(stderr,
+                "femdem_biaxial: --predictor extrapolate is for the biaxial and single tests (a cyclic "
+                "reversal would extrapolate the wrong way)\n");
         return 2;
     }
     if (o->nx == -1) o->nx = o->cyclic ? 2 : 8;
@@ -2247,6 +2278,7 @@ int main(int argc, char **argv) {
     printf(
         "femdem_biaxial: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n",
         o->test, o->nx, o->ny, o->elem == GK_Q8 ? "Q8" : "Q4", M.ngp, M.rve[0].n, o->tangent, o->threads);
+    if (o->extrapolate) printf("femdem_biaxial: predictor: the last converged increment, scaled\n");
     if (o->cyclic)
         printf("femdem_biaxial: %s, void ratio %.4f, p0 = %.2f kPa, sigma_yy0 = %.2f kPa; left/right "
                "periodic: %d "
@@ -2284,6 +2316,8 @@ int main(int argc, char **argv) {
                 continue;
             }
             commit(&M);
+            memcpy(M.ulast, M.u, (size_t)M.ndof * sizeof(double));
+            M.inclast = inc;
             M.eps_done += inc;
             ++M.step;
             residual(&M, M.sig_n, &err);

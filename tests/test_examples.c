@@ -465,6 +465,34 @@ TEST(femdem_krylov_probe_leaves_the_run_unchanged) {
     CHECK(fd_refused("--krylov-probe 2 --krylov-scale 1.5", "out of range"));
 }
 
+/* --predictor extrapolate: the first iterate of a step is the last converged increment, scaled. The run
+ * is the same for 1 and 2 threads and across a restart (the checkpoint carries that increment); before
+ * the peak it converges to the tangent predictor's curve (sigma_yy within 0.5 %) along other iterates
+ * (E_d of the accepted iterates differs from step 2 on); a bad kind, and the cyclic tests, refuse it */
+TEST(femdem_extrapolated_predictor) {
+    char header[512];
+    double a[5 * F_NCOL], b[5 * F_NCOL];
+    int na, nb, r, differs = 0;
+    CHECK(run_threads_and_restart("build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --predictor "
+                                  "extrapolate",
+                                  "--steps 4", "--steps 2", "t_fx"));
+    check_threads_and_restart("t_fx", "biaxial.csv", 6);
+    CHECK(gk_test_file_has("build/t_fxA.out", "predictor: the last converged increment"));
+    CHECK(system("build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --steps 4 --threads 2 --out "
+                 "build/t_fxT > build/t_fxT.out 2>&1") == 0);
+    na = read_csv("build/t_fxA/biaxial.csv", F_NCOL, a, 5, header, sizeof header);
+    nb = read_csv("build/t_fxT/biaxial.csv", F_NCOL, b, 5, header, sizeof header);
+    CHECK_EQ_INT(na, 5);
+    CHECK_EQ_INT(nb, 5);
+    for (r = 1; r < 5 && na == 5 && nb == 5; ++r) {
+        CHECK(fabs(a[r * F_NCOL + F_SYY] - b[r * F_NCOL + F_SYY]) < 5e-3 * b[r * F_NCOL + F_SYY]);
+        if (r >= 2 && a[r * F_NCOL + 7] != b[r * F_NCOL + 7]) differs = 1; /* column 7: E_d */
+    }
+    CHECK(differs);
+    CHECK(fd_refused("--predictor linear", "tangent or extrapolate"));
+    CHECK(fd_refused("--test cyclic-strain --predictor extrapolate", "biaxial and single"));
+}
+
 /* --ed newton: E_d is the Newton correction before relaxation; every accepted row of the CSV meets
  * E_d < 0.01 or E_f < 0.003 (columns 7 and 8); a value other than step or newton is refused */
 TEST(femdem_ed_newton_accepts_by_the_criterion) {
@@ -694,6 +722,7 @@ int main(int argc, char **argv) {
     RUN(femdem_refuses_malformed_numbers);
     RUN(femdem_noise_probe_leaves_the_run_unchanged);
     RUN(femdem_krylov_probe_leaves_the_run_unchanged);
+    RUN(femdem_extrapolated_predictor);
     RUN(femdem_ed_newton_accepts_by_the_criterion);
     RUN(femdem_dem_rule_and_tangent_reuse);
     RUN(femdem_relaxed_tangent_converges_to_the_same_curve);
