@@ -79,8 +79,8 @@
  *     any deformation near the iterate reduces the residual (GMRES with the
  *     RVEs' own responses): before the peak 2-3 directions remove nearly all
  *     of it; at the first step after the peak on the 8 x 16 mesh 6 directions
- *     remove 2 %, at finite-difference steps of 0.5-20 % of |u|, so no
- *     tangent, however exact, makes Newton converge there (README).
+ *     remove 2 %, at finite-difference steps of 0.5-20 % of |u|: a better
+ *     tangent would have to point outside that space (README).
  *   - Aitken relaxation: the approximate (affine) tangent makes Newton
  *     converge linearly with a nearly constant ratio; the correction d_k is
  *     scaled by w_k = -w_(k-1) d_(k-1).(d_k - d_(k-1)) / |d_k - d_(k-1)|^2
