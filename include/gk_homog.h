@@ -421,34 +421,34 @@ GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
     double V = gk_rve_volume(rve);
     for (k = 0; k < n4; ++k) D[k] = 0.0;
     if (!(V > 0.0)) return GK_ERR_CELL;
-    if (opts & GK_TANGENT_RELAXED) {
+    if (opts & GK_TANGENT_RELAXED) { /* the condensation builds D, divided by V; not with GEOMETRIC */
         gk_result res = (opts & GK_TANGENT_GEOMETRIC) ? GK_ERR_ARG : gk__tangent_relaxed(rve, opts, V, D);
         if (res) {
             for (k = 0; k < n4; ++k) D[k] = 0.0;
             return res;
         }
-    }
-    for (c = 0; !(opts & GK_TANGENT_RELAXED) && c < rve->pl.n; ++c) {
-        double d[3], n[3], dd, A[9];
-        if (!gk__contact_spring(rve, c, opts, A, d, n, &dd)) continue;
-        if (opts & GK_TANGENT_GEOMETRIC) { /* A_ik += -(F_n/|d|)(delta_ik - n_i n_k) + n_i F_t,k / |d| */
-            double F[3], Fn, Ft[3];
-            for (k = 0; k < 3; ++k) F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
-            Fn = F[0] * n[0] + F[1] * n[1] + F[2] * n[2];
-            for (k = 0; k < 3; ++k) Ft[k] = F[k] - Fn * n[k];
+    } else {
+        for (c = 0; c < rve->pl.n; ++c) {
+            double d[3], n[3], dd, A[9];
+            if (!gk__contact_spring(rve, c, opts, A, d, n, &dd)) continue;
+            if (opts & GK_TANGENT_GEOMETRIC) { /* A_ik += -(F_n/|d|)(delta_ik - n_i n_k) + n_i F_t,k / |d| */
+                double F[3], Fn, Ft[3];
+                for (k = 0; k < 3; ++k) F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
+                Fn = F[0] * n[0] + F[1] * n[1] + F[2] * n[2];
+                for (k = 0; k < 3; ++k) Ft[k] = F[k] - Fn * n[k];
+                for (i = 0; i < dim; ++i)
+                    for (k = 0; k < dim; ++k)
+                        A[3 * i + k] += -(Fn / dd) * ((i == k ? 1.0 : 0.0) - n[i] * n[k]) + n[i] * Ft[k] / dd;
+            }
+            /* A_ik = kn n_i n_k + kt (delta_ik - n_i n_k) [+ geometric]; D_ijkl += A_ik d_j d_l / V */
             for (i = 0; i < dim; ++i)
-                for (k = 0; k < dim; ++k)
-                    A[3 * i + k] += -(Fn / dd) * ((i == k ? 1.0 : 0.0) - n[i] * n[k]) + n[i] * Ft[k] / dd;
+                for (j = 0; j < dim; ++j)
+                    for (k = 0; k < dim; ++k)
+                        for (l = 0; l < dim; ++l)
+                            D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
         }
-        /* A_ik = kn n_i n_k + kt (delta_ik - n_i n_k) [+ geometric]; D_ijkl += A_ik d_j d_l / V */
-        for (i = 0; i < dim; ++i)
-            for (j = 0; j < dim; ++j)
-                for (k = 0; k < dim; ++k)
-                    for (l = 0; l < dim; ++l)
-                        D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
-    }
-    if (!(opts & GK_TANGENT_RELAXED))
         for (k = 0; k < n4; ++k) D[k] /= V;
+    }
     if (opts & GK_TANGENT_GEOMETRIC) {
         const double *s = rve->stress;
         for (i = 0; i < dim; ++i)
