@@ -969,6 +969,18 @@ static double residual(model *M, const double *sig, gk_err *err) {
     return nf > 0 ? norm(M->R, M->ndof) / nf : 0.0;
 }
 
+/* the end of a probe: the iterate at u0 again (deterministic: the same stresses, tangents and residual)
+ * and the work counters as before the probe (pd, pr, pc), its RVE runs uncounted. Returns the failed
+ * RVE runs. */
+static int probe_end(model *M, const double *u0, long long pd, long long pr, long long pc, gk_err *err) {
+    int nbad;
+    memcpy(M->u, u0, (size_t)M->ndof * sizeof(double));
+    nbad = eval_rves(M, M->u);
+    if (!nbad) residual(M, M->sig, err);
+    M->pend_dem = pd, M->pend_reused = pr, M->pend_computed = pc;
+    return nbad;
+}
+
 /* --noise-probe: the change of the residual under u -> u (1 + eps), relative to |f_int|, for eps =
  * 1e-6 ... 1e-2, printed next to E_f; then the iterate at u again (deterministic: the same stresses and
  * tangents), the probe's DEM work uncounted. Where the change grows in proportion to eps it is the RVE
@@ -998,10 +1010,7 @@ static int noise_probe(model *M, int it, double Ef, gk_err *err) {
         fprintf(stderr, " %.0e: %.2e", eps, fn > 0 ? sqrt(d) / fn : 0.0);
     }
     fprintf(stderr, nbad ? " (an RVE run failed)\n" : "\n");
-    memcpy(M->u, u0, (size_t)M->ndof * sizeof(double));
-    nbad = eval_rves(M, M->u);
-    if (!nbad) residual(M, M->sig, err);
-    M->pend_dem = pd, M->pend_reused = pr, M->pend_computed = pc;
+    nbad = probe_end(M, u0, pd, pr, pc, err);
     free(R0), free(u0);
     return nbad;
 }
@@ -1084,10 +1093,7 @@ static int krylov_probe(model *M, int it, double Ef, gk_err *err) {
         fprintf(stderr, "      m %d: %.3e  E_f %.3e\n", m, fabs(gv[m]) / beta, Efm);
     }
     if (nbad) fprintf(stderr, "      (an RVE run failed; probe stopped)\n");
-    memcpy(M->u, u0, (size_t)n * sizeof(double));
-    nbad = eval_rves(M, M->u);
-    if (!nbad) residual(M, M->sig, err);
-    M->pend_dem = pd, M->pend_reused = pr, M->pend_computed = pc;
+    nbad = probe_end(M, u0, pd, pr, pc, err);
     free(Dp), free(u0), free(R0), free(V), free(Z), free(w);
     return nbad;
 }
@@ -1931,7 +1937,7 @@ static int single_rve_reference(const model *M, double *eps, double *syy, double
              * D_xxxx starts the iteration and the secant of the last two iterates continues it: near the
              * peak the RVE's lateral response is several times softer than D_xxxx (about 5 times at
              * 1.9-2.4 %), and Newton with D_xxxx alone crawls there */
-            double H[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, g, hp = 0.0, gp = 0.0, tol = 1e-3 * p;
+            double H[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, g, hp = 0.0, gp = 0.0;
             H[4] = -M->o.inc;
             if (gk_rve_state_save(&st, &r)) {
                 gk_err_set(err, GK_ERR_ALLOC, "state");
@@ -1952,7 +1958,7 @@ static int single_rve_reference(const model *M, double *eps, double *syy, double
                 }
                 gk_rve_stress(&r, sig);
                 g = sig[0] + p;
-                if (fabs(g) <= (p > 0 ? tol : 1e-3 * fabs(sig[4]))) break;
+                if (fabs(g) <= 1e-3 * (p > 0 ? p : fabs(sig[4]))) break;
                 if (it == SINGLE_MAX_IT) {
                     gk_err_set(
                         err, GK_ERR_STATE,
