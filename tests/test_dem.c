@@ -262,12 +262,9 @@ TEST(full_tangent_is_fd_tangent_prestressed) {
 
 static double h_d_h(const double *D, int dim, const double H[9]) {
     double s = 0;
-    int i, j, k, l;
+    int i, j;
     for (i = 0; i < dim; ++i)
-        for (j = 0; j < dim; ++j)
-            for (k = 0; k < dim; ++k)
-                for (l = 0; l < dim; ++l)
-                    s += H[3 * i + j] * D[((i * dim + j) * dim + k) * dim + l] * H[3 * k + l];
+        for (j = 0; j < dim; ++j) s += H[3 * i + j] * contract(D, dim, H, i, j);
     return s;
 }
 
