@@ -99,6 +99,17 @@ $(BUILD)/mpi/mpi_%: tests/mpi_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/mpi
 $(BUILD)/mpi/run_%: $(BUILD)/mpi/mpi_% | $(BUILD)/mpi
 	@printf '#!/bin/sh\nexec %s %s -np 2 %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
 
+# the MPMxDEM drivers built on MPI (their RVEs spread over the ranks) and the 2-rank launcher their
+# test uses (tests/test_mpmdem_biaxial.c: 2 ranks give the CSV of the OpenMP build)
+MPI_EXAMPLES := $(patsubst %,$(BUILD)/mpi/mpmdem_%_mpi,biaxial footing collapse)
+MPI_PROGS    += $(MPI_EXAMPLES) $(BUILD)/mpi/mpirun2
+
+$(BUILD)/mpi/%_mpi: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)/mpi
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
+
+$(BUILD)/mpi/mpirun2: | $(BUILD)/mpi
+	@printf '#!/bin/sh\nexec %s %s -np 2 "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' > $@ && chmod +x $@
+
 ifeq ($(HAVE_MPI),yes)
 mpi: $(MPI_PROGS)
 MPI_RUN := $(MPI_RUNNERS)

@@ -1,44 +1,80 @@
-/* mpmdem.h - what the three MPMxDEM drivers share (examples, not library).
+/* mpmdem.h - the MPM side the three MPMxDEM drivers share (examples, not library).
  *
  * mpmdem_biaxial.c, mpmdem_footing.c and mpmdem_collapse.c put one periodic
- * 2D RVE behind every material point of an explicit MPM (seed 003, Liang &
- * Zhao; notes in ../shared/notes/seed-003.md). This file holds the parts
- * they have in common, included once by each driver after the grainkit
- * headers with GK_IMPLEMENTATION:
+ * 2D RVE behind every material point of an explicit MPM (Liang & Zhao 2019).
+ * The micro side - one RVE per point, the DEM steps of each MPM step, the
+ * per-point fields, the RVEs' checkpoint, threads or MPI ranks - is
+ * gk_twoscale.h; this file is what the drivers add on the MPM side. A driver
+ * defines GK_IMPLEMENTATION and includes it (it includes the grainkit
+ * headers):
  *
- *   mpd_opts / mpd_parse_common / mpd_usage_common   flags every driver takes
- *   mpd_prepare_rve     the packing, the DEM material, consolidation to a
- *                       pressure, the bulk density and P-wave modulus
- *   mpd_rves_*          one RVE per point; mpd_stress is the
- *                       gk_mpm_stress_fn of gk_mpm_step (seed 003 Sec 2.3
- *                       (b): dH = dt L -> RVE -> total Love stress back)
- *   mpd_fields          per-point output fields
- *   mpd_write_vtk / mpd_svg_field   material points for ParaView / an SVG
- *   mpd_ck_write / mpd_ck_read      checkpoints (every RVE, every point)
+ *   mpd_begin / mpd_end     the run: MPI (built with GK_TWOSCALE_MPI), the
+ *                           output folder, messages on rank 0 only
+ *   mpd_opts, mpd_common_opts   the flags every driver takes (cli.h tables)
+ *   mpd_proto, mpd_prepare_rve  the packing, the DEM material, consolidation
+ *                           to a pressure; bulk density, P-wave modulus
+ *   mpd_micro               the gk_twoscale set of the points and the MPM
+ *                           strain each point has accumulated; mpd_stress is
+ *                           the gk_mpm_stress_fn of the step (Liang & Zhao
+ *                           2019 Sec 2.3 (b): dH = dt L -> RVE -> Love stress)
+ *   mpd_edge, mpd_step      one USF step with follower edge pressures
+ *   mpd_fields              the per-point fields (strains, rotation, p, q, ...)
+ *   mpmdem_io.h             what the drivers write: CSV, plots, VTK, field
+ *                           pictures, the checkpoint (gk_twoscale's file with
+ *                           the driver's block: points, state, rows, pictures)
  *
  * THE DEM STEPS PER MPM STEP (the paper leaves it unstated; it says the DEM
- * runs "until a quasi-static state"). Default (--dem-rule adaptive):
- * gk_rve_deform_adaptive (gk_homog.h) - the point's dH is applied over
+ * runs "until a quasi-static state"): gk_twoscale's rule. Default
+ * (--dem-rule adaptive): the point's dH is applied over
  *     n = clamp(ceil(I_1 / I_max), dem_min, dem_max)
- * steps, I_1 the inertial number (seed 000 eq 20) of dH in one DEM step at
- * the RVE's current pressure, so the RVE deforms at I <= I_max (5e-4: at
- * 100 kPa the same count as the 1e-5-strain-per-step rule of seed 000's
+ * steps, I_1 the inertial number (Guo & Zhao 2014 eq 20) of dH in one DEM
+ * step at the RVE's current pressure, so the RVE deforms at I <= I_max (5e-4:
+ * at 100 kPa the count of the 1e-5-strain-per-step rule of Guo & Zhao's
  * scripts; more steps where p is low), then relaxes at fixed cell while its
  * unbalanced force ratio exceeds --dem-unbalanced (5e-3), within dem_max
- * steps in all. --dem-rule strain: n_s = clamp(ceil(max|dH_ij| /
- * dem_strain), dem_min, dem_max), no relaxation. dem_max caps the cost; the
- * collapse driver sets it to the real-time count dt_MPM / dt_DEM (a flowing
- * point cannot be more quasi-static than the flow), the quasi-static
- * drivers leave it large.
+ * steps in all. --dem-rule strain: n = clamp(ceil(max|dH_ij| / dem_strain),
+ * dem_min, dem_max), no relaxation. dem_max caps the cost; the collapse sets
+ * it to the real-time count dt_MPM / dt_DEM (a flowing point cannot be more
+ * quasi-static than the flow), the quasi-static drivers leave it large.
  *
  * THE MPM TIME STEP: dt = cfl h / c, c = sqrt(M / rho) with M = max(D_xxxx,
- * D_yyyy) of the Taylor (affine, eq 9 of seed 000) tangent of the prepared
- * RVE: the affine tangent bounds the RVE's real stiffness from above, so c
- * is an upper bound of the P-wave speed and the step is safe while the
- * contact network keeps its stiffness (the drivers print M, rho, c, dt).
+ * D_yyyy) of the Taylor (affine, Guo & Zhao 2014 eq 9) tangent of the
+ * prepared RVE: the affine tangent bounds the RVE's stiffness from above, so
+ * c bounds the P-wave speed and the step is safe while the contact network
+ * keeps its stiffness (the drivers print M, rho, c, dt).
+ *
+ * MPI. Built with mpicc and -DGK_TWOSCALE_MPI (make mpi: build/mpi/NAME_mpi),
+ * every rank runs the whole MPM (it is cheap next to the RVEs) and the
+ * gk_twoscale set spreads the RVEs over the ranks (each stores only its
+ * own); rank 0 alone prints and writes. The results are those of the
+ * OpenMP build, bit for bit, for any rank and thread count:
+ *     mpirun -np 2 build/mpi/mpmdem_biaxial_mpi --threads 1 --out DIR
+ *
+ * OUTPUT AND EXIT STATUS. --out DIR is created (with its parents) and must
+ * not be a file; every result written (CSV, SVG, VTK, checkpoint) is
+ * checked, and one that cannot be written ends the run with its path and
+ * status 1. Status: 0 done, 1 setup or output failed, 2 bad arguments, 3 the
+ * simulation failed (the message names the point; the last checkpoint
+ * written is intact).
+ *
+ * FIELD PICTURES (mpd_snap_add): the points as dots in metres at equal aspect,
+ * the geometry (plates, walls, footing, base) drawn on top, a colour bar
+ * with the quantity's unit, strains in %. The snapshots of one quantity in
+ * a run share ONE colour scale: the range of that quantity over all its
+ * snapshots so far; a snapshot that widens it rewrites the earlier ones
+ * (the snapshots travel in the checkpoint, so a restart keeps the scale).
  */
 #ifndef MPMDEM_H
 #define MPMDEM_H
+
+#define _POSIX_C_SOURCE 200809L
+#include "gk_base.h"
+#include "gk_dem.h"
+#include "gk_homog.h"
+#include "gk_io.h"
+#include "gk_mpm.h"
+#include "gk_twoscale.h"
+#include "cli.h"
 
 #include <errno.h>
 #include <math.h>
@@ -48,53 +84,175 @@
 #include <sys/stat.h>
 
 #define MPD_PI 3.14159265358979323846
+#define MPD_PATH 1200
 
+/* ---------------------------------------------------------------- the run */
+typedef struct mpd_run {
+    const char *prog; /* driver name for messages */
+    const char *out;  /* output folder            */
+    int rank, nranks;
+} mpd_run;
+
+static void mpd_begin(mpd_run *run, const char *prog, int *argc, char ***argv) {
+    memset(run, 0, sizeof *run);
+    run->prog = prog, run->nranks = 1;
+#ifdef GK_TWOSCALE_MPI
+    {
+        int provided;
+        MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+        MPI_Comm_rank(MPI_COMM_WORLD, &run->rank);
+        MPI_Comm_size(MPI_COMM_WORLD, &run->nranks);
+        if (run->rank != 0) { /* the driver is replicated: rank 0 speaks for all */
+            FILE *q = freopen("/dev/null", "w", stdout);
+            q = freopen("/dev/null", "w", stderr);
+            (void)q;
+        }
+    }
+#else
+    (void)argc, (void)argv;
+#endif
+}
+
+static int mpd_end(int status) {
+#ifdef GK_TWOSCALE_MPI
+    MPI_Finalize();
+#endif
+    return status;
+}
+
+/* rank 0's verdict on every rank (rank 0 alone writes files) */
+static int mpd_agree(const mpd_run *run, int bad) {
+#ifdef GK_TWOSCALE_MPI
+    if (run->nranks > 1) MPI_Bcast(&bad, 1, MPI_INT, 0, MPI_COMM_WORLD);
+#else
+    (void)run;
+#endif
+    return bad;
+}
+
+/* the output folder and its parents; an existing file is refused */
+static int mpd_out_dir(const mpd_run *run) {
+    char buf[MPD_PATH];
+    struct stat st;
+    size_t k, n = strlen(run->out);
+    int bad = 0;
+    if (run->rank == 0) {
+        if (n == 0 || n >= sizeof buf) {
+            fprintf(stderr, "%s: --out '%s': need a folder name of 1 to %d characters\n", run->prog, run->out,
+                    (int)sizeof buf - 1);
+            bad = 1;
+        }
+        for (k = 1; !bad && k <= n; ++k) /* each prefix ending at a '/' or the end */
+            if (k == n || run->out[k] == '/') {
+                memcpy(buf, run->out, k), buf[k] = 0;
+                if (stat(buf, &st) == 0 ? !S_ISDIR(st.st_mode) : mkdir(buf, 0755) != 0 && errno != EEXIST) {
+                    fprintf(stderr, "%s: --out %s: %s is %s\n", run->prog, run->out, buf,
+                            stat(buf, &st) == 0 ? "a file, not a folder" : "a folder that cannot be created");
+                    bad = 1;
+                }
+            }
+    }
+    return mpd_agree(run, bad);
+}
+
+/* DIR/name; 1 (said) if the path is too long */
+static int mpd_path(const mpd_run *run, char *buf, const char *name) {
+    if (snprintf(buf, MPD_PATH, "%s/%s", run->out, name) < MPD_PATH) return 0;
+    fprintf(stderr, "%s: the output path %s/%s is too long\n", run->prog, run->out, name);
+    return 1;
+}
+
+/* a result that could not be written: said once, status 1 */
+static int mpd_write_failed(const mpd_run *run, const char *path, const char *why) {
+    fprintf(stderr, "%s: cannot write %s%s%s\n", run->prog, path, why ? ": " : "", why ? why : "");
+    return 1;
+}
+
+/* ---------------------------------------------------------------- options */
 typedef struct mpd_opts {
     const char *out, *packing, *restart;
-    int threads, ppc;
-    gk_mpm_basis basis;
-    double alpha;                        /* PIC fraction (seed 003: 0.1)                          */
-    double cfl;                          /* dt = cfl h / c                                        */
-    int dem_adaptive;                    /* 1: gk_rve_deform_adaptive, 0: the strain rule         */
-    double dem_inertial, dem_unbalanced; /* bounds of the adaptive rule        */
-    double dem_strain;                   /* RVE strain per DEM step bound (strain rule)           */
+    int threads, ppc, basis;             /* basis: index of mpd_basis_names                          */
+    double alpha;                        /* PIC fraction (Liang & Zhao: 0.1)                         */
+    double cfl;                          /* dt = cfl h / c                                           */
+    int dem_rule;                        /* 0 adaptive, 1 strain (gk_twoscale_rule_kind)            */
+    double dem_inertial, dem_unbalanced; /* bounds of the adaptive rule                              */
+    double dem_strain;                   /* RVE strain per DEM step bound (strain rule)              */
     int dem_min, dem_max;
-    double dem_dt; /* DEM time step [s]; 0 -> 0.5 x critical                */
+    double dem_dt; /* DEM time step [s]; 0 -> 0.5 x critical                                          */
     double young, kt_ratio, friction_deg, roll_beta, roll_eta, dem_damping;
-    int vtk_every; /* MPM steps between VTK files (0: first and last only)   */
+    int vtk_every; /* MPM steps between VTK files (0: first and last only)                           */
     int checkpoint_every;
     int quiet;
 } mpd_opts;
 
+static const gk_mpm_basis mpd_basis[4] = {GK_MPM_LINEAR, GK_MPM_UGIMP, GK_MPM_QUADRATIC, GK_MPM_CUBIC};
+
 static void mpd_opts_default(mpd_opts *o, const char *out) {
-    gk_material m = gk_material_default(); /* seed 000 / seed 003 Table 3 values */
+    gk_material m = gk_material_default(); /* Guo & Zhao 2014 / Liang & Zhao 2019 Table 3 values */
     memset(o, 0, sizeof *o);
     o->out = out;
     o->packing = "examples/data/rve400.txt";
     o->threads = 2;
     o->ppc = 1;
-    o->basis = GK_MPM_UGIMP;
+    o->basis = 1; /* uGIMP */
     o->alpha = 0.1;
     o->cfl = 0.4;
-    o->dem_adaptive = 1;
     o->dem_inertial = 5e-4;
     o->dem_unbalanced = 5e-3;
     o->dem_strain = 1e-5;
     o->dem_min = 1;
     o->dem_max = 1000;
-    o->dem_dt = 3.16e-5; /* the step seed 000's scripts use with this packing */
+    o->dem_dt = 3.16e-5; /* the step of Guo & Zhao's scripts with this packing */
     o->young = m.young;
     o->kt_ratio = m.kt_ratio;
     o->friction_deg = atan(m.friction) * 180.0 / MPD_PI;
-    o->dem_damping = 0.1; /* seed 003 eq 29, alpha = 0.1 */
-    o->vtk_every = 0;
-    o->checkpoint_every = 0;
+    o->dem_damping = 0.1; /* Liang & Zhao 2019 eq 29, alpha = 0.1 */
 }
 
-/* the DEM-step rule in force, as the quasi-static drivers print it at start (the collapse prints its
- * real-time cap with it); inline: a driver that does not call it gets no unused-function warning */
+/* the table of the common flags, pointing into *o (24 and the terminator) */
+#define MPD_NCOMMON 25
+static void mpd_common_opts(mpd_opts *o, cli_opt *t) {
+    const cli_opt c[MPD_NCOMMON] = {
+        {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
+        {"--threads", CLI_INT, &o->threads, 1, 1024, NULL, NULL, 0},
+        {"--ppc", CLI_INT, &o->ppc, 1, 4, NULL, NULL, 0},
+        {"--basis", CLI_CHOICE, &o->basis, 0, 0, NULL, "linear|ugimp|quadratic|cubic", 0},
+        {"--alpha", CLI_REAL, &o->alpha, 0, 1, NULL, NULL, 0},
+        {"--cfl", CLI_REAL, &o->cfl, 0, 1, NULL, NULL, CLI_LO_OPEN},
+        {"--packing", CLI_STR, &o->packing, 0, 0, NULL, NULL, 0},
+        {"--dem-rule", CLI_CHOICE, &o->dem_rule, 0, 0, NULL, "adaptive|strain", 0},
+        {"--dem-inertial", CLI_REAL, &o->dem_inertial, 0, 1, NULL, NULL, CLI_LO_OPEN},
+        {"--dem-unbalanced", CLI_REAL, &o->dem_unbalanced, 0, HUGE_VAL, "a positive number", NULL,
+         CLI_LO_OPEN},
+        {"--dem-strain", CLI_REAL, &o->dem_strain, 0, 1, NULL, NULL, CLI_LO_OPEN},
+        {"--dem-min", CLI_INT, &o->dem_min, 1, 1000000, NULL, NULL, 0},
+        {"--dem-max", CLI_INT, &o->dem_max, 1, 1000000, NULL, NULL, 0},
+        {"--dem-dt", CLI_REAL, &o->dem_dt, 0, 1, NULL, NULL, 0},
+        {"--young", CLI_REAL, &o->young, 0, HUGE_VAL, "a positive modulus", NULL, CLI_LO_OPEN},
+        {"--kt-ratio", CLI_REAL, &o->kt_ratio, 0, 1, NULL, NULL, 0},
+        {"--friction-deg", CLI_REAL, &o->friction_deg, 0, 90, NULL, NULL, CLI_HI_OPEN},
+        {"--roll-beta", CLI_REAL, &o->roll_beta, 0, HUGE_VAL, "a number >= 0", NULL, 0},
+        {"--roll-eta", CLI_REAL, &o->roll_eta, 0, HUGE_VAL, "a number >= 0", NULL, 0},
+        {"--dem-damping", CLI_REAL, &o->dem_damping, 0, 1, NULL, NULL, CLI_HI_OPEN},
+        {"--vtk-every", CLI_INT, &o->vtk_every, 0, 1000000000, NULL, NULL, 0},
+        {"--checkpoint", CLI_INT, &o->checkpoint_every, 0, 1000000000, NULL, NULL, 0},
+        {"--restart", CLI_STR, &o->restart, 0, 0, NULL, NULL, 0},
+        {"--quiet", CLI_FLAG, &o->quiet, 0, 0, NULL, NULL, 0},
+        {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    memcpy(t, c, sizeof c);
+}
+
+static int mpd_check_opts(const mpd_run *run, const mpd_opts *o) {
+    if (o->dem_min > o->dem_max) {
+        fprintf(stderr, "%s: --dem-min %d exceeds --dem-max %d\n", run->prog, o->dem_min, o->dem_max);
+        return 2;
+    }
+    return 0;
+}
+
+/* the DEM-step rule in force, as the quasi-static drivers print it at start */
 GK_INLINE void mpd_print_dem_rule(const mpd_opts *o) {
-    if (o->dem_adaptive)
+    if (o->dem_rule == GK_TWOSCALE_ADAPTIVE)
         printf("DEM steps per MPM step: adaptive, I <= %g then relaxation to an unbalanced force ratio < %g, "
                "%d..%d steps\n",
                o->dem_inertial, o->dem_unbalanced, o->dem_min, o->dem_max);
@@ -107,10 +265,10 @@ static void mpd_usage_common(FILE *fp, const mpd_opts *d) {
     fprintf(
         fp,
         "common options (MPMxDEM):\n"
-        "  --out DIR              output directory (default %s)\n"
+        "  --out DIR              output folder, created with its parents (default %s)\n"
         "  --threads T            OpenMP threads over the RVEs and the MPM (default %d)\n"
         "  --ppc K                material points per cell edge: K^2 per cell (default %d)\n"
-        "  --basis B              linear | ugimp | quadratic | cubic (default ugimp; seed 003: GIMP)\n"
+        "  --basis B              linear | ugimp | quadratic | cubic (default ugimp; the paper: GIMP)\n"
         "  --alpha A              PIC fraction of the PIC/FLIP blend, eq 19 (default %g)\n"
         "  --cfl C                MPM step = C h / c, c from the RVE's Taylor tangent (default %g)\n"
         "  --packing FILE         RVE packing every point starts from (default %s)\n"
@@ -118,115 +276,65 @@ static void mpd_usage_common(FILE *fp, const mpd_opts *d) {
         "                         the unbalanced force (default), or from the strain per DEM step\n"
         "  --dem-inertial I       adaptive: inertial number bound of the RVE deformation (default %g)\n"
         "  --dem-unbalanced U     adaptive: relax until the unbalanced force ratio < U (default %g)\n"
-        "  --dem-strain S         strain rule: RVE strain per DEM step bound (default %g)\n"
-        "  --dem-min N --dem-max N  bounds of the DEM steps per MPM step (default %d, %d)\n"
-        "  --dem-dt DT            DEM time step [s] (default %g)\n"
-        "  --young E --kt-ratio R --friction-deg PHI --roll-beta B --roll-eta ETA\n"
-        "                         DEM contact law, seed 003 eqs 26-28 (defaults %g Pa, %g, %g deg, %g, %g)\n"
-        "  --dem-damping A        local non-viscous damping in the RVEs, eq 29 (default %g)\n"
-        "  --vtk-every N          VTK of the points every N MPM steps (default: first and last)\n"
-        "  --checkpoint N         checkpoint every N MPM steps into DIR/checkpoint.bin (0: at the end)\n"
-        "  --restart DIR          continue from DIR/checkpoint.bin (same flags) to the same result\n"
-        "  --quiet                no progress lines\n",
+        "  --dem-strain S         strain rule: RVE strain per DEM step bound (default %g)\n",
         d->out, d->threads, d->ppc, d->alpha, d->cfl, d->packing, d->dem_inertial, d->dem_unbalanced,
-        d->dem_strain, d->dem_min, d->dem_max, d->dem_dt, d->young, d->kt_ratio, d->friction_deg,
-        d->roll_beta, d->roll_eta, d->dem_damping);
+        d->dem_strain);
+    fprintf(fp,
+            "  --dem-min N --dem-max N  bounds of the DEM steps per MPM step (default %d, %d)\n"
+            "  --dem-dt DT            DEM time step [s] (default %g)\n"
+            "  --young E --kt-ratio R --friction-deg PHI --roll-beta B --roll-eta ETA\n"
+            "                         DEM contact law, Liang & Zhao eqs 26-28 (defaults %g Pa, %g, %g deg, "
+            "%g, %g)\n"
+            "  --dem-damping A        local non-viscous damping in the RVEs, eq 29 (default %g)\n"
+            "  --vtk-every N          VTK of the points every N MPM steps (default: first and last)\n"
+            "  --checkpoint N         checkpoint every N MPM steps into DIR/checkpoint.bin (0: at the end)\n"
+            "  --restart DIR          continue from DIR/checkpoint.bin (same flags) to the same result\n"
+            "  --quiet                no progress lines\n"
+            "MPI: build/mpi/<driver>_mpi under mpirun spreads the RVEs over the ranks (same results).\n"
+            "exit status: 0 done, 1 setup or an output failed, 2 bad arguments, 3 the simulation failed\n",
+            d->dem_min, d->dem_max, d->dem_dt, d->young, d->kt_ratio, d->friction_deg, d->roll_beta,
+            d->roll_eta, d->dem_damping);
 }
 
-/* numbers on the command line: the whole string must parse and be finite */
-static int mpd_num(const char *s, double *v) {
-    char *end;
-    errno = 0;
-    *v = strtod(s, &end);
-    return !(end != s && *end == '\0' && errno == 0 && isfinite(*v));
-}
-
-/* consumes argv[*i] (and its value) if it is a common flag: 1 consumed, 0 not
- * a common flag, -1 bad value (message on stderr) */
-static int mpd_parse_common(mpd_opts *o, int argc, char **argv, int *i) {
-    const char *a = argv[*i], *val = *i + 1 < argc ? argv[*i + 1] : NULL;
-    double v = 0.0;
-    static const char *with_value[] = {
-        "--out",        "--threads",      "--ppc",       "--basis",        "--alpha",         "--cfl",
-        "--packing",    "--dem-strain",   "--dem-min",   "--dem-max",      "--dem-dt",        "--young",
-        "--kt-ratio",   "--friction-deg", "--roll-beta", "--roll-eta",     "--dem-damping",   "--vtk-every",
-        "--checkpoint", "--restart",      "--dem-rule",  "--dem-inertial", "--dem-unbalanced"};
-    size_t k;
-    if (!strcmp(a, "--quiet")) return o->quiet = 1, 1;
-    for (k = 0; k < sizeof with_value / sizeof *with_value; ++k)
-        if (!strcmp(a, with_value[k])) break;
-    if (k == sizeof with_value / sizeof *with_value) return 0;
-    if (!val) return fprintf(stderr, "error: %s needs a value\n", a), -1;
-    ++*i;
-    if (!strcmp(a, "--out")) return o->out = val, 1;
-    if (!strcmp(a, "--packing")) return o->packing = val, 1;
-    if (!strcmp(a, "--restart")) return o->restart = val, 1;
-    if (!strcmp(a, "--dem-rule")) {
-        if (!strcmp(val, "adaptive"))
-            o->dem_adaptive = 1;
-        else if (!strcmp(val, "strain"))
-            o->dem_adaptive = 0;
-        else
-            return fprintf(stderr, "error: --dem-rule %s: use adaptive or strain\n", val), -1;
-        return 1;
-    }
-    if (!strcmp(a, "--basis")) {
-        if (!strcmp(val, "linear"))
-            o->basis = GK_MPM_LINEAR;
-        else if (!strcmp(val, "ugimp"))
-            o->basis = GK_MPM_UGIMP;
-        else if (!strcmp(val, "quadratic"))
-            o->basis = GK_MPM_QUADRATIC;
-        else if (!strcmp(val, "cubic"))
-            o->basis = GK_MPM_CUBIC;
-        else
-            return fprintf(stderr, "error: --basis %s: use linear, ugimp, quadratic or cubic\n", val), -1;
-        return 1;
-    }
-    if (mpd_num(val, &v)) return fprintf(stderr, "error: %s %s: not a number\n", a, val), -1;
-#define MPD_INT(flag, field, lo, hi)                                                                   \
-    if (!strcmp(a, flag)) {                                                                            \
-        if (v != floor(v) || v < (lo) || v > (hi))                                                     \
-            return fprintf(stderr, "error: %s %s: need an integer in [%d, %d]\n", a, val, lo, hi), -1; \
-        return o->field = (int)v, 1;                                                                   \
-    }
-#define MPD_REAL(flag, field, ok, what)                                                 \
-    if (!strcmp(a, flag)) {                                                             \
-        if (!(ok)) return fprintf(stderr, "error: %s %s: need %s\n", a, val, what), -1; \
-        return o->field = v, 1;                                                         \
-    }
-    MPD_INT("--threads", threads, 1, 1024)
-    MPD_INT("--ppc", ppc, 1, 4)
-    MPD_INT("--dem-min", dem_min, 1, 1000000)
-    MPD_INT("--dem-max", dem_max, 1, 1000000)
-    MPD_INT("--vtk-every", vtk_every, 0, 1000000000)
-    MPD_INT("--checkpoint", checkpoint_every, 0, 1000000000)
-    MPD_REAL("--alpha", alpha, v >= 0.0 && v <= 1.0, "a value in [0, 1]")
-    MPD_REAL("--cfl", cfl, v > 0.0 && v <= 1.0, "a value in (0, 1]")
-    MPD_REAL("--dem-strain", dem_strain, v > 0.0, "a positive value")
-    MPD_REAL("--dem-inertial", dem_inertial, v > 0.0, "a positive value")
-    MPD_REAL("--dem-unbalanced", dem_unbalanced, v > 0.0, "a positive value")
-    MPD_REAL("--dem-dt", dem_dt, v >= 0.0, "a value >= 0")
-    MPD_REAL("--young", young, v > 0.0, "a positive modulus")
-    MPD_REAL("--kt-ratio", kt_ratio, v >= 0.0 && v <= 1.0, "a value in [0, 1]")
-    MPD_REAL("--friction-deg", friction_deg, v >= 0.0 && v < 90.0, "an angle in [0, 90)")
-    MPD_REAL("--roll-beta", roll_beta, v >= 0.0, "a value >= 0")
-    MPD_REAL("--roll-eta", roll_eta, v >= 0.0, "a value >= 0")
-    MPD_REAL("--dem-damping", dem_damping, v >= 0.0 && v < 1.0, "a value in [0, 1)")
-#undef MPD_INT
-#undef MPD_REAL
+/* parse argv against the common table and the driver's; 0, 1 after --help (printed), 2 refused (the
+ * driver checks the options together with mpd_check_opts once its defaults are settled) */
+static int mpd_parse(const mpd_run *run, int argc, char **argv, mpd_opts *o, const cli_opt *mine,
+                     void (*usage)(FILE *fp)) {
+    cli_opt common[MPD_NCOMMON];
+    const cli_opt *tables[3];
+    int help = 0, r;
+    mpd_common_opts(o, common);
+    tables[0] = common, tables[1] = mine, tables[2] = NULL;
+    r = cli_parse(run->rank == 0 ? run->prog : NULL, argc, argv, tables, &help);
+    if (r) return 2;
+    if (help) return usage(stdout), 1;
     return 0;
 }
 
-static int mpd_check_opts(const mpd_opts *o) {
-    if (o->dem_min > o->dem_max)
-        return fprintf(stderr, "error: --dem-min %d exceeds --dem-max %d\n", o->dem_min, o->dem_max), 1;
-    return 0;
-}
-
-static int mpd_mkdir(const char *d) {
-    if (mkdir(d, 0755) && errno != EEXIST) return fprintf(stderr, "error: cannot create %s\n", d), 1;
-    return 0;
+/* a comma-separated list of 1 to cap numbers in [lo, hi] ((lo, hi] if lo_open), increasing if
+ * `rising`; the count, or -1 after a message naming the option */
+GK_INLINE int mpd_list(const mpd_run *run, const char *opt, const char *s, double *v, int cap, double lo,
+                       int lo_open, double hi, int rising) {
+    const char *p = s;
+    int n = 0;
+    for (;;) {
+        char tok[64], *end;
+        size_t len = strcspn(p, ",");
+        double x;
+        if (n == cap || len == 0 || len >= sizeof tok) break;
+        memcpy(tok, p, len), tok[len] = 0;
+        errno = 0;
+        x = strtod(tok, &end);
+        if (*end || errno || !(lo_open ? x > lo : x >= lo) || !(x <= hi) ||
+            (rising && n > 0 && !(x > v[n - 1])))
+            break;
+        v[n++] = x, p += len;
+        if (*p == 0) return n;
+        ++p; /* the comma: a value must follow */
+    }
+    fprintf(stderr, "%s: %s '%s': need 1 to %d%s numbers in %c%g, %g], comma-separated\n", run->prog, opt, s,
+            cap, rising ? " increasing" : "", lo_open ? '(' : '[', lo, hi);
+    return -1;
 }
 
 /* ------------------------------------------------------------ the RVE */
@@ -237,6 +345,7 @@ typedef struct mpd_proto {
     double rho;     /* bulk density of the RVE: solid mass / cell volume      */
     double M;       /* P-wave modulus max(D_xxxx, D_yyyy), Taylor tangent [Pa] */
     double p0, e0;  /* pressure and void ratio of the consolidated state      */
+    double dt;      /* DEM time step of its RVEs [s]                          */
 } mpd_proto;
 
 static gk_result mpd_proto_open(mpd_proto *P, const mpd_opts *o, gk_err *err) {
@@ -263,7 +372,7 @@ static void mpd_proto_close(mpd_proto *P) { gk_packing_free(&P->pk); }
 /* One RVE from the packing, brought to the isotropic pressure p (compression
  * positive) by gk_rve_consolidate with the contact friction on (the packing's
  * fabric is kept; the void ratio is what it becomes), its state in *st.
- * p <= 0: the packing as it is. Fills rho, M, p0, e0 of P from the result. */
+ * p <= 0: the packing as it is. Fills rho, M, p0, e0, dt of P from the result. */
 static gk_result mpd_prepare_rve(mpd_proto *P, double p, gk_rve_state *st, gk_err *err) {
     gk_rve r;
     double s[9], D[16];
@@ -293,6 +402,7 @@ static gk_result mpd_prepare_rve(mpd_proto *P, double p, gk_rve_state *st, gk_er
     P->M = D[0] > D[15] ? D[0] : D[15];
     P->p0 = gk_stress_p(s, 2);
     P->e0 = gk_homog_void_ratio(&r);
+    P->dt = r.dt;
     res = gk_rve_state_save(st, &r);
     gk_rve_destroy(&r);
     if (res) return gk_err_set(err, res, "out of memory saving the RVE state");
@@ -300,114 +410,139 @@ static gk_result mpd_prepare_rve(mpd_proto *P, double p, gk_rve_state *st, gk_er
 }
 
 /* ------------------------------------------------------- RVE per point */
-typedef struct mpd_rves {
-    int n;
-    gk_rve *rve;
-    double *eps; /* accumulated small strain sum sym(dH), 9 per point [seed 003 (b)] */
-    int *nsub;   /* DEM steps of the last MPM step, per point                        */
-    int *status; /* gk_result of the last RVE call, per point                        */
-    const mpd_opts *o;
-    long long dem_steps; /* sum of n_s over points and MPM steps (cost measure)     */
-} mpd_rves;
+typedef struct mpd_micro {
+    gk_twoscale ts;            /* the RVEs (gk_twoscale.h)                                         */
+    int n, freeze;             /* points; 1: a point whose RVE refuses dH as GK_ERR_CELL is frozen  */
+    double *dH, *sig;          /* 9 n: the increments sent, the stresses back                       */
+    double *eps;               /* 9 n: the point's small strain, sum of sym(dH) [Liang & Zhao (b)]  */
+    int *nsub, *frozen, *thin; /* per point: DEM steps of the last MPM step; refused it; refusals   */
+    int thin_step;             /* refusals in the last MPM step                                     */
+    long long dem_steps;       /* DEM steps over all points and MPM steps (cost)                    */
+    long warned;               /* frozen-point warnings printed                                     */
+    double t;                  /* time at the start of the step (for those warnings)                */
+    gk_twoscale_field *fld;    /* n: the fields of the accepted states (mpd_micro_fields)           */
+} mpd_micro;
 
-static void mpd_rves_free(mpd_rves *f) {
-    int p;
-    if (f->rve)
-        for (p = 0; p < f->n; ++p) gk_rve_destroy(&f->rve[p]);
-    free(f->rve);
-    free(f->eps);
-    free(f->nsub);
-    free(f->status);
-    memset(f, 0, sizeof *f);
+static void mpd_micro_free(mpd_micro *m) {
+    if (m->ts.n > 0) gk_twoscale_destroy(&m->ts);
+    free(m->dH), free(m->sig), free(m->eps), free(m->nsub), free(m->frozen), free(m->thin), free(m->fld);
+    memset(m, 0, sizeof *m);
 }
 
-/* n RVEs created from the packing, each then set to the state chosen for it
- * by pick(p, user) (an index into states[]) */
-static gk_result mpd_rves_create(mpd_rves *f, int n, const mpd_proto *P, const gk_rve_state *states,
-                                 int (*pick)(int p, void *user), void *user, const mpd_opts *o, gk_err *err) {
-    int p;
-    memset(f, 0, sizeof *f);
-    f->n = n;
-    f->o = o;
-    f->rve = (gk_rve *)calloc((size_t)n, sizeof *f->rve);
-    f->eps = (double *)calloc(9 * (size_t)n, sizeof *f->eps);
-    f->nsub = (int *)calloc((size_t)n, sizeof *f->nsub);
-    f->status = (int *)calloc((size_t)n, sizeof *f->status);
-    if (!f->rve || !f->eps || !f->nsub || !f->status) {
-        mpd_rves_free(f);
-        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d RVEs", n);
+/* n points, point p starting from states[pick[p]] (pick NULL: states[0] everywhere); the RVEs'
+ * stresses (2D block) into pts->sigma */
+static gk_result mpd_micro_create(mpd_micro *m, gk_mpm_points *pts, const mpd_proto *P,
+                                  const gk_rve_state *states, int nstates, const int *pick, const mpd_opts *o,
+                                  gk_err *err) {
+    gk_twoscale_def d;
+    gk_twoscale_proto pr[64];
+    int n = pts->n, k, p;
+    memset(m, 0, sizeof *m);
+    memset(&d, 0, sizeof d);
+    if (nstates < 1 || nstates > 64) return gk_err_set(err, GK_ERR_ARG, "%d RVE states (1..64)", nstates);
+    for (k = 0; k < nstates; ++k) pr[k].packing = &P->pk, pr[k].state = &states[k];
+    d.npoints = n, d.protos = pr, d.nprotos = nstates, d.pick = pick;
+    d.rve = P->def;
+    d.rule.kind = o->dem_rule ? GK_TWOSCALE_STRAIN : GK_TWOSCALE_ADAPTIVE;
+    d.rule.inertial_max = o->dem_inertial, d.rule.unbalanced_max = o->dem_unbalanced;
+    d.rule.strain = o->dem_strain, d.rule.n_min = o->dem_min, d.rule.n_max = o->dem_max;
+    d.threads = o->threads;
+    m->n = n;
+    m->dH = (double *)calloc(9 * (size_t)n, sizeof(double));
+    m->sig = (double *)calloc(9 * (size_t)n, sizeof(double));
+    m->eps = (double *)calloc(9 * (size_t)n, sizeof(double));
+    m->nsub = (int *)calloc((size_t)n, sizeof(int));
+    m->frozen = (int *)calloc((size_t)n, sizeof(int));
+    m->thin = (int *)calloc((size_t)n, sizeof(int));
+    m->fld = (gk_twoscale_field *)calloc((size_t)n, sizeof *m->fld);
+    if (!m->dH || !m->sig || !m->eps || !m->nsub || !m->frozen || !m->thin || !m->fld) {
+        mpd_micro_free(m);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d points", n);
     }
-    for (p = 0; p < n; ++p) {
-        int k = pick ? pick(p, user) : 0;
-        if (gk_rve_create(&f->rve[p], &P->def, &P->pk) || gk_rve_state_restore(&states[k], &f->rve[p])) {
-            gk_err_set(err, GK_ERR_STATE, "RVE %d: %s", p, gk_rve_error(&f->rve[p]));
-            f->n = p + 1;
-            mpd_rves_free(f);
-            return GK_ERR_STATE;
-        }
+    if (gk_twoscale_create(&m->ts, &d)) {
+        gk_err_set(err, m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
+        mpd_micro_free(m);
+        return err->code;
+    }
+    if (gk_twoscale_accepted(&m->ts, m->sig, NULL)) {
+        gk_err_set(err, m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
+        mpd_micro_free(m);
+        return err->code;
+    }
+    for (p = 0; p < n; ++p) { /* the point's stress is its RVE's (gk_mpm tracks the plane block) */
+        double *s = pts->sigma + 9 * (size_t)p;
+        const double *r = m->sig + 9 * (size_t)p;
+        gk_m3_zero(s);
+        s[0] = r[0], s[1] = r[1], s[3] = r[3], s[4] = r[4];
     }
     return GK_OK;
 }
 
-static int mpd_dem_steps(const mpd_opts *o, const double dH[9]) {
-    double mx = 0.0, n;
-    int k;
-    for (k = 0; k < 9; ++k)
-        if (fabs(dH[k]) > mx) mx = fabs(dH[k]);
-    n = ceil(mx / o->dem_strain);
-    if (n < o->dem_min) n = o->dem_min;
-    if (n > o->dem_max) n = o->dem_max;
-    return (int)n;
-}
-
-/* Initial point stress = the RVE's stress (2D block; sigma_zz of the plane is
- * not tracked by gk_mpm) */
-static void mpd_rve_sigma(const gk_rve *r, double *sig) {
-    double s[9];
-    gk_rve_stress(r, s);
-    gk_m3_zero(sig);
-    sig[0] = s[0], sig[1] = s[1], sig[3] = s[3], sig[4] = s[4];
+/* the fields of the accepted states into m->fld (collective under MPI) */
+static gk_result mpd_micro_fields(mpd_micro *m, gk_err *err) {
+    if (gk_twoscale_fields(&m->ts, m->fld))
+        return gk_err_set(err, m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
+    return GK_OK;
 }
 
 /* gk_mpm_stress_fn: every point's RVE deforms by dH = dt L (stretch and spin)
- * over n_s DEM steps and returns its total Love stress [seed 003 Sec 2.3 (b)].
- * Points are independent: parallel, and the result does not depend on the
- * thread count. A failing RVE stops the run with its point and message. */
+ * by the DEM-step rule and returns its Love stress [Liang & Zhao 2019 Sec 2.3
+ * (b)]. A failing RVE stops the run with its point and message - unless
+ * m->freeze and it refused the increment because its cell would get too thin
+ * (GK_ERR_CELL): that point keeps its RVE and stress, and its MPM strain goes
+ * on (frozen, counted in m->thin, the first 20 named on stderr). */
 static gk_result mpd_stress(gk_mpm_points *pts, double dt, void *user, gk_err *err) {
-    mpd_rves *f = (mpd_rves *)user;
-    int p;
-    long long total = 0;
-    (void)dt;
-    GK_OMP(parallel for num_threads(f->o->threads) schedule(dynamic, 2) reduction(+ : total))
+    mpd_micro *m = (mpd_micro *)user;
+    const gk_twoscale_point *rp;
+    gk_result res;
+    int p, k, bad = -1, warn = 0;
     for (p = 0; p < pts->n; ++p) {
-        double dH[9];
-        int k, ns;
+        double *dH = m->dH + 9 * (size_t)p;
         gk_mpm_point_dH(pts, p, dt, dH);
         dH[2] = dH[5] = dH[6] = dH[7] = dH[8] = 0.0; /* plane */
-        if (f->o->dem_adaptive) {
-            gk_adapt_def ad;
-            gk_adapt_report rep;
-            memset(&ad, 0, sizeof ad);
-            ad.inertial_max = f->o->dem_inertial, ad.unbalanced_max = f->o->dem_unbalanced;
-            ad.n_min = f->o->dem_min, ad.n_max = f->o->dem_max;
-            memset(&rep, 0, sizeof rep);
-            f->status[p] = (int)gk_rve_deform_adaptive(&f->rve[p], dH, &ad, &rep);
-            ns = rep.n_deform + rep.n_relax;
-        } else {
-            ns = mpd_dem_steps(f->o, dH);
-            f->status[p] = (int)gk_rve_deform(&f->rve[p], dH, ns);
-        }
-        f->nsub[p] = ns;
-        total += ns;
-        if (f->status[p]) continue;
-        mpd_rve_sigma(&f->rve[p], pts->sigma + 9 * (size_t)p);
-        for (k = 0; k < 9; ++k) f->eps[9 * (size_t)p + k] += 0.5 * (dH[k] + dH[3 * (k % 3) + k / 3]);
     }
-    f->dem_steps += total;
-    for (p = 0; p < pts->n; ++p)
-        if (f->status[p])
-            return gk_err_set(err, (gk_result)f->status[p], "RVE of point %d at (%.4g, %.4g) m: %s", p,
-                              pts->x[0][p], pts->x[1][p], gk_rve_error(&f->rve[p]));
+    res = gk_twoscale_run(&m->ts, m->dH, NULL, m->sig, NULL);
+    if (res && res != GK_ERR_STATE) return gk_err_set(err, res, "%s", gk_twoscale_error(&m->ts));
+    rp = gk_twoscale_points(&m->ts);
+    m->thin_step = 0;
+    for (p = 0; p < pts->n; ++p) {
+        const double *dH = m->dH + 9 * (size_t)p, *s = m->sig + 9 * (size_t)p;
+        double *sp = pts->sigma + 9 * (size_t)p;
+        int frz = m->freeze && rp[p].code == GK_ERR_CELL;
+        if (rp[p].code && !frz) {
+            if (bad < 0) bad = p;
+            continue;
+        }
+        m->nsub[p] = rp[p].n_deform + rp[p].n_relax;
+        m->dem_steps += rp[p].work;
+        m->frozen[p] = frz;
+        if (frz) {
+            ++m->thin_step;
+            warn += m->thin[p]++ == 0;
+        } else
+            sp[0] = s[0], sp[1] = s[1], sp[3] = s[3], sp[4] = s[4];
+        for (k = 0; k < 9; ++k) m->eps[9 * (size_t)p + k] += 0.5 * (dH[k] + dH[3 * (k % 3) + k / 3]);
+    }
+    if (bad >= 0) {
+        gk_twoscale_reject(&m->ts);
+        return gk_err_set(err, (gk_result)rp[bad].code, "RVE of point %d at (%.4g, %.4g) m: %s", bad,
+                          pts->x[0][bad], pts->x[1][bad], gk_twoscale_point_error(&m->ts, bad));
+    }
+    if (gk_twoscale_accept(&m->ts)) return gk_err_set(err, m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
+    if (warn && m->warned < 20 && mpd_micro_fields(m, err) == GK_OK)
+        for (p = 0; p < pts->n && m->warned < 20; ++p)
+            if (m->frozen[p] && m->thin[p] == 1) {
+                const double *F = pts->F + 9 * (size_t)p;
+                ++m->warned;
+                fprintf(
+                    stderr,
+                    "warning: t = %.4f s: point %d at (%.4g, %.4g) m, F = [%.3g %.3g; %.3g %.3g]: its RVE "
+                    "refuses dH (%s); frozen: no DEM steps, its stress kept (p = %.4g Pa, %g contacts) until "
+                    "a "
+                    "dH fits again\n",
+                    m->t, p, pts->x[0][p], pts->x[1][p], F[0], F[1], F[3], F[4],
+                    gk_twoscale_point_error(&m->ts, p), m->fld[p].p, m->fld[p].contacts);
+            }
     return GK_OK;
 }
 
@@ -430,18 +565,17 @@ typedef struct mpd_edge {
     double pressure; /* [Pa], compression positive */
 } mpd_edge;
 
-/* One USF step (seed 003 Sec 2.3; the sequence gk_mpm_step runs) with the
- * edge loads added to the nodal external forces after P2G, then the rigid
- * bodies advance by v dt. The RVEs update in mpd_stress. */
-static gk_result mpd_step(gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def *def, double dt, mpd_rves *f,
+/* One USF step (Liang & Zhao 2019 Sec 2.3; the sequence gk_mpm_step runs)
+ * with the edge loads added to the nodal external forces after P2G, then the
+ * rigid bodies advance by v dt. The RVEs update in mpd_stress. */
+static gk_result mpd_step(gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def *def, double dt, mpd_micro *m,
                           const mpd_edge *edge, int nedge, gk_err *err) {
     gk_mpm_basis lb = def->basis == GK_MPM_UGIMP ? GK_MPM_LINEAR : def->basis;
     gk_result r;
     int k, a;
-    if (def->scheme != GK_MPM_USF) return gk_err_set(err, GK_ERR_ARG, "mpd_step runs USF only");
     if ((r = gk_mpm_p2g(g, pts, def, GK_MPM_P2G_MOMENTUM, err))) return r;
     if ((r = gk_mpm_g2p(g, pts, def, dt, GK_MPM_G2P_GRADIENT_OLD, err))) return r;
-    if ((r = mpd_stress(pts, dt, f, err))) return r;
+    if ((r = mpd_stress(pts, dt, m, err))) return r;
     if ((r = gk_mpm_p2g(g, pts, def, GK_MPM_P2G_FORCE, err))) return r;
     for (k = 0; k < nedge; ++k) {
         const mpd_edge *E = &edge[k];
@@ -464,202 +598,10 @@ static gk_result mpd_step(gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def *
     return GK_OK;
 }
 
-/* ------------------------------------------------------------- fields */
-#define MPD_NFIELD 9
-static const char *mpd_field_names[MPD_NFIELD] = {
-    "eps_q",        "eps_v",    "rotation_deg", "p", "q", "void_ratio", "fabric_anisotropy",
-    "coordination", "dem_steps"};
-
-/* eps_q [seed 003 eq 35 with the 2D deviator], eps_v compression-positive
- * (eq 34 with the seeds' sign), rotation of F = R U [eqs 36-40] in degrees
- * (counter-clockwise positive), p, q [eqs 31-33] compression-positive [Pa],
- * void ratio, |F_a| [eqs 41-43], coordination 2 N_c / N_p, DEM steps of the
- * last MPM step */
-static void mpd_fields(const mpd_rves *f, const gk_mpm_points *pts, int p, double *v) {
-    const gk_rve *r = &f->rve[p];
-    double s[9], phi[9], Fa[9];
-    const double *e = f->eps + 9 * (size_t)p;
-    gk_rve_stress(r, s);
-    v[0] = gk_strain_q(e, 2);
-    v[1] = -gk_strain_v(e, 2);
-    v[2] = gk_rotation_angle(pts->F + 9 * (size_t)p, 2) * 180.0 / MPD_PI;
-    v[3] = gk_stress_p(s, 2);
-    v[4] = gk_stress_q(s, 2);
-    v[5] = gk_homog_void_ratio(r);
-    v[6] = gk_homog_fabric(r, phi, Fa);
-    v[7] = r->n > 0 ? 2.0 * r->ncontacts / r->n : 0.0;
-    v[8] = f->nsub[p];
-}
-
-/* all fields of all points, field-major: out[k * n + p] */
-static double *mpd_all_fields(const mpd_rves *f, const gk_mpm_points *pts) {
-    double *out = (double *)malloc((size_t)MPD_NFIELD * (size_t)pts->n * sizeof *out);
-    int p, k;
-    if (!out) return NULL;
-    for (p = 0; p < pts->n; ++p) {
-        double v[MPD_NFIELD];
-        mpd_fields(f, pts, p, v);
-        for (k = 0; k < MPD_NFIELD; ++k) out[(size_t)k * pts->n + p] = v[k];
-    }
-    return out;
-}
-
-/* material points as VTK vertices: the fields above, velocity, stress */
-static int mpd_write_vtk(const char *path, const mpd_rves *f, const gk_mpm_points *pts) {
-    gk_vtk v;
-    int n = pts->n, p, k, ok;
-    double *xyz = (double *)malloc(3 * (size_t)n * sizeof *xyz),
-           *vel = (double *)malloc(3 * (size_t)n * sizeof *vel);
-    int *conn = (int *)malloc((size_t)n * sizeof *conn);
-    double *fld = mpd_all_fields(f, pts);
-    ok = xyz && vel && conn && fld;
-    if (ok) {
-        for (p = 0; p < n; ++p) {
-            xyz[3 * p] = pts->x[0][p], xyz[3 * p + 1] = pts->x[1][p], xyz[3 * p + 2] = 0.0;
-            vel[3 * p] = pts->v[0][p], vel[3 * p + 1] = pts->v[1][p], vel[3 * p + 2] = 0.0;
-            conn[p] = p;
-        }
-        ok = !gk_vtk_open(&v, path, "grainkit MPMxDEM material points") && !gk_vtk_points(&v, n, xyz) &&
-             !gk_vtk_cells(&v, n, 1, conn, GK_VTK_VERTEX);
-        for (k = 0; ok && k < MPD_NFIELD; ++k)
-            ok = !gk_vtk_point_scalar(&v, mpd_field_names[k], fld + (size_t)k * n);
-        ok = ok && !gk_vtk_point_vector(&v, "velocity", vel) &&
-             !gk_vtk_point_tensor(&v, "stress", pts->sigma) && !gk_vtk_close(&v);
-    }
-    free(xyz), free(vel), free(conn), free(fld);
-    if (!ok) fprintf(stderr, "warning: could not write %s\n", path);
-    return !ok;
-}
-
-/* one field on the points as coloured dots */
-static int mpd_svg_field(const char *path, const char *title, const mpd_rves *f, const gk_mpm_points *pts,
-                         int k, double dot) {
-    gk_err err;
-    int n = pts->n, p, bad;
-    double *xy = (double *)malloc(2 * (size_t)n * sizeof *xy), *fld = mpd_all_fields(f, pts);
-    bad = !xy || !fld;
-    if (!bad) {
-        for (p = 0; p < n; ++p) xy[2 * p] = pts->x[0][p], xy[2 * p + 1] = pts->x[1][p];
-        bad =
-            gk_svg_field(path, title, mpd_field_names[k], n, 1, xy, fld + (size_t)k * n, dot, &err) != GK_OK;
-    }
-    free(xy), free(fld);
-    if (bad) fprintf(stderr, "warning: could not write %s\n", path);
-    return bad;
-}
-
-/* -------------------------------------------------------- checkpoints */
-/* File: magic, driver tag, nblob x (size, bytes) of driver data, the points
- * (every array), the accumulated strains and the RVE states. Written to a
- * temporary file then renamed, so a crash never leaves half a checkpoint. */
-#define MPD_CK_MAGIC "GKMPMDEM1"
-
-static int mpd_points_io(gk_mpm_points *pts, FILE *fp, int write) {
-    size_t n = (size_t)pts->n;
-    int k, ok = 1;
-    double *a1[] = {pts->x[0],    pts->x[1], pts->v[0], pts->v[1], pts->fext[0],
-                    pts->fext[1], pts->m,    pts->vol0, pts->vol,  pts->lp};
-    double *a9[] = {pts->F, pts->L, pts->sigma, pts->C};
-    for (k = 0; k < (int)(sizeof a1 / sizeof *a1); ++k)
-        ok &= (write ? fwrite(a1[k], sizeof(double), n, fp) : fread(a1[k], sizeof(double), n, fp)) == n;
-    for (k = 0; k < (int)(sizeof a9 / sizeof *a9); ++k)
-        ok &= (write ? fwrite(a9[k], sizeof(double), 9 * n, fp) : fread(a9[k], sizeof(double), 9 * n, fp)) ==
-              9 * n;
-    return ok;
-}
-
-static int mpd_ck_write(const char *dir, const char *tag, void *const *blob, const size_t *size, int nblob,
-                        gk_mpm_points *pts, const mpd_rves *f) {
-    char path[1200], tmp[1300], tg[16];
-    FILE *fp;
-    int k, ok = 1;
-    size_t cap = 0;
-    void *buf = NULL;
-    snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    fp = fopen(tmp, "wb");
-    if (!fp) return fprintf(stderr, "error: cannot write %s\n", tmp), 1;
-    memset(tg, 0, sizeof tg);
-    strncpy(tg, tag, sizeof tg - 1);
-    ok &= fwrite(MPD_CK_MAGIC, 1, 9, fp) == 9 && fwrite(tg, 1, sizeof tg, fp) == sizeof tg;
-    ok &= fwrite(&nblob, sizeof nblob, 1, fp) == 1 && fwrite(&pts->n, sizeof pts->n, 1, fp) == 1;
-    for (k = 0; k < nblob; ++k)
-        ok &= fwrite(&size[k], sizeof *size, 1, fp) == 1 && fwrite(blob[k], 1, size[k], fp) == size[k];
-    ok &= mpd_points_io(pts, fp, 1);
-    ok &= fwrite(f->eps, sizeof(double), 9 * (size_t)f->n, fp) == 9 * (size_t)f->n;
-    ok &= fwrite(&f->dem_steps, sizeof f->dem_steps, 1, fp) == 1;
-    for (k = 0; k < f->n && ok; ++k) {
-        size_t n = gk_rve_state_size(&f->rve[k]);
-        if (n > cap) {
-            free(buf);
-            cap = n;
-            buf = malloc(cap);
-            if (!buf) ok = 0;
-        }
-        if (ok && gk_rve_save(&f->rve[k], buf, cap, &n)) ok = 0;
-        ok &= fwrite(&n, sizeof n, 1, fp) == 1 && fwrite(buf, 1, n, fp) == n;
-    }
-    free(buf);
-    ok &= fclose(fp) == 0;
-    if (!ok || rename(tmp, path)) return fprintf(stderr, "error: cannot write %s\n", path), 1;
-    return 0;
-}
-
-/* blobs of the sizes given are read into blob[k] (size[k] must match);
- * blob sizes of 0 mean "variable": that blob is malloc'ed into *blob[k] and
- * its size returned in size[k] */
-static gk_result mpd_ck_read(const char *dir, const char *tag, void **blob, size_t *size, int nblob,
-                             gk_mpm_points *pts, mpd_rves *f, gk_err *err) {
-    char path[1200], magic[9], tg[16], want[16];
-    FILE *fp;
-    int k, nb = 0, np = 0, ok = 1;
-    snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
-    fp = fopen(path, "rb");
-    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open %s", path);
-    memset(want, 0, sizeof want);
-    strncpy(want, tag, sizeof want - 1);
-    ok &= fread(magic, 1, 9, fp) == 9 && !memcmp(magic, MPD_CK_MAGIC, 9);
-    ok &= fread(tg, 1, sizeof tg, fp) == sizeof tg && !memcmp(tg, want, sizeof tg);
-    ok &=
-        fread(&nb, sizeof nb, 1, fp) == 1 && nb == nblob && fread(&np, sizeof np, 1, fp) == 1 && np == pts->n;
-    if (!ok) {
-        fclose(fp);
-        return gk_err_set(err, GK_ERR_FORMAT, "%s is not a %s checkpoint of this model (same flags needed)",
-                          path, tag);
-    }
-    for (k = 0; k < nblob && ok; ++k) {
-        size_t s = 0;
-        ok &= fread(&s, sizeof s, 1, fp) == 1 && s < ((size_t)1 << 34);
-        if (!ok) break;
-        if (size[k] == 0) {
-            void *b = malloc(s ? s : 1);
-            ok &= b && fread(b, 1, s, fp) == s;
-            *(void **)blob[k] = b;
-            size[k] = s;
-        } else
-            ok &= s == size[k] && fread(blob[k], 1, s, fp) == s;
-    }
-    ok = ok && mpd_points_io(pts, fp, 0);
-    ok = ok && fread(f->eps, sizeof(double), 9 * (size_t)f->n, fp) == 9 * (size_t)f->n;
-    ok = ok && fread(&f->dem_steps, sizeof f->dem_steps, 1, fp) == 1;
-    for (k = 0; k < f->n && ok; ++k) {
-        size_t n;
-        void *buf;
-        ok &= fread(&n, sizeof n, 1, fp) == 1 && n < ((size_t)1 << 31);
-        if (!ok) break;
-        buf = malloc(n);
-        ok &= buf && fread(buf, 1, n, fp) == n && gk_rve_restore(&f->rve[k], buf, n) == GK_OK;
-        free(buf);
-    }
-    fclose(fp);
-    if (!ok) return gk_err_set(err, GK_ERR_FORMAT, "%s: truncated or corrupt checkpoint", path);
-    return GK_OK;
-}
-
-/* the MPM options every driver uses (seed 003: USF, PIC/FLIP blend) */
+/* the MPM options every driver uses (Liang & Zhao: USF, PIC/FLIP blend) */
 static gk_mpm_def mpd_mpm_def(const mpd_opts *o) {
     gk_mpm_def d = gk_mpm_def_default();
-    d.basis = o->basis;
+    d.basis = mpd_basis[o->basis];
     d.transfer = GK_MPM_PIC_FLIP;
     d.scheme = GK_MPM_USF;
     d.alpha = o->alpha;
@@ -668,17 +610,36 @@ static gk_mpm_def mpd_mpm_def(const mpd_opts *o) {
 }
 
 /* ghost node layers a basis needs outside the material (support radius) */
-static int mpd_ghost_layers(gk_mpm_basis b) { return b == GK_MPM_CUBIC ? 3 : 2; }
+static int mpd_ghost_layers(const mpd_opts *o) { return mpd_basis[o->basis] == GK_MPM_CUBIC ? 3 : 2; }
 
-/* "12.3 s" / "4.5 min" / "2.1 h" */
-static const char *mpd_duration(double s, char *buf, size_t cap) {
-    if (s < 120.0)
-        snprintf(buf, cap, "%.1f s", s);
-    else if (s < 7200.0)
-        snprintf(buf, cap, "%.1f min", s / 60.0);
-    else
-        snprintf(buf, cap, "%.1f h", s / 3600.0);
-    return buf;
+/* ------------------------------------------------------------- fields */
+#define MPD_NFIELD 9
+static const char *mpd_field_names[MPD_NFIELD] = {
+    "eps_q",        "eps_v",    "rotation_deg", "p", "q", "void_ratio", "fabric_anisotropy",
+    "coordination", "dem_steps"};
+enum { MPD_EPS_Q, MPD_EPS_V, MPD_ROTATION, MPD_P, MPD_Q, MPD_VOID, MPD_FABRIC, MPD_COORD, MPD_DEM };
+
+/* every field of every point, field-major out[k n + p] (collective): eps_q [Liang & Zhao eq 35 with
+ * the 2D deviator] and eps_v compression-positive (eq 34) of the point's strain, rotation of F = R U
+ * [eqs 36-40] in degrees counter-clockwise, p, q [eqs 31-33] compression-positive [Pa], void ratio,
+ * |F_a| [eqs 41-43], coordination 2 N_c / N_p, DEM steps of the last MPM step */
+static gk_result mpd_fields(mpd_micro *m, const gk_mpm_points *pts, double *out, gk_err *err) {
+    int n = pts->n, p;
+    gk_result res = mpd_micro_fields(m, err);
+    if (res) return res;
+    for (p = 0; p < n; ++p) {
+        const double *e = m->eps + 9 * (size_t)p;
+        const gk_twoscale_field *f = &m->fld[p];
+        out[MPD_EPS_Q * n + p] = gk_strain_q(e, 2);
+        out[MPD_EPS_V * n + p] = -gk_strain_v(e, 2);
+        out[MPD_ROTATION * n + p] = gk_rotation_angle(pts->F + 9 * (size_t)p, 2) * 180.0 / MPD_PI;
+        out[MPD_P * n + p] = f->p, out[MPD_Q * n + p] = f->q, out[MPD_VOID * n + p] = f->void_ratio;
+        out[MPD_FABRIC * n + p] = f->fabric, out[MPD_COORD * n + p] = f->coordination;
+        out[MPD_DEM * n + p] = m->nsub[p];
+    }
+    return GK_OK;
 }
+
+#include "mpmdem_io.h"
 
 #endif /* MPMDEM_H */

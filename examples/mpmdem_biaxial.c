@@ -1,13 +1,14 @@
-/* mpmdem_biaxial.c - the MPMxDEM biaxial test of seed 003 (Liang & Zhao,
- * Sec 3.2): a 1 x 2 m specimen of material points, each with its own
- * periodic 400-disk RVE, 100 kPa lateral pressure on both sides, fixed base,
- * rough rigid top plate moving down at 0.02 m/s (ramped), no gravity.
- * Reported by the seed for mesh M (20x10 cells, 4 points per cell): peak
- * sigma_yy ~ 280 kPa at ~1.6 % axial strain, ~220 kPa at 8 %, cross-shaped
- * shear bands, rotations up to 58 deg in the bands at 15 %.
+/* mpmdem_biaxial.c - the MPMxDEM biaxial test of Liang & Zhao (2019) Sec
+ * 3.2: a 1 x 2 m specimen of material points, each with its own periodic
+ * 400-disk RVE, 100 kPa lateral pressure on both sides, fixed base, rough
+ * rigid top plate moving down at 0.02 m/s (ramped), no gravity. Reported by
+ * the paper for mesh M (20x10 cells, 4 points per cell): peak sigma_yy ~ 280
+ * kPa at ~1.6 % axial strain, ~220 kPa at 8 %, cross-shaped shear bands,
+ * rotations up to 58 deg in the bands at 15 %.
  *
  *   build/mpmdem_biaxial                       # 8 x 16 cells, 1 point each, to 3 %
- *   build/mpmdem_biaxial --nx 10 --ny 20 --ppc 2 --strain 0.15   # the seed's M4
+ *   build/mpmdem_biaxial --nx 10 --ny 20 --ppc 2 --strain 0.15   # the paper's M4
+ *   mpirun -np 2 build/mpi/mpmdem_biaxial_mpi --threads 1         # the RVEs on 2 ranks
  *
  * Model. Points fill the specimen (ppc^2 per cell, h = width / nx); the grid
  * is padded by ghost layers and by room for the bulge. The base and the top
@@ -15,24 +16,20 @@
  * are the axial loads. The lateral pressure is a follower load on the outer
  * edges of the points of the outer columns (mpd_edge in mpmdem.h: the edge
  * turns and stretches with the point's F, and its load goes to the nodes
- * with the weights of the edge, so the initial state is in equilibrium). Every point's RVE starts from the packing
- * (default: the seed 000 authors' 400 disks, consolidated to 100 kPa, e =
- * 0.177 as seed 003 states) and receives dH = dt L each MPM step (USF,
- * mpmdem.h). sigma_yy = -(plate reaction)/width (the rough plate keeps the
- * top width), averaged over each output interval; eps_v from the point
- * volumes; rotation of each point from the polar decomposition of F.
+ * with the weights of the edge, so the initial state is in equilibrium).
+ * Every point's RVE starts from the packing (default: Guo & Zhao's 400
+ * disks, consolidated to 100 kPa, e = 0.175; the paper states 0.177) and
+ * receives dH = dt L each MPM step (USF, mpmdem.h). sigma_yy = -(plate
+ * reaction)/width (the rough plate keeps the top width), averaged over each
+ * output interval; eps_v from the point volumes; rotation of each point from
+ * the polar decomposition of F.
  *
- * Outputs in --out DIR: biaxial.csv, biaxial_stress.svg, biaxial_volume.svg,
- * rotation_*.svg and eps_q_*.svg (fields at 1.5 %, 2 %, 3 % and the end,
- * the seed's stages), points_NNNNNN.vtk, checkpoint.bin; a RESULT line.
+ * Outputs in --out DIR (default build/mpm_biaxial): biaxial.csv,
+ * biaxial_stress.svg, biaxial_volume.svg, rotation_*.svg and eps_q_*.svg
+ * (fields at 1.5 %, 2 %, 3 % and the end, the paper's stages; one colour
+ * scale per quantity), points_NNNNNN.vtk, checkpoint.bin; a RESULT line.
  */
-#define _POSIX_C_SOURCE 200809L
 #define GK_IMPLEMENTATION
-#include "gk_base.h"
-#include "gk_dem.h"
-#include "gk_homog.h"
-#include "gk_io.h"
-#include "gk_mpm.h"
 #include "mpmdem.h"
 
 typedef struct bx_opts {
@@ -44,7 +41,7 @@ typedef struct bx_row { /* one CSV row: means over an output interval */
     double t, eps, syy_top, syy_base, ev, ek, dem_mean, secs;
 } bx_row;
 
-/* the state a checkpoint must carry besides points and RVEs */
+/* the state a checkpoint carries besides points and RVEs */
 typedef struct bx_state {
     long step;
     double t, disp;
@@ -56,80 +53,184 @@ typedef struct bx_state {
     int nstage;
 } bx_state;
 
-static void usage(FILE *fp, const mpd_opts *d) {
+typedef struct bx { /* the whole model */
+    mpd_run run;
+    mpd_opts o;
+    bx_opts b;
+    mpd_proto P;
+    gk_rve_state st0;
+    mpd_micro M;
+    gk_mpm_grid g;
+    gk_mpm_points pts;
+    gk_mpm_def def;
+    mpd_edge *edge;
+    int nedge;
+    bx_state S;
+    mpd_rows rows;
+    mpd_snaps snaps;
+    double h, dt, c, vol0, dot;
+} bx;
+
+static const double bx_stages[3] = {0.015, 0.02, 0.03};
+
+static void usage(FILE *fp) {
+    mpd_opts d;
+    mpd_opts_default(&d, "build/mpm_biaxial");
     fprintf(
         fp,
-        "mpmdem_biaxial - MPMxDEM biaxial test of seed 003 Sec 3.2: every material point has a periodic\n"
-        "400-disk RVE; lateral pressure, rough top plate, fixed base, no gravity.\n\n"
+        "mpmdem_biaxial - MPMxDEM biaxial test of Liang & Zhao (2019) Sec 3.2: every material point has a\n"
+        "periodic 400-disk RVE; lateral pressure, rough top plate, fixed base, no gravity.\n\n"
         "usage: mpmdem_biaxial [options]\n"
-        "  --nx N --ny N          cells across the width and the height (default 8 x 16; seed meshes\n"
+        "  --nx N --ny N          cells across the width and the height (default 8 x 16; the paper's meshes\n"
         "                         C 8x16, M 10x20, F 15x30 with --ppc 1 or 2, or 3 for 9 points per cell)\n"
         "  --width W --height H   specimen [m] (default 1 x 2); W/nx must equal H/ny\n"
         "  --pressure P           lateral pressure sigma_3 [Pa] (default 1e5)\n"
-        "  --velocity V           top plate speed [m/s] (default 0.02, the seed's)\n"
+        "  --velocity V           top plate speed [m/s] (default 0.02, the paper's)\n"
         "  --ramp T               the plate speed ramps up linearly over T seconds (default 0.5)\n"
-        "  --strain E             final axial strain (default 0.03; the seed goes to 0.15)\n"
+        "  --strain E             final axial strain (default 0.03; the paper goes to 0.15)\n"
         "  --every E              axial strain between CSV rows (default 0.001)\n"
         "  --help                 this text\n");
-    mpd_usage_common(fp, d);
+    mpd_usage_common(fp, &d);
     fprintf(fp,
             "\nends with: RESULT peak_sigma_yy=... eps_at_peak=... sigma_yy_end=... max_rotation_deg=...\n"
             "           n_rves=... mpm_steps=... seconds_per_step=... seconds_per_step_per_1000_rves=...\n");
 }
 
-static void write_csv(const char *out, const bx_row *r, int n) {
-    char path[1200];
-    FILE *fp;
-    int k;
-    snprintf(path, sizeof path, "%s/biaxial.csv", out);
-    fp = fopen(path, "w");
-    if (!fp) {
-        fprintf(stderr, "warning: cannot write %s\n", path);
-        return;
+static int parse(bx *X, int argc, char **argv) {
+    bx_opts *b = &X->b;
+    const cli_opt mine[] = {{"--nx", CLI_INT, &b->nx, 1, 2000, NULL, NULL, 0},
+                            {"--ny", CLI_INT, &b->ny, 1, 2000, NULL, NULL, 0},
+                            {"--width", CLI_REAL, &b->width, 0, 1e4, NULL, NULL, CLI_LO_OPEN},
+                            {"--height", CLI_REAL, &b->height, 0, 1e4, NULL, NULL, CLI_LO_OPEN},
+                            {"--pressure", CLI_REAL, &b->pressure, 0, 1e10, NULL, NULL, 0},
+                            {"--velocity", CLI_REAL, &b->velocity, 0, 1e3, NULL, NULL, CLI_LO_OPEN},
+                            {"--ramp", CLI_REAL, &b->ramp, 0, 1e6, NULL, NULL, 0},
+                            {"--strain", CLI_REAL, &b->strain, 0, 0.5, NULL, NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+                            {"--every", CLI_REAL, &b->every, 0, 0.5, NULL, NULL, CLI_LO_OPEN},
+                            {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    bx_opts def = {8, 16, 1.0, 2.0, 1e5, 0.02, 0.5, 0.03, 0.001};
+    int r;
+    *b = def;
+    mpd_opts_default(&X->o, "build/mpm_biaxial");
+    if ((r = mpd_parse(&X->run, argc, argv, &X->o, mine, usage)) != 0) return r;
+    X->run.out = X->o.out;
+    if (mpd_check_opts(&X->run, &X->o)) return 2;
+    X->h = b->width / b->nx;
+    if (fabs(b->height / b->ny - X->h) > 1e-9 * X->h) {
+        fprintf(stderr, "mpmdem_biaxial: cells must be square: width/nx = %g, height/ny = %g\n", X->h,
+                b->height / b->ny);
+        return 2;
     }
-    fprintf(fp, "time,eps_axial,sigma_yy,sigma_yy_base,eps_v,kinetic_energy,dem_steps_per_point,seconds\n");
-    for (k = 0; k < n; ++k)
-        fprintf(fp, "%.6g,%.6g,%.9g,%.9g,%.6g,%.6g,%.4g,%.3f\n", r[k].t, r[k].eps, r[k].syy_top,
-                r[k].syy_base, r[k].ev, r[k].ek, r[k].dem_mean, r[k].secs);
-    fclose(fp);
+    return 0;
 }
 
-static void write_plots(const char *out, const bx_row *r, int n) {
-    double *x = (double *)malloc((size_t)(n + 1) * sizeof *x),
-           *y1 = (double *)malloc((size_t)(n + 1) * sizeof *y1),
-           *y2 = (double *)malloc((size_t)(n + 1) * sizeof *y2);
-    char path[1200];
-    gk_err err;
-    gk_plot pl;
+/* the prepared RVE at every point, the grid with its two plates, the points and their edge loads */
+static int setup(bx *X, gk_err *err) {
+    bx_opts *b = &X->b;
+    double h = X->h, org[3], lo[3] = {0, 0, 0}, hi[3];
+    int n[3], i, gl = mpd_ghost_layers(&X->o), padx = gl + (int)ceil(0.3 * b->nx);
+    bx_state *S = &X->S;
+    if (mpd_proto_open(&X->P, &X->o, err) || mpd_prepare_rve(&X->P, b->pressure, &X->st0, err)) return 1;
+    X->c = sqrt(X->P.M / X->P.rho);
+    X->dt = X->o.cfl * h / X->c;
+    /* grid: ghost layers, room for a 30 % bulge on each side, the plate above */
+    org[0] = -padx * h, org[1] = -gl * h, org[2] = 0;
+    n[0] = b->nx + 2 * padx + 1, n[1] = b->ny + 2 * gl + 1, n[2] = 1;
+    hi[0] = b->width, hi[1] = b->height, hi[2] = 0;
+    if (gk_mpm_grid_create(&X->g, 2, org, h, n, NULL, err) ||
+        gk_mpm_points_create_box(&X->pts, 2, lo, hi, h, X->o.ppc, X->P.rho, NULL, err) ||
+        mpd_micro_create(&X->M, &X->pts, &X->P, &X->st0, 1, NULL, &X->o, err))
+        return 1;
+    if (!(X->edge = (mpd_edge *)calloc((size_t)X->pts.n, sizeof *X->edge)))
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+    for (i = 0; i < X->pts.n; ++i) { /* the lateral pressure on the outer columns' outer edges */
+        double a = 0.5 * h / X->o.ppc, side = X->pts.x[0][i] < 2 * a              ? -1
+                                              : X->pts.x[0][i] > b->width - 2 * a ? 1
+                                                                                  : 0;
+        mpd_edge *E = &X->edge[X->nedge];
+        X->vol0 += X->pts.vol0[i];
+        if (side == 0) continue;
+        E->p = i, E->pressure = b->pressure, E->off[0] = side * a, E->off[1] = 0, E->e[0] = 0,
+        E->e[1] = side * 2 * a;
+        ++X->nedge;
+    }
+    X->def = mpd_mpm_def(&X->o);
+    X->dot = 0.5 * h / X->o.ppc;
+    memset(S, 0, sizeof *S);
+    S->body[0].lo[0] = org[0] - h, S->body[0].hi[0] = -org[0] + b->width + h;
+    S->body[0].lo[1] = org[1] - h, S->body[0].hi[1] = 1e-9 * h;
+    S->body[1].lo[0] = S->body[0].lo[0], S->body[1].hi[0] = S->body[0].hi[0];
+    S->body[1].lo[1] = b->height - 1e-9 * h, S->body[1].hi[1] = b->height + 10 * h;
+    S->body[0].contact = S->body[1].contact = GK_MPM_CONTACT_STICK;
+    S->next_out = b->every;
+    X->rows.size = sizeof(bx_row);
+    if (X->o.restart &&
+        mpd_load(X->o.restart, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps, err))
+        return 1;
+    X->g.body = S->body, X->g.nbody = 2;
+    return 0;
+}
+
+/* the base and the plate over the specimen's current width */
+static void outline(const bx *X, mpd_outline *ol) {
+    double x0 = 1e300, x1 = -1e300, y = X->b.height - X->S.disp, e = 0.5 * X->h, base[4], plate[4];
+    int p;
+    for (p = 0; p < X->pts.n; ++p) x0 = fmin(x0, X->pts.x[0][p]), x1 = fmax(x1, X->pts.x[0][p]);
+    base[0] = x0 - 2 * e, base[1] = 0, base[2] = x1 + 2 * e, base[3] = 0;
+    plate[0] = base[0], plate[1] = y, plate[2] = base[2], plate[3] = y;
+    memset(ol, 0, sizeof *ol);
+    mpd_outline_add(ol, 2, base);
+    mpd_outline_add(ol, 2, plate);
+}
+
+/* rotation and eps_q fields at a stage (the paper's Fig 8) */
+static int stage_fields(bx *X, const char *tag) {
+    char file[48], title[160];
+    mpd_outline ol;
+    int bad;
+    outline(X, &ol);
+    snprintf(file, sizeof file, "rotation_%s", tag);
+    snprintf(title, sizeof title, "rotation of F = RU at %s axial strain (Liang & Zhao Fig 8)", tag);
+    bad = mpd_snap_field(&X->run, &X->snaps, &X->M, &X->pts, MPD_ROTATION, file, title, X->dot, &ol);
+    snprintf(file, sizeof file, "eps_q_%s", tag);
+    snprintf(title, sizeof title, "deviatoric strain eps_q at %s axial strain", tag);
+    return bad || mpd_snap_field(&X->run, &X->snaps, &X->M, &X->pts, MPD_EPS_Q, file, title, X->dot, &ol);
+}
+
+static void put_csv(FILE *fp, const void *user) {
+    const mpd_rows *R = (const mpd_rows *)user;
     int k;
-    if (x && y1 && y2) {
-        for (k = 0; k < n; ++k)
-            x[k] = 100 * r[k].eps, y1[k] = r[k].syy_top / 1e3, y2[k] = r[k].syy_base / 1e3;
-        gk_plot_init(&pl, "MPMxDEM biaxial (seed 003 Fig 6: peak ~280 kPa at 1.6 %)", "axial strain [%]",
-                     "sigma_yy [kPa]");
-        gk_plot_add(&pl, x, y1, n, "top plate reaction / width");
-        gk_plot_add(&pl, x, y2, n, "base reaction / width");
-        snprintf(path, sizeof path, "%s/biaxial_stress.svg", out);
-        gk_plot_svg(&pl, path, &err);
-        for (k = 0; k < n; ++k) y1[k] = 100 * r[k].ev;
+    fprintf(fp, "time,eps_axial,sigma_yy,sigma_yy_base,eps_v,kinetic_energy,dem_steps_per_point,seconds\n");
+    for (k = 0; k < R->n; ++k) {
+        const bx_row *r = (const bx_row *)mpd_row(R, k);
+        fprintf(fp, "%.6g,%.6g,%.9g,%.9g,%.6g,%.6g,%.4g,%.3f\n", r->t, r->eps, r->syy_top, r->syy_base, r->ev,
+                r->ek, r->dem_mean, r->secs);
+    }
+}
+
+static int write_plots(const bx *X) {
+    int n = X->rows.n, k, bad = 1;
+    double *x = (double *)malloc((size_t)(n + 1) * 3 * sizeof *x), *y1 = x + n + 1, *y2 = y1 + n + 1;
+    gk_plot pl;
+    if (!x) return fprintf(stderr, "mpmdem_biaxial: out of memory for the plots\n"), 1;
+    for (k = 0; k < n; ++k) {
+        const bx_row *r = (const bx_row *)mpd_row(&X->rows, k);
+        x[k] = 100 * r->eps, y1[k] = r->syy_top / 1e3, y2[k] = r->syy_base / 1e3;
+    }
+    gk_plot_init(&pl, "MPMxDEM biaxial (Liang & Zhao Fig 6: peak ~280 kPa at 1.6 %)", "axial strain [%]",
+                 "sigma_yy [kPa]");
+    gk_plot_add(&pl, x, y1, n, "top plate reaction / width");
+    if ((k = gk_plot_add(&pl, x, y2, n, "base reaction / width")) >= 0)
+        pl.s[k].dashed = 1; /* on top, visible */
+    if (!mpd_plot(&X->run, &pl, "biaxial_stress.svg")) {
+        for (k = 0; k < n; ++k) y1[k] = 100 * ((const bx_row *)mpd_row(&X->rows, k))->ev;
         gk_plot_init(&pl, "MPMxDEM biaxial: volumetric strain (compression positive)", "axial strain [%]",
                      "eps_v [%]");
         gk_plot_add(&pl, x, y1, n, "specimen (sum of point volumes)");
-        snprintf(path, sizeof path, "%s/biaxial_volume.svg", out);
-        gk_plot_svg(&pl, path, &err);
+        bad = mpd_plot(&X->run, &pl, "biaxial_volume.svg");
     }
-    free(x), free(y1), free(y2);
-}
-
-static void stage_fields(const char *out, const char *tag, const mpd_rves *f, const gk_mpm_points *pts,
-                         double dot) {
-    char path[1200], title[200];
-    snprintf(path, sizeof path, "%s/rotation_%s.svg", out, tag);
-    snprintf(title, sizeof title, "rotation of F = RU [deg] at %s axial strain (seed 003 Fig 8)", tag);
-    mpd_svg_field(path, title, f, pts, 2, dot);
-    snprintf(path, sizeof path, "%s/eps_q_%s.svg", out, tag);
-    snprintf(title, sizeof title, "deviatoric strain eps_q at %s axial strain", tag);
-    mpd_svg_field(path, title, f, pts, 0, dot);
+    free(x);
+    return bad;
 }
 
 static int cmp_double(const void *a, const void *b) {
@@ -141,282 +242,171 @@ static int cmp_double(const void *a, const void *b) {
  * their principal axis (largest eigenvector of the covariance of their
  * positions, weighted by eps_q) -> angle from the horizontal in [0, 90] deg.
  * NaN when no point stands out (no localisation yet). */
-static double band_angle(const mpd_rves *f, const gk_mpm_points *pts) {
+static double band_angle(const mpd_micro *M, const gk_mpm_points *pts) {
     int n = pts->n, p, m = 0;
-    double *e = (double *)malloc((size_t)n * sizeof *e), *s = (double *)malloc((size_t)n * sizeof *s), med,
-           w = 0, mx = 0, my = 0, cxx = 0, cyy = 0, cxy = 0, ang = NAN;
-    if (e && s) {
-        for (p = 0; p < n; ++p) {
-            double v[MPD_NFIELD];
-            mpd_fields(f, pts, p, v);
-            e[p] = s[p] = v[0];
-        }
-        qsort(s, (size_t)n, sizeof *s, cmp_double);
-        med = s[n / 2];
+    double *e = (double *)malloc(2 * (size_t)n * sizeof *e), *s = e + n, med, w = 0, mx = 0, my = 0, cxx = 0,
+           cyy = 0, cxy = 0, ang = NAN;
+    if (!e) return NAN;
+    for (p = 0; p < n; ++p) e[p] = s[p] = gk_strain_q(M->eps + 9 * (size_t)p, 2);
+    qsort(s, (size_t)n, sizeof *s, cmp_double);
+    med = s[n / 2];
+    for (p = 0; p < n; ++p)
+        if (e[p] > 2 * med) ++m, w += e[p], mx += e[p] * pts->x[0][p], my += e[p] * pts->x[1][p];
+    if (m >= 3 && w > 0) {
+        mx /= w, my /= w;
         for (p = 0; p < n; ++p)
-            if (e[p] > 2 * med) ++m, w += e[p], mx += e[p] * pts->x[0][p], my += e[p] * pts->x[1][p];
-        if (m >= 3 && w > 0) {
-            mx /= w, my /= w;
-            for (p = 0; p < n; ++p)
-                if (e[p] > 2 * med) {
-                    double dx = pts->x[0][p] - mx, dy = pts->x[1][p] - my;
-                    cxx += e[p] * dx * dx, cyy += e[p] * dy * dy, cxy += e[p] * dx * dy;
-                }
-            ang = 0.5 * atan2(2 * cxy, cxx - cyy) * 180.0 / MPD_PI; /* principal direction */
-            ang = fabs(ang);
-            if (ang > 90) ang = 180 - ang;
-        }
+            if (e[p] > 2 * med) {
+                double dx = pts->x[0][p] - mx, dy = pts->x[1][p] - my;
+                cxx += e[p] * dx * dx, cyy += e[p] * dy * dy, cxy += e[p] * dx * dy;
+            }
+        ang = fabs(0.5 * atan2(2 * cxy, cxx - cyy) * 180.0 / MPD_PI); /* principal direction */
+        if (ang > 90) ang = 180 - ang;
     }
-    free(e), free(s);
+    free(e);
     return ang;
 }
 
-int main(int argc, char **argv) {
-    mpd_opts o, od;
-    bx_opts b = {8, 16, 1.0, 2.0, 1e5, 0.02, 0.5, 0.03, 0.001};
-    mpd_proto P;
-    gk_rve_state st0;
-    mpd_rves F;
-    gk_mpm_grid g;
-    gk_mpm_points pts;
-    gk_mpm_def def;
-    bx_state S;
-    bx_row *rows = NULL;
-    int nrows = 0, caprows = 0, i, nedge = 0, status = 0;
-    mpd_edge *edge = NULL;
-    double h, dt, c, lo[3], hi[3], org[3], vol0 = 0, t0, t_start, stages[3] = {0.015, 0.02, 0.03};
+/* after a step: the interval sums, and a CSV row (with the stage fields) when due; 0 or 1 (said) */
+static int after_step(bx *X, double vplate, double t0, double t_start, long nsteps_total) {
+    bx_state *S = &X->S;
+    const bx_opts *b = &X->b;
+    double ek, m, mom[3];
+    long long sum = 0;
+    int i, bad;
+    bx_row r;
+    S->t += X->dt, S->disp += vplate * X->dt, ++S->step;
+    S->acc_top += -S->body[1].force[1] * X->dt, S->acc_base += S->body[0].force[1] * X->dt,
+        S->acc_dt += X->dt;
+    gk_mpm_points_totals(&X->pts, &m, mom, &ek);
+    S->acc_ek += ek, ++S->nacc;
+    for (i = 0; i < X->pts.n; ++i) sum += X->M.nsub[i];
+    S->acc_dem += (double)sum / X->pts.n;
+    if (!(S->disp >= S->next_out * b->height * (1 - 1e-9) || S->disp >= b->strain * b->height * (1 - 1e-12)))
+        return 0;
+    r.t = S->t, r.eps = S->disp / b->height, r.ev = 0;
+    for (i = 0; i < X->pts.n; ++i) r.ev += X->pts.vol[i];
+    r.syy_top = S->acc_top / S->acc_dt / b->width, r.syy_base = S->acc_base / S->acc_dt / b->width;
+    r.ev = (X->vol0 - r.ev) / X->vol0, r.ek = S->acc_ek / S->nacc, r.dem_mean = S->acc_dem / S->nacc;
+    r.secs = gk_wtime() - t0;
+    S->acc_top = S->acc_base = S->acc_dt = 0, S->acc_ek = S->acc_dem = 0, S->nacc = 0;
+    S->next_out += b->every;
+    bad = mpd_rows_push(&X->run, &X->rows, &r) || mpd_write(&X->run, "biaxial.csv", put_csv, &X->rows);
+    while (!bad && S->nstage < 3 && r.eps >= bx_stages[S->nstage] * (1 - 1e-9)) {
+        char tag[32];
+        snprintf(tag, sizeof tag, "%.1f%%", 100 * bx_stages[S->nstage]);
+        bad = stage_fields(X, tag);
+        ++S->nstage;
+    }
+    if (!X->o.quiet) {
+        char what[300];
+        snprintf(what, sizeof what, "eps %.2f %%  sigma_yy %.1f kPa (base %.1f)  eps_v %.3f %%  DEM %.1f/pt",
+                 100 * r.eps, r.syy_top / 1e3, r.syy_base / 1e3, 100 * r.ev, r.dem_mean);
+        gk_progress(stderr, S->step, nsteps_total, t_start, what);
+    }
+    return bad;
+}
+
+/* the summary and the RESULT line */
+static void report(bx *X, double secs, long steps_run, long long dems, int wrote) {
+    double peak = 0, epk = 0, rmax = 0, ang = band_angle(&X->M, &X->pts), last = 0, eps_end = 0;
+    char buf[64];
+    int k, n = X->pts.n;
+    for (k = 0; k < X->rows.n; ++k) {
+        const bx_row *r = (const bx_row *)mpd_row(&X->rows, k);
+        if (r->syy_top > peak) peak = r->syy_top, epk = r->eps;
+        last = r->syy_top, eps_end = r->eps;
+    }
+    for (k = 0; k < n; ++k)
+        rmax = fmax(rmax, fabs(gk_rotation_angle(X->pts.F + 9 * (size_t)k, 2) * 180.0 / MPD_PI));
+    if (wrote)
+        printf("wrote %s/biaxial.csv, biaxial_stress.svg, biaxial_volume.svg, rotation_*.svg, eps_q_*.svg, "
+               "points_*.vtk (ParaView), checkpoint.bin\n",
+               X->run.out);
+    printf("Liang & Zhao (mesh M4, their RVE): peak sigma_yy ~ 280 kPa at 1.6 %%; here %.1f kPa at %.2f %% "
+           "(sigma_1/sigma_3 = %.2f; paper ~2.8)\n",
+           peak / 1e3, 100 * epk, X->b.pressure > 0 ? peak / X->b.pressure : 0.0);
+    if (ang == ang)
+        printf(
+            "shear band: %.1f deg from the horizontal (principal axis of the points with eps_q > 2 x median; "
+            "Liang & Zhao: first band ~60 deg)\n",
+            ang);
+    else
+        printf("shear band: none yet (no point with eps_q > 2 x median)\n");
+    printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step); MPI "
+           "ranks %d, "
+           "%.4g bytes sent per MPM step\n",
+           mpd_duration(secs, buf, sizeof buf), steps_run, dems,
+           steps_run ? (double)dems / steps_run / n : 0.0, X->run.nranks,
+           mpd_bytes_per_step(&X->M, steps_run));
+    printf("RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g sigma_yy_end=%.6g eps_end=%.5g max_rotation_deg=%.3g "
+           "band_angle_deg=%.3g n_rves=%d mpm_steps=%ld dt=%.4g seconds_per_step=%.4g "
+           "seconds_per_step_per_1000_rves=%.4g total_seconds=%.2f\n",
+           peak, epk, last, eps_end, rmax, ang, n, steps_run, X->dt, steps_run ? secs / steps_run : 0.0,
+           steps_run ? secs / steps_run * 1000.0 / n : 0.0, secs);
+}
+
+static int run(bx *X, int argc, char **argv) {
+    const bx_opts *b = &X->b;
+    bx_state *S = &X->S;
+    double t0, t_start;
     long nsteps_total, step0;
     long long dem0;
+    int status = parse(X, argc, argv), bad = 0;
     gk_err err;
-    char buf[64], what[300], path[1200];
-    int n[3];
-
-    mpd_opts_default(&od, "build/mpmdem_biaxial");
-    o = od;
-    for (i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        double v;
-        int r = mpd_parse_common(&o, argc, argv, &i);
-        if (r < 0) return 2;
-        if (r > 0) continue;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) return usage(stdout, &od), 0;
-        if (i + 1 >= argc) return fprintf(stderr, "mpmdem_biaxial: %s needs a value (see --help)\n", a), 2;
-        if (mpd_num(argv[i + 1], &v))
-            return fprintf(stderr, "mpmdem_biaxial: %s %s: not a number\n", a, argv[i + 1]), 2;
-        if (!strcmp(a, "--nx"))
-            b.nx = (int)v;
-        else if (!strcmp(a, "--ny"))
-            b.ny = (int)v;
-        else if (!strcmp(a, "--width"))
-            b.width = v;
-        else if (!strcmp(a, "--height"))
-            b.height = v;
-        else if (!strcmp(a, "--pressure"))
-            b.pressure = v;
-        else if (!strcmp(a, "--velocity"))
-            b.velocity = v;
-        else if (!strcmp(a, "--ramp"))
-            b.ramp = v;
-        else if (!strcmp(a, "--strain"))
-            b.strain = v;
-        else if (!strcmp(a, "--every"))
-            b.every = v;
-        else
-            return fprintf(stderr, "mpmdem_biaxial: unknown option %s (see --help)\n", a), 2;
-        ++i;
-    }
-    if (b.nx < 1 || b.ny < 1 || b.nx > 2000 || b.ny > 2000 || !(b.width > 0) || !(b.height > 0) ||
-        !(b.pressure >= 0) || !(b.velocity > 0) || !(b.ramp >= 0) || !(b.strain > 0 && b.strain < 0.5) ||
-        !(b.every > 0) || mpd_check_opts(&o))
-        return fprintf(stderr, "mpmdem_biaxial: an option is out of range (see --help)\n"), 2;
-    h = b.width / b.nx;
-    if (fabs(b.height / b.ny - h) > 1e-9 * h)
-        return fprintf(stderr, "mpmdem_biaxial: cells must be square: width/nx = %g, height/ny = %g\n", h,
-                       b.height / b.ny),
-               2;
-    if (mpd_mkdir(o.out)) return 1;
-
-    /* ---- the RVE every point starts from */
-    gk_rve_state_init(&st0, NULL);
-    if (mpd_proto_open(&P, &o, &err) || mpd_prepare_rve(&P, b.pressure, &st0, &err)) {
-        fprintf(stderr, "mpmdem_biaxial: %s\n", err.msg);
-        return 1;
-    }
-    c = sqrt(P.M / P.rho);
-    dt = o.cfl * h / c;
-    /* ---- grid: ghost layers, room for a 30 % bulge on each side, the plate above */
-    {
-        int gl = mpd_ghost_layers(o.basis), padx = gl + (int)ceil(0.3 * b.nx);
-        org[0] = -padx * h, org[1] = -gl * h, org[2] = 0;
-        n[0] = b.nx + 2 * padx + 1, n[1] = b.ny + 2 * gl + 1, n[2] = 1;
-        if (gk_mpm_grid_create(&g, 2, org, h, n, NULL, &err))
-            return fprintf(stderr, "mpmdem_biaxial: %s\n", err.msg), 1;
-    }
-    lo[0] = 0, lo[1] = 0, lo[2] = 0, hi[0] = b.width, hi[1] = b.height, hi[2] = 0;
-    if (gk_mpm_points_create_box(&pts, 2, lo, hi, h, o.ppc, P.rho, NULL, &err))
-        return fprintf(stderr, "mpmdem_biaxial: %s\n", err.msg), 1;
-    if (mpd_rves_create(&F, pts.n, &P, &st0, NULL, NULL, &o, &err))
-        return fprintf(stderr, "mpmdem_biaxial: %s\n", err.msg), 1;
-    edge = (mpd_edge *)calloc((size_t)pts.n, sizeof *edge);
-    if (!edge) return fprintf(stderr, "mpmdem_biaxial: out of memory\n"), 1;
-    for (i = 0; i < pts.n; ++i) { /* the lateral pressure on the outer columns' outer edges */
-        double a = 0.5 * h / o.ppc, side = pts.x[0][i] < 2 * a ? -1 : pts.x[0][i] > b.width - 2 * a ? 1 : 0;
-        mpd_rve_sigma(&F.rve[i], pts.sigma + 9 * (size_t)i);
-        vol0 += pts.vol0[i];
-        if (side == 0) continue;
-        edge[nedge].p = i, edge[nedge].pressure = b.pressure;
-        edge[nedge].off[0] = side * a, edge[nedge].off[1] = 0;
-        edge[nedge].e[0] = 0, edge[nedge].e[1] = side * 2 * a;
-        ++nedge;
-    }
-    def = mpd_mpm_def(&o);
-    memset(&S, 0, sizeof S);
-    S.body[0].lo[0] = org[0] - h, S.body[0].hi[0] = -org[0] + b.width + h;
-    S.body[0].lo[1] = org[1] - h, S.body[0].hi[1] = 1e-9 * h;
-    S.body[1].lo[0] = S.body[0].lo[0], S.body[1].hi[0] = S.body[0].hi[0];
-    S.body[1].lo[1] = b.height - 1e-9 * h, S.body[1].hi[1] = b.height + 10 * h;
-    S.body[0].contact = S.body[1].contact = GK_MPM_CONTACT_STICK;
-    S.next_out = b.every;
-    if (o.restart) {
-        void *blob[2];
-        size_t size[2] = {sizeof S, 0};
-        bx_row *rr = NULL;
-        blob[0] = &S, blob[1] = &rr;
-        if (mpd_ck_read(o.restart, "biaxial", blob, size, 2, &pts, &F, &err))
-            return fprintf(stderr, "mpmdem_biaxial: %s\n", err.msg), 1;
-        rows = rr, nrows = caprows = (int)(size[1] / sizeof *rows);
-    }
-    g.body = S.body, g.nbody = 2;
-    nsteps_total = (long)ceil((b.strain * b.height / b.velocity + 0.5 * b.ramp) / dt);
+    if (status) return status == 1 ? 0 : status;
+    if (mpd_out_dir(&X->run)) return 1;
+    if (setup(X, &err)) return fprintf(stderr, "mpmdem_biaxial: %s\n", err.msg), 1;
+    nsteps_total = (long)ceil((b->strain * b->height / b->velocity + 0.5 * b->ramp) / X->dt);
     printf("mpmdem_biaxial: %d x %d cells, h = %.4g m, %d points (= RVEs of %d disks), basis %d, alpha %g\n",
-           b.nx, b.ny, h, pts.n, F.rve[0].n, (int)o.basis, o.alpha);
+           b->nx, b->ny, X->h, X->pts.n, X->P.pk.n, (int)X->def.basis, X->o.alpha);
     printf("RVE: p0 = %.4g kPa, e0 = %.4f, rho = %.1f kg/m3, M (Taylor) = %.4g MPa -> c = %.1f m/s; MPM dt = "
            "%.4g s "
            "(cfl %.2f); DEM dt = %.3g s\n",
-           P.p0 / 1e3, P.e0, P.rho, P.M / 1e6, c, dt, o.cfl, F.rve[0].dt);
-    mpd_print_dem_rule(&o);
-    printf("about %ld MPM steps to %.1f %% axial strain at %g m/s\n", nsteps_total, 100 * b.strain,
-           b.velocity);
-    if (!o.restart) {
-        snprintf(path, sizeof path, "%s/points_%06ld.vtk", o.out, 0L);
-        mpd_write_vtk(path, &F, &pts);
-    }
-    t_start = gk_wtime();
-    t0 = t_start;
-    step0 = S.step, dem0 = F.dem_steps;
-    {
-        while (S.disp < b.strain * b.height * (1 - 1e-12)) {
-            double vplate = b.velocity * (b.ramp > 0 && S.t < b.ramp ? (S.t + 0.5 * dt) / b.ramp : 1.0), ek,
-                   m, mom[3];
-            S.body[1].v[1] = -vplate;
-            if (mpd_step(&g, &pts, &def, dt, &F, edge, nedge, &err)) {
-                fprintf(stderr, "mpmdem_biaxial: step %ld (axial strain %.3f %%): %s\n", S.step,
-                        100 * S.disp / b.height, err.msg);
-                status = 3;
-                break;
-            }
-            S.t += dt, S.disp += vplate * dt, ++S.step;
-            S.acc_top += -S.body[1].force[1] * dt, S.acc_base += S.body[0].force[1] * dt, S.acc_dt += dt;
-            gk_mpm_points_totals(&pts, &m, mom, &ek);
-            S.acc_ek += ek, ++S.nacc;
-            {
-                long long sum = 0;
-                for (i = 0; i < pts.n; ++i) sum += F.nsub[i];
-                S.acc_dem += (double)sum / pts.n;
-            }
-            if (S.disp >= S.next_out * b.height * (1 - 1e-9) || S.disp >= b.strain * b.height * (1 - 1e-12)) {
-                bx_row r;
-                double vol = 0;
-                for (i = 0; i < pts.n; ++i) vol += pts.vol[i];
-                r.t = S.t, r.eps = S.disp / b.height;
-                r.syy_top = S.acc_top / S.acc_dt / b.width, r.syy_base = S.acc_base / S.acc_dt / b.width;
-                r.ev = (vol0 - vol) / vol0, r.ek = S.acc_ek / S.nacc, r.dem_mean = S.acc_dem / S.nacc;
-                r.secs = gk_wtime() - t0;
-                S.acc_top = S.acc_base = S.acc_dt = 0, S.acc_ek = S.acc_dem = 0, S.nacc = 0;
-                S.next_out += b.every;
-                if (nrows == caprows) {
-                    caprows = caprows ? 2 * caprows : 64;
-                    rows = (bx_row *)realloc(rows, (size_t)caprows * sizeof *rows);
-                    if (!rows) return fprintf(stderr, "mpmdem_biaxial: out of memory\n"), 1;
-                }
-                rows[nrows++] = r;
-                write_csv(o.out, rows, nrows);
-                while (S.nstage < 3 && r.eps >= stages[S.nstage] * (1 - 1e-9)) {
-                    char tag[32];
-                    snprintf(tag, sizeof tag, "%.1f%%", 100 * stages[S.nstage]);
-                    stage_fields(o.out, tag, &F, &pts, 0.5 * h / o.ppc);
-                    ++S.nstage;
-                }
-                if (!o.quiet) {
-                    snprintf(what, sizeof what,
-                             "eps %.2f %%  sigma_yy %.1f kPa (base %.1f)  eps_v %.3f %%  DEM %.1f/pt",
-                             100 * r.eps, r.syy_top / 1e3, r.syy_base / 1e3, 100 * r.ev, r.dem_mean);
-                    gk_progress(stderr, S.step, nsteps_total, t_start, what);
-                }
-            }
-            if (o.vtk_every && S.step % o.vtk_every == 0) {
-                snprintf(path, sizeof path, "%s/points_%06ld.vtk", o.out, S.step);
-                mpd_write_vtk(path, &F, &pts);
-            }
-            if (o.checkpoint_every && S.step % o.checkpoint_every == 0) {
-                void *blob[2];
-                size_t size[2];
-                blob[0] = &S, size[0] = sizeof S, blob[1] = rows, size[1] = (size_t)nrows * sizeof *rows;
-                mpd_ck_write(o.out, "biaxial", blob, size, 2, &pts, &F);
-            }
+           X->P.p0 / 1e3, X->P.e0, X->P.rho, X->P.M / 1e6, X->c, X->dt, X->o.cfl, X->P.dt);
+    mpd_print_dem_rule(&X->o);
+    printf("about %ld MPM steps to %.1f %% axial strain at %g m/s\n", nsteps_total, 100 * b->strain,
+           b->velocity);
+    if (!X->o.restart && mpd_write_vtk(&X->run, 0, &X->M, &X->pts)) return 1;
+    t_start = t0 = gk_wtime();
+    step0 = S->step, dem0 = X->M.dem_steps;
+    while (!bad && S->disp < b->strain * b->height * (1 - 1e-12)) {
+        double vplate = b->velocity * (b->ramp > 0 && S->t < b->ramp ? (S->t + 0.5 * X->dt) / b->ramp : 1.0);
+        S->body[1].v[1] = -vplate;
+        if (mpd_step(&X->g, &X->pts, &X->def, X->dt, &X->M, X->edge, X->nedge, &err)) {
+            fprintf(stderr, "mpmdem_biaxial: step %ld (axial strain %.3f %%): %s\n", S->step,
+                    100 * S->disp / b->height, err.msg);
+            status = 3;
+            break;
         }
+        bad = after_step(X, vplate, t0, t_start, nsteps_total);
+        if (!bad && X->o.vtk_every && S->step % X->o.vtk_every == 0)
+            bad = mpd_write_vtk(&X->run, S->step, &X->M, &X->pts);
+        if (!bad && X->o.checkpoint_every && S->step % X->o.checkpoint_every == 0)
+            bad = mpd_save(&X->run, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps);
     }
-    {
-        double secs = gk_wtime() - t_start, peak = 0, epk = 0, rmax = 0, ang = band_angle(&F, &pts);
-        long steps_run = S.step - step0;
-        void *blob[2];
-        size_t size[2];
-        int k;
-        blob[0] = &S, size[0] = sizeof S, blob[1] = rows, size[1] = (size_t)nrows * sizeof *rows;
-        if (status == 0) mpd_ck_write(o.out, "biaxial", blob, size, 2, &pts, &F);
-        write_csv(o.out, rows, nrows);
-        write_plots(o.out, rows, nrows);
-        stage_fields(o.out, "end", &F, &pts, 0.5 * h / o.ppc);
-        snprintf(path, sizeof path, "%s/points_%06ld.vtk", o.out, S.step);
-        mpd_write_vtk(path, &F, &pts);
-        for (k = 0; k < nrows; ++k)
-            if (rows[k].syy_top > peak) peak = rows[k].syy_top, epk = rows[k].eps;
-        for (i = 0; i < pts.n; ++i) {
-            double v[MPD_NFIELD];
-            mpd_fields(&F, &pts, i, v);
-            if (fabs(v[2]) > rmax) rmax = fabs(v[2]);
-        }
-        printf("wrote %s/biaxial.csv, biaxial_stress.svg, biaxial_volume.svg, rotation_*.svg, eps_q_*.svg, "
-               "points_*.vtk (ParaView), checkpoint.bin\n",
-               o.out);
-        printf("seed 003 (mesh M4, its RVE): peak sigma_yy ~ 280 kPa at 1.6 %%; here %.1f kPa at %.2f %% "
-               "(sigma_1/sigma_3 = %.2f; seed ~2.8)\n",
-               peak / 1e3, 100 * epk, b.pressure > 0 ? peak / b.pressure : 0.0);
-        if (ang == ang)
-            printf("shear band: %.1f deg from the horizontal (principal axis of the points with eps_q > 2 x "
-                   "median; "
-                   "seed 003: first band ~60 deg)\n",
-                   ang);
-        else
-            printf("shear band: none yet (no point with eps_q > 2 x median)\n");
-        printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step)\n",
-               mpd_duration(secs, buf, sizeof buf), steps_run, F.dem_steps - dem0,
-               steps_run ? (double)(F.dem_steps - dem0) / steps_run / pts.n : 0.0);
-        printf(
-            "RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g sigma_yy_end=%.6g eps_end=%.5g max_rotation_deg=%.3g "
-            "band_angle_deg=%.3g "
-            "n_rves=%d mpm_steps=%ld dt=%.4g seconds_per_step=%.4g seconds_per_step_per_1000_rves=%.4g "
-            "total_seconds=%.2f\n",
-            peak, epk, nrows ? rows[nrows - 1].syy_top : 0.0, nrows ? rows[nrows - 1].eps : 0.0, rmax, ang,
-            pts.n, steps_run, dt, steps_run ? secs / steps_run : 0.0,
-            steps_run ? secs / steps_run * 1000.0 / pts.n : 0.0, secs);
-    }
-    free(rows);
-    free(edge);
-    mpd_rves_free(&F);
-    gk_rve_state_free(&st0);
-    mpd_proto_close(&P);
-    gk_mpm_points_destroy(&pts);
-    gk_mpm_grid_destroy(&g);
-    return status;
+    if (!bad && status == 0)
+        bad = mpd_save(&X->run, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps);
+    if (!bad)
+        bad =
+            mpd_write(&X->run, "biaxial.csv", put_csv, &X->rows) || write_plots(X) || stage_fields(X, "end");
+    if (!bad) bad = mpd_write_vtk(&X->run, S->step, &X->M, &X->pts);
+    report(X, gk_wtime() - t_start, S->step - step0, X->M.dem_steps - dem0, !bad);
+    return status ? status : bad;
+}
+
+int main(int argc, char **argv) {
+    bx X;
+    int status;
+    memset(&X, 0, sizeof X);
+    gk_rve_state_init(&X.st0, NULL);
+    mpd_begin(&X.run, "mpmdem_biaxial", &argc, &argv);
+    status = run(&X, argc, argv);
+    free(X.rows.r), free(X.edge);
+    mpd_snaps_free(&X.snaps);
+    mpd_micro_free(&X.M);
+    gk_rve_state_free(&X.st0);
+    mpd_proto_close(&X.P);
+    gk_mpm_points_destroy(&X.pts);
+    gk_mpm_grid_destroy(&X.g);
+    return mpd_end(status);
 }

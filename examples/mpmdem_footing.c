@@ -1,15 +1,16 @@
-/* mpmdem_footing.c - the MPMxDEM rigid footing of seed 003 (Liang & Zhao,
- * Sec 3.3): a rigid rough strip footing pushed into a weightless soil with a
+/* mpmdem_footing.c - the MPMxDEM rigid footing of Liang & Zhao (2019)
+ * Sec 3.3: a rigid rough strip footing pushed into a weightless soil with a
  * 20 kPa surcharge; every material point has its own periodic 400-disk RVE.
  * Load-settlement curve, the bearing-capacity factor N_q = p_u / q_s (eq 45)
  * against Prandtl's N_q = tan^2(pi/4 + phi/2) exp(pi tan phi) (eq 46; eq 47
  * phi_r = atan(2/3 tan phi) for local / punching failure), with phi the
  * friction angle of the RVE MEASURED here by single-RVE drained biaxial
- * tests; the failure mode picture (eps_q field). Seed: N_q 14.4 (MPMxDEM)
+ * tests; the failure mode picture (eps_q field). The paper: N_q 14.4 (MPMxDEM)
  * vs 14.8 (eq 46, phi = 28.1 deg) for the dense packing.
  *
  *   build/mpmdem_footing                  # reduced default (about a minute)
  *   build/mpmdem_footing --paper          # 12 x 8 m, 108 x 72 cells, 7776 RVEs
+ *   mpirun -np 2 build/mpi/mpmdem_footing_mpi --threads 1   # the RVEs on 2 ranks
  *
  * GEOMETRY (half model, x = 0 is the symmetry plane). The paper: soil 12 m
  * wide, 8 m deep, footing "1 m x 2 m (width x height)", d/B = 1.5 at the end.
@@ -43,35 +44,26 @@
  * RVE copied to every point), so the model starts in equilibrium and the
  * footing's first reaction is q_s b.
  *
- * MATERIAL = seed 003 Table 2 (--material dense | medium | soft): E, kt/kn
+ * MATERIAL = Liang & Zhao Table 2 (--material dense | medium | soft): E, kt/kn
  * (the table's nu), interparticle friction, rolling beta and eta, local
  * damping 0.1. "Medium dense" differs from "dense" only by e0 (0.2314 vs
  * 0.1874): give it a looser packing with --packing (the default one is
- * dense: e ~ 0.18 at 20 kPa; examples/data/rve400_e0223.txt is looser). DEM step: 3.16e-5 s sqrt(6e8 / E), the same
- * fraction of the critical step as seed 000's 3.16e-5 s at E = 600 MPa.
+ * dense: e ~ 0.18 at 20 kPa; examples/data/rve400_e0223.txt is looser). DEM
+ * step: 3.16e-5 s sqrt(6e8 / E), the same
+ * fraction of the critical step as Guo & Zhao's (2014) 3.16e-5 s at E = 600 MPa.
  *
- * FRICTION ANGLE (what eq 46 needs). Before the footing, the driver runs one
- * RVE per confining pressure (--phi-pressures, default 10, 20, 30 kPa; the
- * seed used 10..30 kPa): prepared at sigma_3 like the footing's RVEs, then a
- * drained biaxial test with gk_rve_set_servo (axis 0 stress-controlled at
- * -sigma_3, axis 1 compressed at constant rate: the inertial number
- * --dem-inertial at sigma_3 with the adaptive DEM rule, --dem-strain per DEM
- * step with the strain rule, i.e. as the MPM's RVEs deform) to
- * --phi-strain and on until the peak lies 1 % of strain behind (a hardening
- * RVE, e.g. a loose one, that has not peaked by 25 % uses its maximum). Peak = maximum of the mobilised sin phi = (s1 - s3)/(s1 +
- * s3) after a centred moving average over +-0.1 % axial strain (a 400-disk
- * RVE is noisy). phi per test = asin of that; the Mohr-Coulomb envelope
- * through the origin tangent (least squares) to the peak circles, sin phi
- * = sum(c r) / sum(c^2) (c, r = centre and radius), is the phi used (the
- * regression r = c sin phi + c' cos phi with a cohesion c' is printed too).
- * The same fit of the means over the last 2 % of strain gives phi_res (the
- * softened end of the tests, not yet a critical state at 8 %): the dense
- * RVE peaks at ~0.7 % and loses ~7 deg, and a footing on it fails
+ * FRICTION ANGLE (what eq 46 needs), measured before the footing by drained
+ * biaxial tests of one RVE per confining pressure (--phi-pressures, default
+ * 10, 20, 30 kPa; the paper used 10..30 kPa), prepared like the footing's
+ * RVEs and compressed at the rate the MPM's RVEs deform at (mpmdem_phi.h):
+ * phi from the Mohr-Coulomb envelope of the peaks through the origin,
+ * phi_res from that of the softened ends (not yet a critical state at 8 %):
+ * the dense RVE peaks at ~0.7 % and loses ~7 deg, and a footing on it fails
  * progressively, so its N_q lies between eq 46 of phi_res and of phi; the
- * output also gives the phi whose eq 46 is the computed N_q.
- * Nothing is cached: every run measures (or --phi-deg X skips it).
+ * output also gives the phi whose eq 46 is the computed N_q. Nothing is
+ * cached: every run measures (or --phi-deg X skips it).
  *
- * ULTIMATE LOAD (Vesic's rule, as the seed: the first point where the slope
+ * ULTIMATE LOAD (Vesic's rule, as the paper: the first point where the slope
  * of the load-settlement curve reaches zero, or its steady minimum). The
  * curve of an explicit MPM with points crossing cells is noisy, so: (1)
  * centred moving average of q over a window of --smooth (in d/B); (2) a
@@ -94,53 +86,51 @@
  * grows with alpha v (measured with --dem-rule strain on the 18 x 12 grid:
  * 12.8 at 0.1 m/s, 15.2 at 0.25 m/s, 11.9 at 0.25 m/s with alpha 0; on a
  * 24 x 16 grid 1 m/s gave ~1.5 x the 0.25 m/s value). The default keeps
- * the seed's alpha = 0.1 and 0.1 m/s.
+ * the paper's alpha = 0.1 and 0.1 m/s.
  *
  * SIZE AND COST. The paper's grid (--paper: 12 x 8 m, 108 x 72 cells, h =
  * 0.111 m, 1 point per cell = 7776 RVEs x 400 disks, 0.1 m/s to d/B = 1.5)
  * takes hours. The default is a reduced problem that finishes in about a
  * minute on 2 idle cores and still reaches the ultimate load: a 6 x 3 m
  * domain (the Prandtl mechanism of phi <= 32 deg reaches 5.3 B from the
- * axis and ~1.5 B deep), h = 0.2 m (b = 2.5 cells, 450 RVEs), the seed's
+ * axis and ~1.5 B deep), h = 0.2 m (b = 2.5 cells, 450 RVEs), the paper's
  * 0.1 m/s, to d/B = 0.14 (the dense footing peaks at d/B ~ 0.06). The run
  * prints its memory (VmHWM, per RVE) and projects the paper-size memory and
  * wall time; --max-steps N stops early (e.g. a 5-step run at the paper's
  * size to measure both there).
  *
- * Outputs in --out DIR: footing.csv (load-settlement), footing_load.svg,
- * rve_biaxial.svg and rve_mohr.svg (phi measurement), eps_q_dB*.svg (stages)
- * and eps_q_end.svg, rotation_end.svg, void_ratio_end.svg, displacement_end.svg
- * (failure mode), points_NNNNNN.vtk, checkpoint.bin; a RESULT line.
+ * Outputs in --out DIR (default build/mpm_footing): footing.csv
+ * (load-settlement), footing_load.svg, rve_biaxial.svg and rve_mohr.svg (phi
+ * measurement), eps_q_dB*.svg (stages, one colour scale) and eps_q_end.svg,
+ * rotation_end.svg, void_ratio_end.svg, displacement_end.svg (failure mode;
+ * the footing, the wall and the base drawn on the points), points_NNNNNN.vtk,
+ * checkpoint.bin; a RESULT line.
  */
-#define _POSIX_C_SOURCE 200809L
-#define GK_IMPLEMENTATION
-#include "gk_base.h"
-#include "gk_dem.h"
-#include "gk_homog.h"
-#include "gk_io.h"
-#include "gk_mpm.h"
-#include "mpmdem.h"
 
-#define FT_MAXPHI 6
+#define GK_IMPLEMENTATION
+#include "mpmdem.h"
+#include "mpmdem_phi.h"
+
 #define FT_NSTAGE 6
-#define FT_DEM_DT_REF 3.16e-5 /* seed 000's DEM step at E = 600 MPa */
+#define FT_DEM_DT_REF 3.16e-5 /* Guo & Zhao's DEM step at E = 600 MPa */
 
 typedef struct ft_opts {
-    int nx, ny, material;
+    int nx, ny, material, paper;
     double width, depth, B, foot_height, surcharge, velocity, ramp, final_dB, every, smooth;
     double phi_deg; /* > 0: skip the measurement */
     double phi_p[FT_MAXPHI];
     int nphi;
+    const char *phi_list;
     double phi_strain;   /* largest axial strain of a biaxial RVE test */
-    double grid_damping; /* local non-viscous grid damping (0: none, as the seed) */
-    long max_steps;      /* 0: no limit */
+    double grid_damping; /* local non-viscous grid damping (0: none, as the paper) */
+    int max_steps;       /* 0: no limit */
 } ft_opts;
 
 typedef struct ft_row { /* one CSV row: means over an output interval */
     double t, d, q, load, ek, dem_mean, secs;
 } ft_row;
 
-/* what a checkpoint must carry besides points and RVEs */
+/* what a checkpoint carries besides points and RVEs */
 typedef struct ft_state {
     long step;
     double t, disp;
@@ -152,22 +142,34 @@ typedef struct ft_state {
     double wall; /* wall seconds of the runs before this one */
 } ft_state;
 
-typedef struct ft_phi_test {
-    double s3;                     /* confining pressure [Pa] */
-    double e0, p0;                 /* state after preparation */
-    double rate;                   /* axial strain rate [1/s] */
-    double s1, s3m, eps_peak, phi; /* smoothed peak: s1, s3 [Pa], strain, phi [deg] */
-    double r1, r3, phi_res;        /* residual: means over the last 2 % of axial strain */
-    double eps_end;
-    int nsamp, nopeak;   /* nopeak: no peak by FT_PHI_STRAIN_MAX (the maximum is used) */
-    double *eps, *ratio; /* sampled curve: axial strain, s1/s3 (for the plot) */
-    int status;
-    char msg[400];
-} ft_phi_test;
+typedef struct ft { /* the whole model */
+    mpd_run run;
+    mpd_opts o;
+    ft_opts f;
+    mpd_proto P;
+    gk_rve_state st0;
+    mpd_micro M;
+    gk_mpm_grid g;
+    gk_mpm_points pts;
+    gk_mpm_def def;
+    mpd_edge *edge;
+    int nedge, measured;
+    double *x0; /* initial point positions (displacement field) */
+    ft_state S;
+    mpd_rows rows;
+    mpd_snaps snaps;
+    double h, b, bnode, dt, c, dot, phi, phi_res, rss_before, rss_after, t_first;
+    long long dem_first;
+} ft;
 
 static const char *material_names[3] = {"dense", "medium", "soft"};
+static const double table2_e0[3] = {0.1874, 0.2314, 0.2299};
+static const double paper_phi[3] = {28.1, 20.8, 18.2};
+static const double paper_nq[3] = {14.4, 4.8, 3.7};
+static const double paper_nq_analytic[3] = {14.8, 3.7, 3.1};
+static const double ft_stages[FT_NSTAGE] = {0.05, 0.1, 0.25, 0.5, 1.0, 1.5};
 
-/* seed 003 Table 2 (400 disks, r 3-7 mm, rho 2650, nu = kt/kn 0.5, beta 1.0, alpha 0.1) */
+/* Liang & Zhao Table 2 (400 disks, r 3-7 mm, rho 2650, nu = kt/kn 0.5, beta 1.0, alpha 0.1) */
 static void apply_material(mpd_opts *o, int m) {
     o->young = m == 2 ? 80e6 : 800e6;
     o->kt_ratio = 0.5;
@@ -176,24 +178,34 @@ static void apply_material(mpd_opts *o, int m) {
     o->roll_eta = m == 2 ? 0.02 : 0.05;
     o->dem_damping = 0.1;
 }
-static const double table2_e0[3] = {0.1874, 0.2314, 0.2299};
-static const double seed_phi[3] = {28.1, 20.8, 18.2};
-static const double seed_nq[3] = {14.4, 4.8, 3.7};
-static const double seed_nq_analytic[3] = {14.8, 3.7, 3.1};
 
-static void paper_size(ft_opts *f) {
-    f->width = 12.0, f->depth = 8.0, f->nx = 108, f->ny = 72;
-    f->velocity = 0.1, f->ramp = 0.5, f->final_dB = 1.5, f->every = 0.01, f->smooth = 0.05;
+/* the defaults, with the presets of --material m and --paper */
+static void defaults(ft *X, int material, int paper) {
+    ft_opts *f = &X->f;
+    memset(f, 0, sizeof *f);
+    f->nx = 30, f->ny = 15, f->width = 6.0, f->depth = 3.0, f->B = 1.0, f->foot_height = 2.0;
+    f->surcharge = 2e4, f->velocity = 0.1, f->ramp = 0.1, f->final_dB = 0.14, f->every = 0.005;
+    f->smooth = 0.04, f->phi_strain = 0.08;
+    f->nphi = 3, f->phi_p[0] = 1e4, f->phi_p[1] = 2e4, f->phi_p[2] = 3e4;
+    if (paper)
+        f->width = 12.0, f->depth = 8.0, f->nx = 108, f->ny = 72, f->velocity = 0.1, f->ramp = 0.5,
+        f->final_dB = 1.5, f->every = 0.01, f->smooth = 0.05;
+    mpd_opts_default(&X->o, "build/mpm_footing");
+    apply_material(&X->o, material);
+    X->o.dem_dt = FT_DEM_DT_REF * sqrt(6e8 / X->o.young);
 }
 
-static void usage(FILE *fp, const mpd_opts *d, const ft_opts *f) {
+static void usage(FILE *fp) {
+    ft X;
+    defaults(&X, 0, 0);
     fprintf(
         fp,
-        "mpmdem_footing - MPMxDEM rigid rough strip footing of seed 003 Sec 3.3: weightless soil, "
-        "surcharge,\n"
-        "half model (symmetry plane at x = 0, smooth right wall, fixed base), every material point a "
-        "periodic\n"
-        "400-disk RVE; load-settlement curve, N_q vs eqs 45-47 with the RVE's measured friction angle.\n\n"
+        "mpmdem_footing - MPMxDEM rigid rough strip footing of Liang & Zhao (2019) Sec 3.3: weightless "
+        "soil,\n"
+        "surcharge, half model (symmetry plane at x = 0, smooth right wall, fixed base), every material "
+        "point\n"
+        "a periodic 400-disk RVE; load-settlement curve, N_q vs eqs 45-47 with the RVE's measured friction "
+        "angle.\n\n"
         "usage: mpmdem_footing [options]\n"
         "  --nx N --ny N          cells across the width and the depth (default %d x %d; paper 108 x 72)\n"
         "  --width W --depth D    soil domain of the half model [m] (default %g x %g; paper 12 x 8);\n"
@@ -201,35 +213,38 @@ static void usage(FILE *fp, const mpd_opts *d, const ft_opts *f) {
         "  --paper                the paper's size: 12 x 8 m, 108 x 72 cells (7776 RVEs), 0.1 m/s, ramp 0.5 "
         "s,\n"
         "                         to d/B = 1.5, rows every 0.01 (other flags given override it)\n"
-        "  --B W                  FULL footing width [m] (default %g: the seed's 1 m x 2 m footing); the\n"
+        "  --B W                  FULL footing width [m] (default %g: the paper's 1 m x 2 m footing); the\n"
         "                         half model carries b = B/2; q = load / b\n"
         "  --footing-height H     footing height above the ground [m] (default %g)\n"
         "  --surcharge Q          surcharge q_s on the ground outside the footing [Pa] (default %g)\n"
-        "  --velocity V           footing speed [m/s] (default %g; the seed's 0.1)\n"
+        "  --velocity V           footing speed [m/s] (default %g; the paper's 0.1)\n"
         "  --ramp T               the speed ramps up linearly over T seconds (default %g)\n"
-        "  --final X              final settlement d/B (default %g; the seed's 1.5)\n"
+        "  --final X              final settlement d/B (default %g; the paper's 1.5)\n"
         "  --every X              d/B between CSV rows (default %g)\n"
-        "  --smooth X             moving-average window in d/B for the ultimate-load rule (default %g)\n"
-        "  --material M           dense | medium | soft: seed 003 Table 2 contact parameters (default\n"
+        "  --smooth X             moving-average window in d/B for the ultimate-load rule (default %g)\n",
+        X.f.nx, X.f.ny, X.f.width, X.f.depth, X.f.B, X.f.foot_height, X.f.surcharge, X.f.velocity, X.f.ramp,
+        X.f.final_dB, X.f.every, X.f.smooth);
+    fprintf(
+        fp,
+        "  --material M           dense | medium | soft: Liang & Zhao Table 2 contact parameters (default\n"
         "                         dense: E 800 MPa, kt/kn 0.5, friction 23 deg, beta 1.0, eta 0.05, damping\n"
         "                         0.1; soft: E 80 MPa, 20 deg, eta 0.02; medium = dense with e0 0.2314:\n"
         "                         give it a looser --packing). --young etc. given too override it.\n"
         "  --phi-deg X            friction angle for eq 46 [deg]; skips the RVE biaxial measurement\n"
         "  --phi-pressures LIST   confining pressures of the measurement [kPa], comma-separated, at most %d\n"
-        "                         (default 10,20,30; the seed used 10,15,20,25,30)\n"
+        "                         (default 10,20,30; the paper used 10,15,20,25,30)\n"
         "  --phi-strain E         axial strain a measurement test runs to at least; then on until its peak "
         "lies\n"
         "                         1 %% behind, at most 25 %% (default %g)\n"
         "  --grid-damping A       local non-viscous damping on the grid nodes in [0, 1) (default %g: none,\n"
-        "                         as the seed; reactions never include it)\n"
+        "                         as the paper; reactions never include it)\n"
         "  --max-steps N          stop after N MPM steps (timing / memory probe; default: no limit)\n"
         "  --help                 this text\n",
-        f->nx, f->ny, f->width, f->depth, f->B, f->foot_height, f->surcharge, f->velocity, f->ramp,
-        f->final_dB, f->every, f->smooth, FT_MAXPHI, f->phi_strain, f->grid_damping);
-    mpd_usage_common(fp, d);
+        FT_MAXPHI, X.f.phi_strain, X.f.grid_damping);
+    mpd_usage_common(fp, &X.o);
     fprintf(
         fp,
-        "  (footing: --dem-dt defaults to 3.16e-5 s x sqrt(6e8 / E), seed 000's fraction of the critical "
+        "  (footing: --dem-dt defaults to 3.16e-5 s x sqrt(6e8 / E), Guo & Zhao's fraction of the critical "
         "step)\n"
         "\noutputs in --out: footing.csv (time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,\n"
         "  dem_steps_per_point,seconds), footing_load.svg, rve_biaxial.svg, rve_mohr.svg, eps_q_dB*.svg,\n"
@@ -241,6 +256,72 @@ static void usage(FILE *fp, const mpd_opts *d, const ft_opts *f) {
         "           n_rves=... mpm_steps=... dt=... seconds_per_step=... seconds_per_step_per_1000_rves=...\n"
         "           seconds_per_step_per_1000_rves_after_first=... mem_per_rve_kb=... vmhwm_mb=... "
         "total_seconds=...\n");
+}
+
+/* the flags, twice: the presets (--material, --paper) first, then every flag given over them */
+static int parse(ft *X, int argc, char **argv) {
+    ft_opts *f = &X->f;
+    const cli_opt mine[] = {
+        {"--nx", CLI_INT, &f->nx, 1, 4000, NULL, NULL, 0},
+        {"--ny", CLI_INT, &f->ny, 1, 4000, NULL, NULL, 0},
+        {"--width", CLI_REAL, &f->width, 0, 1e4, NULL, NULL, CLI_LO_OPEN},
+        {"--depth", CLI_REAL, &f->depth, 0, 1e4, NULL, NULL, CLI_LO_OPEN},
+        {"--paper", CLI_FLAG, &f->paper, 0, 0, NULL, NULL, 0},
+        {"--B", CLI_REAL, &f->B, 0, 1e4, NULL, NULL, CLI_LO_OPEN},
+        {"--footing-height", CLI_REAL, &f->foot_height, 0, 1e4, NULL, NULL, CLI_LO_OPEN},
+        {"--surcharge", CLI_REAL, &f->surcharge, 0, 1e10, NULL, NULL, CLI_LO_OPEN},
+        {"--velocity", CLI_REAL, &f->velocity, 0, 1e3, NULL, NULL, CLI_LO_OPEN},
+        {"--ramp", CLI_REAL, &f->ramp, 0, 1e6, NULL, NULL, 0},
+        {"--final", CLI_REAL, &f->final_dB, 0, 3, NULL, NULL, CLI_LO_OPEN},
+        {"--every", CLI_REAL, &f->every, 0, 3, NULL, NULL, CLI_LO_OPEN},
+        {"--smooth", CLI_REAL, &f->smooth, 0, 3, NULL, NULL, CLI_LO_OPEN},
+        {"--material", CLI_CHOICE, &f->material, 0, 0, NULL, "dense|medium|soft", 0},
+        {"--phi-deg", CLI_REAL, &f->phi_deg, 0, 60, "an angle in (0, 60) deg", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--phi-pressures", CLI_STR, &f->phi_list, 0, 0, NULL, NULL, 0},
+        {"--phi-strain", CLI_REAL, &f->phi_strain, 0.01, FT_PHI_STRAIN_MAX, NULL, NULL, 0},
+        {"--grid-damping", CLI_REAL, &f->grid_damping, 0, 1, NULL, NULL, CLI_HI_OPEN},
+        {"--max-steps", CLI_INT, &f->max_steps, 1, 2000000000, NULL, NULL, 0},
+        {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    int r, k;
+    defaults(X, 0, 0);
+    if ((r = mpd_parse(&X->run, argc, argv, &X->o, mine, usage)) != 0) return r;
+    r = f->material, k = f->paper;
+    defaults(X, r, k);
+    X->o.dem_dt = -1.0; /* not given: from E below */
+    mpd_parse(&X->run, argc, argv, &X->o, mine, usage);
+    if (X->o.dem_dt < 0) X->o.dem_dt = FT_DEM_DT_REF * sqrt(6e8 / X->o.young);
+    X->run.out = X->o.out;
+    if (mpd_check_opts(&X->run, &X->o)) return 2;
+    if (f->phi_list) {
+        if ((f->nphi = mpd_list(&X->run, "--phi-pressures", f->phi_list, f->phi_p, FT_MAXPHI, 0, 1, 1e7, 0)) <
+            0)
+            return 2;
+        for (k = 0; k < f->nphi; ++k) f->phi_p[k] *= 1e3;
+    }
+    if (f->every > f->final_dB)
+        return fprintf(stderr, "mpmdem_footing: --every %g is out of range: exceeds --final %g\n", f->every,
+                       f->final_dB),
+               2;
+    X->h = f->width / f->nx;
+    /* the footing covers the nodes x <= b - h/2; their tributary width (the reach of a uniform stress
+     * under them) ends half a cell further: that is the effective half-width, = b when b/h = k + 1/2 */
+    X->bnode = floor((0.5 * f->B - 0.5 * X->h) / X->h + 1e-9) * X->h;
+    X->b = X->bnode + 0.5 * X->h;
+    if (fabs(f->depth / f->ny - X->h) > 1e-9 * X->h)
+        return fprintf(stderr, "mpmdem_footing: cells must be square: width/nx = %g, depth/ny = %g\n", X->h,
+                       f->depth / f->ny),
+               2;
+    if (X->bnode < X->h * (1 - 1e-9) || X->b > 0.5 * f->width)
+        return fprintf(stderr,
+                       "mpmdem_footing: the half footing B/2 = %g m must span at least 1.5 cells (h = %g m) "
+                       "and at most half the width\n",
+                       0.5 * f->B, X->h),
+               2;
+    if (f->final_dB * f->B >= 0.9 * f->depth)
+        return fprintf(stderr, "mpmdem_footing: --final %g: the footing would reach the base\n", f->final_dB),
+               2;
+    return 0;
 }
 
 /* kB of a /proc/self/status line ("VmHWM", "VmRSS"); -1 if unavailable */
@@ -259,264 +340,122 @@ static double proc_kb(const char *key) {
     return v;
 }
 
-/* N_q of Prandtl, eq 46 (phi in degrees) */
-static double nq_prandtl(double phi_deg) {
-    double p = phi_deg * MPD_PI / 180.0, t = tan(MPD_PI / 4 + p / 2);
-    return t * t * exp(MPD_PI * tan(p));
+/* the friction angle (given or measured), the RVE at q_s at every point, the grid with its walls and
+ * the footing, the points and the surcharge on the ground beyond the footing */
+static int setup(ft *X, gk_err *err) {
+    const ft_opts *f = &X->f;
+    ft_state *S = &X->S;
+    double h = X->h, org[3], lo[3] = {0, 0, 0}, hi[3];
+    int n[3], i, gl = mpd_ghost_layers(&X->o), up = gl + (int)ceil(fmax(f->final_dB * f->B, 2 * h) / h);
+    if (mpd_proto_open(&X->P, &X->o, err)) return 1;
+    printf("mpmdem_footing: Liang & Zhao Table 2 '%s': E = %g MPa, kt/kn = %g, friction %g deg, beta %g, eta "
+           "%g, "
+           "damping %g; DEM dt = %.3g s\n",
+           material_names[f->material], X->o.young / 1e6, X->o.kt_ratio, X->o.friction_deg, X->o.roll_beta,
+           X->o.roll_eta, X->o.dem_damping, X->o.dem_dt);
+    if (f->material == 1 && !strcmp(X->o.packing, "examples/data/rve400.txt"))
+        printf("note: 'medium' has Table 2's dense contact law; with the shipped dense packing it is the "
+               "dense soil "
+               "(give a looser --packing for e0 = 0.2314, e.g. examples/data/rve400_e0223.txt)\n");
+    X->phi = f->phi_deg, X->phi_res = NAN;
+    if (f->phi_deg > 0)
+        printf("friction angle: phi = %g deg given (--phi-deg), no measurement\n", X->phi);
+    else if (phi_measure(&X->run, &X->P, &X->o, f->phi_p, f->nphi, f->phi_strain, material_names[f->material],
+                         paper_phi[f->material], &X->phi, &X->phi_res))
+        return gk_err_set(err, GK_ERR_STATE, "the friction angle could not be measured (above)"), 1;
+    else
+        X->measured = 1;
+    if (mpd_prepare_rve(&X->P, f->surcharge, &X->st0, err)) return 1;
+    X->c = sqrt(X->P.M / X->P.rho);
+    X->dt = X->o.cfl * h / X->c;
+    /* grid: ghost layers; room above the ground for the heave */
+    org[0] = -gl * h, org[1] = -gl * h, org[2] = 0;
+    n[0] = f->nx + 2 * gl + 1, n[1] = f->ny + gl + up + 1, n[2] = 1;
+    hi[0] = f->width, hi[1] = f->depth, hi[2] = 0;
+    if (gk_mpm_grid_create(&X->g, 2, org, h, n, NULL, err) ||
+        gk_mpm_grid_set_bc(&X->g, 0, GK_MPM_BC_ROLLER, 0, gl + 1, err) || /* symmetry plane x = 0 */
+        gk_mpm_grid_set_bc(&X->g, 1, GK_MPM_BC_ROLLER, 0, gl + 1, err) || /* smooth wall x = W */
+        gk_mpm_grid_set_bc(&X->g, 2, GK_MPM_BC_FIXED, 0, gl + 1, err) ||  /* base y = 0 */
+        gk_mpm_points_create_box(&X->pts, 2, lo, hi, h, X->o.ppc, X->P.rho, NULL, err))
+        return 1;
+    X->rss_before = proc_kb("VmRSS");
+    if (mpd_micro_create(&X->M, &X->pts, &X->P, &X->st0, 1, NULL, &X->o, err)) return 1;
+    X->rss_after = proc_kb("VmRSS");
+    X->edge = (mpd_edge *)calloc((size_t)X->pts.n, sizeof *X->edge);
+    X->x0 = (double *)malloc(2 * (size_t)X->pts.n * sizeof *X->x0);
+    if (!X->edge || !X->x0) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+    for (i = 0; i < X->pts.n; ++i) {
+        double a = 0.5 * h / X->o.ppc, xl = X->pts.x[0][i] - a, xr = X->pts.x[0][i] + a;
+        mpd_edge *E = &X->edge[X->nedge];
+        X->x0[2 * i] = X->pts.x[0][i], X->x0[2 * i + 1] = X->pts.x[1][i];
+        if (X->pts.x[1][i] < f->depth - 2 * a || xr <= X->b + 1e-9 * h) continue;
+        if (xl < X->b) xl = X->b; /* the part of the top edge beyond the footing edge */
+        E->p = i, E->pressure = f->surcharge;
+        E->off[0] = 0.5 * (xl + xr) - X->pts.x[0][i], E->off[1] = a;
+        E->e[0] = -(xr - xl), E->e[1] = 0; /* outward normal (e_y, -e_x) = up */
+        ++X->nedge;
+    }
+    X->def = mpd_mpm_def(&X->o);
+    X->def.damping = f->grid_damping;
+    X->dot = 0.5 * h / X->o.ppc;
+    memset(S, 0, sizeof *S);
+    S->body.lo[0] = org[0] - h, S->body.hi[0] = X->bnode + 1e-9 * h;
+    S->body.lo[1] = f->depth - 1e-9 * h, S->body.hi[1] = f->depth + f->foot_height;
+    S->body.contact = GK_MPM_CONTACT_STICK;
+    S->next_out = 0.0; /* a row after the first step (d ~ 0) */
+    X->rows.size = sizeof(ft_row);
+    if (X->o.restart &&
+        mpd_load(X->o.restart, &X->M, &X->pts, "footing", S, sizeof *S, &X->rows, &X->snaps, err))
+        return 1;
+    X->g.body = &S->body, X->g.nbody = 1;
+    return 0;
 }
-/* the angle whose eq 46 gives N_q (bisection; N_q < 1 has none) [deg] */
-static double phi_of_nq(double nq) {
-    double lo = 0.0, hi = 60.0;
+
+/* the footing (its base and edge, a stub of its height), the smooth wall and the base */
+static void outline(const ft *X, mpd_outline *ol) {
+    double W = X->f.width, D = X->f.depth, yb = D - X->S.disp, hs = fmin(X->f.foot_height, 3 * X->h);
+    double foot[8], box[6];
+    foot[0] = 0, foot[1] = yb + hs, foot[2] = X->b, foot[3] = yb + hs, foot[4] = X->b, foot[5] = yb,
+    foot[6] = 0, foot[7] = yb;
+    box[0] = 0, box[1] = 0, box[2] = W, box[3] = 0, box[4] = W, box[5] = D + 2 * X->h;
+    memset(ol, 0, sizeof *ol);
+    mpd_outline_add(ol, 4, foot);
+    mpd_outline_add(ol, 3, box);
+}
+
+static int snap_field(ft *X, int k, const char *file, const char *title) {
+    mpd_outline ol;
+    outline(X, &ol);
+    return mpd_snap_field(&X->run, &X->snaps, &X->M, &X->pts, k, file, title, X->dot, &ol);
+}
+
+/* |u| of the points at the end */
+static int displacement_field(ft *X) {
+    int n = X->pts.n, p, bad;
+    double *u = (double *)malloc((size_t)n * sizeof *u + 1);
+    mpd_outline ol;
+    if (!u) return fprintf(stderr, "mpmdem_footing: out of memory\n"), 1;
+    for (p = 0; p < n; ++p) {
+        double dx = X->pts.x[0][p] - X->x0[2 * p], dy = X->pts.x[1][p] - X->x0[2 * p + 1];
+        u[p] = sqrt(dx * dx + dy * dy);
+    }
+    outline(X, &ol);
+    bad =
+        mpd_snap_add(&X->run, &X->snaps, "displacement_end",
+                     "displacement |u| at the end (Liang & Zhao Fig 14)", "|u| [m]", &X->pts, u, X->dot, &ol);
+    free(u);
+    return bad;
+}
+
+static void put_csv(FILE *fp, const void *user) {
+    const ft *X = (const ft *)user;
     int k;
-    if (!(nq >= 1.0) || nq > nq_prandtl(hi)) return NAN;
-    for (k = 0; k < 60; ++k) {
-        double m = 0.5 * (lo + hi);
-        if (nq_prandtl(m) < nq)
-            lo = m;
-        else
-            hi = m;
-    }
-    return 0.5 * (lo + hi);
-}
-
-/* Terzaghi's reduced angle for local / punching failure, eq 47 [deg] */
-static double phi_reduced(double phi_deg) {
-    return atan(2.0 / 3.0 * tan(phi_deg * MPD_PI / 180.0)) * 180.0 / MPD_PI;
-}
-
-/* centred moving average of y over x-window w (shrinks at the ends to stay centred) */
-static void smooth_curve(const double *x, const double *y, int n, double w, double *ys) {
-    int k, j;
-    for (k = 0; k < n; ++k) {
-        double hw = 0.5 * w, s = 0.0;
-        int c = 0;
-        if (x[k] - x[0] < hw) hw = x[k] - x[0];
-        if (x[n - 1] - x[k] < hw) hw = x[n - 1] - x[k];
-        for (j = 0; j < n; ++j)
-            if (fabs(x[j] - x[k]) <= hw * (1 + 1e-12)) s += y[j], ++c;
-        ys[k] = c ? s / c : y[k];
-    }
-}
-
-/* ------------------------------------------------- friction angle of the RVE */
-#define FT_PHI_STRAIN_MAX 0.25 /* a test that has not peaked by then uses its maximum */
-
-/* index of the largest smoothed sin phi_mob = (s1 - s3)/(s1 + s3) (means
- * over +-0.1 % of axial strain); the smoothed s1, s3 there */
-static int smoothed_peak(const double *eps, const double *s1, const double *s3, int n, double *a, double *b,
-                         double *a_pk, double *b_pk) {
-    int k, kb = 0;
-    double best = -2.0;
-    smooth_curve(eps, s1, n, 0.002, a);
-    smooth_curve(eps, s3, n, 0.002, b);
-    for (k = 0; k < n; ++k) {
-        double sn = a[k] + b[k] > 0 ? (a[k] - b[k]) / (a[k] + b[k]) : -1.0;
-        if (sn > best) best = sn, kb = k;
-    }
-    *a_pk = a[kb], *b_pk = b[kb];
-    return kb;
-}
-/* one drained biaxial test (see the top comment); 0 or 1 with out->msg */
-static int phi_test(const mpd_proto *P0, const mpd_opts *o, double max_strain, ft_phi_test *out) {
-    mpd_proto P = *P0; /* mpd_prepare_rve writes rho, M, p0, e0: keep the caller's */
-    gk_rve_state st;
-    gk_rve r;
-    gk_servo sv;
-    gk_err err;
-    double rate, L[9], *s1 = NULL, *s3 = NULL, *wa = NULL, *wb = NULL;
-    int chunk, cap, n = 0, k, bad = 0;
-    gk_rve_state_init(&st, NULL);
-    if (mpd_prepare_rve(&P, out->s3, &st, &err)) {
-        snprintf(out->msg, sizeof out->msg, "%s", err.msg);
-        gk_rve_state_free(&st);
-        return out->status = 1;
-    }
-    out->e0 = P.e0, out->p0 = P.p0;
-    if (gk_rve_create(&r, &P.def, &P.pk) || gk_rve_state_restore(&st, &r)) {
-        snprintf(out->msg, sizeof out->msg, "RVE: %s", gk_rve_error(&r));
-        gk_rve_state_free(&st);
-        return out->status = 1;
-    }
-    gk_rve_state_free(&st);
-    if (o->dem_adaptive) { /* the inertial number the coupling's RVEs deform at, at sigma_3 */
-        double one[9], rmean = 0;
-        for (k = 0; k < r.n; ++k) rmean += (double)r.r[k];
-        rmean /= r.n;
-        gk_m3_zero(one);
-        one[4] = 1.0;
-        rate = o->dem_inertial / gk_inertial_number(one, 2, rmean, r.def.mat.density, out->s3);
-    } else {
-        rate = o->dem_strain / r.dt; /* the coupling's strain per DEM step */
-    }
-    memset(&sv, 0, sizeof sv);
-    sv.mode[0] = GK_SERVO_STRESS, sv.target[0] = -out->s3;
-    sv.mode[1] = GK_SERVO_STRAIN, sv.rate[1] = -rate;
-    sv.mode[2] = GK_SERVO_STRAIN;
-    sv.max_rate = 10.0 * rate; /* lateral strain rate: dilatancy can exceed the axial one */
-    sv.gain = 0.5;
-    gk_m3_zero(L);
-    out->rate = rate;
-    chunk = (int)ceil(1e-4 / (rate * r.dt)); /* a sample every 1e-4 of axial strain */
-    cap = (int)ceil(1.5 * FT_PHI_STRAIN_MAX / (chunk * rate * r.dt)) + 10; /* the servo moves F_11 a little */
-    out->eps = (double *)malloc((size_t)cap * sizeof(double));
-    out->ratio = (double *)malloc((size_t)cap * sizeof(double));
-    s1 = (double *)malloc((size_t)cap * sizeof(double));
-    s3 = (double *)malloc((size_t)cap * sizeof(double));
-    wa = (double *)malloc((size_t)cap * sizeof(double));
-    wb = (double *)malloc((size_t)cap * sizeof(double));
-    if (!out->eps || !out->ratio || !s1 || !s3 || !wa || !wb) {
-        snprintf(out->msg, sizeof out->msg, "out of memory");
-        bad = 1;
-    }
-    if (!bad && (gk_rve_set_velocity_gradient(&r, L) || gk_rve_set_servo(&r, &sv))) {
-        snprintf(out->msg, sizeof out->msg, "servo: %s", gk_rve_error(&r));
-        bad = 1;
-    }
-    /* to --phi-strain, then on until the peak lies 1 % of strain behind (a hardening RVE) */
-    while (!bad && n < cap) {
-        double e;
-        if (gk_rve_step(&r, chunk)) {
-            snprintf(out->msg, sizeof out->msg, "biaxial at %g Pa: %s", out->s3, gk_rve_error(&r));
-            bad = 1;
-            break;
-        }
-        e = 1.0 - r.cell.F[4];
-        out->eps[n] = e, s1[n] = -r.stress[4], s3[n] = -r.stress[0];
-        out->ratio[n] = s3[n] > 0 ? s1[n] / s3[n] : 0.0;
-        ++n;
-        if (e >= FT_PHI_STRAIN_MAX) {
-            out->nopeak = 1;
-            break;
-        }
-        if (e >= max_strain && n % 50 == 0) {
-            double u, v;
-            if (out->eps[smoothed_peak(out->eps, s1, s3, n, wa, wb, &u, &v)] <= e - 0.01) break;
-        }
-    }
-    out->nsamp = n;
-    if (!bad && n > 0) {
-        int kp = smoothed_peak(out->eps, s1, s3, n, wa, wb, &out->s1, &out->s3m), c = 0;
-        double sn = (out->s1 - out->s3m) / (out->s1 + out->s3m);
-        out->eps_peak = out->eps[kp];
-        out->phi = sn > 0 ? asin(sn) * 180.0 / MPD_PI : 0.0;
-        out->eps_end = out->eps[n - 1];
-        out->r1 = out->r3 = 0;
-        for (k = 0; k < n; ++k)
-            if (out->eps[k] >= out->eps_end - 0.02) out->r1 += s1[k], out->r3 += s3[k], ++c;
-        if (c) out->r1 /= c, out->r3 /= c;
-        out->phi_res = out->r1 > out->r3 && out->r3 > 0
-                           ? asin((out->r1 - out->r3) / (out->r1 + out->r3)) * 180.0 / MPD_PI
-                           : 0.0;
-    }
-    free(wa), free(wb);
-    free(s1), free(s3);
-    gk_rve_destroy(&r);
-    return out->status = bad;
-}
-
-/* Mohr-Coulomb envelope: through the origin (least squares tangent) and
- * with cohesion (regression of the radii on the centres) */
-static double phi_fit(const ft_phi_test *T, int n, int residual, double *phi_c, double *coh) {
-    double sc = 0, sr = 0, scc = 0, scr = 0, sinp;
-    int k;
-    for (k = 0; k < n; ++k) {
-        double a = residual ? T[k].r1 : T[k].s1, b = residual ? T[k].r3 : T[k].s3m;
-        double c = 0.5 * (a + b), r = 0.5 * (a - b);
-        sc += c, sr += r, scc += c * c, scr += c * r;
-    }
-    sinp = scr / scc;
-    *phi_c = *coh = NAN;
-    if (n >= 2) {
-        double slope = (n * scr - sc * sr) / (n * scc - sc * sc), icpt = (sr - slope * sc) / n;
-        if (fabs(slope) < 1) {
-            *phi_c = asin(slope) * 180.0 / MPD_PI;
-            *coh = icpt / cos(asin(slope));
-        }
-    }
-    return asin(gk_clamp(sinp, -1.0, 1.0)) * 180.0 / MPD_PI;
-}
-
-static void phi_plots(const char *out, const ft_phi_test *T, int n, double phi) {
-    char path[1200], lab[FT_MAXPHI][64], el[64];
-    gk_plot pl;
-    gk_err err;
-    int k, j, m = 97, s;
-    double cx[FT_MAXPHI][97], cy[FT_MAXPHI][97], ex[2], ey[2], smax = 0, *x[FT_MAXPHI];
-    gk_plot_init(&pl, "RVE drained biaxial tests (the friction angle eq 46 uses)", "axial strain [%]",
-                 "sigma_1 / sigma_3");
-    for (k = 0; k < n; ++k) {
-        x[k] = (double *)malloc((size_t)(T[k].nsamp + 1) * sizeof(double));
-        if (!x[k]) continue;
-        for (j = 0; j < T[k].nsamp; ++j) x[k][j] = 100 * T[k].eps[j];
-        snprintf(lab[k], sizeof lab[k], "sigma_3 = %g kPa: phi = %.1f deg", T[k].s3 / 1e3, T[k].phi);
-        gk_plot_add(&pl, x[k], T[k].ratio, T[k].nsamp, lab[k]);
-    }
-    snprintf(path, sizeof path, "%s/rve_biaxial.svg", out);
-    gk_plot_svg(&pl, path, &err);
-    for (k = 0; k < n; ++k) free(x[k]);
-    gk_plot_init(&pl, "Mohr circles at the peak and the envelope through the origin", "sigma [kPa]",
-                 "tau [kPa]");
-    for (k = 0; k < n; ++k) {
-        double c = 0.5 * (T[k].s1 + T[k].s3m) / 1e3, r = 0.5 * (T[k].s1 - T[k].s3m) / 1e3;
-        for (j = 0; j < m; ++j) {
-            double a = MPD_PI * j / (m - 1);
-            cx[k][j] = c - r * cos(a), cy[k][j] = r * sin(a);
-        }
-        if (T[k].s1 / 1e3 > smax) smax = T[k].s1 / 1e3;
-        snprintf(lab[k], sizeof lab[k], "sigma_3 = %g kPa", T[k].s3 / 1e3);
-        gk_plot_add(&pl, cx[k], cy[k], m, lab[k]);
-    }
-    ex[0] = 0, ey[0] = 0, ex[1] = smax, ey[1] = smax * tan(phi * MPD_PI / 180.0);
-    snprintf(el, sizeof el, "envelope phi = %.2f deg", phi);
-    s = gk_plot_add(&pl, ex, ey, 2, el);
-    if (s >= 0) pl.s[s].dashed = 1;
-    pl.has_ylim = 1, pl.ylim[0] = 0, pl.ylim[1] = 0.75 * smax;
-    snprintf(path, sizeof path, "%s/rve_mohr.svg", out);
-    gk_plot_svg(&pl, path, &err);
-}
-
-/* ---------------------------------------------------------- outputs */
-static void write_csv(const char *out, const ft_row *r, int n, double B, double qs) {
-    char path[1200];
-    FILE *fp;
-    int k;
-    snprintf(path, sizeof path, "%s/footing.csv", out);
-    fp = fopen(path, "w");
-    if (!fp) {
-        fprintf(stderr, "warning: cannot write %s\n", path);
-        return;
-    }
     fprintf(fp, "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds\n");
-    for (k = 0; k < n; ++k)
-        fprintf(fp, "%.6g,%.6g,%.6g,%.9g,%.6g,%.9g,%.6g,%.4g,%.3f\n", r[k].t, r[k].d, r[k].d / B, r[k].q,
-                r[k].q / qs, r[k].load, r[k].ek, r[k].dem_mean, r[k].secs);
-    fclose(fp);
-}
-
-static void stage_field(const char *out, const char *tag, const char *title, const mpd_rves *F,
-                        const gk_mpm_points *pts, int k, double dot) {
-    char path[1200];
-    snprintf(path, sizeof path, "%s/%s.svg", out, tag);
-    mpd_svg_field(path, title, F, pts, k, dot);
-}
-
-static void displacement_field(const char *out, const gk_mpm_points *pts, const double *x0, double dot) {
-    char path[1200];
-    gk_err err;
-    int n = pts->n, p;
-    double *xy = (double *)malloc(2 * (size_t)n * sizeof *xy), *u = (double *)malloc((size_t)n * sizeof *u);
-    if (xy && u) {
-        for (p = 0; p < n; ++p) {
-            double dx = pts->x[0][p] - x0[2 * p], dy = pts->x[1][p] - x0[2 * p + 1];
-            xy[2 * p] = pts->x[0][p], xy[2 * p + 1] = pts->x[1][p];
-            u[p] = sqrt(dx * dx + dy * dy);
-        }
-        snprintf(path, sizeof path, "%s/displacement_end.svg", out);
-        if (gk_svg_field(path, "displacement |u| [m] at the end (seed 003 Fig 14)", "|u| [m]", n, 1, xy, u,
-                         dot, &err))
-            fprintf(stderr, "warning: %s\n", err.msg);
+    for (k = 0; k < X->rows.n; ++k) {
+        const ft_row *r = (const ft_row *)mpd_row(&X->rows, k);
+        fprintf(fp, "%.6g,%.6g,%.6g,%.9g,%.6g,%.9g,%.6g,%.4g,%.3f\n", r->t, r->d, r->d / X->f.B, r->q,
+                r->q / X->f.surcharge, r->load, r->ek, r->dem_mean, r->secs);
     }
-    free(xy), free(u);
 }
 
 /* the ultimate load by the rule of the top comment; returns the row index
@@ -561,536 +500,274 @@ static int ultimate(const double *x, const double *q, int n, double w, double *q
     return n - 1;
 }
 
-static void load_plot(const char *out, const ft_row *r, int n, const double *qsm, double B, double qs, int ku,
-                      double nq46, double nq47, double phi) {
-    double *x = (double *)malloc((size_t)n * sizeof *x), *y = (double *)malloc((size_t)n * sizeof *y),
-           *ys = (double *)malloc((size_t)n * sizeof *ys);
-    double hx[2], h1[2], h2[2], ux[1], uy[1];
-    char path[1200], l1[80], l2[80], lu[80];
+static int load_plot(const ft *X, const double *qsm, int ku, double nq46, double nq47) {
+    int n = X->rows.n, k, s, bad;
+    double *x = (double *)malloc(3 * (size_t)n * sizeof *x + 1), *y = x + n, *ys = y + n, hx[2], h1[2], h2[2],
+           ux[1], uy[1], B = X->f.B, qs = X->f.surcharge;
+    char l1[80], l2[80], lu[80];
     gk_plot pl;
-    gk_err err;
-    int k, s;
-    if (x && y && ys && n > 0) {
-        for (k = 0; k < n; ++k) x[k] = r[k].d / B, y[k] = r[k].q / qs, ys[k] = qsm[k] / qs;
-        gk_plot_init(&pl, "MPMxDEM rigid footing: load-settlement (seed 003 Fig 16)", "settlement d/B",
-                     "footing pressure q / q_s");
-        gk_plot_add(&pl, x, y, n, "q / q_s (interval means)");
-        gk_plot_add(&pl, x, ys, n, "smoothed (ultimate-load rule)");
-        hx[0] = 0, hx[1] = x[n - 1], h1[0] = h1[1] = nq46, h2[0] = h2[1] = nq47;
-        snprintf(l1, sizeof l1, "N_q eq 46, phi = %.1f deg: %.2f", phi, nq46);
-        snprintf(l2, sizeof l2, "N_q eq 47, phi_r = %.1f deg: %.2f", phi_reduced(phi), nq47);
-        s = gk_plot_add(&pl, hx, h1, 2, l1);
-        if (s >= 0) pl.s[s].dashed = 1;
-        s = gk_plot_add(&pl, hx, h2, 2, l2);
-        if (s >= 0) pl.s[s].dashed = 1;
-        if (ku >= 0) {
-            ux[0] = x[ku], uy[0] = ys[ku];
-            snprintf(lu, sizeof lu, "ultimate: N_q = %.2f", ys[ku]);
-            gk_plot_add(&pl, ux, uy, 1, lu);
-        }
-        pl.has_ylim = 1, pl.ylim[0] = 0;
-        pl.ylim[1] = 1.15 * nq46;
-        for (k = 0; k < n; ++k)
-            if (1.1 * y[k] > pl.ylim[1]) pl.ylim[1] = 1.1 * y[k];
-        snprintf(path, sizeof path, "%s/footing_load.svg", out);
-        gk_plot_svg(&pl, path, &err);
+    if (!x) return fprintf(stderr, "mpmdem_footing: out of memory\n"), 1;
+    for (k = 0; k < n; ++k) {
+        const ft_row *r = (const ft_row *)mpd_row(&X->rows, k);
+        x[k] = r->d / B, y[k] = r->q / qs, ys[k] = qsm[k] / qs;
     }
-    free(x), free(y), free(ys);
+    gk_plot_init(&pl, "MPMxDEM rigid footing: load-settlement (Liang & Zhao Fig 16)", "settlement d/B",
+                 "footing pressure q / q_s");
+    gk_plot_add(&pl, x, y, n, "q / q_s (interval means)");
+    gk_plot_add(&pl, x, ys, n, "smoothed (ultimate-load rule)");
+    hx[0] = 0, hx[1] = x[n - 1], h1[0] = h1[1] = nq46, h2[0] = h2[1] = nq47;
+    snprintf(l1, sizeof l1, "N_q eq 46, phi = %.1f deg: %.2f", X->phi, nq46);
+    snprintf(l2, sizeof l2, "N_q eq 47, phi_r = %.1f deg: %.2f", phi_reduced(X->phi), nq47);
+    if ((s = gk_plot_add(&pl, hx, h1, 2, l1)) >= 0) pl.s[s].dashed = 1;
+    if ((s = gk_plot_add(&pl, hx, h2, 2, l2)) >= 0) pl.s[s].dashed = 1;
+    if (ku >= 0) {
+        ux[0] = x[ku], uy[0] = ys[ku];
+        snprintf(lu, sizeof lu, "ultimate: N_q = %.2f", ys[ku]);
+        gk_plot_add(&pl, ux, uy, 1, lu);
+    }
+    pl.has_ylim = 1, pl.ylim[0] = 0, pl.ylim[1] = 1.15 * nq46;
+    for (k = 0; k < n; ++k)
+        if (1.1 * y[k] > pl.ylim[1]) pl.ylim[1] = 1.1 * y[k];
+    bad = mpd_plot(&X->run, &pl, "footing_load.svg");
+    free(x);
+    return bad;
 }
 
-static int parse_list(const char *s, double *v, int max) {
-    int n = 0;
-    char buf[256], *tok, *save = NULL;
-    snprintf(buf, sizeof buf, "%s", s);
-    for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-        double x;
-        if (n >= max || mpd_num(tok, &x) || !(x > 0)) return -1;
-        v[n++] = x * 1e3;
+/* after a step: the interval sums, and a CSV row (with the stage field) when due; 0 or 1 (said) */
+static int after_step(ft *X, double vf, double t_start, long step0, long nsteps_total) {
+    const ft_opts *f = &X->f;
+    ft_state *S = &X->S;
+    double ek, m, mom[3];
+    long long sum = 0;
+    int i, bad;
+    ft_row r;
+    S->t += X->dt, S->disp += vf * X->dt, ++S->step;
+    if (S->step == 1) X->t_first = gk_wtime() - t_start, X->dem_first = X->M.dem_steps; /* fresh runs only */
+    S->acc_load += -S->body.force[1] * X->dt, S->acc_dt += X->dt;
+    gk_mpm_points_totals(&X->pts, &m, mom, &ek);
+    S->acc_ek += ek, ++S->nacc;
+    for (i = 0; i < X->pts.n; ++i) sum += X->M.nsub[i];
+    S->acc_dem += (double)sum / X->pts.n;
+    if (!(S->disp >= S->next_out * f->B * (1 - 1e-9) || S->disp >= f->final_dB * f->B * (1 - 1e-12) ||
+          (f->max_steps && S->step - step0 >= f->max_steps)))
+        return 0;
+    r.t = S->t, r.d = S->disp, r.load = S->acc_load / S->acc_dt, r.q = r.load / X->b;
+    r.ek = S->acc_ek / S->nacc, r.dem_mean = S->acc_dem / S->nacc;
+    r.secs = S->wall + gk_wtime() - t_start;
+    S->acc_load = S->acc_dt = 0, S->acc_ek = S->acc_dem = 0, S->nacc = 0;
+    while (S->next_out * f->B <= S->disp * (1 + 1e-9)) S->next_out += f->every;
+    bad = mpd_rows_push(&X->run, &X->rows, &r) || mpd_write(&X->run, "footing.csv", put_csv, X);
+    while (!bad && S->nstage < FT_NSTAGE && ft_stages[S->nstage] <= f->final_dB &&
+           r.d >= ft_stages[S->nstage] * f->B * (1 - 1e-9)) {
+        char file[48], title[120];
+        snprintf(file, sizeof file, "eps_q_dB%.2f", ft_stages[S->nstage]);
+        snprintf(title, sizeof title, "deviatoric strain eps_q at d/B = %.2f", ft_stages[S->nstage]);
+        bad = snap_field(X, MPD_EPS_Q, file, title);
+        ++S->nstage;
     }
-    return n;
+    if (!X->o.quiet) {
+        char what[300];
+        snprintf(what, sizeof what, "d/B %.4f  q %.1f kPa (q/q_s %.2f)  DEM %.1f/pt", r.d / f->B, r.q / 1e3,
+                 r.q / f->surcharge, r.dem_mean);
+        gk_progress(stderr, S->step - step0, nsteps_total - step0, t_start, what);
+    }
+    return bad;
 }
 
-int main(int argc, char **argv) {
-    mpd_opts o, od;
-    ft_opts f, fd;
-    mpd_proto P;
-    gk_rve_state st0;
-    mpd_rves F;
-    gk_mpm_grid g;
-    gk_mpm_points pts;
-    gk_mpm_def def;
-    ft_state S;
-    ft_row *rows = NULL;
-    ft_phi_test T[FT_MAXPHI];
-    int nrows = 0, caprows = 0, i, status = 0, measured = 0, gl, nedge = 0;
-    mpd_edge *edge = NULL;
-    double h, b, bnode, dt, c, lo[3], hi[3], org[3], t_start, phi, phi_c = NAN, coh = NAN, *x0 = NULL;
-    double phi_res = NAN, phi_rc = NAN, coh_r = NAN;
-    double rss_before, rss_after, stages[FT_NSTAGE] = {0.05, 0.1, 0.25, 0.5, 1.0, 1.5};
-    long nsteps_total, step0;
-    long long dem0, dem_first = 0;
-    double t_first = 0;
-    gk_err err;
-    char buf[64], what[300], path[1200];
-    int n[3];
+/* the checkpoint, with the wall time of this run added */
+static int save(ft *X, double t_start) {
+    double w0 = X->S.wall;
+    int bad;
+    X->S.wall += gk_wtime() - t_start;
+    bad = mpd_save(&X->run, &X->M, &X->pts, "footing", &X->S, sizeof X->S, &X->rows, &X->snaps);
+    X->S.wall = w0;
+    return bad;
+}
 
-    /* ---- options: presets (--material, --paper) first, then every flag */
-    memset(&fd, 0, sizeof fd);
-    fd.nx = 30, fd.ny = 15, fd.width = 6.0, fd.depth = 3.0, fd.B = 1.0, fd.foot_height = 2.0;
-    fd.surcharge = 2e4, fd.velocity = 0.1, fd.ramp = 0.1, fd.final_dB = 0.14, fd.every = 0.005;
-    fd.smooth = 0.04, fd.phi_deg = 0, fd.nphi = 3, fd.phi_p[0] = 1e4, fd.phi_p[1] = 2e4, fd.phi_p[2] = 3e4;
-    fd.phi_strain = 0.08;
-    mpd_opts_default(&od, "build/mpmdem_footing");
-    apply_material(&od, 0);
-    od.dem_dt = FT_DEM_DT_REF * sqrt(6e8 / od.young);
-    o = od, f = fd;
-    for (i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) return usage(stdout, &od, &fd), 0;
-        if (!strcmp(argv[i], "--paper")) paper_size(&f);
-        if (!strcmp(argv[i], "--material") && i + 1 < argc) {
-            int m;
-            for (m = 0; m < 3; ++m)
-                if (!strcmp(argv[i + 1], material_names[m])) break;
-            if (m == 3)
-                return fprintf(stderr, "mpmdem_footing: --material %s: use dense, medium or soft\n",
-                               argv[i + 1]),
-                       2;
-            f.material = m;
-            apply_material(&o, m);
+/* the ultimate load, the end fields, and the summary with its RESULT line; 0 or 1 (a write failed) */
+static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
+    const ft_opts *f = &X->f;
+    int n = X->rows.n, ku = -1, reached = 0, k, excl = X->S.step == steps_run && steps_run > 1, np = X->pts.n;
+    double *x = (double *)malloc(3 * (size_t)n * sizeof *x + 1), *q = x + n, *qsm = q + n, nq = NAN, qu = NAN,
+           du = NAN;
+    double nq46 = nq_prandtl(X->phi), nq47 = nq_prandtl(phi_reduced(X->phi)), hwm, per_rve, ck_mb = 0;
+    /* cost per RVE per step without the first step's one-off relaxation of every RVE */
+    double per_step_rve = steps_run ? (secs - (excl ? X->t_first : 0)) / (steps_run - excl) / np : 0.0;
+    double dem_after_first =
+        steps_run ? (double)(dems - (excl ? X->dem_first : 0)) / (steps_run - excl) / np : 0.0;
+    const char *mode = "not reached";
+    char buf[64], path[MPD_PATH];
+    struct stat st;
+    if (!x) return fprintf(stderr, "mpmdem_footing: out of memory\n"), 1;
+    if (n > 0) {
+        for (k = 0; k < n; ++k) {
+            const ft_row *r = (const ft_row *)mpd_row(&X->rows, k);
+            x[k] = r->d / f->B, q[k] = qsm[k] = r->q;
         }
+        ku = ultimate(x, q, n, f->smooth, qsm, &reached, &mode);
+        qu = qsm[ku], du = x[ku], nq = qu / f->surcharge;
+        if (!bad) bad = load_plot(X, qsm, reached ? ku : -1, nq46, nq47);
     }
-    o.dem_dt = -1.0; /* not given: from E below */
-    for (i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        double v;
-        int r = mpd_parse_common(&o, argc, argv, &i);
-        if (r < 0) return 2;
-        if (r > 0) continue;
-        if (!strcmp(a, "--paper")) continue;
-        if (i + 1 >= argc) return fprintf(stderr, "mpmdem_footing: %s needs a value (see --help)\n", a), 2;
-        if (!strcmp(a, "--material")) {
-            ++i;
-            continue;
-        }
-        if (!strcmp(a, "--phi-pressures")) {
-            f.nphi = parse_list(argv[++i], f.phi_p, FT_MAXPHI);
-            if (f.nphi < 1)
-                return fprintf(stderr,
-                               "mpmdem_footing: --phi-pressures %s: need 1 to %d positive pressures in kPa, "
-                               "comma-separated\n",
-                               argv[i], FT_MAXPHI),
-                       2;
-            continue;
-        }
-        if (mpd_num(argv[i + 1], &v))
-            return fprintf(stderr, "mpmdem_footing: %s %s: not a number\n", a, argv[i + 1]), 2;
-        if (!strcmp(a, "--nx"))
-            f.nx = (int)v;
-        else if (!strcmp(a, "--ny"))
-            f.ny = (int)v;
-        else if (!strcmp(a, "--width"))
-            f.width = v;
-        else if (!strcmp(a, "--depth"))
-            f.depth = v;
-        else if (!strcmp(a, "--B"))
-            f.B = v;
-        else if (!strcmp(a, "--footing-height"))
-            f.foot_height = v;
-        else if (!strcmp(a, "--surcharge"))
-            f.surcharge = v;
-        else if (!strcmp(a, "--velocity"))
-            f.velocity = v;
-        else if (!strcmp(a, "--ramp"))
-            f.ramp = v;
-        else if (!strcmp(a, "--final"))
-            f.final_dB = v;
-        else if (!strcmp(a, "--every"))
-            f.every = v;
-        else if (!strcmp(a, "--smooth"))
-            f.smooth = v;
-        else if (!strcmp(a, "--phi-deg")) {
-            if (!(v > 0 && v < 60))
-                return fprintf(stderr, "mpmdem_footing: --phi-deg %s: need an angle in (0, 60)\n",
-                               argv[i + 1]),
-                       2;
-            f.phi_deg = v;
-        } else if (!strcmp(a, "--phi-strain"))
-            f.phi_strain = v;
-        else if (!strcmp(a, "--grid-damping"))
-            f.grid_damping = v;
-        else if (!strcmp(a, "--max-steps")) {
-            if (v != floor(v) || v < 1 || v > 1e12)
-                return fprintf(stderr, "mpmdem_footing: --max-steps %s: need a positive integer\n",
-                               argv[i + 1]),
-                       2;
-            f.max_steps = (long)v;
-        } else
-            return fprintf(stderr, "mpmdem_footing: unknown option %s (see --help)\n", a), 2;
-        ++i;
-    }
-    if (o.dem_dt < 0) o.dem_dt = FT_DEM_DT_REF * sqrt(6e8 / o.young);
-    if (f.nx < 1 || f.ny < 1 || f.nx > 4000 || f.ny > 4000 || !(f.width > 0) || !(f.depth > 0) ||
-        !(f.B > 0) || !(f.foot_height > 0) || !(f.surcharge > 0) || !(f.velocity > 0) || !(f.ramp >= 0) ||
-        !(f.final_dB > 0 && f.final_dB <= 3) || !(f.every > 0 && f.every <= f.final_dB) || !(f.smooth > 0) ||
-        !(f.phi_strain >= 0.01 && f.phi_strain <= FT_PHI_STRAIN_MAX) ||
-        !(f.grid_damping >= 0 && f.grid_damping < 1) || mpd_check_opts(&o))
-        return fprintf(stderr, "mpmdem_footing: an option is out of range (see --help)\n"), 2;
-    h = f.width / f.nx;
-    /* the footing covers the nodes x <= b - h/2; their tributary width (the
-     * reach of a uniform stress under them) ends half a cell further: that is
-     * the effective half-width, = b when b/h = k + 1/2 */
-    bnode = floor((0.5 * f.B - 0.5 * h) / h + 1e-9) * h;
-    b = bnode + 0.5 * h;
-    if (fabs(f.depth / f.ny - h) > 1e-9 * h)
-        return fprintf(stderr, "mpmdem_footing: cells must be square: width/nx = %g, depth/ny = %g\n", h,
-                       f.depth / f.ny),
-               2;
-    if (bnode < h * (1 - 1e-9) || b > 0.5 * f.width)
-        return fprintf(
-                   stderr,
-                   "mpmdem_footing: the half footing B/2 = %g m must span at least 1.5 cells (h = %g m) and "
-                   "at most half the width\n",
-                   0.5 * f.B, h),
-               2;
-    if (f.final_dB * f.B >= 0.9 * f.depth)
-        return fprintf(stderr, "mpmdem_footing: --final %g: the footing would reach the base\n", f.final_dB),
-               2;
-    if (mpd_mkdir(o.out)) return 1;
-    /* from here on every exit goes through `done`, which frees what exists */
-    memset(&P, 0, sizeof P), memset(&F, 0, sizeof F), memset(&g, 0, sizeof g), memset(&pts, 0, sizeof pts);
-    gk_rve_state_init(&st0, NULL);
-    memset(T, 0, sizeof T);
-#define FAIL(msg)                                     \
-    do {                                              \
-        fprintf(stderr, "mpmdem_footing: %s\n", msg); \
-        status = 1;                                   \
-        goto done;                                    \
-    } while (0)
-
-    /* ---- the RVE: open the packing, measure phi, prepare at q_s */
-    if (mpd_proto_open(&P, &o, &err)) FAIL(err.msg);
-    printf("mpmdem_footing: seed 003 Table 2 '%s': E = %g MPa, kt/kn = %g, friction %g deg, beta %g, eta %g, "
-           "damping %g; DEM dt = %.3g s\n",
-           material_names[f.material], o.young / 1e6, o.kt_ratio, o.friction_deg, o.roll_beta, o.roll_eta,
-           o.dem_damping, o.dem_dt);
-    if (f.material == 1 && !strcmp(o.packing, od.packing))
+    if (!bad)
+        bad = snap_field(X, MPD_EPS_Q, "eps_q_end",
+                         "deviatoric strain eps_q at the end (failure mode, Liang & Zhao Fig 14)") ||
+              snap_field(X, MPD_ROTATION, "rotation_end",
+                         "rotation of F = RU at the end (Liang & Zhao Fig 15)") ||
+              snap_field(X, MPD_VOID, "void_ratio_end", "void ratio at the end (Liang & Zhao Fig 15)") ||
+              displacement_field(X) || mpd_write_vtk(&X->run, X->S.step, &X->M, &X->pts);
+    if (!mpd_path(&X->run, path, "checkpoint.bin") && stat(path, &st) == 0) ck_mb = st.st_size / 1048576.0;
+    if (!bad)
+        printf("wrote %s/footing.csv, footing_load.svg, %seps_q_*.svg, rotation_end.svg, void_ratio_end.svg, "
+               "displacement_end.svg, points_*.vtk (ParaView), checkpoint.bin\n",
+               X->run.out, X->measured ? "rve_biaxial.svg, rve_mohr.svg, " : "");
+    if (n > 0) {
+        const ft_row *r0 = (const ft_row *)mpd_row(&X->rows, 0),
+                     *rl = (const ft_row *)mpd_row(&X->rows, n - 1);
         printf(
-            "note: 'medium' has Table 2's dense contact law; with the shipped dense packing it is the dense "
-            "soil (give a looser --packing for e0 = 0.2314, e.g. examples/data/rve400_e0223.txt)\n");
-    if (f.phi_deg > 0) {
-        phi = f.phi_deg;
-        printf("friction angle: phi = %g deg given (--phi-deg), no measurement\n", phi);
-    } else {
-        int k, nbad = 0;
-        double t0 = gk_wtime();
-        printf(
-            "friction angle: %d drained biaxial RVE tests (sigma_3 held by the servo; axial compression at "
-            "%s) ...\n",
-            f.nphi,
-            o.dem_adaptive ? "the inertial number of --dem-inertial at sigma_3"
-                           : "--dem-strain per DEM step");
-        fflush(stdout);
-        for (k = 0; k < f.nphi; ++k) T[k].s3 = f.phi_p[k];
-        GK_OMP(parallel for num_threads(o.threads) schedule(dynamic, 1) reduction(+ : nbad))
-        for (k = 0; k < f.nphi; ++k) nbad += phi_test(&P, &o, f.phi_strain, &T[k]);
-        for (k = 0; k < f.nphi; ++k) {
-            if (T[k].status) {
-                fprintf(stderr, "mpmdem_footing: RVE biaxial at sigma_3 = %g kPa: %s\n", T[k].s3 / 1e3,
-                        T[k].msg);
-                continue;
-            }
-            printf("  sigma_3 = %4.0f kPa (%.3g /s): e0 = %.4f, peak sigma_1 = %.1f kPa (sigma_3 %.1f) at "
-                   "%.2f %% axial "
-                   "strain -> phi = %.2f deg; residual (mean over %.1f-%.1f %%) %.2f deg\n",
-                   T[k].s3 / 1e3, T[k].rate, T[k].e0, T[k].s1 / 1e3, T[k].s3m / 1e3, 100 * T[k].eps_peak,
-                   T[k].phi, fmax(0.0, 100 * T[k].eps_end - 2), 100 * T[k].eps_end, T[k].phi_res);
-            if (T[k].nopeak)
-                printf("    (no peak by %.0f %% axial strain: the maximum is used, a hardening RVE)\n",
-                       100 * FT_PHI_STRAIN_MAX);
-        }
-        if (nbad) {
-            status = 1;
-            goto done;
-        }
-        phi = phi_fit(T, f.nphi, 0, &phi_c, &coh);
-        phi_res = phi_fit(T, f.nphi, 1, &phi_rc, &coh_r);
-        measured = 1;
-        printf("  Mohr-Coulomb envelope of the peaks through the origin: phi = %.2f deg", phi);
-        if (f.nphi >= 2 && isfinite(phi_c))
-            printf(" (with cohesion: phi = %.2f deg, c = %.2f kPa)", phi_c, coh / 1e3);
-        printf("; seed 003 '%s': %.1f deg\n", material_names[f.material], seed_phi[f.material]);
-        printf("  residual envelope (end of the tests): phi_res = %.2f deg; %.1f s for the tests\n", phi_res,
-               gk_wtime() - t0);
-        phi_plots(o.out, T, f.nphi, phi);
+            "load-settlement: q(d/B = %.4f) = %.2f kPa (q_s = %g kPa); at the end d/B = %.4f: q = %.1f kPa\n",
+            r0->d / f->B, r0->q / 1e3, f->surcharge / 1e3, rl->d / f->B, rl->q / 1e3);
     }
-    if (mpd_prepare_rve(&P, f.surcharge, &st0, &err)) FAIL(err.msg);
-    c = sqrt(P.M / P.rho);
-    dt = o.cfl * h / c;
-
-    /* ---- grid: ghost layers; room above the ground for the heave */
-    gl = mpd_ghost_layers(o.basis);
+    if (reached)
+        printf("ultimate load (%s, smoothing window d/B %g): p_u = %.1f kPa at d/B = %.4f -> N_q = p_u/q_s = "
+               "%.2f\n",
+               mode, f->smooth, qu / 1e3, du, nq);
+    else
+        printf("ultimate load NOT reached by d/B = %.4f (no zero or steady minimum slope confirmed one "
+               "window before "
+               "the end): N_q below is the last smoothed value, a lower bound; run further (--final)\n",
+               n ? x[n - 1] : 0.0);
+    printf("N_q: MPMxDEM %.2f; eq 46 (general shear, phi = %.2f deg) %.2f; eq 47 (local/punching, phi_r = "
+           "%.2f deg) "
+           "%.2f; ratio %.3f to eq 46\n",
+           nq, X->phi, nq46, phi_reduced(X->phi), nq47, nq / nq46);
+    if (isnan(phi_of_nq(nq)))
+        printf("no angle's eq 46 gives the MPMxDEM N_q %.3g (eq 46 spans %.3g at 0 deg to %.4g at 60 deg; "
+               "RESULT "
+               "phi_mobilised_deg=nan)\n",
+               nq, nq_prandtl(0.0), nq_prandtl(60.0));
+    else
+        printf("the MPMxDEM N_q is eq 46 of phi = %.2f deg (the angle the footing mobilises)\n",
+               phi_of_nq(nq));
+    if (X->measured)
+        printf("N_q of eq 46 with the residual angle phi_res = %.2f deg (the softened end of the RVE tests): "
+               "%.2f; "
+               "MPMxDEM / that = %.3f\n",
+               X->phi_res, nq_prandtl(X->phi_res), nq / nq_prandtl(X->phi_res));
+    printf("Liang & Zhao '%s': N_q %.1f (MPMxDEM) vs %.1f (analytic, phi = %.1f deg)\n",
+           material_names[f->material], paper_nq[f->material], paper_nq_analytic[f->material],
+           paper_phi[f->material]);
+    hwm = proc_kb("VmHWM");
+    per_rve = X->rss_after > 0 && X->rss_before > 0 ? (X->rss_after - X->rss_before) / np : NAN;
+    printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step); %.4g s "
+           "per MPM "
+           "step per 1000 RVEs (%.3g us per RVE DEM step); MPI ranks %d, %.4g bytes sent per MPM step\n",
+           mpd_duration(secs, buf, sizeof buf), steps_run, dems,
+           steps_run ? (double)dems / steps_run / np : 0.0, steps_run ? secs / steps_run * 1000.0 / np : 0.0,
+           dems ? 1e6 * secs / (double)dems : 0.0, X->run.nranks, mpd_bytes_per_step(&X->M, steps_run));
+    printf(
+        "memory (rank 0): VmHWM %.1f MB, %.1f kB per RVE (RSS growth on creation), checkpoint file %.1f MB\n",
+        hwm / 1024, per_rve, ck_mb);
     {
-        int up = gl + (int)ceil(fmax(f.final_dB * f.B, 2 * h) / h);
-        org[0] = -gl * h, org[1] = -gl * h, org[2] = 0;
-        n[0] = f.nx + 2 * gl + 1, n[1] = f.ny + gl + up + 1, n[2] = 1;
-        if (gk_mpm_grid_create(&g, 2, org, h, n, NULL, &err) ||
-            gk_mpm_grid_set_bc(&g, 0, GK_MPM_BC_ROLLER, 0, gl + 1, &err) || /* symmetry plane x = 0 */
-            gk_mpm_grid_set_bc(&g, 1, GK_MPM_BC_ROLLER, 0, gl + 1, &err) || /* smooth wall x = W */
-            gk_mpm_grid_set_bc(&g, 2, GK_MPM_BC_FIXED, 0, gl + 1, &err))    /* base y = 0 */
-            FAIL(err.msg);
+        /* the paper's size: 7776 RVEs, h = 12/108, 0.1 m/s to d/B = 1.5 with a 0.5 s ramp */
+        double hp = 12.0 / 108.0, dtp = X->o.cfl * hp / X->c, stepsp = (1.5 * f->B / 0.1 + 0.25) / dtp;
+        double base = hwm > 0 && isfinite(per_rve) ? hwm - per_rve * np : NAN;
+        printf("paper size projection (7776 RVEs, h = %.4g m, dt = %.3g s, %.0f MPM steps at 0.1 m/s to d/B "
+               "= 1.5): "
+               "memory ~ %.2f GB, checkpoint file %.2f GB; wall ~ %s on these cores at this run's %.3g ms "
+               "per RVE per "
+               "MPM step (first step excluded; %.1f DEM steps per RVE per MPM step here)\n",
+               hp, dtp, stepsp, (base + 7776.0 * per_rve) / 1048576.0, 7776.0 * ck_mb / np / 1024.0,
+               mpd_duration(per_step_rve * 7776.0 * stepsp, buf, sizeof buf), 1e3 * per_step_rve,
+               dem_after_first);
     }
-    lo[0] = 0, lo[1] = 0, lo[2] = 0, hi[0] = f.width, hi[1] = f.depth, hi[2] = 0;
-    if (gk_mpm_points_create_box(&pts, 2, lo, hi, h, o.ppc, P.rho, NULL, &err)) FAIL(err.msg);
-    rss_before = proc_kb("VmRSS");
-    if (mpd_rves_create(&F, pts.n, &P, &st0, NULL, NULL, &o, &err)) FAIL(err.msg);
-    rss_after = proc_kb("VmRSS");
-    edge = (mpd_edge *)calloc((size_t)pts.n, sizeof *edge);
-    x0 = (double *)malloc(2 * (size_t)pts.n * sizeof *x0);
-    if (!edge || !x0) FAIL("out of memory");
-    for (i = 0; i < pts.n; ++i) {
-        double a = 0.5 * h / o.ppc, xl = pts.x[0][i] - a, xr = pts.x[0][i] + a;
-        mpd_rve_sigma(&F.rve[i], pts.sigma + 9 * (size_t)i);
-        x0[2 * i] = pts.x[0][i], x0[2 * i + 1] = pts.x[1][i];
-        if (pts.x[1][i] < f.depth - 2 * a || xr <= b + 1e-9 * h) continue;
-        if (xl < b) xl = b; /* the part of the top edge beyond the footing edge */
-        edge[nedge].p = i, edge[nedge].pressure = f.surcharge;
-        edge[nedge].off[0] = 0.5 * (xl + xr) - pts.x[0][i], edge[nedge].off[1] = a;
-        edge[nedge].e[0] = -(xr - xl), edge[nedge].e[1] = 0; /* outward normal (e_y, -e_x) = up */
-        ++nedge;
-    }
-    def = mpd_mpm_def(&o);
-    def.damping = f.grid_damping;
-    memset(&S, 0, sizeof S);
-    S.body.lo[0] = org[0] - h, S.body.hi[0] = bnode + 1e-9 * h;
-    S.body.lo[1] = f.depth - 1e-9 * h, S.body.hi[1] = f.depth + f.foot_height;
-    S.body.contact = GK_MPM_CONTACT_STICK;
-    S.next_out = 0.0; /* a row after the first step (d ~ 0) */
-    if (o.restart) {
-        void *blob[2];
-        size_t size[2] = {sizeof S, 0};
-        ft_row *rr = NULL;
-        blob[0] = &S, blob[1] = &rr;
-        if (mpd_ck_read(o.restart, "footing", blob, size, 2, &pts, &F, &err)) FAIL(err.msg);
-        rows = rr, nrows = caprows = (int)(size[1] / sizeof *rows);
-    }
-    g.body = &S.body, g.nbody = 1;
-    nsteps_total = (long)ceil((f.final_dB * f.B / f.velocity + 0.5 * f.ramp) / dt);
-    if (f.max_steps && f.max_steps < nsteps_total) nsteps_total = f.max_steps;
+    printf("RESULT Nq=%.5g Nq_analytic=%.5g Nq_analytic_local=%.5g phi_deg=%.4g phi_res_deg=%.4g "
+           "Nq_analytic_res=%.5g "
+           "phi_mobilised_deg=%.4g q_ult=%.6g d_ult_over_B=%.4g ultimate_reached=%d n_rves=%d mpm_steps=%ld "
+           "dt=%.4g "
+           "seconds_per_step=%.4g seconds_per_step_per_1000_rves=%.4g "
+           "seconds_per_step_per_1000_rves_after_first=%.4g "
+           "mem_per_rve_kb=%.4g vmhwm_mb=%.5g total_seconds=%.2f\n",
+           nq, nq46, nq47, X->phi, X->phi_res, X->measured ? nq_prandtl(X->phi_res) : NAN, phi_of_nq(nq), qu,
+           du, reached, np, steps_run, X->dt, steps_run ? secs / steps_run : 0.0,
+           steps_run ? secs / steps_run * 1000.0 / np : 0.0, 1000.0 * per_step_rve, per_rve, hwm / 1024,
+           secs);
+    free(x);
+    return bad;
+}
+
+static int run(ft *X, int argc, char **argv) {
+    const ft_opts *f = &X->f;
+    ft_state *S = &X->S;
+    double t_start;
+    long nsteps_total, step0;
+    long long dem0;
+    int status = parse(X, argc, argv), bad = 0;
+    gk_err err;
+    if (status) return status == 1 ? 0 : status;
+    if (mpd_out_dir(&X->run)) return 1;
+    if (setup(X, &err)) return fprintf(stderr, "mpmdem_footing: %s\n", err.msg), 1;
+    nsteps_total = (long)ceil((f->final_dB * f->B / f->velocity + 0.5 * f->ramp) / X->dt);
+    if (f->max_steps && f->max_steps < nsteps_total) nsteps_total = f->max_steps;
     printf("grid: %d x %d cells over %g x %g m (half model), h = %.4g m; footing B = %g m, half-width b = %g "
            "m = "
            "%.3g cells (nodes x <= %.4g m), rough; surcharge %g kPa\n",
-           f.nx, f.ny, f.width, f.depth, h, f.B, b, b / h, bnode, f.surcharge / 1e3);
-    if (fabs(b - 0.5 * f.B) > 1e-6 * f.B)
-        printf(
-            "note: B/2 = %g m is not (k + 1/2) h: the footing's effective half-width is b = %g m (q = load / "
-            "b); choose h = B / (2k + 1) for an exact footing\n",
-            0.5 * f.B, b);
-    printf("%d points (= RVEs of %d disks), basis %d, alpha %g, grid damping %g\n", pts.n, F.rve[0].n,
-           (int)o.basis, o.alpha, f.grid_damping);
+           f->nx, f->ny, f->width, f->depth, X->h, f->B, X->b, X->b / X->h, X->bnode, f->surcharge / 1e3);
+    if (fabs(X->b - 0.5 * f->B) > 1e-6 * f->B)
+        printf("note: B/2 = %g m is not (k + 1/2) h: the footing's effective half-width is b = %g m (q = "
+               "load / b); "
+               "choose h = B / (2k + 1) for an exact footing\n",
+               0.5 * f->B, X->b);
+    printf("%d points (= RVEs of %d disks), basis %d, alpha %g, grid damping %g\n", X->pts.n, X->P.pk.n,
+           (int)X->def.basis, X->o.alpha, f->grid_damping);
     printf("RVE at q_s: p0 = %.4g kPa, e0 = %.4f (Table 2: %.4f), rho = %.1f kg/m3, M (Taylor) = %.4g MPa -> "
-           "c = "
-           "%.1f m/s; MPM dt = %.4g s (cfl %.2f)\n",
-           P.p0 / 1e3, P.e0, table2_e0[f.material], P.rho, P.M / 1e6, c, dt, o.cfl);
-    mpd_print_dem_rule(&o);
+           "c = %.1f "
+           "m/s; MPM dt = %.4g s (cfl %.2f)\n",
+           X->P.p0 / 1e3, X->P.e0, table2_e0[f->material], X->P.rho, X->P.M / 1e6, X->c, X->dt, X->o.cfl);
+    mpd_print_dem_rule(&X->o);
     printf("memory: %.1f kB per RVE (RSS growth over creating %d RVEs)\n",
-           rss_after > 0 && rss_before > 0 ? (rss_after - rss_before) / pts.n : -1.0, pts.n);
-    printf("footing at %g m/s (ramp %g s) to d/B = %g: about %ld MPM steps%s\n", f.velocity, f.ramp,
-           f.final_dB, nsteps_total, f.max_steps ? " (--max-steps)" : "");
+           X->rss_after > 0 && X->rss_before > 0 ? (X->rss_after - X->rss_before) / X->pts.n : -1.0,
+           X->pts.n);
+    printf("footing at %g m/s (ramp %g s) to d/B = %g: about %ld MPM steps%s\n", f->velocity, f->ramp,
+           f->final_dB, nsteps_total, f->max_steps ? " (--max-steps)" : "");
     fflush(stdout);
-    if (!o.restart) {
-        snprintf(path, sizeof path, "%s/points_%06ld.vtk", o.out, 0L);
-        mpd_write_vtk(path, &F, &pts);
-    }
+    if (!X->o.restart && mpd_write_vtk(&X->run, 0, &X->M, &X->pts)) return 1;
     t_start = gk_wtime();
-    step0 = S.step, dem0 = F.dem_steps;
-    while (S.disp < f.final_dB * f.B * (1 - 1e-12) && !(f.max_steps && S.step - step0 >= f.max_steps)) {
-        double vf = f.velocity * (f.ramp > 0 && S.t < f.ramp ? fmin(1.0, (S.t + 0.5 * dt) / f.ramp) : 1.0),
-               ek, m, mom[3];
-        S.body.v[1] = -vf;
-        if (mpd_step(&g, &pts, &def, dt, &F, edge, nedge, &err)) { /* also moves the footing */
-            fprintf(stderr, "mpmdem_footing: step %ld (d/B = %.4f): %s\n", S.step, S.disp / f.B, err.msg);
+    step0 = S->step, dem0 = X->M.dem_steps;
+    while (!bad && S->disp < f->final_dB * f->B * (1 - 1e-12) &&
+           !(f->max_steps && S->step - step0 >= f->max_steps)) {
+        double vf =
+            f->velocity * (f->ramp > 0 && S->t < f->ramp ? fmin(1.0, (S->t + 0.5 * X->dt) / f->ramp) : 1.0);
+        S->body.v[1] = -vf;
+        if (mpd_step(&X->g, &X->pts, &X->def, X->dt, &X->M, X->edge, X->nedge,
+                     &err)) { /* also moves the footing */
+            fprintf(stderr, "mpmdem_footing: step %ld (d/B = %.4f): %s\n", S->step, S->disp / f->B, err.msg);
             status = 3;
             break;
         }
-        S.t += dt, S.disp += vf * dt, ++S.step;
-        if (S.step == 1) t_first = gk_wtime() - t_start, dem_first = F.dem_steps - dem0; /* fresh runs only */
-        S.acc_load += -S.body.force[1] * dt, S.acc_dt += dt;
-        gk_mpm_points_totals(&pts, &m, mom, &ek);
-        S.acc_ek += ek, ++S.nacc;
-        {
-            long long sum = 0;
-            for (i = 0; i < pts.n; ++i) sum += F.nsub[i];
-            S.acc_dem += (double)sum / pts.n;
-        }
-        if (S.disp >= S.next_out * f.B * (1 - 1e-9) || S.disp >= f.final_dB * f.B * (1 - 1e-12) ||
-            (f.max_steps && S.step - step0 >= f.max_steps)) {
-            ft_row r;
-            r.t = S.t, r.d = S.disp, r.load = S.acc_load / S.acc_dt, r.q = r.load / b;
-            r.ek = S.acc_ek / S.nacc, r.dem_mean = S.acc_dem / S.nacc;
-            r.secs = S.wall + gk_wtime() - t_start;
-            S.acc_load = S.acc_dt = 0, S.acc_ek = S.acc_dem = 0, S.nacc = 0;
-            while (S.next_out * f.B <= S.disp * (1 + 1e-9)) S.next_out += f.every;
-            if (nrows == caprows) {
-                caprows = caprows ? 2 * caprows : 64;
-                ft_row *grown = (ft_row *)realloc(rows, (size_t)caprows * sizeof *rows);
-                if (!grown) FAIL("out of memory");
-                rows = grown;
-            }
-            rows[nrows++] = r;
-            write_csv(o.out, rows, nrows, f.B, f.surcharge);
-            while (S.nstage < FT_NSTAGE && stages[S.nstage] <= f.final_dB &&
-                   r.d >= stages[S.nstage] * f.B * (1 - 1e-9)) {
-                char tag[32], title[120];
-                snprintf(tag, sizeof tag, "eps_q_dB%.2f", stages[S.nstage]);
-                snprintf(title, sizeof title, "deviatoric strain eps_q at d/B = %.2f", stages[S.nstage]);
-                stage_field(o.out, tag, title, &F, &pts, 0, 0.5 * h / o.ppc);
-                ++S.nstage;
-            }
-            if (!o.quiet) {
-                snprintf(what, sizeof what, "d/B %.4f  q %.1f kPa (q/q_s %.2f)  DEM %.1f/pt", r.d / f.B,
-                         r.q / 1e3, r.q / f.surcharge, r.dem_mean);
-                gk_progress(stderr, S.step - step0, nsteps_total - step0, t_start, what);
-            }
-        }
-        if (o.vtk_every && S.step % o.vtk_every == 0) {
-            snprintf(path, sizeof path, "%s/points_%06ld.vtk", o.out, S.step);
-            mpd_write_vtk(path, &F, &pts);
-        }
-        if (o.checkpoint_every && S.step % o.checkpoint_every == 0) {
-            void *blob[2];
-            size_t size[2];
-            double w0 = S.wall;
-            S.wall += gk_wtime() - t_start;
-            blob[0] = &S, size[0] = sizeof S, blob[1] = rows, size[1] = (size_t)nrows * sizeof *rows;
-            mpd_ck_write(o.out, "footing", blob, size, 2, &pts, &F);
-            S.wall = w0;
-        }
+        bad = after_step(X, vf, t_start, step0, nsteps_total);
+        if (!bad && X->o.vtk_every && S->step % X->o.vtk_every == 0)
+            bad = mpd_write_vtk(&X->run, S->step, &X->M, &X->pts);
+        if (!bad && X->o.checkpoint_every && S->step % X->o.checkpoint_every == 0) bad = save(X, t_start);
     }
-    {
-        double secs = gk_wtime() - t_start, *x = NULL, *q = NULL, *qsm = NULL, nq = NAN, qu = NAN, du = NAN;
-        double nq46 = nq_prandtl(phi), nq47 = nq_prandtl(phi_reduced(phi)), hwm, per_rve, ck_mb = 0;
-        long steps_run = S.step - step0;
-        long long dems = F.dem_steps - dem0;
-        int excl = step0 == 0 && steps_run > 1; /* leave out the first step's one-off relaxation */
-        double per_step_rve = steps_run ? (secs - (excl ? t_first : 0)) / (steps_run - excl) / pts.n : 0.0;
-        double dem_after_first =
-            steps_run ? (double)(dems - (excl ? dem_first : 0)) / (steps_run - excl) / pts.n : 0.0;
-        int ku = -1, reached = 0, k;
-        const char *mode = "not reached";
-        void *blob[2];
-        size_t size[2];
-        double w0 = S.wall;
-        S.wall += secs;
-        blob[0] = &S, size[0] = sizeof S, blob[1] = rows, size[1] = (size_t)nrows * sizeof *rows;
-        if (status == 0) mpd_ck_write(o.out, "footing", blob, size, 2, &pts, &F);
-        S.wall = w0;
-        for (k = 0; k < F.n; ++k) ck_mb += gk_rve_state_size(&F.rve[k]) / 1048576.0;
-        write_csv(o.out, rows, nrows, f.B, f.surcharge);
-        x = (double *)malloc((size_t)(nrows + 1) * sizeof *x);
-        q = (double *)malloc((size_t)(nrows + 1) * sizeof *q);
-        qsm = (double *)malloc((size_t)(nrows + 1) * sizeof *qsm);
-        if (x && q && qsm && nrows > 0) {
-            for (k = 0; k < nrows; ++k) x[k] = rows[k].d / f.B, q[k] = rows[k].q, qsm[k] = rows[k].q;
-            ku = ultimate(x, q, nrows, f.smooth, qsm, &reached, &mode);
-            qu = qsm[ku], du = x[ku], nq = qu / f.surcharge;
-            load_plot(o.out, rows, nrows, qsm, f.B, f.surcharge, reached ? ku : -1, nq46, nq47, phi);
-        }
-        stage_field(o.out, "eps_q_end", "deviatoric strain eps_q at the end (failure mode, seed 003 Fig 14)",
-                    &F, &pts, 0, 0.5 * h / o.ppc);
-        stage_field(o.out, "rotation_end", "rotation of F = RU [deg] at the end (seed 003 Fig 15)", &F, &pts,
-                    2, 0.5 * h / o.ppc);
-        stage_field(o.out, "void_ratio_end", "void ratio at the end (seed 003 Fig 15)", &F, &pts, 5,
-                    0.5 * h / o.ppc);
-        displacement_field(o.out, &pts, x0, 0.5 * h / o.ppc);
-        snprintf(path, sizeof path, "%s/points_%06ld.vtk", o.out, S.step);
-        mpd_write_vtk(path, &F, &pts);
-        printf("wrote %s/footing.csv, footing_load.svg, %seps_q_*.svg, rotation_end.svg, void_ratio_end.svg, "
-               "displacement_end.svg, points_*.vtk (ParaView), checkpoint.bin\n",
-               o.out, measured ? "rve_biaxial.svg, rve_mohr.svg, " : "");
-        if (nrows > 0)
-            printf("load-settlement: q(d/B = %.4f) = %.2f kPa (q_s = %g kPa); at the end d/B = %.4f: q = "
-                   "%.1f kPa\n",
-                   rows[0].d / f.B, rows[0].q / 1e3, f.surcharge / 1e3, rows[nrows - 1].d / f.B,
-                   rows[nrows - 1].q / 1e3);
-        if (reached)
-            printf("ultimate load (%s, smoothing window d/B %g): p_u = %.1f kPa at d/B = %.4f -> N_q = "
-                   "p_u/q_s = "
-                   "%.2f\n",
-                   mode, f.smooth, qu / 1e3, du, nq);
-        else
-            printf("ultimate load NOT reached by d/B = %.4f (no zero or steady minimum slope confirmed one "
-                   "window "
-                   "before the end): N_q below is the last smoothed value, a lower bound; run further "
-                   "(--final)\n",
-                   nrows ? rows[nrows - 1].d / f.B : 0.0);
-        printf(
-            "N_q: MPMxDEM %.2f; eq 46 (general shear, phi = %.2f deg) %.2f; eq 47 (local/punching, phi_r = "
-            "%.2f deg) %.2f; ratio %.3f to eq 46\n",
-            nq, phi, nq46, phi_reduced(phi), nq47, nq / nq46);
-        if (isnan(phi_of_nq(nq)))
-            printf(
-                "no angle's eq 46 gives the MPMxDEM N_q %.3g (eq 46 spans %.3g at 0 deg to %.4g at 60 deg; "
-                "RESULT phi_mobilised_deg=nan)\n",
-                nq, nq_prandtl(0.0), nq_prandtl(60.0));
-        else
-            printf("the MPMxDEM N_q is eq 46 of phi = %.2f deg (the angle the footing mobilises)\n",
-                   phi_of_nq(nq));
-        if (measured)
-            printf("N_q of eq 46 with the residual angle phi_res = %.2f deg (the softened end of the RVE "
-                   "tests): "
-                   "%.2f; MPMxDEM / that = %.3f\n",
-                   phi_res, nq_prandtl(phi_res), nq / nq_prandtl(phi_res));
-        printf("seed 003 '%s': N_q %.1f (MPMxDEM) vs %.1f (analytic, phi = %.1f deg)\n",
-               material_names[f.material], seed_nq[f.material], seed_nq_analytic[f.material],
-               seed_phi[f.material]);
-        hwm = proc_kb("VmHWM");
-        per_rve = rss_after > 0 && rss_before > 0 ? (rss_after - rss_before) / pts.n : NAN;
-        printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step); %.4g "
-               "s per "
-               "MPM step per 1000 RVEs (%.3g us per RVE DEM step)\n",
-               mpd_duration(secs, buf, sizeof buf), steps_run, dems,
-               steps_run ? (double)dems / steps_run / pts.n : 0.0,
-               steps_run ? secs / steps_run * 1000.0 / pts.n : 0.0, dems ? 1e6 * secs / (double)dems : 0.0);
-        printf("memory: VmHWM %.1f MB, %.1f kB per RVE (RSS growth on creation), checkpoint %.1f MB of RVE "
-               "states\n",
-               hwm / 1024, per_rve, ck_mb);
-        {
-            /* the paper's size: 7776 RVEs, h = 12/108, 0.1 m/s to d/B = 1.5 with a 0.5 s ramp; cost per
-             * RVE per MPM step of this run without its first step (the one-off relaxation of every RVE) */
-            double hp = 12.0 / 108.0, dtp = o.cfl * hp / c, stepsp = (1.5 * f.B / 0.1 + 0.25) / dtp;
-            double base = hwm > 0 && isfinite(per_rve) ? hwm - per_rve * pts.n : NAN;
-            double tp = per_step_rve * 7776.0 * stepsp;
-            printf("paper size projection (7776 RVEs, h = %.4g m, dt = %.3g s, %.0f MPM steps at 0.1 m/s to "
-                   "d/B = "
-                   "1.5): memory ~ %.2f GB, checkpoint file %.2f GB; wall ~ %s on these cores at this run's "
-                   "%.3g ms "
-                   "per RVE per MPM step (first step excluded; %.1f DEM steps per RVE per MPM step here)\n",
-                   hp, dtp, stepsp, (base + 7776.0 * per_rve) / 1048576.0, 7776.0 * ck_mb / pts.n / 1024.0,
-                   mpd_duration(tp, buf, sizeof buf), 1e3 * per_step_rve, dem_after_first);
-        }
-        printf("RESULT Nq=%.5g Nq_analytic=%.5g Nq_analytic_local=%.5g phi_deg=%.4g phi_res_deg=%.4g "
-               "Nq_analytic_res=%.5g phi_mobilised_deg=%.4g q_ult=%.6g d_ult_over_B=%.4g ultimate_reached=%d "
-               "n_rves=%d "
-               "mpm_steps=%ld dt=%.4g "
-               "seconds_per_step=%.4g seconds_per_step_per_1000_rves=%.4g "
-               "seconds_per_step_per_1000_rves_after_first=%.4g mem_per_rve_kb=%.4g vmhwm_mb=%.5g "
-               "total_seconds=%.2f\n",
-               nq, nq46, nq47, phi, phi_res, measured ? nq_prandtl(phi_res) : NAN, phi_of_nq(nq), qu, du,
-               reached, pts.n, steps_run, dt, steps_run ? secs / steps_run : 0.0,
-               steps_run ? secs / steps_run * 1000.0 / pts.n : 0.0, 1000.0 * per_step_rve, per_rve,
-               hwm / 1024, secs);
-        free(x), free(q), free(qsm);
-    }
-done : {
-    int k;
-    for (k = 0; k < FT_MAXPHI; ++k) free(T[k].eps), free(T[k].ratio);
+    if (!bad && status == 0) bad = save(X, t_start);
+    if (!bad) bad = mpd_write(&X->run, "footing.csv", put_csv, X);
+    bad = finish(X, gk_wtime() - t_start, S->step - step0, X->M.dem_steps - dem0, bad);
+    return status ? status : bad;
 }
-#undef FAIL
-    free(rows), free(edge), free(x0);
-    mpd_rves_free(&F);
-    gk_rve_state_free(&st0);
-    mpd_proto_close(&P);
-    gk_mpm_points_destroy(&pts);
-    gk_mpm_grid_destroy(&g);
-    return status;
+
+int main(int argc, char **argv) {
+    ft X;
+    int status;
+    memset(&X, 0, sizeof X);
+    gk_rve_state_init(&X.st0, NULL);
+    mpd_begin(&X.run, "mpmdem_footing", &argc, &argv);
+    status = run(&X, argc, argv);
+    free(X.rows.r), free(X.edge), free(X.x0);
+    mpd_snaps_free(&X.snaps);
+    mpd_micro_free(&X.M);
+    gk_rve_state_free(&X.st0);
+    mpd_proto_close(&X.P);
+    gk_mpm_points_destroy(&X.pts);
+    gk_mpm_grid_destroy(&X.g);
+    return mpd_end(status);
 }

@@ -1,11 +1,15 @@
 /* test_mpmdem_biaxial.c - smoke tests of examples/mpmdem_biaxial.c (the
- * MPMxDEM biaxial test of seed 003): it runs, writes its documented outputs,
- * starts in equilibrium, loads the specimen, does not depend on the thread
- * count, restarts to the identical result, and refuses bad arguments. Needs
- * build/mpmdem_biaxial (`make test` builds examples first). */
+ * MPMxDEM biaxial test of Liang & Zhao 2019): it runs, writes its documented
+ * outputs, starts in equilibrium, loads the specimen, does not depend on the
+ * thread count nor on the MPI rank count, restarts to the identical result,
+ * refuses a corrupted or foreign checkpoint, bad arguments and an --out that
+ * is a file, and ends with status 1 when a result cannot be written. Needs
+ * build/mpmdem_biaxial (`make test` builds examples first) and, for the MPI
+ * test, build/mpi/mpmdem_biaxial_mpi and build/mpi/mpirun2 (`make mpi`). */
 #define GK_TEST_DRIVERS
 #include "gk_test.h"
 #include <stdlib.h>
+#include <unistd.h>
 
 /* a 2 x 4 cell specimen (8 RVEs): tiny but the whole path */
 #define BX "build/mpmdem_biaxial --nx 2 --ny 4 --strain 0.002 --every 0.0005 --quiet "
@@ -97,9 +101,21 @@ TEST(biaxial_bad_arguments) {
     CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "cannot open"));
     CHECK(system("build/mpmdem_biaxial --help > build/t_mpmbx_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--dem-strain"));
+    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "(default build/mpm_biaxial)"));
+    /* values parsed strictly; the message names the option */
+    CHECK(system("build/mpmdem_biaxial --nx -1 > build/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--nx -1 is out of range"));
+    CHECK(system("build/mpmdem_biaxial --nx=8 > build/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--nx=8: write the value after the option"));
+    CHECK(system("build/mpmdem_biaxial --nx 99999999999 > build/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--nx 99999999999 is out of range"));
+    CHECK(system("build/mpmdem_biaxial --nx 8x > build/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--nx '8x' is not a whole number"));
+    CHECK(system("build/mpmdem_biaxial --strain 1e999 > build/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--strain '1e999' is not a finite number"));
     /* the DEM-rule flags of mpmdem.h are taken (they were listed in --help but refused), bad ones not */
     CHECK(system("build/mpmdem_biaxial --dem-rule foo > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "use adaptive or strain"));
+    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "adaptive or strain"));
     CHECK(system("build/mpmdem_biaxial --dem-inertial -1 > build/t_mpmbx_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--dem-inertial"));
     CHECK(system(BX "--strain 0.0005 --dem-rule strain --dem-strain 2e-5 --out build/t_mpmbx_rule "
@@ -112,11 +128,130 @@ TEST(biaxial_bad_arguments) {
                            "ratio < 0.01"));
 }
 
+/* lines of a file containing needle */
+static int count_lines(const char *path, const char *needle) {
+    FILE *fp = fopen(path, "r");
+    char buf[4096];
+    int n = 0;
+    if (!fp) return -1;
+    while (fgets(buf, sizeof buf, fp)) n += strstr(buf, needle) != NULL;
+    fclose(fp);
+    return n;
+}
+
+/* a copy of src at dst: the first `keep` bytes (all if < 0), byte `flip` (if >= 0) inverted */
+static int copy_damaged(const char *src, const char *dst, long keep, long flip) {
+    FILE *in = fopen(src, "rb"), *out = in ? fopen(dst, "wb") : NULL;
+    long k = 0;
+    int c, ok = in && out;
+    while (ok && (c = fgetc(in)) != EOF && (keep < 0 || k < keep))
+        ok = fputc(k == flip ? c ^ 0xff : c, out) != EOF, ++k;
+    if (in) fclose(in);
+    if (out) ok = fclose(out) == 0 && ok;
+    return ok && k > flip;
+}
+
+/* a checkpoint that is corrupt (one byte of its middle), truncated, of another model or of the old
+ * format is refused by name with status 1, before anything is run or written */
+TEST(biaxial_bad_checkpoint_refused) {
+    long size;
+    FILE *fp = fopen("build/t_mpmbx_a/checkpoint.bin", "rb");
+    CHECK(fp != NULL);
+    if (!fp) return;
+    fseek(fp, 0, SEEK_END), size = ftell(fp), fclose(fp);
+    CHECK(system("rm -rf build/t_mpmbx_ck build/t_mpmbx_ckout && mkdir -p build/t_mpmbx_ck") == 0);
+    CHECK(copy_damaged("build/t_mpmbx_a/checkpoint.bin", "build/t_mpmbx_ck/checkpoint.bin", -1, size / 2));
+    CHECK(system(BX "--restart build/t_mpmbx_ck --out build/t_mpmbx_ckout > build/t_mpmbx_ck.out 2>&1; "
+                    "test $? -eq 1") == 0);
+    CHECK(
+        gk_test_file_has("build/t_mpmbx_ck.out", "checkpoint.bin: checksum mismatch (the file is corrupt)"));
+    CHECK(!gk_test_file_has("build/t_mpmbx_ckout/biaxial.csv", "time")); /* nothing ran */
+    CHECK(copy_damaged("build/t_mpmbx_a/checkpoint.bin", "build/t_mpmbx_ck/checkpoint.bin", size - 100, -1));
+    CHECK(system(BX "--restart build/t_mpmbx_ck --out build/t_mpmbx_ckout > build/t_mpmbx_ck.out 2>&1; "
+                    "test $? -eq 1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_ck.out", "truncated"));
+    CHECK(system("build/mpmdem_biaxial --nx 2 --ny 2 --height 1 --quiet --restart build/t_mpmbx_a "
+                 "--out build/t_mpmbx_ckout > build/t_mpmbx_ck.out 2>&1; test $? -eq 1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_ck.out", "holds 8 points"));
+    CHECK(system("printf 'GKMPMDEM1biaxial' > build/t_mpmbx_ck/checkpoint.bin && " BX
+                 "--restart build/t_mpmbx_ck --out build/t_mpmbx_ckout > build/t_mpmbx_ck.out 2>&1; test $? "
+                 "-eq 1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_ck.out", "is not a grainkit two-scale checkpoint"));
+}
+
+/* a result that cannot be written (its path taken by a folder, or a full disk: /dev/full) ends the
+ * run with status 1, said once, naming the file */
+TEST(biaxial_failed_write_exits) {
+    static const char *cases[][2] = {
+        {"mkdir -p build/t_mpmbx_w/biaxial.csv", "build/t_mpmbx_w/biaxial.csv"},
+        {"mkdir -p build/t_mpmbx_w && ln -s /dev/full build/t_mpmbx_w/biaxial.csv",
+         "build/t_mpmbx_w/biaxial.csv"},
+        {"mkdir -p build/t_mpmbx_w/checkpoint.bin.tmp", "build/t_mpmbx_w/checkpoint.bin"},
+        {"mkdir -p build/t_mpmbx_w && ln -s /dev/full build/t_mpmbx_w/rotation_end.svg",
+         "build/t_mpmbx_w/rotation_end.svg"},
+        {"mkdir -p build/t_mpmbx_w/points_000000.vtk", "build/t_mpmbx_w/points_000000.vtk"}};
+    char cmd[1024], msg[256];
+    int k;
+    for (k = 0; k < (int)(sizeof cases / sizeof *cases); ++k) {
+        snprintf(cmd, sizeof cmd,
+                 "rm -rf build/t_mpmbx_w && %s && " BX
+                 "--strain 0.0005 --out build/t_mpmbx_w > build/t_mpmbx_w.out "
+                 "2>&1; test $? -eq 1",
+                 cases[k][0]);
+        CHECK(system(cmd) == 0);
+        snprintf(msg, sizeof msg, "mpmdem_biaxial: cannot write %s", cases[k][1]);
+        CHECK(gk_test_file_has("build/t_mpmbx_w.out", msg));
+        CHECK(count_lines("build/t_mpmbx_w.out", "cannot write") == 1);
+        CHECK(!gk_test_file_has("build/t_mpmbx_w.out", "wrote ")); /* no claim of what was not written */
+    }
+}
+
+/* --out must be a folder (created with its parents): a file there is refused, and the default
+ * (no --out) is build/mpm_biaxial, where the results land */
+TEST(biaxial_out_folder) {
+    CHECK(system("rm -rf build/t_mpmbx_f && echo x > build/t_mpmbx_file && " BX
+                 "--out build/t_mpmbx_file > build/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_f.out",
+                           "--out build/t_mpmbx_file: build/t_mpmbx_file is a file, not a folder"));
+    CHECK(gk_test_file_has("build/t_mpmbx_file", "x")); /* untouched */
+    CHECK(system(BX "--out build/t_mpmbx_file/sub > build/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_f.out", "is a file, not a folder"));
+    CHECK(system("rm -rf build/mpm_biaxial/biaxial.csv && " BX
+                 "--strain 0.0005 > build/t_mpmbx_f.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/mpm_biaxial/biaxial.csv", "time,eps_axial"));
+    CHECK(system(BX "--strain 0.0005 --out build/t_mpmbx_f/a/b > build/t_mpmbx_f.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_f/a/b/biaxial.csv", "time,eps_axial"));
+}
+
+/* the MPI build on 2 ranks x 1 thread gives the OpenMP build's (2 threads) CSV, first and last VTK
+ * (every field and the stress of every point) and RESULT, to the last digit */
+TEST(biaxial_mpi_matches_openmp) {
+    if (access("build/mpi/mpmdem_biaxial_mpi", X_OK) || access("build/mpi/mpirun2", X_OK)) {
+        printf("skip biaxial_mpi_matches_openmp: no build/mpi/mpmdem_biaxial_mpi (make mpi needs mpicc)\n");
+        return;
+    }
+    CHECK(system("build/mpi/mpirun2 build/mpi/mpmdem_biaxial_mpi --nx 2 --ny 4 --strain 0.002 --every 0.0005 "
+                 "--quiet "
+                 "--threads 1 --out build/t_mpmbx_mpi > build/t_mpmbx_mpi.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmbx_mpi.out", "MPI ranks 2"));
+    CHECK(gk_test_result("build/t_mpmbx_mpi.out", "peak_sigma_yy") ==
+          gk_test_result("build/t_mpmbx.out", "peak_sigma_yy"));
+    CHECK(system("cut -d, -f1-7 build/t_mpmbx_mpi/biaxial.csv > build/t_mpmbx_mpi.c && "
+                 "cmp -s build/t_mpmbx_mpi.c build/t_mpmbx2.c") == 0);
+    CHECK(system("cmp -s build/t_mpmbx_mpi/points_000000.vtk build/t_mpmbx/points_000000.vtk && "
+                 "cmp -s build/t_mpmbx_mpi/points_000278.vtk build/t_mpmbx/points_000278.vtk") == 0);
+    CHECK(count_lines("build/t_mpmbx_mpi.out", "RESULT ") == 1); /* rank 0 alone speaks */
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(biaxial_runs_and_loads);
     RUN(biaxial_thread_independent);
     RUN(biaxial_restart_identical);
     RUN(biaxial_bad_arguments);
+    RUN(biaxial_bad_checkpoint_refused);
+    RUN(biaxial_failed_write_exits);
+    RUN(biaxial_out_folder);
+    RUN(biaxial_mpi_matches_openmp);
     return gk_test_done();
 }

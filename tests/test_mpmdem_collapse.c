@@ -1,8 +1,9 @@
 /* test_mpmdem_collapse.c - smoke tests of examples/mpmdem_collapse.c (the
- * MPMxDEM column collapse of seed 003 Sec 3.5): it runs, writes its
+ * MPMxDEM column collapse of Liang & Zhao 2019 Sec 3.5): it runs, writes its
  * documented outputs, keeps the energy balance and the mass, spreads the
  * column outward, does not depend on the thread count, restarts to the
- * identical result, and refuses bad arguments. Needs build/mpmdem_collapse
+ * identical result, refuses bad arguments and a corrupted checkpoint, and
+ * ends with status 1 when a result cannot be written. Needs build/mpmdem_collapse
  * (`make test` builds examples first). */
 #define GK_TEST_DRIVERS
 #include "gk_test.h"
@@ -101,9 +102,8 @@ TEST(collapse_runs_and_conserves) {
 }
 
 /* RVEs run in parallel: one thread gives the same history to the last digit.
- * This run also takes the other stress path (--thin-cell stop: mpmdem.h's
- * mpd_step + mpd_stress instead of gk_mpm_step + the driver's freezing
- * update), identical while no RVE cell gets too thin. */
+ * This run also takes the other thin-cell policy (--thin-cell stop instead of
+ * freeze), identical while no RVE cell gets too thin. */
 TEST(collapse_thread_independent) {
     CHECK(system(CL "--t-end " CL_T_END " --threads 1 --thin-cell stop --out build/t_mpmcl1 "
                     "> build/t_mpmcl1.out 2>&1") == 0);
@@ -140,7 +140,7 @@ TEST(collapse_bad_arguments) {
     CHECK(system("build/mpmdem_collapse --mu -1 > build/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_mpmcl_bad.out", "--mu"));
     CHECK(system("build/mpmdem_collapse --t-end abc > build/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmcl_bad.out", "not a number"));
+    CHECK(gk_test_file_has("build/t_mpmcl_bad.out", "not a finite number"));
     CHECK(system("build/mpmdem_collapse --snapshots 0.5,0.2 > build/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_mpmcl_bad.out", "--snapshots"));
     CHECK(system("build/mpmdem_collapse --thin-cell maybe > build/t_mpmcl_bad.out 2>&1") != 0);
@@ -159,11 +159,34 @@ TEST(collapse_bad_arguments) {
     CHECK(gk_test_file_has("build/t_mpmcl_bad.out", "--dem-max"));
 }
 
+/* a corrupted checkpoint is refused by name (status 1); a result that cannot be written (the CSV's
+ * path taken by a folder) ends the run with status 1, said once; --out onto a file is refused */
+TEST(collapse_bad_files) {
+    CHECK(
+        system(
+            "rm -rf build/t_mpmcl_k && mkdir -p build/t_mpmcl_k && "
+            "cp build/t_mpmcl_a/checkpoint.bin build/t_mpmcl_k/ && "
+            "printf 'X' | dd of=build/t_mpmcl_k/checkpoint.bin bs=1 seek=5000 conv=notrunc 2>/dev/null && " CL
+            "--t-end " CL_T_END
+            " --restart build/t_mpmcl_k --out build/t_mpmcl_k2 > build/t_mpmcl_k.out 2>&1; "
+            "test $? -eq 1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmcl_k.out", "checksum mismatch"));
+    CHECK(system("rm -rf build/t_mpmcl_w && mkdir -p build/t_mpmcl_w/collapse.csv && " CL
+                 "--t-end 0.03 --out build/t_mpmcl_w > build/t_mpmcl_w.out 2>&1; test $? -eq 1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmcl_w.out",
+                           "mpmdem_collapse: cannot write build/t_mpmcl_w/collapse.csv"));
+    CHECK(system("grep -c 'cannot write' build/t_mpmcl_w.out | grep -qx 1") == 0);
+    CHECK(system("echo x > build/t_mpmcl_file && " CL "--out build/t_mpmcl_file > build/t_mpmcl_f.out 2>&1; "
+                 "test $? -eq 1") == 0);
+    CHECK(gk_test_file_has("build/t_mpmcl_f.out", "is a file, not a folder"));
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(collapse_runs_and_conserves);
     RUN(collapse_thread_independent);
     RUN(collapse_restart_identical);
     RUN(collapse_bad_arguments);
+    RUN(collapse_bad_files);
     return gk_test_done();
 }

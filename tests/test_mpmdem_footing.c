@@ -1,5 +1,5 @@
 /* test_mpmdem_footing.c - smoke tests of examples/mpmdem_footing.c (the
- * MPMxDEM rigid footing of seed 003 Sec 3.3): it runs, writes its documented
+ * MPMxDEM rigid footing of Liang & Zhao 2019 Sec 3.3): it runs, writes its documented
  * outputs, starts in equilibrium (footing pressure = surcharge at d = 0),
  * loads the footing, measures a sane friction angle of the RVE, does not
  * depend on the thread count, restarts to the identical result, and refuses
@@ -137,6 +137,10 @@ TEST(footing_bad_arguments) {
     BAD("--alpha 2", "--alpha");
     BAD("--packing /nonexistent", "nonexistent");
     BAD("--phi-deg 30 --restart /nonexistent", "cannot open");
+    BAD("--phi-pressures 10,,20", "--phi-pressures");
+    BAD("--phi-pressures 10,20,", "--phi-pressures");
+    BAD("--every 0.5 --final 0.2", "--every 0.5 is out of range");
+    BAD("--out build/t_mpmft_bad.out", "is a file, not a folder");
 #undef BAD
     CHECK(system("build/mpmdem_footing --help > build/t_mpmft_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/t_mpmft_bad.out", "--phi-pressures"));
