@@ -418,6 +418,7 @@ typedef struct mpd_micro {
     int *nsub, *frozen, *thin; /* per point: DEM steps of the last MPM step; refused it; refusals   */
     int thin_step;             /* refusals in the last MPM step                                     */
     long long dem_steps;       /* DEM steps over all points and MPM steps (cost)                    */
+    long long bytes;           /* bytes this rank sent to others in the MPM steps (MPI traffic)     */
     long warned;               /* frozen-point warnings printed                                     */
     double t;                  /* time at the start of the step (for those warnings)                */
     gk_twoscale_field *fld;    /* n: the fields of the accepted states (mpd_micro_fields)           */
@@ -496,6 +497,7 @@ static gk_result mpd_stress(gk_mpm_points *pts, double dt, void *user, gk_err *e
     const gk_twoscale_point *rp;
     gk_result res;
     int p, k, bad = -1, warn = 0;
+    long long b0 = m->ts.stats.bytes_out;
     for (p = 0; p < pts->n; ++p) {
         double *dH = m->dH + 9 * (size_t)p;
         gk_mpm_point_dH(pts, p, dt, dH);
@@ -529,6 +531,7 @@ static gk_result mpd_stress(gk_mpm_points *pts, double dt, void *user, gk_err *e
                           pts->x[0][bad], pts->x[1][bad], gk_twoscale_point_error(&m->ts, bad));
     }
     if (gk_twoscale_accept(&m->ts)) return gk_err_set(err, m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
+    m->bytes += m->ts.stats.bytes_out - b0; /* the step's: dH, results, migrations (not checkpoints) */
     if (warn && m->warned < 20 && mpd_micro_fields(m, err) == GK_OK)
         for (p = 0; p < pts->n && m->warned < 20; ++p)
             if (m->frozen[p] && m->thin[p] == 1) {

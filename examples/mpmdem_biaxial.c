@@ -332,12 +332,10 @@ static void report(bx *X, double secs, long steps_run, long long dems, int wrote
             ang);
     else
         printf("shear band: none yet (no point with eps_q > 2 x median)\n");
-    printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step); MPI "
-           "ranks %d, "
-           "%.4g bytes sent per MPM step\n",
+    printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step)\n",
            mpd_duration(secs, buf, sizeof buf), steps_run, dems,
-           steps_run ? (double)dems / steps_run / n : 0.0, X->run.nranks,
-           mpd_bytes_per_step(&X->M, steps_run));
+           steps_run ? (double)dems / steps_run / n : 0.0);
+    mpd_print_traffic(&X->run, &X->M, steps_run, X->o.threads);
     printf("RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g sigma_yy_end=%.6g eps_end=%.5g max_rotation_deg=%.3g "
            "band_angle_deg=%.3g n_rves=%d mpm_steps=%ld dt=%.4g seconds_per_step=%.4g "
            "seconds_per_step_per_1000_rves=%.4g total_seconds=%.2f\n",

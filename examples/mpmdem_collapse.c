@@ -560,12 +560,10 @@ static int finish(cl *X, double t_start, long steps_run, int bad) {
     if (S->at_rest) printf("at rest (E_k < %g E_p0) from t = %.3f s\n", b->rest_frac, S->t_rest);
     printf("RVEs without contacts at the end: %d of %d (zero stress); thin-cell refusals: %lld (%d points)\n",
            last->loose, n, S->thin_total, nthin);
-    printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.2f per point per MPM step); MPI "
-           "ranks %d, "
-           "%.4g bytes sent per MPM step\n",
+    printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.2f per point per MPM step)\n",
            mpd_duration(secs, buf, sizeof buf), steps_run, X->M.dem_steps,
-           steps_run ? (double)X->M.dem_steps / steps_run / n : 0.0, X->run.nranks,
-           mpd_bytes_per_step(&X->M, steps_run));
+           steps_run ? (double)X->M.dem_steps / steps_run / n : 0.0);
+    mpd_print_traffic(&X->run, &X->M, steps_run, X->o.threads);
     printf("RESULT dstar=%.4g dstar_paper=1.8 Ek_peak_over_Ep0=%.4g t_Ek_peak=%.4g Ed_final_over_Ep0=%.4g "
            "final_height=%.4g t_rest=%.4g n_rves=%d mpm_steps=%ld dt=%.4g dem_max=%d thin_points=%d "
            "seconds_per_step=%.4g seconds_per_step_per_1000_rves=%.4g total_seconds=%.2f\n",

@@ -660,10 +660,11 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
     per_rve = X->rss_after > 0 && X->rss_before > 0 ? (X->rss_after - X->rss_before) / np : NAN;
     printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step); %.4g s "
            "per MPM "
-           "step per 1000 RVEs (%.3g us per RVE DEM step); MPI ranks %d, %.4g bytes sent per MPM step\n",
+           "step per 1000 RVEs (%.3g us per RVE DEM step)\n",
            mpd_duration(secs, buf, sizeof buf), steps_run, dems,
            steps_run ? (double)dems / steps_run / np : 0.0, steps_run ? secs / steps_run * 1000.0 / np : 0.0,
-           dems ? 1e6 * secs / (double)dems : 0.0, X->run.nranks, mpd_bytes_per_step(&X->M, steps_run));
+           dems ? 1e6 * secs / (double)dems : 0.0);
+    mpd_print_traffic(&X->run, &X->M, steps_run, X->o.threads);
     printf(
         "memory (rank 0): VmHWM %.1f MB, %.1f kB per RVE (RSS growth on creation), checkpoint file %.1f MB\n",
         hwm / 1024, per_rve, ck_mb);

@@ -389,13 +389,16 @@ static const char *mpd_duration(double s, char *buf, size_t cap) {
     return buf;
 }
 
-/* bytes this run's ranks sent per MPM step (0 without MPI) */
-static double mpd_bytes_per_step(const mpd_micro *m, long steps) {
-    long long b = m->ts.stats.bytes_out, all = b;
+/* the line of the RVEs' traffic over the ranks (collective): bytes sent per MPM step by all ranks
+ * together in this run's steps (checkpoints left out), migrations of accepted RVE states by the load
+ * balance (zeros without MPI) */
+static void mpd_print_traffic(const mpd_run *run, const mpd_micro *m, long steps, int threads) {
+    long long b = m->bytes, all = b;
 #ifdef GK_TWOSCALE_MPI
     MPI_Allreduce(&b, &all, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
 #endif
-    return steps > 0 ? (double)all / steps : 0.0;
+    printf("MPI: %d ranks x %d threads, %.6g bytes sent per MPM step (all ranks), %lld RVE migrations\n",
+           run->nranks, threads, steps > 0 ? (double)all / steps : 0.0, m->ts.stats.migrated);
 }
 
 #endif /* MPMDEM_IO_H */

@@ -233,7 +233,7 @@ TEST(biaxial_mpi_matches_openmp) {
     CHECK(system("build/mpi/mpirun2 build/mpi/mpmdem_biaxial_mpi --nx 2 --ny 4 --strain 0.002 --every 0.0005 "
                  "--quiet "
                  "--threads 1 --out build/t_mpmbx_mpi > build/t_mpmbx_mpi.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_mpi.out", "MPI ranks 2"));
+    CHECK(gk_test_file_has("build/t_mpmbx_mpi.out", "MPI: 2 ranks x 1 threads"));
     CHECK(gk_test_result("build/t_mpmbx_mpi.out", "peak_sigma_yy") ==
           gk_test_result("build/t_mpmbx.out", "peak_sigma_yy"));
     CHECK(system("cut -d, -f1-7 build/t_mpmbx_mpi/biaxial.csv > build/t_mpmbx_mpi.c && "
