@@ -399,12 +399,8 @@ int main(int argc, char **argv) {
     gk_rve_state_init(&X.st0, NULL);
     mpd_begin(&X.run, "mpmdem_biaxial", &argc, &argv);
     status = run(&X, argc, argv);
-    free(X.rows.r), free(X.edge);
-    mpd_snaps_free(&X.snaps);
-    mpd_micro_free(&X.M);
+    free(X.edge);
+    mpd_free_all(&X.M, &X.P, &X.pts, &X.g, &X.rows, &X.snaps);
     gk_rve_state_free(&X.st0);
-    mpd_proto_close(&X.P);
-    gk_mpm_points_destroy(&X.pts);
-    gk_mpm_grid_destroy(&X.g);
     return mpd_end(status);
 }

@@ -656,12 +656,8 @@ int main(int argc, char **argv) {
     for (k = 0; k < CL_MAX_LEVELS; ++k) gk_rve_state_init(&X.st[k], NULL);
     mpd_begin(&X.run, "mpmdem_collapse", &argc, &argv);
     status = run(&X, argc, argv);
-    free(X.rows.r), free(X.work), free(X.pick);
-    mpd_snaps_free(&X.snaps);
-    mpd_micro_free(&X.M);
+    free(X.work), free(X.pick);
+    mpd_free_all(&X.M, &X.P, &X.pts, &X.g, &X.rows, &X.snaps);
     for (k = 0; k < CL_MAX_LEVELS; ++k) gk_rve_state_free(&X.st[k]);
-    mpd_proto_close(&X.P);
-    gk_mpm_points_destroy(&X.pts);
-    gk_mpm_grid_destroy(&X.g);
     return mpd_end(status);
 }

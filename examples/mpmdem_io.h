@@ -389,6 +389,18 @@ static const char *mpd_duration(double s, char *buf, size_t cap) {
     return buf;
 }
 
+/* what every driver frees at its end (whatever exists of it) */
+static void mpd_free_all(mpd_micro *m, mpd_proto *P, gk_mpm_points *pts, gk_mpm_grid *g, mpd_rows *R,
+                         mpd_snaps *sn) {
+    free(R->r);
+    R->r = NULL, R->n = R->cap = 0;
+    mpd_snaps_free(sn);
+    mpd_micro_free(m);
+    mpd_proto_close(P);
+    gk_mpm_points_destroy(pts);
+    gk_mpm_grid_destroy(g);
+}
+
 /* the line of the RVEs' traffic over the ranks (collective): bytes sent per MPM step by all ranks
  * together in this run's steps (checkpoints left out), migrations of accepted RVE states by the load
  * balance (zeros without MPI) */
