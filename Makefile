@@ -36,10 +36,13 @@ HAVE_MPI := $(shell command -v $(MPICC) >/dev/null 2>&1 && command -v $(MPIRUN) 
 # --oversubscribe (other MPIs do not know these flags)
 MPIRUN_FLAGS ?= $(shell $(MPIRUN) --version 2>/dev/null | grep -q 'Open MPI' && \
                   { [ "$$(id -u)" = 0 ] && echo '--allow-run-as-root --oversubscribe' || echo '--oversubscribe'; })
+# tests/mpi_*.c are MPI programs (mpicc) run on 2 ranks; tests/mpirun_*.c plain programs that launch
+# MPI programs themselves (GK_MPIRUN); each gets a runner script for tests/run_tests.sh
 MPI_TEST_SRC := $(wildcard tests/mpi_*.c)
-MPI_TESTS    := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/mpi_%,$(MPI_TEST_SRC))
-MPI_RUNNERS  := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/run_%,$(MPI_TEST_SRC))
-MPI_PROGS    := $(MPI_TESTS) $(MPI_RUNNERS)
+MPIRUN_SRC   := $(wildcard tests/mpirun_*.c)
+MPI_RUNNERS  := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/run_%,$(MPI_TEST_SRC)) \
+                $(patsubst tests/mpirun_%.c,$(BUILD)/mpi/drive_%,$(MPIRUN_SRC))
+MPI_PROGS    := $(BUILD)/femdem_biaxial_mpi $(MPI_RUNNERS)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/%,$(EX_SRC))
 BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
 TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
@@ -95,9 +98,19 @@ $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 $(BUILD)/mpi/mpi_%: tests/mpi_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/mpi
 	$(MPICC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
+.PRECIOUS: $(BUILD)/mpi/mpi_% $(BUILD)/mpi/mpirun_%
+$(BUILD)/mpi/mpirun_%: tests/mpirun_%.c tests/gk_test.h | $(BUILD)/mpi
+	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
+
 # a runner script per MPI test, so that tests/run_tests.sh runs it as any other test program
 $(BUILD)/mpi/run_%: $(BUILD)/mpi/mpi_% | $(BUILD)/mpi
 	@printf '#!/bin/sh\nexec %s %s -np 2 %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
+$(BUILD)/mpi/drive_%: $(BUILD)/mpi/mpirun_% | $(BUILD)/mpi
+	@printf '#!/bin/sh\nGK_MPIRUN="%s %s" exec %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
+
+# the FEMxDEM driver with its RVEs over MPI ranks (the same results: tests/mpirun_femdem.c)
+$(BUILD)/femdem_biaxial_mpi: examples/femdem_biaxial.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
 
 # the MPMxDEM drivers built on MPI (their RVEs spread over the ranks) and the 2-rank launcher their
 # test uses (tests/test_mpmdem_biaxial.c: 2 ranks give the CSV of the OpenMP build)
