@@ -112,16 +112,11 @@ $(BUILD)/mpi/drive_%: $(BUILD)/mpi/mpirun_% | $(BUILD)/mpi
 $(BUILD)/femdem_biaxial_mpi: examples/femdem_biaxial.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
 	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
 
-# the MPMxDEM drivers built on MPI (their RVEs spread over the ranks) and the 2-rank launcher their
-# test uses (tests/test_mpmdem_biaxial.c: 2 ranks give the CSV of the OpenMP build)
-MPI_EXAMPLES := $(patsubst %,$(BUILD)/mpi/mpmdem_%_mpi,biaxial footing collapse)
-MPI_PROGS    += $(MPI_EXAMPLES) $(BUILD)/mpi/mpirun2
-
-$(BUILD)/mpi/%_mpi: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)/mpi
+# the MPMxDEM drivers with their RVEs over MPI ranks (the same results: tests/mpirun_mpmdem.c)
+MPI_EXAMPLES := $(patsubst %,$(BUILD)/mpmdem_%_mpi,biaxial footing collapse)
+MPI_PROGS    += $(MPI_EXAMPLES)
+$(MPI_EXAMPLES): $(BUILD)/%_mpi: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
 	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
-
-$(BUILD)/mpi/mpirun2: | $(BUILD)/mpi
-	@printf '#!/bin/sh\nexec %s %s -np 2 "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' > $@ && chmod +x $@
 
 ifeq ($(HAVE_MPI),yes)
 mpi: $(MPI_PROGS)

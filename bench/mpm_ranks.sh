@@ -2,6 +2,7 @@
 # mpm_ranks.sh - the MPMxDEM footing's RVEs on 2 MPI ranks against 2 OpenMP threads.
 #
 #   make build/mpmdem_footing mpi && bench/mpm_ranks.sh [STEPS] [REPEATS]
+#   (GK_MPIRUN: the mpirun command and its flags; default mpirun --oversubscribe)
 #
 # Runs the default footing of mpmdem_footing (30 x 15 cells, 450 RVEs of 400
 # disks; --phi-deg 30 skips the friction-angle tests) for STEPS MPM steps
@@ -9,7 +10,7 @@
 # times (default 3):
 #   1x1  build/mpmdem_footing --threads 1
 #   1x2  build/mpmdem_footing --threads 2
-#   2x1  build/mpi/mpirun2 build/mpi/mpmdem_footing_mpi --threads 1   (2 ranks)
+#   2x1  $GK_MPIRUN -np 2 build/mpmdem_footing_mpi --threads 1
 # For each run: seconds per MPM step without the first step (the one-off
 # relaxation of every RVE: RESULT seconds_per_step_per_1000_rves_after_first
 # x 0.45), the bytes all ranks sent per MPM step and the RVE migrations of the
@@ -24,15 +25,21 @@ STEPS=${1:-60}
 REP=${2:-3}
 W=${BENCH_DIR:-build/bench_mpm_ranks}
 ARGS="--phi-deg 30 --max-steps $STEPS --quiet"
-[ -x build/mpmdem_footing ] && [ -x build/mpi/mpmdem_footing_mpi ] && [ -x build/mpi/mpirun2 ] || {
-    echo "mpm_ranks.sh: needs build/mpmdem_footing and build/mpi/mpmdem_footing_mpi (make mpi: mpicc)"
+# mpirun and its flags: Open MPI refuses root without --allow-run-as-root and more ranks than it
+# counts cores without --oversubscribe
+if [ -z "${GK_MPIRUN:-}" ]; then
+    GK_MPIRUN="mpirun --oversubscribe"
+    [ "$(id -u)" = 0 ] && GK_MPIRUN="$GK_MPIRUN --allow-run-as-root"
+fi
+[ -x build/mpmdem_footing ] && [ -x build/mpmdem_footing_mpi ] || {
+    echo "mpm_ranks.sh: needs build/mpmdem_footing and build/mpmdem_footing_mpi (make build/mpmdem_footing mpi: mpicc)"
     exit 2
 }
 mkdir -p "$W" || exit 1
 # seconds per step after the first, bytes per step, migrations of one run's output
 stats() {
     awk '/^RESULT / { for (i = 1; i <= NF; ++i) if ($i ~ /^seconds_per_step_per_1000_rves_after_first=/) { split($i, a, "="); t = a[2] * 0.45 } }
-         /^MPI: / { b = $7; m = $(NF - 2) }
+         /^MPI ranks=/ { for (i = 1; i <= NF; ++i) { split($i, a, "="); if (a[1] == "bytes_sent_per_step") b = a[2]; if (a[1] == "point_moves") m = a[2] } }
          END { printf "%.6g %s %s", t, b, m }' "$1"
 }
 strip() { cut -d, -f1-8 "$1"; }
@@ -40,7 +47,7 @@ echo "footing, 450 RVEs, $STEPS MPM steps, $REP repeats (s/step after the first;
 for r in $(seq 1 "$REP"); do
     build/mpmdem_footing $ARGS --threads 1 --out "$W/1x1" > "$W/1x1.out" 2>&1 || echo "1x1 failed"
     build/mpmdem_footing $ARGS --threads 2 --out "$W/1x2" > "$W/1x2.out" 2>&1 || echo "1x2 failed"
-    build/mpi/mpirun2 build/mpi/mpmdem_footing_mpi $ARGS --threads 1 --out "$W/2x1" > "$W/2x1.out" 2>&1 || echo "2x1 failed"
+    $GK_MPIRUN -np 2 build/mpmdem_footing_mpi $ARGS --threads 1 --out "$W/2x1" > "$W/2x1.out" 2>&1 || echo "2x1 failed"
     set -- $(stats "$W/1x1.out") $(stats "$W/1x2.out") $(stats "$W/2x1.out")
     awk -v r="$r" -v a="$1" -v b="$4" -v c="$7" -v cb="$8" -v cm="$9" 'BEGIN {
         printf "repeat %s: 1x1 %.4g s, 1x2 %.4g s, 2x1 %.4g s (%.0f bytes/step, %d migrations) | 2 threads %.3fx, 2 ranks %.3fx, 2-rank efficiency %.1f %%, ranks/threads %.3f\n",

@@ -43,12 +43,12 @@
  * c bounds the P-wave speed and the step is safe while the contact network
  * keeps its stiffness (the drivers print M, rho, c, dt).
  *
- * MPI. Built with mpicc and -DGK_TWOSCALE_MPI (make mpi: build/mpi/NAME_mpi),
+ * MPI. Built with mpicc and -DGK_TWOSCALE_MPI (make mpi: build/mpmdem_NAME_mpi),
  * every rank runs the whole MPM (it is cheap next to the RVEs) and the
  * gk_twoscale set spreads the RVEs over the ranks (each stores only its
  * own); rank 0 alone prints and writes. The results are those of the
  * OpenMP build, bit for bit, for any rank and thread count:
- *     mpirun -np 2 build/mpi/mpmdem_biaxial_mpi --threads 1 --out DIR
+ *     mpirun -np 2 build/mpmdem_biaxial_mpi --threads 1 --out DIR
  *
  * OUTPUT AND EXIT STATUS. --out DIR is created (with its parents) and must
  * not be a file; every result written (CSV, SVG, VTK, checkpoint) is
@@ -290,7 +290,7 @@ static void mpd_usage_common(FILE *fp, const mpd_opts *d) {
             "  --checkpoint N         checkpoint every N MPM steps into DIR/checkpoint.bin (0: at the end)\n"
             "  --restart DIR          continue from DIR/checkpoint.bin (same flags) to the same result\n"
             "  --quiet                no progress lines\n"
-            "MPI: build/mpi/<driver>_mpi under mpirun spreads the RVEs over the ranks (same results).\n"
+            "MPI: build/<driver>_mpi (make mpi) under mpirun spreads the RVEs over the ranks (same results).\n"
             "exit status: 0 done, 1 setup or an output failed, 2 bad arguments, 3 the simulation failed\n",
             d->dem_min, d->dem_max, d->dem_dt, d->young, d->kt_ratio, d->friction_deg, d->roll_beta,
             d->roll_eta, d->dem_damping);

@@ -8,7 +8,7 @@
  *
  *   build/mpmdem_biaxial                       # 8 x 16 cells, 1 point each, to 3 %
  *   build/mpmdem_biaxial --nx 10 --ny 20 --ppc 2 --strain 0.15   # the paper's M4
- *   mpirun -np 2 build/mpi/mpmdem_biaxial_mpi --threads 1         # the RVEs on 2 ranks
+ *   mpirun -np 2 build/mpmdem_biaxial_mpi --threads 1         # the RVEs on 2 ranks
  *
  * Model. Points fill the specimen (ppc^2 per cell, h = width / nx); the grid
  * is padded by ghost layers and by room for the bulge. The base and the top

@@ -11,7 +11,7 @@
  *
  *   build/mpmdem_collapse                         # 8 x 8 cells, 1 point each
  *   build/mpmdem_collapse --nx 16 --ppc 2         # the paper's size, 1024 RVEs
- *   mpirun -np 2 build/mpi/mpmdem_collapse_mpi --threads 1   # the RVEs on 2 ranks
+ *   mpirun -np 2 build/mpmdem_collapse_mpi --threads 1   # the RVEs on 2 ranks
  *
  * Model. Square cells h = width / nx; the column holds nx x ny cells (ny =
  * nx height / width) with ppc^2 points each (uGIMP by default). The grid

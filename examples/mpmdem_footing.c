@@ -10,7 +10,7 @@
  *
  *   build/mpmdem_footing                  # reduced default (about a minute)
  *   build/mpmdem_footing --paper          # 12 x 8 m, 108 x 72 cells, 7776 RVEs
- *   mpirun -np 2 build/mpi/mpmdem_footing_mpi --threads 1   # the RVEs on 2 ranks
+ *   mpirun -np 2 build/mpmdem_footing_mpi --threads 1   # the RVEs on 2 ranks
  *
  * GEOMETRY (half model, x = 0 is the symmetry plane). The paper: soil 12 m
  * wide, 8 m deep, footing "1 m x 2 m (width x height)", d/B = 1.5 at the end.

@@ -409,8 +409,9 @@ static void mpd_print_traffic(const mpd_run *run, const mpd_micro *m, long steps
 #ifdef GK_TWOSCALE_MPI
     MPI_Allreduce(&b, &all, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
 #endif
-    printf("MPI: %d ranks x %d threads, %.6g bytes sent per MPM step (all ranks), %lld RVE migrations\n",
-           run->nranks, threads, steps > 0 ? (double)all / steps : 0.0, m->ts.stats.migrated);
+    printf(
+        "MPI ranks=%d threads=%d bytes_sent_per_step=%.6g point_moves=%lld (all ranks, in the MPM steps)\n",
+        run->nranks, threads, steps > 0 ? (double)all / steps : 0.0, m->ts.stats.migrated);
 }
 
 #endif /* MPMDEM_IO_H */

@@ -1,15 +1,14 @@
 /* test_mpmdem_biaxial.c - smoke tests of examples/mpmdem_biaxial.c (the
  * MPMxDEM biaxial test of Liang & Zhao 2019): it runs, writes its documented
  * outputs, starts in equilibrium, loads the specimen, does not depend on the
- * thread count nor on the MPI rank count, restarts to the identical result,
+ * thread count, restarts to the identical result,
  * refuses a corrupted or foreign checkpoint, bad arguments and an --out that
  * is a file, and ends with status 1 when a result cannot be written. Needs
- * build/mpmdem_biaxial (`make test` builds examples first) and, for the MPI
- * test, build/mpi/mpmdem_biaxial_mpi and build/mpi/mpirun2 (`make mpi`). */
+ * build/mpmdem_biaxial (`make test` builds examples first); the MPI build's
+ * test is tests/mpirun_mpmdem.c. */
 #define GK_TEST_DRIVERS
 #include "gk_test.h"
 #include <stdlib.h>
-#include <unistd.h>
 
 /* a 2 x 4 cell specimen (8 RVEs): tiny but the whole path */
 #define BX "build/mpmdem_biaxial --nx 2 --ny 4 --strain 0.002 --every 0.0005 --quiet "
@@ -223,26 +222,6 @@ TEST(biaxial_out_folder) {
     CHECK(gk_test_file_has("build/t_mpmbx_f/a/b/biaxial.csv", "time,eps_axial"));
 }
 
-/* the MPI build on 2 ranks x 1 thread gives the OpenMP build's (2 threads) CSV, first and last VTK
- * (every field and the stress of every point) and RESULT, to the last digit */
-TEST(biaxial_mpi_matches_openmp) {
-    if (access("build/mpi/mpmdem_biaxial_mpi", X_OK) || access("build/mpi/mpirun2", X_OK)) {
-        printf("skip biaxial_mpi_matches_openmp: no build/mpi/mpmdem_biaxial_mpi (make mpi needs mpicc)\n");
-        return;
-    }
-    CHECK(system("build/mpi/mpirun2 build/mpi/mpmdem_biaxial_mpi --nx 2 --ny 4 --strain 0.002 --every 0.0005 "
-                 "--quiet "
-                 "--threads 1 --out build/t_mpmbx_mpi > build/t_mpmbx_mpi.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_mpi.out", "MPI: 2 ranks x 1 threads"));
-    CHECK(gk_test_result("build/t_mpmbx_mpi.out", "peak_sigma_yy") ==
-          gk_test_result("build/t_mpmbx.out", "peak_sigma_yy"));
-    CHECK(system("cut -d, -f1-7 build/t_mpmbx_mpi/biaxial.csv > build/t_mpmbx_mpi.c && "
-                 "cmp -s build/t_mpmbx_mpi.c build/t_mpmbx2.c") == 0);
-    CHECK(system("cmp -s build/t_mpmbx_mpi/points_000000.vtk build/t_mpmbx/points_000000.vtk && "
-                 "cmp -s build/t_mpmbx_mpi/points_000278.vtk build/t_mpmbx/points_000278.vtk") == 0);
-    CHECK(count_lines("build/t_mpmbx_mpi.out", "RESULT ") == 1); /* rank 0 alone speaks */
-}
-
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(biaxial_runs_and_loads);
@@ -252,6 +231,5 @@ int main(int argc, char **argv) {
     RUN(biaxial_bad_checkpoint_refused);
     RUN(biaxial_failed_write_exits);
     RUN(biaxial_out_folder);
-    RUN(biaxial_mpi_matches_openmp);
     return gk_test_done();
 }
