@@ -13,7 +13,8 @@ BUILD   ?= build
 PREFIX  ?= /usr/local
 
 WARN    := -std=c99 -pedantic -Wall -Wextra -Werror
-# determinism: no FMA contraction, never -ffast-math (DESIGN.md principle 3)
+# determinism: no FMA contraction, never -ffast-math (results must not depend on
+# the compiler's choice of fused operations)
 FPFLAGS := -ffp-contract=off -fno-fast-math
 CFLAGS  := $(WARN) $(OPT) $(ARCH) $(FPFLAGS) $(OMP) -Iinclude -Itests
 LDLIBS  := -lm
@@ -38,7 +39,7 @@ help:
 	@echo "make            build tests, examples, benchmarks and tools into $(BUILD)/"
 	@echo "make run        the main job: FEMxDEM biaxial test (see README.md)"
 	@echo "make run-rve    one RVE along a shear path"
-	@echo "make run-mpm | run-footing | run-collapse   seed 003's MPMxDEM biaxial, footing, column collapse"
+	@echo "make run-mpm | run-footing | run-collapse   MPMxDEM biaxial, footing, column collapse (Liang & Zhao 2019)"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability"
 	@echo "make bench      performance programs (2 cores)"
@@ -47,7 +48,7 @@ help:
 	@echo "make install PREFIX=dir   headers + pkg-config file"
 	@echo "make format / format-check   clang-format"
 
-$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr:
+$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests:
 	@mkdir -p $@
 
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
@@ -75,7 +76,7 @@ $(BUILD)/bench_tradeoff: | $(BUILD)/femdem_biaxial $(BUILD)/femdem_biaxial_float
 $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
-test: $(TESTS) $(EXAMPLES) $(TOOLS)
+test: $(TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 	@tests/run_tests.sh $(TESTS)
 
 # ---------------------------------------------------------------- check
@@ -89,11 +90,11 @@ $(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/asan
 $(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/nosimd
 	$(CC) $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude -Itests -o $@ $< $(LDLIBS)
 
-check-asan: $(ASAN_TESTS) $(EXAMPLES) $(TOOLS)
+check-asan: $(ASAN_TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 	@echo "== tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 	@ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 tests/run_tests.sh $(ASAN_TESTS)
 
-check-nosimd: $(NOSIMD_TESTS) $(EXAMPLES) $(TOOLS)
+check-nosimd: $(NOSIMD_TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 	@echo "== tests built without SIMD (GK_NO_SIMD, no -march)"
 	@tests/run_tests.sh $(NOSIMD_TESTS)
 
@@ -120,13 +121,13 @@ check-headers: | $(BUILD)/hdr
 check: check-headers check-nosimd check-asan
 
 # ---------------------------------------------------------------- run / bench
-# the seed 000 FEMxDEM biaxial test at a size that runs in about a minute on
-# 2 cores (4 x 8 Q8, 128 RVEs, through the peak); the paper's mesh is
-# --nx 8 --ny 16 --steps 100
+# the FEMxDEM biaxial test of Guo & Zhao (2014) at a size that runs in about a minute on
+# 2 cores (4 x 8 Q8, 128 RVEs, through the peak); examples/README.md has the
+# larger runs
 run: $(BUILD)/femdem_biaxial
 	$(BUILD)/femdem_biaxial --nx 4 --ny 8 --element q8 --steps 30 --threads 2 --out $(BUILD)/biaxial
 
-# seed 003's MPMxDEM systems at default sizes of about a minute each on 2
+# the MPMxDEM systems of Liang & Zhao (2019) at default sizes of about a minute each on 2
 # cores (128-400 RVEs); every driver's --help gives the paper's sizes
 run-mpm: $(BUILD)/mpmdem_biaxial
 	$(BUILD)/mpmdem_biaxial --threads 2 --out $(BUILD)/mpm_biaxial
@@ -142,8 +143,8 @@ run-rve: $(BUILD)/rve_path
 bench: $(BENCHES)
 	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
 
-# issue 6: error against cost over RVE size, DEM steps, float, tangent, mesh,
-# element and MPM points per cell (make bench runs the short version)
+# error against cost over RVE size, DEM steps, float, tangent, mesh, element
+# and MPM points per cell (make bench runs the short version)
 tradeoff: $(BUILD)/bench_tradeoff
 	$(BUILD)/bench_tradeoff --full
 
