@@ -90,13 +90,25 @@
  *   simple shear); tests/test_fem.c has periodic patch tests.
  *
  * SOLVERS
+ *   gk_solver_init          an empty solver (every gk_solver starts here:
+ *                           factor refuses one that did not, GK_ERR_ARG)
  *   gk_solver_factor/solve  direct: reverse Cuthill-McKee ordering, then a
  *                           banded LU with partial pivoting (robust for the
  *                           non-symmetric perturbation tangent). A pivot below
  *                           1e-12 x max|A| -> GK_ERR_SINGULAR naming the dof
  *                           (typically an unconstrained rigid-body mode).
+ *                           A new factorisation replaces (frees) the one the
+ *                           solver held only on success; on failure the old
+ *                           one is kept. gk_solver_free returns it to the
+ *                           gk_solver_init state. solve: a non-finite b ->
+ *                           GK_ERR_NAN, a non-finite solution (overflow) ->
+ *                           GK_ERR_DIVERGED; x is then unchanged and the
+ *                           message is in s->err.
  *   gk_pcg                  Jacobi-preconditioned conjugate gradients for large
- *                           symmetric positive definite systems.
+ *                           symmetric positive definite systems; rtol in
+ *                           (0, 1), b and the start x finite. x is changed
+ *                           on success and on GK_ERR_NOCONVERGE (the last
+ *                           iterate) only.
  *
  * Units and signs as gk_base.h: SI, tension-positive stress. 2D is plane
  * strain per unit thickness (forces are N/m).
@@ -147,13 +159,17 @@ typedef struct gk_dofmap {
 } gk_dofmap;
 
 typedef struct gk_solver {
+    int cookie;       /* set by gk_solver_init                              */
     int n, kl, ku, w; /* band: kl below, ku above (+kl fill from pivoting)  */
     int *perm;        /* perm[new] = old dof (reverse Cuthill-McKee)        */
     int *ipiv;        /* row interchanges                                   */
     double *ab;       /* n x w row-band: A(i,j) at ab[i*w + j - i + kl]     */
     double *tmp;      /* n                                                  */
     gk_allocator alloc;
+    gk_err err;       /* message of the last failed gk_solver_solve         */
 } gk_solver;
+
+#define GK_SOLVER_COOKIE 0x534f4c56
 
 #ifdef __cplusplus
 extern "C" {
@@ -215,6 +231,7 @@ GKDEF void gk_dofmap_expand(const gk_dofmap *dm, const double *ur, int with_jump
 GKDEF gk_result gk_dofmap_dirichlet(const gk_dofmap *dm, int nfix, const int *dofs, const double *vals,
                                     int *rdofs, double *rvals, int *nrfix, gk_err *err);
 
+GKDEF void gk_solver_init(gk_solver *s);
 GKDEF gk_result gk_solver_factor(gk_solver *s, const gk_csr *A, const gk_allocator *alloc, gk_err *err);
 GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x);
 GKDEF void gk_solver_free(gk_solver *s);
@@ -315,7 +332,12 @@ GKDEF gk_result gk_fem_jacobian(const gk_mesh *m, int e, const double *xi, doubl
                                 double *detJ, gk_err *err) {
     double Nl[GK_FEM_MAX_NPE], dN[3 * GK_FEM_MAX_NPE], J[9], Ji[9], det;
     int a, i, j, dim = m->dim, npe = m->npe;
-    const int *c = m->conn + (size_t)e * npe;
+    const int *c;
+    if (e < 0 || e >= m->nelem) return gk_err_set(err, GK_ERR_ARG, "element %d of %d", e, m->nelem);
+    c = m->conn + (size_t)e * npe;
+    for (a = 0; a < npe; ++a)
+        if (c[a] < 0 || c[a] >= m->nnode)
+            return gk_err_set(err, GK_ERR_MESH, "element %d: node id %d out of range", e, c[a]);
     gk_fem_shape(m->type, xi, Nl, dN);
     gk_m3_identity(J);
     for (i = 0; i < dim; ++i)
@@ -354,6 +376,10 @@ GKDEF gk_result gk_fem_elem_stiffness(const gk_mesh *m, int e, const gk_quad *q,
                                       gk_err *err) {
     int dim = m->dim, npe = m->npe, nd = dim * npe, n4 = dim * dim * dim * dim, g, a, b, i, j, k, l;
     double dNdx[3 * GK_FEM_MAX_NPE], detJ;
+    if (e < 0 || e >= m->nelem) return gk_err_set(err, GK_ERR_ARG, "element %d of %d", e, m->nelem);
+    for (k = 0; k < q->n * n4; ++k)
+        if (!(fabs(D[k]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_NAN, "tangent of element %d, Gauss point %d is not finite", e, k / n4);
     for (k = 0; k < nd * nd; ++k) Ke[k] = 0.0;
     for (g = 0; g < q->n; ++g) {
         const double *Dg = D + (size_t)g * n4;
@@ -387,6 +413,10 @@ GKDEF gk_result gk_fem_elem_force(const gk_mesh *m, int e, const gk_quad *q, con
                                   gk_err *err) {
     int dim = m->dim, npe = m->npe, g, a, i, j;
     double dNdx[3 * GK_FEM_MAX_NPE], detJ;
+    if (e < 0 || e >= m->nelem) return gk_err_set(err, GK_ERR_ARG, "element %d of %d", e, m->nelem);
+    for (a = 0; a < 9 * q->n; ++a)
+        if (!(fabs(sigma[a]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_NAN, "stress of element %d, Gauss point %d is not finite", e, a / 9);
     for (a = 0; a < dim * npe; ++a) fe[a] = 0.0;
     for (g = 0; g < q->n; ++g) {
         const double *s = sigma + 9 * (size_t)g;
@@ -404,27 +434,45 @@ GKDEF gk_result gk_fem_elem_force(const gk_mesh *m, int e, const gk_quad *q, con
 
 GKDEF gk_result gk_fem_assemble(const gk_mesh *m, const gk_quad *q, const double *D, const double *sigma,
                                 gk_csr *K, double *fint, gk_err *err) {
-    int dim = m->dim, npe = m->npe, nd = dim * npe, n4 = dim * dim * dim * dim, e, a, b, i, k;
-    double Ke[24 * 24], fe[24];
+    int dim = m->dim, npe = m->npe, nd = dim * npe, n4 = dim * dim * dim * dim, e, a, b, i, k, g;
+    double Ke[24 * 24], fe[24], dNdx[3 * GK_FEM_MAX_NPE], detJ;
+    /* every check before K or fint is touched: bad input changes nothing */
     if (K) {
+        size_t t, nt = (size_t)m->nelem * q->n * n4;
         if (K->n != dim * m->nnode)
             return gk_err_set(err, GK_ERR_ARG, "matrix has %d rows, mesh %d dofs", K->n, dim * m->nnode);
         if (!D) return gk_err_set(err, GK_ERR_ARG, "a matrix needs tangents D");
-        size_t t, nt = (size_t)m->nelem * q->n * n4;
         for (t = 0; t < nt; ++t)
             if (!(fabs(D[t]) < HUGE_VAL))
                 return gk_err_set(err, GK_ERR_NAN, "tangent of element %d, Gauss point %d is not finite",
                                   (int)(t / ((size_t)q->n * n4)), (int)(t / n4) % q->n);
-        gk_csr_zero(K);
     }
     if (fint) {
+        size_t t, nt = (size_t)m->nelem * q->n * 9;
         if (!sigma) return gk_err_set(err, GK_ERR_ARG, "an internal force needs stresses");
-        for (k = 0; k < m->nelem * q->n * 9; ++k)
-            if (!(fabs(sigma[k]) < HUGE_VAL))
+        for (t = 0; t < nt; ++t)
+            if (!(fabs(sigma[t]) < HUGE_VAL))
                 return gk_err_set(err, GK_ERR_NAN, "stress of element %d, Gauss point %d is not finite",
-                                  k / (q->n * 9), (k / 9) % q->n);
-        for (k = 0; k < dim * m->nnode; ++k) fint[k] = 0.0;
+                                  (int)(t / ((size_t)q->n * 9)), (int)(t / 9) % q->n);
     }
+    for (e = 0; e < m->nelem; ++e) {
+        const int *c = m->conn + (size_t)e * npe;
+        for (g = 0; g < q->n; ++g) {
+            gk_result r = gk_fem_jacobian(m, e, q->xi[g], NULL, dNdx, &detJ, err);
+            if (r) return r;
+        }
+        if (K)
+            for (a = 0; a < npe * dim; ++a)
+                for (b = 0; b < npe * dim; ++b)
+                    if (!gk_csr_at(K, dim * c[a / dim] + a % dim, dim * c[b / dim] + b % dim))
+                        return gk_err_set(err, GK_ERR_ARG,
+                                          "matrix pattern lacks nodes %d-%d of element %d (build it with "
+                                          "gk_csr_from_mesh of this mesh)",
+                                          c[a / dim], c[b / dim], e);
+    }
+    if (K) gk_csr_zero(K);
+    if (fint)
+        for (k = 0; k < dim * m->nnode; ++k) fint[k] = 0.0;
     for (e = 0; e < m->nelem; ++e) {
         const int *c = m->conn + (size_t)e * npe;
         gk_result r;
@@ -610,6 +658,13 @@ GKDEF gk_result gk_mesh_structured(gk_mesh *m, gk_elem_type t, const int n[3], c
                               k);
     }
     nx = n[0], ny = n[1], nz = dim == 3 ? n[2] : 1;
+    { /* counts as doubles first: node ids, dofs (dim per node) and connectivity entries are int */
+        double ne = (double)nx * ny * nz, nn = t == GK_Q8 ? (2.0 * nx + 1) * (2.0 * ny + 1)
+                                                         : (nx + 1.0) * (ny + 1.0) * (dim == 3 ? nz + 1.0 : 1.0);
+        if (ne * gk_fem_npe(t) > (double)INT_MAX || nn * dim > (double)INT_MAX)
+            return gk_err_set(err, GK_ERR_ARG, "%d x %d x %d mesh: %.0f elements, %.0f nodes exceed int indices",
+                              nx, ny, nz, ne, nn);
+    }
     if (t == GK_Q4 || t == GK_HEX8) {
         int nn = (nx + 1) * (ny + 1) * (dim == 3 ? nz + 1 : 1);
         r = gk__mesh_alloc(&z, t, nn, nx * ny * nz, alloc, err);
@@ -1558,19 +1613,29 @@ GKDEF gk_result gk_rcm_order(const gk_csr *A, int *perm, const gk_allocator *all
     return GK_OK;
 }
 
-GKDEF void gk_solver_free(gk_solver *s) {
-    gk_free(&s->alloc, s->perm), gk_free(&s->alloc, s->ipiv), gk_free(&s->alloc, s->ab),
-        gk_free(&s->alloc, s->tmp);
+GKDEF void gk_solver_init(gk_solver *s) {
     memset(s, 0, sizeof *s);
+    s->cookie = GK_SOLVER_COOKIE;
+}
+
+GKDEF void gk_solver_free(gk_solver *s) {
+    if (s->cookie == GK_SOLVER_COOKIE)
+        gk_free(&s->alloc, s->perm), gk_free(&s->alloc, s->ipiv), gk_free(&s->alloc, s->ab),
+            gk_free(&s->alloc, s->tmp);
+    gk_solver_init(s);
 }
 
 GKDEF gk_result gk_solver_factor(gk_solver *s, const gk_csr *A, const gk_allocator *alloc, gk_err *err) {
     gk_solver z;
-    int n = A->n, i, p, k, *inv = NULL, kl = 0, ku = 0;
+    int n, i, p, k, *inv = NULL, kl = 0, ku = 0;
     double amax = 0.0, tiny;
     gk_result res;
-    memset(&z, 0, sizeof z);
+    if (!s || s->cookie != GK_SOLVER_COOKIE)
+        return gk_err_set(err, GK_ERR_ARG, "gk_solver not initialised with gk_solver_init()");
+    if (!A || !A->rowptr) return gk_err_set(err, GK_ERR_ARG, "no matrix given");
+    gk_solver_init(&z);
     if (alloc) z.alloc = *alloc;
+    n = A->n;
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "empty system");
     for (p = 0; p < A->nnz; ++p) {
         if (!(fabs(A->val[p]) < HUGE_VAL))
@@ -1648,9 +1713,13 @@ fail:
 }
 
 GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x) {
-    int n = s->n, kl = s->kl, k, i, j;
-    double *y = s->tmp;
-    if (!s->ab) return GK_ERR_STATE;
+    int n, kl, k, i, j;
+    double *y;
+    if (s->cookie != GK_SOLVER_COOKIE || !s->ab)
+        return gk_err_set(&s->err, GK_ERR_STATE, "solve before a successful gk_solver_factor");
+    n = s->n, kl = s->kl, y = s->tmp;
+    for (i = 0; i < n; ++i)
+        if (!(fabs(b[i]) < HUGE_VAL)) return gk_err_set(&s->err, GK_ERR_NAN, "right-hand side %d is %g", i, b[i]);
 #define GK__AB(r, c) s->ab[(size_t)(r)*s->w + (c) - (r) + kl]
     for (i = 0; i < n; ++i) y[i] = b[s->perm[i]];
     for (k = 0; k < n; ++k) {
@@ -1668,22 +1737,33 @@ GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x) {
         y[k] = acc / GK__AB(k, k);
     }
 #undef GK__AB
+    for (i = 0; i < n; ++i)
+        if (!(fabs(y[i]) < HUGE_VAL))
+            return gk_err_set(&s->err, GK_ERR_DIVERGED, "solution entry %d is %g (overflow: a near-singular system?)",
+                              s->perm[i], y[i]);
     for (i = 0; i < n; ++i) x[s->perm[i]] = y[i];
     return GK_OK;
 }
 
-GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol, int maxit, int *iters,
+GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x_out, double rtol, int maxit, int *iters,
                        const gk_allocator *alloc, gk_err *err) {
+    double *x = x_out;
     int n = A->n, i, it, p;
-    double *r, *z, *d, *q, *Mi, rz, bn = 0.0;
+    double *r, *z, *d, *q, *Mi, *xw, rz, bn = 0.0;
     gk_allocator al;
     memset(&al, 0, sizeof al);
     if (alloc) al = *alloc;
-    if (!(rtol > 0.0) || maxit < 1)
-        return gk_err_set(err, GK_ERR_ARG, "PCG tolerance %g, max iterations %d", rtol, maxit);
-    r = (double *)gk_alloc(&al, 5 * (size_t)n * sizeof(double));
+    if (!(rtol > 0.0 && rtol < 1.0) || maxit < 1)
+        return gk_err_set(err, GK_ERR_ARG, "PCG tolerance %g (must be in (0, 1)), max iterations %d (>= 1)", rtol,
+                          maxit);
+    for (i = 0; i < n; ++i)
+        if (!(fabs(b[i]) < HUGE_VAL) || !(fabs(x[i]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_NAN, "PCG: right-hand side or start value %d is not finite", i);
+    r = (double *)gk_alloc(&al, 6 * (size_t)n * sizeof(double));
     if (!r) return gk_err_set(err, GK_ERR_ALLOC, "PCG work arrays");
-    z = r + n, d = z + n, q = d + n, Mi = q + n;
+    z = r + n, d = z + n, q = d + n, Mi = q + n, xw = Mi + n;
+    memcpy(xw, x, (size_t)n * sizeof(double)); /* x changes only on success or GK_ERR_NOCONVERGE */
+    x = xw;
     for (i = 0; i < n; ++i) {
         double dg = 0.0;
         for (p = A->rowptr[i]; p < A->rowptr[i + 1]; ++p)
@@ -1715,8 +1795,14 @@ GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol,
         beta = rz1 / rz, rz = rz1;
         for (i = 0; i < n; ++i) d[i] = z[i] + beta * d[i];
     }
-    gk_free(&al, r);
     if (iters) *iters = it;
+    for (i = 0; i < n; ++i)
+        if (!(fabs(x[i]) < HUGE_VAL)) {
+            gk_free(&al, r);
+            return gk_err_set(err, GK_ERR_DIVERGED, "PCG iterate %d is not finite", i);
+        }
+    memcpy(x_out, x, (size_t)n * sizeof(double));
+    gk_free(&al, r);
     if (it == maxit)
         return gk_err_set(err, GK_ERR_NOCONVERGE, "PCG did not reach %g in %d iterations", rtol, maxit);
     return GK_OK;
