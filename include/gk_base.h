@@ -57,6 +57,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <math.h>
 
 #define GK_VERSION_MAJOR 0
@@ -200,6 +201,10 @@ GKDEF gk_result gk_realloc(const gk_allocator *a, void **ptr, size_t old_n, size
  * unreadable file or one above GK_FILE_MAX bytes is GK_ERR_IO naming the path
  * and the reason. On error *text and *len are untouched. */
 GKDEF gk_result gk_file_read(const char *path, const gk_allocator *alloc, char **text, size_t *len, gk_err *err);
+/* Closes a FILE * that was written: fflush, ferror and fclose,
+ * so a lost byte anywhere (disk full, /dev/full, a quota) is GK_ERR_IO naming
+ * path and reason. The file is closed in every case. */
+GKDEF gk_result gk_file_close(FILE *fp, const char *path, gk_err *err);
 
 GKDEF void gk_rng_seed(gk_rng *r, uint64_t seed);
 GKDEF uint64_t gk_rng_u64(gk_rng *r);
@@ -855,6 +860,22 @@ GKDEF gk_result gk_file_read(const char *path, const gk_allocator *alloc, char *
     buf[n] = '\0';
     *text = buf;
     *len = n;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_file_close(FILE *fp, const char *path, gk_err *err) {
+    int bad, e;
+    if (!fp) return gk_err_set(err, GK_ERR_ARG, "no file to close ('%s')", path ? path : "");
+    errno = 0;
+    bad = fflush(fp) != 0 || ferror(fp);
+    e = errno;
+    if (fclose(fp) != 0) {
+        bad = 1;
+        if (!e) e = errno;
+    }
+    if (bad)
+        return gk_err_set(err, GK_ERR_IO, "error writing '%s': %s", path ? path : "file",
+                          e ? strerror(e) : "write error");
     return GK_OK;
 }
 

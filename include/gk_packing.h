@@ -343,8 +343,7 @@ GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const c
         else
             fprintf(fp, "%.17g %.17g %.17g %.17g\n", pk->x[k], pk->y[k], pk->z[k], pk->r[k]);
     }
-    if (fclose(fp) != 0) return gk_err_set(err, GK_ERR_IO, "error writing '%s'", path);
-    return GK_OK;
+    return gk_file_close(fp, path, err);
 }
 
 GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err) {
