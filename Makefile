@@ -82,7 +82,8 @@ $(BUILD)/bench_tradeoff: | $(BUILD)/femdem_biaxial $(BUILD)/femdem_biaxial_float
 $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
-test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) | $(BUILD)/tests
+# bench_tradeoff too: test_untrusted checks that a failed run fails it
+test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) $(BUILD)/bench_tradeoff | $(BUILD)/tests
 	@tests/run_tests.sh $(TESTS) $(FUZZ_REPLAY)
 
 # the fuzz corpora and every crasher replayed by a plain program (tests/fuzz/replay.c)

@@ -12,20 +12,55 @@
  *                              #include "gk_dem.h"
  *
  *   gk_packing pk;  gk_err e;  gk_rve rve;
- *   gk_rve_def def = gk_rve_def_default();          // seed 000 material
- *   gk_packing_read("rve400.txt", &pk, NULL, &e);
- *   gk_rve_create(&rve, &def, &pk);
+ *   gk_rve_def def = gk_rve_def_default();          // Guo & Zhao (2014) material
+ *   if (gk_packing_read("rve400.txt", &pk, NULL, &e)) { puts(e.msg); return 1; }
+ *   if (gk_rve_create(&rve, &def, &pk)) { puts(gk_rve_error(&rve)); gk_packing_free(&pk); return 1; }
+ *   gk_packing_free(&pk);
  *   double dH[9] = {0, 1e-3, 0,  0, 0, 0,  0, 0, 0};  // H01 = du_x/dy
- *   gk_rve_deform(&rve, dH, 100);                   // 100 DEM steps
- *   double sig[9]; gk_rve_stress(&rve, sig);        // Love stress, tension +
- *   gk_rve_destroy(&rve); gk_packing_free(&pk);
+ *   if (gk_rve_deform(&rve, dH, 100)) puts(gk_rve_error(&rve));  // 100 DEM steps
+ *   double sig[9]; gk_rve_stress(&rve, sig);        // Love stress, tension +, last step
+ *   gk_rve_destroy(&rve);
  *
- * THE RVE CONTRACT (DESIGN.md principle 6)
- *   gk_rve_deform(rve, dH, n)  cell map I + dH over n steps; stress after
- *   gk_rve_stress / gk_homog_tangent (gk_homog.h)
+ * THE RVE CONTRACT
+ *   gk_rve_deform(rve, dH, n)  applies the displacement-gradient increment
+ *     dH (H_ij = du_i/dx_j) to the cell over n DEM steps. The path
+ *     (def.path, gk_pcell.h) decides the end map: GK_PATH_CONSTANT_L (the
+ *     default; the Guo & Zhao (2014) authors' code and YADE) runs the
+ *     constant velocity gradient L = dH / (n dt) and ends at exp(dH) =
+ *     I + dH + dH^2/2 + ...; GK_PATH_OBJECTIVE ends exactly at I + dH.
+ *     det(I + dH) <= 0 is refused on both paths (GK_ERR_SINGULAR).
+ *   ADMISSIBLE INCREMENT PER DEM STEP. The cell map E of one step (exp(dH/n)
+ *     on the constant-L path) may change the overlap of a contact (i, j) by
+ *     at most GK_RVE_STEP_OVERLAP_MAX (0.1) times the smaller radius:
+ *       s(E) (r_min + r_max) <= 0.1 r_min,  s(E) = max_k |sigma_k(E) - 1|
+ *     over the singular values sigma_k of E (a rotation costs nothing). For
+ *     the 400-disk seed packing (r 3 to 7 mm) that is a stretch of 0.030 per
+ *     step: a shear of 0.5 needs at least 9 steps. A larger increment is
+ *     refused before anything moves, GK_ERR_ARG with the step count that
+ *     would do; gk_rve_step applies the same bound to exp(L dt) (with a
+ *     servo, to its max_rate). Refused rather than split into more steps
+ *     because the step count is the loading rate (dt is fixed): sub-steps
+ *     would silently change the time and the inertial number the caller
+ *     asked for. gk_rve_deform_adaptive (gk_homog.h) picks the count from
+ *     the inertial number instead. (The old behaviour, measured on the seed
+ *     packing: 50 % shear in one step returned GK_OK with overlaps of 0.7 r.)
+ *   gk_rve_stress after gk_rve_deform or gk_rve_step: the Love stress of the
+ *     forces of the LAST step, computed at the positions before that step
+ *     moved them (with the step's tangential increment): it lags the end
+ *     state by about one step's increment, dH/n. With n = 1 that is most of
+ *     dH (a shear of 1e-5 on the seed packing: sigma_xy 617 Pa before, 690
+ *     after the deform, 782 after gk_rve_refresh). gk_rve_refresh gives the
+ *     stress of the end state (one force pass, history unchanged).
+ *   gk_homog_tangent (gk_homog.h): the tangent at the current contacts.
  *   gk_rve_save / gk_rve_restore  the full state (positions, velocities,
  *     spins, cell, pair list with contact history) to and from caller
  *     memory, so an implicit driver can retry an increment bit for bit.
+ *     A buffer is untrusted: restore checks every field (reals finite, the
+ *     cell invertible and wide enough, pair lists sorted and in range,
+ *     counters and flags in range, friction >= 0, the servo valid, and dt
+ *     at most the critical step of this RVE at the state's own geometry)
+ *     before it changes anything; a bad buffer is refused with a message
+ *     and the RVE stays as it was.
  *
  * KINEMATICS. Positions are stored as reduced coordinates s (double, also in
  * the float build) and x = h s; velocities v and spins w are the
@@ -92,7 +127,10 @@
  * (restore a saved state to continue).
  *
  * CONFIG: GK_REAL_FLOAT (see gk_base.h), GK_DEM_PAR_MIN (pairs below which
- * one RVE never uses threads, default 20000).
+ * one RVE never uses threads, default 20000), GK_RVE_STEP_OVERLAP_MAX (the
+ * admissible overlap change per DEM step as a fraction of the smaller
+ * radius, default 0.1). An RVE holds at most GK_RVE_MAX_PARTICLES (2^26):
+ * its pair lists are int32.
  *
  * LICENCE: MIT (see gk_base.h).
  */
@@ -133,7 +171,7 @@ typedef struct gk_rve_def {
     gk_mass_model mass2d;
     double damping;           /* local non-viscous damping alpha in [0, 1)          */
     gk_damp_form damping_form;
-    gk_path_kind path;        /* how gk_rve_deform splits I + dH over the steps     */
+    gk_path_kind path;        /* how gk_rve_deform splits dH over the steps         */
     unsigned flags;           /* GK_RVE_*                                           */
     int threads;              /* threads inside this RVE; <= 1: serial              */
     gk_allocator alloc;
@@ -672,7 +710,7 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         dtc = R.dt_crit;
         if (!(dtc > 0.0) || !isfinite(dtc) || !(dtc * (def->dt_factor > 0.0 ? def->dt_factor : 0.5) > 0.0))
             res = gk_err_set(&R.err, GK_ERR_DT,
-                             "critical time step %g s (seed 000 eq 19) is not a positive number: radii %g to %g m "
+                             "critical time step %g s (Guo & Zhao 2014, eq 19) is not a positive number: radii %g to %g m "
                              "and the stiffness are out of range (rescale the units)",
                              dtc, R.rmin, R.rmax);
         else if (def->dt > 0.0) {
@@ -2155,6 +2193,21 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
     return GK_OK;
 }
 
+/* the largest per-step stretch of dH carried out in n steps on the RVE's path */
+static double gk__deform_stretch(const gk_rve *rve, const double dH[9], int n) {
+    gk_path path;
+    double E[9], st = 0.0;
+    int k;
+    if (gk_path_init(&path, rve->dim, rve->def.path, dH, n, NULL)) return NAN;
+    for (k = 1; k <= (rve->def.path == GK_PATH_CONSTANT_L ? 1 : n); ++k) { /* constant L: one map */
+        double a;
+        gk_path_step(&path, k, E);
+        a = gk__map_stretch(rve->dim, E);
+        if (!(a <= st)) st = a;
+    }
+    return st;
+}
+
 GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     gk_path path;
     double E[9];
@@ -2165,19 +2218,22 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     res = gk_path_init(&path, rve->dim, rve->def.path, dH, nsteps, &rve->err);
     if (res) return res;
     {   /* refuse up front an increment too large for one DEM step (the contract) */
-        double st = 0.0, lim = gk__step_stretch_max(rve);
-        for (k = 1; k <= (rve->def.path == GK_PATH_CONSTANT_L ? 1 : nsteps); ++k) {
-            double a;
-            gk_path_step(&path, k, E);
-            a = gk__map_stretch(rve->dim, E);
-            if (!(a <= st)) st = a;
-        }
-        if (!(st <= lim))
+        double st = gk__deform_stretch(rve, dH, nsteps), lim = gk__step_stretch_max(rve);
+        if (!(st <= lim)) { /* the fewest steps that would do: doubling, then bisection */
+            int lo = nsteps, hi = nsteps;
+            while (hi < (1 << 29) && !(gk__deform_stretch(rve, dH, hi) <= lim)) lo = hi, hi *= 2;
+            while (hi - lo > 1) {
+                int mid = lo + (hi - lo) / 2;
+                if (gk__deform_stretch(rve, dH, mid) <= lim)
+                    hi = mid;
+                else
+                    lo = mid;
+            }
             return gk_err_set(&rve->err, GK_ERR_ARG,
                               "dH in %d DEM steps changes a contact's overlap by up to %.3g of the smaller radius in "
-                              "one step (admissible %g, GK_RVE_STEP_OVERLAP_MAX): use at least %.0f steps",
-                              nsteps, st * (rve->rmin + rve->rmax) / rve->rmin, GK_RVE_STEP_OVERLAP_MAX,
-                              ceil(nsteps * st / lim));
+                              "one step (admissible %g, GK_RVE_STEP_OVERLAP_MAX): use at least %d steps",
+                              nsteps, st * (rve->rmin + rve->rmax) / rve->rmin, GK_RVE_STEP_OVERLAP_MAX, hi);
+        }
     }
     {   /* refuse up front a map that leaves the cell too thin for the nearest image */
         gk_pcell end = rve->cell;
@@ -2678,7 +2734,7 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         if (!(hd.dt <= dtc))
             return gk_err_set(err, GK_ERR_DT,
                               "RVE state time step %g s is above the critical %g s of this RVE at the state's "
-                              "geometry (seed 000 eq 19)",
+                              "geometry (Guo & Zhao 2014, eq 19)",
                               hd.dt, dtc);
     }
     /* capacity first, so a failure changes nothing observable */

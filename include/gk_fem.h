@@ -30,7 +30,13 @@
  *                           K_(a i)(b k) = int dN_a/dx_j D_ijkl dN_b/dx_l [eq 3]
  *   gk_fem_elem_force       f_(a i) = int sigma_ij dN_a/dx_j dV        [eq 4]
  *   gk_fem_assemble         all elements into a CSR matrix and/or a force
- *                           vector, in element order (deterministic)
+ *                           vector, in element order (deterministic). Every
+ *                           tangent, stress, element (det J > 0 at each
+ *                           Gauss point) and pattern entry is checked before
+ *                           K or fint is touched: an error changes neither.
+ *   (Element functions refuse an element index outside the mesh, GK_ERR_ARG,
+ *   a node id outside it, GK_ERR_MESH, and a non-finite tangent or stress,
+ *   GK_ERR_NAN.)
  *   gk_fem_elastic_tangent  isotropic D_ijkl = lambda d_ij d_kl + mu (d_ik d_jl
  *                           + d_il d_jk); 2D = plane strain
  *   gk_fem_lumped_mass      HRZ-lumped nodal masses (positive for Q8 too)

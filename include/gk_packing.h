@@ -35,7 +35,12 @@
  *   line 1:  "2 N Lx Ly" or "3 N Lx Ly Lz"
  *   lines starting with '#': comments; grainkit writes and reads an optional
  *            "# cell h00 h01 ... " line holding the full (skewed) cell matrix
- *   N lines: "x y r" or "x y z r" (SI units), positions in the cell. */
+ *   N lines: "x y r" or "x y z r" (SI units), positions in the cell.
+ * The text is untrusted: the particle lines are counted before anything is
+ * allocated (memory follows what the text holds, never the N it announces);
+ * a data or '# cell' line longer than 1023 characters, a NUL byte, a
+ * non-finite number, a radius <= 0 or a cell whose volume is not a finite
+ * positive number is refused, the message naming the line. */
 typedef struct gk_packing {
     int dim, n;
     double h[9];     /* cell matrix (a box is diag(Lx, Ly, Lz)); 2D: h22 = 1 */
