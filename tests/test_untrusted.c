@@ -718,51 +718,45 @@ TEST(writers_report_a_full_disk) {
 }
 
 /* =============================================================== tools */
+#define RVE_PATH "build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
+#define GK_PACK "build/gk_pack --n 60 "
+#define LOG(name) " > build/tests/t_untrusted_" name ".out 2>&1"
+#define OUT(name) "build/tests/t_untrusted_" name
+
 /* gk_pack --target-void-ratio 2.5 (no 2D disk packing gets there) ended
  * with exit 0 and e = 0.24; now exit 1 and no file */
 TEST(gk_pack_fails_on_a_void_ratio_it_cannot_reach) {
-    remove("build/tests/t_untrusted_pack.txt");
-    CHECK_EQ_INT(run_status("build/gk_pack --n 60 --target-void-ratio 2.5 --out build/tests/t_untrusted_pack.txt "
-                            "> build/tests/t_untrusted_pack.out 2>&1"),
-                 1);
-    CHECK(!exists("build/tests/t_untrusted_pack.txt"));
-    CHECK(gk_test_file_has("build/tests/t_untrusted_pack.out", "not reached"));
+    remove(OUT("pack.txt"));
+    CHECK_EQ_INT(run_status(GK_PACK "--target-void-ratio 2.5 --out " OUT("pack.txt") LOG("pack")), 1);
+    CHECK(!exists(OUT("pack.txt")));
+    CHECK(gk_test_file_has(OUT("pack.out"), "not reached"));
 }
 
 /* --friction-deg everywhere (degrees); 35 meant as radians is refused */
 TEST(friction_angle_in_degrees_with_a_plausible_range) {
-    CHECK_EQ_INT(run_status("build/gk_pack --n 60 --friction-deg 35 --out build/tests/t_untrusted_deg.txt "
-                            "> build/tests/t_untrusted_deg.out 2>&1"),
+    CHECK_EQ_INT(run_status(GK_PACK "--friction-deg 35 --out " OUT("deg.txt") LOG("deg")), 0);
+    CHECK(gk_test_file_has(OUT("deg.txt"), "friction angle 35 deg"));
+    CHECK(gk_test_result(OUT("deg.out"), "void_ratio") > 0.0);
+    CHECK_EQ_INT(run_status(GK_PACK "--friction-deg 95 --out " OUT("deg.txt") LOG("deg")), 2);
+    CHECK_EQ_INT(run_status(RVE_PATH "--increments 1 --steps-per-increment 5 --friction-deg 35 --out " OUT("deg.csv")
+                                     LOG("deg")),
                  0);
-    CHECK(gk_test_file_has("build/tests/t_untrusted_deg.txt", "friction angle 35 deg"));
-    CHECK(gk_test_result("build/tests/t_untrusted_deg.out", "void_ratio") > 0.0);
-    CHECK_EQ_INT(run_status("build/gk_pack --n 60 --friction-deg 95 --out build/tests/t_untrusted_deg.txt "
-                            "> build/tests/t_untrusted_deg.out 2>&1"),
-                 2);
-    CHECK_EQ_INT(run_status("build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 1 "
-                            "--steps-per-increment 5 --friction-deg 35 --out build/tests/t_untrusted_deg.csv "
-                            "> build/tests/t_untrusted_deg.out 2>&1"),
-                 0);
-    CHECK_EQ_INT(run_status("build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
-                            "--friction-angle 35 > build/tests/t_untrusted_deg.out 2>&1"),
-                 2);
-    CHECK(gk_test_file_has("build/tests/t_untrusted_deg.out", "0 to 85 degrees"));
+    CHECK_EQ_INT(run_status(RVE_PATH "--friction-angle 35" LOG("deg")), 2);
+    CHECK(gk_test_file_has(OUT("deg.out"), "0 to 85 degrees"));
 }
 
 /* rve_path --out /dev/full wrote nothing and said 'wrote' with exit 0 */
 TEST(rve_path_exits_nonzero_when_its_result_is_lost) {
-    CHECK_EQ_INT(run_status("build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 1 "
-                            "--steps-per-increment 5 --out /dev/full > build/tests/t_untrusted_full.out 2>&1"),
-                 1);
-    CHECK(gk_test_file_has("build/tests/t_untrusted_full.out", "error writing '/dev/full'"));
-    CHECK(!gk_test_file_has("build/tests/t_untrusted_full.out", "wrote"));
+    CHECK_EQ_INT(run_status(RVE_PATH "--increments 1 --steps-per-increment 5 --out /dev/full" LOG("full")), 1);
+    CHECK(gk_test_file_has(OUT("full.out"), "error writing '/dev/full'"));
+    CHECK(!gk_test_file_has(OUT("full.out"), "wrote"));
 }
 
 /* bench_tradeoff exited 0 when a configuration failed (only a failed
  * reference counted). Drivers replaced by a script that fails the adaptive
  * runs and writes a 3-row curve otherwise: exit 1, the run named. */
 TEST(bench_tradeoff_fails_when_a_run_fails) {
-    const char *dir = "build/tests/t_untrusted_fakebin";
+    const char *dir = OUT("fakebin");
     const char *script = "#!/bin/sh\n"
                          "case \"$*\" in *adaptive*) exit 1;; esac\n"
                          "while [ $# -gt 0 ]; do [ \"$1\" = --out ] && out=$2; shift; done\n"
@@ -788,12 +782,11 @@ TEST(bench_tradeoff_fails_when_a_run_fails) {
         fclose(fp);
         chmod(path, 0755);
     }
-    CHECK_EQ_INT(run_status("build/bench_tradeoff --bin build/tests/t_untrusted_fakebin --out "
-                            "build/tests/t_untrusted_tradeoff --steps 2 > build/tests/t_untrusted_tradeoff.out 2>&1"),
+    CHECK_EQ_INT(run_status("build/bench_tradeoff --bin " OUT("fakebin") " --out " OUT("tradeoff") " --steps 2"
+                                LOG("tradeoff")),
                  1);
-    CHECK(gk_test_file_has("build/tests/t_untrusted_tradeoff.out", "failed: see"));
-    CHECK(gk_test_file_has("build/tests/t_untrusted_tradeoff.out", "adaptive"));
-    CHECK(gk_test_file_has("build/tests/t_untrusted_tradeoff/tradeoff.csv", "group,sweep"));
+    CHECK(gk_test_file_has(OUT("tradeoff.out"), "400d adaptive) failed: see"));
+    CHECK(gk_test_file_has(OUT("tradeoff/tradeoff.csv"), "group,sweep"));
 }
 
 int main(int argc, char **argv) {
