@@ -193,7 +193,8 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
     for (k = 0; k < dim; ++k)
         for (p = 0; p < n; ++p)
             if (!isfinite(s[k][p]))
-                return gk_err_set(err, GK_ERR_NAN, "particle %d has a non-finite reduced coordinate %g", p, s[k][p]);
+                return gk_err_set(err, GK_ERR_NAN, "particle %d has a non-finite reduced coordinate %g", p,
+                                  s[k][p]);
     if (dim == 2) nbin[2] = 1;
     /* keep the grid at most ~2n + 27 bins (dilute or huge cells) */
     for (;;) {
@@ -204,7 +205,8 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
         if (nbin[0] <= 3 && nbin[1] <= 3 && nbin[2] <= 3) break;
     }
     total = (double)nbin[0] * nbin[1] * nbin[2]; /* <= 2n + 27 or 27 */
-    if (total >= (double)INT32_MAX) return gk_err_set(err, GK_ERR_ALLOC, "%.0f cell-list bins overflow int", total);
+    if (total >= (double)INT32_MAX)
+        return gk_err_set(err, GK_ERR_ALLOC, "%.0f cell-list bins overflow int", total);
     if (gk__cells_grow(c, &c->bin_start, &c->cap_bins, (size_t)total + 1))
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %.0f cell-list bins", total);
     for (k = 0; k < 3; ++k) c->nbin[k] = nbin[k];

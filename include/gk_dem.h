@@ -510,7 +510,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "packing has %d particles", n);
     if (n > GK_RVE_MAX_PARTICLES)
-        return gk_err_set(err, GK_ERR_ARG, "packing has %d particles; an RVE holds at most %d (int32 pair lists)", n,
+        return gk_err_set(err, GK_ERR_ARG,
+                          "packing has %d particles; an RVE holds at most %d (int32 pair lists)", n,
                           GK_RVE_MAX_PARTICLES);
     if (!(def->damping >= 0.0 && def->damping < 1.0))
         return gk_err_set(err, GK_ERR_ARG, "local damping %g outside [0, 1)", def->damping);
@@ -709,10 +710,11 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         R.dt_crit = gk__dt_critical(&R);
         dtc = R.dt_crit;
         if (!(dtc > 0.0) || !isfinite(dtc) || !(dtc * (def->dt_factor > 0.0 ? def->dt_factor : 0.5) > 0.0))
-            res = gk_err_set(&R.err, GK_ERR_DT,
-                             "critical time step %g s (Guo & Zhao 2014, eq 19) is not a positive number: radii %g to %g m "
-                             "and the stiffness are out of range (rescale the units)",
-                             dtc, R.rmin, R.rmax);
+            res = gk_err_set(
+                &R.err, GK_ERR_DT,
+                "critical time step %g s (Guo & Zhao 2014, eq 19) is not a positive number: radii %g to %g m "
+                "and the stiffness are out of range (rescale the units)",
+                dtc, R.rmin, R.rmax);
         else if (def->dt > 0.0) {
             if (def->dt > dtc)
                 res = gk_err_set(&R.err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)",
@@ -2155,25 +2157,27 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
     if (nsteps < 0) return gk_err_set(&rve->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
-    {   /* the largest per-step map: the servo's rates are bounded by max_rate */
+    { /* the largest per-step map: the servo's rates are bounded by max_rate */
         double C[9], f = 0.0, lim = gk__step_stretch_max(rve);
         int i, j;
         for (i = 0; i < 3; ++i)
             for (j = 0; j < 3; ++j) {
-                int servo = rve->servo_on && i < rve->dim && j < rve->dim &&
-                            ((i == j && rve->servo.mode[i] == GK_SERVO_STRESS) || (i != j && rve->servo.shear));
-                C[3 * i + j] = servo ? rve->servo.max_rate : (rve->servo_on && i == j && i < rve->dim
-                                                                  ? fabs(rve->servo.rate[i])
-                                                                  : fabs(rve->L[3 * i + j]));
+                int servo =
+                    rve->servo_on && i < rve->dim && j < rve->dim &&
+                    ((i == j && rve->servo.mode[i] == GK_SERVO_STRESS) || (i != j && rve->servo.shear));
+                C[3 * i + j] = servo ? rve->servo.max_rate
+                                     : (rve->servo_on && i == j && i < rve->dim ? fabs(rve->servo.rate[i])
+                                                                                : fabs(rve->L[3 * i + j]));
                 f += C[3 * i + j] * C[3 * i + j];
             }
         f = expm1(sqrt(f) * rve->dt); /* |exp(A) - I| <= exp(|A|) - 1 bounds the stretch */
         if (!(f <= lim))
-            return gk_err_set(&rve->err, GK_ERR_ARG,
-                              "the velocity gradient%s moves a contact by up to %.3g of the smaller radius in one "
-                              "step of %g s (admissible %g, GK_RVE_STEP_OVERLAP_MAX): lower the rates or dt",
-                              rve->servo_on ? " (with the servo's max_rate)" : "",
-                              f * (rve->rmin + rve->rmax) / rve->rmin, rve->dt, GK_RVE_STEP_OVERLAP_MAX);
+            return gk_err_set(
+                &rve->err, GK_ERR_ARG,
+                "the velocity gradient%s moves a contact by up to %.3g of the smaller radius in one "
+                "step of %g s (admissible %g, GK_RVE_STEP_OVERLAP_MAX): lower the rates or dt",
+                rve->servo_on ? " (with the servo's max_rate)" : "", f * (rve->rmin + rve->rmax) / rve->rmin,
+                rve->dt, GK_RVE_STEP_OVERLAP_MAX);
     }
     gk_m3_copy(rve->L, Lcur);
     for (st = 0; st < nsteps; ++st) {
@@ -2217,7 +2221,7 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
     res = gk_path_init(&path, rve->dim, rve->def.path, dH, nsteps, &rve->err);
     if (res) return res;
-    {   /* refuse up front an increment too large for one DEM step (the contract) */
+    { /* refuse up front an increment too large for one DEM step (the contract) */
         double st = gk__deform_stretch(rve, dH, nsteps), lim = gk__step_stretch_max(rve);
         if (!(st <= lim)) { /* the fewest steps that would do: doubling, then bisection */
             int lo = nsteps, hi = nsteps;
@@ -2229,10 +2233,11 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
                 else
                     lo = mid;
             }
-            return gk_err_set(&rve->err, GK_ERR_ARG,
-                              "dH in %d DEM steps changes a contact's overlap by up to %.3g of the smaller radius in "
-                              "one step (admissible %g, GK_RVE_STEP_OVERLAP_MAX): use at least %d steps",
-                              nsteps, st * (rve->rmin + rve->rmax) / rve->rmin, GK_RVE_STEP_OVERLAP_MAX, hi);
+            return gk_err_set(
+                &rve->err, GK_ERR_ARG,
+                "dH in %d DEM steps changes a contact's overlap by up to %.3g of the smaller radius in "
+                "one step (admissible %g, GK_RVE_STEP_OVERLAP_MAX): use at least %d steps",
+                nsteps, st * (rve->rmin + rve->rmax) / rve->rmin, GK_RVE_STEP_OVERLAP_MAX, hi);
         }
     }
     {   /* refuse up front a map that leaves the cell too thin for the nearest image */
@@ -2635,7 +2640,8 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     size_t off = 0, n, np, R = sizeof(gk_real);
     int k, dim = rve->dim, p, c, nr, nroll;
     gk_err *err = &rve->err;
-    if (rve->n < 1 || !rve->s[0]) return gk_err_set(err, GK_ERR_STATE, "restore into an RVE that was not created");
+    if (rve->n < 1 || !rve->s[0])
+        return gk_err_set(err, GK_ERR_STATE, "restore into an RVE that was not created");
     if (!buf || size < sizeof hd) return gk_err_set(err, GK_ERR_FORMAT, "RVE state buffer too small");
     memcpy(&hd, buf, sizeof hd);
     if (memcmp(hd.magic, GK__STATE_MAGIC, 8) != 0 || hd.endian != 0x01020304)
@@ -2645,9 +2651,10 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
                           GK__STATE_VERSION);
     if (hd.dim != rve->dim || hd.n != rve->n || hd.real_size != (int32_t)R || hd.phys != (int32_t)rve->phys ||
         hd.rot != GK__HAS_ROT(rve) || hd.roll != GK__HAS_ROLL(rve))
-        return gk_err_set(err, GK_ERR_FORMAT,
-                          "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
-                          hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
+        return gk_err_set(
+            err, GK_ERR_FORMAT,
+            "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
+            hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
     if (hd.npairs < 0 || hd.nouter < 0 || size != gk__state_bytes(rve, hd.npairs, hd.nouter))
         return gk_err_set(err, GK_ERR_FORMAT, "RVE state has the wrong size");
     n = (size_t)rve->n;
@@ -2655,17 +2662,20 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0;
     nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
     /* ---- header scalars */
-    if (!(hd.dt > 0.0) || !isfinite(hd.dt)) return gk_err_set(err, GK_ERR_DT, "RVE state time step %g", hd.dt);
-    if (!(hd.dt_crit > 0.0) || !isfinite(hd.dt_crit) || !isfinite(hd.time) || hd.step < 0 || hd.rebuilds < 0 ||
-        hd.flips < 0)
-        return gk_err_set(err, GK_ERR_FORMAT, "RVE state has an invalid time %g, step %ld or critical step %g",
-                          hd.time, (long)hd.step, hd.dt_crit);
+    if (!(hd.dt > 0.0) || !isfinite(hd.dt))
+        return gk_err_set(err, GK_ERR_DT, "RVE state time step %g", hd.dt);
+    if (!(hd.dt_crit > 0.0) || !isfinite(hd.dt_crit) || !isfinite(hd.time) || hd.step < 0 ||
+        hd.rebuilds < 0 || hd.flips < 0)
+        return gk_err_set(err, GK_ERR_FORMAT,
+                          "RVE state has an invalid time %g, step %ld or critical step %g", hd.time,
+                          (long)hd.step, hd.dt_crit);
     if (!(hd.skin > 0.0) || !isfinite(hd.skin) || !(hd.skin_in > 0.0) || !(hd.skin_in <= hd.skin))
-        return gk_err_set(err, GK_ERR_FORMAT, "RVE state Verlet skins %g and %g invalid", hd.skin, hd.skin_in);
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state Verlet skins %g and %g invalid", hd.skin,
+                          hd.skin_in);
     if (!gk__map_valid(dim, hd.h) || !gk__map_valid(dim, hd.F) || !gk__map_valid(dim, hd.h0) ||
         !gk__map_valid(dim, hd.ho0))
-        return gk_err_set(err, GK_ERR_CELL, "RVE state cell (h %g %g %g %g ...) is not a valid cell matrix", hd.h[0],
-                          hd.h[1], hd.h[3], hd.h[4]);
+        return gk_err_set(err, GK_ERR_CELL, "RVE state cell (h %g %g %g %g ...) is not a valid cell matrix",
+                          hd.h[0], hd.h[1], hd.h[3], hd.h[4]);
     {
         gk_pcell cell;
         double w[3];
@@ -2677,15 +2687,18 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
                                   "RVE state cell is %g wide, below twice the interaction distance %g", w[k],
                                   2.0 * rve->rmax + hd.skin);
     }
-    if (!gk_m3_isfinite(hd.L) || !gk_m3_isfinite(hd.G) || !gk_m3_isfinite(hd.stress) || !isfinite(hd.stiff[0]) ||
-        !isfinite(hd.stiff[1]) || !isfinite(hd.stiff[2]) || !(hd.fc_mean >= 0.0) || !isfinite(hd.fc_mean))
-        return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite velocity gradient, stress or stiffness");
+    if (!gk_m3_isfinite(hd.L) || !gk_m3_isfinite(hd.G) || !gk_m3_isfinite(hd.stress) ||
+        !isfinite(hd.stiff[0]) || !isfinite(hd.stiff[1]) || !isfinite(hd.stiff[2]) || !(hd.fc_mean >= 0.0) ||
+        !isfinite(hd.fc_mean))
+        return gk_err_set(err, GK_ERR_NAN,
+                          "RVE state has a non-finite velocity gradient, stress or stiffness");
     if (dim == 2 && (hd.L[2] != 0 || hd.L[5] != 0 || hd.L[6] != 0 || hd.L[7] != 0 || hd.L[8] != 0))
         return gk_err_set(err, GK_ERR_FORMAT, "RVE state: 2D velocity gradient with a third row or column");
     if (hd.ncontacts < 0 || hd.ncontacts > hd.npairs || (hd.need_rebuild != 0 && hd.need_rebuild != 1) ||
         (hd.servo_on != 0 && hd.servo_on != 1) || (hd.outer_valid != 0 && hd.outer_valid != 1))
-        return gk_err_set(err, GK_ERR_FORMAT, "RVE state has invalid counters or flags (%d contacts of %d pairs)",
-                          hd.ncontacts, hd.npairs);
+        return gk_err_set(err, GK_ERR_FORMAT,
+                          "RVE state has invalid counters or flags (%d contacts of %d pairs)", hd.ncontacts,
+                          hd.npairs);
     {
         gk_material m = rve->def.mat;
         gk_result r = hd.servo_on ? gk__servo_check(dim, &hd.servo, err) : GK_OK;
@@ -2693,7 +2706,8 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         m.friction = hd.mu;
         if ((r = gk_material_check(&m, err)) != GK_OK) return r;
         if (hd.mu > 0.0 && !(rve->phys & GK_PHYS_TANGENT))
-            return gk_err_set(err, GK_ERR_STATE, "RVE state has friction %g for an RVE created frictionless", hd.mu);
+            return gk_err_set(err, GK_ERR_STATE, "RVE state has friction %g for an RVE created frictionless",
+                              hd.mu);
     }
     /* ---- arrays, in the order gk_rve_save writes them */
     off = sizeof hd;
@@ -2720,22 +2734,25 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
             return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has invalid or unsorted particles", c);
         for (c = 0; c < hd.npairs; ++c)
             if (cs[c] & ~(GK_CS_CONTACT | GK_CS_SLIDING | GK_CS_BONDED | GK_CS_BROKEN))
-                return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has unknown contact bits 0x%x", c, cs[c]);
+                return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has unknown contact bits 0x%x", c,
+                                  cs[c]);
         off += np * 9;
         if (!gk__finite_bytes(in + off, ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np, R))
             return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite contact force or history");
         off += ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np * R;
         if ((c = gk__pairs_valid(in + off, in + off + 4 * (size_t)hd.nouter, hd.nouter, rve->n)) >= 0)
-            return gk_err_set(err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid or unsorted particles", c);
+            return gk_err_set(err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid or unsorted particles",
+                              c);
         off += 8 * (size_t)hd.nouter;
         if (!gk__finite_bytes(in + off, dim * n, dbl))
             return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite outer-list reference position");
         dtc = gk__dt_critical_at(rve, hd.h, sb, ib, jb, hd.npairs);
         if (!(hd.dt <= dtc))
-            return gk_err_set(err, GK_ERR_DT,
-                              "RVE state time step %g s is above the critical %g s of this RVE at the state's "
-                              "geometry (Guo & Zhao 2014, eq 19)",
-                              hd.dt, dtc);
+            return gk_err_set(
+                err, GK_ERR_DT,
+                "RVE state time step %g s is above the critical %g s of this RVE at the state's "
+                "geometry (Guo & Zhao 2014, eq 19)",
+                hd.dt, dtc);
     }
     /* capacity first, so a failure changes nothing observable */
     if (gk__pairs_reserve(rve, np + 1, (size_t)rve->pl.n) || gk_pairlist_reserve(&rve->pl, np + 1, n) ||

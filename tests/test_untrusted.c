@@ -32,7 +32,8 @@ static void *counting_alloc(size_t size, size_t align, void *user) {
     counting *c = (counting *)user;
     void *p = NULL;
     if (size > c->largest) c->largest = size;
-    if (size > c->cap || posix_memalign(&p, align < sizeof(void *) ? sizeof(void *) : align, size)) return NULL;
+    if (size > c->cap || posix_memalign(&p, align < sizeof(void *) ? sizeof(void *) : align, size))
+        return NULL;
     return p;
 }
 static void counting_free(void *p, void *user) {
@@ -243,8 +244,9 @@ static const char *GMSH_HEAD = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
  * 400 MB tag map; tags are now looked up sorted, in memory of the node
  * count. Checked with an allocator that records the largest request. */
 TEST(gmsh_counts_and_tags_allocate_from_the_text) {
-    const char *v41 = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 768614336404564651 1 1\n0 1 0 1\n1\n0 0 "
-                      "0\n$EndNodes\n";
+    const char *v41 =
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 768614336404564651 1 1\n0 1 0 1\n1\n0 0 "
+        "0\n$EndNodes\n";
     char v22[256], tag[512];
     const char *in[3];
     gk_result want[3] = {GK_ERR_FORMAT, GK_ERR_FORMAT, GK_ERR_MESH};
@@ -306,7 +308,9 @@ TEST(gmsh_duplicate_tags_and_nan_coordinates_are_refused) {
 
 /* ======================================================= RVE states */
 /* offset of the first particle velocity and of the first pair in a state */
-static size_t off_v(const gk_rve *r) { return sizeof(gk__state_hdr) + (size_t)r->n * 2 * r->dim * sizeof(double); }
+static size_t off_v(const gk_rve *r) {
+    return sizeof(gk__state_hdr) + (size_t)r->n * 2 * r->dim * sizeof(double);
+}
 static size_t off_pairs(const gk_rve *r) {
     int nr = r->w[2] ? (r->dim == 2 ? 1 : 3) : 0;
     return off_v(r) + (size_t)r->n * sizeof(gk_real) * (2 * r->dim + 2 * nr) +
@@ -335,7 +339,7 @@ TEST(rve_restore_refuses_invalid_states_and_changes_nothing) {
     n = st.size;
     good = st.buf;
     bad = (unsigned char *)malloc(n);
-    {   /* a state where the RVE has moved on, so that 'unchanged' means something */
+    { /* a state where the RVE has moved on, so that 'unchanged' means something */
         double dH[9] = {0, 1e-4, 0, 0, 0, 0, 0, 0, 0};
         CHECK(gk_rve_deform(&rve, dH, 20) == GK_OK);
     }
@@ -365,13 +369,15 @@ TEST(rve_restore_refuses_invalid_states_and_changes_nothing) {
         case 13: /* the first two pairs swapped: the list must stay sorted */
             memcpy(bad + off_pairs(&rve), good + off_pairs(&rve) + 4, 4);
             memcpy(bad + off_pairs(&rve) + 4, good + off_pairs(&rve), 4);
-            memcpy(bad + off_pairs(&rve) + 4 * (size_t)hd.npairs, good + off_pairs(&rve) + 4 * (size_t)hd.npairs + 4,
-                   4);
-            memcpy(bad + off_pairs(&rve) + 4 * (size_t)hd.npairs + 4, good + off_pairs(&rve) + 4 * (size_t)hd.npairs,
-                   4);
+            memcpy(bad + off_pairs(&rve) + 4 * (size_t)hd.npairs,
+                   good + off_pairs(&rve) + 4 * (size_t)hd.npairs + 4, 4);
+            memcpy(bad + off_pairs(&rve) + 4 * (size_t)hd.npairs + 4,
+                   good + off_pairs(&rve) + 4 * (size_t)hd.npairs, 4);
             what = "unsorted pairs";
             break;
-        case 14: i32 = rve.n, memcpy(bad + off_pairs(&rve) + 4 * (size_t)hd.npairs, &i32, 4), what = "j = n"; break;
+        case 14:
+            i32 = rve.n, memcpy(bad + off_pairs(&rve) + 4 * (size_t)hd.npairs, &i32, 4), what = "j = n";
+            break;
         case 15: bad[off_pairs(&rve) + 8 * (size_t)hd.npairs] = 0x80, what = "unknown contact bits"; break;
         }
         if (c < 12) memcpy(bad, &hd, sizeof hd);
@@ -462,7 +468,8 @@ static double stress_lag(gk_rve *rve, const gk_rve_state *st, int n, double *tot
     CHECK(gk_rve_refresh(rve) == GK_OK);
     gk_rve_stress(rve, s2);
     *total = fabs(s2[1] - s0[1]);
-    printf("    %2d steps: sigma_xy %.2f before, %.2f after deform, %.2f after refresh\n", n, s0[1], s1[1], s2[1]);
+    printf("    %2d steps: sigma_xy %.2f before, %.2f after deform, %.2f after refresh\n", n, s0[1], s1[1],
+           s2[1]);
     return fabs(s2[1] - s1[1]);
 }
 
@@ -529,7 +536,8 @@ TEST(fem_assemble_with_an_inverted_element_changes_nothing) {
     D = (double *)malloc((size_t)m.nelem * q.n * 16 * sizeof(double));
     sig = (double *)calloc((size_t)m.nelem * q.n * 9, sizeof(double));
     for (k = 0; k < m.nelem * q.n; ++k) gk_fem_elastic_tangent(2, 1e7, 0.3, D + 16 * k);
-    t = m.conn[4 * 5 + 1], m.conn[4 * 5 + 1] = m.conn[4 * 5 + 3], m.conn[4 * 5 + 3] = t; /* element 5 inverted */
+    t = m.conn[4 * 5 + 1], m.conn[4 * 5 + 1] = m.conn[4 * 5 + 3],
+    m.conn[4 * 5 + 3] = t; /* element 5 inverted */
     for (k = 0; k < K.nnz; ++k) K.val[k] = 42.0;
     for (k = 0; k < 2 * m.nnode; ++k) fint[k] = 42.0;
     CHECK_EQ_INT(gk_fem_assemble(&m, &q, D, sig, &K, fint, &e), GK_ERR_MESH);
@@ -738,8 +746,8 @@ TEST(friction_angle_in_degrees_with_a_plausible_range) {
     CHECK(gk_test_file_has(OUT("deg.txt"), "friction angle 35 deg"));
     CHECK(gk_test_result(OUT("deg.out"), "void_ratio") > 0.0);
     CHECK_EQ_INT(run_status(GK_PACK "--friction-deg 95 --out " OUT("deg.txt") LOG("deg")), 2);
-    CHECK_EQ_INT(run_status(RVE_PATH "--increments 1 --steps-per-increment 5 --friction-deg 35 --out " OUT("deg.csv")
-                                     LOG("deg")),
+    CHECK_EQ_INT(run_status(RVE_PATH "--increments 1 --steps-per-increment 5 --friction-deg 35 --out " OUT(
+                     "deg.csv") LOG("deg")),
                  0);
     CHECK_EQ_INT(run_status(RVE_PATH "--friction-angle 35" LOG("deg")), 2);
     CHECK(gk_test_file_has(OUT("deg.out"), "0 to 85 degrees"));
@@ -747,7 +755,8 @@ TEST(friction_angle_in_degrees_with_a_plausible_range) {
 
 /* rve_path --out /dev/full wrote nothing and said 'wrote' with exit 0 */
 TEST(rve_path_exits_nonzero_when_its_result_is_lost) {
-    CHECK_EQ_INT(run_status(RVE_PATH "--increments 1 --steps-per-increment 5 --out /dev/full" LOG("full")), 1);
+    CHECK_EQ_INT(run_status(RVE_PATH "--increments 1 --steps-per-increment 5 --out /dev/full" LOG("full")),
+                 1);
     CHECK(gk_test_file_has(OUT("full.out"), "error writing '/dev/full'"));
     CHECK(!gk_test_file_has(OUT("full.out"), "wrote"));
 }
@@ -782,8 +791,8 @@ TEST(bench_tradeoff_fails_when_a_run_fails) {
         fclose(fp);
         chmod(path, 0755);
     }
-    CHECK_EQ_INT(run_status("build/bench_tradeoff --bin " OUT("fakebin") " --out " OUT("tradeoff") " --steps 2"
-                                LOG("tradeoff")),
+    CHECK_EQ_INT(run_status("build/bench_tradeoff --bin " OUT("fakebin") " --out " OUT(
+                     "tradeoff") " --steps 2" LOG("tradeoff")),
                  1);
     CHECK(gk_test_file_has(OUT("tradeoff.out"), "400d adaptive) failed: see"));
     CHECK(gk_test_file_has(OUT("tradeoff/tradeoff.csv"), "group,sweep"));
