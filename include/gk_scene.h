@@ -86,17 +86,26 @@
  * gk_scene_release frees it. (Seed 001's frame of boundary particles and
  * seed 002's trained grains are prescribed particles.)
  *
- * MEMBRANE (2D). gk_scene_add_membrane(sc, k, ids, pressure, stiffness): a
- * chain of particles (stable ids, the material on the chain's LEFT, i.e. a
- * counter-clockwise boundary) loaded by a follower pressure: every segment
- * a-b between consecutive centres receives p t |x_b - x_a| along its inward
- * normal, half on each end (t the 2D thickness of gk_rve: the same t the
- * stress is divided by). With stiffness > 0, consecutive members are also
- * tied by tension-only springs of that stiffness and rest length their
- * initial distance (the mass-spring membrane of seed 002 App. B), so the
- * chain cannot open gaps an inner particle could escape through. This is
- * the follower-pressure flexible boundary of Cheung & O'Sullivan (2008)
- * with a fixed chain (members chosen once, e.g. by gk_scene_side_chain).
+ * MEMBRANE (2D). gk_scene_add_membrane(sc, k, ids, pressure, stiffness,
+ * anchor_first, anchor_last): a chain of particles (stable ids, the
+ * material on the chain's LEFT, i.e. a counter-clockwise boundary) loaded
+ * by a follower pressure: every segment a-b between consecutive centres
+ * receives p t |x_b - x_a| along its inward normal, half on each end (t the
+ * 2D thickness of gk_rve: the same t the stress is divided by). With
+ * stiffness > 0, consecutive members are also tied by tension-only springs
+ * of that stiffness and rest length their initial distance (the mass-spring
+ * membrane of seed 002 App. B), so the chain cannot open gaps an inner
+ * particle could escape through. An anchor (a wall index, -1 for none)
+ * closes the chain at that end on a platen, as the rubber sleeve of a
+ * biaxial cell is clamped to it: the end member is tied (same spring) to
+ * its nearest point on that wall - it slides along the wall freely but
+ * cannot leave it by more than its initial distance, so no inner particle
+ * can pass round the chain end - and the segment member-wall carries the
+ * pressure too (its half on the wall is not applied). Without anchors the strips between the end
+ * members and the platens are unloaded and an inner particle can escape
+ * round a chain end. This is the follower-pressure flexible boundary of
+ * Cheung & O'Sullivan (2008) with a fixed chain (members chosen once, e.g.
+ * by gk_scene_side_chain).
  *
  * INSERTION AND DELETION. gk_scene_insert adds particles (world positions,
  * optional velocities) and returns their stable ids; gk_scene_remove
@@ -225,6 +234,9 @@ typedef struct gk_membrane {
     int n, cap;          /* members, capacity                                   */
     int32_t *ids;        /* stable ids, the material on the chain's left        */
     double *rest;        /* rest length of each link (n - 1)                    */
+    int anchor[2];       /* wall of the first / last member's anchor, or -1     */
+    double arest[2];     /* rest length of the anchor links                     */
+    double af[2][2];     /* anchor link force on the first / last member, last step */
     double pressure;     /* [Pa]                                                */
     double stiffness;    /* link springs [N/m]; 0: none                         */
     double *fx, *fy;     /* pressure force on each member, last step (energy)   */
@@ -276,6 +288,7 @@ typedef struct gk_scene {
     gk_real *hft[3], *hmr[3];
     unsigned char *hcs;
     size_t hcap;
+    double wall_love[9];     /* wall contacts' f (x) (x_c - x_p) and membrane links' f L u (x) u, last step */
     double el_step;          /* elastic energy summed during the current step           */
     long energy_mismatch;    /* pairs whose re-evaluation differed from the kernel (0)  */
     gk_err err;
@@ -300,6 +313,13 @@ GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps);
 GKDEF void gk_scene_position(const gk_scene *sc, int p, double x[3]);
 GKDEF int gk_scene_index(const gk_scene *sc, int32_t id);
 GKDEF double gk_scene_dt_critical(const gk_scene *sc);
+/* mean stress of the particles over `volume` (2D: an area; the thickness t
+ * is applied), tension-positive, at the last step of the last call:
+ * (1/V) sum over particles of f (x) (x_c - x_p) over their contact forces
+ * with each other (the Love form -F (x) d of gk_dem.h) and with walls
+ * (forces applied at particle centres - gravity, membrane, external - add
+ * nothing). In equilibrium it is the stress the boundary applies. */
+GKDEF void gk_scene_stress(const gk_scene *sc, double volume, double sigma[9]);
 
 GKDEF gk_result gk_scene_add_wall(gk_scene *sc, const gk_wall_def *wd, int *index);
 GKDEF gk_result gk_scene_add_box(gk_scene *sc, const gk_material *m, unsigned faces, int *first);
@@ -312,7 +332,7 @@ GKDEF gk_result gk_scene_set_mass(gk_scene *sc, int p, double m, double I);
 GKDEF gk_result gk_scene_set_velocity(gk_scene *sc, int p, const double v[3], const double w[3]);
 
 GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, double pressure, double stiffness,
-                                      int *index);
+                                      int anchor_first, int anchor_last, int *index);
 /* 2D: the outermost particle of every band of width `band` along the other
  * axis, on side (-1 low, +1 high) of axis `axis`, ordered with the material
  * on the chain's left; ids written to ids (capacity cap), count to *k */
@@ -832,6 +852,12 @@ static double gk__walls_dt_critical(const gk_scene *sc) {
     return dtc;
 }
 
+GKDEF void gk_scene_stress(const gk_scene *sc, double volume, double sigma[9]) {
+    double V = volume * (sc->dim == 2 ? sc->rve.volume_factor : 1.0), Vc = gk_rve_volume(&sc->rve);
+    int k;
+    for (k = 0; k < 9; ++k) sigma[k] = (sc->rve.stress[k] * Vc + sc->wall_love[k]) / V;
+}
+
 GKDEF double gk_scene_dt_critical(const gk_scene *sc) {
     double a = gk_rve_dt_critical(&sc->rve), b = gk__walls_dt_critical(sc);
     return a < b ? a : b;
@@ -1171,6 +1197,12 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
                 F[k] -= f[k];
                 M[k] -= mp[k] + (dim == 3 || k == 2 ? (double)t.o.tj[k] : 0.0);
             }
+            { /* stress: f (x) (x_c - x_p), the contact point at r - delta/2 towards the wall */
+                double l = r - 0.5 * (double)t.o.delta;
+                int a, b;
+                for (a = 0; a < dim; ++a)
+                    for (b = 0; b < dim; ++b) sc->wall_love[3 * a + b] += f[a] * (-n[b] * l);
+            }
             work += gk__dot3(f, vs) * (double)dt;
             el += t.elastic;
             vis += t.viscous;
@@ -1244,6 +1276,35 @@ static void gk__membranes(gk_scene *sc) {
                 rve->f[0][b] -= (gk_real)(f * ux);
                 rve->f[1][b] -= (gk_real)(f * uy);
                 el += 0.5 * M->stiffness * (L - M->rest[e]) * (L - M->rest[e]);
+                /* stress: an inner force of the particles, f L u (x) u (tension) */
+                sc->wall_love[0] += f * L * ux * ux;
+                sc->wall_love[1] += f * L * ux * uy;
+                sc->wall_love[3] += f * L * uy * ux;
+                sc->wall_love[4] += f * L * uy * uy;
+            }
+        }
+        for (e = 0; e < 2 && M->n > 0; ++e) { /* anchors: the segment to the platen and its link */
+            int end = e ? M->n - 1 : 0, a = gk_scene_index(sc, M->ids[end]);
+            double xa[3], A[3], nw[3], ex, ey, L;
+            gk_wall *W;
+            M->af[e][0] = M->af[e][1] = 0.0;
+            if (M->anchor[e] < 0 || a < 0) continue;
+            W = &sc->walls[M->anchor[e]];
+            gk_scene_position(sc, a, xa);
+            L = gk__wall_geom(W, sc->dim, xa, A, nw); /* A: the member's foot on the wall */
+            /* chain order: anchor -> first member, last member -> anchor */
+            ex = e ? A[0] - xa[0] : xa[0] - A[0];
+            ey = e ? A[1] - xa[1] : xa[1] - A[1];
+            M->fx[end] += 0.5 * M->pressure * t * -ey;
+            M->fy[end] += 0.5 * M->pressure * t * ex;
+            if (M->stiffness > 0.0 && L > M->arest[e]) {
+                double f = M->stiffness * (L - M->arest[e]), ux = -nw[0], uy = -nw[1];
+                rve->f[0][a] += (gk_real)(f * ux);
+                rve->f[1][a] += (gk_real)(f * uy);
+                M->af[e][0] = f * ux; /* the wall holds it; not in W->force (its contacts only) */
+                M->af[e][1] = f * uy;
+                el += 0.5 * M->stiffness * (L - M->arest[e]) * (L - M->arest[e]);
+                if (sc->energy_on) sc->en.walls += f * (ux * W->vel[0] + uy * W->vel[1]) * rve->dt;
             }
         }
         for (e = 0; e < M->n; ++e) {
@@ -1344,6 +1405,7 @@ static void gk__hook_post_forces(gk_scene *sc) {
         sc->el_step = 0.0;
         gk__energy_pairs(sc);
     }
+    for (k = 0; k < 9; ++k) sc->wall_love[k] = 0.0;
     for (w = 0; w < sc->nwalls; ++w) gk__wall_contacts(sc, &sc->walls[w]);
     if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0)
         for (k = 0; k < dim; ++k)
@@ -1573,9 +1635,9 @@ GKDEF gk_result gk_scene_set_velocity(gk_scene *sc, int p, const double v[3], co
 
 /* ------------------------------------------------------------- membranes */
 GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, double pressure, double stiffness,
-                                      int *index) {
+                                      int anchor_first, int anchor_last, int *index) {
     gk_membrane M;
-    int e;
+    int e, a;
     if (sc->dim != 2) return gk_err_set(&sc->err, GK_ERR_UNSUPPORTED, "membranes are 2D");
     if (k < 2 || !ids) return gk_err_set(&sc->err, GK_ERR_ARG, "a membrane needs at least 2 members");
     if (!isfinite(pressure) || !(stiffness >= 0.0) || !isfinite(stiffness))
@@ -1583,7 +1645,19 @@ GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, d
     for (e = 0; e < k; ++e)
         if (gk_scene_index(sc, ids[e]) < 0)
             return gk_err_set(&sc->err, GK_ERR_ARG, "membrane member %d: no particle with id %d", e, (int)ids[e]);
+    if (anchor_first < -1 || anchor_first >= sc->nwalls || anchor_last < -1 || anchor_last >= sc->nwalls)
+        return gk_err_set(&sc->err, GK_ERR_ARG, "membrane anchors %d, %d: not walls of this scene", anchor_first,
+                          anchor_last);
     memset(&M, 0, sizeof M);
+    M.anchor[0] = anchor_first;
+    M.anchor[1] = anchor_last;
+    for (a = 0; a < 2; ++a)
+        if (M.anchor[a] >= 0) {
+            gk_wall *W = &sc->walls[M.anchor[a]];
+            double x[3], c[3], nn[3];
+            gk_scene_position(sc, gk_scene_index(sc, ids[a ? k - 1 : 0]), x);
+            M.arest[a] = gk__wall_geom(W, sc->dim, x, c, nn);
+        }
     M.n = M.cap = k;
     M.pressure = pressure;
     M.stiffness = stiffness;
@@ -1632,7 +1706,7 @@ GKDEF gk_result gk_scene_side_chain(const gk_scene *sc, int axis, int side, doub
         if (x[other] < lo) lo = x[other];
         if (x[other] > hi) hi = x[other];
     }
-    nb = (int)((hi - lo) / band) + 1;
+    nb = (int)((hi - lo) / band + 0.5) + 1; /* bands centred on lo + k band */
     best = (int32_t *)gk_alloc(&sc->def.rve.alloc, (size_t)nb * sizeof(int32_t));
     bx = (double *)gk_alloc(&sc->def.rve.alloc, (size_t)nb * sizeof(double));
     if (!best || !bx) {
@@ -1644,7 +1718,7 @@ GKDEF gk_result gk_scene_side_chain(const gk_scene *sc, int axis, int side, doub
     for (p = 0; p < sc->rve.n; ++p) {
         double x[3], e;
         gk_scene_position(sc, p, x);
-        b = (int)((x[other] - lo) / band);
+        b = (int)((x[other] - lo) / band + 0.5);
         if (b >= nb) b = nb - 1;
         e = side * (x[axis] + side * (double)sc->rve.r[p]); /* outer edge, larger is further out */
         if (best[b] < 0 || e > bx[b]) {
@@ -1929,6 +2003,7 @@ typedef struct gk__scene_hdr {
     int32_t have_presc, have_ext, pad0, pad1;
     int64_t lost;
     gk_energy en;
+    double wall_love[9];
     uint64_t rve_bytes;
 } gk__scene_hdr;
 
@@ -1950,7 +2025,9 @@ static size_t gk__scene_bytes(const gk_scene *sc, size_t rve_bytes) {
         if (W->ft[0]) b += n * R * (size_t)nh;
         if (W->mr[0]) b += n * R * (size_t)nh;
     }
-    for (m = 0; m < sc->nmem; ++m) b += 3 * sizeof(double) + sizeof(int32_t) + (size_t)sc->mem[m].n * (sizeof(int32_t) + 3 * sizeof(double));
+    for (m = 0; m < sc->nmem; ++m)
+        b += 4 * sizeof(double) + 2 * sizeof(int) + sizeof(int32_t) +
+             (size_t)sc->mem[m].n * (sizeof(int32_t) + 3 * sizeof(double));
     return b;
 }
 
@@ -1993,6 +2070,7 @@ GKDEF gk_result gk_scene_save(const gk_scene *sc, void *buf, size_t cap, size_t 
     hd.have_ext = sc->fext[0] != NULL;
     hd.lost = sc->lost;
     hd.en = sc->en;
+    for (k = 0; k < 9; ++k) hd.wall_love[k] = sc->wall_love[k];
     hd.rve_bytes = rb;
     GK__SPUT(&hd, sizeof hd);
     GK__SPUT(sc->rve.r, n * R);
@@ -2042,7 +2120,8 @@ GKDEF gk_result gk_scene_save(const gk_scene *sc, void *buf, size_t cap, size_t 
         GK__SPUT(&nm, sizeof nm);
         GK__SPUT(&M->pressure, sizeof(double));
         GK__SPUT(&M->stiffness, sizeof(double));
-        GK__SPUT(&M->pressure, sizeof(double)); /* reserved */
+        GK__SPUT(M->arest, 2 * sizeof(double));
+        GK__SPUT(M->anchor, 2 * sizeof(int));
         GK__SPUT(M->ids, (size_t)M->n * sizeof(int32_t));
         GK__SPUT(M->rest, (size_t)M->n * sizeof(double));
         GK__SPUT(M->fx, (size_t)M->n * sizeof(double));
@@ -2165,13 +2244,16 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
     for (m = 0; m < sc->nmem; ++m) {
         gk_membrane *M = &sc->mem[m];
         int32_t nm;
-        double resv;
+        int anc[2];
         GK__SGET(&nm, sizeof nm);
         if (nm < 0 || nm > M->cap) return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state membrane %d is invalid", m);
         M->n = nm;
         GK__SGET(&M->pressure, sizeof(double));
         GK__SGET(&M->stiffness, sizeof(double));
-        GK__SGET(&resv, sizeof(double));
+        GK__SGET(M->arest, 2 * sizeof(double));
+        GK__SGET(anc, 2 * sizeof(int));
+        if (anc[0] != M->anchor[0] || anc[1] != M->anchor[1])
+            return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state membrane %d has other anchors", m);
         GK__SGET(M->ids, (size_t)nm * sizeof(int32_t));
         GK__SGET(M->rest, (size_t)nm * sizeof(double));
         GK__SGET(M->fx, (size_t)nm * sizeof(double));
@@ -2185,6 +2267,7 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
     sc->nprescribed = hd.nprescribed;
     sc->lost = hd.lost;
     sc->en = hd.en;
+    for (k = 0; k < 9; ++k) sc->wall_love[k] = hd.wall_love[k];
     sc->energy_pending = hd.energy_pending;
     if (hd.energy_on && !sc->energy_on) {
         gk_energy keep = sc->en;

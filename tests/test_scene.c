@@ -617,6 +617,321 @@ TEST(chung_ooi_8_different_spheres) {
     gk_scene_destroy(&sc);
 }
 
+/* ================================================================ scenes */
+/* nx x ny (x nz) polydisperse particles (radii uniform in [0.8, 1] r) on a
+ * square lattice of spacing 2.2 r starting at (x0, y0, z0), shifted
+ * sideways by up to jitter r (0.1: the columns do not stand) */
+static int lattice(gk_packing *pk, int dim, int nx, int ny, int nz, double r, double x0, double y0, double z0,
+                   double jitter, uint64_t seed) {
+    gk_rng rng;
+    gk_err e;
+    int a, b, c, q = 0, n = nx * ny * (dim == 3 ? nz : 1);
+    if (gk_packing_alloc(pk, dim, n, NULL, &e)) return 1;
+    gk_rng_seed(&rng, seed);
+    for (c = 0; c < (dim == 3 ? nz : 1); ++c)
+        for (b = 0; b < ny; ++b)
+            for (a = 0; a < nx; ++a) {
+                pk->x[q] = x0 + 2.2 * r * (a + 0.5) + jitter * r * (2.0 * gk_rng_uniform(&rng) - 1.0);
+                pk->y[q] = y0 + 2.2 * r * (b + 0.5);
+                pk->z[q] = dim == 3 ? z0 + 2.2 * r * (c + 0.5) + jitter * r * (2.0 * gk_rng_uniform(&rng) - 1.0) : 0.0;
+                pk->r[q] = r * (0.8 + 0.2 * gk_rng_uniform(&rng));
+                ++q;
+            }
+    return 0;
+}
+
+/* a 2D (or 3D) box [0, W] x [0, H] (x [0, W]) of particles settling under
+ * gravity on a frictional floor and walls; linear law, viscous damping */
+static int box_scene(gk_scene *sc, int dim, int nx, int ny, double W, double H, double damping, unsigned periodic) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_packing pk;
+    gk_material wm;
+    int k;
+    double r = W / (2.2 * nx);
+    d.dim = dim;
+    d.hi[0] = W;
+    d.hi[1] = H;
+    d.hi[2] = W;
+    d.periodic = periodic;
+    d.gravity[1] = -9.81;
+    d.rve.mat.friction = 0.5;
+    d.rve.mat.zeta_n = 0.3;
+    d.rve.mat.density = 2650;
+    d.rve.mat.young = 5e7; /* soft: a larger time step */
+    d.rve.damping = damping;
+    d.rve.dt_factor = 0.2;
+    if (lattice(&pk, dim, nx, ny, dim == 3 ? nx : 1, r, 0.0, 0.0, 0.0, 0.1, 7)) return 1;
+    k = gk_scene_create(sc, &d, &pk);
+    gk_packing_free(&pk);
+    if (k) {
+        printf("    create: %s\n", gk_scene_error(sc));
+        return 1;
+    }
+    wm = d.rve.mat;
+    if (gk_scene_add_box(sc, &wm, GK_BOX_ALL & ~(2u << 2), NULL)) { /* no lid */
+        printf("    box: %s\n", gk_scene_error(sc));
+        gk_scene_destroy(sc);
+        return 1;
+    }
+    return 0;
+}
+
+static double total_weight(const gk_scene *sc) {
+    double w = 0.0;
+    int p;
+    for (p = 0; p < sc->rve.n; ++p) w += sc->mass[p] * 9.81;
+    return w;
+}
+
+/* Statics: particles poured into a box come to rest; the walls together
+ * carry their whole weight (sum of the wall forces = -sum m g e_y, to 1e-3:
+ * the floor most of it, the frictional side walls the rest, as in a
+ * silo) and the side walls' pushes cancel (2D and 3D). */
+TEST(gravity_floor_carries_the_weight) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        gk_scene sc;
+        double wt;
+        if (box_scene(&sc, dim, dim == 2 ? 12 : 4, dim == 2 ? 12 : 4, 0.12, 0.3, 0.3, 0)) {
+            CHECK(0);
+            continue;
+        }
+        CHECK(gk_scene_step(&sc, dim == 2 ? QUICK(40000, 20000) : QUICK(100000, 50000)) == GK_OK);
+        wt = total_weight(&sc);
+        {
+            double F[3] = {0, 0, 0};
+            int w, k;
+            for (w = 0; w < sc.nwalls; ++w)
+                for (k = 0; k < 3; ++k) F[k] += sc.walls[w].force[k];
+            printf("    %dD: walls carry %.6g N (floor %.6g N), weight %.6g N, side walls %.4g / %.4g N, kinetic %.3g J\n",
+                   dim, -F[1], sc.walls[2].resistance, wt, sc.walls[0].resistance, sc.walls[1].resistance,
+                   gk_rve_kinetic_energy(&sc.rve));
+            CHECK_REL(-F[1], wt, 1e-3);
+            CHECK_NEAR(F[0], 0.0, 1e-3 * wt);
+            CHECK_NEAR(F[2], 0.0, 1e-3 * wt);
+            CHECK(sc.walls[2].resistance > 0.8 * wt && sc.walls[0].resistance > 0.0);
+        }
+        gk_scene_destroy(&sc);
+    }
+}
+
+/* A servo lid: a plane driven to a target force settles on it (to 1e-3),
+ * and the floor then carries the lid force plus the weight minus what the
+ * side walls hold (vertical balance of the walls' forces, to 1e-3). */
+TEST(servo_wall_reaches_its_target) {
+    gk_scene sc;
+    gk_wall_def lid = gk_wall_def_default();
+    double target, F = 0.0;
+    int w, iw;
+    if (box_scene(&sc, 2, 10, 10, 0.1, 0.3, 0.3, 0)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_scene_step(&sc, QUICK(20000, 10000)) == GK_OK); /* settle */
+    target = 5.0 * total_weight(&sc);
+    lid.point[1] = 0.3;
+    lid.normal[1] = -1.0;
+    lid.mat = sc.def.rve.mat;
+    lid.drive = GK_DRIVE_FORCE;
+    lid.target = target;
+    lid.max_speed = 0.5;
+    lid.gain = 0.02;
+    CHECK(gk_scene_add_wall(&sc, &lid, &iw) == GK_OK);
+    CHECK(gk_scene_step(&sc, QUICK(40000, 30000)) == GK_OK);
+    for (w = 0; w < sc.nwalls; ++w) F += sc.walls[w].force[1];
+    printf("    lid %.6g N (target %.6g N) at y = %.5f m; walls' vertical sum %.6g N, weight %.6g N\n",
+           sc.walls[iw].resistance, target, sc.walls[iw].pos[1], -F, total_weight(&sc));
+    CHECK_REL(sc.walls[iw].resistance, target, 1e-3);
+    CHECK_REL(-F, total_weight(&sc), 1e-3);
+    CHECK(sc.walls[iw].pos[1] < 0.3);
+    /* a stress target over an area is the same servo */
+    sc.walls[iw].def.drive = GK_DRIVE_STRESS;
+    sc.walls[iw].def.area = 0.1 * sc.rve.volume_factor;
+    sc.walls[iw].def.target = 2.0 * target / sc.walls[iw].def.area;
+    CHECK(gk_scene_step(&sc, QUICK(40000, 30000)) == GK_OK);
+    CHECK_REL(sc.walls[iw].resistance, 2.0 * target, 1e-3);
+    gk_scene_destroy(&sc);
+}
+
+/* Prescribed particles: the bottom row is held fixed and the top row moves
+ * down at 5 mm/s (no walls, no gravity): after n steps the top row has
+ * moved exactly n dt v, the bottom row not at all, and in the slow
+ * compression the loads on the two rows balance (to 2 %) and push back
+ * (the top row's load points up). */
+TEST(prescribed_particles_move_and_report_their_load) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_scene sc;
+    gk_packing pk;
+    int p, nx = 8, ny = 8;
+    double r = 0.005, y0[64], v[3] = {0, -0.005, 0}, zero[3] = {0, 0, 0}, top = 0.0, bot = 0.0;
+    long n = 16000;
+    d.dim = 2;
+    d.hi[0] = d.hi[1] = 0.2;
+    d.rve.mat.young = 5e7;
+    d.rve.mat.zeta_n = 0.3;
+    d.rve.damping = 0.3;
+    d.rve.dt_factor = 0.2;
+    CHECK(lattice(&pk, 2, nx, ny, 1, r, 0.02, 0.02, 0.0, 0.0, 11) == 0);
+    for (p = 0; p < pk.n; ++p) pk.r[p] = 1.09 * r; /* gaps of 0.02 r */
+    CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    for (p = 0; p < sc.rve.n; ++p) {
+        int row = sc.rve.id[p] / nx;
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        y0[sc.rve.id[p]] = x[1];
+        if (row == 0) gk_scene_prescribe(&sc, p, zero, zero);
+        if (row == ny - 1) gk_scene_prescribe(&sc, p, v, zero);
+    }
+    CHECK(sc.nprescribed == 2 * nx);
+    if (gk_scene_step(&sc, n)) {
+        printf("    step: %s\n", gk_scene_error(&sc));
+        CHECK(0);
+    }
+    for (p = 0; p < sc.rve.n; ++p) {
+        int row = sc.rve.id[p] / nx;
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        if (row == 0) {
+            CHECK(x[1] == y0[sc.rve.id[p]]);
+            bot += sc.load[1][p];
+        }
+        if (row == ny - 1) {
+            CHECK_NEAR(x[1], y0[sc.rve.id[p]] + n * sc.rve.dt * v[1], 1e-12);
+            top += sc.load[1][p];
+        }
+    }
+    printf("    load on the moving row %.5g N, on the fixed row %.5g N\n", top, bot);
+    CHECK(top > 0.0);
+    CHECK_NEAR(top, -bot, 0.02 * top);
+    /* released, a particle moves freely again */
+    gk_scene_release(&sc, gk_scene_index(&sc, (ny - 1) * nx));
+    CHECK(sc.nprescribed == 2 * nx - 1);
+    gk_scene_destroy(&sc);
+}
+
+/* The follower-pressure membrane (2D biaxial cell: smooth rigid floor and
+ * servo lid at stress p, membranes on both sides at pressure p, loaded in ten
+ * stages): once in equilibrium the mean stress of the particles
+ * (gk_scene_stress over the area A the chains' centre lines and the walls
+ * enclose) is what the boundary applies, (1/A) sum load (x) position over
+ * the membrane loads (pressure and anchor links), the lid and the one
+ * particle held in place (smooth platens), to 1 % (static equilibrium:
+ * Love-Weber; the chains' tension-only links count as inner forces);
+ * sigma_xx is -p to 3 % (the anchored chains carry the pressure from
+ * platen to platen) and within 10 % of sigma_yy (isotropic loading; the
+ * lid pushes on the full width W, the chains act on their centre lines, a
+ * radius further in); the lid holds p W; no particle leaks. */
+TEST(membrane_confines_at_its_pressure) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_scene sc;
+    gk_packing pk;
+    gk_wall_def lid = gk_wall_def_default(), flo = gk_wall_def_default();
+    int32_t left[64], right[64];
+    int nl, nr, p, e, bad = 0;
+    double pr = 2e4, W = 0.1, H = 0.2, sig[9], area = 0.0, r = 0.0025, hchain = 0.0;
+    d.dim = 2;
+    d.lo[0] = -0.1;
+    d.hi[0] = 0.2;
+    d.hi[1] = 0.25;
+    d.rve.mat.young = 5e7;
+    d.rve.mat.friction = 0.3;
+    d.rve.damping = 0.5;
+    d.rve.dt_factor = 0.2;
+    CHECK(lattice(&pk, 2, 18, 36, 1, r, 0.0, 0.0, 0.0, 0.0, 3) == 0);
+    for (p = 0; p < pk.n; ++p) pk.r[p] = 1.05 * r + 0.04 * r * (double)(p % 3); /* nearly touching */
+    CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    flo.normal[1] = 1.0;
+    flo.mat = d.rve.mat;
+    flo.mat.friction = 0.0; /* lubricated platens */
+    lid.point[1] = 36 * 2.2 * r;
+    lid.normal[1] = -1.0;
+    lid.mat = flo.mat;
+    lid.drive = GK_DRIVE_STRESS;
+    lid.target = pr;
+    lid.area = W * sc.rve.volume_factor;
+    lid.max_speed = 0.05;
+    CHECK(gk_scene_add_wall(&sc, &flo, NULL) == GK_OK);
+    CHECK(gk_scene_add_wall(&sc, &lid, NULL) == GK_OK);
+    CHECK(gk_scene_side_chain(&sc, 0, -1, 2.2 * r, left, 64, &nl) == GK_OK);
+    CHECK(gk_scene_side_chain(&sc, 0, 1, 2.2 * r, right, 64, &nr) == GK_OK);
+    CHECK(nl == 36 && nr == 36);
+    /* the left chain runs top to bottom (lid to floor), the right one bottom to top */
+    CHECK(gk_scene_add_membrane(&sc, nl, left, pr, 1e5, 1, 0, NULL) == GK_OK);
+    CHECK(gk_scene_add_membrane(&sc, nr, right, pr, 1e5, 0, 1, NULL) == GK_OK);
+    /* smooth platens leave the specimen free to slide: hold one particle of the bottom row */
+    CHECK(gk_scene_prescribe(&sc, gk_scene_index(&sc, 9), NULL, NULL) == GK_OK);
+    for (e = 1; e <= 20; ++e) { /* load in 10 stages, then hold */
+        sc.mem[0].pressure = sc.mem[1].pressure = pr * (e < 10 ? e : 10) / 10.0;
+        sc.walls[1].def.target = pr * (e < 10 ? e : 10) / 10.0;
+        if (gk_scene_step(&sc, QUICK(3000, 2000))) {
+            printf("    step: %s\n", gk_scene_error(&sc));
+            CHECK(0);
+            break;
+        }
+    }
+    /* the boundary the loads act on: the chains' centre lines, closed along
+     * the floor and the lid; the membranes load only the chain's height */
+    {
+        double xs[200], ys[200], x[3], yb, yt;
+        int m = 0, k;
+        H = sc.walls[1].pos[1];
+        gk_scene_position(&sc, gk_scene_index(&sc, right[0]), x);
+        xs[m] = x[0], ys[m++] = 0.0;
+        yb = x[1];
+        for (e = 0; e < nr; ++e) {
+            gk_scene_position(&sc, gk_scene_index(&sc, right[e]), x);
+            xs[m] = x[0], ys[m++] = x[1];
+        }
+        yt = x[1];
+        xs[m] = x[0], ys[m++] = H;
+        gk_scene_position(&sc, gk_scene_index(&sc, left[0]), x);
+        xs[m] = x[0], ys[m++] = H;
+        for (e = 0; e < nl; ++e) {
+            gk_scene_position(&sc, gk_scene_index(&sc, left[e]), x);
+            xs[m] = x[0], ys[m++] = x[1];
+        }
+        xs[m] = x[0], ys[m++] = 0.0;
+        for (k = 0; k < m; ++k) area += 0.5 * (xs[k] * ys[(k + 1) % m] - xs[(k + 1) % m] * ys[k]);
+        hchain = yt - yb;
+    }
+    /* what the boundary applies: sum of load (x) position over the membrane
+     * loads (at the chain centres) and the lid (at y = H; the floor's lever is 0) */
+    {
+        double bx = 0.0, by = -sc.walls[1].force[1] * H, x[3];
+        int m, q = gk_scene_index(&sc, 9);
+        gk_scene_position(&sc, q, x); /* the hold: minus its load, at its centre */
+        bx -= sc.load[0][q] * x[0];
+        by -= sc.load[1][q] * x[1];
+        for (m = 0; m < 2; ++m)
+            for (e = 0; e < sc.mem[m].n; ++e) {
+                int end = e == 0 ? 0 : (e == sc.mem[m].n - 1 ? 1 : -1);
+                gk_scene_position(&sc, gk_scene_index(&sc, sc.mem[m].ids[e]), x);
+                bx += (sc.mem[m].fx[e] + (end >= 0 ? sc.mem[m].af[end][0] : 0.0)) * x[0];
+                by += (sc.mem[m].fy[e] + (end >= 0 ? sc.mem[m].af[end][1] : 0.0)) * x[1];
+            }
+        gk_scene_stress(&sc, area, sig);
+        bx /= area * sc.rve.volume_factor;
+        by /= area * sc.rve.volume_factor;
+        printf("    sigma_xx %.5g (boundary %.5g), sigma_yy %.5g (%.5g), sigma_xy %.3g Pa over %.5g m^2; p = %g Pa, chain "
+               "height %.4f of %.4f m\n",
+               sig[0], bx, sig[4], by, sig[1], area, pr, hchain, H);
+        CHECK_REL(sig[0], bx, 0.01);
+        CHECK_REL(sig[4], by, 0.01);
+        CHECK_REL(sig[0], -pr, 0.03);
+        CHECK(sig[0] / sig[4] > 0.9 && sig[0] / sig[4] < 1.1);
+    }
+    CHECK_REL(sc.walls[1].resistance, pr * W * sc.rve.volume_factor, 1e-3);
+    for (p = 0; p < sc.rve.n; ++p) {
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        if (!(x[0] > -0.02 && x[0] < 0.12)) ++bad;
+    }
+    CHECK(bad == 0);
+    gk_scene_destroy(&sc);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(chung_ooi_1_two_spheres_normal);
@@ -627,5 +942,9 @@ int main(int argc, char **argv) {
     RUN(chung_ooi_6_spinning_sphere_on_wall);
     RUN(chung_ooi_7_two_spheres_oblique);
     RUN(chung_ooi_8_different_spheres);
+    RUN(gravity_floor_carries_the_weight);
+    RUN(servo_wall_reaches_its_target);
+    RUN(prescribed_particles_move_and_report_their_load);
+    RUN(membrane_confines_at_its_pressure);
     return gk_test_done();
 }
