@@ -123,17 +123,25 @@
  * membrane springs), the work done on the particles by gravity, walls
  * (force times the wall's surface velocity), external loads, the membrane
  * pressure and the constraints of prescribed particles, and the energy
- * dissipated by Coulomb sliding (F_t times the slip (F_trial - F_t) / k_t,
- * and the same for rolling), contact dashpots (F_v^2 / g dt) and local
- * damping. Work of a force F over a step is F . (v_{n-1/2} + v_{n+1/2})
- * dt / 2, which makes the kinetic part exact; the contact terms are
- * computed from the contact law itself (each pair is evaluated a second
- * time, and sliding pairs a third time without the Coulomb cap, so
- * tracking costs about twice the contact time: pay for it only when
- * needed). balance = kinetic + elastic - (initial + works - dissipation)
- * is then small: O(dt) of the energy moved (tests: below 1e-3 of it for
- * the linear law; Hertz-Mindlin's tangential spring, whose stiffness
- * follows the overlap, is not exactly conservative). Particles removed or
+ * dissipated by contact dashpots, Coulomb sliding (and rolling slip) and
+ * local damping. The work of a force F over a step is F . v_bar dt with
+ * v_bar = (v_{n-1/2} + v_{n+1/2}) / 2 (with torques and spins likewise),
+ * the leap-frog's own measure, which makes the kinetic part exact: damping
+ * is what the applied forces did beyond the kinetic energy change; the
+ * dashpots' dissipation is the work of their forces; friction is what the
+ * tangential forces and the torques took out of the particles beyond the
+ * change of the tangential and rolling springs' energy (the slip energy of
+ * PFC), so the incremental Hertz-Mindlin spring, whose stiffness follows
+ * the overlap, is booked exactly too; `slip` estimates the same friction
+ * from the slips (F_t (F_trial - F_t) / k_t per sliding contact) as a
+ * check. The contacts are evaluated again with the law itself for the
+ * books (each pair once more, sliding ones twice: tracking costs about two
+ * to three times the contact time; pay for it only when needed).
+ * balance = kinetic + elastic - (initial + works - dissipation) is then
+ * the time integration's own energy error: the normal springs' energy at
+ * the steps against the kinetic energy at the half steps, and contacts
+ * that open or close between two steps (tests: below 1e-3 of the energy
+ * moved at dt = 0.2 dt_crit, shrinking with dt). Particles removed or
  * inserted carry their kinetic energy (and removed ones their contacts'
  * elastic energy) in `removed` / `inserted`; an inserted particle that
  * overlaps another brings elastic energy the balance does not book.
@@ -247,6 +255,7 @@ typedef struct gk_energy {
     double elastic;      /* contact and membrane springs, last step [J]                  */
     double gravity, walls, external, pressure, prescribed; /* work on the particles [J]  */
     double friction, viscous, damping;                     /* dissipated, >= 0 [J]      */
+    double slip;         /* friction estimated from the Coulomb and rolling slips (a check) */
     double removed, inserted;                               /* carried out, in [J]       */
     double initial;      /* kinetic + elastic when tracking started                      */
     double balance;      /* kinetic + elastic - (initial + works - dissipation + in - out) */
@@ -290,6 +299,10 @@ typedef struct gk_scene {
     size_t hcap;
     double wall_love[9];     /* wall contacts' f (x) (x_c - x_p) and membrane links' f L u (x) u, last step */
     double el_step;          /* elastic energy summed during the current step           */
+    double erest_now, erest_prev, slip_step; /* tangential + rolling spring energy, slip     */
+    void *rec;               /* gk__erec: the step's contact forces for the books        */
+    size_t nrec, caprec;
+    int rec_failed;
     long energy_mismatch;    /* pairs whose re-evaluation differed from the kernel (0)  */
     gk_err err;
 } gk_scene;
@@ -557,6 +570,7 @@ GKDEF void gk_scene_destroy(gk_scene *sc) {
         gk__sc_free(sc, sc->hmr[k]);
     }
     gk__sc_free(sc, sc->hcs);
+    gk__sc_free(sc, sc->rec);
     gk_rve_destroy(&sc->rve);
     sc->walls = NULL;
     sc->mem = NULL;
@@ -570,6 +584,8 @@ GKDEF void gk_scene_destroy(gk_scene *sc) {
         sc->hft[k] = sc->hmr[k] = NULL;
     }
     sc->hcs = NULL;
+    sc->rec = NULL;
+    sc->nrec = sc->caprec = 0;
 }
 
 /* ------------------------------------------------------------- create */
@@ -973,35 +989,49 @@ static gk_result gk__wall_build(gk_scene *sc, gk_wall *W) {
 }
 
 /* ------------------------------------------------------------- energy helpers */
-/* elastic energy of one contact: normal spring (overlap delta), tangential
- * spring ft, rolling spring mr, with the law's current stiffnesses */
+/* elastic energy of one contact: normal spring (overlap delta) returned,
+ * tangential spring ft and rolling spring mr in *rest, with the law's
+ * current stiffnesses */
 static double gk__contact_elastic(const gk_law_consts *K, gk_law law, unsigned fl, int dim, gk_real ri, gk_real rj,
-                                  gk_real delta, const gk_real *ft, const gk_real *mr) {
+                                  gk_real delta, const gk_real *ft, const gk_real *mr, double *rest) {
     gk_real kn, fn, kt;
     double e, t2 = 0.0, m2 = 0.0;
     int k, nh = dim == 2 ? 1 : 3;
     gk_contact_stiffness(K, law, ri, rj, delta, &kn, &fn, &kt);
     e = law == GK_LAW_LINEAR ? 0.5 * (double)fn * (double)delta : 0.4 * (double)fn * (double)delta;
+    *rest = 0.0;
     if ((fl & GK_PHYS_TANGENT) && kt > 0) {
         for (k = 0; k < nh; ++k) t2 += (double)ft[k] * (double)ft[k];
-        e += t2 / (2.0 * (double)kt);
+        *rest += t2 / (2.0 * (double)kt);
     }
     if ((fl & GK_PHYS_ROLLING) && mr) {
         double kr = (double)K->beta * (double)kt * (double)ri * (double)rj;
         for (k = 0; k < nh; ++k) m2 += (double)mr[k] * (double)mr[k];
-        if (kr > 0) e += m2 / (2.0 * kr);
+        if (kr > 0) *rest += m2 / (2.0 * kr);
     }
     return e;
 }
 
-/* energy terms of one contact evaluated at this step from its old history:
- * elastic energy after the step, viscous and frictional dissipation during
- * it. d: branch vector, v: relative velocity, wi, wj: spins (2D: [2]).
- * Writes the new history to ft, mr, cs (what the kernel wrote). */
+/* One contact evaluated with the law from its old history (writes the new
+ * history to ft, mr, cs: what the kernel wrote) and, with `energy`, its
+ * books: elastic energy after the step (normal; tangential + rolling in
+ * rest), and for the step's dissipation the forces it applied (kept in a
+ * record and priced at the mean velocities once the leap-frog update is
+ * known), the tangential dashpot's work at the old velocities and the slip
+ * estimate of Coulomb sliding (F_t times (F_trial - F_t) / k_t: the check
+ * on the friction the records give). */
 typedef struct gk__cterm {
-    double elastic, viscous, friction;
+    double elastic, rest, visc_t, slip, fvn, n[3];
     gk_contact_out o;
 } gk__cterm;
+
+/* the forces of one contact for the books: i, j particles (i < 0: wall
+ * -1 - i, moving at vs at the contact), normal n (i to j), normal dashpot
+ * force fvn (on j, along n), tangential force ft (on j), torques ti, tj */
+typedef struct gk__erec {
+    int32_t i, j;
+    double n[3], fvn, ft[3], ti[3], tj[3], vs[3];
+} gk__erec;
 
 static void gk__contact_terms(const gk_law_consts *K, gk_law law, unsigned fl, int dim, const gk_real d[3], gk_real ri,
                               gk_real rj, gk_real mi, gk_real mj, const gk_real v[3], const gk_real wi[3],
@@ -1010,11 +1040,12 @@ static void gk__contact_terms(const gk_law_consts *K, gk_law law, unsigned fl, i
     gk_real ft0[3], mr0[3], dummy[3] = {0, 0, 0}, kn, fn, kt;
     unsigned char cs0 = *cs;
     int k, nh = dim == 2 ? 1 : 3, in;
+    double dist;
     for (k = 0; k < 3; ++k) {
         ft0[k] = ft[k];
         mr0[k] = mr ? mr[k] : 0;
     }
-    t->elastic = t->viscous = t->friction = 0.0;
+    t->elastic = t->rest = t->visc_t = t->slip = t->fvn = 0.0;
     if (dim == 2)
         in = gk_contact_2d(K, law, fl, d[0], d[1], ri, rj, mi, mj, v[0], v[1], wi[2], wj[2], dt, ft,
                            (fl & GK_PHYS_ROLLING) ? mr : dummy, cs, &t->o);
@@ -1023,24 +1054,20 @@ static void gk__contact_terms(const gk_law_consts *K, gk_law law, unsigned fl, i
                            &t->o);
     if (!in || !energy) return;
     gk_contact_stiffness(K, law, ri, rj, t->o.delta, &kn, &fn, &kt);
-    t->elastic = gk__contact_elastic(K, law, fl, dim, ri, rj, t->o.delta, ft, mr);
-    if (fl & GK_PHYS_VISCOUS) {
-        double mstar = (double)((mi * mj) / (mi + mj)), gn = (double)K->zn2 * sqrt(mstar * (double)kn);
-        double fv = (double)fn - (double)t->o.fn;
-        if (gn > 0) t->viscous += fv * fv / gn * (double)dt;
-        if ((fl & GK_PHYS_TANGENT) && kt > 0) {
-            double gt = (double)K->zt2 * sqrt(mstar * (double)kt), nrm[3], ftot[3], q = 0.0, fn_t = (double)t->o.fn;
-            double dist = (double)(ri + rj) - (double)t->o.delta;
-            for (k = 0; k < 3; ++k) nrm[k] = k < dim ? (double)d[k] / dist : 0.0;
-            for (k = 0; k < 3; ++k) ftot[k] = (double)t->o.f[k] - fn_t * nrm[k];
-            if (dim == 2) { /* spring minus total along t = (-ny, nx) */
-                double ftt = -ftot[0] * nrm[1] + ftot[1] * nrm[0], fv2 = (double)ft[0] - ftt;
-                q = fv2 * fv2;
-            } else {
-                for (k = 0; k < 3; ++k) q += ((double)ft[k] - ftot[k]) * ((double)ft[k] - ftot[k]);
-            }
-            if (gt > 0) t->viscous += q / gt * (double)dt;
+    t->elastic = gk__contact_elastic(K, law, fl, dim, ri, rj, t->o.delta, ft, mr, &t->rest);
+    dist = (double)(ri + rj) - (double)t->o.delta;
+    for (k = 0; k < 3; ++k) t->n[k] = k < dim ? (double)d[k] / dist : 0.0;
+    t->fvn = (double)t->o.fn - (double)fn;
+    if ((fl & GK_PHYS_VISCOUS) && (fl & GK_PHYS_TANGENT) && kt > 0) {
+        double mstar = (double)((mi * mj) / (mi + mj)), gt = (double)K->zt2 * sqrt(mstar * (double)kt), tot[3], q = 0.0;
+        for (k = 0; k < 3; ++k) tot[k] = (double)t->o.f[k] - (double)t->o.fn * t->n[k];
+        if (dim == 2) { /* spring minus total along t = (-ny, nx) */
+            double fv2 = (double)ft[0] - (-tot[0] * t->n[1] + tot[1] * t->n[0]);
+            q = fv2 * fv2;
+        } else {
+            for (k = 0; k < 3; ++k) q += ((double)ft[k] - tot[k]) * ((double)ft[k] - tot[k]);
         }
+        if (gt > 0) t->visc_t = q / gt * (double)dt;
     }
     if (((fl & GK_PHYS_TANGENT) && (*cs & GK_CS_SLIDING)) || (fl & GK_PHYS_ROLLING)) {
         /* the trial springs without the Coulomb caps: slip = (trial - new) / k */
@@ -1060,23 +1087,81 @@ static void gk__contact_terms(const gk_law_consts *K, gk_law law, unsigned fl, i
         else
             gk_contact_3d(&Kf, law, fl, d, ri, rj, mi, mj, v, wi, wj, dt, tf, tm, &tcs, &o2);
         if ((fl & GK_PHYS_TANGENT) && (*cs & GK_CS_SLIDING) && kt > 0) {
-            double dist = (double)(ri + rj) - (double)t->o.delta, nrm[3], tot[3];
-            for (k = 0; k < 3; ++k) nrm[k] = k < dim ? (double)d[k] / dist : 0.0;
-            for (k = 0; k < 3; ++k) tot[k] = (double)t->o.f[k] - (double)t->o.fn * nrm[k];
+            double tot[3];
+            for (k = 0; k < 3; ++k) tot[k] = (double)t->o.f[k] - (double)t->o.fn * t->n[k];
             for (k = 0; k < nh; ++k) s2 += ((double)tf[k] - (double)ft[k]) * ((double)tf[k] - (double)ft[k]);
             for (k = 0; k < 3; ++k) f2 += tot[k] * tot[k];
-            t->friction += sqrt(f2) * sqrt(s2) / (double)kt;
+            t->slip += sqrt(f2) * sqrt(s2) / (double)kt;
         }
         if (fl & GK_PHYS_ROLLING) {
             double kr = (double)K->beta * (double)kt * (double)ri * (double)rj, m2 = 0.0, ds2 = 0.0;
             for (k = 0; k < nh; ++k) {
-                int q = dim == 2 ? 0 : k;
-                m2 += (double)mr[q] * (double)mr[q];
-                ds2 += ((double)tm[q] - (double)mr[q]) * ((double)tm[q] - (double)mr[q]);
+                m2 += (double)mr[k] * (double)mr[k];
+                ds2 += ((double)tm[k] - (double)mr[k]) * ((double)tm[k] - (double)mr[k]);
             }
-            if (kr > 0) t->friction += sqrt(m2) * sqrt(ds2) / kr;
+            if (kr > 0) t->slip += sqrt(m2) * sqrt(ds2) / kr;
         }
     }
+}
+
+/* book one evaluated contact: energies now, and its forces for the step's dissipation */
+static void gk__book(gk_scene *sc, int32_t i, int32_t j, const gk__cterm *t, const double vs[3]) {
+    gk__erec *e;
+    int k;
+    sc->el_step += t->elastic + t->rest;
+    sc->erest_now += t->rest;
+    sc->en.viscous += t->visc_t;
+    sc->en.friction -= t->visc_t; /* the records price both dashpot and slip; see gk__price_records */
+    sc->slip_step += t->slip;
+    if (sc->nrec == sc->caprec) {
+        size_t cap = sc->caprec ? 2 * sc->caprec : 256;
+        if (gk_realloc(gk__sc_alloc(sc), (void **)&sc->rec, sc->nrec, cap, sizeof(gk__erec))) {
+            sc->rec_failed = 1;
+            return;
+        }
+        sc->caprec = cap;
+    }
+    e = (gk__erec *)sc->rec + sc->nrec++;
+    e->i = i;
+    e->j = j;
+    e->fvn = t->fvn;
+    for (k = 0; k < 3; ++k) {
+        e->n[k] = t->n[k];
+        e->ft[k] = (double)t->o.f[k] - (double)t->o.fn * t->n[k];
+        e->ti[k] = (double)t->o.ti[k];
+        e->tj[k] = (double)t->o.tj[k];
+        e->vs[k] = vs ? vs[k] : 0.0;
+    }
+}
+
+/* the step's contact dissipation from the records, at the mean velocities
+ * v_bar = (v_{n-1/2} + v_{n+1/2}) / 2 (the leap-frog's own work): the normal
+ * dashpots' work is viscous; what the tangential forces and the torques
+ * took out of the particles beyond the change of the tangential and rolling
+ * springs' energy is friction (Coulomb and rolling slip, plus the
+ * tangential dashpots, moved to viscous at their old-velocity estimate) */
+static void gk__price_records(gk_scene *sc) {
+    gk_rve *rve = &sc->rve;
+    double dt = rve->dt, dvn = 0.0, prest = 0.0;
+    size_t c;
+    int k;
+    for (c = 0; c < sc->nrec; ++c) {
+        const gk__erec *e = (const gk__erec *)sc->rec + c;
+        double vj[3], vi[3], wj[3], wi[3], dv[3];
+        for (k = 0; k < 3; ++k) {
+            int j = e->j, i = e->i;
+            vj[k] = k < sc->dim ? 0.5 * ((double)rve->v[k][j] + sc->vold[k][j]) : 0.0;
+            wj[k] = rve->w[k] ? 0.5 * ((double)rve->w[k][j] + sc->wold[k][j]) : 0.0;
+            vi[k] = i >= 0 ? (k < sc->dim ? 0.5 * ((double)rve->v[k][i] + sc->vold[k][i]) : 0.0) : e->vs[k];
+            wi[k] = i >= 0 && rve->w[k] ? 0.5 * ((double)rve->w[k][i] + sc->wold[k][i]) : 0.0;
+            dv[k] = vj[k] - vi[k];
+        }
+        dvn += e->fvn * gk__dot3(e->n, dv);
+        prest += gk__dot3(e->ft, dv) + gk__dot3(e->ti, wi) + gk__dot3(e->tj, wj);
+    }
+    sc->en.viscous -= dvn * dt;
+    sc->en.friction += -prest * dt - (sc->erest_now - sc->erest_prev);
+    sc->erest_prev = sc->erest_now;
 }
 
 /* branch vector and relative kinematics of pair c, exactly as the kernels
@@ -1102,7 +1187,6 @@ static void gk__pair_inputs(const gk_rve *rve, int c, gk_real d[3], gk_real v[3]
 static void gk__energy_pairs(gk_scene *sc) {
     gk_rve *rve = &sc->rve;
     int c, k, dim = rve->dim, nh = dim == 2 ? 1 : 3;
-    double el = 0.0, vis = 0.0, fr = 0.0;
     gk_real dt = (gk_real)rve->dt;
     for (c = 0; c < rve->pl.n; ++c) {
         gk_real d[3], v[3], wi[3], wj[3], ft[3] = {0, 0, 0}, mr[3] = {0, 0, 0};
@@ -1124,13 +1208,8 @@ static void gk__energy_pairs(gk_scene *sc) {
             if ((rve->phys & GK_PHYS_ROLLING) && mr[k] != rve->mr[dim == 2 ? 2 : k][c]) same = 0;
         }
         if (!same) ++sc->energy_mismatch;
-        el += t.elastic;
-        vis += t.viscous;
-        fr += t.friction;
+        if (cs & GK_CS_CONTACT) gk__book(sc, i, j, &t, NULL);
     }
-    sc->el_step += el;
-    sc->en.viscous += vis;
-    sc->en.friction += fr;
 }
 
 /* ------------------------------------------------------------- wall contacts */
@@ -1139,7 +1218,7 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
     int e, k, dim = sc->dim, rot = (rve->phys & GK_PHYS_ROTATION) != 0, nh = dim == 2 ? 1 : 3;
     gk_law law = W->def.mat.law;
     gk_real dt = (gk_real)rve->dt, zero3[3] = {0, 0, 0};
-    double F[3] = {0, 0, 0}, M[3] = {0, 0, 0}, K = 0.0, dmax = 0.0, el = 0.0, vis = 0.0, fr = 0.0, work = 0.0;
+    double F[3] = {0, 0, 0}, M[3] = {0, 0, 0}, K = 0.0, dmax = 0.0, work = 0.0;
     int nc = 0;
     for (e = 0; e < W->ncand; ++e) {
         int p = W->cand[e];
@@ -1204,9 +1283,7 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
                     for (b = 0; b < dim; ++b) sc->wall_love[3 * a + b] += f[a] * (-n[b] * l);
             }
             work += gk__dot3(f, vs) * (double)dt;
-            el += t.elastic;
-            vis += t.viscous;
-            fr += t.friction;
+            if (sc->energy_on) gk__book(sc, (int32_t)(-1 - (W - sc->walls)), p, &t, vs);
             ++nc;
         }
     }
@@ -1218,12 +1295,7 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
     W->ncontacts = nc;
     W->dmax = dmax;
     W->resistance = -gk__dot3(F, W->def.normal);
-    if (sc->energy_on) {
-        sc->el_step += el;
-        sc->en.viscous += vis;
-        sc->en.friction += fr;
-        sc->en.walls += work;
-    }
+    if (sc->energy_on) sc->en.walls += work;
 }
 
 /* the wall's velocity for the next step: prescribed, or the servo's */
@@ -1402,7 +1474,8 @@ static void gk__hook_post_forces(gk_scene *sc) {
         for (k = 0; k < 3; ++k)
             if (rve->w[k])
                 for (p = 0; p < n; ++p) sc->wold[k][p] = (double)rve->w[k][p];
-        sc->el_step = 0.0;
+        sc->el_step = sc->erest_now = sc->slip_step = 0.0;
+        sc->nrec = 0;
         gk__energy_pairs(sc);
     }
     for (k = 0; k < 9; ++k) sc->wall_love[k] = 0.0;
@@ -1426,8 +1499,10 @@ static void gk__hook_post_forces(gk_scene *sc) {
             if (rve->t[k])
                 for (p = 0; p < n; ++p) sc->ttot[k][p] = (double)rve->t[k][p];
         sc->en.elastic = sc->el_step;
-        if (sc->energy_pending) {
+        sc->en.slip += sc->slip_step;
+        if (sc->energy_pending) { /* the springs' energy when tracking started */
             sc->en.initial += sc->el_step;
+            sc->erest_prev = sc->erest_now;
             sc->energy_pending = 0;
         }
     }
@@ -1490,6 +1565,7 @@ static void gk__hook_post_step(gk_scene *sc) {
         sc->en.prescribed += wpr;
         sc->en.damping += dmp;
         sc->en.pressure += wm;
+        gk__price_records(sc);
         sc->en.kinetic = gk__kinetic(sc);
         ++sc->en.steps;
     }
@@ -1503,12 +1579,15 @@ static void gk__hook_post_step(gk_scene *sc) {
 
 static gk_result gk__scene_hook(gk_rve *rve, int stage, void *user) {
     gk_scene *sc = (gk_scene *)user;
-    (void)rve;
     if (stage == GK_HOOK_PRE_FORCES) return gk__hook_pre(sc);
     if (stage == GK_HOOK_POST_FORCES)
         gk__hook_post_forces(sc);
     else
         gk__hook_post_step(sc);
+    if (sc->rec_failed) {
+        sc->rec_failed = 0;
+        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for the energy bookkeeping");
+    }
     return GK_OK;
 }
 
@@ -1838,10 +1917,11 @@ out:
 }
 
 /* elastic energy stored in the contacts of the particles marked in drop */
-static double gk__dropped_elastic(gk_scene *sc, const unsigned char *drop) {
+static double gk__dropped_elastic(gk_scene *sc, const unsigned char *drop, double *erest) {
     gk_rve *rve = &sc->rve;
     int c, k, w, e, dim = sc->dim, nh = dim == 2 ? 1 : 3;
-    double el = 0.0;
+    double el = 0.0, rest;
+    *erest = 0.0;
     for (c = 0; c < rve->pl.n; ++c) {
         int i = rve->pl.i[c], j = rve->pl.j[c];
         gk_real d[3], v[3], wi[3], wj[3], ft[3] = {0, 0, 0}, mr[3] = {0, 0, 0}, dist;
@@ -1853,7 +1933,9 @@ static double gk__dropped_elastic(gk_scene *sc, const unsigned char *drop) {
             if (rve->mr[dim == 2 ? 2 : k]) mr[dim == 2 ? 0 : k] = rve->mr[dim == 2 ? 2 : k][c];
         }
         el += gk__contact_elastic(&rve->K, rve->def.mat.law, rve->phys, dim, rve->r[i], rve->r[j],
-                                  rve->r[i] + rve->r[j] - dist, ft, mr);
+                                  rve->r[i] + rve->r[j] - dist, ft, mr, &rest);
+        el += rest;
+        *erest += rest;
     }
     for (w = 0; w < sc->nwalls; ++w) {
         gk_wall *W = &sc->walls[w];
@@ -1871,7 +1953,9 @@ static double gk__dropped_elastic(gk_scene *sc, const unsigned char *drop) {
             }
             gk__wall_consts(W, (double)rve->r[p], &K);
             el += gk__contact_elastic(&K, W->def.mat.law, W->phys, dim, rve->r[p], rve->r[p],
-                                      (gk_real)((double)rve->r[p] - dist), ft, mr);
+                                      (gk_real)((double)rve->r[p] - dist), ft, mr, &rest);
+            el += rest;
+            *erest += rest;
         }
     }
     return el;
@@ -1881,7 +1965,7 @@ static gk_result gk__scene_delete(gk_scene *sc, const unsigned char *drop) {
     gk_rve *rve = &sc->rve;
     int n = rve->n, p, q, k, w, m, e;
     gk_result r;
-    double ke = 0.0, el = 0.0;
+    double ke = 0.0, el = 0.0, erest = 0.0;
     for (p = 0, q = 0; p < n; ++p) q += !drop[p];
     if (q == n) return GK_OK;
     if (q < 1) return gk_err_set(&sc->err, GK_ERR_ARG, "cannot remove every particle");
@@ -1894,7 +1978,8 @@ static gk_result gk__scene_delete(gk_scene *sc, const unsigned char *drop) {
                     if (rve->w[k]) ke += 0.5 * I * (double)rve->w[k][p] * (double)rve->w[k][p];
                 }
             }
-        el = gk__dropped_elastic(sc, drop);
+        el = gk__dropped_elastic(sc, drop, &erest);
+        sc->erest_prev -= erest; /* their springs leave the books, not as dissipation */
     }
     /* the scene's arrays first (the RVE's compaction keeps the same order) */
     for (p = 0, q = 0; p < n; ++p) {
@@ -2003,7 +2088,7 @@ typedef struct gk__scene_hdr {
     int32_t have_presc, have_ext, pad0, pad1;
     int64_t lost;
     gk_energy en;
-    double wall_love[9];
+    double wall_love[9], erest_prev;
     uint64_t rve_bytes;
 } gk__scene_hdr;
 
@@ -2071,6 +2156,7 @@ GKDEF gk_result gk_scene_save(const gk_scene *sc, void *buf, size_t cap, size_t 
     hd.lost = sc->lost;
     hd.en = sc->en;
     for (k = 0; k < 9; ++k) hd.wall_love[k] = sc->wall_love[k];
+    hd.erest_prev = sc->erest_prev;
     hd.rve_bytes = rb;
     GK__SPUT(&hd, sizeof hd);
     GK__SPUT(sc->rve.r, n * R);
@@ -2268,6 +2354,7 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
     sc->lost = hd.lost;
     sc->en = hd.en;
     for (k = 0; k < 9; ++k) sc->wall_love[k] = hd.wall_love[k];
+    sc->erest_prev = hd.erest_prev;
     sc->energy_pending = hd.energy_pending;
     if (hd.energy_on && !sc->energy_on) {
         gk_energy keep = sc->en;
