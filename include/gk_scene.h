@@ -68,7 +68,9 @@
  * R = -F.normal (F the force the particles exert on the wall) reaches
  * def.target [N], or def.target x def.area [Pa x m^2; 2D: m x thickness]:
  * v = gain (target - R) / (K dt), K the sum of the wall's contact normal
- * stiffnesses, capped at max_speed (which the servo moves at when K = 0).
+ * stiffnesses, capped at max_speed (which the servo moves at when K = 0);
+ * the wall moves with def.velocity's part across that direction as well
+ * (a shear box under constant normal load).
  * A wall reports each step force[3], moment[3] (about its point, both
  * exerted BY the particles ON the wall), ncontacts, stiffness, and
  * displacement. The fields of sc.walls[w].def may be changed between
@@ -1305,14 +1307,16 @@ static void gk__wall_drive(gk_scene *sc, gk_wall *W) {
     if (d->drive == GK_DRIVE_VELOCITY) {
         for (k = 0; k < 3; ++k) W->vel[k] = d->velocity[k];
     } else {
-        double target = d->drive == GK_DRIVE_STRESS ? d->target * d->area : d->target, sp;
+        double target = d->drive == GK_DRIVE_STRESS ? d->target * d->area : d->target, sp, vn;
         double gain = d->gain > 0.0 ? d->gain : 0.05;
         if (W->stiffness > 0.0)
             sp = gain * (target - W->resistance) / (W->stiffness * sc->rve.dt);
         else
             sp = target > W->resistance ? d->max_speed : -d->max_speed;
         sp = gk_clamp(sp, -d->max_speed, d->max_speed);
-        for (k = 0; k < 3; ++k) W->vel[k] = sp * d->normal[k];
+        /* plus def.velocity's part across the servo direction (shear under a constant normal load) */
+        vn = gk__dot3(d->velocity, d->normal);
+        for (k = 0; k < 3; ++k) W->vel[k] = sp * d->normal[k] + d->velocity[k] - vn * d->normal[k];
     }
     if (sc->dim == 2) W->vel[2] = 0.0;
 }
@@ -2237,6 +2241,25 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
                           hd.dim, hd.real_size, hd.nwalls, hd.nmem, sc->dim, (int)R, sc->nwalls, sc->nmem);
     if (hd.rve_bytes > size) return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state has the wrong size");
     n = (size_t)hd.n;
+    { /* the whole layout before anything changes: walk it (membrane lengths are inside) */
+        size_t want = sizeof hd + n * (3 * R + sizeof(int32_t) + sizeof(double) + 1);
+        if (hd.have_presc) want += n * 12 * sizeof(double);
+        if (hd.have_ext) want += n * 6 * sizeof(double);
+        for (w = 0; w < sc->nwalls; ++w) {
+            const gk_wall *W = &sc->walls[w];
+            want += sizeof(gk__wall_rec) + n;
+            if (W->ft[0]) want += n * R * (size_t)nh;
+            if (W->mr[0]) want += n * R * (size_t)nh;
+        }
+        for (m = 0; m < sc->nmem; ++m) {
+            int32_t nm;
+            if (want + sizeof nm > size) goto bad;
+            memcpy(&nm, in + want, sizeof nm);
+            if (nm < 0 || nm > sc->mem[m].cap) goto bad;
+            want += 4 * sizeof(double) + 2 * sizeof(int) + sizeof(int32_t) + (size_t)nm * (sizeof(int32_t) + 3 * sizeof(double));
+        }
+        if (want + hd.rve_bytes != size) goto bad;
+    }
     /* particle count of the state: append or drop at the end, then overwrite everything */
     if (hd.n > sc->rve.n) {
         int add = hd.n - sc->rve.n, a;

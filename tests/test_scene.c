@@ -1092,6 +1092,459 @@ TEST(energy_balance_closes) {
         }
 }
 
+/* a scene with every moving part: 2D biaxial cell (floor, servo lid),
+ * anchored membranes, one held particle, one pushed one, energy books */
+static int full_scene(gk_scene *sc, int threads) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_packing pk;
+    gk_wall_def lid = gk_wall_def_default(), flo = gk_wall_def_default();
+    int32_t left[64], right[64];
+    int nl, nr, p;
+    double r = 0.0025, f[3] = {0.3, 0.0, 0.0};
+    d.dim = 2;
+    d.lo[0] = -0.1;
+    d.hi[0] = 0.2;
+    d.hi[1] = 0.25;
+    d.gravity[1] = -9.81;
+    d.rve.mat.young = 5e7;
+    d.rve.mat.friction = 0.3;
+    d.rve.mat.zeta_n = 0.2;
+    d.rve.damping = 0.2;
+    d.rve.dt_factor = 0.2;
+    d.rve.threads = threads;
+    if (lattice(&pk, 2, 16, 24, 1, r, 0.0, 0.0, 0.0, 0.0, 3)) return 1;
+    for (p = 0; p < pk.n; ++p) pk.r[p] = 1.05 * r + 0.04 * r * (double)(p % 3);
+    if (gk_scene_create(sc, &d, &pk)) {
+        gk_packing_free(&pk);
+        return 1;
+    }
+    gk_packing_free(&pk);
+    flo.normal[1] = 1.0;
+    flo.mat = d.rve.mat;
+    lid.point[1] = 24 * 2.2 * r;
+    lid.normal[1] = -1.0;
+    lid.mat = d.rve.mat;
+    lid.drive = GK_DRIVE_STRESS;
+    lid.target = 2e4;
+    lid.area = 16 * 2.2 * r * sc->rve.volume_factor;
+    lid.max_speed = 0.05;
+    if (gk_scene_add_wall(sc, &flo, NULL) || gk_scene_add_wall(sc, &lid, NULL) ||
+        gk_scene_side_chain(sc, 0, -1, 2.2 * r, left, 64, &nl) || gk_scene_side_chain(sc, 0, 1, 2.2 * r, right, 64, &nr) ||
+        gk_scene_add_membrane(sc, nl, left, 1e4, 1e5, 1, 0, NULL) ||
+        gk_scene_add_membrane(sc, nr, right, 1e4, 1e5, 0, 1, NULL) || gk_scene_prescribe(sc, 8, NULL, NULL) ||
+        gk_scene_set_external(sc, 100, f, NULL) || gk_scene_energy_track(sc, 1))
+        return 1;
+    return 0;
+}
+
+static unsigned char *state_of(const gk_scene *sc, size_t *n) {
+    unsigned char *b;
+    *n = gk_scene_state_size(sc);
+    b = (unsigned char *)malloc(*n);
+    if (b && gk_scene_save(sc, b, *n, NULL)) {
+        free(b);
+        return NULL;
+    }
+    return b;
+}
+
+/* gk_scene_save / gk_scene_restore continue a run bit for bit (walls,
+ * servo, membranes, prescribed and pushed particles, energy books), also
+ * across a change of the particle count (a state saved before a deletion
+ * restored after it); 1 and 2 threads give the same bits. */
+TEST(save_restore_and_threads_are_bitwise) {
+    gk_scene A, B;
+    unsigned char *s0, *s1, *s2;
+    size_t n0, n1, n2;
+    long st = QUICK(3000, 1500);
+    int32_t gone[2] = {40, 41};
+    /* threads: a short run (OpenMP on a shared machine is slow, not different) */
+    if (full_scene(&A, 1) || full_scene(&B, 2)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_scene_step(&A, 600) == GK_OK && gk_scene_step(&B, 600) == GK_OK);
+    CHECK(B.rve.pl.n >= GK_DEM_PAR_MIN); /* B's pair forces did run on 2 threads */
+    s1 = state_of(&A, &n1);
+    s2 = state_of(&B, &n2);
+    CHECK(s1 && s2 && n1 == n2 && memcmp(s1, s2, n1) == 0);
+    printf("    1 vs 2 threads after 600 steps: %s\n", s1 && s2 && n1 == n2 && !memcmp(s1, s2, n1) ? "identical" : "DIFFER");
+    free(s1);
+    free(s2);
+    gk_scene_destroy(&B);
+    if (full_scene(&B, 1)) {
+        CHECK(0);
+        gk_scene_destroy(&A);
+        return;
+    }
+    CHECK(gk_scene_step(&A, st) == GK_OK && gk_scene_step(&B, st + 600) == GK_OK);
+    s0 = state_of(&A, &n0);
+    CHECK(s0 != NULL);
+    CHECK(gk_scene_step(&A, st) == GK_OK);
+    s1 = state_of(&A, &n1);
+    /* restore in B (remove two particles first: the count changes back) and run on */
+    CHECK(gk_scene_remove(&B, 2, gone) == GK_OK && B.rve.n == A.rve.n - 2);
+    CHECK(gk_scene_restore(&B, s0, n0) == GK_OK);
+    CHECK(B.rve.n == A.rve.n && gk_scene_index(&B, 40) >= 0);
+    CHECK(gk_scene_step(&B, st) == GK_OK);
+    s2 = state_of(&B, &n2);
+    CHECK(s2 && n1 == n2 && memcmp(s1, s2, n1) == 0);
+    printf("    state %zu bytes; the restored run %s the uninterrupted one\n", n1,
+           s2 && n1 == n2 && !memcmp(s1, s2, n1) ? "matches" : "DIFFERS from");
+    /* a damaged state is refused */
+    s0[0] ^= 1;
+    CHECK(gk_scene_restore(&B, s0, n0) == GK_ERR_FORMAT);
+    CHECK(gk_scene_restore(&B, s0, 10) == GK_ERR_FORMAT);
+    free(s0);
+    free(s1);
+    free(s2);
+    gk_scene_destroy(&A);
+    gk_scene_destroy(&B);
+}
+
+/* Periodic in x, walls in y: a layer sheared between a fixed rough floor
+ * and a rough lid moving along x (servo in y to a normal force): particles
+ * wrap in x and stay in the period; in steady shear the floor and the lid
+ * hold equal and opposite shear forces (means over 20 000 steps, 5 %), the
+ * servo holds the normal force (2 %), the shear resistance is
+ * frictional (between 0.05 and the contact friction 0.5 times the normal
+ * force). */
+TEST(periodic_shear_between_walls) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_scene sc;
+    gk_packing pk;
+    gk_wall_def lid = gk_wall_def_default(), flo = gk_wall_def_default();
+    double r = 0.0025, W = 20 * 2.2 * r, N = 200.0, ratio, shear, floor_shear, normal;
+    int p, bad = 0;
+    d.dim = 2;
+    d.hi[0] = W;
+    d.hi[1] = 0.1;
+    d.periodic = 1u;
+    d.rve.mat.young = 5e7;
+    d.rve.mat.friction = 0.5;
+    d.rve.mat.zeta_n = 0.2;
+    d.rve.damping = 0.1;
+    d.rve.dt_factor = 0.2;
+    CHECK(lattice(&pk, 2, 20, 12, 1, r, 0.0, 0.0, 0.0, 0.1, 13) == 0);
+    CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    flo.normal[1] = 1.0;
+    flo.mat = d.rve.mat;
+    flo.mat.friction = 1.0;
+    lid = flo;
+    lid.point[1] = 12 * 2.2 * r + 0.002;
+    lid.normal[1] = -1.0;
+    lid.drive = GK_DRIVE_FORCE;
+    lid.target = N;
+    lid.max_speed = 0.05;
+    CHECK(gk_scene_add_wall(&sc, &flo, NULL) == GK_OK && gk_scene_add_wall(&sc, &lid, NULL) == GK_OK);
+    CHECK(gk_scene_step(&sc, QUICK(10000, 6000)) == GK_OK); /* consolidate */
+    sc.walls[1].def.velocity[0] = 0.05; /* servo in y, sliding at 5 cm/s in x */
+    CHECK(gk_scene_step(&sc, QUICK(15000, 8000)) == GK_OK);
+    { /* averages over the next 20000 steps (the forces fluctuate) */
+        int k;
+        double sl = 0.0, sf = 0.0, sn = 0.0;
+        for (k = 0; k < 100; ++k) {
+            CHECK(gk_scene_step(&sc, QUICK(200, 100)) == GK_OK);
+            sl -= sc.walls[1].force[0]; /* the particles resist the lid's motion */
+            sf += sc.walls[0].force[0];
+            sn += sc.walls[1].resistance;
+        }
+        shear = sl / 100;
+        floor_shear = sf / 100;
+        normal = sn / 100;
+    }
+    ratio = shear / normal;
+    printf("    lid normal %.4g N (target %g), shear %.4g N, floor shear %.4g N, ratio %.3f (means)\n", normal, N, shear,
+           floor_shear, ratio);
+    CHECK_NEAR(floor_shear, shear, 0.05 * fabs(shear));
+    CHECK_REL(normal, N, 0.02);
+    CHECK(ratio > 0.05 && ratio < 0.5);
+    for (p = 0; p < sc.rve.n; ++p) {
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        if (!(x[0] >= 0.0 && x[0] < W)) ++bad;
+    }
+    CHECK(bad == 0);
+    gk_scene_destroy(&sc);
+}
+
+/* gk_packing_tile: the seed 000 RVE repeated 2 x 1 is the same periodic
+ * material - its Love stress (after a force refresh) is the original's to
+ * 1e-9 - with twice the particles and cell; gk_packing_subset: exactly the
+ * particles (wholly) inside the box, in order, shifted to its corner. */
+TEST(packing_tile_and_subset) {
+    gk_packing pk, t, sub;
+    gk_err e;
+    gk_rve a, b;
+    gk_rve_def def = gk_rve_def_default();
+    double sa[9], sb[9], lo[3] = {0.02, 0.03, 0}, hi[3] = {0.15, 0.12, 0};
+    int p, cnt = 0, q = 0, ok = 1;
+    if (gk_packing_read("examples/data/rve400.txt", &pk, NULL, &e)) {
+        printf("    %s\n", e.msg);
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_packing_tile(&pk, 2, 1, 1, &t, NULL, &e) == GK_OK);
+    CHECK(t.n == 800 && t.h[0] == 2.0 * pk.h[0] && t.h[4] == pk.h[4]);
+    CHECK(gk_rve_create(&a, &def, &pk) == GK_OK && gk_rve_create(&b, &def, &t) == GK_OK);
+    CHECK(gk_rve_refresh(&a) == GK_OK && gk_rve_refresh(&b) == GK_OK);
+    gk_rve_stress(&a, sa);
+    gk_rve_stress(&b, sb);
+    printf("    sigma_xx %.10g vs tiled %.10g Pa, sigma_xy %.6g vs %.6g\n", sa[0], sb[0], sa[1], sb[1]);
+    CHECK_REL(sb[0], sa[0], 1e-9);
+    CHECK_REL(sb[4], sa[4], 1e-9);
+    CHECK_NEAR(sb[1], sa[1], 1e-9 * fabs(sa[0]));
+    gk_rve_destroy(&a);
+    gk_rve_destroy(&b);
+    CHECK(gk_packing_subset(&t, lo, hi, 1, &sub, NULL, &e) == GK_OK);
+    for (p = 0; p < t.n; ++p)
+        if (t.x[p] - t.r[p] >= lo[0] && t.x[p] + t.r[p] <= hi[0] && t.y[p] - t.r[p] >= lo[1] && t.y[p] + t.r[p] <= hi[1]) {
+            ++cnt;
+            if (q < sub.n && (sub.x[q] != t.x[p] - lo[0] || sub.y[q] != t.y[p] - lo[1] || sub.r[q] != t.r[p])) ok = 0;
+            ++q;
+        }
+    CHECK(sub.n == cnt && ok);
+    CHECK(sub.h[0] == hi[0] - lo[0] && sub.h[4] == hi[1] - lo[1]);
+    printf("    subset: %d of %d particles in the box\n", sub.n, t.n);
+    /* bad boxes and counts are refused */
+    CHECK(gk_packing_subset(&t, hi, lo, 1, &sub, NULL, &e) == GK_ERR_ARG);
+    CHECK(gk_packing_tile(&pk, 0, 1, 1, &t, NULL, &e) == GK_ERR_ARG);
+    gk_packing_free(&sub);
+    gk_packing_free(&t);
+    gk_packing_free(&pk);
+}
+
+/* Bodies: a disk (2D pipe) pushed down at constant speed into a settled bed
+ * meets a resistance that grows with its depth (means over 3000 steps); a drum (particles inside a
+ * disk) turning counter-clockwise drags its bed up on its right (centre of
+ * mass to +x) and the bed's moment on it opposes the turn; a sphere resting
+ * on a 3D rectangle or inside a horizontal cylinder presses on it with its
+ * weight; one beyond the rectangle's edge falls past it. */
+TEST(bodies_pipe_drum_rectangle_cylinder) {
+    gk_scene sc;
+    gk_wall_def pipe = gk_wall_def_default(), drum = gk_wall_def_default();
+    int ip, k, p;
+    double f1, f2;
+    /* pipe */
+    if (box_scene(&sc, 2, 16, 10, 0.16, 0.3, 0.3, 0)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_scene_step(&sc, QUICK(15000, 8000)) == GK_OK);
+    pipe.kind = GK_WALL_DISK;
+    pipe.radius = 0.02;
+    pipe.point[0] = 0.08;
+    for (p = 0; p < sc.rve.n; ++p) { /* just above the bed */
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        if (x[1] + (double)sc.rve.r[p] + pipe.radius + 0.001 > pipe.point[1])
+            pipe.point[1] = x[1] + (double)sc.rve.r[p] + pipe.radius + 0.001;
+    }
+    pipe.mat = sc.def.rve.mat;
+    pipe.velocity[1] = -0.2;
+    CHECK(gk_scene_add_wall(&sc, &pipe, &ip) == GK_OK);
+    f1 = f2 = 0.0;
+    for (k = 0; k < 60; ++k) { /* mean uplift over the first and the second 3000 steps */
+        CHECK(gk_scene_step(&sc, 100) == GK_OK);
+        if (k < 30)
+            f1 += sc.walls[ip].force[1] / 30;
+        else
+            f2 += sc.walls[ip].force[1] / 30;
+    }
+    printf("    pipe: mean uplift %.4g N, then %.4g N (now at y = %.4f m)\n", f1, f2, sc.walls[ip].pos[1]);
+    CHECK(f1 > 0.0 && f2 > f1);
+    gk_scene_destroy(&sc);
+    /* drum */
+    {
+        gk_scene_def d = gk_scene_def_default();
+        gk_packing pk;
+        double cm = 0.0, M = 0.0;
+        d.dim = 2;
+        d.lo[0] = d.lo[1] = -0.1;
+        d.hi[0] = d.hi[1] = 0.1;
+        d.gravity[1] = -9.81;
+        d.rve.mat.young = 5e7;
+        d.rve.mat.friction = 0.5;
+        d.rve.mat.zeta_n = 0.3;
+        d.rve.dt_factor = 0.2;
+        CHECK(lattice(&pk, 2, 10, 5, 1, 0.004, -0.044, -0.07, 0, 0.1, 17) == 0);
+        CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+        gk_packing_free(&pk);
+        drum.kind = GK_WALL_DISK;
+        drum.inside = 1;
+        drum.radius = 0.09;
+        drum.mat = d.rve.mat;
+        drum.mat.friction = 0.8;
+        drum.spin[2] = 2.0;
+        CHECK(gk_scene_add_wall(&sc, &drum, &ip) == GK_OK);
+        CHECK(gk_scene_step(&sc, QUICK(20000, 12000)) == GK_OK);
+        for (p = 0; p < sc.rve.n; ++p) {
+            double x[3];
+            gk_scene_position(&sc, p, x);
+            cm += sc.mass[p] * x[0];
+            M += sc.mass[p];
+        }
+        printf("    drum: centre of mass x = %.4f m, moment on the drum %.4g N m\n", cm / M, sc.walls[ip].moment[2]);
+        CHECK(cm / M > 0.005);
+        CHECK(sc.walls[ip].moment[2] < 0.0);
+        for (p = 0; p < sc.rve.n; ++p) {
+            double x[3];
+            gk_scene_position(&sc, p, x);
+            CHECK(x[0] * x[0] + x[1] * x[1] < 0.09 * 0.09);
+        }
+        gk_scene_destroy(&sc);
+    }
+    /* 3D: a rectangle and a cylinder */
+    for (k = 0; k < 3; ++k) {
+        gk_scene_def d = gk_scene_def_default();
+        gk_packing pk;
+        gk_err e;
+        gk_wall_def w = gk_wall_def_default();
+        double m;
+        d.dim = 3;
+        for (p = 0; p < 3; ++p) {
+            d.lo[p] = -0.2;
+            d.hi[p] = 0.2;
+        }
+        d.gravity[1] = -9.81;
+        d.rve.mat.young = 5e7;
+        d.rve.mat.zeta_n = 0.5;
+        d.rve.damping = 0.3;
+        d.rve.dt_factor = 0.2;
+        CHECK(gk_packing_alloc(&pk, 3, 1, NULL, &e) == GK_OK);
+        pk.r[0] = 0.01;
+        pk.x[0] = k == 1 ? 0.06 : 0.0; /* k = 1: beyond the rectangle's edge */
+        pk.y[0] = k == 2 ? -0.05 : 0.012;
+        CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+        gk_packing_free(&pk);
+        w.mat = d.rve.mat;
+        if (k < 2) {
+            w.kind = GK_WALL_RECT;
+            w.point[0] = -0.05;
+            w.point[2] = -0.05;
+            w.e1[0] = 0.1;
+            w.e2[2] = 0.1;
+        } else {
+            w.kind = GK_WALL_CYLINDER;
+            w.inside = 1;
+            w.radius = 0.08;
+            w.axis[2] = 1.0;
+        }
+        CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_OK);
+        CHECK(gk_scene_step(&sc, k == 1 ? 6000 : QUICK(20000, 10000)) == GK_OK);
+        m = sc.mass[0];
+        if (k == 1) {
+            double x[3];
+            gk_scene_position(&sc, 0, x);
+            CHECK(sc.walls[0].ncontacts == 0 && x[1] < -0.02);
+        } else {
+            printf("    sphere on a %s: force %.6g N, weight %.6g N\n", k ? "cylinder" : "rectangle", -sc.walls[0].force[1],
+                   m * 9.81);
+            CHECK_REL(-sc.walls[0].force[1], m * 9.81, 1e-3);
+        }
+        gk_scene_destroy(&sc);
+    }
+}
+
+/* A particle thrown out of an open domain is an error (nothing moves on)
+ * or, with GK_LOST_DELETE, is deleted and counted; the run goes on. */
+TEST(lost_particles) {
+    int pol;
+    for (pol = 0; pol < 2; ++pol) {
+        gk_scene sc;
+        double v[3] = {0, 30.0, 0};
+        gk_result r;
+        if (box_scene(&sc, 2, 6, 6, 0.1, 0.3, 0.0, 0)) {
+            CHECK(0);
+            continue;
+        }
+        sc.def.lost = pol ? GK_LOST_DELETE : GK_LOST_ERROR;
+        CHECK(gk_scene_set_velocity(&sc, gk_scene_index(&sc, 35), v, NULL) == GK_OK);
+        r = gk_scene_step(&sc, 5000);
+        if (pol == 0) {
+            printf("    error: %s\n", gk_scene_error(&sc));
+            CHECK(r == GK_ERR_OUTSIDE && strstr(gk_scene_error(&sc), "left the open domain") != NULL);
+            CHECK(sc.rve.n == 36);
+        } else {
+            CHECK(r == GK_OK && sc.lost == 1 && sc.rve.n == 35 && gk_scene_index(&sc, 35) == -1);
+        }
+        gk_scene_destroy(&sc);
+    }
+}
+
+/* Bad input gets a clear error and changes nothing. */
+TEST(bad_input_is_refused) {
+    gk_scene sc;
+    gk_scene_def d = gk_scene_def_default();
+    gk_wall_def w = gk_wall_def_default();
+    gk_packing pk;
+    gk_material m = gk_material_default(), out;
+    gk_err e;
+    int nw;
+    double nanv[3] = {NAN, 0, 0};
+    CHECK(lattice(&pk, 2, 4, 4, 1, 0.005, 0.0, 0.0, 0.0, 0.0, 1) == 0);
+    d.dim = 2;
+    d.hi[0] = d.hi[1] = 0.1;
+    {
+        gk_scene_def b = d;
+        b.cookie = 0;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_ARG);
+        b = d;
+        b.hi[0] = -1.0;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_CELL);
+        b = d;
+        b.hi[0] = 0.03; /* particles beyond the open domain */
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_OUTSIDE);
+        b = d;
+        b.dim = 3;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_ARG);
+        b = d;
+        b.gravity[1] = NAN;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_NAN);
+        b = d;
+        b.periodic = 4u;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_ARG);
+    }
+    CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    nw = sc.nwalls;
+    w.normal[1] = 2.0; /* not a unit vector */
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_ARG);
+    w.normal[1] = 1.0;
+    w.kind = GK_WALL_RECT; /* 3D only */
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_ARG);
+    w.kind = GK_WALL_PLANE;
+    w.drive = GK_DRIVE_FORCE; /* no max_speed */
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_ARG);
+    w.drive = GK_DRIVE_VELOCITY;
+    w.point[0] = NAN;
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_NAN);
+    w.point[0] = 0.0;
+    w.mat.young = 6e12; /* far stiffer than the time step allows */
+    d.rve.dt = sc.rve.dt;
+    sc.def.rve.dt = sc.rve.dt; /* an explicit dt is checked, not reduced */
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_DT);
+    printf("    %s\n", gk_scene_error(&sc));
+    CHECK(sc.nwalls == nw);
+    CHECK(gk_scene_prescribe(&sc, 99, NULL, NULL) == GK_ERR_ARG);
+    CHECK(gk_scene_set_external(&sc, 0, nanv, NULL) == GK_ERR_NAN);
+    CHECK(gk_scene_set_mass(&sc, 0, -1.0, 1.0) == GK_ERR_MASS);
+    {
+        int32_t ids[2] = {0, 1};
+        CHECK(gk_scene_add_membrane(&sc, 1, ids, 1e4, 0.0, -1, -1, NULL) == GK_ERR_ARG);
+        CHECK(gk_scene_add_membrane(&sc, 2, ids, 1e4, 0.0, 5, -1, NULL) == GK_ERR_ARG);
+        ids[1] = 99;
+        CHECK(gk_scene_add_membrane(&sc, 2, ids, 1e4, 0.0, -1, -1, NULL) == GK_ERR_ARG);
+    }
+    CHECK(gk_scene_step(&sc, -1) == GK_ERR_ARG);
+    m.law = GK_LAW_HERTZ;
+    m.poisson = 0.3;
+    CHECK(gk_scene_pair_material(&m, &sc.def.rve.mat, &out, &e) == GK_ERR_ARG); /* laws differ */
+    CHECK(sc.rve.n == 16 && sc.nwalls == nw && sc.nmem == 0 && sc.nprescribed == 0);
+    gk_scene_destroy(&sc);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(chung_ooi_1_two_spheres_normal);
@@ -1108,5 +1561,11 @@ int main(int argc, char **argv) {
     RUN(membrane_confines_at_its_pressure);
     RUN(insert_and_remove_leave_the_others_alone);
     RUN(energy_balance_closes);
+    RUN(save_restore_and_threads_are_bitwise);
+    RUN(periodic_shear_between_walls);
+    RUN(packing_tile_and_subset);
+    RUN(bodies_pipe_drum_rectangle_cylinder);
+    RUN(lost_particles);
+    RUN(bad_input_is_refused);
     return gk_test_done();
 }
