@@ -2,12 +2,15 @@
  * particle-level benchmarks of Chung & Ooi (2011), walls and their servo,
  * gravity, prescribed particles, the membrane, insertion and deletion, the
  * energy balance, save/restore and thread invariance, packing tiles and
- * subsets, and smoke runs of the two scene drivers. */
+ * subsets, and smoke runs of the two scene drivers (build/dem_biaxial,
+ * build/dem_collapse: `make test` builds the examples first). */
 #define GK_DEM_PAR_MIN 64 /* let small scenes use threads, to test thread invariance */
 #define GK_IMPLEMENTATION
+#define GK_TEST_DRIVERS
 #include "gk_scene.h"
 #include "gk_test.h"
 #include <stdlib.h>
+#include <sys/wait.h>
 
 #ifdef GK_TEST_QUICK /* sanitizer builds: fewer steps */
 #define QUICK(full, quick) (quick)
@@ -1545,6 +1548,84 @@ TEST(bad_input_is_refused) {
     gk_scene_destroy(&sc);
 }
 
+/* examples/dem_biaxial.c on one 400-disk tile to 1 % strain: it writes its
+ * documented outputs and RESULT; the platen stress at consolidation is the
+ * confining pressure (2 %) and the membranes hold sigma_xx there (10 % in
+ * this 400-disk specimen); the
+ * specimen hardens (sigma_yy grows, the stress ratio mobilises friction:
+ * 0.1 to 0.8); bad arguments are refused by name, a failed write exits 1. */
+TEST(dem_biaxial_smoke) {
+    double ratio, n;
+    int rc;
+    rc = system("build/dem_biaxial --tiles 1x1 --strain 0.01 --every 0.002 --pictures 0.004 --quiet "
+                "--out build/t_dembx > build/t_dembx.out 2>&1");
+    CHECK(rc == 0);
+    CHECK(gk_test_file_has("build/t_dembx/biaxial.csv",
+                           "eps_axial,sigma_yy_lid,sigma_xx,sigma_yy,eps_vol,stress_ratio,phi_deg,coordination"));
+    CHECK(gk_test_file_has("build/t_dembx/particles_001.vtk", "POINT_DATA"));
+    CHECK(gk_test_file_has("build/t_dembx/walls_end.vtk", "CELL_DATA"));
+    CHECK(gk_test_file_has("build/t_dembx/particles_000.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_dembx/biaxial_stress.svg", "<svg"));
+    ratio = gk_test_result("build/t_dembx.out", "peak_ratio");
+    n = gk_test_result("build/t_dembx.out", "n");
+    printf("    n %g, peak stress ratio %.4f at %.4f, sigma_yy peak %.4g Pa\n", n, ratio,
+           gk_test_result("build/t_dembx.out", "eps_peak"), gk_test_result("build/t_dembx.out", "syy_peak"));
+    CHECK(n == 400);
+    CHECK(ratio > 0.1 && ratio < 0.8);
+    CHECK(gk_test_result("build/t_dembx.out", "syy_peak") > 1.2e5);
+    {
+        FILE *fp = fopen("build/t_dembx/biaxial.csv", "r");
+        char line[512];
+        double e, lid, sxx;
+        int ok = fp && fgets(line, sizeof line, fp) && fgets(line, sizeof line, fp) &&
+                 sscanf(line, "%lf,%lf,%lf", &e, &lid, &sxx) == 3;
+        if (fp) fclose(fp);
+        CHECK(ok);
+        CHECK_REL(lid, 1e5, 0.02);
+        CHECK_REL(sxx, 1e5, 0.1);
+    }
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --strain abc > build/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_dembx.err", "--strain abc: not a number"));
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --tiles 0x2 > build/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_dembx.err", "--tiles"));
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --bogus 1 > build/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_dembx.err", "unknown option --bogus"));
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --tiles 1x1 --strain 0.002 --every 0.001 --quiet "
+                             "--out /proc/no_such_dir > build/t_dembx.err 2>&1")) == 1);
+    CHECK(system("build/dem_biaxial --help > build/t_dembx.err 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_dembx.err", "RESULT"));
+}
+
+/* examples/dem_collapse.c on a small column (8 disks across, 0.6 s): the
+ * outputs and RESULT; the column spreads (d* > 0.3) and loses height,
+ * energy is dissipated, not created (0 < E_d <= 1), the scene's books
+ * close (balance below 1e-3 of E_p0); bad arguments are refused by name. */
+TEST(dem_collapse_smoke) {
+    double ds, ed, bal, h;
+    CHECK(system("build/dem_collapse --diameters 8 --t-end 0.6 --every 0.02 --snapshots 0.3 --quiet "
+                 "--out build/t_demcl > build/t_demcl.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_demcl/collapse.csv", "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0"));
+    CHECK(gk_test_file_has("build/t_demcl/particles_001.vtk", "POINT_DATA"));
+    CHECK(gk_test_file_has("build/t_demcl/walls_000.vtk", "CELL_DATA"));
+    CHECK(gk_test_file_has("build/t_demcl/collapse_front.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_demcl/collapse_energy.svg", "<svg"));
+    ds = gk_test_result("build/t_demcl.out", "dstar");
+    ed = gk_test_result("build/t_demcl.out", "Ed_final_over_Ep0");
+    bal = gk_test_result("build/t_demcl.out", "energy_balance");
+    h = gk_test_result("build/t_demcl.out", "height_over_H0");
+    printf("    d* %.4f, E_d %.4f E_p0, height %.4f H0, balance %.2e E_p0\n", ds, ed, h, bal);
+    CHECK(ds > 0.3);
+    CHECK(ed > 0.0 && ed <= 1.0);
+    CHECK(h < 1.0);
+    CHECK(fabs(bal) < 1e-3);
+    CHECK(WEXITSTATUS(system("build/dem_collapse --a 20 > build/t_demcl.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_demcl.err", "--a: need an aspect ratio"));
+    CHECK(WEXITSTATUS(system("build/dem_collapse --snapshots 1,0.5 > build/t_demcl.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_demcl.err", "--snapshots"));
+    CHECK(WEXITSTATUS(system("build/dem_collapse --diameters 8 --t-end 0.02 --quiet --out /proc/no_such_dir "
+                             "> build/t_demcl.err 2>&1")) == 1);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(chung_ooi_1_two_spheres_normal);
@@ -1567,5 +1648,7 @@ int main(int argc, char **argv) {
     RUN(bodies_pipe_drum_rectangle_cylinder);
     RUN(lost_particles);
     RUN(bad_input_is_refused);
+    RUN(dem_biaxial_smoke);
+    RUN(dem_collapse_smoke);
     return gk_test_done();
 }
