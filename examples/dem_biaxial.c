@@ -96,24 +96,6 @@ static void usage(FILE *fp) {
             "exit status: 0 done, 1 setup, simulation or output failed (message), 2 bad arguments\n");
 }
 
-static int parse_list(const char *s, double *t, int cap) {
-    int n = 0;
-    const char *p = s;
-    while (*p) {
-        char buf[64];
-        size_t len = strcspn(p, ",");
-        double v;
-        if (len == 0 || len >= sizeof buf || n == cap) return -1;
-        memcpy(buf, p, len);
-        buf[len] = '\0';
-        if (dsc_num(buf, &v) || v <= 0 || (n > 0 && v <= t[n - 1])) return -1;
-        t[n++] = v;
-        p += len;
-        if (*p == ',') ++p;
-    }
-    return n;
-}
-
 static int parse(int argc, char **argv, db_opts *o) {
     int i, k;
     memset(o, 0, sizeof *o);
@@ -122,7 +104,7 @@ static int parse(int argc, char **argv, db_opts *o) {
     o->tx = 1, o->ty = 2, o->threads = 1, o->seed = 1;
     o->pressure = 1e5, o->strain = 0.04, o->rate = 0.0, o->every = 0.001, o->damping = 0.3, o->platen_mu = -1.0;
     o->link_k = 0.0, o->max_cons = 200000;
-    o->npic = parse_list("0.02", o->pic, 8);
+    o->npic = dsc_list("0.02", o->pic, 8, 1);
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i];
         double v;
@@ -148,7 +130,7 @@ static int parse(int argc, char **argv, db_opts *o) {
             continue;
         }
         if (!strcmp(a, "--pictures")) {
-            if ((o->npic = parse_list(argv[++i], o->pic, 8)) < 0)
+            if ((o->npic = dsc_list(argv[++i], o->pic, 8, 1)) < 0)
                 return fprintf(stderr, "dem_biaxial: --pictures %s: need up to 8 increasing strains > 0\n", argv[i]),
                        2;
             continue;

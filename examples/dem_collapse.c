@@ -95,31 +95,13 @@ static void usage(FILE *fp) {
             "exit status: 0 done, 1 setup, simulation or output failed (message), 2 bad arguments\n");
 }
 
-static int parse_times(const char *s, double *t, int cap) {
-    int n = 0;
-    const char *p = s;
-    while (*p) {
-        char buf[64];
-        size_t len = strcspn(p, ",");
-        double v;
-        if (len == 0 || len >= sizeof buf || n == cap) return -1;
-        memcpy(buf, p, len);
-        buf[len] = '\0';
-        if (dsc_num(buf, &v) || v < 0 || (n > 0 && v <= t[n - 1])) return -1;
-        t[n++] = v;
-        p += len;
-        if (*p == ',') ++p;
-    }
-    return n;
-}
-
 static int parse(int argc, char **argv, dc_opts *o) {
     int i, k;
     o->a = 1.0, o->width = 1.0, o->diameters = 24, o->mu = 0.5, o->roll_beta = 0.0, o->roll_eta = 0.0;
     o->restitution = 0.5, o->young = 6e8, o->gravity = 9.81, o->t_end = 4.0, o->every = 0.01;
     o->rest_frac = 5e-3, o->rest_hold = 0.05, o->threads = 1, o->quiet = 0, o->seed = 1;
     o->out = "build/dem_collapse";
-    o->nsnap = parse_times("0.2,0.5,1", o->snap, DC_MAX_SNAP);
+    o->nsnap = dsc_list("0.2,0.5,1", o->snap, DC_MAX_SNAP, 0);
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i];
         double v;
@@ -134,7 +116,7 @@ static int parse(int argc, char **argv, dc_opts *o) {
             continue;
         }
         if (!strcmp(a, "--snapshots")) {
-            if ((o->nsnap = parse_times(argv[++i], o->snap, DC_MAX_SNAP)) < 0)
+            if ((o->nsnap = dsc_list(argv[++i], o->snap, DC_MAX_SNAP, 0)) < 0)
                 return fprintf(stderr,
                                "dem_collapse: --snapshots %s: need up to %d increasing times >= 0, comma-separated\n",
                                argv[i], DC_MAX_SNAP),

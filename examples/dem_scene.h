@@ -18,6 +18,26 @@ static int dsc_num(const char *s, double *v) {
     return !(end != s && *end == '\0' && errno == 0 && isfinite(*v));
 }
 
+/* "v1,v2,..." into t (at most cap values, increasing, >= 0; > 0 with
+ * positive): the count, or -1 */
+static int dsc_list(const char *s, double *t, int cap, int positive) {
+    int n = 0;
+    const char *p = s;
+    while (*p) {
+        char buf[64];
+        size_t len = strcspn(p, ",");
+        double v;
+        if (len == 0 || len >= sizeof buf || n == cap) return -1;
+        memcpy(buf, p, len);
+        buf[len] = '\0';
+        if (dsc_num(buf, &v) || v < 0 || (positive && v == 0) || (n > 0 && v <= t[n - 1])) return -1;
+        t[n++] = v;
+        p += len;
+        if (*p == ',') ++p;
+    }
+    return n;
+}
+
 static int dsc_mkdir(const char *prog, const char *d) {
     if (mkdir(d, 0755) && errno != EEXIST) return fprintf(stderr, "%s: cannot create %s\n", prog, d), 1;
     return 0;

@@ -344,6 +344,7 @@ GKDEF gk_result gk_scene_prescribe(gk_scene *sc, int p, const double v[3], const
 GKDEF gk_result gk_scene_release(gk_scene *sc, int p);
 /* mass and moment of inertia of particle p (e.g. another density) */
 GKDEF gk_result gk_scene_set_mass(gk_scene *sc, int p, double m, double I);
+/* velocity and spin of particle p (NULL: unchanged), e.g. the initial state */
 GKDEF gk_result gk_scene_set_velocity(gk_scene *sc, int p, const double v[3], const double w[3]);
 
 GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, double pressure, double stiffness,
@@ -351,8 +352,7 @@ GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, d
 /* 2D: the outermost particle of every band of width `band` along the other
  * axis, on side (-1 low, +1 high) of axis `axis`, ordered with the material
  * on the chain's left; ids written to ids (capacity cap), count to *k */
-GKDEF gk_result gk_scene_side_chain(const gk_scene *sc, int axis, int side, double band, int32_t *ids, int cap,
-                                    int *k);
+GKDEF gk_result gk_scene_side_chain(gk_scene *sc, int axis, int side, double band, int32_t *ids, int cap, int *k);
 
 GKDEF gk_result gk_scene_insert(gk_scene *sc, int k, const double *const x[3], const double *r,
                                 const double *const v[3], int32_t *ids);
@@ -665,11 +665,12 @@ GKDEF gk_result gk_scene_create(gk_scene *out, const gk_scene_def *def, const gk
     gk_packing_free(&fr);
     if (res) return res;
     for (k = 0; k < dim; ++k)
-        if (!(def->periodic & (1u << k)) && !(0.5 * (def->hi[k] - def->lo[k]) > gk__scene_cutoff(&S))) {
+        if (!(def->periodic & (1u << k)) && !(0.5 * (def->hi[k] - def->lo[k]) > gk__scene_cutoff(&S) + S.rve.skin)) {
             gk_rve_destroy(&S.rve);
             return gk_err_set(err, GK_ERR_CELL,
-                              "open axis %d: the domain (%g) must be longer than twice the interaction range %g", k,
-                              def->hi[k] - def->lo[k], gk__scene_cutoff(&S));
+                              "open axis %d: the domain (%g) must be longer than twice the interaction range plus "
+                              "the skin, %g",
+                              k, def->hi[k] - def->lo[k], gk__scene_cutoff(&S) + S.rve.skin);
         }
     S.rve.cells.open = S.open;
     S.rve.outer_valid = 0;
@@ -1611,6 +1612,10 @@ GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps) {
         if ((r = gk__wall_check(sc, &W->def)) != GK_OK) return r;
         if (sc->rve.step == 0 || W->def.drive == GK_DRIVE_VELOCITY) gk__wall_drive(sc, W);
     }
+    for (w = 0; w < sc->nmem; ++w)
+        if (!isfinite(sc->mem[w].pressure) || !(sc->mem[w].stiffness >= 0.0) || !isfinite(sc->mem[w].stiffness))
+            return gk_err_set(&sc->err, GK_ERR_ARG, "membrane %d: pressure %g / stiffness %g invalid", w,
+                              sc->mem[w].pressure, sc->mem[w].stiffness);
     sc->rve.hook = gk__scene_hook;
     sc->rve.hook_user = sc; /* the scene may have moved since the last call */
     done0 = sc->rve.step;
@@ -1774,15 +1779,14 @@ GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, d
     return GK_OK;
 }
 
-GKDEF gk_result gk_scene_side_chain(const gk_scene *sc, int axis, int side, double band, int32_t *ids, int cap,
-                                    int *k) {
+GKDEF gk_result gk_scene_side_chain(gk_scene *sc, int axis, int side, double band, int32_t *ids, int cap, int *k) {
     int other = 1 - axis, nb, b, p, cnt = 0;
     double lo = 1e300, hi = -1e300;
     int32_t *best;
     double *bx;
-    if (sc->dim != 2) return gk_err_set((gk_err *)&sc->err, GK_ERR_UNSUPPORTED, "side chains are 2D");
+    if (sc->dim != 2) return gk_err_set(&sc->err, GK_ERR_UNSUPPORTED, "side chains are 2D");
     if ((axis != 0 && axis != 1) || (side != -1 && side != 1) || !(band > 0.0) || !ids || !k)
-        return gk_err_set((gk_err *)&sc->err, GK_ERR_ARG, "side chain: axis 0|1, side -1|1, band > 0 and output");
+        return gk_err_set(&sc->err, GK_ERR_ARG, "side chain: axis 0|1, side -1|1, band > 0 and output");
     for (p = 0; p < sc->rve.n; ++p) {
         double x[3];
         gk_scene_position(sc, p, x);
@@ -1795,7 +1799,7 @@ GKDEF gk_result gk_scene_side_chain(const gk_scene *sc, int axis, int side, doub
     if (!best || !bx) {
         gk_free(&sc->def.rve.alloc, best);
         gk_free(&sc->def.rve.alloc, bx);
-        return gk_err_set((gk_err *)&sc->err, GK_ERR_ALLOC, "out of memory for a side chain");
+        return gk_err_set(&sc->err, GK_ERR_ALLOC, "out of memory for a side chain");
     }
     for (b = 0; b < nb; ++b) best[b] = -1;
     for (p = 0; p < sc->rve.n; ++p) {
@@ -1817,7 +1821,7 @@ GKDEF gk_result gk_scene_side_chain(const gk_scene *sc, int axis, int side, doub
         if (cnt >= cap) {
             gk_free(&sc->def.rve.alloc, best);
             gk_free(&sc->def.rve.alloc, bx);
-            return gk_err_set((gk_err *)&sc->err, GK_ERR_ARG, "side chain: more than %d members", cap);
+            return gk_err_set(&sc->err, GK_ERR_ARG, "side chain: more than %d members", cap);
         }
         ids[cnt++] = sc->rve.id[best[q]];
     }
