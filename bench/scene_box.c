@@ -54,22 +54,32 @@ int main(int argc, char **argv) {
     for (i = 1; i < argc; ++i) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(o, "--help")) {
-            puts("usage: bench_scene_box [--nx N] [--nz N] [--pour S] [--compress S] [--threads T] [--write-data FILE]");
+            puts("usage: bench_scene_box [--nx N] [--nz N] [--pour S] [--compress S] [--threads T] "
+                 "[--write-data FILE]");
             return 0;
         }
         if (!v) return fprintf(stderr, "bench_scene_box: %s needs a value\n", o), 2;
-        if (!strcmp(o, "--nx")) nx = atoi(v);
-        else if (!strcmp(o, "--nz")) nz = atoi(v);
-        else if (!strcmp(o, "--pour")) pour = atol(v);
-        else if (!strcmp(o, "--compress")) comp = atol(v);
-        else if (!strcmp(o, "--threads")) threads = atoi(v);
-        else if (!strcmp(o, "--write-data")) data = v;
-        else return fprintf(stderr, "bench_scene_box: unknown option %s\n", o), 2;
+        if (!strcmp(o, "--nx"))
+            nx = atoi(v);
+        else if (!strcmp(o, "--nz"))
+            nz = atoi(v);
+        else if (!strcmp(o, "--pour"))
+            pour = atol(v);
+        else if (!strcmp(o, "--compress"))
+            comp = atol(v);
+        else if (!strcmp(o, "--threads"))
+            threads = atoi(v);
+        else if (!strcmp(o, "--write-data"))
+            data = v;
+        else
+            return fprintf(stderr, "bench_scene_box: unknown option %s\n", o), 2;
         ++i;
     }
     if (nx < 2 || nz < 2 || pour < 1 || comp < SB_NF || threads < 1)
-        return fprintf(stderr, "bench_scene_box: need --nx, --nz >= 2, --pour >= 1, --compress >= %d, --threads >= 1\n",
-                       SB_NF),
+        return fprintf(
+                   stderr,
+                   "bench_scene_box: need --nx, --nz >= 2, --pour >= 1, --compress >= %d, --threads >= 1\n",
+                   SB_NF),
                2;
     L = nx * 2.4 * SB_R;
     H = (nz + 1) * 2.4 * SB_R;
@@ -90,7 +100,8 @@ int main(int argc, char **argv) {
         fprintf(fp, "LAMMPS data file from bench_scene_box\n\n%d atoms\n1 atom types\n\n", pk.n);
         fprintf(fp, "0 %.17g xlo xhi\n0 %.17g ylo yhi\n0 %.17g zlo zhi\n\nAtoms # sphere\n\n", L, L, 2.0 * H);
         for (q = 0; q < pk.n; ++q)
-            fprintf(fp, "%d 1 %.17g %.17g %.17g %.17g %.17g\n", q + 1, 2.0 * SB_R, SB_RHO, pk.x[q], pk.y[q], pk.z[q]);
+            fprintf(fp, "%d 1 %.17g %.17g %.17g %.17g %.17g\n", q + 1, 2.0 * SB_R, SB_RHO, pk.x[q], pk.y[q],
+                    pk.z[q]);
         if (fclose(fp)) return fprintf(stderr, "bench_scene_box: error writing %s\n", data), 1;
     }
     d.dim = 3;
@@ -106,7 +117,8 @@ int main(int argc, char **argv) {
     d.rve.dt = SB_DT;
     d.rve.skin = 0.1 * SB_R;
     d.rve.threads = threads;
-    if (gk_scene_create(&sc, &d, &pk)) return fprintf(stderr, "bench_scene_box: %s\n", gk_scene_error(&sc)), 1;
+    if (gk_scene_create(&sc, &d, &pk))
+        return fprintf(stderr, "bench_scene_box: %s\n", gk_scene_error(&sc)), 1;
     gk_packing_free(&pk);
     wm = d.rve.mat; /* a wall contact with constant kn: the same k_n, the dashpot on the particle's mass */
     if (gk_scene_add_box(&sc, &wm, GK_BOX_ALL & ~(2u << 4), NULL))
@@ -123,27 +135,32 @@ int main(int argc, char **argv) {
         zmean += x[2] / sc.rve.n;
         if (x[2] > zmax) zmax = x[2];
     }
-    printf("SCENE phase=pour n=%d steps=%ld seconds=%.4g cpu_seconds=%.4g particle_steps_per_s=%.4g zmean=%.8g "
-           "zmax=%.8g height_2zmean=%.8g kinetic=%.4g\n",
-           sc.rve.n, pour, tp, cpu_p, sc.rve.n * (double)pour / tp, zmean, zmax, 2.0 * zmean, ke);
-    lid0 = 2.0 * zmean + SB_R + 1e-3; /* 1 mm above the bed's mean top (2<z> + R): bulk, not the highest sphere */
+    printf(
+        "SCENE phase=pour n=%d steps=%ld seconds=%.4g cpu_seconds=%.4g particle_steps_per_s=%.4g zmean=%.8g "
+        "zmax=%.8g height_2zmean=%.8g kinetic=%.4g\n",
+        sc.rve.n, pour, tp, cpu_p, sc.rve.n * (double)pour / tp, zmean, zmax, 2.0 * zmean, ke);
+    lid0 = 2.0 * zmean + SB_R +
+           1e-3; /* 1 mm above the bed's mean top (2<z> + R): bulk, not the highest sphere */
     lid.point[2] = lid0;
     lid.normal[2] = -1.0;
     lid.mat = wm;
     lid.velocity[2] = -SB_VLID;
-    if (gk_scene_add_wall(&sc, &lid, NULL)) return fprintf(stderr, "bench_scene_box: %s\n", gk_scene_error(&sc)), 1;
+    if (gk_scene_add_wall(&sc, &lid, NULL))
+        return fprintf(stderr, "bench_scene_box: %s\n", gk_scene_error(&sc)), 1;
     t0 = gk_wtime();
     c0 = clock();
     for (k = 0; k < SB_NF; ++k) {
-        if (gk_scene_step(&sc, comp / SB_NF)) return fprintf(stderr, "bench_scene_box: %s\n", gk_scene_error(&sc)), 1;
+        if (gk_scene_step(&sc, comp / SB_NF))
+            return fprintf(stderr, "bench_scene_box: %s\n", gk_scene_error(&sc)), 1;
         force[k] = sc.walls[sc.nwalls - 1].resistance;
     }
     tc = gk_wtime() - t0;
     cpu_c = (double)(clock() - c0) / CLOCKS_PER_SEC;
-    printf("SCENE phase=compress n=%d steps=%ld seconds=%.4g cpu_seconds=%.4g particle_steps_per_s=%.4g lid_start=%.8g "
+    printf("SCENE phase=compress n=%d steps=%ld seconds=%.4g cpu_seconds=%.4g particle_steps_per_s=%.4g "
+           "lid_start=%.8g "
            "lid_end=%.8g",
-           sc.rve.n, (comp / SB_NF) * SB_NF, tc, cpu_c, sc.rve.n * (double)((comp / SB_NF) * SB_NF) / tc, lid0,
-           sc.walls[sc.nwalls - 1].pos[2]);
+           sc.rve.n, (comp / SB_NF) * SB_NF, tc, cpu_c, sc.rve.n * (double)((comp / SB_NF) * SB_NF) / tc,
+           lid0, sc.walls[sc.nwalls - 1].pos[2]);
     for (k = 0; k < SB_NF; ++k) printf(" lid_force_%d=%.8g", k + 1, force[k]);
     printf(" simd=%s\n", GK_SIMD_NAME);
     gk_scene_destroy(&sc);

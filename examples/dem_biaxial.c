@@ -69,31 +69,32 @@ typedef struct db_row {
 } db_row;
 
 static void usage(FILE *fp) {
-    fprintf(fp,
-            "dem_biaxial - 2D biaxial DNS in DEM (gk_scene.h): a tiled periodic packing opened between rigid\n"
-            "platens, confined by follower-pressure membranes, consolidated then compressed (Liu, Bosco &\n"
-            "Suiker 2018, DNS of 441 and 1681 disks).\n\n"
-            "usage: dem_biaxial [options]\n"
-            "  --packing FILE         periodic 2D packing (default examples/data/rve400.txt)\n"
-            "  --generate N           instead: generate and consolidate N disks, R_max/R_min = 1.5\n"
-            "  --tiles NXxNY          copies of the packing across x and y (default 1x2)\n"
-            "  --pressure P           confining pressure [Pa] (default 1e5)\n"
-            "  --strain E             final axial strain (default 0.04; the paper goes to 0.1)\n"
-            "  --rate R               axial strain rate [1/s] (default: inertial number 1e-3)\n"
-            "  --every E              axial strain between CSV rows (default 0.001)\n"
-            "  --pictures E1,E2,...   strains of the pictures (default 0.02)\n"
-            "  --damping A            local damping (default 0.3)\n"
-            "  --platen-mu M          platen friction (default: the disks')\n"
-            "  --link-stiffness K     membrane links [N/m] (default 0.05 k_n of the mean contact)\n"
-            "  --max-consolidation N  steps of stage 1 at most (default 200000)\n"
-            "  --seed S               generated packing (default 1)\n"
-            "  --threads T            threads of the pair forces (default 1; results do not depend on it)\n"
-            "  --out DIR              output directory (default build/dem_biaxial)\n"
-            "  --quiet                no progress lines\n"
-            "  --help                 this text\n\n"
-            "ends with: RESULT n=... W=... H0=... peak_ratio=... eps_peak=... phi_peak_deg=... ratio_final=...\n"
-            "           syy_peak=... ev_final=... z0=... steps=... dt=... seconds=...\n"
-            "exit status: 0 done, 1 setup, simulation or output failed (message), 2 bad arguments\n");
+    fprintf(
+        fp,
+        "dem_biaxial - 2D biaxial DNS in DEM (gk_scene.h): a tiled periodic packing opened between rigid\n"
+        "platens, confined by follower-pressure membranes, consolidated then compressed (Liu, Bosco &\n"
+        "Suiker 2018, DNS of 441 and 1681 disks).\n\n"
+        "usage: dem_biaxial [options]\n"
+        "  --packing FILE         periodic 2D packing (default examples/data/rve400.txt)\n"
+        "  --generate N           instead: generate and consolidate N disks, R_max/R_min = 1.5\n"
+        "  --tiles NXxNY          copies of the packing across x and y (default 1x2)\n"
+        "  --pressure P           confining pressure [Pa] (default 1e5)\n"
+        "  --strain E             final axial strain (default 0.04; the paper goes to 0.1)\n"
+        "  --rate R               axial strain rate [1/s] (default: inertial number 1e-3)\n"
+        "  --every E              axial strain between CSV rows (default 0.001)\n"
+        "  --pictures E1,E2,...   strains of the pictures (default 0.02)\n"
+        "  --damping A            local damping (default 0.3)\n"
+        "  --platen-mu M          platen friction (default: the disks')\n"
+        "  --link-stiffness K     membrane links [N/m] (default 0.05 k_n of the mean contact)\n"
+        "  --max-consolidation N  steps of stage 1 at most (default 200000)\n"
+        "  --seed S               generated packing (default 1)\n"
+        "  --threads T            threads of the pair forces (default 1; results do not depend on it)\n"
+        "  --out DIR              output directory (default build/dem_biaxial)\n"
+        "  --quiet                no progress lines\n"
+        "  --help                 this text\n\n"
+        "ends with: RESULT n=... W=... H0=... peak_ratio=... eps_peak=... phi_peak_deg=... ratio_final=...\n"
+        "           syy_peak=... ev_final=... z0=... steps=... dt=... seconds=...\n"
+        "exit status: 0 done, 1 setup, simulation or output failed (message), 2 bad arguments\n");
 }
 
 static int parse(int argc, char **argv, db_opts *o) {
@@ -102,7 +103,8 @@ static int parse(int argc, char **argv, db_opts *o) {
     o->packing = "examples/data/rve400.txt";
     o->out = "build/dem_biaxial";
     o->tx = 1, o->ty = 2, o->threads = 1, o->seed = 1;
-    o->pressure = 1e5, o->strain = 0.04, o->rate = 0.0, o->every = 0.001, o->damping = 0.3, o->platen_mu = -1.0;
+    o->pressure = 1e5, o->strain = 0.04, o->rate = 0.0, o->every = 0.001, o->damping = 0.3,
+    o->platen_mu = -1.0;
     o->link_k = 0.0, o->max_cons = 200000;
     o->npic = dsc_list("0.02", o->pic, 8, 1);
     for (i = 1; i < argc; ++i) {
@@ -124,30 +126,46 @@ static int parse(int argc, char **argv, db_opts *o) {
         }
         if (!strcmp(a, "--tiles")) {
             char c;
-            if (sscanf(argv[++i], "%dx%d%c", &o->tx, &o->ty, &c) != 2 || o->tx < 1 || o->ty < 1 || o->tx > 64 ||
-                o->ty > 64)
-                return fprintf(stderr, "dem_biaxial: --tiles %s: need NXxNY with 1 <= NX, NY <= 64\n", argv[i]), 2;
+            if (sscanf(argv[++i], "%dx%d%c", &o->tx, &o->ty, &c) != 2 || o->tx < 1 || o->ty < 1 ||
+                o->tx > 64 || o->ty > 64)
+                return fprintf(stderr, "dem_biaxial: --tiles %s: need NXxNY with 1 <= NX, NY <= 64\n",
+                               argv[i]),
+                       2;
             continue;
         }
         if (!strcmp(a, "--pictures")) {
             if ((o->npic = dsc_list(argv[++i], o->pic, 8, 1)) < 0)
-                return fprintf(stderr, "dem_biaxial: --pictures %s: need up to 8 increasing strains > 0\n", argv[i]),
+                return fprintf(stderr, "dem_biaxial: --pictures %s: need up to 8 increasing strains > 0\n",
+                               argv[i]),
                        2;
             continue;
         }
-        if (dsc_num(argv[i + 1], &v)) return fprintf(stderr, "dem_biaxial: %s %s: not a number\n", a, argv[i + 1]), 2;
-        if (!strcmp(a, "--generate")) o->generate = v == floor(v) && v >= 16 && v <= 1000000 ? (int)v : -1;
-        else if (!strcmp(a, "--pressure")) o->pressure = v;
-        else if (!strcmp(a, "--strain")) o->strain = v;
-        else if (!strcmp(a, "--rate")) o->rate = v;
-        else if (!strcmp(a, "--every")) o->every = v;
-        else if (!strcmp(a, "--damping")) o->damping = v;
-        else if (!strcmp(a, "--platen-mu")) o->platen_mu = v;
-        else if (!strcmp(a, "--link-stiffness")) o->link_k = v;
-        else if (!strcmp(a, "--max-consolidation")) o->max_cons = v;
-        else if (!strcmp(a, "--seed")) o->seed = v >= 0 && v == floor(v) ? (unsigned long)v : 0;
-        else if (!strcmp(a, "--threads")) o->threads = v == floor(v) && v >= 1 && v <= 256 ? (int)v : -1;
-        else return fprintf(stderr, "dem_biaxial: unknown option %s (see --help)\n", a), 2;
+        if (dsc_num(argv[i + 1], &v))
+            return fprintf(stderr, "dem_biaxial: %s %s: not a number\n", a, argv[i + 1]), 2;
+        if (!strcmp(a, "--generate"))
+            o->generate = v == floor(v) && v >= 16 && v <= 1000000 ? (int)v : -1;
+        else if (!strcmp(a, "--pressure"))
+            o->pressure = v;
+        else if (!strcmp(a, "--strain"))
+            o->strain = v;
+        else if (!strcmp(a, "--rate"))
+            o->rate = v;
+        else if (!strcmp(a, "--every"))
+            o->every = v;
+        else if (!strcmp(a, "--damping"))
+            o->damping = v;
+        else if (!strcmp(a, "--platen-mu"))
+            o->platen_mu = v;
+        else if (!strcmp(a, "--link-stiffness"))
+            o->link_k = v;
+        else if (!strcmp(a, "--max-consolidation"))
+            o->max_cons = v;
+        else if (!strcmp(a, "--seed"))
+            o->seed = v >= 0 && v == floor(v) ? (unsigned long)v : 0;
+        else if (!strcmp(a, "--threads"))
+            o->threads = v == floor(v) && v >= 1 && v <= 256 ? (int)v : -1;
+        else
+            return fprintf(stderr, "dem_biaxial: unknown option %s (see --help)\n", a), 2;
         ++i;
     }
     {
@@ -198,10 +216,11 @@ static int generate(const db_opts *o, const gk_rve_def *base, gk_packing *out) {
     cd.friction = 0.0;
     r = gk_rve_consolidate(&rve, &cd, &rep);
     if (!r) r = gk_rve_to_packing(&rve, out, NULL, &err);
-    if (r) fprintf(stderr, "dem_biaxial: consolidation: %s\n", gk_rve_error(&rve));
+    if (r)
+        fprintf(stderr, "dem_biaxial: consolidation: %s\n", gk_rve_error(&rve));
     else if (!o->quiet)
-        printf("dem_biaxial: generated %d disks, consolidated to %.4g Pa in %ld steps (void ratio %.4f)\n", o->generate,
-               o->pressure, rep.steps, rep.void_ratio);
+        printf("dem_biaxial: generated %d disks, consolidated to %.4g Pa in %ld steps (void ratio %.4f)\n",
+               o->generate, o->pressure, rep.steps, rep.void_ratio);
     gk_rve_destroy(&rve);
     return r != 0;
 }
@@ -233,14 +252,16 @@ int main(int argc, char **argv) {
     db_row *rows = NULL;
     int32_t *chain = NULL;
     int status = 0, created = 0, nrows = 0, caprows = 0, k, p, nl, nr, ipic = 0;
-    double W, H0, H, A0, t, rmean = 0.0, rate, v, peak = 0.0, eps_peak = 0.0, syy_peak = 0.0, z0 = 0.0, t0 = gk_wtime();
+    double W, H0, H, A0, t, rmean = 0.0, rate, v, peak = 0.0, eps_peak = 0.0, syy_peak = 0.0, z0 = 0.0,
+                            t0 = gk_wtime();
     long steps = 0;
     char path[1200];
     FILE *csv = NULL;
     k = parse(argc, argv, &o);
     if (k) return k < 0 ? 0 : k;
     if (dsc_mkdir("dem_biaxial", o.out)) return 1;
-    d.rve = gk_rve_def_default(); /* the seed 000 material (linear, E 6e8, kt/kn 0.8, mu tan 0.5, 2D t = 0.1) */
+    d.rve =
+        gk_rve_def_default(); /* the seed 000 material (linear, E 6e8, kt/kn 0.8, mu tan 0.5, 2D t = 0.1) */
     d.rve.damping = o.damping;
     d.rve.threads = o.threads;
     if (o.generate) {
@@ -318,8 +339,8 @@ int main(int argc, char **argv) {
             gk_scene_add_membrane(&sc, nr, chain, o.pressure, km, 0, 1, NULL))
             goto fail;
         if (!o.quiet)
-            printf("dem_biaxial: %d disks, %.4g x %.4g m, membranes of %d and %d disks, dt %.3g s\n", sc.rve.n, W, H0,
-                   nl, nr, sc.rve.dt);
+            printf("dem_biaxial: %d disks, %.4g x %.4g m, membranes of %d and %d disks, dt %.3g s\n",
+                   sc.rve.n, W, H0, nl, nr, sc.rve.dt);
     }
     /* ---- stage 1: consolidation */
     {
@@ -333,9 +354,10 @@ int main(int argc, char **argv) {
             a = enclosed_area(&sc, H);
             sc.walls[1].def.area = a / H * sc.rve.volume_factor; /* the lid's stress over the current width */
             err1 = fabs(sc.walls[1].resistance / sc.walls[1].def.area - o.pressure) / o.pressure;
-            calm = (err1 < 0.01 && gk_rve_kinetic_energy(&sc.rve) < 1e-7 * o.pressure * a * sc.rve.volume_factor)
-                       ? calm + 1
-                       : 0;
+            calm =
+                (err1 < 0.01 && gk_rve_kinetic_energy(&sc.rve) < 1e-7 * o.pressure * a * sc.rve.volume_factor)
+                    ? calm + 1
+                    : 0;
             if (calm >= 3 || st >= (long)o.max_cons) break;
         }
         if (!o.quiet)
@@ -352,7 +374,8 @@ int main(int argc, char **argv) {
     /* ---- stage 2: constant axial strain rate */
     {
         double rho = d.rve.mat.density;
-        rate = o.rate > 0 ? o.rate : 1e-3 * sqrt(o.pressure / rho) / (2.0 * rmean); /* I = rate 2r sqrt(rho/p) */
+        rate =
+            o.rate > 0 ? o.rate : 1e-3 * sqrt(o.pressure / rho) / (2.0 * rmean); /* I = rate 2r sqrt(rho/p) */
         v = rate * H0;
         sc.walls[1].def.drive = GK_DRIVE_VELOCITY;
         sc.walls[1].def.velocity[1] = -v;
@@ -365,7 +388,9 @@ int main(int argc, char **argv) {
         status = 1;
         goto done;
     }
-    fprintf(csv, "eps_axial,sigma_yy_lid,sigma_xx,sigma_yy,eps_vol,stress_ratio,phi_deg,coordination,n_contacts\n");
+    fprintf(
+        csv,
+        "eps_axial,sigma_yy_lid,sigma_xx,sigma_yy,eps_vol,stress_ratio,phi_deg,coordination,n_contacts\n");
     t = 0.0;
     for (k = 0;; ++k) {
         double eps = k * o.every, s[9], a, sxx, syy, ratio, z;
@@ -398,10 +423,11 @@ int main(int argc, char **argv) {
         }
         rows[nrows].eps = (H0 - H) / H0;
         rows[nrows].syy_lid = sc.walls[1].resistance / (a / H * sc.rve.volume_factor);
-        rows[nrows].sxx = sxx, rows[nrows].syy = syy, rows[nrows].ev = (A0 - a) / A0, rows[nrows].ratio = ratio;
+        rows[nrows].sxx = sxx, rows[nrows].syy = syy, rows[nrows].ev = (A0 - a) / A0,
+        rows[nrows].ratio = ratio;
         rows[nrows].z = z;
-        fprintf(csv, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.4f,%.4f,%d\n", rows[nrows].eps, rows[nrows].syy_lid, sxx, syy,
-                rows[nrows].ev, ratio, asin(ratio < 1 ? ratio : 1) * 180.0 / GK_PI, z, nc);
+        fprintf(csv, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.4f,%.4f,%d\n", rows[nrows].eps, rows[nrows].syy_lid,
+                sxx, syy, rows[nrows].ev, ratio, asin(ratio < 1 ? ratio : 1) * 180.0 / GK_PI, z, nc);
         if (ratio > peak) peak = ratio, eps_peak = rows[nrows].eps, syy_peak = syy;
         if (!o.quiet && k % 5 == 0)
             printf("eps %.4f  sigma_yy %.5g (lid %.5g)  sigma_xx %.5g Pa  ratio %.4f  eps_v %+.5f  Z %.3f\n",
@@ -430,7 +456,8 @@ int main(int argc, char **argv) {
         goto done;
     }
     {
-        double *x = (double *)malloc((size_t)nrows * sizeof *x), *y0 = (double *)malloc((size_t)nrows * sizeof *y0),
+        double *x = (double *)malloc((size_t)nrows * sizeof *x),
+               *y0 = (double *)malloc((size_t)nrows * sizeof *y0),
                *y1 = (double *)malloc((size_t)nrows * sizeof *y1);
         const double *yy[4];
         const char *lab[4], *rl[1] = {""};
@@ -439,22 +466,25 @@ int main(int argc, char **argv) {
             fprintf(stderr, "dem_biaxial: out of memory for the plot\n");
             status = 1;
         }
-        for (k = 0; !status && k < nrows; ++k) x[k] = rows[k].eps, y0[k] = rows[k].ratio, y1[k] = 10.0 * rows[k].ev;
+        for (k = 0; !status && k < nrows; ++k)
+            x[k] = rows[k].eps, y0[k] = rows[k].ratio, y1[k] = 10.0 * rows[k].ev;
         if (!status) {
             yy[0] = y0, yy[1] = y1, yy[2] = yy[3] = NULL;
             lab[0] = "stress ratio |s_yy - s_xx| / (s_yy + s_xx) (seed 001 eq 40)";
             lab[1] = "10 x volumetric strain (compaction +)";
             lab[2] = lab[3] = NULL;
             snprintf(path, sizeof path, "%s/biaxial_stress.svg", o.out);
-            status = dsc_plot("dem_biaxial", path, "DEM biaxial DNS", "axial strain", "", x, nrows, yy, lab, 0, ref, rl);
+            status = dsc_plot("dem_biaxial", path, "DEM biaxial DNS", "axial strain", "", x, nrows, yy, lab,
+                              0, ref, rl);
         }
         free(x), free(y0), free(y1);
         if (status) goto done;
     }
-    printf("RESULT n=%d W=%.5g H0=%.5g peak_ratio=%.4f eps_peak=%.4f phi_peak_deg=%.2f ratio_final=%.4f syy_peak=%.5g "
+    printf("RESULT n=%d W=%.5g H0=%.5g peak_ratio=%.4f eps_peak=%.4f phi_peak_deg=%.2f ratio_final=%.4f "
+           "syy_peak=%.5g "
            "ev_final=%.5f z0=%.3f steps=%ld dt=%.4g seconds=%.2f\n",
-           sc.rve.n, W, H0, peak, eps_peak, asin(peak < 1 ? peak : 1) * 180.0 / GK_PI, rows[nrows - 1].ratio, syy_peak,
-           rows[nrows - 1].ev, z0, steps, sc.rve.dt, gk_wtime() - t0);
+           sc.rve.n, W, H0, peak, eps_peak, asin(peak < 1 ? peak : 1) * 180.0 / GK_PI, rows[nrows - 1].ratio,
+           syy_peak, rows[nrows - 1].ev, z0, steps, sc.rve.dt, gk_wtime() - t0);
     goto done;
 fail:
     fprintf(stderr, "dem_biaxial: %s\n", gk_scene_error(&sc));

@@ -65,34 +65,35 @@ typedef struct dc_row {
 } dc_row;
 
 static void usage(FILE *fp) {
-    fprintf(fp,
-            "dem_collapse - 2D granular column collapse in DEM (gk_scene.h): a column d0 wide and a d0 high\n"
-            "on a rough floor (fixed disks), a smooth symmetry wall on its left, the gate on its right pulled\n"
-            "away at t = 0; run-out d* = (d_f - d0)/d0 against the experiments (Lube et al. 2005,\n"
-            "Lajeunesse et al. 2005: d* ~ 1.2 a to 1.6 a for a < 3) and examples/mpmdem_collapse.c.\n\n"
-            "usage: dem_collapse [options]\n"
-            "  --a A                  aspect ratio H0/d0 (default 1)\n"
-            "  --width D0             column width [m] (default 1, as mpmdem_collapse)\n"
-            "  --diameters N          mean disk diameters across the column (default 24)\n"
-            "  --mu M                 Coulomb friction of the disks and the floor disks (default 0.5)\n"
-            "  --roll-beta B --roll-eta E   rolling resistance (default 0 0: none)\n"
-            "  --restitution E        normal restitution of the contact dashpots (default 0.5)\n"
-            "  --young E              contact modulus, k_n = E r* [Pa] (default 6e8, seed 000/003)\n"
-            "  --gravity G            [m/s^2] (default 9.81)\n"
-            "  --t-end T              simulated time after release [s] (default 4)\n"
-            "  --every DT             time between CSV rows [s] (default 0.01)\n"
-            "  --snapshots T1,T2,...  picture times [s] (default 0.2,0.5,1)\n"
-            "  --rest-frac F          at rest when E_k < F E_p0 after its peak (default 5e-3)\n"
-            "  --rest-hold T          stop T s after coming to rest (default 0.05)\n"
-            "  --seed S               radii and lattice jitter (default 1)\n"
-            "  --threads T            threads of the pair forces (default 1; results do not depend on it)\n"
-            "  --out DIR              output directory (default build/dem_collapse)\n"
-            "  --quiet                no progress lines\n"
-            "  --help                 this text\n\n"
-            "ends with: RESULT a=... dstar=... dstar_lube=1.2a dstar_lajeunesse_hi=1.6a height_over_H0=...\n"
-            "           Ek_peak_over_Ep0=... t_Ek_peak=... Ed_final_over_Ep0=... t_rest=... (-1: not at rest)\n"
-            "           energy_balance=... (of E_p0) n=... lost=... steps=... dt=... seconds=...\n"
-            "exit status: 0 done, 1 setup, simulation or output failed (message), 2 bad arguments\n");
+    fprintf(
+        fp,
+        "dem_collapse - 2D granular column collapse in DEM (gk_scene.h): a column d0 wide and a d0 high\n"
+        "on a rough floor (fixed disks), a smooth symmetry wall on its left, the gate on its right pulled\n"
+        "away at t = 0; run-out d* = (d_f - d0)/d0 against the experiments (Lube et al. 2005,\n"
+        "Lajeunesse et al. 2005: d* ~ 1.2 a to 1.6 a for a < 3) and examples/mpmdem_collapse.c.\n\n"
+        "usage: dem_collapse [options]\n"
+        "  --a A                  aspect ratio H0/d0 (default 1)\n"
+        "  --width D0             column width [m] (default 1, as mpmdem_collapse)\n"
+        "  --diameters N          mean disk diameters across the column (default 24)\n"
+        "  --mu M                 Coulomb friction of the disks and the floor disks (default 0.5)\n"
+        "  --roll-beta B --roll-eta E   rolling resistance (default 0 0: none)\n"
+        "  --restitution E        normal restitution of the contact dashpots (default 0.5)\n"
+        "  --young E              contact modulus, k_n = E r* [Pa] (default 6e8, seed 000/003)\n"
+        "  --gravity G            [m/s^2] (default 9.81)\n"
+        "  --t-end T              simulated time after release [s] (default 4)\n"
+        "  --every DT             time between CSV rows [s] (default 0.01)\n"
+        "  --snapshots T1,T2,...  picture times [s] (default 0.2,0.5,1)\n"
+        "  --rest-frac F          at rest when E_k < F E_p0 after its peak (default 5e-3)\n"
+        "  --rest-hold T          stop T s after coming to rest (default 0.05)\n"
+        "  --seed S               radii and lattice jitter (default 1)\n"
+        "  --threads T            threads of the pair forces (default 1; results do not depend on it)\n"
+        "  --out DIR              output directory (default build/dem_collapse)\n"
+        "  --quiet                no progress lines\n"
+        "  --help                 this text\n\n"
+        "ends with: RESULT a=... dstar=... dstar_lube=1.2a dstar_lajeunesse_hi=1.6a height_over_H0=...\n"
+        "           Ek_peak_over_Ep0=... t_Ek_peak=... Ed_final_over_Ep0=... t_rest=... (-1: not at rest)\n"
+        "           energy_balance=... (of E_p0) n=... lost=... steps=... dt=... seconds=...\n"
+        "exit status: 0 done, 1 setup, simulation or output failed (message), 2 bad arguments\n");
 }
 
 static int parse(int argc, char **argv, dc_opts *o) {
@@ -118,50 +119,70 @@ static int parse(int argc, char **argv, dc_opts *o) {
         if (!strcmp(a, "--snapshots")) {
             if ((o->nsnap = dsc_list(argv[++i], o->snap, DC_MAX_SNAP, 0)) < 0)
                 return fprintf(stderr,
-                               "dem_collapse: --snapshots %s: need up to %d increasing times >= 0, comma-separated\n",
+                               "dem_collapse: --snapshots %s: need up to %d increasing times >= 0, "
+                               "comma-separated\n",
                                argv[i], DC_MAX_SNAP),
                        2;
             continue;
         }
-        if (dsc_num(argv[i + 1], &v)) return fprintf(stderr, "dem_collapse: %s %s: not a number\n", a, argv[i + 1]), 2;
-        if (!strcmp(a, "--a")) o->a = v;
-        else if (!strcmp(a, "--width")) o->width = v;
-        else if (!strcmp(a, "--diameters")) o->diameters = v;
-        else if (!strcmp(a, "--mu")) o->mu = v;
-        else if (!strcmp(a, "--roll-beta")) o->roll_beta = v;
-        else if (!strcmp(a, "--roll-eta")) o->roll_eta = v;
-        else if (!strcmp(a, "--restitution")) o->restitution = v;
-        else if (!strcmp(a, "--young")) o->young = v;
-        else if (!strcmp(a, "--gravity")) o->gravity = v;
-        else if (!strcmp(a, "--t-end")) o->t_end = v;
-        else if (!strcmp(a, "--every")) o->every = v;
-        else if (!strcmp(a, "--rest-frac")) o->rest_frac = v;
-        else if (!strcmp(a, "--rest-hold")) o->rest_hold = v;
-        else if (!strcmp(a, "--seed")) o->seed = v >= 0 && v == floor(v) ? (unsigned long)v : 0, o->seed += v < 0;
-        else if (!strcmp(a, "--threads")) o->threads = v == floor(v) && v >= 1 && v <= 256 ? (int)v : -1;
-        else return fprintf(stderr, "dem_collapse: unknown option %s (see --help)\n", a), 2;
+        if (dsc_num(argv[i + 1], &v))
+            return fprintf(stderr, "dem_collapse: %s %s: not a number\n", a, argv[i + 1]), 2;
+        if (!strcmp(a, "--a"))
+            o->a = v;
+        else if (!strcmp(a, "--width"))
+            o->width = v;
+        else if (!strcmp(a, "--diameters"))
+            o->diameters = v;
+        else if (!strcmp(a, "--mu"))
+            o->mu = v;
+        else if (!strcmp(a, "--roll-beta"))
+            o->roll_beta = v;
+        else if (!strcmp(a, "--roll-eta"))
+            o->roll_eta = v;
+        else if (!strcmp(a, "--restitution"))
+            o->restitution = v;
+        else if (!strcmp(a, "--young"))
+            o->young = v;
+        else if (!strcmp(a, "--gravity"))
+            o->gravity = v;
+        else if (!strcmp(a, "--t-end"))
+            o->t_end = v;
+        else if (!strcmp(a, "--every"))
+            o->every = v;
+        else if (!strcmp(a, "--rest-frac"))
+            o->rest_frac = v;
+        else if (!strcmp(a, "--rest-hold"))
+            o->rest_hold = v;
+        else if (!strcmp(a, "--seed"))
+            o->seed = v >= 0 && v == floor(v) ? (unsigned long)v : 0, o->seed += v < 0;
+        else if (!strcmp(a, "--threads"))
+            o->threads = v == floor(v) && v >= 1 && v <= 256 ? (int)v : -1;
+        else
+            return fprintf(stderr, "dem_collapse: unknown option %s (see --help)\n", a), 2;
         ++i;
     }
     {
         struct {
             const char *flag, *need;
             int ok;
-        } chk[] = {{"--a", "an aspect ratio in [0.2, 10]", o->a >= 0.2 && o->a <= 10},
-                   {"--width", "a positive length", o->width > 0},
-                   {"--diameters", "a number of diameters in [4, 400]", o->diameters >= 4 && o->diameters <= 400},
-                   {"--mu", "a friction coefficient >= 0", o->mu >= 0},
-                   {"--roll-beta", "a value >= 0", o->roll_beta >= 0},
-                   {"--roll-eta", "a value >= 0", o->roll_eta >= 0},
-                   {"--restitution", "a value in (0, 1]", o->restitution > 0 && o->restitution <= 1},
-                   {"--young", "a positive modulus", o->young > 0},
-                   {"--gravity", "a positive value", o->gravity > 0},
-                   {"--t-end", "a positive time", o->t_end > 0},
-                   {"--every", "a positive time", o->every > 0},
-                   {"--rest-frac", "a value >= 0", o->rest_frac >= 0},
-                   {"--rest-hold", "a time >= 0", o->rest_hold >= 0},
-                   {"--threads", "an integer in [1, 256]", o->threads >= 1}};
+        } chk[] = {
+            {"--a", "an aspect ratio in [0.2, 10]", o->a >= 0.2 && o->a <= 10},
+            {"--width", "a positive length", o->width > 0},
+            {"--diameters", "a number of diameters in [4, 400]", o->diameters >= 4 && o->diameters <= 400},
+            {"--mu", "a friction coefficient >= 0", o->mu >= 0},
+            {"--roll-beta", "a value >= 0", o->roll_beta >= 0},
+            {"--roll-eta", "a value >= 0", o->roll_eta >= 0},
+            {"--restitution", "a value in (0, 1]", o->restitution > 0 && o->restitution <= 1},
+            {"--young", "a positive modulus", o->young > 0},
+            {"--gravity", "a positive value", o->gravity > 0},
+            {"--t-end", "a positive time", o->t_end > 0},
+            {"--every", "a positive time", o->every > 0},
+            {"--rest-frac", "a value >= 0", o->rest_frac >= 0},
+            {"--rest-hold", "a time >= 0", o->rest_hold >= 0},
+            {"--threads", "an integer in [1, 256]", o->threads >= 1}};
         for (k = 0; k < (int)(sizeof chk / sizeof *chk); ++k)
-            if (!chk[k].ok) return fprintf(stderr, "dem_collapse: %s: need %s\n", chk[k].flag, chk[k].need), 2;
+            if (!chk[k].ok)
+                return fprintf(stderr, "dem_collapse: %s: need %s\n", chk[k].flag, chk[k].need), 2;
     }
     return 0;
 }
@@ -208,7 +229,8 @@ static void measure(const gk_scene *sc, double g, double y0, double dmean, doubl
         if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) continue;
         gk_scene_position(sc, p, x);
         *ep += sc->mass[p] * g * (x[1] - y0);
-        if (x[0] < dmean && x[1] + (double)sc->rve.r[p] - y0 > *height) *height = x[1] + (double)sc->rve.r[p] - y0;
+        if (x[0] < dmean && x[1] + (double)sc->rve.r[p] - y0 > *height)
+            *height = x[1] + (double)sc->rve.r[p] - y0;
     }
 }
 
@@ -221,7 +243,8 @@ int main(int argc, char **argv) {
     gk_wall_def wall = gk_wall_def_default(), gate = gk_wall_def_default();
     dc_row *rows = NULL;
     int nrows = 0, caprows = 0, status = 0, created = 0, isnap = 0, igate, p, k;
-    double rmax, rmean, rf, W, H, L, Ep0 = 0.0, ek_peak = 0.0, t_ek_peak = 0.0, t_rest = -1.0, t = 0.0, next = 0.0;
+    double rmax, rmean, rf, W, H, L, Ep0 = 0.0, ek_peak = 0.0, t_ek_peak = 0.0, t_rest = -1.0, t = 0.0,
+                                     next = 0.0;
     double *xs = NULL, *rs = NULL, t0 = gk_wtime();
     int *idx = NULL, at_rest = 0;
     long steps = 0;
@@ -239,7 +262,8 @@ int main(int argc, char **argv) {
     /* ---- the scene: column on a lattice, floor of fixed disks */
     {
         /* a square lattice fills about half the area a settled column does */
-        int nx = (int)floor(W / (2.2 * rmax)), ny = (int)ceil(2.0 * H / (2.2 * rmax)), nf = (int)floor(L / (2.0 * rf));
+        int nx = (int)floor(W / (2.2 * rmax)), ny = (int)ceil(2.0 * H / (2.2 * rmax)),
+            nf = (int)floor(L / (2.0 * rf));
         gk_rng rng;
         int q = 0, a, b;
         d.dim = 2;
@@ -293,8 +317,8 @@ int main(int argc, char **argv) {
         gate.normal[0] = 0.0;
         if (gk_scene_add_wall(&sc, &wall, NULL) || gk_scene_add_wall(&sc, &gate, &igate)) goto fail;
         if (!o.quiet)
-            printf("dem_collapse: %d disks in the column (r %.4g-%.4g m), %d floor disks, dt %.3g s\n", sc.rve.n - nf,
-                   0.6 * rmax, rmax, nf, sc.rve.dt);
+            printf("dem_collapse: %d disks in the column (r %.4g-%.4g m), %d floor disks, dt %.3g s\n",
+                   sc.rve.n - nf, 0.6 * rmax, rmax, nf, sc.rve.dt);
     }
     /* ---- preparation: settle, cut at H0, settle again */
     {
@@ -327,7 +351,9 @@ int main(int argc, char **argv) {
             }
         }
         measure(&sc, o.gravity, 0.0, rmean, &Ep0, &H);
-        if (!o.quiet) printf("dem_collapse: column of %d disks, %.4g m high (a = %.3g), settled\n", sc.rve.n - (int)floor(L / (2.0 * rf)), H, H / W);
+        if (!o.quiet)
+            printf("dem_collapse: column of %d disks, %.4g m high (a = %.3g), settled\n",
+                   sc.rve.n - (int)floor(L / (2.0 * rf)), H, H / W);
     }
     /* ---- release */
     if (gk_rve_set_damping(&sc.rve, 0.0, GK_DAMP_COMPONENT) || gk_scene_energy_track(&sc, 1)) goto fail;
@@ -342,8 +368,9 @@ int main(int argc, char **argv) {
         status = 1;
         goto done;
     }
-    fprintf(csv, "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0,friction_over_Ep0,viscous_over_Ep0,"
-                 "balance_over_Ep0,n,lost\n");
+    fprintf(csv,
+            "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0,friction_over_Ep0,viscous_over_Ep0,"
+            "balance_over_Ep0,n,lost\n");
     if (dsc_pictures("dem_collapse", &sc, o.out, "000", "column at release")) {
         status = 1;
         goto done;
@@ -367,13 +394,13 @@ int main(int argc, char **argv) {
             caprows = caprows ? 2 * caprows : 256;
         }
         rows[nrows++] = r;
-        fprintf(csv, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.3g,%d,%ld\n", t, f, (f - W) / W, h, r.ek, r.ep,
-                r.ed, r.friction, r.viscous, r.balance, sc.rve.n, sc.lost);
+        fprintf(csv, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.3g,%d,%ld\n", t, f, (f - W) / W, h, r.ek,
+                r.ep, r.ed, r.friction, r.viscous, r.balance, sc.rve.n, sc.lost);
         if (r.ek > ek_peak) ek_peak = r.ek, t_ek_peak = t;
         if (!at_rest && t > t_ek_peak && ek_peak > 0 && r.ek < o.rest_frac) at_rest = 1, t_rest = t;
         if (!o.quiet && nrows % 20 == 1)
-            printf("t %.3f s  d* %.3f  height %.3f H0  E_k %.4f  E_d %.4f E_p0  (books %.3g)\n", t, (f - W) / W, h / H,
-                   r.ek, r.ed, r.balance);
+            printf("t %.3f s  d* %.3f  height %.3f H0  E_k %.4f  E_d %.4f E_p0  (books %.3g)\n", t,
+                   (f - W) / W, h / H, r.ek, r.ed, r.balance);
         if (isnap < o.nsnap && t >= o.snap[isnap] - 1e-12) {
             char tag[32], title[64];
             snprintf(tag, sizeof tag, "%03d", isnap + 1);
@@ -427,12 +454,14 @@ int main(int argc, char **argv) {
             {
                 const double *yy[4];
                 yy[0] = y[0], yy[1] = yy[2] = yy[3] = NULL;
-                status = dsc_plot("dem_collapse", path, "DEM column collapse: run-out", "time after release [s]",
-                                  "d* = (d_f - d0) / d0", x, nrows, yy, lab, fabs(o.a - 1.0) < 1e-9 ? 3 : 2, ref, rl);
+                status = dsc_plot("dem_collapse", path, "DEM column collapse: run-out",
+                                  "time after release [s]", "d* = (d_f - d0) / d0", x, nrows, yy, lab,
+                                  fabs(o.a - 1.0) < 1e-9 ? 3 : 2, ref, rl);
             }
         }
         for (k = 0; !status && k < nrows; ++k) {
-            y[0][k] = rows[k].ep, y[1][k] = rows[k].ek, y[2][k] = rows[k].ed, y[3][k] = rows[k].friction + rows[k].viscous;
+            y[0][k] = rows[k].ep, y[1][k] = rows[k].ek, y[2][k] = rows[k].ed,
+            y[3][k] = rows[k].friction + rows[k].viscous;
         }
         if (!status) {
             const double *yy[4];
@@ -440,8 +469,8 @@ int main(int argc, char **argv) {
             for (k = 0; k < 4; ++k) yy[k] = y[k];
             ref[0] = 1.0 - 0.74 / (2.0 * o.a), rl[0] = "Lajeunesse et al.: E_d = 1 - 0.74/(2a)";
             snprintf(path, sizeof path, "%s/collapse_energy.svg", o.out);
-            status = dsc_plot("dem_collapse", path, "DEM column collapse: energies / E_p0", "time after release [s]",
-                              "energy / E_p0", x, nrows, yy, lab, 1, ref, rl);
+            status = dsc_plot("dem_collapse", path, "DEM column collapse: energies / E_p0",
+                              "time after release [s]", "energy / E_p0", x, nrows, yy, lab, 1, ref, rl);
         } else {
             fprintf(stderr, "dem_collapse: out of memory for the plots\n");
         }
@@ -452,10 +481,11 @@ int main(int argc, char **argv) {
     {
         const dc_row *e = &rows[nrows - 1];
         printf("RESULT a=%.4g dstar=%.4g dstar_lube=%.4g dstar_lajeunesse_hi=%.4g height_over_H0=%.4g "
-               "Ek_peak_over_Ep0=%.4g t_Ek_peak=%.4g Ed_final_over_Ep0=%.4g t_rest=%.4g energy_balance=%.3g n=%d "
+               "Ek_peak_over_Ep0=%.4g t_Ek_peak=%.4g Ed_final_over_Ep0=%.4g t_rest=%.4g energy_balance=%.3g "
+               "n=%d "
                "lost=%ld steps=%ld dt=%.4g seconds=%.2f\n",
-               H / W, (e->front - W) / W, 1.2 * H / W, 1.6 * H / W, e->height / H, ek_peak, t_ek_peak, e->ed, t_rest,
-               e->balance, sc.rve.n, sc.lost, steps, sc.rve.dt, gk_wtime() - t0);
+               H / W, (e->front - W) / W, 1.2 * H / W, 1.6 * H / W, e->height / H, ek_peak, t_ek_peak, e->ed,
+               t_rest, e->balance, sc.rve.n, sc.lost, steps, sc.rve.dt, gk_wtime() - t0);
     }
     goto done;
 fail:

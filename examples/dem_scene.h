@@ -45,7 +45,8 @@ static int dsc_mkdir(const char *prog, const char *d) {
 
 /* particles_TAG.vtk and walls_TAG.vtk (ParaView), 2D also particles_TAG.svg;
  * non-zero (message on stderr) if a file cannot be written */
-static int dsc_pictures(const char *prog, const gk_scene *sc, const char *out, const char *tag, const char *title) {
+static int dsc_pictures(const char *prog, const gk_scene *sc, const char *out, const char *tag,
+                        const char *title) {
     char path[1200];
     gk_err err;
     snprintf(path, sizeof path, "%s/particles_%s.vtk", out, tag);

@@ -169,8 +169,8 @@ TEST(chung_ooi_1_two_spheres_normal) {
         gk_scene_set_velocity(&sc, gk_scene_index(&sc, 0), vel, NULL);
         gk_scene_set_velocity(&sc, gk_scene_index(&sc, 1), vel2, NULL);
         CHECK(run_impact(&sc, gk_scene_index(&sc, 0), gk_scene_index(&sc, 1), &o, 100000) == 0);
-        printf("    %-9s F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n", ms[t]->name,
-               o.fmax, fm, o.dmax, dm, o.tc, tc);
+        printf("    %-9s F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n",
+               ms[t]->name, o.fmax, fm, o.dmax, dm, o.tc, tc);
         CHECK_REL(o.fmax, fm, 2e-3);
         CHECK_REL(o.dmax, dm, 2e-3);
         CHECK_REL(o.tc, tc, 2e-3);
@@ -211,7 +211,8 @@ TEST(chung_ooi_2_sphere_on_wall_normal) {
     int t;
     for (t = 0; t < 2; ++t) {
         double R = 0.1, v = 0.2, m = sphere_mass(ms[t]->rho, R), Es = estar(ms[t], NULL);
-        double tc = hertz_tc(m, R, Es, v), dm = hertz_dmax(m, R, Es, v), fm = 4.0 / 3.0 * Es * sqrt(R) * pow(dm, 1.5);
+        double tc = hertz_tc(m, R, Es, v), dm = hertz_dmax(m, R, Es, v),
+               fm = 4.0 / 3.0 * Es * sqrt(R) * pow(dm, 1.5);
         double vel[3] = {0, -0.2, 0}, fwall = 0.0;
         gk_material mat = hertz_mat(ms[t], 0.0);
         gk_scene sc;
@@ -222,8 +223,8 @@ TEST(chung_ooi_2_sphere_on_wall_normal) {
             continue;
         }
         CHECK(run_impact(&sc, 0, -1, &o, 100000) == 0);
-        printf("    %-9s F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n", ms[t]->name,
-               o.fmax, fm, o.dmax, dm, o.tc, tc);
+        printf("    %-9s F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n",
+               ms[t]->name, o.fmax, fm, o.dmax, dm, o.tc, tc);
         CHECK_REL(o.fmax, fm, 2e-3);
         CHECK_REL(o.dmax, dm, 2e-3);
         CHECK_REL(o.tc, tc, 2e-3);
@@ -248,8 +249,10 @@ static double restitution(const gk_material *m, double R, double v, double dt) {
     double vel[3] = {0, 0, 0}, e;
     vel[1] = -v;
     if (sphere_on_plane(&sc, m, R, vel, NULL, dt)) return -1.0;
-    if (run_impact(&sc, 0, -1, &o, 1000000)) e = -1.0;
-    else e = (double)sc.rve.v[1][0] / v;
+    if (run_impact(&sc, 0, -1, &o, 1000000))
+        e = -1.0;
+    else
+        e = (double)sc.rve.v[1][0] / v;
     gk_scene_destroy(&sc);
     return e;
 }
@@ -269,7 +272,8 @@ static double hertz_dashpot_e(double zeta) {
         double k3x = u + 0.5 * h * k2u, k3u = GK_T_ACC(x + 0.5 * h * k2x, u + 0.5 * h * k2u);
         double k4x = u + h * k3u, k4u = GK_T_ACC(x + h * k3x, u + h * k3u);
 #undef GK_T_ACC
-        double xn = x + h / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x), un = u + h / 6.0 * (k1u + 2 * k2u + 2 * k3u + k4u);
+        double xn = x + h / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x),
+               un = u + h / 6.0 * (k1u + 2 * k2u + 2 * k3u + k4u);
         if (it > 10 && xn <= 0.0) return -(u + (un - u) * x / (x - xn)); /* interpolate the crossing */
         x = xn;
         u = un;
@@ -288,7 +292,8 @@ TEST(chung_ooi_3_restitution) {
     const double es[5] = {0.2, 0.4, 0.6, 0.8, 1.0};
     int t, i;
     for (t = 0; t < 2; ++t) {
-        double R = 2.5e-3, m = sphere_mass(ms[t]->rho, R), Es = estar(ms[t], NULL), tc = hertz_tc(m, R, Es, 3.9);
+        double R = 2.5e-3, m = sphere_mass(ms[t]->rho, R), Es = estar(ms[t], NULL),
+               tc = hertz_tc(m, R, Es, 3.9);
         for (i = 0; i < 5; ++i) {
             gk_material lin = gk_material_default();
             double e, kn = 4.0 * ms[t]->E * R; /* the wall's linear k_n = E x 2 R* with the pair's 2 E */
@@ -308,8 +313,8 @@ TEST(chung_ooi_3_restitution) {
             e1 = restitution(&hz, R, 3.9, tc / 1000.0);
             e2 = restitution(&hz, R, 39.0, hertz_tc(m, R, Es, 39.0) / 1000.0);
             em = hertz_dashpot_e(0.2);
-            printf("    %-9s Hertz, zeta 0.2: e = %.5f, %.5f, %.5f at 0.39, 3.9, 39 m/s; model %.5f\n", ms[t]->name, e0,
-                   e1, e2, em);
+            printf("    %-9s Hertz, zeta 0.2: e = %.5f, %.5f, %.5f at 0.39, 3.9, 39 m/s; model %.5f\n",
+                   ms[t]->name, e0, e1, e2, em);
             CHECK_NEAR(e0, em, 2e-3);
             CHECK_NEAR(e1, em, 2e-3);
             CHECK_NEAR(e2, em, 2e-3);
@@ -318,8 +323,8 @@ TEST(chung_ooi_3_restitution) {
 }
 
 /* one oblique impact on the plane: rebound velocity and spin */
-static int oblique(const gk_material *m, double R, const double v[3], const double w[3], double dt, double vout[3],
-                   double wout[3]) {
+static int oblique(const gk_material *m, double R, const double v[3], const double w[3], double dt,
+                   double vout[3], double wout[3]) {
     gk_scene sc;
     impact_rec o;
     int k, bad;
@@ -349,7 +354,8 @@ TEST(chung_ooi_4_oblique_constant_speed) {
     gk_material mat = hertz_mat(&AL_OXIDE, mu);
     int a;
     for (a = 0; a < 7; ++a) {
-        double th = ang[a] * GK_PI / 180.0, vn = V * cos(th), vt = V * sin(th), v[3], vo[3], wo[3], et, L0, L1;
+        double th = ang[a] * GK_PI / 180.0, vn = V * cos(th), vt = V * sin(th), v[3], vo[3], wo[3], et, L0,
+               L1;
         v[0] = vt;
         v[1] = -vn;
         v[2] = 0.0;
@@ -357,11 +363,13 @@ TEST(chung_ooi_4_oblique_constant_speed) {
         et = vo[0] / vt;
         L0 = -m * R * vt;
         L1 = I * wo[2] - m * R * vo[0];
-        printf("    theta %4.1f: e_t %.4f, omega %9.3f rad/s, rebound angle %6.2f deg, contact point %+.4f m/s\n", ang[a],
-               et, wo[2], atan2(vo[0], vo[1]) * 180.0 / GK_PI, vo[0] + R * wo[2]);
+        printf("    theta %4.1f: e_t %.4f, omega %9.3f rad/s, rebound angle %6.2f deg, contact point %+.4f "
+               "m/s\n",
+               ang[a], et, wo[2], atan2(vo[0], vo[1]) * 180.0 / GK_PI, vo[0] + R * wo[2]);
         CHECK_NEAR(L1, L0, 2e-3 * fabs(L0));
         CHECK_NEAR(vo[1], vn, 1e-3 * vn);
-        CHECK(0.5 * m * (vo[0] * vo[0] + vo[1] * vo[1]) + 0.5 * I * wo[2] * wo[2] <= 0.5 * m * V * V * (1.0 + 1e-6));
+        CHECK(0.5 * m * (vo[0] * vo[0] + vo[1] * vo[1]) + 0.5 * I * wo[2] * wo[2] <=
+              0.5 * m * V * V * (1.0 + 1e-6));
         if (tan(th) >= 7.0 * mu * 1.01) {
             CHECK_NEAR(et, 1.0 - 2.0 * mu / tan(th), 2e-3);
             CHECK_NEAR(wo[2], -5.0 * mu * vn / R, 2e-3 * 5.0 * mu * vn / R);
@@ -436,7 +444,8 @@ TEST(chung_ooi_6_spinning_sphere_on_wall) {
     double R = 0.1, mu = 0.4, vn = 0.2;
     int t, i;
     for (t = 0; t < 2; ++t) {
-        double m = sphere_mass(ms[t]->rho, R), I = 0.4 * m * R * R, dt = hertz_tc(m, R, estar(ms[t], NULL), vn) / 1000.0;
+        double m = sphere_mass(ms[t]->rho, R), I = 0.4 * m * R * R,
+               dt = hertz_tc(m, R, estar(ms[t], NULL), vn) / 1000.0;
         gk_material mat = hertz_mat(ms[t], mu);
         for (i = 0; i < 5; ++i) {
             double v[3] = {0, 0, 0}, w[3] = {0, 0, 0}, vo[3], wo[3];
@@ -465,8 +474,8 @@ TEST(chung_ooi_6_spinning_sphere_on_wall) {
         /* vx + R wz = -R w0 and I wz - m R vx = I w0 */
         wz = (I * w0 - m * R * R * w0) / (I + m * R * R);
         vx = -R * w0 - R * wz;
-        printf("    linear k_t/k_n = 2/7, w0 %.3f: v_x' %+.6f (exact %+.6f), w' %+.5f (%+.5f)\n", w0, vo[0], vx, wo[2],
-               wz);
+        printf("    linear k_t/k_n = 2/7, w0 %.3f: v_x' %+.6f (exact %+.6f), w' %+.5f (%+.5f)\n", w0, vo[0],
+               vx, wo[2], wz);
         CHECK_NEAR(vo[0], vx, 3e-3 * R * w0);
         CHECK_NEAR(wo[2], wz, 3e-3 * w0);
     }
@@ -476,8 +485,8 @@ TEST(chung_ooi_6_spinning_sphere_on_wall) {
  * spinning at w0 about z: the contact points slide at 2 R w0 for equal radii
  * (R_A w0 + R_B w0 in general) while the centres have no tangential speed,
  * so the line of centres stays put */
-static int two_spheres(gk_scene *sc, const gk_material *m, double RA, double RB, double mB, double vn, double w0,
-                       double dt) {
+static int two_spheres(gk_scene *sc, const gk_material *m, double RA, double RB, double mB, double vn,
+                       double w0, double dt) {
     double x[2][3] = {{0, 0, 0}, {0, 0, 0}}, r[2];
     double mA, vA[3] = {0, 0, 0}, vB[3] = {0, 0, 0}, w[3] = {0, 0, 0};
     x[0][1] = -RA * (1.0 + 1e-4);
@@ -510,7 +519,8 @@ TEST(chung_ooi_7_two_spheres_oblique) {
     int t, i;
     for (t = 0; t < 2; ++t) {
         double m = sphere_mass(ms[t]->rho, R), I = 0.4 * m * R * R, Es = estar(ms[t], ms[t]);
-        double dt = hertz_tc(0.5 * m, 0.5 * R, Es, vn) / 1000.0, tol = hertz_dmax(0.5 * m, 0.5 * R, Es, vn) / R + 2e-3;
+        double dt = hertz_tc(0.5 * m, 0.5 * R, Es, vn) / 1000.0,
+               tol = hertz_dmax(0.5 * m, 0.5 * R, Es, vn) / R + 2e-3;
         gk_material mat = hertz_mat(ms[t], mu);
         for (i = 0; i < 4; ++i) {
             gk_scene sc;
@@ -525,11 +535,14 @@ TEST(chung_ooi_7_two_spheres_oblique) {
             b = gk_scene_index(&sc, 1);
             CHECK(run_impact(&sc, a, b, &o, 1000000) == 0);
             /* B's contact point (at -R y) relative to A's (at +R y) */
-            vc = ((double)sc.rve.v[0][b] + R * (double)sc.rve.w[2][b]) - ((double)sc.rve.v[0][a] - R * (double)sc.rve.w[2][a]);
+            vc = ((double)sc.rve.v[0][b] + R * (double)sc.rve.w[2][b]) -
+                 ((double)sc.rve.v[0][a] - R * (double)sc.rve.w[2][a]);
             /* about the initial contact point: A at -R y, B at +R y */
-            Lz = I * ((double)sc.rve.w[2][a] + (double)sc.rve.w[2][b]) + m * R * ((double)sc.rve.v[0][a] - (double)sc.rve.v[0][b]);
-            printf("    %-9s w0 %6.3f: A v_x %+.5f w %+.5f, B v_x %+.5f w %+.5f, contact %+.5f (from %+.4f)\n",
-                   ms[t]->name, w0s[i], sc.rve.v[0][a], sc.rve.w[2][a], sc.rve.v[0][b], sc.rve.w[2][b], vc, vc0);
+            Lz = I * ((double)sc.rve.w[2][a] + (double)sc.rve.w[2][b]) +
+                 m * R * ((double)sc.rve.v[0][a] - (double)sc.rve.v[0][b]);
+            printf(
+                "    %-9s w0 %6.3f: A v_x %+.5f w %+.5f, B v_x %+.5f w %+.5f, contact %+.5f (from %+.4f)\n",
+                ms[t]->name, w0s[i], sc.rve.v[0][a], sc.rve.w[2][a], sc.rve.v[0][b], sc.rve.w[2][b], vc, vc0);
             CHECK_NEAR(Lz, 2.0 * I * w0s[i], 2e-3 * 2.0 * I * w0s[i]);
             CHECK(fabs(vc) <= vc0 * (1.0 + 1e-3));
             /* normal rebound along y, to the turn of the line of centres (tangential travel / 2R) */
@@ -557,9 +570,10 @@ TEST(chung_ooi_7_two_spheres_oblique) {
             a = gk_scene_index(&sc, 0);
             b = gk_scene_index(&sc, 1);
             CHECK(run_impact(&sc, a, b, &o, 1000000) == 0);
-            vc = ((double)sc.rve.v[0][b] + R * (double)sc.rve.w[2][b]) - ((double)sc.rve.v[0][a] - R * (double)sc.rve.w[2][a]);
-            printf("    linear k_t/k_n = 2/7, w0 %.3f: relative contact velocity %+.6f (exact %+.6f)\n", w0, vc,
-                   -2.0 * R * w0);
+            vc = ((double)sc.rve.v[0][b] + R * (double)sc.rve.w[2][b]) -
+                 ((double)sc.rve.v[0][a] - R * (double)sc.rve.w[2][a]);
+            printf("    linear k_t/k_n = 2/7, w0 %.3f: relative contact velocity %+.6f (exact %+.6f)\n", w0,
+                   vc, -2.0 * R * w0);
             CHECK_NEAR(vc, -2.0 * R * w0, 3e-3 * 2.0 * R * w0);
             gk_scene_destroy(&sc);
         } else {
@@ -577,9 +591,11 @@ TEST(chung_ooi_7_two_spheres_oblique) {
  * impulse mu J_n = mu m* 2 v_n and spins down by R J_t / I (to delta_max /
  * R_B). */
 TEST(chung_ooi_8_different_spheres) {
-    double RA = 0.1, RB = 0.05, vn = 0.2, mu = 0.3, mA = sphere_mass(AL_ALLOY.rho, RA), mB = sphere_mass(MG_ALLOY.rho, RB);
+    double RA = 0.1, RB = 0.05, vn = 0.2, mu = 0.3, mA = sphere_mass(AL_ALLOY.rho, RA),
+           mB = sphere_mass(MG_ALLOY.rho, RB);
     double ms = mA * mB / (mA + mB), Rs = RA * RB / (RA + RB), Es = estar(&AL_ALLOY, &MG_ALLOY), w0 = 20.0;
-    double tc = hertz_tc(ms, Rs, Es, vn), dm = hertz_dmax(ms, Rs, Es, vn), fm = 4.0 / 3.0 * Es * sqrt(Rs) * pow(dm, 1.5);
+    double tc = hertz_tc(ms, Rs, Es, vn), dm = hertz_dmax(ms, Rs, Es, vn),
+           fm = 4.0 / 3.0 * Es * sqrt(Rs) * pow(dm, 1.5);
     double tol = dm / RB + 2e-3;
     gk_material a = hertz_mat(&AL_ALLOY, mu), b = hertz_mat(&MG_ALLOY, mu), pair;
     gk_scene sc;
@@ -594,8 +610,8 @@ TEST(chung_ooi_8_different_spheres) {
     ia = gk_scene_index(&sc, 0);
     ib = gk_scene_index(&sc, 1);
     CHECK(run_impact(&sc, ia, ib, &o, 1000000) == 0);
-    printf("    normal: F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n", o.fmax, fm, o.dmax, dm,
-           o.tc, tc);
+    printf("    normal: F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n", o.fmax, fm,
+           o.dmax, dm, o.tc, tc);
     CHECK_REL(o.fmax, fm, 2e-3);
     CHECK_REL(o.dmax, dm, 2e-3);
     CHECK_REL(o.tc, tc, 2e-3);
@@ -614,8 +630,10 @@ TEST(chung_ooi_8_different_spheres) {
                sc.rve.v[0][ib], sc.rve.w[2][ib]);
         CHECK_NEAR(sc.rve.v[0][ia], Jt / mA, tol * Jt / mA);
         CHECK_NEAR(sc.rve.v[0][ib], -Jt / mB, tol * Jt / mB);
-        CHECK_NEAR(sc.rve.w[2][ia], w0 - RA * Jt / (0.4 * mA * RA * RA), tol * RA * Jt / (0.4 * mA * RA * RA));
-        CHECK_NEAR(sc.rve.w[2][ib], w0 - RB * Jt / (0.4 * mB * RB * RB), tol * RB * Jt / (0.4 * mB * RB * RB));
+        CHECK_NEAR(sc.rve.w[2][ia], w0 - RA * Jt / (0.4 * mA * RA * RA),
+                   tol * RA * Jt / (0.4 * mA * RA * RA));
+        CHECK_NEAR(sc.rve.w[2][ib], w0 - RB * Jt / (0.4 * mB * RB * RB),
+                   tol * RB * Jt / (0.4 * mB * RB * RB));
     }
     gk_scene_destroy(&sc);
 }
@@ -636,7 +654,9 @@ static int lattice(gk_packing *pk, int dim, int nx, int ny, int nz, double r, do
             for (a = 0; a < nx; ++a) {
                 pk->x[q] = x0 + 2.2 * r * (a + 0.5) + jitter * r * (2.0 * gk_rng_uniform(&rng) - 1.0);
                 pk->y[q] = y0 + 2.2 * r * (b + 0.5);
-                pk->z[q] = dim == 3 ? z0 + 2.2 * r * (c + 0.5) + jitter * r * (2.0 * gk_rng_uniform(&rng) - 1.0) : 0.0;
+                pk->z[q] = dim == 3
+                               ? z0 + 2.2 * r * (c + 0.5) + jitter * r * (2.0 * gk_rng_uniform(&rng) - 1.0)
+                               : 0.0;
                 pk->r[q] = r * (0.8 + 0.2 * gk_rng_uniform(&rng));
                 ++q;
             }
@@ -645,7 +665,8 @@ static int lattice(gk_packing *pk, int dim, int nx, int ny, int nz, double r, do
 
 /* a 2D (or 3D) box [0, W] x [0, H] (x [0, W]) of particles settling under
  * gravity on a frictional floor and walls; linear law, viscous damping */
-static int box_scene(gk_scene *sc, int dim, int nx, int ny, double W, double H, double damping, unsigned periodic) {
+static int box_scene(gk_scene *sc, int dim, int nx, int ny, double W, double H, double damping,
+                     unsigned periodic) {
     gk_scene_def d = gk_scene_def_default();
     gk_packing pk;
     gk_material wm;
@@ -699,14 +720,16 @@ TEST(gravity_floor_carries_the_weight) {
             CHECK(0);
             continue;
         }
-        CHECK(gk_scene_step(&sc, dim == 2 ? 40000 : 100000) == GK_OK); /* to rest (also in the quick builds) */
+        CHECK(gk_scene_step(&sc, dim == 2 ? 40000 : 100000) ==
+              GK_OK); /* to rest (also in the quick builds) */
         wt = total_weight(&sc);
         {
             double F[3] = {0, 0, 0};
             int w, k;
             for (w = 0; w < sc.nwalls; ++w)
                 for (k = 0; k < 3; ++k) F[k] += sc.walls[w].force[k];
-            printf("    %dD: walls carry %.6g N (floor %.6g N), weight %.6g N, side walls %.4g / %.4g N, kinetic %.3g J\n",
+            printf("    %dD: walls carry %.6g N (floor %.6g N), weight %.6g N, side walls %.4g / %.4g N, "
+                   "kinetic %.3g J\n",
                    dim, -F[1], sc.walls[2].resistance, wt, sc.walls[0].resistance, sc.walls[1].resistance,
                    gk_rve_kinetic_energy(&sc.rve));
             CHECK_REL(-F[1], wt, 1e-3);
@@ -917,7 +940,8 @@ TEST(membrane_confines_at_its_pressure) {
         gk_scene_stress(&sc, area, sig);
         bx /= area * sc.rve.volume_factor;
         by /= area * sc.rve.volume_factor;
-        printf("    sigma_xx %.5g (boundary %.5g), sigma_yy %.5g (%.5g), sigma_xy %.3g Pa over %.5g m^2; p = %g Pa, chain "
+        printf("    sigma_xx %.5g (boundary %.5g), sigma_yy %.5g (%.5g), sigma_xy %.3g Pa over %.5g m^2; p = "
+               "%g Pa, chain "
                "height %.4f of %.4f m\n",
                sig[0], bx, sig[4], by, sig[1], area, pr, hchain, H);
         CHECK_REL(sig[0], bx, 0.01);
@@ -936,7 +960,9 @@ TEST(membrane_confines_at_its_pressure) {
 }
 
 /* position of the particle with stable id `id` */
-static void pos_of(const gk_scene *sc, int32_t id, double x[3]) { gk_scene_position(sc, gk_scene_index(sc, id), x); }
+static void pos_of(const gk_scene *sc, int32_t id, double x[3]) {
+    gk_scene_position(sc, gk_scene_index(sc, id), x);
+}
 
 /* Insertion and deletion leave the others alone: a pile with one extra,
  * held, far-away particle (A) and the same pile from which that particle is
@@ -965,14 +991,16 @@ TEST(insert_and_remove_leave_the_others_alone) {
         CHECK(idx == 64 && A.rve.n == 65);
         CHECK(gk_scene_prescribe(&A, gk_scene_index(&A, idx), zero, zero) == GK_OK);
         CHECK(gk_scene_prescribe(&B, gk_scene_index(&B, idx), zero, zero) == GK_OK);
-        CHECK(gk_scene_step(&A, 3000) == GK_OK && gk_scene_step(&B, 3000) == GK_OK && gk_scene_step(&C, 3000) == GK_OK);
+        CHECK(gk_scene_step(&A, 3000) == GK_OK && gk_scene_step(&B, 3000) == GK_OK &&
+              gk_scene_step(&C, 3000) == GK_OK);
         CHECK(gk_scene_remove(&B, 1, &idx) == GK_OK);
         CHECK(B.rve.n == 64 && gk_scene_index(&B, idx) == -1 && B.nprescribed == 0);
         CHECK(gk_scene_insert(&C, 1, xs, &rr, NULL, &newid) == GK_OK);
         CHECK(newid == 64);
         CHECK(gk_scene_prescribe(&C, gk_scene_index(&C, newid), zero, zero) == GK_OK);
     }
-    CHECK(gk_scene_step(&A, 3000) == GK_OK && gk_scene_step(&B, 3000) == GK_OK && gk_scene_step(&C, 3000) == GK_OK);
+    CHECK(gk_scene_step(&A, 3000) == GK_OK && gk_scene_step(&B, 3000) == GK_OK &&
+          gk_scene_step(&C, 3000) == GK_OK);
     for (p = 0; p < 64; ++p) {
         pos_of(&A, p, xa);
         pos_of(&B, p, xb);
@@ -980,7 +1008,8 @@ TEST(insert_and_remove_leave_the_others_alone) {
         if (memcmp(xa, xb, sizeof xa)) ++diffB;
         if (memcmp(xa, xc, sizeof xa)) ++diffC;
     }
-    printf("    particles differing from the run with the extra particle: %d (removed), %d (inserted)\n", diffB, diffC);
+    printf("    particles differing from the run with the extra particle: %d (removed), %d (inserted)\n",
+           diffB, diffC);
     CHECK(diffB == 0 && diffC == 0);
     CHECK(A.walls[2].force[1] == B.walls[2].force[1] && A.walls[2].force[1] == C.walls[2].force[1]);
     /* an unknown id is refused and changes nothing */
@@ -1006,9 +1035,10 @@ static double report_energy(const gk_scene *sc, const char *what) {
     gk_energy e;
     gk_scene_energy(sc, &e);
     printf("    %s: kinetic %.5g, elastic %.5g | gravity %.5g, walls %.5g, external %.5g, pressure %.5g, "
-           "prescribed %.5g | friction %.5g (slips %.5g), viscous %.5g, damping %.5g | balance %.3g of %.5g J (%.2e)\n",
-           what, e.kinetic, e.elastic, e.gravity, e.walls, e.external, e.pressure, e.prescribed, e.friction, e.slip,
-           e.viscous, e.damping, e.balance, e.scale, fabs(e.balance) / e.scale);
+           "prescribed %.5g | friction %.5g (slips %.5g), viscous %.5g, damping %.5g | balance %.3g of %.5g "
+           "J (%.2e)\n",
+           what, e.kinetic, e.elastic, e.gravity, e.walls, e.external, e.pressure, e.prescribed, e.friction,
+           e.slip, e.viscous, e.damping, e.balance, e.scale, fabs(e.balance) / e.scale);
     return fabs(e.balance) / e.scale;
 }
 
@@ -1132,7 +1162,8 @@ static int full_scene(gk_scene *sc, int threads) {
     lid.area = 16 * 2.2 * r * sc->rve.volume_factor;
     lid.max_speed = 0.05;
     if (gk_scene_add_wall(sc, &flo, NULL) || gk_scene_add_wall(sc, &lid, NULL) ||
-        gk_scene_side_chain(sc, 0, -1, 2.2 * r, left, 64, &nl) || gk_scene_side_chain(sc, 0, 1, 2.2 * r, right, 64, &nr) ||
+        gk_scene_side_chain(sc, 0, -1, 2.2 * r, left, 64, &nl) ||
+        gk_scene_side_chain(sc, 0, 1, 2.2 * r, right, 64, &nr) ||
         gk_scene_add_membrane(sc, nl, left, 1e4, 1e5, 1, 0, NULL) ||
         gk_scene_add_membrane(sc, nr, right, 1e4, 1e5, 0, 1, NULL) || gk_scene_prescribe(sc, 8, NULL, NULL) ||
         gk_scene_set_external(sc, 100, f, NULL) || gk_scene_energy_track(sc, 1))
@@ -1171,7 +1202,8 @@ TEST(save_restore_and_threads_are_bitwise) {
     s1 = state_of(&A, &n1);
     s2 = state_of(&B, &n2);
     CHECK(s1 && s2 && n1 == n2 && memcmp(s1, s2, n1) == 0);
-    printf("    1 vs 2 threads after 600 steps: %s\n", s1 && s2 && n1 == n2 && !memcmp(s1, s2, n1) ? "identical" : "DIFFER");
+    printf("    1 vs 2 threads after 600 steps: %s\n",
+           s1 && s2 && n1 == n2 && !memcmp(s1, s2, n1) ? "identical" : "DIFFER");
     free(s1);
     free(s2);
     gk_scene_destroy(&B);
@@ -1242,7 +1274,7 @@ TEST(periodic_shear_between_walls) {
     lid.max_speed = 0.05;
     CHECK(gk_scene_add_wall(&sc, &flo, NULL) == GK_OK && gk_scene_add_wall(&sc, &lid, NULL) == GK_OK);
     CHECK(gk_scene_step(&sc, 10000) == GK_OK); /* consolidate */
-    sc.walls[1].def.velocity[0] = 0.05; /* servo in y, sliding at 5 cm/s in x */
+    sc.walls[1].def.velocity[0] = 0.05;        /* servo in y, sliding at 5 cm/s in x */
     CHECK(gk_scene_step(&sc, 15000) == GK_OK);
     { /* averages over the next 20000 steps (the forces fluctuate) */
         int k;
@@ -1258,8 +1290,8 @@ TEST(periodic_shear_between_walls) {
         normal = sn / 100;
     }
     ratio = shear / normal;
-    printf("    lid normal %.4g N (target %g), shear %.4g N, floor shear %.4g N, ratio %.3f (means)\n", normal, N, shear,
-           floor_shear, ratio);
+    printf("    lid normal %.4g N (target %g), shear %.4g N, floor shear %.4g N, ratio %.3f (means)\n",
+           normal, N, shear, floor_shear, ratio);
     CHECK_NEAR(floor_shear, shear, 0.05 * fabs(shear));
     CHECK_REL(normal, N, 0.02);
     CHECK(ratio > 0.05 && ratio < 0.5);
@@ -1302,9 +1334,11 @@ TEST(packing_tile_and_subset) {
     gk_rve_destroy(&b);
     CHECK(gk_packing_subset(&t, lo, hi, 1, &sub, NULL, &e) == GK_OK);
     for (p = 0; p < t.n; ++p)
-        if (t.x[p] - t.r[p] >= lo[0] && t.x[p] + t.r[p] <= hi[0] && t.y[p] - t.r[p] >= lo[1] && t.y[p] + t.r[p] <= hi[1]) {
+        if (t.x[p] - t.r[p] >= lo[0] && t.x[p] + t.r[p] <= hi[0] && t.y[p] - t.r[p] >= lo[1] &&
+            t.y[p] + t.r[p] <= hi[1]) {
             ++cnt;
-            if (q < sub.n && (sub.x[q] != t.x[p] - lo[0] || sub.y[q] != t.y[p] - lo[1] || sub.r[q] != t.r[p])) ok = 0;
+            if (q < sub.n && (sub.x[q] != t.x[p] - lo[0] || sub.y[q] != t.y[p] - lo[1] || sub.r[q] != t.r[p]))
+                ok = 0;
             ++q;
         }
     CHECK(sub.n == cnt && ok);
@@ -1388,7 +1422,8 @@ TEST(bodies_pipe_drum_rectangle_cylinder) {
             cm += sc.mass[p] * x[0];
             M += sc.mass[p];
         }
-        printf("    drum: centre of mass x = %.4f m, moment on the drum %.4g N m\n", cm / M, sc.walls[ip].moment[2]);
+        printf("    drum: centre of mass x = %.4f m, moment on the drum %.4g N m\n", cm / M,
+               sc.walls[ip].moment[2]);
         CHECK(cm / M > 0.005);
         CHECK(sc.walls[ip].moment[2] < 0.0);
         for (p = 0; p < sc.rve.n; ++p) {
@@ -1442,8 +1477,8 @@ TEST(bodies_pipe_drum_rectangle_cylinder) {
             gk_scene_position(&sc, 0, x);
             CHECK(sc.walls[0].ncontacts == 0 && x[1] < -0.02);
         } else {
-            printf("    sphere on a %s: force %.6g N, weight %.6g N\n", k ? "cylinder" : "rectangle", -sc.walls[0].force[1],
-                   m * 9.81);
+            printf("    sphere on a %s: force %.6g N, weight %.6g N\n", k ? "cylinder" : "rectangle",
+                   -sc.walls[0].force[1], m * 9.81);
             CHECK_REL(-sc.walls[0].force[1], m * 9.81, 1e-3);
         }
         gk_scene_destroy(&sc);
@@ -1560,8 +1595,9 @@ TEST(dem_biaxial_smoke) {
     rc = system("build/dem_biaxial --tiles 1x1 --strain 0.01 --every 0.002 --pictures 0.004 --quiet "
                 "--out build/t_dembx > build/t_dembx.out 2>&1");
     CHECK(rc == 0);
-    CHECK(gk_test_file_has("build/t_dembx/biaxial.csv",
-                           "eps_axial,sigma_yy_lid,sigma_xx,sigma_yy,eps_vol,stress_ratio,phi_deg,coordination"));
+    CHECK(gk_test_file_has(
+        "build/t_dembx/biaxial.csv",
+        "eps_axial,sigma_yy_lid,sigma_xx,sigma_yy,eps_vol,stress_ratio,phi_deg,coordination"));
     CHECK(gk_test_file_has("build/t_dembx/particles_001.vtk", "POINT_DATA"));
     CHECK(gk_test_file_has("build/t_dembx/walls_end.vtk", "CELL_DATA"));
     CHECK(gk_test_file_has("build/t_dembx/particles_000.svg", "<svg"));
@@ -1604,7 +1640,8 @@ TEST(dem_collapse_smoke) {
     double ds, ed, bal, h;
     CHECK(system("build/dem_collapse --diameters 8 --t-end 0.6 --every 0.02 --snapshots 0.3 --quiet "
                  "--out build/t_demcl > build/t_demcl.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_demcl/collapse.csv", "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0"));
+    CHECK(gk_test_file_has("build/t_demcl/collapse.csv",
+                           "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0"));
     CHECK(gk_test_file_has("build/t_demcl/particles_001.vtk", "POINT_DATA"));
     CHECK(gk_test_file_has("build/t_demcl/walls_000.vtk", "CELL_DATA"));
     CHECK(gk_test_file_has("build/t_demcl/collapse_front.svg", "<svg"));
