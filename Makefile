@@ -41,7 +41,7 @@ MPI_TEST_SRC := $(wildcard tests/mpi_*.c)
 MPIRUN_SRC   := $(wildcard tests/mpirun_*.c)
 MPI_RUNNERS  := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/run_%,$(MPI_TEST_SRC)) \
                 $(patsubst tests/mpirun_%.c,$(BUILD)/mpi/drive_%,$(MPIRUN_SRC))
-MPI_PROGS    := $(BUILD)/femdem_biaxial_mpi $(MPI_RUNNERS)
+MPI_PROGS    := $(BUILD)/femdem_biaxial_mpi $(BUILD)/mpi/bench_twoscale_mpi $(MPI_RUNNERS)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/%,$(EX_SRC))
 BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
 TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
@@ -106,6 +106,10 @@ $(BUILD)/mpi/run_%: $(BUILD)/mpi/mpi_% | $(BUILD)/mpi
 	@printf '#!/bin/sh\nexec %s %s -np 2 %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
 $(BUILD)/mpi/drive_%: $(BUILD)/mpi/mpirun_% | $(BUILD)/mpi
 	@printf '#!/bin/sh\nGK_MPIRUN="%s %s" exec %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
+
+# bench/twoscale.c on MPI ranks (bench/README.md)
+$(BUILD)/mpi/bench_twoscale_mpi: bench/twoscale.c $(HEADERS) examples/cli.h | $(BUILD)/mpi
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
 
 # the FEMxDEM driver with its RVEs over MPI ranks (the same results: tests/mpirun_femdem.c)
 $(BUILD)/femdem_biaxial_mpi: examples/femdem_biaxial.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)

@@ -100,6 +100,23 @@ typedef struct fd_model {
 } fd_model;
 
 /* ------------------------------------------------------------ messages */
+/* MPI started (the MPI build); whether this process prints and writes (rank 0) */
+static int fd_start(int *argc, char ***argv) {
+    int rank = 0;
+#ifdef GK_TWOSCALE_MPI
+    MPI_Init(argc, argv);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+#else
+    (void)argc, (void)argv;
+#endif
+    return rank == 0;
+}
+static void fd_stop(void) {
+#ifdef GK_TWOSCALE_MPI
+    MPI_Finalize();
+#endif
+}
+
 static void fd_say(const fd_model *M, const char *fmt, ...) {
     va_list ap;
     if (!M->root) return;
