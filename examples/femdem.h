@@ -100,6 +100,23 @@ typedef struct fd_model {
 } fd_model;
 
 /* ------------------------------------------------------------ messages */
+/* MPI started (the MPI build); whether this process prints and writes (rank 0) */
+static int fd_start(int *argc, char ***argv) {
+    int rank = 0;
+#ifdef GK_TWOSCALE_MPI
+    MPI_Init(argc, argv);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+#else
+    (void)argc, (void)argv;
+#endif
+    return rank == 0;
+}
+static void fd_stop(void) {
+#ifdef GK_TWOSCALE_MPI
+    MPI_Finalize();
+#endif
+}
+
 static void fd_say(const fd_model *M, const char *fmt, ...) {
     va_list ap;
     if (!M->root) return;
@@ -545,7 +562,7 @@ static int fd_solve(fd_model *M, const double *D, const double *rhs_in, double t
     gk_solver s;
     double vals[4096], *vp = vals;
     int k, r = 0;
-    memset(&s, 0, sizeof s);
+    gk_solver_init(&s);
     if (M->nfix > 4096 && !(vp = (double *)malloc((size_t)M->nfix * sizeof(double))))
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
     for (k = 0; k < M->nfix; ++k) vp[k] = M->fixtop[k] ? top_value : 0.0;

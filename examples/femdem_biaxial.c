@@ -281,15 +281,12 @@ int main(int argc, char **argv) {
     fd_model M;
     const cli_opt *tables[3];
     int status, help = 0;
-#ifdef GK_TWOSCALE_MPI
-    int rank;
-    MPI_Init(&argc, &argv);
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-#endif
     memset(&M, 0, sizeof M);
-    M.prog = "femdem_biaxial", M.root = 1;
+    M.root = fd_start(&argc, &argv);
 #ifdef GK_TWOSCALE_MPI
-    M.prog = "femdem_biaxial_mpi", M.root = rank == 0;
+    M.prog = "femdem_biaxial_mpi";
+#else
+    M.prog = "femdem_biaxial";
 #endif
     fdb_defaults(&M);
     tables[0] = fd_common_opts(&M.o), tables[1] = fdb_opts(&M.o), tables[2] = NULL;
@@ -301,8 +298,6 @@ int main(int argc, char **argv) {
         if (status != 1 && !strcmp(M.o.test, "single") && M.ncurve > 1 && single_element(&M)) status = 1;
     }
     fd_free(&M);
-#ifdef GK_TWOSCALE_MPI
-    MPI_Finalize();
-#endif
+    fd_stop();
     return status;
 }

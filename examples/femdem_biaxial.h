@@ -183,12 +183,7 @@ static int fdb_loop(fd_model *M, double t_start, gk_err *err) {
         fd_row *c;
         char what[200];
         if (M->eps_done + inc > target) inc = target - M->eps_done;
-        r = fd_load_step(M, inc, &iters, &Ed, &Ef, err);
-        if (r == 2) {
-            fd_say(M, "%s: %s\n", M->prog, err->msg);
-            gk_twoscale_reject(&M->ts);
-            return 1;
-        }
+        if ((r = fd_load_step(M, inc, &iters, &Ed, &Ef, err)) == 2) return 1;
         if (r == 1) {
             good_in_row = 0;
             if (fd_cut_back(M, "axial strain", M->eps_done, o->inc, iters, Ed, err)) return 3;

@@ -284,12 +284,7 @@ static int run_cyclic(cyc_model *C, double t_start, gk_err *err) {
             if (c->dir * (c->gamma + inc - target) > -1e-9 * C->amp) inc = target - c->gamma;
         } else
             inc = forced != 0.0 ? forced : c->dir * c->h * M->scale;
-        r = fd_load_step(M, inc, &iters, &Ed, &Ef, err);
-        if (r == 2) {
-            fd_say(M, "%s: %s\n", M->prog, err->msg);
-            gk_twoscale_reject(&M->ts);
-            return 1;
-        }
+        if ((r = fd_load_step(M, inc, &iters, &Ed, &Ef, err)) == 2) return 1;
         if (r == 1) {
             forced = 0.0, tries = 0, c->good = 0;
             if (fd_cut_back(M, "shear strain", c->gamma, C->test == 0 ? o->inc : c->h, iters, Ed, err)) return 3;
@@ -456,16 +451,8 @@ int main(int argc, char **argv) {
     gk_err err;
     gk_twoscale_field *f0 = NULL;
     int status, help = 0;
-#ifdef GK_TWOSCALE_MPI
-    int rank;
-    MPI_Init(&argc, &argv);
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-#endif
     memset(&C, 0, sizeof C);
-    M->prog = "femdem_cyclic", M->root = 1, M->checkpoint = checkpoint;
-#ifdef GK_TWOSCALE_MPI
-    M->root = rank == 0;
-#endif
+    M->prog = "femdem_cyclic", M->root = fd_start(&argc, &argv), M->checkpoint = checkpoint;
     status = parse(&C, argc, argv, &help);
     if (!status && help) {
         if (M->root) usage(stdout);
@@ -495,8 +482,6 @@ int main(int argc, char **argv) {
     }
     free(C.cx), free(f0);
     fd_free(M);
-#ifdef GK_TWOSCALE_MPI
-    MPI_Finalize();
-#endif
+    fd_stop();
     return status;
 }

@@ -95,8 +95,17 @@ static void fd_aitken(fd_model *M, int *have_prev, double *omega) {
 
 /* one load (sub)step of platen increment inc (biaxial: axial strain, the top moves down by inc H;
  * cyclic: shear strain, the top moves by inc H in x); 0 = converged, 1 = not converged, 2 = hard
- * error */
+ * error (said; the trial states rejected) */
+static int fd_newton(fd_model *M, double inc, int *iters, double *Ed_out, double *Ef_out, gk_err *err);
 static int fd_load_step(fd_model *M, double inc, int *iters, double *Ed_out, double *Ef_out, gk_err *err) {
+    int r = fd_newton(M, inc, iters, Ed_out, Ef_out, err);
+    if (r == 2) {
+        fd_say(M, "%s: %s\n", M->prog, err->msg);
+        gk_twoscale_reject(&M->ts);
+    }
+    return r;
+}
+static int fd_newton(fd_model *M, double inc, int *iters, double *Ed_out, double *Ef_out, gk_err *err) {
     int it, k, nbad, have_prev = 0, hist = 0, it_and = 0;
     double Ed = 1.0, Ef = 0.0, Rprev = HUGE_VAL, top = (M->o.cyclic ? inc : -inc) * M->o.height, omega = 1.0,
            dnewton = 0.0;

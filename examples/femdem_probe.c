@@ -182,7 +182,7 @@ int main(int argc, char **argv) {
                            {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     int status, help = 0;
     memset(&P, 0, sizeof P);
-    M->prog = "femdem_probe", M->root = 1, M->probe = probe;
+    M->prog = "femdem_probe", M->root = fd_start(&argc, &argv), M->probe = probe;
     P.kscale = 0.05;
     fdb_defaults(M);
     tables[0] = fd_common_opts(&M->o), tables[1] = fdb_opts(&M->o), tables[2] = own, tables[3] = NULL;
@@ -197,5 +197,6 @@ int main(int argc, char **argv) {
     } else if (!status && !(status = fdb_check(M)))
         status = fdb_run(M);
     fd_free(M);
+    fd_stop();
     return status;
 }

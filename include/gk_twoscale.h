@@ -892,20 +892,23 @@ static gk_result gk__ts_create(gk_twoscale *ts, const gk_twoscale_def *def) {
     return res;
 }
 
-GKDEF gk_result gk_twoscale_create(gk_twoscale *ts, const gk_twoscale_def *def) {
-#ifdef GK_TWOSCALE_MPI
-    return gk_twoscale_create_mpi(ts, def, MPI_COMM_WORLD);
-#else
-    gk_result res;
-    memset(ts, 0, sizeof *ts);
-    ts->nranks = 1;
-    res = gk__ts_create(ts, def);
+/* a failed creation leaves only its message */
+static gk_result gk__ts_created(gk_twoscale *ts, gk_result res) {
     if (res) {
         gk_err e = ts->err;
         gk__ts_free_all(ts);
         ts->n = 0, ts->err = e;
     }
     return res;
+}
+
+GKDEF gk_result gk_twoscale_create(gk_twoscale *ts, const gk_twoscale_def *def) {
+#ifdef GK_TWOSCALE_MPI
+    return gk_twoscale_create_mpi(ts, def, MPI_COMM_WORLD);
+#else
+    memset(ts, 0, sizeof *ts);
+    ts->nranks = 1;
+    return gk__ts_created(ts, gk__ts_create(ts, def));
 #endif
 }
 
@@ -920,13 +923,7 @@ GKDEF gk_result gk_twoscale_create_mpi(gk_twoscale *ts, const gk_twoscale_def *d
     if (!res && ts->nranks > 1 &&
         !(ts->hbuf = (double *)gk_alloc(&ts->def.alloc, ((size_t)ts->n * 9 + 2) * sizeof(double))))
         res = gk_err_set(&ts->err, GK_ERR_ALLOC, "out of memory for %d points' dH", ts->n);
-    res = gk__ts_agree(ts, res);
-    if (res) {
-        gk_err e = ts->err;
-        gk__ts_free_all(ts);
-        ts->n = 0, ts->err = e;
-    }
-    return res;
+    return gk__ts_created(ts, gk__ts_agree(ts, res));
 }
 #endif
 
