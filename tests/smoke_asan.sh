@@ -42,5 +42,18 @@ run 0 "$B/gk_pack" --n 60 --out "$T/pack.txt"
 run 1 "$B/gk_pack" --n 60 --target-void-ratio 2.5 --out "$T/pack2.txt"
 run 1 "$B/gk_pack" --n 60 --out /dev/full
 run 2 "$B/gk_pack" --n 60 --friction-deg 95 --out "$T/pack3.txt"
+# the MPMxDEM drivers at their tests' sizes: a run, its restart, a corrupt checkpoint, a result that
+# cannot be written, a refused option
+BX="--nx 2 --ny 4 --every 0.0005 --quiet --threads 2"
+run 0 "$B/mpmdem_biaxial" $BX --strain 0.001 --out "$T/bx"
+run 0 "$B/mpmdem_biaxial" $BX --strain 0.0015 --restart "$T/bx" --out "$T/bx2"
+head -c 3000 "$T/bx/checkpoint.bin" > "$T/bx_cut.bin" && mkdir -p "$T/bxc" && mv "$T/bx_cut.bin" "$T/bxc/checkpoint.bin"
+run 1 "$B/mpmdem_biaxial" $BX --strain 0.0015 --restart "$T/bxc" --out "$T/bx3"
+rm -rf "$T/bxw" && mkdir -p "$T/bxw" && ln -s /dev/full "$T/bxw/biaxial.csv"
+run 1 "$B/mpmdem_biaxial" $BX --strain 0.0005 --out "$T/bxw"
+run 2 "$B/mpmdem_biaxial" $BX --nx 3
+run 0 "$B/mpmdem_footing" --width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 \
+    --every 0.005 --smooth 0.01 --phi-deg 30 --final 0.01 --quiet --threads 2 --out "$T/ft"
+run 0 "$B/mpmdem_collapse" --nx 4 --every 0.025 --snapshots 0.05 --t-end 0.05 --quiet --threads 2 --out "$T/cl"
 echo "# smoke_asan: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -10,7 +10,7 @@
 # with its .out is reused), then compares the CSV in every column but
 # `seconds` and the RESULT line in every key but the timings and the memory.
 # A restart case runs NEW in two parts (the first to the given stop, then
-# --restart to the end) against the uninterrupted REF run of its _default. Prints one line per case,
+# --restart to the end) against the uninterrupted REF run (its _default for the README sizes). Prints one line per case,
 # SAME or DIFF (with the first differing lines); exit status 1 if any differs.
 #
 # The cases are the MPMxDEM commands of examples/README.md:
@@ -23,13 +23,19 @@
 #   ft_restart      mpmdem_footing to d/B 0.07, then --restart to 0.14
 #   cl_default      mpmdem_collapse                         (64 RVEs to rest)
 #   cl_restart      mpmdem_collapse to t = 0.8 s, then --restart (to rest)
-# They take 10-30 minutes each at one thread on a busy machine.
+# They take 10-30 minutes each at one thread on a busy machine. The tests'
+# sizes (tests/test_mpmdem_*.c, seconds each):
+#   bx_test         mpmdem_biaxial 2 x 4 cells to 0.2 %     (bx_test_restart: 0.1 %, then to 0.2 %)
+#   ft_test         mpmdem_footing 4 x 3 cells with the friction-angle tests
+#   ft_test_u       mpmdem_footing 4 x 3 cells to d/B 0.08  (ft_test_restart: 0.01, then to 0.02)
+#   cl_test         mpmdem_collapse 4 x 4 cells to t = 0.15 s (cl_test_restart: 0.075 s, then on)
 set -u
 [ $# -ge 3 ] || { sed -n '2,/^$/p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 REF=$1 NEW=$2 W=$3
 shift 3
 mkdir -p "$W" || exit 1
 CASES=${*:-"bx_default bx_strain bx_restart ft_default ft_medium ft_soft ft_restart cl_default cl_restart"}
+FT="--width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 --every 0.005 --smooth 0.01"
 LOOSE="--material medium --packing examples/data/rve400_e0223.txt --final 0.3"
 # the flags of a case, and for a restart case the first part's stop
 args() {
@@ -40,6 +46,11 @@ args() {
     ft_medium) echo "mpmdem_footing csv=footing.csv $LOOSE" ;;
     ft_soft) echo "mpmdem_footing csv=footing.csv --material soft --packing examples/data/rve400_e0223.txt --final 0.3" ;;
     cl_default | cl_restart) echo "mpmdem_collapse csv=collapse.csv" ;;
+    bx_test | bx_test_restart) echo "mpmdem_biaxial csv=biaxial.csv --nx 2 --ny 4 --every 0.0005 --strain 0.002" ;;
+    ft_test) echo "mpmdem_footing csv=footing.csv $FT --final 0.02 --phi-pressures 20 --phi-strain 0.025" ;;
+    ft_test_u) echo "mpmdem_footing csv=footing.csv $FT --final 0.08 --smooth 0.02 --phi-deg 30" ;;
+    ft_test_restart) echo "mpmdem_footing csv=footing.csv $FT --final 0.02 --phi-deg 30" ;;
+    cl_test | cl_test_restart) echo "mpmdem_collapse csv=collapse.csv --nx 4 --every 0.025 --snapshots 0.05 --t-end 0.15" ;;
     *) echo "unknown case $1" >&2; exit 2 ;;
     esac
 }
@@ -48,6 +59,9 @@ first_part() {
     bx_restart) echo "--strain 0.015" ;;
     ft_restart) echo "--final 0.07" ;;
     cl_restart) echo "--t-end 0.8 --no-stop" ;;
+    bx_test_restart) echo "--strain 0.001" ;;
+    ft_test_restart) echo "--final 0.01" ;;
+    cl_test_restart) echo "--t-end 0.075" ;;
     esac
 }
 # a CSV without its `seconds` column
@@ -61,7 +75,10 @@ for c in $CASES; do
     drv=$1 csv=${2#csv=}
     shift 2
     r=$c
-    case $c in *_restart) r=${c%_restart}_default ;; esac # the uninterrupted run is the reference
+    case $c in # the uninterrupted run is the reference
+    *_test_restart) ;; # REF runs it uninterrupted
+    *_restart) r=${c%_restart}_default ;;
+    esac
     if [ ! -s "$W/$r.ref.out" ] || ! grep -q '^RESULT ' "$W/$r.ref.out"; then
         "$REF/$drv" "$@" --threads 1 --quiet --out "$W/$r.ref" > "$W/$r.ref.out" 2>&1 || echo "$c: the REF run failed (status $?)"
     fi
