@@ -35,7 +35,7 @@
  *   gk_hybrid_cont          per-point continuum state next to gk_mpm_points
  *                           (reference position, packing fraction Phi,
  *                           accumulated plastic strain, plastic strain
- *                           rate, flags); gk_hybrid_dp_stress is the
+ *                           rate, zone); gk_hybrid_dp_stress is the
  *                           gk_mpm_stress_fn of the Drucker-Prager
  *                           continuum [eqs 4-8]; gk_hybrid_points_keep
  *                           deletes points (and their state)
@@ -72,8 +72,8 @@
  * triggers the enrichment when it is non-empty and has not changed for
  * tau_g; tau_l = c_l / gdot_max, tau_g = c_g / gdot_max with gdot_max the
  * largest equivalent shear rate sqrt(2 D':D') over the points at that
- * time (seed 002 Sec 3.2). Points the caller marks (the "weak" points that
- * seed a band) are left out of the rasterisation, as in the paper.
+ * time (Sec 3.2). The oracle is told nothing else: in particular not where
+ * the "weak" points that seed a band are (the paper's rule).
  *
  * ZONES (Sec 4). phi_d = distance to the nearest flagged node (periodic
  * axes: nearest image); with t_h the overlap thickness (one cell):
@@ -151,9 +151,6 @@
 #define GK_ZONE_OVERLAP 1
 #define GK_ZONE_DISCRETE 2
 
-/* per-point flags of gk_hybrid_cont */
-#define GK_HYBRID_WEAK 1u /* left out of the oracle (a seed of the band) */
-
 /* A grid axis k with period[k] > 0 wraps: nodes ghost[k] .. ghost[k] +
  * period[k] - 1 are the home nodes (positions origin + h (ghost .. ghost +
  * period)), every other node is the copy of ghost + (i - ghost) mod period.
@@ -170,7 +167,6 @@ typedef struct gk_hybrid_cont {
     double *Phi;         /* packing fraction (eqs 7-8)                             */
     double *ep;          /* accumulated plastic strain, 3 per point (xx, yy, xy)   */
     double *rate;        /* ||plastic strain rate|| of the last update [1/s]      */
-    unsigned char *flags; /* GK_HYBRID_WEAK                                       */
     unsigned char *zone; /* GK_ZONE_* (after enrichment; CONTINUUM before)         */
     gk_mpm_dp dp;        /* the Drucker-Prager continuum [eqs 4-8], chi > 0        */
     double gdot_max;     /* largest sqrt(2 D':D') of the last update [1/s]         */
@@ -208,6 +204,8 @@ typedef struct gk_hybrid_oracle {
 typedef struct gk_hybrid_coupling {
     size_t nnode;
     double *md, *pd[2], *dv[2];
+    gk_mpm_stencil *st; /* the stencils of the coupled grains of a step */
+    int cap;
     gk_allocator alloc;
 } gk_hybrid_coupling;
 
@@ -423,21 +421,47 @@ static int gk__hy_has_period(const gk_hybrid_periodic *per) {
     return per && (per->period[0] > 0 || per->period[1] > 0 || per->period[2] > 0);
 }
 
+/* visit every copy node I with its home H, in index order */
+#define GK__HY_FOR_COPIES(g, per, BODY)                                                                        \
+    do {                                                                                                     \
+        int gk__i, gk__j, gk__k;                                                                             \
+        for (gk__k = 0; gk__k < (g)->n[2]; ++gk__k)                                                          \
+            for (gk__j = 0; gk__j < (g)->n[1]; ++gk__j)                                                      \
+                for (gk__i = 0; gk__i < (g)->n[0]; ++gk__i) {                                                \
+                    int gk__c[3], gk__a, gk__copy = 0;                                                       \
+                    size_t I, H;                                                                             \
+                    gk__c[0] = gk__i;                                                                        \
+                    gk__c[1] = gk__j;                                                                        \
+                    gk__c[2] = gk__k;                                                                        \
+                    for (gk__a = 0; gk__a < (g)->dim; ++gk__a)                                               \
+                        if ((per)->period[gk__a] > 0) {                                                      \
+                            int gk__w = gk__hy_wrap_index(gk__c[gk__a], (per)->ghost[gk__a], (per)->period[gk__a]); \
+                            gk__copy |= gk__w != gk__c[gk__a];                                               \
+                            gk__c[gk__a] = gk__w;                                                            \
+                        }                                                                                    \
+                    if (!gk__copy) {                                                                         \
+                        /* only x wraps: jump over the home range of the row */                              \
+                        if ((per)->period[1] <= 0 && (per)->period[2] <= 0 && gk__i == (per)->ghost[0])      \
+                            gk__i = (per)->ghost[0] + (per)->period[0] - 1;                                  \
+                        continue;                                                                            \
+                    }                                                                                        \
+                    I = (size_t)gk__i + (size_t)(g)->n[0] * ((size_t)gk__j + (size_t)(g)->n[1] * (size_t)gk__k); \
+                    H = (size_t)gk__c[0] + (size_t)(g)->n[0] * ((size_t)gk__c[1] + (size_t)(g)->n[1] * (size_t)gk__c[2]); \
+                    BODY;                                                                                    \
+                }                                                                                            \
+    } while (0)
+
 GKDEF void gk_hybrid_fold(const gk_mpm_grid *g, const gk_hybrid_periodic *per, double *a) {
-    size_t I, H;
     if (!gk__hy_has_period(per)) return;
-    for (I = 0; I < g->nnode; ++I)
-        if ((H = gk_hybrid_home(g, per, I)) != I) {
-            a[H] += a[I];
-            a[I] = 0.0;
-        }
+    GK__HY_FOR_COPIES(g, per, {
+        a[H] += a[I];
+        a[I] = 0.0;
+    });
 }
 
 GKDEF void gk_hybrid_sync(const gk_mpm_grid *g, const gk_hybrid_periodic *per, double *a) {
-    size_t I, H;
     if (!gk__hy_has_period(per)) return;
-    for (I = 0; I < g->nnode; ++I)
-        if ((H = gk_hybrid_home(g, per, I)) != I) a[I] = a[H];
+    GK__HY_FOR_COPIES(g, per, a[I] = a[H]);
 }
 
 GKDEF void gk_hybrid_fold_momentum(gk_mpm_grid *g, const gk_hybrid_periodic *per) {
@@ -549,7 +573,6 @@ static void gk__hy_cont_free_arrays(gk_hybrid_cont *c) {
     gk_free(&c->alloc, c->Phi);
     gk_free(&c->alloc, c->ep);
     gk_free(&c->alloc, c->rate);
-    gk_free(&c->alloc, c->flags);
     gk_free(&c->alloc, c->zone);
 }
 
@@ -574,9 +597,8 @@ GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *out, const gk_mpm_points *pt
     c.Phi = (double *)gk_alloc(&c.alloc, nn * sizeof(double));
     c.ep = (double *)gk_alloc(&c.alloc, 3 * nn * sizeof(double));
     c.rate = (double *)gk_alloc(&c.alloc, nn * sizeof(double));
-    c.flags = (unsigned char *)gk_alloc(&c.alloc, nn);
     c.zone = (unsigned char *)gk_alloc(&c.alloc, nn);
-    if (bad || !c.Phi || !c.ep || !c.rate || !c.flags || !c.zone) {
+    if (bad || !c.Phi || !c.ep || !c.rate || !c.zone) {
         gk__hy_cont_free_arrays(&c);
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the state of %d points", n);
     }
@@ -586,7 +608,6 @@ GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *out, const gk_mpm_points *pt
         c.Phi[p] = Phi0;
         c.ep[3 * p] = c.ep[3 * p + 1] = c.ep[3 * p + 2] = 0.0;
         c.rate[p] = 0.0;
-        c.flags[p] = 0;
         c.zone[p] = GK_ZONE_CONTINUUM;
     }
     c.n = c.cap = n;
@@ -613,6 +634,19 @@ GKDEF gk_result gk_hybrid_dp_stress(gk_mpm_points *pts, double dt, void *user, g
         gk_result r;
         int i, j;
         gk_mpm_point_dH(pts, p, dt, dH);
+        {
+            /* the objective rotation R = exp(dt W) in closed form (2D), then the
+             * symmetric dH alone to the return map (whose own rotation then has
+             * nothing to do): the same update without a general exponential */
+            double th = 0.5 * (dH[3] - dH[1]), cs = cos(th), sn = sin(th), *sg = pts->sigma + 9 * p;
+            double a = sg[0], b = 0.5 * (sg[1] + sg[3]), d = sg[4];
+            if (th != 0.0) {
+                sg[0] = cs * cs * a - 2.0 * cs * sn * b + sn * sn * d;
+                sg[4] = sn * sn * a + 2.0 * cs * sn * b + cs * cs * d;
+                sg[1] = sg[3] = cs * sn * (a - d) + (cs * cs - sn * sn) * b;
+            }
+            dH[1] = dH[3] = 0.5 * (dH[1] + dH[3]);
+        }
         gk_m3_sym(pts->L + 9 * p, D);
         tr = 0.5 * (D[0] + D[4]);
         for (i = 0; i < 2; ++i)
@@ -671,7 +705,6 @@ GKDEF int gk_hybrid_points_keep(gk_mpm_points *P, gk_hybrid_cont *c, const unsig
         gk__hy_compact(c->Phi, 1, n, keep);
         gk__hy_compact(c->ep, 3, n, keep);
         gk__hy_compact(c->rate, 1, n, keep);
-        gk__hy_compact_u8(c->flags, n, keep);
         gk__hy_compact_u8(c->zone, n, keep);
     }
     for (e = 0; e < nextra; ++e) gk__hy_compact(extra[e], stride[e], n, keep);
@@ -1132,6 +1165,7 @@ GKDEF gk_result gk_hybrid_coupling_init(gk_hybrid_coupling *out, const gk_mpm_gr
 GKDEF void gk_hybrid_coupling_free(gk_hybrid_coupling *c) {
     int k;
     if (!c) return;
+    gk_free(&c->alloc, c->st);
     gk_free(&c->alloc, c->md);
     for (k = 0; k < 2; ++k) {
         gk_free(&c->alloc, c->pd[k]);
@@ -1145,9 +1179,8 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
                                  const unsigned char *coupled, const unsigned char *skip, double t, double dt,
                                  gk_hybrid_couple_report *rep_out, gk_err *err) {
     gk_hybrid_couple_report rep;
-    gk_mpm_stencil st;
     size_t I, nn = g->nnode;
-    int p, q, k, ng = sc->rve.n;
+    int p, q, k, ng = sc->rve.n, nc = 0, i;
     double inv_t;
     if (c->nnode != nn || g->dim != 2 || sc->dim != 2)
         return gk_err_set(err, GK_ERR_ARG, "coupling scratch of %lu nodes for a grid of %lu (2D only)",
@@ -1156,14 +1189,23 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
         return gk_err_set(err, GK_ERR_ARG, "thickness %g, time step %g (must be > 0)", t, dt);
     inv_t = 1.0 / t;
     memset(&rep, 0, sizeof rep);
-    for (p = 0; p < ng; ++p) {
+    for (p = 0; p < ng; ++p) nc += coupled[p] != 0;
+    if (nc > c->cap) {
+        gk_mpm_stencil *s2 = (gk_mpm_stencil *)gk_alloc(&c->alloc, (size_t)nc * sizeof(gk_mpm_stencil));
+        if (!s2) return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d grain stencils", nc);
+        gk_free(&c->alloc, c->st);
+        c->st = s2;
+        c->cap = nc;
+    }
+    /* every stencil first (nothing is written if a grain is off the grid) */
+    for (p = 0, i = 0; p < ng; ++p) {
         double x[3];
         gk_result r;
         if (!coupled[p]) continue;
         x[0] = xpre[0][p];
         x[1] = xpre[1][p];
         x[2] = 0.0;
-        if ((r = gk_mpm_shape(g, basis, x, lp, &st, err)))
+        if ((r = gk_mpm_shape(g, basis, x, lp, &c->st[i++], err)))
             return gk_err_set(err, r, "coupled grain %d: %s", p, err ? err->msg : "");
     }
     memset(c->md, 0, nn * sizeof(double));
@@ -1172,23 +1214,21 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
         memset(c->dv[k], 0, nn * sizeof(double));
     }
     /* grains to the nodes: mass at x^n, momentum with v^{n+1/2} */
-    for (p = 0; p < ng; ++p) {
-        double x[3], m;
+    for (p = 0, i = 0; p < ng; ++p) {
+        const gk_mpm_stencil *st;
+        double m;
         if (!coupled[p]) continue;
-        x[0] = xpre[0][p];
-        x[1] = xpre[1][p];
-        x[2] = 0.0;
+        st = &c->st[i++];
         m = sc->mass[p] * inv_t;
-        gk_mpm_shape(g, basis, x, lp, &st, NULL);
-        for (q = 0; q < st.n; ++q) {
-            double wm = st.w[q] * m;
-            if (st.w[q] == 0.0) continue;
-            c->md[st.node[q]] += wm;
-            c->pd[0][st.node[q]] += wm * (double)sc->rve.v[0][p];
-            c->pd[1][st.node[q]] += wm * (double)sc->rve.v[1][p];
+        for (q = 0; q < st->n; ++q) {
+            double wm = st->w[q] * m;
+            if (st->w[q] == 0.0) continue;
+            c->md[st->node[q]] += wm;
+            c->pd[0][st->node[q]] += wm * (double)sc->rve.v[0][p];
+            c->pd[1][st->node[q]] += wm * (double)sc->rve.v[1][p];
         }
-        ++rep.grains;
     }
+    rep.grains = nc;
     gk_hybrid_fold(g, per, c->md);
     gk_hybrid_fold(g, per, c->pd[0]);
     gk_hybrid_fold(g, per, c->pd[1]);
@@ -1211,16 +1251,14 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
     gk_hybrid_sync(g, per, c->dv[1]);
     gk_hybrid_sync_velocity(g, per);
     /* FLIP correction of the grains and of their new positions */
-    for (p = 0; p < ng; ++p) {
-        double x[3], dv[2] = {0.0, 0.0};
+    for (p = 0, i = 0; p < ng; ++p) {
+        const gk_mpm_stencil *st;
+        double dv[2] = {0.0, 0.0};
         if (!coupled[p]) continue;
-        x[0] = xpre[0][p];
-        x[1] = xpre[1][p];
-        x[2] = 0.0;
-        gk_mpm_shape(g, basis, x, lp, &st, NULL);
-        for (q = 0; q < st.n; ++q) {
-            dv[0] += st.w[q] * c->dv[0][st.node[q]];
-            dv[1] += st.w[q] * c->dv[1][st.node[q]];
+        st = &c->st[i++];
+        for (q = 0; q < st->n; ++q) {
+            dv[0] += st->w[q] * c->dv[0][st->node[q]];
+            dv[1] += st->w[q] * c->dv[1][st->node[q]];
         }
         for (k = 0; k < 2; ++k) {
             sc->rve.v[k][p] = (gk_real)((double)sc->rve.v[k][p] + dv[k]);
