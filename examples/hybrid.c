@@ -585,7 +585,7 @@ static double platen_speed(const run *R, double t) {
 
 /* ---- membranes on the grains at the specimen's sides (biaxial) */
 /* On each side, the outermost free grain of every band of D50 along y whose
- * outer edge lies within half a diameter of the side (left[row], right[row]
+ * outer edge lies within 1.5 D50 of the side (left[row], right[row]
  * for rows of row_h), chained in height order (the material on the chain's
  * left: down the left side, up the right side), split where a gap of 3 D50
  * opens; a chain end within 2 D50 of the top wall is tied to it. */
@@ -609,7 +609,7 @@ static int add_membranes(run *R, const double *left, const double *right, int nr
             if (row < 0 || row >= nrow || band < 0 || band >= nb) continue;
             edge = s < 0 ? left[row] : right[row];
             if (!isfinite(edge)) continue;
-            if (s < 0 ? x[0] - r < edge + 0.5 * DIAM : x[0] + r > edge - 0.5 * DIAM) {
+            if (s < 0 ? x[0] - r < edge + 1.5 * DIAM : x[0] + r > edge - 1.5 * DIAM) {
                 double out = s < 0 ? -(x[0] - r) : x[0] + r;
                 if (best[band] < 0 || out > bx[band]) {
                     best[band] = p;
@@ -677,9 +677,15 @@ static void extent_rows(const run *R, int nrow, double row_h, double *left, doub
 
 static double specimen_height(const run *R) { return R->H + R->plate_y; }
 
-/* biaxial: area from the extent per row of about 2 D50 */
+/* rows for the specimen's extent: one MPM cell (two rows of points, a few grains) */
+static int extent_nrow(const run *R) {
+    int n = (int)floor(R->H / R->o.cell);
+    return n > 1 ? n : 1;
+}
+
+/* biaxial: area from the material's extent per row */
 static double specimen_area(const run *R) {
-    int nrow = (int)floor(R->H / (2.0 * DIAM)), k;
+    int nrow = extent_nrow(R), k;
     double Hc = specimen_height(R), row_h = Hc / nrow, A = 0.0, *l, *r;
     l = (double *)malloc((size_t)nrow * sizeof(double));
     r = (double *)malloc((size_t)nrow * sizeof(double));
@@ -883,11 +889,11 @@ static int setup_mpm(run *R) {
     gk_mpm_grid_set_bc(&R->g, 2, GK_MPM_BC_FIXED, 0.0, 2, &e); /* bottom: no slip */
     /* points: ppd per cell edge on the cells' lattice (a point row that straddled
      * a cell boundary would tie a band to its neighbours); the continuum's
-     * height is the whole number of point rows nearest the packing's */
+     * height is the whole number of cells nearest the packing's (its top
+     * surface on a node row, where the platen acts) */
     nxp = ncx * o->ppd;
-    nyp = (int)floor(R->H / (R->h / o->ppd) + 0.5);
+    nyp = (int)floor(R->H / R->h + 0.5) * o->ppd;
     R->dxp = R->dyp = R->h / o->ppd;
-    R->H = nyp * R->dyp;
     if (gk_mpm_points_create(&R->P, 2, nxp * nyp, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
     R->side = (double *)calloc((size_t)nxp * nyp, sizeof(double));
     R->Fw = (double *)calloc(9 * (size_t)nxp * nyp, sizeof(double));
@@ -922,7 +928,7 @@ static int setup_mpm(run *R) {
     memset(&R->body, 0, sizeof R->body);
     R->body.lo[0] = org[0] - R->h;
     R->body.hi[0] = org[0] + (n[0] + 1) * R->h;
-    R->body.lo[1] = R->H - 0.5 * R->dyp - 1e-9;
+    R->body.lo[1] = R->H - 1e-9; /* the nodes at and above the material's top surface */
     R->body.hi[1] = org[1] + (n[1] + 1) * R->h;
     if (o->test == T_PLANAR) {
         R->body.contact = GK_MPM_CONTACT_STICK;
@@ -1268,7 +1274,7 @@ static int enrich(run *R) {
         if (role == 1 && gk_scene_prescribe(&R->sc, p, z, z)) return fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc)), 1;
     }
     if (o->test == T_BIAXIAL) {
-        int nrow = (int)floor(R->H / (2.0 * DIAM));
+        int nrow = extent_nrow(R);
         double row_h = specimen_height(R) / nrow, ytop = R->H + R->plate_y, *l, *r, gmax = -HUGE_VAL;
         for (p = 0; p < ng; ++p) {
             double x[3];
@@ -1664,13 +1670,28 @@ int main(int argc, char **argv) {
     R->t_start = wtime();
     if (make_packing(o, &R->pk, &R->phi_pack)) return 1;
     R->W = R->pk.h[0];
-    R->H = R->pk.h[4];
+    /* the specimen: the packing's width (periodic, planar) and a whole number of
+     * MPM cells of height (the continuum's top surface on a node row, where its
+     * platen acts): the packing is cut there, for every mode alike */
+    hg = R->W / floor(R->W / o->cell + 0.5);
+    R->H = floor(R->pk.h[4] / hg + 1e-9) * hg;
+    {
+        int k, q = 0;
+        for (k = 0; k < R->pk.n; ++k)
+            if (R->pk.y[k] < R->H) {
+                R->pk.x[q] = R->pk.x[k];
+                R->pk.y[q] = R->pk.y[k];
+                R->pk.r[q] = R->pk.r[k];
+                ++q;
+            }
+        R->pk.n = q;
+        R->pk.h[4] = R->H;
+    }
     R->rho = R->phi_pack * RHO_S;
     R->M = K_C + G_C;
     R->c = sqrt(R->M / R->rho);
     R->role = (unsigned char *)calloc((size_t)R->pk.n, 1);
     if (!R->role) return fprintf(stderr, "error: out of memory\n"), 1;
-    hg = R->W / floor(R->W / o->cell + 0.5);
     if (!o->quiet)
         printf("%s %s: specimen %.4g x %.4g m, %d grains, packing fraction %.4f, pressure %g Pa, speed %g m/s, dt %g s\n",
                test_name[o->test], mode_name[o->mode], R->W, R->H, R->pk.n, R->phi_pack, o->pressure, o->speed, R->dt);
