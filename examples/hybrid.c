@@ -368,7 +368,8 @@ static double zeta_paper(void) {
 static int make_dir(const char *d) {
     char buf[1024];
     size_t k, n = strlen(d);
-    if (n + 1 > sizeof buf) return 1;
+    struct stat st;
+    if (n + 1 > sizeof buf) return fprintf(stderr, "error: --out %s: path too long\n", d), 1;
     memcpy(buf, d, n + 1);
     for (k = 1; k <= n; ++k)
         if (buf[k] == '/' || buf[k] == '\0') {
@@ -377,6 +378,7 @@ static int make_dir(const char *d) {
             if (mkdir(buf, 0755) && errno != EEXIST) return fprintf(stderr, "error: cannot create %s\n", buf), 1;
             buf[k] = c;
         }
+    if (stat(d, &st) || !S_ISDIR(st.st_mode)) return fprintf(stderr, "error: --out %s: not a directory\n", d), 1;
     return 0;
 }
 
