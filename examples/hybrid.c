@@ -79,9 +79,9 @@
  *          seconds=T speedup_vs_dem=R
  * (band thickness by App. A: top --percentile, outliers beyond 2 sd out,
  * minimum-area box; speedup_vs_dem = --dem-seconds / seconds, nan without).
- * --speed-probe N: after setting up (and, hybrid, enriching), time N steps
- * of the hybrid and N steps of the all-grain specimen alternately in this
- * process (paired, the same load) and print the cost model of Sec 6.4.1.
+ * On stdout, "cost:" counts the grain-steps and point-steps of the run (the
+ * N_D and element terms of the cost model of Sec 6.4.1) with the wall time
+ * spent in each.
  *
  * COST. The defaults are reduced (3 x 6 cm planar, 3 x 4.71 cm biaxial,
  * 5x the paper's platen speed); the paper's sizes are --width 0.06 --height
@@ -124,7 +124,7 @@ typedef struct opts {
     double cell, alpha, train, train_speed, phi0, c0, c1, cl, cg, phi_init, weak_dphi, xi;
     double win0, win1, band_window, percentile, dem_seconds, platen_zeta, ramp;
     int ppd, threads, oracle_every, quiet;
-    long grains, speed_probe;
+    long grains;
     unsigned long seed;
 } opts;
 
@@ -212,7 +212,6 @@ static void usage(FILE *fp) {
             "  --platen-damping Z   planar top platen: damping ratio of its dashpot (default %g)\n"
             "  --ramp K             the platen speed rises linearly over K wave transits H / c (default %g)\n"
             "  --dem-seconds S      wall seconds of the dem run of the same test (for speedup_vs_dem)\n"
-            "  --speed-probe N      time N hybrid and N all-grain steps side by side and stop\n"
             "  --quiet              no progress lines\n",
             p.out, p.width, p.height, b.width, b.height, p.seed, p.pressure, b.pressure, p.speed, p.strain_end,
             b.strain_end, p.out_every, b.out_every, p.cell, p.ppd, p.alpha, p.phi0, b.phi0, p.oracle_every,
@@ -329,7 +328,6 @@ static int parse(int argc, char **argv, opts *o) {
         INT("--grains", grains, 0, 5000000)
         INT("--ppd", ppd, 1, 4)
         INT("--oracle-every", oracle_every, 1, 1000000)
-        INT("--speed-probe", speed_probe, 1, 100000000)
         INT("--seed", seed, 0, 4294967295.0)
 #undef REAL
 #undef INT

@@ -1,9 +1,10 @@
 /* test_hybrid.c - the hybrid continuum-grain method (gk_hybrid.h) of Chen,
  * Chantharayukhonthorn, Yue, Grinspun & Kamrin (2021): the oracle (Alg. 1)
- * on synthetic fields, zones, the periodic grid fold, the history of the
- * recent plastic strain, the overlap coupling (eq 9), the enrichment's mass
- * and momentum, Cundall's best-fit strain (App. A), the band thickness,
- * kinematic training (Sec 4.1.1) and the driver (1 vs 2 threads). */
+ * on synthetic fields, the continuum's stress update (eqs 5-8), zones, the
+ * periodic grid fold, the history of the recent plastic strain, the overlap
+ * coupling (eq 9), the enrichment's mass and momentum, Cundall's best-fit
+ * strain (App. A), the band thickness and kinematic training (Sec 4.1.1).
+ * The driver (1 vs 2 threads) is in test_hybrid_driver.c. */
 #define GK_IMPLEMENTATION
 #include "gk_hybrid.h"
 #include "gk_test.h"
@@ -686,9 +687,87 @@ TEST(training_raises_packing_stress) {
     free(bnd);
 }
 
+/* ================================================================ continuum
+ * gk_hybrid_dp_stress on one point (2D, Table 2's K, G, phi_cs, Phi_cs, chi).
+ * (a) A pure spin L = [[0, -w], [w, 0]] inside the yield surface rotates the
+ * stress exactly, sigma' = R sigma R^T with R the rotation by w dt, and
+ * makes no plastic strain (no deviatoric rate: gdot_max = 0).
+ * (b) Simple shear L = [[0, g], [0, 0]] of a dense point (Phi > Phi_cs):
+ * gdot_max = sqrt(2 D':D') = g exactly; after yield the stress stays on
+ * f = sqrt(J2) + eta p = 0 [eq 5, no cohesion] with eta = sin phi, tan phi =
+ * tan phi_cs + (Phi - Phi_cs) chi [eq 7] (Phi at the step's start); the flow is g's [eq 6]: in 2D,
+ * tr deps_p / ||dev deps_p|| = sqrt(2) sin psi, tan psi = (Phi - Phi_cs)
+ * chi (dilation); and Phi follows eq 8, dPhi/ds = -xi Phi (Phi - Phi_cs)
+ * with s = the accumulated ||deps_p||: 1/Phi = 1/Phi_cs + (1/Phi0 -
+ * 1/Phi_cs) exp(-xi Phi_cs s) (a large xi makes the relaxation visible). */
+TEST(continuum_rotation_flow_and_softening) {
+    gk_mpm_points P;
+    gk_hybrid_cont c;
+    gk_mpm_dp dp;
+    gk_err e;
+    const double K = 6.3e8, G = 4.6e8, Phi_cs = 0.815, chi = 7.0, Phi0 = 0.8425, dt = 1e-6;
+    double s0[4] = {-3e5, 0.0, 0.0, -5e5}, th, cs, sn, a, b, d, s = 0.0, ep_prev[3], Phi_prev = Phi0;
+    int k, it;
+    CHECK(gk_mpm_points_create(&P, 2, 1, NULL, &e) == GK_OK);
+    CHECK(gk_mpm_dp_init(&dp, 2, K, G, 0.3, 0.0, 0.0, &e) == GK_OK);
+    dp.tan_phi_cs = tan(0.27);
+    dp.Phi_cs = Phi_cs;
+    dp.chi = chi;
+    dp.xi = 20.0;
+    CHECK(gk_hybrid_cont_init(&c, &P, &dp, Phi0, NULL, &e) == GK_OK);
+    /* (a) spin */
+    for (k = 0; k < 9; ++k) P.sigma[k] = P.L[k] = 0.0;
+    P.sigma[0] = s0[0], P.sigma[4] = s0[3], P.sigma[1] = P.sigma[3] = 1e5, P.sigma[8] = -4e5;
+    P.L[1] = -1e4, P.L[3] = 1e4;
+    CHECK(gk_hybrid_dp_stress(&P, dt, &c, &e) == GK_OK);
+    th = 1e4 * dt, cs = cos(th), sn = sin(th), a = s0[0], b = 1e5, d = s0[3];
+    CHECK_NEAR(P.sigma[0], cs * cs * a - 2.0 * cs * sn * b + sn * sn * d, 1e-6);
+    CHECK_NEAR(P.sigma[4], sn * sn * a + 2.0 * cs * sn * b + cs * cs * d, 1e-6);
+    CHECK_NEAR(P.sigma[1], cs * sn * (a - d) + (cs * cs - sn * sn) * b, 1e-6);
+    CHECK_NEAR(P.sigma[3], P.sigma[1], 0.0);
+    CHECK_NEAR(c.rate[0], 0.0, 0.0);
+    CHECK_NEAR(c.ep[0] + fabs(c.ep[1]) + fabs(c.ep[2]), 0.0, 0.0);
+    CHECK_NEAR(c.Phi[0], Phi0, 0.0);
+    CHECK_NEAR(c.gdot_max, 0.0, 1e-12);
+    /* (b) simple shear from -400 kPa isotropic */
+    for (k = 0; k < 9; ++k) P.sigma[k] = P.L[k] = 0.0;
+    P.sigma[0] = P.sigma[4] = P.sigma[8] = -4e5;
+    P.L[1] = 10.0;
+    ep_prev[0] = ep_prev[1] = ep_prev[2] = 0.0;
+    for (it = 0; it < 20000; ++it) {
+        for (k = 0; k < 3; ++k) ep_prev[k] = c.ep[k];
+        Phi_prev = c.Phi[0];
+        if (gk_hybrid_dp_stress(&P, dt, &c, &e) != GK_OK) break;
+        s += c.rate[0] * dt;
+    }
+    CHECK_EQ_INT(it, 20000);
+    CHECK_NEAR(c.gdot_max, 10.0, 1e-12);
+    CHECK(s > 0.05); /* yielded: plastic strain far beyond the elastic ~1e-3 */
+    {
+        /* the return map of a step uses the Phi it starts with (eq 8 then updates Phi) */
+        double Phi = c.Phi[0], tphi = tan(0.27) + (Phi_prev - Phi_cs) * chi, eta = sin(atan(tphi));
+        double p = 0.5 * (P.sigma[0] + P.sigma[4]), q = sqrt(0.25 * (P.sigma[0] - P.sigma[4]) * (P.sigma[0] - P.sigma[4]) + P.sigma[1] * P.sigma[1]);
+        double de[3], tr, dev, spsi = sin(atan((Phi_prev - Phi_cs) * chi));
+        double inv = 1.0 / Phi_cs + (1.0 / Phi0 - 1.0 / Phi_cs) * exp(-dp.xi * Phi_cs * s);
+        CHECK_NEAR(q + eta * p, 0.0, 1e-6 * fabs(p)); /* on the yield surface [eq 5] */
+        for (k = 0; k < 3; ++k) de[k] = c.ep[k] - ep_prev[k];
+        tr = de[0] + de[1];
+        dev = sqrt(0.5 * (de[0] - de[1]) * (de[0] - de[1]) + 2.0 * de[2] * de[2]);
+        CHECK(tr > 0.0); /* dilation while Phi > Phi_cs */
+        CHECK_REL(tr / dev, sqrt(2.0) * spsi, 1e-3); /* eq 6 flow direction */
+        CHECK(Phi < Phi0 && Phi > Phi_cs);
+        CHECK_REL(Phi - Phi_cs, 1.0 / inv - Phi_cs, 1e-3); /* eq 8, integrated */
+        printf("    s = %.4f, Phi %.5f (eq 8: %.5f), q/|p| = %.4f, tr/dev = %.4f (sqrt2 sin psi = %.4f)\n", s, Phi,
+               1.0 / inv, q / fabs(p), tr / dev, sqrt(2.0) * spsi);
+    }
+    gk_hybrid_cont_free(&c);
+    gk_mpm_points_destroy(&P);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(oracle_synthetic_fields);
+    RUN(continuum_rotation_flow_and_softening);
     RUN(oracle_persistence);
     RUN(zones_and_distance);
     RUN(periodic_fold);
