@@ -212,6 +212,8 @@ static void usage(FILE *fp) {
             "  --platen-damping Z   planar top platen: damping ratio of its dashpot (default %g)\n"
             "  --ramp K             the platen speed rises linearly over K wave transits H / c (default %g)\n"
             "  --dem-seconds S      wall seconds of the dem run of the same test (for speedup_vs_dem)\n"
+            "  --paper              the paper's specimen and speed (Tables 3, 5): 6 x 12 cm (planar, phi_0 2.2 cm) or\n"
+            "                       6 x 9.42 cm (biaxial), 0.02 m/s; the other flags override it\n"
             "  --quiet              no progress lines\n",
             p.out, p.width, p.height, b.width, b.height, p.seed, p.pressure, b.pressure, p.speed, p.strain_end,
             b.strain_end, p.out_every, b.out_every, p.cell, p.ppd, p.alpha, p.phi0, b.phi0, p.oracle_every,
@@ -246,6 +248,16 @@ static int parse(int argc, char **argv, opts *o) {
     }
     if (test < 0) return fprintf(stderr, "error: --test planar|biaxial is required\n"), 1;
     defaults(o, test);
+    for (i = 1; i < argc; ++i)
+        if (!strcmp(argv[i], "--paper")) { /* Tables 3-6; the other flags override it */
+            o->width = 0.06;
+            o->height = test == T_PLANAR ? 0.12 : 0.0942;
+            o->speed = 0.02;
+            if (test == T_PLANAR) {
+                o->phi0 = 0.022;
+                o->band_window = 0.022;
+            }
+        }
     memset(have, 0, sizeof have);
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -254,6 +266,7 @@ static int parse(int argc, char **argv, opts *o) {
             o->quiet = 1;
             continue;
         }
+        if (!strcmp(a, "--paper")) continue;
         if (!val) return fprintf(stderr, "error: %s needs a value (or is unknown; see --help)\n", a), 1;
         ++i;
         if (!strcmp(a, "--test")) continue;
