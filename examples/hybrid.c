@@ -83,11 +83,20 @@
  * N_D and element terms of the cost model of Sec 6.4.1) with the wall time
  * spent in each.
  *
- * COST. The defaults are reduced (3 x 6 cm planar, 3 x 4.71 cm biaxial,
- * 5x the paper's platen speed); the paper's sizes are --width 0.06 --height
- * 0.12 --speed 0.02 (planar, 7640 grains) and --width 0.06 --height 0.0942
- * --speed 0.02 (biaxial, 5910 grains); see examples/README.md for their
- * measured cost.
+ * COST. The defaults are reduced (3 x 6 cm planar, 1778 grains; 3 x 4.71
+ * cm biaxial, 1435 grains; 5x the paper's platen speed): one thread, about
+ * 25 CPU s for dem and 35-75 CPU s for continuum or hybrid. --paper runs
+ * the paper's sizes (Tables 3, 5: 7640 and 5910 grains at 0.02 m/s): about
+ * 40x the grain-steps of the reduced runs (4 x the grains, 10 x the steps),
+ * so some 40 x 23 CPU s = 15 CPU min for each dem run (estimated, not run
+ * to the end).
+ *
+ * KNOWN LIMITS. The planar continuum and hybrid runs at the default size
+ * stop at 43 % (continuum) and 49 % (hybrid) strain: a point of the top
+ * layer leaves the grid ("its support leaves the grid"); run them to
+ * --strain 0.3 --window 0.2 0.3. The continuum's cost per MPM point-step is far above
+ * the paper's relative to a grain-step, so the hybrid is slower than dem at
+ * these sizes (see the cost: line).
  */
 #define GK_IMPLEMENTATION
 #define _POSIX_C_SOURCE 200809L
