@@ -1,0 +1,781 @@
+/* test_hybrid.c - the hybrid continuum-grain method (gk_hybrid.h) of Chen,
+ * Chantharayukhonthorn, Yue, Grinspun & Kamrin (2021): the oracle (Alg. 1)
+ * on synthetic fields, the continuum's stress update (eqs 5-8), zones, the
+ * periodic grid fold, the history of the recent plastic strain, the overlap
+ * coupling (eq 9), the enrichment's mass and momentum, Cundall's best-fit
+ * strain (App. A), the band thickness and kinematic training (Sec 4.1.1).
+ * The driver (1 vs 2 threads) is in test_hybrid_driver.c. */
+#define GK_IMPLEMENTATION
+#include "gk_hybrid.h"
+#include "gk_test.h"
+#include <stdlib.h>
+
+#ifdef GK_TEST_QUICK /* sanitizer builds: fewer steps */
+#define QUICK(full, quick) (quick)
+#else
+#define QUICK(full, quick) (full)
+#endif
+
+/* a 2D grid of nx x ny nodes, spacing h, origin 0 */
+static void grid2(gk_mpm_grid *g, int nx, int ny, double h, double ox, double oy) {
+    double o[3];
+    int n[3];
+    o[0] = ox;
+    o[1] = oy;
+    o[2] = 0.0;
+    n[0] = nx;
+    n[1] = ny;
+    n[2] = 1;
+    if (gk_mpm_grid_create(g, 2, o, h, n, NULL, NULL)) abort();
+}
+
+static size_t node(const gk_mpm_grid *g, int i, int j) { return (size_t)i + (size_t)g->n[0] * (size_t)j; }
+
+/* ================================================================ oracle
+ * Alg. 1 line 3: a node is flagged where e_max > 0, R > c1 and |lap e| /
+ * e_max > min(c0/D50^2, c0/dX^2). A one-row band of plastic strain rate
+ * has a Laplacian -2 e/h^2 on the row and e/h^2 on its neighbours, zero
+ * beyond; a uniform or linear field has none. */
+TEST(oracle_synthetic_fields) {
+    gk_mpm_grid g;
+    gk_hybrid_oracle_def d;
+    gk_hybrid_periodic per;
+    int nx = 21, ny = 21, i, j, n;
+    double h = 0.01, *rate, *recent, H[441];
+    unsigned char *active, flag[441];
+    grid2(&g, nx, ny, h, 0.0, 0.0);
+    memset(&d, 0, sizeof d);
+    d.c0 = 1e-2; /* threshold c0/dX^2 = 100 m^-2, far below the band's 1/h^2 = 1e4 */
+    d.c1 = 1e-3;
+    d.cl = d.cg = 1.0;
+    d.D50 = 1e-3;
+    rate = (double *)calloc(g.nnode, sizeof(double));
+    recent = (double *)calloc(g.nnode, sizeof(double));
+    active = (unsigned char *)calloc(g.nnode, 1);
+    for (i = 0; i < (int)g.nnode; ++i) {
+        active[i] = 1;
+        recent[i] = 0.05;
+    }
+    /* (1) a one-row band at j = 10 */
+    for (i = 0; i < nx; ++i) rate[node(&g, i, 10)] = 3.0;
+    n = gk_hybrid_oracle_flag(&g, NULL, &d, rate, recent, active, flag, H);
+    CHECK_EQ_INT(n, 3 * (nx - 2)); /* rows 9, 10, 11 on the interior columns */
+    for (j = 0; j < ny; ++j)
+        for (i = 0; i < nx; ++i) {
+            int want = (j >= 9 && j <= 11 && i > 0 && i < nx - 1);
+            CHECK_EQ_INT(flag[node(&g, i, j)], want);
+        }
+    CHECK_NEAR(H[node(&g, 5, 10)], 2.0 / (h * h), 1e-6);
+    CHECK_NEAR(H[node(&g, 5, 9)], 1.0 / (h * h), 1e-6);
+    /* the same band on a grid periodic in x: every column is interior */
+    memset(&per, 0, sizeof per);
+    per.ghost[0] = 0;
+    per.period[0] = nx - 1; /* node nx-1 is node 0 */
+    n = gk_hybrid_oracle_flag(&g, &per, &d, rate, recent, active, flag, NULL);
+    CHECK_EQ_INT(n, 3 * (nx - 1));
+    CHECK(flag[node(&g, 0, 10)] && !flag[node(&g, nx - 1, 10)]); /* counted on the home node only */
+    /* (2) the band with too little recent strain: R <= c1 */
+    for (i = 0; i < (int)g.nnode; ++i) recent[i] = 1e-3;
+    CHECK_EQ_INT(gk_hybrid_oracle_flag(&g, NULL, &d, rate, recent, active, flag, NULL), 0);
+    for (i = 0; i < (int)g.nnode; ++i) recent[i] = 0.05;
+    /* (3) uniform flow (the under-consolidated case): no gradient, no flag */
+    for (i = 0; i < (int)g.nnode; ++i) rate[i] = 3.0;
+    CHECK_EQ_INT(gk_hybrid_oracle_flag(&g, NULL, &d, rate, recent, active, flag, NULL), 0);
+    /* (4) a linear profile (simple shear with a graded rate): lap = 0 */
+    for (j = 0; j < ny; ++j)
+        for (i = 0; i < nx; ++i) rate[node(&g, i, j)] = 0.5 + 0.1 * j;
+    CHECK_EQ_INT(gk_hybrid_oracle_flag(&g, NULL, &d, rate, recent, active, flag, NULL), 0);
+    /* (5) no plastic flow at all: e_max = 0 */
+    memset(rate, 0, g.nnode * sizeof(double));
+    CHECK_EQ_INT(gk_hybrid_oracle_flag(&g, NULL, &d, rate, recent, active, flag, NULL), 0);
+    free(rate);
+    free(recent);
+    free(active);
+    gk_mpm_grid_destroy(&g);
+}
+
+/* Alg. 1 line 7: enrich when the flagged set is non-empty and unchanged for tau_g */
+TEST(oracle_persistence) {
+    gk_mpm_grid g;
+    gk_hybrid_oracle o;
+    gk_hybrid_oracle_def d;
+    int i;
+    double *rate, *recent;
+    unsigned char *active;
+    grid2(&g, 9, 9, 0.01, 0.0, 0.0);
+    memset(&d, 0, sizeof d);
+    d.c0 = 1e-2;
+    d.c1 = 1e-3;
+    d.cl = d.cg = 1.0;
+    d.D50 = 1e-3;
+    CHECK(gk_hybrid_oracle_init(&o, &d, g.nnode, NULL, NULL) == GK_OK);
+    rate = (double *)calloc(g.nnode, sizeof(double));
+    recent = (double *)calloc(g.nnode, sizeof(double));
+    active = (unsigned char *)calloc(g.nnode, 1);
+    for (i = 0; i < (int)g.nnode; ++i) {
+        active[i] = 1;
+        recent[i] = 0.05;
+    }
+    for (i = 0; i < 9; ++i) rate[node(&g, i, 4)] = 1.0;
+    CHECK_EQ_INT(gk_hybrid_oracle_step(&o, &g, NULL, rate, recent, active, 0.0, 0.8), 0);
+    CHECK_EQ_INT(gk_hybrid_oracle_step(&o, &g, NULL, rate, recent, active, 0.5, 0.8), 0);
+    CHECK_EQ_INT(gk_hybrid_oracle_step(&o, &g, NULL, rate, recent, active, 0.9, 0.8), 1);
+    /* the band moves: the clock restarts */
+    memset(rate, 0, g.nnode * sizeof(double));
+    for (i = 0; i < 9; ++i) rate[node(&g, i, 5)] = 1.0;
+    CHECK_EQ_INT(gk_hybrid_oracle_step(&o, &g, NULL, rate, recent, active, 1.0, 0.8), 0);
+    CHECK_EQ_INT(gk_hybrid_oracle_step(&o, &g, NULL, rate, recent, active, 1.5, 0.8), 0);
+    CHECK_EQ_INT(gk_hybrid_oracle_step(&o, &g, NULL, rate, recent, active, 1.8, 0.8), 1);
+    /* nothing flagged never triggers */
+    memset(rate, 0, g.nnode * sizeof(double));
+    CHECK_EQ_INT(gk_hybrid_oracle_step(&o, &g, NULL, rate, recent, active, 2.0, 0.8), 0);
+    CHECK_EQ_INT(gk_hybrid_oracle_step(&o, &g, NULL, rate, recent, active, 9.0, 0.8), 0);
+    {
+        gk_hybrid_oracle o2;
+        gk_err e;
+        d.cg = 0.0;
+        CHECK(gk_hybrid_oracle_init(&o2, &d, g.nnode, NULL, &e) == GK_ERR_ARG);
+    }
+    gk_hybrid_oracle_free(&o);
+    free(rate);
+    free(recent);
+    free(active);
+    gk_mpm_grid_destroy(&g);
+}
+
+/* zones of Sec 4 from the distance to the flagged nodes */
+TEST(zones_and_distance) {
+    gk_mpm_grid g;
+    gk_hybrid_periodic per;
+    unsigned char *flag;
+    double x[3] = {0.0, 0.0, 0.0}, h = 0.01, phi0 = 0.02;
+    grid2(&g, 11, 11, h, 0.0, 0.0);
+    flag = (unsigned char *)calloc(g.nnode, 1);
+    flag[node(&g, 5, 5)] = 1;
+    x[0] = 0.05 + 0.03;
+    x[1] = 0.05 + 0.04;
+    CHECK_NEAR(gk_hybrid_distance(&g, NULL, flag, x), 0.05, 1e-15);
+    CHECK_EQ_INT(gk_hybrid_zone(0.010, phi0, h), GK_ZONE_DISCRETE);
+    CHECK_EQ_INT(gk_hybrid_zone(0.015, phi0, h), GK_ZONE_DISCRETE); /* phi0 - th/2 belongs to the discrete zone */
+    CHECK_EQ_INT(gk_hybrid_zone(0.020, phi0, h), GK_ZONE_OVERLAP);
+    CHECK_EQ_INT(gk_hybrid_zone(0.025, phi0, h), GK_ZONE_OVERLAP);
+    CHECK_EQ_INT(gk_hybrid_zone(0.026, phi0, h), GK_ZONE_CONTINUUM);
+    /* periodic in x (period 10 cells): the nearest image across the seam */
+    memset(&per, 0, sizeof per);
+    per.period[0] = 10;
+    flag[node(&g, 5, 5)] = 0;
+    flag[node(&g, 1, 5)] = 1;
+    x[0] = 0.095;
+    x[1] = 0.05;
+    CHECK_NEAR(gk_hybrid_distance(&g, &per, flag, x), 0.015, 1e-15);
+    CHECK_NEAR(gk_hybrid_distance(&g, NULL, flag, x), 0.085, 1e-15);
+    memset(flag, 0, g.nnode);
+    CHECK(gk_hybrid_distance(&g, NULL, flag, x) == HUGE_VAL);
+    free(flag);
+    gk_mpm_grid_destroy(&g);
+}
+
+/* ================================================================ periodic grid
+ * Folding the ghost copies into their home nodes conserves mass and
+ * momentum; a uniform translation of points across the seam moves the
+ * same momentum with or without the wrap. */
+TEST(periodic_fold) {
+    gk_mpm_grid g;
+    gk_mpm_points P;
+    gk_hybrid_periodic per;
+    gk_mpm_def d = gk_mpm_def_default();
+    double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.08, 0.04, 0.0}, M, mom[3], gm = 0.0, gp[2] = {0.0, 0.0};
+    int p, k;
+    size_t I;
+    gk_err e;
+    grid2(&g, 11, 7, 0.01, -0.01, -0.01); /* x nodes -0.01 .. 0.09: home 1..8, ghosts 0, 9, 10 */
+    memset(&per, 0, sizeof per);
+    per.ghost[0] = 1;
+    per.period[0] = 8;
+    d.basis = GK_MPM_UGIMP;
+    CHECK(gk_hybrid_periodic_check(&g, &per, d.basis, &e) == GK_OK);
+    per.period[0] = 9;
+    CHECK(gk_hybrid_periodic_check(&g, &per, d.basis, &e) == GK_ERR_ARG);
+    per.period[0] = 8;
+    CHECK(gk_mpm_points_create_box(&P, 2, lo, hi, 0.01, 2, 1000.0, NULL, NULL) == GK_OK);
+    for (p = 0; p < P.n; ++p) {
+        P.v[0][p] = 1.0 + 0.1 * p;
+        P.v[1][p] = -0.5;
+    }
+    CHECK(gk_mpm_p2g(&g, &P, &d, GK_MPM_P2G_MOMENTUM, &e) == GK_OK);
+    gk_hybrid_fold_momentum(&g, &per);
+    for (I = 0; I < g.nnode; ++I) {
+        gm += g.m[I];
+        gp[0] += g.p[0][I];
+        gp[1] += g.p[1][I];
+        if (gk_hybrid_home(&g, &per, I) != I) {
+            CHECK(g.m[I] == 0.0);
+            CHECK(g.v[0][I] == g.v[0][gk_hybrid_home(&g, &per, I)]);
+        }
+    }
+    gk_mpm_points_totals(&P, &M, mom, NULL);
+    CHECK_REL(gm, M, 1e-14);
+    CHECK_REL(gp[0], mom[0], 1e-13);
+    CHECK_REL(gp[1], mom[1], 1e-13);
+    /* wrapping: a point past the seam comes back by one period, its follower too */
+    {
+        double X0[1] = {0.0}, *fol[3];
+        P.x[0][0] = 0.0805;
+        X0[0] = 0.07;
+        fol[0] = X0;
+        fol[1] = fol[2] = NULL;
+        for (k = 1; k < P.n; ++k) P.x[0][k] = 0.04;
+        P.n = 1;
+        gk_hybrid_wrap_points(&g, &per, &P, fol);
+        CHECK_NEAR(P.x[0][0], 0.0005, 1e-15);
+        CHECK_NEAR(P.x[0][0] - X0[0], 0.0805 - 0.07, 1e-15);
+    }
+    gk_mpm_points_destroy(&P);
+    gk_mpm_grid_destroy(&g);
+}
+
+/* ================================================================ history */
+TEST(history_window) {
+    gk_hybrid_history h;
+    double v[2], out[2];
+    int s;
+    gk_err e;
+    CHECK(gk_hybrid_history_init(&h, 1, 2, 4, NULL, &e) == GK_OK);
+    CHECK_EQ_INT(gk_hybrid_history_at(&h, 0.0, out), -1);
+    for (s = 0; s < 6; ++s) { /* the first two snapshots fall out of the ring */
+        v[0] = 10.0 * s;
+        v[1] = -s;
+        CHECK(gk_hybrid_history_push(&h, 1.0 * s, v, &e) == GK_OK);
+    }
+    CHECK(gk_hybrid_history_push(&h, 5.0, v, &e) == GK_ERR_ARG); /* not after the newest */
+    CHECK_EQ_INT(gk_hybrid_history_at(&h, 3.25, out), 0);
+    CHECK_NEAR(out[0], 32.5, 1e-12);
+    CHECK_NEAR(out[1], -3.25, 1e-12);
+    CHECK_EQ_INT(gk_hybrid_history_at(&h, 1.0, out), 1); /* before the oldest kept (t = 2) */
+    CHECK_NEAR(out[0], 20.0, 0.0);
+    CHECK_EQ_INT(gk_hybrid_history_at(&h, 7.0, out), 0);
+    CHECK_NEAR(out[0], 50.0, 0.0);
+    gk_hybrid_history_free(&h);
+    /* dropping points keeps the others' values */
+    {
+        double w[3] = {1.0, 2.0, 3.0};
+        unsigned char keep[3] = {1, 0, 1};
+        CHECK(gk_hybrid_history_init(&h, 3, 1, 3, NULL, &e) == GK_OK);
+        gk_hybrid_history_push(&h, 0.0, w, &e);
+        w[0] = 4.0;
+        w[2] = 6.0;
+        gk_hybrid_history_push(&h, 1.0, w, &e);
+        gk_hybrid_history_keep(&h, keep);
+        CHECK_EQ_INT(h.n, 2);
+        gk_hybrid_history_at(&h, 0.5, out);
+        CHECK_NEAR(out[0], 2.5, 1e-15);
+        CHECK_NEAR(out[1], 4.5, 1e-15);
+        gk_hybrid_history_free(&h);
+    }
+}
+
+/* ================================================================ grains */
+static gk_material paper_material(void) {
+    gk_material m = gk_material_default();
+    m.kn = 1.7720938e6; /* Chen et al. Table 1 */
+    m.kt_ratio = 0.5;
+    m.friction = 0.5;
+    m.density = 2530.0;
+    m.zeta_n = 0.2; /* low damping for the short tests */
+    m.zeta_t = 0.0;
+    return m;
+}
+
+/* a small periodic packing of n disks of mean diameter 1 mm consolidated at p (frictionless, then mu 0.5) */
+static int consolidated_packing(int n, double aspect_y, double p, uint64_t seed, gk_packing *out) {
+    gk_packing pk;
+    gk_gen_def g;
+    gk_rve_def d = gk_rve_def_default();
+    gk_rve rve;
+    gk_consolidate_def cd;
+    memset(&g, 0, sizeof g);
+    g.dim = 2;
+    g.n = n;
+    g.psd = GK_PSD_UNIFORM;
+    g.r_min = 0.45e-3;
+    g.r_max = 0.55e-3;
+    g.aspect[0] = 1.0;
+    g.aspect[1] = aspect_y;
+    g.seed = seed;
+    if (gk_packing_generate(&pk, &g, NULL, NULL)) return 1;
+    d.mat = paper_material();
+    d.thickness = 0.01;
+    d.dt = 5e-7;
+    d.damping = 0.2;
+    if (gk_rve_create(&rve, &d, &pk)) return 1;
+    gk_packing_free(&pk);
+    memset(&cd, 0, sizeof cd);
+    cd.pressure = p;
+    cd.friction = 0.0;
+    cd.stress_tol = 2e-2;
+    cd.unbalanced_tol = 2e-2;
+    if (gk_rve_consolidate(&rve, &cd, NULL)) {
+        printf("    %s\n", gk_rve_error(&rve));
+        return 1;
+    }
+    if (gk_rve_to_packing(&rve, out, NULL, NULL)) return 1;
+    gk_rve_destroy(&rve);
+    return 0;
+}
+
+static gk_scene_def scene_def(double W, double H, unsigned periodic) {
+    gk_scene_def d = gk_scene_def_default();
+    d.dim = 2;
+    d.lo[0] = periodic & 1u ? 0.0 : -0.5 * W;
+    d.hi[0] = periodic & 1u ? W : 1.5 * W;
+    d.lo[1] = -0.5 * H;
+    d.hi[1] = 1.5 * H;
+    d.periodic = periodic;
+    d.rve.mat = paper_material();
+    d.rve.thickness = 0.01;
+    d.rve.dt = 5e-7;
+    d.rve.damping = 0.0;
+    return d;
+}
+
+/* ================================================================ coupling
+ * eq 9 with the operator split of Yue et al. (2018): at a node where both
+ * media have mass, v* = (p_c + p_d) / (m_c + m_d); the momentum moved to
+ * the grains is exactly what the continuum loses. With uniform velocities
+ * U (grains) and V (continuum), every coupled node takes the mass-weighted
+ * mean, and a grain whose stencil is entirely coupled ends at the
+ * continuum's interpolated velocity (the FLIP correction moves it by
+ * Sum N (v* - U)). */
+TEST(coupling_equalises_and_conserves) {
+    gk_mpm_grid g;
+    gk_mpm_points P;
+    gk_mpm_def d = gk_mpm_def_default();
+    gk_hybrid_coupling c;
+    gk_hybrid_couple_report rep;
+    gk_packing pk;
+    gk_scene sc;
+    gk_scene_def sd;
+    double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.03, 0.02, 0.0}, t = 0.01, dt = 5e-7, lp;
+    double *xp[2], pc0[2] = {0.0, 0.0}, pd0[2] = {0.0, 0.0}, pc1[2] = {0.0, 0.0}, pd1[2] = {0.0, 0.0};
+    unsigned char *coupled;
+    int p, k, ng, checked = 0;
+    size_t I;
+    gk_err e;
+    grid2(&g, 6, 5, 0.01, -0.01, -0.01);
+    d.basis = GK_MPM_UGIMP;
+    CHECK(gk_mpm_points_create_box(&P, 2, lo, hi, 0.01, 2, 2100.0, NULL, NULL) == GK_OK);
+    lp = P.lp[0];
+    for (p = 0; p < P.n; ++p) {
+        P.v[0][p] = 0.3;
+        P.v[1][p] = -0.1;
+    }
+    CHECK(gk_mpm_p2g(&g, &P, &d, GK_MPM_P2G_MOMENTUM | GK_MPM_P2G_FORCE, &e) == GK_OK);
+    CHECK(gk_mpm_grid_update(&g, &d, dt, &e) == GK_OK); /* no stress: vn = v */
+    /* grains on the right part of the box */
+    CHECK(consolidated_packing(60, 1.0, 1e5, 3, &pk) == 0);
+    for (p = 0; p < pk.n; ++p) {
+        pk.x[p] += 0.012;
+        pk.y[p] += 0.006;
+    }
+    sd = scene_def(0.04, 0.03, 0u);
+    sd.lo[0] = sd.lo[1] = -0.02;
+    sd.hi[0] = sd.hi[1] = 0.06;
+    CHECK(gk_scene_create(&sc, &sd, &pk) == GK_OK);
+    ng = sc.rve.n;
+    xp[0] = (double *)malloc((size_t)ng * sizeof(double));
+    xp[1] = (double *)malloc((size_t)ng * sizeof(double));
+    coupled = (unsigned char *)malloc((size_t)ng);
+    for (p = 0; p < ng; ++p) {
+        double x[3], v[3] = {-0.2, 0.4, 0.0}, w[3] = {0.0, 0.0, 0.0};
+        gk_scene_position(&sc, p, x);
+        xp[0][p] = x[0];
+        xp[1][p] = x[1];
+        gk_scene_set_velocity(&sc, p, v, w);
+        coupled[p] = 1;
+    }
+    CHECK(gk_hybrid_coupling_init(&c, &g, NULL, &e) == GK_OK);
+    for (I = 0; I < g.nnode; ++I)
+        for (k = 0; k < 2; ++k) pc0[k] += g.m[I] * g.vn[k][I];
+    for (p = 0; p < ng; ++p)
+        for (k = 0; k < 2; ++k) pd0[k] += sc.mass[p] / t * (double)sc.rve.v[k][p];
+    CHECK(gk_hybrid_couple(&c, &g, NULL, d.basis, lp, &sc, (const double *const *)xp, coupled, NULL, t, dt, &rep,
+                           &e) == GK_OK);
+    CHECK(rep.grains == ng && rep.nodes > 4);
+    CHECK_NEAR(rep.dv_max, sqrt(0.5 * 0.5 + 0.5 * 0.5), 1e-12); /* |V - U| */
+    for (I = 0; I < g.nnode; ++I) {
+        for (k = 0; k < 2; ++k) pc1[k] += g.m[I] * g.vn[k][I];
+        if (g.m[I] > g.mass_min && c.md[I] > 0.0) { /* the mass-weighted mean of 0.3 and -0.2 */
+            double want = (g.m[I] * 0.3 + c.md[I] * -0.2) / (g.m[I] + c.md[I]);
+            CHECK_NEAR(g.vn[0][I], want, 1e-13);
+        }
+    }
+    for (p = 0; p < ng; ++p)
+        for (k = 0; k < 2; ++k) pd1[k] += sc.mass[p] / t * (double)sc.rve.v[k][p];
+    for (k = 0; k < 2; ++k) {
+        CHECK_NEAR(pc1[k] + pd1[k], pc0[k] + pd0[k], 1e-12 * (fabs(pc0[k]) + fabs(pd0[k])));
+        CHECK_NEAR(pd1[k] - pd0[k], rep.exchange[k], 1e-12 * fabs(pd0[k]));
+    }
+    /* grains whose stencil is entirely coupled: v = Sum N vn (the continuum's velocity there),
+     * and their positions moved by dt times the correction */
+    for (p = 0; p < ng; ++p) {
+        gk_mpm_stencil st;
+        double x[3] = {xp[0][p], xp[1][p], 0.0}, v[2] = {0.0, 0.0}, xnow[3];
+        int q, all = 1;
+        gk_mpm_shape(&g, d.basis, x, lp, &st, NULL);
+        for (q = 0; q < st.n; ++q) {
+            if (st.w[q] == 0.0) continue;
+            if (!(g.m[st.node[q]] > g.mass_min && c.md[st.node[q]] > 0.0)) all = 0;
+            v[0] += st.w[q] * g.vn[0][st.node[q]];
+            v[1] += st.w[q] * g.vn[1][st.node[q]];
+        }
+        gk_scene_position(&sc, p, xnow);
+        CHECK_NEAR(xnow[0] - xp[0][p], dt * ((double)sc.rve.v[0][p] + 0.2), 1e-15);
+        if (!all) continue;
+        ++checked;
+        CHECK_NEAR(sc.rve.v[0][p], v[0], 1e-12);
+        CHECK_NEAR(sc.rve.v[1][p], v[1], 1e-12);
+    }
+    CHECK(checked > 5);
+    gk_hybrid_coupling_free(&c);
+    gk_scene_destroy(&sc);
+    gk_packing_free(&pk);
+    free(xp[0]);
+    free(xp[1]);
+    free(coupled);
+    gk_mpm_points_destroy(&P);
+    gk_mpm_grid_destroy(&g);
+}
+
+/* ================================================================ enrichment
+ * Sec 4.1: the grains that replace the continuum carry the same total mass
+ * and momentum: the discrete-zone points and (1 - w) of the overlap points
+ * leave, the grains (w in the overlap) arrive, masses scaled by one factor
+ * and velocities shifted by one vector. */
+TEST(enrichment_conserves_mass_and_momentum) {
+    gk_mpm_points P;
+    gk_hybrid_cont cont;
+    gk_mpm_dp dp;
+    gk_packing pk;
+    gk_scene sc;
+    gk_scene_def sd;
+    gk_hybrid_enrich_report rep;
+    double lo[3] = {0.0, 0.0, 0.0}, hi[3], *vg[2], extra_data[2000], *extra[1], W, H, h, yc, a, th, Phi;
+    unsigned char *gz;
+    int p, ng, stride[1] = {1}, nd = 0, no = 0, n0;
+    gk_err e;
+    /* grains fill a strip of height H centred at yc: discrete |y - yc| <= a, overlap up to a + th = H/2 */
+    CHECK(consolidated_packing(150, 0.5, 1e5, 5, &pk) == 0);
+    W = pk.h[0];
+    H = pk.h[4];
+    h = W / 6.0;
+    hi[0] = W;
+    hi[1] = 12.0 * h;
+    hi[2] = 0.0;
+    yc = 6.0 * h;
+    th = 0.5 * h;
+    a = 0.5 * H - th;
+    for (p = 0, Phi = 0.0; p < pk.n; ++p) Phi += GK_PI * pk.r[p] * pk.r[p] / (W * H);
+    CHECK(gk_mpm_points_create_box(&P, 2, lo, hi, h, 2, 2530.0 * Phi, NULL, NULL) == GK_OK);
+    CHECK(gk_mpm_dp_init(&dp, 2, 6.3e8, 4.6e8, 0.3, 0.0, 0.0, &e) == GK_OK);
+    dp.chi = 7.0;
+    dp.xi = 0.01;
+    dp.Phi_cs = 0.815;
+    dp.tan_phi_cs = tan(0.27);
+    CHECK(gk_hybrid_cont_init(&cont, &P, &dp, 0.84, NULL, &e) == GK_OK);
+    n0 = P.n;
+    CHECK(n0 <= 2000);
+    for (p = 0; p < P.n; ++p) {
+        double d = fabs(P.x[1][p] - yc);
+        P.v[0][p] = 0.02 * P.x[1][p] / hi[1];
+        P.v[1][p] = 0.001;
+        cont.zone[p] = d <= a ? GK_ZONE_DISCRETE : (d <= a + th ? GK_ZONE_OVERLAP : GK_ZONE_CONTINUUM);
+        nd += cont.zone[p] == GK_ZONE_DISCRETE;
+        no += cont.zone[p] == GK_ZONE_OVERLAP;
+        extra_data[p] = p;
+    }
+    extra[0] = extra_data;
+    for (p = 0; p < pk.n; ++p) pk.y[p] += yc - 0.5 * H;
+    sd = scene_def(W, hi[1], 1u);
+    CHECK(gk_scene_create(&sc, &sd, &pk) == GK_OK);
+    ng = sc.rve.n;
+    vg[0] = (double *)malloc((size_t)ng * sizeof(double));
+    vg[1] = (double *)malloc((size_t)ng * sizeof(double));
+    gz = (unsigned char *)malloc((size_t)ng);
+    for (p = 0; p < ng; ++p) {
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        vg[0][p] = 0.02 * x[1] / hi[1];
+        vg[1][p] = 0.0;
+        gz[p] = fabs(x[1] - yc) <= a ? GK_ZONE_DISCRETE : GK_ZONE_OVERLAP;
+    }
+    CHECK(gk_hybrid_enrich(&P, &cont, &sc, gz, (const double *const *)vg, 0.5, 0.01, 1, extra, stride, &rep, &e) ==
+          GK_OK);
+    CHECK_REL(rep.mass_after, rep.mass_before, 1e-13);
+    CHECK_NEAR(rep.mom_after[0], rep.mom_before[0], 1e-13 * fabs(rep.mom_before[0]));
+    CHECK_NEAR(rep.mom_after[1], rep.mom_before[1], 1e-13 * fabs(rep.mom_before[1]));
+    CHECK_EQ_INT(rep.points_deleted, nd);
+    CHECK_EQ_INT(rep.points_overlap, no);
+    CHECK_EQ_INT(P.n, n0 - nd);
+    CHECK_EQ_INT(cont.n, P.n);
+    /* the same material on both sides: one factor near 1 (the points' density is the packing's) */
+    printf("    mass factor %.4f, velocity shift (%.2e, %.2e) m/s\n", rep.mass_scale, rep.dv[0], rep.dv[1]);
+    CHECK(fabs(rep.mass_scale - 1.0) < 0.1);
+    for (p = 0; p < P.n; ++p) {
+        int orig = (int)extra_data[p]; /* the caller's array followed the deletion */
+        CHECK(cont.zone[p] != GK_ZONE_DISCRETE);
+        if (cont.zone[p] == GK_ZONE_OVERLAP) CHECK_NEAR(P.m[p], 0.5 * 2530.0 * Phi * 0.25 * h * h, 1e-15);
+        CHECK(orig >= p && orig < n0);
+    }
+    /* refused: a grain left in the continuum zone; nothing changed */
+    gz[0] = GK_ZONE_CONTINUUM;
+    nd = P.n;
+    CHECK(gk_hybrid_enrich(&P, &cont, &sc, gz, NULL, 0.5, 0.01, 0, NULL, NULL, &rep, &e) == GK_ERR_ARG);
+    CHECK_EQ_INT(P.n, nd);
+    gk_scene_destroy(&sc);
+    gk_packing_free(&pk);
+    gk_hybrid_cont_free(&cont);
+    gk_mpm_points_destroy(&P);
+    free(vg[0]);
+    free(vg[1]);
+    free(gz);
+}
+
+/* ================================================================ Cundall strain
+ * App. A: grad u = (Sum du dX^T)(Sum dX dX^T)^-1 is exact for an affine
+ * displacement u = (A - I) X + b, whatever the neighbours, also across a
+ * periodic seam. */
+TEST(cundall_exact_for_affine_motion) {
+    int n = 400, p, k, nan = 0;
+    double *X[2], *x[2], *eps, A[4] = {1.02, 0.15, -0.01, 0.97}, b[2] = {0.003, -0.001}, period[2] = {0.02, 0.0};
+    gk_rng rng;
+    gk_err e;
+    gk_rng_seed(&rng, 11);
+    for (k = 0; k < 2; ++k) {
+        X[k] = (double *)malloc((size_t)n * sizeof(double));
+        x[k] = (double *)malloc((size_t)n * sizeof(double));
+    }
+    eps = (double *)malloc(4 * (size_t)n * sizeof(double));
+    for (p = 0; p < n; ++p) {
+        X[0][p] = 0.02 * gk_rng_uniform(&rng);
+        X[1][p] = 0.02 * gk_rng_uniform(&rng);
+        x[0][p] = A[0] * X[0][p] + A[1] * X[1][p] + b[0];
+        x[1][p] = A[2] * X[0][p] + A[3] * X[1][p] + b[1];
+    }
+    CHECK(gk_hybrid_cundall(n, (const double *const *)X, (const double *const *)x, NULL, 2.5e-3, eps, NULL, &e) ==
+          GK_OK);
+    for (p = 0; p < n; ++p) {
+        if (isnan(eps[4 * p])) {
+            ++nan;
+            continue;
+        }
+        CHECK_NEAR(eps[4 * p], A[0] - 1.0, 1e-12);
+        CHECK_NEAR(eps[4 * p + 1], A[3] - 1.0, 1e-12);
+        CHECK_NEAR(eps[4 * p + 2], 0.5 * (A[1] + A[2]), 1e-12);
+        {
+            double m = 0.5 * (A[0] + A[3]) - 1.0, d0 = A[0] - 1.0 - m, d1 = A[3] - 1.0 - m, s = 0.5 * (A[1] + A[2]);
+            CHECK_NEAR(eps[4 * p + 3], sqrt(2.0 * (d0 * d0 + d1 * d1 + 2.0 * s * s)), 1e-12);
+        }
+    }
+    CHECK(nan < n / 50);
+    /* periodic along x: a shear that carries grains across the seam (wrapped positions) */
+    for (p = 0; p < n; ++p) {
+        x[0][p] = X[0][p] + 0.3 * X[1][p];
+        x[0][p] -= period[0] * floor(x[0][p] / period[0]);
+        x[1][p] = X[1][p];
+    }
+    CHECK(gk_hybrid_cundall(n, (const double *const *)X, (const double *const *)x, period, 2.5e-3, eps, NULL, &e) ==
+          GK_OK);
+    for (p = 0; p < n; ++p) {
+        if (isnan(eps[4 * p])) continue;
+        CHECK_NEAR(eps[4 * p + 2], 0.15, 1e-12);
+        CHECK_NEAR(eps[4 * p + 3], 0.3, 1e-12); /* simple shear: gamma */
+    }
+    CHECK(gk_hybrid_cundall(n, (const double *const *)X, (const double *const *)x, NULL, -1.0, eps, NULL, &e) ==
+          GK_ERR_ARG);
+    for (k = 0; k < 2; ++k) {
+        free(X[k]);
+        free(x[k]);
+    }
+    free(eps);
+}
+
+/* ================================================================ band thickness
+ * App. A on a synthetic band: values high in a tilted strip (rows 1 mm
+ * apart, |w| <= 2.5 mm), low elsewhere, one far outlier: the minimum-area
+ * box of the top percentile (the outlier cut) spans the strip's rows. */
+TEST(band_thickness_of_a_strip) {
+    int n = 0, i, j;
+    double x[4000], y[4000], v[4000], ang = 0.4, c = cos(ang), s = sin(ang);
+    gk_hybrid_band_result b;
+    gk_err e;
+    for (j = 0; j < 60; ++j)
+        for (i = 0; i < 60; ++i) {
+            double u = -0.03 + 0.001 * i, w = -0.03 + 0.001 * j;
+            x[n] = c * u - s * w;
+            y[n] = s * u + c * w;
+            v[n] = fabs(w) <= 0.0025 ? 1.0 + 0.001 * i : 0.01 * (i % 7);
+            ++n;
+        }
+    x[n] = 0.5;
+    y[n] = 0.5;
+    v[n++] = 5.0;
+    /* the strip's 300 high values are rows w = -2..2 mm: the top 5 % of 3601 lie in it */
+    CHECK(gk_hybrid_band(n, x, y, v, 95.0, 2.0, &b, NULL, &e) == GK_OK);
+    CHECK_NEAR(b.thickness, 0.004, 1e-9);
+    CHECK_NEAR(b.angle, ang, 1e-9);
+    CHECK_EQ_INT(b.kept, b.selected - 1);
+    CHECK(gk_hybrid_band(n, x, y, v, 100.0, 2.0, &b, NULL, &e) == GK_ERR_ARG);
+}
+
+/* ================================================================ training
+ * Sec 4.1.1 / Fig 13: a packing whose boundary is moved by the continuum's
+ * simple-shear displacement builds the shear stress the continuum carries;
+ * the untrained packing has almost none. */
+TEST(training_raises_packing_stress) {
+    gk_packing pk;
+    gk_scene sc;
+    gk_scene_def sd;
+    double *u[2], s0[9], s1[9], W, H, gam = 0.02, P = 1e5;
+    unsigned char *bnd;
+    int p, n;
+    gk_err e;
+    CHECK(consolidated_packing(QUICK(300, 150), 1.0, P, 9, &pk) == 0);
+    W = pk.h[0];
+    H = pk.h[4];
+    sd = scene_def(W, H, 1u); /* periodic along x, open along y */
+    CHECK(gk_scene_create(&sc, &sd, &pk) == GK_OK);
+    n = sc.rve.n;
+    u[0] = (double *)malloc((size_t)n * sizeof(double));
+    u[1] = (double *)malloc((size_t)n * sizeof(double));
+    bnd = (unsigned char *)malloc((size_t)n);
+    for (p = 0; p < n; ++p) {
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        bnd[p] = x[1] < 1.5e-3 || x[1] > H - 1.5e-3;
+        u[0][p] = gam * (x[1] - 0.5 * H);
+        u[1][p] = 0.0;
+    }
+    /* untrained: the boundary held still */
+    {
+        double z[3] = {0.0, 0.0, 0.0};
+        for (p = 0; p < n; ++p)
+            if (bnd[p]) gk_scene_prescribe(&sc, p, z, z);
+        CHECK(gk_scene_step(&sc, QUICK(2000, 1000)) == GK_OK);
+        gk_scene_stress(&sc, W * H, s0);
+        for (p = 0; p < n; ++p)
+            if (bnd[p]) gk_scene_release(&sc, p);
+    }
+    CHECK(gk_hybrid_train(&sc, bnd, (const double *const *)u, QUICK(20000, 8000), QUICK(2000, 1000), &e) == GK_OK);
+    CHECK_EQ_INT(sc.nprescribed, 0);
+    {
+        double z[3] = {0.0, 0.0, 0.0};
+        for (p = 0; p < n; ++p)
+            if (bnd[p]) gk_scene_prescribe(&sc, p, z, z);
+        CHECK(gk_scene_step(&sc, 1) == GK_OK);
+    }
+    gk_scene_stress(&sc, W * H, s1);
+    printf("    sigma_xy untrained %.3g kPa, trained %.3g kPa (sigma_yy %.3g kPa)\n", 1e-3 * s0[1], 1e-3 * s1[1],
+           1e-3 * s1[4]);
+    CHECK(s1[1] > 0.1 * P);          /* simple shear gamma > 0: sigma_xy > 0 (tension-positive) */
+    CHECK(s1[1] > 5.0 * fabs(s0[1])); /* training raised the shear stress */
+    /* bad input is refused */
+    CHECK(gk_hybrid_train(&sc, bnd, (const double *const *)u, 0, 0, &e) == GK_ERR_ARG);
+    gk_scene_destroy(&sc);
+    gk_packing_free(&pk);
+    free(u[0]);
+    free(u[1]);
+    free(bnd);
+}
+
+/* ================================================================ continuum
+ * gk_hybrid_dp_stress on one point (2D, Table 2's K, G, phi_cs, Phi_cs, chi).
+ * (a) A pure spin L = [[0, -w], [w, 0]] inside the yield surface rotates the
+ * stress exactly, sigma' = R sigma R^T with R the rotation by w dt, and
+ * makes no plastic strain (no deviatoric rate: gdot_max = 0).
+ * (b) Simple shear L = [[0, g], [0, 0]] of a dense point (Phi > Phi_cs):
+ * gdot_max = sqrt(2 D':D') = g exactly; after yield the stress stays on
+ * f = sqrt(J2) + eta p = 0 [eq 5, no cohesion] with eta = sin phi, tan phi =
+ * tan phi_cs + (Phi - Phi_cs) chi [eq 7] (Phi at the step's start); the flow is g's [eq 6]: in 2D,
+ * tr deps_p / ||dev deps_p|| = sqrt(2) sin psi, tan psi = (Phi - Phi_cs)
+ * chi (dilation); and Phi follows eq 8, dPhi/ds = -xi Phi (Phi - Phi_cs)
+ * with s = the accumulated ||deps_p||: 1/Phi = 1/Phi_cs + (1/Phi0 -
+ * 1/Phi_cs) exp(-xi Phi_cs s) (a large xi makes the relaxation visible). */
+TEST(continuum_rotation_flow_and_softening) {
+    gk_mpm_points P;
+    gk_hybrid_cont c;
+    gk_mpm_dp dp;
+    gk_err e;
+    const double K = 6.3e8, G = 4.6e8, Phi_cs = 0.815, chi = 7.0, Phi0 = 0.8425, dt = 1e-6;
+    double s0[4] = {-3e5, 0.0, 0.0, -5e5}, th, cs, sn, a, b, d, s = 0.0, ep_prev[3], Phi_prev = Phi0;
+    int k, it;
+    CHECK(gk_mpm_points_create(&P, 2, 1, NULL, &e) == GK_OK);
+    CHECK(gk_mpm_dp_init(&dp, 2, K, G, 0.3, 0.0, 0.0, &e) == GK_OK);
+    dp.tan_phi_cs = tan(0.27);
+    dp.Phi_cs = Phi_cs;
+    dp.chi = chi;
+    dp.xi = 20.0;
+    CHECK(gk_hybrid_cont_init(&c, &P, &dp, Phi0, NULL, &e) == GK_OK);
+    /* (a) spin */
+    for (k = 0; k < 9; ++k) P.sigma[k] = P.L[k] = 0.0;
+    P.sigma[0] = s0[0], P.sigma[4] = s0[3], P.sigma[1] = P.sigma[3] = 1e5, P.sigma[8] = -4e5;
+    P.L[1] = -1e4, P.L[3] = 1e4;
+    CHECK(gk_hybrid_dp_stress(&P, dt, &c, &e) == GK_OK);
+    th = 1e4 * dt, cs = cos(th), sn = sin(th), a = s0[0], b = 1e5, d = s0[3];
+    CHECK_NEAR(P.sigma[0], cs * cs * a - 2.0 * cs * sn * b + sn * sn * d, 1e-6);
+    CHECK_NEAR(P.sigma[4], sn * sn * a + 2.0 * cs * sn * b + cs * cs * d, 1e-6);
+    CHECK_NEAR(P.sigma[1], cs * sn * (a - d) + (cs * cs - sn * sn) * b, 1e-6);
+    CHECK_NEAR(P.sigma[3], P.sigma[1], 0.0);
+    CHECK_NEAR(c.rate[0], 0.0, 0.0);
+    CHECK_NEAR(c.ep[0] + fabs(c.ep[1]) + fabs(c.ep[2]), 0.0, 0.0);
+    CHECK_NEAR(c.Phi[0], Phi0, 0.0);
+    CHECK_NEAR(c.gdot_max, 0.0, 1e-12);
+    /* (b) simple shear from -400 kPa isotropic */
+    for (k = 0; k < 9; ++k) P.sigma[k] = P.L[k] = 0.0;
+    P.sigma[0] = P.sigma[4] = P.sigma[8] = -4e5;
+    P.L[1] = 10.0;
+    ep_prev[0] = ep_prev[1] = ep_prev[2] = 0.0;
+    for (it = 0; it < 20000; ++it) {
+        for (k = 0; k < 3; ++k) ep_prev[k] = c.ep[k];
+        Phi_prev = c.Phi[0];
+        if (gk_hybrid_dp_stress(&P, dt, &c, &e) != GK_OK) break;
+        s += c.rate[0] * dt;
+    }
+    CHECK_EQ_INT(it, 20000);
+    CHECK_NEAR(c.gdot_max, 10.0, 1e-12);
+    CHECK(s > 0.05); /* yielded: plastic strain far beyond the elastic ~1e-3 */
+    {
+        /* the return map of a step uses the Phi it starts with (eq 8 then updates Phi) */
+        double Phi = c.Phi[0], tphi = tan(0.27) + (Phi_prev - Phi_cs) * chi, eta = sin(atan(tphi));
+        double p = 0.5 * (P.sigma[0] + P.sigma[4]), q = sqrt(0.25 * (P.sigma[0] - P.sigma[4]) * (P.sigma[0] - P.sigma[4]) + P.sigma[1] * P.sigma[1]);
+        double de[3], tr, dev, spsi = sin(atan((Phi_prev - Phi_cs) * chi));
+        double inv = 1.0 / Phi_cs + (1.0 / Phi0 - 1.0 / Phi_cs) * exp(-dp.xi * Phi_cs * s);
+        CHECK_NEAR(q + eta * p, 0.0, 1e-6 * fabs(p)); /* on the yield surface [eq 5] */
+        for (k = 0; k < 3; ++k) de[k] = c.ep[k] - ep_prev[k];
+        tr = de[0] + de[1];
+        dev = sqrt(0.5 * (de[0] - de[1]) * (de[0] - de[1]) + 2.0 * de[2] * de[2]);
+        CHECK(tr > 0.0); /* dilation while Phi > Phi_cs */
+        CHECK_REL(tr / dev, sqrt(2.0) * spsi, 1e-3); /* eq 6 flow direction */
+        CHECK(Phi < Phi0 && Phi > Phi_cs);
+        CHECK_REL(Phi - Phi_cs, 1.0 / inv - Phi_cs, 1e-3); /* eq 8, integrated */
+        printf("    s = %.4f, Phi %.5f (eq 8: %.5f), q/|p| = %.4f, tr/dev = %.4f (sqrt2 sin psi = %.4f)\n", s, Phi,
+               1.0 / inv, q / fabs(p), tr / dev, sqrt(2.0) * spsi);
+    }
+    gk_hybrid_cont_free(&c);
+    gk_mpm_points_destroy(&P);
+}
+
+int main(int argc, char **argv) {
+    gk_test_init(argc, argv);
+    RUN(oracle_synthetic_fields);
+    RUN(continuum_rotation_flow_and_softening);
+    RUN(oracle_persistence);
+    RUN(zones_and_distance);
+    RUN(periodic_fold);
+    RUN(history_window);
+    RUN(coupling_equalises_and_conserves);
+    RUN(enrichment_conserves_mass_and_momentum);
+    RUN(cundall_exact_for_affine_motion);
+    RUN(band_thickness_of_a_strip);
+    RUN(training_raises_packing_stress);
+    return gk_test_done();
+}

@@ -1,0 +1,186 @@
+/* test_hybrid_driver.c - smoke tests of examples/hybrid.c (the hybrid
+ * continuum-grain simulation of Chen et al. 2021): each mode runs on a tiny
+ * specimen, writes its documented outputs, starts at the applied stress, the
+ * hybrid enriches conserving mass, the result does not depend on the thread
+ * count, and bad arguments are refused. Needs build/hybrid (`make test`
+ * builds examples first). Seconds in all. */
+#define GK_TEST_DRIVERS
+#include "gk_test.h"
+#include <stdlib.h>
+
+/* a 1.2 x 2.4 cm planar specimen (about 250 grains, 4 x 8 cells): tiny but the whole path */
+#define PLANAR "build/hybrid --test planar --width 0.012 --height 0.024 --cell 0.003 --phi0 0.005 "
+#define BIAXIAL "build/hybrid --test biaxial --width 0.012 --height 0.018 --cell 0.003 --quiet "
+#define HEADER "time,strain,tau,sigma_n,eps_v,eps_v_band,grains,points,enriched,flagged_nodes,seconds\n"
+#define NCOL 11
+
+/* the data rows of a hybrid.csv (at most max), -1 when unreadable or the header differs */
+static int read_rows(const char *path, double rows[][NCOL], int max) {
+    FILE *fp = fopen(path, "r");
+    char line[1024];
+    int n = 0;
+    if (!fp) return -1;
+    if (!fgets(line, sizeof line, fp) || strcmp(line, HEADER) != 0) n = -1;
+    while (n >= 0 && n < max && fgets(line, sizeof line, fp)) {
+        double *r = rows[n];
+        if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &r[0], &r[1], &r[2], &r[3], &r[4], &r[5],
+                   &r[6], &r[7], &r[8], &r[9], &r[10]) != NCOL)
+            break;
+        ++n;
+    }
+    fclose(fp);
+    return n;
+}
+
+/* two files equal line by line in everything before the last comma (the seconds) */
+static int same_but_seconds(const char *a, const char *b) {
+    FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
+    char la[1024], lb[1024];
+    int same = fa && fb, rows = 0;
+    while (same) {
+        char *pa = fgets(la, sizeof la, fa), *pb = fgets(lb, sizeof lb, fb), *ca, *cb;
+        if (!pa || !pb) {
+            same = !pa && !pb;
+            break;
+        }
+        ca = strrchr(la, ',');
+        cb = strrchr(lb, ',');
+        same = ca && cb && ca - la == cb - lb && !strncmp(la, lb, (size_t)(ca - la));
+        ++rows;
+    }
+    if (fa) fclose(fa);
+    if (fb) fclose(fb);
+    return same && rows > 2;
+}
+
+/* hybrid mode, planar shear: the continuum starts at the applied normal
+ * stress (sigma_n = 400 kPa, tau = 0 in row 0), the oracle triggers, the
+ * swap deletes points, adds grains and keeps the total mass (the driver's
+ * "mass A -> B" line: A = B), the grains carry shear afterwards (tau > 0),
+ * every output is written; run again with 1 thread on the packing the first
+ * run wrote, the CSV is identical but for the seconds. */
+TEST(hybrid_planar_enriches_and_is_thread_independent) {
+    double r[8][NCOL];
+    int n, k;
+    system("rm -rf build/t_hyA build/t_hy1");
+    CHECK(system(PLANAR "--mode hybrid --strain 0.005 --out-every 0.0025 --window 0.001 0.005 --threads 2 "
+                        "--out build/t_hyA > build/t_hyA.out 2>&1") == 0);
+    n = read_rows("build/t_hyA/hybrid.csv", r, 8);
+    CHECK_EQ_INT(n, 3);
+    if (n != 3) return;
+    CHECK_NEAR(r[0][3], 4e5, 1e-6); /* sigma_n [Pa], consolidated state */
+    CHECK_NEAR(r[0][2], 0.0, 1e-6); /* tau */
+    CHECK(r[0][6] == 0.0 && r[0][7] > 0.0 && r[0][8] == 0.0); /* no grains, points, not enriched */
+    CHECK(r[2][8] == 1.0);                                    /* enriched */
+    CHECK(r[2][6] > 50.0);                                    /* grains */
+    CHECK(r[2][7] > 0.0 && r[2][7] < r[0][7]);                /* points deleted, some remain */
+    CHECK(r[2][2] > 0.0);                                     /* shear stress carried */
+    CHECK_NEAR(r[2][1], 0.005, 1e-4);                         /* strain reached */
+    for (k = 0; k < 3; ++k) CHECK(r[k][10] >= 0.0);
+    {
+        FILE *fp = fopen("build/t_hyA.out", "r");
+        char line[1024];
+        double m0 = -1, m1 = -2;
+        while (fp && fgets(line, sizeof line, fp)) {
+            const char *q = strstr(line, "mass ");
+            if (!strncmp(line, "swap:", 5) && q) sscanf(q, "mass %lf -> %lf", &m0, &m1);
+        }
+        if (fp) fclose(fp);
+        CHECK(m0 > 0.0);
+        CHECK_NEAR(m1, m0, 1e-4 * m0); /* printed to 5 digits */
+    }
+    CHECK(gk_test_result("build/t_hyA.out", "strain_at_enrichment") > 0.0);
+    CHECK(gk_test_result("build/t_hyA.out", "peak_tau") > 0.0);
+    CHECK(gk_test_file_has("build/t_hyA.out", "RESULT mode=hybrid peak_tau="));
+    CHECK(gk_test_file_has("build/t_hyA/points_start.vtk", "POINTS"));
+    CHECK(gk_test_file_has("build/t_hyA/grains_enrichment.vtk", "POINTS"));
+    CHECK(gk_test_file_has("build/t_hyA/grains_end.vtk", "POINTS"));
+    CHECK(gk_test_file_has("build/t_hyA/stress_strain.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_hyA/volume.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_hyA/band.svg", "<svg"));
+    CHECK(system(PLANAR "--mode hybrid --strain 0.005 --out-every 0.0025 --window 0.001 0.005 --threads 1 "
+                        "--packing build/t_hyA/packing.txt --out build/t_hy1 > build/t_hy1.out 2>&1") == 0);
+    CHECK(same_but_seconds("build/t_hyA/hybrid.csv", "build/t_hy1/hybrid.csv"));
+}
+
+/* dem mode, biaxial: the specimen starts at the confining pressure
+ * (sigma_n = 100 kPa, tau = 0), axial compression raises the deviator
+ * (tau > 0, sigma_n > 100 kPa), App. A's band measurement runs on the grains */
+TEST(hybrid_biaxial_dem_loads) {
+    double r[8][NCOL];
+    int n;
+    system("rm -rf build/t_hyB");
+    CHECK(system(BIAXIAL "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
+                         "--out build/t_hyB > build/t_hyB.out 2>&1") == 0);
+    n = read_rows("build/t_hyB/hybrid.csv", r, 8);
+    CHECK_EQ_INT(n, 4);
+    if (n != 4) return;
+    CHECK_NEAR(r[0][3], 1e5, 1e-6);
+    CHECK_NEAR(r[0][2], 0.0, 1e-6);
+    CHECK(r[0][6] > 100.0 && r[0][7] == 0.0);
+    CHECK(r[3][2] > 0.0 && r[3][3] > 1e5);
+    CHECK(gk_test_result("build/t_hyB.out", "band_thickness_D50") > 0.0);
+    CHECK(gk_test_file_has("build/t_hyB/grains_end.vtk", "POINTS"));
+}
+
+/* continuum mode, biaxial: MPM only, never enriched, starts at the confining pressure */
+TEST(hybrid_biaxial_continuum_runs) {
+    double r[8][NCOL];
+    int n, k;
+    system("rm -rf build/t_hyC");
+    CHECK(system(BIAXIAL "--mode continuum --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
+                         "--out build/t_hyC > build/t_hyC.out 2>&1") == 0);
+    n = read_rows("build/t_hyC/hybrid.csv", r, 8);
+    CHECK_EQ_INT(n, 4);
+    if (n != 4) return;
+    CHECK_NEAR(r[0][3], 1e5, 1e-6);
+    for (k = 0; k < n; ++k) CHECK(r[k][6] == 0.0 && r[k][8] == 0.0 && r[k][7] == r[0][7]);
+    CHECK(r[3][3] > 1e5);
+    CHECK(gk_test_file_has("build/t_hyC.out", "RESULT mode=continuum"));
+    CHECK(gk_test_file_has("build/t_hyC/points_end.vtk", "POINTS"));
+}
+
+/* a bad argument: status != 0, the message, and no output directory */
+static int refused(const char *flags, const char *msg) {
+    char cmd[512];
+    FILE *fp;
+    int ok;
+    system("rm -rf build/t_hybad");
+    snprintf(cmd, sizeof cmd, "build/hybrid %s --out build/t_hybad > build/t_bad.out 2>&1", flags);
+    ok = system(cmd) != 0 && gk_test_file_has("build/t_bad.out", msg);
+    fp = fopen("build/t_hybad", "r");
+    if (fp) fclose(fp), ok = 0;
+    if (!ok) printf("    not refused as expected: hybrid %s\n", flags);
+    return ok;
+}
+
+TEST(hybrid_refuses_bad_arguments) {
+    CHECK(refused("--mode dem", "--test planar|biaxial is required"));
+    CHECK(refused("--test indent --mode dem", "is not implemented"));
+    CHECK(refused("--test planar --mode foo", "--mode foo"));
+    CHECK(refused("--test planar --mode hybrid --train 2", "--train 2"));
+    CHECK(refused("--test planar --mode dem --width 0.03x", "not a number"));
+    CHECK(refused("--test planar --mode dem --threads 1.5", "--threads 1.5"));
+    CHECK(refused("--test planar --mode dem --window 0.5 0.1", "--window"));
+    CHECK(refused("--test planar --mode dem --strain 0.1", "beyond --strain"));
+    CHECK(refused("--test planar --mode dem --speed", "--speed"));
+    CHECK(refused("--test planar --mode dem --bogus 1", "--bogus"));
+    /* an unreadable packing: an error, not a crash (the directory may exist) */
+    CHECK(system("build/hybrid --test planar --mode dem --packing build/no_such_packing.txt --out build/t_hybad "
+                 "> build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "no_such_packing"));
+    /* --out naming an existing file */
+    CHECK(system("rm -rf build/t_hyfile && touch build/t_hyfile") == 0);
+    CHECK(system("build/hybrid --test planar --mode dem --out build/t_hyfile > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "t_hyfile"));
+    remove("build/t_hyfile");
+}
+
+int main(int argc, char **argv) {
+    gk_test_init(argc, argv);
+    RUN(hybrid_refuses_bad_arguments);
+    RUN(hybrid_planar_enriches_and_is_thread_independent);
+    RUN(hybrid_biaxial_dem_loads);
+    RUN(hybrid_biaxial_continuum_runs);
+    return gk_test_done();
+}
