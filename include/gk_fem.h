@@ -236,9 +236,10 @@ GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol,
  * exactly as the paper writes the discrete form: the weights are normalised
  * per point and carry NO quadrature weights or volumes (on a uniform mesh the
  * two agree; on a graded one the paper's form weighs a fine region more).
- *   - Periodic directions: distances are minimum-image distances across the
- *     faces of a period (period[k] > 0 along axis k); 2R must be below every
- *     period (an image counted twice is an error).
+ *   - Periodic directions (period[k] > 0 along axis k): every periodic
+ *     image of x_J within R counts, a(x_I, x_J) = sum_images a(|x_J + k P -
+ *     x_I|) (I's own images too when a period is below R): the average over
+ *     the infinite periodic medium, for any R and period.
  *   - Boundaries: points near a free or fixed boundary have a neighbourhood
  *     cut by it; the renormalisation of A.4 makes the weights still sum to
  *     one (a constant is kept), but the kernel is then one-sided, so a
@@ -1750,16 +1751,29 @@ GKDEF void gk_nonlocal_free(gk_nonlocal *nl) {
     memset(nl, 0, sizeof *nl);
 }
 
-/* squared (minimum-image) distance between points a and b */
-static double gk__nl_dist2(int dim, const double *xa, const double *xb, const double *period) {
-    double s = 0.0;
-    int k;
+/* bell weight of point b (with all its periodic images) seen from a */
+static double gk__nl_weight(int dim, const double *xa, const double *xb, const double *period, double R) {
+    int k, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, i0, i1, i2;
+    double d[3] = {0, 0, 0}, w = 0.0;
     for (k = 0; k < dim; ++k) {
-        double d = xb[k] - xa[k];
-        if (period && period[k] > 0.0) d -= period[k] * floor(d / period[k] + 0.5);
-        s += d * d;
+        d[k] = xb[k] - xa[k];
+        if (period && period[k] > 0.0) { /* images k P with |d + k P| < R */
+            lo[k] = (int)floor((-R - d[k]) / period[k]) + 1;
+            hi[k] = (int)ceil((R - d[k]) / period[k]) - 1;
+        }
     }
-    return s;
+    for (i0 = lo[0]; i0 <= hi[0]; ++i0)
+        for (i1 = lo[1]; i1 <= hi[1]; ++i1)
+            for (i2 = lo[2]; i2 <= hi[2]; ++i2) {
+                int im[3] = {i0, i1, i2};
+                double r2 = 0.0;
+                for (k = 0; k < dim; ++k) {
+                    double e = d[k] + (im[k] ? im[k] * period[k] : 0.0);
+                    r2 += e * e;
+                }
+                w += gk_nonlocal_bell(sqrt(r2), R);
+            }
+    return w;
 }
 
 GKDEF gk_result gk_nonlocal_build(gk_nonlocal *nl, int dim, int n, const double *x, double R, const double *period,
@@ -1776,19 +1790,13 @@ GKDEF gk_result gk_nonlocal_build(gk_nonlocal *nl, int dim, int n, const double 
         if (!isfinite(x[k])) return gk_err_set(err, GK_ERR_NAN, "nonlocal: coordinate %d of point %d is %g", k % dim, k / dim, x[k]);
     if (period)
         for (k = 0; k < dim; ++k) {
-            if (!(period[k] >= 0.0) || !isfinite(period[k]))
-                return gk_err_set(err, GK_ERR_ARG, "nonlocal: period %g along axis %d", period[k], k);
-            if (period[k] > 0.0 && !(2.0 * R < period[k]))
-                return gk_err_set(err, GK_ERR_ARG,
-                                  "nonlocal: diameter 2R = %g is not below the period %g along axis %d (a point "
-                                  "would meet its own image)",
-                                  2.0 * R, period[k], k);
+            if (!(period[k] >= 0.0) || !isfinite(period[k]) || (period[k] > 0.0 && !(R / period[k] < 1000.0)))
+                return gk_err_set(err, GK_ERR_ARG, "nonlocal: period %g along axis %d (radius %g)", period[k], k, R);
         }
     /* count, then fill: neighbours in ascending order */
     for (I = 0; I < n; ++I)
         for (J = 0; J < n; ++J)
-            if (J == I || gk_nonlocal_bell(sqrt(gk__nl_dist2(dim, x + (size_t)dim * I, x + (size_t)dim * J, period)), R) > 0.0)
-                ++cnt;
+            if (J == I || gk__nl_weight(dim, x + (size_t)dim * I, x + (size_t)dim * J, period, R) > 0.0) ++cnt;
     cap = cnt;
     z.start = (int *)gk_alloc(&z.alloc, ((size_t)n + 1) * sizeof(int));
     z.nbr = (int *)gk_alloc(&z.alloc, cap * sizeof(int));
@@ -1803,7 +1811,8 @@ GKDEF gk_result gk_nonlocal_build(gk_nonlocal *nl, int dim, int n, const double 
         size_t b = cnt, c;
         z.start[I] = (int)cnt;
         for (J = 0; J < n; ++J) {
-            double a = J == I ? 1.0 : gk_nonlocal_bell(sqrt(gk__nl_dist2(dim, x + (size_t)dim * I, x + (size_t)dim * J, period)), R);
+            double a = gk__nl_weight(dim, x + (size_t)dim * I, x + (size_t)dim * J, period, R);
+            if (J == I && !(a > 0.0)) a = 1.0; /* R = 0: the point alone */
             if (!(a > 0.0)) continue;
             z.nbr[cnt] = J;
             z.w[cnt++] = a;

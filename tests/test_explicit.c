@@ -520,7 +520,8 @@ TEST(corotational_stretch_then_rotation) {
 
 /* Appendix A: the bell weights of every point sum to one; on a regular grid
  * a linear field is reproduced exactly where the neighbourhood is whole, and
- * everywhere across periodic faces; R = 0 is the local model */
+ * everywhere across periodic faces (with every image within R, also for a
+ * period below 2R); R = 0 is the local model */
 TEST(nonlocal_weights_and_linear_field) {
     int nx = 12, ny = 9, nz = 7, n = nx * ny * nz, I, p, i, j, k, interior = 0;
     double h = 1e-3, R = 2.6e-3, *x = (double *)malloc(sizeof(double) * 3 * n), *phi, *out;
@@ -580,8 +581,31 @@ TEST(nonlocal_weights_and_linear_field) {
     gk_nonlocal_apply(&nl, 2, phi, out);
     for (I = 0; I < 2 * n; ++I) CHECK(out[I] == phi[I]);
     gk_nonlocal_free(&nl);
+    /* a period shorter than 2R: every image within R counts; on a periodic
+     * lattice the operator commutes with translations, so a Fourier mode is
+     * only scaled: <sin(2 pi x / P)> = c sin(2 pi x / P), c equal at every point */
+    {
+        double x1[8 * 3], ph[8], av[8], P = 8e-3, c = 0.0;
+        double per1[3] = {P, 0.0, 0.0};
+        for (I = 0; I < 8; ++I) {
+            x1[3 * I] = (I + 0.5) * 1e-3, x1[3 * I + 1] = 0.0, x1[3 * I + 2] = 0.0;
+            ph[I] = sin(2.0 * GK_PI * x1[3 * I] / P);
+        }
+        CHECK(gk_nonlocal_build(&nl, 3, 8, x1, 1.3 * P, per1, NULL, &err) == GK_OK);
+        gk_nonlocal_apply(&nl, 1, ph, av);
+        for (I = 0; I < 8; ++I) {
+            double s = 0.0;
+            for (p = nl.start[I]; p < nl.start[I + 1]; ++p) s += nl.w[p];
+            CHECK_NEAR(s, 1.0, 1e-14);
+            CHECK_EQ_INT(nl.start[I + 1] - nl.start[I], 8); /* every point, with its images */
+            if (I == 0) c = av[0] / ph[0];
+            CHECK_NEAR(av[I], c * ph[I], 1e-14);
+        }
+        CHECK(fabs(c) < 1.0); /* averaging attenuates the mode */
+        gk_nonlocal_free(&nl);
+    }
     /* bad input */
-    per[0] = 2.0 * R;
+    per[0] = -1.0;
     CHECK(gk_nonlocal_build(&nl, 3, n, x, R, per, NULL, &err) == GK_ERR_ARG);
     CHECK(strstr(err.msg, "axis 0") != NULL);
     CHECK(gk_nonlocal_build(&nl, 3, n, x, -1.0, NULL, NULL, &err) == GK_ERR_ARG);
