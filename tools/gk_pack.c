@@ -2,6 +2,9 @@
  *
  *   build/gk_pack --dim 2 --n 400 --rmin 0.003 --rmax 0.007 --pressure 1e5 \
  *                 [--consolidation-friction 0 | --target-void-ratio E] --out FILE
+ *   build/gk_pack --dim 3 --n 1000 --rmin 2.15e-4 --rmax 5.9e-4 --pressure 4.16e5 \
+ *                 --law hertz --G 2.9e10 --poisson 0.15 --friction-angle 0.4636 \
+ *                 --density 2492 --dt-factor 0.2 --out FILE     (Hertz-Mindlin)
  *
  * A random loose cloud (no overlaps) is compressed by a stress servo until
  * every normal stress is within the tolerance of the target and the
@@ -34,6 +37,11 @@ static void usage(FILE *fp) {
             "  --target-void-ratio E      search the consolidation friction that gives void ratio E\n"
             "  --friction-angle A         contact friction angle after consolidation [rad] (0.5)\n"
             "  --E, --kt-ratio, --density, --thickness, --damping   material (seed 000 defaults)\n"
+            "  --law linear|hertz         contact law (linear); hertz: Hertz-Mindlin from --G and --poisson\n"
+            "  --G, --poisson             Hertz-Mindlin grain shear modulus [Pa] and Poisson ratio (sets E = 2G(1+nu))\n"
+            "  --contact-damping Z        tangential viscous damping, fraction of critical (0)\n"
+            "  --max-strain-rate R        consolidation strain-rate cap [1/s] (0: inertial number 1e-2)\n"
+            "  --dt-factor F              DEM step as a fraction of the critical step (0.5; Hertz: use 0.2)\n"
             "  --seed S                   random seed (1)\n"
             "  --tol T                    relative stress tolerance (1e-3)\n"
             "  --out FILE                 output packing\n");
@@ -41,7 +49,8 @@ static void usage(FILE *fp) {
 
 typedef struct opts {
     int dim, n;
-    double rmin, rmax, pressure, mu_cons, target_e, phi, E, ktr, rho, thick, damp, tol;
+    double rmin, rmax, pressure, mu_cons, target_e, phi, E, ktr, rho, thick, damp, tol, G, nu, zeta_t, dtf, rate;
+    int hertz;
     unsigned long seed;
     const char *psd, *psd_by, *out;
 } opts;
@@ -51,7 +60,11 @@ static gk_result consolidate_once(const opts *o, const gk_packing *cloud, double
     gk_rve_def def = gk_rve_def_default();
     gk_consolidate_def cd;
     gk_result r;
-    def.mat.young = o->E;
+    def.mat.young = o->hertz ? 2.0 * o->G * (1.0 + o->nu) : o->E;
+    def.mat.law = o->hertz ? GK_LAW_HERTZ : GK_LAW_LINEAR;
+    def.mat.poisson = o->nu;
+    def.mat.zeta_t = o->zeta_t;
+    def.dt_factor = o->dtf;
     def.mat.kt_ratio = o->ktr;
     def.mat.density = o->rho;
     def.mat.friction = tan(o->phi) > mu_cons ? tan(o->phi) : mu_cons;
@@ -63,6 +76,7 @@ static gk_result consolidate_once(const opts *o, const gk_packing *cloud, double
     cd.pressure = o->pressure;
     cd.friction = mu_cons;
     cd.stress_tol = o->tol;
+    cd.max_strain_rate = o->rate;
     r = gk_rve_consolidate(rve, &cd, rep);
     if (!r) r = gk_rve_set_friction(rve, tan(o->phi));
     return r;
@@ -117,6 +131,8 @@ int main(int argc, char **argv) {
     o.damp = 0.1;
     o.tol = 1e-3;
     o.seed = 1;
+    o.nu = 0.25;
+    o.dtf = 0.5;
     o.psd_by = "mass";
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -144,6 +160,18 @@ int main(int argc, char **argv) {
         else if (!strcmp(a, "--density")) bad = real_opt(a, v, &o.rho);
         else if (!strcmp(a, "--thickness")) bad = real_opt(a, v, &o.thick);
         else if (!strcmp(a, "--damping")) bad = real_opt(a, v, &o.damp);
+        else if (!strcmp(a, "--G")) bad = real_opt(a, v, &o.G);
+        else if (!strcmp(a, "--poisson")) bad = real_opt(a, v, &o.nu);
+        else if (!strcmp(a, "--contact-damping")) bad = real_opt(a, v, &o.zeta_t);
+        else if (!strcmp(a, "--dt-factor")) bad = real_opt(a, v, &o.dtf);
+        else if (!strcmp(a, "--max-strain-rate")) bad = real_opt(a, v, &o.rate);
+        else if (!strcmp(a, "--law")) {
+            if (!strcmp(v, "hertz")) o.hertz = 1;
+            else if (strcmp(v, "linear")) {
+                fprintf(stderr, "gk_pack: --law '%s' is neither linear nor hertz\n", v);
+                bad = 1;
+            }
+        }
         else if (!strcmp(a, "--seed")) {
             char *e;
             errno = 0;
@@ -161,6 +189,10 @@ int main(int argc, char **argv) {
         }
         if (bad) return 2;
         ++i;
+    }
+    if (o.hertz && !(o.G > 0.0)) {
+        fprintf(stderr, "gk_pack: --law hertz needs --G > 0 (grain shear modulus)\n");
+        return 2;
     }
     if (!o.out) {
         fprintf(stderr, "gk_pack: --out is required (see --help)\n");
@@ -230,23 +262,38 @@ int main(int argc, char **argv) {
     {
         gk_coordination z;
         gk_homog_coordination(&rve, &z);
+        char law[256], cmd[768];
+        size_t len = 0;
+        int a;
+        if (o.hertz)
+            snprintf(law, sizeof law, "Hertz-Mindlin G=%g Pa, nu=%g (E=%g Pa), tangential damping %g of critical",
+                     o.G, o.nu, 2.0 * o.G * (1.0 + o.nu), o.zeta_t);
+        else
+            snprintf(law, sizeof law, "linear kn = E r*, E=%g Pa, kt/kn=%g", o.E, o.ktr);
+        cmd[0] = 0;
+        for (a = 0; a < argc && len + 2 < sizeof cmd; ++a) { /* the command, truncated if very long */
+            int w = snprintf(cmd + len, sizeof cmd - len, "%s%s", a ? " " : "", argv[a]);
+            if (w < 0) break;
+            len += (size_t)w;
+        }
         snprintf(comment, sizeof comment,
                  "consolidated by gk_pack: %dD, %d particles, radii %g-%g m, seed %lu\n"
-                 "material: linear kn = E r*, E=%g Pa, kt/kn=%g, friction angle %g rad (mu %.6g); density %g; "
+                 "command: %s\n"
+                 "material: %s, friction angle %g rad (mu %.6g); density %g; "
                  "2D thickness %g; local damping %g\n"
                  "consolidation friction %.6g; target %g Pa isotropic; %ld steps\n"
-                 "RVE state: stress (Pa, tension +) sxx=%.6f syy=%.6f%s%.6f sxy=%.6f ; void ratio %.6f ; Z=%.4f "
-                 "(YADE skipFree %.6f, mechanical %.4f) ; contacts=%d ; unbalanced=%.3e",
-                 o.dim, o.n, o.rmin, o.rmax, o.seed, o.E, o.ktr, o.phi, tan(o.phi), o.rho, o.thick, o.damp, mu,
+                 "RVE state: stress (Pa, tension +) sxx=%.6f syy=%.6f%s%.6f sxy=%.6f ; void ratio %.6f "
+                 "(porosity %.6f) ; Z=%.4f (YADE skipFree %.6f, mechanical %.4f) ; contacts=%d ; unbalanced=%.3e",
+                 o.dim, o.n, o.rmin, o.rmax, o.seed, cmd, law, o.phi, tan(o.phi), o.rho, o.thick, o.damp, mu,
                  o.pressure, rep.steps, rep.stress[0], rep.stress[4], o.dim == 3 ? " szz=" : " (2D) ",
-                 o.dim == 3 ? rep.stress[8] : 0.0, rep.stress[1], rep.void_ratio, z.z, z.z_nofree, z.z_mech,
-                 z.contacts, rep.unbalanced);
+                 o.dim == 3 ? rep.stress[8] : 0.0, rep.stress[1], rep.void_ratio,
+                 rep.void_ratio / (1.0 + rep.void_ratio), z.z, z.z_nofree, z.z_mech, z.contacts, rep.unbalanced);
         if (gk_rve_to_packing(&rve, &pk, NULL, &err) || gk_packing_write(o.out, &pk, comment, &err)) {
             fprintf(stderr, "gk_pack: %s\n", err.msg);
             return 1;
         }
-        printf("RESULT void_ratio=%.6f Z=%.4f consolidation_friction=%.6g p=%.6g steps=%ld seconds=%.2f\n",
-               rep.void_ratio, z.z, mu, gk_stress_p(rep.stress, o.dim), rep.steps, gk_wtime() - t0);
+        printf("RESULT void_ratio=%.6f porosity=%.6f Z=%.4f Z_mech=%.4f consolidation_friction=%.6g p=%.6g steps=%ld seconds=%.2f\n",
+               rep.void_ratio, rep.void_ratio / (1.0 + rep.void_ratio), z.z, z.z_mech, mu, gk_stress_p(rep.stress, o.dim), rep.steps, gk_wtime() - t0);
     }
     gk_packing_free(&pk);
     gk_packing_free(&cloud);
