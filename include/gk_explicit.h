@@ -63,6 +63,16 @@
  *                          no bound given, omega_start.
  *   GK_DR_OMEGA_IMAGINARY  (U - U0)^T (f_int - f0) < 0 (softening, a load
  *                          reversal): omega^2 < 0; handled as above.
+ *   GK_DR_OMEGA_CAPPED     eq 26 above def.omega_cap (opt-in; e.g. omega_max):
+ *                          with the total U of eq 26 as printed, a free dof
+ *                          whose displacement passes through 0 while its
+ *                          force does not (a pre-stressed body, lateral
+ *                          expansion after compression) sends the quotient
+ *                          to infinity, dt to 0 and alpha dt to a constant:
+ *                          the velocities then decay geometrically, E_kin
+ *                          falls below tol E_kin,max and the step "converges"
+ *                          wherever it stands (tests/test_explicit.c). The
+ *                          cap keeps omega no higher than the mesh can ring.
  *   GK_DR_DT_BOUNDED       the Rayleigh quotient of eq 26 estimates the
  *                          LOWEST active mode: eq 27 with it can exceed the
  *                          stability limit of the highest one. With
@@ -109,6 +119,7 @@
 #define GK_DR_OMEGA_UNDEFINED 1u
 #define GK_DR_OMEGA_IMAGINARY 2u
 #define GK_DR_DT_BOUNDED 4u
+#define GK_DR_OMEGA_CAPPED 8u
 
 typedef struct gk_dr_def {
     double xi;          /* damping ratio of eqs 25, 27; 0 -> 1                         */
@@ -117,6 +128,7 @@ typedef struct gk_dr_def {
     double force_tol;   /* also |r|_inf <= force_tol max(|f_ext|, |f_int|); 0 -> off   */
     double omega_max;   /* bound on the highest frequency [rad/s]; 0 -> no dt guard    */
     double omega_start; /* omega before eq 26 is defined, when omega_max = 0; 0 -> 1   */
+    double omega_cap;   /* upper bound on eq 26's omega [rad/s]; 0 -> none             */
     long max_iter;      /* gk_dr_solve's cap per load step; 0 -> 1 000 000            */
 } gk_dr_def;
 
@@ -276,6 +288,8 @@ GKDEF gk_result gk_dr_init(gk_dr *dr, const gk_dr_def *def, int n, const double 
         return gk_err_set(err, GK_ERR_ARG, "dynamic relaxation: force_tol %g must be >= 0", z.def.force_tol);
     if (!(z.def.omega_max >= 0.0) || !isfinite(z.def.omega_max))
         return gk_err_set(err, GK_ERR_ARG, "dynamic relaxation: omega_max %g must be >= 0", z.def.omega_max);
+    if (!(z.def.omega_cap >= 0.0) || !isfinite(z.def.omega_cap))
+        return gk_err_set(err, GK_ERR_ARG, "dynamic relaxation: omega_cap %g must be >= 0", z.def.omega_cap);
     if (!(z.def.omega_start > 0.0) || !isfinite(z.def.omega_start))
         return gk_err_set(err, GK_ERR_ARG, "dynamic relaxation: omega_start %g must be > 0",
                           z.def.omega_start);
@@ -337,6 +351,10 @@ GKDEF gk_result gk_dr_iterate(gk_dr *dr, const double *f_int, const double *f_ex
             dr->omega > 0.0 ? dr->omega : (dr->def.omega_max > 0.0 ? dr->def.omega_max : dr->def.omega_start);
     } else {
         omega = sqrt(num / den);
+        if (dr->def.omega_cap > 0.0 && omega > dr->def.omega_cap) {
+            omega = dr->def.omega_cap;
+            guards |= GK_DR_OMEGA_CAPPED;
+        }
     }
     alpha = 2.0 * dr->def.xi * omega;                                /* eq 25 */
     dt = dr->def.gamma * gk_explicit_dt_critical(omega, dr->def.xi); /* eq 27 */

@@ -267,6 +267,51 @@ TEST(dr_guards_no_nan_at_zero_or_negative_quotient) {
     CHECK(dr.converged);
 }
 
+/* eq 26 as printed takes the total U: a pre-stressed spring f_int = k u + c
+ * (c = f_int(0) > 0) relaxing from u = 1 to u* = (f_ext - c) / k = -0.5
+ * passes u = 0, where omega^2 = k + c / u -> infinity: dt -> 0, the
+ * velocity decays by (2 - alpha dt) / (2 + alpha dt) per iteration and the
+ * run "converges" (E_kin / E_kin,max <= tol) near u = 0, far from u*; asked
+ * for equilibrium too (force_tol) it never gets there. With omega capped
+ * (omega_cap, the spring's own frequency x 10) it crosses and converges to
+ * u* (force residual 1e-8). */
+static int spring_dr(const gk_dr_def *def, double *u_end, long *iters, unsigned *seen) {
+    double m = 1.0, k = 1.0, c = 1.0, fe = 0.5, u = 1.0, v = 0.0, fi;
+    gk_dr dr;
+    if (gk_dr_init(&dr, def, 1, &m, NULL, NULL) != GK_OK) return -1;
+    gk_dr_begin(&dr);
+    *seen = 0;
+    while (!dr.converged && dr.iter < 20000) {
+        fi = k * u + c;
+        if (gk_dr_iterate(&dr, &fi, &fe, &u, &v) != GK_OK) return -1;
+        *seen |= dr.guards;
+    }
+    *u_end = u, *iters = dr.iter;
+    return dr.converged;
+}
+TEST(dr_omega_cap_keeps_eq26_from_stalling_at_u_zero) {
+    gk_dr_def def;
+    gk_dr dr;
+    double u, m = 1.0;
+    long it;
+    unsigned seen;
+    memset(&def, 0, sizeof def);
+    CHECK(spring_dr(&def, &u, &it, &seen) == 1);
+    printf("    no cap: 'converged' at u = %.3g after %ld iterations (u* = -0.5)\n", u, it);
+    CHECK(fabs(u) < 0.05); /* the stall */
+    def.force_tol = 1e-8;
+    CHECK(spring_dr(&def, &u, &it, &seen) == 0);
+    printf("    no cap, force residual 1e-8 asked: not converged in %ld iterations, u = %.3g\n", it, u);
+    CHECK(fabs(u) < 0.05);
+    def.omega_cap = 10.0;
+    CHECK(spring_dr(&def, &u, &it, &seen) == 1);
+    printf("    capped at 10: u = %.9f after %ld iterations\n", u, it);
+    CHECK(seen & GK_DR_OMEGA_CAPPED);
+    CHECK_NEAR(u, -0.5, 1e-7);
+    def.omega_cap = -1.0;
+    CHECK(gk_dr_init(&dr, &def, 1, &m, NULL, NULL) == GK_ERR_ARG);
+}
+
 /* bad input is refused with a code and changes nothing */
 TEST(bad_input_refused_unchanged) {
     double m[2] = {1.0, 1.0}, u[2] = {1.0, 2.0}, v[2] = {3.0, 4.0}, f[2] = {1.0, NAN}, fe[2] = {0, 0};
@@ -621,6 +666,7 @@ int main(int argc, char **argv) {
     RUN(dr_converges_to_direct_static_solution);
     RUN(dr_without_element_bound_does_not_converge);
     RUN(dr_guards_no_nan_at_zero_or_negative_quotient);
+    RUN(dr_omega_cap_keeps_eq26_from_stalling_at_u_zero);
     RUN(bad_input_refused_unchanged);
     RUN(element_omega_bounds_the_mesh);
     RUN(hex8_wave_speed_within_one_percent);
