@@ -126,11 +126,11 @@ enum { TEST_BIAXIAL = 0, TEST_RVE = 1, TEST_DNS = 2 };
 
 typedef struct opts {
     int test, nx, ny, iso_steps, steps, threads, frame, no_rotation, vtk_every, checkpoint, max_dr, servo_max, rayleigh;
-    int rve_max, stop_after;
+    int rve_max, stop_after, material;
     int tiles[2];
     double strain, pressure, friction, width, height, kn_ratio, dt_factor, damping, tol_energy, tol_dr, tol_servo;
     double xi, gamma, force_tol;
-    const char *out, *restart, *packing, *test_s, *frame_s, *tiles_s, *rayleigh_s;
+    const char *out, *restart, *packing, *test_s, *frame_s, *tiles_s, *rayleigh_s, *material_s;
 } opts;
 
 /* ------------------------------------------------------------------ options */
@@ -165,6 +165,9 @@ static void usage(FILE *fp) {
             "  --dr-xi X --dr-gamma G  eqs 25, 27 (1, 0.5)\n"
             "  --dr-force-tol T        also |f_ext - f_int| <= T max|f| to end a step (0: eq 28 alone)\n"
             "  --rayleigh step|total   eq 26 relative to the step's start (step) or to U = 0 (total)\n"
+            "  --material paper|guo-zhao  the contact law above, or Guo & Zhao 2014's (femdem_biaxial's:\n"
+            "                          k_n = E r*, E 0.6 GPa, k_t 0.8 k_n, friction angle 0.5, 2650 kg/m^3,\n"
+            "                          0.1 m disks, damping 0.1; with --frame periodic)\n"
             "  --max-dr N              DR iterations per load step (20000)\n"
             "  --width W --height H    specimen [m] (0.01 x 0.02)\n"
             "  --dns-tiles NXxNY       dns: copies of the periodic cell (1x2)\n"
@@ -204,6 +207,7 @@ static int parse(int argc, char **argv, opts *o) {
         {"--dr-gamma", O_REAL, &o->gamma, 1e-6, 1.0},
         {"--dr-force-tol", O_REAL, &o->force_tol, 0.0, 1.0},
         {"--rayleigh", O_STR, &o->rayleigh_s, 0, 0},
+        {"--material", O_STR, &o->material_s, 0, 0},
         {"--out", O_STR, &o->out, 0, 0},
         {"--restart", O_STR, &o->restart, 0, 0},
         {"--packing", O_STR, &o->packing, 0, 0},
@@ -290,6 +294,19 @@ static int parse(int argc, char **argv, opts *o) {
             return 2;
         }
     }
+    if (o->material_s) {
+        if (!strcmp(o->material_s, "paper")) o->material = 0;
+        else if (!strcmp(o->material_s, "guo-zhao")) o->material = 1;
+        else {
+            fprintf(stderr, PROG ": --material '%s' must be paper or guo-zhao\n", o->material_s);
+            return 2;
+        }
+        if (o->material == 1 && o->frame == GK_FRAME_SERVO) {
+            fprintf(stderr, PROG ": --material guo-zhao (k_n = E r*) needs --frame periodic: the servo's gains are per "
+                            "constant k_n\n");
+            return 2;
+        }
+    }
     if (o->rayleigh_s) {
         if (!strcmp(o->rayleigh_s, "step")) o->rayleigh = 0;
         else if (!strcmp(o->rayleigh_s, "total")) o->rayleigh = 1;
@@ -352,6 +369,11 @@ static void *xcalloc(size_t n, size_t s) {
 
 static gk_rve_def rve_def(const opts *o) {
     gk_rve_def d = gk_rve_def_default();
+    if (o->material == 1) { /* Guo & Zhao 2014's, as examples/femdem_biaxial.c: E r*, their YADE time step */
+        d.dt = 3.1602315723728926e-05;
+        d.flags = o->no_rotation ? GK_RVE_NO_ROTATION : 0u;
+        return d;
+    }
     d.mat.law = GK_LAW_LINEAR;
     d.mat.kn = o->kn_ratio * o->pressure;
     d.mat.kt_ratio = 0.2;

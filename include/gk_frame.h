@@ -103,8 +103,8 @@
  *   gk_frame_piola(sigma, F, P) / gk_frame_cauchy(P, F, sigma)   eq 16 both ways
  *
  * CONVENTIONS as gk_base.h: SI, tension-positive, 3x3 row-major, 2D only
- * (disks; the plane block of F). Contact law: linear with a constant k_n
- * (gk_material.kn: eq 32 and the gains are per k_n).
+ * (disks; the plane block of F). Contact law: linear (eq 32); the servo's
+ * gains are per k_n, so the servo frame takes a constant k_n (gk_material.kn).
  *
  * REFERENCES: Liu J., Bosco E., Suiker A.S.J. (2018) Multi-scale modelling
  * of granular materials: numerical framework and study on micro-structural
@@ -182,8 +182,8 @@ GKDEF gk_result gk_frame_run(void *set, int point, int proto, gk_rve *rve, const
 /* eq 11 from the positions x (2 per boundary particle, relative to the origin) */
 GKDEF void gk_frame_gradient(const gk_frame *fr, const double *x, double F[9]);
 /* eqs 31-32: kinetic energy of the particles whose skip[id] is 0 (skip NULL: all), elastic energy of
- * every contact of the last step; GK_ERR_ARG (nothing written) unless the law is linear with a
- * constant k_n */
+ * every contact of the last step (k_n constant or E r*); GK_ERR_ARG (nothing written) for a non-linear
+ * law, GK_ERR_ALLOC */
 GKDEF gk_result gk_frame_energy(const gk_rve *rve, const unsigned char *skip, double *ekin, double *epot);
 
 #ifdef __cplusplus
@@ -373,9 +373,16 @@ GKDEF void gk_frame_gradient(const gk_frame *fr, const double *x, double F[9]) {
 
 GKDEF gk_result gk_frame_energy(const gk_rve *rve, const unsigned char *skip, double *ekin, double *epot) {
     gk_rve_contact k;
-    double ek = 0.0, ep = 0.0, kn = (double)rve->K.kn_const, kt = (double)rve->K.kt_ratio * kn;
-    int c = 0, p, d;
-    if (rve->def.mat.law != GK_LAW_LINEAR || !(kn > 0.0)) return GK_ERR_ARG;
+    double ek = 0.0, ep = 0.0, kn = (double)rve->K.kn_const, *rad = NULL;
+    int c = 0, p, d, maxid = 0;
+    if (rve->def.mat.law != GK_LAW_LINEAR) return GK_ERR_ARG;
+    if (!(kn > 0.0)) { /* k_n = E r*, r* = 2 r_i r_j / (r_i + r_j) (gk_contact.h): the radii by packing id */
+        for (p = 0; p < rve->n; ++p)
+            if (rve->id[p] > maxid) maxid = rve->id[p];
+        rad = (double *)gk_alloc(&rve->def.alloc, ((size_t)maxid + 1) * sizeof(double));
+        if (!rad) return GK_ERR_ALLOC;
+        for (p = 0; p < rve->n; ++p) rad[rve->id[p]] = (double)rve->r[p];
+    }
     for (p = 0; p < rve->n; ++p) {
         double m = 1.0 / (double)rve->minv[p];
         if (skip && skip[rve->id[p]]) continue;
@@ -383,10 +390,13 @@ GKDEF gk_result gk_frame_energy(const gk_rve *rve, const unsigned char *skip, do
         if (rve->w[2]) ek += 0.5 / (double)rve->Iinv[p] * (double)rve->w[2][p] * (double)rve->w[2][p];
     }
     while (gk_rve_contact_next(rve, &c, &k)) {
-        double dd = sqrt(k.d[0] * k.d[0] + k.d[1] * k.d[1] + k.d[2] * k.d[2]), fn = 0.0, f2 = 0.0;
+        double dd = sqrt(k.d[0] * k.d[0] + k.d[1] * k.d[1] + k.d[2] * k.d[2]), fn = 0.0, f2 = 0.0, kk = kn, kt;
         for (d = 0; d < 3; ++d) fn += k.f[d] * k.d[d] / dd, f2 += k.f[d] * k.f[d];
-        ep += 0.5 * fn * fn / kn + (kt > 0.0 ? 0.5 * (f2 - fn * fn) / kt : 0.0);
+        if (rad) kk = (double)rve->K.young * 2.0 * rad[k.i] * rad[k.j] / (rad[k.i] + rad[k.j]);
+        kt = (double)rve->K.kt_ratio * kk;
+        ep += 0.5 * fn * fn / kk + (kt > 0.0 ? 0.5 * (f2 - fn * fn) / kt : 0.0);
     }
+    gk_free(&rve->def.alloc, rad);
     *ekin = ek, *epot = ep;
     return GK_OK;
 }
@@ -455,7 +465,7 @@ static gk_result gk__fw_relax(gk__fw *w) {
         if ((r = gk_scene_step(&w->sc, w->d->every)) != GK_OK) return r;
         w->steps += w->d->every, w->relax += w->d->every;
         if ((r = gk_frame_energy(&w->sc.rve, w->skip, &w->ek, &w->ep)) != GK_OK)
-            return gk_err_set(&w->sc.err, r, "frame: eqs 31-32 need a linear law with a constant k_n");
+            return gk_err_set(&w->sc.err, r, "frame: eqs 31-32 need the linear contact law");
     } while (!gk__frame_calm(w->ek, w->ep, w->d->tol_energy));
     return GK_OK;
 }
@@ -505,6 +515,8 @@ static gk_result gk__frame_servo(const gk_frame_set *set, const gk_frame *fr, gk
     w.fr = fr, w.d = &set->def;
     w.rot = !(rve->def.flags & GK_RVE_NO_ROTATION);
     if (rve->n != fr->n) return gk_err_set(&rve->err, GK_ERR_ARG, "frame: the RVE has %d particles, its frame %d", rve->n, fr->n);
+    if (!(rve->K.kn_const > 0))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "frame: the servo's gains need a constant k_n (gk_material.kn)");
     for (i = 0; i < 4; ++i) {
         Fa[i] = H[3 * (i / 2) + i % 2] + (i == 0 || i == 3);
         Fn[i] = Fa[i] + dH[3 * (i / 2) + i % 2];
@@ -597,7 +609,7 @@ static gk_result gk__frame_periodic(const gk_frame_set *set, gk_rve *rve, const 
         if ((r = gk_rve_step(rve, set->def.every)) != GK_OK) return r;
         steps += set->def.every;
         if ((r = gk_frame_energy(rve, NULL, &ek, &ep)) != GK_OK)
-            return gk_err_set(&rve->err, r, "frame: eqs 31-32 need a linear law with a constant k_n");
+            return gk_err_set(&rve->err, r, "frame: eqs 31-32 need the linear contact law");
     } while (!gk__frame_calm(ek, ep, set->def.tol_energy));
     gk_rve_set_velocity_gradient(rve, Ls);
     gk_rve_stress(rve, sigma);

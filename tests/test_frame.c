@@ -80,7 +80,8 @@ TEST(frame_geometry_and_eq11) {
     gk_frame_free(&fr);
 }
 
-/* eq 32 on two disks pressed together by delta: E_pot = f_n^2 / (2 k_n) = k_n delta^2 / 2 (no shear) */
+/* eq 32 on two disks pressed together by delta: E_pot = f_n^2 / (2 k_n) = k_n delta^2 / 2 (no shear),
+ * k_n constant or E r* */
 TEST(energy_of_one_contact_is_eq32) {
     gk_packing two;
     gk_rve r;
@@ -97,7 +98,13 @@ TEST(energy_of_one_contact_is_eq32) {
     CHECK_NEAR(ek, 0.0, 0.0);
     CHECK_NEAR(ep, 0.5 * 1.5e7 * delta * delta, 1e-9 * 0.5 * 1.5e7 * delta * delta);
     gk_rve_destroy(&r);
-    d.mat.kn = 0.0; /* E r*: eq 32 is written per k_n constant here */
+    d.mat.kn = 0.0, d.mat.young = 6e8; /* k_n = E r*, r* = 2 r r / (r + r) = r */
+    CHECK(gk_rve_create(&r, &d, &two) == GK_OK);
+    CHECK(gk_rve_refresh(&r) == GK_OK);
+    CHECK(gk_frame_energy(&r, NULL, &ek, &ep) == GK_OK);
+    CHECK_NEAR(ep, 0.5 * 6e8 * rr * delta * delta, 1e-9 * 0.5 * 6e8 * rr * delta * delta);
+    gk_rve_destroy(&r);
+    d.mat.law = GK_LAW_HERTZ; /* eq 32 is the linear law's */
     CHECK(gk_rve_create(&r, &d, &two) == GK_OK);
     CHECK(gk_frame_energy(&r, NULL, &ek, &ep) == GK_ERR_ARG);
     gk_rve_destroy(&r);
