@@ -1,8 +1,10 @@
 /* femdem_dr - FEMxDEM by explicit adaptive dynamic relaxation with servo-framed
  * RVEs, and the same specimen as one DEM simulation (Liu, Bosco & Suiker 2018).
  *
- *   build/femdem_dr --test biaxial --nx 2 --ny 4 --threads 2 --out DIR
- *                   [--iso-steps 10 --steps 50 --strain 0.10 --pressure 1.5e5 --friction 0.4]
+ *   build/femdem_dr --out DIR            the reduced run: 1 x 2 mesh (8 RVEs), 10 + 20 steps
+ *   build/femdem_dr --paper --out DIR    the paper's parametric mesh 2 x 4 (32 RVEs), 10 + 50 steps
+ *   build/femdem_dr --test biaxial --nx N --ny M --threads 2 --out DIR
+ *                   [--iso-steps 10 --steps 20 --strain 0.10 --pressure 1.5e5 --friction 0.4]
  *                   [--no-rotation] [--frame servo|periodic] [--packing FILE] [--restart DIR]
  *   build/femdem_dr --test rve ...          the RVE alone on the same stress path
  *   build/femdem_dr --test dns --dns-tiles 1x2|2x4 ...   the specimen as one DEM scene
@@ -49,8 +51,8 @@
  * sigma0 = 0.15 MN/m, which would make the overlaps ~15 particle diameters;
  * the response of a linear-contact packing depends on k_n only through
  * k_n / sigma0 (and R_min / L, R_max / R_min), so k_n is set as a ratio to
- * the confinement, --kn-ratio 1000 (k_n = 1.5e8 N/m: overlaps ~ 1e-3 of a
- * diameter at sigma0). DEM step 0.4 sqrt(m_min / k_n) = 0.78 us (the paper:
+ * the confinement, --kn-ratio 100 (k_n = 1.5e7 N/m: overlaps ~ 1e-2 of a
+ * diameter at sigma0). DEM step 0.4 sqrt(m_min / k_n) = 2.5 us (the paper:
  * 1 us). --no-rotation locks every particle's rotation (the paper's
  * theta_p = 0). --packing takes another framed packing (the anisotropic
  * ones: frame228_a005.txt, frame228_a008.txt).
@@ -63,7 +65,7 @@
  * --test dns: the specimen as one DEM scene (gk_scene.h): the periodic
  * packing tiled --dns-tiles NXxNY times (1x2: 2L x L, 2x4: 4L x 2L; the
  * paper's DNS A and B with 441 and 1681 disks; here 205 NX NY disks plus
- * the boundary copies closing the right and top edges: 443 and 1697), the
+ * the boundary copies closing the right and top edges: 444 for 1x2), the
  * same contact law; bottom and top rigid frictionless platens (walls), the
  * sides confined by follower-pressure membranes along the boundary
  * particles (anchored to the platens, tension-only links), the top platen
@@ -126,7 +128,7 @@ enum { TEST_BIAXIAL = 0, TEST_RVE = 1, TEST_DNS = 2 };
 
 typedef struct opts {
     int test, nx, ny, iso_steps, steps, threads, frame, no_rotation, vtk_every, checkpoint, max_dr, servo_max, rayleigh;
-    int rve_max, stop_after, material;
+    int rve_max, stop_after, material, paper;
     int tiles[2];
     double strain, pressure, friction, width, height, kn_ratio, dt_factor, damping, tol_energy, tol_dr, tol_servo;
     double xi, gamma, force_tol;
@@ -145,9 +147,11 @@ typedef struct optdef {
 static void usage(FILE *fp) {
     fprintf(fp,
             "usage: " PROG " [--test biaxial|rve|dns] [options] --out DIR\n"
-            "  --nx N --ny N           Q4 elements across and up (2 x 4)\n"
+            "  --paper                 the paper's sizes: --nx 2 --ny 4 --steps 50, dns --dns-tiles 2x4\n"
+            "                          (options given as well win)\n"
+            "  --nx N --ny N           Q4 elements across and up (1 x 2)\n"
             "  --iso-steps N           isotropic stage in N steps (10)\n"
-            "  --steps N               biaxial stage in N steps (50)\n"
+            "  --steps N               biaxial stage in N steps (20)\n"
             "  --strain E              final axial strain d / h_ic (0.10)\n"
             "  --pressure P            confinement sigma0 [Pa = N/m per m] (1.5e5)\n"
             "  --friction MU           contact friction (0.4)\n"
@@ -215,8 +219,11 @@ static int parse(int argc, char **argv, opts *o) {
         {"--frame", O_STR, &o->frame_s, 0, 0},
         {"--dns-tiles", O_STR, &o->tiles_s, 0, 0},
         {"--no-rotation", O_FLAG, &o->no_rotation, 0, 0},
+        {"--paper", O_FLAG, &o->paper, 0, 0},
         {NULL, O_FLAG, NULL, 0, 0}};
     int i;
+    for (i = 1; i < argc; ++i) /* --paper first: the options given with it win wherever they stand */
+        if (!strcmp(argv[i], "--paper")) o->nx = 2, o->ny = 4, o->steps = 50, o->tiles[0] = 2, o->tiles[1] = 4;
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i], *v;
         const optdef *d;
@@ -1299,8 +1306,9 @@ static int run_dns(model *m) {
 int main(int argc, char **argv) {
     model m;
     int rc;
+    char kn_txt[32];
     memset(&m, 0, sizeof m);
-    m.o.test = TEST_BIAXIAL, m.o.nx = 2, m.o.ny = 4, m.o.iso_steps = 10, m.o.steps = 50, m.o.threads = 1;
+    m.o.test = TEST_BIAXIAL, m.o.nx = 1, m.o.ny = 2, m.o.iso_steps = 10, m.o.steps = 20, m.o.threads = 1;
     m.o.frame = GK_FRAME_SERVO, m.o.vtk_every = 10, m.o.checkpoint = 10, m.o.max_dr = 20000, m.o.servo_max = 20, m.o.rve_max = 20000;
     m.o.tiles[0] = 1, m.o.tiles[1] = 2;
     m.o.strain = 0.10, m.o.pressure = 1.5e5, m.o.friction = 0.4, m.o.width = 0.01, m.o.height = 0.02;
@@ -1326,11 +1334,13 @@ int main(int argc, char **argv) {
     m.single = m.o.test == TEST_RVE;
     if (m.single) m.o.nx = m.o.ny = 1;
     if (setup(&m)) return 1;
-    printf("femdem_dr: %s, %s RVE (%d particles, %d boundary), rotation %s, %d Gauss points, k_n %.4g N/m, "
+    if (m.o.material == 1) snprintf(kn_txt, sizeof kn_txt, "E r*");
+    else snprintf(kn_txt, sizeof kn_txt, "%.4g N/m", m.o.kn_ratio * m.o.pressure);
+    printf("femdem_dr: %s, %s RVE (%d particles, %d boundary), rotation %s, %d Gauss points, k_n %s, "
            "omega_max %.4g rad/s\n",
            m.single ? "the RVE alone" : "biaxial test", m.o.frame == GK_FRAME_SERVO ? "servo-framed" : "periodic-cell",
            m.o.frame == GK_FRAME_SERVO ? m.fr.n : m.pk.n, m.o.frame == GK_FRAME_SERVO ? m.fr.nq : 0,
-           m.o.no_rotation ? "locked" : "free", m.ngp, m.o.kn_ratio * m.o.pressure, m.omega_max);
+           m.o.no_rotation ? "locked" : "free", m.ngp, kn_txt, m.omega_max);
     rc = run_fem(&m);
     gk_twoscale_destroy(&m.ts);
     gk_frame_free(&m.fr);

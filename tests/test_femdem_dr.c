@@ -148,6 +148,20 @@ TEST(dns_runs) {
     CHECK(gk_test_file_has("build/t_fdr_dns/dns_0003.vtk", "POINTS"));
 }
 
+/* the sizes: the reduced default is the 1 x 2 mesh (8 Gauss points); --paper is the paper's 2 x 4 mesh,
+ * and an option given with it wins wherever it stands (--ny 2 before --paper: 2 x 2, 16 points) */
+TEST(default_and_paper_sizes) {
+    const char *cut = "--frame periodic --iso-steps 1 --steps 1 --strain 0.001 --stop-after 1 --vtk-every 0";
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, FDR "%s --out build/t_fdr_def > build/t_fdr_def.out 2>&1", cut);
+    CHECK(system(cmd) == 0);
+    CHECK(gk_test_file_has("build/t_fdr_def.out", " 8 Gauss points"));
+    snprintf(cmd, sizeof cmd, FDR "--ny 2 --paper %s --out build/t_fdr_pap > build/t_fdr_pap.out 2>&1", cut);
+    CHECK(system(cmd) == 0);
+    CHECK(gk_test_file_has("build/t_fdr_pap.out", " 16 Gauss points"));
+    CHECK(gk_test_file_has("build/t_fdr_pap.out", "stopped after step 1"));
+}
+
 /* bad input: a message naming the option and status 2; an output that cannot be written: status 1 */
 TEST(bad_input_and_failed_writes) {
     CHECK(system(FDR "--nx 2x --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
@@ -158,6 +172,10 @@ TEST(bad_input_and_failed_writes) {
     CHECK(gk_test_file_has("build/t_bad.out", "--pressure -1 must be > 0"));
     CHECK(system(FDR "--strain nan --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has("build/t_bad.out", "--strain 'nan' is not a finite number"));
+    CHECK(system(FDR "--material clay --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "--material 'clay' must be paper or guo-zhao"));
+    CHECK(system(FDR "--material guo-zhao --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "needs --frame periodic")); /* the servo's gains are per k_n */
     CHECK(system(FDR "--bogus 1 > build/t_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has("build/t_bad.out", "unknown option --bogus"));
     CHECK(system(FDR "--test rve > build/t_bad.out 2>&1") == 2 * 256);
@@ -181,6 +199,7 @@ int main(int argc, char **argv) {
     RUN(locked_rotation_is_stronger);
     RUN(threads_and_restart_give_the_same_rows);
     RUN(dns_runs);
+    RUN(default_and_paper_sizes);
     RUN(bad_input_and_failed_writes);
     return gk_test_done();
 }
