@@ -282,6 +282,9 @@ typedef struct gk_consolidate_def {
     double max_strain_rate;   /* [1/s]; 0 -> inertial number 1e-2 at the target pressure   */
     long max_steps;           /* 0 -> 2 000 000                                            */
     double damping;           /* local damping while consolidating; 0 -> the RVE's own     */
+    double ratio[3];          /* target sigma_kk = -pressure x ratio[k] (anisotropic
+                                 consolidation); 0 -> 1                                  */
+    int box;                  /* 1: the cell stays a box (shear stresses not driven)      */
 } gk_consolidate_def;
 
 typedef struct gk_consolidate_report {
@@ -2465,6 +2468,7 @@ GKDEF int gk_rve_contact_next(const gk_rve *rve, int *cursor, gk_rve_contact *ou
 GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk_consolidate_report *rep) {
     gk_servo sv;
     double mu_final = rve->def.mat.friction, alpha_final = rve->def.damping, rmean = 0.0, tol, utol, rate;
+    double ratio[3];
     long maxs, st = 0, calm = 0;
     int k, p;
     gk_result res = gk__rve_ready(rve);
@@ -2488,12 +2492,16 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
                                    : 1e-2 * sqrt(cd->pressure / rve->def.mat.density) / (2.0 * rmean);
     memset(&sv, 0, sizeof sv);
     for (k = 0; k < 3; ++k) {
+        if (!(cd->ratio[k] >= 0.0) || !isfinite(cd->ratio[k]))
+            return gk_err_set(&rve->err, GK_ERR_ARG, "consolidation stress ratio %d is %g (must be >= 0)", k,
+                              cd->ratio[k]);
+        ratio[k] = cd->ratio[k] > 0.0 ? cd->ratio[k] : 1.0;
         sv.mode[k] = GK_SERVO_STRESS;
-        sv.target[k] = -cd->pressure;
+        sv.target[k] = -cd->pressure * ratio[k];
     }
     sv.max_rate = rate;
     sv.gain = 0.1; /* of the Taylor stiffness, which overestimates the packing's own */
-    sv.shear = 1;  /* isotropic: the shear stresses go to zero as well */
+    sv.shear = !cd->box; /* principal axes along the cell axes: the shear stresses go to zero as well */
     rve->K.mu = (gk_real)cd->friction;
     if (cd->damping > 0.0) rve->def.damping = cd->damping;
     gk_m3_zero(rve->L);
@@ -2505,10 +2513,10 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
         st += 100;
         if (res) break;
         for (k = 0; k < rve->dim; ++k) {
-            double e = fabs(rve->stress[4 * k] + cd->pressure) / cd->pressure;
+            double e = fabs(rve->stress[4 * k] + cd->pressure * ratio[k]) / (cd->pressure * ratio[k]);
             int l;
             if (e > errmax) errmax = e;
-            for (l = k + 1; l < rve->dim; ++l) {
+            for (l = k + 1; l < rve->dim && !cd->box; ++l) {
                 e = fabs(0.5 * (rve->stress[3 * k + l] + rve->stress[3 * l + k])) / cd->pressure;
                 if (e > errmax) errmax = e;
             }

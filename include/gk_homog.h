@@ -51,6 +51,8 @@
  *                                (-> GK_ERR_ARG).
  *     Layout: D[((i*dim + j)*dim + k)*dim + l], d sigma_ij = D_ijkl dH_kl,
  *     tension-positive, [Pa]. No contacts -> D = 0 (never NaN).
+ *   gk_fabric_ratio            A = Pi_1 / Pi_2 - 1 from the eigenvalues of phi
+ *                              [Liu, Bosco & Suiker 2018 eq 38]
  *   gk_homog_fabric            phi = (1/N_c) sum n (x) n; 2D anisotropy
  *                              F_a = 4 dev phi, |F_a| = sqrt(F_a:F_a / 2)
  *                              [seed 000 eqs 22-25, seed 003 eqs 41-43];
@@ -156,6 +158,24 @@ GK_INLINE double gk_stress_q(const double s[9], int dim) {
             ss += d * d;
         }
     return dim == 2 ? sqrt(0.5 * ss) : sqrt(1.5 * ss);
+}
+/* fabric anisotropy as an eigenvalue ratio, A = Pi_1 / Pi_2 - 1 (largest over
+ * smallest eigenvalue of the fabric tensor phi of gk_homog_fabric; Liu,
+ * Bosco & Suiker 2018 eqs 38-39; 3D: largest over smallest); 0 for an
+ * isotropic fabric, +inf when the smallest eigenvalue is 0 (no contacts: 0) */
+GK_INLINE double gk_fabric_ratio(const double phi[9], int dim) {
+    double lo, hi;
+    if (dim == 2) {
+        double m = 0.5 * (phi[0] + phi[4]), h = 0.5 * (phi[0] - phi[4]), b = 0.5 * (phi[1] + phi[3]);
+        double r = sqrt(h * h + b * b);
+        hi = m + r, lo = m - r;
+    } else {
+        double val[3], vec[9];
+        gk_m3_sym_eigen(phi, val, vec);
+        lo = val[0], hi = val[2];
+    }
+    if (!(hi > 0.0)) return 0.0;
+    return lo > 0.0 ? hi / lo - 1.0 : HUGE_VAL;
 }
 GK_INLINE double gk_strain_v(const double e[9], int dim) { return e[0] + e[4] + (dim == 3 ? e[8] : 0.0); }
 GK_INLINE double gk_strain_q(const double e[9], int dim) {

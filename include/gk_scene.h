@@ -128,6 +128,17 @@
  * Cheung & O'Sullivan (2008) with a fixed chain (members chosen once, e.g.
  * by gk_scene_side_chain).
  *
+ * A SCENE AROUND AN RVE THE CALLER OWNS (gk_scene_wrap / gk_scene_unwrap),
+ * e.g. the RVE of one point of gk_twoscale.h run under boundary conditions
+ * of its own (a frame of prescribed particles: gk_frame.h). wrap moves the
+ * RVE's struct into a scene whose domain is the RVE's cell (a box, every
+ * axis periodic, no gravity, nothing prescribed); the RVE's state
+ * (positions, velocities, contact history, ids) is the scene's particles.
+ * unwrap frees what the scene added (walls, prescribed motion, loads,
+ * membranes, energy) and moves the RVE back, its hook cleared: the RVE is
+ * then as if stepped by itself with those forces. Between the two calls
+ * use only the scene (the caller's gk_rve is zeroed meanwhile).
+ *
  * INSERTION AND DELETION. gk_scene_insert adds particles (world positions,
  * optional velocities) and returns their stable ids; gk_scene_remove
  * deletes by id. Survivors keep their ids, contact histories (pairs and
@@ -343,6 +354,9 @@ GKDEF gk_result gk_scene_pair_material(const gk_material *a, const gk_material *
 
 GKDEF gk_result gk_scene_create(gk_scene *sc, const gk_scene_def *def, const gk_packing *pk);
 GKDEF void gk_scene_destroy(gk_scene *sc);
+/* a scene around an RVE (its cell a box, no velocity gradient or servo), and back (see above) */
+GKDEF gk_result gk_scene_wrap(gk_scene *sc, gk_rve *rve);
+GKDEF void gk_scene_unwrap(gk_scene *sc, gk_rve *rve);
 GKDEF const char *gk_scene_error(const gk_scene *sc);
 GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps);
 GKDEF void gk_scene_position(const gk_scene *sc, int p, double x[3]);
@@ -566,7 +580,8 @@ static void gk__wall_free(gk_scene *sc, gk_wall *W) {
     gk__sc_free(sc, W->cand);
 }
 
-GKDEF void gk_scene_destroy(gk_scene *sc) {
+/* everything but the RVE */
+static void gk__scene_free_own(gk_scene *sc) {
     int k, w;
     for (w = 0; w < sc->nwalls; ++w) gk__wall_free(sc, &sc->walls[w]);
     for (w = 0; w < sc->nmem; ++w) {
@@ -596,7 +611,6 @@ GKDEF void gk_scene_destroy(gk_scene *sc) {
     }
     gk__sc_free(sc, sc->hcs);
     gk__sc_free(sc, sc->rec);
-    gk_rve_destroy(&sc->rve);
     sc->walls = NULL;
     sc->mem = NULL;
     sc->nwalls = sc->nmem = 0;
@@ -611,6 +625,60 @@ GKDEF void gk_scene_destroy(gk_scene *sc) {
     sc->hcs = NULL;
     sc->rec = NULL;
     sc->nrec = sc->caprec = 0;
+}
+
+GKDEF void gk_scene_destroy(gk_scene *sc) {
+    gk__scene_free_own(sc);
+    gk_rve_destroy(&sc->rve);
+}
+
+GKDEF gk_result gk_scene_wrap(gk_scene *out, gk_rve *rve) {
+    gk_scene S;
+    gk_result res = GK_OK;
+    int k, p;
+    gk_err_clear(&out->err);
+    if (!rve || rve->n < 1 || (rve->dim != 2 && rve->dim != 3))
+        return gk_err_set(&out->err, GK_ERR_ARG, "wrap: no RVE (or an empty one)");
+    for (k = 0; k < 9; ++k)
+        if ((k % 4 != 0 && rve->cell.h[k] != 0.0) || rve->L[k] != 0.0 || rve->servo_on)
+            return gk_err_set(&out->err, GK_ERR_STATE,
+                              "wrap: the RVE's cell must be a box with no velocity gradient or servo");
+    memset(&S, 0, sizeof S);
+    S.def = gk_scene_def_default();
+    S.def.dim = S.dim = rve->dim;
+    S.def.periodic = (1u << rve->dim) - 1u;
+    for (k = 0; k < rve->dim; ++k) S.def.hi[k] = rve->cell.h[4 * k];
+    S.def.rve = rve->def;
+    S.rve = *rve;
+    S.seen_rebuilds = -1;
+    for (p = 0; p < rve->n; ++p)
+        if (rve->id[p] >= S.next_id) S.next_id = rve->id[p] + 1;
+    S.mass = (double *)gk_alloc(&rve->def.alloc, (size_t)rve->n * sizeof(double));
+    S.flags = (unsigned char *)gk_alloc(&rve->def.alloc, (size_t)rve->n);
+    S.cap = rve->n;
+    if (!S.mass || !S.flags) res = gk_err_set(&S.err, GK_ERR_ALLOC, "wrap: out of memory for %d particles", rve->n);
+    for (p = 0; !res && p < rve->n; ++p) {
+        S.mass[p] = 1.0 / (double)rve->minv[p];
+        S.flags[p] = 0;
+    }
+    if (!res) res = gk__scene_index(&S);
+    if (res) { /* the RVE stays the caller's, untouched */
+        gk_err e = S.err;
+        gk__scene_free_own(&S);
+        out->err = e;
+        return res;
+    }
+    memset(rve, 0, sizeof *rve);
+    *out = S;
+    return GK_OK;
+}
+
+GKDEF void gk_scene_unwrap(gk_scene *sc, gk_rve *rve) {
+    gk__scene_free_own(sc);
+    *rve = sc->rve;
+    rve->hook = NULL;
+    rve->hook_user = NULL;
+    memset(&sc->rve, 0, sizeof sc->rve);
 }
 
 /* ------------------------------------------------------------- create */

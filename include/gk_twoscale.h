@@ -66,6 +66,24 @@
  *   (strain x scale, I_max x scale), so a cut-back increment keeps the step
  *   count of the full one - a slower ramp, not fewer and noisier steps.
  *
+ * THE CALLER'S PROCEDURE (def.proc; boundary conditions other than the
+ *   deforming periodic cell, e.g. a frame of prescribed boundary particles
+ *   servo-controlled to periodicity: gk_frame.h). Instead of the DEM-steps
+ *   rule, every run calls, for each point from its accepted state,
+ *       proc(def.proc_user, point, prototype, rve, H, dH, scale, stress, &steps)
+ *   H the sum of the dH of its accepted runs, dH this run's; the procedure
+ *   moves the RVE as it likes (gk_rve_step, a hook, another cell), writes
+ *   the point's stress (whatever its measure: the set returns it, keeps the
+ *   accepted one for gk_twoscale_accepted, the fields' stress, p and q, and
+ *   the checkpoint, never recomputing it from the RVE) and the DEM steps it
+ *   took, and returns GK_OK or a code with its message in rve->err. It is
+ *   called concurrently for different points (the set's threads): it may
+ *   change only its point's RVE (def.proc_user read-only, or per point).
+ *   A point's accepted stress is 0 until its first accepted run. No
+ *   tangent: a run or gk_twoscale_accepted asking for D is refused
+ *   (GK_ERR_ARG). The fields that come from the RVE itself (void ratio,
+ *   volume, coordination, fabric) are those of its whole cell.
+ *
  * THE TANGENT (D != NULL in gk_twoscale_run)
  *   GK_TWOSCALE_TANGENT_HOMOG (default): gk_homog_tangent with tangent_opts:
  *     0 = eq 9 of seed 000 (Taylor, sliding contacts k_t = 0),
@@ -114,8 +132,8 @@
  *   set, whatever the rank count: a header (magic "GKTWOSC\0", format
  *   version, byte order, real size, dim, N, prototypes, the prototype of
  *   every point), one record per point in point order (its accumulated dH,
- *   DEM steps of its last accepted run, tangent-reuse reference, accepted
- *   RVE state), then the DRIVER'S OWN BLOCK (any bytes: the macro state),
+ *   accepted stress, DEM steps of its last accepted run, tangent-reuse
+ *   reference, accepted RVE state), then the DRIVER'S OWN BLOCK (any bytes: the macro state),
  *   then a 64-bit FNV-1a checksum of all of it. Written to PATH.tmp and
  *   renamed. Loading checks the checksum over the whole file, every size
  *   and count against the file and the set, and restores all points into
@@ -154,7 +172,7 @@
 #include <mpi.h>
 #endif
 
-#define GK_TWOSCALE_CHECKPOINT_VERSION 1
+#define GK_TWOSCALE_CHECKPOINT_VERSION 2
 
 typedef enum gk_twoscale_rule_kind { GK_TWOSCALE_ADAPTIVE = 0, GK_TWOSCALE_STRAIN = 1 } gk_twoscale_rule_kind;
 
@@ -172,6 +190,10 @@ typedef enum gk_twoscale_tangent_kind {
     GK_TWOSCALE_TANGENT_HOMOG = 0,       /* gk_homog_tangent(tangent_opts): eq 9, relaxed     */
     GK_TWOSCALE_TANGENT_PERTURBATION = 1 /* eq 8: finite differences of dim^2 perturbed runs */
 } gk_twoscale_tangent_kind;
+
+/* a run of one point by the caller's procedure (THE CALLER'S PROCEDURE) */
+typedef gk_result (*gk_twoscale_proc_fn)(void *user, int point, int proto, gk_rve *rve, const double H[9],
+                                         const double dH[9], double scale, double stress[9], int *steps);
 
 /* what a point starts from: an RVE created from `packing` (with def->rve),
  * then set to `state` (saved from an RVE created the same way) or, when
@@ -191,6 +213,8 @@ typedef struct gk_twoscale_def {
     gk_twoscale_rule rule;
     gk_twoscale_tangent_kind tangent;
     unsigned tangent_opts; /* GK_TANGENT_* of gk_homog_tangent (also eq 8's start tangent)  */
+    gk_twoscale_proc_fn proc; /* the caller's procedure instead of the rule (above); NULL: none */
+    void *proc_user;          /* its first argument                                          */
     double xi;             /* eq 8 perturbation of dH; 0 -> 5e-5 (seed 000 Fig 6)          */
     double reuse;          /* tangent reuse bound, 0 <= X < 1; 0: off                      */
     int threads;           /* OpenMP threads over a rank's points; 0 -> 1                  */
@@ -333,6 +357,7 @@ typedef struct gk__tspt {
     int trial_ok;         /* the last run succeeded and was not accepted yet          */
     double H[9], dH[9];   /* accumulated dH of accepted runs; dH of the last run      */
     double sacc[9];       /* stress of the accepted state                             */
+    double strial[9];     /* the procedure's stress of the last run (def.proc)        */
     int steps_acc, steps_trial;
     /* tangent reuse: reference tangent, its network (sorted keys), the current network */
     double *Dref;
@@ -488,7 +513,7 @@ static gk_result gk__ts_pt_new(gk_twoscale *ts, int id, int k, const void *state
         return res;
     }
     pt->live = 1;
-    gk_rve_stress(&pt->rve, pt->sacc);
+    if (!ts->def.proc) gk_rve_stress(&pt->rve, pt->sacc);
     *out = pt;
     return GK_OK;
 }
@@ -630,6 +655,26 @@ static void gk__ts_point(const gk_twoscale *ts, gk__tspt *pt, const double H[9],
     memcpy(pt->dH, H, sizeof pt->dH);
     pt->trial_ok = 0;
     rp.particles = pt->rve.n;
+    if (d->proc) {
+        res = gk__ts_reset(pt);
+        if (!res) {
+            pt->live = 0;
+            res = d->proc(d->proc_user, pt->id, ts->pick[pt->id], &pt->rve, pt->H, H, scale, s0, &nd);
+            if (!res && !gk_m3_isfinite(s0))
+                res = gk_err_set(&pt->rve.err, GK_ERR_NAN, "the procedure's stress is not finite");
+        }
+        if (res) {
+            gk__ts_fail(pt, &rp, res);
+            goto failed;
+        }
+        rp.work = rp.n_deform = pt->steps_trial = nd;
+        rp.contacts = pt->rve.ncontacts;
+        memcpy(s_out, s0, sizeof s0);
+        memcpy(pt->strial, s0, sizeof s0);
+        pt->trial_ok = 1;
+        gk__ts_put_rep(rec + 9, &rp);
+        return;
+    }
     if (before) {
         nd = gk__ts_strain_steps(&d->rule, scale, H);
         for (k = 0; k < nk; ++k) {
@@ -1035,6 +1080,8 @@ GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twos
 #endif
     if (!(scale > 0.0 && scale <= 1.0))
         return gk_err_set(&ts->err, GK_ERR_ARG, "run scale %g outside (0, 1]", scale);
+    if (want_D && ts->def.proc)
+        return gk_err_set(&ts->err, GK_ERR_ARG, "a set run by the caller's procedure has no tangent: D must be NULL");
     if ((res = gk__ts_check_dH(ts, H)) != GK_OK) return res;
     nrec = 9 + (want_D ? ts->nd4 : 0) + GK__TS_NREP;
     if (gk__ts_agree(ts, gk__ts_bufs(ts, nrec))) return ts->err.code;
@@ -1088,9 +1135,10 @@ GKDEF void gk_twoscale_reject(gk_twoscale *ts) {
 
 /* ------------------------------------------------ point records (checkpoint, migration) */
 /* int32 id, prototype, DEM steps of the last accepted run, reference keys (-1: no tangent reference);
- * double H[9]; [reference tangent (nd4 doubles), keys (uint64)]; uint64 state size; the accepted state */
+ * double H[9], accepted stress[9]; [reference tangent (nd4 doubles), keys (uint64)]; uint64 state size;
+ * the accepted state */
 typedef void (*gk__ts_sink)(void *ctx, const void *p, size_t n);
-#define GK__TS_REC_MIN (4 * 4 + 9 * 8 + 8)
+#define GK__TS_REC_MIN (4 * 4 + 18 * 8 + 8)
 
 static int gk__ts_has_ref(const gk__tspt *pt) { return pt->Dref && pt->valid; }
 
@@ -1106,6 +1154,7 @@ static void gk__ts_rec_emit(const gk_twoscale *ts, const gk__tspt *pt, gk__ts_si
     v[0] = pt->id, v[1] = ts->pick[pt->id], v[2] = pt->steps_acc, v[3] = gk__ts_has_ref(pt) ? pt->nkey : -1;
     put(ctx, v, sizeof v);
     put(ctx, pt->H, sizeof pt->H);
+    put(ctx, pt->sacc, sizeof pt->sacc);
     if (v[3] >= 0) {
         put(ctx, pt->Dref, (size_t)ts->nd4 * sizeof(double));
         put(ctx, pt->key, (size_t)pt->nkey * sizeof *pt->key);
@@ -1118,8 +1167,8 @@ static void gk__ts_rec_emit(const gk_twoscale *ts, const gk__tspt *pt, gk__ts_si
 static gk_result gk__ts_rec_parse(gk_twoscale *ts, int id, const unsigned char *b, size_t n, gk__tspt **out) {
     int32_t v[4];
     uint64_t ss;
-    double H[9];
-    size_t off = 4 * 4 + 9 * 8, ref;
+    double H[9], S[9];
+    size_t off = 4 * 4 + 18 * 8, ref;
     gk__tspt *pt;
     gk_result res;
     int k;
@@ -1128,13 +1177,15 @@ static gk_result gk__ts_rec_parse(gk_twoscale *ts, int id, const unsigned char *
         return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d is %lu bytes", id, (unsigned long)n);
     memcpy(v, b, sizeof v);
     memcpy(H, b + 16, sizeof H);
+    memcpy(S, b + 16 + sizeof H, sizeof S);
     if (v[0] != id || v[1] != ts->pick[id] || v[2] < 0 || v[3] < -1 || v[3] > GK__TS_MAXKEYS)
         return gk_err_set(&ts->err, GK_ERR_FORMAT,
                           "the record of point %d names point %d, prototype %d (expected %d), %d DEM steps, %d "
                           "contact keys",
                           id, (int)v[0], (int)v[1], ts->pick[id], (int)v[2], (int)v[3]);
     for (k = 0; k < 9; ++k)
-        if (!isfinite(H[k])) return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d has a NaN dH", id);
+        if (!isfinite(H[k]) || !isfinite(S[k]))
+            return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d has a NaN dH or stress", id);
     ref = v[3] >= 0 ? (size_t)ts->nd4 * 8 + (size_t)v[3] * 8 : 0;
     if (ref > n - GK__TS_REC_MIN)
         return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d is shorter than its %d contact keys", id,
@@ -1146,6 +1197,7 @@ static gk_result gk__ts_rec_parse(gk_twoscale *ts, int id, const unsigned char *
     res = gk__ts_pt_new(ts, id, v[1], b + off + ref + 8, (size_t)ss, &pt);
     if (res) return res;
     memcpy(pt->H, H, sizeof H);
+    memcpy(pt->sacc, S, sizeof S);
     pt->steps_acc = v[2];
     if (v[3] >= 0 && pt->Dref) { /* without reuse in this set the reference is not needed */
         if (gk__ts_reserve_keys(&ts->def.alloc, pt, v[3] + 1)) {
@@ -1342,7 +1394,10 @@ GKDEF gk_result gk_twoscale_accept(gk_twoscale *ts) {
         gk_rve_save(&pt->rve, pt->acc.buf, pt->acc.cap, &pt->acc.size);
         for (k = 0; k < 9; ++k) pt->H[k] += pt->dH[k];
         pt->steps_acc = pt->steps_trial;
-        gk_rve_stress(&pt->rve, pt->sacc);
+        if (ts->def.proc)
+            memcpy(pt->sacc, pt->strial, sizeof pt->sacc);
+        else
+            gk_rve_stress(&pt->rve, pt->sacc);
         pt->live = 1, pt->trial_ok = 0;
     }
     ts->pending = 0;
@@ -1385,6 +1440,10 @@ static const double *gk__ts_collect(gk_twoscale *ts, int nrec, int want_D, gk__t
 }
 
 static gk_result gk__ts_fill_acc(const gk_twoscale *ts, gk__tspt *pt, int want_D, double *rec) {
+    if (ts->def.proc) {
+        memcpy(rec, pt->sacc, sizeof pt->sacc);
+        return GK_OK;
+    }
     gk_rve_stress(&pt->rve, rec);
     return want_D ? gk_homog_tangent(&pt->rve, ts->def.tangent_opts, rec + 9) : GK_OK;
 }
@@ -1398,6 +1457,8 @@ GKDEF gk_result gk_twoscale_accepted(gk_twoscale *ts, double *stress, double *D)
         ++ts->stats.collectives;
     }
 #endif
+    if (want_D && ts->def.proc)
+        return gk_err_set(&ts->err, GK_ERR_ARG, "a set run by the caller's procedure has no tangent: D must be NULL");
     nrec = 9 + (want_D ? ts->nd4 : 0) + 1;
     if (!(all = gk__ts_collect(ts, nrec, want_D, gk__ts_fill_acc))) return ts->err.code;
     for (j = 0; j < ts->n; ++j) {
@@ -1417,7 +1478,10 @@ static gk_result gk__ts_fill_field(const gk_twoscale *ts, gk__tspt *pt, int want
     for (k = 0; k < 9; ++k) eps[k] = 0.5 * (pt->H[k] + pt->H[3 * (k % 3) + k / 3]);
     gk_m3_identity(F);
     for (k = 0; k < 9; ++k) F[k] += pt->H[k];
-    gk_rve_stress(r, f.stress);
+    if (ts->def.proc)
+        memcpy(f.stress, pt->sacc, sizeof f.stress);
+    else
+        gk_rve_stress(r, f.stress);
     f.p = gk_stress_p(f.stress, dim);
     f.q = gk_stress_q(f.stress, dim);
     f.void_ratio = gk_homog_void_ratio(r);

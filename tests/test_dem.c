@@ -559,6 +559,37 @@ static gk_result gen_consolidate(gk_rve *rve, int dim, int n, double mu_cons, do
     return r;
 }
 
+/* anisotropic consolidation (gk_consolidate_def.ratio), frictional (a frictionless packing flows under
+ * a deviator): sigma_yy = 1.5 sigma_xx within 1 % with the cell kept a box (box = 1: no shear stress
+ * driven, the cell's off-diagonal stays 0) */
+TEST(consolidation_to_a_stress_ratio) {
+    gk_gen_def g;
+    gk_packing pk;
+    gk_err e;
+    gk_rve r;
+    gk_rve_def def = gk_rve_def_default();
+    gk_consolidate_def cd;
+    gk_consolidate_report rep;
+    memset(&g, 0, sizeof g);
+    g.dim = 2, g.n = 120, g.r_min = 0.003, g.r_max = 0.007, g.seed = 2;
+    CHECK(gk_packing_generate(&pk, &g, NULL, &e) == GK_OK);
+    CHECK(gk_rve_create(&r, &def, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    memset(&cd, 0, sizeof cd);
+    cd.pressure = 1e5, cd.ratio[1] = 1.5, cd.box = 1, cd.stress_tol = 2e-3, cd.unbalanced_tol = 2e-3;
+    cd.friction = 0.5;
+    if (gk_rve_consolidate(&r, &cd, &rep) != GK_OK) {
+        printf("    %s\n", gk_rve_error(&r));
+        CHECK(0);
+    }
+    CHECK_REL(-rep.stress[0], 1e5, 0.01);
+    CHECK_REL(-rep.stress[4], 1.5e5, 0.01);
+    CHECK(r.cell.h[1] == 0.0 && r.cell.h[3] == 0.0);
+    cd.ratio[0] = -1.0; /* refused, nothing run */
+    CHECK(gk_rve_consolidate(&r, &cd, &rep) == GK_ERR_ARG);
+    gk_rve_destroy(&r);
+}
+
 /* consolidation reaches 100 kPa isotropic within 1 %, and the friction used
  * while consolidating selects dense (mu = 0) or looser (mu = 0.5) states */
 TEST(consolidation_reaches_target_stress) {
@@ -1144,6 +1175,7 @@ int main(int argc, char **argv) {
     RUN(skin_does_not_change_results);
     RUN(threads_do_not_change_results);
     RUN(consolidation_reaches_target_stress);
+    RUN(consolidation_to_a_stress_ratio);
     RUN(rve_3d_pipeline);
     RUN(relaxed_tangent_3d_is_the_quasistatic_dem_response);
     RUN(dt_at_0_9_critical_stays_bounded);

@@ -95,6 +95,35 @@ TEST(gk_pack_makes_a_consolidated_packing) {
     if (fp) fclose(fp);
 }
 
+/* gk_pack --frame: one particle at the corner and K on each of the lines x = 0, y = 0, exactly (the
+ * frame of Liu, Bosco & Suiker 2018 Fig 2), the cell a box; --stress-ratio records its cycle and the
+ * anisotropy of eq 38 */
+TEST(gk_pack_makes_a_framed_packing) {
+    gk_packing pk;
+    gk_err e;
+    int p, nx = 0, ny = 0, corner = 0;
+    CHECK(system("build/gk_pack --dim 2 --n 60 --rmin 3e-4 --rmax 4.5e-4 --pressure 1500 --kn 1.5e8 --frame 3 "
+                 "--stress-ratio 1.3 --out build/t_pack_frame.txt > build/t_pack_frame.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_pack_frame.out", "RESULT void_ratio="));
+    CHECK(gk_test_file_has("build/t_pack_frame.out", "anisotropy="));
+    CHECK(gk_test_file_has("build/t_pack_frame.txt", "sigma_yy to 1.3 sigma_xx and back"));
+    CHECK(gk_test_file_has("build/t_pack_frame.txt", "frame: 7 particles"));
+    CHECK(gk_packing_read("build/t_pack_frame.txt", &pk, NULL, &e) == GK_OK);
+    if (pk.n != 60) return;
+    CHECK(pk.h[1] == 0.0 && pk.h[3] == 0.0); /* a box */
+    for (p = 0; p < pk.n; ++p) {
+        nx += pk.x[p] == 0.0 && pk.y[p] != 0.0;
+        ny += pk.y[p] == 0.0 && pk.x[p] != 0.0;
+        corner += pk.x[p] == 0.0 && pk.y[p] == 0.0;
+    }
+    CHECK_EQ_INT(nx, 3);
+    CHECK_EQ_INT(ny, 3);
+    CHECK_EQ_INT(corner, 1);
+    gk_packing_free(&pk);
+    CHECK(system("build/gk_pack --dim 3 --frame 3 --out build/t_pack_bad.txt > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "2D only"));
+}
+
 /* the first `ncol` columns of every data row of two CSV files are identical */
 static int csv_same(const char *a, const char *b, int ncol) {
     FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
@@ -788,6 +817,7 @@ int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(rve_path_writes_csv_and_svg);
     RUN(gk_pack_makes_a_consolidated_packing);
+    RUN(gk_pack_makes_a_framed_packing);
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
     RUN(femdem_single_element_matches_rve_alone);
     RUN(femdem_single_reference_holds_the_lateral_stress);

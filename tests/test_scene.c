@@ -959,6 +959,54 @@ TEST(membrane_confines_at_its_pressure) {
     gk_scene_destroy(&sc);
 }
 
+/* A scene around an RVE the caller owns (gk_scene_wrap): the same particles
+ * with one of them prescribed move bit for bit as in a scene created from the
+ * same packing with every axis periodic; unwrap gives the RVE back, hook
+ * cleared, and it steps on by itself; a sheared cell is refused, the RVE
+ * untouched. */
+TEST(wrap_runs_an_rve_as_a_scene) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_scene a, b;
+    gk_gen_def g;
+    gk_packing pk;
+    gk_rve rve;
+    gk_err e;
+    double v[3] = {0.3, -0.2, 0}, w[3] = {0, 0, 5.0}, L[9] = {0, 1e-3, 0, 0, 0, 0, 0, 0, 0};
+    int p, same = 1, n, moved = 0;
+    memset(&g, 0, sizeof g);
+    g.dim = 2, g.n = 60, g.r_min = 0.004, g.r_max = 0.006, g.seed = 5, g.packing_fraction = 0.5;
+    CHECK(gk_packing_generate(&pk, &g, NULL, &e) == GK_OK);
+    d.dim = 2, d.hi[0] = pk.h[0], d.hi[1] = pk.h[4], d.periodic = 3u;
+    d.rve.damping = 0.3;
+    CHECK(gk_scene_create(&a, &d, &pk) == GK_OK);
+    CHECK(gk_rve_create(&rve, &d.rve, &pk) == GK_OK);
+    n = rve.n;
+    CHECK(gk_scene_wrap(&b, &rve) == GK_OK);
+    CHECK(rve.n == 0 && b.rve.n == n);
+    CHECK(gk_scene_prescribe(&a, gk_scene_index(&a, 7), v, w) == GK_OK);
+    CHECK(gk_scene_prescribe(&b, gk_scene_index(&b, 7), v, w) == GK_OK);
+    CHECK(gk_scene_step(&a, 3000) == GK_OK && gk_scene_step(&b, 3000) == GK_OK);
+    for (p = 0; p < n; ++p) {
+        double xa[3], xb[3];
+        gk_scene_position(&a, gk_scene_index(&a, p), xa);
+        gk_scene_position(&b, gk_scene_index(&b, p), xb);
+        same &= xa[0] == xb[0] && xa[1] == xb[1];
+        moved += b.rve.v[0][gk_scene_index(&b, p)] != 0; /* pushed by the prescribed one */
+    }
+    CHECK(same);
+    CHECK(moved > 3);
+    CHECK(b.load[0][gk_scene_index(&b, 7)] == a.load[0][gk_scene_index(&a, 7)]);
+    gk_scene_unwrap(&b, &rve);
+    CHECK(rve.n == n && rve.hook == NULL && b.mass == NULL);
+    CHECK(gk_rve_step(&rve, 10) == GK_OK);
+    CHECK(gk_rve_set_velocity_gradient(&rve, L) == GK_OK);
+    CHECK(gk_scene_wrap(&b, &rve) == GK_ERR_STATE && rve.n == n);
+    CHECK(strstr(gk_scene_error(&b), "box") != NULL);
+    gk_rve_destroy(&rve);
+    gk_scene_destroy(&a);
+    gk_packing_free(&pk);
+}
+
 /* position of the particle with stable id `id` */
 static void pos_of(const gk_scene *sc, int32_t id, double x[3]) {
     gk_scene_position(sc, gk_scene_index(sc, id), x);
@@ -1677,6 +1725,7 @@ int main(int argc, char **argv) {
     RUN(servo_wall_reaches_its_target);
     RUN(prescribed_particles_move_and_report_their_load);
     RUN(membrane_confines_at_its_pressure);
+    RUN(wrap_runs_an_rve_as_a_scene);
     RUN(insert_and_remove_leave_the_others_alone);
     RUN(energy_balance_closes);
     RUN(save_restore_and_threads_are_bitwise);

@@ -5,7 +5,8 @@
  * Zhao 2014 by finite differences), then what the set adds: thread-count
  * independence bit for bit, a failed point reported without hiding the
  * others, the checkpoint round trip bit for bit, corrupt checkpoints and bad
- * arguments refused with nothing changed. Small packings (100 and 200
+ * arguments refused with nothing changed; a set run by the caller's procedure
+ * (another micro model on the same RVEs). Small packings (100 and 200
  * disks) keep it to seconds. The MPI build has its own program
  * (tests/mpi_twoscale.c, run by `make test` with mpirun -np 2). */
 #define GK_IMPLEMENTATION
@@ -442,12 +443,12 @@ TEST(corrupt_checkpoints_are_refused_and_change_nothing) {
         ok &= refused(&b, bad, "", dH, sb);
     }
     CHECK(ok);
-    memcpy(x, img, (size_t)n); /* format version 2 */
-    x[8] = 2;
+    memcpy(x, img, (size_t)n); /* format version 3 */
+    x[8] = 3;
     reseal(x, n);
     put_bytes(bad, x, n);
-    CHECK(refused(&b, bad, "format version 2; this build reads 1", dH, sb));
-    memcpy(x, img, (size_t)n); /* version 1 but a bad checksum */
+    CHECK(refused(&b, bad, "format version 3; this build reads 2", dH, sb));
+    memcpy(x, img, (size_t)n); /* this version but a bad checksum */
     x[n / 2] ^= 0x10;
     put_bytes(bad, x, n);
     CHECK(refused(&b, bad, "checksum mismatch", dH, sb));
@@ -476,6 +477,98 @@ TEST(corrupt_checkpoints_are_refused_and_change_nothing) {
         gk_twoscale_free(&b, blk);
     }
     free(img), free(x);
+    gk_twoscale_destroy(&a), gk_twoscale_destroy(&b);
+}
+
+/* the caller's procedure: a stand-in that deforms the RVE by dH over 40 DEM steps (gk_rve_deform) and
+ * returns twice the Love stress (another measure than the set's own); it records what it was given,
+ * and fails at a point asked to */
+typedef struct proc_log {
+    int point[8], proto[8], fail_at;
+    double H4[8];
+} proc_log;
+static gk_result double_love(void *user, int point, int proto, gk_rve *rve, const double H[9], const double dH[9],
+                             double scale, double stress[9], int *steps) {
+    proc_log *lg = (proc_log *)user;
+    gk_result r;
+    int k;
+    (void)scale;
+    lg->point[point] = point, lg->proto[point] = proto, lg->H4[point] = H[4]; /* its own slot only */
+    if (point == lg->fail_at) return gk_err_set(&rve->err, GK_ERR_NOCONVERGE, "stand-in failure at %d", point);
+    if ((r = gk_rve_deform(rve, dH, 40)) != GK_OK) return r;
+    gk_rve_stress(rve, stress);
+    for (k = 0; k < 9; ++k) stress[k] *= 2.0;
+    *steps = 40;
+    return GK_OK;
+}
+
+static gk_result make_proc_set(gk_twoscale *ts, int threads, proc_log *lg) {
+    gk_twoscale_proto pr[2];
+    gk_twoscale_def d;
+    pr[0].packing = &pk100, pr[0].state = NULL;
+    pr[1].packing = &pk200, pr[1].state = NULL;
+    memset(&d, 0, sizeof d);
+    d.npoints = 4, d.protos = pr, d.nprotos = 2, d.seed = 3, d.threads = threads;
+    d.rve = gk_rve_def_default();
+    d.rve.dt = DT;
+    d.proc = double_love, d.proc_user = lg;
+    return gk_twoscale_create(ts, &d);
+}
+
+/* with a procedure every point runs it from its accepted state (given H and dH): the set returns, keeps
+ * (accepted, fields, checkpoint) and restores exactly the procedure's stress, not the RVE's Love stress;
+ * 0 before the first accepted run; no tangent; a failing point reports the procedure's message */
+TEST(caller_procedure_runs_every_point) {
+    gk_twoscale a, b;
+    gk_rve r;
+    gk_rve_def rd = gk_rve_def_default();
+    proc_log lg, lgb;
+    gk_twoscale_field f[4];
+    double dH[9 * 4], dH2[9 * 4], s[9 * 4], s2[9 * 4], sb[9 * 4], acc[9 * 4], D[16 * 4], sr[9];
+    const gk_twoscale_point *pts;
+    void *blk = NULL;
+    size_t nb = 0;
+    int k;
+    CHECK(load_packings());
+    if (!have_packings) return;
+    memset(&lg, 0, sizeof lg), memset(&lgb, 0, sizeof lgb);
+    lg.fail_at = lgb.fail_at = -1;
+    CHECK(make_proc_set(&a, 2, &lg) == GK_OK);
+    CHECK(gk_twoscale_accepted(&a, acc, NULL) == GK_OK);
+    for (k = 0; k < 36; ++k) CHECK(acc[k] == 0.0);
+    step_dH(4, 0, 1e-3, dH);
+    step_dH(4, 1, 1e-3, dH2);
+    CHECK(gk_twoscale_run(&a, dH, NULL, s, D) == GK_ERR_ARG && strstr(gk_twoscale_error(&a), "no tangent"));
+    CHECK(gk_twoscale_run(&a, dH, NULL, s, NULL) == GK_OK);
+    for (k = 0; k < 4; ++k) CHECK(lg.point[k] == k && lg.proto[k] == a.pick[k] && lg.H4[k] == 0.0);
+    /* point 3 by hand: its prototype refreshed, the same 40 steps, twice the Love stress */
+    rd.dt = DT;
+    CHECK(gk_rve_create(&r, &rd, a.pick[3] ? &pk200 : &pk100) == GK_OK);
+    gk_rve_refresh(&r);
+    CHECK(gk_rve_deform(&r, dH + 27, 40) == GK_OK);
+    gk_rve_stress(&r, sr);
+    for (k = 0; k < 9; ++k) CHECK(s[27 + k] == 2.0 * sr[k]);
+    gk_rve_destroy(&r);
+    pts = gk_twoscale_points(&a);
+    CHECK(pts[1].work == 40 && pts[1].code == GK_OK && pts[1].tangent == 0);
+    CHECK(gk_twoscale_accept(&a) == GK_OK);
+    CHECK(gk_twoscale_accepted(&a, acc, NULL) == GK_OK && same(acc, s, 36));
+    CHECK(gk_twoscale_accepted(&a, acc, D) == GK_ERR_ARG);
+    CHECK(gk_twoscale_fields(&a, f) == GK_OK && same(f[2].stress, s + 18, 9) && f[2].p == gk_stress_p(s + 18, 2));
+    CHECK(gk_twoscale_save(&a, "build/t_ts_proc.bin", "x", 1) == GK_OK);
+    CHECK(gk_twoscale_run(&a, dH2, NULL, s2, NULL) == GK_OK);
+    for (k = 0; k < 4; ++k) CHECK(lg.H4[k] == dH[9 * k + 4]); /* the accepted H */
+    /* a fresh set from the checkpoint (one thread): the accepted stress and the next run, bit for bit */
+    CHECK(make_proc_set(&b, 1, &lgb) == GK_OK);
+    CHECK(gk_twoscale_load(&b, "build/t_ts_proc.bin", &blk, &nb) == GK_OK && nb == 1);
+    gk_twoscale_free(&b, blk);
+    CHECK(gk_twoscale_accepted(&b, acc, NULL) == GK_OK && same(acc, s, 36));
+    CHECK(gk_twoscale_run(&b, dH2, NULL, sb, NULL) == GK_OK && same(sb, s2, 36));
+    gk_twoscale_reject(&b);
+    lgb.fail_at = 2; /* one failing point: its message, its accepted stress, the others untouched */
+    CHECK(gk_twoscale_run(&b, dH2, NULL, sb, NULL) == GK_ERR_STATE);
+    CHECK(strstr(gk_twoscale_point_error(&b, 2), "stand-in failure at 2") != NULL);
+    CHECK(same(sb + 18, s + 18, 9) && same(sb, s2, 18) && same(sb + 27, s2 + 27, 9));
     gk_twoscale_destroy(&a), gk_twoscale_destroy(&b);
 }
 
@@ -542,6 +635,7 @@ int main(int argc, char **argv) {
     RUN(one_failed_point_does_not_hide_the_others);
     RUN(checkpoint_round_trip_is_bit_identical);
     RUN(corrupt_checkpoints_are_refused_and_change_nothing);
+    RUN(caller_procedure_runs_every_point);
     RUN(bad_arguments_are_refused);
     if (have_packings) gk_packing_free(&pk100), gk_packing_free(&pk200);
     return gk_test_done();

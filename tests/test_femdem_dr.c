@@ -1,0 +1,205 @@
+/* test_femdem_dr.c - examples/femdem_dr.c, FEMxDEM by adaptive dynamic
+ * relaxation with servo-framed RVEs (Liu, Bosco & Suiker 2018): the
+ * isotropic stage ends at sigma0, the 1 x 1 mesh follows the RVE alone, a
+ * locked-rotation RVE is stronger, no NaN anywhere from U = 0 on, 1 and 2
+ * threads and a restart give the same rows, the DNS runs, bad input is
+ * refused by name and a failed write is an error. Short runs (reduced load
+ * paths; the periodic cell where the frame is not what is tested). Needs
+ * build/femdem_dr (`make test` builds the examples first). */
+#define GK_TEST_DRIVERS
+#include "gk_test.h"
+#include <stdlib.h>
+
+#define FDR "build/femdem_dr "
+#define MAXR 64
+
+/* the numeric rows of dr.csv (12 columns); -1 if the header is not the documented one */
+static int rows(const char *path, double r[][12]) {
+    FILE *fp = fopen(path, "r");
+    char line[1024];
+    int n = 0, k;
+    if (!fp) return -1;
+    if (!fgets(line, sizeof line, fp) ||
+        strcmp(line, "step,stage,eps_axial,sigma_bar,sigma_11,sigma_22,J,coordination,anisotropy,dr_iterations,"
+                     "dem_steps,seconds\n")) {
+        fclose(fp);
+        return -1;
+    }
+    while (n < MAXR && fgets(line, sizeof line, fp)) {
+        double *v = r[n];
+        if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
+                   &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) != 12)
+            break;
+        for (k = 0; k < 12; ++k)
+            if (!isfinite(v[k])) {
+                fclose(fp);
+                return -2;
+            }
+        ++n;
+    }
+    fclose(fp);
+    return n;
+}
+
+/* every column but the seconds of two dr.csv files */
+static int same_rows(const char *a, const char *b) {
+    static double ra[MAXR][12], rb[MAXR][12];
+    int na = rows(a, ra), nb = rows(b, rb), i, k, same = na > 1 && na == nb;
+    for (i = 0; same && i < na; ++i)
+        for (k = 0; k < 11; ++k) same &= ra[i][k] == rb[i][k];
+    return same;
+}
+
+/* The RVE alone (--test rve: a homogeneous specimen) and the 1 x 1 mesh with four RVEs, both with the
+ * periodic cell: the isotropic stage ends at sigma0 in both directions within 1 % (eq 28 leaves a few
+ * per mille of each step's imbalance); from U = 0 on (where eq 26 is 0/0) every value is finite; the
+ * mesh follows the RVE alone within 2 % of the peak stress ratio up to 2 % axial strain (the four
+ * RVEs stay alike while the specimen is uniform); the outputs are the documented ones. */
+TEST(isotropic_stage_and_one_element_against_the_rve) {
+    static double a[MAXR][12], b[MAXR][12];
+    int na, nb, i;
+    double peak = 0.0, dmax = 0.0;
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.02 --out build/t_fdr_rve > build/t_fdr_rve.out "
+                     "2>&1") == 0);
+    CHECK(system(FDR "--nx 1 --ny 1 --frame periodic --steps 4 --strain 0.02 --out build/t_fdr_11 "
+                     "> build/t_fdr_11.out 2>&1") == 0);
+    na = rows("build/t_fdr_rve/dr.csv", a);
+    nb = rows("build/t_fdr_11/dr.csv", b);
+    CHECK_EQ_INT(na, 15);
+    CHECK_EQ_INT(nb, 15);
+    if (na != 15 || nb != 15) return;
+    CHECK(a[10][1] == 1 && a[11][1] == 2);
+    CHECK_REL(a[10][4], 1.5e5, 0.01);
+    CHECK_REL(a[10][5], 1.5e5, 0.01);
+    CHECK_REL(b[10][4], 1.5e5, 0.01);
+    CHECK_REL(b[10][5], 1.5e5, 0.01);
+    for (i = 11; i < 15; ++i) {
+        CHECK_REL(b[i][4], 1.5e5, 0.01); /* the sides stay at sigma0 */
+        if (a[i][3] > peak) peak = a[i][3];
+    }
+    for (i = 11; i < 15; ++i)
+        if (fabs(a[i][3] - b[i][3]) > dmax) dmax = fabs(a[i][3] - b[i][3]);
+    printf("    sigma_bar at 2 %%: RVE alone %.4f, 1 x 1 mesh %.4f; largest difference %.2f %% of the peak\n", a[14][3],
+           b[14][3], 100.0 * dmax / peak);
+    CHECK(peak > 0.2);
+    CHECK(dmax <= 0.02 * peak);
+    CHECK_NEAR(gk_test_result("build/t_fdr_11.out", "peak_sigma_bar"), peak, 0.02 * peak); /* RESULT */
+    CHECK(gk_test_file_has("build/t_fdr_11.out", "dr_iterations_mean="));
+    CHECK(gk_test_file_has("build/t_fdr_11/mesh_0014.vtk", "displacement"));
+    CHECK(gk_test_file_has("build/t_fdr_11/gp_0014.vtk", "anisotropy"));
+    CHECK(gk_test_file_has("build/t_fdr_11/dr_stress.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_fdr_11/deq_field.svg", "deq"));
+}
+
+/* Liu, Bosco & Suiker 2018 Figs 10-11: with particle rotation locked (theta_p = 0) the RVE is stronger:
+ * its stress ratio at 4 % axial strain exceeds the free one (the RVE alone, periodic cell) */
+TEST(locked_rotation_is_stronger) {
+    static double f[MAXR][12], l[MAXR][12];
+    int nf, nl;
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --out build/t_fdr_free > build/t_fdr_free.out "
+                     "2>&1") == 0);
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --no-rotation --out build/t_fdr_lock "
+                     "> build/t_fdr_lock.out 2>&1") == 0);
+    nf = rows("build/t_fdr_free/dr.csv", f);
+    nl = rows("build/t_fdr_lock/dr.csv", l);
+    CHECK(nf == 15 && nl == 15);
+    if (nf != 15 || nl != 15) return;
+    printf("    sigma_bar at 4 %%: free %.4f, locked %.4f\n", f[14][3], l[14][3]);
+    CHECK(l[14][3] > f[14][3] * 1.05);
+    CHECK(gk_test_file_has("build/t_fdr_lock.out", "rotation=locked"));
+}
+
+/* the servo frame (the paper's RVE) on a 1 x 2 mesh: 2 threads and 1 thread give the same rows bit for
+ * bit, and so does a run stopped after 2 steps and restarted from its checkpoint */
+TEST(threads_and_restart_give_the_same_rows) {
+    const char *base = FDR "--nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 ";
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 2 --out build/t_fdrA > build/t_fdrA.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 1 --out build/t_fdr1 > build/t_fdr1.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 2 --stop-after 2 --out build/t_fdrB > build/t_fdrB.out 2>&1",
+             base);
+    CHECK(system(cmd) == 0);
+    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 2 --restart build/t_fdrB --out build/t_fdrC "
+                              "> build/t_fdrC.out 2>&1",
+             base);
+    CHECK(system(cmd) == 0);
+    CHECK(same_rows("build/t_fdrA/dr.csv", "build/t_fdr1/dr.csv"));
+    CHECK(gk_test_file_has("build/t_fdrA.out", "frame=servo"));
+    CHECK(gk_test_file_has("build/t_fdrC.out", "restarted from"));
+    CHECK(same_rows("build/t_fdrA/dr.csv", "build/t_fdrC/dr.csv"));
+}
+
+/* the DNS: the packing tiled 1 x 2 (444 disks) between platens and membranes; the isotropic stage
+ * reaches sigma0 on the platen within 2 %, compression raises the stress ratio */
+TEST(dns_runs) {
+    static double r[MAXR][12];
+    int n;
+    CHECK(system(FDR "--test dns --iso-steps 2 --steps 1 --strain 0.01 --out build/t_fdr_dns > build/t_fdr_dns.out "
+                     "2>&1") == 0);
+    n = rows("build/t_fdr_dns/dr.csv", r);
+    CHECK_EQ_INT(n, 4);
+    if (n != 4) return;
+    CHECK_REL(r[2][4], 1.5e5, 1e-9); /* the membranes' pressure */
+    CHECK_REL(r[2][5], 1.5e5, 0.02); /* the platen's */
+    CHECK(r[3][3] > 0.05);
+    CHECK(gk_test_file_has("build/t_fdr_dns.out", "444 disks"));
+    CHECK(gk_test_file_has("build/t_fdr_dns/dns_0003.vtk", "POINTS"));
+}
+
+/* the sizes: the reduced default is the 1 x 2 mesh (8 Gauss points); --paper is the paper's 2 x 4 mesh,
+ * and an option given with it wins wherever it stands (--ny 2 before --paper: 2 x 2, 16 points) */
+TEST(default_and_paper_sizes) {
+    const char *cut = "--frame periodic --iso-steps 1 --steps 1 --strain 0.001 --stop-after 1 --vtk-every 0";
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, FDR "%s --out build/t_fdr_def > build/t_fdr_def.out 2>&1", cut);
+    CHECK(system(cmd) == 0);
+    CHECK(gk_test_file_has("build/t_fdr_def.out", " 8 Gauss points"));
+    snprintf(cmd, sizeof cmd, FDR "--ny 2 --paper %s --out build/t_fdr_pap > build/t_fdr_pap.out 2>&1", cut);
+    CHECK(system(cmd) == 0);
+    CHECK(gk_test_file_has("build/t_fdr_pap.out", " 16 Gauss points"));
+    CHECK(gk_test_file_has("build/t_fdr_pap.out", "stopped after step 1"));
+}
+
+/* bad input: a message naming the option and status 2; an output that cannot be written: status 1 */
+TEST(bad_input_and_failed_writes) {
+    CHECK(system(FDR "--nx 2x --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "--nx '2x' is not a whole number"));
+    CHECK(system(FDR "--frame square --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "--frame 'square' must be servo or periodic"));
+    CHECK(system(FDR "--pressure -1 --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "--pressure -1 must be > 0"));
+    CHECK(system(FDR "--strain nan --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "--strain 'nan' is not a finite number"));
+    CHECK(system(FDR "--material clay --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "--material 'clay' must be paper or guo-zhao"));
+    CHECK(system(FDR "--material guo-zhao --out build/t_fdr_bad > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "needs --frame periodic")); /* the servo's gains are per k_n */
+    CHECK(system(FDR "--bogus 1 > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "unknown option --bogus"));
+    CHECK(system(FDR "--test rve > build/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "--out DIR is required"));
+    CHECK(system(FDR "--test rve --packing examples/data/rve400.txt --out build/t_fdr_bad > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "corner"));
+    CHECK(system(FDR "--test rve --restart build/no_such_dir --out build/t_fdr_bad > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "no_such_dir"));
+    /* --out names a file: the directory exists as a file, nothing can be written in it */
+    CHECK(system("touch build/t_fdr_file") == 0);
+    CHECK(system(FDR "--test rve --frame periodic --iso-steps 1 --steps 1 --out build/t_fdr_file > build/t_bad.out "
+                     "2>&1") == 1 * 256);
+    CHECK(gk_test_file_has("build/t_bad.out", "cannot write"));
+    CHECK(system(FDR "--help > build/t_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "--frame servo|periodic"));
+}
+
+int main(int argc, char **argv) {
+    gk_test_init(argc, argv);
+    RUN(isotropic_stage_and_one_element_against_the_rve);
+    RUN(locked_rotation_is_stronger);
+    RUN(threads_and_restart_give_the_same_rows);
+    RUN(dns_runs);
+    RUN(default_and_paper_sizes);
+    RUN(bad_input_and_failed_writes);
+    return gk_test_done();
+}
