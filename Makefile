@@ -25,11 +25,25 @@ BENCH_SRC:= $(filter-out bench/%_part.c,$(wildcard bench/*.c))
 TOOL_SRC := $(wildcard tools/*.c)
 
 TESTS    := $(patsubst tests/%.c,$(BUILD)/%,$(TEST_SRC))
+
+# the optional MPI build (gk_twoscale.h with GK_TWOSCALE_MPI): `make mpi`; `make test` runs its tests
+# with 2 ranks when mpicc is installed (Open MPI: openmpi-bin libopenmpi-dev) and says so when not
+MPICC   ?= mpicc
+MPIRUN  ?= mpirun
+HAVE_MPI := $(shell command -v $(MPICC) >/dev/null 2>&1 && command -v $(MPIRUN) >/dev/null 2>&1 && echo yes)
+# Open MPI refuses root without --allow-run-as-root, and more ranks than it counts cores without
+# --oversubscribe (other MPIs do not know these flags)
+MPIRUN_FLAGS ?= $(shell $(MPIRUN) --version 2>/dev/null | grep -q 'Open MPI' && \
+                  { [ "$$(id -u)" = 0 ] && echo '--allow-run-as-root --oversubscribe' || echo '--oversubscribe'; })
+MPI_TEST_SRC := $(wildcard tests/mpi_*.c)
+MPI_TESTS    := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/mpi_%,$(MPI_TEST_SRC))
+MPI_RUNNERS  := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/run_%,$(MPI_TEST_SRC))
+MPI_PROGS    := $(MPI_TESTS) $(MPI_RUNNERS)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/%,$(EX_SRC))
 BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
 TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
 
-.PHONY: all test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
+.PHONY: all mpi test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
         check-headers check-asan check-nosimd tradeoff
 
 all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
@@ -40,6 +54,7 @@ help:
 	@echo "make run-rve    one RVE along a shear path"
 	@echo "make run-mpm | run-footing | run-collapse   seed 003's MPMxDEM biaxial, footing, column collapse"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
+	@echo "make mpi        the MPI programs (mpicc; gk_twoscale.h with GK_TWOSCALE_MPI) into $(BUILD)/mpi/"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability"
 	@echo "make bench      performance programs (2 cores)"
 	@echo "make tradeoff   accuracy against cost of the drivers, the whole sweep (10-15 min; build/tradeoff/)"
@@ -47,7 +62,7 @@ help:
 	@echo "make install PREFIX=dir   headers + pkg-config file"
 	@echo "make format / format-check   clang-format"
 
-$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr:
+$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/mpi:
 	@mkdir -p $@
 
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
@@ -75,8 +90,26 @@ $(BUILD)/bench_tradeoff: | $(BUILD)/femdem_biaxial $(BUILD)/femdem_biaxial_float
 $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
-test: $(TESTS) $(EXAMPLES) $(TOOLS)
-	@tests/run_tests.sh $(TESTS)
+# ---------------------------------------------------------------- MPI
+$(BUILD)/mpi/mpi_%: tests/mpi_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/mpi
+	$(MPICC) $(CFLAGS) -o $@ $< $(LDLIBS)
+
+# a runner script per MPI test, so that tests/run_tests.sh runs it as any other test program
+$(BUILD)/mpi/run_%: $(BUILD)/mpi/mpi_% | $(BUILD)/mpi
+	@printf '#!/bin/sh\nexec %s %s -np 2 %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
+
+ifeq ($(HAVE_MPI),yes)
+mpi: $(MPI_PROGS)
+MPI_RUN := $(MPI_RUNNERS)
+else
+mpi:
+	@echo "make mpi: $(MPICC) or $(MPIRUN) not found, the MPI programs are skipped (Debian: apt-get install openmpi-bin libopenmpi-dev)"
+MPI_RUN :=
+endif
+
+test: $(TESTS) $(EXAMPLES) $(TOOLS) $(if $(HAVE_MPI),$(MPI_PROGS))
+	@$(if $(HAVE_MPI),,echo "make test: $(MPICC) not found, the MPI tests are skipped (apt-get install openmpi-bin libopenmpi-dev)";) \
+	  tests/run_tests.sh $(TESTS) $(MPI_RUN)
 
 # ---------------------------------------------------------------- check
 SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer

@@ -197,6 +197,14 @@ typedef struct gk_rve_state {
     gk_allocator alloc;
 } gk_rve_state;
 
+/* one contact (a touching pair) of gk_rve_contact_next, read-only */
+typedef struct gk_rve_contact {
+    int i, j;    /* the two particles as indices of the input packing (gk_rve.id), i < j */
+    int sliding; /* 1 if its tangential force was on the Coulomb cap in the last step */
+    double f[3]; /* contact force on particle j in the last step [N] (2D: f[2] = 0)   */
+    double d[3]; /* branch vector x_j - x_i, nearest image [m] (2D: d[2] = 0)         */
+} gk_rve_contact;
+
 typedef struct gk_consolidate_def {
     double pressure;          /* target isotropic stress, compression-positive [Pa] (> 0) */
     double friction;          /* Coulomb coefficient while consolidating (0 = dense)      */
@@ -240,6 +248,10 @@ GKDEF double gk_rve_volume(const gk_rve *rve);     /* stress volume             
 GKDEF double gk_rve_kinetic_energy(const gk_rve *rve); /* of the fluctuations     */
 GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]);
 GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *pk, const gk_allocator *alloc, gk_err *err);
+/* the contacts of the last step, one per call, in the RVE's pair order (the same for the same
+ * state): `int c = 0; gk_rve_contact k; while (gk_rve_contact_next(rve, &c, &k)) ...` (c is a
+ * cursor: start it at 0 and leave it to the call); 0 when there are no more */
+GKDEF int gk_rve_contact_next(const gk_rve *rve, int *cursor, gk_rve_contact *out);
 
 /* state */
 GKDEF size_t gk_rve_state_size(const gk_rve *rve);
@@ -2201,6 +2213,32 @@ GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *out, const gk_a
 }
 
 /* ---------------------------------------------------------------- consolidation */
+GKDEF int gk_rve_contact_next(const gk_rve *rve, int *cursor, gk_rve_contact *out) {
+    int c = *cursor < 0 ? 0 : *cursor, k;
+    for (; c < rve->pl.n; ++c) {
+        int a = rve->pl.i[c], b = rve->pl.j[c], swap;
+        double ds[3];
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        swap = rve->id[a] > rve->id[b];
+        out->i = swap ? rve->id[b] : rve->id[a];
+        out->j = swap ? rve->id[a] : rve->id[b];
+        out->sliding = (rve->cs[c] & GK_CS_SLIDING) != 0;
+        for (k = 0; k < 3; ++k) {
+            double fk = k < rve->dim ? (double)rve->fc[k][c] : 0.0;
+            ds[k] = k < rve->dim ? rve->s[k][b] - rve->s[k][a] : 0.0;
+            out->f[k] = swap ? -fk : fk;
+        }
+        gk_pcell_min_image(&rve->cell, ds, out->d);
+        if (rve->dim == 2) out->d[2] = 0.0;
+        if (swap)
+            for (k = 0; k < 3; ++k) out->d[k] = -out->d[k];
+        *cursor = c + 1;
+        return 1;
+    }
+    *cursor = rve->pl.n;
+    return 0;
+}
+
 GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk_consolidate_report *rep) {
     gk_servo sv;
     double mu_final = rve->def.mat.friction, alpha_final = rve->def.damping, rmean = 0.0, tol, utol, rate;
