@@ -116,6 +116,7 @@ typedef enum gk_mass_model { GK_MASS_CYLINDER = 0, GK_MASS_SPHERE = 1 } gk_mass_
 #define GK_RVE_NO_ROTATION 1u /* particles do not rotate (spin with the cell only) */
 #define GK_RVE_SCALAR 2u      /* always use the scalar reference kernels          */
 #define GK_RVE_WRAP 4u        /* accept positions outside the cell (wrap them)    */
+#define GK_RVE_TRACK_ROTATION 8u /* 3D: accumulate each particle's rotation vector  */
 #define GK_RVE_DEF_COOKIE 0x52564531
 
 typedef struct gk_rve_def {
@@ -153,7 +154,9 @@ typedef struct gk_rve {
     gk_real *f[3];            /* contact force sum of the last step [N]             */
     gk_real *t[3];            /* contact torque sum of the last step (2D: t[2])     */
     gk_real *r, *minv, *Iinv;
-    double *theta;            /* 2D: accumulated rotation [rad] (incl. cell spin)   */
+    double *theta;            /* 2D: accumulated rotation [rad] (incl. cell spin);
+                                 3D with GK_RVE_TRACK_ROTATION: 3 n, the sum of the
+                                 rotation increments (w + cell spin) dt per particle */
     int32_t *id;              /* index in the input packing                         */
     double rmin, rmax, mmin, solid_volume, mass_total;
     /* pairs, sorted by (i, j) */
@@ -559,8 +562,10 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         R.Iinv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
         R.id = (int32_t *)gk_alloc(&def->alloc, (size_t)n * sizeof(int32_t));
         R.jstart = (int32_t *)gk_alloc(&def->alloc, ((size_t)n + 1) * sizeof(int32_t));
-        if (dim == 2) R.theta = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
-        if (!R.r || !R.minv || !R.Iinv || !R.id || !R.jstart || (dim == 2 && !R.theta)) res = GK_ERR_ALLOC;
+        if (dim == 2 || (def->flags & GK_RVE_TRACK_ROTATION))
+            R.theta = (double *)gk_alloc(&def->alloc, (size_t)n * (dim == 2 ? 1 : 3) * sizeof(double));
+        if (!R.r || !R.minv || !R.Iinv || !R.id || !R.jstart || ((dim == 2 || (def->flags & GK_RVE_TRACK_ROTATION)) && !R.theta))
+            res = GK_ERR_ALLOC;
         gk_pairlist_init(&R.pl, &def->alloc);
         gk_pairlist_init(&R.outer, &def->alloc);
         gk_pairlist_init(&R.spare.pl, &def->alloc);
@@ -594,7 +599,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                 R.minv[p] = (gk_real)(1.0 / m);
                 R.Iinv[p] = (gk_real)(1.0 / I);
                 R.id[p] = q;
-                if (R.theta) R.theta[p] = 0.0;
+                if (R.theta)
+                    for (k = 0; k < (dim == 2 ? 1 : 3); ++k) R.theta[(dim == 2 ? 1 : 3) * p + k] = 0.0;
                 if (rq < R.rmin) R.rmin = rq;
                 if (rq > R.rmax) R.rmax = rq;
                 if (m < R.mmin) R.mmin = m;
@@ -1968,6 +1974,12 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
         rve->outer_valid = 0;
     }
     dispmax2 = gk__integrate(rve, &x, rve->cell.hinv, rve->cell.h, &bad);
+    if (rve->dim == 3 && rve->theta) { /* GK_RVE_TRACK_ROTATION: outside the kernels, paid only when asked */
+        int p;
+        for (p = 0; p < rve->n; ++p)
+            for (k = 0; k < 3; ++k)
+                rve->theta[3 * p + k] += ((double)x.wa[k] + (rve->w[k] ? (double)rve->w[k][p] : 0.0)) * rve->dt;
+    }
     rve->time += rve->dt;
     ++rve->step;
     if (bad) {
@@ -2355,7 +2367,7 @@ static size_t gk__state_bytes(const gk_rve *rve, int npairs, int nouter) {
     size_t n = (size_t)rve->n, np = (size_t)npairs, R = sizeof(gk_real), b = sizeof(gk__state_hdr);
     b += n * (2 * dim * sizeof(double)); /* s, s0 */
     b += n * R * (2 * dim + 2 * nr);      /* v, f, w, t */
-    b += dim == 2 ? n * sizeof(double) : 0; /* theta */
+    b += rve->theta ? n * (dim == 2 ? 1 : 3) * sizeof(double) : 0; /* theta */
     b += np * (2 * sizeof(int32_t) + 1);   /* i, j, cs */
     b += np * R * ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll); /* ft, fc, tci, tcj, mr */
     b += (size_t)nouter * 2 * sizeof(int32_t) + n * dim * sizeof(double); /* outer list, o0 */
@@ -2427,7 +2439,7 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
             GK__PUT(rve->w[k], n * R);
             GK__PUT(rve->t[k], n * R);
         }
-    if (dim == 2) GK__PUT(rve->theta, n * sizeof(double));
+    if (rve->theta) GK__PUT(rve->theta, n * (dim == 2 ? 1 : 3) * sizeof(double));
     GK__PUT(rve->pl.i, np * sizeof(int32_t));
     GK__PUT(rve->pl.j, np * sizeof(int32_t));
     GK__PUT(rve->cs, np);
@@ -2486,7 +2498,7 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     {
         size_t base = sizeof hd + n * (2 * dim * sizeof(double)) +
                       n * R * (2 * dim + 2 * (GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0)) +
-                      (dim == 2 ? n * sizeof(double) : 0);
+                      (rve->theta ? n * (dim == 2 ? 1 : 3) * sizeof(double) : 0);
         for (c = 0; c < (int)np; ++c) {
             int32_t a, b;
             memcpy(&a, in + base + (size_t)c * 4, 4);
@@ -2506,7 +2518,7 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
             GK__GET(rve->w[k], n * R);
             GK__GET(rve->t[k], n * R);
         }
-    if (dim == 2) GK__GET(rve->theta, n * sizeof(double));
+    if (rve->theta) GK__GET(rve->theta, n * (dim == 2 ? 1 : 3) * sizeof(double));
     GK__GET(rve->pl.i, np * sizeof(int32_t));
     GK__GET(rve->pl.j, np * sizeof(int32_t));
     GK__GET(rve->cs, np);
