@@ -128,8 +128,8 @@ enum { T_RVE, T_EBIAX, T_ESHEAR, T_WAVE, T_SSHEAR, T_BIAX, T_COUNT };
 static const char *test_name[T_COUNT] = {"rve", "element-biaxial", "element-shear", "wave", "simple-shear", "biaxial"};
 
 typedef struct opts {
-    int test, mesh[3], threads, steps, stop_after, checkpoint, vtk_every, every, imperfection, dem_min, dem_max;
-    double R, pressure, strain, iuf, dem_damping, contact_damping, density, xi, mass_scale, kappa, dt, dt_safety;
+    int test, mesh[3], threads, steps, stop_after, checkpoint, vtk_every, every, imperfection, dem_min, dem_max, lone;
+    double R, pressure, strain, iuf, dem_inertial, dem_damping, contact_damping, density, xi, mass_scale, kappa, dt, dt_safety;
     double amplitude, frequency, duration;
     const char *packing, *out, *restart;
 } opts;
@@ -198,8 +198,10 @@ static int parse(int argc, char **argv, opts *o) {
     o->every = -1;
     o->imperfection = -1;
     o->iuf = 0.01;
+    o->dem_inertial = 2e-3;
     o->dem_min = 10;
     o->dem_max = 4000;
+    o->lone = 400;
     o->dem_damping = 0.2;
     o->contact_damping = -1;
     o->density = 2492.0;
@@ -256,8 +258,10 @@ static int parse(int argc, char **argv, opts *o) {
         else if (!strcmp(a, "--every")) bad = int_opt(a, v, &o->every);
         else if (!strcmp(a, "--imperfection")) bad = int_opt(a, v, &o->imperfection);
         else if (!strcmp(a, "--iuf")) bad = real_opt(a, v, &o->iuf);
+        else if (!strcmp(a, "--dem-inertial")) bad = real_opt(a, v, &o->dem_inertial);
         else if (!strcmp(a, "--dem-min")) bad = int_opt(a, v, &o->dem_min);
         else if (!strcmp(a, "--dem-max")) bad = int_opt(a, v, &o->dem_max);
+        else if (!strcmp(a, "--lone-increments")) bad = int_opt(a, v, &o->lone);
         else if (!strcmp(a, "--dem-damping")) bad = real_opt(a, v, &o->dem_damping);
         else if (!strcmp(a, "--contact-damping")) bad = real_opt(a, v, &o->contact_damping);
         else if (!strcmp(a, "--density")) bad = real_opt(a, v, &o->density);
@@ -292,7 +296,7 @@ static int parse(int argc, char **argv, opts *o) {
             if (o->steps < 0) o->steps = (int)floor(o->duration / o->dt + 0.5);
         }
         if (o->steps < 0) o->steps = steps[t];
-        if (o->imperfection < 0) o->imperfection = t == T_SSHEAR ? 25 : 0;
+        if (o->imperfection < 0) o->imperfection = t == T_SSHEAR ? -2 : 0; /* -2: 25 x N / 4096 (after reading) */
         if (o->contact_damping < 0) o->contact_damping = t == T_BIAX ? 0.0 : 0.12;
         if (o->xi < 0) o->xi = t == T_WAVE ? 0.0 : 0.3;
         if (o->every < 0) o->every = o->steps / (t == T_EBIAX || t == T_ESHEAR ? 1000 : 200) > 1 ? o->steps / (t == T_EBIAX || t == T_ESHEAR ? 1000 : 200) : 1;
@@ -314,10 +318,12 @@ static int parse(int argc, char **argv, opts *o) {
     REQ(o->checkpoint >= 0, "--checkpoint %d must be >= 0", o->checkpoint);
     REQ(o->vtk_every >= 0, "--vtk-every %d must be >= 0", o->vtk_every);
     REQ(o->every >= 1, "--every %d must be >= 1", o->every);
-    REQ(o->imperfection >= 0, "--imperfection %d must be >= 0", o->imperfection);
+    REQ(o->imperfection >= -2, "--imperfection %d must be >= 0", o->imperfection);
     REQ(o->iuf > 0 && o->iuf < 1, "--iuf %g must be in (0, 1)", o->iuf);
+    REQ(o->dem_inertial > 0 && o->dem_inertial < 1, "--dem-inertial %g must be in (0, 1)", o->dem_inertial);
     REQ(o->dem_min >= 1 && o->dem_max >= o->dem_min, "--dem-min %d, --dem-max %d: 1 <= min <= max", o->dem_min,
         o->dem_max);
+    REQ(o->lone >= 2 && o->lone <= 100000, "--lone-increments %d must be 2-100000", o->lone);
     REQ(o->dem_damping >= 0 && o->dem_damping < 1, "--dem-damping %g must be in [0, 1)", o->dem_damping);
     REQ(o->contact_damping >= 0 && o->contact_damping < 1, "--contact-damping %g must be in [0, 1)",
         o->contact_damping);
@@ -366,6 +372,7 @@ static void ts_def_make(const opts *o, const micro *m, const gk_twoscale_proto *
     d->rve = m->rd;
     d->rule.kind = GK_TWOSCALE_ADAPTIVE;
     d->rule.unbalanced_max = o->iuf;
+    d->rule.inertial_max = o->dem_inertial;
     d->rule.unbalanced_rms = 1; /* eq 57 */
     d->rule.n_min = o->dem_min;
     d->rule.n_max = o->dem_max;
@@ -1025,8 +1032,8 @@ static void track(model *md) {
         }
         free(prof);
     }
-    if (md->test == T_WAVE) { /* first time the element's shear strain passes 5 % of a / (element length) */
-        double thr = 0.05 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
+    if (md->test == T_WAVE) { /* first time the element's shear strain passes 1e-3 a / (element length) */
+        double thr = 1e-3 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
         for (e = 0; e < md->ne; ++e) {
             const double *H = md->H + 9 * e;
             if (md->arrival[e] < 0 && fabs(H[1] + H[3]) > thr) md->arrival[e] = md->time;
@@ -1136,10 +1143,10 @@ static uint64_t fingerprint(const opts *o, const gk_packing *pk) {
     int i;
     for (i = 0; i < pk->n; ++i) sx += pk->x[i] + 2.0 * pk->y[i] + 3.0 * pk->z[i] + 5.0 * pk->r[i];
     snprintf(buf, sizeof buf, "%d %d %d %d %.17g %.17g %.17g %d %d %.17g %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
-             "%.17g %.17g %.17g %.17g %d %d %d %.17g",
+             "%.17g %.17g %.17g %.17g %d %d %d %.17g %.17g",
              o->test, o->mesh[0], o->mesh[1], o->mesh[2], o->R, o->pressure, o->strain, o->steps, o->imperfection,
              o->iuf, o->dem_min, o->dem_max, o->dem_damping, o->contact_damping, o->density, o->xi, o->mass_scale,
-             o->kappa, o->dt, o->dt_safety, o->amplitude, o->frequency, o->duration, o->every, pk->n, 3, sx);
+             o->kappa, o->dt, o->dt_safety, o->amplitude, o->frequency, o->duration, o->every, pk->n, 3, sx, o->dem_inertial);
     for (k = 0; buf[k]; ++k) h = (h ^ (unsigned char)buf[k]) * 1099511628211ull;
     return h;
 }
@@ -1389,7 +1396,7 @@ static void wave_elastic(model *md, double *arr) {
     int e, a, k, i, j;
     long n;
     double lam = md->mi->K - 2.0 / 3.0 * md->mi->G, mu = md->mi->G;
-    double thr = 0.05 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
+    double thr = 1e-3 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
     double *u = (double *)xcalloc((size_t)md->nd, sizeof(double)), *f = (double *)xcalloc((size_t)md->nd, sizeof(double));
     double *ur = (double *)xcalloc((size_t)md->nr, sizeof(double)), *vr = (double *)xcalloc((size_t)md->nr, sizeof(double));
     double *fr = (double *)xcalloc((size_t)md->nr, sizeof(double));
@@ -1501,6 +1508,8 @@ int main(int argc, char **argv) {
     gk_rve_state_init(&mi.st_imp, NULL);
     if (gk_packing_read(o.packing, &mi.pk, NULL, &err)) return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
     if (mi.pk.dim != 3) return fprintf(stderr, "femdem_nonlocal: %s is a %dD packing (3D needed)\n", o.packing, mi.pk.dim), 1;
+    if (o.imperfection == -2) /* the paper's 25 of 4096 particles, in proportion */
+        o.imperfection = (int)floor(25.0 * mi.pk.n / 4096.0 + 0.5) > 1 ? (int)floor(25.0 * mi.pk.n / 4096.0 + 0.5) : 1;
     rve_def_make(&o, &mi.rd);
     if (rve_frequency(&mi)) return 1;
     if (o.test == T_RVE) return run_rve_test(&o, &mi, t0);
@@ -1534,7 +1543,7 @@ int main(int argc, char **argv) {
         md.dt = o.dt;
     }
     md.nsteps = o.steps;
-    md.nramp = o.steps / 20 > 1 ? o.steps / 20 : 1;
+    md.nramp = o.steps / 10 > 1 ? o.steps / 10 : 1;
     md.vload = o.strain * md.L[1] / ((md.nsteps - 0.5 * md.nramp) * md.dt);
     {
         double rho = mi.rho * o.mass_scale, E = 9.0 * mi.K * mi.G / (3.0 * mi.K + mi.G);
@@ -1613,7 +1622,7 @@ int main(int argc, char **argv) {
         snprintf(path, sizeof path, "%s/mesh_%06ld.vtk", o.out, md.step);
         if (write_vtk(&md, path)) return 1;
         if (o.test == T_EBIAX || o.test == T_ESHEAR) {
-            int nl = 200;
+            int nl = o.lone;
             double *lone = (double *)xcalloc((size_t)8 * (nl + 1), sizeof(double)), *lx, *ly, dev, pkr;
             printf("the RVE alone on the same path (%d increments)...\n", nl);
             if (rve_alone(&o, &mi, nl, lone)) return 1;
