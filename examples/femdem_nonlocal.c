@@ -380,63 +380,56 @@ static void ts_def_make(const opts *o, const micro *m, const gk_twoscale_proto *
 }
 
 /* the initial state, K and G of Table II (and the rve test's curves): point 0
- * compressed isotropically, point 1 sheared, from the same packing */
-static int rve_moduli(const opts *o, micro *m, const char *csv) {
+ * compressed isotropically, point 1 sheared, from the same packing; ten
+ * increments of 1e-5, then (rows != NULL) --steps more to --strain. Rows of
+ * RVE_NCOL: eps_v, p, K_MPa (secant), gamma, tau, G_MPa (secant), porosity
+ * and Z of each point, DEM steps */
+#define RVE_NCOL 11
+static int rve_moduli(const opts *o, micro *m, double *rows) {
     gk_twoscale ts;
     gk_twoscale_def d;
     gk_twoscale_proto pr = {&m->pk, NULL};
     gk_twoscale_field f[2];
     double dH[18], s[18], s0[18], eps = 0.0, gam = 0.0, ninc;
-    int i, nsmall = 10, ntot = nsmall + (csv ? o->steps : 0);
-    FILE *fp = NULL;
+    int i, nsmall = 10, ntot = nsmall + (rows ? o->steps : 0);
     ts_def_make(o, m, &pr, 1, NULL, 2, &d);
     d.rule.unbalanced_max = 1e-3; /* the reference moduli: relaxed 10 x tighter than the mesh runs */
-    d.rule.n_min = 200;
-    if (gk_twoscale_create(&ts, &d)) {
-        fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&ts));
-        return 1;
-    }
+    d.rule.n_min = 200, d.rule.n_max = 20000;
+    if (gk_twoscale_create(&ts, &d)) return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&ts)), 1;
     gk_twoscale_fields(&ts, f);
     gk_twoscale_accepted(&ts, s0, NULL);
     m->porosity0 = f[0].void_ratio / (1.0 + f[0].void_ratio);
     m->Z0 = f[0].coordination;
     m->p0 = f[0].p;
-    m->rho = f[0].mass / f[0].volume;
-    if (csv) {
-        fp = fopen(csv, "w");
-        if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", csv), 1;
-        fprintf(fp, "eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,Z_iso,porosity_shear,Z_shear,dem_steps\n");
-        fprintf(fp, "0,%.9g,nan,0,%.9g,nan,%.9g,%.9g,%.9g,%.9g,0\n", f[0].p, s0[9 + 1], m->porosity0, m->Z0,
-                m->porosity0, f[1].coordination);
-    }
-    for (i = 0; i < ntot; ++i) {
-        const gk_twoscale_point *pt;
-        ninc = i < nsmall ? 1e-5 : (o->strain - 1e-4) / o->steps;
-        memset(dH, 0, sizeof dH);
-        dH[0] = dH[4] = dH[8] = -ninc / 3.0; /* isotropic compression, eps_v = ninc */
-        dH[9 + 1] = ninc;                    /* simple shear H_xy, gamma = ninc */
-        if (gk_twoscale_run(&ts, dH, NULL, s, NULL) || gk_twoscale_accept(&ts)) {
-            fprintf(stderr, "femdem_nonlocal: RVE test: %s\n", gk_twoscale_error(&ts));
-            gk_twoscale_destroy(&ts);
-            if (fp) fclose(fp);
-            return 1;
+    m->rho = f[0].mass / f[0].volume; /* eq 26 */
+    for (i = 0; i <= ntot; ++i) {
+        if (i > 0) {
+            const gk_twoscale_point *pt;
+            ninc = i <= nsmall ? 1e-5 : (o->strain - 1e-4) / o->steps;
+            memset(dH, 0, sizeof dH);
+            dH[0] = dH[4] = dH[8] = -ninc / 3.0; /* isotropic compression, eps_v = ninc */
+            dH[9 + 1] = ninc;                    /* simple shear H_xy, gamma = ninc */
+            if (gk_twoscale_run(&ts, dH, NULL, s, NULL) || gk_twoscale_accept(&ts)) {
+                fprintf(stderr, "femdem_nonlocal: RVE test: %s\n", gk_twoscale_error(&ts));
+                gk_twoscale_destroy(&ts);
+                return 1;
+            }
+            eps += ninc, gam += ninc;
+            gk_twoscale_fields(&ts, f);
+            pt = gk_twoscale_points(&ts);
+            if (i == nsmall) m->K = (f[0].p - m->p0) / eps, m->G = (s[9 + 1] - s0[9 + 1]) / gam;
+            if (rows) rows[RVE_NCOL * i + 10] = pt[0].work + pt[1].work;
+        } else
+            gk_m3_copy(s0 + 9, s + 9);
+        if (rows) {
+            double *r = rows + RVE_NCOL * i;
+            r[0] = eps, r[1] = f[0].p, r[2] = i ? (f[0].p - m->p0) / eps / 1e6 : NAN, r[3] = gam, r[4] = s[9 + 1];
+            r[5] = i ? (s[9 + 1] - s0[9 + 1]) / gam / 1e6 : NAN;
+            r[6] = f[0].void_ratio / (1 + f[0].void_ratio), r[7] = f[0].coordination;
+            r[8] = f[1].void_ratio / (1 + f[1].void_ratio), r[9] = f[1].coordination;
         }
-        eps += ninc, gam += ninc;
-        pt = gk_twoscale_points(&ts);
-        gk_twoscale_fields(&ts, f);
-        if (i == nsmall - 1) {
-            m->K = (f[0].p - m->p0) / eps;
-            m->G = (s[9 + 1] - s0[9 + 1]) / gam;
-        }
-        if (fp)
-            fprintf(fp, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", eps, f[0].p,
-                    (f[0].p - m->p0) / eps / 1e6, gam, s[9 + 1], (s[9 + 1] - s0[9 + 1]) / gam / 1e6,
-                    f[0].void_ratio / (1 + f[0].void_ratio), f[0].coordination,
-                    f[1].void_ratio / (1 + f[1].void_ratio), f[1].coordination,
-                    pt[0].n_deform + pt[0].n_relax + pt[1].n_deform + pt[1].n_relax);
     }
     gk_twoscale_destroy(&ts);
-    if (fp && (ferror(fp) | fclose(fp))) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", csv), 1;
     return 0;
 }
 
@@ -1042,14 +1035,14 @@ static void track(model *md) {
 }
 
 /* ------------------------------------------------------------ outputs */
-static int write_rows(const char *path, const char *head, const double *rows, long nrow, int ncol) {
+static int write_rows(const char *path, const char *head, const double *rows, long nrow, int ncol, int real0) {
     FILE *fp = fopen(path, "w");
     long r;
     int c, bad;
     if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
     fprintf(fp, "%s\n", head);
     for (r = 0; r < nrow; ++r) {
-        for (c = 0; c < ncol; ++c) fprintf(fp, c == 0 ? "%.0f" : ",%.9g", rows[(size_t)r * ncol + c]);
+        for (c = 0; c < ncol; ++c) fprintf(fp, c == 0 ? (real0 ? "%.9g" : "%.0f") : ",%.9g", rows[(size_t)r * ncol + c]);
         fputc('\n', fp);
     }
     bad = ferror(fp);
@@ -1441,51 +1434,36 @@ static double front_speed(const model *md, const double *arr) {
 }
 
 /* ------------------------------------------------------------ main */
-static void result_line(const model *md, const micro *mi, const double *extra_vals, const char *extra, double pk,
-                        double epk, double bc, double bw, double secs) {
+static void result_line(const micro *mi, const char *extra, double pk, double epk, double bc, double bw, double secs) {
     printf("RESULT K_MPa=%.2f G_MPa=%.2f porosity0=%.4f Z0=%.3f peak_stress=%.6g eps_at_peak=%.5g band_center_mm=%.3g "
-           "band_width_mm=%.3g seconds=%.1f",
-           mi->K / 1e6, mi->G / 1e6, mi->porosity0, mi->Z0, pk, epk, bc, bw, secs);
-    if (extra) printf(" %s", extra);
-    (void)md, (void)extra_vals;
-    printf("\n");
+           "band_width_mm=%.3g seconds=%.1f%s%s\n",
+           mi->K / 1e6, mi->G / 1e6, mi->porosity0, mi->Z0, pk, epk, bc, bw, secs, extra ? " " : "", extra ? extra : "");
 }
 
 static int run_rve_test(const opts *o, micro *mi, double t0) {
-    char path[1024], svg[1024];
-    FILE *fp;
-    double *a = (double *)xcalloc((size_t)6 * (o->steps + 12), sizeof(double));
-    int n = 0, r;
+    char path[1024];
+    int n = o->steps + 11, k, r;
+    double *rows = (double *)xcalloc((size_t)RVE_NCOL * n, sizeof(double));
+    double *x1 = (double *)xcalloc((size_t)n, sizeof(double)), *y1 = (double *)xcalloc((size_t)n, sizeof(double));
+    double *x2 = (double *)xcalloc((size_t)n, sizeof(double)), *y2 = (double *)xcalloc((size_t)n, sizeof(double));
+    if (rve_moduli(o, mi, rows)) return 1;
     snprintf(path, sizeof path, "%s/rve.csv", o->out);
-    if (rve_moduli(o, mi, path)) return 1;
-    fp = fopen(path, "r");
-    if (fp) { /* curves for the plot */
-        char line[1024];
-        if (fgets(line, sizeof line, fp))
-            while (fgets(line, sizeof line, fp) && n < o->steps + 11) {
-                double v[6];
-                if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) == 6)
-                    memcpy(a + 6 * n++, v, sizeof v);
-            }
-        fclose(fp);
+    if (write_rows(path, "eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,Z_iso,porosity_shear,Z_shear,dem_steps", rows,
+                   n, RVE_NCOL, 1))
+        return 1;
+    for (k = 0; k < n; ++k) {
+        const double *rw = rows + RVE_NCOL * k;
+        x1[k] = rw[0], y1[k] = (rw[1] - mi->p0) / 1e3, x2[k] = rw[3], y2[k] = rw[4] / 1e3;
     }
-    {
-        double *x1 = (double *)xcalloc((size_t)n, sizeof(double)), *y1 = (double *)xcalloc((size_t)n, sizeof(double));
-        double *x2 = (double *)xcalloc((size_t)n, sizeof(double)), *y2 = (double *)xcalloc((size_t)n, sizeof(double));
-        int k;
-        for (k = 0; k < n; ++k) x1[k] = a[6 * k], y1[k] = (a[6 * k + 1] - mi->p0) / 1e3, x2[k] = a[6 * k + 3],
-        y2[k] = a[6 * k + 4] / 1e3;
-        snprintf(svg, sizeof svg, "%s/rve_curve.svg", o->out);
-        r = plot2(svg, "RVE alone: isotropic compression and simple shear", "strain (eps_v, gamma)",
-                  "stress change (p - p0, tau) [kPa]", x1, y1, n, "p - p0 vs eps_v", x2, y2, n, "tau vs gamma");
-        free(x1), free(y1), free(x2), free(y2);
-    }
-    free(a);
+    snprintf(path, sizeof path, "%s/rve_curve.svg", o->out);
+    r = plot2(path, "RVE alone: isotropic compression and simple shear", "strain (eps_v, gamma)",
+              "stress change (p - p0, tau) [kPa]", x1, y1, n, "p - p0 vs eps_v", x2, y2, n, "tau vs gamma");
+    free(rows), free(x1), free(y1), free(x2), free(y2);
     if (r) return 1;
     printf("RVE: initial p %.0f Pa, porosity %.4f, Z %.3f, density %.1f kg/m^3; K %.1f MPa, G %.1f MPa (secants at "
            "1e-4; Table II: 335, 241)\n",
            mi->p0, mi->porosity0, mi->Z0, mi->rho, mi->K / 1e6, mi->G / 1e6);
-    result_line(NULL, mi, NULL, NULL, NAN, NAN, NAN, NAN, gk_wtime() - t0);
+    result_line(mi, NULL, NAN, NAN, NAN, NAN, gk_wtime() - t0);
     return 0;
 }
 
@@ -1578,7 +1556,7 @@ int main(int argc, char **argv) {
             if (rc) {
                 save_checkpoint(&md, fpr);
                 fprintf(stderr, "femdem_nonlocal: stopped at step %ld (checkpoint of the last state written)\n", md.step);
-                write_rows(csv, csv_head, md.rows, md.nrow, NCOL);
+                write_rows(csv, csv_head, md.rows, md.nrow, NCOL, 0);
                 return rc;
             }
             track(&md);
@@ -1596,7 +1574,7 @@ int main(int argc, char **argv) {
                 gk_progress(stdout, md.step, md.nsteps, t0, what);
             }
         }
-        if (write_rows(csv, csv_head, md.rows, md.nrow, NCOL) || save_checkpoint(&md, fpr)) return 1;
+        if (write_rows(csv, csv_head, md.rows, md.nrow, NCOL, 0) || save_checkpoint(&md, fpr)) return 1;
         if (md.step < md.nsteps) {
             printf("stopped after step %ld of %ld (--stop-after); checkpoint written: continue with --restart %s\n",
                    md.step, md.nsteps, o.out);
@@ -1726,7 +1704,7 @@ int main(int argc, char **argv) {
         {
             char ex2[1200];
             snprintf(ex2, sizeof ex2, "%s%sdem_steps_total=%ld dt=%.4g", extra, extra[0] ? " " : "", md.dem_total, md.dt);
-            result_line(&md, &mi, NULL, ex2, pk, epk, bc, bw, gk_wtime() - t0);
+            result_line(&mi, ex2, pk, epk, bc, bw, gk_wtime() - t0);
         }
         free(x), free(y), free(y2), free(val);
     }

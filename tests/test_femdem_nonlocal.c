@@ -89,29 +89,6 @@ TEST(adaptive_rule_on_eq57) {
     gk_packing_free(&pk);
 }
 
-/* the first ncol columns of every data row of two CSV files are identical */
-static int csv_same(const char *a, const char *b, int ncol) {
-    FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
-    char la[4096], lb[4096];
-    int same = fa && fb, rows = 0;
-    while (same) {
-        char *pa = fgets(la, sizeof la, fa), *pb = fgets(lb, sizeof lb, fb);
-        int k, c = 0;
-        if (!pa || !pb) {
-            same = !pa && !pb;
-            break;
-        }
-        for (k = 0; la[k] && lb[k] && c < ncol; ++k) {
-            if (la[k] != lb[k]) same = 0;
-            if (la[k] == ',') ++c;
-        }
-        ++rows;
-    }
-    if (fa) fclose(fa);
-    if (fb) fclose(fb);
-    return same && rows > 2;
-}
-
 /* a run with 2 and 1 threads, and a run stopped half way and restarted from
  * its checkpoint: the same CSV in every column but the seconds */
 static void threads_and_restart(const char *args, const char *tag, const char *csv, int stop) {
@@ -129,9 +106,9 @@ static void threads_and_restart(const char *args, const char *tag, const char *c
     CHECK(system(cmd) == 0);
     snprintf(a, sizeof a, "build/%sA/%s", tag, csv);
     snprintf(b, sizeof b, "build/%s1/%s", tag, csv);
-    CHECK(csv_same(a, b, 14));
+    CHECK(gk_test_csv_same(a, b, 14));
     snprintf(b, sizeof b, "build/%sB/%s", tag, csv);
-    CHECK(csv_same(a, b, 14));
+    CHECK(gk_test_csv_same(a, b, 14));
     snprintf(b, sizeof b, "build/%sB2.out", tag);
     CHECK(gk_test_file_has(b, "restarted from"));
 }
