@@ -1,113 +1,180 @@
 /* femdem_nonlocal - the nonlocal multiscale discrete-continuum model of Liu,
- * Sun, Yuan & Fish (2016) in 3D: explicit Hex8 FEM x periodic Hertz-Mindlin
- * sphere RVEs.
+ * Sun, Yuan & Fish (2016, IJNME 106:129-160) in 3D: explicit Hex8 FEM x
+ * periodic Hertz-Mindlin sphere RVEs, one per Gauss point.
  *
  *   build/femdem_nonlocal --test rve|element-biaxial|element-shear|wave|simple-shear|biaxial
  *       [--mesh NXxNYxNZ] [--nonlocal R|off] [--pressure 4.16e5] [--strain S] [--steps N]
- *       [--packing F] [--threads T] --out DIR [--restart DIR]
+ *       [--packing F] [--threads T] --out DIR [--restart DIR]        (--help: every flag)
  *
- * THE MODEL (Liu, Sun, Yuan & Fish 2016, eqs 44-66 and Appendix A)
+ * THE MODEL (eqs 44-66 and Appendix A of the paper)
  *   Macro: 8-node hexahedra with one Gauss point and Flanagan-Belytschko
- *   hourglass control (kappa 0.1 of lambda + 2 mu of the RVE), lumped mass
- *   (density = RVE mass / volume, eq 26, times --mass-scale), explicit
- *   central differences (eqs 51-52; gk_explicit.h), updated Lagrangian with
- *   the corotational update of eqs 60-62 (gk_explicit.h: F at mid-step,
- *   polar decomposition, the strain increment rotated in and the stress out;
- *   what the missing Appendix B leaves open is written there).
+ *   stiffness hourglass control (k = kappa (lambda + 2 mu) V sum|grad N|^2 /
+ *   192, kappa = --hourglass 0.1, lambda and mu of the RVE), lumped mass
+ *   (rho V / 8 per node, rho = RVE mass / RVE volume of eq 26, times
+ *   --mass-scale), explicit central differences (eqs 51-52; gk_explicit.h),
+ *   updated Lagrangian with the corotational update of eqs 60-62
+ *   (gk_explicit.h: F at mid-step, polar decomposition, the strain increment
+ *   rotated in and the stress out; what the missing Appendix B leaves open
+ *   is written there). Stress tension-positive inside, compression-positive
+ *   in every output.
  *   Micro: one periodic RVE per Gauss point (gk_twoscale.h), incremental
- *   Hertz-Mindlin with Coulomb friction (eqs 53-56: G 29 GPa, nu 0.15, mu
- *   0.5, tangential contact damping 0.12 of critical, 0 for the biaxial
- *   test as in the paper's section 3.5), the cell deformed by the rotated
- *   (nonlocal) strain increment and relaxed until the unbalanced-force
- *   index I_uf of eq 57 is below 0.01 (--iuf); the Love stress of eq 44b.
+ *   Hertz-Mindlin with Coulomb friction (Table I: G 29 GPa, nu 0.15, mu 0.5,
+ *   tangential contact damping 0.12 of critical (eq 56), 0 for the biaxial
+ *   test as in the paper's section 3.5; grain density --density 2492 kg/m^3,
+ *   the paper's 1650 kg/m^3 at porosity 0.338), local damping --dem-damping
+ *   0.2 as the DEM's artificial relaxation damping, the particles' rotation
+ *   tracked (GK_RVE_TRACK_ROTATION) for the rotation field. The cell takes
+ *   the rotated (and averaged) strain increment as a pure stretch, over the
+ *   DEM steps of the adaptive rule (inertial number <= --dem-inertial 2e-3
+ *   while deforming), then relaxes at fixed cell until the unbalanced-force
+ *   index I_uf of eq 57 (the RMS ratio) is below --iuf 0.01, within
+ *   --dem-min 10 and --dem-max 4000 steps; the Love stress of eq 44b. The
+ *   two mesh tests cap the runs at --dem-max 20 by default: on the
+ *   one-element shear test (4000 steps) that gives the same mean stress
+ *   after the peak (252.9 against 253.1 kPa) with half the DEM steps,
+ *   although 90 % of the runs then stop above the I_uf bound (the CSV's
+ *   dem_capped counts them); --dem-max 4000 restores the paper's rule.
  *   Nonlocal (eq 58, Appendix A; gk_fem.h): the whole strain increment at
  *   every Gauss point is replaced by its bell-weighted average over the
  *   points within R (--nonlocal R, or off), normalised per point without
- *   volumes as the paper writes it, across periodic faces, truncated at
+ *   volumes as the paper writes it, with every periodic image, truncated at
  *   free boundaries. All local increments of a step are known before any
  *   DEM run, so the average uses current increments only (the paper's
- *   staggered form takes a neighbour's previous one when it has to).
+ *   staggered form takes a neighbour's previous one when it must).
  *   One step: forces -> velocities and displacements (eqs 22-23) ->
  *   corotational increments -> nonlocal average -> rotate in (eq 60) -> all
  *   RVEs (threads) -> rotate out (eq 62) -> internal forces.
  *
  * TIME STEPS (eqs 63-66). K and G of the RVE are measured first (Table II:
- *   isotropic compression and simple shear of the RVE alone, 10 increments
- *   of 1e-5 each). The coarse step is --dt-safety (0.5) x eq 65 at the
- *   highest frequency of the mesh, bounded by element frequencies with that
- *   elastic stiffness (gk_explicit_elem_omega), or --dt. The DEM's highest
- *   frequency (eq 64, from the RVE's own contacts) gives the step ratio of
- *   eq 66; it is reported. Each RVE run then takes the DEM steps the
- *   adaptive rule gives (inertial number, then relaxation until I_uf <
- *   --iuf), at least --dem-min and at most --dem-max: the DEM is a dynamic
- *   relaxation in pseudo-time (its masses are not physical, sec 2.3.4).
+ *   isotropic compression and simple shear of the RVE alone, ten increments
+ *   of 1e-5, relaxed to I_uf < 1e-3: secant moduli at 1e-4). The coarse step
+ *   is --dt-safety 0.5 x eq 65 at the highest frequency of the mesh, bounded
+ *   by the element frequencies with that elastic stiffness
+ *   (gk_explicit_elem_omega), or --dt (refused above eq 65). The DEM's
+ *   highest frequency (eq 64 over the RVE's contacts) gives the step ratio
+ *   of eq 66, which is printed: the DEM needs ~20 of its critical steps per
+ *   coarse step to keep physical time; it runs instead as the dynamic
+ *   relaxation the paper describes (sec 2.3.4: its masses are not
+ *   physical), with the step counts above.
  *
- * DAMPING OF THE MACRO SCALE (what the paper calls mass scaling and dynamic
- *   relaxation without numbers): mass-proportional damping alpha M (v -
- *   v_hom), v_hom the homogeneous (rigid plus affine) part of the current
- *   velocity field (the volume average of grad v, and the mean velocity):
- *   it damps waves and start-up transients and never resists a homogeneous
- *   deformation, which plain alpha M v would (at quasi-static rates a
- *   critically damped alpha M v adds a viscous shear stress larger than
- *   the material's). alpha = 2 --xi omega_1 (0.3), omega_1 the estimated
- *   fundamental frequency of the specimen; the wave test has none. The
- *   boundary velocity ramps up over the first 5 % of the steps.
+ * DAMPING AND LOADING OF THE MACRO SCALE (the paper's mass scaling and
+ *   dynamic relaxation come without numbers). Mass-proportional damping
+ *   alpha M (v - v_hom) (gk_explicit_step with alpha M v_hom added to the
+ *   force), alpha = 2 --xi omega_1 (--xi 0.3; 0 in the wave test), omega_1 =
+ *   (pi / 2) c / H the fundamental frequency of the specimen (c = sqrt(G /
+ *   rho) in the shear tests, sqrt(E / rho) otherwise). v_hom is the
+ *   homogeneous part of the velocity field (mean velocity and volume average
+ *   of grad v): the damping acts on waves and transients and never resists
+ *   a homogeneous deformation, which plain alpha M v does (at these rates a
+ *   critically damped alpha M v adds a viscous stress of the order of the
+ *   material's). A single element is homogeneous through and through; there
+ *   v_hom keeps only the loading's own gradient, so the lateral (normal)
+ *   motion is damped, which biases the lateral stress by alpha rho eps_rate
+ *   W^2 / 2 (~0.5 % at the default 4000 steps). The specimen starts with
+ *   the loading's homogeneous velocity field (u_x = V y / H, or u_y = -V y /
+ *   H): a steady homogeneous deformation needs no acceleration, so the
+ *   platen's start sends no wave (with a velocity ramp over the first 10 %
+ *   of 4000 steps the simple shear's top row was overstressed by the start-up
+ *   wave, rho c V ~ 3 x the strength, and localized there). Mass scaling does not make an explicit
+ *   quasi-static run cheaper: the inertial stress rho c v of a platen speed v
+ *   is unchanged when rho and dt are scaled together, so what counts is the
+ *   number of steps (--steps).
  *
- * TESTS (units SI; stresses in the CSVs compression-positive)
+ * TESTS (units SI; stresses in the outputs compression-positive)
  *   rve              Table II: K and G of the RVE alone from isotropic
  *                    compression and simple shear to --strain (2e-3) in
  *                    --steps increments; initial porosity, Z, p.
- *   element-biaxial  one element (Fig 5 left): top displaced down, the
- *                    right face under --pressure, plane strain; and the RVE
- *                    alone on the same path (its lateral stress held at
- *                    --pressure by a secant iteration), within 2 % (Fig 6a)
- *   element-shear    one element (Fig 5 right): top sheared, constant
- *                    normal --pressure on it; against the RVE alone (Fig 6b)
+ *   element-biaxial  one 10 mm element (Fig 5 left): bottom and left face on
+ *                    rollers, plane strain, the top pressed down, --pressure
+ *                    on the right face; and the RVE alone on the same path
+ *                    with the same corotational kinematics, its lateral
+ *                    stress held at --pressure per increment by a secant /
+ *                    regula falsi iteration (1e-3 p; where a 512-sphere
+ *                    RVE's response jumps - up to 6 % of p between
+ *                    neighbouring increments at critical state - the closest
+ *                    run within 10 % of p; rve_alone.csv has its stress_2),
+ *                    --lone-increments 400 (half of them in the first tenth
+ *                    of the strain). Compared over ten equal strain windows
+ *                    (mean stress of each curve; both fluctuate by several %
+ *                    at critical state): rve_alone_dev_pct = the largest gap
+ *                    / the RVE's peak, and peak_ratio (Fig 6a).
+ *   element-shear    one element (Fig 5 right): bottom fixed, the top moved
+ *                    horizontally as a rigid platen (one u_y) carrying the
+ *                    normal --pressure, plane strain; the RVE alone likewise
+ *                    with its normal stress held (Fig 6b).
  *   wave             Fig 8: a 100 x 10 x 10 mm column of 10 elements, left
- *                    end fixed, lateral faces periodic, the right end moved
- *                    transversally u_y = a sin(2 pi f t) (a 0.1 mm, f 10 kHz,
- *                    dt 1 us, --duration 1 ms); the shear-wave front's
- *                    arrival along the column against sqrt(G / rho) and
- *                    against a linear elastic run of the same mesh; the
- *                    stress-strain loops, porosity and Z of element 9.
+ *                    end fixed, lateral faces periodic (eps_22 = eps_33 =
+ *                    eps_23 = 0), the right end moved transversally u_y = a
+ *                    sin(2 pi f t) (--amplitude 1e-4 m, --frequency 1e4 Hz,
+ *                    --dt 1e-6 s, --duration 1e-3 s), no macro damping. The
+ *                    front's arrival per element (the first time |gamma| >
+ *                    1e-3 a / h) against sqrt(G / rho) and against a linear
+ *                    elastic column of the same mesh, steps and excitation
+ *                    (the RVE's K and G, initial stress -p I), whose front
+ *                    runs ahead of sqrt(G / rho) on 4.5 elements per
+ *                    wavelength (mesh dispersion); the loops of element 9
+ *                    and its porosity and Z (Fig 8a, b).
  *   simple-shear     Figs 9-14: 50.6 x 118 x 12.7 mm, --mesh 5x12x1 (the
  *                    paper's "12 x 5 x 1": 12 rows over the height), bottom
- *                    fixed, top sheared under --pressure, periodic in x and z,
- *                    one imperfect RVE (--imperfection 25 particles removed,
- *                    re-consolidated to --pressure) in the middle column of
- *                    the row starting at 3/4 of the height; shear stress =
- *                    base reaction / base area, strain = u_top / 118 mm.
- *   biaxial          Figs 15-19: 40 x 80 x 5 mm plane strain, top pressed
- *                    down, --pressure on the sides, the bottom rough on its
- *                    left half and smooth on its right half (the paper's
- *                    "asymmetric boundary condition"); contact damping 0.
+ *                    fixed, the top a rigid platen moved horizontally under
+ *                    --pressure, periodic in x and z, one imperfect RVE
+ *                    (--imperfection N particles removed at random, by
+ *                    default 25 x N_particles / 4096 as the paper's 25 of
+ *                    4096, re-consolidated to --pressure with friction) in
+ *                    the middle column of the row starting at 3/4 of the
+ *                    height. Shear stress = base reaction / base area,
+ *                    strain = u_top / 118 mm.
+ *   biaxial          Figs 15-19: 40 x 80 x 5 mm plane strain (--mesh 4x8x1),
+ *                    the top a smooth platen pressed down, --pressure on both
+ *                    sides, the bottom on rollers and rough (u_x = 0) on its
+ *                    left half: the paper's unspecified "asymmetric boundary
+ *                    condition" that starts the band; contact damping 0.
  *
- * OUTPUTS in DIR
- *   <test>.csv       one row per --every steps:
- *                    step,time,strain,stress,stress_2,p,q,porosity,Z,u_probe,dem_steps_mean,dem_steps_max,
- *                    iuf_max,kinetic,seconds
- *                    strain/stress: axial (biaxial tests), shear (shear tests),
- *                    probe element's shear strain / stress (wave); stress_2: the
- *                    lateral (biaxial), normal (shear) or axial (wave) stress;
- *                    p, q, porosity, Z: means over the Gauss points (wave: the probe)
- *   rve_alone.csv    (element tests) the RVE alone on the same path
- *   rve.csv          (rve test) eps_v,p,K_MPa,gamma,tau,G_MPa,porosity,Z
- *   profile.csv      (simple-shear) per row: y_mm, shear strain and porosity at
- *                    12 % and at the end
- *   wave_arrival.csv (wave) per element: distance, arrival (multiscale, elastic)
- *   mesh_NNNNNN.vtk  mesh and Gauss-point fields (stress, p, q, porosity,
- *                    coordination, particle rotation, eps_q, eps_v, DEM steps)
- *                    every --vtk-every steps and at the end
- *   <test>_curve.svg, <test>_state.svg, <test>_field.svg
- *   checkpoint.bin   every --checkpoint steps and at the end (gk_twoscale's
- *                    checkpoint with the macro state as its driver block)
+ * OUTPUTS in DIR (a write that fails is an error: exit status 1)
+ *   <test>.csv       one row per --every steps (steps / 200; element tests
+ *                    steps / 1000): step,time,strain,stress,stress_2,p,q,
+ *                    porosity,Z,u_probe,dem_steps_mean,dem_steps_max,dem_capped,
+ *                    kinetic,seconds. strain, stress: axial (biaxial tests),
+ *                    u_top / h and base shear stress (shear tests), element
+ *                    9's shear strain and stress (wave); stress_2: lateral
+ *                    (biaxial), normal (shear), axial (wave) stress; p, q,
+ *                    porosity, Z: means over the Gauss points (wave: element
+ *                    9); u_probe: right face u_x (biaxial), platen u_y
+ *                    (shear), driven end u_y (wave); dem_steps of the last
+ *                    run per point, dem_capped = points that stopped at
+ *                    --dem-max above --iuf; kinetic = macro kinetic energy [J]
+ *   rve_alone.csv    (element tests) strain,stress,stress_2,p,q,porosity,Z,runs
+ *   rve.csv          (rve test) eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,
+ *                    Z_iso,porosity_shear,Z_shear,dem_steps
+ *   profile.csv      (simple-shear) per row: y_mm, shear strain at the peak,
+ *                    shear strain and porosity at 12 % and at the end
+ *   wave_arrival.csv (wave) per element: distance from the driven end,
+ *                    arrival multiscale / elastic / distance over sqrt(G/rho)
+ *   mesh_NNNNNN.vtk  the deformed mesh, displacement, and per Gauss point
+ *                    stress, p, q, porosity, coordination, particle_rotation
+ *                    (mean |accumulated rotation vector| of its particles),
+ *                    dem_steps, shear_strain, eps_v, eps_q; every
+ *                    --vtk-every steps and at the end
+ *   <test>_curve.svg (stress-strain, with the RVE alone for element tests),
+ *   <test>_state.svg (porosity, Z / 10), <test>_field.svg (the deformed x-y
+ *                    section coloured by shear strain, or eps_q)
+ *   checkpoint.bin   every --checkpoint steps, at the end and when a step
+ *                    fails: gk_twoscale's checksummed checkpoint with the
+ *                    macro state (velocities, displacements, stresses, the
+ *                    CSV rows, the band profiles) as its driver block and a
+ *                    fingerprint of every option that changes the result, so
+ *                    --restart DIR continues exactly (tested) and refuses
+ *                    another run's file; --stop-after N ends early with one
  *   stdout: RESULT K_MPa= G_MPa= porosity0= Z0= peak_stress= eps_at_peak=
- *           band_center_mm= band_width_mm= seconds= (then test-specific keys;
- *           nan where a key does not apply)
- *   Band (simple-shear): the profile over the rows of the shear strain gained
- *   since the peak, w_j = its excess over the row minimum; centre = sum y w /
- *   sum w, width = sum w h / max w (the width of the rectangle with the same
- *   area and height), at 12 % strain (the paper's Fig 14) or the end.
+ *           band_center_mm= band_width_mm= seconds= (then test-specific
+ *           keys; nan where a key does not apply)
+ *   Band (simple-shear): over the rows, the shear strain gained since the
+ *   peak, w_j = its excess over the row minimum; centre = sum y w / sum w,
+ *   width = sum w h / max w (the rectangle of the same area and height), at
+ *   12 % strain (the paper's Fig 14) or at the end if it is never reached.
+ *
+ * The results are the same for any --threads (the RVEs run in parallel, the
+ * macro scale is serial; tested). Costs and the reproduced figures: README.
  *
  * LICENCE: MIT (see gk_base.h).
  */
@@ -125,11 +192,14 @@
 #include <sys/stat.h>
 
 enum { T_RVE, T_EBIAX, T_ESHEAR, T_WAVE, T_SSHEAR, T_BIAX, T_COUNT };
-static const char *test_name[T_COUNT] = {"rve", "element-biaxial", "element-shear", "wave", "simple-shear", "biaxial"};
+static const char *test_name[T_COUNT] = {"rve",  "element-biaxial", "element-shear",
+                                         "wave", "simple-shear",    "biaxial"};
 
 typedef struct opts {
-    int test, mesh[3], threads, steps, stop_after, checkpoint, vtk_every, every, imperfection, dem_min, dem_max, lone;
-    double R, pressure, strain, iuf, dem_inertial, dem_damping, contact_damping, density, xi, mass_scale, kappa, dt, dt_safety;
+    int test, mesh[3], threads, steps, stop_after, checkpoint, vtk_every, every, imperfection, dem_min,
+        dem_max, lone;
+    double R, pressure, strain, iuf, dem_inertial, dem_damping, contact_damping, density, xi, mass_scale,
+        kappa, dt, dt_safety;
     double amplitude, frequency, duration;
     const char *packing, *out, *restart;
 } opts;
@@ -145,7 +215,8 @@ static int real_opt(const char *a, const char *v, double *out) {
     char *e;
     errno = 0;
     *out = strtod(v, &e);
-    if (e == v || *e || errno == ERANGE || !isfinite(*out)) return fail("%s '%s' is not a finite number", a, v);
+    if (e == v || *e || errno == ERANGE || !isfinite(*out))
+        return fail("%s '%s' is not a finite number", a, v);
     return 0;
 }
 static int int_opt(const char *a, const char *v, int *out) {
@@ -153,35 +224,43 @@ static int int_opt(const char *a, const char *v, int *out) {
     long x;
     errno = 0;
     x = strtol(v, &e, 10);
-    if (e == v || *e || errno == ERANGE || x < INT_MIN || x > INT_MAX) return fail("%s '%s' is not a whole number", a, v);
+    if (e == v || *e || errno == ERANGE || x < INT_MIN || x > INT_MAX)
+        return fail("%s '%s' is not a whole number", a, v);
     *out = (int)x;
     return 0;
 }
 static void *xcalloc(size_t n, size_t sz) {
     void *p = calloc(n ? n : 1, sz);
     if (!p) {
-        fprintf(stderr, "femdem_nonlocal: out of memory (%lu x %lu bytes)\n", (unsigned long)n, (unsigned long)sz);
+        fprintf(stderr, "femdem_nonlocal: out of memory (%lu x %lu bytes)\n", (unsigned long)n,
+                (unsigned long)sz);
         exit(1);
     }
     return p;
 }
 
 static void usage(FILE *fp) {
-    fprintf(fp, "usage: femdem_nonlocal --test rve|element-biaxial|element-shear|wave|simple-shear|biaxial --out DIR\n"
-                "  [--mesh NXxNYxNZ] [--nonlocal R|off] [--pressure P] [--strain S] [--steps N] [--packing F]\n"
-                "  [--threads T] [--restart DIR] [--stop-after N] [--checkpoint K] [--vtk-every K] [--every K]\n"
-                "  [--imperfection N] [--iuf X] [--dem-min N] [--dem-max N] [--dem-damping A]\n"
-                "  [--contact-damping Z] [--density RHO] [--xi X] [--mass-scale S] [--hourglass K] [--dt DT]\n"
-                "  [--dt-safety F] [--amplitude A] [--frequency F] [--duration T]\n");
-    fprintf(fp, "defaults: --pressure 4.16e5 --packing examples/data/rve512_hm.txt --threads 1 --nonlocal off\n"
-                "  --iuf 0.01 --dem-min 10 --dem-max 4000 --dem-damping 0.2 --contact-damping 0.12 (biaxial 0)\n"
-                "  --density 2492 (grain) --xi 0.3 (wave 0) --mass-scale 1 --hourglass 0.1 --dt-safety 0.5\n"
-                "  rve: --strain 2e-3 --steps 20; element-biaxial: --mesh 1x1x1 --strain 0.05 --steps 400;\n"
-                "  element-shear: --mesh 1x1x1 --strain 0.1 --steps 400; wave: --mesh 10x1x1 --dt 1e-6\n"
-                "  --duration 1e-3 --amplitude 1e-4 --frequency 1e4; simple-shear: --mesh 5x12x1 --strain 0.2\n"
-                "  --steps 4000 --imperfection 25; biaxial: --mesh 4x8x1 --strain 0.1 --steps 2000.\n"
-                "  The paper's RVE: --packing examples/data/rve4096_hm.txt; its biaxial nonlocal radius: --nonlocal 6.75e-3.\n"
-                "See the top of examples/femdem_nonlocal.c for the model, the outputs and the RESULT line.\n");
+    fprintf(fp,
+            "usage: femdem_nonlocal --test rve|element-biaxial|element-shear|wave|simple-shear|biaxial --out "
+            "DIR\n"
+            "  [--mesh NXxNYxNZ] [--nonlocal R|off] [--pressure P] [--strain S] [--steps N] [--packing F]\n"
+            "  [--threads T] [--restart DIR] [--stop-after N] [--checkpoint K] [--vtk-every K] [--every K]\n"
+            "  [--imperfection N] [--iuf X] [--dem-inertial I] [--dem-min N] [--dem-max N]\n"
+            "  [--dem-damping A] [--contact-damping Z] [--density RHO] [--xi X] [--mass-scale S]\n"
+            "  [--hourglass K] [--dt DT] [--dt-safety F] [--amplitude A] [--frequency F] [--duration T]\n"
+            "  [--lone-increments N]\n");
+    fprintf(fp,
+            "defaults: --pressure 4.16e5 --packing examples/data/rve512_hm.txt --threads 1 --nonlocal off\n"
+            "  --iuf 0.01 --dem-inertial 2e-3 --dem-min 10 --dem-max 4000 (simple-shear, biaxial: 20)\n"
+            "  --dem-damping 0.2 --contact-damping 0.12 (biaxial 0) --density 2492 --xi 0.3 (wave 0)\n"
+            "  --mass-scale 1 --hourglass 0.1 --dt-safety 0.5 --lone-increments 400\n"
+            "  rve: --strain 2e-3 --steps 20; element-biaxial: --mesh 1x1x1 --strain 0.05 --steps 4000;\n"
+            "  element-shear: --mesh 1x1x1 --strain 0.1 --steps 4000; wave: --mesh 10x1x1 --dt 1e-6\n"
+            "  --duration 1e-3 --amplitude 1e-4 --frequency 1e4; simple-shear: --mesh 5x12x1 --strain 0.2\n"
+            "  --steps 4000 --imperfection 25 x N/4096; biaxial: --mesh 4x8x1 --strain 0.08 --steps 3000.\n"
+            "  The paper's RVE: --packing examples/data/rve4096_hm.txt; its nonlocal radius: --nonlocal "
+            "6.75e-3.\n"
+            "See the top of examples/femdem_nonlocal.c for the model, the outputs and the RESULT line.\n");
 }
 
 static int parse(int argc, char **argv, opts *o) {
@@ -200,7 +279,7 @@ static int parse(int argc, char **argv, opts *o) {
     o->iuf = 0.01;
     o->dem_inertial = 2e-3;
     o->dem_min = 10;
-    o->dem_max = 4000;
+    o->dem_max = -1;
     o->lone = 400;
     o->dem_damping = 0.2;
     o->contact_damping = -1;
@@ -227,9 +306,10 @@ static int parse(int argc, char **argv, opts *o) {
             for (t = 0; t < T_COUNT; ++t)
                 if (!strcmp(v, test_name[t])) o->test = t;
             if (o->test < 0)
-                return fail("--test '%s' is not one of rve, element-biaxial, element-shear, wave, simple-shear, "
-                            "biaxial%s",
-                            v, "");
+                return fail(
+                    "--test '%s' is not one of rve, element-biaxial, element-shear, wave, simple-shear, "
+                    "biaxial%s",
+                    v, "");
         } else if (!strcmp(a, "--mesh")) {
             char *e;
             int k;
@@ -248,35 +328,64 @@ static int parse(int argc, char **argv, opts *o) {
                 o->R = 0.0;
             else if (!(bad = real_opt(a, v, &o->R)) && !(o->R > 0.0))
                 return fail("--nonlocal '%s' must be a radius > 0 [m] or off%s", v, "");
-        } else if (!strcmp(a, "--pressure")) bad = real_opt(a, v, &o->pressure);
-        else if (!strcmp(a, "--strain")) bad = real_opt(a, v, &o->strain);
-        else if (!strcmp(a, "--steps")) bad = int_opt(a, v, &o->steps);
-        else if (!strcmp(a, "--stop-after")) bad = int_opt(a, v, &o->stop_after);
-        else if (!strcmp(a, "--threads")) bad = int_opt(a, v, &o->threads);
-        else if (!strcmp(a, "--checkpoint")) bad = int_opt(a, v, &o->checkpoint);
-        else if (!strcmp(a, "--vtk-every")) bad = int_opt(a, v, &o->vtk_every);
-        else if (!strcmp(a, "--every")) bad = int_opt(a, v, &o->every);
-        else if (!strcmp(a, "--imperfection")) bad = int_opt(a, v, &o->imperfection);
-        else if (!strcmp(a, "--iuf")) bad = real_opt(a, v, &o->iuf);
-        else if (!strcmp(a, "--dem-inertial")) bad = real_opt(a, v, &o->dem_inertial);
-        else if (!strcmp(a, "--dem-min")) bad = int_opt(a, v, &o->dem_min);
-        else if (!strcmp(a, "--dem-max")) bad = int_opt(a, v, &o->dem_max);
-        else if (!strcmp(a, "--lone-increments")) bad = int_opt(a, v, &o->lone);
-        else if (!strcmp(a, "--dem-damping")) bad = real_opt(a, v, &o->dem_damping);
-        else if (!strcmp(a, "--contact-damping")) bad = real_opt(a, v, &o->contact_damping);
-        else if (!strcmp(a, "--density")) bad = real_opt(a, v, &o->density);
-        else if (!strcmp(a, "--xi")) bad = real_opt(a, v, &o->xi);
-        else if (!strcmp(a, "--mass-scale")) bad = real_opt(a, v, &o->mass_scale);
-        else if (!strcmp(a, "--hourglass")) bad = real_opt(a, v, &o->kappa);
-        else if (!strcmp(a, "--dt")) bad = real_opt(a, v, &o->dt);
-        else if (!strcmp(a, "--dt-safety")) bad = real_opt(a, v, &o->dt_safety);
-        else if (!strcmp(a, "--amplitude")) bad = real_opt(a, v, &o->amplitude);
-        else if (!strcmp(a, "--frequency")) bad = real_opt(a, v, &o->frequency);
-        else if (!strcmp(a, "--duration")) bad = real_opt(a, v, &o->duration);
-        else if (!strcmp(a, "--packing")) o->packing = v;
-        else if (!strcmp(a, "--out")) o->out = v;
-        else if (!strcmp(a, "--restart")) o->restart = v;
-        else return fail("unknown option %s (see --help)%s", a, "");
+        } else if (!strcmp(a, "--pressure"))
+            bad = real_opt(a, v, &o->pressure);
+        else if (!strcmp(a, "--strain"))
+            bad = real_opt(a, v, &o->strain);
+        else if (!strcmp(a, "--steps"))
+            bad = int_opt(a, v, &o->steps);
+        else if (!strcmp(a, "--stop-after"))
+            bad = int_opt(a, v, &o->stop_after);
+        else if (!strcmp(a, "--threads"))
+            bad = int_opt(a, v, &o->threads);
+        else if (!strcmp(a, "--checkpoint"))
+            bad = int_opt(a, v, &o->checkpoint);
+        else if (!strcmp(a, "--vtk-every"))
+            bad = int_opt(a, v, &o->vtk_every);
+        else if (!strcmp(a, "--every"))
+            bad = int_opt(a, v, &o->every);
+        else if (!strcmp(a, "--imperfection"))
+            bad = int_opt(a, v, &o->imperfection);
+        else if (!strcmp(a, "--iuf"))
+            bad = real_opt(a, v, &o->iuf);
+        else if (!strcmp(a, "--dem-inertial"))
+            bad = real_opt(a, v, &o->dem_inertial);
+        else if (!strcmp(a, "--dem-min"))
+            bad = int_opt(a, v, &o->dem_min);
+        else if (!strcmp(a, "--dem-max"))
+            bad = int_opt(a, v, &o->dem_max);
+        else if (!strcmp(a, "--lone-increments"))
+            bad = int_opt(a, v, &o->lone);
+        else if (!strcmp(a, "--dem-damping"))
+            bad = real_opt(a, v, &o->dem_damping);
+        else if (!strcmp(a, "--contact-damping"))
+            bad = real_opt(a, v, &o->contact_damping);
+        else if (!strcmp(a, "--density"))
+            bad = real_opt(a, v, &o->density);
+        else if (!strcmp(a, "--xi"))
+            bad = real_opt(a, v, &o->xi);
+        else if (!strcmp(a, "--mass-scale"))
+            bad = real_opt(a, v, &o->mass_scale);
+        else if (!strcmp(a, "--hourglass"))
+            bad = real_opt(a, v, &o->kappa);
+        else if (!strcmp(a, "--dt"))
+            bad = real_opt(a, v, &o->dt);
+        else if (!strcmp(a, "--dt-safety"))
+            bad = real_opt(a, v, &o->dt_safety);
+        else if (!strcmp(a, "--amplitude"))
+            bad = real_opt(a, v, &o->amplitude);
+        else if (!strcmp(a, "--frequency"))
+            bad = real_opt(a, v, &o->frequency);
+        else if (!strcmp(a, "--duration"))
+            bad = real_opt(a, v, &o->duration);
+        else if (!strcmp(a, "--packing"))
+            o->packing = v;
+        else if (!strcmp(a, "--out"))
+            o->out = v;
+        else if (!strcmp(a, "--restart"))
+            o->restart = v;
+        else
+            return fail("unknown option %s (see --help)%s", a, "");
         if (bad) return 2;
         ++i;
     }
@@ -284,9 +393,10 @@ static int parse(int argc, char **argv, opts *o) {
     if (!o->out) return fail("--out DIR is required%s%s", "", "");
     /* test defaults */
     {
-        static const int mesh[T_COUNT][3] = {{1, 1, 1}, {1, 1, 1}, {1, 1, 1}, {10, 1, 1}, {5, 12, 1}, {4, 8, 1}};
-        static const double strain[T_COUNT] = {2e-3, 0.05, 0.1, 0.0, 0.2, 0.1};
-        static const int steps[T_COUNT] = {20, 400, 400, 0, 4000, 2000};
+        static const int mesh[T_COUNT][3] = {{1, 1, 1},  {1, 1, 1},  {1, 1, 1},
+                                             {10, 1, 1}, {5, 12, 1}, {4, 8, 1}};
+        static const double strain[T_COUNT] = {2e-3, 0.05, 0.1, 0.0, 0.2, 0.08};
+        static const int steps[T_COUNT] = {20, 4000, 4000, 0, 4000, 3000};
         int t = o->test, k;
         if (!o->mesh[0])
             for (k = 0; k < 3; ++k) o->mesh[k] = mesh[t][k];
@@ -296,24 +406,29 @@ static int parse(int argc, char **argv, opts *o) {
             if (o->steps < 0) o->steps = (int)floor(o->duration / o->dt + 0.5);
         }
         if (o->steps < 0) o->steps = steps[t];
-        if (o->imperfection < 0) o->imperfection = t == T_SSHEAR ? -2 : 0; /* -2: 25 x N / 4096 (after reading) */
+        if (o->dem_max < 0) o->dem_max = t == T_SSHEAR || t == T_BIAX ? 20 : 4000;
+        if (o->imperfection < 0)
+            o->imperfection = t == T_SSHEAR ? -2 : 0; /* -2: 25 x N / 4096 (after reading) */
         if (o->contact_damping < 0) o->contact_damping = t == T_BIAX ? 0.0 : 0.12;
         if (o->xi < 0) o->xi = t == T_WAVE ? 0.0 : 0.3;
-        if (o->every < 0) o->every = o->steps / (t == T_EBIAX || t == T_ESHEAR ? 1000 : 200) > 1 ? o->steps / (t == T_EBIAX || t == T_ESHEAR ? 1000 : 200) : 1;
+        if (o->every < 0)
+            o->every = o->steps / (t == T_EBIAX || t == T_ESHEAR ? 1000 : 200) > 1
+                           ? o->steps / (t == T_EBIAX || t == T_ESHEAR ? 1000 : 200)
+                           : 1;
     }
-#define REQ(c, ...)                                                                                   \
-    if (!(c)) {                                                                                       \
-        fprintf(stderr, "femdem_nonlocal: ");                                                         \
-        fprintf(stderr, __VA_ARGS__);                                                                 \
-        fputc('\n', stderr);                                                                          \
-        return 2;                                                                                     \
+#define REQ(c, ...)                           \
+    if (!(c)) {                               \
+        fprintf(stderr, "femdem_nonlocal: "); \
+        fprintf(stderr, __VA_ARGS__);         \
+        fputc('\n', stderr);                  \
+        return 2;                             \
     }
     REQ(o->pressure > 0, "--pressure %g must be > 0 [Pa]", o->pressure);
     REQ(o->strain > 0 || o->test == T_WAVE, "--strain %g must be > 0", o->strain);
     REQ(o->strain < 0.5, "--strain %g must be below 0.5", o->strain);
     REQ(o->steps >= 1 && o->steps <= 100000000, "--steps %d must be 1-1e8", o->steps);
-    REQ(o->stop_after >= 0 && o->stop_after <= o->steps, "--stop-after %d must be 0-%d (--steps)", o->stop_after,
-        o->steps);
+    REQ(o->stop_after >= 0 && o->stop_after <= o->steps, "--stop-after %d must be 0-%d (--steps)",
+        o->stop_after, o->steps);
     REQ(o->threads >= 1 && o->threads <= 1024, "--threads %d must be 1-1024", o->threads);
     REQ(o->checkpoint >= 0, "--checkpoint %d must be >= 0", o->checkpoint);
     REQ(o->vtk_every >= 0, "--vtk-every %d must be >= 0", o->vtk_every);
@@ -321,8 +436,8 @@ static int parse(int argc, char **argv, opts *o) {
     REQ(o->imperfection >= -2, "--imperfection %d must be >= 0", o->imperfection);
     REQ(o->iuf > 0 && o->iuf < 1, "--iuf %g must be in (0, 1)", o->iuf);
     REQ(o->dem_inertial > 0 && o->dem_inertial < 1, "--dem-inertial %g must be in (0, 1)", o->dem_inertial);
-    REQ(o->dem_min >= 1 && o->dem_max >= o->dem_min, "--dem-min %d, --dem-max %d: 1 <= min <= max", o->dem_min,
-        o->dem_max);
+    REQ(o->dem_min >= 1 && o->dem_max >= o->dem_min && o->dem_max <= 1000000,
+        "--dem-min %d, --dem-max %d: 1 <= min <= max <= 1e6", o->dem_min, o->dem_max);
     REQ(o->lone >= 2 && o->lone <= 100000, "--lone-increments %d must be 2-100000", o->lone);
     REQ(o->dem_damping >= 0 && o->dem_damping < 1, "--dem-damping %g must be in [0, 1)", o->dem_damping);
     REQ(o->contact_damping >= 0 && o->contact_damping < 1, "--contact-damping %g must be in [0, 1)",
@@ -333,7 +448,8 @@ static int parse(int argc, char **argv, opts *o) {
     REQ(o->kappa >= 0 && o->kappa <= 1, "--hourglass %g must be in [0, 1]", o->kappa);
     REQ(o->dt >= 0, "--dt %g must be >= 0 (0: from eq 65)", o->dt);
     REQ(o->dt_safety > 0 && o->dt_safety <= 1, "--dt-safety %g must be in (0, 1]", o->dt_safety);
-    REQ(o->amplitude > 0 && o->frequency > 0 && o->duration > 0, "--amplitude, --frequency, --duration must be > 0");
+    REQ(o->amplitude > 0 && o->frequency > 0 && o->duration > 0,
+        "--amplitude, --frequency, --duration must be > 0");
     REQ(o->test != T_RVE || o->R == 0.0, "--nonlocal is for mesh tests, not --test rve");
 #undef REQ
     return 0;
@@ -341,12 +457,12 @@ static int parse(int argc, char **argv, opts *o) {
 
 /* ------------------------------------------------------------ the micro side */
 typedef struct micro {
-    gk_packing pk, pk_imp;   /* the packing, and the imperfect one                    */
-    gk_rve_state st_imp;     /* the imperfect RVE re-consolidated                     */
-    gk_rve_def rd;           /* Table I                                               */
-    double K, G;             /* Table II: secant moduli at 1e-4 [Pa]                  */
+    gk_packing pk, pk_imp;         /* the packing, and the imperfect one                    */
+    gk_rve_state st_imp;           /* the imperfect RVE re-consolidated                     */
+    gk_rve_def rd;                 /* Table I                                               */
+    double K, G;                   /* Table II: secant moduli at 1e-4 [Pa]                  */
     double porosity0, Z0, p0, rho; /* initial state; density of the RVE (eq 26)        */
-    double omega_f, dt_f;    /* eq 64 over the contacts; the DEM step                 */
+    double omega_f, dt_f;          /* eq 64 over the contacts; the DEM step                 */
 } micro;
 
 static void rve_def_make(const opts *o, gk_rve_def *rd) {
@@ -358,7 +474,7 @@ static void rve_def_make(const opts *o, gk_rve_def *rd) {
     rd->mat.zeta_t = o->contact_damping; /* eq 56: on the tangential sliding velocity */
     rd->mat.density = o->density;
     rd->damping = o->dem_damping;
-    rd->dt_factor = 0.3; /* dense 3D packings (gk_dem.h) */
+    rd->dt_factor = 0.3;                /* dense 3D packings (gk_dem.h) */
     rd->flags |= GK_RVE_TRACK_ROTATION; /* the particle rotation field (Fig 14b) */
 }
 
@@ -395,7 +511,8 @@ static int rve_moduli(const opts *o, micro *m, double *rows) {
     ts_def_make(o, m, &pr, 1, NULL, 2, &d);
     d.rule.unbalanced_max = 1e-3; /* the reference moduli: relaxed 10 x tighter than the mesh runs */
     d.rule.n_min = 200, d.rule.n_max = 20000;
-    if (gk_twoscale_create(&ts, &d)) return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&ts)), 1;
+    if (gk_twoscale_create(&ts, &d))
+        return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&ts)), 1;
     gk_twoscale_fields(&ts, f);
     gk_twoscale_accepted(&ts, s0, NULL);
     m->porosity0 = f[0].void_ratio / (1.0 + f[0].void_ratio);
@@ -423,7 +540,8 @@ static int rve_moduli(const opts *o, micro *m, double *rows) {
             gk_m3_copy(s0 + 9, s + 9);
         if (rows) {
             double *r = rows + RVE_NCOL * i;
-            r[0] = eps, r[1] = f[0].p, r[2] = i ? (f[0].p - m->p0) / eps / 1e6 : NAN, r[3] = gam, r[4] = s[9 + 1];
+            r[0] = eps, r[1] = f[0].p, r[2] = i ? (f[0].p - m->p0) / eps / 1e6 : NAN, r[3] = gam,
+            r[4] = s[9 + 1];
             r[5] = i ? (s[9 + 1] - s0[9 + 1]) / gam / 1e6 : NAN;
             r[6] = f[0].void_ratio / (1 + f[0].void_ratio), r[7] = f[0].coordination;
             r[8] = f[1].void_ratio / (1 + f[1].void_ratio), r[9] = f[1].coordination;
@@ -446,10 +564,11 @@ static int rve_frequency(micro *m) {
     }
     while (gk_rve_contact_next(&rve, &cur, &c)) {
         double ri = m->pk.r[c.i], rj = m->pk.r[c.j], rmin = ri < rj ? ri : rj;
-        double delta = ri + rj - sqrt(gk_v3_dot(c.d, c.d)), mm = gk_particle_volume(3, rmin) * m->rd.mat.density;
+        double delta = ri + rj - sqrt(gk_v3_dot(c.d, c.d)),
+               mm = gk_particle_volume(3, rmin) * m->rd.mat.density;
         gk_real kn, fn, kt;
-        gk_contact_stiffness(&rve.K, GK_LAW_HERTZ, (gk_real)ri, (gk_real)rj, (gk_real)(delta > 0 ? delta : 0), &kn,
-                             &fn, &kt);
+        gk_contact_stiffness(&rve.K, GK_LAW_HERTZ, (gk_real)ri, (gk_real)rj, (gk_real)(delta > 0 ? delta : 0),
+                             &kn, &fn, &kt);
         if (sqrt(kn / mm) > wmax) wmax = sqrt(kn / mm);
         if (sqrt(2.5 * kt / mm) > wmax) wmax = sqrt(2.5 * kt / mm);
     }
@@ -468,21 +587,25 @@ static int rve_imperfect(const opts *o, micro *m) {
     gk_consolidate_report rep;
     gk_err e;
     int n = m->pk.n, k, j, *idx = (int *)xcalloc((size_t)n, sizeof(int));
-    if (o->imperfection >= n / 2) return fprintf(stderr, "femdem_nonlocal: --imperfection %d too large\n", o->imperfection), 1;
+    if (o->imperfection >= n / 2)
+        return fprintf(stderr, "femdem_nonlocal: --imperfection %d too large\n", o->imperfection), 1;
     for (k = 0; k < n; ++k) idx[k] = k;
     gk_rng_seed(&rng, 25);
     for (k = 0; k < o->imperfection; ++k) { /* partial Fisher-Yates: idx[0..N) are removed */
         int r = k + (int)(gk_rng_uniform(&rng) * (n - k)), t = idx[k];
         idx[k] = idx[r], idx[r] = t;
     }
-    if (gk_packing_alloc(&m->pk_imp, 3, n - o->imperfection, NULL, &e)) return fprintf(stderr, "%s\n", e.msg), 1;
+    if (gk_packing_alloc(&m->pk_imp, 3, n - o->imperfection, NULL, &e))
+        return fprintf(stderr, "%s\n", e.msg), 1;
     gk_m3_copy(m->pk.h, m->pk_imp.h);
     for (k = o->imperfection, j = 0; k < n; ++k, ++j) {
         int p = idx[k];
-        m->pk_imp.x[j] = m->pk.x[p], m->pk_imp.y[j] = m->pk.y[p], m->pk_imp.z[j] = m->pk.z[p], m->pk_imp.r[j] = m->pk.r[p];
+        m->pk_imp.x[j] = m->pk.x[p], m->pk_imp.y[j] = m->pk.y[p], m->pk_imp.z[j] = m->pk.z[p],
+        m->pk_imp.r[j] = m->pk.r[p];
     }
     free(idx);
-    if (gk_rve_create(&rve, &m->rd, &m->pk_imp)) return fprintf(stderr, "femdem_nonlocal: %s\n", gk_rve_error(&rve)), 1;
+    if (gk_rve_create(&rve, &m->rd, &m->pk_imp))
+        return fprintf(stderr, "femdem_nonlocal: %s\n", gk_rve_error(&rve)), 1;
     memset(&cd, 0, sizeof cd);
     cd.pressure = o->pressure;
     cd.friction = m->rd.mat.friction;
@@ -491,16 +614,18 @@ static int rve_imperfect(const opts *o, micro *m) {
         gk_rve_destroy(&rve);
         return 1;
     }
-    printf("imperfect RVE: %d particles removed, re-consolidated in %ld steps to p = %.0f Pa, porosity %.4f\n",
-           o->imperfection, rep.steps, gk_stress_p(rep.stress, 3), rep.void_ratio / (1 + rep.void_ratio));
+    printf(
+        "imperfect RVE: %d particles removed, re-consolidated in %ld steps to p = %.0f Pa, porosity %.4f\n",
+        o->imperfection, rep.steps, gk_stress_p(rep.stress, 3), rep.void_ratio / (1 + rep.void_ratio));
     gk_rve_destroy(&rve);
     return 0;
 }
 
 /* ------------------------------------------------------------ the macro side */
 #define NCOL 15 /* columns of the CSV rows kept in memory (and in the checkpoint) */
-static const char *csv_head = "step,time,strain,stress,stress_2,p,q,porosity,Z,u_probe,dem_steps_mean,dem_steps_max,"
-                              "dem_capped,kinetic,seconds";
+static const char *csv_head =
+    "step,time,strain,stress,stress_2,p,q,porosity,Z,u_probe,dem_steps_mean,dem_steps_max,"
+    "dem_capped,kinetic,seconds";
 
 typedef struct pface {
     int n[4];
@@ -511,15 +636,15 @@ typedef struct model {
     const opts *o;
     micro *mi;
     int test, nn, nd, ne, nr;
-    double L[3];                    /* specimen size [m]                                      */
-    gk_mesh ref, cur;               /* reference and current configurations                   */
-    gk_quad q1;                     /* one Gauss point                                         */
-    gk_dofmap dm;                   /* periodic ties (identity without)                       */
-    double *u, *v, *fint, *fext, *f, *mass, *vhom;   /* nd                                   */
-    double *ur, *vr, *fr, *mr;      /* nr: the independent dofs                               */
-    unsigned char *fix, *fixr;      /* prescribed velocity                                    */
-    double *vpre;                   /* nd: the prescribed velocity of this step               */
-    double *dNdX, *V0, *hg;         /* reference gradients (24), volumes, hourglass stiffness  */
+    double L[3];      /* specimen size [m]                                      */
+    gk_mesh ref, cur; /* reference and current configurations                   */
+    gk_quad q1;       /* one Gauss point                                         */
+    gk_dofmap dm;     /* periodic ties (identity without)                       */
+    double *u, *v, *fint, *fext, *f, *mass, *vhom; /* nd                                   */
+    double *ur, *vr, *fr, *mr; /* nr: the independent dofs                               */
+    unsigned char *fix, *fixr; /* prescribed velocity                                    */
+    double *vpre;              /* nd: the prescribed velocity of this step               */
+    double *dNdX, *V0, *hg;    /* reference gradients (24), volumes, hourglass stiffness  */
     double *Hn, *H, *deps, *depsnl, *dH, *Rh, *R1, *sigR, *sig; /* 9 per point              */
     gk_twoscale_field *fld;
     gk_nonlocal nl;
@@ -528,8 +653,8 @@ typedef struct model {
     pface *pf;
     int npf;
     double omega_c, omega1, alpha, dt, vload, time, kin;
-    long step, nsteps, nramp;
-    int probe;                      /* wave: element 9 (1-based)                              */
+    long step, nsteps;
+    int probe; /* wave: element 9 (1-based)                              */
     /* history */
     double *rows;
     long nrow, caprow;
@@ -628,7 +753,8 @@ static int build_ties(model *md, unsigned axes, int platen) {
         if (!(axes & (1u << ax))) continue;
         r = gk_mesh_periodic_pairs(&md->ref, ax, 0.0, md->L[ax], 1e-9, ps, pm, &np, &err);
         for (k = 0; k < np && !r; ++k) {
-            if (tied[ps[k]]) continue; /* an edge node already tied along an earlier axis: the chain does the rest */
+            if (tied[ps[k]])
+                continue; /* an edge node already tied along an earlier axis: the chain does the rest */
             tied[ps[k]] = 1;
             for (a = 0; a < 3; ++a, ++nt) sl[nt] = 3 * ps[k] + a, ms[nt] = 3 * pm[k] + a;
         }
@@ -669,8 +795,10 @@ static int macro_setup(model *md) {
     ALLOC(md->u, md->nd), ALLOC(md->v, md->nd), ALLOC(md->fint, md->nd), ALLOC(md->fext, md->nd);
     ALLOC(md->f, md->nd), ALLOC(md->mass, md->nd), ALLOC(md->vhom, md->nd), ALLOC(md->fix, md->nd);
     ALLOC(md->vpre, md->nd), ALLOC(md->dNdX, 24 * md->ne), ALLOC(md->V0, md->ne), ALLOC(md->hg, md->ne);
-    ALLOC(md->Hn, 9 * md->ne), ALLOC(md->H, 9 * md->ne), ALLOC(md->deps, 9 * md->ne), ALLOC(md->depsnl, 9 * md->ne);
-    ALLOC(md->dH, 9 * md->ne), ALLOC(md->Rh, 9 * md->ne), ALLOC(md->R1, 9 * md->ne), ALLOC(md->sigR, 9 * md->ne);
+    ALLOC(md->Hn, 9 * md->ne), ALLOC(md->H, 9 * md->ne), ALLOC(md->deps, 9 * md->ne),
+        ALLOC(md->depsnl, 9 * md->ne);
+    ALLOC(md->dH, 9 * md->ne), ALLOC(md->Rh, 9 * md->ne), ALLOC(md->R1, 9 * md->ne),
+        ALLOC(md->sigR, 9 * md->ne);
     ALLOC(md->sig, 9 * md->ne), ALLOC(md->fld, md->ne), ALLOC(md->top, md->nn), ALLOC(md->bot, md->nn);
     ALLOC(md->right, md->nn), ALLOC(md->pf, 2 * (nx * nz + ny * nz + nx * ny)), ALLOC(md->arrival, md->ne);
     ALLOC(md->gam_peak, ny), ALLOC(md->prof12, 2 * ny), ALLOC(md->prof_end, 2 * ny);
@@ -741,7 +869,8 @@ static int macro_setup(model *md) {
     if (t == T_SSHEAR) axes = 1u | 4u;
     if (build_ties(md, axes, t == T_ESHEAR || t == T_SSHEAR)) return 1;
     md->nr = md->dm.nred;
-    ALLOC(md->ur, md->nr), ALLOC(md->vr, md->nr), ALLOC(md->fr, md->nr), ALLOC(md->mr, md->nr), ALLOC(md->fixr, md->nr);
+    ALLOC(md->ur, md->nr), ALLOC(md->vr, md->nr), ALLOC(md->fr, md->nr), ALLOC(md->mr, md->nr),
+        ALLOC(md->fixr, md->nr);
     gk_dofmap_restrict(&md->dm, NULL, md->mass, md->mr, NULL);
     for (a = 0; a < md->nd; ++a)
         if (md->fix[a]) md->fixr[md->dm.red[a]] = 1;
@@ -764,7 +893,7 @@ static int macro_setup(model *md) {
 /* the prescribed velocities of step n (at its mid-point) */
 static void loading(model *md, long n) {
     int a, t = md->test;
-    double ramp = (n + 0.5) / (double)md->nramp, V = md->vload * (ramp < 1.0 ? ramp : 1.0);
+    double V = md->vload;
     for (a = 0; a < md->nd; ++a) md->vpre[a] = 0.0;
     for (a = 0; a < md->nn; ++a) {
         const double *x = md->ref.x + 3 * a;
@@ -785,8 +914,8 @@ static void external_force(model *md) {
     for (a = 0; a < md->nd; ++a) md->fext[a] = 0.0;
     for (k = 0; k < md->npf; ++k) {
         const pface *p = md->pf + k;
-        const double *x0 = md->cur.x + 3 * p->n[0], *x1 = md->cur.x + 3 * p->n[1], *x2 = md->cur.x + 3 * p->n[2],
-                     *x3 = md->cur.x + 3 * p->n[3];
+        const double *x0 = md->cur.x + 3 * p->n[0], *x1 = md->cur.x + 3 * p->n[1],
+                     *x2 = md->cur.x + 3 * p->n[2], *x3 = md->cur.x + 3 * p->n[3];
         double d1[3], d2[3], nrm[3], len, t[3];
         for (a = 0; a < 3; ++a) d1[a] = x2[a] - x0[a], d2[a] = x3[a] - x1[a];
         gk_v3_cross(d1, d2, nrm);
@@ -810,7 +939,8 @@ static int internal_force(model *md) {
         if (gk_fem_elem_force(&md->cur, e, &md->q1, md->sig + 9 * e, fe, &err))
             return fprintf(stderr, "femdem_nonlocal: step %ld: %s\n", md->step, err.msg), 1;
         for (a = 0; a < 8; ++a)
-            for (k = 0; k < 3; ++k) xe[3 * a + k] = md->ref.x[3 * c[a] + k], ue[3 * a + k] = md->u[3 * c[a] + k];
+            for (k = 0; k < 3; ++k)
+                xe[3 * a + k] = md->ref.x[3 * c[a] + k], ue[3 * a + k] = md->u[3 * c[a] + k];
         gk_fem_hex8_hourglass(xe, ue, md->hg[e], fh);
         for (a = 0; a < 8; ++a)
             for (k = 0; k < 3; ++k) md->fint[3 * c[a] + k] += fe[3 * a + k] - fh[3 * a + k];
@@ -864,11 +994,13 @@ static int macro_step(model *md) {
     loading(md, md->step);
     if (md->alpha > 0.0) velocity_hom(md);
     for (a = 0; a < md->nd; ++a) /* alpha M (v - v_hom): the v_hom part enters as a force */
-        md->f[a] = md->fext[a] - md->fint[a] + (md->alpha > 0.0 ? md->alpha * md->mass[a] * md->vhom[a] : 0.0);
+        md->f[a] =
+            md->fext[a] - md->fint[a] + (md->alpha > 0.0 ? md->alpha * md->mass[a] * md->vhom[a] : 0.0);
     gk_dofmap_restrict(&md->dm, NULL, md->f, md->fr, NULL);
     for (a = 0; a < md->nd; ++a)
         if (md->fix[a]) md->vr[md->dm.red[a]] = md->vpre[a];
-    r = gk_explicit_step(md->nr, md->mr, md->fixr, md->fr, md->alpha, md->dt, md->vr, md->ur, &err); /* eqs 22-23 */
+    r = gk_explicit_step(md->nr, md->mr, md->fixr, md->fr, md->alpha, md->dt, md->vr, md->ur,
+                         &err); /* eqs 22-23 */
     if (r) return fprintf(stderr, "femdem_nonlocal: step %ld: %s\n", md->step, err.msg), 1;
     gk_dofmap_expand(&md->dm, md->ur, 0, md->u);
     gk_dofmap_expand(&md->dm, md->vr, 0, md->v);
@@ -876,7 +1008,8 @@ static int macro_step(model *md) {
     /* corotational increments (eqs 60-61) */
     for (e = 0; e < md->ne; ++e) {
         elem_grad(md, md->u, e, md->H + 9 * e);
-        if (gk_corot_increment(3, md->Hn + 9 * e, md->H + 9 * e, md->deps + 9 * e, md->Rh + 9 * e, md->R1 + 9 * e, &err))
+        if (gk_corot_increment(3, md->Hn + 9 * e, md->H + 9 * e, md->deps + 9 * e, md->Rh + 9 * e,
+                               md->R1 + 9 * e, &err))
             return fprintf(stderr, "femdem_nonlocal: step %ld, element %d: %s\n", md->step, e, err.msg), 1;
     }
     gk_nonlocal_apply(&md->nl, 9, md->deps, md->depsnl); /* eq 58 (R = 0: each point alone) */
@@ -889,12 +1022,14 @@ static int macro_step(model *md) {
             if (pt[e].code) fprintf(stderr, "  Gauss point %d: %s\n", e, gk_twoscale_point_error(&md->ts, e));
         return 3;
     }
-    if (gk_twoscale_accept(&md->ts)) return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&md->ts)), 1;
+    if (gk_twoscale_accept(&md->ts))
+        return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&md->ts)), 1;
     {
         const gk_twoscale_point *pt = gk_twoscale_points(&md->ts);
         for (e = 0; e < md->ne; ++e) md->dem_total += pt[e].work;
     }
-    for (e = 0; e < md->ne; ++e) gk_corot_rotate_out(md->R1 + 9 * e, md->sigR + 9 * e, md->sig + 9 * e); /* eq 62 */
+    for (e = 0; e < md->ne; ++e)
+        gk_corot_rotate_out(md->R1 + 9 * e, md->sigR + 9 * e, md->sig + 9 * e); /* eq 62 */
     memcpy(md->Hn, md->H, sizeof(double) * 9 * md->ne);
     ++md->step;
     md->time += md->dt;
@@ -919,7 +1054,8 @@ static void measure(model *md, double *strain, double *stress, double *stress2, 
         for (e = 0; e < md->ne; ++e) /* the current area of the top face: nodes 3, 2, 6, 7 of the top row */
             if ((e / md->o->mesh[0]) % md->o->mesh[1] == md->o->mesh[1] - 1) {
                 const int *c = md->ref.conn + 8 * e;
-                double dx = md->cur.x[3 * c[2]] - md->cur.x[3 * c[3]], dz = md->cur.x[3 * c[7] + 2] - md->cur.x[3 * c[3] + 2];
+                double dx = md->cur.x[3 * c[2]] - md->cur.x[3 * c[3]],
+                       dz = md->cur.x[3 * c[7] + 2] - md->cur.x[3 * c[3] + 2];
                 area += fabs(dx * dz);
             }
         *strain = -md->u[3 * md->top[0] + 1] / md->L[1];
@@ -992,7 +1128,8 @@ static int record(model *md, double seconds) {
         p = f->p * n, q = f->q * n, por = f->void_ratio / (1 + f->void_ratio) * n, Z = f->coordination * n;
     }
     row[0] = (double)md->step, row[1] = md->time, row[2] = strain, row[3] = stress, row[4] = s2;
-    row[5] = p / n, row[6] = q / n, row[7] = por / n, row[8] = Z / n, row[9] = up, row[10] = dm / n, row[11] = dx;
+    row[5] = p / n, row[6] = q / n, row[7] = por / n, row[8] = Z / n, row[9] = up, row[10] = dm / n,
+    row[11] = dx;
     row[12] = capped, row[13] = md->kin, row[14] = seconds;
     if (md->nrow == md->caprow) {
         double *nr;
@@ -1035,14 +1172,16 @@ static void track(model *md) {
 }
 
 /* ------------------------------------------------------------ outputs */
-static int write_rows(const char *path, const char *head, const double *rows, long nrow, int ncol, int real0) {
+static int write_rows(const char *path, const char *head, const double *rows, long nrow, int ncol,
+                      int real0) {
     FILE *fp = fopen(path, "w");
     long r;
     int c, bad;
     if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
     fprintf(fp, "%s\n", head);
     for (r = 0; r < nrow; ++r) {
-        for (c = 0; c < ncol; ++c) fprintf(fp, c == 0 ? (real0 ? "%.9g" : "%.0f") : ",%.9g", rows[(size_t)r * ncol + c]);
+        for (c = 0; c < ncol; ++c)
+            fprintf(fp, c == 0 ? (real0 ? "%.9g" : "%.0f") : ",%.9g", rows[(size_t)r * ncol + c]);
         fputc('\n', fp);
     }
     bad = ferror(fp);
@@ -1060,13 +1199,13 @@ static int write_vtk(model *md, const char *path) {
     ok &= ok && !gk_vtk_cells(&vk, n, 8, md->ref.conn, GK_VTK_HEX);
     ok &= ok && !gk_vtk_point_vector(&vk, "displacement", md->u);
     ok &= ok && !gk_vtk_cell_tensor(&vk, "stress", md->sig);
-#define FIELD(name, expr)                                   \
-    for (e = 0; e < n; ++e) {                               \
-        const gk_twoscale_field *f = md->fld + e;           \
-        const double *H = md->H + 9 * e;                    \
-        (void)f, (void)H;                                   \
-        val[e] = (expr);                                    \
-    }                                                       \
+#define FIELD(name, expr)                         \
+    for (e = 0; e < n; ++e) {                     \
+        const gk_twoscale_field *f = md->fld + e; \
+        const double *H = md->H + 9 * e;          \
+        (void)f, (void)H;                         \
+        val[e] = (expr);                          \
+    }                                             \
     ok &= ok && !gk_vtk_cell_scalar(&vk, name, val);
     FIELD("p", f->p)
     FIELD("q", f->q)
@@ -1075,8 +1214,7 @@ static int write_vtk(model *md, const char *path) {
     FIELD("particle_rotation", f->rotation)
     FIELD("dem_steps", f->dem_steps)
     FIELD("shear_strain", H[1] + H[3])
-    FIELD("eps_v", H[0] + H[4] + H[8])
-    {
+    FIELD("eps_v", H[0] + H[4] + H[8]) {
         double eps[9];
         for (e = 0; e < n; ++e) {
             gk_m3_sym(md->H + 9 * e, eps);
@@ -1109,7 +1247,8 @@ static int write_field(model *md, const char *path, const char *title, const cha
 }
 
 static int plot2(const char *path, const char *title, const char *xl, const char *yl, const double *x1,
-                 const double *y1, int n1, const char *l1, const double *x2, const double *y2, int n2, const char *l2) {
+                 const double *y1, int n1, const char *l1, const double *x2, const double *y2, int n2,
+                 const char *l2) {
     gk_plot p;
     gk_err err;
     gk_plot_init(&p, title, xl, yl);
@@ -1135,19 +1274,22 @@ static uint64_t fingerprint(const opts *o, const gk_packing *pk) {
     double sx = 0.0;
     int i;
     for (i = 0; i < pk->n; ++i) sx += pk->x[i] + 2.0 * pk->y[i] + 3.0 * pk->z[i] + 5.0 * pk->r[i];
-    snprintf(buf, sizeof buf, "%d %d %d %d %.17g %.17g %.17g %d %d %.17g %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
+    snprintf(buf, sizeof buf,
+             "%d %d %d %d %.17g %.17g %.17g %d %d %.17g %d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
              "%.17g %.17g %.17g %.17g %d %d %d %.17g %.17g",
-             o->test, o->mesh[0], o->mesh[1], o->mesh[2], o->R, o->pressure, o->strain, o->steps, o->imperfection,
-             o->iuf, o->dem_min, o->dem_max, o->dem_damping, o->contact_damping, o->density, o->xi, o->mass_scale,
-             o->kappa, o->dt, o->dt_safety, o->amplitude, o->frequency, o->duration, o->every, pk->n, 3, sx, o->dem_inertial);
+             o->test, o->mesh[0], o->mesh[1], o->mesh[2], o->R, o->pressure, o->strain, o->steps,
+             o->imperfection, o->iuf, o->dem_min, o->dem_max, o->dem_damping, o->contact_damping, o->density,
+             o->xi, o->mass_scale, o->kappa, o->dt, o->dt_safety, o->amplitude, o->frequency, o->duration,
+             o->every, pk->n, 3, sx, o->dem_inertial);
     for (k = 0; buf[k]; ++k) h = (h ^ (unsigned char)buf[k]) * 1099511628211ull;
     return h;
 }
 
 static int save_checkpoint(model *md, uint64_t fp) {
     ckhead hd;
-    size_t ny = (size_t)md->o->mesh[1], nb = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->ne +
-                                                                        NCOL * (size_t)md->nrow + 3 * ny + md->ne);
+    size_t ny = (size_t)md->o->mesh[1],
+           nb = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->ne +
+                                              NCOL * (size_t)md->nrow + 3 * ny + md->ne);
     unsigned char *b = (unsigned char *)xcalloc(nb, 1), *q = b;
     char path[1024];
     int k;
@@ -1155,13 +1297,14 @@ static int save_checkpoint(model *md, uint64_t fp) {
     memcpy(hd.magic, "GKFNL01", 8);
     hd.test = md->test;
     for (k = 0; k < 3; ++k) hd.mesh[k] = md->o->mesh[k];
-    hd.nd = md->nd, hd.nr = md->nr, hd.ne = md->ne, hd.ny = (int32_t)ny, hd.have12 = md->have12, hd.ncol = NCOL;
+    hd.nd = md->nd, hd.nr = md->nr, hd.ne = md->ne, hd.ny = (int32_t)ny, hd.have12 = md->have12,
+    hd.ncol = NCOL;
     hd.step = md->step, hd.nrow = md->nrow, hd.dem_total = md->dem_total, hd.fingerprint = fp;
     hd.time = md->time, hd.peak = md->peak;
-#define PUT(p, n)                  \
-    do {                           \
-        memcpy(q, (p), (n));       \
-        q += (n);                  \
+#define PUT(p, n)            \
+    do {                     \
+        memcpy(q, (p), (n)); \
+        q += (n);            \
     } while (0)
     PUT(&hd, sizeof hd);
     PUT(md->ur, sizeof(double) * md->nr);
@@ -1195,13 +1338,14 @@ static int load_checkpoint(model *md, uint64_t fp) {
         hd.ne != md->ne || hd.ny != (int32_t)ny || hd.ncol != NCOL || hd.fingerprint != fp || hd.nrow < 1 ||
         hd.step < 0 || hd.step > md->o->steps)
         goto bad;
-    need = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->ne + NCOL * (size_t)hd.nrow + 3 * ny + md->ne);
+    need = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->ne + NCOL * (size_t)hd.nrow +
+                                         3 * ny + md->ne);
     if (nb != need) goto bad;
     q = (const unsigned char *)blk + sizeof hd;
-#define GET(p, n)                  \
-    do {                           \
-        memcpy((p), q, (n));       \
-        q += (n);                  \
+#define GET(p, n)            \
+    do {                     \
+        memcpy((p), q, (n)); \
+        q += (n);            \
     } while (0)
     GET(md->ur, sizeof(double) * md->nr);
     GET(md->vr, sizeof(double) * md->nr);
@@ -1214,7 +1358,8 @@ static int load_checkpoint(model *md, uint64_t fp) {
     GET(md->arrival, sizeof(double) * md->ne);
 #undef GET
     gk_twoscale_free(&md->ts, blk);
-    md->step = hd.step, md->time = hd.time, md->peak = hd.peak, md->have12 = hd.have12, md->dem_total = hd.dem_total;
+    md->step = hd.step, md->time = hd.time, md->peak = hd.peak, md->have12 = hd.have12,
+    md->dem_total = hd.dem_total;
     gk_dofmap_expand(&md->dm, md->ur, 0, md->u);
     gk_dofmap_expand(&md->dm, md->vr, 0, md->v);
     for (e = 0; e < md->nd; ++e) md->cur.x[e] = md->ref.x[e] + md->u[e];
@@ -1228,7 +1373,8 @@ static int load_checkpoint(model *md, uint64_t fp) {
 bad:
     gk_twoscale_free(&md->ts, blk);
     return fprintf(stderr,
-                   "femdem_nonlocal: restart: %s was written by another run (test, mesh, options or packing differ) "
+                   "femdem_nonlocal: restart: %s was written by another run (test, mesh, options or packing "
+                   "differ) "
                    "or is damaged\n",
                    path),
            1;
@@ -1257,12 +1403,14 @@ static int rve_alone(const opts *o, micro *mi, int nstep, double *rows) {
     double H0[9], x_prev = 0.0, M = mi->K + 4.0 / 3.0 * mi->G, s0[9];
     ts_def_make(o, mi, &pr, 1, NULL, 1, &d);
     d.threads = 1;
-    if (gk_twoscale_create(&ts, &d)) return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&ts)), 1;
+    if (gk_twoscale_create(&ts, &d))
+        return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&ts)), 1;
     gk_twoscale_accepted(&ts, s0, NULL);
     gk_twoscale_fields(&ts, &f);
     gk_m3_zero(H0);
     rows[0] = 0.0, rows[1] = shear ? s0[1] : -s0[4], rows[2] = shear ? -s0[4] : -s0[0];
-    rows[3] = f.p, rows[4] = f.q, rows[5] = f.void_ratio / (1 + f.void_ratio), rows[6] = f.coordination, rows[7] = 0;
+    rows[3] = f.p, rows[4] = f.q, rows[5] = f.void_ratio / (1 + f.void_ratio), rows[6] = f.coordination,
+    rows[7] = 0;
     for (i = 1; i <= nstep; ++i) {
         /* the response is noisy and jumps where the DEM step count changes:
          * a secant step, then regula falsi (Illinois) inside a bracket */
@@ -1308,7 +1456,8 @@ static int rve_alone(const opts *o, micro *mi, int nstep, double *rows) {
          * neighbouring increments (one DEM step more or less): then the closest run is taken
          * if within 10 % of p; its normal stress is in rve_alone.csv (stress_2) */
         if (!ok && fabs(rbest) < 0.1 * o->pressure) ok = 1;
-        if (ok && fabs(rs[1]) > fabs(rbest)) { /* end on the best run (the next run starts from the accepted state) */
+        if (ok && fabs(rs[1]) >
+                      fabs(rbest)) { /* end on the best run (the next run starts from the accepted state) */
             double deps[9], Rh[9], R1[9], dH[9], sR[9];
             gk_m3_copy(H0, H1);
             if (shear)
@@ -1323,8 +1472,8 @@ static int rve_alone(const opts *o, micro *mi, int nstep, double *rows) {
         }
         if (ok) x_prev = xbest;
         if (!ok || gk_twoscale_accept(&ts)) {
-            fprintf(stderr, "femdem_nonlocal: the RVE alone did not hold the pressure at increment %d (%s)\n", i,
-                    gk_twoscale_error(&ts));
+            fprintf(stderr, "femdem_nonlocal: the RVE alone did not hold the pressure at increment %d (%s)\n",
+                    i, gk_twoscale_error(&ts));
             gk_twoscale_destroy(&ts);
             return 1;
         }
@@ -1350,7 +1499,8 @@ static double interp(const double *c, long n, int stride, int yc, double x) {
     for (k = 0; k + 1 < n; ++k) {
         double x0 = c[stride * k], x1 = c[stride * (k + 1)];
         if (x0 <= x && x <= x1 && x1 > x0)
-            return c[stride * k + yc] + (x - x0) / (x1 - x0) * (c[stride * (k + 1) + yc] - c[stride * k + yc]);
+            return c[stride * k + yc] +
+                   (x - x0) / (x1 - x0) * (c[stride * (k + 1) + yc] - c[stride * k + yc]);
     }
     return NAN;
 }
@@ -1359,7 +1509,8 @@ static double interp(const double *c, long n, int stride, int yc, double x) {
  * strains, the mean gap over each of ten equal strain windows (DEM noise
  * averages out; both curves fluctuate by several % at critical state), the
  * largest of the ten relative to the RVE's peak; and the ratio of the peaks */
-static double curve_deviation(const double *rows, long nrow, const double *lone, int nl, double S, double *peak_ratio) {
+static double curve_deviation(const double *rows, long nrow, const double *lone, int nl, double S,
+                              double *peak_ratio) {
     double dmax = 0.0, pl = -HUGE_VAL, pe = -HUGE_VAL;
     long r;
     int k, w;
@@ -1390,8 +1541,10 @@ static void wave_elastic(model *md, double *arr) {
     long n;
     double lam = md->mi->K - 2.0 / 3.0 * md->mi->G, mu = md->mi->G;
     double thr = 1e-3 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
-    double *u = (double *)xcalloc((size_t)md->nd, sizeof(double)), *f = (double *)xcalloc((size_t)md->nd, sizeof(double));
-    double *ur = (double *)xcalloc((size_t)md->nr, sizeof(double)), *vr = (double *)xcalloc((size_t)md->nr, sizeof(double));
+    double *u = (double *)xcalloc((size_t)md->nd, sizeof(double)),
+           *f = (double *)xcalloc((size_t)md->nd, sizeof(double));
+    double *ur = (double *)xcalloc((size_t)md->nr, sizeof(double)),
+           *vr = (double *)xcalloc((size_t)md->nr, sizeof(double));
     double *fr = (double *)xcalloc((size_t)md->nr, sizeof(double));
     for (e = 0; e < md->ne; ++e) arr[e] = -1.0;
     for (n = 0; n < md->o->steps; ++n) {
@@ -1402,10 +1555,13 @@ static void wave_elastic(model *md, double *arr) {
             elem_grad(md, u, e, H);
             tr = H[0] + H[4] + H[8];
             for (i = 0; i < 3; ++i)
-                for (j = 0; j < 3; ++j) s[3 * i + j] = mu * (H[3 * i + j] + H[3 * j + i]) + (i == j ? lam * tr - md->o->pressure : 0.0);
+                for (j = 0; j < 3; ++j)
+                    s[3 * i + j] =
+                        mu * (H[3 * i + j] + H[3 * j + i]) + (i == j ? lam * tr - md->o->pressure : 0.0);
             gk_fem_elem_force(&md->ref, e, &md->q1, s, fe, NULL);
             for (a = 0; a < 8; ++a)
-                for (k = 0; k < 3; ++k) xe[3 * a + k] = md->ref.x[3 * c[a] + k], ue[3 * a + k] = u[3 * c[a] + k];
+                for (k = 0; k < 3; ++k)
+                    xe[3 * a + k] = md->ref.x[3 * c[a] + k], ue[3 * a + k] = u[3 * c[a] + k];
             gk_fem_hex8_hourglass(xe, ue, md->hg[e], fh);
             for (a = 0; a < 8; ++a)
                 for (k = 0; k < 3; ++k) f[3 * c[a] + k] -= fe[3 * a + k] - fh[3 * a + k];
@@ -1434,22 +1590,27 @@ static double front_speed(const model *md, const double *arr) {
 }
 
 /* ------------------------------------------------------------ main */
-static void result_line(const micro *mi, const char *extra, double pk, double epk, double bc, double bw, double secs) {
-    printf("RESULT K_MPa=%.2f G_MPa=%.2f porosity0=%.4f Z0=%.3f peak_stress=%.6g eps_at_peak=%.5g band_center_mm=%.3g "
+static void result_line(const micro *mi, const char *extra, double pk, double epk, double bc, double bw,
+                        double secs) {
+    printf("RESULT K_MPa=%.2f G_MPa=%.2f porosity0=%.4f Z0=%.3f peak_stress=%.6g eps_at_peak=%.5g "
+           "band_center_mm=%.3g "
            "band_width_mm=%.3g seconds=%.1f%s%s\n",
-           mi->K / 1e6, mi->G / 1e6, mi->porosity0, mi->Z0, pk, epk, bc, bw, secs, extra ? " " : "", extra ? extra : "");
+           mi->K / 1e6, mi->G / 1e6, mi->porosity0, mi->Z0, pk, epk, bc, bw, secs, extra ? " " : "",
+           extra ? extra : "");
 }
 
 static int run_rve_test(const opts *o, micro *mi, double t0) {
     char path[1024];
     int n = o->steps + 11, k, r;
     double *rows = (double *)xcalloc((size_t)RVE_NCOL * n, sizeof(double));
-    double *x1 = (double *)xcalloc((size_t)n, sizeof(double)), *y1 = (double *)xcalloc((size_t)n, sizeof(double));
-    double *x2 = (double *)xcalloc((size_t)n, sizeof(double)), *y2 = (double *)xcalloc((size_t)n, sizeof(double));
+    double *x1 = (double *)xcalloc((size_t)n, sizeof(double)),
+           *y1 = (double *)xcalloc((size_t)n, sizeof(double));
+    double *x2 = (double *)xcalloc((size_t)n, sizeof(double)),
+           *y2 = (double *)xcalloc((size_t)n, sizeof(double));
     if (rve_moduli(o, mi, rows)) return 1;
     snprintf(path, sizeof path, "%s/rve.csv", o->out);
-    if (write_rows(path, "eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,Z_iso,porosity_shear,Z_shear,dem_steps", rows,
-                   n, RVE_NCOL, 1))
+    if (write_rows(path, "eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,Z_iso,porosity_shear,Z_shear,dem_steps",
+                   rows, n, RVE_NCOL, 1))
         return 1;
     for (k = 0; k < n; ++k) {
         const double *rw = rows + RVE_NCOL * k;
@@ -1460,7 +1621,8 @@ static int run_rve_test(const opts *o, micro *mi, double t0) {
               "stress change (p - p0, tau) [kPa]", x1, y1, n, "p - p0 vs eps_v", x2, y2, n, "tau vs gamma");
     free(rows), free(x1), free(y1), free(x2), free(y2);
     if (r) return 1;
-    printf("RVE: initial p %.0f Pa, porosity %.4f, Z %.3f, density %.1f kg/m^3; K %.1f MPa, G %.1f MPa (secants at "
+    printf("RVE: initial p %.0f Pa, porosity %.4f, Z %.3f, density %.1f kg/m^3; K %.1f MPa, G %.1f MPa "
+           "(secants at "
            "1e-4; Table II: 335, 241)\n",
            mi->p0, mi->porosity0, mi->Z0, mi->rho, mi->K / 1e6, mi->G / 1e6);
     result_line(mi, NULL, NAN, NAN, NAN, NAN, gk_wtime() - t0);
@@ -1480,20 +1642,25 @@ int main(int argc, char **argv) {
     char path[1024];
     rc = parse(argc, argv, &o);
     if (rc) return rc;
-    if (mkdir(o.out, 0777) && errno != EEXIST) return fprintf(stderr, "femdem_nonlocal: cannot create %s\n", o.out), 1;
+    if (mkdir(o.out, 0777) && errno != EEXIST)
+        return fprintf(stderr, "femdem_nonlocal: cannot create %s\n", o.out), 1;
     memset(&mi, 0, sizeof mi);
     memset(&md, 0, sizeof md);
     gk_rve_state_init(&mi.st_imp, NULL);
-    if (gk_packing_read(o.packing, &mi.pk, NULL, &err)) return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
-    if (mi.pk.dim != 3) return fprintf(stderr, "femdem_nonlocal: %s is a %dD packing (3D needed)\n", o.packing, mi.pk.dim), 1;
+    if (gk_packing_read(o.packing, &mi.pk, NULL, &err))
+        return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
+    if (mi.pk.dim != 3)
+        return fprintf(stderr, "femdem_nonlocal: %s is a %dD packing (3D needed)\n", o.packing, mi.pk.dim), 1;
     if (o.imperfection == -2) /* the paper's 25 of 4096 particles, in proportion */
-        o.imperfection = (int)floor(25.0 * mi.pk.n / 4096.0 + 0.5) > 1 ? (int)floor(25.0 * mi.pk.n / 4096.0 + 0.5) : 1;
+        o.imperfection =
+            (int)floor(25.0 * mi.pk.n / 4096.0 + 0.5) > 1 ? (int)floor(25.0 * mi.pk.n / 4096.0 + 0.5) : 1;
     rve_def_make(&o, &mi.rd);
     if (rve_frequency(&mi)) return 1;
     if (o.test == T_RVE) return run_rve_test(&o, &mi, t0);
     if (rve_moduli(&o, &mi, NULL)) return 1;
-    printf("RVE (%d spheres): p %.0f Pa, porosity %.4f, Z %.3f, density %.1f kg/m^3, K %.1f MPa, G %.1f MPa\n",
-           mi.pk.n, mi.p0, mi.porosity0, mi.Z0, mi.rho, mi.K / 1e6, mi.G / 1e6);
+    printf(
+        "RVE (%d spheres): p %.0f Pa, porosity %.4f, Z %.3f, density %.1f kg/m^3, K %.1f MPa, G %.1f MPa\n",
+        mi.pk.n, mi.p0, mi.porosity0, mi.Z0, mi.rho, mi.K / 1e6, mi.G / 1e6);
     md.o = &o;
     md.mi = &mi;
     if (macro_setup(&md)) return 1;
@@ -1508,28 +1675,31 @@ int main(int argc, char **argv) {
         pick[row * o.mesh[0] + col] = 1; /* front layer (k = 0) */
     }
     ts_def_make(&o, &mi, pr, o.imperfection > 0 ? 2 : 1, pick, md.ne, &d);
-    if (gk_twoscale_create(&md.ts, &d)) return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&md.ts)), 1;
+    if (gk_twoscale_create(&md.ts, &d))
+        return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&md.ts)), 1;
     /* time steps: eq 65 from the element bound with the RVE's K, G; eq 66 */
     md.omega_c = macro_omega(&md);
-    if (!(md.omega_c > 0)) return fprintf(stderr, "femdem_nonlocal: no stable step (element frequency %g)\n", md.omega_c), 1;
+    if (!(md.omega_c > 0))
+        return fprintf(stderr, "femdem_nonlocal: no stable step (element frequency %g)\n", md.omega_c), 1;
     md.dt = o.dt_safety * gk_explicit_dt_critical(md.omega_c, 0.0);
     if (o.dt > 0) {
         if (o.dt > gk_explicit_dt_critical(md.omega_c, 0.0))
-            return fprintf(stderr, "femdem_nonlocal: --dt %g is above the stable step %g of eq 65 for this mesh\n",
+            return fprintf(stderr,
+                           "femdem_nonlocal: --dt %g is above the stable step %g of eq 65 for this mesh\n",
                            o.dt, gk_explicit_dt_critical(md.omega_c, 0.0)),
                    2;
         md.dt = o.dt;
     }
     md.nsteps = o.steps;
-    md.nramp = o.steps / 10 > 1 ? o.steps / 10 : 1;
-    md.vload = o.strain * md.L[1] / ((md.nsteps - 0.5 * md.nramp) * md.dt);
+    md.vload = o.strain * md.L[1] / (md.nsteps * md.dt);
     {
         double rho = mi.rho * o.mass_scale, E = 9.0 * mi.K * mi.G / (3.0 * mi.K + mi.G);
         double c = (o.test == T_ESHEAR || o.test == T_SSHEAR) ? sqrt(mi.G / rho) : sqrt(E / rho);
         md.omega1 = 0.5 * GK_PI * c / md.L[1];
         md.alpha = 2.0 * o.xi * md.omega1;
     }
-    printf("mesh %dx%dx%d (%d Gauss points), nonlocal %s (R %g m, %d neighbour pairs), dt %.4g s (eq 65: omega_max "
+    printf("mesh %dx%dx%d (%d Gauss points), nonlocal %s (R %g m, %d neighbour pairs), dt %.4g s (eq 65: "
+           "omega_max "
            "%.4g rad/s), eq 66: %.1f DEM critical steps per coarse step (omega_f %.4g rad/s, DEM dt %.3g s), "
            "damping alpha %.4g 1/s\n",
            o.mesh[0], o.mesh[1], o.mesh[2], md.ne, o.R > 0 ? "on" : "off", o.R, md.nl.start[md.ne], md.dt,
@@ -1541,6 +1711,14 @@ int main(int argc, char **argv) {
     if (o.restart) {
         if (load_checkpoint(&md, fpr)) return 1;
     } else {
+        /* the loading's own homogeneous velocity field from the start: a steady
+         * homogeneous deformation needs no acceleration, so no start-up wave */
+        for (k = 0; k < md.nn; ++k) {
+            const double *x = md.ref.x + 3 * k;
+            if (o.test == T_ESHEAR || o.test == T_SSHEAR) md.v[3 * k] = md.vload * x[1] / md.L[1];
+            if (o.test == T_EBIAX || o.test == T_BIAX) md.v[3 * k + 1] = -md.vload * x[1] / md.L[1];
+        }
+        for (k = 0; k < md.nd; ++k) md.vr[md.dm.red[k]] = md.v[k];
         external_force(&md);
         if (internal_force(&md)) return 1;
         track(&md);
@@ -1548,14 +1726,17 @@ int main(int argc, char **argv) {
     }
     /* the loop */
     {
-        long stop = o.stop_after > 0 ? o.stop_after : md.nsteps, every_print = md.nsteps / 20 > 0 ? md.nsteps / 20 : 1;
+        long stop = o.stop_after > 0 ? o.stop_after : md.nsteps,
+             every_print = md.nsteps / 20 > 0 ? md.nsteps / 20 : 1;
         char csv[1024];
         snprintf(csv, sizeof csv, "%s/%s.csv", o.out, test_name[o.test]);
         while (md.step < stop) {
             rc = macro_step(&md);
             if (rc) {
                 save_checkpoint(&md, fpr);
-                fprintf(stderr, "femdem_nonlocal: stopped at step %ld (checkpoint of the last state written)\n", md.step);
+                fprintf(stderr,
+                        "femdem_nonlocal: stopped at step %ld (checkpoint of the last state written)\n",
+                        md.step);
                 write_rows(csv, csv_head, md.rows, md.nrow, NCOL, 0);
                 return rc;
             }
@@ -1570,13 +1751,15 @@ int main(int argc, char **argv) {
             if (md.step % every_print == 0) {
                 const double *row = md.rows + NCOL * (md.nrow - 1);
                 char what[256];
-                snprintf(what, sizeof what, "strain %.4g stress %.4g Pa, DEM steps %.0f", row[2], row[3], row[10]);
+                snprintf(what, sizeof what, "strain %.4g stress %.4g Pa, DEM steps %.0f", row[2], row[3],
+                         row[10]);
                 gk_progress(stdout, md.step, md.nsteps, t0, what);
             }
         }
         if (write_rows(csv, csv_head, md.rows, md.nrow, NCOL, 0) || save_checkpoint(&md, fpr)) return 1;
         if (md.step < md.nsteps) {
-            printf("stopped after step %ld of %ld (--stop-after); checkpoint written: continue with --restart %s\n",
+            printf("stopped after step %ld of %ld (--stop-after); checkpoint written: continue with "
+                   "--restart %s\n",
                    md.step, md.nsteps, o.out);
             return 0;
         }
@@ -1584,8 +1767,10 @@ int main(int argc, char **argv) {
     /* final outputs */
     {
         long r, n = md.nrow, ipk = 0;
-        double *x = (double *)xcalloc((size_t)n, sizeof(double)), *y = (double *)xcalloc((size_t)n, sizeof(double));
-        double *y2 = (double *)xcalloc((size_t)n, sizeof(double)), *val = (double *)xcalloc((size_t)md.ne, sizeof(double));
+        double *x = (double *)xcalloc((size_t)n, sizeof(double)),
+               *y = (double *)xcalloc((size_t)n, sizeof(double));
+        double *y2 = (double *)xcalloc((size_t)n, sizeof(double)),
+               *val = (double *)xcalloc((size_t)md.ne, sizeof(double));
         double pk = -HUGE_VAL, epk = NAN, bc = NAN, bw = NAN;
         char extra[1024], svg[1024];
         const char *xl = "strain", *yl = "stress [kPa]";
@@ -1612,48 +1797,56 @@ int main(int argc, char **argv) {
                 fprintf(fp, "strain,stress,stress_2,p,q,porosity,Z,runs\n");
                 for (k2 = 0; k2 <= nl; ++k2)
                     fprintf(fp, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.0f\n", lone[8 * k2], lone[8 * k2 + 1],
-                            lone[8 * k2 + 2], lone[8 * k2 + 3], lone[8 * k2 + 4], lone[8 * k2 + 5], lone[8 * k2 + 6],
-                            lone[8 * k2 + 7]);
+                            lone[8 * k2 + 2], lone[8 * k2 + 3], lone[8 * k2 + 4], lone[8 * k2 + 5],
+                            lone[8 * k2 + 6], lone[8 * k2 + 7]);
                 bad = ferror(fp);
                 if (fclose(fp) || bad) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", path), 1;
             }
             dev = curve_deviation(md.rows, md.nrow, lone, nl, o.strain, &pkr);
-            lx = (double *)xcalloc((size_t)nl + 1, sizeof(double)), ly = (double *)xcalloc((size_t)nl + 1, sizeof(double));
+            lx = (double *)xcalloc((size_t)nl + 1, sizeof(double)),
+            ly = (double *)xcalloc((size_t)nl + 1, sizeof(double));
             for (k = 0; k <= nl; ++k) lx[k] = lone[8 * k], ly[k] = lone[8 * k + 1] / 1e3;
             snprintf(svg, sizeof svg, "%s/%s_curve.svg", o.out, test_name[o.test]);
-            if (plot2(svg, o.test == T_EBIAX ? "one element, biaxial (Fig 6a)" : "one element, simple shear (Fig 6b)",
+            if (plot2(svg,
+                      o.test == T_EBIAX ? "one element, biaxial (Fig 6a)"
+                                        : "one element, simple shear (Fig 6b)",
                       o.test == T_EBIAX ? "axial strain" : "shear strain u_top / h",
-                      o.test == T_EBIAX ? "axial stress [kPa]" : "shear stress [kPa]", x, y, (int)n, "FEM x DEM, 1 element",
-                      lx, ly, nl + 1, "RVE alone"))
+                      o.test == T_EBIAX ? "axial stress [kPa]" : "shear stress [kPa]", x, y, (int)n,
+                      "FEM x DEM, 1 element", lx, ly, nl + 1, "RVE alone"))
                 return 1;
             snprintf(extra, sizeof extra, "rve_alone_dev_pct=%.3f peak_ratio=%.4f", 100.0 * dev, pkr);
-            printf("one element against the RVE alone: largest gap of the 10 strain-window means %.2f %% of the "
-                   "peak; peaks %.4f\n",
-                   100.0 * dev, pkr);
+            printf(
+                "one element against the RVE alone: largest gap of the 10 strain-window means %.2f %% of the "
+                "peak; peaks %.4f\n",
+                100.0 * dev, pkr);
             free(lone), free(lx), free(ly);
         } else if (o.test == T_WAVE) {
             double *ae = (double *)xcalloc((size_t)md.ne, sizeof(double)), cm, ce, cs;
             FILE *fp;
             int bad;
             wave_elastic(&md, ae);
-            cm = front_speed(&md, md.arrival), ce = front_speed(&md, ae), cs = sqrt(mi.G / (mi.rho * o.mass_scale));
+            cm = front_speed(&md, md.arrival), ce = front_speed(&md, ae),
+            cs = sqrt(mi.G / (mi.rho * o.mass_scale));
             snprintf(path, sizeof path, "%s/wave_arrival.csv", o.out);
             fp = fopen(path, "w");
             if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
             fprintf(fp, "element,distance_mm,arrival_us,arrival_elastic_us,arrival_sqrtGrho_us\n");
             for (e = 0; e < md.ne; ++e) {
                 double dd = md.L[0] - (e + 0.5) * md.L[0] / md.ne;
-                fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g\n", e + 1, 1e3 * dd, 1e6 * md.arrival[e], 1e6 * ae[e], 1e6 * dd / cs);
+                fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g\n", e + 1, 1e3 * dd, 1e6 * md.arrival[e], 1e6 * ae[e],
+                        1e6 * dd / cs);
             }
             bad = ferror(fp);
             if (fclose(fp) || bad) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", path), 1;
-            snprintf(extra, sizeof extra, "wave_speed_ms=%.2f wave_speed_elastic_ms=%.2f sqrtGrho_ms=%.2f", cm, ce, cs);
-            printf("shear-wave front: %.1f m/s (multiscale), %.1f m/s (elastic, same mesh), sqrt(G/rho) = %.1f m/s\n", cm,
-                   ce, cs);
+            snprintf(extra, sizeof extra, "wave_speed_ms=%.2f wave_speed_elastic_ms=%.2f sqrtGrho_ms=%.2f",
+                     cm, ce, cs);
+            printf("shear-wave front: %.1f m/s (multiscale), %.1f m/s (elastic, same mesh), sqrt(G/rho) = "
+                   "%.1f m/s\n",
+                   cm, ce, cs);
             for (r = 0; r < n; ++r) x[r] = md.rows[NCOL * r + 2], y[r] = md.rows[NCOL * r + 3] / 1e3;
             snprintf(svg, sizeof svg, "%s/wave_curve.svg", o.out);
-            if (plot2(svg, "wave column: element 9 (Fig 8a)", "shear strain", "shear stress [kPa]", x, y, (int)n,
-                      "element 9", NULL, NULL, 0, NULL))
+            if (plot2(svg, "wave column: element 9 (Fig 8a)", "shear strain", "shear stress [kPa]", x, y,
+                      (int)n, "element 9", NULL, NULL, 0, NULL))
                 return 1;
             free(ae);
         } else {
@@ -1669,8 +1862,9 @@ int main(int argc, char **argv) {
                 if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
                 fprintf(fp, "row,y_mm,gamma_peak,gamma_12,porosity_12,gamma_end,porosity_end\n");
                 for (j = 0; j < ny; ++j)
-                    fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", j, 1e3 * (j + 0.5) * md.L[1] / ny, md.gam_peak[j],
-                            md.have12 ? md.prof12[j] : NAN, md.have12 ? md.prof12[ny + j] : NAN, pe[j], pe[ny + j]);
+                    fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", j, 1e3 * (j + 0.5) * md.L[1] / ny,
+                            md.gam_peak[j], md.have12 ? md.prof12[j] : NAN,
+                            md.have12 ? md.prof12[ny + j] : NAN, pe[j], pe[ny + j]);
                 bad = ferror(fp);
                 if (fclose(fp) || bad) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", path), 1;
                 printf("band (shear strain gained since the peak, at %s): centre %.1f mm, width %.1f mm\n",
@@ -1678,18 +1872,20 @@ int main(int argc, char **argv) {
                 free(pe);
             }
             snprintf(svg, sizeof svg, "%s/%s_curve.svg", o.out, test_name[o.test]);
-            if (plot2(svg, o.test == T_SSHEAR ? "simple shear (Fig 10)" : "plane-strain biaxial (Figs 16, 18)",
+            if (plot2(svg,
+                      o.test == T_SSHEAR ? "simple shear (Fig 10)" : "plane-strain biaxial (Figs 16, 18)",
                       o.test == T_SSHEAR ? "shear strain u_top / h" : "axial strain",
-                      o.test == T_SSHEAR ? "shear stress [kPa]" : "axial stress [kPa]", x, y, (int)n, "FEM x DEM",
-                      NULL, NULL, 0, NULL))
+                      o.test == T_SSHEAR ? "shear stress [kPa]" : "axial stress [kPa]", x, y, (int)n,
+                      "FEM x DEM", NULL, NULL, 0, NULL))
                 return 1;
         }
         (void)xl, (void)yl;
         /* state curves: porosity and Z */
         for (r = 0; r < n; ++r) y[r] = md.rows[NCOL * r + 7], y2[r] = md.rows[NCOL * r + 8] / 10.0;
         snprintf(svg, sizeof svg, "%s/%s_state.svg", o.out, test_name[o.test]);
-        if (plot2(svg, "porosity and coordination (Figs 8b, 12, 13)", o.test == T_WAVE ? "time [ms]" : "strain",
-                  "porosity, Z / 10", x, y, (int)n, "porosity", x, y2, (int)n, "Z / 10"))
+        if (plot2(svg, "porosity and coordination (Figs 8b, 12, 13)",
+                  o.test == T_WAVE ? "time [ms]" : "strain", "porosity, Z / 10", x, y, (int)n, "porosity", x,
+                  y2, (int)n, "Z / 10"))
             return 1;
         for (e = 0; e < md.ne; ++e) val[e] = md.H[9 * e + 1] + md.H[9 * e + 3];
         if (o.test == T_BIAX || o.test == T_EBIAX)
@@ -1699,11 +1895,13 @@ int main(int argc, char **argv) {
                 val[e] = gk_strain_q(eps, 3);
             }
         snprintf(svg, sizeof svg, "%s/%s_field.svg", o.out, test_name[o.test]);
-        if (write_field(&md, svg, "deformed mesh", o.test == T_BIAX || o.test == T_EBIAX ? "eps_q" : "shear strain", val))
+        if (write_field(&md, svg, "deformed mesh",
+                        o.test == T_BIAX || o.test == T_EBIAX ? "eps_q" : "shear strain", val))
             return 1;
         {
             char ex2[1200];
-            snprintf(ex2, sizeof ex2, "%s%sdem_steps_total=%ld dt=%.4g", extra, extra[0] ? " " : "", md.dem_total, md.dt);
+            snprintf(ex2, sizeof ex2, "%s%sdem_steps_total=%ld dt=%.4g", extra, extra[0] ? " " : "",
+                     md.dem_total, md.dt);
             result_line(&mi, ex2, pk, epk, bc, bw, gk_wtime() - t0);
         }
         free(x), free(y), free(y2), free(val);

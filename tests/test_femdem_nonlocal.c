@@ -34,14 +34,18 @@ TEST(rotation_tracking_3d) {
         CHECK(!"rve");
         return;
     }
-    rve.def.path = GK_PATH_OBJECTIVE; /* ends exactly at the rotation R(0.01) (a skew dH alone stretches too) */
+    rve.def.path =
+        GK_PATH_OBJECTIVE; /* ends exactly at the rotation R(0.01) (a skew dH alone stretches too) */
     CHECK(gk_rve_deform(&rve, dH, 100) == GK_OK);
     th = gk_homog_mean_rotation(&rve);
     printf("    mean particle rotation %.9f rad after a cell spin of 0.01 rad\n", th);
     CHECK_NEAR(th, 0.01, 2e-5);
     for (p = 0; p < rve.n; ++p) {
         double dz = fabs(rve.theta[3 * p + 2] - 0.01), dx = fabs(rve.theta[3 * p]);
-        if (dz > 1e-4 || dx > 1e-4) printf("    particle %d: theta %g %g %g\n", p, rve.theta[3 * p], rve.theta[3 * p + 1], rve.theta[3 * p + 2]), ++bad;
+        if (dz > 1e-4 || dx > 1e-4)
+            printf("    particle %d: theta %g %g %g\n", p, rve.theta[3 * p], rve.theta[3 * p + 1],
+                   rve.theta[3 * p + 2]),
+                ++bad;
     }
     CHECK(bad <= 2);
     gk_rve_state_init(&st, NULL);
@@ -78,7 +82,8 @@ TEST(adaptive_rule_on_eq57) {
         return;
     }
     memset(&ad, 0, sizeof ad);
-    ad.unbalanced_max = 1e-2, ad.rms = 1, ad.n_max = 20000, ad.inertial_max = 0.05; /* few deformation steps */
+    ad.unbalanced_max = 1e-2, ad.rms = 1, ad.n_max = 20000,
+    ad.inertial_max = 0.05; /* few deformation steps */
     CHECK(gk_rve_deform_adaptive(&rve, dH, &ad, &rep) == GK_OK);
     gk_homog_unbalanced(&rve, &mean, &rms);
     printf("    I_uf %.4f (mean ratio %.4f) after %d + %d steps\n", rms, mean, rep.n_deform, rep.n_relax);
@@ -93,16 +98,19 @@ TEST(adaptive_rule_on_eq57) {
  * its checkpoint: the same CSV in every column but the seconds */
 static void threads_and_restart(const char *args, const char *tag, const char *csv, int stop) {
     char cmd[2048], a[256], b[256];
-    snprintf(cmd, sizeof cmd, "build/femdem_nonlocal %s --threads 2 --out build/%sA > build/%sA.out 2>&1", args, tag, tag);
+    snprintf(cmd, sizeof cmd, "build/femdem_nonlocal %s --threads 2 --out build/%sA > build/%sA.out 2>&1",
+             args, tag, tag);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "build/femdem_nonlocal %s --threads 1 --out build/%s1 > build/%s1.out 2>&1", args, tag, tag);
+    snprintf(cmd, sizeof cmd, "build/femdem_nonlocal %s --threads 1 --out build/%s1 > build/%s1.out 2>&1",
+             args, tag, tag);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "build/femdem_nonlocal %s --threads 2 --stop-after %d --out build/%sB > build/%sB.out 2>&1",
+    snprintf(cmd, sizeof cmd,
+             "build/femdem_nonlocal %s --threads 2 --stop-after %d --out build/%sB > build/%sB.out 2>&1",
              args, stop, tag, tag);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "build/femdem_nonlocal %s --threads 2 --restart build/%sB --out build/%sB > build/%sB2.out 2>&1", args, tag,
-             tag, tag);
+             "build/femdem_nonlocal %s --threads 2 --restart build/%sB --out build/%sB > build/%sB2.out 2>&1",
+             args, tag, tag, tag);
     CHECK(system(cmd) == 0);
     snprintf(a, sizeof a, "build/%sA/%s", tag, csv);
     snprintf(b, sizeof b, "build/%s1/%s", tag, csv);
@@ -117,12 +125,14 @@ static void threads_and_restart(const char *args, const char *tag, const char *c
  * writes the documented CSV, RESULT line, VTK fields and plots; the RVE
  * alone holds the normal stress; 1 vs 2 threads and a restart identical */
 TEST(element_shear_runs_threads_restart) {
-    const char *args = "--test element-shear --packing " PK160 " --steps 40 --strain 0.004 --lone-increments 10";
+    const char *args =
+        "--test element-shear --packing " PK160 " --steps 40 --strain 0.004 --lone-increments 10";
     double K, G;
     threads_and_restart(args, "t_fnle", "element-shear.csv", 17);
-    CHECK(gk_test_file_has("build/t_fnleA/element-shear.csv",
-                           "step,time,strain,stress,stress_2,p,q,porosity,Z,u_probe,dem_steps_mean,dem_steps_max,"
-                           "dem_capped,kinetic,seconds"));
+    CHECK(gk_test_file_has(
+        "build/t_fnleA/element-shear.csv",
+        "step,time,strain,stress,stress_2,p,q,porosity,Z,u_probe,dem_steps_mean,dem_steps_max,"
+        "dem_capped,kinetic,seconds"));
     K = gk_test_result("build/t_fnleA.out", "K_MPa"), G = gk_test_result("build/t_fnleA.out", "G_MPa");
     CHECK(K > 100 && K < 1000 && G > 100 && G < 1000); /* Table II scale: 335, 241 MPa */
     CHECK_NEAR(gk_test_result("build/t_fnleA.out", "porosity0"), 0.3496, 1e-3); /* the packing's comment */
@@ -138,7 +148,8 @@ TEST(element_shear_runs_threads_restart) {
 /* a small periodic simple shear with the nonlocal operator on (every
  * point sees its neighbours), an imperfect RVE: threads and restart */
 TEST(simple_shear_nonlocal_threads_restart) {
-    const char *args = "--test simple-shear --packing " PK160 " --mesh 2x3x1 --nonlocal 0.05 --steps 16 --strain 0.002";
+    const char *args =
+        "--test simple-shear --packing " PK160 " --mesh 2x3x1 --nonlocal 0.05 --steps 16 --strain 0.002";
     threads_and_restart(args, "t_fnls", "simple-shear.csv", 7);
     CHECK(gk_test_file_has("build/t_fnlsA.out", "imperfect RVE: 1 particles removed"));
     CHECK(gk_test_file_has("build/t_fnlsA.out", "nonlocal on"));
@@ -165,8 +176,8 @@ TEST(bad_input_is_refused) {
     char cmd[1024];
     size_t k;
     for (k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
-        snprintf(cmd, sizeof cmd, "build/femdem_nonlocal %s%s --out build/t_fnlbad > build/t_bad.out 2>&1", bad[k][0],
-                 strstr(bad[k][0], "--packing") ? "" : " --packing " PK160);
+        snprintf(cmd, sizeof cmd, "build/femdem_nonlocal %s%s --out build/t_fnlbad > build/t_bad.out 2>&1",
+                 bad[k][0], strstr(bad[k][0], "--packing") ? "" : " --packing " PK160);
         CHECK(system(cmd) != 0);
         if (!gk_test_file_has("build/t_bad.out", bad[k][1])) printf("    missing message: %s\n", bad[k][1]);
         CHECK(gk_test_file_has("build/t_bad.out", bad[k][1]));
@@ -175,14 +186,16 @@ TEST(bad_input_is_refused) {
     CHECK(gk_test_file_has("build/t_bad.out", "--nonlocal"));
     /* a checkpoint of another run (other strain) is refused by name */
     CHECK(system("build/femdem_nonlocal --test element-shear --packing " PK160
-                 " --steps 40 --strain 0.005 --restart build/t_fnleB --out build/t_fnlbad > build/t_bad.out 2>&1") != 0);
+                 " --steps 40 --strain 0.005 --restart build/t_fnleB --out build/t_fnlbad > build/t_bad.out "
+                 "2>&1") != 0);
     CHECK(gk_test_file_has("build/t_bad.out", "was written by another run"));
     /* a result that cannot be written: its path is taken by a directory */
     CHECK(system("mkdir -p build/t_fnlw/element-shear.csv") == 0);
     CHECK(system("build/femdem_nonlocal --test element-shear --packing " PK160
                  " --steps 4 --strain 0.001 --out build/t_fnlw > build/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_bad.out", "element-shear.csv"));
-    CHECK(system("build/femdem_nonlocal --test rve --packing " PK160 " --out /dev/null/x > build/t_bad.out 2>&1") != 0);
+    CHECK(system("build/femdem_nonlocal --test rve --packing " PK160
+                 " --out /dev/null/x > build/t_bad.out 2>&1") != 0);
     /* gk_pack's Hertz options */
     CHECK(system("build/gk_pack --dim 3 --law foo --out build/t_pack_bad.txt > build/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_bad.out", "--law 'foo' is neither linear nor hertz"));
