@@ -13,7 +13,8 @@ BUILD   ?= build
 PREFIX  ?= /usr/local
 
 WARN    := -std=c99 -pedantic -Wall -Wextra -Werror
-# determinism: no FMA contraction, never -ffast-math (DESIGN.md principle 3)
+# determinism: no FMA contraction, never -ffast-math (results must not depend on
+# the compiler's choice of fused operations)
 FPFLAGS := -ffp-contract=off -fno-fast-math
 CFLAGS  := $(WARN) $(OPT) $(ARCH) $(FPFLAGS) $(OMP) -Iinclude -Itests
 LDLIBS  := -lm
@@ -35,16 +36,24 @@ HAVE_MPI := $(shell command -v $(MPICC) >/dev/null 2>&1 && command -v $(MPIRUN) 
 # --oversubscribe (other MPIs do not know these flags)
 MPIRUN_FLAGS ?= $(shell $(MPIRUN) --version 2>/dev/null | grep -q 'Open MPI' && \
                   { [ "$$(id -u)" = 0 ] && echo '--allow-run-as-root --oversubscribe' || echo '--oversubscribe'; })
+# tests/mpi_*.c are MPI programs (mpicc) run on 2 ranks; tests/mpirun_*.c plain programs that launch
+# MPI programs themselves (GK_MPIRUN); each gets a runner script for tests/run_tests.sh
 MPI_TEST_SRC := $(wildcard tests/mpi_*.c)
-MPI_TESTS    := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/mpi_%,$(MPI_TEST_SRC))
-MPI_RUNNERS  := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/run_%,$(MPI_TEST_SRC))
-MPI_PROGS    := $(MPI_TESTS) $(MPI_RUNNERS)
+MPIRUN_SRC   := $(wildcard tests/mpirun_*.c)
+MPI_RUNNERS  := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/run_%,$(MPI_TEST_SRC)) \
+                $(patsubst tests/mpirun_%.c,$(BUILD)/mpi/drive_%,$(MPIRUN_SRC))
+MPI_PROGS    := $(BUILD)/femdem_biaxial_mpi $(BUILD)/mpi/bench_twoscale_mpi $(MPI_RUNNERS)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/%,$(EX_SRC))
 BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
 TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
+# fuzz harnesses tests/fuzz/fuzz_NAME.c (seeds in tests/fuzz/corpus/NAME/, findings
+# kept in tests/fuzz/crashers/NAME/): found by name, nothing to add here
+FUZZ_SRC   := $(wildcard tests/fuzz/fuzz_*.c)
+FUZZ_NAMES := $(patsubst tests/fuzz/fuzz_%.c,%,$(FUZZ_SRC))
+FUZZ_REPLAY := $(patsubst %,$(BUILD)/fuzz_replay_%,$(FUZZ_NAMES))
 
 .PHONY: all mpi test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
-        check-headers check-asan check-nosimd tradeoff
+        check-headers check-asan check-nosimd check-smoke tradeoff fuzz
 
 all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
 
@@ -52,17 +61,18 @@ help:
 	@echo "make            build tests, examples, benchmarks and tools into $(BUILD)/"
 	@echo "make run        the main job: FEMxDEM biaxial test (see README.md)"
 	@echo "make run-rve    one RVE along a shear path"
-	@echo "make run-mpm | run-footing | run-collapse   seed 003's MPMxDEM biaxial, footing, column collapse"
+	@echo "make run-mpm | run-footing | run-collapse   MPMxDEM biaxial, footing, column collapse (Liang & Zhao 2019)"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
 	@echo "make mpi        the MPI programs (mpicc; gk_twoscale.h with GK_TWOSCALE_MPI) into $(BUILD)/mpi/"
-	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability"
+	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability, tool smoke runs"
+	@echo "make fuzz       each libFuzzer harness of tests/fuzz for FUZZ_SECONDS (60) s, one at a time (clang)"
 	@echo "make bench      performance programs (2 cores)"
 	@echo "make tradeoff   accuracy against cost of the drivers, the whole sweep (10-15 min; build/tradeoff/)"
 	@echo "make bench-peers  the same workloads in LAMMPS / LIGGGHTS / YADE when installed"
 	@echo "make install PREFIX=dir   headers + pkg-config file"
 	@echo "make format / format-check   clang-format"
 
-$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/mpi:
+$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests $(BUILD)/fuzz $(BUILD)/mpi:
 	@mkdir -p $@
 
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
@@ -94,9 +104,23 @@ $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 $(BUILD)/mpi/mpi_%: tests/mpi_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/mpi
 	$(MPICC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
+.PRECIOUS: $(BUILD)/mpi/mpi_% $(BUILD)/mpi/mpirun_%
+$(BUILD)/mpi/mpirun_%: tests/mpirun_%.c tests/gk_test.h | $(BUILD)/mpi
+	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
+
 # a runner script per MPI test, so that tests/run_tests.sh runs it as any other test program
 $(BUILD)/mpi/run_%: $(BUILD)/mpi/mpi_% | $(BUILD)/mpi
 	@printf '#!/bin/sh\nexec %s %s -np 2 %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
+$(BUILD)/mpi/drive_%: $(BUILD)/mpi/mpirun_% | $(BUILD)/mpi
+	@printf '#!/bin/sh\nGK_MPIRUN="%s %s" exec %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
+
+# bench/twoscale.c on MPI ranks (bench/README.md)
+$(BUILD)/mpi/bench_twoscale_mpi: bench/twoscale.c $(HEADERS) examples/cli.h | $(BUILD)/mpi
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
+
+# the FEMxDEM driver with its RVEs over MPI ranks (the same results: tests/mpirun_femdem.c)
+$(BUILD)/femdem_biaxial_mpi: examples/femdem_biaxial.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
 
 ifeq ($(HAVE_MPI),yes)
 mpi: $(MPI_PROGS)
@@ -107,26 +131,46 @@ mpi:
 MPI_RUN :=
 endif
 
-test: $(TESTS) $(EXAMPLES) $(TOOLS) $(if $(HAVE_MPI),$(MPI_PROGS))
+# bench_tradeoff too: test_untrusted checks that a failed run fails it
+test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) $(BUILD)/bench_tradeoff $(if $(HAVE_MPI),$(MPI_PROGS)) | $(BUILD)/tests
 	@$(if $(HAVE_MPI),,echo "make test: $(MPICC) not found, the MPI tests are skipped (apt-get install openmpi-bin libopenmpi-dev)";) \
-	  tests/run_tests.sh $(TESTS) $(MPI_RUN)
+	  tests/run_tests.sh $(TESTS) $(FUZZ_REPLAY) $(MPI_RUN)
+
+# the fuzz corpora and every crasher replayed by a plain program (tests/fuzz/replay.c)
+$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)
+	$(CC) $(CFLAGS) -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(LDLIBS)
 
 # ---------------------------------------------------------------- check
 SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
-ASAN_TESTS   := $(patsubst tests/%.c,$(BUILD)/asan/%,$(TEST_SRC))
+ASAN_TESTS   := $(patsubst tests/%.c,$(BUILD)/asan/%,$(TEST_SRC)) $(patsubst %,$(BUILD)/asan/fuzz_replay_%,$(FUZZ_NAMES))
 NOSIMD_TESTS := $(patsubst tests/%.c,$(BUILD)/nosimd/%,$(TEST_SRC))
 
 $(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/asan
 	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -Itests -DGK_TEST_QUICK -o $@ $< $(LDLIBS)
 
+$(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)/asan
+	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(LDLIBS)
+
+# tools and drivers under ASan + UBSan for tests/smoke_asan.sh (a driver joins
+# by its name in SMOKE and its runs in the script)
+SMOKE := rve_path gk_pack
+$(BUILD)/asan/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)/asan
+	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
+$(BUILD)/asan/%: tools/%.c $(HEADERS) | $(BUILD)/asan
+	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
+
+check-smoke: $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) | $(BUILD)/tests
+	@echo "== tool and driver smoke runs under AddressSanitizer + UndefinedBehaviorSanitizer, leaks included"
+	@tests/run_tests.sh tests/smoke_asan.sh
+
 $(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/nosimd
 	$(CC) $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude -Itests -o $@ $< $(LDLIBS)
 
-check-asan: $(ASAN_TESTS) $(EXAMPLES) $(TOOLS)
+check-asan: $(ASAN_TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 	@echo "== tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 	@ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 tests/run_tests.sh $(ASAN_TESTS)
 
-check-nosimd: $(NOSIMD_TESTS) $(EXAMPLES) $(TOOLS)
+check-nosimd: $(NOSIMD_TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 	@echo "== tests built without SIMD (GK_NO_SIMD, no -march)"
 	@tests/run_tests.sh $(NOSIMD_TESTS)
 
@@ -150,16 +194,16 @@ check-headers: | $(BUILD)/hdr
 	  echo "ok   $$h (gcc, clang: c99 -pedantic; g++, clang++: c++11; float; no-SIMD)"; \
 	done
 
-check: check-headers check-nosimd check-asan
+check: check-headers check-nosimd check-asan check-smoke
 
 # ---------------------------------------------------------------- run / bench
-# the seed 000 FEMxDEM biaxial test at a size that runs in about a minute on
-# 2 cores (4 x 8 Q8, 128 RVEs, through the peak); the paper's mesh is
-# --nx 8 --ny 16 --steps 100
+# the FEMxDEM biaxial test of Guo & Zhao (2014) at a size that runs in about a minute on
+# 2 cores (4 x 8 Q8, 128 RVEs, through the peak); examples/README.md has the
+# larger runs
 run: $(BUILD)/femdem_biaxial
 	$(BUILD)/femdem_biaxial --nx 4 --ny 8 --element q8 --steps 30 --threads 2 --out $(BUILD)/biaxial
 
-# seed 003's MPMxDEM systems at default sizes of about a minute each on 2
+# the MPMxDEM systems of Liang & Zhao (2019) at default sizes of about a minute each on 2
 # cores (128-400 RVEs); every driver's --help gives the paper's sizes
 run-mpm: $(BUILD)/mpmdem_biaxial
 	$(BUILD)/mpmdem_biaxial --threads 2 --out $(BUILD)/mpm_biaxial
@@ -173,12 +217,34 @@ run-rve: $(BUILD)/rve_path
 	  --steps-per-increment 100 --out $(BUILD)/rve_path.csv
 
 bench: $(BENCHES)
-	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
+	@for b in $(BENCHES); do echo "== $$b"; $$b || { echo "make bench: $$b failed (exit $$?)"; exit 1; }; done
 
-# issue 6: error against cost over RVE size, DEM steps, float, tangent, mesh,
-# element and MPM points per cell (make bench runs the short version)
+# error against cost over RVE size, DEM steps, float, tangent, mesh, element
+# and MPM points per cell (make bench runs the short version)
 tradeoff: $(BUILD)/bench_tradeoff
 	$(BUILD)/bench_tradeoff --full
+
+# libFuzzer (clang, libclang-rt-dev): each harness for FUZZ_SECONDS, one at a time;
+# new inputs in build/fuzz/NAME/, findings in build/fuzz/NAME-crash-*
+FUZZ_SECONDS ?= 60
+FUZZ_CC ?= clang
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)/fuzz
+	$(FUZZ_CC) -std=c99 -g -O1 $(FPFLAGS) -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
+	  -Iinclude -Itests/fuzz -o $@ $< -lm
+
+fuzz: $(patsubst %,$(BUILD)/fuzz/fuzz_%,$(FUZZ_NAMES))
+	@set -e; for n in $(FUZZ_NAMES); do \
+	  mkdir -p $(BUILD)/fuzz/$$n; echo "== fuzz_$$n for $(FUZZ_SECONDS) s"; \
+	  seeds=tests/fuzz/corpus/$$n; [ -d tests/fuzz/crashers/$$n ] && seeds="$$seeds tests/fuzz/crashers/$$n"; \
+	  if $(BUILD)/fuzz/fuzz_$$n -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
+	       -artifact_prefix=$(BUILD)/fuzz/$$n- $(BUILD)/fuzz/$$n $$seeds > $(BUILD)/fuzz/$$n.log 2>&1; then \
+	    grep -E '^(stat::number_of_executed_units|stat::peak_rss_mb|Done)' $(BUILD)/fuzz/$$n.log; \
+	  else \
+	    tail -n 30 $(BUILD)/fuzz/$$n.log; \
+	    echo "make fuzz: fuzz_$$n found a crash: $(BUILD)/fuzz/$$n-crash-* (log $(BUILD)/fuzz/$$n.log);" \
+	      "fix it, then keep the input in tests/fuzz/crashers/$$n/"; exit 1; \
+	  fi; \
+	done
 
 bench-peers: $(BUILD)/bench_dem_step
 	@bench/peers/run_peers.sh

@@ -23,6 +23,14 @@
  * size ratio of 10 is correct (small particles share bins; it costs time,
  * not accuracy).
  *
+ * OPEN AXES. An axis whose bit is set in gk_cells.open is not periodic: its
+ * bins span the particles' own extent along it (not the whole cell) and the
+ * neighbour search does not wrap around it. The pair test still takes the
+ * nearest image, so the caller keeps every particle within less than half
+ * the cell along an open axis (gk_scene.h uses a cell twice the domain):
+ * then no image is ever nearer than the particle itself. open = 0 (what
+ * gk_cells_init sets) is the periodic cell of the RVE, unchanged.
+ *
  * VERLET SKIN. gk_cells_skin_ok tells whether a list built at reduced
  * positions s0 in cell h0 still contains every touching pair: it bounds the
  * change of any pair distance by the affine map A = h h0^-1 (through its
@@ -39,6 +47,8 @@ typedef struct gk_cells {
     int dim, n;
     int nbin[3];
     int nbins;
+    unsigned open;      /* bit k set: axis k is open (not periodic), see OPEN AXES */
+    double lo[3], inv[3]; /* open axis k: bin = (s - lo[k]) inv[k], clamped      */
     int32_t *bin_start; /* nbins + 1: particles of bin b are order[bin_start[b] .. bin_start[b+1]) */
     int32_t *order;     /* particle indices sorted by bin, ascending inside a bin */
     int32_t *bin_of;    /* bin of each particle */
@@ -68,6 +78,11 @@ GKDEF void gk_cells_free(gk_cells *c);
  * they are wrapped into [0,1) for binning) in cell h with bin size >= cutoff.
  * GK_ERR_CELL if cutoff >= half the smallest cell width (minimum image would
  * be ambiguous). */
+GK_INLINE int gk__open_bin(double s, double lo, double inv, int nb) {
+    int b = (int)((s - lo) * inv);
+    return b >= nb ? nb - 1 : (b < 0 ? 0 : b);
+}
+
 GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3], double cutoff,
                              gk_err *err);
 /* After gk_cells_bin: all pairs with nearest-image distance < r_i + r_j + skin. */
@@ -96,6 +111,7 @@ GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n
 GKDEF void gk_cells_init(gk_cells *c, const gk_allocator *alloc) {
     c->dim = c->n = c->nbins = 0;
     c->nbin[0] = c->nbin[1] = c->nbin[2] = 0;
+    c->open = 0;
     c->bin_start = c->order = c->bin_of = c->buf = NULL;
     c->cap_bins = c->cap_n = c->cap_buf = 0;
     if (alloc)
@@ -157,21 +173,27 @@ static gk_result gk__cells_grow(gk_cells *c, int32_t **arr, size_t *cap, size_t 
     return GK_OK;
 }
 
+/* bin of a finite reduced coordinate (the caller has checked finiteness) */
 GK_INLINE int gk__wrap_bin(double s, int nb) {
-    double f = s - floor(s);
-    int b = (int)(f * (double)nb);
-    return b >= nb ? nb - 1 : (b < 0 ? 0 : b);
+    double f = (s - floor(s)) * (double)nb;
+    int b = f < (double)nb ? (int)f : nb - 1;
+    return b < 0 ? 0 : b;
 }
+
+/* the largest bin count along one axis: bounds every product and the 3/4
+ * shrink step below in int */
+#define GK__CELLS_MAXBIN (1 << 29)
 
 GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3], double cutoff,
                              gk_err *err) {
-    double hinv[9], w[3];
-    long total = 1;
-    int k, p;
+    double hinv[9], w[3], total = 1.0, det;
+    int k, p, nbin[3];
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
     if (n < 0) return gk_err_set(err, GK_ERR_ARG, "particle count %d < 0", n);
     if (!(cutoff > 0.0) || !isfinite(cutoff)) return gk_err_set(err, GK_ERR_ARG, "cutoff %g must be > 0", cutoff);
-    if (!(gk_m3_inverse(h, hinv) > 0.0)) return gk_err_set(err, GK_ERR_CELL, "cell matrix is singular or inverted");
+    det = gk_m3_inverse(h, hinv);
+    if (!(det > 0.0) || !isfinite(det) || !gk_m3_isfinite(hinv))
+        return gk_err_set(err, GK_ERR_CELL, "cell matrix is singular, inverted or not finite (det %g)", det);
     for (k = 0; k < dim; ++k) {
         const double *row = hinv + 3 * k;
         w[k] = 1.0 / sqrt(row[0] * row[0] + row[1] * row[1] + (dim == 3 ? row[2] * row[2] : 0.0));
@@ -180,21 +202,52 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
                               "cell width %g across axis %d is less than twice the interaction distance %g: "
                               "nearest image ambiguous (use a larger cell)",
                               w[k], k, cutoff);
-        c->nbin[k] = (int)(w[k] / cutoff);
-        if (c->nbin[k] < 1) c->nbin[k] = 1;
+        /* compared as a double first: a huge cell or a tiny cutoff never reaches the int cast */
+        nbin[k] = w[k] / cutoff < (double)GK__CELLS_MAXBIN ? (int)(w[k] / cutoff) : GK__CELLS_MAXBIN;
+        if (c->open & (1u << k)) { /* bins over the particles' extent only */
+            double smin = 1e300, smax = -1e300, nb;
+            for (p = 0; p < n; ++p) {
+                if (s[k][p] < smin) smin = s[k][p];
+                if (s[k][p] > smax) smax = s[k][p];
+            }
+            if (n == 0 || !(smax >= smin) || !(smax - smin < 1.0))
+                return gk_err_set(err, GK_ERR_OUTSIDE,
+                                  "open axis %d: the particles span %g of the cell (must be below 1, not NaN)", k,
+                                  smax - smin);
+            c->lo[k] = smin;
+            nb = (smax - smin) * w[k] / cutoff;
+            nbin[k] = nb < (double)GK__CELLS_MAXBIN ? (int)nb : GK__CELLS_MAXBIN;
+        }
+        if (nbin[k] < 1) nbin[k] = 1;
     }
-    if (dim == 2) c->nbin[2] = 1;
+    for (k = 0; k < dim; ++k)
+        for (p = 0; p < n; ++p)
+            if (!isfinite(s[k][p]))
+                return gk_err_set(err, GK_ERR_NAN, "particle %d has a non-finite reduced coordinate %g", p,
+                                  s[k][p]);
+    if (dim == 2) nbin[2] = 1;
     /* keep the grid at most ~2n + 27 bins (dilute or huge cells) */
     for (;;) {
-        total = (long)c->nbin[0] * c->nbin[1] * c->nbin[2];
-        if (total <= 2L * n + 27) break;
+        total = (double)nbin[0] * nbin[1] * nbin[2];
+        if (total <= 2.0 * n + 27) break;
         for (k = 0; k < dim; ++k)
-            if (c->nbin[k] > 3) c->nbin[k] = c->nbin[k] * 3 / 4 > 3 ? c->nbin[k] * 3 / 4 : 3;
-        if (c->nbin[0] <= 3 && c->nbin[1] <= 3 && c->nbin[2] <= 3) break;
+            if (nbin[k] > 3) nbin[k] = nbin[k] * 3 / 4 > 3 ? nbin[k] * 3 / 4 : 3;
+        if (nbin[0] <= 3 && nbin[1] <= 3 && nbin[2] <= 3) break;
     }
-    c->nbins = (int)total;
+    total = (double)nbin[0] * nbin[1] * nbin[2]; /* <= 2n + 27 or 27 */
+    if (total >= (double)INT32_MAX)
+        return gk_err_set(err, GK_ERR_ALLOC, "%.0f cell-list bins overflow int", total);
     if (gk__cells_grow(c, &c->bin_start, &c->cap_bins, (size_t)total + 1))
-        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %ld cell-list bins", total);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %.0f cell-list bins", total);
+    for (k = 0; k < 3; ++k) c->nbin[k] = nbin[k];
+    c->nbins = (int)total;
+    for (k = 0; k < dim; ++k)
+        if (c->open & (1u << k)) {
+            double smax = c->lo[k];
+            for (p = 0; p < n; ++p)
+                if (s[k][p] > smax) smax = s[k][p];
+            c->inv[k] = smax > c->lo[k] ? (double)c->nbin[k] / (smax - c->lo[k]) : 0.0;
+        }
     if ((size_t)n + 1 > c->cap_n) { /* order and bin_of share one capacity */
         size_t cap = (size_t)n + 1;
         if (gk_realloc(&c->alloc, (void **)&c->order, 0, cap, sizeof(int32_t)) ||
@@ -206,9 +259,18 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
     c->n = n;
     for (k = 0; k <= c->nbins; ++k) c->bin_start[k] = 0;
     for (p = 0; p < n; ++p) {
-        int b = gk__wrap_bin(s[0][p], c->nbin[0]) +
+        int b;
+        if (c->open) {
+            int bk[3] = {0, 0, 0};
+            for (k = 0; k < dim; ++k)
+                bk[k] = (c->open & (1u << k)) ? gk__open_bin(s[k][p], c->lo[k], c->inv[k], c->nbin[k])
+                                               : gk__wrap_bin(s[k][p], c->nbin[k]);
+            b = bk[0] + c->nbin[0] * (bk[1] + c->nbin[1] * bk[2]);
+        } else {
+            b = gk__wrap_bin(s[0][p], c->nbin[0]) +
                 c->nbin[0] * (gk__wrap_bin(s[1][p], c->nbin[1]) +
                               c->nbin[1] * (dim == 3 ? gk__wrap_bin(s[2][p], c->nbin[2]) : 0));
+        }
         c->bin_of[p] = b;
         ++c->bin_start[b + 1];
     }
@@ -233,7 +295,7 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
         if (k >= dim || nb == 1) {
             noff[k] = 1;
             off[k][0] = 0;
-        } else if (nb == 2) { /* bins -1 and +1 coincide: visit each once */
+        } else if (nb == 2 && !(c->open & (1u << k))) { /* bins -1 and +1 coincide: visit each once */
             noff[k] = 2;
             off[k][0] = 0;
             off[k][1] = 1;
@@ -262,6 +324,10 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
                     int cy = (by + off[1][a1] + c->nbin[1]) % c->nbin[1];
                     int cz = (bz + off[2][a2] + c->nbin[2]) % c->nbin[2];
                     int nb = cx + c->nbin[0] * (cy + c->nbin[1] * cz), e;
+                    if (c->open && (((c->open & 1u) && cx != bx + off[0][a0]) ||
+                                    ((c->open & 2u) && cy != by + off[1][a1]) ||
+                                    ((c->open & 4u) && cz != bz + off[2][a2])))
+                        continue; /* no wrap across an open axis */
                     for (e = c->bin_start[nb]; e < c->bin_start[nb + 1]; ++e) {
                         int q2 = c->order[e];
                         double dx, dy, dz, ex, ey, ez, cut;
@@ -295,6 +361,8 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
             }
             c->buf[t + 1] = v;
         }
+        if (cnt > INT32_MAX - out->n)
+            return gk_err_set(err, GK_ERR_ALLOC, "more than %ld candidate pairs", (long)INT32_MAX);
         if ((size_t)(out->n + cnt) > out->cap) {
             size_t want = out->cap * 2 > (size_t)(out->n + cnt) ? out->cap * 2 : (size_t)(out->n + cnt);
             if (gk_pairlist_reserve(out, want, (size_t)n))

@@ -12,20 +12,55 @@
  *                              #include "gk_dem.h"
  *
  *   gk_packing pk;  gk_err e;  gk_rve rve;
- *   gk_rve_def def = gk_rve_def_default();          // seed 000 material
- *   gk_packing_read("rve400.txt", &pk, NULL, &e);
- *   gk_rve_create(&rve, &def, &pk);
+ *   gk_rve_def def = gk_rve_def_default();          // Guo & Zhao (2014) material
+ *   if (gk_packing_read("rve400.txt", &pk, NULL, &e)) { puts(e.msg); return 1; }
+ *   if (gk_rve_create(&rve, &def, &pk)) { puts(gk_rve_error(&rve)); gk_packing_free(&pk); return 1; }
+ *   gk_packing_free(&pk);
  *   double dH[9] = {0, 1e-3, 0,  0, 0, 0,  0, 0, 0};  // H01 = du_x/dy
- *   gk_rve_deform(&rve, dH, 100);                   // 100 DEM steps
- *   double sig[9]; gk_rve_stress(&rve, sig);        // Love stress, tension +
- *   gk_rve_destroy(&rve); gk_packing_free(&pk);
+ *   if (gk_rve_deform(&rve, dH, 100)) puts(gk_rve_error(&rve));  // 100 DEM steps
+ *   double sig[9]; gk_rve_stress(&rve, sig);        // Love stress, tension +, last step
+ *   gk_rve_destroy(&rve);
  *
- * THE RVE CONTRACT (DESIGN.md principle 6)
- *   gk_rve_deform(rve, dH, n)  cell map I + dH over n steps; stress after
- *   gk_rve_stress / gk_homog_tangent (gk_homog.h)
+ * THE RVE CONTRACT
+ *   gk_rve_deform(rve, dH, n)  applies the displacement-gradient increment
+ *     dH (H_ij = du_i/dx_j) to the cell over n DEM steps. The path
+ *     (def.path, gk_pcell.h) decides the end map: GK_PATH_CONSTANT_L (the
+ *     default; the Guo & Zhao (2014) authors' code and YADE) runs the
+ *     constant velocity gradient L = dH / (n dt) and ends at exp(dH) =
+ *     I + dH + dH^2/2 + ...; GK_PATH_OBJECTIVE ends exactly at I + dH.
+ *     det(I + dH) <= 0 is refused on both paths (GK_ERR_SINGULAR).
+ *   ADMISSIBLE INCREMENT PER DEM STEP. The cell map E of one step (exp(dH/n)
+ *     on the constant-L path) may change the overlap of a contact (i, j) by
+ *     at most GK_RVE_STEP_OVERLAP_MAX (0.1) times the smaller radius:
+ *       s(E) (r_min + r_max) <= 0.1 r_min,  s(E) = max_k |sigma_k(E) - 1|
+ *     over the singular values sigma_k of E (a rotation costs nothing). For
+ *     the 400-disk seed packing (r 3 to 7 mm) that is a stretch of 0.030 per
+ *     step: a shear of 0.5 needs at least 9 steps. A larger increment is
+ *     refused before anything moves, GK_ERR_ARG with the step count that
+ *     would do; gk_rve_step applies the same bound to exp(L dt) (with a
+ *     servo, to its max_rate). Refused rather than split into more steps
+ *     because the step count is the loading rate (dt is fixed): sub-steps
+ *     would silently change the time and the inertial number the caller
+ *     asked for. gk_rve_deform_adaptive (gk_homog.h) picks the count from
+ *     the inertial number instead. (The old behaviour, measured on the seed
+ *     packing: 50 % shear in one step returned GK_OK with overlaps of 0.7 r.)
+ *   gk_rve_stress after gk_rve_deform or gk_rve_step: the Love stress of the
+ *     forces of the LAST step, computed at the positions before that step
+ *     moved them (with the step's tangential increment): it lags the end
+ *     state by about one step's increment, dH/n. With n = 1 that is most of
+ *     dH (a shear of 1e-5 on the seed packing: sigma_xy 617 Pa before, 690
+ *     after the deform, 782 after gk_rve_refresh). gk_rve_refresh gives the
+ *     stress of the end state (one force pass, history unchanged).
+ *   gk_homog_tangent (gk_homog.h): the tangent at the current contacts.
  *   gk_rve_save / gk_rve_restore  the full state (positions, velocities,
  *     spins, cell, pair list with contact history) to and from caller
  *     memory, so an implicit driver can retry an increment bit for bit.
+ *     A buffer is untrusted: restore checks every field (reals finite, the
+ *     cell invertible and wide enough, pair lists sorted and in range,
+ *     counters and flags in range, friction >= 0, the servo valid, and dt
+ *     at most the critical step of this RVE at the state's own geometry)
+ *     before it changes anything; a bad buffer is refused with a message
+ *     and the RVE stays as it was.
  *
  * KINEMATICS. Positions are stored as reduced coordinates s (double, also in
  * the float build) and x = h s; velocities v and spins w are the
@@ -91,8 +126,28 @@
  * produces a non-finite value returns GK_ERR_DIVERGED and marks the RVE
  * (restore a saved state to continue).
  *
+ * BEYOND THE PERIODIC CELL (the seam gk_scene.h builds on; an RVE never
+ * uses it and pays one test of a NULL pointer per step):
+ *   gk_rve.hook    called in every step at GK_HOOK_PRE_FORCES (after a list
+ *                  rebuild, before the pair forces), GK_HOOK_POST_FORCES (f, t
+ *                  hold the contact sums; the hook may add external forces,
+ *                  or zero a particle's f, t and set its v, w to prescribe
+ *                  its motion: local damping of a zero force is zero) and
+ *                  GK_HOOK_POST_STEP (after the leap-frog update). A non-OK
+ *                  result stops the step with that result.
+ *   gk_rve_reserve / gk_rve_append / gk_rve_remove   change the particle
+ *                  count between steps: appended particles get the next
+ *                  indices, removal keeps the survivors' order (so the pair
+ *                  list stays sorted and every survivor keeps its contact
+ *                  history); both force a list rebuild. id[] is the caller's.
+ *                  gk_rve_update_totals after changing r[] or minv[] directly.
+ *   gk_cells.open  open (non-periodic) axes of the cell lists (gk_cells.h).
+ *
  * CONFIG: GK_REAL_FLOAT (see gk_base.h), GK_DEM_PAR_MIN (pairs below which
- * one RVE never uses threads, default 20000).
+ * one RVE never uses threads, default 20000), GK_RVE_STEP_OVERLAP_MAX (the
+ * admissible overlap change per DEM step as a fraction of the smaller
+ * radius, default 0.1). An RVE holds at most GK_RVE_MAX_PARTICLES (2^26):
+ * its pair lists are int32.
  *
  * LICENCE: MIT (see gk_base.h).
  */
@@ -107,6 +162,11 @@
 
 #ifndef GK_DEM_PAR_MIN
 #define GK_DEM_PAR_MIN 20000
+#endif
+/* particles of one RVE: int32 pair lists hold up to ~30 candidates each */
+#define GK_RVE_MAX_PARTICLES (1 << 26)
+#ifndef GK_RVE_STEP_OVERLAP_MAX
+#define GK_RVE_STEP_OVERLAP_MAX 0.1
 #endif
 
 /* ------------------------------------------------------------- RVE def */
@@ -129,7 +189,7 @@ typedef struct gk_rve_def {
     gk_mass_model mass2d;
     double damping;           /* local non-viscous damping alpha in [0, 1)          */
     gk_damp_form damping_form;
-    gk_path_kind path;        /* how gk_rve_deform splits I + dH over the steps     */
+    gk_path_kind path;        /* how gk_rve_deform splits dH over the steps         */
     unsigned flags;           /* GK_RVE_*                                           */
     int threads;              /* threads inside this RVE; <= 1: serial              */
     gk_allocator alloc;
@@ -191,7 +251,16 @@ typedef struct gk_rve {
     int servo_on;
     gk_servo servo;
     gk_err err;
+    /* seam for scenes beyond the periodic cell (gk_scene.h); NULL/0 in an RVE */
+    gk_result (*hook)(struct gk_rve *rve, int stage, void *user);
+    void *hook_user;
+    int ncap;                 /* capacity of the per-particle arrays (0: n)         */
 } gk_rve;
+
+/* stages at which gk_rve.hook is called in every step */
+#define GK_HOOK_PRE_FORCES 0
+#define GK_HOOK_POST_FORCES 1
+#define GK_HOOK_POST_STEP 2
 
 /* a growable buffer for gk_rve_save / gk_rve_restore */
 typedef struct gk_rve_state {
@@ -255,6 +324,18 @@ GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *pk, const gk_al
  * state): `int c = 0; gk_rve_contact k; while (gk_rve_contact_next(rve, &c, &k)) ...` (c is a
  * cursor: start it at 0 and leave it to the call); 0 when there are no more */
 GKDEF int gk_rve_contact_next(const gk_rve *rve, int *cursor, gk_rve_contact *out);
+
+/* particle count changes between steps (scenes; see BEYOND THE PERIODIC CELL).
+ * reserve: capacity for cap particles. append: k particles at reduced
+ * positions s[0..dim-1][k] with radii r and ids id, at rest, masses from the
+ * material; refused (nothing changed) for a bad radius or position or one
+ * too large for the cell. remove: drops every p with drop[p] != 0. */
+GKDEF gk_result gk_rve_reserve(gk_rve *rve, int cap);
+GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], const double *r, const int32_t *id);
+GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop);
+/* rmin, rmax, mmin, mass_total, solid_volume from r[], minv[] (after the
+ * caller changed radii or masses directly) */
+GKDEF void gk_rve_update_totals(gk_rve *rve);
 
 /* state */
 GKDEF size_t gk_rve_state_size(const gk_rve *rve);
@@ -412,20 +493,36 @@ static gk_result gk__spare_reserve(gk_rve *rve, size_t cap) {
     return GK_OK;
 }
 
-/* critical time step, seed 000 eq 19 */
-static double gk__dt_critical(const gk_rve *rve) {
+/* critical time step, seed 000 eq 19, at the geometry (h, reduced positions
+ * sb[k], pairs ib/jb of np) given as bytes: the live RVE's arrays or a saved
+ * state being checked before it is restored */
+static double gk__dt_critical_at(const gk_rve *rve, const double h[9], const unsigned char *const sb[3],
+                                 const unsigned char *ib, const unsigned char *jb, int np) {
     double knmax;
     const gk_material *m = &rve->def.mat;
     if (m->law == GK_LAW_LINEAR) {
         knmax = m->kn > 0 ? m->kn : m->young * rve->rmax; /* r* <= r_max */
     } else {
         double dmax = 1e-3 * rve->rmin, G = m->young / (2.0 * (1.0 + m->poisson));
+        gk_pcell cell;
         int c;
-        for (c = 0; c < rve->pl.n; ++c) { /* current largest overlap, from the geometry */
-            int i = rve->pl.i[c], j = rve->pl.j[c], k;
+        cell.dim = rve->dim;
+        gk_m3_copy(h, cell.h);
+        for (c = 0; c < np; ++c) { /* current largest overlap, from the geometry */
+            int32_t i, j;
+            int k;
             double ds[3], d[3], dd;
-            for (k = 0; k < 3; ++k) ds[k] = k < rve->dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
-            gk_pcell_min_image(&rve->cell, ds, d);
+            memcpy(&i, ib + 4 * (size_t)c, 4);
+            memcpy(&j, jb + 4 * (size_t)c, 4);
+            for (k = 0; k < 3; ++k) {
+                double si = 0.0, sj = 0.0;
+                if (k < rve->dim) {
+                    memcpy(&si, sb[k] + 8 * (size_t)i, 8);
+                    memcpy(&sj, sb[k] + 8 * (size_t)j, 8);
+                }
+                ds[k] = sj - si;
+            }
+            gk_pcell_min_image(&cell, ds, d);
             if (rve->dim == 2) d[2] = 0.0;
             dd = (double)rve->r[i] + (double)rve->r[j] - sqrt(gk_v3_dot(d, d));
             if (2.0 * dd > dmax) dmax = 2.0 * dd;
@@ -433,6 +530,14 @@ static double gk__dt_critical(const gk_rve *rve) {
         knmax = G / (1.0 - m->poisson) * sqrt(2.0 * rve->rmax * dmax);
     }
     return sqrt(rve->mmin / knmax);
+}
+
+static double gk__dt_critical(const gk_rve *rve) {
+    const unsigned char *sb[3];
+    int k;
+    for (k = 0; k < 3; ++k) sb[k] = (const unsigned char *)rve->s[k];
+    return gk__dt_critical_at(rve, rve->cell.h, sb, (const unsigned char *)rve->pl.i,
+                              (const unsigned char *)rve->pl.j, rve->pl.n);
 }
 
 GKDEF double gk_rve_dt_critical(const gk_rve *rve) { return gk__dt_critical(rve); }
@@ -457,6 +562,10 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     n = pk->n;
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "packing has %d particles", n);
+    if (n > GK_RVE_MAX_PARTICLES)
+        return gk_err_set(err, GK_ERR_ARG,
+                          "packing has %d particles; an RVE holds at most %d (int32 pair lists)", n,
+                          GK_RVE_MAX_PARTICLES);
     if (!(def->damping >= 0.0 && def->damping < 1.0))
         return gk_err_set(err, GK_ERR_ARG, "local damping %g outside [0, 1)", def->damping);
     if (def->damping_form != GK_DAMP_COMPONENT && def->damping_form != GK_DAMP_VECTOR)
@@ -532,14 +641,16 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                 /* binning for ordering only: any bin size below half the cell works */
                 cutoff = 2.0 * rmax < 0.49 * wmin ? 2.0 * rmax : 0.49 * wmin;
             }
-            res = gk_cells_bin(&cl, dim, R.cell.h, n, (const double *const *)tmp, cutoff, NULL);
+            res = gk_cells_bin(&cl, dim, R.cell.h, n, (const double *const *)tmp, cutoff, err);
             if (!res) memcpy(perm, cl.order, (size_t)n * sizeof(int32_t));
+        } else {
+            gk_err_set(err, res, "out of memory ordering %d particles", n);
         }
         gk_cells_free(&cl);
         if (res) {
             for (k = 0; k < 3; ++k) gk_free(&def->alloc, tmp[k]);
             gk_free(&def->alloc, perm);
-            return gk_err_set(err, res == GK_ERR_ALLOC ? GK_ERR_ALLOC : res, "could not order %d particles", n);
+            return res;
         }
         /* allocate */
         for (k = 0; k < 3; ++k) {
@@ -598,6 +709,16 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                 R.r[p] = (gk_real)rq;
                 R.minv[p] = (gk_real)(1.0 / m);
                 R.Iinv[p] = (gk_real)(1.0 / I);
+                if (!(m > 0.0 && isfinite(m) && I > 0.0 && isfinite(I)) || !(R.r[p] > 0) ||
+                    !((double)R.minv[p] > 0.0 && isfinite((double)R.minv[p])) ||
+                    !((double)R.Iinv[p] > 0.0 && isfinite((double)R.Iinv[p]))) {
+                    gk_err_set(err, GK_ERR_MASS,
+                               "particle %d (radius %g): mass %g and inertia %g are out of the range of %s "
+                               "(rescale the units)",
+                               q, rq, m, I, GK_REAL_NAME);
+                    res = GK_ERR_MASS;
+                    break;
+                }
                 R.id[p] = q;
                 if (R.theta)
                     for (k = 0; k < (dim == 2 ? 1 : 3); ++k) R.theta[(dim == 2 ? 1 : 3) * p + k] = 0.0;
@@ -613,7 +734,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         gk_free(&def->alloc, perm);
         if (res) {
             gk__rve_free_arrays(&R);
-            return gk_err_set(err, GK_ERR_ALLOC, "out of memory for an RVE of %d particles", n);
+            if (res == GK_ERR_ALLOC) gk_err_set(err, res, "out of memory for an RVE of %d particles", n);
+            return res;
         }
     }
     R.skin = def->skin > 0.0 ? def->skin : 0.1 * rsum / n;
@@ -643,7 +765,13 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     if (!res) {
         R.dt_crit = gk__dt_critical(&R);
         dtc = R.dt_crit;
-        if (def->dt > 0.0) {
+        if (!(dtc > 0.0) || !isfinite(dtc) || !(dtc * (def->dt_factor > 0.0 ? def->dt_factor : 0.5) > 0.0))
+            res = gk_err_set(
+                &R.err, GK_ERR_DT,
+                "critical time step %g s (Guo & Zhao 2014, eq 19) is not a positive number: radii %g to %g m "
+                "and the stiffness are out of range (rescale the units)",
+                dtc, R.rmin, R.rmax);
+        else if (def->dt > 0.0) {
             if (def->dt > dtc)
                 res = gk_err_set(&R.err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)",
                                  def->dt, dtc);
@@ -1939,9 +2067,11 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
         res = gk__rve_rebuild(rve);
         if (res) return res;
     }
+    if (rve->hook && (res = rve->hook(rve, GK_HOOK_PRE_FORCES, rve->hook_user)) != GK_OK) return res;
     gk__ctx_make(rve, E, &x);
     for (k = 0; k < 9; ++k) rve->G[k] = (double)x.G[k];
     gk__forces(rve, &x, want_stress);
+    if (rve->hook && (res = rve->hook(rve, GK_HOOK_POST_FORCES, rve->hook_user)) != GK_OK) return res;
     if (want_stress) gk__stress_pass(rve);
     res = gk_pcell_advance(&rve->cell, E, &rve->err);
     if (res) return res;
@@ -2006,6 +2136,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
         margin = smin * rve->skin_in - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
         if (!(margin > 0.0)) rve->need_rebuild = 1;
     }
+    if (rve->hook) return rve->hook(rve, GK_HOOK_POST_STEP, rve->hook_user);
     return GK_OK;
 }
 
@@ -2024,28 +2155,64 @@ GKDEF gk_result gk_rve_set_velocity_gradient(gk_rve *rve, const double L[9]) {
     return GK_OK;
 }
 
-GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *s) {
+static gk_result gk__servo_check(int dim, const gk_servo *s, gk_err *err) {
     int k;
+    if (s->shear && !(isfinite(s->shear_target[0]) && isfinite(s->shear_target[1]) && isfinite(s->shear_target[2])))
+        return gk_err_set(err, GK_ERR_NAN, "servo: non-finite shear target");
+    for (k = 0; k < dim; ++k) {
+        if (s->mode[k] != GK_SERVO_STRAIN && s->mode[k] != GK_SERVO_STRESS)
+            return gk_err_set(err, GK_ERR_ARG, "servo axis %d: unknown mode %d", k, (int)s->mode[k]);
+        if (!isfinite(s->target[k]) || !isfinite(s->rate[k]))
+            return gk_err_set(err, GK_ERR_NAN, "servo axis %d: non-finite target or rate", k);
+    }
+    if (!(s->max_rate > 0.0) || !isfinite(s->max_rate))
+        return gk_err_set(err, GK_ERR_ARG, "servo max_rate %g must be > 0", s->max_rate);
+    if (!(s->gain >= 0.0 && s->gain <= 1.0))
+        return gk_err_set(err, GK_ERR_ARG, "servo gain %g outside [0, 1]", s->gain);
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *s) {
+    gk_result res;
     if (!s) {
         rve->servo_on = 0;
         return GK_OK;
     }
-    if (s->shear && !(isfinite(s->shear_target[0]) && isfinite(s->shear_target[1]) && isfinite(s->shear_target[2])))
-        return gk_err_set(&rve->err, GK_ERR_NAN, "servo: non-finite shear target");
-    for (k = 0; k < rve->dim; ++k) {
-        if (s->mode[k] != GK_SERVO_STRAIN && s->mode[k] != GK_SERVO_STRESS)
-            return gk_err_set(&rve->err, GK_ERR_ARG, "servo axis %d: unknown mode %d", k, (int)s->mode[k]);
-        if (!isfinite(s->target[k]) || !isfinite(s->rate[k]))
-            return gk_err_set(&rve->err, GK_ERR_NAN, "servo axis %d: non-finite target or rate", k);
-    }
-    if (!(s->max_rate > 0.0) || !isfinite(s->max_rate))
-        return gk_err_set(&rve->err, GK_ERR_ARG, "servo max_rate %g must be > 0", s->max_rate);
-    if (!(s->gain >= 0.0 && s->gain <= 1.0))
-        return gk_err_set(&rve->err, GK_ERR_ARG, "servo gain %g outside [0, 1]", s->gain);
+    res = gk__servo_check(rve->dim, s, &rve->err);
+    if (res) return res;
     rve->servo = *s;
     rve->servo_on = 1;
     if (rve->pl.i) gk__stiff_pass(rve); /* the stiffness of the current contacts (unused without servo) */
     return GK_OK;
+}
+
+/* largest relative change of length the map E gives any vector: max |sigma_k(E) - 1|
+ * over its singular values (0 for a rotation) */
+static double gk__map_stretch(int dim, const double E[9]) {
+    double Et[9], EtE[9], lo, hi;
+    gk_m3_transpose(E, Et);
+    gk_m3_mul(Et, E, EtE);
+    if (dim == 2) {
+        double a = EtE[0], b = EtE[1], d = EtE[4], disc = sqrt(0.25 * (a - d) * (a - d) + b * b);
+        lo = 0.5 * (a + d) - disc;
+        hi = 0.5 * (a + d) + disc;
+    } else {
+        double val[3], vec[9];
+        gk_m3_sym_eigen(EtE, val, vec);
+        lo = val[0];
+        hi = val[2];
+    }
+    lo = 1.0 - sqrt(lo > 0.0 ? lo : 0.0);
+    hi = sqrt(hi) - 1.0;
+    return hi > lo ? hi : lo; /* NaN stays NaN: refused */
+}
+
+/* The admissible increment of one DEM step (see THE RVE CONTRACT): a per-step
+ * cell map of this stretch changes the overlap of a contact (i, j) by at most
+ * stretch (r_i + r_j), which must stay below GK_RVE_STEP_OVERLAP_MAX x the
+ * smaller radius for every possible pair. */
+static double gk__step_stretch_max(const gk_rve *rve) {
+    return GK_RVE_STEP_OVERLAP_MAX * rve->rmin / (rve->rmin + rve->rmax);
 }
 
 GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
@@ -2055,6 +2222,28 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
     if (nsteps < 0) return gk_err_set(&rve->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
+    { /* the largest per-step map: the servo's rates are bounded by max_rate */
+        double C[9], f = 0.0, lim = gk__step_stretch_max(rve);
+        int i, j;
+        for (i = 0; i < 3; ++i)
+            for (j = 0; j < 3; ++j) {
+                int servo =
+                    rve->servo_on && i < rve->dim && j < rve->dim &&
+                    ((i == j && rve->servo.mode[i] == GK_SERVO_STRESS) || (i != j && rve->servo.shear));
+                C[3 * i + j] = servo ? rve->servo.max_rate
+                                     : (rve->servo_on && i == j && i < rve->dim ? fabs(rve->servo.rate[i])
+                                                                                : fabs(rve->L[3 * i + j]));
+                f += C[3 * i + j] * C[3 * i + j];
+            }
+        f = expm1(sqrt(f) * rve->dt); /* |exp(A) - I| <= exp(|A|) - 1 bounds the stretch */
+        if (!(f <= lim))
+            return gk_err_set(
+                &rve->err, GK_ERR_ARG,
+                "the velocity gradient%s moves a contact by up to %.3g of the smaller radius in one "
+                "step of %g s (admissible %g, GK_RVE_STEP_OVERLAP_MAX): lower the rates or dt",
+                rve->servo_on ? " (with the servo's max_rate)" : "", f * (rve->rmin + rve->rmax) / rve->rmin,
+                rve->dt, GK_RVE_STEP_OVERLAP_MAX);
+    }
     gk_m3_copy(rve->L, Lcur);
     for (st = 0; st < nsteps; ++st) {
         if (rve->servo_on) {
@@ -2073,6 +2262,21 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
     return GK_OK;
 }
 
+/* the largest per-step stretch of dH carried out in n steps on the RVE's path */
+static double gk__deform_stretch(const gk_rve *rve, const double dH[9], int n) {
+    gk_path path;
+    double E[9], st = 0.0;
+    int k;
+    if (gk_path_init(&path, rve->dim, rve->def.path, dH, n, NULL)) return NAN;
+    for (k = 1; k <= (rve->def.path == GK_PATH_CONSTANT_L ? 1 : n); ++k) { /* constant L: one map */
+        double a;
+        gk_path_step(&path, k, E);
+        a = gk__map_stretch(rve->dim, E);
+        if (!(a <= st)) st = a;
+    }
+    return st;
+}
+
 GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     gk_path path;
     double E[9];
@@ -2082,6 +2286,25 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
     res = gk_path_init(&path, rve->dim, rve->def.path, dH, nsteps, &rve->err);
     if (res) return res;
+    { /* refuse up front an increment too large for one DEM step (the contract) */
+        double st = gk__deform_stretch(rve, dH, nsteps), lim = gk__step_stretch_max(rve);
+        if (!(st <= lim)) { /* the fewest steps that would do: doubling, then bisection */
+            int lo = nsteps, hi = nsteps;
+            while (hi < (1 << 29) && !(gk__deform_stretch(rve, dH, hi) <= lim)) lo = hi, hi *= 2;
+            while (hi - lo > 1) {
+                int mid = lo + (hi - lo) / 2;
+                if (gk__deform_stretch(rve, dH, mid) <= lim)
+                    hi = mid;
+                else
+                    lo = mid;
+            }
+            return gk_err_set(
+                &rve->err, GK_ERR_ARG,
+                "dH in %d DEM steps changes a contact's overlap by up to %.3g of the smaller radius in "
+                "one step (admissible %g, GK_RVE_STEP_OVERLAP_MAX): use at least %d steps",
+                nsteps, st * (rve->rmin + rve->rmax) / rve->rmin, GK_RVE_STEP_OVERLAP_MAX, hi);
+        }
+    }
     {   /* refuse up front a map that leaves the cell too thin for the nearest image */
         gk_pcell end = rve->cell;
         double Mend[9], B[9], w[3];
@@ -2345,6 +2568,172 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
     return GK_OK;
 }
 
+/* ---------------------------------------------------------------- particle count (scenes) */
+GKDEF void gk_rve_update_totals(gk_rve *rve) {
+    int p;
+    rve->rmin = 1e300;
+    rve->rmax = 0.0;
+    rve->mmin = 1e300;
+    rve->mass_total = rve->solid_volume = 0.0;
+    for (p = 0; p < rve->n; ++p) {
+        double rp = (double)rve->r[p], m = 1.0 / (double)rve->minv[p];
+        if (rp < rve->rmin) rve->rmin = rp;
+        if (rp > rve->rmax) rve->rmax = rp;
+        if (m < rve->mmin) rve->mmin = m;
+        rve->mass_total += m;
+        rve->solid_volume += gk_particle_volume(rve->dim, rp) * (rve->dim == 2 ? rve->volume_factor : 1.0);
+    }
+}
+
+GKDEF gk_result gk_rve_reserve(gk_rve *rve, int cap) {
+    const gk_allocator *a = &rve->def.alloc;
+    size_t n = (size_t)rve->n, c, R = sizeof(gk_real);
+    int k, have = rve->ncap > rve->n ? rve->ncap : rve->n;
+    if (cap <= have) return GK_OK;
+    c = (size_t)cap;
+    for (k = 0; k < 3; ++k) {
+        if (rve->s[k] && (gk_realloc(a, (void **)&rve->s[k], n, c, sizeof(double)) ||
+                          gk_realloc(a, (void **)&rve->s0[k], n, c, sizeof(double)) ||
+                          gk_realloc(a, (void **)&rve->o0[k], n, c, sizeof(double)) ||
+                          gk_realloc(a, (void **)&rve->v[k], n, c, R) || gk_realloc(a, (void **)&rve->f[k], n, c, R)))
+            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
+        if (rve->w[k] && (gk_realloc(a, (void **)&rve->w[k], n, c, R) || gk_realloc(a, (void **)&rve->t[k], n, c, R)))
+            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
+    }
+    if (gk_realloc(a, (void **)&rve->r, n, c, R) || gk_realloc(a, (void **)&rve->minv, n, c, R) ||
+        gk_realloc(a, (void **)&rve->Iinv, n, c, R) || gk_realloc(a, (void **)&rve->id, n, c, sizeof(int32_t)) ||
+        gk_realloc(a, (void **)&rve->jstart, n + 1, c + 1, sizeof(int32_t)) ||
+        (rve->theta && gk_realloc(a, (void **)&rve->theta, n * (rve->dim == 2 ? 1 : 3), c * (rve->dim == 2 ? 1 : 3),
+                                  sizeof(double))))
+        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
+    rve->ncap = cap;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], const double *r, const int32_t *id) {
+    int dim = rve->dim, q, a, n0 = rve->n;
+    double rmax = rve->rmax, w[3];
+    gk_result res;
+    if (k < 0 || !s || !r || !id) return gk_err_set(&rve->err, GK_ERR_ARG, "append: bad arguments");
+    if (k == 0) return GK_OK;
+    for (q = 0; q < k; ++q) {
+        if (!(r[q] > 0.0) || !isfinite(r[q]))
+            return gk_err_set(&rve->err, GK_ERR_RADIUS, "append: particle %d has radius %g", q, r[q]);
+        for (a = 0; a < dim; ++a)
+            if (!isfinite(s[a][q])) return gk_err_set(&rve->err, GK_ERR_NAN, "append: particle %d has a NaN position", q);
+        if (r[q] > rmax) rmax = r[q];
+    }
+    gk_pcell_widths(&rve->cell, w);
+    for (a = 0; a < dim; ++a)
+        if (!(2.0 * (2.0 * rmax + rve->skin) < w[a]))
+            return gk_err_set(&rve->err, GK_ERR_CELL, "append: radius %g too large for a cell %g wide", rmax, w[a]);
+    if (n0 + k > (rve->ncap > n0 ? rve->ncap : n0)) {
+        int cap = n0 + n0 / 2 > n0 + k ? n0 + n0 / 2 : n0 + k;
+        if ((res = gk_rve_reserve(rve, cap)) != GK_OK) return res;
+    }
+    for (q = 0; q < k; ++q) {
+        int p = n0 + q;
+        double rq = r[q], m, I;
+        for (a = 0; a < dim; ++a) {
+            rve->s[a][p] = rve->s0[a][p] = rve->o0[a][p] = s[a][q] - floor(s[a][q]);
+            rve->v[a][p] = rve->f[a][p] = 0;
+        }
+        for (a = 0; a < 3; ++a)
+            if (rve->w[a]) rve->w[a][p] = rve->t[a][p] = 0;
+        if (dim == 3 || rve->def.mass2d == GK_MASS_SPHERE) {
+            m = rve->def.mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
+            I = 0.4 * m * rq * rq;
+        } else {
+            m = rve->def.mat.density * rve->def.thickness * GK_PI * rq * rq;
+            I = 0.5 * m * rq * rq;
+        }
+        rve->r[p] = (gk_real)rq;
+        rve->minv[p] = (gk_real)(1.0 / m);
+        rve->Iinv[p] = (gk_real)(1.0 / I);
+        rve->id[p] = id[q];
+        if (rve->theta)
+            for (a = 0; a < (dim == 2 ? 1 : 3); ++a) rve->theta[(dim == 2 ? 1 : 3) * p + a] = 0.0;
+    }
+    rve->n = n0 + k;
+    gk_rve_update_totals(rve);
+    rve->need_rebuild = 1;
+    rve->outer_valid = 0;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop) {
+    int n = rve->n, dim = rve->dim, p, q = 0, c, m = 0, k, nft = dim == 2 ? 1 : 3;
+    int32_t *map = NULL;
+    if (!drop) return gk_err_set(&rve->err, GK_ERR_ARG, "remove: no mask");
+    for (p = 0; p < n; ++p)
+        if (!drop[p]) ++q;
+    if (q == n) return GK_OK;
+    if (q < 1) return gk_err_set(&rve->err, GK_ERR_ARG, "remove: would leave no particle");
+    map = (int32_t *)gk_alloc(&rve->def.alloc, (size_t)n * sizeof(int32_t));
+    if (!map) return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory removing particles");
+    for (p = 0, q = 0; p < n; ++p) {
+        map[p] = drop[p] ? -1 : q;
+        if (drop[p]) continue;
+        for (k = 0; k < dim; ++k) {
+            rve->s[k][q] = rve->s[k][p];
+            rve->s0[k][q] = rve->s0[k][p];
+            rve->o0[k][q] = rve->o0[k][p];
+            rve->v[k][q] = rve->v[k][p];
+            rve->f[k][q] = rve->f[k][p];
+        }
+        for (k = 0; k < 3; ++k)
+            if (rve->w[k]) {
+                rve->w[k][q] = rve->w[k][p];
+                rve->t[k][q] = rve->t[k][p];
+            }
+        rve->r[q] = rve->r[p];
+        rve->minv[q] = rve->minv[p];
+        rve->Iinv[q] = rve->Iinv[p];
+        rve->id[q] = rve->id[p];
+        if (rve->theta)
+            for (k = 0; k < (dim == 2 ? 1 : 3); ++k) rve->theta[(dim == 2 ? 1 : 3) * q + k] = rve->theta[(dim == 2 ? 1 : 3) * p + k];
+        ++q;
+    }
+    /* survivors keep their order: the remapped pair list stays sorted by (i, j) */
+    for (c = 0; c < rve->pl.n; ++c) {
+        int32_t i = map[rve->pl.i[c]], j = map[rve->pl.j[c]];
+        if (i < 0 || j < 0) continue;
+        rve->pl.i[m] = i;
+        rve->pl.j[m] = j;
+        for (k = 0; k < nft; ++k) rve->ft[k][m] = rve->ft[k][c];
+        for (k = 0; k < dim; ++k) rve->fc[k][m] = rve->fc[k][c];
+        for (k = 0; k < 3; ++k) {
+            if (rve->tci[k]) {
+                rve->tci[k][m] = rve->tci[k][c];
+                rve->tcj[k][m] = rve->tcj[k][c];
+            }
+            if (rve->mr[k]) rve->mr[k][m] = rve->mr[k][c];
+        }
+        rve->cs[m] = rve->cs[c];
+        ++m;
+    }
+    gk_free(&rve->def.alloc, map);
+    rve->n = q;
+    rve->pl.n = m;
+    rve->pl.np = q;
+    for (p = 0; p <= q; ++p) rve->pl.start[p] = rve->jstart[p] = 0;
+    for (c = 0; c < m; ++c) {
+        ++rve->pl.start[rve->pl.i[c] + 1];
+        ++rve->jstart[rve->pl.j[c] + 1];
+    }
+    for (p = 0; p < q; ++p) {
+        rve->pl.start[p + 1] += rve->pl.start[p];
+        rve->jstart[p + 1] += rve->jstart[p];
+    }
+    for (c = 0; c < m; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
+    for (p = q; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
+    rve->jstart[0] = 0;
+    gk_rve_update_totals(rve);
+    rve->need_rebuild = 1;
+    rve->outer_valid = 0;
+    return GK_OK;
+}
+
 /* ---------------------------------------------------------------- save / restore */
 #define GK__STATE_MAGIC "GKRVE\001\000\000"
 #define GK__STATE_VERSION 1
@@ -2459,55 +2848,173 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
     return GK_OK;
 }
 
+/* count values of elem (4 or 8) bytes at b, all finite */
+static int gk__finite_bytes(const unsigned char *b, size_t count, size_t elem) {
+    size_t k;
+    for (k = 0; k < count; ++k) {
+        if (elem == 8) {
+            double v;
+            memcpy(&v, b + 8 * k, 8);
+            if (!isfinite(v)) return 0;
+        } else {
+            float v;
+            memcpy(&v, b + 4 * k, 4);
+            if (!isfinite(v)) return 0;
+        }
+    }
+    return 1;
+}
+
+/* a pair list of np (i, j) int32 at ib, jb: 0 <= i < j < n, sorted by (i, j) without repeats */
+static int gk__pairs_valid(const unsigned char *ib, const unsigned char *jb, int np, int n) {
+    int32_t pi = -1, pj = -1;
+    int c;
+    for (c = 0; c < np; ++c) {
+        int32_t a, b;
+        memcpy(&a, ib + 4 * (size_t)c, 4);
+        memcpy(&b, jb + 4 * (size_t)c, 4);
+        if (a < 0 || b <= a || b >= n || a < pi || (a == pi && b <= pj)) return c;
+        pi = a, pj = b;
+    }
+    return -1;
+}
+
+/* a 3x3 map of the cell kind: finite, det > 0 and finite, 2D block structure */
+static int gk__map_valid(int dim, const double a[9]) {
+    double d = gk_m3_det(a);
+    if (!gk_m3_isfinite(a) || !(d > 0.0) || !isfinite(d)) return 0;
+    return dim == 3 || (a[2] == 0.0 && a[5] == 0.0 && a[6] == 0.0 && a[7] == 0.0 && a[8] == 1.0);
+}
+
+/* Every field of a state is checked before anything is changed: header
+ * scalars in their ranges, every real finite, the maps invertible, both pair
+ * lists sorted and in range, the contact bits known, and the time step at or
+ * below the critical one of this RVE at the state's own geometry (the check
+ * every list rebuild makes). */
 GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     gk__state_hdr hd;
     const unsigned char *in = (const unsigned char *)buf;
     size_t off = 0, n, np, R = sizeof(gk_real);
-    int k, dim = rve->dim, p, c;
-    if (!buf || size < sizeof hd) return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state buffer too small");
+    int k, dim = rve->dim, p, c, nr, nroll;
+    gk_err *err = &rve->err;
+    if (rve->n < 1 || !rve->s[0])
+        return gk_err_set(err, GK_ERR_STATE, "restore into an RVE that was not created");
+    if (!buf || size < sizeof hd) return gk_err_set(err, GK_ERR_FORMAT, "RVE state buffer too small");
     memcpy(&hd, buf, sizeof hd);
     if (memcmp(hd.magic, GK__STATE_MAGIC, 8) != 0 || hd.endian != 0x01020304)
-        return gk_err_set(&rve->err, GK_ERR_FORMAT, "not a grainkit RVE state (bad magic or byte order)");
+        return gk_err_set(err, GK_ERR_FORMAT, "not a grainkit RVE state (bad magic or byte order)");
     if (hd.version != GK__STATE_VERSION)
-        return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state version %d (this build reads %d)", hd.version,
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state version %d (this build reads %d)", hd.version,
                           GK__STATE_VERSION);
-    if (hd.dim != rve->dim || hd.n != rve->n || hd.real_size != (int32_t)R || hd.phys != (int32_t)rve->phys)
-        return gk_err_set(&rve->err, GK_ERR_FORMAT,
-                          "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
-                          hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
+    if (hd.dim != rve->dim || hd.n != rve->n || hd.real_size != (int32_t)R || hd.phys != (int32_t)rve->phys ||
+        hd.rot != GK__HAS_ROT(rve) || hd.roll != GK__HAS_ROLL(rve))
+        return gk_err_set(
+            err, GK_ERR_FORMAT,
+            "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
+            hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
     if (hd.npairs < 0 || hd.nouter < 0 || size != gk__state_bytes(rve, hd.npairs, hd.nouter))
-        return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state has the wrong size");
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state has the wrong size");
     n = (size_t)rve->n;
     np = (size_t)hd.npairs;
+    nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0;
+    nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
+    /* ---- header scalars */
+    if (!(hd.dt > 0.0) || !isfinite(hd.dt))
+        return gk_err_set(err, GK_ERR_DT, "RVE state time step %g", hd.dt);
+    if (!(hd.dt_crit > 0.0) || !isfinite(hd.dt_crit) || !isfinite(hd.time) || hd.step < 0 ||
+        hd.rebuilds < 0 || hd.flips < 0)
+        return gk_err_set(err, GK_ERR_FORMAT,
+                          "RVE state has an invalid time %g, step %ld or critical step %g", hd.time,
+                          (long)hd.step, hd.dt_crit);
+    if (!(hd.skin > 0.0) || !isfinite(hd.skin) || !(hd.skin_in > 0.0) || !(hd.skin_in <= hd.skin))
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state Verlet skins %g and %g invalid", hd.skin,
+                          hd.skin_in);
+    if (!gk__map_valid(dim, hd.h) || !gk__map_valid(dim, hd.F) || !gk__map_valid(dim, hd.h0) ||
+        !gk__map_valid(dim, hd.ho0))
+        return gk_err_set(err, GK_ERR_CELL, "RVE state cell (h %g %g %g %g ...) is not a valid cell matrix",
+                          hd.h[0], hd.h[1], hd.h[3], hd.h[4]);
+    {
+        gk_pcell cell;
+        double w[3];
+        if (gk_pcell_init(&cell, dim, hd.h, err)) return GK_ERR_CELL;
+        gk_pcell_widths(&cell, w);
+        for (k = 0; k < dim; ++k)
+            if (!(2.0 * (2.0 * rve->rmax + hd.skin) < w[k]))
+                return gk_err_set(err, GK_ERR_CELL,
+                                  "RVE state cell is %g wide, below twice the interaction distance %g", w[k],
+                                  2.0 * rve->rmax + hd.skin);
+    }
+    if (!gk_m3_isfinite(hd.L) || !gk_m3_isfinite(hd.G) || !gk_m3_isfinite(hd.stress) ||
+        !isfinite(hd.stiff[0]) || !isfinite(hd.stiff[1]) || !isfinite(hd.stiff[2]) || !(hd.fc_mean >= 0.0) ||
+        !isfinite(hd.fc_mean))
+        return gk_err_set(err, GK_ERR_NAN,
+                          "RVE state has a non-finite velocity gradient, stress or stiffness");
+    if (dim == 2 && (hd.L[2] != 0 || hd.L[5] != 0 || hd.L[6] != 0 || hd.L[7] != 0 || hd.L[8] != 0))
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state: 2D velocity gradient with a third row or column");
+    if (hd.ncontacts < 0 || hd.ncontacts > hd.npairs || (hd.need_rebuild != 0 && hd.need_rebuild != 1) ||
+        (hd.servo_on != 0 && hd.servo_on != 1) || (hd.outer_valid != 0 && hd.outer_valid != 1))
+        return gk_err_set(err, GK_ERR_FORMAT,
+                          "RVE state has invalid counters or flags (%d contacts of %d pairs)", hd.ncontacts,
+                          hd.npairs);
+    {
+        gk_material m = rve->def.mat;
+        gk_result r = hd.servo_on ? gk__servo_check(dim, &hd.servo, err) : GK_OK;
+        if (r) return r;
+        m.friction = hd.mu;
+        if ((r = gk_material_check(&m, err)) != GK_OK) return r;
+        if (hd.mu > 0.0 && !(rve->phys & GK_PHYS_TANGENT))
+            return gk_err_set(err, GK_ERR_STATE, "RVE state has friction %g for an RVE created frictionless",
+                              hd.mu);
+    }
+    /* ---- arrays, in the order gk_rve_save writes them */
+    off = sizeof hd;
+    {
+        const unsigned char *sb[3] = {NULL, NULL, NULL}, *ib, *jb, *cs;
+        double dtc;
+        size_t dbl = 8;
+        for (k = 0; k < dim; ++k) sb[k] = in + off + (size_t)k * n * dbl;
+        if (!gk__finite_bytes(in + off, 2 * dim * n, dbl))
+            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite position");
+        off += 2 * dim * n * dbl;
+        if (!gk__finite_bytes(in + off, (2 * dim + 2 * nr) * n, R))
+            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite velocity, force, spin or torque");
+        off += (2 * dim + 2 * nr) * n * R;
+        if (rve->theta) {
+            if (!gk__finite_bytes(in + off, n * (dim == 2 ? 1 : 3), dbl))
+                return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite rotation");
+            off += n * (dim == 2 ? 1 : 3) * dbl;
+        }
+        ib = in + off;
+        jb = ib + 4 * np;
+        cs = jb + 4 * np;
+        if ((c = gk__pairs_valid(ib, jb, hd.npairs, rve->n)) >= 0)
+            return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has invalid or unsorted particles", c);
+        for (c = 0; c < hd.npairs; ++c)
+            if (cs[c] & ~(GK_CS_CONTACT | GK_CS_SLIDING | GK_CS_BONDED | GK_CS_BROKEN))
+                return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has unknown contact bits 0x%x", c,
+                                  cs[c]);
+        off += np * 9;
+        if (!gk__finite_bytes(in + off, ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np, R))
+            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite contact force or history");
+        off += ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np * R;
+        if ((c = gk__pairs_valid(in + off, in + off + 4 * (size_t)hd.nouter, hd.nouter, rve->n)) >= 0)
+            return gk_err_set(err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid or unsorted particles",
+                              c);
+        off += 8 * (size_t)hd.nouter;
+        if (!gk__finite_bytes(in + off, dim * n, dbl))
+            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite outer-list reference position");
+        dtc = gk__dt_critical_at(rve, hd.h, sb, ib, jb, hd.npairs);
+        if (!(hd.dt <= dtc))
+            return gk_err_set(
+                err, GK_ERR_DT,
+                "RVE state time step %g s is above the critical %g s of this RVE at the state's "
+                "geometry (Guo & Zhao 2014, eq 19)",
+                hd.dt, dtc);
+    }
     /* capacity first, so a failure changes nothing observable */
     if (gk__pairs_reserve(rve, np + 1, (size_t)rve->pl.n) || gk_pairlist_reserve(&rve->pl, np + 1, n) ||
         gk_pairlist_reserve(&rve->outer, (size_t)hd.nouter + 1, n))
-        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory restoring %d pairs", hd.npairs);
-    {   /* outer list indices */
-        size_t ob = size - (size_t)hd.nouter * 8 - n * (size_t)dim * sizeof(double);
-        for (c = 0; c < hd.nouter; ++c) {
-            int32_t a, b;
-            memcpy(&a, in + ob + (size_t)c * 4, 4);
-            memcpy(&b, in + ob + (size_t)hd.nouter * 4 + (size_t)c * 4, 4);
-            if (a < 0 || b <= a || b >= rve->n)
-                return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid particles (%d, %d)", c,
-                                  a, b);
-        }
-    }
-    /* validate pair indices before touching anything */
-    {
-        size_t base = sizeof hd + n * (2 * dim * sizeof(double)) +
-                      n * R * (2 * dim + 2 * (GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0)) +
-                      (rve->theta ? n * (dim == 2 ? 1 : 3) * sizeof(double) : 0);
-        for (c = 0; c < (int)np; ++c) {
-            int32_t a, b;
-            memcpy(&a, in + base + (size_t)c * 4, 4);
-            memcpy(&b, in + base + np * 4 + (size_t)c * 4, 4);
-            if (a < 0 || b <= a || b >= rve->n)
-                return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state pair %d has invalid particles (%d, %d)", c, a,
-                                  b);
-        }
-    }
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory restoring %d pairs", hd.npairs);
     off = sizeof hd;
     for (k = 0; k < dim; ++k) GK__GET(rve->s[k], n * sizeof(double));
     for (k = 0; k < dim; ++k) GK__GET(rve->s0[k], n * sizeof(double));

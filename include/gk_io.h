@@ -3,14 +3,30 @@
  * Dependency-free writers used by the example drivers, usable in your own:
  *
  *   gk_plot / gk_plot_svg      x-y line plot (up to GK_PLOT_MAX series) with
- *                              axes, "nice" ticks, grid, legend, title
- *   gk_svg_field               a scalar field on polygons (FEM elements, MPM
- *                              cells) or on dots (material points), with a
- *                              perceptually uniform colour map and colour bar
+ *                              axes, "nice" ticks, grid, title and a legend
+ *                              that never covers data: it goes to the first
+ *                              inside corner (top right, top left, bottom
+ *                              right, bottom left, then the edge middles)
+ *                              that no curve crosses, else outside, right of
+ *                              the axes. equal_aspect: one unit is as long
+ *                              on both axes (geometry, Mohr circles).
+ *   gk_field_svg               a scalar field on polygons (FEM elements, MPM
+ *                              cells) or on dots (material points) at equal
+ *                              aspect, with axes (ticks, labels with units),
+ *                              a perceptually uniform colour map (viridis), a
+ *                              colour bar with ticks and the quantity's unit,
+ *                              the outline of the geometry (platens, footing,
+ *                              walls) drawn on top, and an optional fixed
+ *                              colour range so snapshots of a run compare
+ *   gk_svg_field               the same with defaults (kept for old callers)
  *   gk_vtk_*                   legacy-VTK (ASCII) unstructured grids with
  *                              point and cell data (scalars, vectors, 3x3
  *                              tensors) for ParaView
  *   gk_progress                one line per step with elapsed time and ETA
+ *   gk_file_close (gk_base.h)  closes a file you wrote (a CSV) the way every
+ *                              writer here does: fflush + ferror + fclose,
+ *                              GK_ERR_IO naming the path and the reason when
+ *                              any byte was lost (disk full, /dev/full)
  *   gk_wtime                   wall-clock seconds (clock_gettime when the
  *                              includer defines _POSIX_C_SOURCE >= 199309L,
  *                              else omp_get_wtime with OpenMP, else time())
@@ -43,7 +59,23 @@ typedef struct gk_plot {
     int width, height; /* pixels; 0 -> 640 x 420 */
     int has_xlim, has_ylim;
     double xlim[2], ylim[2];
+    int equal_aspect; /* 1: one data unit spans as many pixels on x as on y */
 } gk_plot;
+
+/* A field plot; zero means the default for every member. */
+typedef struct gk_field_def {
+    const char *title;           /* NULL: none                                          */
+    const char *label;           /* the colour bar's quantity with its unit, "eps_q [%]" */
+    const char *xlabel, *ylabel; /* axis labels with units; NULL: "x [m]", "y [m]"      */
+    double coord_scale;          /* axis values = coordinates x this (1e3: m to mm); 0: 1 */
+    double dot;                  /* nv == 1: dot radius in data units; 0: 1 % of width */
+    int fixed_range;             /* 1: colours span [vmin, vmax] (the same scale for every
+                                    snapshot of a run); values beyond take the end colours */
+    double vmin, vmax;
+    int nlines;                  /* outline polylines drawn on top (platens, walls, ...) */
+    const int *line_len;         /* points in each polyline                            */
+    const double *line_xy;       /* their points, (x, y) pairs, polyline after polyline */
+} gk_field_def;
 
 typedef struct gk_vtk {
     FILE *fp;
@@ -68,8 +100,11 @@ GKDEF int gk_plot_add(gk_plot *p, const double *x, const double *y, int n, const
 GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err);
 
 /* Scalar field. Polygons: npoly polygons of nv vertices each, vertex
- * coordinates xy[2 * (nv * k + v)]; or dots (nv == 1) of radius `dot` in
- * data units. value[k] per polygon/dot. */
+ * coordinates xy[2 * (nv * k + v)]; or dots (nv == 1). value[k] per
+ * polygon/dot (non-finite values are drawn grey). def may be NULL. */
+GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def, int npoly, int nv, const double *xy,
+                             const double *value, gk_err *err);
+/* gk_field_svg with title, colour-bar label and dot radius only */
 GKDEF gk_result gk_svg_field(const char *path, const char *title, const char *label, int npoly, int nv,
                              const double *xy, const double *value, double dot, gk_err *err);
 
@@ -156,20 +191,81 @@ static void gk__xml_text(FILE *fp, const char *s) {
 static const char *gk__cycle[GK_PLOT_MAX] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
                                              "#9467bd", "#8c564b", "#e377c2", "#17becf"};
 
+/* Liang-Barsky: does the segment a-b meet the box bx = {xmin, xmax, ymin, ymax}? */
+static int gk__seg_hits_box(double ax, double ay, double bx_, double by_, const double bx[4]) {
+    double t0 = 0.0, t1 = 1.0, dx = bx_ - ax, dy = by_ - ay;
+    double pp[4], qq[4];
+    int i;
+    pp[0] = -dx, pp[1] = dx, pp[2] = -dy, pp[3] = dy;
+    qq[0] = ax - bx[0], qq[1] = bx[1] - ax, qq[2] = ay - bx[2], qq[3] = bx[3] - ay;
+    for (i = 0; i < 4; ++i) {
+        if (pp[i] == 0.0) {
+            if (qq[i] < 0.0) return 0;
+        } else {
+            double r = qq[i] / pp[i];
+            if (pp[i] < 0.0) {
+                if (r > t1) return 0;
+                if (r > t0) t0 = r;
+            } else {
+                if (r < t0) return 0;
+                if (r < t1) t1 = r;
+            }
+        }
+    }
+    return 1;
+}
+
+/* the axes of a line plot: pixel margins, data window and scales */
+typedef struct gk__frame {
+    double W, H, ml, mr, mt, mb, x0, x1, y0, y1, sx, sy;
+} gk__frame;
+
+static void gk__frame_scale(gk__frame *f, int equal) {
+    f->sx = (f->W - f->ml - f->mr) / (f->x1 - f->x0);
+    f->sy = (f->H - f->mt - f->mb) / (f->y1 - f->y0);
+    if (equal) { /* widen the window of the axis with the larger scale */
+        if (f->sx > f->sy) {
+            double c = 0.5 * (f->x0 + f->x1), h = 0.5 * (f->W - f->ml - f->mr) / f->sy;
+            f->x0 = c - h, f->x1 = c + h, f->sx = f->sy;
+        } else {
+            double c = 0.5 * (f->y0 + f->y1), h = 0.5 * (f->H - f->mt - f->mb) / f->sx;
+            f->y0 = c - h, f->y1 = c + h, f->sy = f->sx;
+        }
+    }
+}
+
+/* 1 if some drawn segment or single point of the plot meets the pixel box */
+static int gk__plot_hits(const gk_plot *p, const gk__frame *f, const double box[4]) {
+    int k, i;
+    for (k = 0; k < p->ns; ++k) {
+        double px = 0.0, py = 0.0;
+        int have = 0;
+        for (i = 0; i < p->s[k].n; ++i) {
+            double x = p->s[k].x[i], y = p->s[k].y[i], X, Y;
+            if (!isfinite(x) || !isfinite(y)) continue;
+            X = f->ml + (x - f->x0) * f->sx;
+            Y = f->H - f->mb - (y - f->y0) * f->sy;
+            if (gk__seg_hits_box(have ? px : X, have ? py : Y, X, Y, box)) return 1;
+            px = X, py = Y, have = 1;
+        }
+    }
+    return 0;
+}
+
 GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
     FILE *fp;
-    int W = p->width > 0 ? p->width : 640, H = p->height > 0 ? p->height : 420;
-    double ml = 78, mr = 20, mt = 36, mb = 52, x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300, sx, sy, t, st;
-    double lx, lw = 0.0; /* legend: left edge and width (text at ~0.55 em per character) */
-    int k, i, nleg = 0;
+    gk__frame f;
+    double t, st, lw = 0.0, lh, box[4] = {0, 0, 0, 0}, x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+    int k, i, nleg = 0, placed = 0;
+    f.W = p->width > 0 ? p->width : 640, f.H = p->height > 0 ? p->height : 420;
+    f.ml = 78, f.mr = 20, f.mt = 36, f.mb = 52;
     for (k = 0; k < p->ns; ++k)
         if (p->s[k].label) {
-            double w = 30.0 + 6.6 * (double)strlen(p->s[k].label);
+            double w = 30.0 + 6.6 * (double)strlen(p->s[k].label); /* text at ~0.55 em per character */
             if (w > lw) lw = w;
             ++nleg;
         }
-    lx = W - mr - 8 - lw;
-    if (lx < ml + 8) lx = ml + 8;
+    lh = 16.0 * nleg + 6.0;
     for (k = 0; k < p->ns; ++k)
         for (i = 0; i < p->s[k].n; ++i) {
             double x = p->s[k].x[i], y = p->s[k].y[i];
@@ -196,42 +292,62 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
         y0 -= d;
         y1 += d;
     }
+    f.x0 = x0, f.x1 = x1, f.y0 = y0, f.y1 = y1;
+    gk__frame_scale(&f, p->equal_aspect);
+    if (nleg > 0) { /* the first inside spot that no curve crosses */
+        double L = f.ml + 8, R = f.W - f.mr - 8 - lw - 10, T = f.mt + 8, B = f.H - f.mb - 8 - lh;
+        double cx[8], cy[8];
+        cx[0] = R, cy[0] = T, cx[1] = L, cy[1] = T, cx[2] = R, cy[2] = B, cx[3] = L, cy[3] = B;
+        cx[4] = R, cy[4] = 0.5 * (T + B), cx[5] = L, cy[5] = 0.5 * (T + B);
+        cx[6] = 0.5 * (L + R), cy[6] = T, cx[7] = 0.5 * (L + R), cy[7] = B;
+        for (k = 0; k < 8 && !placed; ++k) {
+            box[0] = cx[k], box[1] = cx[k] + lw + 10, box[2] = cy[k], box[3] = cy[k] + lh;
+            if (box[0] >= L && box[1] <= f.W - f.mr - 8 && box[3] <= f.H - f.mb - 8 && !gk__plot_hits(p, &f, box))
+                placed = 1;
+        }
+        if (!placed) { /* outside: the axes make room on the right */
+            f.mr = 20 + lw + 22;
+            f.x0 = x0, f.x1 = x1, f.y0 = y0, f.y1 = y1;
+            gk__frame_scale(&f, p->equal_aspect);
+            box[0] = f.W - f.mr + 12, box[1] = box[0] + lw + 10, box[2] = f.mt, box[3] = f.mt + lh;
+        }
+    }
     fp = fopen(path, "w");
     if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot write plot '%s'", path);
-    sx = (W - ml - mr) / (x1 - x0);
-    sy = (H - mt - mb) / (y1 - y0);
-#define GK__X(x) (ml + ((x)-x0) * sx)
-#define GK__Y(y) (H - mb - ((y)-y0) * sy)
+#define GK__X(x) (f.ml + ((x)-f.x0) * f.sx)
+#define GK__Y(y) (f.H - f.mb - ((y)-f.y0) * f.sy)
     fprintf(fp,
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\" "
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
             "font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n",
-            W, H, W, H);
+            f.W, f.H, f.W, f.H);
     fprintf(fp, "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n");
-    st = gk__nice_step(x1 - x0, 6);
-    for (t = ceil(x0 / st) * st; t <= x1 + 1e-9 * st; t += st) {
+    st = gk__nice_step(f.x1 - f.x0, 6);
+    for (t = ceil(f.x0 / st) * st; t <= f.x1 + 1e-9 * st; t += st) {
         double tt = fabs(t) < 1e-12 * st ? 0.0 : t;
-        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e5e5e5\"/>\n", GK__X(tt), mt,
-                GK__X(tt), H - mb);
-        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%g</text>\n", GK__X(tt), H - mb + 16, tt);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e5e5e5\"/>\n", GK__X(tt), f.mt,
+                GK__X(tt), f.H - f.mb);
+        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%g</text>\n", GK__X(tt), f.H - f.mb + 16, tt);
     }
-    st = gk__nice_step(y1 - y0, 6);
-    for (t = ceil(y0 / st) * st; t <= y1 + 1e-9 * st; t += st) {
+    st = gk__nice_step(f.y1 - f.y0, 6);
+    for (t = ceil(f.y0 / st) * st; t <= f.y1 + 1e-9 * st; t += st) {
         double tt = fabs(t) < 1e-12 * st ? 0.0 : t;
-        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e5e5e5\"/>\n", ml, GK__Y(tt),
-                W - mr, GK__Y(tt));
-        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%g</text>\n", ml - 6, GK__Y(tt) + 4, tt);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e5e5e5\"/>\n", f.ml, GK__Y(tt),
+                f.W - f.mr, GK__Y(tt));
+        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%g</text>\n", f.ml - 6, GK__Y(tt) + 4, tt);
     }
-    fprintf(fp, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n", ml, mt,
-            W - ml - mr, H - mt - mb);
-    if (y0 < 0 && y1 > 0)
-        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#999\"/>\n", ml, GK__Y(0.0), W - mr,
-                GK__Y(0.0));
-    fprintf(fp, "<clipPath id=\"gkclip\"><rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/></clipPath>\n", ml,
-            mt, W - ml - mr, H - mt - mb);
+    fprintf(fp, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n", f.ml,
+            f.mt, f.W - f.ml - f.mr, f.H - f.mt - f.mb);
+    if (f.y0 < 0 && f.y1 > 0)
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#999\"/>\n", f.ml, GK__Y(0.0),
+                f.W - f.mr, GK__Y(0.0));
+    fprintf(fp, "<clipPath id=\"gkclip\"><rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/></clipPath>\n",
+            f.ml, f.mt, f.W - f.ml - f.mr, f.H - f.mt - f.mb);
     for (k = 0; k < p->ns; ++k) {
         const char *col = p->s[k].color ? p->s[k].color : gk__cycle[k % GK_PLOT_MAX];
         int started = 0;
-        fprintf(fp, "<polyline clip-path=\"url(#gkclip)\" fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\"%s points=\"",
+        fprintf(fp,
+                "<polyline class=\"series\" clip-path=\"url(#gkclip)\" fill=\"none\" stroke=\"%s\" "
+                "stroke-width=\"1.8\"%s points=\"",
                 col, p->s[k].dashed ? " stroke-dasharray=\"6,4\"" : "");
         for (i = 0; i < p->s[k].n; ++i) {
             double x = p->s[k].x[i], y = p->s[k].y[i];
@@ -244,16 +360,16 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
             fprintf(fp, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"3\" fill=\"%s\"/>\n", GK__X(p->s[k].x[0]),
                     GK__Y(p->s[k].y[0]), col);
     }
-    if (nleg > 0) /* legend over the curves: a box, then a line and the label per series */
+    if (nleg > 0) /* a box, then a line and the label per series */
         fprintf(fp,
-                "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"white\" fill-opacity=\"0.85\" "
-                "stroke=\"#ccc\"/>\n",
-                lx - 6, mt + 4, lw + 10, 16.0 * nleg + 6);
+                "<rect class=\"legend\" x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"white\" "
+                "fill-opacity=\"0.85\" stroke=\"#ccc\"/>\n",
+                box[0], box[2], box[1] - box[0], box[3] - box[2]);
     nleg = 0;
     for (k = 0; k < p->ns; ++k) {
         const char *col = p->s[k].color ? p->s[k].color : gk__cycle[k % GK_PLOT_MAX];
         if (p->s[k].label) {
-            double ly = mt + 14 + 16 * nleg++;
+            double lx = box[0] + 6, ly = box[2] + 14 + 16 * nleg++;
             fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" stroke-width=\"2\"%s/>\n",
                     lx, ly - 4, lx + 24, ly - 4, col, p->s[k].dashed ? " stroke-dasharray=\"6,4\"" : "");
             fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\">", lx + 30, ly);
@@ -262,25 +378,25 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
         }
     }
     if (p->title) {
-        fprintf(fp, "<text x=\"%.1f\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">", 0.5 * W);
+        fprintf(fp, "<text x=\"%.1f\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">", 0.5 * f.W);
         gk__xml_text(fp, p->title);
         fprintf(fp, "</text>\n");
     }
     if (p->xlabel) {
-        fprintf(fp, "<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">", ml + 0.5 * (W - ml - mr), H - 12);
+        fprintf(fp, "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">", f.ml + 0.5 * (f.W - f.ml - f.mr), f.H - 12);
         gk__xml_text(fp, p->xlabel);
         fprintf(fp, "</text>\n");
     }
     if (p->ylabel) {
-        fprintf(fp, "<text transform=\"translate(18,%.1f) rotate(-90)\" text-anchor=\"middle\">", mt + 0.5 * (H - mt - mb));
+        fprintf(fp, "<text transform=\"translate(18,%.1f) rotate(-90)\" text-anchor=\"middle\">",
+                f.mt + 0.5 * (f.H - f.mt - f.mb));
         gk__xml_text(fp, p->ylabel);
         fprintf(fp, "</text>\n");
     }
     fprintf(fp, "</svg>\n");
 #undef GK__X
 #undef GK__Y
-    if (fclose(fp) != 0) return gk_err_set(err, GK_ERR_IO, "error writing plot '%s'", path);
-    return GK_OK;
+    return gk_file_close(fp, path, err);
 }
 
 /* viridis, 9 control points, linear in between */
@@ -300,77 +416,178 @@ static void gk__colormap(double t, int *r, int *g, int *b) {
     *b = (int)(c[k][2] + u * (c[k + 1][2] - c[k][2]) + 0.5);
 }
 
-GKDEF gk_result gk_svg_field(const char *path, const char *title, const char *label, int npoly, int nv,
-                             const double *xy, const double *value, double dot, gk_err *err) {
+GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def_in, int npoly, int nv, const double *xy,
+                             const double *value, gk_err *err) {
+    gk_field_def d;
     FILE *fp;
-    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300, v0 = 1e300, v1 = -1e300, sc, W = 560, Hh, ml = 20,
-           mt = 36, plotw = 440;
-    int k, v, nval = npoly;
-    if (npoly < 1 || nv < 1) return gk_err_set(err, GK_ERR_ARG, "empty field");
+    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300, v0 = 1e300, v1 = -1e300, sc, cs, dot, st, t;
+    double ml = 70, mt = 36, mb = 48, plotw = 440, ploth, W, H, barx, bary0, bary1;
+    int k, v;
+    if (def_in)
+        d = *def_in;
+    else
+        memset(&d, 0, sizeof d);
+    if (npoly < 1 || nv < 1 || !xy || !value) return gk_err_set(err, GK_ERR_ARG, "empty field");
+    if (d.fixed_range && !(isfinite(d.vmin) && isfinite(d.vmax) && d.vmax > d.vmin))
+        return gk_err_set(err, GK_ERR_ARG, "fixed colour range [%g, %g] is not an interval", d.vmin, d.vmax);
+    if (d.nlines < 0 || (d.nlines > 0 && (!d.line_len || !d.line_xy)))
+        return gk_err_set(err, GK_ERR_ARG, "outline: %d polylines without their points", d.nlines);
+    for (k = 0; k < d.nlines; ++k)
+        if (d.line_len[k] < 0) return gk_err_set(err, GK_ERR_ARG, "outline polyline %d has %d points", k, d.line_len[k]);
+    cs = d.coord_scale > 0 ? d.coord_scale : 1.0;
     for (k = 0; k < npoly * nv; ++k) {
         double x = xy[2 * k], y = xy[2 * k + 1];
-        if (x - dot < x0) x0 = x - dot;
-        if (x + dot > x1) x1 = x + dot;
-        if (y - dot < y0) y0 = y - dot;
-        if (y + dot > y1) y1 = y + dot;
+        if (!isfinite(x) || !isfinite(y)) continue;
+        if (x < x0) x0 = x;
+        if (x > x1) x1 = x;
+        if (y < y0) y0 = y;
+        if (y > y1) y1 = y;
     }
-    for (k = 0; k < nval; ++k)
-        if (isfinite(value[k])) {
-            if (value[k] < v0) v0 = value[k];
-            if (value[k] > v1) v1 = value[k];
+    if (d.nlines > 0) { /* the outline is part of the picture */
+        int L, npts = 0;
+        for (L = 0; L < d.nlines; ++L) npts += d.line_len[L] > 0 ? d.line_len[L] : 0;
+        for (k = 0; k < npts; ++k) {
+            double x = d.line_xy[2 * k], y = d.line_xy[2 * k + 1];
+            if (!isfinite(x) || !isfinite(y)) continue;
+            if (x < x0) x0 = x;
+            if (x > x1) x1 = x;
+            if (y < y0) y0 = y;
+            if (y > y1) y1 = y;
         }
-    if (!(v1 >= v0)) v0 = 0, v1 = 1;
-    if (v1 == v0) v1 = v0 + 1e-300 + fabs(v0) * 1e-12;
+    }
+    if (!(x1 >= x0)) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
     if (!(x1 > x0)) x1 = x0 + 1;
     if (!(y1 > y0)) y1 = y0 + 1;
+    dot = nv == 1 ? (d.dot > 0 ? d.dot : 0.01 * (x1 - x0)) : 0.0;
+    x0 -= dot, x1 += dot, y0 -= dot, y1 += dot;
+    if (d.fixed_range) {
+        v0 = d.vmin, v1 = d.vmax;
+    } else {
+        for (k = 0; k < npoly; ++k)
+            if (isfinite(value[k])) {
+                if (value[k] < v0) v0 = value[k];
+                if (value[k] > v1) v1 = value[k];
+            }
+        if (!(v1 >= v0)) v0 = 0, v1 = 1;
+        if (v1 == v0) v1 = v0 + 1e-300 + fabs(v0) * 1e-12;
+    }
+    /* equal aspect, at most 440 x 600 pixels of field */
     sc = plotw / (x1 - x0);
-    Hh = (y1 - y0) * sc + mt + 30;
-    if (Hh < 260) Hh = 260;
+    if ((y1 - y0) * sc > 600) sc = 600 / (y1 - y0);
+    plotw = (x1 - x0) * sc;
+    ploth = (y1 - y0) * sc;
+    W = ml + plotw + 130;
+    if (W < 360) W = 360;
+    H = mt + ploth + mb;
+    if (H < 240) H = 240;
     fp = fopen(path, "w");
     if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot write field plot '%s'", path);
+#define GK__FX(x) (ml + ((x)-x0) * sc)
+#define GK__FY(y) (mt + (y1 - (y)) * sc)
     fprintf(fp,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
             "font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n<rect width=\"100%%\" height=\"100%%\" "
             "fill=\"white\"/>\n",
-            W, Hh, W, Hh);
+            W, H, W, H);
     for (k = 0; k < npoly; ++k) {
-        int r, g, b;
-        double t = isfinite(value[k]) ? (value[k] - v0) / (v1 - v0) : 0.0;
-        gk__colormap(t, &r, &g, &b);
-        if (nv == 1) {
-            fprintf(fp, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"rgb(%d,%d,%d)\"/>\n",
-                    ml + (xy[2 * k] - x0) * sc, mt + (y1 - xy[2 * k + 1]) * sc, dot * sc, r, g, b);
+        char col[32];
+        if (isfinite(value[k])) {
+            int r, g, b;
+            gk__colormap((value[k] - v0) / (v1 - v0), &r, &g, &b);
+            snprintf(col, sizeof col, "rgb(%d,%d,%d)", r, g, b);
         } else {
-            fprintf(fp, "<polygon fill=\"rgb(%d,%d,%d)\" stroke=\"rgb(%d,%d,%d)\" stroke-width=\"0.5\" points=\"", r, g, b,
-                    r, g, b);
+            snprintf(col, sizeof col, "#bbbbbb"); /* no value */
+        }
+        if (nv == 1) {
+            fprintf(fp, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"%.2f\" fill=\"%s\"/>\n", GK__FX(xy[2 * k]),
+                    GK__FY(xy[2 * k + 1]), dot * sc, col);
+        } else {
+            fprintf(fp, "<polygon fill=\"%s\" stroke=\"%s\" stroke-width=\"0.5\" points=\"", col, col);
             for (v = 0; v < nv; ++v)
-                fprintf(fp, "%s%.2f,%.2f", v ? " " : "", ml + (xy[2 * (nv * k + v)] - x0) * sc,
-                        mt + (y1 - xy[2 * (nv * k + v) + 1]) * sc);
+                fprintf(fp, "%s%.2f,%.2f", v ? " " : "", GK__FX(xy[2 * (nv * k + v)]), GK__FY(xy[2 * (nv * k + v) + 1]));
             fprintf(fp, "\"/>\n");
         }
     }
-    /* colour bar */
+    /* the geometry's outline on top */
+    if (d.nlines > 0) {
+        const double *q = d.line_xy;
+        int L;
+        for (L = 0; L < d.nlines; ++L) {
+            fprintf(fp, "<polyline class=\"outline\" fill=\"none\" stroke=\"black\" stroke-width=\"2\" points=\"");
+            for (v = 0; v < d.line_len[L]; ++v, q += 2) fprintf(fp, "%s%.2f,%.2f", v ? " " : "", GK__FX(q[0]), GK__FY(q[1]));
+            fprintf(fp, "\"/>\n");
+        }
+    }
+    /* axes: a frame, ticks and labels in scaled coordinates */
+    fprintf(fp, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n", ml, mt,
+            plotw, ploth);
+    st = gk__nice_step((x1 - x0) * cs, 5);
+    for (t = ceil(x0 * cs / st) * st; t <= x1 * cs + 1e-9 * st; t += st) {
+        double tt = fabs(t) < 1e-12 * st ? 0.0 : t, X = GK__FX(tt / cs);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#333\"/>\n", X, mt + ploth, X,
+                mt + ploth + 5);
+        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%g</text>\n", X, mt + ploth + 18, tt);
+    }
+    st = gk__nice_step((y1 - y0) * cs, 5);
+    for (t = ceil(y0 * cs / st) * st; t <= y1 * cs + 1e-9 * st; t += st) {
+        double tt = fabs(t) < 1e-12 * st ? 0.0 : t, Y = GK__FY(tt / cs);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#333\"/>\n", ml - 5, Y, ml, Y);
+        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%g</text>\n", ml - 8, Y + 4, tt);
+    }
+    fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", ml + 0.5 * plotw, mt + ploth + 38);
+    gk__xml_text(fp, d.xlabel ? d.xlabel : "x [m]");
+    fprintf(fp, "</text>\n<text transform=\"translate(16,%.1f) rotate(-90)\" text-anchor=\"middle\">",
+            mt + 0.5 * ploth);
+    gk__xml_text(fp, d.ylabel ? d.ylabel : "y [m]");
+    fprintf(fp, "</text>\n");
+#undef GK__FX
+#undef GK__FY
+    /* colour bar with ticks; its label (quantity and unit) above it */
+    barx = ml + plotw + 26, bary0 = mt + 22, bary1 = H - mb;
+    if (bary1 - bary0 > 300) bary1 = bary0 + 300;
     for (k = 0; k < 64; ++k) {
         int r, g, b;
-        double h = (Hh - mt - 40) / 64.0;
+        double h = (bary1 - bary0) / 64.0;
         gk__colormap(k / 63.0, &r, &g, &b);
-        fprintf(fp, "<rect x=\"%.1f\" y=\"%.2f\" width=\"16\" height=\"%.2f\" fill=\"rgb(%d,%d,%d)\"/>\n", ml + plotw + 24,
-                Hh - 30 - (k + 1) * h, h + 0.5, r, g, b);
+        fprintf(fp, "<rect x=\"%.1f\" y=\"%.2f\" width=\"16\" height=\"%.2f\" fill=\"rgb(%d,%d,%d)\"/>\n", barx,
+                bary1 - (k + 1) * h, h + 0.5, r, g, b);
     }
-    fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\">%.4g</text>\n", ml + plotw + 44, mt + 10, v1);
-    fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\">%.4g</text>\n", ml + plotw + 44, Hh - 30, v0);
-    if (label) {
-        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\">", ml + plotw + 20, Hh - 10);
-        gk__xml_text(fp, label);
+    fprintf(fp, "<rect x=\"%.1f\" y=\"%.1f\" width=\"16\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n", barx, bary0,
+            bary1 - bary0);
+    st = gk__nice_step(v1 - v0, 5);
+    for (t = ceil(v0 / st) * st; t <= v1 + 1e-9 * st; t += st) {
+        double tt = fabs(t) < 1e-12 * st ? 0.0 : t, Y = bary1 - (tt - v0) / (v1 - v0) * (bary1 - bary0);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#333\"/>\n", barx + 16, Y, barx + 20,
+                Y);
+        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\">%g</text>\n", barx + 23, Y + 4, tt);
+    }
+    if (d.label) {
+        fprintf(fp, "<text class=\"colorbar-label\" x=\"%.1f\" y=\"%.1f\">", barx - 4, bary0 - 8);
+        gk__xml_text(fp, d.label);
         fprintf(fp, "</text>\n");
     }
-    if (title) {
+    if (d.title) {
         fprintf(fp, "<text x=\"%.1f\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">", 0.5 * W);
-        gk__xml_text(fp, title);
+        gk__xml_text(fp, d.title);
         fprintf(fp, "</text>\n");
     }
     fprintf(fp, "</svg>\n");
-    if (fclose(fp) != 0) return gk_err_set(err, GK_ERR_IO, "error writing '%s'", path);
+    return gk_file_close(fp, path, err);
+}
+
+GKDEF gk_result gk_svg_field(const char *path, const char *title, const char *label, int npoly, int nv,
+                             const double *xy, const double *value, double dot, gk_err *err) {
+    gk_field_def d;
+    memset(&d, 0, sizeof d);
+    d.title = title;
+    d.label = label;
+    d.dot = dot;
+    return gk_field_svg(path, &d, npoly, nv, xy, value, err);
+}
+
+/* a write that already failed (the stream's error flag) is reported at once */
+static gk_result gk__vtk_status(gk_vtk *v) {
+    if (ferror(v->fp)) return gk_err_set(&v->err, GK_ERR_IO, "error writing VTK file (disk full?)");
     return GK_OK;
 }
 
@@ -388,7 +605,7 @@ GKDEF gk_result gk_vtk_points(gk_vtk *v, int n, const double *xyz) {
     v->npoints = n;
     fprintf(v->fp, "POINTS %d double\n", n);
     for (k = 0; k < n; ++k) fprintf(v->fp, "%.9g %.9g %.9g\n", xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 GKDEF gk_result gk_vtk_cells(gk_vtk *v, int ncells, int nv, const int *conn, int vtk_type) {
@@ -403,7 +620,7 @@ GKDEF gk_result gk_vtk_cells(gk_vtk *v, int ncells, int nv, const int *conn, int
     }
     fprintf(v->fp, "CELL_TYPES %d\n", ncells);
     for (k = 0; k < ncells; ++k) fprintf(v->fp, "%d\n", vtk_type);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 static gk_result gk__vtk_section(gk_vtk *v, int cell) {
@@ -427,7 +644,7 @@ static gk_result gk__vtk_scalar(gk_vtk *v, int cell, const char *name, const dou
     n = cell ? v->ncells : v->npoints;
     fprintf(v->fp, "SCALARS %s double 1\nLOOKUP_TABLE default\n", name);
     for (k = 0; k < n; ++k) fprintf(v->fp, "%.9g\n", isfinite(val[k]) ? val[k] : 0.0);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 static gk_result gk__vtk_tensor(gk_vtk *v, int cell, const char *name, const double *val9) {
@@ -439,7 +656,7 @@ static gk_result gk__vtk_tensor(gk_vtk *v, int cell, const char *name, const dou
     for (k = 0; k < n; ++k)
         for (j = 0; j < 3; ++j)
             fprintf(v->fp, "%.9g %.9g %.9g\n", val9[9 * k + 3 * j], val9[9 * k + 3 * j + 1], val9[9 * k + 3 * j + 2]);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 GKDEF gk_result gk_vtk_point_scalar(gk_vtk *v, const char *name, const double *val) {
@@ -460,19 +677,14 @@ GKDEF gk_result gk_vtk_point_vector(gk_vtk *v, const char *name, const double *v
     if (r) return r;
     fprintf(v->fp, "VECTORS %s double\n", name);
     for (k = 0; k < v->npoints; ++k) fprintf(v->fp, "%.9g %.9g %.9g\n", val3[3 * k], val3[3 * k + 1], val3[3 * k + 2]);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 GKDEF gk_result gk_vtk_close(gk_vtk *v) {
-    int bad;
-    if (!v->fp) return GK_ERR_STATE;
-    bad = ferror(v->fp);
-    if (fclose(v->fp) != 0 || bad) {
-        v->fp = NULL;
-        return gk_err_set(&v->err, GK_ERR_IO, "error writing VTK file");
-    }
+    FILE *fp = v->fp;
+    if (!fp) return GK_ERR_STATE;
     v->fp = NULL;
-    return GK_OK;
+    return gk_file_close(fp, "VTK file", &v->err);
 }
 
 GKDEF void gk_progress(FILE *fp, long step, long nsteps, double t_start, const char *what) {

@@ -17,6 +17,9 @@
  *   gk_packing_read / gk_packing_parse   the text format, from a file or memory
  *   gk_packing_write                     the same format (round-trips exactly)
  *   gk_packing_generate                  a random loose (non-overlapping) cloud
+ *   gk_packing_tile                      nx x ny (x nz) copies of a periodic packing
+ *   gk_packing_subset                    the particles inside a box (a specimen cut
+ *                                        from a packing, e.g. for gk_scene.h)
  *   gk_particle_volume                   pi r^2 (2D) or 4/3 pi r^3 (3D)
  *
  * ERRORS are values: every fallible call returns gk_result and writes its
@@ -35,7 +38,12 @@
  *   line 1:  "2 N Lx Ly" or "3 N Lx Ly Lz"
  *   lines starting with '#': comments; grainkit writes and reads an optional
  *            "# cell h00 h01 ... " line holding the full (skewed) cell matrix
- *   N lines: "x y r" or "x y z r" (SI units), positions in the cell. */
+ *   N lines: "x y r" or "x y z r" (SI units), positions in the cell.
+ * The text is untrusted: the particle lines are counted before anything is
+ * allocated (memory follows what the text holds, never the N it announces);
+ * a data or '# cell' line longer than 1023 characters, a NUL byte, a
+ * non-finite number, a radius <= 0 or a cell whose volume is not a finite
+ * positive number is refused, the message naming the line. */
 typedef struct gk_packing {
     int dim, n;
     double h[9];     /* cell matrix (a box is diag(Lx, Ly, Lz)); 2D: h22 = 1 */
@@ -74,6 +82,19 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *pk, c
                                  gk_err *err);
 GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const char *comment, gk_err *err);
 GKDEF gk_result gk_packing_generate(gk_packing *pk, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err);
+/* A periodic packing repeated nx x ny (x nz in 3D; nz ignored in 2D) times:
+ * cell h diag(nx, ny, nz), copy (a, b, c) at a e1 + b e2 + c e3 (e_k the cell
+ * edges, positions wrapped into the cell first); copies follow each other,
+ * a fastest, each in pk's order. Still periodic: the copies match across
+ * every face. */
+GKDEF gk_result gk_packing_tile(const gk_packing *pk, int nx, int ny, int nz, gk_packing *out,
+                                const gk_allocator *alloc, gk_err *err);
+/* The particles whose centre lies in the box [lo, hi] (whole != 0: the
+ * whole disk or sphere, centre -+ r), in pk's order, shifted by -lo; the
+ * result's cell is the box diag(hi - lo). Positions are taken as given
+ * (not wrapped). GK_ERR_ARG if the box holds none. */
+GKDEF gk_result gk_packing_subset(const gk_packing *pk, const double lo[3], const double hi[3], int whole,
+                                  gk_packing *out, const gk_allocator *alloc, gk_err *err);
 
 #ifdef __cplusplus
 }
@@ -121,18 +142,25 @@ GKDEF void gk_packing_free(gk_packing *pk) {
     pk->n = 0;
 }
 
-/* line reader over a memory buffer */
+/* line reader over a memory buffer; a line longer than the buffer or
+ * holding a NUL byte is flagged, never silently cut */
 typedef struct gk__lines {
     const char *p, *end;
     long lineno;
+    int toolong, nul;
     char line[1024];
 } gk__lines;
 
 static int gk__next_line(gk__lines *L) {
     size_t k = 0;
     if (L->p >= L->end) return 0;
+    L->toolong = L->nul = 0;
     while (L->p < L->end && *L->p != '\n') {
-        if (k + 1 < sizeof L->line) L->line[k++] = *L->p;
+        if (*L->p == '\0') L->nul = 1;
+        if (k + 1 < sizeof L->line)
+            L->line[k++] = *L->p;
+        else
+            L->toolong = 1;
         ++L->p;
     }
     if (L->p < L->end) ++L->p;
@@ -167,18 +195,39 @@ static int gk__parse_doubles(const char *s, double *out, int max, int *bad) {
     return k;
 }
 
+/* 0: blank; 1: a comment; 2: the '# cell' line; 3: a particle line */
+static int gk__line_kind(const char *s) {
+    while (*s == ' ' || *s == '\t') ++s;
+    if (*s == '#') return strncmp(s, "# cell ", 7) == 0 ? 2 : 1;
+    return gk__blank(s) ? 0 : 3;
+}
+
+/* a line that cannot be read whole is an error; only a plain comment may be cut */
+static gk_result gk__line_ok(const gk__lines *L, int kind, gk_err *err) {
+    if (L->nul)
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld holds a NUL byte (not a text packing?)", L->lineno);
+    if (L->toolong && kind != 1)
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld is longer than %d characters", L->lineno,
+                          (int)sizeof L->line - 1);
+    return GK_OK;
+}
+
 GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, const gk_allocator *alloc,
                                  gk_err *err) {
     gk__lines L;
     double hd[5], h[9], vals[8];
     int nh, bad, dim, n, k = 0;
+    long body, lines = 0;
+    const char *first;
     gk_packing pk;
     gk_result r;
+    if (!text) return gk_err_set(err, GK_ERR_ARG, "no packing text given");
     L.p = text;
     L.end = text + len;
     L.lineno = 0;
     do {
         if (!gk__next_line(&L)) return gk_err_set(err, GK_ERR_FORMAT, "empty packing: no header line");
+        if ((r = gk__line_ok(&L, 3, err)) != GK_OK) return r;
     } while (gk__blank(L.line));
     nh = gk__parse_doubles(L.line, hd, 5, &bad);
     if (bad || nh < 4) return gk_err_set(err, GK_ERR_FORMAT, "line %ld: header must be 'dim N Lx Ly [Lz]'", L.lineno);
@@ -197,37 +246,51 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
             return gk_err_set(err, GK_ERR_CELL, "line %ld: cell length %g must be > 0", L.lineno, hd[2 + k]);
         h[4 * k] = hd[2 + k];
     }
+    /* count the particle lines before allocating: memory follows what the
+     * text holds, never what its header announces */
+    first = L.p;
+    body = L.lineno;
+    while (gk__next_line(&L)) {
+        int kind = gk__line_kind(L.line);
+        if ((r = gk__line_ok(&L, kind, err)) != GK_OK) return r;
+        if (kind == 3 && ++lines > n)
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced",
+                              L.lineno, n);
+    }
+    if (lines != n)
+        return gk_err_set(err, GK_ERR_FORMAT, "packing announces %d particles but lists %ld", n, lines);
     r = gk_packing_alloc(&pk, dim, n, alloc, err);
     if (r) return r;
+    L.p = first;
+    L.lineno = body;
     k = 0;
     while (gk__next_line(&L)) {
         const char *s = L.line;
-        int nv;
-        while (*s == ' ' || *s == '\t') ++s;
-        if (*s == '#') {
-            if (strncmp(s, "# cell ", 7) == 0) {
-                double hc[9];
-                int nc = gk__parse_doubles(s + 7, hc, 9, &bad), a, b;
-                if (bad || nc != dim * dim) {
-                    gk_packing_free(&pk);
-                    return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno, dim * dim);
-                }
-                gk_m3_identity(h);
-                for (a = 0; a < dim; ++a)
-                    for (b = 0; b < dim; ++b) h[3 * a + b] = hc[dim * a + b];
+        int nv, kind = gk__line_kind(s);
+        if (kind == 2) {
+            double hc[9];
+            int nc = gk__parse_doubles(s + strspn(s, " \t") + 7, hc, 9, &bad), a, b;
+            if (bad || nc != dim * dim) {
+                gk_packing_free(&pk);
+                return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno,
+                                  dim * dim);
             }
-            continue;
+            for (a = 0; a < nc; ++a)
+                if (!isfinite(hc[a])) {
+                    gk_packing_free(&pk);
+                    return gk_err_set(err, GK_ERR_CELL, "line %ld: '# cell' entry %d is %g (must be finite)",
+                                      L.lineno, a + 1, hc[a]);
+                }
+            gk_m3_identity(h);
+            for (a = 0; a < dim; ++a)
+                for (b = 0; b < dim; ++b) h[3 * a + b] = hc[dim * a + b];
         }
-        if (gk__blank(s)) continue;
+        if (kind != 3) continue;
         nv = gk__parse_doubles(s, vals, 8, &bad);
         if (bad || nv != dim + 1) {
             gk_packing_free(&pk);
             return gk_err_set(err, GK_ERR_FORMAT, "line %ld: expected %d numbers (%s r), found %s", L.lineno, dim + 1,
                               dim == 2 ? "x y" : "x y z", bad ? "a non-number" : "a different count");
-        }
-        if (k >= n) {
-            gk_packing_free(&pk);
-            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced", L.lineno, n);
         }
         for (nv = 0; nv <= dim; ++nv)
             if (!isfinite(vals[nv])) {
@@ -244,13 +307,9 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
         pk.r[k] = vals[dim];
         ++k;
     }
-    if (k != n) {
+    if (!(gk_m3_det(h) > 0.0) || !isfinite(gk_m3_det(h))) {
         gk_packing_free(&pk);
-        return gk_err_set(err, GK_ERR_FORMAT, "packing announces %d particles but lists %d", n, k);
-    }
-    if (!(gk_m3_det(h) > 0.0)) {
-        gk_packing_free(&pk);
-        return gk_err_set(err, GK_ERR_CELL, "cell matrix has det <= 0");
+        return gk_err_set(err, GK_ERR_CELL, "cell matrix has det %g (must be finite and > 0)", gk_m3_det(h));
     }
     gk_m3_copy(h, pk.h);
     *out = pk;
@@ -258,36 +317,14 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
 }
 
 GKDEF gk_result gk_packing_read(const char *path, gk_packing *pk, const gk_allocator *alloc, gk_err *err) {
-    FILE *fp;
-    long len;
-    char *buf;
-    gk_allocator a;
+    char *buf = NULL;
+    size_t len = 0;
     gk_result r;
-    if (alloc)
-        a = *alloc;
-    else
-        memset(&a, 0, sizeof a);
     if (!path) return gk_err_set(err, GK_ERR_ARG, "no packing path given");
-    fp = fopen(path, "rb");
-    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open packing '%s'", path);
-    if (fseek(fp, 0, SEEK_END) != 0 || (len = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0) {
-        fclose(fp);
-        return gk_err_set(err, GK_ERR_IO, "cannot size packing '%s'", path);
-    }
-    buf = (char *)gk_alloc(&a, (size_t)len + 1);
-    if (!buf) {
-        fclose(fp);
-        return gk_err_set(err, GK_ERR_ALLOC, "out of memory reading '%s'", path);
-    }
-    if (fread(buf, 1, (size_t)len, fp) != (size_t)len) {
-        fclose(fp);
-        gk_free(&a, buf);
-        return gk_err_set(err, GK_ERR_IO, "cannot read packing '%s'", path);
-    }
-    fclose(fp);
-    buf[len] = '\0';
-    r = gk_packing_parse(buf, (size_t)len, pk, alloc, err);
-    gk_free(&a, buf);
+    r = gk_file_read(path, alloc, &buf, &len, err);
+    if (r) return r;
+    r = gk_packing_parse(buf, len, pk, alloc, err);
+    gk_free(alloc, buf);
     if (r && err) {
         char msg[GK_ERR_MSG_LEN];
         memcpy(msg, err->msg, sizeof msg);
@@ -331,8 +368,7 @@ GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const c
         else
             fprintf(fp, "%.17g %.17g %.17g %.17g\n", pk->x[k], pk->y[k], pk->z[k], pk->r[k]);
     }
-    if (fclose(fp) != 0) return gk_err_set(err, GK_ERR_IO, "error writing '%s'", path);
-    return GK_OK;
+    return gk_file_close(fp, path, err);
 }
 
 GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err) {
@@ -413,6 +449,12 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
     side = pow(V / (asp[0] * asp[1] * (dim == 3 ? asp[2] : 1.0)), 1.0 / dim);
     gk_m3_identity(pk.h);
     for (k = 0; k < dim; ++k) pk.h[4 * k] = side * asp[k];
+    if (!(vs > 0.0) || !isfinite(gk_m3_det(pk.h)) || !(gk_m3_det(pk.h) > 0.0)) {
+        gk_packing_free(&pk);
+        return gk_err_set(err, GK_ERR_ARG,
+                          "radii (largest %g) and cell aspect give a cell volume %g out of range", rr[0],
+                          gk_m3_det(pk.h));
+    }
     /* random sequential addition with a linked-cell grid updated as particles land */
     {
         double *sx = (double *)gk_alloc(alloc, (size_t)n * sizeof(double));
@@ -422,9 +464,8 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
         int32_t *head = NULL, *next = NULL;
         double cut = 2.0 * rr[0];
         for (k = 0; k < 3; ++k) {
-            nbin[k] = k < dim ? (int)(pk.h[4 * k] / cut) : 1;
+            nbin[k] = k < dim ? (pk.h[4 * k] / cut < 1024.0 ? (int)(pk.h[4 * k] / cut) : 1024) : 1;
             if (nbin[k] < 1) nbin[k] = 1;
-            if (nbin[k] > 1024) nbin[k] = 1024;
         }
         head = (int32_t *)gk_alloc(alloc, (size_t)nbin[0] * nbin[1] * nbin[2] * sizeof(int32_t));
         next = (int32_t *)gk_alloc(alloc, (size_t)n * sizeof(int32_t));
@@ -494,6 +535,93 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
         return res;
     }
     *out = pk;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_packing_tile(const gk_packing *pk, int nx, int ny, int nz, gk_packing *out,
+                                const gk_allocator *alloc, gk_err *err) {
+    gk_packing t;
+    double hi[9];
+    int dim, rep[3], a, b, c, p, k, q = 0;
+    long total;
+    gk_result res;
+    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1) return gk_err_set(err, GK_ERR_ARG, "tile: empty packing");
+    dim = pk->dim;
+    rep[0] = nx;
+    rep[1] = ny;
+    rep[2] = dim == 3 ? nz : 1;
+    if (rep[0] < 1 || rep[1] < 1 || rep[2] < 1)
+        return gk_err_set(err, GK_ERR_ARG, "tile: copies %d x %d x %d must be >= 1", nx, ny, dim == 3 ? nz : 1);
+    total = (long)pk->n * rep[0] * rep[1] * rep[2];
+    if (total > 2000000000L) return gk_err_set(err, GK_ERR_ARG, "tile: %ld particles are too many", total);
+    if (!(gk_m3_inverse(pk->h, hi) > 0.0)) return gk_err_set(err, GK_ERR_CELL, "tile: singular cell");
+    if ((res = gk_packing_alloc(&t, dim, (int)total, alloc, err)) != GK_OK) return res;
+    gk_m3_copy(pk->h, t.h);
+    for (k = 0; k < 3; ++k) /* column k of h scaled by rep[k] */
+        for (a = 0; a < 3; ++a) t.h[3 * a + k] *= rep[k];
+    if (dim == 2) t.h[8] = 1.0;
+    for (c = 0; c < rep[2]; ++c)
+        for (b = 0; b < rep[1]; ++b)
+            for (a = 0; a < rep[0]; ++a)
+                for (p = 0; p < pk->n; ++p) {
+                    double x[3], s[3], y[3];
+                    x[0] = pk->x[p];
+                    x[1] = pk->y[p];
+                    x[2] = dim == 3 && pk->z ? pk->z[p] : 0.0;
+                    gk_m3_matvec(hi, x, s);
+                    for (k = 0; k < 3; ++k) s[k] = k < dim ? s[k] - floor(s[k]) : 0.0;
+                    s[0] += a;
+                    s[1] += b;
+                    s[2] += c;
+                    gk_m3_matvec(pk->h, s, y);
+                    t.x[q] = y[0];
+                    t.y[q] = y[1];
+                    t.z[q] = dim == 3 ? y[2] : 0.0;
+                    t.r[q] = pk->r[p];
+                    ++q;
+                }
+    *out = t;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_packing_subset(const gk_packing *pk, const double lo[3], const double hi[3], int whole,
+                                  gk_packing *out, const gk_allocator *alloc, gk_err *err) {
+    gk_packing t;
+    int dim, p, k, cnt = 0, q = 0;
+    gk_result res;
+    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1) return gk_err_set(err, GK_ERR_ARG, "subset: empty packing");
+    if (!lo || !hi) return gk_err_set(err, GK_ERR_ARG, "subset: no box given");
+    dim = pk->dim;
+    for (k = 0; k < dim; ++k)
+        if (!isfinite(lo[k]) || !isfinite(hi[k]) || !(hi[k] > lo[k]))
+            return gk_err_set(err, GK_ERR_ARG, "subset: box axis %d [%g, %g] is not an interval", k, lo[k], hi[k]);
+    for (q = 0; q < 2; ++q) { /* count, then copy */
+        for (p = 0; p < pk->n; ++p) {
+            double x[3], m = whole ? pk->r[p] : 0.0;
+            int in = 1;
+            x[0] = pk->x[p];
+            x[1] = pk->y[p];
+            x[2] = dim == 3 && pk->z ? pk->z[p] : 0.0;
+            for (k = 0; k < dim; ++k)
+                if (!(x[k] - m >= lo[k] && x[k] + m <= hi[k])) in = 0;
+            if (!in) continue;
+            if (q == 1) {
+                t.x[cnt] = x[0] - lo[0];
+                t.y[cnt] = x[1] - lo[1];
+                t.z[cnt] = dim == 3 ? x[2] - lo[2] : 0.0;
+                t.r[cnt] = pk->r[p];
+            }
+            ++cnt;
+        }
+        if (q == 0) {
+            if (cnt < 1) return gk_err_set(err, GK_ERR_ARG, "subset: no particle inside the box");
+            if ((res = gk_packing_alloc(&t, dim, cnt, alloc, err)) != GK_OK) return res;
+            gk_m3_identity(t.h);
+            for (k = 0; k < dim; ++k) t.h[4 * k] = hi[k] - lo[k];
+            cnt = 0;
+        }
+    }
+    *out = t;
     return GK_OK;
 }
 

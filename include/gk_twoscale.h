@@ -236,8 +236,11 @@ typedef struct gk_twoscale_field {
 /* traffic of this rank (MPI; zero otherwise) since creation */
 typedef struct gk_twoscale_stats {
     long long runs;          /* gk_twoscale_run calls                                    */
-    long long bytes_out;     /* bytes this rank passed to MPI as its own data            */
-    long long bytes_in;      /* bytes it received from other ranks                       */
+    long long run_bytes_out; /* ... bytes this rank sent in them (its part of the results; rank 0:
+                                the dH broadcast too)                                    */
+    long long run_bytes_in;  /* ... bytes it received in them (dH, the other ranks' results) */
+    long long bytes_out;     /* bytes sent in all calls (fields, checkpoints, migrations too) */
+    long long bytes_in;      /* bytes received in all calls                              */
     long long collectives;   /* collective calls                                         */
     long long migrated;      /* points that moved to another rank (all ranks counted)    */
 } gk_twoscale_stats;
@@ -892,20 +895,23 @@ static gk_result gk__ts_create(gk_twoscale *ts, const gk_twoscale_def *def) {
     return res;
 }
 
-GKDEF gk_result gk_twoscale_create(gk_twoscale *ts, const gk_twoscale_def *def) {
-#ifdef GK_TWOSCALE_MPI
-    return gk_twoscale_create_mpi(ts, def, MPI_COMM_WORLD);
-#else
-    gk_result res;
-    memset(ts, 0, sizeof *ts);
-    ts->nranks = 1;
-    res = gk__ts_create(ts, def);
+/* a failed creation leaves only its message */
+static gk_result gk__ts_created(gk_twoscale *ts, gk_result res) {
     if (res) {
         gk_err e = ts->err;
         gk__ts_free_all(ts);
         ts->n = 0, ts->err = e;
     }
     return res;
+}
+
+GKDEF gk_result gk_twoscale_create(gk_twoscale *ts, const gk_twoscale_def *def) {
+#ifdef GK_TWOSCALE_MPI
+    return gk_twoscale_create_mpi(ts, def, MPI_COMM_WORLD);
+#else
+    memset(ts, 0, sizeof *ts);
+    ts->nranks = 1;
+    return gk__ts_created(ts, gk__ts_create(ts, def));
 #endif
 }
 
@@ -920,13 +926,7 @@ GKDEF gk_result gk_twoscale_create_mpi(gk_twoscale *ts, const gk_twoscale_def *d
     if (!res && ts->nranks > 1 &&
         !(ts->hbuf = (double *)gk_alloc(&ts->def.alloc, ((size_t)ts->n * 9 + 2) * sizeof(double))))
         res = gk_err_set(&ts->err, GK_ERR_ALLOC, "out of memory for %d points' dH", ts->n);
-    res = gk__ts_agree(ts, res);
-    if (res) {
-        gk_err e = ts->err;
-        gk__ts_free_all(ts);
-        ts->n = 0, ts->err = e;
-    }
-    return res;
+    return gk__ts_created(ts, gk__ts_agree(ts, res));
 }
 #endif
 
@@ -1017,6 +1017,7 @@ GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twos
     double scale = rd && rd->scale != 0.0 ? rd->scale : 1.0;
     const double *H = dH, *all;
     int want_D = D != NULL, nrec, j, nf;
+    long long bin = ts->stats.bytes_in, bout = ts->stats.bytes_out;
     gk_result res;
     gk_err_clear(&ts->err);
     if (ts->n < 1) return gk_err_set(&ts->err, GK_ERR_STATE, "the set was not created");
@@ -1058,6 +1059,7 @@ GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twos
     ++ts->stats.runs;
     ts->pending = 1;
     res = gk__ts_failures(ts);
+    ts->stats.run_bytes_in += ts->stats.bytes_in - bin, ts->stats.run_bytes_out += ts->stats.bytes_out - bout;
     for (nf = 0, j = 0; j < ts->n; ++j) nf += ts->last[j].code != 0;
     if (!nf) return GK_OK;
     {

@@ -81,7 +81,7 @@ static void direct_solve(elastic *el, const double *f, const unsigned char *fixe
     double *vals = (double *)calloc((size_t)n, sizeof(double)), *rhs = (double *)malloc(sizeof(double) * n);
     gk_csr A;
     gk_solver s;
-    memset(&s, 0, sizeof s); /* gk_solver_factor frees a previous factorisation */
+    gk_solver_init(&s);
     A = el->K;
     A.val = (double *)malloc(sizeof(double) * el->K.nnz);
     memcpy(A.val, el->K.val, sizeof(double) * el->K.nnz);
