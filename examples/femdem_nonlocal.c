@@ -186,7 +186,8 @@
  *   --paper where the runs take 97-138 DEM steps to reach I_uf < 0.01; these
  *   CPU times were taken on a loaded shared machine and are indicative).
  *   Projections (CPU time, one thread; the RVEs run in parallel with
- *   --threads): default simple shear to 20 % (4000 steps) ~6 min; --paper
+ *   --threads): default simple shear to 20 % (4000 steps) ~6 min (the
+ *   whole run measured 241 s, the DEM runs being shorter later); --paper
  *   ~4.7 h if the runs stay at ~120 DEM steps (the paper reports 22 h CPU for
  *   its run). The measurement: --stop-after 4 and --stop-after 24
  *   (or 84) of the same test, the difference of their CPU times over the
@@ -209,6 +210,39 @@
  *     gap is not explained (the element takes 4000 coarse steps, the RVE
  *     alone 400 increments; both curves fluctuate by several % at critical
  *     state).
+ *   simple-shear (Figs 9-14, default: 512 spheres, 5x12x1, local, 4000
+ *     steps to 20 %, 241 s CPU): shear stress, mean over 2 % windows, 261
+ *     kPa at 1-3 %, 252 at 4-6 %, 248 at 6-8 %, 238 at 8-10 %, 229 at 10-12 %,
+ *     207 at 16-18 %, normal stress 413-421 kPa: an early peak and gradual
+ *     softening, NOT the paper's plateau to 6 % and abrupt drop between 6
+ *     and 8 %. Porosity rises monotonically (0.3457 to 0.371) and Z falls
+ *     fast (5.69 to 3.6 by 4 %) then stays nearly constant, as in Figs 12
+ *     and 13. No band of 13-16 mm: at 12 % the shear strain is spread over
+ *     five of the twelve rows (0.14-0.32); the imperfect row (93 mm) leads
+ *     at the end (0.88 against 0.03-0.37). The start of the platen gives a
+ *     transient (272 kPa at 0.2 %) that the RESULT line takes as the peak
+ *     (peak_stress 300 kPa at 0.3 %), so band_center_mm 58.6 and
+ *     band_width_mm 38 there measure the whole shear profile, not a band.
+ *     20-60 of the 60 points stop at the 20-step cap (dem_capped).
+ *   wave (Fig 8, 1 ms): the shear front runs at 566 m/s, the elastic
+ *     column of the same mesh (the RVE's K and G) at 607 m/s and
+ *     sqrt(G / rho) is 451 m/s (with the paper's G = 241 MPa and 1650 kg/m^3:
+ *     382 m/s); over the first 0.1 ms the front is within 2.6 % of the
+ *     elastic column (tested). The paper gives Fig 8 without numbers; the
+ *     loops of element 9 and its porosity and Z are in wave.csv.
+ *   biaxial (Figs 15-19): the mesh study (4x8x1, 6x12x1, 8x16x1, local and
+ *     nonlocal, to 6 %) is NOT reproduced here: it was not run to the end
+ *     with this version. Measured: on 2x4x1 with 160-sphere RVEs local and
+ *     nonlocal (R 25 mm) give the same pre-peak stress within 0.3 % (tested);
+ *     on 6x12x1 (160 spheres, 3375 steps to 6 %) the paper's R = 6.75 mm
+ *     runs stably through 0.53 %, but R = 13.5 mm (2R = 27 mm, two thirds of
+ *     the width) blows up: the kinetic energy grows from 1e-3 to 1.8 J and
+ *     the axial stress jumps from 1.7 to 3.9 MPa at 0.28 % strain (at 0.53 %
+ *     with half the coarse step, so not the step bound of eq 65), and the
+ *     first RVEs to fail are the left column's at mid-height (their
+ *     critical DEM step falls below the step as overlaps grow). Averaging the
+ *     total strain increment (eq 58) leaves short modes of wavelength below
+ *     R with little stiffness, the likely cause; not investigated further.
  *
  * LICENCE: MIT (see gk_base.h).
  */
