@@ -480,7 +480,8 @@ static int parse(int argc, char **argv, opts *o) {
         }
         if (o->steps < 0) o->steps = steps[t];
         if (o->dem_max < 0) o->dem_max = (t == T_SSHEAR || t == T_BIAX) && !o->paper ? 20 : 4000;
-        if (!o->packing) o->packing = o->paper ? "examples/data/rve4096_hm.txt" : "examples/data/rve512_hm.txt";
+        if (!o->packing)
+            o->packing = o->paper ? "examples/data/rve4096_hm.txt" : "examples/data/rve512_hm.txt";
         if (o->imperfection < 0)
             o->imperfection = t == T_SSHEAR ? -2 : 0; /* -2: 25 x N / 4096 (after reading) */
         if (o->contact_damping < 0) o->contact_damping = t == T_BIAX ? 0.0 : 0.12;

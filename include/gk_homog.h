@@ -82,7 +82,7 @@
  *       number (eq 20) of dH applied in one step at the RVE's current
  *       pressure (p <= 0: n_max), so the deformation runs at I <= I_max;
  *       then, if the unbalanced force ratio (mean, as YADE; or with
- *       rms = 1 the RMS ratio I_uf of seed 004 eq 57) exceeds
+ *       rms = 1 the RMS ratio I_uf of Liu et al. 2016 eq 57) exceeds
  *       uf_max, relaxation steps at fixed cell (L = 0) in chunks of
  *       `every` until it does not or the total reaches n_max (reported as
  *       capped). Quasi-static by construction; more steps where p is
@@ -131,7 +131,7 @@ typedef struct gk_adapt_def {
     double unbalanced_max; /* unbalanced force ratio to reach after it; 0 -> 5e-3     */
     int n_min, n_max;      /* bounds on the total DEM steps; 0 -> 10 and 5000          */
     int every;             /* relaxation steps between checks; 0 -> 20                 */
-    int rms;               /* 1: test the RMS ratio I_uf of seed 004 eq 57 instead       */
+    int rms;               /* 1: the RMS ratio I_uf (Liu, Sun, Yuan & Fish 2016 eq 57) */
 } gk_adapt_def;
 
 typedef struct gk_adapt_report {

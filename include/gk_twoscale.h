@@ -168,7 +168,7 @@ typedef struct gk_twoscale_rule {
     double strain;         /* strain rule: max |dH_ij| per DEM step; 0 -> 1e-5             */
     int n_min, n_max;      /* DEM steps per run, in all; 0 -> 10 and 5000                 */
     int every;             /* adaptive: relaxation steps between checks; 0 -> 20          */
-    int unbalanced_rms;    /* adaptive: 1 = the RMS ratio I_uf (seed 004 eq 57), not the mean */
+    int unbalanced_rms;    /* adaptive: 1 = the RMS ratio I_uf (Liu et al. 2016 eq 57), not the mean */
 } gk_twoscale_rule;
 
 typedef enum gk_twoscale_tangent_kind {

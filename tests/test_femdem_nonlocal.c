@@ -168,8 +168,8 @@ TEST(rve_table2_moduli) {
     FILE *fp;
     char line[1024];
     int rows = 0;
-    CHECK(system("build/femdem_nonlocal --test rve --packing " PK160 " --out build/t_fnlr > build/t_fnlr.out 2>&1") ==
-          0);
+    CHECK(system("build/femdem_nonlocal --test rve --packing " PK160
+                 " --out build/t_fnlr > build/t_fnlr.out 2>&1") == 0);
     CHECK_NEAR(gk_test_result("build/t_fnlr.out", "K_MPa"), 335.0, 33.5);
     CHECK_NEAR(gk_test_result("build/t_fnlr.out", "porosity0"), 0.3496, 1e-4); /* the packing's comment */
     CHECK_NEAR(gk_test_result("build/t_fnlr.out", "Z0"), 5.35, 0.01);
@@ -210,7 +210,8 @@ TEST(wave_front_matches_elastic_column) {
  * switches the mesh tests to the I_uf rule of eq 57 (--dem-max 4000) */
 TEST(biaxial_local_and_nonlocal_prepeak) {
     double sl, sn;
-    const char *a = "build/femdem_nonlocal --test biaxial --packing " PK160 " --mesh 2x4x1 --steps 60 --strain 0.003";
+    const char *a =
+        "build/femdem_nonlocal --test biaxial --packing " PK160 " --mesh 2x4x1 --steps 60 --strain 0.003";
     char cmd[512];
     snprintf(cmd, sizeof cmd, "%s --nonlocal off --out build/t_fnlbl > build/t_fnlbl.out 2>&1", a);
     CHECK(system(cmd) == 0);
