@@ -42,12 +42,5 @@ run 0 "$B/gk_pack" --n 60 --out "$T/pack.txt"
 run 1 "$B/gk_pack" --n 60 --target-void-ratio 2.5 --out "$T/pack2.txt"
 run 1 "$B/gk_pack" --n 60 --out /dev/full
 run 2 "$B/gk_pack" --n 60 --friction-deg 95 --out "$T/pack3.txt"
-# femdem_nonlocal: a small nonlocal simple shear stopped and restarted, a
-# result that cannot be written, a refused option
-N="--test simple-shear --packing examples/data/rve160_hm.txt --mesh 2x3x1 --nonlocal 0.05 --steps 6 --strain 0.001"
-run 0 "$B/femdem_nonlocal" $N --stop-after 3 --out "$T/fnl"
-run 0 "$B/femdem_nonlocal" $N --restart "$T/fnl" --out "$T/fnl"
-run 1 "$B/femdem_nonlocal" --test rve --packing examples/data/rve160_hm.txt --steps 2 --out /dev/full/x
-run 2 "$B/femdem_nonlocal" --test wave --iuf 2 --out "$T/fnl2"
 echo "# smoke_asan: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
