@@ -176,6 +176,7 @@ typedef enum gk_mass_model { GK_MASS_CYLINDER = 0, GK_MASS_SPHERE = 1 } gk_mass_
 #define GK_RVE_NO_ROTATION 1u /* particles do not rotate (spin with the cell only) */
 #define GK_RVE_SCALAR 2u      /* always use the scalar reference kernels          */
 #define GK_RVE_WRAP 4u        /* accept positions outside the cell (wrap them)    */
+#define GK_RVE_TRACK_ROTATION 8u /* 3D: accumulate each particle's rotation vector  */
 #define GK_RVE_DEF_COOKIE 0x52564531
 
 typedef struct gk_rve_def {
@@ -213,7 +214,9 @@ typedef struct gk_rve {
     gk_real *f[3];            /* contact force sum of the last step [N]             */
     gk_real *t[3];            /* contact torque sum of the last step (2D: t[2])     */
     gk_real *r, *minv, *Iinv;
-    double *theta;            /* 2D: accumulated rotation [rad] (incl. cell spin)   */
+    double *theta;            /* 2D: accumulated rotation [rad] (incl. cell spin);
+                                 3D with GK_RVE_TRACK_ROTATION: 3 n, the sum of the
+                                 rotation increments (w + cell spin) dt per particle */
     int32_t *id;              /* index in the input packing                         */
     double rmin, rmax, mmin, solid_volume, mass_total;
     /* pairs, sorted by (i, j) */
@@ -673,8 +676,10 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         R.Iinv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
         R.id = (int32_t *)gk_alloc(&def->alloc, (size_t)n * sizeof(int32_t));
         R.jstart = (int32_t *)gk_alloc(&def->alloc, ((size_t)n + 1) * sizeof(int32_t));
-        if (dim == 2) R.theta = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
-        if (!R.r || !R.minv || !R.Iinv || !R.id || !R.jstart || (dim == 2 && !R.theta)) res = GK_ERR_ALLOC;
+        if (dim == 2 || (def->flags & GK_RVE_TRACK_ROTATION))
+            R.theta = (double *)gk_alloc(&def->alloc, (size_t)n * (dim == 2 ? 1 : 3) * sizeof(double));
+        if (!R.r || !R.minv || !R.Iinv || !R.id || !R.jstart || ((dim == 2 || (def->flags & GK_RVE_TRACK_ROTATION)) && !R.theta))
+            res = GK_ERR_ALLOC;
         gk_pairlist_init(&R.pl, &def->alloc);
         gk_pairlist_init(&R.outer, &def->alloc);
         gk_pairlist_init(&R.spare.pl, &def->alloc);
@@ -718,7 +723,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                     break;
                 }
                 R.id[p] = q;
-                if (R.theta) R.theta[p] = 0.0;
+                if (R.theta)
+                    for (k = 0; k < (dim == 2 ? 1 : 3); ++k) R.theta[(dim == 2 ? 1 : 3) * p + k] = 0.0;
                 if (rq < R.rmin) R.rmin = rq;
                 if (rq > R.rmax) R.rmax = rq;
                 if (m < R.mmin) R.mmin = m;
@@ -2101,6 +2107,12 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
         rve->outer_valid = 0;
     }
     dispmax2 = gk__integrate(rve, &x, rve->cell.hinv, rve->cell.h, &bad);
+    if (rve->dim == 3 && rve->theta) { /* GK_RVE_TRACK_ROTATION: outside the kernels, paid only when asked */
+        int p;
+        for (p = 0; p < rve->n; ++p)
+            for (k = 0; k < 3; ++k)
+                rve->theta[3 * p + k] += ((double)x.wa[k] + (rve->w[k] ? (double)rve->w[k][p] : 0.0)) * rve->dt;
+    }
     rve->time += rve->dt;
     ++rve->step;
     if (bad) {
@@ -2599,7 +2611,8 @@ GKDEF gk_result gk_rve_reserve(gk_rve *rve, int cap) {
     if (gk_realloc(a, (void **)&rve->r, n, c, R) || gk_realloc(a, (void **)&rve->minv, n, c, R) ||
         gk_realloc(a, (void **)&rve->Iinv, n, c, R) || gk_realloc(a, (void **)&rve->id, n, c, sizeof(int32_t)) ||
         gk_realloc(a, (void **)&rve->jstart, n + 1, c + 1, sizeof(int32_t)) ||
-        (rve->theta && gk_realloc(a, (void **)&rve->theta, n, c, sizeof(double))))
+        (rve->theta && gk_realloc(a, (void **)&rve->theta, n * (rve->dim == 2 ? 1 : 3), c * (rve->dim == 2 ? 1 : 3),
+                                  sizeof(double))))
         return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
     rve->ncap = cap;
     return GK_OK;
@@ -2646,7 +2659,8 @@ GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], cons
         rve->minv[p] = (gk_real)(1.0 / m);
         rve->Iinv[p] = (gk_real)(1.0 / I);
         rve->id[p] = id[q];
-        if (rve->theta) rve->theta[p] = 0.0;
+        if (rve->theta)
+            for (a = 0; a < (dim == 2 ? 1 : 3); ++a) rve->theta[(dim == 2 ? 1 : 3) * p + a] = 0.0;
     }
     rve->n = n0 + k;
     gk_rve_update_totals(rve);
@@ -2684,7 +2698,8 @@ GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop) {
         rve->minv[q] = rve->minv[p];
         rve->Iinv[q] = rve->Iinv[p];
         rve->id[q] = rve->id[p];
-        if (rve->theta) rve->theta[q] = rve->theta[p];
+        if (rve->theta)
+            for (k = 0; k < (dim == 2 ? 1 : 3); ++k) rve->theta[(dim == 2 ? 1 : 3) * q + k] = rve->theta[(dim == 2 ? 1 : 3) * p + k];
         ++q;
     }
     /* survivors keep their order: the remapped pair list stays sorted by (i, j) */
@@ -2749,7 +2764,7 @@ static size_t gk__state_bytes(const gk_rve *rve, int npairs, int nouter) {
     size_t n = (size_t)rve->n, np = (size_t)npairs, R = sizeof(gk_real), b = sizeof(gk__state_hdr);
     b += n * (2 * dim * sizeof(double)); /* s, s0 */
     b += n * R * (2 * dim + 2 * nr);      /* v, f, w, t */
-    b += dim == 2 ? n * sizeof(double) : 0; /* theta */
+    b += rve->theta ? n * (dim == 2 ? 1 : 3) * sizeof(double) : 0; /* theta */
     b += np * (2 * sizeof(int32_t) + 1);   /* i, j, cs */
     b += np * R * ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll); /* ft, fc, tci, tcj, mr */
     b += (size_t)nouter * 2 * sizeof(int32_t) + n * dim * sizeof(double); /* outer list, o0 */
@@ -2821,7 +2836,7 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
             GK__PUT(rve->w[k], n * R);
             GK__PUT(rve->t[k], n * R);
         }
-    if (dim == 2) GK__PUT(rve->theta, n * sizeof(double));
+    if (rve->theta) GK__PUT(rve->theta, n * (dim == 2 ? 1 : 3) * sizeof(double));
     GK__PUT(rve->pl.i, np * sizeof(int32_t));
     GK__PUT(rve->pl.j, np * sizeof(int32_t));
     GK__PUT(rve->cs, np);
@@ -2972,10 +2987,10 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         if (!gk__finite_bytes(in + off, (2 * dim + 2 * nr) * n, R))
             return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite velocity, force, spin or torque");
         off += (2 * dim + 2 * nr) * n * R;
-        if (dim == 2) {
-            if (!gk__finite_bytes(in + off, n, dbl))
+        if (rve->theta) {
+            if (!gk__finite_bytes(in + off, n * (dim == 2 ? 1 : 3), dbl))
                 return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite rotation");
-            off += n * dbl;
+            off += n * (dim == 2 ? 1 : 3) * dbl;
         }
         ib = in + off;
         jb = ib + 4 * np;
@@ -3018,7 +3033,7 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
             GK__GET(rve->w[k], n * R);
             GK__GET(rve->t[k], n * R);
         }
-    if (dim == 2) GK__GET(rve->theta, n * sizeof(double));
+    if (rve->theta) GK__GET(rve->theta, n * (dim == 2 ? 1 : 3) * sizeof(double));
     GK__GET(rve->pl.i, np * sizeof(int32_t));
     GK__GET(rve->pl.j, np * sizeof(int32_t));
     GK__GET(rve->cs, np);

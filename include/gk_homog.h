@@ -64,7 +64,9 @@
  *   gk_homog_void_ratio        e = (V_cell - V_solid) / V_solid (2D: areas)
  *   gk_homog_unbalanced        mean |sum F_p| / mean |F_c| (YADE), and the
  *                              RMS ratio I_uf of seed 004 eq 57
- *   gk_homog_mean_rotation     2D mean particle rotation (incl. cell spin)
+ *   gk_homog_mean_rotation     2D mean particle rotation (incl. cell spin);
+ *                              3D (GK_RVE_TRACK_ROTATION): mean magnitude of
+ *                              the particles' accumulated rotation vectors
  *   gk_stress_p, gk_stress_q   p = -tr sigma / dim (compression-positive);
  *                              2D q = sqrt(s:s / 2) [seed 000 eq 7];
  *                              3D q = sqrt(3/2 s:s)
@@ -81,7 +83,8 @@
  *       n = ceil(I_1 / I_max) clamped to [n_min, n_max], I_1 the inertial
  *       number (eq 20) of dH applied in one step at the RVE's current
  *       pressure (p <= 0: n_max), so the deformation runs at I <= I_max;
- *       then, if the unbalanced force ratio (mean, as YADE) exceeds
+ *       then, if the unbalanced force ratio (mean, as YADE; or with
+ *       rms = 1 the RMS ratio I_uf of Liu et al. 2016 eq 57) exceeds
  *       uf_max, relaxation steps at fixed cell (L = 0) in chunks of
  *       `every` until it does not or the total reaches n_max (reported as
  *       capped). Quasi-static by construction; more steps where p is
@@ -130,12 +133,13 @@ typedef struct gk_adapt_def {
     double unbalanced_max; /* unbalanced force ratio to reach after it; 0 -> 5e-3     */
     int n_min, n_max;      /* bounds on the total DEM steps; 0 -> 10 and 5000          */
     int every;             /* relaxation steps between checks; 0 -> 20                 */
+    int rms;               /* 1: the RMS ratio I_uf (Liu, Sun, Yuan & Fish 2016 eq 57) */
 } gk_adapt_def;
 
 typedef struct gk_adapt_report {
     int n_deform, n_relax; /* steps of the deformation and of the relaxation         */
     double inertial;       /* I of the deformation (at the pressure before it)       */
-    double unbalanced;     /* mean unbalanced force ratio at the end                  */
+    double unbalanced;     /* unbalanced force ratio at the end (mean, or eq 57's RMS)  */
     int capped;            /* 1 if n_max stopped the relaxation above uf_max          */
 } gk_adapt_report;
 
@@ -605,8 +609,9 @@ GKDEF void gk_homog_unbalanced(const gk_rve *rve, double *mean_ratio, double *rm
 GKDEF double gk_homog_mean_rotation(const gk_rve *rve) {
     double s = 0.0;
     int p;
-    if (rve->dim != 2 || !rve->theta) return 0.0;
-    for (p = 0; p < rve->n; ++p) s += rve->theta[p];
+    if (!rve->theta) return 0.0;
+    for (p = 0; p < rve->n; ++p)
+        s += rve->dim == 2 ? rve->theta[p] : sqrt(gk_v3_dot(rve->theta + 3 * p, rve->theta + 3 * p));
     return s / rve->n;
 }
 
@@ -684,7 +689,7 @@ GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk
     R.inertial = isfinite(I1) ? I1 / n : I1;
     res = gk_rve_deform(rve, dH, R.n_deform);
     if (res) return res;
-    gk_homog_unbalanced(rve, &R.unbalanced, NULL);
+    gk_homog_unbalanced(rve, ad.rms ? NULL : &R.unbalanced, ad.rms ? &R.unbalanced : NULL);
     if (R.unbalanced > ad.unbalanced_max && R.n_deform < ad.n_max) {
         gk_m3_copy(rve->L, Lsave);
         gk_m3_zero(L0);
@@ -695,7 +700,7 @@ GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk
             res = gk_rve_step(rve, m);
             if (res) break;
             R.n_relax += m;
-            gk_homog_unbalanced(rve, &R.unbalanced, NULL);
+            gk_homog_unbalanced(rve, ad.rms ? NULL : &R.unbalanced, ad.rms ? &R.unbalanced : NULL);
         }
         gk_rve_set_velocity_gradient(rve, Lsave);
         if (res) return res;

@@ -59,7 +59,9 @@
  *     over n = clamp(ceil(I_1 / I_max), n_min, n_max) steps, I_1 the inertial
  *     number (seed 000 eq 20) of dH in one DEM step at the RVE's pressure,
  *     then relaxation at fixed cell in chunks of `every` steps while the
- *     unbalanced force ratio exceeds unbalanced_max, n_max steps in all.
+ *     unbalanced force ratio exceeds unbalanced_max, n_max steps in all
+ *     (the mean ratio, as YADE; unbalanced_rms = 1: the RMS ratio I_uf of
+ *     Liu, Sun, Yuan & Fish 2016 eq 57).
  *   GK_TWOSCALE_STRAIN: n = clamp(ceil(max|dH_ij| / strain), n_min, n_max),
  *     no relaxation (seed 000's scripts: strain = 1e-5).
  *   run_def.scale < 1 marks a cut-back increment: the bound is scaled with it
@@ -184,6 +186,7 @@ typedef struct gk_twoscale_rule {
     double strain;         /* strain rule: max |dH_ij| per DEM step; 0 -> 1e-5             */
     int n_min, n_max;      /* DEM steps per run, in all; 0 -> 10 and 5000                 */
     int every;             /* adaptive: relaxation steps between checks; 0 -> 20          */
+    int unbalanced_rms;    /* adaptive: 1 = the RMS ratio I_uf (Liu et al. 2016 eq 57), not the mean */
 } gk_twoscale_rule;
 
 typedef enum gk_twoscale_tangent_kind {
@@ -244,7 +247,7 @@ typedef struct gk_twoscale_field {
     double void_ratio;   /* gk_homog_void_ratio                                            */
     double coordination; /* Z = 2 contacts / particles                                     */
     double fabric;       /* |F_a| of the contact normals (gk_homog_fabric)                 */
-    double rotation;     /* 2D: mean particle rotation incl. the cell's spin [rad]; 3D: 0  */
+    double rotation;     /* gk_homog_mean_rotation [rad] (3D: 0 without GK_RVE_TRACK_ROTATION) */
     double spin;         /* rotation of the polar decomposition of I + H [rad]             */
     double eps_v, eps_q; /* of the small strain sym(H): tension-positive eps_v            */
     double volume, mass; /* stress volume [m^3 in 3D, m^2 x thickness in 2D], mass [kg]   */
@@ -551,7 +554,7 @@ static gk_result gk__ts_trial(const gk_twoscale *ts, gk__tspt *pt, const double 
         memset(&ad, 0, sizeof ad);
         memset(&rep, 0, sizeof rep);
         ad.inertial_max = r->inertial_max * scale, ad.unbalanced_max = r->unbalanced_max;
-        ad.n_min = r->n_min, ad.n_max = r->n_max, ad.every = r->every;
+        ad.n_min = r->n_min, ad.n_max = r->n_max, ad.every = r->every, ad.rms = r->unbalanced_rms;
         res = gk_rve_deform_adaptive(&pt->rve, H, &ad, &rep);
         *nd = rep.n_deform, *nr = rep.n_relax;
         return res;

@@ -3,7 +3,7 @@
  *   build/gk_pack --dim 2 --n 400 --rmin 0.003 --rmax 0.007 --pressure 1e5 \
  *                 [--consolidation-friction 0 | --target-void-ratio E] --out FILE
  *   build/gk_pack --dim 3 --n 1000 --rmin 2.15e-4 --rmax 5.9e-4 --pressure 4.16e5 \
- *                 --law hertz --G 2.9e10 --poisson 0.15 --friction-deg 26.56 \
+ *                 --law hertz --G 2.9e10 --poisson 0.15 --friction-deg 26.565 \
  *                 --density 2492 --dt-factor 0.2 --out FILE     (Hertz-Mindlin)
  *
  * A random loose cloud (no overlaps) is compressed by a stress servo until
