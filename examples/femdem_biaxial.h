@@ -11,7 +11,7 @@
 
 #define FDB_TAG "GKFEMDEM5" /* checkpoint block of the biaxial and single-element tests */
 #define FDB_MAX_FIELDS_AT 16
-#define FDB_FABRIC_LABEL "fabric anisotropy F_a [-] (eq 25; 1 and above: one colour)"
+#define FDB_FABRIC_LABEL "F_a [-]"
 
 /* the biaxial defaults (seed 000: 50 x 100 mm, 100 kPa, the authors' 8 x 16 Q8 mesh and RVE) */
 static void fdb_defaults(fd_model *M) {
@@ -67,7 +67,8 @@ static int fdb_check(fd_model *M) {
     {
         double v[FDB_MAX_FIELDS_AT];
         if (fdb_fields_at(o->fields_at, v) < 0) {
-            fd_say(M, "%s: --fields-at '%s' is not a list of at most %d positive axial strains in %% (4,4.8)\n",
+            fd_say(M,
+                   "%s: --fields-at '%s' is not a list of at most %d positive axial strains in %% (4,4.8)\n",
                    M->prog, o->fields_at, FDB_MAX_FIELDS_AT);
             return 2;
         }
@@ -112,8 +113,9 @@ static int fdb_restart(fd_model *M, gk_err *err) {
     size_t nh = (size_t)M->ngp * FD_NFIELD;
     if (!bad && !(M->hist = (double *)malloc((size_t)M->ncurve * nh * sizeof(double))))
         bad = 1, gk_err_set(err, GK_ERR_ALLOC, "out of memory");
-    if (!bad && (fd_get(&B, &M->inclast, sizeof(double)) || fd_get(&B, M->ulast, (size_t)M->ndof * sizeof(double)) ||
-                 fd_get(&B, M->hist, (size_t)M->ncurve * nh * sizeof(double)) || B.pos != B.n))
+    if (!bad &&
+        (fd_get(&B, &M->inclast, sizeof(double)) || fd_get(&B, M->ulast, (size_t)M->ndof * sizeof(double)) ||
+         fd_get(&B, M->hist, (size_t)M->ncurve * nh * sizeof(double)) || B.pos != B.n))
         bad = 1, gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the driver's block has the wrong length",
                             M->o.restart);
     free(B.b);
@@ -199,7 +201,8 @@ out:
 /* the Gauss-point fields of the last row (M->ncurve - 1) into M->hist; 0, or 1 (out of memory, said) */
 static int fdb_record(fd_model *M) {
     size_t nh = (size_t)M->ngp * FD_NFIELD;
-    double *f = fd_gp_fields(M), *h = f ? (double *)realloc(M->hist, (size_t)M->ncurve * nh * sizeof(double)) : NULL;
+    double *f = fd_gp_fields(M),
+           *h = f ? (double *)realloc(M->hist, (size_t)M->ncurve * nh * sizeof(double)) : NULL;
     if (h) M->hist = h, memcpy(h + (size_t)(M->ncurve - 1) * nh, f, nh * sizeof(double));
     free(f);
     return h ? 0 : (fd_say(M, "%s: out of memory\n", M->prog), 1);
@@ -218,13 +221,15 @@ static void fdb_first_row(fd_model *M, gk_err *err) {
 
 /* --fields-at: the fabric map when this row is the first at or past one of the strains. 0, or 1 */
 static int fdb_fields_now(fd_model *M) {
-    double v[FDB_MAX_FIELDS_AT], e1 = M->curve[M->ncurve - 1].eps, e0 = M->curve[M->ncurve - 2].eps, tiny = 1e-9;
+    double v[FDB_MAX_FIELDS_AT], e1 = M->curve[M->ncurve - 1].eps, e0 = M->curve[M->ncurve - 2].eps,
+                                 tiny = 1e-9;
     int n = fdb_fields_at(M->o.fields_at, v), k;
     char file[64], title[200];
     for (k = 0; k < n; ++k)
         if (e0 < 1e-2 * v[k] - tiny && e1 >= 1e-2 * v[k] - tiny) {
             snprintf(file, sizeof file, "fabric_field_%04d.svg", M->step);
-            snprintf(title, sizeof title, "fabric anisotropy at axial strain %.2f %%", 100 * e1);
+            snprintf(title, sizeof title, "fabric anisotropy F_a (eq 25) at axial strain %.2f %% (range 0-1)",
+                     100 * e1);
             return fd_write_field_svg(M, 7, file, title, FDB_FABRIC_LABEL, 0.0, 1.0);
         }
     return 0;
@@ -275,9 +280,9 @@ static int fdb_loop(fd_model *M, double t_start, gk_err *err) {
     return 0;
 }
 
-/* ---------------------------------------------- local histories (seed Figs 15, 17, 18) */
+/* ---------------------------------------------- local histories (Guo & Zhao 2014 Figs 15, 17, 18) */
 /* the three Gauss points of gp_history.csv, from the last row: inside the band (largest eps_q), at its
- * edge (largest void ratio, where points fail: seed Fig 17) and outside (smallest eps_q) */
+ * edge (largest void ratio, where points fail: Guo & Zhao 2014 Fig 17) and outside (smallest eps_q) */
 static const char *fdb_point_names[3] = {"inside", "edge", "outside"};
 static void fdb_points(const fd_model *M, int pt[3]) {
     const double *h = M->hist + (size_t)(M->ncurve - 1) * M->ngp * FD_NFIELD;
@@ -301,15 +306,16 @@ static void fdb_history_row(FILE *fp, const fd_model *M, int k, const void *user
     for (i = 0; i < 3; ++i) {
         double x[3];
         gk_mesh_point(&M->mesh, pt[i] / M->q.n, M->q.xi[pt[i] % M->q.n], x);
-        fprintf(fp, "%s,%d,%.6g,%.6g,%d,%.9g", fdb_point_names[i], pt[i], 1e3 * x[0], 1e3 * x[1], k, M->curve[k].eps);
+        fprintf(fp, "%s,%d,%.6g,%.6g,%d,%.9g", fdb_point_names[i], pt[i], 1e3 * x[0], 1e3 * x[1], k,
+                M->curve[k].eps);
         for (f = 0; f < FD_NFIELD - 1; ++f) fprintf(fp, ",%.9g", fdb_h(M, k, pt[i], f) + 0.0); /* no -0 */
         fprintf(fp, "\n");
     }
 }
 
 /* one plot of the three points: field fy against field fx, each times its scale */
-static int fdb_history_plot(const fd_model *M, const int pt[3], int fx, double sx, int fy, double sy, const char *title,
-                            const char *xl, const char *yl, const char *file) {
+static int fdb_history_plot(const fd_model *M, const int pt[3], int fx, double sx, int fy, double sy,
+                            const char *title, const char *xl, const char *yl, const char *file) {
     int n = M->ncurve, i, k, bad;
     double *v = (double *)malloc((size_t)6 * n * sizeof(double));
     char lab[3][80];
@@ -318,7 +324,8 @@ static int fdb_history_plot(const fd_model *M, const int pt[3], int fx, double s
     gk_plot_init(&pl, title, xl, yl);
     for (i = 0; i < 3; ++i) {
         for (k = 0; k < n; ++k)
-            v[2 * i * n + k] = sx * fdb_h(M, k, pt[i], fx), v[(2 * i + 1) * n + k] = sy * fdb_h(M, k, pt[i], fy);
+            v[2 * i * n + k] = sx * fdb_h(M, k, pt[i], fx),
+                          v[(2 * i + 1) * n + k] = sy * fdb_h(M, k, pt[i], fy);
         snprintf(lab[i], sizeof lab[i], "Gauss point %d, %s", pt[i], fdb_point_names[i]);
         gk_plot_add(&pl, v + 2 * i * n, v + (2 * i + 1) * n, n, lab[i]);
     }
@@ -338,14 +345,18 @@ static int fdb_local(fd_model *M) {
                        "point,gp,x_mm,y_mm,step,eps_axial,eps_q,eps_v,void_ratio,rotation_deg,spin_deg,p,q,"
                        "fabric_anisotropy,coordination\n",
                        fdb_history_row, pt);
-    bad = bad || fdb_history_plot(M, pt, 0, 100, 6, 1e-3, "Gauss-point histories (seed Fig 15): deviatoric stress",
+    bad = bad || fdb_history_plot(M, pt, 0, 100, 6, 1e-3,
+                                  "Gauss-point histories (Guo & Zhao 2014 Fig 15): deviatoric stress",
                                   "eps_q [%]", "q [kPa] (eq 7)", "gp_history_q.svg");
-    bad = bad || fdb_history_plot(M, pt, 0, 100, 1, 100, "Gauss-point histories (seed Fig 15): volume", "eps_q [%]",
-                                  "eps_v [%] (contraction positive)", "gp_history_volume.svg");
-    bad = bad || fdb_history_plot(M, pt, 5, 1e-3, 6, 1e-3, "Gauss-point stress paths (seed Fig 15)", "p [kPa] (eq 6)",
-                                  "q [kPa] (eq 7)", "gp_history_path.svg");
-    bad = bad || fdb_history_plot(M, pt, 0, 100, 7, 1, "Gauss-point histories (seed Fig 15): fabric", "eps_q [%]",
-                                  "fabric anisotropy F_a (eq 25)", "gp_history_fabric.svg");
+    bad = bad ||
+          fdb_history_plot(M, pt, 0, 100, 1, 100, "Gauss-point histories (Guo & Zhao 2014 Fig 15): volume",
+                           "eps_q [%]", "eps_v [%] (contraction positive)", "gp_history_volume.svg");
+    bad =
+        bad || fdb_history_plot(M, pt, 5, 1e-3, 6, 1e-3, "Gauss-point stress paths (Guo & Zhao 2014 Fig 15)",
+                                "p [kPa] (eq 6)", "q [kPa] (eq 7)", "gp_history_path.svg");
+    bad =
+        bad || fdb_history_plot(M, pt, 0, 100, 7, 1, "Gauss-point histories (Guo & Zhao 2014 Fig 15): fabric",
+                                "eps_q [%]", "fabric anisotropy F_a (eq 25)", "gp_history_fabric.svg");
     if (!x) return fd_say(M, "%s: out of memory\n", M->prog), 1;
     for (k = 0; k < n; ++k) {
         x[k] = 100 * M->curve[k].eps, x[n + k] = 100.0 * M->curve[k].failed / M->ngp;
@@ -355,18 +366,21 @@ static int fdb_local(fd_model *M) {
             if (fdb_h(M, k, g, 7) > famax) famax = fdb_h(M, k, g, 7);
         if (fdb_h(M, k, pt[2], 0) > outmax) outmax = fdb_h(M, k, pt[2], 0);
     }
-    gk_plot_init(&pl, "Failed Gauss points (fewer contacts than half the particles; seed Fig 17)", "axial strain [%]",
-                 "failed Gauss points [% of all]");
+    gk_plot_init(&pl, "Failed Gauss points (fewer contacts than half the particles; Guo & Zhao 2014 Fig 17)",
+                 "axial strain [%]", "failed Gauss points [% of all]");
     gk_plot_add(&pl, x, x + n, n, NULL);
     bad = bad || fd_plot(M, &pl, "failed_fraction.svg");
     free(x);
-    snprintf(title, sizeof title, "fabric anisotropy at axial strain %.2f %%", 100 * M->eps_done);
+    snprintf(title, sizeof title, "fabric anisotropy F_a (eq 25) at axial strain %.2f %% (range 0-1)",
+             100 * M->eps_done);
     bad = bad || fd_write_field_svg(M, 7, "fabric_field.svg", title, FDB_FABRIC_LABEL, 0.0, 1.0);
     if (bad || !M->root) return bad;
-    printf("LOCAL inside_gp=%d inside_eps_q=%.4g edge_gp=%d edge_void_ratio=%.4g outside_gp=%d outside_eps_q=%.4g "
+    printf("LOCAL inside_gp=%d inside_eps_q=%.4g edge_gp=%d edge_void_ratio=%.4g outside_gp=%d "
+           "outside_eps_q=%.4g "
            "outside_eps_q_max=%.4g first_failed_eps=%.4g failed_fraction_mean=%.4g fabric_max=%.4g\n",
-           pt[0], fdb_h(M, n - 1, pt[0], 0), pt[1], fdb_h(M, n - 1, pt[1], 2), pt[2], fdb_h(M, n - 1, pt[2], 0), outmax,
-           first >= 0 ? M->curve[first].eps : NAN, nafter ? 1e-2 * fsum / nafter : 0.0, famax);
+           pt[0], fdb_h(M, n - 1, pt[0], 0), pt[1], fdb_h(M, n - 1, pt[1], 2), pt[2],
+           fdb_h(M, n - 1, pt[2], 0), outmax, first >= 0 ? M->curve[first].eps : NAN,
+           nafter ? 1e-2 * fsum / nafter : 0.0, famax);
     return 0;
 }
 
@@ -399,7 +413,7 @@ static int fdb_finish(fd_model *M, int status) {
     }
     free(x), free(y1), free(y2);
     snprintf(title, sizeof title, "eps_q at axial strain %.2f %%", 100 * M->eps_done);
-    bad = bad || fd_write_field_svg(M, 0, "eps_q_field.svg", title, "eps_q [-] (eq 13)", 0, 0);
+    bad = bad || fd_write_field_svg(M, 0, "eps_q_field.svg", title, "eps_q [-]", 0, 0);
     bad = bad || fdb_local(M);
     bad = bad || (status != 3 && fdb_checkpoint(M));
     if (bad) return 1;

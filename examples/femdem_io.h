@@ -84,7 +84,8 @@ static int fd_write_field_svg(fd_model *M, int field, const char *file, const ch
                               double vmin, double vmax) {
     int per = M->o.quad, e, i, j, c, a, g = 0, bad = 0, len[2] = {2, 2};
     double *all = fd_gp_fields(M), *xy = (double *)malloc((size_t)M->ngp * 8 * sizeof(double)),
-           *val = (double *)malloc((size_t)M->ngp * sizeof(double)), line[8], lo = HUGE_VAL, hi = -HUGE_VAL, yt = 0;
+           *val = (double *)malloc((size_t)M->ngp * sizeof(double)), line[8], lo = HUGE_VAL, hi = -HUGE_VAL,
+           yt = 0;
     char path[1200];
     gk_err err;
     gk_field_def d;
@@ -107,7 +108,8 @@ static int fd_write_field_svg(fd_model *M, int field, const char *file, const ch
             if (M->mesh.x[2 * a] > hi) hi = M->mesh.x[2 * a];
         }
         for (a = 0; a < M->ntop; ++a) yt += M->mesh.x[2 * M->top[a] + 1] / M->ntop;
-        line[0] = lo, line[1] = 0.0, line[2] = hi, line[3] = 0.0, line[4] = lo, line[5] = yt, line[6] = hi, line[7] = yt;
+        line[0] = lo, line[1] = 0.0, line[2] = hi, line[3] = 0.0, line[4] = lo, line[5] = yt, line[6] = hi,
+        line[7] = yt;
         memset(&d, 0, sizeof d);
         d.title = title, d.label = label, d.xlabel = "x [mm]", d.ylabel = "y [mm]", d.coord_scale = 1e3;
         d.fixed_range = vmax > vmin, d.vmin = vmin, d.vmax = vmax;

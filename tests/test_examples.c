@@ -153,7 +153,7 @@ static int refused(const char *bin, const char *flags, const char *msg);
 /* femdem_biaxial's local outputs (Guo & Zhao 2014 Figs 15, 17, 18): gp_history.csv holds, per row,
  * the three chosen Gauss points (inside: largest final eps_q, edge: largest final void ratio, outside:
  * smallest final eps_q). Before the peak every point of this uniform 2 x 2 specimen follows the drained
- * path of the seed's biaxial test: sigma_xx stays at the confinement, so with p and q of eqs 6-7
+ * path of Guo & Zhao's (2014) biaxial test: sigma_xx stays at the confinement, so with p and q of eqs 6-7
  * (p = (s1 + s2) / 2, q = |s1 - s2| / 2) dq = dp, the 1:1 slope of Fig 15. */
 TEST(femdem_biaxial_local_histories) {
     FILE *fp;
@@ -175,8 +175,9 @@ TEST(femdem_biaxial_local_histories) {
         memcpy(name, line, (size_t)(c - line)), name[c - line] = 0;
         i = !strcmp(name, "inside") ? 0 : !strcmp(name, "edge") ? 1 : !strcmp(name, "outside") ? 2 : -1;
         CHECK(i == rows % 3);
-        if (i < 0 || sscanf(c + 1, "%d,%lf,%lf,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &gp, &y, &y, &step, &x[0],
-                            &x[1], &x[2], &x[3], &x[4], &x[5], &x[6], &x[7], &x[8], &x[9]) != 14)
+        if (i < 0 ||
+            sscanf(c + 1, "%d,%lf,%lf,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &gp, &y, &y, &step, &x[0],
+                   &x[1], &x[2], &x[3], &x[4], &x[5], &x[6], &x[7], &x[8], &x[9]) != 14)
             break;
         CHECK_EQ_INT(step, rows / 3);
         if (step == 0 || step == 4) memcpy(v[i][step == 4], x, sizeof x);
