@@ -204,6 +204,32 @@ TEST(femdem_biaxial_local_histories) {
     CHECK(refused("femdem_biaxial", "--fields-at -1", "is not a list"));
 }
 
+/* examples/data/rve400_hex.txt, the regular RVE of Guo & Zhao 2014 Sec 4.1.4: 400 equal disks on a
+ * hexagonal lattice whose overlap delta makes the Love stress (eq 5) of the lattice, sqrt(3) k_n delta /
+ * (a Lz) in every direction, exactly 100 kPa: the RVE read by rve_path is isotropic at 100 kPa with 6
+ * contacts per disk and void ratio sqrt(3) a^2 / (2 pi r^2) - 1 = 0.098426 */
+TEST(hexagonal_rve_is_isotropic_at_100_kPa) {
+    FILE *fp;
+    char line[1024];
+    double v[12];
+    int ok = 0;
+    CHECK(system("build/rve_path --packing examples/data/rve400_hex.txt --dH \"0 0 0 0\" --increments 1 "
+                 "--steps-per-increment 10 --out build/t_hex.csv > build/t_hex.out 2>&1") == 0);
+    fp = fopen("build/t_hex.csv", "r");
+    CHECK(fp != NULL);
+    if (!fp) return;
+    while (fgets(line, sizeof line, fp))
+        ok = sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4],
+                    &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) == 12;
+    fclose(fp);
+    CHECK(ok);
+    CHECK_NEAR(v[5], 1e5, 1e-3); /* sxx after 10 DEM steps: the lattice is in equilibrium */
+    CHECK_NEAR(v[6], 1e5, 1e-3); /* syy */
+    CHECK_NEAR(v[9], 0.0, 1e-3); /* q */
+    CHECK_NEAR(v[10], 0.098426, 1e-6);
+    CHECK_NEAR(v[11], 6.0, 1e-12);
+}
+
 /* femdem_biaxial (seed 000): documented CSV header and RESULT line, VTK and
  * SVG outputs; the same result for 1 and 2 threads; a restart from a
  * checkpoint continues to the identical curve; the initial state carries the
@@ -847,6 +873,7 @@ int main(int argc, char **argv) {
     RUN(gk_pack_makes_a_consolidated_packing);
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
     RUN(femdem_biaxial_local_histories);
+    RUN(hexagonal_rve_is_isotropic_at_100_kPa);
     RUN(femdem_single_element_matches_rve_alone);
     RUN(femdem_single_reference_holds_the_lateral_stress);
     RUN(femdem_single_reference_through_a_slip);
