@@ -151,18 +151,18 @@ static void fdb_macro_state(const fd_model *M, double *syy, double *sxx, double 
 
 /* shear band from the eps_q field: points above the median + half the range; angle of their principal
  * axis from the horizontal (weighted by excess eps_q), width = sqrt(12 var) of the perpendicular
- * distances (a uniform band of width W has variance W^2/12). No band (NAN) if max eps_q < 1.5 x
- * median. */
+ * distances (a uniform band of width W has variance W^2/12); *mid: the band point nearest their
+ * weighted centroid. No band (NAN, *mid = -1) if max eps_q < 1.5 x median. */
 static int fdb_cmp_d(const void *a, const void *b) {
     double x = *(const double *)a, y = *(const double *)b;
     return x < y ? -1 : x > y;
 }
-static void fdb_band(fd_model *M, double *angle, double *width) {
+static void fdb_band(fd_model *M, double *angle, double *width, int *mid) {
     double *all = fd_gp_fields(M), *v = (double *)malloc((size_t)M->ngp * sizeof(double)),
            *s = (double *)malloc((size_t)M->ngp * sizeof(double));
-    double med, mx, thr, sw = 0, cx = 0, cy = 0, sxx = 0, syy = 0, sxy = 0, th, nx, ny, var = 0;
+    double med, mx, thr, sw = 0, cx = 0, cy = 0, sxx = 0, syy = 0, sxy = 0, th, nx, ny, var = 0, dmin = HUGE_VAL;
     int g;
-    *angle = *width = NAN;
+    *angle = *width = NAN, *mid = -1;
     if (!all || !v || !s) goto out;
     for (g = 0; g < M->ngp; ++g) v[g] = s[g] = all[FD_NFIELD * g];
     qsort(s, (size_t)M->ngp, sizeof(double), fdb_cmp_d);
@@ -190,6 +190,8 @@ static void fdb_band(fd_model *M, double *angle, double *width) {
         gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], x);
         d = (x[0] - cx) * nx + (x[1] - cy) * ny;
         var += w * d * d;
+        if ((x[0] - cx) * (x[0] - cx) + (x[1] - cy) * (x[1] - cy) < dmin)
+            dmin = (x[0] - cx) * (x[0] - cx) + (x[1] - cy) * (x[1] - cy), *mid = g;
     }
     *angle = fabs(th * 180.0 / FD_PI);
     if (*angle > 90) *angle = 180 - *angle;
@@ -281,10 +283,11 @@ static int fdb_loop(fd_model *M, double t_start, gk_err *err) {
 }
 
 /* ---------------------------------------------- local histories (Guo & Zhao 2014 Figs 15, 17, 18) */
-/* the three Gauss points of gp_history.csv, from the last row: inside the band (largest eps_q), at its
- * edge (largest void ratio, where points fail: Guo & Zhao 2014 Fig 17) and outside (smallest eps_q) */
+/* the three Gauss points of gp_history.csv, from the last row: inside the band (mid: the band point
+ * nearest the band's centre, fdb_band; without a band the largest eps_q), at its edge (largest void
+ * ratio, where points fail: Guo & Zhao 2014 Fig 17) and outside (smallest eps_q) */
 static const char *fdb_point_names[3] = {"inside", "edge", "outside"};
-static void fdb_points(const fd_model *M, int pt[3]) {
+static void fdb_points(const fd_model *M, int mid, int pt[3]) {
     const double *h = M->hist + (size_t)(M->ncurve - 1) * M->ngp * FD_NFIELD;
     int g;
     pt[0] = pt[1] = pt[2] = 0;
@@ -293,6 +296,7 @@ static void fdb_points(const fd_model *M, int pt[3]) {
         if (h[FD_NFIELD * g + 2] > h[FD_NFIELD * pt[1] + 2]) pt[1] = g;
         if (h[FD_NFIELD * g] < h[FD_NFIELD * pt[2]]) pt[2] = g;
     }
+    if (mid >= 0) pt[0] = mid;
 }
 
 /* field k of Gauss point g at row r */
@@ -335,12 +339,12 @@ static int fdb_history_plot(const fd_model *M, const int pt[3], int fx, double s
 }
 
 /* gp_history.csv and its plots, failed_fraction.svg, fabric_field.svg and the LOCAL line. 0, or 1 */
-static int fdb_local(fd_model *M) {
+static int fdb_local(fd_model *M, int mid) {
     int pt[3], n = M->ncurve, k, g, bad, first = -1, nafter = 0;
     double *x = (double *)malloc((size_t)2 * n * sizeof(double)), fsum = 0, famax = 0, outmax = 0;
     gk_plot pl;
     char title[200];
-    fdb_points(M, pt);
+    fdb_points(M, mid, pt);
     bad = fd_write_csv(M, "gp_history.csv",
                        "point,gp,x_mm,y_mm,step,eps_axial,eps_q,eps_v,void_ratio,rotation_deg,spin_deg,p,q,"
                        "fabric_anisotropy,coordination\n",
@@ -392,7 +396,7 @@ static int fdb_finish(fd_model *M, int status) {
     double *x = (double *)malloc((size_t)M->ncurve * sizeof(double)),
            *y1 = (double *)malloc((size_t)M->ncurve * sizeof(double)),
            *y2 = (double *)malloc((size_t)M->ncurve * sizeof(double)), peak = 0, epk = 0, ang, wid, tot = 0;
-    int k, itmax = 0, itsum = 0, bad = !x || !y1 || !y2;
+    int k, itmax = 0, itsum = 0, bad = !x || !y1 || !y2, mid;
     char title[200];
     gk_plot pl;
     bad = bad || fdb_write_csv(M);
@@ -414,7 +418,8 @@ static int fdb_finish(fd_model *M, int status) {
     free(x), free(y1), free(y2);
     snprintf(title, sizeof title, "eps_q at axial strain %.2f %%", 100 * M->eps_done);
     bad = bad || fd_write_field_svg(M, 0, "eps_q_field.svg", title, "eps_q [-]", 0, 0);
-    bad = bad || fdb_local(M);
+    fdb_band(M, &ang, &wid, &mid);
+    bad = bad || fdb_local(M, mid);
     bad = bad || (status != 3 && fdb_checkpoint(M));
     if (bad) return 1;
     for (k = 0; k < M->ncurve; ++k) {
@@ -422,7 +427,6 @@ static int fdb_finish(fd_model *M, int status) {
         if (M->curve[k].iters > itmax) itmax = M->curve[k].iters;
         if (k > 0) itsum += M->curve[k].iters, tot += M->curve[k].secs;
     }
-    fdb_band(M, &ang, &wid);
     if (!M->root) return status;
     printf("wrote %s/biaxial.csv, %s/gp_*.vtk and mesh_*.vtk (ParaView), %s/biaxial_stress.svg, biaxial_volume.svg, "
            "eps_q_field.svg, checkpoint.bin\n",
