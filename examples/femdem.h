@@ -53,6 +53,7 @@ typedef struct fd_opts {
     int extrapolate;            /* predictor: the last converged increment, scaled (1), or the tangent solve (0) */
     int relax_kind;             /* --relaxation aitken|anderson|none */
     unsigned long packing_seed; /* --packing A,B,...: seed of the per-Gauss-point draw */
+    const char *fields_at;      /* --fields-at: axial strains [%] of the fabric maps (biaxial) */
 } fd_opts;
 
 /* one row of a driver's CSV: the state after a converged step and the work of the step */
@@ -90,6 +91,7 @@ typedef struct fd_model {
     int step;
     fd_row *curve;
     int ncurve, cap;
+    double *hist;          /* biaxial: the Gauss-point fields (FD_NFIELD each) of every row */
     /* cyclic: periodic ties, condensed matrix, reduced work arrays */
     gk_dofmap dm;
     gk_csr Kr;
@@ -515,7 +517,7 @@ static void fd_free(fd_model *M) {
     void *p[] = {M->dH,   M->sig,   M->sig_n, M->D,    M->D_n,   M->dNdx, M->detJ,  M->v0,   M->failed,
                  M->u,    M->du,    M->dprev, M->andF, M->andG,  M->fprev, M->Gprev, M->fint, M->fext,
                  M->R,    M->rhs,   M->utot,  M->ulast, M->A0x,  M->fix,  M->fixtop, M->top, M->right,
-                 M->lface, M->rface, M->rfix, M->rvals, M->rr,   M->ur,   M->curve};
+                 M->lface, M->rface, M->rfix, M->rvals, M->rr,   M->ur,   M->curve, M->hist};
     size_t k;
     for (k = 0; k < sizeof p / sizeof *p; ++k) free(p[k]);
     gk_twoscale_destroy(&M->ts);

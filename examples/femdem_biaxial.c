@@ -2,7 +2,7 @@
  *
  *   build/femdem_biaxial --nx 8 --ny 16 --element q8 --steps 100 --threads 2 --out DIR
  *                        [--tangent taylor|yade|relaxed|perturbation] [--restart DIR]
- *                        [--test biaxial|single]
+ *                        [--test biaxial|single] [--fields-at 4,4.8]
  *   mpirun -np R build/femdem_biaxial_mpi ...   (make mpi: the RVEs over R ranks, the same numbers)
  *
  * A 2D plane-strain mesh (Q4 or Q8) of a 50 x 100 mm specimen with a periodic 400-disk RVE
@@ -76,9 +76,25 @@
  *   gp_NNNN.vtk   Gauss-point fields per step (eps_q, eps_v, void_ratio, rotation_deg, spin_deg, p, q,
  *                 fabric_anisotropy, coordination, dem_steps), mesh_NNNN.vtk the deformed mesh
  *   biaxial_stress.svg, biaxial_volume.svg, eps_q_field.svg (final eps_q)
+ *   gp_history.csv point,gp,x_mm,y_mm,step,eps_axial,eps_q,eps_v,void_ratio,rotation_deg,spin_deg,p,q,
+ *                 fabric_anisotropy,coordination: per row of biaxial.csv, three Gauss points chosen on the
+ *                 final state (Guo & Zhao 2014 Fig 15): inside = the band point (fdb_band) nearest the
+ *                 band's centre (no band: the largest eps_q), edge = the largest void ratio (where
+ *                 points fail, Fig 17), outside = the smallest eps_q; x, y of the final mesh. Plots:
+ *                 gp_history_q.svg (q vs eps_q), gp_history_volume.svg (eps_v vs eps_q),
+ *                 gp_history_path.svg (q vs p), gp_history_fabric.svg (F_a vs eps_q). The fields of
+ *                 every Gauss point and row are kept (ngp x 10 doubles per row) and in the checkpoint.
+ *   failed_fraction.svg  failed Gauss points [% of all] vs axial strain (Fig 17; failed: fewer
+ *                 contacts than half the particles; the count is biaxial.csv's failed_gp)
+ *   fabric_field.svg     F_a (eq 25) at the end, and fabric_field_NNNN.svg at the first step at or past
+ *                 each --fields-at strain (Fig 18: --fields-at 4,4.8); colour range fixed at [0, 1]
+ *                 (F_a = 2 when all normals are parallel; above 1: the top colour)
  *   single_element.csv/svg (--test single: FEM element vs the RVE alone)
  *   checkpoint.bin every --checkpoint K steps and at the end (gk_twoscale_save: checksummed)
  * and prints per step a progress line with ETA and finally
+ *   LOCAL inside_gp=... inside_eps_q=... edge_gp=... edge_void_ratio=... outside_gp=... outside_eps_q=...
+ *         outside_eps_q_max=... first_failed_eps=... (nan: none) failed_fraction_mean=... (from the first
+ *         failure on) fabric_max=... (any point, any row)
  *   RESULT peak_sigma_yy=... eps_at_peak=... band_angle_deg=... band_width_mm=... total_seconds=...
  *          mean_iterations=... dem_rule=... dem_steps_total=... dem_steps_max=... tangents_reused=...
  *          tangents_computed=...
@@ -106,6 +122,9 @@ static void usage(FILE *fp) {
             "                         once formed, is carried into the next step)\n"
             "  --width, --height M    specimen size [m] (0.05 x 0.1)\n"
             "  --pressure P           confining pressure [Pa] (1e5)\n"
+            "  --fields-at A,B        also write fabric_field_NNNN.svg at these axial strains [%%] (Guo & Zhao\n"
+            "                         2014 Fig 18: 4,4.8); gp_history.csv, failed_fraction.svg and\n"
+            "                         fabric_field.svg (final) are always written\n"
             "  (defaults: --nx 8 --ny 16 --vtk-every 1 --packing examples/data/rve400.txt)\n");
     fd_usage_common(fp);
     fprintf(fp, "\nbiaxial.csv ends with dem_steps_mean,dem_steps_max (per Gauss point, accepted iterate),\n"

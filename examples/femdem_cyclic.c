@@ -87,6 +87,8 @@ static void usage(FILE *fp) {
             "  --cycles N             stop after N cycles (default 20)\n"
             "  --liq-ratio R          liquefaction when p' < R x p'_0 (default 0.1); cyclic-strain stops there\n"
             "  --gamma-limit G        cyclic-stress: stop when |gamma| >= G (default 0.05, the seed's 5 %%)\n"
+            "  --paper-mesh           Guo & Zhao 2014's mesh: 15 x 10 Q4 elements, 2 x 2 Gauss points (600 RVEs;\n"
+            "                         its cost: examples/README.md, cyclic simple shear)\n"
             "  --pressure P           initial isotropic stress [Pa]: when it differs from the packing's own by\n"
             "                         more than 0.5 %% the RVE is first re-consolidated to P with its contact\n"
             "                         friction (default: the packing as it is, 100 kPa for the shipped ones)\n"
@@ -364,8 +366,8 @@ static int cyclic_summary(cyc_model *C, int status) {
         bad = bad || fd_plot(M, &pl, "cyclic_pressure.svg");
         free(v);
     }
-    snprintf(title, sizeof title, "void ratio after %.2f cycles, gamma = %.2f %% (x, y in mm)", xl->cycle, 100 * c->gamma);
-    bad = bad || fd_write_field_svg(M, 2, "void_ratio_field.svg", title);
+    snprintf(title, sizeof title, "void ratio after %.2f cycles, gamma = %.2f %%", xl->cycle, 100 * c->gamma);
+    bad = bad || fd_write_field_svg(M, 2, "void_ratio_field.svg", title, "void ratio e [-]", 0, 0);
     bad = bad || ((!o->vtk_every || M->step % o->vtk_every) && fd_write_vtk(M, M->step));
     bad = bad || (status != 3 && checkpoint(M));
     if (bad) return 1;
@@ -413,6 +415,7 @@ static int parse(cyc_model *C, int argc, char **argv, int *help) {
     fd_model *M = &C->m;
     fd_opts *o = &M->o;
     const char *prog = M->root ? M->prog : NULL;
+    int paper = 0;
     const cli_opt own[] = {
         {"--test", CLI_CHOICE, &C->test, 0, 0, NULL, "cyclic-strain|cyclic-stress", 0},
         {"--amplitude", CLI_REAL, &C->amp, 0, 0.5, "a shear strain in (0, 0.5)", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
@@ -421,6 +424,7 @@ static int parse(cyc_model *C, int argc, char **argv, int *help) {
         {"--cycles", CLI_REAL, &C->cycles, 0, 1e5, "a number of cycles in (0, 1e5]", NULL, CLI_LO_OPEN},
         {"--liq-ratio", CLI_REAL, &C->liq_ratio, 0, 1, "a fraction in (0, 1)", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
         {"--gamma-limit", CLI_REAL, &C->gamma_stop, 0, HUGE_VAL, "a positive shear strain", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--paper-mesh", CLI_FLAG, &paper, 0, 0, NULL, NULL, 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     const cli_opt *tables[3];
     fd_opts_default(o);
@@ -429,6 +433,14 @@ static int parse(cyc_model *C, int argc, char **argv, int *help) {
     C->amp = 0.01, C->tau_amp = 3e4, C->stress_steps = 6, C->cycles = 20, C->gamma_stop = 0.05, C->liq_ratio = 0.1;
     tables[0] = fd_common_opts(o), tables[1] = own, tables[2] = NULL;
     if (cli_parse(prog, argc, argv, tables, help) || *help) return *help ? 0 : 2;
+    if (paper) { /* Guo & Zhao 2014 Sec 5: 15 x 10 elements, 600 Gauss points */
+        if (o->nx != 2 || o->ny != 2 || o->elem_kind != 1 || o->quad != 2) {
+            cli_say(prog, "%s: --paper-mesh is 15 x 10 Q4 elements with 2 x 2 Gauss points: give it or --nx, --ny, "
+                          "--element, --quad\n", prog);
+            return 2;
+        }
+        o->nx = 15, o->ny = 10, o->elem_kind = 0, o->quad = 2;
+    }
     o->cyclic = C->test + 1;
     o->test = C->test ? "cyclic-stress" : "cyclic-strain";
     if (!o->packing) o->packing = C->test ? "examples/data/rve400_e0209.txt" : "examples/data/rve400_e0223.txt";

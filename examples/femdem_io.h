@@ -76,14 +76,19 @@ static int fd_write_vtk(fd_model *M, int step) {
     return fd_agree(M, bad);
 }
 
-/* a Gauss-point field (fd_gp_fields index) as a map: each Gauss point owns the sub-quad of its
- * element around it */
-static int fd_write_field_svg(fd_model *M, int field, const char *file, const char *title) {
-    int per = M->o.quad, e, i, j, c, g = 0, bad = 0;
+/* a Gauss-point field (fd_gp_fields index) as a map in mm: each Gauss point owns the sub-quad of its
+ * element around it; the platens (the bottom and top node rows) drawn on top; label: the colour bar's
+ * quantity with its unit; range [vmin, vmax] fixed when vmax > vmin (values beyond take the end
+ * colours), else the field's own */
+static int fd_write_field_svg(fd_model *M, int field, const char *file, const char *title, const char *label,
+                              double vmin, double vmax) {
+    int per = M->o.quad, e, i, j, c, a, g = 0, bad = 0, len[2] = {2, 2};
     double *all = fd_gp_fields(M), *xy = (double *)malloc((size_t)M->ngp * 8 * sizeof(double)),
-           *val = (double *)malloc((size_t)M->ngp * sizeof(double));
+           *val = (double *)malloc((size_t)M->ngp * sizeof(double)), line[8], lo = HUGE_VAL, hi = -HUGE_VAL,
+           yt = 0;
     char path[1200];
     gk_err err;
+    gk_field_def d;
     if (!all || !xy || !val) bad = 1;
     if (!bad && M->root) {
         for (e = 0; e < M->mesh.nelem; ++e)
@@ -94,12 +99,23 @@ static int fd_write_field_svg(fd_model *M, int field, const char *file, const ch
                         double xi[3], x[3];
                         xi[0] = -1 + 2.0 * (i + ci[c][0]) / per, xi[1] = -1 + 2.0 * (j + ci[c][1]) / per, xi[2] = 0;
                         gk_mesh_point(&M->mesh, e, xi, x);
-                        xy[8 * g + 2 * c] = x[0] * 1e3, xy[8 * g + 2 * c + 1] = x[1] * 1e3;
+                        xy[8 * g + 2 * c] = x[0], xy[8 * g + 2 * c + 1] = x[1];
                     }
                     val[g] = all[FD_NFIELD * g + field];
                 }
+        for (a = 0; a < M->mesh.nnode; ++a) { /* the platens span the specimen's extent in x */
+            if (M->mesh.x[2 * a] < lo) lo = M->mesh.x[2 * a];
+            if (M->mesh.x[2 * a] > hi) hi = M->mesh.x[2 * a];
+        }
+        for (a = 0; a < M->ntop; ++a) yt += M->mesh.x[2 * M->top[a] + 1] / M->ntop;
+        line[0] = lo, line[1] = 0.0, line[2] = hi, line[3] = 0.0, line[4] = lo, line[5] = yt, line[6] = hi,
+        line[7] = yt;
+        memset(&d, 0, sizeof d);
+        d.title = title, d.label = label, d.xlabel = "x [mm]", d.ylabel = "y [mm]", d.coord_scale = 1e3;
+        d.fixed_range = vmax > vmin, d.vmin = vmin, d.vmax = vmax;
+        d.nlines = 2, d.line_len = len, d.line_xy = line;
         snprintf(path, sizeof path, "%s/%s", M->o.out, file);
-        bad = gk_svg_field(path, title, fd_field_names[field], M->ngp, 4, xy, val, 0.0, &err) != GK_OK;
+        bad = gk_field_svg(path, &d, M->ngp, 4, xy, val, &err) != GK_OK;
     }
     if (bad) fd_say(M, "%s: cannot write %s/%s\n", M->prog, M->o.out, file);
     free(all), free(xy), free(val);

@@ -177,6 +177,88 @@ static void check_threads_and_restart(const char *tag, const char *csv, int ncol
     CHECK(gk_test_file_has(b, "restarted from"));
 }
 
+static int refused(const char *bin, const char *flags, const char *msg);
+
+/* femdem_biaxial's local outputs (Guo & Zhao 2014 Figs 15, 17, 18): gp_history.csv holds, per row,
+ * the three chosen Gauss points (inside: largest final eps_q, edge: largest final void ratio, outside:
+ * smallest final eps_q). Before the peak every point of this uniform 2 x 2 specimen follows the drained
+ * path of Guo & Zhao's (2014) biaxial test: sigma_xx stays at the confinement, so with p and q of eqs 6-7
+ * (p = (s1 + s2) / 2, q = |s1 - s2| / 2) dq = dp, the 1:1 slope of Fig 15. */
+TEST(femdem_biaxial_local_histories) {
+    FILE *fp;
+    char line[1024], name[16];
+    double v[3][2][13], eq_last[3] = {0, 0, 0}, e_last[3] = {0, 0, 0};
+    int rows = 0, gp, step, i;
+    CHECK(system("build/femdem_biaxial --nx 2 --ny 2 --element q4 --steps 4 --threads 2 --vtk-every 0 "
+                 "--fields-at 0.2 --out build/t_fdl > build/t_fdl.out 2>&1") == 0);
+    fp = fopen("build/t_fdl/gp_history.csv", "r");
+    CHECK(fp != NULL);
+    if (!fp) return;
+    CHECK(fgets(line, sizeof line, fp) != NULL);
+    CHECK(strcmp(line, "point,gp,x_mm,y_mm,step,eps_axial,eps_q,eps_v,void_ratio,rotation_deg,spin_deg,p,q,"
+                       "fabric_anisotropy,coordination\n") == 0);
+    while (fgets(line, sizeof line, fp)) {
+        double x[10], y;
+        char *c = strchr(line, ',');
+        if (!c || c - line >= (int)sizeof name) break;
+        memcpy(name, line, (size_t)(c - line)), name[c - line] = 0;
+        i = !strcmp(name, "inside") ? 0 : !strcmp(name, "edge") ? 1 : !strcmp(name, "outside") ? 2 : -1;
+        CHECK(i == rows % 3);
+        if (i < 0 ||
+            sscanf(c + 1, "%d,%lf,%lf,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &gp, &y, &y, &step, &x[0],
+                   &x[1], &x[2], &x[3], &x[4], &x[5], &x[6], &x[7], &x[8], &x[9]) != 14)
+            break;
+        CHECK_EQ_INT(step, rows / 3);
+        if (step == 0 || step == 4) memcpy(v[i][step == 4], x, sizeof x);
+        eq_last[i] = x[1], e_last[i] = x[3];
+        ++rows;
+    }
+    fclose(fp);
+    CHECK_EQ_INT(rows, 15);
+    CHECK(eq_last[0] >= eq_last[2] && eq_last[0] > 0.003); /* eps_q at 0.4 % axial strain: about 0.5 % */
+    CHECK(e_last[1] >= e_last[0] && e_last[1] >= e_last[2]);
+    for (i = 0; i < 3; ++i) { /* columns p (6) and q (7) of x: dq / dp = 1 within 3 % */
+        double dp = v[i][1][6] - v[i][0][6], dq = v[i][1][7] - v[i][0][7];
+        CHECK(dp > 3e4); /* sigma_yy rises by about 95 kPa */
+        CHECK_NEAR(dq / dp, 1.0, 0.03);
+    }
+    CHECK(gk_test_file_has("build/t_fdl.out", "LOCAL inside_gp="));
+    CHECK(gk_test_file_has("build/t_fdl.out", "first_failed_eps=nan failed_fraction_mean=0 "));
+    CHECK(gk_test_file_has("build/t_fdl/failed_fraction.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_fdl/gp_history_path.svg", "q [kPa]"));
+    CHECK(gk_test_file_has("build/t_fdl/fabric_field.svg", "fabric anisotropy F_a"));
+    CHECK(gk_test_file_has("build/t_fdl/fabric_field_0002.svg", "axial strain 0.20 %"));
+    CHECK(!gk_test_file_has("build/t_fdl/fabric_field_0003.svg", "<svg"));
+    CHECK(refused("femdem_biaxial", "--fields-at 4,x", "--fields-at '4,x' is not a list"));
+    CHECK(refused("femdem_biaxial", "--fields-at -1", "is not a list"));
+}
+
+/* examples/data/rve400_hex.txt, the regular RVE of Guo & Zhao 2014 Sec 4.1.4: 400 equal disks on a
+ * hexagonal lattice whose overlap delta makes the Love stress (eq 5) of the lattice, sqrt(3) k_n delta /
+ * (a Lz) in every direction, exactly 100 kPa: the RVE read by rve_path is isotropic at 100 kPa with 6
+ * contacts per disk and void ratio sqrt(3) a^2 / (2 pi r^2) - 1 = 0.098426 */
+TEST(hexagonal_rve_is_isotropic_at_100_kPa) {
+    FILE *fp;
+    char line[1024];
+    double v[12];
+    int ok = 0;
+    CHECK(system("build/rve_path --packing examples/data/rve400_hex.txt --dH \"0 0 0 0\" --increments 1 "
+                 "--steps-per-increment 10 --out build/t_hex.csv > build/t_hex.out 2>&1") == 0);
+    fp = fopen("build/t_hex.csv", "r");
+    CHECK(fp != NULL);
+    if (!fp) return;
+    while (fgets(line, sizeof line, fp))
+        ok = sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4],
+                    &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) == 12;
+    fclose(fp);
+    CHECK(ok);
+    CHECK_NEAR(v[5], 1e5, 1e-3); /* sxx after 10 DEM steps: the lattice is in equilibrium */
+    CHECK_NEAR(v[6], 1e5, 1e-3); /* syy */
+    CHECK_NEAR(v[9], 0.0, 1e-3); /* q */
+    CHECK_NEAR(v[10], 0.098426, 1e-6);
+    CHECK_NEAR(v[11], 6.0, 1e-12);
+}
+
 /* femdem_biaxial (seed 000): documented CSV header and RESULT line, VTK and
  * SVG outputs; the same result for 1 and 2 threads; a restart from a
  * checkpoint continues to the identical curve; the initial state carries the
@@ -209,6 +291,7 @@ TEST(femdem_biaxial_runs_restarts_and_is_thread_independent) {
     CHECK(gk_test_file_has("build/t_fdA/biaxial_stress.svg", "<svg"));
     CHECK(gk_test_file_has("build/t_fdA/eps_q_field.svg", "<svg"));
     check_threads_and_restart("t_fd", "biaxial.csv", 6); /* columns step..iterations */
+    check_threads_and_restart("t_fd", "gp_history.csv", 15); /* the histories survive the checkpoint */
     /* bad input: a message and status 2 */
     CHECK(system("build/femdem_biaxial --element q9 > build/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_bad.out", "q4 or q8"));
@@ -819,6 +902,8 @@ int main(int argc, char **argv) {
     RUN(gk_pack_makes_a_consolidated_packing);
     RUN(gk_pack_makes_a_framed_packing);
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
+    RUN(femdem_biaxial_local_histories);
+    RUN(hexagonal_rve_is_isotropic_at_100_kPa);
     RUN(femdem_single_element_matches_rve_alone);
     RUN(femdem_single_reference_holds_the_lateral_stress);
     RUN(femdem_single_reference_through_a_slip);
