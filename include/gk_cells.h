@@ -23,6 +23,14 @@
  * size ratio of 10 is correct (small particles share bins; it costs time,
  * not accuracy).
  *
+ * OPEN AXES. An axis whose bit is set in gk_cells.open is not periodic: its
+ * bins span the particles' own extent along it (not the whole cell) and the
+ * neighbour search does not wrap around it. The pair test still takes the
+ * nearest image, so the caller keeps every particle within less than half
+ * the cell along an open axis (gk_scene.h uses a cell twice the domain):
+ * then no image is ever nearer than the particle itself. open = 0 (what
+ * gk_cells_init sets) is the periodic cell of the RVE, unchanged.
+ *
  * VERLET SKIN. gk_cells_skin_ok tells whether a list built at reduced
  * positions s0 in cell h0 still contains every touching pair: it bounds the
  * change of any pair distance by the affine map A = h h0^-1 (through its
@@ -39,6 +47,8 @@ typedef struct gk_cells {
     int dim, n;
     int nbin[3];
     int nbins;
+    unsigned open;      /* bit k set: axis k is open (not periodic), see OPEN AXES */
+    double lo[3], inv[3]; /* open axis k: bin = (s - lo[k]) inv[k], clamped      */
     int32_t *bin_start; /* nbins + 1: particles of bin b are order[bin_start[b] .. bin_start[b+1]) */
     int32_t *order;     /* particle indices sorted by bin, ascending inside a bin */
     int32_t *bin_of;    /* bin of each particle */
@@ -68,6 +78,11 @@ GKDEF void gk_cells_free(gk_cells *c);
  * they are wrapped into [0,1) for binning) in cell h with bin size >= cutoff.
  * GK_ERR_CELL if cutoff >= half the smallest cell width (minimum image would
  * be ambiguous). */
+GK_INLINE int gk__open_bin(double s, double lo, double inv, int nb) {
+    int b = (int)((s - lo) * inv);
+    return b >= nb ? nb - 1 : (b < 0 ? 0 : b);
+}
+
 GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3], double cutoff,
                              gk_err *err);
 /* After gk_cells_bin: all pairs with nearest-image distance < r_i + r_j + skin. */
@@ -96,6 +111,7 @@ GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n
 GKDEF void gk_cells_init(gk_cells *c, const gk_allocator *alloc) {
     c->dim = c->n = c->nbins = 0;
     c->nbin[0] = c->nbin[1] = c->nbin[2] = 0;
+    c->open = 0;
     c->bin_start = c->order = c->bin_of = c->buf = NULL;
     c->cap_bins = c->cap_n = c->cap_buf = 0;
     if (alloc)
@@ -181,6 +197,19 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
                               "nearest image ambiguous (use a larger cell)",
                               w[k], k, cutoff);
         c->nbin[k] = (int)(w[k] / cutoff);
+        if (c->open & (1u << k)) { /* bins over the particles' extent only */
+            double smin = 1e300, smax = -1e300;
+            for (p = 0; p < n; ++p) {
+                if (s[k][p] < smin) smin = s[k][p];
+                if (s[k][p] > smax) smax = s[k][p];
+            }
+            if (n == 0 || !(smax >= smin) || !(smax - smin < 1.0))
+                return gk_err_set(err, GK_ERR_OUTSIDE,
+                                  "open axis %d: the particles span %g of the cell (must be below 1, not NaN)", k,
+                                  smax - smin);
+            c->lo[k] = smin;
+            c->nbin[k] = (int)((smax - smin) * w[k] / cutoff);
+        }
         if (c->nbin[k] < 1) c->nbin[k] = 1;
     }
     if (dim == 2) c->nbin[2] = 1;
@@ -193,6 +222,13 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
         if (c->nbin[0] <= 3 && c->nbin[1] <= 3 && c->nbin[2] <= 3) break;
     }
     c->nbins = (int)total;
+    for (k = 0; k < dim; ++k)
+        if (c->open & (1u << k)) {
+            double smax = c->lo[k];
+            for (p = 0; p < n; ++p)
+                if (s[k][p] > smax) smax = s[k][p];
+            c->inv[k] = smax > c->lo[k] ? (double)c->nbin[k] / (smax - c->lo[k]) : 0.0;
+        }
     if (gk__cells_grow(c, &c->bin_start, &c->cap_bins, (size_t)total + 1))
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %ld cell-list bins", total);
     if ((size_t)n + 1 > c->cap_n) { /* order and bin_of share one capacity */
@@ -206,9 +242,18 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
     c->n = n;
     for (k = 0; k <= c->nbins; ++k) c->bin_start[k] = 0;
     for (p = 0; p < n; ++p) {
-        int b = gk__wrap_bin(s[0][p], c->nbin[0]) +
+        int b;
+        if (c->open) {
+            int bk[3] = {0, 0, 0};
+            for (k = 0; k < dim; ++k)
+                bk[k] = (c->open & (1u << k)) ? gk__open_bin(s[k][p], c->lo[k], c->inv[k], c->nbin[k])
+                                               : gk__wrap_bin(s[k][p], c->nbin[k]);
+            b = bk[0] + c->nbin[0] * (bk[1] + c->nbin[1] * bk[2]);
+        } else {
+            b = gk__wrap_bin(s[0][p], c->nbin[0]) +
                 c->nbin[0] * (gk__wrap_bin(s[1][p], c->nbin[1]) +
                               c->nbin[1] * (dim == 3 ? gk__wrap_bin(s[2][p], c->nbin[2]) : 0));
+        }
         c->bin_of[p] = b;
         ++c->bin_start[b + 1];
     }
@@ -233,7 +278,7 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
         if (k >= dim || nb == 1) {
             noff[k] = 1;
             off[k][0] = 0;
-        } else if (nb == 2) { /* bins -1 and +1 coincide: visit each once */
+        } else if (nb == 2 && !(c->open & (1u << k))) { /* bins -1 and +1 coincide: visit each once */
             noff[k] = 2;
             off[k][0] = 0;
             off[k][1] = 1;
@@ -262,6 +307,10 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
                     int cy = (by + off[1][a1] + c->nbin[1]) % c->nbin[1];
                     int cz = (bz + off[2][a2] + c->nbin[2]) % c->nbin[2];
                     int nb = cx + c->nbin[0] * (cy + c->nbin[1] * cz), e;
+                    if (c->open && (((c->open & 1u) && cx != bx + off[0][a0]) ||
+                                    ((c->open & 2u) && cy != by + off[1][a1]) ||
+                                    ((c->open & 4u) && cz != bz + off[2][a2])))
+                        continue; /* no wrap across an open axis */
                     for (e = c->bin_start[nb]; e < c->bin_start[nb + 1]; ++e) {
                         int q2 = c->order[e];
                         double dx, dy, dz, ex, ey, ez, cut;

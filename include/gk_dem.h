@@ -91,6 +91,23 @@
  * produces a non-finite value returns GK_ERR_DIVERGED and marks the RVE
  * (restore a saved state to continue).
  *
+ * BEYOND THE PERIODIC CELL (the seam gk_scene.h builds on; an RVE never
+ * uses it and pays one test of a NULL pointer per step):
+ *   gk_rve.hook    called in every step at GK_HOOK_PRE_FORCES (after a list
+ *                  rebuild, before the pair forces), GK_HOOK_POST_FORCES (f, t
+ *                  hold the contact sums; the hook may add external forces,
+ *                  or zero a particle's f, t and set its v, w to prescribe
+ *                  its motion: local damping of a zero force is zero) and
+ *                  GK_HOOK_POST_STEP (after the leap-frog update). A non-OK
+ *                  result stops the step with that result.
+ *   gk_rve_reserve / gk_rve_append / gk_rve_remove   change the particle
+ *                  count between steps: appended particles get the next
+ *                  indices, removal keeps the survivors' order (so the pair
+ *                  list stays sorted and every survivor keeps its contact
+ *                  history); both force a list rebuild. id[] is the caller's.
+ *                  gk_rve_update_totals after changing r[] or minv[] directly.
+ *   gk_cells.open  open (non-periodic) axes of the cell lists (gk_cells.h).
+ *
  * CONFIG: GK_REAL_FLOAT (see gk_base.h), GK_DEM_PAR_MIN (pairs below which
  * one RVE never uses threads, default 20000).
  *
@@ -188,7 +205,16 @@ typedef struct gk_rve {
     int servo_on;
     gk_servo servo;
     gk_err err;
+    /* seam for scenes beyond the periodic cell (gk_scene.h); NULL/0 in an RVE */
+    gk_result (*hook)(struct gk_rve *rve, int stage, void *user);
+    void *hook_user;
+    int ncap;                 /* capacity of the per-particle arrays (0: n)         */
 } gk_rve;
+
+/* stages at which gk_rve.hook is called in every step */
+#define GK_HOOK_PRE_FORCES 0
+#define GK_HOOK_POST_FORCES 1
+#define GK_HOOK_POST_STEP 2
 
 /* a growable buffer for gk_rve_save / gk_rve_restore */
 typedef struct gk_rve_state {
@@ -240,6 +266,18 @@ GKDEF double gk_rve_volume(const gk_rve *rve);     /* stress volume             
 GKDEF double gk_rve_kinetic_energy(const gk_rve *rve); /* of the fluctuations     */
 GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]);
 GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *pk, const gk_allocator *alloc, gk_err *err);
+
+/* particle count changes between steps (scenes; see BEYOND THE PERIODIC CELL).
+ * reserve: capacity for cap particles. append: k particles at reduced
+ * positions s[0..dim-1][k] with radii r and ids id, at rest, masses from the
+ * material; refused (nothing changed) for a bad radius or position or one
+ * too large for the cell. remove: drops every p with drop[p] != 0. */
+GKDEF gk_result gk_rve_reserve(gk_rve *rve, int cap);
+GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], const double *r, const int32_t *id);
+GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop);
+/* rmin, rmax, mmin, mass_total, solid_volume from r[], minv[] (after the
+ * caller changed radii or masses directly) */
+GKDEF void gk_rve_update_totals(gk_rve *rve);
 
 /* state */
 GKDEF size_t gk_rve_state_size(const gk_rve *rve);
@@ -1921,9 +1959,11 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
         res = gk__rve_rebuild(rve);
         if (res) return res;
     }
+    if (rve->hook && (res = rve->hook(rve, GK_HOOK_PRE_FORCES, rve->hook_user)) != GK_OK) return res;
     gk__ctx_make(rve, E, &x);
     for (k = 0; k < 9; ++k) rve->G[k] = (double)x.G[k];
     gk__forces(rve, &x, want_stress);
+    if (rve->hook && (res = rve->hook(rve, GK_HOOK_POST_FORCES, rve->hook_user)) != GK_OK) return res;
     if (want_stress) gk__stress_pass(rve);
     res = gk_pcell_advance(&rve->cell, E, &rve->err);
     if (res) return res;
@@ -1982,6 +2022,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
         margin = smin * rve->skin_in - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
         if (!(margin > 0.0)) rve->need_rebuild = 1;
     }
+    if (rve->hook) return rve->hook(rve, GK_HOOK_POST_STEP, rve->hook_user);
     return GK_OK;
 }
 
@@ -2292,6 +2333,169 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
         return gk_err_set(&rve->err, GK_ERR_NOCONVERGE,
                           "consolidation to %g Pa did not converge in %ld steps (stress %g %g, see report)",
                           cd->pressure, st, -rve->stress[0], -rve->stress[4]);
+    return GK_OK;
+}
+
+/* ---------------------------------------------------------------- particle count (scenes) */
+GKDEF void gk_rve_update_totals(gk_rve *rve) {
+    int p;
+    rve->rmin = 1e300;
+    rve->rmax = 0.0;
+    rve->mmin = 1e300;
+    rve->mass_total = rve->solid_volume = 0.0;
+    for (p = 0; p < rve->n; ++p) {
+        double rp = (double)rve->r[p], m = 1.0 / (double)rve->minv[p];
+        if (rp < rve->rmin) rve->rmin = rp;
+        if (rp > rve->rmax) rve->rmax = rp;
+        if (m < rve->mmin) rve->mmin = m;
+        rve->mass_total += m;
+        rve->solid_volume += gk_particle_volume(rve->dim, rp) * (rve->dim == 2 ? rve->volume_factor : 1.0);
+    }
+}
+
+GKDEF gk_result gk_rve_reserve(gk_rve *rve, int cap) {
+    const gk_allocator *a = &rve->def.alloc;
+    size_t n = (size_t)rve->n, c, R = sizeof(gk_real);
+    int k, have = rve->ncap > rve->n ? rve->ncap : rve->n;
+    if (cap <= have) return GK_OK;
+    c = (size_t)cap;
+    for (k = 0; k < 3; ++k) {
+        if (rve->s[k] && (gk_realloc(a, (void **)&rve->s[k], n, c, sizeof(double)) ||
+                          gk_realloc(a, (void **)&rve->s0[k], n, c, sizeof(double)) ||
+                          gk_realloc(a, (void **)&rve->o0[k], n, c, sizeof(double)) ||
+                          gk_realloc(a, (void **)&rve->v[k], n, c, R) || gk_realloc(a, (void **)&rve->f[k], n, c, R)))
+            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
+        if (rve->w[k] && (gk_realloc(a, (void **)&rve->w[k], n, c, R) || gk_realloc(a, (void **)&rve->t[k], n, c, R)))
+            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
+    }
+    if (gk_realloc(a, (void **)&rve->r, n, c, R) || gk_realloc(a, (void **)&rve->minv, n, c, R) ||
+        gk_realloc(a, (void **)&rve->Iinv, n, c, R) || gk_realloc(a, (void **)&rve->id, n, c, sizeof(int32_t)) ||
+        gk_realloc(a, (void **)&rve->jstart, n + 1, c + 1, sizeof(int32_t)) ||
+        (rve->theta && gk_realloc(a, (void **)&rve->theta, n, c, sizeof(double))))
+        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
+    rve->ncap = cap;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], const double *r, const int32_t *id) {
+    int dim = rve->dim, q, a, n0 = rve->n;
+    double rmax = rve->rmax, w[3];
+    gk_result res;
+    if (k < 0 || !s || !r || !id) return gk_err_set(&rve->err, GK_ERR_ARG, "append: bad arguments");
+    if (k == 0) return GK_OK;
+    for (q = 0; q < k; ++q) {
+        if (!(r[q] > 0.0) || !isfinite(r[q]))
+            return gk_err_set(&rve->err, GK_ERR_RADIUS, "append: particle %d has radius %g", q, r[q]);
+        for (a = 0; a < dim; ++a)
+            if (!isfinite(s[a][q])) return gk_err_set(&rve->err, GK_ERR_NAN, "append: particle %d has a NaN position", q);
+        if (r[q] > rmax) rmax = r[q];
+    }
+    gk_pcell_widths(&rve->cell, w);
+    for (a = 0; a < dim; ++a)
+        if (!(2.0 * (2.0 * rmax + rve->skin) < w[a]))
+            return gk_err_set(&rve->err, GK_ERR_CELL, "append: radius %g too large for a cell %g wide", rmax, w[a]);
+    if (n0 + k > (rve->ncap > n0 ? rve->ncap : n0)) {
+        int cap = n0 + n0 / 2 > n0 + k ? n0 + n0 / 2 : n0 + k;
+        if ((res = gk_rve_reserve(rve, cap)) != GK_OK) return res;
+    }
+    for (q = 0; q < k; ++q) {
+        int p = n0 + q;
+        double rq = r[q], m, I;
+        for (a = 0; a < dim; ++a) {
+            rve->s[a][p] = rve->s0[a][p] = rve->o0[a][p] = s[a][q] - floor(s[a][q]);
+            rve->v[a][p] = rve->f[a][p] = 0;
+        }
+        for (a = 0; a < 3; ++a)
+            if (rve->w[a]) rve->w[a][p] = rve->t[a][p] = 0;
+        if (dim == 3 || rve->def.mass2d == GK_MASS_SPHERE) {
+            m = rve->def.mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
+            I = 0.4 * m * rq * rq;
+        } else {
+            m = rve->def.mat.density * rve->def.thickness * GK_PI * rq * rq;
+            I = 0.5 * m * rq * rq;
+        }
+        rve->r[p] = (gk_real)rq;
+        rve->minv[p] = (gk_real)(1.0 / m);
+        rve->Iinv[p] = (gk_real)(1.0 / I);
+        rve->id[p] = id[q];
+        if (rve->theta) rve->theta[p] = 0.0;
+    }
+    rve->n = n0 + k;
+    gk_rve_update_totals(rve);
+    rve->need_rebuild = 1;
+    rve->outer_valid = 0;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop) {
+    int n = rve->n, dim = rve->dim, p, q = 0, c, m = 0, k, nft = dim == 2 ? 1 : 3;
+    int32_t *map = NULL;
+    if (!drop) return gk_err_set(&rve->err, GK_ERR_ARG, "remove: no mask");
+    for (p = 0; p < n; ++p)
+        if (!drop[p]) ++q;
+    if (q == n) return GK_OK;
+    if (q < 1) return gk_err_set(&rve->err, GK_ERR_ARG, "remove: would leave no particle");
+    map = (int32_t *)gk_alloc(&rve->def.alloc, (size_t)n * sizeof(int32_t));
+    if (!map) return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory removing particles");
+    for (p = 0, q = 0; p < n; ++p) {
+        map[p] = drop[p] ? -1 : q;
+        if (drop[p]) continue;
+        for (k = 0; k < dim; ++k) {
+            rve->s[k][q] = rve->s[k][p];
+            rve->s0[k][q] = rve->s0[k][p];
+            rve->o0[k][q] = rve->o0[k][p];
+            rve->v[k][q] = rve->v[k][p];
+            rve->f[k][q] = rve->f[k][p];
+        }
+        for (k = 0; k < 3; ++k)
+            if (rve->w[k]) {
+                rve->w[k][q] = rve->w[k][p];
+                rve->t[k][q] = rve->t[k][p];
+            }
+        rve->r[q] = rve->r[p];
+        rve->minv[q] = rve->minv[p];
+        rve->Iinv[q] = rve->Iinv[p];
+        rve->id[q] = rve->id[p];
+        if (rve->theta) rve->theta[q] = rve->theta[p];
+        ++q;
+    }
+    /* survivors keep their order: the remapped pair list stays sorted by (i, j) */
+    for (c = 0; c < rve->pl.n; ++c) {
+        int32_t i = map[rve->pl.i[c]], j = map[rve->pl.j[c]];
+        if (i < 0 || j < 0) continue;
+        rve->pl.i[m] = i;
+        rve->pl.j[m] = j;
+        for (k = 0; k < nft; ++k) rve->ft[k][m] = rve->ft[k][c];
+        for (k = 0; k < dim; ++k) rve->fc[k][m] = rve->fc[k][c];
+        for (k = 0; k < 3; ++k) {
+            if (rve->tci[k]) {
+                rve->tci[k][m] = rve->tci[k][c];
+                rve->tcj[k][m] = rve->tcj[k][c];
+            }
+            if (rve->mr[k]) rve->mr[k][m] = rve->mr[k][c];
+        }
+        rve->cs[m] = rve->cs[c];
+        ++m;
+    }
+    gk_free(&rve->def.alloc, map);
+    rve->n = q;
+    rve->pl.n = m;
+    rve->pl.np = q;
+    for (p = 0; p <= q; ++p) rve->pl.start[p] = rve->jstart[p] = 0;
+    for (c = 0; c < m; ++c) {
+        ++rve->pl.start[rve->pl.i[c] + 1];
+        ++rve->jstart[rve->pl.j[c] + 1];
+    }
+    for (p = 0; p < q; ++p) {
+        rve->pl.start[p + 1] += rve->pl.start[p];
+        rve->jstart[p + 1] += rve->jstart[p];
+    }
+    for (c = 0; c < m; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
+    for (p = q; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
+    rve->jstart[0] = 0;
+    gk_rve_update_totals(rve);
+    rve->need_rebuild = 1;
+    rve->outer_valid = 0;
     return GK_OK;
 }
 

@@ -17,6 +17,9 @@
  *   gk_packing_read / gk_packing_parse   the text format, from a file or memory
  *   gk_packing_write                     the same format (round-trips exactly)
  *   gk_packing_generate                  a random loose (non-overlapping) cloud
+ *   gk_packing_tile                      nx x ny (x nz) copies of a periodic packing
+ *   gk_packing_subset                    the particles inside a box (a specimen cut
+ *                                        from a packing, e.g. for gk_scene.h)
  *   gk_particle_volume                   pi r^2 (2D) or 4/3 pi r^3 (3D)
  *
  * ERRORS are values: every fallible call returns gk_result and writes its
@@ -74,6 +77,19 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *pk, c
                                  gk_err *err);
 GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const char *comment, gk_err *err);
 GKDEF gk_result gk_packing_generate(gk_packing *pk, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err);
+/* A periodic packing repeated nx x ny (x nz in 3D; nz ignored in 2D) times:
+ * cell h diag(nx, ny, nz), copy (a, b, c) at a e1 + b e2 + c e3 (e_k the cell
+ * edges, positions wrapped into the cell first); copies follow each other,
+ * a fastest, each in pk's order. Still periodic: the copies match across
+ * every face. */
+GKDEF gk_result gk_packing_tile(const gk_packing *pk, int nx, int ny, int nz, gk_packing *out,
+                                const gk_allocator *alloc, gk_err *err);
+/* The particles whose centre lies in the box [lo, hi] (whole != 0: the
+ * whole disk or sphere, centre -+ r), in pk's order, shifted by -lo; the
+ * result's cell is the box diag(hi - lo). Positions are taken as given
+ * (not wrapped). GK_ERR_ARG if the box holds none. */
+GKDEF gk_result gk_packing_subset(const gk_packing *pk, const double lo[3], const double hi[3], int whole,
+                                  gk_packing *out, const gk_allocator *alloc, gk_err *err);
 
 #ifdef __cplusplus
 }
@@ -494,6 +510,93 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
         return res;
     }
     *out = pk;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_packing_tile(const gk_packing *pk, int nx, int ny, int nz, gk_packing *out,
+                                const gk_allocator *alloc, gk_err *err) {
+    gk_packing t;
+    double hi[9];
+    int dim, rep[3], a, b, c, p, k, q = 0;
+    long total;
+    gk_result res;
+    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1) return gk_err_set(err, GK_ERR_ARG, "tile: empty packing");
+    dim = pk->dim;
+    rep[0] = nx;
+    rep[1] = ny;
+    rep[2] = dim == 3 ? nz : 1;
+    if (rep[0] < 1 || rep[1] < 1 || rep[2] < 1)
+        return gk_err_set(err, GK_ERR_ARG, "tile: copies %d x %d x %d must be >= 1", nx, ny, dim == 3 ? nz : 1);
+    total = (long)pk->n * rep[0] * rep[1] * rep[2];
+    if (total > 2000000000L) return gk_err_set(err, GK_ERR_ARG, "tile: %ld particles are too many", total);
+    if (!(gk_m3_inverse(pk->h, hi) > 0.0)) return gk_err_set(err, GK_ERR_CELL, "tile: singular cell");
+    if ((res = gk_packing_alloc(&t, dim, (int)total, alloc, err)) != GK_OK) return res;
+    gk_m3_copy(pk->h, t.h);
+    for (k = 0; k < 3; ++k) /* column k of h scaled by rep[k] */
+        for (a = 0; a < 3; ++a) t.h[3 * a + k] *= rep[k];
+    if (dim == 2) t.h[8] = 1.0;
+    for (c = 0; c < rep[2]; ++c)
+        for (b = 0; b < rep[1]; ++b)
+            for (a = 0; a < rep[0]; ++a)
+                for (p = 0; p < pk->n; ++p) {
+                    double x[3], s[3], y[3];
+                    x[0] = pk->x[p];
+                    x[1] = pk->y[p];
+                    x[2] = dim == 3 && pk->z ? pk->z[p] : 0.0;
+                    gk_m3_matvec(hi, x, s);
+                    for (k = 0; k < 3; ++k) s[k] = k < dim ? s[k] - floor(s[k]) : 0.0;
+                    s[0] += a;
+                    s[1] += b;
+                    s[2] += c;
+                    gk_m3_matvec(pk->h, s, y);
+                    t.x[q] = y[0];
+                    t.y[q] = y[1];
+                    t.z[q] = dim == 3 ? y[2] : 0.0;
+                    t.r[q] = pk->r[p];
+                    ++q;
+                }
+    *out = t;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_packing_subset(const gk_packing *pk, const double lo[3], const double hi[3], int whole,
+                                  gk_packing *out, const gk_allocator *alloc, gk_err *err) {
+    gk_packing t;
+    int dim, p, k, cnt = 0, q = 0;
+    gk_result res;
+    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1) return gk_err_set(err, GK_ERR_ARG, "subset: empty packing");
+    if (!lo || !hi) return gk_err_set(err, GK_ERR_ARG, "subset: no box given");
+    dim = pk->dim;
+    for (k = 0; k < dim; ++k)
+        if (!isfinite(lo[k]) || !isfinite(hi[k]) || !(hi[k] > lo[k]))
+            return gk_err_set(err, GK_ERR_ARG, "subset: box axis %d [%g, %g] is not an interval", k, lo[k], hi[k]);
+    for (q = 0; q < 2; ++q) { /* count, then copy */
+        for (p = 0; p < pk->n; ++p) {
+            double x[3], m = whole ? pk->r[p] : 0.0;
+            int in = 1;
+            x[0] = pk->x[p];
+            x[1] = pk->y[p];
+            x[2] = dim == 3 && pk->z ? pk->z[p] : 0.0;
+            for (k = 0; k < dim; ++k)
+                if (!(x[k] - m >= lo[k] && x[k] + m <= hi[k])) in = 0;
+            if (!in) continue;
+            if (q == 1) {
+                t.x[cnt] = x[0] - lo[0];
+                t.y[cnt] = x[1] - lo[1];
+                t.z[cnt] = dim == 3 ? x[2] - lo[2] : 0.0;
+                t.r[cnt] = pk->r[p];
+            }
+            ++cnt;
+        }
+        if (q == 0) {
+            if (cnt < 1) return gk_err_set(err, GK_ERR_ARG, "subset: no particle inside the box");
+            if ((res = gk_packing_alloc(&t, dim, cnt, alloc, err)) != GK_OK) return res;
+            gk_m3_identity(t.h);
+            for (k = 0; k < dim; ++k) t.h[4 * k] = hi[k] - lo[k];
+            cnt = 0;
+        }
+    }
+    *out = t;
     return GK_OK;
 }
 
