@@ -29,9 +29,14 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/%,$(TEST_SRC))
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/%,$(EX_SRC))
 BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
 TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
+# fuzz harnesses tests/fuzz/fuzz_NAME.c (seeds in tests/fuzz/corpus/NAME/, findings
+# kept in tests/fuzz/crashers/NAME/): found by name, nothing to add here
+FUZZ_SRC   := $(wildcard tests/fuzz/fuzz_*.c)
+FUZZ_NAMES := $(patsubst tests/fuzz/fuzz_%.c,%,$(FUZZ_SRC))
+FUZZ_REPLAY := $(patsubst %,$(BUILD)/fuzz_replay_%,$(FUZZ_NAMES))
 
 .PHONY: all test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
-        check-headers check-asan check-nosimd tradeoff
+        check-headers check-asan check-nosimd check-smoke tradeoff fuzz
 
 all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
 
@@ -41,14 +46,15 @@ help:
 	@echo "make run-rve    one RVE along a shear path"
 	@echo "make run-mpm | run-footing | run-collapse   MPMxDEM biaxial, footing, column collapse (Liang & Zhao 2019)"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
-	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability"
+	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability, tool smoke runs"
+	@echo "make fuzz       each libFuzzer harness of tests/fuzz for FUZZ_SECONDS (60) s, one at a time (clang)"
 	@echo "make bench      performance programs (2 cores)"
 	@echo "make tradeoff   accuracy against cost of the drivers, the whole sweep (10-15 min; build/tradeoff/)"
 	@echo "make bench-peers  the same workloads in LAMMPS / LIGGGHTS / YADE when installed"
 	@echo "make install PREFIX=dir   headers + pkg-config file"
 	@echo "make format / format-check   clang-format"
 
-$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests:
+$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests $(BUILD)/fuzz:
 	@mkdir -p $@
 
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
@@ -76,16 +82,35 @@ $(BUILD)/bench_tradeoff: | $(BUILD)/femdem_biaxial $(BUILD)/femdem_biaxial_float
 $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
-test: $(TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
-	@tests/run_tests.sh $(TESTS)
+test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) | $(BUILD)/tests
+	@tests/run_tests.sh $(TESTS) $(FUZZ_REPLAY)
+
+# the fuzz corpora and every crasher replayed by a plain program (tests/fuzz/replay.c)
+$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)
+	$(CC) $(CFLAGS) -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(LDLIBS)
 
 # ---------------------------------------------------------------- check
 SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
-ASAN_TESTS   := $(patsubst tests/%.c,$(BUILD)/asan/%,$(TEST_SRC))
+ASAN_TESTS   := $(patsubst tests/%.c,$(BUILD)/asan/%,$(TEST_SRC)) $(patsubst %,$(BUILD)/asan/fuzz_replay_%,$(FUZZ_NAMES))
 NOSIMD_TESTS := $(patsubst tests/%.c,$(BUILD)/nosimd/%,$(TEST_SRC))
 
 $(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/asan
 	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -Itests -DGK_TEST_QUICK -o $@ $< $(LDLIBS)
+
+$(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)/asan
+	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(LDLIBS)
+
+# tools and drivers under ASan + UBSan for tests/smoke_asan.sh (a driver joins
+# by its name in SMOKE and its runs in the script)
+SMOKE := rve_path gk_pack
+$(BUILD)/asan/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)/asan
+	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
+$(BUILD)/asan/%: tools/%.c $(HEADERS) | $(BUILD)/asan
+	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
+
+check-smoke: $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) | $(BUILD)/tests
+	@echo "== tool and driver smoke runs under AddressSanitizer + UndefinedBehaviorSanitizer, leaks included"
+	@tests/run_tests.sh tests/smoke_asan.sh
 
 $(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/nosimd
 	$(CC) $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude -Itests -o $@ $< $(LDLIBS)
@@ -118,7 +143,7 @@ check-headers: | $(BUILD)/hdr
 	  echo "ok   $$h (gcc, clang: c99 -pedantic; g++, clang++: c++11; float; no-SIMD)"; \
 	done
 
-check: check-headers check-nosimd check-asan
+check: check-headers check-nosimd check-asan check-smoke
 
 # ---------------------------------------------------------------- run / bench
 # the FEMxDEM biaxial test of Guo & Zhao (2014) at a size that runs in about a minute on
@@ -141,12 +166,34 @@ run-rve: $(BUILD)/rve_path
 	  --steps-per-increment 100 --out $(BUILD)/rve_path.csv
 
 bench: $(BENCHES)
-	@for b in $(BENCHES); do echo "== $$b"; $$b || exit 1; done
+	@for b in $(BENCHES); do echo "== $$b"; $$b || { echo "make bench: $$b failed (exit $$?)"; exit 1; }; done
 
 # error against cost over RVE size, DEM steps, float, tangent, mesh, element
 # and MPM points per cell (make bench runs the short version)
 tradeoff: $(BUILD)/bench_tradeoff
 	$(BUILD)/bench_tradeoff --full
+
+# libFuzzer (clang, libclang-rt-dev): each harness for FUZZ_SECONDS, one at a time;
+# new inputs in build/fuzz/NAME/, findings in build/fuzz/NAME-crash-*
+FUZZ_SECONDS ?= 60
+FUZZ_CC ?= clang
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)/fuzz
+	$(FUZZ_CC) -std=c99 -g -O1 $(FPFLAGS) -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
+	  -Iinclude -Itests/fuzz -o $@ $< -lm
+
+fuzz: $(patsubst %,$(BUILD)/fuzz/fuzz_%,$(FUZZ_NAMES))
+	@set -e; for n in $(FUZZ_NAMES); do \
+	  mkdir -p $(BUILD)/fuzz/$$n; echo "== fuzz_$$n for $(FUZZ_SECONDS) s"; \
+	  seeds=tests/fuzz/corpus/$$n; [ -d tests/fuzz/crashers/$$n ] && seeds="$$seeds tests/fuzz/crashers/$$n"; \
+	  if $(BUILD)/fuzz/fuzz_$$n -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
+	       -artifact_prefix=$(BUILD)/fuzz/$$n- $(BUILD)/fuzz/$$n $$seeds > $(BUILD)/fuzz/$$n.log 2>&1; then \
+	    grep -E '^(stat::number_of_executed_units|stat::peak_rss_mb|Done)' $(BUILD)/fuzz/$$n.log; \
+	  else \
+	    tail -n 30 $(BUILD)/fuzz/$$n.log; \
+	    echo "make fuzz: fuzz_$$n found a crash: $(BUILD)/fuzz/$$n-crash-* (log $(BUILD)/fuzz/$$n.log);" \
+	      "fix it, then keep the input in tests/fuzz/crashers/$$n/"; exit 1; \
+	  fi; \
+	done
 
 bench-peers: $(BUILD)/bench_dem_step
 	@bench/peers/run_peers.sh

@@ -71,6 +71,10 @@
  * Fixed DEM step counts N are asked as --dem-rule strain --dem-strain inc/N
  * --dem-min N --dem-max N; the adaptive rows as --dem-rule adaptive.
  *
+ * Exit status: 0 only if every run completed and both files were written
+ * completely; a failed run still gets its row (completed=no) and is named
+ * on stderr, then the program exits 1, so `make bench` fails.
+ *
  * Output: OUT/tradeoff.csv (one row per configuration), OUT/tradeoff.svg
  * (error against seconds, log axes, Pareto front of each group), OUT/runs/ID
  * (each child's output and log), a table on stdout and one line per row:
@@ -89,6 +93,14 @@
 #include <time.h>
 
 #define MAXCFG 64
+
+/* fclose of a file we wrote, reporting any lost byte (full disk, /dev/full) */
+static int close_written(FILE *fp, const char *path) {
+    int bad = fflush(fp) != 0 || ferror(fp);
+    if (fclose(fp) != 0) bad = 1;
+    if (bad) fprintf(stderr, "bench_tradeoff: error writing %s: %s\n", path, strerror(errno));
+    return bad;
+}
 #define INC 0.001 /* femdem_biaxial's default axial strain per load step */
 
 typedef struct curve {
@@ -680,7 +692,7 @@ static int write_svg(const char *path, cfg *L, int n) {
     fprintf(fp, "</svg>\n");
 #undef PX
 #undef PY
-    return fclose(fp);
+    return close_written(fp, path);
 }
 
 static void usage(FILE *fp) {
@@ -877,7 +889,7 @@ int main(int argc, char **argv) {
                : c->same_as >= 0 ? "  (same run as above)"
                                  : "");
     }
-    fclose(fp);
+    k = close_written(fp, path);
     printf("\n");
     for (i = 0; i < n; ++i) {
         cfg *c = &L[i];
@@ -889,16 +901,21 @@ int main(int argc, char **argv) {
                c->eps_a, c->err_sa, c->eps_b, c->err_sb, c->ev_rms, c->err_max, c->err_base, c->is_ref);
     }
     snprintf(path, sizeof path, "%s/tradeoff.svg", o.out);
-    if (write_svg(path, L, n)) fprintf(stderr, "bench_tradeoff: cannot write %s\n", path);
-    printf("wrote %s/tradeoff.csv and %s/tradeoff.svg (runs in %s/runs/); %.0f s in all\n", o.out, o.out,
-           o.out, now() - t0);
-    k = 0;
+    if (write_svg(path, L, n)) {
+        fprintf(stderr, "bench_tradeoff: cannot write %s\n", path);
+        k = 1;
+    }
+    if (!k)
+        printf("wrote %s/tradeoff.csv and %s/tradeoff.svg (runs in %s/runs/); %.0f s in all\n", o.out, o.out,
+               o.out, now() - t0);
     for (i = 0; i < n; ++i) {
-        if (L[i].is_ref && !L[i].completed) {
-            fprintf(stderr, "bench_tradeoff: reference run %s failed: no errors for its group\n", L[i].id);
+        if (!L[i].completed && L[i].same_as < 0) {
+            snprintf(path, sizeof path, "%s/runs/%s/log.txt", o.out, L[i].id);
+            fprintf(stderr, "bench_tradeoff: run %d (%s%s) failed: see %s\n", i, L[i].id,
+                    L[i].is_ref ? ", the reference: no errors for its group" : "", path);
             k = 1;
         }
         curve_free(&L[i].c);
     }
-    return k; /* a failed configuration is a result; a failed reference is not */
+    return k; /* every run must complete: a failed run fails `make bench` (its row says completed=no) */
 }

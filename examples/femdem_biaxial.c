@@ -928,7 +928,7 @@ static int solve(model *M, const double *D, const double *rhs_in, double top_val
     gk_solver s;
     double vals[4096], *vp = vals;
     int k, r = 0;
-    memset(&s, 0, sizeof s);
+    gk_solver_init(&s);
     if (M->nfix > 4096) vp = (double *)malloc((size_t)M->nfix * sizeof(double));
     for (k = 0; k < M->nfix; ++k) vp[k] = M->fixtop[k] ? top_value : 0.0;
     memcpy(M->rhs, rhs_in, (size_t)M->ndof * sizeof(double));

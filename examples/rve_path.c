@@ -1,7 +1,7 @@
 /* rve_path - load one periodic RVE along a displacement-gradient path.
  *
  *   build/rve_path --packing FILE --dH "H00 H01 H10 H11" --increments N \
- *       --steps-per-increment S [--E 6e8] [--kt-ratio 0.8] [--friction-angle 0.5] \
+ *       --steps-per-increment S [--E 6e8] [--kt-ratio 0.8] [--friction-deg 28.65] \
  *       [--density 2650] [--thickness 0.1] [--damping 0.1] [--damping-form component|vector] \
  *       [--dt DT] [--law linear|hertz] [--poisson 0.25] [--path constant-L|objective] \
  *       [--threads T] [--out FILE.csv] [--svg FILE.svg]
@@ -18,7 +18,9 @@
  * 000 eq 7 (2D) or sqrt(3/2 s:s) (3D); Z = 2 contacts / particles.
  * Defaults are the seed 000 material; with no --dt it uses 0.5 x the critical
  * step of seed 000 eq 19. It also writes an SVG plot of q/p against the
- * deviatoric strain eps_q of the accumulated H (seed 000 eq 13). */
+ * deviatoric strain eps_q of the accumulated H (seed 000 eq 13).
+ * A result that cannot be written completely (--out /dev/full, a full disk)
+ * is an error: exit status 1. */
 #define _POSIX_C_SOURCE 200809L
 #define GK_IMPLEMENTATION
 #include "gk_homog.h"
@@ -32,7 +34,7 @@
 static void usage(FILE *fp) {
     fprintf(fp,
             "usage: rve_path --packing FILE --dH \"H00 H01 H10 H11\" --increments N --steps-per-increment S\n"
-            "                [--E 6e8] [--kt-ratio 0.8] [--friction-angle 0.5] [--density 2650]\n"
+            "                [--E 6e8] [--kt-ratio 0.8] [--friction-deg 28.65] [--density 2650]\n"
             "                [--thickness 0.1] [--damping 0.1] [--damping-form component|vector]\n"
             "                [--dt DT] [--law linear|hertz] [--poisson 0.25] [--path constant-L|objective]\n"
             "                [--threads T] [--out FILE.csv] [--svg FILE.svg]\n"
@@ -44,7 +46,8 @@ static void usage(FILE *fp) {
             "  --steps-per-increment S  DEM steps per increment (default 100)\n"
             "  --E                      contact modulus [Pa]: linear kn = E r*, r* = 2 r1 r2/(r1 + r2) (6e8)\n"
             "  --kt-ratio               kt / kn of the linear law (0.8)\n"
-            "  --friction-angle         contact friction angle [rad], mu = tan(angle) (0.5)\n"
+            "  --friction-deg           contact friction angle [degrees, 0 to 85], mu = tan(angle)\n"
+            "                           (28.65 = 0.5 rad, seed 000)\n"
             "  --density                particle density [kg/m^3] (2650)\n"
             "  --thickness              2D disk thickness [m]: m = rho t pi r^2, volume = area t (0.1)\n"
             "  --damping                local non-viscous damping alpha (0.1)\n"
@@ -99,7 +102,7 @@ static int long_opt(const char *a, const char *v, long *out) {
 int main(int argc, char **argv) {
     const char *packing = NULL, *dhs = NULL, *out = "rve_path.csv", *svg = NULL, *law = "linear", *form = "component",
                *path = "constant-L";
-    double E = 6e8, ktr = 0.8, phi = 0.5, rho = 2650, thick = 0.1, damp = 0.1, dt = 0, poisson = 0.25, dHin[9],
+    double E = 6e8, ktr = 0.8, phi = 0.5, phi_deg = -1.0, rho = 2650, thick = 0.1, damp = 0.1, dt = 0, poisson = 0.25, dHin[9],
            dH[9], Hacc[9], t0;
     long ninc = 10, nsteps = 100;
     int threads = 1, i, nd, dim, k;
@@ -107,8 +110,10 @@ int main(int argc, char **argv) {
     gk_err err;
     gk_rve rve;
     gk_rve_def def = gk_rve_def_default();
-    FILE *fp;
-    double *xs, *qp;
+    FILE *fp = NULL;
+    double *xs = NULL, *qp = NULL;
+    gk_result res;
+    int rc = 1;
     char svgname[1024];
     for (i = 1; i < argc; ++i) {
         const char *a = argv[i];
@@ -128,7 +133,11 @@ int main(int argc, char **argv) {
         else if (!strcmp(a, "--steps-per-increment")) bad = long_opt(a, v, &nsteps);
         else if (!strcmp(a, "--E")) bad = real_opt(a, v, &E);
         else if (!strcmp(a, "--kt-ratio")) bad = real_opt(a, v, &ktr);
-        else if (!strcmp(a, "--friction-angle")) bad = real_opt(a, v, &phi);
+        else if (!strcmp(a, "--friction-deg")) bad = real_opt(a, v, &phi_deg);
+        else if (!strcmp(a, "--friction-angle")) { /* the old radian option, kept for old scripts */
+            fprintf(stderr, "rve_path: --friction-angle (radians) is deprecated: use --friction-deg\n");
+            bad = real_opt(a, v, &phi);
+        }
         else if (!strcmp(a, "--density")) bad = real_opt(a, v, &rho);
         else if (!strcmp(a, "--thickness")) bad = real_opt(a, v, &thick);
         else if (!strcmp(a, "--damping")) bad = real_opt(a, v, &damp);
@@ -159,27 +168,21 @@ int main(int argc, char **argv) {
         fprintf(stderr, "rve_path: --packing and --dH are required (see --help)\n");
         return 2;
     }
-    if (ninc < 1 || nsteps < 1 || nsteps > 2000000000L) {
-        fprintf(stderr, "rve_path: --increments and --steps-per-increment must be >= 1\n");
+    if (ninc < 1 || ninc > 100000000L || nsteps < 1 || nsteps > 2000000000L) {
+        fprintf(stderr, "rve_path: --increments (1 to 1e8) and --steps-per-increment (1 to 2e9) out of range\n");
         return 2;
     }
-    if (gk_packing_read(packing, &pk, NULL, &err)) {
-        fprintf(stderr, "rve_path: %s\n", err.msg);
-        return 1;
+    if (phi_deg != -1.0) phi = phi_deg * GK_PI / 180.0;
+    if (!(phi >= 0.0 && phi <= 85.0 * GK_PI / 180.0)) { /* 35 meant as radians is refused */
+        fprintf(stderr, "rve_path: friction angle %g degrees: a contact friction angle is 0 to 85 degrees\n",
+                phi * 180.0 / GK_PI);
+        return 2;
     }
-    dim = pk.dim;
     nd = parse_numbers(dhs, dHin, 9);
     if (nd < 0) {
         fprintf(stderr, "rve_path: --dH '%s' is not a list of finite numbers\n", dhs);
         return 2;
     }
-    if (nd != dim * dim) {
-        fprintf(stderr, "rve_path: --dH needs %d numbers for a %dD packing, got %d\n", dim * dim, dim, nd);
-        return 2;
-    }
-    gk_m3_zero(dH);
-    for (i = 0; i < dim; ++i)
-        for (k = 0; k < dim; ++k) dH[3 * i + k] = dHin[dim * i + k];
     def.mat.young = E;
     def.mat.kt_ratio = ktr;
     def.mat.friction = tan(phi);
@@ -207,38 +210,54 @@ int main(int argc, char **argv) {
     def.damping = damp;
     def.dt = dt;
     def.threads = threads;
-    if (gk_rve_create(&rve, &def, &pk)) {
+    if (gk_packing_read(packing, &pk, NULL, &err)) {
+        fprintf(stderr, "rve_path: %s\n", err.msg);
+        return 1;
+    }
+    dim = pk.dim;
+    if (nd != dim * dim) {
+        fprintf(stderr, "rve_path: --dH needs %d numbers for a %dD packing, got %d\n", dim * dim, dim, nd);
+        gk_packing_free(&pk);
+        return 2;
+    }
+    gk_m3_zero(dH);
+    for (i = 0; i < dim; ++i)
+        for (k = 0; k < dim; ++k) dH[3 * i + k] = dHin[dim * i + k];
+    res = gk_rve_create(&rve, &def, &pk);
+    gk_packing_free(&pk);
+    if (res) {
         fprintf(stderr, "rve_path: %s\n", gk_rve_error(&rve));
         return 1;
     }
-    gk_packing_free(&pk);
+    /* from here every exit frees what it holds (rc 1: a failed step or a result not written) */
+    xs = (double *)malloc((size_t)(ninc + 1) * sizeof(double));
+    qp = (double *)malloc((size_t)(ninc + 1) * sizeof(double));
     fp = fopen(out, "w");
-    if (!fp) {
-        fprintf(stderr, "rve_path: cannot write %s\n", out);
-        return 1;
+    if (!fp || !xs || !qp) {
+        if (fp)
+            fprintf(stderr, "rve_path: out of memory\n");
+        else
+            fprintf(stderr, "rve_path: cannot write %s\n", out);
+        goto done;
     }
     if (dim == 2)
         fprintf(fp, "inc,H00,H01,H10,H11,sxx,syy,sxy,p,q,e_void,Z\n");
     else
         fprintf(fp, "inc,H00,H01,H02,H10,H11,H12,H20,H21,H22,sxx,syy,szz,syz,sxz,sxy,p,q,e_void,Z\n");
-    xs = (double *)malloc((size_t)(ninc + 1) * sizeof(double));
-    qp = (double *)malloc((size_t)(ninc + 1) * sizeof(double));
-    if (!xs || !qp) {
-        fprintf(stderr, "rve_path: out of memory\n");
-        return 1;
-    }
     fprintf(stderr, "rve_path: %d %s, %s law, dt %.4g s (critical %.4g s), %ld x %ld steps\n", rve.n,
             dim == 2 ? "disks" : "spheres", law, rve.dt, rve.dt_crit, ninc, nsteps);
     gk_m3_zero(Hacc);
     t0 = gk_wtime();
-    gk_rve_refresh(&rve);
+    if (gk_rve_refresh(&rve)) {
+        fprintf(stderr, "rve_path: %s\n", gk_rve_error(&rve));
+        goto done;
+    }
     for (i = 0; i <= ninc; ++i) {
         double s[9], p, q, Z;
         if (i > 0) {
             if (gk_rve_deform(&rve, dH, (int)nsteps)) {
                 fprintf(stderr, "rve_path: increment %d: %s\n", i, gk_rve_error(&rve));
-                fclose(fp);
-                return 1;
+                goto done;
             }
             for (k = 0; k < 9; ++k) Hacc[k] += dH[k];
         }
@@ -257,7 +276,12 @@ int main(int argc, char **argv) {
         xs[i] = gk_strain_q(Hacc, dim);
         qp[i] = p > 0 ? q / p : 0.0;
     }
-    fclose(fp);
+    res = gk_file_close(fp, out, &err);
+    fp = NULL;
+    if (res) {
+        fprintf(stderr, "rve_path: %s\n", err.msg);
+        goto done;
+    }
     {
         gk_plot pl;
         size_t L = strlen(out);
@@ -273,7 +297,10 @@ int main(int argc, char **argv) {
         gk_plot_init(&pl, "RVE stress ratio along the applied path", "deviatoric strain eps_q (seed 000 eq 13)",
                      "q / p");
         gk_plot_add(&pl, xs, qp, (int)ninc + 1, NULL);
-        if (gk_plot_svg(&pl, svg, &err)) fprintf(stderr, "rve_path: %s\n", err.msg);
+        if (gk_plot_svg(&pl, svg, &err)) {
+            fprintf(stderr, "rve_path: %s\n", err.msg);
+            goto done;
+        }
     }
     {
         double s[9];
@@ -283,8 +310,11 @@ int main(int argc, char **argv) {
                gk_homog_void_ratio(&rve), 2.0 * rve.ncontacts / rve.n, rve.step, gk_wtime() - t0);
     }
     fprintf(stderr, "rve_path: wrote %s and %s\n", out, svg);
+    rc = 0;
+done:
+    if (fp) fclose(fp);
     free(xs);
     free(qp);
     gk_rve_destroy(&rve);
-    return 0;
+    return rc;
 }

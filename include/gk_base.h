@@ -29,6 +29,8 @@
  *   GK_HW_GATHER      undefined    use vgather instructions (default: loads)
  *   GK_ASSERT(c)      assert(c)    internal invariant checks
  *   GK_MALLOC/GK_FREE malloc/free  default allocator behind gk_allocator
+ *   GK_FILE_MAX       INT_MAX      largest file gk_file_read accepts [bytes]
+ *                                  (a reader given /dev/zero stops there)
  *
  * CONVENTIONS (all headers)
  *   - SI units throughout: m, kg, s, N, Pa.
@@ -55,6 +57,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <math.h>
 
 #define GK_VERSION_MAJOR 0
@@ -192,6 +195,16 @@ GKDEF void gk_free(const gk_allocator *a, void *ptr);
 /* grow *ptr (elements of elem_size) from old_n to new_n, copying old_n; on
  * failure *ptr is untouched and GK_ERR_ALLOC returned. */
 GKDEF gk_result gk_realloc(const gk_allocator *a, void **ptr, size_t old_n, size_t new_n, size_t elem_size);
+/* Reads a whole file into a NUL-terminated buffer (*text, free it with
+ * gk_free(alloc, *text)) of *len bytes plus the NUL. Reads until end of file,
+ * so pipes work and a file's announced size is never trusted; a directory, an
+ * unreadable file or one above GK_FILE_MAX bytes is GK_ERR_IO naming the path
+ * and the reason. On error *text and *len are untouched. */
+GKDEF gk_result gk_file_read(const char *path, const gk_allocator *alloc, char **text, size_t *len, gk_err *err);
+/* Closes a FILE * that was written: fflush, ferror and fclose,
+ * so a lost byte anywhere (disk full, /dev/full, a quota) is GK_ERR_IO naming
+ * path and reason. The file is closed in every case. */
+GKDEF gk_result gk_file_close(FILE *fp, const char *path, gk_err *err);
 
 GKDEF void gk_rng_seed(gk_rng *r, uint64_t seed);
 GKDEF uint64_t gk_rng_u64(gk_rng *r);
@@ -697,6 +710,8 @@ typedef gk_vdm gk_vrm;
 #if (defined(GK_IMPLEMENTATION) || defined(GK_BASE_IMPLEMENTATION)) && !defined(GK_BASE_IMPL_ONCE)
 #define GK_BASE_IMPL_ONCE
 
+#include <errno.h>
+#include <limits.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -791,6 +806,76 @@ GKDEF gk_result gk_realloc(const gk_allocator *a, void **ptr, size_t old_n, size
     if (*ptr && old_n) memcpy(p, *ptr, (old_n < new_n ? old_n : new_n) * elem_size);
     gk_free(a, *ptr);
     *ptr = p;
+    return GK_OK;
+}
+
+#ifndef GK_FILE_MAX
+#define GK_FILE_MAX ((size_t)INT_MAX)
+#endif
+GKDEF gk_result gk_file_read(const char *path, const gk_allocator *alloc, char **text, size_t *len, gk_err *err) {
+    FILE *fp;
+    char *buf = NULL;
+    size_t n = 0, cap = 0;
+    int bad;
+    if (!path) return gk_err_set(err, GK_ERR_ARG, "no file name given");
+    errno = 0;
+    fp = fopen(path, "rb");
+    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open '%s': %s", path, errno ? strerror(errno) : "unknown error");
+    for (;;) {
+        size_t got;
+        if (n + 1 >= cap) { /* grow by doubling; one byte always left for the NUL */
+            size_t nc = cap ? 2 * cap : 65536;
+            if (cap > GK_FILE_MAX) {
+                fclose(fp);
+                gk_free(alloc, buf);
+                return gk_err_set(err, GK_ERR_IO, "'%s' is larger than %lu bytes (GK_FILE_MAX)", path,
+                                  (unsigned long)GK_FILE_MAX);
+            }
+            if (gk_realloc(alloc, (void **)&buf, n, nc, 1)) {
+                fclose(fp);
+                gk_free(alloc, buf);
+                return gk_err_set(err, GK_ERR_ALLOC, "out of memory reading '%s' (%lu bytes so far)", path,
+                                  (unsigned long)n);
+            }
+            cap = nc;
+        }
+        errno = 0;
+        got = fread(buf + n, 1, cap - 1 - n, fp);
+        n += got;
+        if (got == 0) break;
+    }
+    bad = ferror(fp);
+    if (bad) {
+        int e = errno;
+        fclose(fp);
+        gk_free(alloc, buf);
+        return gk_err_set(err, GK_ERR_IO, "cannot read '%s': %s", path, e ? strerror(e) : "read error");
+    }
+    fclose(fp);
+    if (n > GK_FILE_MAX) {
+        gk_free(alloc, buf);
+        return gk_err_set(err, GK_ERR_IO, "'%s' is larger than %lu bytes (GK_FILE_MAX)", path,
+                          (unsigned long)GK_FILE_MAX);
+    }
+    buf[n] = '\0';
+    *text = buf;
+    *len = n;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_file_close(FILE *fp, const char *path, gk_err *err) {
+    int bad, e;
+    if (!fp) return gk_err_set(err, GK_ERR_ARG, "no file to close ('%s')", path ? path : "");
+    errno = 0;
+    bad = fflush(fp) != 0 || ferror(fp);
+    e = errno;
+    if (fclose(fp) != 0) {
+        bad = 1;
+        if (!e) e = errno;
+    }
+    if (bad)
+        return gk_err_set(err, GK_ERR_IO, "error writing '%s': %s", path ? path : "file",
+                          e ? strerror(e) : "write error");
     return GK_OK;
 }
 

@@ -173,21 +173,27 @@ static gk_result gk__cells_grow(gk_cells *c, int32_t **arr, size_t *cap, size_t 
     return GK_OK;
 }
 
+/* bin of a finite reduced coordinate (the caller has checked finiteness) */
 GK_INLINE int gk__wrap_bin(double s, int nb) {
-    double f = s - floor(s);
-    int b = (int)(f * (double)nb);
-    return b >= nb ? nb - 1 : (b < 0 ? 0 : b);
+    double f = (s - floor(s)) * (double)nb;
+    int b = f < (double)nb ? (int)f : nb - 1;
+    return b < 0 ? 0 : b;
 }
+
+/* the largest bin count along one axis: bounds every product and the 3/4
+ * shrink step below in int */
+#define GK__CELLS_MAXBIN (1 << 29)
 
 GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3], double cutoff,
                              gk_err *err) {
-    double hinv[9], w[3];
-    long total = 1;
-    int k, p;
+    double hinv[9], w[3], total = 1.0, det;
+    int k, p, nbin[3];
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
     if (n < 0) return gk_err_set(err, GK_ERR_ARG, "particle count %d < 0", n);
     if (!(cutoff > 0.0) || !isfinite(cutoff)) return gk_err_set(err, GK_ERR_ARG, "cutoff %g must be > 0", cutoff);
-    if (!(gk_m3_inverse(h, hinv) > 0.0)) return gk_err_set(err, GK_ERR_CELL, "cell matrix is singular or inverted");
+    det = gk_m3_inverse(h, hinv);
+    if (!(det > 0.0) || !isfinite(det) || !gk_m3_isfinite(hinv))
+        return gk_err_set(err, GK_ERR_CELL, "cell matrix is singular, inverted or not finite (det %g)", det);
     for (k = 0; k < dim; ++k) {
         const double *row = hinv + 3 * k;
         w[k] = 1.0 / sqrt(row[0] * row[0] + row[1] * row[1] + (dim == 3 ? row[2] * row[2] : 0.0));
@@ -196,9 +202,10 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
                               "cell width %g across axis %d is less than twice the interaction distance %g: "
                               "nearest image ambiguous (use a larger cell)",
                               w[k], k, cutoff);
-        c->nbin[k] = (int)(w[k] / cutoff);
+        /* compared as a double first: a huge cell or a tiny cutoff never reaches the int cast */
+        nbin[k] = w[k] / cutoff < (double)GK__CELLS_MAXBIN ? (int)(w[k] / cutoff) : GK__CELLS_MAXBIN;
         if (c->open & (1u << k)) { /* bins over the particles' extent only */
-            double smin = 1e300, smax = -1e300;
+            double smin = 1e300, smax = -1e300, e;
             for (p = 0; p < n; ++p) {
                 if (s[k][p] < smin) smin = s[k][p];
                 if (s[k][p] > smax) smax = s[k][p];
@@ -208,19 +215,29 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
                                   "open axis %d: the particles span %g of the cell (must be below 1, not NaN)", k,
                                   smax - smin);
             c->lo[k] = smin;
-            c->nbin[k] = (int)((smax - smin) * w[k] / cutoff);
+            e = (smax - smin) * w[k] / cutoff;
+            nbin[k] = e < (double)GK__CELLS_MAXBIN ? (int)e : GK__CELLS_MAXBIN;
         }
-        if (c->nbin[k] < 1) c->nbin[k] = 1;
+        if (nbin[k] < 1) nbin[k] = 1;
     }
-    if (dim == 2) c->nbin[2] = 1;
+    for (k = 0; k < dim; ++k)
+        for (p = 0; p < n; ++p)
+            if (!isfinite(s[k][p]))
+                return gk_err_set(err, GK_ERR_NAN, "particle %d has a non-finite reduced coordinate %g", p, s[k][p]);
+    if (dim == 2) nbin[2] = 1;
     /* keep the grid at most ~2n + 27 bins (dilute or huge cells) */
     for (;;) {
-        total = (long)c->nbin[0] * c->nbin[1] * c->nbin[2];
-        if (total <= 2L * n + 27) break;
+        total = (double)nbin[0] * nbin[1] * nbin[2];
+        if (total <= 2.0 * n + 27) break;
         for (k = 0; k < dim; ++k)
-            if (c->nbin[k] > 3) c->nbin[k] = c->nbin[k] * 3 / 4 > 3 ? c->nbin[k] * 3 / 4 : 3;
-        if (c->nbin[0] <= 3 && c->nbin[1] <= 3 && c->nbin[2] <= 3) break;
+            if (nbin[k] > 3) nbin[k] = nbin[k] * 3 / 4 > 3 ? nbin[k] * 3 / 4 : 3;
+        if (nbin[0] <= 3 && nbin[1] <= 3 && nbin[2] <= 3) break;
     }
+    total = (double)nbin[0] * nbin[1] * nbin[2]; /* <= 2n + 27 or 27 */
+    if (total >= (double)INT32_MAX) return gk_err_set(err, GK_ERR_ALLOC, "%.0f cell-list bins overflow int", total);
+    if (gk__cells_grow(c, &c->bin_start, &c->cap_bins, (size_t)total + 1))
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %.0f cell-list bins", total);
+    for (k = 0; k < 3; ++k) c->nbin[k] = nbin[k];
     c->nbins = (int)total;
     for (k = 0; k < dim; ++k)
         if (c->open & (1u << k)) {
@@ -229,8 +246,6 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
                 if (s[k][p] > smax) smax = s[k][p];
             c->inv[k] = smax > c->lo[k] ? (double)c->nbin[k] / (smax - c->lo[k]) : 0.0;
         }
-    if (gk__cells_grow(c, &c->bin_start, &c->cap_bins, (size_t)total + 1))
-        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %ld cell-list bins", total);
     if ((size_t)n + 1 > c->cap_n) { /* order and bin_of share one capacity */
         size_t cap = (size_t)n + 1;
         if (gk_realloc(&c->alloc, (void **)&c->order, 0, cap, sizeof(int32_t)) ||
@@ -344,6 +359,8 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
             }
             c->buf[t + 1] = v;
         }
+        if (cnt > INT32_MAX - out->n)
+            return gk_err_set(err, GK_ERR_ALLOC, "more than %ld candidate pairs", (long)INT32_MAX);
         if ((size_t)(out->n + cnt) > out->cap) {
             size_t want = out->cap * 2 > (size_t)(out->n + cnt) ? out->cap * 2 : (size_t)(out->n + cnt);
             if (gk_pairlist_reserve(out, want, (size_t)n))

@@ -125,6 +125,11 @@
 #ifndef GK_DEM_PAR_MIN
 #define GK_DEM_PAR_MIN 20000
 #endif
+/* particles of one RVE: int32 pair lists hold up to ~30 candidates each */
+#define GK_RVE_MAX_PARTICLES (1 << 26)
+#ifndef GK_RVE_STEP_OVERLAP_MAX
+#define GK_RVE_STEP_OVERLAP_MAX 0.1
+#endif
 
 /* ------------------------------------------------------------- RVE def */
 typedef enum gk_damp_form { GK_DAMP_COMPONENT = 0, GK_DAMP_VECTOR = 1 } gk_damp_form;
@@ -435,20 +440,36 @@ static gk_result gk__spare_reserve(gk_rve *rve, size_t cap) {
     return GK_OK;
 }
 
-/* critical time step, seed 000 eq 19 */
-static double gk__dt_critical(const gk_rve *rve) {
+/* critical time step, seed 000 eq 19, at the geometry (h, reduced positions
+ * sb[k], pairs ib/jb of np) given as bytes: the live RVE's arrays or a saved
+ * state being checked before it is restored */
+static double gk__dt_critical_at(const gk_rve *rve, const double h[9], const unsigned char *const sb[3],
+                                 const unsigned char *ib, const unsigned char *jb, int np) {
     double knmax;
     const gk_material *m = &rve->def.mat;
     if (m->law == GK_LAW_LINEAR) {
         knmax = m->kn > 0 ? m->kn : m->young * rve->rmax; /* r* <= r_max */
     } else {
         double dmax = 1e-3 * rve->rmin, G = m->young / (2.0 * (1.0 + m->poisson));
+        gk_pcell cell;
         int c;
-        for (c = 0; c < rve->pl.n; ++c) { /* current largest overlap, from the geometry */
-            int i = rve->pl.i[c], j = rve->pl.j[c], k;
+        cell.dim = rve->dim;
+        gk_m3_copy(h, cell.h);
+        for (c = 0; c < np; ++c) { /* current largest overlap, from the geometry */
+            int32_t i, j;
+            int k;
             double ds[3], d[3], dd;
-            for (k = 0; k < 3; ++k) ds[k] = k < rve->dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
-            gk_pcell_min_image(&rve->cell, ds, d);
+            memcpy(&i, ib + 4 * (size_t)c, 4);
+            memcpy(&j, jb + 4 * (size_t)c, 4);
+            for (k = 0; k < 3; ++k) {
+                double si = 0.0, sj = 0.0;
+                if (k < rve->dim) {
+                    memcpy(&si, sb[k] + 8 * (size_t)i, 8);
+                    memcpy(&sj, sb[k] + 8 * (size_t)j, 8);
+                }
+                ds[k] = sj - si;
+            }
+            gk_pcell_min_image(&cell, ds, d);
             if (rve->dim == 2) d[2] = 0.0;
             dd = (double)rve->r[i] + (double)rve->r[j] - sqrt(gk_v3_dot(d, d));
             if (2.0 * dd > dmax) dmax = 2.0 * dd;
@@ -456,6 +477,14 @@ static double gk__dt_critical(const gk_rve *rve) {
         knmax = G / (1.0 - m->poisson) * sqrt(2.0 * rve->rmax * dmax);
     }
     return sqrt(rve->mmin / knmax);
+}
+
+static double gk__dt_critical(const gk_rve *rve) {
+    const unsigned char *sb[3];
+    int k;
+    for (k = 0; k < 3; ++k) sb[k] = (const unsigned char *)rve->s[k];
+    return gk__dt_critical_at(rve, rve->cell.h, sb, (const unsigned char *)rve->pl.i,
+                              (const unsigned char *)rve->pl.j, rve->pl.n);
 }
 
 GKDEF double gk_rve_dt_critical(const gk_rve *rve) { return gk__dt_critical(rve); }
@@ -480,6 +509,9 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     n = pk->n;
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "packing has %d particles", n);
+    if (n > GK_RVE_MAX_PARTICLES)
+        return gk_err_set(err, GK_ERR_ARG, "packing has %d particles; an RVE holds at most %d (int32 pair lists)", n,
+                          GK_RVE_MAX_PARTICLES);
     if (!(def->damping >= 0.0 && def->damping < 1.0))
         return gk_err_set(err, GK_ERR_ARG, "local damping %g outside [0, 1)", def->damping);
     if (def->damping_form != GK_DAMP_COMPONENT && def->damping_form != GK_DAMP_VECTOR)
@@ -555,14 +587,16 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                 /* binning for ordering only: any bin size below half the cell works */
                 cutoff = 2.0 * rmax < 0.49 * wmin ? 2.0 * rmax : 0.49 * wmin;
             }
-            res = gk_cells_bin(&cl, dim, R.cell.h, n, (const double *const *)tmp, cutoff, NULL);
+            res = gk_cells_bin(&cl, dim, R.cell.h, n, (const double *const *)tmp, cutoff, err);
             if (!res) memcpy(perm, cl.order, (size_t)n * sizeof(int32_t));
+        } else {
+            gk_err_set(err, res, "out of memory ordering %d particles", n);
         }
         gk_cells_free(&cl);
         if (res) {
             for (k = 0; k < 3; ++k) gk_free(&def->alloc, tmp[k]);
             gk_free(&def->alloc, perm);
-            return gk_err_set(err, res == GK_ERR_ALLOC ? GK_ERR_ALLOC : res, "could not order %d particles", n);
+            return res;
         }
         /* allocate */
         for (k = 0; k < 3; ++k) {
@@ -619,6 +653,16 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                 R.r[p] = (gk_real)rq;
                 R.minv[p] = (gk_real)(1.0 / m);
                 R.Iinv[p] = (gk_real)(1.0 / I);
+                if (!(m > 0.0 && isfinite(m) && I > 0.0 && isfinite(I)) || !(R.r[p] > 0) ||
+                    !((double)R.minv[p] > 0.0 && isfinite((double)R.minv[p])) ||
+                    !((double)R.Iinv[p] > 0.0 && isfinite((double)R.Iinv[p]))) {
+                    gk_err_set(err, GK_ERR_MASS,
+                               "particle %d (radius %g): mass %g and inertia %g are out of the range of %s "
+                               "(rescale the units)",
+                               q, rq, m, I, GK_REAL_NAME);
+                    res = GK_ERR_MASS;
+                    break;
+                }
                 R.id[p] = q;
                 if (R.theta) R.theta[p] = 0.0;
                 if (rq < R.rmin) R.rmin = rq;
@@ -633,7 +677,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         gk_free(&def->alloc, perm);
         if (res) {
             gk__rve_free_arrays(&R);
-            return gk_err_set(err, GK_ERR_ALLOC, "out of memory for an RVE of %d particles", n);
+            if (res == GK_ERR_ALLOC) gk_err_set(err, res, "out of memory for an RVE of %d particles", n);
+            return res;
         }
     }
     R.skin = def->skin > 0.0 ? def->skin : 0.1 * rsum / n;
@@ -663,7 +708,12 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     if (!res) {
         R.dt_crit = gk__dt_critical(&R);
         dtc = R.dt_crit;
-        if (def->dt > 0.0) {
+        if (!(dtc > 0.0) || !isfinite(dtc) || !(dtc * (def->dt_factor > 0.0 ? def->dt_factor : 0.5) > 0.0))
+            res = gk_err_set(&R.err, GK_ERR_DT,
+                             "critical time step %g s (seed 000 eq 19) is not a positive number: radii %g to %g m "
+                             "and the stiffness are out of range (rescale the units)",
+                             dtc, R.rmin, R.rmax);
+        else if (def->dt > 0.0) {
             if (def->dt > dtc)
                 res = gk_err_set(&R.err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)",
                                  def->dt, dtc);
@@ -2041,28 +2091,64 @@ GKDEF gk_result gk_rve_set_velocity_gradient(gk_rve *rve, const double L[9]) {
     return GK_OK;
 }
 
-GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *s) {
+static gk_result gk__servo_check(int dim, const gk_servo *s, gk_err *err) {
     int k;
+    if (s->shear && !(isfinite(s->shear_target[0]) && isfinite(s->shear_target[1]) && isfinite(s->shear_target[2])))
+        return gk_err_set(err, GK_ERR_NAN, "servo: non-finite shear target");
+    for (k = 0; k < dim; ++k) {
+        if (s->mode[k] != GK_SERVO_STRAIN && s->mode[k] != GK_SERVO_STRESS)
+            return gk_err_set(err, GK_ERR_ARG, "servo axis %d: unknown mode %d", k, (int)s->mode[k]);
+        if (!isfinite(s->target[k]) || !isfinite(s->rate[k]))
+            return gk_err_set(err, GK_ERR_NAN, "servo axis %d: non-finite target or rate", k);
+    }
+    if (!(s->max_rate > 0.0) || !isfinite(s->max_rate))
+        return gk_err_set(err, GK_ERR_ARG, "servo max_rate %g must be > 0", s->max_rate);
+    if (!(s->gain >= 0.0 && s->gain <= 1.0))
+        return gk_err_set(err, GK_ERR_ARG, "servo gain %g outside [0, 1]", s->gain);
+    return GK_OK;
+}
+
+GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *s) {
+    gk_result res;
     if (!s) {
         rve->servo_on = 0;
         return GK_OK;
     }
-    if (s->shear && !(isfinite(s->shear_target[0]) && isfinite(s->shear_target[1]) && isfinite(s->shear_target[2])))
-        return gk_err_set(&rve->err, GK_ERR_NAN, "servo: non-finite shear target");
-    for (k = 0; k < rve->dim; ++k) {
-        if (s->mode[k] != GK_SERVO_STRAIN && s->mode[k] != GK_SERVO_STRESS)
-            return gk_err_set(&rve->err, GK_ERR_ARG, "servo axis %d: unknown mode %d", k, (int)s->mode[k]);
-        if (!isfinite(s->target[k]) || !isfinite(s->rate[k]))
-            return gk_err_set(&rve->err, GK_ERR_NAN, "servo axis %d: non-finite target or rate", k);
-    }
-    if (!(s->max_rate > 0.0) || !isfinite(s->max_rate))
-        return gk_err_set(&rve->err, GK_ERR_ARG, "servo max_rate %g must be > 0", s->max_rate);
-    if (!(s->gain >= 0.0 && s->gain <= 1.0))
-        return gk_err_set(&rve->err, GK_ERR_ARG, "servo gain %g outside [0, 1]", s->gain);
+    res = gk__servo_check(rve->dim, s, &rve->err);
+    if (res) return res;
     rve->servo = *s;
     rve->servo_on = 1;
     if (rve->pl.i) gk__stiff_pass(rve); /* the stiffness of the current contacts (unused without servo) */
     return GK_OK;
+}
+
+/* largest relative change of length the map E gives any vector: max |sigma_k(E) - 1|
+ * over its singular values (0 for a rotation) */
+static double gk__map_stretch(int dim, const double E[9]) {
+    double Et[9], EtE[9], lo, hi;
+    gk_m3_transpose(E, Et);
+    gk_m3_mul(Et, E, EtE);
+    if (dim == 2) {
+        double a = EtE[0], b = EtE[1], d = EtE[4], disc = sqrt(0.25 * (a - d) * (a - d) + b * b);
+        lo = 0.5 * (a + d) - disc;
+        hi = 0.5 * (a + d) + disc;
+    } else {
+        double val[3], vec[9];
+        gk_m3_sym_eigen(EtE, val, vec);
+        lo = val[0];
+        hi = val[2];
+    }
+    lo = 1.0 - sqrt(lo > 0.0 ? lo : 0.0);
+    hi = sqrt(hi) - 1.0;
+    return hi > lo ? hi : lo; /* NaN stays NaN: refused */
+}
+
+/* The admissible increment of one DEM step (see THE RVE CONTRACT): a per-step
+ * cell map of this stretch changes the overlap of a contact (i, j) by at most
+ * stretch (r_i + r_j), which must stay below GK_RVE_STEP_OVERLAP_MAX x the
+ * smaller radius for every possible pair. */
+static double gk__step_stretch_max(const gk_rve *rve) {
+    return GK_RVE_STEP_OVERLAP_MAX * rve->rmin / (rve->rmin + rve->rmax);
 }
 
 GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
@@ -2072,6 +2158,26 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
     if (nsteps < 0) return gk_err_set(&rve->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
+    {   /* the largest per-step map: the servo's rates are bounded by max_rate */
+        double C[9], f = 0.0, lim = gk__step_stretch_max(rve);
+        int i, j;
+        for (i = 0; i < 3; ++i)
+            for (j = 0; j < 3; ++j) {
+                int servo = rve->servo_on && i < rve->dim && j < rve->dim &&
+                            ((i == j && rve->servo.mode[i] == GK_SERVO_STRESS) || (i != j && rve->servo.shear));
+                C[3 * i + j] = servo ? rve->servo.max_rate : (rve->servo_on && i == j && i < rve->dim
+                                                                  ? fabs(rve->servo.rate[i])
+                                                                  : fabs(rve->L[3 * i + j]));
+                f += C[3 * i + j] * C[3 * i + j];
+            }
+        f = expm1(sqrt(f) * rve->dt); /* |exp(A) - I| <= exp(|A|) - 1 bounds the stretch */
+        if (!(f <= lim))
+            return gk_err_set(&rve->err, GK_ERR_ARG,
+                              "the velocity gradient%s moves a contact by up to %.3g of the smaller radius in one "
+                              "step of %g s (admissible %g, GK_RVE_STEP_OVERLAP_MAX): lower the rates or dt",
+                              rve->servo_on ? " (with the servo's max_rate)" : "",
+                              f * (rve->rmin + rve->rmax) / rve->rmin, rve->dt, GK_RVE_STEP_OVERLAP_MAX);
+    }
     gk_m3_copy(rve->L, Lcur);
     for (st = 0; st < nsteps; ++st) {
         if (rve->servo_on) {
@@ -2099,6 +2205,21 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
     res = gk_path_init(&path, rve->dim, rve->def.path, dH, nsteps, &rve->err);
     if (res) return res;
+    {   /* refuse up front an increment too large for one DEM step (the contract) */
+        double st = 0.0, lim = gk__step_stretch_max(rve);
+        for (k = 1; k <= (rve->def.path == GK_PATH_CONSTANT_L ? 1 : nsteps); ++k) {
+            double a;
+            gk_path_step(&path, k, E);
+            a = gk__map_stretch(rve->dim, E);
+            if (!(a <= st)) st = a;
+        }
+        if (!(st <= lim))
+            return gk_err_set(&rve->err, GK_ERR_ARG,
+                              "dH in %d DEM steps changes a contact's overlap by up to %.3g of the smaller radius in "
+                              "one step (admissible %g, GK_RVE_STEP_OVERLAP_MAX): use at least %.0f steps",
+                              nsteps, st * (rve->rmin + rve->rmax) / rve->rmin, GK_RVE_STEP_OVERLAP_MAX,
+                              ceil(nsteps * st / lim));
+    }
     {   /* refuse up front a map that leaves the cell too thin for the nearest image */
         gk_pcell end = rve->cell;
         double Mend[9], B[9], w[3];
@@ -2613,55 +2734,161 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
     return GK_OK;
 }
 
+/* count values of elem (4 or 8) bytes at b, all finite */
+static int gk__finite_bytes(const unsigned char *b, size_t count, size_t elem) {
+    size_t k;
+    for (k = 0; k < count; ++k) {
+        if (elem == 8) {
+            double v;
+            memcpy(&v, b + 8 * k, 8);
+            if (!isfinite(v)) return 0;
+        } else {
+            float v;
+            memcpy(&v, b + 4 * k, 4);
+            if (!isfinite(v)) return 0;
+        }
+    }
+    return 1;
+}
+
+/* a pair list of np (i, j) int32 at ib, jb: 0 <= i < j < n, sorted by (i, j) without repeats */
+static int gk__pairs_valid(const unsigned char *ib, const unsigned char *jb, int np, int n) {
+    int32_t pi = -1, pj = -1;
+    int c;
+    for (c = 0; c < np; ++c) {
+        int32_t a, b;
+        memcpy(&a, ib + 4 * (size_t)c, 4);
+        memcpy(&b, jb + 4 * (size_t)c, 4);
+        if (a < 0 || b <= a || b >= n || a < pi || (a == pi && b <= pj)) return c;
+        pi = a, pj = b;
+    }
+    return -1;
+}
+
+/* a 3x3 map of the cell kind: finite, det > 0 and finite, 2D block structure */
+static int gk__map_valid(int dim, const double a[9]) {
+    double d = gk_m3_det(a);
+    if (!gk_m3_isfinite(a) || !(d > 0.0) || !isfinite(d)) return 0;
+    return dim == 3 || (a[2] == 0.0 && a[5] == 0.0 && a[6] == 0.0 && a[7] == 0.0 && a[8] == 1.0);
+}
+
+/* Every field of a state is checked before anything is changed: header
+ * scalars in their ranges, every real finite, the maps invertible, both pair
+ * lists sorted and in range, the contact bits known, and the time step at or
+ * below the critical one of this RVE at the state's own geometry (the check
+ * every list rebuild makes). */
 GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     gk__state_hdr hd;
     const unsigned char *in = (const unsigned char *)buf;
     size_t off = 0, n, np, R = sizeof(gk_real);
-    int k, dim = rve->dim, p, c;
-    if (!buf || size < sizeof hd) return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state buffer too small");
+    int k, dim = rve->dim, p, c, nr, nroll;
+    gk_err *err = &rve->err;
+    if (rve->n < 1 || !rve->s[0]) return gk_err_set(err, GK_ERR_STATE, "restore into an RVE that was not created");
+    if (!buf || size < sizeof hd) return gk_err_set(err, GK_ERR_FORMAT, "RVE state buffer too small");
     memcpy(&hd, buf, sizeof hd);
     if (memcmp(hd.magic, GK__STATE_MAGIC, 8) != 0 || hd.endian != 0x01020304)
-        return gk_err_set(&rve->err, GK_ERR_FORMAT, "not a grainkit RVE state (bad magic or byte order)");
+        return gk_err_set(err, GK_ERR_FORMAT, "not a grainkit RVE state (bad magic or byte order)");
     if (hd.version != GK__STATE_VERSION)
-        return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state version %d (this build reads %d)", hd.version,
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state version %d (this build reads %d)", hd.version,
                           GK__STATE_VERSION);
-    if (hd.dim != rve->dim || hd.n != rve->n || hd.real_size != (int32_t)R || hd.phys != (int32_t)rve->phys)
-        return gk_err_set(&rve->err, GK_ERR_FORMAT,
+    if (hd.dim != rve->dim || hd.n != rve->n || hd.real_size != (int32_t)R || hd.phys != (int32_t)rve->phys ||
+        hd.rot != GK__HAS_ROT(rve) || hd.roll != GK__HAS_ROLL(rve))
+        return gk_err_set(err, GK_ERR_FORMAT,
                           "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
                           hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
     if (hd.npairs < 0 || hd.nouter < 0 || size != gk__state_bytes(rve, hd.npairs, hd.nouter))
-        return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state has the wrong size");
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state has the wrong size");
     n = (size_t)rve->n;
     np = (size_t)hd.npairs;
+    nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0;
+    nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
+    /* ---- header scalars */
+    if (!(hd.dt > 0.0) || !isfinite(hd.dt)) return gk_err_set(err, GK_ERR_DT, "RVE state time step %g", hd.dt);
+    if (!(hd.dt_crit > 0.0) || !isfinite(hd.dt_crit) || !isfinite(hd.time) || hd.step < 0 || hd.rebuilds < 0 ||
+        hd.flips < 0)
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state has an invalid time %g, step %ld or critical step %g",
+                          hd.time, (long)hd.step, hd.dt_crit);
+    if (!(hd.skin > 0.0) || !isfinite(hd.skin) || !(hd.skin_in > 0.0) || !(hd.skin_in <= hd.skin))
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state Verlet skins %g and %g invalid", hd.skin, hd.skin_in);
+    if (!gk__map_valid(dim, hd.h) || !gk__map_valid(dim, hd.F) || !gk__map_valid(dim, hd.h0) ||
+        !gk__map_valid(dim, hd.ho0))
+        return gk_err_set(err, GK_ERR_CELL, "RVE state cell (h %g %g %g %g ...) is not a valid cell matrix", hd.h[0],
+                          hd.h[1], hd.h[3], hd.h[4]);
+    {
+        gk_pcell cell;
+        double w[3];
+        if (gk_pcell_init(&cell, dim, hd.h, err)) return GK_ERR_CELL;
+        gk_pcell_widths(&cell, w);
+        for (k = 0; k < dim; ++k)
+            if (!(2.0 * (2.0 * rve->rmax + hd.skin) < w[k]))
+                return gk_err_set(err, GK_ERR_CELL,
+                                  "RVE state cell is %g wide, below twice the interaction distance %g", w[k],
+                                  2.0 * rve->rmax + hd.skin);
+    }
+    if (!gk_m3_isfinite(hd.L) || !gk_m3_isfinite(hd.G) || !gk_m3_isfinite(hd.stress) || !isfinite(hd.stiff[0]) ||
+        !isfinite(hd.stiff[1]) || !isfinite(hd.stiff[2]) || !(hd.fc_mean >= 0.0) || !isfinite(hd.fc_mean))
+        return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite velocity gradient, stress or stiffness");
+    if (dim == 2 && (hd.L[2] != 0 || hd.L[5] != 0 || hd.L[6] != 0 || hd.L[7] != 0 || hd.L[8] != 0))
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state: 2D velocity gradient with a third row or column");
+    if (hd.ncontacts < 0 || hd.ncontacts > hd.npairs || (hd.need_rebuild != 0 && hd.need_rebuild != 1) ||
+        (hd.servo_on != 0 && hd.servo_on != 1) || (hd.outer_valid != 0 && hd.outer_valid != 1))
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state has invalid counters or flags (%d contacts of %d pairs)",
+                          hd.ncontacts, hd.npairs);
+    {
+        gk_material m = rve->def.mat;
+        gk_result r = hd.servo_on ? gk__servo_check(dim, &hd.servo, err) : GK_OK;
+        if (r) return r;
+        m.friction = hd.mu;
+        if ((r = gk_material_check(&m, err)) != GK_OK) return r;
+        if (hd.mu > 0.0 && !(rve->phys & GK_PHYS_TANGENT))
+            return gk_err_set(err, GK_ERR_STATE, "RVE state has friction %g for an RVE created frictionless", hd.mu);
+    }
+    /* ---- arrays, in the order gk_rve_save writes them */
+    off = sizeof hd;
+    {
+        const unsigned char *sb[3] = {NULL, NULL, NULL}, *ib, *jb, *cs;
+        double dtc;
+        size_t dbl = 8;
+        for (k = 0; k < dim; ++k) sb[k] = in + off + (size_t)k * n * dbl;
+        if (!gk__finite_bytes(in + off, 2 * dim * n, dbl))
+            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite position");
+        off += 2 * dim * n * dbl;
+        if (!gk__finite_bytes(in + off, (2 * dim + 2 * nr) * n, R))
+            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite velocity, force, spin or torque");
+        off += (2 * dim + 2 * nr) * n * R;
+        if (dim == 2) {
+            if (!gk__finite_bytes(in + off, n, dbl))
+                return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite rotation");
+            off += n * dbl;
+        }
+        ib = in + off;
+        jb = ib + 4 * np;
+        cs = jb + 4 * np;
+        if ((c = gk__pairs_valid(ib, jb, hd.npairs, rve->n)) >= 0)
+            return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has invalid or unsorted particles", c);
+        for (c = 0; c < hd.npairs; ++c)
+            if (cs[c] & ~(GK_CS_CONTACT | GK_CS_SLIDING | GK_CS_BONDED | GK_CS_BROKEN))
+                return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has unknown contact bits 0x%x", c, cs[c]);
+        off += np * 9;
+        if (!gk__finite_bytes(in + off, ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np, R))
+            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite contact force or history");
+        off += ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np * R;
+        if ((c = gk__pairs_valid(in + off, in + off + 4 * (size_t)hd.nouter, hd.nouter, rve->n)) >= 0)
+            return gk_err_set(err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid or unsorted particles", c);
+        off += 8 * (size_t)hd.nouter;
+        if (!gk__finite_bytes(in + off, dim * n, dbl))
+            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite outer-list reference position");
+        dtc = gk__dt_critical_at(rve, hd.h, sb, ib, jb, hd.npairs);
+        if (!(hd.dt <= dtc))
+            return gk_err_set(err, GK_ERR_DT,
+                              "RVE state time step %g s is above the critical %g s of this RVE at the state's "
+                              "geometry (seed 000 eq 19)",
+                              hd.dt, dtc);
+    }
     /* capacity first, so a failure changes nothing observable */
     if (gk__pairs_reserve(rve, np + 1, (size_t)rve->pl.n) || gk_pairlist_reserve(&rve->pl, np + 1, n) ||
         gk_pairlist_reserve(&rve->outer, (size_t)hd.nouter + 1, n))
-        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory restoring %d pairs", hd.npairs);
-    {   /* outer list indices */
-        size_t ob = size - (size_t)hd.nouter * 8 - n * (size_t)dim * sizeof(double);
-        for (c = 0; c < hd.nouter; ++c) {
-            int32_t a, b;
-            memcpy(&a, in + ob + (size_t)c * 4, 4);
-            memcpy(&b, in + ob + (size_t)hd.nouter * 4 + (size_t)c * 4, 4);
-            if (a < 0 || b <= a || b >= rve->n)
-                return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid particles (%d, %d)", c,
-                                  a, b);
-        }
-    }
-    /* validate pair indices before touching anything */
-    {
-        size_t base = sizeof hd + n * (2 * dim * sizeof(double)) +
-                      n * R * (2 * dim + 2 * (GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0)) +
-                      (dim == 2 ? n * sizeof(double) : 0);
-        for (c = 0; c < (int)np; ++c) {
-            int32_t a, b;
-            memcpy(&a, in + base + (size_t)c * 4, 4);
-            memcpy(&b, in + base + np * 4 + (size_t)c * 4, 4);
-            if (a < 0 || b <= a || b >= rve->n)
-                return gk_err_set(&rve->err, GK_ERR_FORMAT, "RVE state pair %d has invalid particles (%d, %d)", c, a,
-                                  b);
-        }
-    }
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory restoring %d pairs", hd.npairs);
     off = sizeof hd;
     for (k = 0; k < dim; ++k) GK__GET(rve->s[k], n * sizeof(double));
     for (k = 0; k < dim; ++k) GK__GET(rve->s0[k], n * sizeof(double));

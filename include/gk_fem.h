@@ -40,6 +40,9 @@
  *   gk_mesh_nodes_on_plane  nodes lying on x_axis = value
  *   gk_mesh_structured      nx x ny (x nz) mesh of a box, any element type
  *   gk_mesh_read_gmsh       Gmsh .msh ASCII v2.2 and v4.1: quad4/quad8/hex8
+ *   gk_mesh_parse_gmsh      the same from len bytes of text in memory (need
+ *                           not end in NUL); memory follows what the text
+ *                           holds, never the counts or tags it announces
  *   gk_mesh_check           every element has det J > 0 at every Gauss point
  *   gk_mesh_update          updated-Lagrangian node update x += u
  *   gk_csr_from_mesh        sparsity of the nodal-dof graph (dof = dim*node+c)
@@ -87,13 +90,25 @@
  *   simple shear); tests/test_fem.c has periodic patch tests.
  *
  * SOLVERS
+ *   gk_solver_init          an empty solver (every gk_solver starts here:
+ *                           factor refuses one that did not, GK_ERR_ARG)
  *   gk_solver_factor/solve  direct: reverse Cuthill-McKee ordering, then a
  *                           banded LU with partial pivoting (robust for the
  *                           non-symmetric perturbation tangent). A pivot below
  *                           1e-12 x max|A| -> GK_ERR_SINGULAR naming the dof
  *                           (typically an unconstrained rigid-body mode).
+ *                           A new factorisation replaces (frees) the one the
+ *                           solver held only on success; on failure the old
+ *                           one is kept. gk_solver_free returns it to the
+ *                           gk_solver_init state. solve: a non-finite b ->
+ *                           GK_ERR_NAN, a non-finite solution (overflow) ->
+ *                           GK_ERR_DIVERGED; x is then unchanged and the
+ *                           message is in s->err.
  *   gk_pcg                  Jacobi-preconditioned conjugate gradients for large
- *                           symmetric positive definite systems.
+ *                           symmetric positive definite systems; rtol in
+ *                           (0, 1), b and the start x finite. x is changed
+ *                           on success and on GK_ERR_NOCONVERGE (the last
+ *                           iterate) only.
  *
  * Units and signs as gk_base.h: SI, tension-positive stress. 2D is plane
  * strain per unit thickness (forces are N/m).
@@ -144,13 +159,17 @@ typedef struct gk_dofmap {
 } gk_dofmap;
 
 typedef struct gk_solver {
+    int cookie;       /* set by gk_solver_init                              */
     int n, kl, ku, w; /* band: kl below, ku above (+kl fill from pivoting)  */
     int *perm;        /* perm[new] = old dof (reverse Cuthill-McKee)        */
     int *ipiv;        /* row interchanges                                   */
     double *ab;       /* n x w row-band: A(i,j) at ab[i*w + j - i + kl]     */
     double *tmp;      /* n                                                  */
     gk_allocator alloc;
+    gk_err err;       /* message of the last failed gk_solver_solve         */
 } gk_solver;
+
+#define GK_SOLVER_COOKIE 0x534f4c56
 
 #ifdef __cplusplus
 extern "C" {
@@ -179,6 +198,8 @@ GKDEF void gk_fem_hex8_hourglass(const double *xe, const double *ue, double k, d
 GKDEF gk_result gk_mesh_structured(gk_mesh *m, gk_elem_type t, const int n[3], const double origin[3],
                                    const double len[3], const gk_allocator *alloc, gk_err *err);
 GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *m, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_mesh_parse_gmsh(const char *text, size_t len, gk_mesh *m, const gk_allocator *alloc,
+                                   gk_err *err);
 GKDEF gk_result gk_mesh_check(const gk_mesh *m, const gk_quad *q, gk_err *err);
 GKDEF void gk_mesh_free(gk_mesh *m);
 GKDEF void gk_mesh_update(gk_mesh *m, const double *u);
@@ -210,6 +231,7 @@ GKDEF void gk_dofmap_expand(const gk_dofmap *dm, const double *ur, int with_jump
 GKDEF gk_result gk_dofmap_dirichlet(const gk_dofmap *dm, int nfix, const int *dofs, const double *vals,
                                     int *rdofs, double *rvals, int *nrfix, gk_err *err);
 
+GKDEF void gk_solver_init(gk_solver *s);
 GKDEF gk_result gk_solver_factor(gk_solver *s, const gk_csr *A, const gk_allocator *alloc, gk_err *err);
 GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x);
 GKDEF void gk_solver_free(gk_solver *s);
@@ -227,6 +249,7 @@ GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol,
 #if (defined(GK_IMPLEMENTATION) || defined(GK_FEM_IMPLEMENTATION)) && !defined(GK_FEM_IMPL_ONCE)
 #define GK_FEM_IMPL_ONCE
 
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -309,7 +332,12 @@ GKDEF gk_result gk_fem_jacobian(const gk_mesh *m, int e, const double *xi, doubl
                                 double *detJ, gk_err *err) {
     double Nl[GK_FEM_MAX_NPE], dN[3 * GK_FEM_MAX_NPE], J[9], Ji[9], det;
     int a, i, j, dim = m->dim, npe = m->npe;
-    const int *c = m->conn + (size_t)e * npe;
+    const int *c;
+    if (e < 0 || e >= m->nelem) return gk_err_set(err, GK_ERR_ARG, "element %d of %d", e, m->nelem);
+    c = m->conn + (size_t)e * npe;
+    for (a = 0; a < npe; ++a)
+        if (c[a] < 0 || c[a] >= m->nnode)
+            return gk_err_set(err, GK_ERR_MESH, "element %d: node id %d out of range", e, c[a]);
     gk_fem_shape(m->type, xi, Nl, dN);
     gk_m3_identity(J);
     for (i = 0; i < dim; ++i)
@@ -348,6 +376,10 @@ GKDEF gk_result gk_fem_elem_stiffness(const gk_mesh *m, int e, const gk_quad *q,
                                       gk_err *err) {
     int dim = m->dim, npe = m->npe, nd = dim * npe, n4 = dim * dim * dim * dim, g, a, b, i, j, k, l;
     double dNdx[3 * GK_FEM_MAX_NPE], detJ;
+    if (e < 0 || e >= m->nelem) return gk_err_set(err, GK_ERR_ARG, "element %d of %d", e, m->nelem);
+    for (k = 0; k < q->n * n4; ++k)
+        if (!(fabs(D[k]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_NAN, "tangent of element %d, Gauss point %d is not finite", e, k / n4);
     for (k = 0; k < nd * nd; ++k) Ke[k] = 0.0;
     for (g = 0; g < q->n; ++g) {
         const double *Dg = D + (size_t)g * n4;
@@ -381,6 +413,10 @@ GKDEF gk_result gk_fem_elem_force(const gk_mesh *m, int e, const gk_quad *q, con
                                   gk_err *err) {
     int dim = m->dim, npe = m->npe, g, a, i, j;
     double dNdx[3 * GK_FEM_MAX_NPE], detJ;
+    if (e < 0 || e >= m->nelem) return gk_err_set(err, GK_ERR_ARG, "element %d of %d", e, m->nelem);
+    for (a = 0; a < 9 * q->n; ++a)
+        if (!(fabs(sigma[a]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_NAN, "stress of element %d, Gauss point %d is not finite", e, a / 9);
     for (a = 0; a < dim * npe; ++a) fe[a] = 0.0;
     for (g = 0; g < q->n; ++g) {
         const double *s = sigma + 9 * (size_t)g;
@@ -398,27 +434,45 @@ GKDEF gk_result gk_fem_elem_force(const gk_mesh *m, int e, const gk_quad *q, con
 
 GKDEF gk_result gk_fem_assemble(const gk_mesh *m, const gk_quad *q, const double *D, const double *sigma,
                                 gk_csr *K, double *fint, gk_err *err) {
-    int dim = m->dim, npe = m->npe, nd = dim * npe, n4 = dim * dim * dim * dim, e, a, b, i, k;
-    double Ke[24 * 24], fe[24];
+    int dim = m->dim, npe = m->npe, nd = dim * npe, n4 = dim * dim * dim * dim, e, a, b, i, k, g;
+    double Ke[24 * 24], fe[24], dNdx[3 * GK_FEM_MAX_NPE], detJ;
+    /* every check before K or fint is touched: bad input changes nothing */
     if (K) {
+        size_t t, nt = (size_t)m->nelem * q->n * n4;
         if (K->n != dim * m->nnode)
             return gk_err_set(err, GK_ERR_ARG, "matrix has %d rows, mesh %d dofs", K->n, dim * m->nnode);
         if (!D) return gk_err_set(err, GK_ERR_ARG, "a matrix needs tangents D");
-        size_t t, nt = (size_t)m->nelem * q->n * n4;
         for (t = 0; t < nt; ++t)
             if (!(fabs(D[t]) < HUGE_VAL))
                 return gk_err_set(err, GK_ERR_NAN, "tangent of element %d, Gauss point %d is not finite",
                                   (int)(t / ((size_t)q->n * n4)), (int)(t / n4) % q->n);
-        gk_csr_zero(K);
     }
     if (fint) {
+        size_t t, nt = (size_t)m->nelem * q->n * 9;
         if (!sigma) return gk_err_set(err, GK_ERR_ARG, "an internal force needs stresses");
-        for (k = 0; k < m->nelem * q->n * 9; ++k)
-            if (!(fabs(sigma[k]) < HUGE_VAL))
+        for (t = 0; t < nt; ++t)
+            if (!(fabs(sigma[t]) < HUGE_VAL))
                 return gk_err_set(err, GK_ERR_NAN, "stress of element %d, Gauss point %d is not finite",
-                                  k / (q->n * 9), (k / 9) % q->n);
-        for (k = 0; k < dim * m->nnode; ++k) fint[k] = 0.0;
+                                  (int)(t / ((size_t)q->n * 9)), (int)(t / 9) % q->n);
     }
+    for (e = 0; e < m->nelem; ++e) {
+        const int *c = m->conn + (size_t)e * npe;
+        for (g = 0; g < q->n; ++g) {
+            gk_result r = gk_fem_jacobian(m, e, q->xi[g], NULL, dNdx, &detJ, err);
+            if (r) return r;
+        }
+        if (K)
+            for (a = 0; a < npe * dim; ++a)
+                for (b = 0; b < npe * dim; ++b)
+                    if (!gk_csr_at(K, dim * c[a / dim] + a % dim, dim * c[b / dim] + b % dim))
+                        return gk_err_set(err, GK_ERR_ARG,
+                                          "matrix pattern lacks nodes %d-%d of element %d (build it with "
+                                          "gk_csr_from_mesh of this mesh)",
+                                          c[a / dim], c[b / dim], e);
+    }
+    if (K) gk_csr_zero(K);
+    if (fint)
+        for (k = 0; k < dim * m->nnode; ++k) fint[k] = 0.0;
     for (e = 0; e < m->nelem; ++e) {
         const int *c = m->conn + (size_t)e * npe;
         gk_result r;
@@ -604,6 +658,13 @@ GKDEF gk_result gk_mesh_structured(gk_mesh *m, gk_elem_type t, const int n[3], c
                               k);
     }
     nx = n[0], ny = n[1], nz = dim == 3 ? n[2] : 1;
+    { /* counts as doubles first: node ids, dofs (dim per node) and connectivity entries are int */
+        double ne = (double)nx * ny * nz, nn = t == GK_Q8 ? (2.0 * nx + 1) * (2.0 * ny + 1)
+                                                         : (nx + 1.0) * (ny + 1.0) * (dim == 3 ? nz + 1.0 : 1.0);
+        if (ne * gk_fem_npe(t) > (double)INT_MAX || nn * dim > (double)INT_MAX)
+            return gk_err_set(err, GK_ERR_ARG, "%d x %d x %d mesh: %.0f elements, %.0f nodes exceed int indices",
+                              nx, ny, nz, ne, nn);
+    }
     if (t == GK_Q4 || t == GK_HEX8) {
         int nn = (nx + 1) * (ny + 1) * (dim == 3 ? nz + 1 : 1);
         r = gk__mesh_alloc(&z, t, nn, nx * ny * nz, alloc, err);
@@ -748,197 +809,217 @@ typedef struct gk__rd {
     const char *p, *end;
 } gk__rd;
 
+/* next line into buf: 1, 0 at the end, -1 for a line that does not fit
+ * (an error wherever the line is data: never silently cut) */
 static int gk__rd_line(gk__rd *r, char *buf, size_t cap) {
     size_t n = 0;
+    int cut = 0;
     if (r->p >= r->end) return 0;
     while (r->p < r->end && *r->p != '\n') {
-        if (n + 1 < cap) buf[n++] = *r->p;
+        if (n + 1 < cap)
+            buf[n++] = *r->p;
+        else
+            cut = 1;
         ++r->p;
     }
     if (r->p < r->end) ++r->p;
     while (n && (buf[n - 1] == '\r' || buf[n - 1] == ' ')) --n;
     buf[n] = 0;
-    return 1;
+    return cut ? -1 : 1;
 }
 
 static int gk__rd_find(gk__rd *r, const char *section) {
     char line[256];
-    while (gk__rd_line(r, line, sizeof line))
-        if (!strcmp(line, section)) return 1;
+    int k;
+    while ((k = gk__rd_line(r, line, sizeof line)) != 0)
+        if (k == 1 && !strcmp(line, section)) return 1;
     return 0;
 }
 
-static int gk__gmsh_npe(int type) { return type == 3 ? 4 : type == 16 ? 8 : type == 5 ? 8 : -1; }
+static int gk__gmsh_npe(long type) { return type == 3 ? 4 : type == 16 ? 8 : type == 5 ? 8 : -1; }
 
-GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_allocator *alloc, gk_err *err) {
-    FILE *fp = fopen(path, "rb");
-    char *text = NULL, line[1024];
-    long len;
+/* node tags sorted for lookup: memory follows the nodes the file lists,
+ * never the size of its largest tag */
+typedef struct gk__tagidx {
+    long tag;
+    int idx;
+} gk__tagidx;
+static int gk__tagidx_cmp(const void *a, const void *b) {
+    long x = ((const gk__tagidx *)a)->tag, y = ((const gk__tagidx *)b)->tag;
+    return x < y ? -1 : x > y;
+}
+static int gk__tag_find(const gk__tagidx *t, long n, long tag) {
+    long lo = 0, hi = n - 1;
+    while (lo <= hi) {
+        long mid = lo + (hi - lo) / 2;
+        if (t[mid].tag == tag) return t[mid].idx;
+        if (t[mid].tag < tag)
+            lo = mid + 1;
+        else
+            hi = mid - 1;
+    }
+    return -1;
+}
+
+GKDEF gk_result gk_mesh_parse_gmsh(const char *text, size_t len, gk_mesh *out, const gk_allocator *alloc,
+                                   gk_err *err) {
+    char line[1024];
     gk__rd r;
     double version = 0.0, *nx = NULL;
-    long *ntag = NULL, nnodes_file = 0, maxtag = 0, k;
-    int *map = NULL, *econn = NULL, *etag = NULL, etype = -1, nel = 0, cap = 0, nused = 0, i;
+    long nnodes_file = 0, k;
+    gk__tagidx *map = NULL;
+    int *econn = NULL, *etag = NULL, etype = -1, nel = 0, cap = 0, nused = 0, i;
     gk_allocator A;
     gk_result res = GK_OK;
     gk_mesh m;
     memset(&A, 0, sizeof A);
     if (alloc) A = *alloc;
-    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open %s", path);
-    if (fseek(fp, 0, SEEK_END) || (len = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET)) {
-        fclose(fp);
-        return gk_err_set(err, GK_ERR_IO, "cannot size %s", path);
-    }
-    text = (char *)gk_alloc(&A, (size_t)len + 1);
-    if (!text) {
-        fclose(fp);
-        return gk_err_set(err, GK_ERR_ALLOC, "%ld bytes for %s", len, path);
-    }
-    if (fread(text, 1, (size_t)len, fp) != (size_t)len) {
-        fclose(fp);
-        gk_free(&A, text);
-        return gk_err_set(err, GK_ERR_IO, "cannot read %s", path);
-    }
-    fclose(fp);
-    text[len] = 0;
+    if (!text) return gk_err_set(err, GK_ERR_ARG, "no Gmsh text given");
 #define GK__GFAIL(code, ...)                      \
     do {                                          \
         res = gk_err_set(err, code, __VA_ARGS__); \
         goto done;                                \
     } while (0)
+/* a node needs at least 8 bytes of text ("1 0 0 0\n"; v4: "1\n" and "0 0 0\n") */
+#define GK__GNODES_FIT(n) ((n) <= (long)((size_t)(r.end - r.p) / 8))
     r.p = text, r.end = text + len;
-    if (!gk__rd_find(&r, "$MeshFormat") || !gk__rd_line(&r, line, sizeof line) ||
+    if (!gk__rd_find(&r, "$MeshFormat") || gk__rd_line(&r, line, sizeof line) != 1 ||
         sscanf(line, "%lf", &version) != 1)
-        GK__GFAIL(GK_ERR_FORMAT, "%s: no $MeshFormat section", path);
+        GK__GFAIL(GK_ERR_FORMAT, "no $MeshFormat section");
     if (strstr(line, " 1 "))
-        GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: binary Gmsh files are not supported (ASCII only)", path);
+        GK__GFAIL(GK_ERR_UNSUPPORTED, "binary Gmsh files are not supported (ASCII only)");
     if (!(version >= 2.0 && version < 3.0) && !(version >= 4.0 && version < 5.0))
-        GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: Gmsh format %g (2.x and 4.x ASCII are read)", path, version);
+        GK__GFAIL(GK_ERR_UNSUPPORTED, "Gmsh format %g (2.x and 4.x ASCII are read)", version);
     /* ---- nodes: tags and coordinates */
     r.p = text;
-    if (!gk__rd_find(&r, "$Nodes") || !gk__rd_line(&r, line, sizeof line))
-        GK__GFAIL(GK_ERR_FORMAT, "%s: no $Nodes section", path);
+    if (!gk__rd_find(&r, "$Nodes") || gk__rd_line(&r, line, sizeof line) != 1)
+        GK__GFAIL(GK_ERR_FORMAT, "no $Nodes section");
     if (version < 3.0) {
-        if (sscanf(line, "%ld", &nnodes_file) != 1 || nnodes_file <= 0)
-            GK__GFAIL(GK_ERR_FORMAT, "%s: bad node count", path);
-        ntag = (long *)gk_alloc(&A, (size_t)nnodes_file * sizeof(long));
+        if (sscanf(line, "%ld", &nnodes_file) != 1 || nnodes_file <= 0 || !GK__GNODES_FIT(nnodes_file))
+            GK__GFAIL(GK_ERR_FORMAT, "bad node count '%.40s' (more than the file can hold?)", line);
+        map = (gk__tagidx *)gk_alloc(&A, (size_t)nnodes_file * sizeof *map);
         nx = (double *)gk_alloc(&A, (size_t)nnodes_file * 3 * sizeof(double));
-        if (!ntag || !nx) GK__GFAIL(GK_ERR_ALLOC, "%s: node arrays", path);
+        if (!map || !nx) GK__GFAIL(GK_ERR_ALLOC, "node arrays for %ld nodes", nnodes_file);
         for (k = 0; k < nnodes_file; ++k) {
-            if (!gk__rd_line(&r, line, sizeof line) ||
-                sscanf(line, "%ld %lf %lf %lf", &ntag[k], &nx[3 * k], &nx[3 * k + 1], &nx[3 * k + 2]) != 4)
-                GK__GFAIL(GK_ERR_FORMAT, "%s: bad node line %ld", path, k + 1);
+            if (gk__rd_line(&r, line, sizeof line) != 1 ||
+                sscanf(line, "%ld %lf %lf %lf", &map[k].tag, &nx[3 * k], &nx[3 * k + 1], &nx[3 * k + 2]) != 4)
+                GK__GFAIL(GK_ERR_FORMAT, "bad node line %ld", k + 1);
         }
     } else {
         long nblocks, minT, maxT, b, got = 0;
-        if (sscanf(line, "%ld %ld %ld %ld", &nblocks, &nnodes_file, &minT, &maxT) != 4 || nnodes_file <= 0)
-            GK__GFAIL(GK_ERR_FORMAT, "%s: bad $Nodes header", path);
-        ntag = (long *)gk_alloc(&A, (size_t)nnodes_file * sizeof(long));
+        if (sscanf(line, "%ld %ld %ld %ld", &nblocks, &nnodes_file, &minT, &maxT) != 4 || nnodes_file <= 0 ||
+            !GK__GNODES_FIT(nnodes_file))
+            GK__GFAIL(GK_ERR_FORMAT, "bad $Nodes header '%.40s' (more nodes than the file can hold?)", line);
+        map = (gk__tagidx *)gk_alloc(&A, (size_t)nnodes_file * sizeof *map);
         nx = (double *)gk_alloc(&A, (size_t)nnodes_file * 3 * sizeof(double));
-        if (!ntag || !nx) GK__GFAIL(GK_ERR_ALLOC, "%s: node arrays", path);
+        if (!map || !nx) GK__GFAIL(GK_ERR_ALLOC, "node arrays for %ld nodes", nnodes_file);
         for (b = 0; b < nblocks; ++b) {
             int edim, etg, par;
             long nin;
-            if (!gk__rd_line(&r, line, sizeof line) ||
-                sscanf(line, "%d %d %d %ld", &edim, &etg, &par, &nin) != 4 || nin < 0 ||
-                got + nin > nnodes_file)
-                GK__GFAIL(GK_ERR_FORMAT, "%s: bad node block %ld", path, b);
-            if (par) GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: parametric node coordinates", path);
+            if (gk__rd_line(&r, line, sizeof line) != 1 ||
+                sscanf(line, "%d %d %d %ld", &edim, &etg, &par, &nin) != 4 || nin < 0 || nin > nnodes_file - got)
+                GK__GFAIL(GK_ERR_FORMAT, "bad node block %ld", b);
+            if (par) GK__GFAIL(GK_ERR_UNSUPPORTED, "parametric node coordinates");
             for (k = 0; k < nin; ++k)
-                if (!gk__rd_line(&r, line, sizeof line) || sscanf(line, "%ld", &ntag[got + k]) != 1)
-                    GK__GFAIL(GK_ERR_FORMAT, "%s: bad node tag in block %ld", path, b);
+                if (gk__rd_line(&r, line, sizeof line) != 1 || sscanf(line, "%ld", &map[got + k].tag) != 1)
+                    GK__GFAIL(GK_ERR_FORMAT, "bad node tag in block %ld", b);
             for (k = 0; k < nin; ++k) {
                 double *c = nx + 3 * (got + k);
-                if (!gk__rd_line(&r, line, sizeof line) ||
+                if (gk__rd_line(&r, line, sizeof line) != 1 ||
                     sscanf(line, "%lf %lf %lf", &c[0], &c[1], &c[2]) != 3)
-                    GK__GFAIL(GK_ERR_FORMAT, "%s: bad node coordinates in block %ld", path, b);
+                    GK__GFAIL(GK_ERR_FORMAT, "bad node coordinates in block %ld", b);
             }
             got += nin;
         }
-        if (got != nnodes_file)
-            GK__GFAIL(GK_ERR_FORMAT, "%s: %ld nodes listed, %ld read", path, nnodes_file, got);
+        if (got != nnodes_file) GK__GFAIL(GK_ERR_FORMAT, "%ld nodes announced, %ld read", nnodes_file, got);
     }
     for (k = 0; k < nnodes_file; ++k) {
-        if (ntag[k] <= 0 || ntag[k] > 100000000L) GK__GFAIL(GK_ERR_FORMAT, "%s: node tag %ld", path, ntag[k]);
-        if (ntag[k] > maxtag) maxtag = ntag[k];
+        if (map[k].tag <= 0) GK__GFAIL(GK_ERR_FORMAT, "node tag %ld (must be > 0)", map[k].tag);
+        if (!(fabs(nx[3 * k]) < HUGE_VAL && fabs(nx[3 * k + 1]) < HUGE_VAL && fabs(nx[3 * k + 2]) < HUGE_VAL))
+            GK__GFAIL(GK_ERR_NAN, "node %ld has a non-finite coordinate", map[k].tag);
+        map[k].idx = (int)k; /* file index; renumbered to used nodes below */
     }
-    map = (int *)gk_alloc(&A, (size_t)(maxtag + 1) * sizeof(int));
-    if (!map) GK__GFAIL(GK_ERR_ALLOC, "%s: node map", path);
-    for (k = 0; k <= maxtag; ++k) map[k] = -1;
-    for (k = 0; k < nnodes_file; ++k) map[ntag[k]] = (int)k; /* file index; renumbered to used nodes below */
+    qsort(map, (size_t)nnodes_file, sizeof *map, gk__tagidx_cmp);
+    for (k = 1; k < nnodes_file; ++k)
+        if (map[k].tag == map[k - 1].tag) GK__GFAIL(GK_ERR_FORMAT, "node tag %ld appears twice", map[k].tag);
     /* ---- elements: keep the highest-dimensional supported type */
     r.p = text;
-    if (!gk__rd_find(&r, "$Elements") || !gk__rd_line(&r, line, sizeof line))
-        GK__GFAIL(GK_ERR_FORMAT, "%s: no $Elements section", path);
+    if (!gk__rd_find(&r, "$Elements") || gk__rd_line(&r, line, sizeof line) != 1)
+        GK__GFAIL(GK_ERR_FORMAT, "no $Elements section");
     {
         long nblocks = 1, nelem_file, b, e;
         if (version < 3.0) {
-            if (sscanf(line, "%ld", &nelem_file) != 1)
-                GK__GFAIL(GK_ERR_FORMAT, "%s: bad element count", path);
+            if (sscanf(line, "%ld", &nelem_file) != 1) GK__GFAIL(GK_ERR_FORMAT, "bad element count");
         } else {
             long a1, a2;
             if (sscanf(line, "%ld %ld %ld %ld", &nblocks, &nelem_file, &a1, &a2) != 4)
-                GK__GFAIL(GK_ERR_FORMAT, "%s: bad $Elements header", path);
+                GK__GFAIL(GK_ERR_FORMAT, "bad $Elements header");
         }
         for (b = 0; b < nblocks; ++b) {
-            long nin = nelem_file;
-            int btype = -1, bphys = 0;
+            long nin = nelem_file, btype = -1;
+            int bphys = 0;
             if (version >= 3.0) {
                 int edim;
-                if (!gk__rd_line(&r, line, sizeof line) ||
-                    sscanf(line, "%d %d %d %ld", &edim, &bphys, &btype, &nin) != 4)
-                    GK__GFAIL(GK_ERR_FORMAT, "%s: bad element block %ld", path, b);
+                if (gk__rd_line(&r, line, sizeof line) != 1 ||
+                    sscanf(line, "%d %d %ld %ld", &edim, &bphys, &btype, &nin) != 4)
+                    GK__GFAIL(GK_ERR_FORMAT, "bad element block %ld", b);
             }
             for (e = 0; e < nin; ++e) {
-                long v[64];
-                int nv = 0, off, type, ntg = 0, np, tagv = bphys;
+                long v[64], type;
+                int nv = 0, off, np, tagv = bphys;
                 char *s = line, *q;
-                if (!gk__rd_line(&r, line, sizeof line))
-                    GK__GFAIL(GK_ERR_FORMAT, "%s: truncated $Elements", path);
+                if (gk__rd_line(&r, line, sizeof line) != 1)
+                    GK__GFAIL(GK_ERR_FORMAT, "truncated $Elements (element %ld of block %ld, or a line over %d "
+                                             "characters)", e + 1, b, (int)sizeof line - 1);
                 while (nv < 64) {
                     long x = strtol(s, &q, 10);
                     if (q == s) break;
                     v[nv++] = x, s = q;
                 }
                 if (version < 3.0) {
-                    if (nv < 3) GK__GFAIL(GK_ERR_FORMAT, "%s: bad element line", path);
-                    type = (int)v[1], ntg = (int)v[2], off = 3 + ntg;
-                    tagv = ntg > 0 ? (int)v[3] : 0;
+                    /* id type ntags tag... nodes...: the tag count is data, checked before it indexes */
+                    if (nv < 3 || v[2] < 0 || v[2] > nv - 3)
+                        GK__GFAIL(GK_ERR_FORMAT, "bad element line (element %ld: %d numbers, tag count %ld)", e + 1,
+                                  nv, nv >= 3 ? v[2] : -1L);
+                    type = v[1], off = 3 + (int)v[2];
+                    tagv = v[2] > 0 && v[3] >= INT_MIN && v[3] <= INT_MAX ? (int)v[3] : 0;
                 } else {
                     type = btype, off = 1;
                 }
                 np = gk__gmsh_npe(type);
                 if (np < 0) continue; /* points, lines, triangles...: not volume elements of this module */
-                if (nv < off + np) GK__GFAIL(GK_ERR_FORMAT, "%s: element with too few nodes", path);
+                if (nv < off + np) GK__GFAIL(GK_ERR_FORMAT, "element %ld has too few nodes", e + 1);
                 if (etype >= 0 && type != etype) {
                     if ((type == 5) == (etype == 5))
-                        GK__GFAIL(GK_ERR_UNSUPPORTED, "%s: mixed element types %d and %d", path, etype, type);
+                        GK__GFAIL(GK_ERR_UNSUPPORTED, "mixed element types %d and %ld", etype, type);
                     if (etype == 5) continue; /* 3D mesh: skip boundary quads */
                     nel = 0;                  /* a hex appears after quads: restart with hexes */
                 }
-                etype = type;
+                etype = (int)type;
                 if (nel == cap) {
                     int nc = cap ? 2 * cap : 256;
+                    if (cap > INT_MAX / 16) GK__GFAIL(GK_ERR_FORMAT, "more than %d elements", cap);
                     if (gk_realloc(&A, (void **)&econn, (size_t)cap * 8, (size_t)nc * 8, sizeof(int)) ||
                         gk_realloc(&A, (void **)&etag, (size_t)cap, (size_t)nc, sizeof(int)))
-                        GK__GFAIL(GK_ERR_ALLOC, "%s: elements", path);
+                        GK__GFAIL(GK_ERR_ALLOC, "elements");
                     cap = nc;
                 }
                 for (i = 0; i < np; ++i) {
                     long t = v[off + i];
-                    if (t <= 0 || t > maxtag || map[t] < 0)
-                        GK__GFAIL(GK_ERR_FORMAT, "%s: element refers to unknown node %ld", path, t);
-                    econn[nel * 8 + i] = map[t];
+                    int id = gk__tag_find(map, nnodes_file, t);
+                    if (id < 0) GK__GFAIL(GK_ERR_FORMAT, "element %ld refers to unknown node %ld", e + 1, t);
+                    econn[nel * 8 + i] = id;
                 }
                 etag[nel++] = tagv;
             }
         }
     }
-    if (etype < 0 || nel == 0) GK__GFAIL(GK_ERR_MESH, "%s: no quad4, quad8 or hex8 elements", path);
+    if (etype < 0 || nel == 0) GK__GFAIL(GK_ERR_MESH, "no quad4, quad8 or hex8 elements");
     { /* keep only the nodes the elements use, in file order */
         gk_elem_type t = etype == 3 ? GK_Q4 : etype == 16 ? GK_Q8 : GK_HEX8;
         int npe = gk_fem_npe(t), dim = gk_fem_dim(t), *used;
         used = (int *)gk_alloc(&A, (size_t)nnodes_file * sizeof(int));
-        if (!used) GK__GFAIL(GK_ERR_ALLOC, "%s: node renumbering", path);
+        if (!used) GK__GFAIL(GK_ERR_ALLOC, "node renumbering");
         for (k = 0; k < nnodes_file; ++k) used[k] = -1;
         for (k = 0; k < (long)nel * npe; ++k) used[econn[(k / npe) * 8 + k % npe]] = 0;
         for (k = 0; k < nnodes_file; ++k)
@@ -960,9 +1041,26 @@ GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_alloc
     }
 done:
 #undef GK__GFAIL
-    gk_free(&A, text), gk_free(&A, nx), gk_free(&A, ntag), gk_free(&A, map), gk_free(&A, econn),
-        gk_free(&A, etag);
+#undef GK__GNODES_FIT
+    gk_free(&A, nx), gk_free(&A, map), gk_free(&A, econn), gk_free(&A, etag);
     return res;
+}
+
+GKDEF gk_result gk_mesh_read_gmsh(const char *path, gk_mesh *out, const gk_allocator *alloc, gk_err *err) {
+    char *text = NULL;
+    size_t len = 0;
+    gk_result r;
+    if (!path) return gk_err_set(err, GK_ERR_ARG, "no mesh path given");
+    r = gk_file_read(path, alloc, &text, &len, err);
+    if (r) return r;
+    r = gk_mesh_parse_gmsh(text, len, out, alloc, err);
+    gk_free(alloc, text);
+    if (r && err) {
+        char msg[GK_ERR_MSG_LEN];
+        memcpy(msg, err->msg, sizeof msg);
+        gk_err_set(err, r, "%s: %s", path, msg);
+    }
+    return r;
 }
 
 /* ------------------------------------------------------------------- CSR */
@@ -1515,19 +1613,29 @@ GKDEF gk_result gk_rcm_order(const gk_csr *A, int *perm, const gk_allocator *all
     return GK_OK;
 }
 
-GKDEF void gk_solver_free(gk_solver *s) {
-    gk_free(&s->alloc, s->perm), gk_free(&s->alloc, s->ipiv), gk_free(&s->alloc, s->ab),
-        gk_free(&s->alloc, s->tmp);
+GKDEF void gk_solver_init(gk_solver *s) {
     memset(s, 0, sizeof *s);
+    s->cookie = GK_SOLVER_COOKIE;
+}
+
+GKDEF void gk_solver_free(gk_solver *s) {
+    if (s->cookie == GK_SOLVER_COOKIE)
+        gk_free(&s->alloc, s->perm), gk_free(&s->alloc, s->ipiv), gk_free(&s->alloc, s->ab),
+            gk_free(&s->alloc, s->tmp);
+    gk_solver_init(s);
 }
 
 GKDEF gk_result gk_solver_factor(gk_solver *s, const gk_csr *A, const gk_allocator *alloc, gk_err *err) {
     gk_solver z;
-    int n = A->n, i, p, k, *inv = NULL, kl = 0, ku = 0;
+    int n, i, p, k, *inv = NULL, kl = 0, ku = 0;
     double amax = 0.0, tiny;
     gk_result res;
-    memset(&z, 0, sizeof z);
+    if (!s || s->cookie != GK_SOLVER_COOKIE)
+        return gk_err_set(err, GK_ERR_ARG, "gk_solver not initialised with gk_solver_init()");
+    if (!A || !A->rowptr) return gk_err_set(err, GK_ERR_ARG, "no matrix given");
+    gk_solver_init(&z);
     if (alloc) z.alloc = *alloc;
+    n = A->n;
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "empty system");
     for (p = 0; p < A->nnz; ++p) {
         if (!(fabs(A->val[p]) < HUGE_VAL))
@@ -1605,9 +1713,13 @@ fail:
 }
 
 GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x) {
-    int n = s->n, kl = s->kl, k, i, j;
-    double *y = s->tmp;
-    if (!s->ab) return GK_ERR_STATE;
+    int n, kl, k, i, j;
+    double *y;
+    if (s->cookie != GK_SOLVER_COOKIE || !s->ab)
+        return gk_err_set(&s->err, GK_ERR_STATE, "solve before a successful gk_solver_factor");
+    n = s->n, kl = s->kl, y = s->tmp;
+    for (i = 0; i < n; ++i)
+        if (!(fabs(b[i]) < HUGE_VAL)) return gk_err_set(&s->err, GK_ERR_NAN, "right-hand side %d is %g", i, b[i]);
 #define GK__AB(r, c) s->ab[(size_t)(r)*s->w + (c) - (r) + kl]
     for (i = 0; i < n; ++i) y[i] = b[s->perm[i]];
     for (k = 0; k < n; ++k) {
@@ -1625,22 +1737,33 @@ GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x) {
         y[k] = acc / GK__AB(k, k);
     }
 #undef GK__AB
+    for (i = 0; i < n; ++i)
+        if (!(fabs(y[i]) < HUGE_VAL))
+            return gk_err_set(&s->err, GK_ERR_DIVERGED, "solution entry %d is %g (overflow: a near-singular system?)",
+                              s->perm[i], y[i]);
     for (i = 0; i < n; ++i) x[s->perm[i]] = y[i];
     return GK_OK;
 }
 
-GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol, int maxit, int *iters,
+GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x_out, double rtol, int maxit, int *iters,
                        const gk_allocator *alloc, gk_err *err) {
+    double *x = x_out;
     int n = A->n, i, it, p;
-    double *r, *z, *d, *q, *Mi, rz, bn = 0.0;
+    double *r, *z, *d, *q, *Mi, *xw, rz, bn = 0.0;
     gk_allocator al;
     memset(&al, 0, sizeof al);
     if (alloc) al = *alloc;
-    if (!(rtol > 0.0) || maxit < 1)
-        return gk_err_set(err, GK_ERR_ARG, "PCG tolerance %g, max iterations %d", rtol, maxit);
-    r = (double *)gk_alloc(&al, 5 * (size_t)n * sizeof(double));
+    if (!(rtol > 0.0 && rtol < 1.0) || maxit < 1)
+        return gk_err_set(err, GK_ERR_ARG, "PCG tolerance %g (must be in (0, 1)), max iterations %d (>= 1)", rtol,
+                          maxit);
+    for (i = 0; i < n; ++i)
+        if (!(fabs(b[i]) < HUGE_VAL) || !(fabs(x[i]) < HUGE_VAL))
+            return gk_err_set(err, GK_ERR_NAN, "PCG: right-hand side or start value %d is not finite", i);
+    r = (double *)gk_alloc(&al, 6 * (size_t)n * sizeof(double));
     if (!r) return gk_err_set(err, GK_ERR_ALLOC, "PCG work arrays");
-    z = r + n, d = z + n, q = d + n, Mi = q + n;
+    z = r + n, d = z + n, q = d + n, Mi = q + n, xw = Mi + n;
+    memcpy(xw, x, (size_t)n * sizeof(double)); /* x changes only on success or GK_ERR_NOCONVERGE */
+    x = xw;
     for (i = 0; i < n; ++i) {
         double dg = 0.0;
         for (p = A->rowptr[i]; p < A->rowptr[i + 1]; ++p)
@@ -1672,8 +1795,14 @@ GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol,
         beta = rz1 / rz, rz = rz1;
         for (i = 0; i < n; ++i) d[i] = z[i] + beta * d[i];
     }
-    gk_free(&al, r);
     if (iters) *iters = it;
+    for (i = 0; i < n; ++i)
+        if (!(fabs(x[i]) < HUGE_VAL)) {
+            gk_free(&al, r);
+            return gk_err_set(err, GK_ERR_DIVERGED, "PCG iterate %d is not finite", i);
+        }
+    memcpy(x_out, x, (size_t)n * sizeof(double));
+    gk_free(&al, r);
     if (it == maxit)
         return gk_err_set(err, GK_ERR_NOCONVERGE, "PCG did not reach %g in %d iterations", rtol, maxit);
     return GK_OK;

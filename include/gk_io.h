@@ -23,6 +23,10 @@
  *                              point and cell data (scalars, vectors, 3x3
  *                              tensors) for ParaView
  *   gk_progress                one line per step with elapsed time and ETA
+ *   gk_file_close (gk_base.h)  closes a file you wrote (a CSV) the way every
+ *                              writer here does: fflush + ferror + fclose,
+ *                              GK_ERR_IO naming the path and the reason when
+ *                              any byte was lost (disk full, /dev/full)
  *   gk_wtime                   wall-clock seconds (clock_gettime when the
  *                              includer defines _POSIX_C_SOURCE >= 199309L,
  *                              else omp_get_wtime with OpenMP, else time())
@@ -392,8 +396,7 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
     fprintf(fp, "</svg>\n");
 #undef GK__X
 #undef GK__Y
-    if (fclose(fp) != 0) return gk_err_set(err, GK_ERR_IO, "error writing plot '%s'", path);
-    return GK_OK;
+    return gk_file_close(fp, path, err);
 }
 
 /* viridis, 9 control points, linear in between */
@@ -569,8 +572,7 @@ GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def_in, int n
         fprintf(fp, "</text>\n");
     }
     fprintf(fp, "</svg>\n");
-    if (fclose(fp) != 0) return gk_err_set(err, GK_ERR_IO, "error writing '%s'", path);
-    return GK_OK;
+    return gk_file_close(fp, path, err);
 }
 
 GKDEF gk_result gk_svg_field(const char *path, const char *title, const char *label, int npoly, int nv,
@@ -581,6 +583,12 @@ GKDEF gk_result gk_svg_field(const char *path, const char *title, const char *la
     d.label = label;
     d.dot = dot;
     return gk_field_svg(path, &d, npoly, nv, xy, value, err);
+}
+
+/* a write that already failed (the stream's error flag) is reported at once */
+static gk_result gk__vtk_status(gk_vtk *v) {
+    if (ferror(v->fp)) return gk_err_set(&v->err, GK_ERR_IO, "error writing VTK file (disk full?)");
+    return GK_OK;
 }
 
 GKDEF gk_result gk_vtk_open(gk_vtk *v, const char *path, const char *title) {
@@ -597,7 +605,7 @@ GKDEF gk_result gk_vtk_points(gk_vtk *v, int n, const double *xyz) {
     v->npoints = n;
     fprintf(v->fp, "POINTS %d double\n", n);
     for (k = 0; k < n; ++k) fprintf(v->fp, "%.9g %.9g %.9g\n", xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 GKDEF gk_result gk_vtk_cells(gk_vtk *v, int ncells, int nv, const int *conn, int vtk_type) {
@@ -612,7 +620,7 @@ GKDEF gk_result gk_vtk_cells(gk_vtk *v, int ncells, int nv, const int *conn, int
     }
     fprintf(v->fp, "CELL_TYPES %d\n", ncells);
     for (k = 0; k < ncells; ++k) fprintf(v->fp, "%d\n", vtk_type);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 static gk_result gk__vtk_section(gk_vtk *v, int cell) {
@@ -636,7 +644,7 @@ static gk_result gk__vtk_scalar(gk_vtk *v, int cell, const char *name, const dou
     n = cell ? v->ncells : v->npoints;
     fprintf(v->fp, "SCALARS %s double 1\nLOOKUP_TABLE default\n", name);
     for (k = 0; k < n; ++k) fprintf(v->fp, "%.9g\n", isfinite(val[k]) ? val[k] : 0.0);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 static gk_result gk__vtk_tensor(gk_vtk *v, int cell, const char *name, const double *val9) {
@@ -648,7 +656,7 @@ static gk_result gk__vtk_tensor(gk_vtk *v, int cell, const char *name, const dou
     for (k = 0; k < n; ++k)
         for (j = 0; j < 3; ++j)
             fprintf(v->fp, "%.9g %.9g %.9g\n", val9[9 * k + 3 * j], val9[9 * k + 3 * j + 1], val9[9 * k + 3 * j + 2]);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 GKDEF gk_result gk_vtk_point_scalar(gk_vtk *v, const char *name, const double *val) {
@@ -669,19 +677,14 @@ GKDEF gk_result gk_vtk_point_vector(gk_vtk *v, const char *name, const double *v
     if (r) return r;
     fprintf(v->fp, "VECTORS %s double\n", name);
     for (k = 0; k < v->npoints; ++k) fprintf(v->fp, "%.9g %.9g %.9g\n", val3[3 * k], val3[3 * k + 1], val3[3 * k + 2]);
-    return GK_OK;
+    return gk__vtk_status(v);
 }
 
 GKDEF gk_result gk_vtk_close(gk_vtk *v) {
-    int bad;
-    if (!v->fp) return GK_ERR_STATE;
-    bad = ferror(v->fp);
-    if (fclose(v->fp) != 0 || bad) {
-        v->fp = NULL;
-        return gk_err_set(&v->err, GK_ERR_IO, "error writing VTK file");
-    }
+    FILE *fp = v->fp;
+    if (!fp) return GK_ERR_STATE;
     v->fp = NULL;
-    return GK_OK;
+    return gk_file_close(fp, "VTK file", &v->err);
 }
 
 GKDEF void gk_progress(FILE *fp, long step, long nsteps, double t_start, const char *what) {

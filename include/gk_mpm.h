@@ -83,6 +83,11 @@
  *        -> p2g(MOMENTUM) (remap the new point velocities) ->
  *        g2p(GRADIENT_OLD) -> stress
  *   Rigid bodies then move by v dt (gk_mpm_bodies_advance).
+ * A step whose gradient update would invert some point (det F <= 0) is
+ * refused (GK_ERR_DIVERGED) with every point as it was before the step:
+ * g2p checks all points before it writes any, and the MUSL step puts back
+ * the positions and velocities it had moved. (A failing stress function
+ * leaves F, L and vol of that step; the grid is scratch.)
  *
  * BOUNDARY CONDITIONS act on the node velocity after the forces, and on the
  * P2G velocity v (then p = m v; no reaction is counted there), faces in the
@@ -1176,9 +1181,10 @@ GKDEF gk_result gk_mpm_grid_update(gk_mpm_grid *g, const gk_mpm_def *d, double d
     return GK_OK;
 }
 
-/* gather one point; returns 1 if det F <= 0 afterwards */
+/* gather one point; returns 1 if det F <= 0 afterwards. dry: write
+ * nothing, only tell whether the gradient update would invert F */
 static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_def *d, double dt, int what,
-                             int p) {
+                             int p, int dry) {
     gk__mpm_w W;
     double x[3] = {0.0, 0.0, 0.0}, vpic[3] = {0.0, 0.0, 0.0}, dv[3] = {0.0, 0.0, 0.0}, Lg[9], Bm[9];
     double l = d->basis == GK_MPM_UGIMP ? P->lp[p] * g->inv_h : 0.0;
@@ -1218,6 +1224,14 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
                         for (q = 0; q < dim; ++q) Bm[3 * k + q] += un * gr[q];
                 }
             }
+    if (dry) {
+        double E[9], Fn[9];
+        for (k = 0; k < 9; ++k) E[k] = dt * Lg[k] + (k % 4 == 0 ? 1.0 : 0.0);
+        if (dim == 2) E[8] = 1.0;
+        gk_m3_mul(E, P->F + 9 * p, Fn);
+        if (dim == 2) Fn[2] = Fn[5] = Fn[6] = Fn[7] = 0.0, Fn[8] = 1.0;
+        return !(gk_m3_det(Fn) > 0.0);
+    }
     if (want_v) {
         if (apic) {
             double Dinv =
@@ -1280,13 +1294,20 @@ GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_
     }
     nth = gk__mpm_nthreads(d);
     (void)nth; /* unused without OpenMP */
-    GK_OMP(parallel for num_threads(nth) schedule(static) reduction(+ : bad) if (nth > 1))
-    for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p);
-    if (bad) {
-        for (p = 0; p < n; ++p)
-            if (!(gk_m3_det(P->F + 9 * p) > 0.0)) break;
-        return gk_err_set(err, GK_ERR_DIVERGED, "%d points inverted (det F <= 0), first point %d", bad, p);
+    if (what & (GK_MPM_G2P_GRADIENT_NEW | GK_MPM_G2P_GRADIENT_OLD)) {
+        /* a dry pass first: an update that inverts some F changes no point */
+        GK_OMP(parallel for num_threads(nth) schedule(static) reduction(+ : bad) if (nth > 1))
+        for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p, 1);
+        if (bad) {
+            for (p = 0; p < n; ++p)
+                if (gk__mpm_g2p_point(g, P, d, dt, what, p, 1)) break;
+            return gk_err_set(err, GK_ERR_DIVERGED,
+                              "%d points would invert (det F <= 0), first point %d: nothing was changed", bad, p);
+        }
     }
+    GK_OMP(parallel for num_threads(nth) schedule(static) reduction(+ : bad) if (nth > 1))
+    for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p, 0);
+    if (bad) return gk_err_set(err, GK_ERR_DIVERGED, "%d points inverted (det F <= 0)", bad);
     return GK_OK;
 }
 
@@ -1322,14 +1343,33 @@ GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_def *
             return r;
         if (stress && (r = stress(P, dt, user, err))) return r;
         break;
-    case GK_MPM_MUSL:
+    case GK_MPM_MUSL: { /* the gradient comes after the move: keep x, v, C to put back if it fails */
+        double *keep;
+        size_t n = (size_t)P->n, k, nk = 2 * (size_t)P->dim + (P->C ? 9 : 0);
         if ((r = gk_mpm_p2g(g, P, d, GK_MPM_P2G_MOMENTUM | GK_MPM_P2G_FORCE, err))) return r;
         if ((r = gk_mpm_grid_update(g, d, dt, err))) return r;
-        if ((r = gk_mpm_g2p(g, P, d, dt, GK_MPM_G2P_VELOCITY | GK_MPM_G2P_POSITION, err))) return r;
-        if ((r = gk_mpm_p2g(g, P, d, GK_MPM_P2G_MOMENTUM, err))) return r;
-        if ((r = gk_mpm_g2p(g, P, d, dt, GK_MPM_G2P_GRADIENT_OLD, err))) return r;
+        keep = (double *)gk_alloc(&P->alloc, nk * n * sizeof(double));
+        if (!keep) return gk_err_set(err, GK_ERR_ALLOC, "MUSL step: a copy of %d points", P->n);
+        for (k = 0; k < (size_t)P->dim; ++k) {
+            memcpy(keep + 2 * k * n, P->x[k], n * sizeof(double));
+            memcpy(keep + (2 * k + 1) * n, P->v[k], n * sizeof(double));
+        }
+        if (P->C) memcpy(keep + 2 * (size_t)P->dim * n, P->C, 9 * n * sizeof(double));
+        r = gk_mpm_g2p(g, P, d, dt, GK_MPM_G2P_VELOCITY | GK_MPM_G2P_POSITION, err);
+        if (!r) r = gk_mpm_p2g(g, P, d, GK_MPM_P2G_MOMENTUM, err);
+        if (!r) r = gk_mpm_g2p(g, P, d, dt, GK_MPM_G2P_GRADIENT_OLD, err);
+        if (r) {
+            for (k = 0; k < (size_t)P->dim; ++k) {
+                memcpy(P->x[k], keep + 2 * k * n, n * sizeof(double));
+                memcpy(P->v[k], keep + (2 * k + 1) * n, n * sizeof(double));
+            }
+            if (P->C) memcpy(P->C, keep + 2 * (size_t)P->dim * n, 9 * n * sizeof(double));
+        }
+        gk_free(&P->alloc, keep);
+        if (r) return r;
         if (stress && (r = stress(P, dt, user, err))) return r;
         break;
+    }
     }
     gk_mpm_bodies_advance(g->body, g->nbody, dt);
     return GK_OK;

@@ -137,18 +137,25 @@ GKDEF void gk_packing_free(gk_packing *pk) {
     pk->n = 0;
 }
 
-/* line reader over a memory buffer */
+/* line reader over a memory buffer; a line longer than the buffer or
+ * holding a NUL byte is flagged, never silently cut */
 typedef struct gk__lines {
     const char *p, *end;
     long lineno;
+    int toolong, nul;
     char line[1024];
 } gk__lines;
 
 static int gk__next_line(gk__lines *L) {
     size_t k = 0;
     if (L->p >= L->end) return 0;
+    L->toolong = L->nul = 0;
     while (L->p < L->end && *L->p != '\n') {
-        if (k + 1 < sizeof L->line) L->line[k++] = *L->p;
+        if (*L->p == '\0') L->nul = 1;
+        if (k + 1 < sizeof L->line)
+            L->line[k++] = *L->p;
+        else
+            L->toolong = 1;
         ++L->p;
     }
     if (L->p < L->end) ++L->p;
@@ -183,18 +190,38 @@ static int gk__parse_doubles(const char *s, double *out, int max, int *bad) {
     return k;
 }
 
+/* 0: blank; 1: a comment; 2: the '# cell' line; 3: a particle line */
+static int gk__line_kind(const char *s) {
+    while (*s == ' ' || *s == '\t') ++s;
+    if (*s == '#') return strncmp(s, "# cell ", 7) == 0 ? 2 : 1;
+    return gk__blank(s) ? 0 : 3;
+}
+
+/* a line that cannot be read whole is an error; only a plain comment may be cut */
+static gk_result gk__line_ok(const gk__lines *L, int kind, gk_err *err) {
+    if (L->nul) return gk_err_set(err, GK_ERR_FORMAT, "line %ld holds a NUL byte (not a text packing?)", L->lineno);
+    if (L->toolong && kind != 1)
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld is longer than %d characters", L->lineno,
+                          (int)sizeof L->line - 1);
+    return GK_OK;
+}
+
 GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, const gk_allocator *alloc,
                                  gk_err *err) {
     gk__lines L;
     double hd[5], h[9], vals[8];
     int nh, bad, dim, n, k = 0;
+    long body, lines = 0;
+    const char *first;
     gk_packing pk;
     gk_result r;
+    if (!text) return gk_err_set(err, GK_ERR_ARG, "no packing text given");
     L.p = text;
     L.end = text + len;
     L.lineno = 0;
     do {
         if (!gk__next_line(&L)) return gk_err_set(err, GK_ERR_FORMAT, "empty packing: no header line");
+        if ((r = gk__line_ok(&L, 3, err)) != GK_OK) return r;
     } while (gk__blank(L.line));
     nh = gk__parse_doubles(L.line, hd, 5, &bad);
     if (bad || nh < 4) return gk_err_set(err, GK_ERR_FORMAT, "line %ld: header must be 'dim N Lx Ly [Lz]'", L.lineno);
@@ -213,37 +240,48 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
             return gk_err_set(err, GK_ERR_CELL, "line %ld: cell length %g must be > 0", L.lineno, hd[2 + k]);
         h[4 * k] = hd[2 + k];
     }
+    /* count the particle lines before allocating: memory follows what the
+     * text holds, never what its header announces */
+    first = L.p;
+    body = L.lineno;
+    while (gk__next_line(&L)) {
+        int kind = gk__line_kind(L.line);
+        if ((r = gk__line_ok(&L, kind, err)) != GK_OK) return r;
+        if (kind == 3 && ++lines > n)
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced", L.lineno, n);
+    }
+    if (lines != n) return gk_err_set(err, GK_ERR_FORMAT, "packing announces %d particles but lists %ld", n, lines);
     r = gk_packing_alloc(&pk, dim, n, alloc, err);
     if (r) return r;
+    L.p = first;
+    L.lineno = body;
     k = 0;
     while (gk__next_line(&L)) {
         const char *s = L.line;
-        int nv;
-        while (*s == ' ' || *s == '\t') ++s;
-        if (*s == '#') {
-            if (strncmp(s, "# cell ", 7) == 0) {
-                double hc[9];
-                int nc = gk__parse_doubles(s + 7, hc, 9, &bad), a, b;
-                if (bad || nc != dim * dim) {
-                    gk_packing_free(&pk);
-                    return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno, dim * dim);
-                }
-                gk_m3_identity(h);
-                for (a = 0; a < dim; ++a)
-                    for (b = 0; b < dim; ++b) h[3 * a + b] = hc[dim * a + b];
+        int nv, kind = gk__line_kind(s);
+        if (kind == 2) {
+            double hc[9];
+            int nc = gk__parse_doubles(s + strspn(s, " \t") + 7, hc, 9, &bad), a, b;
+            if (bad || nc != dim * dim) {
+                gk_packing_free(&pk);
+                return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno, dim * dim);
             }
-            continue;
+            for (a = 0; a < nc; ++a)
+                if (!isfinite(hc[a])) {
+                    gk_packing_free(&pk);
+                    return gk_err_set(err, GK_ERR_CELL, "line %ld: '# cell' entry %d is %g (must be finite)",
+                                      L.lineno, a + 1, hc[a]);
+                }
+            gk_m3_identity(h);
+            for (a = 0; a < dim; ++a)
+                for (b = 0; b < dim; ++b) h[3 * a + b] = hc[dim * a + b];
         }
-        if (gk__blank(s)) continue;
+        if (kind != 3) continue;
         nv = gk__parse_doubles(s, vals, 8, &bad);
         if (bad || nv != dim + 1) {
             gk_packing_free(&pk);
             return gk_err_set(err, GK_ERR_FORMAT, "line %ld: expected %d numbers (%s r), found %s", L.lineno, dim + 1,
                               dim == 2 ? "x y" : "x y z", bad ? "a non-number" : "a different count");
-        }
-        if (k >= n) {
-            gk_packing_free(&pk);
-            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced", L.lineno, n);
         }
         for (nv = 0; nv <= dim; ++nv)
             if (!isfinite(vals[nv])) {
@@ -260,13 +298,9 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
         pk.r[k] = vals[dim];
         ++k;
     }
-    if (k != n) {
+    if (!(gk_m3_det(h) > 0.0) || !isfinite(gk_m3_det(h))) {
         gk_packing_free(&pk);
-        return gk_err_set(err, GK_ERR_FORMAT, "packing announces %d particles but lists %d", n, k);
-    }
-    if (!(gk_m3_det(h) > 0.0)) {
-        gk_packing_free(&pk);
-        return gk_err_set(err, GK_ERR_CELL, "cell matrix has det <= 0");
+        return gk_err_set(err, GK_ERR_CELL, "cell matrix has det %g (must be finite and > 0)", gk_m3_det(h));
     }
     gk_m3_copy(h, pk.h);
     *out = pk;
@@ -274,36 +308,14 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
 }
 
 GKDEF gk_result gk_packing_read(const char *path, gk_packing *pk, const gk_allocator *alloc, gk_err *err) {
-    FILE *fp;
-    long len;
-    char *buf;
-    gk_allocator a;
+    char *buf = NULL;
+    size_t len = 0;
     gk_result r;
-    if (alloc)
-        a = *alloc;
-    else
-        memset(&a, 0, sizeof a);
     if (!path) return gk_err_set(err, GK_ERR_ARG, "no packing path given");
-    fp = fopen(path, "rb");
-    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open packing '%s'", path);
-    if (fseek(fp, 0, SEEK_END) != 0 || (len = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0) {
-        fclose(fp);
-        return gk_err_set(err, GK_ERR_IO, "cannot size packing '%s'", path);
-    }
-    buf = (char *)gk_alloc(&a, (size_t)len + 1);
-    if (!buf) {
-        fclose(fp);
-        return gk_err_set(err, GK_ERR_ALLOC, "out of memory reading '%s'", path);
-    }
-    if (fread(buf, 1, (size_t)len, fp) != (size_t)len) {
-        fclose(fp);
-        gk_free(&a, buf);
-        return gk_err_set(err, GK_ERR_IO, "cannot read packing '%s'", path);
-    }
-    fclose(fp);
-    buf[len] = '\0';
-    r = gk_packing_parse(buf, (size_t)len, pk, alloc, err);
-    gk_free(&a, buf);
+    r = gk_file_read(path, alloc, &buf, &len, err);
+    if (r) return r;
+    r = gk_packing_parse(buf, len, pk, alloc, err);
+    gk_free(alloc, buf);
     if (r && err) {
         char msg[GK_ERR_MSG_LEN];
         memcpy(msg, err->msg, sizeof msg);
@@ -347,8 +359,7 @@ GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const c
         else
             fprintf(fp, "%.17g %.17g %.17g %.17g\n", pk->x[k], pk->y[k], pk->z[k], pk->r[k]);
     }
-    if (fclose(fp) != 0) return gk_err_set(err, GK_ERR_IO, "error writing '%s'", path);
-    return GK_OK;
+    return gk_file_close(fp, path, err);
 }
 
 GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err) {
@@ -429,6 +440,11 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
     side = pow(V / (asp[0] * asp[1] * (dim == 3 ? asp[2] : 1.0)), 1.0 / dim);
     gk_m3_identity(pk.h);
     for (k = 0; k < dim; ++k) pk.h[4 * k] = side * asp[k];
+    if (!(vs > 0.0) || !isfinite(gk_m3_det(pk.h)) || !(gk_m3_det(pk.h) > 0.0)) {
+        gk_packing_free(&pk);
+        return gk_err_set(err, GK_ERR_ARG, "radii (largest %g) and cell aspect give a cell volume %g out of range",
+                          rr[0], gk_m3_det(pk.h));
+    }
     /* random sequential addition with a linked-cell grid updated as particles land */
     {
         double *sx = (double *)gk_alloc(alloc, (size_t)n * sizeof(double));
@@ -438,9 +454,8 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
         int32_t *head = NULL, *next = NULL;
         double cut = 2.0 * rr[0];
         for (k = 0; k < 3; ++k) {
-            nbin[k] = k < dim ? (int)(pk.h[4 * k] / cut) : 1;
+            nbin[k] = k < dim ? (pk.h[4 * k] / cut < 1024.0 ? (int)(pk.h[4 * k] / cut) : 1024) : 1;
             if (nbin[k] < 1) nbin[k] = 1;
-            if (nbin[k] > 1024) nbin[k] = 1024;
         }
         head = (int32_t *)gk_alloc(alloc, (size_t)nbin[0] * nbin[1] * nbin[2] * sizeof(int32_t));
         next = (int32_t *)gk_alloc(alloc, (size_t)n * sizeof(int32_t));

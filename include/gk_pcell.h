@@ -17,10 +17,12 @@
  *   gk_pcell_widths        perpendicular widths (face distances) of the cell
  *   gk_pcell_reduce        lattice reduction: an equivalent, less skewed h' = h M
  *   gk_pcell_min_image     branch vector to the nearest image
- *   gk_path_init/_step     an incremental map I + dH split over n steps:
+ *   gk_path_init/_step     a displacement-gradient increment dH split over
+ *                          n steps (det(I + dH) <= 0 is refused on both):
  *                          GK_PATH_CONSTANT_L  constant velocity gradient
  *                                              L = dH/(n dt) (seed 000 [C],
- *                                              YADE); end map exp(dH)
+ *                                              YADE); end map exp(dH) =
+ *                                              I + dH + dH^2/2 + ...
  *                          GK_PATH_OBJECTIVE   rotation by angle and stretch
  *                                              linearly: ends exactly at
  *                                              I + dH = R U, any size
@@ -64,7 +66,8 @@ typedef enum gk_path_kind {
     GK_PATH_OBJECTIVE = 1   /* M(a) = R(a theta) (I + a (U - I)), a = k/n       */
 } gk_path_kind;
 
-/* An incremental deformation F_inc = I + dH carried out over nsteps steps. */
+/* An incremental deformation carried out over nsteps steps: the end map is
+ * exp(dH) on GK_PATH_CONSTANT_L and exactly I + dH on GK_PATH_OBJECTIVE. */
 typedef struct gk_path {
     int dim, nsteps;
     gk_path_kind kind;
@@ -155,6 +158,9 @@ static gk_result gk__pcell_check(int dim, const double h[9], gk_err *err) {
         return gk_err_set(err, GK_ERR_CELL, "2D cell matrix must have third row and column (0,0,1)");
     if (!(gk_m3_det(h) > 0.0))
         return gk_err_set(err, GK_ERR_CELL, "cell matrix has det %g <= 0 (degenerate or inverted)", gk_m3_det(h));
+    if (!isfinite(gk_m3_det(h)))
+        return gk_err_set(err, GK_ERR_CELL, "cell matrix has a volume beyond the range of double (det %g)",
+                          gk_m3_det(h));
     return GK_OK;
 }
 
@@ -282,7 +288,9 @@ GKDEF gk_result gk_path_init(gk_path *p, int dim, gk_path_kind kind, const doubl
         return gk_err_set(err, GK_ERR_ARG, "2D dH must have zero third row and column");
     gk_m3_identity(F);
     for (k = 0; k < 9; ++k) F[k] += dH[k];
-    if (kind == GK_PATH_OBJECTIVE && gk_m3_polar(F, dim, R, U) != GK_OK)
+    /* both paths: a displacement-gradient increment with det(I + dH) <= 0
+     * inverts material, even where exp(dH) would not */
+    if (!(gk_m3_det(F) > 0.0) || (kind == GK_PATH_OBJECTIVE && gk_m3_polar(F, dim, R, U) != GK_OK))
         return gk_err_set(err, GK_ERR_SINGULAR, "I + dH has det %g <= 0 (inverts the cell)", gk_m3_det(F));
     p->dim = dim;
     p->nsteps = nsteps;

@@ -898,13 +898,16 @@ TEST(bad_input_is_rejected_cleanly) {
         gk_rve_state_save(&st, &rve);
         nan9[1] = NAN;
         CHECK(gk_rve_deform(&rve, nan9, 10) == GK_ERR_NAN);
-        /* constant-L path: exp(-4) squeezes the cell below the interaction distance */
-        CHECK(gk_rve_deform(&rve, thin, 10) == GK_ERR_CELL);
-        /* objective path: I + dH with det < 0 would invert the cell */
+        /* both paths: I + dH with det <= 0 would invert the material (constant L: exp(-4) would not) */
+        CHECK(gk_rve_deform(&rve, thin, 10) == GK_ERR_SINGULAR);
         rve.def.path = GK_PATH_OBJECTIVE;
         thin[0] = -2;
         CHECK(gk_rve_deform(&rve, thin, 10) == GK_ERR_SINGULAR);
         rve.def.path = GK_PATH_CONSTANT_L;
+        /* 50 % compression in one step: beyond the admissible increment per step */
+        thin[0] = -0.5;
+        CHECK(gk_rve_deform(&rve, thin, 1) == GK_ERR_ARG);
+        CHECK(strstr(gk_rve_error(&rve), "steps") != NULL);
         CHECK(gk_rve_set_dt(&rve, 1.0) == GK_ERR_DT);
         CHECK(gk_rve_set_dt(&rve, -1.0) == GK_ERR_DT);
         CHECK(gk_rve_step(&rve, -5) == GK_ERR_ARG);
@@ -912,6 +915,22 @@ TEST(bad_input_is_rejected_cleanly) {
         gk_rve_save(&rve, now, st.size, NULL);
         CHECK(memcmp(now, st.buf, st.size) == 0);
         free(now);
+        /* compressed in admissible calls until the cell would be thinner than twice the
+         * interaction distance: that call is refused and changes nothing */
+        {
+            gk_result r = GK_OK;
+            int calls = 0;
+            while (r == GK_OK && calls < 20) {
+                CHECK(gk_rve_state_save(&st, &rve) == GK_OK);
+                r = gk_rve_deform(&rve, thin, 200);
+                ++calls;
+            }
+            CHECK(r == GK_ERR_CELL && calls > 1);
+            now = (unsigned char *)malloc(st.size);
+            gk_rve_save(&rve, now, st.size, NULL);
+            CHECK(memcmp(now, st.buf, st.size) == 0);
+            free(now);
+        }
         gk_rve_state_free(&st);
     }
     gk_rve_destroy(&rve);

@@ -84,7 +84,7 @@ TEST(patch_test_q4_q8_hex8_reproduce_linear_field) {
         gk_csr K;
         gk_solver s;
         gk_err err;
-        memset(&s, 0, sizeof s);
+        gk_solver_init(&s);
         CHECK(gk_mesh_structured(&m, ty, n, o, L, NULL, &err) == GK_OK);
         distort(&m, ty == GK_Q8 ? 0.03 : 0.08, 11u + (unsigned)t); /* Q8: mid-nodes in the middle half */
         CHECK(gk_quad_rule(&q, ty, 2, &err) == GK_OK);
@@ -224,7 +224,7 @@ static double cantilever_error(gk_elem_type ty, int nx, int ny) {
     gk_csr K;
     gk_solver s;
     gk_err err;
-    memset(&s, 0, sizeof s);
+    gk_solver_init(&s);
     n[0] = nx, n[1] = ny, n[2] = 1;
     gk_mesh_structured(&m, ty, n, o, L, NULL, &err);
     gk_quad_rule(&q, ty, ty == GK_Q8 ? 3 : 2, &err);
@@ -319,7 +319,7 @@ TEST(direct_solver_matches_dense_reference) {
     gk_rng rng;
     int n[3] = {3, 4, 1}, i, p;
     double o[3] = {0, 0, 0}, L[3] = {1, 1, 1}, *Ad, *b, *x, *bd, maxd = 0;
-    memset(&s, 0, sizeof s);
+    gk_solver_init(&s);
     gk_rng_seed(&rng, 9);
     gk_mesh_structured(&m, GK_Q8, n, o, L, NULL, &err);
     gk_csr_from_mesh(&K, &m, NULL, &err);
@@ -374,7 +374,7 @@ TEST(pcg_matches_direct_on_elastic_system) {
     gk_err err;
     int n[3] = {4, 3, 3}, nfix = 0, a, i, e, it = 0, *fix;
     double o[3] = {0, 0, 0}, L[3] = {2, 1, 1}, D[81], *Dall, *rhs, *x1, *x2, *vals, md = 0, mx = 0;
-    memset(&s, 0, sizeof s);
+    gk_solver_init(&s);
     gk_mesh_structured(&m, GK_HEX8, n, o, L, NULL, &err);
     gk_quad_rule(&q, GK_HEX8, 2, &err);
     gk_fem_elastic_tangent(3, 2e5, 0.3, D);
@@ -541,7 +541,7 @@ TEST(bad_meshes_and_unconstrained_system_errors) {
     gk_solver s;
     int n[3] = {2, 2, 1}, e;
     double o[3] = {0, 0, 0}, L[3] = {1, 1, 1}, D[16], Dall[4 * 4 * 16], x5;
-    memset(&s, 0, sizeof s);
+    gk_solver_init(&s);
     gk_mesh_structured(&m, GK_Q4, n, o, L, NULL, &err);
     gk_quad_rule(&q, GK_Q4, 2, &err);
     CHECK(gk_mesh_check(&m, &q, &err) == GK_OK);
@@ -593,7 +593,7 @@ static gk_result solve_tied(const gk_mesh *m, const gk_quad *q, const double *D,
            *ur = (double *)calloc((size_t)dm->nred, sizeof(double)),
            *rv = (double *)malloc((size_t)nfix * sizeof(double) + 1);
     gk_result r;
-    memset(&s, 0, sizeof s);
+    gk_solver_init(&s);
     memset(&K, 0, sizeof K), memset(&Kr, 0, sizeof Kr);
     r = gk_csr_from_mesh(&K, m, NULL, err);
     if (!r) r = gk_fem_assemble(m, q, D, NULL, &K, NULL, err);

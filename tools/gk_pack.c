@@ -9,8 +9,11 @@
  * 000 authors' prepareRVE.py). Friction while consolidating selects the
  * density: 0 gives the densest state; larger values give looser ones.
  * --target-void-ratio searches that friction by bisection (each trial is a
- * full consolidation from the same cloud). The packing is written in the
- * shared/data format; the comment lines record material, state and command. */
+ * full consolidation from the same cloud); a target it cannot reach within
+ * 2e-3 is a failure (exit status 1, no packing written). The packing is
+ * written in the gk_packing.h text format; the comment lines record
+ * material, state and command. A packing that cannot be written completely
+ * is an error (exit status 1). */
 #define _POSIX_C_SOURCE 200809L
 #define GK_IMPLEMENTATION
 #include "gk_homog.h"
@@ -32,7 +35,8 @@ static void usage(FILE *fp) {
             "  --pressure P               target isotropic stress [Pa], compression positive (1e5)\n"
             "  --consolidation-friction M Coulomb coefficient while consolidating (0: densest)\n"
             "  --target-void-ratio E      search the consolidation friction that gives void ratio E\n"
-            "  --friction-angle A         contact friction angle after consolidation [rad] (0.5)\n"
+            "  --friction-deg A           contact friction angle after consolidation [degrees, 0 to 85]\n"
+            "                             (28.65 = 0.5 rad, seed 000)\n"
             "  --E, --kt-ratio, --density, --thickness, --damping   material (seed 000 defaults)\n"
             "  --seed S                   random seed (1)\n"
             "  --tol T                    relative stress tolerance (1e-3)\n"
@@ -41,7 +45,7 @@ static void usage(FILE *fp) {
 
 typedef struct opts {
     int dim, n;
-    double rmin, rmax, pressure, mu_cons, target_e, phi, E, ktr, rho, thick, damp, tol;
+    double rmin, rmax, pressure, mu_cons, target_e, phi, phi_deg, E, ktr, rho, thick, damp, tol;
     unsigned long seed;
     const char *psd, *psd_by, *out;
 } opts;
@@ -103,13 +107,15 @@ int main(int argc, char **argv) {
     int i, ntab = 0;
     char comment[2048];
     memset(&o, 0, sizeof o);
+    memset(&rve, 0, sizeof rve); /* gk_rve_destroy is safe on it before a create and after a failed one */
     o.dim = 2;
     o.n = 400;
     o.rmin = 0.003;
     o.rmax = 0.007;
     o.pressure = 1e5;
-    o.target_e = -1;
+    o.target_e = -1; /* not given */
     o.phi = 0.5;
+    o.phi_deg = -1; /* not given */
     o.E = 6e8;
     o.ktr = 0.8;
     o.rho = 2650;
@@ -138,7 +144,11 @@ int main(int argc, char **argv) {
         else if (!strcmp(a, "--pressure")) bad = real_opt(a, v, &o.pressure);
         else if (!strcmp(a, "--consolidation-friction")) bad = real_opt(a, v, &o.mu_cons);
         else if (!strcmp(a, "--target-void-ratio")) bad = real_opt(a, v, &o.target_e);
-        else if (!strcmp(a, "--friction-angle")) bad = real_opt(a, v, &o.phi);
+        else if (!strcmp(a, "--friction-deg")) bad = real_opt(a, v, &o.phi_deg);
+        else if (!strcmp(a, "--friction-angle")) { /* the old radian option, kept for old scripts */
+            fprintf(stderr, "gk_pack: --friction-angle (radians) is deprecated: use --friction-deg\n");
+            bad = real_opt(a, v, &o.phi);
+        }
         else if (!strcmp(a, "--E")) bad = real_opt(a, v, &o.E);
         else if (!strcmp(a, "--kt-ratio")) bad = real_opt(a, v, &o.ktr);
         else if (!strcmp(a, "--density")) bad = real_opt(a, v, &o.rho);
@@ -166,6 +176,16 @@ int main(int argc, char **argv) {
         fprintf(stderr, "gk_pack: --out is required (see --help)\n");
         return 2;
     }
+    if (o.phi_deg != -1) o.phi = o.phi_deg * GK_PI / 180.0;
+    if (!(o.phi >= 0.0 && o.phi <= 85.0 * GK_PI / 180.0)) { /* 35 meant as radians is refused */
+        fprintf(stderr, "gk_pack: friction angle %g degrees: a contact friction angle is 0 to 85 degrees\n",
+                o.phi * 180.0 / GK_PI);
+        return 2;
+    }
+    if (o.target_e != -1 && !(o.target_e > 0.0)) {
+        fprintf(stderr, "gk_pack: --target-void-ratio %g must be > 0\n", o.target_e);
+        return 2;
+    }
     memset(&g, 0, sizeof g);
     g.dim = o.dim;
     g.n = o.n;
@@ -175,13 +195,34 @@ int main(int argc, char **argv) {
     if (o.psd) {
         FILE *fp = fopen(o.psd, "r");
         char line[256];
+        int lineno = 0;
         if (!fp) {
             fprintf(stderr, "gk_pack: cannot open %s\n", o.psd);
             return 1;
         }
-        while (fgets(line, sizeof line, fp) && ntab < 256) {
-            if (line[0] == '#' || sscanf(line, "%lf %lf", &tab_r[ntab], &tab_c[ntab]) != 2) continue;
+        /* strictly: 'radius fraction' per line, '#' comments and blank lines, at most 256 rows */
+        while (fgets(line, sizeof line, fp)) {
+            char extra[2];
+            ++lineno;
+            if (!strchr(line, '\n') && !feof(fp)) {
+                fprintf(stderr, "gk_pack: %s line %d is longer than %d characters\n", o.psd, lineno,
+                        (int)sizeof line - 2);
+                fclose(fp);
+                return 1;
+            }
+            if (line[strspn(line, " \t\r\n")] == '\0' || line[strspn(line, " \t")] == '#') continue;
+            if (ntab == 256 || sscanf(line, "%lf %lf %1s", &tab_r[ntab], &tab_c[ntab], extra) != 2) {
+                fprintf(stderr, "gk_pack: %s line %d: %s\n", o.psd, lineno,
+                        ntab == 256 ? "more than 256 rows" : "expected 'radius cumulative_fraction'");
+                fclose(fp);
+                return 1;
+            }
             ++ntab;
+        }
+        if (ferror(fp)) {
+            fprintf(stderr, "gk_pack: cannot read %s\n", o.psd);
+            fclose(fp);
+            return 1;
         }
         fclose(fp);
         g.psd = !strcmp(o.psd_by, "number") ? GK_PSD_TABLE_NUMBER : GK_PSD_TABLE_MASS;
@@ -193,17 +234,21 @@ int main(int argc, char **argv) {
         fprintf(stderr, "gk_pack: %s\n", err.msg);
         return 1;
     }
-    if (o.target_e >= 0) {
+    if (o.target_e != -1) {
         /* void ratio grows with the consolidation friction: bisect on mu */
-        double lo = 0.0, hi = 1.0, best = 1e9;
+        double lo = 0.0, hi = 1.0, best = 1e9, emin = 0.0, emax = 0.0;
         int it;
         for (it = 0; it < 12; ++it) {
             double m = it == 0 ? 0.0 : 0.5 * (lo + hi), e;
             if (consolidate_once(&o, &cloud, m, &rve, &rep)) {
                 fprintf(stderr, "gk_pack: %s\n", gk_rve_error(&rve));
+                gk_rve_destroy(&rve);
+                gk_packing_free(&cloud);
                 return 1;
             }
             e = rep.void_ratio;
+            if (it == 0 || e < emin) emin = e;
+            if (it == 0 || e > emax) emax = e;
             fprintf(stderr, "gk_pack: consolidation friction %.4f -> void ratio %.4f\n", m, e);
             gk_rve_destroy(&rve);
             if (fabs(e - o.target_e) < fabs(best - o.target_e)) {
@@ -217,14 +262,21 @@ int main(int argc, char **argv) {
             else
                 hi = m;
         }
-        if (fabs(best - o.target_e) > 2e-3)
-            fprintf(stderr, "gk_pack: warning: closest void ratio %.4f is %.4f from the target %.4f\n", best,
-                    fabs(best - o.target_e), o.target_e);
+        if (fabs(best - o.target_e) > 2e-3) {
+            fprintf(stderr,
+                    "gk_pack: void ratio %g not reached: consolidation friction 0 to 1 gave %.4f to %.4f (closest "
+                    "%.4f at %.4f); no packing written\n",
+                    o.target_e, emin, emax, best, mu);
+            gk_packing_free(&cloud);
+            return 1;
+        }
     } else {
         mu = o.mu_cons;
     }
     if (consolidate_once(&o, &cloud, mu, &rve, &rep)) {
         fprintf(stderr, "gk_pack: %s\n", gk_rve_error(&rve));
+        gk_rve_destroy(&rve);
+        gk_packing_free(&cloud);
         return 1;
     }
     {
@@ -232,17 +284,27 @@ int main(int argc, char **argv) {
         gk_homog_coordination(&rve, &z);
         snprintf(comment, sizeof comment,
                  "consolidated by gk_pack: %dD, %d particles, radii %g-%g m, seed %lu\n"
-                 "material: linear kn = E r*, E=%g Pa, kt/kn=%g, friction angle %g rad (mu %.6g); density %g; "
+                 "material: linear kn = E r*, E=%g Pa, kt/kn=%g, friction angle %.17g deg (mu %.6g); density %g; "
                  "2D thickness %g; local damping %g\n"
                  "consolidation friction %.6g; target %g Pa isotropic; %ld steps\n"
                  "RVE state: stress (Pa, tension +) sxx=%.6f syy=%.6f%s%.6f sxy=%.6f ; void ratio %.6f ; Z=%.4f "
                  "(YADE skipFree %.6f, mechanical %.4f) ; contacts=%d ; unbalanced=%.3e",
-                 o.dim, o.n, o.rmin, o.rmax, o.seed, o.E, o.ktr, o.phi, tan(o.phi), o.rho, o.thick, o.damp, mu,
+                 o.dim, o.n, o.rmin, o.rmax, o.seed, o.E, o.ktr, o.phi * 180.0 / GK_PI, tan(o.phi), o.rho, o.thick,
+                 o.damp, mu,
                  o.pressure, rep.steps, rep.stress[0], rep.stress[4], o.dim == 3 ? " szz=" : " (2D) ",
                  o.dim == 3 ? rep.stress[8] : 0.0, rep.stress[1], rep.void_ratio, z.z, z.z_nofree, z.z_mech,
                  z.contacts, rep.unbalanced);
-        if (gk_rve_to_packing(&rve, &pk, NULL, &err) || gk_packing_write(o.out, &pk, comment, &err)) {
+        if (gk_rve_to_packing(&rve, &pk, NULL, &err)) {
             fprintf(stderr, "gk_pack: %s\n", err.msg);
+            gk_rve_destroy(&rve);
+            gk_packing_free(&cloud);
+            return 1;
+        }
+        if (gk_packing_write(o.out, &pk, comment, &err)) {
+            fprintf(stderr, "gk_pack: %s\n", err.msg);
+            gk_packing_free(&pk);
+            gk_rve_destroy(&rve);
+            gk_packing_free(&cloud);
             return 1;
         }
         printf("RESULT void_ratio=%.6f Z=%.4f consolidation_friction=%.6g p=%.6g steps=%ld seconds=%.2f\n",
