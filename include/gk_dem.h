@@ -732,34 +732,25 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     return GK_OK;
 }
 
-/* Verlet margin of a list built at (href, sref): a pair listed out was at least
- * r_i + r_j + skin apart; it is now at least r_i + r_j + margin apart
- * (smallest singular value of the affine map and largest non-affine
- * displacement, as gk_cells_skin_ok). */
-static double gk__list_margin(const gk_rve *rve, const double href[9], double *const sref[3], double skin) {
-    double hi[9], A[9], At[9], AtA[9], smin, m2 = 0.0;
-    const double *h = rve->cell.h;
-    int p, dim = rve->dim;
-    if (!(gk_m3_inverse(href, hi) > 0.0)) return -1.0;
-    gk_m3_mul(h, hi, A);
-    gk_m3_transpose(A, At);
-    gk_m3_mul(At, A, AtA);
-    if (dim == 2) {
-        double a = AtA[0], b = AtA[1], d = AtA[4], lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
-        smin = lmin > 0.0 ? sqrt(lmin) : 0.0;
-    } else {
-        double val[3], vec[9];
-        gk_m3_sym_eigen(AtA, val, vec);
-        smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
+/* inner list: the outer pairs closer than r_i + r_j + skin_in, in outer
+ * order, into nl (CSR counts in nl->start[i + 1]) */
+GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const int dim) {
+    const double *h = rve->cell.h, skin = rve->skin_in;
+    const int32_t *oi = rve->outer.i, *oj = rve->outer.j;
+    const gk_real *r = rve->r;
+    int c, k, no = rve->outer.n;
+    for (c = 0; c < no; ++c) {
+        int i = oi[c], j = oj[c];
+        double ds[3], d[3], cut = (double)r[i] + (double)r[j] + skin;
+        for (k = 0; k < dim; ++k) ds[k] = rve->s[k][j] - rve->s[k][i];
+        gk_pcell_image(h, dim, ds, d);
+        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut) {
+            nl->i[nl->n] = i;
+            nl->j[nl->n] = j;
+            ++nl->n;
+            ++nl->start[i + 1];
+        }
     }
-    for (p = 0; p < rve->n; ++p) {
-        double e0 = rve->s[0][p] - sref[0][p], e1 = rve->s[1][p] - sref[1][p], e2 = dim == 3 ? rve->s[2][p] - sref[2][p] : 0;
-        double u0 = h[0] * e0 + h[1] * e1 + h[2] * e2, u1 = h[3] * e0 + h[4] * e1 + h[5] * e2;
-        double u2 = dim == 3 ? h[6] * e0 + h[7] * e1 + h[8] * e2 : 0.0, d2 = u0 * u0 + u1 * u1 + u2 * u2;
-        if (d2 > m2) m2 = d2;
-    }
-    if (!isfinite(m2)) return -1.0;
-    return smin * skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(m2);
 }
 
 /* rebuild the pair list at the current positions, carrying history over by merge */
@@ -787,7 +778,10 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
                               "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
                               "too far for this many particles)",
                               w[k], 2.0 * rve->rmax + rve->skin);
-    if (!rve->outer_valid || gk__list_margin(rve, rve->ho0, rve->o0, rve->skin) <= rve->skin_in) {
+    if (!rve->outer_valid ||
+        !(gk_cells_skin_margin(dim, rve->ho0, rve->cell.h, rve->skin, rve->rmax,
+                               gk_cells_disp2_max(dim, rve->cell.h, n, (const double *const *)rve->o0,
+                                                  (const double *const *)rve->s)) > rve->skin_in)) {
         /* outer list from the cell grid (positions are in [0,1): gk__wrap) */
         for (k = 0; k < 3; ++k) sp[k] = rve->s[k < dim ? k : 0];
         res = gk_cells_bin(&rve->cells, dim, rve->cell.h, n, sp, 2.0 * rve->rmax + rve->skin, &rve->err);
@@ -812,48 +806,10 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
     nl.np = n;
     nl.n = 0;
     for (p = 0; p <= n; ++p) nl.start[p] = 0;
-    {
-        const double *h = rve->cell.h, skin = rve->skin_in;
-        const int32_t *oi = rve->outer.i, *oj = rve->outer.j;
-        const gk_real *r = rve->r;
-        int no = rve->outer.n;
-        if (dim == 2) {
-            const double *sx = rve->s[0], *sy = rve->s[1];
-            for (c = 0; c < no; ++c) {
-                int i = oi[c], j = oj[c];
-                double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i], dx, dy, cut = (double)r[i] + (double)r[j] + skin;
-                dsx -= rint(dsx);
-                dsy -= rint(dsy);
-                dx = h[0] * dsx + h[1] * dsy;
-                dy = h[3] * dsx + h[4] * dsy;
-                if (dx * dx + dy * dy < cut * cut) {
-                    nl.i[nl.n] = i;
-                    nl.j[nl.n] = j;
-                    ++nl.n;
-                    ++nl.start[i + 1];
-                }
-            }
-        } else {
-            const double *sx = rve->s[0], *sy = rve->s[1], *sz = rve->s[2];
-            for (c = 0; c < no; ++c) {
-                int i = oi[c], j = oj[c];
-                double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i], dsz = sz[j] - sz[i], dx, dy, dz;
-                double cut = (double)r[i] + (double)r[j] + skin;
-                dsx -= rint(dsx);
-                dsy -= rint(dsy);
-                dsz -= rint(dsz);
-                dx = h[0] * dsx + h[1] * dsy + h[2] * dsz;
-                dy = h[3] * dsx + h[4] * dsy + h[5] * dsz;
-                dz = h[6] * dsx + h[7] * dsy + h[8] * dsz;
-                if (dx * dx + dy * dy + dz * dz < cut * cut) {
-                    nl.i[nl.n] = i;
-                    nl.j[nl.n] = j;
-                    ++nl.n;
-                    ++nl.start[i + 1];
-                }
-            }
-        }
-    }
+    if (dim == 2)
+        gk__inner_filter(rve, &nl, 2);
+    else
+        gk__inner_filter(rve, &nl, 3);
     for (p = 0; p < n; ++p) nl.start[p + 1] += nl.start[p];
     /* history into the spare arrays by a merge with the current list (both sorted by (i, j)) */
     oc = 0;
@@ -942,13 +898,14 @@ GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0
     int c;
     for (c = c0; c < c1; ++c) {
         int i = pi[c], j = pj[c];
-        double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i];
+        double ds[3], dd[3];
         gk_real dx, dy, rvx, rvy, wi, wj;
         gk_contact_out o;
-        dsx -= rint(dsx);
-        dsy -= rint(dsy);
-        dx = (gk_real)(x->hd[0] * dsx + x->hd[1] * dsy);
-        dy = (gk_real)(x->hd[3] * dsx + x->hd[4] * dsy);
+        ds[0] = sx[j] - sx[i];
+        ds[1] = sy[j] - sy[i];
+        gk_pcell_image(x->hd, 2, ds, dd);
+        dx = (gk_real)dd[0];
+        dy = (gk_real)dd[1];
         rvx = (vx[j] - vx[i]) + (x->G[0] * dx + x->G[1] * dy);
         rvy = (vy[j] - vy[i]) + (x->G[3] * dx + x->G[4] * dy);
         wi = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[i] : x->wa[2];
@@ -983,14 +940,12 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
     int c, k;
     for (c = c0; c < c1; ++c) {
         int i = pi[c], j = pj[c];
-        double ds[3];
+        double ds[3], dd[3];
         gk_real d[3], vr[3], wi[3], wj[3], hist[3], mh[3];
         gk_contact_out o;
-        for (k = 0; k < 3; ++k) {
-            ds[k] = rve->s[k][j] - rve->s[k][i];
-            ds[k] -= rint(ds[k]);
-        }
-        for (k = 0; k < 3; ++k) d[k] = (gk_real)(x->hd[3 * k] * ds[0] + x->hd[3 * k + 1] * ds[1] + x->hd[3 * k + 2] * ds[2]);
+        for (k = 0; k < 3; ++k) ds[k] = rve->s[k][j] - rve->s[k][i];
+        gk_pcell_image(x->hd, 3, ds, dd);
+        for (k = 0; k < 3; ++k) d[k] = (gk_real)dd[k];
         for (k = 0; k < 3; ++k)
             vr[k] = (rve->v[k][j] - rve->v[k][i]) + (x->G[3 * k] * d[0] + x->G[3 * k + 1] * d[1] + x->G[3 * k + 2] * d[2]);
         for (k = 0; k < 3; ++k) {
@@ -1929,49 +1884,25 @@ static void gk__stiff_pass(gk_rve *rve) {
 }
 
 /* Love stress (seed 000 eq 5) -(1/V) sum F (x) d over the contacts, their
- * number and mean force. 2D has its own loop (4 products, no min-image
- * call): the same sums in the same order, so the same bits. */
+ * number and mean force, in pair order. */
 static void gk__stress_pass(gk_rve *rve) {
     int dim = rve->dim, c, k, l, nc = 0;
     double S[9], V = gk_rve_volume(rve), fsum = 0.0;
     gk_m3_zero(S);
-    if (dim == 2) {
-        const double *h = rve->cell.h, *sx = rve->s[0], *sy = rve->s[1];
-        const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
-        const gk_real *fx = rve->fc[0], *fy = rve->fc[1];
-        double s00 = 0, s01 = 0, s10 = 0, s11 = 0;
-        for (c = 0; c < rve->pl.n; ++c) {
-            double dsx, dsy, dx, dy, Fx, Fy;
-            if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
-            dsx = sx[pj[c]] - sx[pi[c]];
-            dsy = sy[pj[c]] - sy[pi[c]];
-            dsx -= rint(dsx);
-            dsy -= rint(dsy);
-            dx = h[0] * dsx + h[1] * dsy + 0.0;
-            dy = h[3] * dsx + h[4] * dsy + 0.0;
-            Fx = (double)fx[c], Fy = (double)fy[c];
-            s00 += Fx * dx, s01 += Fx * dy, s10 += Fy * dx, s11 += Fy * dy;
-            fsum += sqrt(Fx * Fx + Fy * Fy + 0.0);
-            ++nc;
+    for (c = 0; c < rve->pl.n; ++c) {
+        int i = rve->pl.i[c], j = rve->pl.j[c];
+        double ds[3], d[3], F[3] = {0.0, 0.0, 0.0};
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        for (k = 0; k < dim; ++k) {
+            ds[k] = rve->s[k][j] - rve->s[k][i];
+            F[k] = (double)rve->fc[k][c];
         }
-        S[0] = s00, S[1] = s01, S[3] = s10, S[4] = s11;
-    } else
-        for (c = 0; c < rve->pl.n; ++c) {
-            int i, j;
-            double ds[3], d[3], F[3];
-            if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
-            i = rve->pl.i[c];
-            j = rve->pl.j[c];
-            for (k = 0; k < 3; ++k) {
-                ds[k] = rve->s[k][j] - rve->s[k][i];
-                F[k] = (double)rve->fc[k][c];
-            }
-            gk_pcell_min_image(&rve->cell, ds, d);
-            for (k = 0; k < 3; ++k)
-                for (l = 0; l < 3; ++l) S[3 * k + l] += F[k] * d[l];
-            fsum += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
-            ++nc;
-        }
+        gk_pcell_image(rve->cell.h, dim, ds, d);
+        for (k = 0; k < dim; ++k)
+            for (l = 0; l < dim; ++l) S[3 * k + l] += F[k] * d[l];
+        fsum += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
+        ++nc;
+    }
     for (k = 0; k < 9; ++k) rve->stress[k] = -S[k] / V;
     if (rve->servo_on) gk__stiff_pass(rve);
     rve->ncontacts = nc;
@@ -2054,24 +1985,9 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
                           "non-finite velocity or position at step %ld (time step too large or unstable input?)",
                           rve->step);
     }
-    if (!rve->need_rebuild) {
-        double h0i[9], A[9], smin, margin, At[9], AtA[9];
-        gk_m3_inverse(rve->h0, h0i);
-        gk_m3_mul(rve->cell.h, h0i, A);
-        gk_m3_transpose(A, At);
-        gk_m3_mul(At, A, AtA);
-        if (rve->dim == 2) {
-            double a = AtA[0], b = AtA[1], d = AtA[4];
-            double lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
-            smin = lmin > 0.0 ? sqrt(lmin) : 0.0;
-        } else {
-            double val[3], vec[9];
-            gk_m3_sym_eigen(AtA, val, vec);
-            smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
-        }
-        margin = smin * rve->skin_in - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
-        if (!(margin > 0.0)) rve->need_rebuild = 1;
-    }
+    if (!rve->need_rebuild &&
+        !(gk_cells_skin_margin(rve->dim, rve->h0, rve->cell.h, rve->skin_in, rve->rmax, dispmax2) > 0.0))
+        rve->need_rebuild = 1;
     if (rve->hook) return rve->hook(rve, GK_HOOK_POST_STEP, rve->hook_user);
     return GK_OK;
 }
