@@ -445,16 +445,10 @@ static gk_result gk__spare_reserve(gk_rve *rve, size_t cap) {
  * state being checked before it is restored */
 static double gk__dt_critical_at(const gk_rve *rve, const double h[9], const unsigned char *const sb[3],
                                  const unsigned char *ib, const unsigned char *jb, int np) {
-    double knmax;
     const gk_material *m = &rve->def.mat;
-    if (m->law == GK_LAW_LINEAR) {
-        knmax = m->kn > 0 ? m->kn : m->young * rve->rmax; /* r* <= r_max */
-    } else {
-        double dmax = 1e-3 * rve->rmin, G = m->young / (2.0 * (1.0 + m->poisson));
-        gk_pcell cell;
-        int c;
-        cell.dim = rve->dim;
-        gk_m3_copy(h, cell.h);
+    double dmax = 1e-3 * rve->rmin;
+    int c;
+    if (gk_law_stiffens(m->law))
         for (c = 0; c < np; ++c) { /* current largest overlap, from the geometry */
             int32_t i, j;
             int k;
@@ -469,14 +463,11 @@ static double gk__dt_critical_at(const gk_rve *rve, const double h[9], const uns
                 }
                 ds[k] = sj - si;
             }
-            gk_pcell_min_image(&cell, ds, d);
-            if (rve->dim == 2) d[2] = 0.0;
+            gk_pcell_image(h, rve->dim, ds, d);
             dd = (double)rve->r[i] + (double)rve->r[j] - sqrt(gk_v3_dot(d, d));
             if (2.0 * dd > dmax) dmax = 2.0 * dd;
         }
-        knmax = G / (1.0 - m->poisson) * sqrt(2.0 * rve->rmax * dmax);
-    }
-    return sqrt(rve->mmin / knmax);
+    return sqrt(rve->mmin / gk_law_kn_max(m, rve->rmax, dmax));
 }
 
 static double gk__dt_critical(const gk_rve *rve) {
@@ -756,8 +747,8 @@ GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const 
 /* rebuild the pair list at the current positions, carrying history over by merge */
 static gk_result gk__rve_rebuild(gk_rve *rve) {
     gk_pairlist nl;
-    if (rve->def.mat.law == GK_LAW_HERTZ && rve->pl.n > 0) {
-        /* Hertz stiffens with load: the critical step shrinks as overlaps grow */
+    if (gk_law_stiffens(rve->def.mat.law) && rve->pl.n > 0) {
+        /* k_n grows with the overlap (Hertz): the critical step shrinks as overlaps grow */
         double dtc = gk__dt_critical(rve);
         if (rve->dt > dtc)
             return gk_err_set(&rve->err, GK_ERR_DT,
@@ -980,14 +971,14 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
 }
 
 /* ---------------------------------------------------------------- SIMD forces
- * The same law as gk_contact_2d/3d, GK_VR_W pairs at a time, every operation
- * in the same order (no FMA, correctly rounded sqrt and division, exact
- * negation), so each lane is bit-identical to the scalar reference. The
+ * GK_VR_W pairs at a time: gather, the wide twin of the law
+ * (gk_contact_2d_w / _3d_w, bit-identical lanes), store and scatter. The
  * remainder of a range (fewer than GK_VR_W pairs) and cohesive contacts go
  * through the scalar reference. */
 #if GK_VR_W > 1
 /* branch vectors d = h (ds - round(ds)) of GK_VR_W pairs, from double
- * positions; H = the cell matrix broadcast once per call */
+ * positions (the wide twin of gk_pcell_image); H = the cell matrix broadcast
+ * once per call */
 GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const int32_t *ii, const int32_t *jj,
                                      int dim, gk_vr d[3]) {
     gk_vd dd[2][3];
@@ -1010,25 +1001,6 @@ GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const 
 #else
         d[k] = dd[0][k];
 #endif
-    }
-}
-
-/* stiffness of GK_VR_W contacts (gk_contact_stiffness) */
-GK_FORCE_INLINE void gk__simd_stiffness(const gk_law_consts *K, gk_law law, gk_vr ri, gk_vr rj, gk_vr delta, gk_vr *kn,
-                                        gk_vr *fn, gk_vr *kt) {
-    gk_vr rr = gk_vr_mul(ri, rj), rs = gk_vr_div(gk_vr_add(rr, rr), gk_vr_add(ri, rj));
-    if (law == GK_LAW_LINEAR) {
-        gk_vr k = K->kn_const > 0 ? gk_vr_set1(K->kn_const) : gk_vr_mul(gk_vr_set1(K->young), rs);
-        *kn = k;
-        *fn = gk_vr_mul(k, delta);
-        *kt = gk_vr_mul(gk_vr_set1(K->kt_ratio), k);
-    } else {
-        gk_vr a = gk_vr_mul(gk_vr_add(rs, rs), delta);
-        gk_vr sq = gk_vr_select(gk_vr_gt(a, gk_vr_zero()), gk_vr_sqrt(a), gk_vr_zero());
-        gk_vr k = gk_vr_mul(gk_vr_set1(K->hn), sq);
-        *kn = k;
-        *fn = gk_vr_mul(gk_vr_set1((gk_real)(2.0 / 3.0)), gk_vr_mul(k, delta));
-        *kt = gk_vr_mul(gk_vr_set1(K->ht), sq);
     }
 }
 
@@ -1094,12 +1066,11 @@ GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const in
 }
 
 GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
-    const gk_law_consts *K = &rve->K;
+    const gk_law_consts K = rve->K; /* a local copy: its broadcasts stay out of the loop */
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
-    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5), dt = gk_vr_set1(x->dt);
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), dt = gk_vr_set1(x->dt);
     const gk_vr G0 = gk_vr_set1(x->G[0]), G1 = gk_vr_set1(x->G[1]), G3 = gk_vr_set1(x->G[3]), G4 = gk_vr_set1(x->G[4]);
-    const gk_vr wa = gk_vr_set1(x->wa[2]), mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
-    const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta);
+    const gk_vr wa = gk_vr_set1(x->wa[2]);
     gk_real bx[GK_VR_W], by[GK_VR_W], bi[GK_VR_W], bj[GK_VR_W];
     gk_vd H[9];
     const uint64_t *lut = gk__bitbytes;
@@ -1107,100 +1078,47 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
     for (k = 0; k < 9; ++k) H[k] = gk_vd_set1(x->hd[k]); /* hoisted: stores to doubles could alias x->hd */
     for (; c + GK_VR_W <= c1; c += GK_VR_W) {
         const int32_t *ii = pi + c, *jj = pj + c;
-        gk_vr d[3], ri, rj, R, d2, dist, inv, nx, ny, delta, kn, fn, kt, vx, vy, vn, mstar = zero, li, lj, hd;
-        gk_vr fx, fy, ti = zero, tj = zero, wi = wa, wj = wa, fnp = zero, ftot = zero, fh = zero, m = zero;
-        gk_vrm in, slide = gk_vr_lt(one, zero);
+        gk_vr d[3], ri, rj, vx, vy, mi = zero, mj = zero, wi = wa, wj = wa, fh = zero, m = zero;
+        gk_vrm in, slide;
+        gk_contact_out_w o;
         gk__simd_branch(rve, H, ii, jj, 2, d);
         ri = gk_vr_gather(rve->r, ii);
         rj = gk_vr_gather(rve->r, jj);
-        R = gk_vr_add(ri, rj);
-        d2 = gk_vr_add(gk_vr_mul(d[0], d[0]), gk_vr_mul(d[1], d[1]));
-        in = gk_vr_lt(d2, gk_vr_mul(R, R));
-        dist = gk_vr_sqrt(d2);
-        inv = gk_vr_div(one, dist);
-        nx = gk_vr_mul(d[0], inv);
-        ny = gk_vr_mul(d[1], inv);
-        delta = gk_vr_sub(R, dist);
-        gk__simd_stiffness(K, law, ri, rj, delta, &kn, &fn, &kt);
         vx = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[0], jj), gk_vr_gather(rve->v[0], ii)),
                        gk_vr_add(gk_vr_mul(G0, d[0]), gk_vr_mul(G1, d[1])));
         vy = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[1], jj), gk_vr_gather(rve->v[1], ii)),
                        gk_vr_add(gk_vr_mul(G3, d[0]), gk_vr_mul(G4, d[1])));
-        vn = gk_vr_add(gk_vr_mul(vx, nx), gk_vr_mul(vy, ny));
         if (fl & GK_PHYS_VISCOUS) {
-            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)), mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
-            mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
-            fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(zn2, gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
+            mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii));
+            mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
         }
-        hd = gk_vr_mul(half, delta);
-        li = gk_vr_sub(ri, hd);
-        lj = gk_vr_sub(rj, hd);
         if (fl & GK_PHYS_ROTATION) {
             wi = gk_vr_add(wa, gk_vr_gather(rve->w[2], ii));
             wj = gk_vr_add(wa, gk_vr_gather(rve->w[2], jj));
         }
-        if (fl & GK_PHYS_TANGENT) {
-            gk_vr tx = gk_vr_neg(ny), ty = nx, vt, f, cap, gt = zero;
-            vt = gk_vr_sub(gk_vr_add(gk_vr_mul(vx, tx), gk_vr_mul(vy, ty)),
-                           gk_vr_add(gk_vr_mul(li, wi), gk_vr_mul(lj, wj)));
-            f = gk_vr_sub(gk_vr_load(rve->ft[0] + c), gk_vr_mul(gk_vr_mul(kt, vt), dt));
-            ftot = f;
-            if (fl & GK_PHYS_VISCOUS) {
-                gt = gk_vr_mul(zt2, gk_vr_sqrt(gk_vr_mul(mstar, kt)));
-                ftot = gk_vr_sub(f, gk_vr_mul(gt, vt));
-            }
-            fnp = gk_vr_max(fn, zero);
-            cap = gk_vr_mul(mu, fnp);
-            slide = gk_vr_gt(gk_vr_abs(ftot), cap);
-            ftot = gk_vr_select(slide, gk_vr_select(gk_vr_gt(ftot, zero), cap, gk_vr_neg(cap)), ftot);
-            if (fl & GK_PHYS_VISCOUS)
-                f = gk_vr_select(slide, gk_vr_add(ftot, gk_vr_mul(gt, vt)), f);
-            else
-                f = gk_vr_select(slide, ftot, f);
-            fh = f;
-            fx = gk_vr_add(gk_vr_mul(fn, nx), gk_vr_mul(ftot, tx));
-            fy = gk_vr_add(gk_vr_mul(fn, ny), gk_vr_mul(ftot, ty));
-            ti = gk_vr_mul(gk_vr_neg(li), ftot);
-            tj = gk_vr_mul(gk_vr_neg(lj), ftot);
-        } else {
-            fx = gk_vr_mul(fn, nx);
-            fy = gk_vr_mul(fn, ny);
-        }
-        if (fl & GK_PHYS_ROLLING) {
-            gk_vr kr = gk_vr_mul(gk_vr_mul(beta, kt), gk_vr_mul(ri, rj)), capr;
-            gk_vrm over;
-            m = gk_vr_sub(gk_vr_load(rve->mr[2] + c), gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wj, wi)), dt));
-            fnp = gk_vr_max(fn, zero);
-            capr = gk_vr_mul(gk_vr_mul(eta, gk_vr_min(ri, rj)), fnp);
-            over = gk_vr_gt(gk_vr_abs(m), capr);
-            m = gk_vr_select(over, gk_vr_select(gk_vr_gt(m, zero), capr, gk_vr_neg(capr)), m);
-            ti = gk_vr_sub(ti, m);
-            tj = gk_vr_add(tj, m);
-        }
-        fx = gk_vr_select(in, fx, zero);
-        fy = gk_vr_select(in, fy, zero);
-        ti = gk_vr_select(in, ti, zero);
-        tj = gk_vr_select(in, tj, zero);
-        if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[0] + c, gk_vr_select(in, fh, zero));
-        if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[2] + c, gk_vr_select(in, m, zero));
+        if (fl & GK_PHYS_TANGENT) fh = gk_vr_load(rve->ft[0] + c);
+        if (fl & GK_PHYS_ROLLING) m = gk_vr_load(rve->mr[2] + c);
+        in = gk_contact_2d_w(&K, law, fl, d[0], d[1], ri, rj, mi, mj, vx, vy, wi, wj, dt, &fh, &m, &slide, &o);
+        if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[0] + c, fh);
+        if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[2] + c, m);
         gk__simd_state(rve->cs + c, in, slide, lut);
         if (x->store) {
-            gk_vr_store(rve->fc[0] + c, fx);
-            gk_vr_store(rve->fc[1] + c, fy);
+            gk_vr_store(rve->fc[0] + c, o.f[0]);
+            gk_vr_store(rve->fc[1] + c, o.f[1]);
             if (fl & GK_PHYS_ROTATION) {
-                gk_vr_store(rve->tci[2] + c, ti);
-                gk_vr_store(rve->tcj[2] + c, tj);
+                gk_vr_store(rve->tci[2] + c, o.ti[2]);
+                gk_vr_store(rve->tcj[2] + c, o.tj[2]);
             }
         }
         if (x->scatter) {
             /* scatter the previous block now (its buffer stores have retired: no
              * store-forwarding stall) and buffer this one; pair order is kept */
             if (pend >= 0) gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
-            gk_vr_storeu(bx, fx);
-            gk_vr_storeu(by, fy);
+            gk_vr_storeu(bx, o.f[0]);
+            gk_vr_storeu(by, o.f[1]);
             if (fl & GK_PHYS_ROTATION) {
-                gk_vr_storeu(bi, ti);
-                gk_vr_storeu(bj, tj);
+                gk_vr_storeu(bi, o.ti[2]);
+                gk_vr_storeu(bj, o.tj[2]);
             }
             pend = c;
         }
@@ -1209,31 +1127,10 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
     gk__forces_ref_2d(rve, x, c, c1, law, fl);
 }
 
-/* gk_contact_rotate_history on GK_VR_W lanes */
-GK_FORCE_INLINE void gk__simd_rotate(const gk_vr n[3], gk_vr a, gk_vr h[3]) {
-    const gk_vr zero = gk_vr_zero();
-    gk_vr m2, p[3], dn, p2, sc;
-    gk_vrm has, pos;
-    int k;
-    m2 = gk_vr_add(gk_vr_add(gk_vr_mul(h[0], h[0]), gk_vr_mul(h[1], h[1])), gk_vr_mul(h[2], h[2]));
-    p[0] = gk_vr_add(h[0], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[1], h[2]), gk_vr_mul(n[2], h[1]))));
-    p[1] = gk_vr_add(h[1], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[2], h[0]), gk_vr_mul(n[0], h[2]))));
-    p[2] = gk_vr_add(h[2], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[0], h[1]), gk_vr_mul(n[1], h[0]))));
-    dn = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], n[0]), gk_vr_mul(p[1], n[1])), gk_vr_mul(p[2], n[2]));
-    for (k = 0; k < 3; ++k) p[k] = gk_vr_sub(p[k], gk_vr_mul(dn, n[k]));
-    p2 = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], p[0]), gk_vr_mul(p[1], p[1])), gk_vr_mul(p[2], p[2]));
-    sc = gk_vr_sqrt(gk_vr_div(m2, p2));
-    has = gk_vr_gt(m2, zero);
-    pos = gk_vr_gt(p2, zero);
-    for (k = 0; k < 3; ++k) h[k] = gk_vr_select(has, gk_vr_select(pos, gk_vr_mul(p[k], sc), zero), h[k]);
-}
-
 GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
-    const gk_law_consts *K = &rve->K;
+    const gk_law_consts K = rve->K; /* a local copy: its broadcasts stay out of the loop */
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
-    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5), dt = gk_vr_set1(x->dt);
-    const gk_vr mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
-    const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta), halfdt = gk_vr_mul(half, dt);
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), dt = gk_vr_set1(x->dt);
     gk_vr G[9], wa[3];
     gk_vd H[9];
     gk_real bF[3][GK_VR_W], bI[3][GK_VR_W], bJ[3][GK_VR_W];
@@ -1246,124 +1143,34 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
     for (k = 0; k < 3; ++k) wa[k] = gk_vr_set1(x->wa[k]);
     for (; c + GK_VR_W <= c1; c += GK_VR_W) {
         const int32_t *ii = pi + c, *jj = pj + c;
-        gk_vr d[3], n[3], v[3], wi[3], wj[3], F[3], ti[3], tj[3], fh[3], mh[3];
-        gk_vr ri, rj, R, d2, dist, inv, delta, kn, fn, kt, vn, mstar = zero, hd, li, lj, twist = zero, fnp;
-        gk_vrm in, slide = gk_vr_lt(one, zero);
+        gk_vr d[3], v[3], wi[3], wj[3], fh[3], mh[3], ri, rj, mi = zero, mj = zero;
+        gk_vrm in, slide;
+        gk_contact_out_w o;
         gk__simd_branch(rve, H, ii, jj, 3, d);
         ri = gk_vr_gather(rve->r, ii);
         rj = gk_vr_gather(rve->r, jj);
-        R = gk_vr_add(ri, rj);
-        d2 = gk_vr_add(gk_vr_add(gk_vr_mul(d[0], d[0]), gk_vr_mul(d[1], d[1])), gk_vr_mul(d[2], d[2]));
-        in = gk_vr_lt(d2, gk_vr_mul(R, R));
-        dist = gk_vr_sqrt(d2);
-        inv = gk_vr_div(one, dist);
-        for (k = 0; k < 3; ++k) n[k] = gk_vr_mul(d[k], inv);
-        delta = gk_vr_sub(R, dist);
-        gk__simd_stiffness(K, law, ri, rj, delta, &kn, &fn, &kt);
-        for (k = 0; k < 3; ++k)
+        for (k = 0; k < 3; ++k) {
             v[k] = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[k], jj), gk_vr_gather(rve->v[k], ii)),
                              gk_vr_add(gk_vr_add(gk_vr_mul(G[3 * k], d[0]), gk_vr_mul(G[3 * k + 1], d[1])),
                                        gk_vr_mul(G[3 * k + 2], d[2])));
-        for (k = 0; k < 3; ++k) {
             wi[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather(rve->w[k], ii)) : wa[k];
             wj[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather(rve->w[k], jj)) : wa[k];
-            ti[k] = tj[k] = zero;
+            fh[k] = (fl & GK_PHYS_TANGENT) ? gk_vr_load(rve->ft[k] + c) : zero;
+            mh[k] = (fl & GK_PHYS_ROLLING) ? gk_vr_load(rve->mr[k] + c) : zero;
         }
-        vn = gk_vr_add(gk_vr_add(gk_vr_mul(v[0], n[0]), gk_vr_mul(v[1], n[1])), gk_vr_mul(v[2], n[2]));
         if (fl & GK_PHYS_VISCOUS) {
-            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)), mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
-            mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
-            fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(zn2, gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
+            mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii));
+            mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
         }
-        hd = gk_vr_mul(half, delta);
-        li = gk_vr_sub(ri, hd);
-        lj = gk_vr_sub(rj, hd);
-        if (fl & (GK_PHYS_TANGENT | GK_PHYS_ROLLING))
-            twist = gk_vr_mul(halfdt, gk_vr_add(gk_vr_add(gk_vr_mul(gk_vr_add(wi[0], wj[0]), n[0]),
-                                                          gk_vr_mul(gk_vr_add(wi[1], wj[1]), n[1])),
-                                                gk_vr_mul(gk_vr_add(wi[2], wj[2]), n[2])));
-        if (fl & GK_PHYS_TANGENT) {
-            gk_vr sw[3], vc[3], vcn, vt[3], f[3], tot[3], cc[3], cap, gt = zero, m2;
-            for (k = 0; k < 3; ++k) sw[k] = gk_vr_add(gk_vr_mul(li, wi[k]), gk_vr_mul(lj, wj[k]));
-            vc[0] = gk_vr_sub(v[0], gk_vr_sub(gk_vr_mul(sw[1], n[2]), gk_vr_mul(sw[2], n[1])));
-            vc[1] = gk_vr_sub(v[1], gk_vr_sub(gk_vr_mul(sw[2], n[0]), gk_vr_mul(sw[0], n[2])));
-            vc[2] = gk_vr_sub(v[2], gk_vr_sub(gk_vr_mul(sw[0], n[1]), gk_vr_mul(sw[1], n[0])));
-            vcn = gk_vr_add(gk_vr_add(gk_vr_mul(vc[0], n[0]), gk_vr_mul(vc[1], n[1])), gk_vr_mul(vc[2], n[2]));
-            for (k = 0; k < 3; ++k) {
-                vt[k] = gk_vr_sub(vc[k], gk_vr_mul(vcn, n[k]));
-                fh[k] = gk_vr_load(rve->ft[k] + c);
-            }
-            gk__simd_rotate(n, twist, fh);
-            for (k = 0; k < 3; ++k) {
-                f[k] = gk_vr_sub(fh[k], gk_vr_mul(gk_vr_mul(kt, vt[k]), dt));
-                tot[k] = f[k];
-            }
-            if (fl & GK_PHYS_VISCOUS) {
-                gt = gk_vr_mul(zt2, gk_vr_sqrt(gk_vr_mul(mstar, kt)));
-                for (k = 0; k < 3; ++k) tot[k] = gk_vr_sub(f[k], gk_vr_mul(gt, vt[k]));
-            }
-            fnp = gk_vr_max(fn, zero);
-            cap = gk_vr_mul(mu, fnp);
-            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(tot[0], tot[0]), gk_vr_mul(tot[1], tot[1])), gk_vr_mul(tot[2], tot[2]));
-            slide = gk_vr_gt(m2, gk_vr_mul(cap, cap));
-            if (gk_vrm_any(slide)) {
-                gk_vr sc = gk_vr_div(cap, gk_vr_sqrt(m2));
-                for (k = 0; k < 3; ++k) {
-                    gk_vr t = gk_vr_mul(tot[k], sc);
-                    tot[k] = gk_vr_select(slide, t, tot[k]);
-                    f[k] = gk_vr_select(slide, (fl & GK_PHYS_VISCOUS) ? gk_vr_add(tot[k], gk_vr_mul(gt, vt[k])) : tot[k],
-                                        f[k]);
-                }
-            }
-            for (k = 0; k < 3; ++k) {
-                fh[k] = f[k];
-                F[k] = gk_vr_add(gk_vr_mul(fn, n[k]), tot[k]);
-            }
-            cc[0] = gk_vr_sub(gk_vr_mul(n[1], tot[2]), gk_vr_mul(n[2], tot[1]));
-            cc[1] = gk_vr_sub(gk_vr_mul(n[2], tot[0]), gk_vr_mul(n[0], tot[2]));
-            cc[2] = gk_vr_sub(gk_vr_mul(n[0], tot[1]), gk_vr_mul(n[1], tot[0]));
-            for (k = 0; k < 3; ++k) {
-                ti[k] = gk_vr_mul(gk_vr_neg(li), cc[k]);
-                tj[k] = gk_vr_mul(gk_vr_neg(lj), cc[k]);
-            }
-        } else {
-            for (k = 0; k < 3; ++k) F[k] = gk_vr_mul(fn, n[k]);
-        }
-        if (fl & GK_PHYS_ROLLING) {
-            gk_vr wr[3], wrn, kr = gk_vr_mul(gk_vr_mul(beta, kt), gk_vr_mul(ri, rj)), capr, m2;
-            gk_vrm over;
-            fnp = gk_vr_max(fn, zero);
-            capr = gk_vr_mul(gk_vr_mul(eta, gk_vr_min(ri, rj)), fnp);
-            for (k = 0; k < 3; ++k) {
-                wr[k] = gk_vr_sub(wj[k], wi[k]);
-                mh[k] = gk_vr_load(rve->mr[k] + c);
-            }
-            wrn = gk_vr_add(gk_vr_add(gk_vr_mul(wr[0], n[0]), gk_vr_mul(wr[1], n[1])), gk_vr_mul(wr[2], n[2]));
-            gk__simd_rotate(n, twist, mh);
-            for (k = 0; k < 3; ++k)
-                mh[k] = gk_vr_sub(mh[k], gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wr[k], gk_vr_mul(wrn, n[k]))), dt));
-            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(mh[0], mh[0]), gk_vr_mul(mh[1], mh[1])), gk_vr_mul(mh[2], mh[2]));
-            over = gk_vr_gt(m2, gk_vr_mul(capr, capr));
-            if (gk_vrm_any(over)) {
-                gk_vr sc = gk_vr_div(capr, gk_vr_sqrt(m2));
-                for (k = 0; k < 3; ++k) mh[k] = gk_vr_select(over, gk_vr_mul(mh[k], sc), mh[k]);
-            }
-            for (k = 0; k < 3; ++k) {
-                ti[k] = gk_vr_sub(ti[k], mh[k]);
-                tj[k] = gk_vr_add(tj[k], mh[k]);
-            }
-        }
+        in = gk_contact_3d_w(&K, law, fl, d, ri, rj, mi, mj, v, wi, wj, dt, fh, mh, &slide, &o);
         for (k = 0; k < 3; ++k) {
-            F[k] = gk_vr_select(in, F[k], zero);
-            ti[k] = gk_vr_select(in, ti[k], zero);
-            tj[k] = gk_vr_select(in, tj[k], zero);
-            if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[k] + c, gk_vr_select(in, fh[k], zero));
-            if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[k] + c, gk_vr_select(in, mh[k], zero));
+            if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[k] + c, fh[k]);
+            if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[k] + c, mh[k]);
             if (x->store) {
-                gk_vr_store(rve->fc[k] + c, F[k]);
+                gk_vr_store(rve->fc[k] + c, o.f[k]);
                 if (fl & GK_PHYS_ROTATION) {
-                    gk_vr_store(rve->tci[k] + c, ti[k]);
-                    gk_vr_store(rve->tcj[k] + c, tj[k]);
+                    gk_vr_store(rve->tci[k] + c, o.ti[k]);
+                    gk_vr_store(rve->tcj[k] + c, o.tj[k]);
                 }
             }
         }
@@ -1371,10 +1178,10 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
         if (x->scatter) { /* pipelined as in 2D */
             if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, bF, bI, bJ, fl & GK_PHYS_ROTATION);
             for (k = 0; k < 3; ++k) {
-                gk_vr_storeu(bF[k], F[k]);
+                gk_vr_storeu(bF[k], o.f[k]);
                 if (fl & GK_PHYS_ROTATION) {
-                    gk_vr_storeu(bI[k], ti[k]);
-                    gk_vr_storeu(bJ[k], tj[k]);
+                    gk_vr_storeu(bI[k], o.ti[k]);
+                    gk_vr_storeu(bJ[k], o.tj[k]);
                 }
             }
             pend = c;
@@ -1385,47 +1192,54 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
 }
 #endif /* GK_VR_W > 1 */
 
-/* instantiate the kernel with constant law and flags (pay only for what is on) */
-#define GK__DISPATCH(fn, rve, x, c0, c1)                                                                              \
+/* instantiate a kernel with constant law and flags (pay only for what is on):
+ * the common flag sets get their own copy, the rest share one with fl */
+#define GK__FLAG_SETS(fn, rve, x, c0, c1, LAW, fl)                                                                    \
     do {                                                                                                               \
-        unsigned fl_ = (rve)->phys;                                                                                    \
-        gk_law law_ = (rve)->def.mat.law;                                                                              \
-        if (law_ == GK_LAW_LINEAR) {                                                                                   \
-            if (fl_ == 0u)                                                                                             \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, 0u);                                                                 \
-            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT);                                                    \
-            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                 \
-            else                                                                                                       \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, fl_);                                                                \
-        } else {                                                                                                       \
-            if (fl_ == 0u)                                                                                             \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, 0u);                                                                  \
-            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT);                                                     \
-            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                  \
-            else                                                                                                       \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, fl_);                                                                 \
-        }                                                                                                              \
+        if ((fl) == 0u)                                                                                                \
+            fn(rve, x, c0, c1, LAW, 0u);                                                                               \
+        else if ((fl) == GK_PHYS_TANGENT)                                                                              \
+            fn(rve, x, c0, c1, LAW, GK_PHYS_TANGENT);                                                                  \
+        else if ((fl) == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                         \
+            fn(rve, x, c0, c1, LAW, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                               \
+        else                                                                                                           \
+            fn(rve, x, c0, c1, LAW, fl);                                                                               \
     } while (0)
 
-static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
+/* one kernel of each law of GK_LAW_TABLE (gk_contact.h) for the dimension and path */
 #if GK_VR_W > 1
-    if (!(rve->def.flags & GK_RVE_SCALAR) && !(rve->phys & GK_PHYS_COHESION)) {
-        if (rve->dim == 2)
-            GK__DISPATCH(gk__forces_simd_2d, rve, x, c0, c1);
-        else
-            GK__DISPATCH(gk__forces_simd_3d, rve, x, c0, c1);
-        return;
-    }
+#define GK__WIDE(rve, x, c0, c1, LAW, fl)                                                                              \
+    if (wide) {                                                                                                        \
+        if ((rve)->dim == 2)                                                                                           \
+            GK__FLAG_SETS(gk__forces_simd_2d, rve, x, c0, c1, LAW, fl);                                                \
+        else                                                                                                           \
+            GK__FLAG_SETS(gk__forces_simd_3d, rve, x, c0, c1, LAW, fl);                                                \
+    } else
+#else
+#define GK__WIDE(rve, x, c0, c1, LAW, fl)
 #endif
-    if (rve->dim == 2)
-        GK__DISPATCH(gk__forces_ref_2d, rve, x, c0, c1);
-    else
-        GK__DISPATCH(gk__forces_ref_3d, rve, x, c0, c1);
+#define GK__LAW_KERNELS(E, name)                                                                                       \
+    case E:                                                                                                            \
+        GK__WIDE(rve, x, c0, c1, E, fl)                                                                                \
+        if (rve->dim == 2)                                                                                             \
+            GK__FLAG_SETS(gk__forces_ref_2d, rve, x, c0, c1, E, fl);                                                   \
+        else                                                                                                           \
+            GK__FLAG_SETS(gk__forces_ref_3d, rve, x, c0, c1, E, fl);                                                   \
+        break;
+
+/* pair forces of [c0, c1): the wide kernels unless GK_RVE_SCALAR or cohesion */
+static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
+    unsigned fl = rve->phys;
+    int wide = !(rve->def.flags & GK_RVE_SCALAR) && !(fl & GK_PHYS_COHESION);
+    (void)wide;
+    switch (rve->def.mat.law) {
+        GK_LAW_TABLE(GK__LAW_KERNELS)
+    default: break;
+    }
 }
+#undef GK__LAW_KERNELS
+#undef GK__WIDE
+#undef GK__FLAG_SETS
 
 static int gk__nthreads(const gk_rve *rve);
 
