@@ -327,51 +327,143 @@ GKDEF gk_rve_def gk_rve_def_default(void) {
 
 GKDEF const char *gk_rve_error(const gk_rve *rve) { return rve->err.msg; }
 
+/* ---------------------------------------------------------------- the field table
+ * Every per-particle and per-pair array of a gk_rve, in the order of the
+ * saved state, with its element size, what it is indexed by and when it
+ * exists. Allocation, growth and release, the rebuild's history merge and
+ * swap, particle removal, gk_rve_refresh, save, restore and the state size
+ * all walk this table: a new array is one line here. */
+#define GK__HAS_ROT(rve) (((rve)->phys & GK_PHYS_ROTATION) != 0)
+#define GK__HAS_ROLL(rve) (((rve)->phys & GK_PHYS_ROLLING) != 0)
+
+enum { GK__PART, GK__PAIR, GK__OUTER }; /* indexed by: particle, pair, outer-list pair            */
+enum { GK__ALL, GK__DIM, GK__ROT, GK__ROLL, GK__TAN, GK__2D }; /* exists: always, k < dim, with
+    rotation (2D: k = 2 only), with rolling (2D: k = 2), 2D k = 0 or 3D, in 2D only */
+#define GK__SAVE 1u    /* in the saved state                                                   */
+#define GK__SPARE 2u   /* per-pair with a twin in rve->spare: carried across rebuilds by pair  */
+#define GK__HIST 4u    /* contact history: gk_rve_refresh leaves it as it was                  */
+#define GK__LIST 8u    /* index array of a gk_pairlist (allocated by it); i, then j            */
+#define GK__DERIVED 16u /* rebuilt from the pair list: never copied                             */
+
+typedef struct gk__field {
+    size_t off, spare;  /* offsetof the array pointer in gk_rve, of its twin in rve->spare      */
+    unsigned char size; /* element bytes                                                         */
+    unsigned char set, when, k, flags;
+    const char *what;   /* named when a restored value is not finite                              */
+} gk__field;
+
+#define GK__R ((unsigned char)sizeof(gk_real))
+#define GK__F(f, k, size, set, when, fl, what) {offsetof(gk_rve, f), 0, size, set, when, k, fl, what}
+#define GK__F3(f, size, when, fl, what)                                                                                \
+    GK__F(f[0], 0, size, GK__PART, when, fl, what), GK__F(f[1], 1, size, GK__PART, when, fl, what),                    \
+        GK__F(f[2], 2, size, GK__PART, when, fl, what)
+#define GK__S(f, k, when, fl, what) {offsetof(gk_rve, f[k]), offsetof(gk_rve, spare.f[k]), GK__R, GK__PAIR, when, k,  \
+                                     GK__SAVE | GK__SPARE | (fl), what}
+
+static const gk__field gk__fields[] = {
+    /* per particle: positions, velocities, forces, spins, torques, rotation */
+    GK__F3(s, 8, GK__DIM, GK__SAVE, "position"),
+    GK__F3(s0, 8, GK__DIM, GK__SAVE, "position"),
+    GK__F3(v, GK__R, GK__DIM, GK__SAVE, "velocity"),
+    GK__F3(f, GK__R, GK__DIM, GK__SAVE, "force"),
+    GK__F(w[0], 0, GK__R, GK__PART, GK__ROT, GK__SAVE, "spin"),
+    GK__F(t[0], 0, GK__R, GK__PART, GK__ROT, GK__SAVE, "torque"),
+    GK__F(w[1], 1, GK__R, GK__PART, GK__ROT, GK__SAVE, "spin"),
+    GK__F(t[1], 1, GK__R, GK__PART, GK__ROT, GK__SAVE, "torque"),
+    GK__F(w[2], 2, GK__R, GK__PART, GK__ROT, GK__SAVE, "spin"),
+    GK__F(t[2], 2, GK__R, GK__PART, GK__ROT, GK__SAVE, "torque"),
+    GK__F(theta, 0, 8, GK__PART, GK__2D, GK__SAVE, "rotation"),
+    /* per pair: the list, state bits, history, forces and torques of the last step */
+    GK__F(pl.i, 0, 4, GK__PAIR, GK__ALL, GK__SAVE | GK__LIST, "pair"),
+    GK__F(pl.j, 0, 4, GK__PAIR, GK__ALL, GK__SAVE | GK__LIST, "pair"),
+    {offsetof(gk_rve, cs), offsetof(gk_rve, spare.cs), 1, GK__PAIR, GK__ALL, 0, GK__SAVE | GK__SPARE, "state"},
+    GK__S(ft, 0, GK__TAN, GK__HIST, "tangential history"),
+    GK__S(ft, 1, GK__TAN, GK__HIST, "tangential history"),
+    GK__S(ft, 2, GK__TAN, GK__HIST, "tangential history"),
+    GK__S(fc, 0, GK__DIM, 0, "contact force"),
+    GK__S(fc, 1, GK__DIM, 0, "contact force"),
+    GK__S(fc, 2, GK__DIM, 0, "contact force"),
+    GK__S(tci, 0, GK__ROT, 0, "contact torque"),
+    GK__S(tcj, 0, GK__ROT, 0, "contact torque"),
+    GK__S(tci, 1, GK__ROT, 0, "contact torque"),
+    GK__S(tcj, 1, GK__ROT, 0, "contact torque"),
+    GK__S(tci, 2, GK__ROT, 0, "contact torque"),
+    GK__S(tcj, 2, GK__ROT, 0, "contact torque"),
+    GK__S(mr, 0, GK__ROLL, GK__HIST, "rolling history"),
+    GK__S(mr, 1, GK__ROLL, GK__HIST, "rolling history"),
+    GK__S(mr, 2, GK__ROLL, GK__HIST, "rolling history"),
+    /* the outer (candidate) list and the positions it was built at */
+    GK__F(outer.i, 0, 4, GK__OUTER, GK__ALL, GK__SAVE | GK__LIST, "pair"),
+    GK__F(outer.j, 0, 4, GK__OUTER, GK__ALL, GK__SAVE | GK__LIST, "pair"),
+    GK__F3(o0, 8, GK__DIM, GK__SAVE, "outer-list reference position"),
+    /* not saved: constants of the particles (the RVE's own) and the j index */
+    GK__F(r, 0, GK__R, GK__PART, GK__ALL, 0, "radius"),
+    GK__F(minv, 0, GK__R, GK__PART, GK__ALL, 0, "mass"),
+    GK__F(Iinv, 0, GK__R, GK__PART, GK__ALL, 0, "inertia"),
+    GK__F(id, 0, 4, GK__PART, GK__ALL, 0, "id"),
+    GK__F(jlist, 0, 4, GK__PAIR, GK__ALL, GK__DERIVED, "pair")};
+#define GK__NFIELDS ((int)(sizeof gk__fields / sizeof gk__fields[0]))
+#undef GK__F
+#undef GK__F3
+#undef GK__S
+
+static int gk__field_on(const gk_rve *rve, const gk__field *f) {
+    int dim = rve->dim, k = f->k;
+    switch (f->when) {
+    case GK__DIM: return k < dim;
+    case GK__ROT: return GK__HAS_ROT(rve) && (dim == 3 || k == 2);
+    case GK__ROLL: return GK__HAS_ROLL(rve) && (dim == 3 || k == 2);
+    case GK__TAN: return dim == 3 || k == 0;
+    case GK__2D: return dim == 2;
+    default: return 1;
+    }
+}
+/* the array of a field (live or its spare twin) */
+static void *gk__fget(const gk_rve *rve, size_t off) {
+    void *p;
+    memcpy(&p, (const char *)rve + off, sizeof p);
+    return p;
+}
+static void gk__fset(gk_rve *rve, size_t off, void *p) { memcpy((char *)rve + off, &p, sizeof p); }
+static size_t gk__fcount(const gk_rve *rve, const gk__field *f, size_t npairs, size_t nouter) {
+    return f->set == GK__PART ? (size_t)rve->n : (f->set == GK__PAIR ? npairs : nouter);
+}
+
+/* grow the arrays of set (GK__PART or GK__PAIR, live ones, or with spare = 1
+ * the spare twins) to cap elements, keeping the first ncopy */
+static gk_result gk__fields_grow(gk_rve *rve, int set, int spare, size_t cap, size_t ncopy) {
+    const gk_allocator *a = &rve->def.alloc;
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        size_t off = spare ? f->spare : f->off;
+        void *p;
+        if (f->set != set || (f->flags & GK__LIST) || (spare && !f->spare) || !gk__field_on(rve, f)) continue;
+        p = gk__fget(rve, off);
+        if (gk_realloc(a, &p, spare || (f->flags & GK__DERIVED) ? 0 : ncopy, cap, f->size)) return GK_ERR_ALLOC;
+        gk__fset(rve, off, p);
+    }
+    if (set == GK__PART && gk_realloc(a, (void **)&rve->jstart, ncopy ? ncopy + 1 : 0, cap + 1, sizeof(int32_t)))
+        return GK_ERR_ALLOC;
+    return GK_OK;
+}
+
 static void gk__rve_free_arrays(gk_rve *rve) {
     const gk_allocator *a = &rve->def.alloc;
-    int k;
-    for (k = 0; k < 3; ++k) {
-        gk_free(a, rve->s[k]);
-        gk_free(a, rve->s0[k]);
-        gk_free(a, rve->v[k]);
-        gk_free(a, rve->w[k]);
-        gk_free(a, rve->f[k]);
-        gk_free(a, rve->t[k]);
-        gk_free(a, rve->ft[k]);
-        gk_free(a, rve->mr[k]);
-        gk_free(a, rve->fc[k]);
-        gk_free(a, rve->tci[k]);
-        gk_free(a, rve->tcj[k]);
-        rve->s[k] = rve->s0[k] = NULL;
-        rve->v[k] = rve->w[k] = rve->f[k] = rve->t[k] = NULL;
-        rve->ft[k] = rve->mr[k] = rve->fc[k] = rve->tci[k] = rve->tcj[k] = NULL;
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if (f->flags & GK__LIST) continue;
+        gk_free(a, gk__fget(rve, f->off));
+        gk__fset(rve, f->off, NULL);
+        if (f->spare) {
+            gk_free(a, gk__fget(rve, f->spare));
+            gk__fset(rve, f->spare, NULL);
+        }
     }
-    gk_free(a, rve->r);
-    gk_free(a, rve->minv);
-    gk_free(a, rve->Iinv);
-    gk_free(a, rve->theta);
-    gk_free(a, rve->id);
-    gk_free(a, rve->cs);
     gk_free(a, rve->jstart);
-    gk_free(a, rve->jlist);
-    rve->r = rve->minv = rve->Iinv = NULL;
-    rve->theta = NULL;
-    rve->id = rve->jstart = rve->jlist = NULL;
-    rve->cs = NULL;
-    for (k = 0; k < 3; ++k) {
-        gk_free(a, rve->o0[k]);
-        gk_free(a, rve->spare.ft[k]);
-        gk_free(a, rve->spare.mr[k]);
-        gk_free(a, rve->spare.fc[k]);
-        gk_free(a, rve->spare.tci[k]);
-        gk_free(a, rve->spare.tcj[k]);
-        rve->o0[k] = NULL;
-        rve->spare.ft[k] = rve->spare.mr[k] = rve->spare.fc[k] = NULL;
-        rve->spare.tci[k] = rve->spare.tcj[k] = NULL;
-    }
-    gk_free(a, rve->spare.cs);
-    rve->spare.cs = NULL;
-    rve->spare.cap = 0;
+    rve->jstart = NULL;
+    rve->pcap = rve->spare.cap = 0;
     gk_pairlist_free(&rve->spare.pl);
     gk_pairlist_free(&rve->pl);
     gk_pairlist_free(&rve->outer);
@@ -383,61 +475,113 @@ GKDEF void gk_rve_destroy(gk_rve *rve) {
     rve->n = 0;
 }
 
-/* which per-pair arrays exist */
-#define GK__HAS_ROT(rve) (((rve)->phys & GK_PHYS_ROTATION) != 0)
-#define GK__HAS_ROLL(rve) (((rve)->phys & GK_PHYS_ROLLING) != 0)
+/* capacity doubling from 64 */
+static size_t gk__grown(size_t have, size_t need) {
+    size_t c = have ? have : 64;
+    while (c < need) c *= 2;
+    return c;
+}
 
-/* allocate per-pair arrays for cap pairs, copying the first ncopy */
+/* per-pair arrays for cap pairs, copying the first ncopy */
 static gk_result gk__pairs_reserve(gk_rve *rve, size_t cap, size_t ncopy) {
-    const gk_allocator *a = &rve->def.alloc;
-    int dim = rve->dim, k, nft = dim == 2 ? 1 : 3;
-    size_t sz = sizeof(gk_real);
     if (cap <= rve->pcap) return GK_OK;
-    {
-        size_t c = rve->pcap ? rve->pcap : 64;
-        while (c < cap) c *= 2;
-        cap = c;
-    }
-    for (k = 0; k < 3; ++k) {
-        if (k < nft && gk_realloc(a, (void **)&rve->ft[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
-        if (k < dim && gk_realloc(a, (void **)&rve->fc[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
-        if (GK__HAS_ROT(rve) && (dim == 3 || k == 2)) {
-            if (gk_realloc(a, (void **)&rve->tci[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
-            if (gk_realloc(a, (void **)&rve->tcj[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
-        }
-        if (GK__HAS_ROLL(rve) && (dim == 3 || k == 2) && gk_realloc(a, (void **)&rve->mr[k], ncopy, cap, sz))
-            return GK_ERR_ALLOC;
-    }
-    if (gk_realloc(a, (void **)&rve->cs, ncopy, cap, 1)) return GK_ERR_ALLOC;
-    if (gk_realloc(a, (void **)&rve->jlist, 0, cap, sizeof(int32_t))) return GK_ERR_ALLOC;
+    cap = gk__grown(rve->pcap, cap);
+    if (gk__fields_grow(rve, GK__PAIR, 0, cap, ncopy)) return GK_ERR_ALLOC;
     rve->pcap = cap;
     return GK_OK;
 }
 
 /* the spare per-pair arrays (same set as the current ones) for cap pairs */
 static gk_result gk__spare_reserve(gk_rve *rve, size_t cap) {
-    const gk_allocator *a = &rve->def.alloc;
-    int dim = rve->dim, k, nft = dim == 2 ? 1 : 3;
-    size_t sz = sizeof(gk_real);
     if (cap <= rve->spare.cap) return GK_OK;
-    {
-        size_t c = rve->spare.cap ? rve->spare.cap : 64;
-        while (c < cap) c *= 2;
-        cap = c;
-    }
-    for (k = 0; k < 3; ++k) {
-        if (k < nft && gk_realloc(a, (void **)&rve->spare.ft[k], 0, cap, sz)) return GK_ERR_ALLOC;
-        if (k < dim && gk_realloc(a, (void **)&rve->spare.fc[k], 0, cap, sz)) return GK_ERR_ALLOC;
-        if (GK__HAS_ROT(rve) && (dim == 3 || k == 2)) {
-            if (gk_realloc(a, (void **)&rve->spare.tci[k], 0, cap, sz)) return GK_ERR_ALLOC;
-            if (gk_realloc(a, (void **)&rve->spare.tcj[k], 0, cap, sz)) return GK_ERR_ALLOC;
-        }
-        if (GK__HAS_ROLL(rve) && (dim == 3 || k == 2) && gk_realloc(a, (void **)&rve->spare.mr[k], 0, cap, sz))
-            return GK_ERR_ALLOC;
-    }
-    if (gk_realloc(a, (void **)&rve->spare.cs, 0, cap, 1)) return GK_ERR_ALLOC;
+    cap = gk__grown(rve->spare.cap, cap);
+    if (gk__fields_grow(rve, GK__PAIR, 1, cap, 0)) return GK_ERR_ALLOC;
     rve->spare.cap = cap;
     return GK_OK;
+}
+
+/* pl.start (CSR by i) and the j index (jstart, jlist: pairs where p is j in
+ * ascending pair order) from the pair list */
+static void gk__pair_index(gk_rve *rve) {
+    int n = rve->n, p, c;
+    for (p = 0; p <= n; ++p) rve->pl.start[p] = rve->jstart[p] = 0;
+    for (c = 0; c < rve->pl.n; ++c) {
+        ++rve->pl.start[rve->pl.i[c] + 1];
+        ++rve->jstart[rve->pl.j[c] + 1];
+    }
+    for (p = 0; p < n; ++p) {
+        rve->pl.start[p + 1] += rve->pl.start[p];
+        rve->jstart[p + 1] += rve->jstart[p];
+    }
+    for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
+    for (p = n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
+    rve->jstart[0] = 0;
+    rve->pl.np = n;
+}
+
+/* dst[c] = src[map[c]] (0 where map[c] < 0) for elements of size bytes */
+static void gk__gather_by(void *dst, const void *src, const int32_t *map, int n, int size) {
+    int c;
+    if (size == 8) {
+        double *d = (double *)dst;
+        const double *s = (const double *)src;
+        for (c = 0; c < n; ++c) d[c] = map[c] >= 0 ? s[map[c]] : 0.0;
+    } else if (size == 4) {
+        float *d = (float *)dst;
+        const float *s = (const float *)src;
+        for (c = 0; c < n; ++c) d[c] = map[c] >= 0 ? s[map[c]] : 0.0f;
+    } else {
+        unsigned char *d = (unsigned char *)dst;
+        const unsigned char *s = (const unsigned char *)src;
+        for (c = 0; c < n; ++c) d[c] = map[c] >= 0 ? s[map[c]] : 0;
+    }
+}
+
+/* every per-pair array carried by pair (GK__SPARE) into its spare twin:
+ * pair c of the new list takes old pair map[c], or zero */
+static void gk__pairs_gather(gk_rve *rve, const int32_t *map, int n) {
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if (!(f->flags & GK__SPARE) || !gk__field_on(rve, f)) continue;
+        gk__gather_by(gk__fget(rve, f->spare), gk__fget(rve, f->off), map, n, f->size);
+    }
+}
+
+/* zero the per-particle arrays for particles [p0, p1) */
+static void gk__fields_zero(gk_rve *rve, int p0, int p1) {
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if (f->set != GK__PART || !gk__field_on(rve, f)) continue;
+        memset((unsigned char *)gk__fget(rve, f->off) + (size_t)f->size * p0, 0, (size_t)f->size * (p1 - p0));
+    }
+}
+
+/* keep the elements with keep[e] != 0 of every array of set, in order */
+static void gk__fields_compact(gk_rve *rve, int set, const unsigned char *keep, int n) {
+    int q, e;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        unsigned char *b;
+        size_t m = 0;
+        if (f->set != set || (f->flags & (GK__LIST | GK__DERIVED)) || !gk__field_on(rve, f)) continue;
+        b = (unsigned char *)gk__fget(rve, f->off);
+        for (e = 0; e < n; ++e)
+            if (keep[e]) memmove(b + f->size * m++, b + (size_t)f->size * e, f->size);
+    }
+}
+
+/* mass and moment of inertia of a particle of radius r (see MASSES) */
+static void gk__particle_mass(const gk_rve *rve, double r, double *m, double *I) {
+    const gk_rve_def *d = &rve->def;
+    if (rve->dim == 2 && d->mass2d == GK_MASS_CYLINDER) {
+        *m = d->mat.density * d->thickness * GK_PI * r * r;
+        *I = 0.5 * *m * r * r;
+    } else {
+        *m = d->mat.density * 4.0 / 3.0 * GK_PI * r * r * r;
+        *I = 0.4 * *m * r * r;
+    }
 }
 
 /* critical time step, seed 000 eq 19, at the geometry (h, reduced positions
@@ -589,29 +733,9 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
             gk_free(&def->alloc, perm);
             return res;
         }
-        /* allocate */
-        for (k = 0; k < 3; ++k) {
-            if (k < dim) {
-                R.s[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
-                R.s0[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
-                R.o0[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
-                R.v[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-                R.f[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-                if (!R.s[k] || !R.s0[k] || !R.o0[k] || !R.v[k] || !R.f[k]) res = GK_ERR_ALLOC;
-            }
-            if (GK__HAS_ROT(&R) && (dim == 3 || k == 2)) {
-                R.w[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-                R.t[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-                if (!R.w[k] || !R.t[k]) res = GK_ERR_ALLOC;
-            }
-        }
-        R.r = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-        R.minv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-        R.Iinv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-        R.id = (int32_t *)gk_alloc(&def->alloc, (size_t)n * sizeof(int32_t));
-        R.jstart = (int32_t *)gk_alloc(&def->alloc, ((size_t)n + 1) * sizeof(int32_t));
-        if (dim == 2) R.theta = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
-        if (!R.r || !R.minv || !R.Iinv || !R.id || !R.jstart || (dim == 2 && !R.theta)) res = GK_ERR_ALLOC;
+        /* allocate (zeroed) */
+        if (!res && gk__fields_grow(&R, GK__PART, 0, (size_t)n, 0)) res = GK_ERR_ALLOC;
+        if (!res) gk__fields_zero(&R, 0, n);
         gk_pairlist_init(&R.pl, &def->alloc);
         gk_pairlist_init(&R.outer, &def->alloc);
         gk_pairlist_init(&R.spare.pl, &def->alloc);
@@ -623,24 +747,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
             for (p = 0; p < n; ++p) {
                 int q = perm[p];
                 double rq = pk->r[q], m, I;
-                for (k = 0; k < dim; ++k) {
-                    R.s[k][p] = tmp[k][q];
-                    R.s0[k][p] = tmp[k][q];
-                    R.v[k][p] = 0;
-                    R.f[k][p] = 0;
-                }
-                for (k = 0; k < 3; ++k)
-                    if (R.w[k]) R.w[k][p] = R.t[k][p] = 0;
-                if (dim == 3) {
-                    m = def->mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
-                    I = 0.4 * m * rq * rq;
-                } else if (def->mass2d == GK_MASS_CYLINDER) {
-                    m = def->mat.density * def->thickness * GK_PI * rq * rq;
-                    I = 0.5 * m * rq * rq;
-                } else {
-                    m = def->mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
-                    I = 0.4 * m * rq * rq;
-                }
+                for (k = 0; k < dim; ++k) R.s[k][p] = R.s0[k][p] = tmp[k][q];
+                gk__particle_mass(&R, rq, &m, &I);
                 R.r[p] = (gk_real)rq;
                 R.minv[p] = (gk_real)(1.0 / m);
                 R.Iinv[p] = (gk_real)(1.0 / I);
@@ -655,7 +763,6 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                     break;
                 }
                 R.id[p] = q;
-                if (R.theta) R.theta[p] = 0.0;
                 if (rq < R.rmin) R.rmin = rq;
                 if (rq > R.rmax) R.rmax = rq;
                 if (m < R.mmin) R.mmin = m;
@@ -724,7 +831,7 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
 }
 
 /* inner list: the outer pairs closer than r_i + r_j + skin_in, in outer
- * order, into nl (CSR counts in nl->start[i + 1]) */
+ * order, into nl */
 GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const int dim) {
     const double *h = rve->cell.h, skin = rve->skin_in;
     const int32_t *oi = rve->outer.i, *oj = rve->outer.j;
@@ -739,7 +846,6 @@ GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const 
             nl->i[nl->n] = i;
             nl->j[nl->n] = j;
             ++nl->n;
-            ++nl->start[i + 1];
         }
     }
 }
@@ -757,7 +863,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
                               rve->dt, dtc);
         rve->dt_crit = dtc;
     }
-    int dim = rve->dim, n = rve->n, k, p, c, oc, nft = dim == 2 ? 1 : 3;
+    int dim = rve->dim, n = rve->n, k, c, oc;
     double w[3];
     gk_result res;
     const double *sp[3];
@@ -796,55 +902,36 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
     }
     nl.np = n;
     nl.n = 0;
-    for (p = 0; p <= n; ++p) nl.start[p] = 0;
     if (dim == 2)
         gk__inner_filter(rve, &nl, 2);
     else
         gk__inner_filter(rve, &nl, 3);
-    for (p = 0; p < n; ++p) nl.start[p + 1] += nl.start[p];
-    /* history into the spare arrays by a merge with the current list (both sorted by (i, j)) */
-    oc = 0;
-    for (c = 0; c < nl.n; ++c) {
-        int32_t ni = nl.i[c], nj = nl.j[c];
-        while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj))) ++oc;
-        if (oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj) {
-            for (k = 0; k < nft; ++k) rve->spare.ft[k][c] = rve->ft[k][oc];
-            for (k = 0; k < dim; ++k) rve->spare.fc[k][c] = rve->fc[k][oc];
-            for (k = 0; k < 3; ++k) {
-                if (rve->spare.tci[k]) {
-                    rve->spare.tci[k][c] = rve->tci[k][oc];
-                    rve->spare.tcj[k][c] = rve->tcj[k][oc];
-                }
-                if (rve->spare.mr[k]) rve->spare.mr[k][c] = rve->mr[k][oc];
-            }
-            rve->spare.cs[c] = rve->cs[oc];
-        } else {
-            for (k = 0; k < nft; ++k) rve->spare.ft[k][c] = 0;
-            for (k = 0; k < dim; ++k) rve->spare.fc[k][c] = 0;
-            for (k = 0; k < 3; ++k) {
-                if (rve->spare.tci[k]) rve->spare.tci[k][c] = rve->spare.tcj[k][c] = 0;
-                if (rve->spare.mr[k]) rve->spare.mr[k][c] = 0;
-            }
-            rve->spare.cs[c] = 0;
+    /* history into the spare arrays by a merge with the current list (both
+     * sorted by (i, j)): map[c] = the old index of new pair c, or -1 (jlist
+     * is the scratch, rebuilt below) */
+    {
+        int32_t *map = rve->jlist;
+        oc = 0;
+        for (c = 0; c < nl.n; ++c) {
+            int32_t ni = nl.i[c], nj = nl.j[c];
+            while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj))) ++oc;
+            map[c] = oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj ? oc : -1;
         }
+        gk__pairs_gather(rve, map, nl.n);
     }
     /* swap the spare set in */
     {
         gk_pairlist t = rve->pl;
         size_t cap = rve->pcap;
-        unsigned char *cs = rve->cs;
-        for (k = 0; k < 3; ++k) {
-            gk_real *x;
-#define GK__SWAP(f) x = rve->f[k], rve->f[k] = rve->spare.f[k], rve->spare.f[k] = x
-            GK__SWAP(ft);
-            GK__SWAP(mr);
-            GK__SWAP(fc);
-            GK__SWAP(tci);
-            GK__SWAP(tcj);
-#undef GK__SWAP
+        int q;
+        for (q = 0; q < GK__NFIELDS; ++q) {
+            const gk__field *f = &gk__fields[q];
+            void *x;
+            if (!f->spare) continue;
+            x = gk__fget(rve, f->off);
+            gk__fset(rve, f->off, gk__fget(rve, f->spare));
+            gk__fset(rve, f->spare, x);
         }
-        rve->cs = rve->spare.cs;
-        rve->spare.cs = cs;
         rve->pcap = rve->spare.cap;
         rve->spare.cap = cap;
         rve->pl = nl;
@@ -852,13 +939,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         if (rve->pcap > cap && gk_realloc(&rve->def.alloc, (void **)&rve->jlist, 0, rve->pcap, sizeof(int32_t)))
             return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", nl.n);
     }
-    /* pairs where p is j, ascending pair index (counting sort by j) */
-    for (p = 0; p <= n; ++p) rve->jstart[p] = 0;
-    for (c = 0; c < rve->pl.n; ++c) ++rve->jstart[rve->pl.j[c] + 1];
-    for (p = 0; p < n; ++p) rve->jstart[p + 1] += rve->jstart[p];
-    for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
-    for (p = n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
-    rve->jstart[0] = 0;
+    gk__pair_index(rve);
     for (k = 0; k < dim; ++k) memcpy(rve->s0[k], rve->s[k], (size_t)n * sizeof(double));
     gk_m3_copy(rve->cell.h, rve->h0);
     rve->need_rebuild = 0;
@@ -1972,47 +2053,45 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     return GK_OK;
 }
 
+/* copy the contact history (GK__HIST fields) of np pairs into its spare
+ * twin (to = 1) or back (to = 0) */
+static void gk__history_copy(gk_rve *rve, int to, size_t np) {
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        void *live, *spare;
+        if (!(f->flags & GK__HIST) || !gk__field_on(rve, f)) continue;
+        live = gk__fget(rve, f->off);
+        spare = gk__fget(rve, f->spare);
+        memcpy(to ? spare : live, to ? live : spare, np * f->size);
+    }
+}
+
 GKDEF gk_result gk_rve_refresh(gk_rve *rve) {
     /* Forces at the current positions as a zero-length step: with dt = 0 and
      * E = I every history increment vanishes. The tangential and rolling
-     * history is copied back afterwards so that a refresh never changes the
-     * future (a 3D projection or a cap could otherwise touch it). */
+     * history is copied back afterwards (kept meanwhile in the spare arrays,
+     * which hold nothing between list rebuilds) so that a refresh never
+     * changes the future (a 3D projection or a cap could otherwise touch it). */
     gk__stepctx x;
     double I[9], dtsave = rve->dt;
     gk_result res = gk__rve_ready(rve);
-    int k;
-    size_t np;
-    gk_real *save[6] = {NULL, NULL, NULL, NULL, NULL, NULL};
     if (res) return res;
     if (rve->need_rebuild) {
         res = gk__rve_rebuild(rve);
         if (res) return res;
     }
-    np = (size_t)rve->pl.n;
-    for (k = 0; k < 3; ++k) {
-        if (rve->ft[k] && !(save[k] = (gk_real *)gk_alloc(&rve->def.alloc, (np + 1) * sizeof(gk_real)))) res = GK_ERR_ALLOC;
-        if (rve->mr[k] && !(save[3 + k] = (gk_real *)gk_alloc(&rve->def.alloc, (np + 1) * sizeof(gk_real))))
-            res = GK_ERR_ALLOC;
-    }
-    if (!res) {
-        for (k = 0; k < 3; ++k) {
-            if (save[k]) memcpy(save[k], rve->ft[k], np * sizeof(gk_real));
-            if (save[3 + k]) memcpy(save[3 + k], rve->mr[k], np * sizeof(gk_real));
-        }
-        gk_m3_identity(I);
-        rve->dt = 1.0; /* G = (E - I)/dt = 0 */
-        gk__ctx_make(rve, I, &x);
-        rve->dt = dtsave;
-        x.dt = 0;
-        gk__forces(rve, &x, 1);
-        gk__stress_pass(rve);
-        for (k = 0; k < 3; ++k) {
-            if (save[k]) memcpy(rve->ft[k], save[k], np * sizeof(gk_real));
-            if (save[3 + k]) memcpy(rve->mr[k], save[3 + k], np * sizeof(gk_real));
-        }
-    }
-    for (k = 0; k < 6; ++k) gk_free(&rve->def.alloc, save[k]);
-    if (res) return gk_err_set(&rve->err, res, "out of memory refreshing forces");
+    if (gk__spare_reserve(rve, (size_t)rve->pl.n + 1))
+        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory refreshing forces");
+    gk__history_copy(rve, 1, (size_t)rve->pl.n);
+    gk_m3_identity(I);
+    rve->dt = 1.0; /* G = (E - I)/dt = 0 */
+    gk__ctx_make(rve, I, &x);
+    rve->dt = dtsave;
+    x.dt = 0;
+    gk__forces(rve, &x, 1);
+    gk__stress_pass(rve);
+    gk__history_copy(rve, 0, (size_t)rve->pl.n);
     return GK_OK;
 }
 
@@ -2205,24 +2284,9 @@ GKDEF void gk_rve_update_totals(gk_rve *rve) {
 }
 
 GKDEF gk_result gk_rve_reserve(gk_rve *rve, int cap) {
-    const gk_allocator *a = &rve->def.alloc;
-    size_t n = (size_t)rve->n, c, R = sizeof(gk_real);
-    int k, have = rve->ncap > rve->n ? rve->ncap : rve->n;
+    int have = rve->ncap > rve->n ? rve->ncap : rve->n;
     if (cap <= have) return GK_OK;
-    c = (size_t)cap;
-    for (k = 0; k < 3; ++k) {
-        if (rve->s[k] && (gk_realloc(a, (void **)&rve->s[k], n, c, sizeof(double)) ||
-                          gk_realloc(a, (void **)&rve->s0[k], n, c, sizeof(double)) ||
-                          gk_realloc(a, (void **)&rve->o0[k], n, c, sizeof(double)) ||
-                          gk_realloc(a, (void **)&rve->v[k], n, c, R) || gk_realloc(a, (void **)&rve->f[k], n, c, R)))
-            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
-        if (rve->w[k] && (gk_realloc(a, (void **)&rve->w[k], n, c, R) || gk_realloc(a, (void **)&rve->t[k], n, c, R)))
-            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
-    }
-    if (gk_realloc(a, (void **)&rve->r, n, c, R) || gk_realloc(a, (void **)&rve->minv, n, c, R) ||
-        gk_realloc(a, (void **)&rve->Iinv, n, c, R) || gk_realloc(a, (void **)&rve->id, n, c, sizeof(int32_t)) ||
-        gk_realloc(a, (void **)&rve->jstart, n + 1, c + 1, sizeof(int32_t)) ||
-        (rve->theta && gk_realloc(a, (void **)&rve->theta, n, c, sizeof(double))))
+    if (gk__fields_grow(rve, GK__PART, 0, (size_t)cap, (size_t)rve->n))
         return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
     rve->ncap = cap;
     return GK_OK;
@@ -2252,24 +2316,13 @@ GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], cons
     for (q = 0; q < k; ++q) {
         int p = n0 + q;
         double rq = r[q], m, I;
-        for (a = 0; a < dim; ++a) {
-            rve->s[a][p] = rve->s0[a][p] = rve->o0[a][p] = s[a][q] - floor(s[a][q]);
-            rve->v[a][p] = rve->f[a][p] = 0;
-        }
-        for (a = 0; a < 3; ++a)
-            if (rve->w[a]) rve->w[a][p] = rve->t[a][p] = 0;
-        if (dim == 3 || rve->def.mass2d == GK_MASS_SPHERE) {
-            m = rve->def.mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
-            I = 0.4 * m * rq * rq;
-        } else {
-            m = rve->def.mat.density * rve->def.thickness * GK_PI * rq * rq;
-            I = 0.5 * m * rq * rq;
-        }
+        gk__fields_zero(rve, p, p + 1);
+        for (a = 0; a < dim; ++a) rve->s[a][p] = rve->s0[a][p] = rve->o0[a][p] = s[a][q] - floor(s[a][q]);
+        gk__particle_mass(rve, rq, &m, &I);
         rve->r[p] = (gk_real)rq;
         rve->minv[p] = (gk_real)(1.0 / m);
         rve->Iinv[p] = (gk_real)(1.0 / I);
         rve->id[p] = id[q];
-        if (rve->theta) rve->theta[p] = 0.0;
     }
     rve->n = n0 + k;
     gk_rve_update_totals(rve);
@@ -2279,71 +2332,37 @@ GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], cons
 }
 
 GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop) {
-    int n = rve->n, dim = rve->dim, p, q = 0, c, m = 0, k, nft = dim == 2 ? 1 : 3;
-    int32_t *map = NULL;
+    int n = rve->n, np = rve->pl.n, p, q = 0, c, m = 0;
+    int32_t *map;
+    unsigned char *keep, *keepc;
     if (!drop) return gk_err_set(&rve->err, GK_ERR_ARG, "remove: no mask");
     for (p = 0; p < n; ++p)
         if (!drop[p]) ++q;
     if (q == n) return GK_OK;
     if (q < 1) return gk_err_set(&rve->err, GK_ERR_ARG, "remove: would leave no particle");
-    map = (int32_t *)gk_alloc(&rve->def.alloc, (size_t)n * sizeof(int32_t));
+    map = (int32_t *)gk_alloc(&rve->def.alloc, (size_t)n * (sizeof(int32_t) + 1) + (size_t)np);
     if (!map) return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory removing particles");
+    keep = (unsigned char *)(map + n);
+    keepc = keep + n;
     for (p = 0, q = 0; p < n; ++p) {
-        map[p] = drop[p] ? -1 : q;
-        if (drop[p]) continue;
-        for (k = 0; k < dim; ++k) {
-            rve->s[k][q] = rve->s[k][p];
-            rve->s0[k][q] = rve->s0[k][p];
-            rve->o0[k][q] = rve->o0[k][p];
-            rve->v[k][q] = rve->v[k][p];
-            rve->f[k][q] = rve->f[k][p];
-        }
-        for (k = 0; k < 3; ++k)
-            if (rve->w[k]) {
-                rve->w[k][q] = rve->w[k][p];
-                rve->t[k][q] = rve->t[k][p];
-            }
-        rve->r[q] = rve->r[p];
-        rve->minv[q] = rve->minv[p];
-        rve->Iinv[q] = rve->Iinv[p];
-        rve->id[q] = rve->id[p];
-        if (rve->theta) rve->theta[q] = rve->theta[p];
-        ++q;
+        keep[p] = !drop[p];
+        map[p] = keep[p] ? q++ : -1;
     }
     /* survivors keep their order: the remapped pair list stays sorted by (i, j) */
-    for (c = 0; c < rve->pl.n; ++c) {
+    for (c = 0; c < np; ++c) {
         int32_t i = map[rve->pl.i[c]], j = map[rve->pl.j[c]];
-        if (i < 0 || j < 0) continue;
+        keepc[c] = i >= 0 && j >= 0;
+        if (!keepc[c]) continue;
         rve->pl.i[m] = i;
         rve->pl.j[m] = j;
-        for (k = 0; k < nft; ++k) rve->ft[k][m] = rve->ft[k][c];
-        for (k = 0; k < dim; ++k) rve->fc[k][m] = rve->fc[k][c];
-        for (k = 0; k < 3; ++k) {
-            if (rve->tci[k]) {
-                rve->tci[k][m] = rve->tci[k][c];
-                rve->tcj[k][m] = rve->tcj[k][c];
-            }
-            if (rve->mr[k]) rve->mr[k][m] = rve->mr[k][c];
-        }
-        rve->cs[m] = rve->cs[c];
         ++m;
     }
+    gk__fields_compact(rve, GK__PART, keep, n);
+    gk__fields_compact(rve, GK__PAIR, keepc, np);
     gk_free(&rve->def.alloc, map);
     rve->n = q;
     rve->pl.n = m;
-    rve->pl.np = q;
-    for (p = 0; p <= q; ++p) rve->pl.start[p] = rve->jstart[p] = 0;
-    for (c = 0; c < m; ++c) {
-        ++rve->pl.start[rve->pl.i[c] + 1];
-        ++rve->jstart[rve->pl.j[c] + 1];
-    }
-    for (p = 0; p < q; ++p) {
-        rve->pl.start[p + 1] += rve->pl.start[p];
-        rve->jstart[p + 1] += rve->jstart[p];
-    }
-    for (c = 0; c < m; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
-    for (p = q; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
-    rve->jstart[0] = 0;
+    gk__pair_index(rve);
     gk_rve_update_totals(rve);
     rve->need_rebuild = 1;
     rve->outer_valid = 0;
@@ -2368,14 +2387,13 @@ typedef struct gk__state_hdr {
 } gk__state_hdr;
 
 static size_t gk__state_bytes(const gk_rve *rve, int npairs, int nouter) {
-    int dim = rve->dim, nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0, nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
-    size_t n = (size_t)rve->n, np = (size_t)npairs, R = sizeof(gk_real), b = sizeof(gk__state_hdr);
-    b += n * (2 * dim * sizeof(double)); /* s, s0 */
-    b += n * R * (2 * dim + 2 * nr);      /* v, f, w, t */
-    b += dim == 2 ? n * sizeof(double) : 0; /* theta */
-    b += np * (2 * sizeof(int32_t) + 1);   /* i, j, cs */
-    b += np * R * ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll); /* ft, fc, tci, tcj, mr */
-    b += (size_t)nouter * 2 * sizeof(int32_t) + n * dim * sizeof(double); /* outer list, o0 */
+    size_t b = sizeof(gk__state_hdr);
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if ((f->flags & GK__SAVE) && gk__field_on(rve, f))
+            b += gk__fcount(rve, f, (size_t)npairs, (size_t)nouter) * f->size;
+    }
     return b;
 }
 
@@ -2395,8 +2413,8 @@ GKDEF size_t gk_rve_state_size(const gk_rve *rve) { return gk__state_bytes(rve, 
 GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *written) {
     gk__state_hdr hd;
     unsigned char *o = (unsigned char *)buf;
-    size_t off = 0, need = gk_rve_state_size(rve), n = (size_t)rve->n, np = (size_t)rve->pl.n, R = sizeof(gk_real);
-    int k, dim = rve->dim;
+    size_t off = 0, need = gk_rve_state_size(rve), np = (size_t)rve->pl.n, R = sizeof(gk_real);
+    int k, q, dim = rve->dim;
     if (written) *written = need;
     if (!buf || cap < need) return GK_ERR_ARG;
     memset(&hd, 0, sizeof hd);
@@ -2435,31 +2453,11 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
     gk_m3_copy(rve->ho0, hd.ho0);
     hd.skin_in = rve->skin_in;
     GK__PUT(&hd, sizeof hd);
-    for (k = 0; k < dim; ++k) GK__PUT(rve->s[k], n * sizeof(double));
-    for (k = 0; k < dim; ++k) GK__PUT(rve->s0[k], n * sizeof(double));
-    for (k = 0; k < dim; ++k) GK__PUT(rve->v[k], n * R);
-    for (k = 0; k < dim; ++k) GK__PUT(rve->f[k], n * R);
-    for (k = 0; k < 3; ++k)
-        if (rve->w[k]) {
-            GK__PUT(rve->w[k], n * R);
-            GK__PUT(rve->t[k], n * R);
-        }
-    if (dim == 2) GK__PUT(rve->theta, n * sizeof(double));
-    GK__PUT(rve->pl.i, np * sizeof(int32_t));
-    GK__PUT(rve->pl.j, np * sizeof(int32_t));
-    GK__PUT(rve->cs, np);
-    for (k = 0; k < (dim == 2 ? 1 : 3); ++k) GK__PUT(rve->ft[k], np * R);
-    for (k = 0; k < dim; ++k) GK__PUT(rve->fc[k], np * R);
-    for (k = 0; k < 3; ++k)
-        if (rve->tci[k]) {
-            GK__PUT(rve->tci[k], np * R);
-            GK__PUT(rve->tcj[k], np * R);
-        }
-    for (k = 0; k < 3; ++k)
-        if (rve->mr[k]) GK__PUT(rve->mr[k], np * R);
-    GK__PUT(rve->outer.i, (size_t)rve->outer.n * sizeof(int32_t));
-    GK__PUT(rve->outer.j, (size_t)rve->outer.n * sizeof(int32_t));
-    for (k = 0; k < dim; ++k) GK__PUT(rve->o0[k], n * sizeof(double));
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if ((f->flags & GK__SAVE) && gk__field_on(rve, f))
+            GK__PUT(gk__fget(rve, f->off), gk__fcount(rve, f, np, (size_t)rve->outer.n) * f->size);
+    }
     GK_ASSERT(off == need);
     return GK_OK;
 }
@@ -2511,7 +2509,7 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     gk__state_hdr hd;
     const unsigned char *in = (const unsigned char *)buf;
     size_t off = 0, n, np, R = sizeof(gk_real);
-    int k, dim = rve->dim, p, c, nr, nroll;
+    int k, q, dim = rve->dim, c;
     gk_err *err = &rve->err;
     if (rve->n < 1 || !rve->s[0]) return gk_err_set(err, GK_ERR_STATE, "restore into an RVE that was not created");
     if (!buf || size < sizeof hd) return gk_err_set(err, GK_ERR_FORMAT, "RVE state buffer too small");
@@ -2530,8 +2528,6 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         return gk_err_set(err, GK_ERR_FORMAT, "RVE state has the wrong size");
     n = (size_t)rve->n;
     np = (size_t)hd.npairs;
-    nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0;
-    nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
     /* ---- header scalars */
     if (!(hd.dt > 0.0) || !isfinite(hd.dt)) return gk_err_set(err, GK_ERR_DT, "RVE state time step %g", hd.dt);
     if (!(hd.dt_crit > 0.0) || !isfinite(hd.dt_crit) || !isfinite(hd.time) || hd.step < 0 || hd.rebuilds < 0 ||
@@ -2573,42 +2569,40 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         if (hd.mu > 0.0 && !(rve->phys & GK_PHYS_TANGENT))
             return gk_err_set(err, GK_ERR_STATE, "RVE state has friction %g for an RVE created frictionless", hd.mu);
     }
-    /* ---- arrays, in the order gk_rve_save writes them */
+    /* ---- arrays, in the order gk_rve_save writes them: reals finite, pair
+     * lists sorted and in range, contact bits known */
     off = sizeof hd;
     {
-        const unsigned char *sb[3] = {NULL, NULL, NULL}, *ib, *jb, *cs;
+        const unsigned char *sb[3] = {NULL, NULL, NULL}, *ib = NULL, *pib = NULL, *pjb = NULL;
         double dtc;
-        size_t dbl = 8;
-        for (k = 0; k < dim; ++k) sb[k] = in + off + (size_t)k * n * dbl;
-        if (!gk__finite_bytes(in + off, 2 * dim * n, dbl))
-            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite position");
-        off += 2 * dim * n * dbl;
-        if (!gk__finite_bytes(in + off, (2 * dim + 2 * nr) * n, R))
-            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite velocity, force, spin or torque");
-        off += (2 * dim + 2 * nr) * n * R;
-        if (dim == 2) {
-            if (!gk__finite_bytes(in + off, n, dbl))
-                return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite rotation");
-            off += n * dbl;
+        for (q = 0; q < GK__NFIELDS; ++q) {
+            const gk__field *f = &gk__fields[q];
+            const unsigned char *b = in + off;
+            size_t cnt;
+            if (!(f->flags & GK__SAVE) || !gk__field_on(rve, f)) continue;
+            cnt = gk__fcount(rve, f, np, (size_t)hd.nouter);
+            off += cnt * f->size;
+            if (f->off == offsetof(gk_rve, s[0]) + f->k * sizeof(double *)) sb[f->k] = b;
+            if (f->flags & GK__LIST) {
+                if (!ib) {
+                    ib = b; /* the i array; j follows */
+                    continue;
+                }
+                if ((c = gk__pairs_valid(ib, b, (int)cnt, rve->n)) >= 0)
+                    return gk_err_set(err, GK_ERR_FORMAT, "RVE state %s %d has invalid or unsorted particles",
+                                      f->set == GK__OUTER ? "outer pair" : "pair", c);
+                if (f->set == GK__PAIR) pib = ib, pjb = b;
+                ib = NULL;
+            } else if (f->size == 1) {
+                for (c = 0; c < (int)cnt; ++c)
+                    if (b[c] & ~(GK_CS_CONTACT | GK_CS_SLIDING | GK_CS_BONDED | GK_CS_BROKEN))
+                        return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has unknown contact bits 0x%x", c,
+                                          b[c]);
+            } else if (!gk__finite_bytes(b, cnt, f->size)) {
+                return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite %s", f->what);
+            }
         }
-        ib = in + off;
-        jb = ib + 4 * np;
-        cs = jb + 4 * np;
-        if ((c = gk__pairs_valid(ib, jb, hd.npairs, rve->n)) >= 0)
-            return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has invalid or unsorted particles", c);
-        for (c = 0; c < hd.npairs; ++c)
-            if (cs[c] & ~(GK_CS_CONTACT | GK_CS_SLIDING | GK_CS_BONDED | GK_CS_BROKEN))
-                return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has unknown contact bits 0x%x", c, cs[c]);
-        off += np * 9;
-        if (!gk__finite_bytes(in + off, ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np, R))
-            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite contact force or history");
-        off += ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np * R;
-        if ((c = gk__pairs_valid(in + off, in + off + 4 * (size_t)hd.nouter, hd.nouter, rve->n)) >= 0)
-            return gk_err_set(err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid or unsorted particles", c);
-        off += 8 * (size_t)hd.nouter;
-        if (!gk__finite_bytes(in + off, dim * n, dbl))
-            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite outer-list reference position");
-        dtc = gk__dt_critical_at(rve, hd.h, sb, ib, jb, hd.npairs);
+        dtc = gk__dt_critical_at(rve, hd.h, sb, pib, pjb, hd.npairs);
         if (!(hd.dt <= dtc))
             return gk_err_set(err, GK_ERR_DT,
                               "RVE state time step %g s is above the critical %g s of this RVE at the state's "
@@ -2620,48 +2614,18 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         gk_pairlist_reserve(&rve->outer, (size_t)hd.nouter + 1, n))
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory restoring %d pairs", hd.npairs);
     off = sizeof hd;
-    for (k = 0; k < dim; ++k) GK__GET(rve->s[k], n * sizeof(double));
-    for (k = 0; k < dim; ++k) GK__GET(rve->s0[k], n * sizeof(double));
-    for (k = 0; k < dim; ++k) GK__GET(rve->v[k], n * R);
-    for (k = 0; k < dim; ++k) GK__GET(rve->f[k], n * R);
-    for (k = 0; k < 3; ++k)
-        if (rve->w[k]) {
-            GK__GET(rve->w[k], n * R);
-            GK__GET(rve->t[k], n * R);
-        }
-    if (dim == 2) GK__GET(rve->theta, n * sizeof(double));
-    GK__GET(rve->pl.i, np * sizeof(int32_t));
-    GK__GET(rve->pl.j, np * sizeof(int32_t));
-    GK__GET(rve->cs, np);
-    for (k = 0; k < (dim == 2 ? 1 : 3); ++k) GK__GET(rve->ft[k], np * R);
-    for (k = 0; k < dim; ++k) GK__GET(rve->fc[k], np * R);
-    for (k = 0; k < 3; ++k)
-        if (rve->tci[k]) {
-            GK__GET(rve->tci[k], np * R);
-            GK__GET(rve->tcj[k], np * R);
-        }
-    for (k = 0; k < 3; ++k)
-        if (rve->mr[k]) GK__GET(rve->mr[k], np * R);
-    GK__GET(rve->outer.i, (size_t)hd.nouter * sizeof(int32_t));
-    GK__GET(rve->outer.j, (size_t)hd.nouter * sizeof(int32_t));
-    for (k = 0; k < dim; ++k) GK__GET(rve->o0[k], n * sizeof(double));
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if ((f->flags & GK__SAVE) && gk__field_on(rve, f))
+            GK__GET(gk__fget(rve, f->off), gk__fcount(rve, f, np, (size_t)hd.nouter) * f->size);
+    }
     rve->outer.n = hd.nouter;
     rve->outer.np = rve->n;
     rve->outer_valid = hd.outer_valid;
     gk_m3_copy(hd.ho0, rve->ho0);
     rve->skin_in = hd.skin_in;
     rve->pl.n = hd.npairs;
-    rve->pl.np = rve->n;
-    /* CSR by i and the j index are functions of the pair list */
-    for (p = 0; p <= rve->n; ++p) rve->pl.start[p] = 0;
-    for (c = 0; c < rve->pl.n; ++c) ++rve->pl.start[rve->pl.i[c] + 1];
-    for (p = 0; p < rve->n; ++p) rve->pl.start[p + 1] += rve->pl.start[p];
-    for (p = 0; p <= rve->n; ++p) rve->jstart[p] = 0;
-    for (c = 0; c < rve->pl.n; ++c) ++rve->jstart[rve->pl.j[c] + 1];
-    for (p = 0; p < rve->n; ++p) rve->jstart[p + 1] += rve->jstart[p];
-    for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
-    for (p = rve->n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
-    rve->jstart[0] = 0;
+    gk__pair_index(rve); /* CSR by i and the j index are functions of the pair list */
     rve->dt = hd.dt;
     rve->time = hd.time;
     rve->dt_crit = hd.dt_crit;
