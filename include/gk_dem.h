@@ -27,6 +27,27 @@
  *     spins, cell, pair list with contact history) to and from caller
  *     memory, so an implicit driver can retry an increment bit for bit.
  *
+ * DRIVING THE CELL. One control yields the cell map of every step; the
+ * drivers are thin wrappers around it:
+ *   gk_rve_deform(dH, n)     the path I + dH split over n steps (def.path:
+ *                            constant velocity gradient or objective)
+ *   gk_rve_step(n)           the velocity gradient of gk_rve_set_velocity_
+ *                            gradient; with a servo (gk_rve_set_servo) its
+ *                            diagonal (and shear) follow the stress each step
+ *   gk_rve_relax(uf, every, max)   L = 0 in runs of `every` steps until the
+ *                            unbalanced force ratio is at most uf
+ *   gk_rve_consolidate       the isotropic servo until the target pressure
+ *                            and balance hold (gk_consolidate_def)
+ *   gk_rve_deform_adaptive   gk_rve_deform with the step count chosen by the
+ *       physics: n = ceil(I_1 / I_max) clamped to [n_min, n_max], I_1 the
+ *       inertial number (seed 000 eq 20) of dH applied in one step at the
+ *       RVE's current pressure (p <= 0: n_max), so the deformation runs at
+ *       I <= I_max; then gk_rve_relax to uf_max with the steps left to n_max
+ *       (reported as capped if the ratio is still above). Quasi-static by
+ *       construction: more steps where p is low (near liquefaction), fewer
+ *       where it is high. Bad input (NaN dH, bounds <= 0, n_min > n_max) ->
+ *       GK_ERR_ARG before anything runs.
+ *
  * KINEMATICS. Positions are stored as reduced coordinates s (double, also in
  * the float build) and x = h s; velocities v and spins w are the
  * FLUCTUATIONS about the affine field of the cell (translational L x and
@@ -238,6 +259,21 @@ typedef struct gk_consolidate_def {
     double damping;           /* local damping while consolidating; 0 -> the RVE's own     */
 } gk_consolidate_def;
 
+/* gk_rve_deform_adaptive: zero means default */
+typedef struct gk_adapt_def {
+    double inertial_max;   /* I bound of the deformation (seed 000 eq 20); 0 -> 5e-4   */
+    double unbalanced_max; /* unbalanced force ratio to reach after it; 0 -> 5e-3     */
+    int n_min, n_max;      /* bounds on the total DEM steps; 0 -> 10 and 5000          */
+    int every;             /* relaxation steps between checks; 0 -> 20                 */
+} gk_adapt_def;
+
+typedef struct gk_adapt_report {
+    int n_deform, n_relax; /* steps of the deformation and of the relaxation         */
+    double inertial;       /* I of the deformation (at the pressure before it)       */
+    double unbalanced;     /* mean unbalanced force ratio at the end                  */
+    int capped;            /* 1 if n_max stopped the relaxation above uf_max          */
+} gk_adapt_report;
+
 typedef struct gk_consolidate_report {
     long steps;
     double stress[9], unbalanced, void_ratio;
@@ -262,6 +298,19 @@ GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *servo); /* NULL sw
 GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps);
 GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps);
 GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk_consolidate_report *rep);
+/* relaxation at a fixed cell (velocity gradient 0, no servo): runs of `every`
+ * DEM steps while gk_rve_unbalanced exceeds uf_max, at most max_steps in all;
+ * *steps (may be NULL) gets the steps run */
+GKDEF gk_result gk_rve_relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps);
+/* gk_rve_deform with the step count chosen by the physics (see DRIVING THE CELL) */
+GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk_adapt_def *ad,
+                                       gk_adapt_report *rep);
+/* unbalanced force ratio (YADE's unbalancedForce): mean |sum of the contact
+ * forces on a particle| / mean |contact force|; 0 without contacts */
+GKDEF double gk_rve_unbalanced(const gk_rve *rve);
+/* inertial number I = 2 gdot r_mean sqrt(rho / p), gdot = sqrt(sym(rate):sym(rate))
+ * (seed 000 eq 20); p <= 0 -> +inf (not NaN) */
+GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p);
 /* Love stress of the last step (seed 000 eq 5), tension-positive, 3x3 */
 GKDEF void gk_rve_stress(const gk_rve *rve, double sigma[9]);
 /* recompute forces at the current positions without advancing (zero-length
@@ -1962,10 +2011,45 @@ static double gk__step_stretch_max(const gk_rve *rve) {
     return GK_RVE_STEP_OVERLAP_MAX * rve->rmin / (rve->rmin + rve->rmax);
 }
 
+/* ---------------------------------------------------------------- driving the cell
+ * One control drives the cell in every run of steps: it yields the map E of
+ * each step (h <- E h) and whether that step computes the stress (the last
+ * of a run; every step under a servo, which reads it). The public drivers
+ * are thin wrappers (see DRIVING THE CELL in the manual above). */
+enum { GK__DRIVE_PATH, GK__DRIVE_RATE, GK__DRIVE_SERVO };
+typedef struct gk__drive {
+    int kind;     /* PATH: I + dH split by a gk_path; RATE: constant L; SERVO  */
+    long n;       /* steps in the run                                          */
+    gk_path path; /* PATH                                                      */
+    double L[9];  /* RATE, SERVO (the servo rewrites its diagonal, shear)       */
+} gk__drive;
+
+static gk_result gk__drive_run(gk_rve *rve, gk__drive *d) {
+    double E[9], A[9];
+    long k;
+    int i;
+    gk_result res;
+    if (d->kind == GK__DRIVE_RATE) {
+        for (i = 0; i < 9; ++i) A[i] = d->L[i] * rve->dt;
+        gk_m3_exp(A, E);
+    }
+    for (k = 1; k <= d->n; ++k) {
+        if (d->kind == GK__DRIVE_PATH) {
+            gk_path_step(&d->path, (int)k, E);
+        } else if (d->kind == GK__DRIVE_SERVO) {
+            if (k == 1 && rve->step == 0) gk_rve_refresh(rve); /* the servo reads the stress */
+            gk_servo_rates(&rve->servo, rve->dim, rve->stress, rve->stiff, rve->dt, d->L);
+            for (i = 0; i < 9; ++i) A[i] = d->L[i] * rve->dt;
+            gk_m3_exp(A, E);
+        }
+        res = gk__step_once(rve, E, d->kind == GK__DRIVE_SERVO || k == d->n);
+        if (res) return res;
+    }
+    return GK_OK;
+}
+
 GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
-    double E[9], A[9], Lcur[9];
-    long st;
-    int k, have = 0;
+    gk__drive d;
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
     if (nsteps < 0) return gk_err_set(&rve->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
@@ -1989,25 +2073,14 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
                               rve->servo_on ? " (with the servo's max_rate)" : "",
                               f * (rve->rmin + rve->rmax) / rve->rmin, rve->dt, GK_RVE_STEP_OVERLAP_MAX);
     }
-    gk_m3_copy(rve->L, Lcur);
-    for (st = 0; st < nsteps; ++st) {
-        if (rve->servo_on) {
-            if (st == 0 && rve->step == 0) gk_rve_refresh(rve);
-            gk_servo_rates(&rve->servo, rve->dim, rve->stress, rve->stiff, rve->dt, Lcur);
-            have = 0;
-        }
-        if (!have) {
-            for (k = 0; k < 9; ++k) A[k] = Lcur[k] * rve->dt;
-            gk_m3_exp(A, E);
-            have = 1;
-        }
-        res = gk__step_once(rve, E, rve->servo_on || st == nsteps - 1);
-        if (res) return res;
-    }
-    return GK_OK;
+    d.kind = rve->servo_on ? GK__DRIVE_SERVO : GK__DRIVE_RATE;
+    d.n = nsteps;
+    gk_m3_copy(rve->L, d.L);
+    return gk__drive_run(rve, &d);
 }
 
 GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
+    gk__drive d;
     gk_path path;
     double E[9];
     int k;
@@ -2045,11 +2118,106 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
                                   "dH would leave a cell %g wide, below twice the interaction distance %g", w[k],
                                   2.0 * rve->rmax + rve->skin);
     }
-    for (k = 1; k <= nsteps; ++k) {
-        gk_path_step(&path, k, E);
-        res = gk__step_once(rve, E, k == nsteps);
-        if (res) return res;
+    d.kind = GK__DRIVE_PATH;
+    d.n = nsteps;
+    d.path = path;
+    return gk__drive_run(rve, &d);
+}
+
+GKDEF double gk_rve_unbalanced(const gk_rve *rve) {
+    double fp = 0.0, fc = 0.0;
+    int p, c, k, nc = 0;
+    for (p = 0; p < rve->n; ++p) {
+        double f2 = 0.0;
+        for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
+        fp += sqrt(f2);
     }
+    for (c = 0; c < rve->pl.n; ++c) {
+        double f2 = 0.0;
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        for (k = 0; k < rve->dim; ++k) f2 += (double)rve->fc[k][c] * (double)rve->fc[k][c];
+        fc += sqrt(f2);
+        ++nc;
+    }
+    return (nc && fc > 0.0) ? (fp / rve->n) / (fc / nc) : 0.0; /* nothing to balance: 0, not NaN */
+}
+
+GKDEF gk_result gk_rve_relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps) {
+    gk__drive d;
+    long done = 0;
+    gk_result res = gk__rve_ready(rve);
+    if (steps) *steps = 0;
+    if (res) return res;
+    if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before relax");
+    if (!(uf_max > 0.0) || every < 1 || max_steps < 0)
+        return gk_err_set(&rve->err, GK_ERR_ARG, "relax: uf_max %g (> 0), every %d (>= 1), max_steps %ld (>= 0)",
+                          uf_max, every, max_steps);
+    memset(&d, 0, sizeof d);
+    d.kind = GK__DRIVE_RATE; /* L = 0: the cell stands still */
+    while (done < max_steps && gk_rve_unbalanced(rve) > uf_max) {
+        d.n = every < max_steps - done ? every : max_steps - done;
+        res = gk__drive_run(rve, &d);
+        if (res) break;
+        done += d.n;
+    }
+    if (steps) *steps = done;
+    return res;
+}
+
+GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p) {
+    double g = 0.0;
+    int i, j;
+    for (i = 0; i < dim; ++i)
+        for (j = 0; j < dim; ++j) {
+            double e = 0.5 * (rate[3 * i + j] + rate[3 * j + i]);
+            g += e * e;
+        }
+    g = sqrt(g);
+    if (g == 0.0) return 0.0;
+    if (!(p > 0.0)) return HUGE_VAL;
+    return 2.0 * g * r_mean * sqrt(density / p);
+}
+
+GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk_adapt_def *ad_in,
+                                       gk_adapt_report *rep) {
+    gk_adapt_def ad;
+    gk_adapt_report R;
+    double rate[9], p, rmean = 0.0, I1, n;
+    long nr = 0;
+    int k;
+    gk_result res;
+    memset(&ad, 0, sizeof ad);
+    if (ad_in) ad = *ad_in;
+    if (ad.inertial_max == 0.0) ad.inertial_max = 5e-4;
+    if (ad.unbalanced_max == 0.0) ad.unbalanced_max = 5e-3;
+    if (ad.n_min == 0) ad.n_min = 10;
+    if (ad.n_max == 0) ad.n_max = 5000;
+    if (ad.every == 0) ad.every = 20;
+    if (!gk_m3_isfinite(dH)) return gk_err_set(&rve->err, GK_ERR_ARG, "dH has a NaN or infinite entry");
+    if (!(ad.inertial_max > 0.0) || !(ad.unbalanced_max > 0.0) || ad.n_min < 1 || ad.n_max < ad.n_min ||
+        ad.every < 1)
+        return gk_err_set(&rve->err, GK_ERR_ARG,
+                          "adaptive bounds: I_max %g, uf_max %g (> 0), n_min %d <= n_max %d, every %d (>= 1)",
+                          ad.inertial_max, ad.unbalanced_max, ad.n_min, ad.n_max, ad.every);
+    memset(&R, 0, sizeof R);
+    for (k = 0; k < rve->n; ++k) rmean += (double)rve->r[k];
+    rmean /= rve->n > 0 ? rve->n : 1;
+    p = -gk_m3_trace(rve->stress) / rve->dim; /* compression-positive mean stress (gk_stress_p) */
+    for (k = 0; k < 9; ++k) rate[k] = dH[k] / rve->dt;
+    I1 = gk_inertial_number(rate, rve->dim, rmean, rve->def.mat.density, p);
+    n = isfinite(I1) ? ceil(I1 / ad.inertial_max) : (double)ad.n_max;
+    if (n < ad.n_min) n = ad.n_min;
+    if (n > ad.n_max) n = ad.n_max;
+    R.n_deform = (int)n;
+    R.inertial = isfinite(I1) ? I1 / n : I1;
+    res = gk_rve_deform(rve, dH, R.n_deform);
+    if (res) return res;
+    res = gk_rve_relax(rve, ad.unbalanced_max, ad.every, ad.n_max - R.n_deform, &nr);
+    if (res) return res;
+    R.n_relax = (int)nr;
+    R.unbalanced = gk_rve_unbalanced(rve);
+    R.capped = R.unbalanced > ad.unbalanced_max;
+    if (rep) *rep = R;
     return GK_OK;
 }
 
@@ -2210,7 +2378,7 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
     res = gk_rve_set_servo(rve, &sv);
     if (res) return res;
     while (st < maxs) {
-        double un, errmax = 0.0, fsum = 0.0;
+        double un, errmax = 0.0;
         res = gk_rve_step(rve, 100);
         st += 100;
         if (res) break;
@@ -2223,12 +2391,7 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
                 if (e > errmax) errmax = e;
             }
         }
-        for (p = 0; p < rve->n; ++p) {
-            double f2 = 0.0;
-            for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
-            fsum += sqrt(f2);
-        }
-        un = rve->fc_mean > 0 ? fsum / rve->n / rve->fc_mean : 1.0;
+        un = rve->fc_mean > 0 ? gk_rve_unbalanced(rve) : 1.0;
         if (errmax < tol && un < utol) {
             if (++calm >= 3) break;
         } else {
@@ -2247,15 +2410,9 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
                 for (c = 0; c < rve->pl.n; ++c) rve->ft[k][c] = 0;
     }
     if (rep) {
-        double fsum = 0.0;
         rep->steps = st;
         gk_m3_copy(rve->stress, rep->stress);
-        for (p = 0; p < rve->n; ++p) {
-            double f2 = 0.0;
-            for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
-            fsum += sqrt(f2);
-        }
-        rep->unbalanced = rve->fc_mean > 0 ? fsum / rve->n / rve->fc_mean : 1.0;
+        rep->unbalanced = rve->fc_mean > 0 ? gk_rve_unbalanced(rve) : 1.0;
         rep->void_ratio = gk_rve_volume(rve) / rve->solid_volume - 1.0;
     }
     if (res) return res;
