@@ -26,6 +26,23 @@ BENCH_SRC:= $(filter-out bench/%_part.c,$(wildcard bench/*.c))
 TOOL_SRC := $(wildcard tools/*.c)
 
 TESTS    := $(patsubst tests/%.c,$(BUILD)/%,$(TEST_SRC))
+
+# the optional MPI build (gk_twoscale.h with GK_TWOSCALE_MPI): `make mpi`; `make test` runs its tests
+# with 2 ranks when mpicc is installed (Open MPI: openmpi-bin libopenmpi-dev) and says so when not
+MPICC   ?= mpicc
+MPIRUN  ?= mpirun
+HAVE_MPI := $(shell command -v $(MPICC) >/dev/null 2>&1 && command -v $(MPIRUN) >/dev/null 2>&1 && echo yes)
+# Open MPI refuses root without --allow-run-as-root, and more ranks than it counts cores without
+# --oversubscribe (other MPIs do not know these flags)
+MPIRUN_FLAGS ?= $(shell $(MPIRUN) --version 2>/dev/null | grep -q 'Open MPI' && \
+                  { [ "$$(id -u)" = 0 ] && echo '--allow-run-as-root --oversubscribe' || echo '--oversubscribe'; })
+# tests/mpi_*.c are MPI programs (mpicc) run on 2 ranks; tests/mpirun_*.c plain programs that launch
+# MPI programs themselves (GK_MPIRUN); each gets a runner script for tests/run_tests.sh
+MPI_TEST_SRC := $(wildcard tests/mpi_*.c)
+MPIRUN_SRC   := $(wildcard tests/mpirun_*.c)
+MPI_RUNNERS  := $(patsubst tests/mpi_%.c,$(BUILD)/mpi/run_%,$(MPI_TEST_SRC)) \
+                $(patsubst tests/mpirun_%.c,$(BUILD)/mpi/drive_%,$(MPIRUN_SRC))
+MPI_PROGS    := $(BUILD)/femdem_biaxial_mpi $(BUILD)/mpi/bench_twoscale_mpi $(MPI_RUNNERS)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/%,$(EX_SRC))
 BENCHES  := $(patsubst bench/%.c,$(BUILD)/bench_%,$(BENCH_SRC))
 TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
@@ -35,7 +52,7 @@ FUZZ_SRC   := $(wildcard tests/fuzz/fuzz_*.c)
 FUZZ_NAMES := $(patsubst tests/fuzz/fuzz_%.c,%,$(FUZZ_SRC))
 FUZZ_REPLAY := $(patsubst %,$(BUILD)/fuzz_replay_%,$(FUZZ_NAMES))
 
-.PHONY: all test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
+.PHONY: all mpi test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
         check-headers check-asan check-nosimd check-smoke tradeoff fuzz
 
 all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
@@ -46,6 +63,7 @@ help:
 	@echo "make run-rve    one RVE along a shear path"
 	@echo "make run-mpm | run-footing | run-collapse   MPMxDEM biaxial, footing, column collapse (Liang & Zhao 2019)"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
+	@echo "make mpi        the MPI programs (mpicc; gk_twoscale.h with GK_TWOSCALE_MPI) into $(BUILD)/mpi/"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability, tool smoke runs"
 	@echo "make fuzz       each libFuzzer harness of tests/fuzz for FUZZ_SECONDS (60) s, one at a time (clang)"
 	@echo "make bench      performance programs (2 cores)"
@@ -54,7 +72,7 @@ help:
 	@echo "make install PREFIX=dir   headers + pkg-config file"
 	@echo "make format / format-check   clang-format"
 
-$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests $(BUILD)/fuzz:
+$(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests $(BUILD)/fuzz $(BUILD)/mpi:
 	@mkdir -p $@
 
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
@@ -82,8 +100,41 @@ $(BUILD)/bench_tradeoff: | $(BUILD)/femdem_biaxial $(BUILD)/femdem_biaxial_float
 $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
-test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) | $(BUILD)/tests
-	@tests/run_tests.sh $(TESTS) $(FUZZ_REPLAY)
+# ---------------------------------------------------------------- MPI
+$(BUILD)/mpi/mpi_%: tests/mpi_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/mpi
+	$(MPICC) $(CFLAGS) -o $@ $< $(LDLIBS)
+
+.PRECIOUS: $(BUILD)/mpi/mpi_% $(BUILD)/mpi/mpirun_%
+$(BUILD)/mpi/mpirun_%: tests/mpirun_%.c tests/gk_test.h | $(BUILD)/mpi
+	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
+
+# a runner script per MPI test, so that tests/run_tests.sh runs it as any other test program
+$(BUILD)/mpi/run_%: $(BUILD)/mpi/mpi_% | $(BUILD)/mpi
+	@printf '#!/bin/sh\nexec %s %s -np 2 %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
+$(BUILD)/mpi/drive_%: $(BUILD)/mpi/mpirun_% | $(BUILD)/mpi
+	@printf '#!/bin/sh\nGK_MPIRUN="%s %s" exec %s "$$@"\n' '$(MPIRUN)' '$(MPIRUN_FLAGS)' '$<' > $@ && chmod +x $@
+
+# bench/twoscale.c on MPI ranks (bench/README.md)
+$(BUILD)/mpi/bench_twoscale_mpi: bench/twoscale.c $(HEADERS) examples/cli.h | $(BUILD)/mpi
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
+
+# the FEMxDEM driver with its RVEs over MPI ranks (the same results: tests/mpirun_femdem.c)
+$(BUILD)/femdem_biaxial_mpi: examples/femdem_biaxial.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
+
+ifeq ($(HAVE_MPI),yes)
+mpi: $(MPI_PROGS)
+MPI_RUN := $(MPI_RUNNERS)
+else
+mpi:
+	@echo "make mpi: $(MPICC) or $(MPIRUN) not found, the MPI programs are skipped (Debian: apt-get install openmpi-bin libopenmpi-dev)"
+MPI_RUN :=
+endif
+
+# bench_tradeoff too: test_untrusted checks that a failed run fails it
+test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) $(BUILD)/bench_tradeoff $(if $(HAVE_MPI),$(MPI_PROGS)) | $(BUILD)/tests
+	@$(if $(HAVE_MPI),,echo "make test: $(MPICC) not found, the MPI tests are skipped (apt-get install openmpi-bin libopenmpi-dev)";) \
+	  tests/run_tests.sh $(TESTS) $(FUZZ_REPLAY) $(MPI_RUN)
 
 # the fuzz corpora and every crasher replayed by a plain program (tests/fuzz/replay.c)
 $(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)

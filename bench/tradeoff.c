@@ -911,7 +911,7 @@ int main(int argc, char **argv) {
     for (i = 0; i < n; ++i) {
         if (!L[i].completed && L[i].same_as < 0) {
             snprintf(path, sizeof path, "%s/runs/%s/log.txt", o.out, L[i].id);
-            fprintf(stderr, "bench_tradeoff: run %d (%s%s) failed: see %s\n", i, L[i].id,
+            fprintf(stderr, "bench_tradeoff: run %d (%s, %s%s) failed: see %s\n", i, L[i].id, L[i].label,
                     L[i].is_ref ? ", the reference: no errors for its group" : "", path);
             k = 1;
         }

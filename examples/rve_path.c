@@ -47,7 +47,7 @@ static void usage(FILE *fp) {
             "  --E                      contact modulus [Pa]: linear kn = E r*, r* = 2 r1 r2/(r1 + r2) (6e8)\n"
             "  --kt-ratio               kt / kn of the linear law (0.8)\n"
             "  --friction-deg           contact friction angle [degrees, 0 to 85], mu = tan(angle)\n"
-            "                           (28.65 = 0.5 rad, seed 000)\n"
+            "                           (28.65 = 0.5 rad, Guo & Zhao 2014)\n"
             "  --density                particle density [kg/m^3] (2650)\n"
             "  --thickness              2D disk thickness [m]: m = rho t pi r^2, volume = area t (0.1)\n"
             "  --damping                local non-viscous damping alpha (0.1)\n"

@@ -200,7 +200,8 @@ GKDEF gk_result gk_realloc(const gk_allocator *a, void **ptr, size_t old_n, size
  * so pipes work and a file's announced size is never trusted; a directory, an
  * unreadable file or one above GK_FILE_MAX bytes is GK_ERR_IO naming the path
  * and the reason. On error *text and *len are untouched. */
-GKDEF gk_result gk_file_read(const char *path, const gk_allocator *alloc, char **text, size_t *len, gk_err *err);
+GKDEF gk_result gk_file_read(const char *path, const gk_allocator *alloc, char **text, size_t *len,
+                             gk_err *err);
 /* Closes a FILE * that was written: fflush, ferror and fclose,
  * so a lost byte anywhere (disk full, /dev/full, a quota) is GK_ERR_IO naming
  * path and reason. The file is closed in every case. */
@@ -812,7 +813,8 @@ GKDEF gk_result gk_realloc(const gk_allocator *a, void **ptr, size_t old_n, size
 #ifndef GK_FILE_MAX
 #define GK_FILE_MAX ((size_t)INT_MAX)
 #endif
-GKDEF gk_result gk_file_read(const char *path, const gk_allocator *alloc, char **text, size_t *len, gk_err *err) {
+GKDEF gk_result gk_file_read(const char *path, const gk_allocator *alloc, char **text, size_t *len,
+                             gk_err *err) {
     FILE *fp;
     char *buf = NULL;
     size_t n = 0, cap = 0;
@@ -820,7 +822,9 @@ GKDEF gk_result gk_file_read(const char *path, const gk_allocator *alloc, char *
     if (!path) return gk_err_set(err, GK_ERR_ARG, "no file name given");
     errno = 0;
     fp = fopen(path, "rb");
-    if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot open '%s': %s", path, errno ? strerror(errno) : "unknown error");
+    if (!fp)
+        return gk_err_set(err, GK_ERR_IO, "cannot open '%s': %s", path,
+                          errno ? strerror(errno) : "unknown error");
     for (;;) {
         size_t got;
         if (n + 1 >= cap) { /* grow by doubling; one byte always left for the NUL */

@@ -218,7 +218,7 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
         /* compared as a double first: a huge cell or a tiny cutoff never reaches the int cast */
         nbin[k] = w[k] / cutoff < (double)GK__CELLS_MAXBIN ? (int)(w[k] / cutoff) : GK__CELLS_MAXBIN;
         if (c->open & (1u << k)) { /* bins over the particles' extent only */
-            double smin = 1e300, smax = -1e300, e;
+            double smin = 1e300, smax = -1e300, nb;
             for (p = 0; p < n; ++p) {
                 if (s[k][p] < smin) smin = s[k][p];
                 if (s[k][p] > smax) smax = s[k][p];
@@ -228,15 +228,16 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
                                   "open axis %d: the particles span %g of the cell (must be below 1, not NaN)", k,
                                   smax - smin);
             c->lo[k] = smin;
-            e = (smax - smin) * w[k] / cutoff;
-            nbin[k] = e < (double)GK__CELLS_MAXBIN ? (int)e : GK__CELLS_MAXBIN;
+            nb = (smax - smin) * w[k] / cutoff;
+            nbin[k] = nb < (double)GK__CELLS_MAXBIN ? (int)nb : GK__CELLS_MAXBIN;
         }
         if (nbin[k] < 1) nbin[k] = 1;
     }
     for (k = 0; k < dim; ++k)
         for (p = 0; p < n; ++p)
             if (!isfinite(s[k][p]))
-                return gk_err_set(err, GK_ERR_NAN, "particle %d has a non-finite reduced coordinate %g", p, s[k][p]);
+                return gk_err_set(err, GK_ERR_NAN, "particle %d has a non-finite reduced coordinate %g", p,
+                                  s[k][p]);
     if (dim == 2) nbin[2] = 1;
     /* keep the grid at most ~2n + 27 bins (dilute or huge cells) */
     for (;;) {
@@ -247,7 +248,8 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
         if (nbin[0] <= 3 && nbin[1] <= 3 && nbin[2] <= 3) break;
     }
     total = (double)nbin[0] * nbin[1] * nbin[2]; /* <= 2n + 27 or 27 */
-    if (total >= (double)INT32_MAX) return gk_err_set(err, GK_ERR_ALLOC, "%.0f cell-list bins overflow int", total);
+    if (total >= (double)INT32_MAX)
+        return gk_err_set(err, GK_ERR_ALLOC, "%.0f cell-list bins overflow int", total);
     if (gk__cells_grow(c, &c->bin_start, &c->cap_bins, (size_t)total + 1))
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %.0f cell-list bins", total);
     for (k = 0; k < 3; ++k) c->nbin[k] = nbin[k];

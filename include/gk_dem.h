@@ -12,20 +12,55 @@
  *                              #include "gk_dem.h"
  *
  *   gk_packing pk;  gk_err e;  gk_rve rve;
- *   gk_rve_def def = gk_rve_def_default();          // seed 000 material
- *   gk_packing_read("rve400.txt", &pk, NULL, &e);
- *   gk_rve_create(&rve, &def, &pk);
+ *   gk_rve_def def = gk_rve_def_default();          // Guo & Zhao (2014) material
+ *   if (gk_packing_read("rve400.txt", &pk, NULL, &e)) { puts(e.msg); return 1; }
+ *   if (gk_rve_create(&rve, &def, &pk)) { puts(gk_rve_error(&rve)); gk_packing_free(&pk); return 1; }
+ *   gk_packing_free(&pk);
  *   double dH[9] = {0, 1e-3, 0,  0, 0, 0,  0, 0, 0};  // H01 = du_x/dy
- *   gk_rve_deform(&rve, dH, 100);                   // 100 DEM steps
- *   double sig[9]; gk_rve_stress(&rve, sig);        // Love stress, tension +
- *   gk_rve_destroy(&rve); gk_packing_free(&pk);
+ *   if (gk_rve_deform(&rve, dH, 100)) puts(gk_rve_error(&rve));  // 100 DEM steps
+ *   double sig[9]; gk_rve_stress(&rve, sig);        // Love stress, tension +, last step
+ *   gk_rve_destroy(&rve);
  *
- * THE RVE CONTRACT (DESIGN.md principle 6)
- *   gk_rve_deform(rve, dH, n)  cell map I + dH over n steps; stress after
- *   gk_rve_stress / gk_homog_tangent (gk_homog.h)
+ * THE RVE CONTRACT
+ *   gk_rve_deform(rve, dH, n)  applies the displacement-gradient increment
+ *     dH (H_ij = du_i/dx_j) to the cell over n DEM steps. The path
+ *     (def.path, gk_pcell.h) decides the end map: GK_PATH_CONSTANT_L (the
+ *     default; the Guo & Zhao (2014) authors' code and YADE) runs the
+ *     constant velocity gradient L = dH / (n dt) and ends at exp(dH) =
+ *     I + dH + dH^2/2 + ...; GK_PATH_OBJECTIVE ends exactly at I + dH.
+ *     det(I + dH) <= 0 is refused on both paths (GK_ERR_SINGULAR).
+ *   ADMISSIBLE INCREMENT PER DEM STEP. The cell map E of one step (exp(dH/n)
+ *     on the constant-L path) may change the overlap of a contact (i, j) by
+ *     at most GK_RVE_STEP_OVERLAP_MAX (0.1) times the smaller radius:
+ *       s(E) (r_min + r_max) <= 0.1 r_min,  s(E) = max_k |sigma_k(E) - 1|
+ *     over the singular values sigma_k of E (a rotation costs nothing). For
+ *     the 400-disk seed packing (r 3 to 7 mm) that is a stretch of 0.030 per
+ *     step: a shear of 0.5 needs at least 9 steps. A larger increment is
+ *     refused before anything moves, GK_ERR_ARG with the step count that
+ *     would do; gk_rve_step applies the same bound to exp(L dt) (with a
+ *     servo, to its max_rate). Refused rather than split into more steps
+ *     because the step count is the loading rate (dt is fixed): sub-steps
+ *     would silently change the time and the inertial number the caller
+ *     asked for. gk_rve_deform_adaptive (gk_homog.h) picks the count from
+ *     the inertial number instead. (The old behaviour, measured on the seed
+ *     packing: 50 % shear in one step returned GK_OK with overlaps of 0.7 r.)
+ *   gk_rve_stress after gk_rve_deform or gk_rve_step: the Love stress of the
+ *     forces of the LAST step, computed at the positions before that step
+ *     moved them (with the step's tangential increment): it lags the end
+ *     state by about one step's increment, dH/n. With n = 1 that is most of
+ *     dH (a shear of 1e-5 on the seed packing: sigma_xy 617 Pa before, 690
+ *     after the deform, 782 after gk_rve_refresh). gk_rve_refresh gives the
+ *     stress of the end state (one force pass, history unchanged).
+ *   gk_homog_tangent (gk_homog.h): the tangent at the current contacts.
  *   gk_rve_save / gk_rve_restore  the full state (positions, velocities,
  *     spins, cell, pair list with contact history) to and from caller
  *     memory, so an implicit driver can retry an increment bit for bit.
+ *     A buffer is untrusted: restore checks every field (reals finite, the
+ *     cell invertible and wide enough, pair lists sorted and in range,
+ *     counters and flags in range, friction >= 0, the servo valid, and dt
+ *     at most the critical step of this RVE at the state's own geometry)
+ *     before it changes anything; a bad buffer is refused with a message
+ *     and the RVE stays as it was.
  *
  * DRIVING THE CELL. One control yields the cell map of every step; the
  * drivers are thin wrappers around it:
@@ -130,7 +165,10 @@
  *   gk_cells.open  open (non-periodic) axes of the cell lists (gk_cells.h).
  *
  * CONFIG: GK_REAL_FLOAT (see gk_base.h), GK_DEM_PAR_MIN (pairs below which
- * one RVE never uses threads, default 20000).
+ * one RVE never uses threads, default 20000), GK_RVE_STEP_OVERLAP_MAX (the
+ * admissible overlap change per DEM step as a fraction of the smaller
+ * radius, default 0.1). An RVE holds at most GK_RVE_MAX_PARTICLES (2^26):
+ * its pair lists are int32.
  *
  * LICENCE: MIT (see gk_base.h).
  */
@@ -171,7 +209,7 @@ typedef struct gk_rve_def {
     gk_mass_model mass2d;
     double damping;           /* local non-viscous damping alpha in [0, 1)          */
     gk_damp_form damping_form;
-    gk_path_kind path;        /* how gk_rve_deform splits I + dH over the steps     */
+    gk_path_kind path;        /* how gk_rve_deform splits dH over the steps         */
     unsigned flags;           /* GK_RVE_*                                           */
     int threads;              /* threads inside this RVE; <= 1: serial              */
     gk_allocator alloc;
@@ -249,6 +287,14 @@ typedef struct gk_rve_state {
     gk_allocator alloc;
 } gk_rve_state;
 
+/* one contact (a touching pair) of gk_rve_contact_next, read-only */
+typedef struct gk_rve_contact {
+    int i, j;    /* the two particles as indices of the input packing (gk_rve.id), i < j */
+    int sliding; /* 1 if its tangential force was on the Coulomb cap in the last step */
+    double f[3]; /* contact force on particle j in the last step [N] (2D: f[2] = 0)   */
+    double d[3]; /* branch vector x_j - x_i, nearest image [m] (2D: d[2] = 0)         */
+} gk_rve_contact;
+
 typedef struct gk_consolidate_def {
     double pressure;          /* target isotropic stress, compression-positive [Pa] (> 0) */
     double friction;          /* Coulomb coefficient while consolidating (0 = dense)      */
@@ -320,6 +366,10 @@ GKDEF double gk_rve_volume(const gk_rve *rve);     /* stress volume             
 GKDEF double gk_rve_kinetic_energy(const gk_rve *rve); /* of the fluctuations     */
 GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]);
 GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *pk, const gk_allocator *alloc, gk_err *err);
+/* the contacts of the last step, one per call, in the RVE's pair order (the same for the same
+ * state): `int c = 0; gk_rve_contact k; while (gk_rve_contact_next(rve, &c, &k)) ...` (c is a
+ * cursor: start it at 0 and leave it to the call); 0 when there are no more */
+GKDEF int gk_rve_contact_next(const gk_rve *rve, int *cursor, gk_rve_contact *out);
 
 /* particle count changes between steps (scenes; see BEYOND THE PERIODIC CELL).
  * reserve: capacity for cap particles. append: k particles at reduced
@@ -694,7 +744,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "packing has %d particles", n);
     if (n > GK_RVE_MAX_PARTICLES)
-        return gk_err_set(err, GK_ERR_ARG, "packing has %d particles; an RVE holds at most %d (int32 pair lists)", n,
+        return gk_err_set(err, GK_ERR_ARG,
+                          "packing has %d particles; an RVE holds at most %d (int32 pair lists)", n,
                           GK_RVE_MAX_PARTICLES);
     if (!(def->damping >= 0.0 && def->damping < 1.0))
         return gk_err_set(err, GK_ERR_ARG, "local damping %g outside [0, 1)", def->damping);
@@ -856,10 +907,11 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         R.dt_crit = gk__dt_critical(&R);
         dtc = R.dt_crit;
         if (!(dtc > 0.0) || !isfinite(dtc) || !(dtc * (def->dt_factor > 0.0 ? def->dt_factor : 0.5) > 0.0))
-            res = gk_err_set(&R.err, GK_ERR_DT,
-                             "critical time step %g s (seed 000 eq 19) is not a positive number: radii %g to %g m "
-                             "and the stiffness are out of range (rescale the units)",
-                             dtc, R.rmin, R.rmax);
+            res = gk_err_set(
+                &R.err, GK_ERR_DT,
+                "critical time step %g s (Guo & Zhao 2014, eq 19) is not a positive number: radii %g to %g m "
+                "and the stiffness are out of range (rescale the units)",
+                dtc, R.rmin, R.rmax);
         else if (def->dt > 0.0) {
             if (def->dt > dtc)
                 res = gk_err_set(&R.err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)",
@@ -2053,25 +2105,27 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
     if (nsteps < 0) return gk_err_set(&rve->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
-    {   /* the largest per-step map: the servo's rates are bounded by max_rate */
+    { /* the largest per-step map: the servo's rates are bounded by max_rate */
         double C[9], f = 0.0, lim = gk__step_stretch_max(rve);
         int i, j;
         for (i = 0; i < 3; ++i)
             for (j = 0; j < 3; ++j) {
-                int servo = rve->servo_on && i < rve->dim && j < rve->dim &&
-                            ((i == j && rve->servo.mode[i] == GK_SERVO_STRESS) || (i != j && rve->servo.shear));
-                C[3 * i + j] = servo ? rve->servo.max_rate : (rve->servo_on && i == j && i < rve->dim
-                                                                  ? fabs(rve->servo.rate[i])
-                                                                  : fabs(rve->L[3 * i + j]));
+                int servo =
+                    rve->servo_on && i < rve->dim && j < rve->dim &&
+                    ((i == j && rve->servo.mode[i] == GK_SERVO_STRESS) || (i != j && rve->servo.shear));
+                C[3 * i + j] = servo ? rve->servo.max_rate
+                                     : (rve->servo_on && i == j && i < rve->dim ? fabs(rve->servo.rate[i])
+                                                                                : fabs(rve->L[3 * i + j]));
                 f += C[3 * i + j] * C[3 * i + j];
             }
         f = expm1(sqrt(f) * rve->dt); /* |exp(A) - I| <= exp(|A|) - 1 bounds the stretch */
         if (!(f <= lim))
-            return gk_err_set(&rve->err, GK_ERR_ARG,
-                              "the velocity gradient%s moves a contact by up to %.3g of the smaller radius in one "
-                              "step of %g s (admissible %g, GK_RVE_STEP_OVERLAP_MAX): lower the rates or dt",
-                              rve->servo_on ? " (with the servo's max_rate)" : "",
-                              f * (rve->rmin + rve->rmax) / rve->rmin, rve->dt, GK_RVE_STEP_OVERLAP_MAX);
+            return gk_err_set(
+                &rve->err, GK_ERR_ARG,
+                "the velocity gradient%s moves a contact by up to %.3g of the smaller radius in one "
+                "step of %g s (admissible %g, GK_RVE_STEP_OVERLAP_MAX): lower the rates or dt",
+                rve->servo_on ? " (with the servo's max_rate)" : "", f * (rve->rmin + rve->rmax) / rve->rmin,
+                rve->dt, GK_RVE_STEP_OVERLAP_MAX);
     }
     d.kind = rve->servo_on ? GK__DRIVE_SERVO : GK__DRIVE_RATE;
     d.n = nsteps;
@@ -2079,30 +2133,48 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
     return gk__drive_run(rve, &d);
 }
 
+/* the largest per-step stretch of dH carried out in n steps on the RVE's path */
+static double gk__deform_stretch(const gk_rve *rve, const double dH[9], int n) {
+    gk_path path;
+    double E[9], st = 0.0;
+    int k;
+    if (gk_path_init(&path, rve->dim, rve->def.path, dH, n, NULL)) return NAN;
+    for (k = 1; k <= (rve->def.path == GK_PATH_CONSTANT_L ? 1 : n); ++k) { /* constant L: one map */
+        double a;
+        gk_path_step(&path, k, E);
+        a = gk__map_stretch(rve->dim, E);
+        if (!(a <= st)) st = a;
+    }
+    return st;
+}
+
 GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     gk__drive d;
     gk_path path;
-    double E[9];
     int k;
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
     if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
     res = gk_path_init(&path, rve->dim, rve->def.path, dH, nsteps, &rve->err);
     if (res) return res;
-    {   /* refuse up front an increment too large for one DEM step (the contract) */
-        double st = 0.0, lim = gk__step_stretch_max(rve);
-        for (k = 1; k <= (rve->def.path == GK_PATH_CONSTANT_L ? 1 : nsteps); ++k) {
-            double a;
-            gk_path_step(&path, k, E);
-            a = gk__map_stretch(rve->dim, E);
-            if (!(a <= st)) st = a;
+    { /* refuse up front an increment too large for one DEM step (the contract) */
+        double st = gk__deform_stretch(rve, dH, nsteps), lim = gk__step_stretch_max(rve);
+        if (!(st <= lim)) { /* the fewest steps that would do: doubling, then bisection */
+            int lo = nsteps, hi = nsteps;
+            while (hi < (1 << 29) && !(gk__deform_stretch(rve, dH, hi) <= lim)) lo = hi, hi *= 2;
+            while (hi - lo > 1) {
+                int mid = lo + (hi - lo) / 2;
+                if (gk__deform_stretch(rve, dH, mid) <= lim)
+                    hi = mid;
+                else
+                    lo = mid;
+            }
+            return gk_err_set(
+                &rve->err, GK_ERR_ARG,
+                "dH in %d DEM steps changes a contact's overlap by up to %.3g of the smaller radius in "
+                "one step (admissible %g, GK_RVE_STEP_OVERLAP_MAX): use at least %d steps",
+                nsteps, st * (rve->rmin + rve->rmax) / rve->rmin, GK_RVE_STEP_OVERLAP_MAX, hi);
         }
-        if (!(st <= lim))
-            return gk_err_set(&rve->err, GK_ERR_ARG,
-                              "dH in %d DEM steps changes a contact's overlap by up to %.3g of the smaller radius in "
-                              "one step (admissible %g, GK_RVE_STEP_OVERLAP_MAX): use at least %.0f steps",
-                              nsteps, st * (rve->rmin + rve->rmax) / rve->rmin, GK_RVE_STEP_OVERLAP_MAX,
-                              ceil(nsteps * st / lim));
     }
     {   /* refuse up front a map that leaves the cell too thin for the nearest image */
         gk_pcell end = rve->cell;
@@ -2340,6 +2412,32 @@ GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *out, const gk_a
 }
 
 /* ---------------------------------------------------------------- consolidation */
+GKDEF int gk_rve_contact_next(const gk_rve *rve, int *cursor, gk_rve_contact *out) {
+    int c = *cursor < 0 ? 0 : *cursor, k;
+    for (; c < rve->pl.n; ++c) {
+        int a = rve->pl.i[c], b = rve->pl.j[c], swap;
+        double ds[3];
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        swap = rve->id[a] > rve->id[b];
+        out->i = swap ? rve->id[b] : rve->id[a];
+        out->j = swap ? rve->id[a] : rve->id[b];
+        out->sliding = (rve->cs[c] & GK_CS_SLIDING) != 0;
+        for (k = 0; k < 3; ++k) {
+            double fk = k < rve->dim ? (double)rve->fc[k][c] : 0.0;
+            ds[k] = k < rve->dim ? rve->s[k][b] - rve->s[k][a] : 0.0;
+            out->f[k] = swap ? -fk : fk;
+        }
+        gk_pcell_min_image(&rve->cell, ds, out->d);
+        if (rve->dim == 2) out->d[2] = 0.0;
+        if (swap)
+            for (k = 0; k < 3; ++k) out->d[k] = -out->d[k];
+        *cursor = c + 1;
+        return 1;
+    }
+    *cursor = rve->pl.n;
+    return 0;
+}
+
 GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk_consolidate_report *rep) {
     gk_servo sv;
     double mu_final = rve->def.mat.friction, alpha_final = rve->def.damping, rmean = 0.0, tol, utol, rate;
@@ -2668,7 +2766,8 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     size_t off = 0, n, np, R = sizeof(gk_real);
     int k, q, dim = rve->dim, c;
     gk_err *err = &rve->err;
-    if (rve->n < 1 || !rve->s[0]) return gk_err_set(err, GK_ERR_STATE, "restore into an RVE that was not created");
+    if (rve->n < 1 || !rve->s[0])
+        return gk_err_set(err, GK_ERR_STATE, "restore into an RVE that was not created");
     if (!buf || size < sizeof hd) return gk_err_set(err, GK_ERR_FORMAT, "RVE state buffer too small");
     memcpy(&hd, buf, sizeof hd);
     if (memcmp(hd.magic, GK__STATE_MAGIC, 8) != 0 || hd.endian != 0x01020304)
@@ -2678,25 +2777,29 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
                           GK__STATE_VERSION);
     if (hd.dim != rve->dim || hd.n != rve->n || hd.real_size != (int32_t)R || hd.phys != (int32_t)rve->phys ||
         hd.rot != GK__HAS_ROT(rve) || hd.roll != GK__HAS_ROLL(rve))
-        return gk_err_set(err, GK_ERR_FORMAT,
-                          "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
-                          hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
+        return gk_err_set(
+            err, GK_ERR_FORMAT,
+            "RVE state is for dim %d, %d particles, %d-byte reals, physics %d; this RVE has %d, %d, %d, %d",
+            hd.dim, hd.n, hd.real_size, hd.phys, rve->dim, rve->n, (int)R, (int)rve->phys);
     if (hd.npairs < 0 || hd.nouter < 0 || size != gk__state_bytes(rve, hd.npairs, hd.nouter))
         return gk_err_set(err, GK_ERR_FORMAT, "RVE state has the wrong size");
     n = (size_t)rve->n;
     np = (size_t)hd.npairs;
     /* ---- header scalars */
-    if (!(hd.dt > 0.0) || !isfinite(hd.dt)) return gk_err_set(err, GK_ERR_DT, "RVE state time step %g", hd.dt);
-    if (!(hd.dt_crit > 0.0) || !isfinite(hd.dt_crit) || !isfinite(hd.time) || hd.step < 0 || hd.rebuilds < 0 ||
-        hd.flips < 0)
-        return gk_err_set(err, GK_ERR_FORMAT, "RVE state has an invalid time %g, step %ld or critical step %g",
-                          hd.time, (long)hd.step, hd.dt_crit);
+    if (!(hd.dt > 0.0) || !isfinite(hd.dt))
+        return gk_err_set(err, GK_ERR_DT, "RVE state time step %g", hd.dt);
+    if (!(hd.dt_crit > 0.0) || !isfinite(hd.dt_crit) || !isfinite(hd.time) || hd.step < 0 ||
+        hd.rebuilds < 0 || hd.flips < 0)
+        return gk_err_set(err, GK_ERR_FORMAT,
+                          "RVE state has an invalid time %g, step %ld or critical step %g", hd.time,
+                          (long)hd.step, hd.dt_crit);
     if (!(hd.skin > 0.0) || !isfinite(hd.skin) || !(hd.skin_in > 0.0) || !(hd.skin_in <= hd.skin))
-        return gk_err_set(err, GK_ERR_FORMAT, "RVE state Verlet skins %g and %g invalid", hd.skin, hd.skin_in);
+        return gk_err_set(err, GK_ERR_FORMAT, "RVE state Verlet skins %g and %g invalid", hd.skin,
+                          hd.skin_in);
     if (!gk__map_valid(dim, hd.h) || !gk__map_valid(dim, hd.F) || !gk__map_valid(dim, hd.h0) ||
         !gk__map_valid(dim, hd.ho0))
-        return gk_err_set(err, GK_ERR_CELL, "RVE state cell (h %g %g %g %g ...) is not a valid cell matrix", hd.h[0],
-                          hd.h[1], hd.h[3], hd.h[4]);
+        return gk_err_set(err, GK_ERR_CELL, "RVE state cell (h %g %g %g %g ...) is not a valid cell matrix",
+                          hd.h[0], hd.h[1], hd.h[3], hd.h[4]);
     {
         gk_pcell cell;
         double w[3];
@@ -2708,15 +2811,18 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
                                   "RVE state cell is %g wide, below twice the interaction distance %g", w[k],
                                   2.0 * rve->rmax + hd.skin);
     }
-    if (!gk_m3_isfinite(hd.L) || !gk_m3_isfinite(hd.G) || !gk_m3_isfinite(hd.stress) || !isfinite(hd.stiff[0]) ||
-        !isfinite(hd.stiff[1]) || !isfinite(hd.stiff[2]) || !(hd.fc_mean >= 0.0) || !isfinite(hd.fc_mean))
-        return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite velocity gradient, stress or stiffness");
+    if (!gk_m3_isfinite(hd.L) || !gk_m3_isfinite(hd.G) || !gk_m3_isfinite(hd.stress) ||
+        !isfinite(hd.stiff[0]) || !isfinite(hd.stiff[1]) || !isfinite(hd.stiff[2]) || !(hd.fc_mean >= 0.0) ||
+        !isfinite(hd.fc_mean))
+        return gk_err_set(err, GK_ERR_NAN,
+                          "RVE state has a non-finite velocity gradient, stress or stiffness");
     if (dim == 2 && (hd.L[2] != 0 || hd.L[5] != 0 || hd.L[6] != 0 || hd.L[7] != 0 || hd.L[8] != 0))
         return gk_err_set(err, GK_ERR_FORMAT, "RVE state: 2D velocity gradient with a third row or column");
     if (hd.ncontacts < 0 || hd.ncontacts > hd.npairs || (hd.need_rebuild != 0 && hd.need_rebuild != 1) ||
         (hd.servo_on != 0 && hd.servo_on != 1) || (hd.outer_valid != 0 && hd.outer_valid != 1))
-        return gk_err_set(err, GK_ERR_FORMAT, "RVE state has invalid counters or flags (%d contacts of %d pairs)",
-                          hd.ncontacts, hd.npairs);
+        return gk_err_set(err, GK_ERR_FORMAT,
+                          "RVE state has invalid counters or flags (%d contacts of %d pairs)", hd.ncontacts,
+                          hd.npairs);
     {
         gk_material m = rve->def.mat;
         gk_result r = hd.servo_on ? gk__servo_check(dim, &hd.servo, err) : GK_OK;
@@ -2724,7 +2830,8 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         m.friction = hd.mu;
         if ((r = gk_material_check(&m, err)) != GK_OK) return r;
         if (hd.mu > 0.0 && !(rve->phys & GK_PHYS_TANGENT))
-            return gk_err_set(err, GK_ERR_STATE, "RVE state has friction %g for an RVE created frictionless", hd.mu);
+            return gk_err_set(err, GK_ERR_STATE, "RVE state has friction %g for an RVE created frictionless",
+                              hd.mu);
     }
     /* ---- arrays, in the order gk_rve_save writes them: reals finite, pair
      * lists sorted and in range, contact bits known */
@@ -2761,10 +2868,11 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         }
         dtc = gk__dt_critical_at(rve, hd.h, sb, pib, pjb, hd.npairs);
         if (!(hd.dt <= dtc))
-            return gk_err_set(err, GK_ERR_DT,
-                              "RVE state time step %g s is above the critical %g s of this RVE at the state's "
-                              "geometry (seed 000 eq 19)",
-                              hd.dt, dtc);
+            return gk_err_set(
+                err, GK_ERR_DT,
+                "RVE state time step %g s is above the critical %g s of this RVE at the state's "
+                "geometry (Guo & Zhao 2014, eq 19)",
+                hd.dt, dtc);
     }
     /* capacity first, so a failure changes nothing observable */
     if (gk__pairs_reserve(rve, np + 1, (size_t)rve->pl.n) || gk_pairlist_reserve(&rve->pl, np + 1, n) ||

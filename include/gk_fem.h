@@ -30,7 +30,13 @@
  *                           K_(a i)(b k) = int dN_a/dx_j D_ijkl dN_b/dx_l [eq 3]
  *   gk_fem_elem_force       f_(a i) = int sigma_ij dN_a/dx_j dV        [eq 4]
  *   gk_fem_assemble         all elements into a CSR matrix and/or a force
- *                           vector, in element order (deterministic)
+ *                           vector, in element order (deterministic). Every
+ *                           tangent, stress, element (det J > 0 at each
+ *                           Gauss point) and pattern entry is checked before
+ *                           K or fint is touched: an error changes neither.
+ *   (Element functions refuse an element index outside the mesh, GK_ERR_ARG,
+ *   a node id outside it, GK_ERR_MESH, and a non-finite tangent or stress,
+ *   GK_ERR_NAN.)
  *   gk_fem_elastic_tangent  isotropic D_ijkl = lambda d_ij d_kl + mu (d_ik d_jl
  *                           + d_il d_jk); 2D = plane strain
  *   gk_fem_lumped_mass      HRZ-lumped nodal masses (positive for Q8 too)
@@ -166,7 +172,7 @@ typedef struct gk_solver {
     double *ab;       /* n x w row-band: A(i,j) at ab[i*w + j - i + kl]     */
     double *tmp;      /* n                                                  */
     gk_allocator alloc;
-    gk_err err;       /* message of the last failed gk_solver_solve         */
+    gk_err err; /* message of the last failed gk_solver_solve         */
 } gk_solver;
 
 #define GK_SOLVER_COOKIE 0x534f4c56
@@ -379,7 +385,8 @@ GKDEF gk_result gk_fem_elem_stiffness(const gk_mesh *m, int e, const gk_quad *q,
     if (e < 0 || e >= m->nelem) return gk_err_set(err, GK_ERR_ARG, "element %d of %d", e, m->nelem);
     for (k = 0; k < q->n * n4; ++k)
         if (!(fabs(D[k]) < HUGE_VAL))
-            return gk_err_set(err, GK_ERR_NAN, "tangent of element %d, Gauss point %d is not finite", e, k / n4);
+            return gk_err_set(err, GK_ERR_NAN, "tangent of element %d, Gauss point %d is not finite", e,
+                              k / n4);
     for (k = 0; k < nd * nd; ++k) Ke[k] = 0.0;
     for (g = 0; g < q->n; ++g) {
         const double *Dg = D + (size_t)g * n4;
@@ -416,7 +423,8 @@ GKDEF gk_result gk_fem_elem_force(const gk_mesh *m, int e, const gk_quad *q, con
     if (e < 0 || e >= m->nelem) return gk_err_set(err, GK_ERR_ARG, "element %d of %d", e, m->nelem);
     for (a = 0; a < 9 * q->n; ++a)
         if (!(fabs(sigma[a]) < HUGE_VAL))
-            return gk_err_set(err, GK_ERR_NAN, "stress of element %d, Gauss point %d is not finite", e, a / 9);
+            return gk_err_set(err, GK_ERR_NAN, "stress of element %d, Gauss point %d is not finite", e,
+                              a / 9);
     for (a = 0; a < dim * npe; ++a) fe[a] = 0.0;
     for (g = 0; g < q->n; ++g) {
         const double *s = sigma + 9 * (size_t)g;
@@ -659,11 +667,13 @@ GKDEF gk_result gk_mesh_structured(gk_mesh *m, gk_elem_type t, const int n[3], c
     }
     nx = n[0], ny = n[1], nz = dim == 3 ? n[2] : 1;
     { /* counts as doubles first: node ids, dofs (dim per node) and connectivity entries are int */
-        double ne = (double)nx * ny * nz, nn = t == GK_Q8 ? (2.0 * nx + 1) * (2.0 * ny + 1)
-                                                         : (nx + 1.0) * (ny + 1.0) * (dim == 3 ? nz + 1.0 : 1.0);
+        double ne = (double)nx * ny * nz, nn = t == GK_Q8
+                                                   ? (2.0 * nx + 1) * (2.0 * ny + 1)
+                                                   : (nx + 1.0) * (ny + 1.0) * (dim == 3 ? nz + 1.0 : 1.0);
         if (ne * gk_fem_npe(t) > (double)INT_MAX || nn * dim > (double)INT_MAX)
-            return gk_err_set(err, GK_ERR_ARG, "%d x %d x %d mesh: %.0f elements, %.0f nodes exceed int indices",
-                              nx, ny, nz, ne, nn);
+            return gk_err_set(err, GK_ERR_ARG,
+                              "%d x %d x %d mesh: %.0f elements, %.0f nodes exceed int indices", nx, ny, nz,
+                              ne, nn);
     }
     if (t == GK_Q4 || t == GK_HEX8) {
         int nn = (nx + 1) * (ny + 1) * (dim == 3 ? nz + 1 : 1);
@@ -917,7 +927,8 @@ GKDEF gk_result gk_mesh_parse_gmsh(const char *text, size_t len, gk_mesh *out, c
             int edim, etg, par;
             long nin;
             if (gk__rd_line(&r, line, sizeof line) != 1 ||
-                sscanf(line, "%d %d %d %ld", &edim, &etg, &par, &nin) != 4 || nin < 0 || nin > nnodes_file - got)
+                sscanf(line, "%d %d %d %ld", &edim, &etg, &par, &nin) != 4 || nin < 0 ||
+                nin > nnodes_file - got)
                 GK__GFAIL(GK_ERR_FORMAT, "bad node block %ld", b);
             if (par) GK__GFAIL(GK_ERR_UNSUPPORTED, "parametric node coordinates");
             for (k = 0; k < nin; ++k)
@@ -969,8 +980,10 @@ GKDEF gk_result gk_mesh_parse_gmsh(const char *text, size_t len, gk_mesh *out, c
                 int nv = 0, off, np, tagv = bphys;
                 char *s = line, *q;
                 if (gk__rd_line(&r, line, sizeof line) != 1)
-                    GK__GFAIL(GK_ERR_FORMAT, "truncated $Elements (element %ld of block %ld, or a line over %d "
-                                             "characters)", e + 1, b, (int)sizeof line - 1);
+                    GK__GFAIL(GK_ERR_FORMAT,
+                              "truncated $Elements (element %ld of block %ld, or a line over %d "
+                              "characters)",
+                              e + 1, b, (int)sizeof line - 1);
                 while (nv < 64) {
                     long x = strtol(s, &q, 10);
                     if (q == s) break;
@@ -979,8 +992,8 @@ GKDEF gk_result gk_mesh_parse_gmsh(const char *text, size_t len, gk_mesh *out, c
                 if (version < 3.0) {
                     /* id type ntags tag... nodes...: the tag count is data, checked before it indexes */
                     if (nv < 3 || v[2] < 0 || v[2] > nv - 3)
-                        GK__GFAIL(GK_ERR_FORMAT, "bad element line (element %ld: %d numbers, tag count %ld)", e + 1,
-                                  nv, nv >= 3 ? v[2] : -1L);
+                        GK__GFAIL(GK_ERR_FORMAT, "bad element line (element %ld: %d numbers, tag count %ld)",
+                                  e + 1, nv, nv >= 3 ? v[2] : -1L);
                     type = v[1], off = 3 + (int)v[2];
                     tagv = v[2] > 0 && v[3] >= INT_MIN && v[3] <= INT_MAX ? (int)v[3] : 0;
                 } else {
@@ -1719,7 +1732,8 @@ GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x) {
         return gk_err_set(&s->err, GK_ERR_STATE, "solve before a successful gk_solver_factor");
     n = s->n, kl = s->kl, y = s->tmp;
     for (i = 0; i < n; ++i)
-        if (!(fabs(b[i]) < HUGE_VAL)) return gk_err_set(&s->err, GK_ERR_NAN, "right-hand side %d is %g", i, b[i]);
+        if (!(fabs(b[i]) < HUGE_VAL))
+            return gk_err_set(&s->err, GK_ERR_NAN, "right-hand side %d is %g", i, b[i]);
 #define GK__AB(r, c) s->ab[(size_t)(r)*s->w + (c) - (r) + kl]
     for (i = 0; i < n; ++i) y[i] = b[s->perm[i]];
     for (k = 0; k < n; ++k) {
@@ -1739,8 +1753,9 @@ GKDEF gk_result gk_solver_solve(gk_solver *s, const double *b, double *x) {
 #undef GK__AB
     for (i = 0; i < n; ++i)
         if (!(fabs(y[i]) < HUGE_VAL))
-            return gk_err_set(&s->err, GK_ERR_DIVERGED, "solution entry %d is %g (overflow: a near-singular system?)",
-                              s->perm[i], y[i]);
+            return gk_err_set(&s->err, GK_ERR_DIVERGED,
+                              "solution entry %d is %g (overflow: a near-singular system?)", s->perm[i],
+                              y[i]);
     for (i = 0; i < n; ++i) x[s->perm[i]] = y[i];
     return GK_OK;
 }
@@ -1754,8 +1769,8 @@ GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x_out, double r
     memset(&al, 0, sizeof al);
     if (alloc) al = *alloc;
     if (!(rtol > 0.0 && rtol < 1.0) || maxit < 1)
-        return gk_err_set(err, GK_ERR_ARG, "PCG tolerance %g (must be in (0, 1)), max iterations %d (>= 1)", rtol,
-                          maxit);
+        return gk_err_set(err, GK_ERR_ARG, "PCG tolerance %g (must be in (0, 1)), max iterations %d (>= 1)",
+                          rtol, maxit);
     for (i = 0; i < n; ++i)
         if (!(fabs(b[i]) < HUGE_VAL) || !(fabs(x[i]) < HUGE_VAL))
             return gk_err_set(err, GK_ERR_NAN, "PCG: right-hand side or start value %d is not finite", i);

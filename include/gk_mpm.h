@@ -1302,7 +1302,8 @@ GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_
             for (p = 0; p < n; ++p)
                 if (gk__mpm_g2p_point(g, P, d, dt, what, p, 1)) break;
             return gk_err_set(err, GK_ERR_DIVERGED,
-                              "%d points would invert (det F <= 0), first point %d: nothing was changed", bad, p);
+                              "%d points would invert (det F <= 0), first point %d: nothing was changed", bad,
+                              p);
         }
     }
     GK_OMP(parallel for num_threads(nth) schedule(static) reduction(+ : bad) if (nth > 1))

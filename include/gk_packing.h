@@ -38,7 +38,12 @@
  *   line 1:  "2 N Lx Ly" or "3 N Lx Ly Lz"
  *   lines starting with '#': comments; grainkit writes and reads an optional
  *            "# cell h00 h01 ... " line holding the full (skewed) cell matrix
- *   N lines: "x y r" or "x y z r" (SI units), positions in the cell. */
+ *   N lines: "x y r" or "x y z r" (SI units), positions in the cell.
+ * The text is untrusted: the particle lines are counted before anything is
+ * allocated (memory follows what the text holds, never the N it announces);
+ * a data or '# cell' line longer than 1023 characters, a NUL byte, a
+ * non-finite number, a radius <= 0 or a cell whose volume is not a finite
+ * positive number is refused, the message naming the line. */
 typedef struct gk_packing {
     int dim, n;
     double h[9];     /* cell matrix (a box is diag(Lx, Ly, Lz)); 2D: h22 = 1 */
@@ -199,7 +204,8 @@ static int gk__line_kind(const char *s) {
 
 /* a line that cannot be read whole is an error; only a plain comment may be cut */
 static gk_result gk__line_ok(const gk__lines *L, int kind, gk_err *err) {
-    if (L->nul) return gk_err_set(err, GK_ERR_FORMAT, "line %ld holds a NUL byte (not a text packing?)", L->lineno);
+    if (L->nul)
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld holds a NUL byte (not a text packing?)", L->lineno);
     if (L->toolong && kind != 1)
         return gk_err_set(err, GK_ERR_FORMAT, "line %ld is longer than %d characters", L->lineno,
                           (int)sizeof L->line - 1);
@@ -248,9 +254,11 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
         int kind = gk__line_kind(L.line);
         if ((r = gk__line_ok(&L, kind, err)) != GK_OK) return r;
         if (kind == 3 && ++lines > n)
-            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced", L.lineno, n);
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: more particle lines than the %d announced",
+                              L.lineno, n);
     }
-    if (lines != n) return gk_err_set(err, GK_ERR_FORMAT, "packing announces %d particles but lists %ld", n, lines);
+    if (lines != n)
+        return gk_err_set(err, GK_ERR_FORMAT, "packing announces %d particles but lists %ld", n, lines);
     r = gk_packing_alloc(&pk, dim, n, alloc, err);
     if (r) return r;
     L.p = first;
@@ -264,7 +272,8 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
             int nc = gk__parse_doubles(s + strspn(s, " \t") + 7, hc, 9, &bad), a, b;
             if (bad || nc != dim * dim) {
                 gk_packing_free(&pk);
-                return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno, dim * dim);
+                return gk_err_set(err, GK_ERR_FORMAT, "line %ld: '# cell' needs %d numbers", L.lineno,
+                                  dim * dim);
             }
             for (a = 0; a < nc; ++a)
                 if (!isfinite(hc[a])) {
@@ -442,8 +451,9 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
     for (k = 0; k < dim; ++k) pk.h[4 * k] = side * asp[k];
     if (!(vs > 0.0) || !isfinite(gk_m3_det(pk.h)) || !(gk_m3_det(pk.h) > 0.0)) {
         gk_packing_free(&pk);
-        return gk_err_set(err, GK_ERR_ARG, "radii (largest %g) and cell aspect give a cell volume %g out of range",
-                          rr[0], gk_m3_det(pk.h));
+        return gk_err_set(err, GK_ERR_ARG,
+                          "radii (largest %g) and cell aspect give a cell volume %g out of range", rr[0],
+                          gk_m3_det(pk.h));
     }
     /* random sequential addition with a linked-cell grid updated as particles land */
     {

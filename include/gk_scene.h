@@ -25,6 +25,25 @@
  *   printf("floor force %g N\n", sc.walls[2].force[1]);
  *   gk_scene_destroy(&sc);
  *
+ * WHAT IS HERE
+ *   gk_scene_def_default / gk_scene_create / gk_scene_destroy / gk_scene_step
+ *   gk_scene_add_wall, gk_scene_add_box, gk_wall_def_default, gk_scene_pair_material
+ *   gk_scene_set_external, gk_scene_prescribe / gk_scene_release,
+ *   gk_scene_set_velocity, gk_scene_set_mass      per particle (index p)
+ *   gk_scene_add_membrane, gk_scene_side_chain      flexible 2D boundary
+ *   gk_scene_insert / gk_scene_remove / gk_scene_index   stable ids
+ *   gk_scene_energy_track / gk_scene_energy        the energy books
+ *   gk_scene_stress                                mean stress of the particles
+ *   gk_scene_save / gk_scene_restore / gk_scene_state_size   bitwise state
+ *   gk_scene_write_vtk / _walls_vtk / _svg           pictures
+ *   gk_scene_position, gk_scene_dt_critical
+ *
+ * TIME STEP. def.rve.dt = 0: dt_factor (0 -> 0.5) x the smallest critical
+ * step (seed 000 eq 19) of the pair and the wall contacts, lowered as walls
+ * are added; an explicit dt is checked against both and refused if above.
+ * Hertz contacts are re-checked at every list rebuild (GK_ERR_DT when the
+ * overlaps have grown too much; choose dt explicitly for Hertz scenes).
+ *
  * DOMAIN. def.lo, def.hi bound the domain; bit k of def.periodic makes axis k
  * periodic with period hi[k] - lo[k] (positions wrap, contacts take the
  * nearest image, as in the RVE). Along an OPEN axis the particles stay in
@@ -68,10 +87,12 @@
  * R = -F.normal (F the force the particles exert on the wall) reaches
  * def.target [N], or def.target x def.area [Pa x m^2; 2D: m x thickness]:
  * v = gain (target - R) / (K dt), K the sum of the wall's contact normal
- * stiffnesses, capped at max_speed (which the servo moves at when K = 0).
+ * stiffnesses, capped at max_speed (which the servo moves at when K = 0);
+ * the wall moves with def.velocity's part across that direction as well
+ * (a shear box under constant normal load).
  * A wall reports each step force[3], moment[3] (about its point, both
- * exerted BY the particles ON the wall), ncontacts, stiffness, and
- * displacement. The fields of sc.walls[w].def may be changed between
+ * exerted BY the particles ON the wall), resistance, ncontacts, stiffness,
+ * and its current position pos (vel, angle). The fields of sc.walls[w].def may be changed between
  * gk_scene_step calls (drive, velocity, target, area, gain): they are
  * checked at the next call.
  *
@@ -86,17 +107,26 @@
  * gk_scene_release frees it. (Seed 001's frame of boundary particles and
  * seed 002's trained grains are prescribed particles.)
  *
- * MEMBRANE (2D). gk_scene_add_membrane(sc, k, ids, pressure, stiffness): a
- * chain of particles (stable ids, the material on the chain's LEFT, i.e. a
- * counter-clockwise boundary) loaded by a follower pressure: every segment
- * a-b between consecutive centres receives p t |x_b - x_a| along its inward
- * normal, half on each end (t the 2D thickness of gk_rve: the same t the
- * stress is divided by). With stiffness > 0, consecutive members are also
- * tied by tension-only springs of that stiffness and rest length their
- * initial distance (the mass-spring membrane of seed 002 App. B), so the
- * chain cannot open gaps an inner particle could escape through. This is
- * the follower-pressure flexible boundary of Cheung & O'Sullivan (2008)
- * with a fixed chain (members chosen once, e.g. by gk_scene_side_chain).
+ * MEMBRANE (2D). gk_scene_add_membrane(sc, k, ids, pressure, stiffness,
+ * anchor_first, anchor_last): a chain of particles (stable ids, the
+ * material on the chain's LEFT, i.e. a counter-clockwise boundary) loaded
+ * by a follower pressure: every segment a-b between consecutive centres
+ * receives p t |x_b - x_a| along its inward normal, half on each end (t the
+ * 2D thickness of gk_rve: the same t the stress is divided by). With
+ * stiffness > 0, consecutive members are also tied by tension-only springs
+ * of that stiffness and rest length their initial distance (the mass-spring
+ * membrane of seed 002 App. B), so the chain cannot open gaps an inner
+ * particle could escape through. An anchor (a wall index, -1 for none)
+ * closes the chain at that end on a platen, as the rubber sleeve of a
+ * biaxial cell is clamped to it: the end member is tied (same spring) to
+ * its nearest point on that wall - it slides along the wall freely but
+ * cannot leave it by more than its initial distance, so no inner particle
+ * can pass round the chain end - and the segment member-wall carries the
+ * pressure too (its half on the wall is not applied). Without anchors the
+ * strips between the end members and the platens are unloaded and an inner
+ * particle can escape round a chain end. This is the follower-pressure flexible boundary of
+ * Cheung & O'Sullivan (2008) with a fixed chain (members chosen once, e.g.
+ * by gk_scene_side_chain).
  *
  * INSERTION AND DELETION. gk_scene_insert adds particles (world positions,
  * optional velocities) and returns their stable ids; gk_scene_remove
@@ -114,17 +144,25 @@
  * membrane springs), the work done on the particles by gravity, walls
  * (force times the wall's surface velocity), external loads, the membrane
  * pressure and the constraints of prescribed particles, and the energy
- * dissipated by Coulomb sliding (F_t times the slip (F_trial - F_t) / k_t,
- * and the same for rolling), contact dashpots (F_v^2 / g dt) and local
- * damping. Work of a force F over a step is F . (v_{n-1/2} + v_{n+1/2})
- * dt / 2, which makes the kinetic part exact; the contact terms are
- * computed from the contact law itself (each pair is evaluated a second
- * time, and sliding pairs a third time without the Coulomb cap, so
- * tracking costs about twice the contact time: pay for it only when
- * needed). balance = kinetic + elastic - (initial + works - dissipation)
- * is then small: O(dt) of the energy moved (tests: below 1e-3 of it for
- * the linear law; Hertz-Mindlin's tangential spring, whose stiffness
- * follows the overlap, is not exactly conservative). Particles removed or
+ * dissipated by contact dashpots, Coulomb sliding (and rolling slip) and
+ * local damping. The work of a force F over a step is F . v_bar dt with
+ * v_bar = (v_{n-1/2} + v_{n+1/2}) / 2 (with torques and spins likewise),
+ * the leap-frog's own measure, which makes the kinetic part exact: damping
+ * is what the applied forces did beyond the kinetic energy change; the
+ * dashpots' dissipation is the work of their forces; friction is what the
+ * tangential forces and the torques took out of the particles beyond the
+ * change of the tangential and rolling springs' energy (the slip energy of
+ * PFC), so the incremental Hertz-Mindlin spring, whose stiffness follows
+ * the overlap, is booked exactly too; `slip` estimates the same friction
+ * from the slips (F_t (F_trial - F_t) / k_t per sliding contact) as a
+ * check. The contacts are evaluated again with the law itself for the
+ * books (each pair once more, sliding ones twice: tracking costs about two
+ * to three times the contact time; pay for it only when needed).
+ * balance = kinetic + elastic - (initial + works - dissipation) is then
+ * the time integration's own energy error: the normal springs' energy at
+ * the steps against the kinetic energy at the half steps, and contacts
+ * that open or close between two steps (tests: 2e-4 of the energy moved at
+ * dt = 0.1 dt_crit, shrinking with dt). Particles removed or
  * inserted carry their kinetic energy (and removed ones their contacts'
  * elastic energy) in `removed` / `inserted`; an inserted particle that
  * overlaps another brings elastic energy the balance does not book.
@@ -160,13 +198,13 @@
 typedef enum gk_lost_policy { GK_LOST_ERROR = 0, GK_LOST_DELETE = 1 } gk_lost_policy;
 
 typedef struct gk_scene_def {
-    int cookie;            /* set by gk_scene_def_default()                         */
-    int dim;               /* 2 or 3                                                */
-    double lo[3], hi[3];   /* domain box [m]                                        */
-    unsigned periodic;     /* bit k: axis k periodic (period hi - lo); 0: all open */
-    double gravity[3];     /* [m/s^2]                                               */
-    gk_lost_policy lost;   /* a particle leaving an open domain                     */
-    gk_rve_def rve;        /* material, dt, skin, damping (default 0 here), thickness,
+    int cookie;          /* set by gk_scene_def_default()                         */
+    int dim;             /* 2 or 3                                                */
+    double lo[3], hi[3]; /* domain box [m]                                        */
+    unsigned periodic;   /* bit k: axis k periodic (period hi - lo); 0: all open */
+    double gravity[3];   /* [m/s^2]                                               */
+    gk_lost_policy lost; /* a particle leaving an open domain                     */
+    gk_rve_def rve;      /* material, dt, skin, damping (default 0 here), thickness,
                               mass model, flags, threads, allocator                 */
 } gk_scene_def;
 
@@ -182,13 +220,13 @@ typedef enum gk_wall_drive { GK_DRIVE_VELOCITY = 0, GK_DRIVE_FORCE = 1, GK_DRIVE
 
 typedef struct gk_wall_def {
     gk_wall_kind kind;
-    double point[3];    /* plane: a point on it; segment, rect: first corner; disk, cylinder: centre */
-    double normal[3];   /* plane: unit normal towards the particles; servo direction of every kind */
+    double point[3];     /* plane: a point on it; segment, rect: first corner; disk, cylinder: centre */
+    double normal[3];    /* plane: unit normal towards the particles; servo direction of every kind */
     double e1[3], e2[3]; /* segment: e1 = b - a; rect: the two (orthogonal) edges                   */
-    double axis[3];     /* cylinder: unit axis                                                       */
-    double radius;      /* disk, cylinder [m]                                                        */
-    int inside;         /* disk, cylinder: particles inside (a drum)                                 */
-    gk_material mat;    /* contact material of the particle-wall pair (see WALLS)                    */
+    double axis[3];      /* cylinder: unit axis                                                       */
+    double radius;       /* disk, cylinder [m]                                                        */
+    int inside;          /* disk, cylinder: particles inside (a drum)                                 */
+    gk_material mat;     /* contact material of the particle-wall pair (see WALLS)                    */
     gk_wall_drive drive;
     double velocity[3]; /* GK_DRIVE_VELOCITY [m/s]                                                    */
     double spin[3];     /* disk, cylinder: angular velocity about point (2D: spin[2]) [rad/s]         */
@@ -199,46 +237,50 @@ typedef struct gk_wall_def {
 } gk_wall_def;
 
 typedef struct gk_wall {
-    gk_wall_def def;     /* as given; def.point is the position at creation    */
-    double pos[3];       /* current point (def.point + displacement)            */
-    double vel[3];       /* translation velocity of the current step            */
-    double angle;        /* rotation about the axis since creation [rad]        */
-    double force[3];     /* exerted by the particles on the wall, last step [N] */
-    double moment[3];    /* about pos, same [N m]                               */
-    double stiffness;    /* sum of the contact normal stiffnesses [N/m]         */
-    double resistance;   /* -force . normal (the servo's measure) [N]           */
+    gk_wall_def def;   /* as given; def.point is the position at creation    */
+    double pos[3];     /* current point (def.point + displacement)            */
+    double vel[3];     /* translation velocity of the current step            */
+    double angle;      /* rotation about the axis since creation [rad]        */
+    double force[3];   /* exerted by the particles on the wall, last step [N] */
+    double moment[3];  /* about pos, same [N m]                               */
+    double stiffness;  /* sum of the contact normal stiffnesses [N/m]         */
+    double resistance; /* -force . normal (the servo's measure) [N]           */
     int ncontacts;
     /* internal */
-    gk_law_consts K;     /* the material's constants, rescaled for a plane      */
-    unsigned phys;       /* GK_PHYS_* of its contacts                           */
+    gk_law_consts K; /* the material's constants, rescaled for a plane      */
+    unsigned phys;   /* GK_PHYS_* of its contacts                           */
     gk_real *ft[3], *mr[3];
-    unsigned char *cs;   /* history per particle index                          */
-    int32_t *cand;       /* candidate particles (ascending)                     */
+    unsigned char *cs; /* history per particle index                          */
+    int32_t *cand;     /* candidate particles (ascending)                     */
     int ncand, capcand;
-    double built[3];     /* pos at the candidate build                          */
+    double built[3]; /* pos at the candidate build                          */
     long built_rebuilds;
     int need_build;
-    double dmax;         /* largest overlap of the last step                    */
+    double dmax; /* largest overlap of the last step                    */
 } gk_wall;
 
 typedef struct gk_membrane {
-    int n, cap;          /* members, capacity                                   */
-    int32_t *ids;        /* stable ids, the material on the chain's left        */
-    double *rest;        /* rest length of each link (n - 1)                    */
-    double pressure;     /* [Pa]                                                */
-    double stiffness;    /* link springs [N/m]; 0: none                         */
-    double *fx, *fy;     /* pressure force on each member, last step (energy)   */
+    int n, cap;       /* members, capacity                                   */
+    int32_t *ids;     /* stable ids, the material on the chain's left        */
+    double *rest;     /* rest length of each link (n - 1)                    */
+    int anchor[2];    /* wall of the first / last member's anchor, or -1     */
+    double arest[2];  /* rest length of the anchor links                     */
+    double af[2][2];  /* anchor link force on the first / last member, last step */
+    double pressure;  /* [Pa]                                                */
+    double stiffness; /* link springs [N/m]; 0: none                         */
+    double *fx, *fy;  /* pressure force on each member, last step (energy)   */
 } gk_membrane;
 
 typedef struct gk_energy {
-    double kinetic;      /* now (half step) [J]                                          */
-    double elastic;      /* contact and membrane springs, last step [J]                  */
+    double kinetic; /* now (half step) [J]                                          */
+    double elastic; /* contact and membrane springs, last step [J]                  */
     double gravity, walls, external, pressure, prescribed; /* work on the particles [J]  */
     double friction, viscous, damping;                     /* dissipated, >= 0 [J]      */
-    double removed, inserted;                               /* carried out, in [J]       */
-    double initial;      /* kinetic + elastic when tracking started                      */
-    double balance;      /* kinetic + elastic - (initial + works - dissipation + in - out) */
-    double scale;        /* |initial| + sum of |works| + dissipation: balance's yardstick */
+    double slip;              /* friction estimated from the Coulomb and rolling slips (a check) */
+    double removed, inserted; /* carried out, in [J]       */
+    double initial;           /* kinetic + elastic when tracking started                      */
+    double balance;           /* kinetic + elastic - (initial + works - dissipation + in - out) */
+    double scale;             /* |initial| + sum of |works| + dissipation: balance's yardstick */
     long steps;
 } gk_energy;
 
@@ -249,25 +291,25 @@ typedef struct gk_energy {
 #define GK_BOX_ALL 0x3fu
 
 typedef struct gk_scene {
-    gk_rve rve;              /* the particles: rve.n, rve.id[] (stable ids), rve.v, ... */
+    gk_rve rve; /* the particles: rve.n, rve.id[] (stable ids), rve.v, ... */
     gk_scene_def def;
     int dim;
-    unsigned open;           /* open axes                                              */
-    double origin[3];        /* world x = origin + h s                                 */
+    unsigned open;    /* open axes                                              */
+    double origin[3]; /* world x = origin + h s                                 */
     gk_wall *walls;
     int nwalls, capwalls;
     gk_membrane *mem;
     int nmem, capmem;
-    int cap;                 /* capacity of the per-particle arrays below               */
-    double *mass;            /* 1 / minv                                                */
-    unsigned char *flags;    /* GK_PARTICLE_*                                           */
-    double *vp[3], *wp[3];   /* prescribed velocity and spin                            */
+    int cap;                    /* capacity of the per-particle arrays below               */
+    double *mass;               /* 1 / minv                                                */
+    unsigned char *flags;       /* GK_PARTICLE_*                                           */
+    double *vp[3], *wp[3];      /* prescribed velocity and spin                            */
     double *load[3], *loadt[3]; /* load on prescribed particles, last step              */
     double *fext[3], *text[3];  /* constant external force and moment                   */
     int nprescribed;
     int32_t next_id, *index_of; /* id -> index (-1: gone), capacity cap_ids              */
     int cap_ids;
-    long lost;               /* particles deleted as lost                               */
+    long lost; /* particles deleted as lost                               */
     long seen_rebuilds;
     /* energy */
     int energy_on, energy_pending;
@@ -276,8 +318,13 @@ typedef struct gk_scene {
     gk_real *hft[3], *hmr[3];
     unsigned char *hcs;
     size_t hcap;
-    double el_step;          /* elastic energy summed during the current step           */
-    long energy_mismatch;    /* pairs whose re-evaluation differed from the kernel (0)  */
+    double wall_love[9]; /* wall contacts' f (x) (x_c - x_p) and membrane links' f L u (x) u, last step */
+    double el_step;      /* elastic energy summed during the current step           */
+    double erest_now, erest_prev, slip_step; /* tangential + rolling spring energy, slip     */
+    void *rec;                               /* gk__erec: the step's contact forces for the books        */
+    size_t nrec, caprec;
+    int rec_failed;
+    long energy_mismatch; /* pairs whose re-evaluation differed from the kernel (0)  */
     gk_err err;
 } gk_scene;
 
@@ -291,7 +338,8 @@ GKDEF gk_wall_def gk_wall_def_default(void);
  * b as a pair of identical bodies (see WALLS): Hertz E*, G* and linear
  * 2 E_a E_b / (E_a + E_b); b = NULL: a rigid body. friction and damping of a;
  * the law of a. */
-GKDEF gk_result gk_scene_pair_material(const gk_material *a, const gk_material *b, gk_material *out, gk_err *err);
+GKDEF gk_result gk_scene_pair_material(const gk_material *a, const gk_material *b, gk_material *out,
+                                       gk_err *err);
 
 GKDEF gk_result gk_scene_create(gk_scene *sc, const gk_scene_def *def, const gk_packing *pk);
 GKDEF void gk_scene_destroy(gk_scene *sc);
@@ -300,6 +348,13 @@ GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps);
 GKDEF void gk_scene_position(const gk_scene *sc, int p, double x[3]);
 GKDEF int gk_scene_index(const gk_scene *sc, int32_t id);
 GKDEF double gk_scene_dt_critical(const gk_scene *sc);
+/* mean stress of the particles over `volume` (2D: an area; the thickness t
+ * is applied), tension-positive, at the last step of the last call:
+ * (1/V) sum over particles of f (x) (x_c - x_p) over their contact forces
+ * with each other (the Love form -F (x) d of gk_dem.h) and with walls
+ * (forces applied at particle centres - gravity, membrane, external - add
+ * nothing). In equilibrium it is the stress the boundary applies. */
+GKDEF void gk_scene_stress(const gk_scene *sc, double volume, double sigma[9]);
 
 GKDEF gk_result gk_scene_add_wall(gk_scene *sc, const gk_wall_def *wd, int *index);
 GKDEF gk_result gk_scene_add_box(gk_scene *sc, const gk_material *m, unsigned faces, int *first);
@@ -309,14 +364,15 @@ GKDEF gk_result gk_scene_prescribe(gk_scene *sc, int p, const double v[3], const
 GKDEF gk_result gk_scene_release(gk_scene *sc, int p);
 /* mass and moment of inertia of particle p (e.g. another density) */
 GKDEF gk_result gk_scene_set_mass(gk_scene *sc, int p, double m, double I);
+/* velocity and spin of particle p (NULL: unchanged), e.g. the initial state */
 GKDEF gk_result gk_scene_set_velocity(gk_scene *sc, int p, const double v[3], const double w[3]);
 
-GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, double pressure, double stiffness,
-                                      int *index);
+GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, double pressure,
+                                      double stiffness, int anchor_first, int anchor_last, int *index);
 /* 2D: the outermost particle of every band of width `band` along the other
  * axis, on side (-1 low, +1 high) of axis `axis`, ordered with the material
  * on the chain's left; ids written to ids (capacity cap), count to *k */
-GKDEF gk_result gk_scene_side_chain(const gk_scene *sc, int axis, int side, double band, int32_t *ids, int cap,
+GKDEF gk_result gk_scene_side_chain(gk_scene *sc, int axis, int side, double band, int32_t *ids, int cap,
                                     int *k);
 
 GKDEF gk_result gk_scene_insert(gk_scene *sc, int k, const double *const x[3], const double *r,
@@ -370,7 +426,8 @@ GKDEF gk_wall_def gk_wall_def_default(void) {
     return w;
 }
 
-GKDEF gk_result gk_scene_pair_material(const gk_material *a, const gk_material *b, gk_material *out, gk_err *err) {
+GKDEF gk_result gk_scene_pair_material(const gk_material *a, const gk_material *b, gk_material *out,
+                                       gk_err *err) {
     gk_material m;
     gk_result r;
     if (!a || !out) return gk_err_set(err, GK_ERR_ARG, "pair material: no material given");
@@ -393,7 +450,8 @@ GKDEF gk_result gk_scene_pair_material(const gk_material *a, const gk_material *
         q = ht / hn;
         nu = (2.0 - 2.0 * q) / (2.0 - q);
         if (!(nu > -1.0 && nu < 0.5))
-            return gk_err_set(err, GK_ERR_ARG, "pair material: equivalent Poisson ratio %g outside (-1, 0.5)", nu);
+            return gk_err_set(err, GK_ERR_ARG, "pair material: equivalent Poisson ratio %g outside (-1, 0.5)",
+                              nu);
         m.poisson = nu;
         m.young = 2.0 * hn * (1.0 - nu * nu);
     } else {
@@ -537,6 +595,7 @@ GKDEF void gk_scene_destroy(gk_scene *sc) {
         gk__sc_free(sc, sc->hmr[k]);
     }
     gk__sc_free(sc, sc->hcs);
+    gk__sc_free(sc, sc->rec);
     gk_rve_destroy(&sc->rve);
     sc->walls = NULL;
     sc->mem = NULL;
@@ -550,6 +609,8 @@ GKDEF void gk_scene_destroy(gk_scene *sc) {
         sc->hft[k] = sc->hmr[k] = NULL;
     }
     sc->hcs = NULL;
+    sc->rec = NULL;
+    sc->nrec = sc->caprec = 0;
 }
 
 /* ------------------------------------------------------------- create */
@@ -569,14 +630,16 @@ GKDEF gk_result gk_scene_create(gk_scene *out, const gk_scene_def *def, const gk
     gk_err_clear(err);
     if (!def || def->cookie != GK_SCENE_DEF_COOKIE)
         return gk_err_set(err, GK_ERR_ARG, "gk_scene_def not initialised with gk_scene_def_default()");
-    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1) return gk_err_set(err, GK_ERR_ARG, "no particles given");
+    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1)
+        return gk_err_set(err, GK_ERR_ARG, "no particles given");
     dim = def->dim;
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "scene dimension %d (must be 2 or 3)", dim);
     if (pk->dim != dim) return gk_err_set(err, GK_ERR_ARG, "packing is %dD, scene %dD", pk->dim, dim);
     if (def->lost != GK_LOST_ERROR && def->lost != GK_LOST_DELETE)
         return gk_err_set(err, GK_ERR_ARG, "unknown lost-particle policy %d", (int)def->lost);
     for (k = 0; k < 3; ++k)
-        if (!isfinite(def->gravity[k])) return gk_err_set(err, GK_ERR_NAN, "gravity has a non-finite component");
+        if (!isfinite(def->gravity[k]))
+            return gk_err_set(err, GK_ERR_NAN, "gravity has a non-finite component");
     if (def->periodic & ~((1u << dim) - 1u))
         return gk_err_set(err, GK_ERR_ARG, "periodic mask 0x%x names an axis beyond %dD", def->periodic, dim);
     for (k = 0; k < dim; ++k) {
@@ -609,8 +672,9 @@ GKDEF gk_result gk_scene_create(gk_scene *out, const gk_scene_def *def, const gk
             if (def->periodic & (1u << k)) {
                 u = def->lo[k] + (u - def->lo[k]) - D * floor((u - def->lo[k]) / D);
             } else if (u < def->lo[k] || u > def->hi[k]) {
-                res = gk_err_set(err, GK_ERR_OUTSIDE, "particle %d at %g on axis %d is outside the domain [%g, %g]",
-                                 p, u, k, def->lo[k], def->hi[k]);
+                res = gk_err_set(err, GK_ERR_OUTSIDE,
+                                 "particle %d at %g on axis %d is outside the domain [%g, %g]", p, u, k,
+                                 def->lo[k], def->hi[k]);
                 break;
             }
             x[k] = u - S.origin[k];
@@ -627,11 +691,14 @@ GKDEF gk_result gk_scene_create(gk_scene *out, const gk_scene_def *def, const gk
     gk_packing_free(&fr);
     if (res) return res;
     for (k = 0; k < dim; ++k)
-        if (!(def->periodic & (1u << k)) && !(0.5 * (def->hi[k] - def->lo[k]) > gk__scene_cutoff(&S))) {
+        if (!(def->periodic & (1u << k)) &&
+            !(0.5 * (def->hi[k] - def->lo[k]) > gk__scene_cutoff(&S) + S.rve.skin)) {
             gk_rve_destroy(&S.rve);
-            return gk_err_set(err, GK_ERR_CELL,
-                              "open axis %d: the domain (%g) must be longer than twice the interaction range %g", k,
-                              def->hi[k] - def->lo[k], gk__scene_cutoff(&S));
+            return gk_err_set(
+                err, GK_ERR_CELL,
+                "open axis %d: the domain (%g) must be longer than twice the interaction range plus "
+                "the skin, %g",
+                k, def->hi[k] - def->lo[k], gk__scene_cutoff(&S) + S.rve.skin);
         }
     S.rve.cells.open = S.open;
     S.rve.outer_valid = 0;
@@ -663,7 +730,9 @@ GKDEF gk_result gk_scene_create(gk_scene *out, const gk_scene_def *def, const gk
 }
 
 /* ------------------------------------------------------------- walls */
-static double gk__dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double gk__dot3(const double a[3], const double b[3]) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 
 /* nearest surface point c of wall W to x; n (unit) from the surface towards
  * x; returns the distance from the surface to x (signed for a plane) */
@@ -768,7 +837,8 @@ static gk_result gk__wall_check(gk_scene *sc, const gk_wall_def *d) {
     switch (d->kind) {
     case GK_WALL_PLANE:
         nn = gk__dot3(d->normal, d->normal);
-        if (fabs(nn - 1.0) > 1e-9) return gk_err_set(e, GK_ERR_ARG, "wall: plane normal must be a unit vector");
+        if (fabs(nn - 1.0) > 1e-9)
+            return gk_err_set(e, GK_ERR_ARG, "wall: plane normal must be a unit vector");
         break;
     case GK_WALL_SEGMENT:
         if (dim != 2) return gk_err_set(e, GK_ERR_ARG, "wall: a segment is 2D (use a rectangle in 3D)");
@@ -805,7 +875,8 @@ static gk_result gk__wall_check(gk_scene *sc, const gk_wall_def *d) {
         if (!(d->gain >= 0.0 && d->gain <= 1.0))
             return gk_err_set(e, GK_ERR_ARG, "wall servo: gain %g outside [0, 1]", d->gain);
         if (fabs(gk__dot3(d->normal, d->normal) - 1.0) > 1e-9)
-            return gk_err_set(e, GK_ERR_ARG, "wall servo: normal (the servo direction) must be a unit vector");
+            return gk_err_set(e, GK_ERR_ARG,
+                              "wall servo: normal (the servo direction) must be a unit vector");
         if (d->drive == GK_DRIVE_STRESS && (!(d->area > 0.0) || !isfinite(d->area)))
             return gk_err_set(e, GK_ERR_ARG, "wall servo: stress target needs area > 0 (got %g)", d->area);
     } else if (d->drive != GK_DRIVE_VELOCITY) {
@@ -825,11 +896,18 @@ static double gk__walls_dt_critical(const gk_scene *sc) {
         gk_real kn, fn, kt;
         double d = 2.0 * W->dmax, r = sc->rve.rmax;
         if (d < 1e-3 * sc->rve.rmin) d = 1e-3 * sc->rve.rmin;
-        gk__wall_consts(W, W->def.inside ? r : 0.0, &K); /* outside: the flattest is a plane; inside: the tightest */
+        gk__wall_consts(W, W->def.inside ? r : 0.0,
+                        &K); /* outside: the flattest is a plane; inside: the tightest */
         gk_contact_stiffness(&K, W->def.mat.law, (gk_real)r, (gk_real)r, (gk_real)d, &kn, &fn, &kt);
         if (kn > 0 && sqrt(sc->rve.mmin / (double)kn) < dtc) dtc = sqrt(sc->rve.mmin / (double)kn);
     }
     return dtc;
+}
+
+GKDEF void gk_scene_stress(const gk_scene *sc, double volume, double sigma[9]) {
+    double V = volume * (sc->dim == 2 ? sc->rve.volume_factor : 1.0), Vc = gk_rve_volume(&sc->rve);
+    int k;
+    for (k = 0; k < 9; ++k) sigma[k] = (sc->rve.stress[k] * Vc + sc->wall_love[k]) / V;
 }
 
 GKDEF double gk_scene_dt_critical(const gk_scene *sc) {
@@ -863,21 +941,28 @@ GKDEF gk_result gk_scene_add_wall(gk_scene *sc, const gk_wall_def *wd, int *inde
     for (k = 0; k < 3; ++k) {
         if (k < (sc->dim == 2 ? 1 : 3) && (W.phys & GK_PHYS_TANGENT)) {
             W.ft[k] = (gk_real *)gk_alloc(gk__sc_alloc(sc), n * R);
-            if (!W.ft[k]) r = GK_ERR_ALLOC;
-            else memset(W.ft[k], 0, n * R);
+            if (!W.ft[k])
+                r = GK_ERR_ALLOC;
+            else
+                memset(W.ft[k], 0, n * R);
         }
         if ((sc->dim == 3 || k == 0) && (W.phys & GK_PHYS_ROLLING)) {
             W.mr[k] = (gk_real *)gk_alloc(gk__sc_alloc(sc), n * R);
-            if (!W.mr[k]) r = GK_ERR_ALLOC;
-            else memset(W.mr[k], 0, n * R);
+            if (!W.mr[k])
+                r = GK_ERR_ALLOC;
+            else
+                memset(W.mr[k], 0, n * R);
         }
     }
     W.cs = (unsigned char *)gk_alloc(gk__sc_alloc(sc), n);
-    if (!W.cs) r = GK_ERR_ALLOC;
-    else memset(W.cs, 0, n);
+    if (!W.cs)
+        r = GK_ERR_ALLOC;
+    else
+        memset(W.cs, 0, n);
     if (!r && sc->nwalls == sc->capwalls) {
         int cap = sc->capwalls ? 2 * sc->capwalls : 8;
-        if (gk_realloc(gk__sc_alloc(sc), (void **)&sc->walls, (size_t)sc->nwalls, (size_t)cap, sizeof(gk_wall)))
+        if (gk_realloc(gk__sc_alloc(sc), (void **)&sc->walls, (size_t)sc->nwalls, (size_t)cap,
+                       sizeof(gk_wall)))
             r = GK_ERR_ALLOC;
         else
             sc->capwalls = cap;
@@ -892,9 +977,10 @@ GKDEF gk_result gk_scene_add_wall(gk_scene *sc, const gk_wall_def *wd, int *inde
     if (sc->def.rve.dt > 0.0) {
         if (sc->rve.dt > dtc) {
             gk__wall_free(sc, &sc->walls[--sc->nwalls]);
-            return gk_err_set(&sc->err, GK_ERR_DT,
-                              "time step %g s is above the critical %g s of this wall's contacts (seed 000 eq 19)",
-                              sc->rve.dt, dtc);
+            return gk_err_set(
+                &sc->err, GK_ERR_DT,
+                "time step %g s is above the critical %g s of this wall's contacts (seed 000 eq 19)",
+                sc->rve.dt, dtc);
         }
     } else {
         double f = sc->def.rve.dt_factor > 0.0 ? sc->def.rve.dt_factor : 0.5;
@@ -933,7 +1019,8 @@ static gk_result gk__wall_build(gk_scene *sc, gk_wall *W) {
             (W->cs[p] & GK_CS_CONTACT)) {
             if (W->ncand == W->capcand) {
                 int cap = W->capcand ? 2 * W->capcand : 64;
-                if (gk_realloc(gk__sc_alloc(sc), (void **)&W->cand, (size_t)W->ncand, (size_t)cap, sizeof(int32_t)))
+                if (gk_realloc(gk__sc_alloc(sc), (void **)&W->cand, (size_t)W->ncand, (size_t)cap,
+                               sizeof(int32_t)))
                     return gk_err_set(&sc->err, GK_ERR_ALLOC, "out of memory for wall contacts");
                 W->capcand = cap;
             }
@@ -947,74 +1034,87 @@ static gk_result gk__wall_build(gk_scene *sc, gk_wall *W) {
 }
 
 /* ------------------------------------------------------------- energy helpers */
-/* elastic energy of one contact: normal spring (overlap delta), tangential
- * spring ft, rolling spring mr, with the law's current stiffnesses */
-static double gk__contact_elastic(const gk_law_consts *K, gk_law law, unsigned fl, int dim, gk_real ri, gk_real rj,
-                                  gk_real delta, const gk_real *ft, const gk_real *mr) {
+/* elastic energy of one contact: normal spring (overlap delta) returned,
+ * tangential spring ft and rolling spring mr in *rest, with the law's
+ * current stiffnesses */
+static double gk__contact_elastic(const gk_law_consts *K, gk_law law, unsigned fl, int dim, gk_real ri,
+                                  gk_real rj, gk_real delta, const gk_real *ft, const gk_real *mr,
+                                  double *rest) {
     gk_real kn, fn, kt;
     double e, t2 = 0.0, m2 = 0.0;
     int k, nh = dim == 2 ? 1 : 3;
     gk_contact_stiffness(K, law, ri, rj, delta, &kn, &fn, &kt);
     e = law == GK_LAW_LINEAR ? 0.5 * (double)fn * (double)delta : 0.4 * (double)fn * (double)delta;
+    *rest = 0.0;
     if ((fl & GK_PHYS_TANGENT) && kt > 0) {
         for (k = 0; k < nh; ++k) t2 += (double)ft[k] * (double)ft[k];
-        e += t2 / (2.0 * (double)kt);
+        *rest += t2 / (2.0 * (double)kt);
     }
     if ((fl & GK_PHYS_ROLLING) && mr) {
         double kr = (double)K->beta * (double)kt * (double)ri * (double)rj;
         for (k = 0; k < nh; ++k) m2 += (double)mr[k] * (double)mr[k];
-        if (kr > 0) e += m2 / (2.0 * kr);
+        if (kr > 0) *rest += m2 / (2.0 * kr);
     }
     return e;
 }
 
-/* energy terms of one contact evaluated at this step from its old history:
- * elastic energy after the step, viscous and frictional dissipation during
- * it. d: branch vector, v: relative velocity, wi, wj: spins (2D: [2]).
- * Writes the new history to ft, mr, cs (what the kernel wrote). */
+/* One contact evaluated with the law from its old history (writes the new
+ * history to ft, mr, cs: what the kernel wrote) and, with `energy`, its
+ * books: elastic energy after the step (normal; tangential + rolling in
+ * rest), and for the step's dissipation the forces it applied (kept in a
+ * record and priced at the mean velocities once the leap-frog update is
+ * known), the tangential dashpot's work at the old velocities and the slip
+ * estimate of Coulomb sliding (F_t times (F_trial - F_t) / k_t: the check
+ * on the friction the records give). */
 typedef struct gk__cterm {
-    double elastic, viscous, friction;
+    double elastic, rest, visc_t, slip, fvn, n[3];
     gk_contact_out o;
 } gk__cterm;
 
-static void gk__contact_terms(const gk_law_consts *K, gk_law law, unsigned fl, int dim, const gk_real d[3], gk_real ri,
-                              gk_real rj, gk_real mi, gk_real mj, const gk_real v[3], const gk_real wi[3],
-                              const gk_real wj[3], gk_real dt, int energy, gk_real *ft, gk_real *mr,
-                              unsigned char *cs, gk__cterm *t) {
+/* the forces of one contact for the books: i, j particles (i < 0: wall
+ * -1 - i, moving at vs at the contact), normal n (i to j), normal dashpot
+ * force fvn (on j, along n), tangential force ft (on j), torques ti, tj */
+typedef struct gk__erec {
+    int32_t i, j;
+    double n[3], fvn, ft[3], ti[3], tj[3], vs[3];
+} gk__erec;
+
+static void gk__contact_terms(const gk_law_consts *K, gk_law law, unsigned fl, int dim, const gk_real d[3],
+                              gk_real ri, gk_real rj, gk_real mi, gk_real mj, const gk_real v[3],
+                              const gk_real wi[3], const gk_real wj[3], gk_real dt, int energy, gk_real *ft,
+                              gk_real *mr, unsigned char *cs, gk__cterm *t) {
     gk_real ft0[3], mr0[3], dummy[3] = {0, 0, 0}, kn, fn, kt;
     unsigned char cs0 = *cs;
     int k, nh = dim == 2 ? 1 : 3, in;
+    double dist;
     for (k = 0; k < 3; ++k) {
         ft0[k] = ft[k];
         mr0[k] = mr ? mr[k] : 0;
     }
-    t->elastic = t->viscous = t->friction = 0.0;
+    t->elastic = t->rest = t->visc_t = t->slip = t->fvn = 0.0;
     if (dim == 2)
         in = gk_contact_2d(K, law, fl, d[0], d[1], ri, rj, mi, mj, v[0], v[1], wi[2], wj[2], dt, ft,
                            (fl & GK_PHYS_ROLLING) ? mr : dummy, cs, &t->o);
     else
-        in = gk_contact_3d(K, law, fl, d, ri, rj, mi, mj, v, wi, wj, dt, ft, (fl & GK_PHYS_ROLLING) ? mr : dummy, cs,
-                           &t->o);
+        in = gk_contact_3d(K, law, fl, d, ri, rj, mi, mj, v, wi, wj, dt, ft,
+                           (fl & GK_PHYS_ROLLING) ? mr : dummy, cs, &t->o);
     if (!in || !energy) return;
     gk_contact_stiffness(K, law, ri, rj, t->o.delta, &kn, &fn, &kt);
-    t->elastic = gk__contact_elastic(K, law, fl, dim, ri, rj, t->o.delta, ft, mr);
-    if (fl & GK_PHYS_VISCOUS) {
-        double mstar = (double)((mi * mj) / (mi + mj)), gn = (double)K->zn2 * sqrt(mstar * (double)kn);
-        double fv = (double)fn - (double)t->o.fn;
-        if (gn > 0) t->viscous += fv * fv / gn * (double)dt;
-        if ((fl & GK_PHYS_TANGENT) && kt > 0) {
-            double gt = (double)K->zt2 * sqrt(mstar * (double)kt), nrm[3], ftot[3], q = 0.0, fn_t = (double)t->o.fn;
-            double dist = (double)(ri + rj) - (double)t->o.delta;
-            for (k = 0; k < 3; ++k) nrm[k] = k < dim ? (double)d[k] / dist : 0.0;
-            for (k = 0; k < 3; ++k) ftot[k] = (double)t->o.f[k] - fn_t * nrm[k];
-            if (dim == 2) { /* spring minus total along t = (-ny, nx) */
-                double ftt = -ftot[0] * nrm[1] + ftot[1] * nrm[0], fv2 = (double)ft[0] - ftt;
-                q = fv2 * fv2;
-            } else {
-                for (k = 0; k < 3; ++k) q += ((double)ft[k] - ftot[k]) * ((double)ft[k] - ftot[k]);
-            }
-            if (gt > 0) t->viscous += q / gt * (double)dt;
+    t->elastic = gk__contact_elastic(K, law, fl, dim, ri, rj, t->o.delta, ft, mr, &t->rest);
+    dist = (double)(ri + rj) - (double)t->o.delta;
+    for (k = 0; k < 3; ++k) t->n[k] = k < dim ? (double)d[k] / dist : 0.0;
+    t->fvn = (double)t->o.fn - (double)fn;
+    if ((fl & GK_PHYS_VISCOUS) && (fl & GK_PHYS_TANGENT) && kt > 0) {
+        double mstar = (double)((mi * mj) / (mi + mj)), gt = (double)K->zt2 * sqrt(mstar * (double)kt),
+               tot[3], q = 0.0;
+        for (k = 0; k < 3; ++k) tot[k] = (double)t->o.f[k] - (double)t->o.fn * t->n[k];
+        if (dim == 2) { /* spring minus total along t = (-ny, nx) */
+            double fv2 = (double)ft[0] - (-tot[0] * t->n[1] + tot[1] * t->n[0]);
+            q = fv2 * fv2;
+        } else {
+            for (k = 0; k < 3; ++k) q += ((double)ft[k] - tot[k]) * ((double)ft[k] - tot[k]);
         }
+        if (gt > 0) t->visc_t = q / gt * (double)dt;
     }
     if (((fl & GK_PHYS_TANGENT) && (*cs & GK_CS_SLIDING)) || (fl & GK_PHYS_ROLLING)) {
         /* the trial springs without the Coulomb caps: slip = (trial - new) / k */
@@ -1030,32 +1130,92 @@ static void gk__contact_terms(const gk_law_consts *K, gk_law law, unsigned fl, i
             tm[k] = mr0[k];
         }
         if (dim == 2)
-            gk_contact_2d(&Kf, law, fl, d[0], d[1], ri, rj, mi, mj, v[0], v[1], wi[2], wj[2], dt, tf, tm, &tcs, &o2);
+            gk_contact_2d(&Kf, law, fl, d[0], d[1], ri, rj, mi, mj, v[0], v[1], wi[2], wj[2], dt, tf, tm,
+                          &tcs, &o2);
         else
             gk_contact_3d(&Kf, law, fl, d, ri, rj, mi, mj, v, wi, wj, dt, tf, tm, &tcs, &o2);
         if ((fl & GK_PHYS_TANGENT) && (*cs & GK_CS_SLIDING) && kt > 0) {
-            double dist = (double)(ri + rj) - (double)t->o.delta, nrm[3], tot[3];
-            for (k = 0; k < 3; ++k) nrm[k] = k < dim ? (double)d[k] / dist : 0.0;
-            for (k = 0; k < 3; ++k) tot[k] = (double)t->o.f[k] - (double)t->o.fn * nrm[k];
+            double tot[3];
+            for (k = 0; k < 3; ++k) tot[k] = (double)t->o.f[k] - (double)t->o.fn * t->n[k];
             for (k = 0; k < nh; ++k) s2 += ((double)tf[k] - (double)ft[k]) * ((double)tf[k] - (double)ft[k]);
             for (k = 0; k < 3; ++k) f2 += tot[k] * tot[k];
-            t->friction += sqrt(f2) * sqrt(s2) / (double)kt;
+            t->slip += sqrt(f2) * sqrt(s2) / (double)kt;
         }
         if (fl & GK_PHYS_ROLLING) {
             double kr = (double)K->beta * (double)kt * (double)ri * (double)rj, m2 = 0.0, ds2 = 0.0;
             for (k = 0; k < nh; ++k) {
-                int q = dim == 2 ? 0 : k;
-                m2 += (double)mr[q] * (double)mr[q];
-                ds2 += ((double)tm[q] - (double)mr[q]) * ((double)tm[q] - (double)mr[q]);
+                m2 += (double)mr[k] * (double)mr[k];
+                ds2 += ((double)tm[k] - (double)mr[k]) * ((double)tm[k] - (double)mr[k]);
             }
-            if (kr > 0) t->friction += sqrt(m2) * sqrt(ds2) / kr;
+            if (kr > 0) t->slip += sqrt(m2) * sqrt(ds2) / kr;
         }
     }
 }
 
+/* book one evaluated contact: energies now, and its forces for the step's dissipation */
+static void gk__book(gk_scene *sc, int32_t i, int32_t j, const gk__cterm *t, const double vs[3]) {
+    gk__erec *e;
+    int k;
+    sc->el_step += t->elastic + t->rest;
+    sc->erest_now += t->rest;
+    sc->en.viscous += t->visc_t;
+    sc->en.friction -= t->visc_t; /* the records price both dashpot and slip; see gk__price_records */
+    sc->slip_step += t->slip;
+    if (sc->nrec == sc->caprec) {
+        size_t cap = sc->caprec ? 2 * sc->caprec : 256;
+        if (gk_realloc(gk__sc_alloc(sc), (void **)&sc->rec, sc->nrec, cap, sizeof(gk__erec))) {
+            sc->rec_failed = 1;
+            return;
+        }
+        sc->caprec = cap;
+    }
+    e = (gk__erec *)sc->rec + sc->nrec++;
+    e->i = i;
+    e->j = j;
+    e->fvn = t->fvn;
+    for (k = 0; k < 3; ++k) {
+        e->n[k] = t->n[k];
+        e->ft[k] = (double)t->o.f[k] - (double)t->o.fn * t->n[k];
+        e->ti[k] = (double)t->o.ti[k];
+        e->tj[k] = (double)t->o.tj[k];
+        e->vs[k] = vs ? vs[k] : 0.0;
+    }
+}
+
+/* the step's contact dissipation from the records, at the mean velocities
+ * v_bar = (v_{n-1/2} + v_{n+1/2}) / 2 (the leap-frog's own work): the normal
+ * dashpots' work is viscous; what the tangential forces and the torques
+ * took out of the particles beyond the change of the tangential and rolling
+ * springs' energy is friction (Coulomb and rolling slip, plus the
+ * tangential dashpots, moved to viscous at their old-velocity estimate) */
+static void gk__price_records(gk_scene *sc) {
+    gk_rve *rve = &sc->rve;
+    double dt = rve->dt, dvn = 0.0, prest = 0.0;
+    size_t c;
+    int k;
+    for (c = 0; c < sc->nrec; ++c) {
+        const gk__erec *e = (const gk__erec *)sc->rec + c;
+        double vj[3], vi[3], wj[3], wi[3], dv[3];
+        for (k = 0; k < 3; ++k) {
+            int j = e->j, i = e->i;
+            vj[k] = k < sc->dim ? 0.5 * ((double)rve->v[k][j] + sc->vold[k][j]) : 0.0;
+            wj[k] = rve->w[k] ? 0.5 * ((double)rve->w[k][j] + sc->wold[k][j]) : 0.0;
+            vi[k] = i >= 0 ? (k < sc->dim ? 0.5 * ((double)rve->v[k][i] + sc->vold[k][i]) : 0.0) : e->vs[k];
+            wi[k] = i >= 0 && rve->w[k] ? 0.5 * ((double)rve->w[k][i] + sc->wold[k][i]) : 0.0;
+            dv[k] = vj[k] - vi[k];
+        }
+        dvn += e->fvn * gk__dot3(e->n, dv);
+        prest += gk__dot3(e->ft, dv) + gk__dot3(e->ti, wi) + gk__dot3(e->tj, wj);
+    }
+    sc->en.viscous -= dvn * dt;
+    sc->en.friction += -prest * dt - (sc->erest_now - sc->erest_prev);
+    sc->erest_prev = sc->erest_now;
+}
+
 /* branch vector and relative kinematics of pair c, exactly as the kernels
  * build them (no affine field in a scene) */
-static void gk__pair_inputs(const gk_rve *rve, int c, gk_real d[3], gk_real v[3], gk_real wi[3], gk_real wj[3]) {
+static void gk__pair_inputs(const gk_rve *rve, int c, gk_real d[3], gk_real v[3], gk_real wi[3],
+                            gk_real wj[3]) {
     int i = rve->pl.i[c], j = rve->pl.j[c], k, dim = rve->dim;
     const double *h = rve->cell.h;
     double ds[3];
@@ -1076,7 +1236,6 @@ static void gk__pair_inputs(const gk_rve *rve, int c, gk_real d[3], gk_real v[3]
 static void gk__energy_pairs(gk_scene *sc) {
     gk_rve *rve = &sc->rve;
     int c, k, dim = rve->dim, nh = dim == 2 ? 1 : 3;
-    double el = 0.0, vis = 0.0, fr = 0.0;
     gk_real dt = (gk_real)rve->dt;
     for (c = 0; c < rve->pl.n; ++c) {
         gk_real d[3], v[3], wi[3], wj[3], ft[3] = {0, 0, 0}, mr[3] = {0, 0, 0};
@@ -1090,21 +1249,17 @@ static void gk__energy_pairs(gk_scene *sc) {
             if (sc->hmr[mk]) mr[k] = sc->hmr[mk][c];
         }
         gk__pair_inputs(rve, c, d, v, wi, wj);
-        gk__contact_terms(&rve->K, rve->def.mat.law, rve->phys, dim, d, rve->r[i], rve->r[j], (gk_real)1 / rve->minv[i],
-                          (gk_real)1 / rve->minv[j], v, wi, wj, dt, 1, ft, mr, &cs, &t);
+        gk__contact_terms(&rve->K, rve->def.mat.law, rve->phys, dim, d, rve->r[i], rve->r[j],
+                          (gk_real)1 / rve->minv[i], (gk_real)1 / rve->minv[j], v, wi, wj, dt, 1, ft, mr, &cs,
+                          &t);
         if (cs != rve->cs[c]) same = 0;
         for (k = 0; k < nh; ++k) {
             if (rve->ft[k] && ft[k] != rve->ft[k][c]) same = 0;
             if ((rve->phys & GK_PHYS_ROLLING) && mr[k] != rve->mr[dim == 2 ? 2 : k][c]) same = 0;
         }
         if (!same) ++sc->energy_mismatch;
-        el += t.elastic;
-        vis += t.viscous;
-        fr += t.friction;
+        if (cs & GK_CS_CONTACT) gk__book(sc, i, j, &t, NULL);
     }
-    sc->el_step += el;
-    sc->en.viscous += vis;
-    sc->en.friction += fr;
 }
 
 /* ------------------------------------------------------------- wall contacts */
@@ -1113,7 +1268,7 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
     int e, k, dim = sc->dim, rot = (rve->phys & GK_PHYS_ROTATION) != 0, nh = dim == 2 ? 1 : 3;
     gk_law law = W->def.mat.law;
     gk_real dt = (gk_real)rve->dt, zero3[3] = {0, 0, 0};
-    double F[3] = {0, 0, 0}, M[3] = {0, 0, 0}, K = 0.0, dmax = 0.0, el = 0.0, vis = 0.0, fr = 0.0, work = 0.0;
+    double F[3] = {0, 0, 0}, M[3] = {0, 0, 0}, K = 0.0, dmax = 0.0, work = 0.0;
     int nc = 0;
     for (e = 0; e < W->ncand; ++e) {
         int p = W->cand[e];
@@ -1141,8 +1296,8 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
             if (W->mr[k]) mr[dim == 2 ? 0 : k] = W->mr[k][p];
         }
         gk__wall_consts(W, r, &Kc);
-        gk__contact_terms(&Kc, law, W->phys, dim, d, (gk_real)r, (gk_real)r, m, m, v, zero3, wj, dt, sc->energy_on, ft,
-                          mr, &cs, &t);
+        gk__contact_terms(&Kc, law, W->phys, dim, d, (gk_real)r, (gk_real)r, m, m, v, zero3, wj, dt,
+                          sc->energy_on, ft, mr, &cs, &t);
         for (k = 0; k < nh; ++k) {
             if (W->ft[k]) W->ft[k][p] = ft[dim == 2 ? 0 : k];
             if (W->mr[k]) W->mr[k][p] = mr[dim == 2 ? 0 : k];
@@ -1171,10 +1326,14 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
                 F[k] -= f[k];
                 M[k] -= mp[k] + (dim == 3 || k == 2 ? (double)t.o.tj[k] : 0.0);
             }
+            { /* stress: f (x) (x_c - x_p), the contact point at r - delta/2 towards the wall */
+                double l = r - 0.5 * (double)t.o.delta;
+                int a, b;
+                for (a = 0; a < dim; ++a)
+                    for (b = 0; b < dim; ++b) sc->wall_love[3 * a + b] += f[a] * (-n[b] * l);
+            }
             work += gk__dot3(f, vs) * (double)dt;
-            el += t.elastic;
-            vis += t.viscous;
-            fr += t.friction;
+            if (sc->energy_on) gk__book(sc, (int32_t)(-1 - (W - sc->walls)), p, &t, vs);
             ++nc;
         }
     }
@@ -1186,12 +1345,7 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
     W->ncontacts = nc;
     W->dmax = dmax;
     W->resistance = -gk__dot3(F, W->def.normal);
-    if (sc->energy_on) {
-        sc->el_step += el;
-        sc->en.viscous += vis;
-        sc->en.friction += fr;
-        sc->en.walls += work;
-    }
+    if (sc->energy_on) sc->en.walls += work;
 }
 
 /* the wall's velocity for the next step: prescribed, or the servo's */
@@ -1201,14 +1355,16 @@ static void gk__wall_drive(gk_scene *sc, gk_wall *W) {
     if (d->drive == GK_DRIVE_VELOCITY) {
         for (k = 0; k < 3; ++k) W->vel[k] = d->velocity[k];
     } else {
-        double target = d->drive == GK_DRIVE_STRESS ? d->target * d->area : d->target, sp;
+        double target = d->drive == GK_DRIVE_STRESS ? d->target * d->area : d->target, sp, vn;
         double gain = d->gain > 0.0 ? d->gain : 0.05;
         if (W->stiffness > 0.0)
             sp = gain * (target - W->resistance) / (W->stiffness * sc->rve.dt);
         else
             sp = target > W->resistance ? d->max_speed : -d->max_speed;
         sp = gk_clamp(sp, -d->max_speed, d->max_speed);
-        for (k = 0; k < 3; ++k) W->vel[k] = sp * d->normal[k];
+        /* plus def.velocity's part across the servo direction (shear under a constant normal load) */
+        vn = gk__dot3(d->velocity, d->normal);
+        for (k = 0; k < 3; ++k) W->vel[k] = sp * d->normal[k] + d->velocity[k] - vn * d->normal[k];
     }
     if (sc->dim == 2) W->vel[2] = 0.0;
 }
@@ -1244,6 +1400,35 @@ static void gk__membranes(gk_scene *sc) {
                 rve->f[0][b] -= (gk_real)(f * ux);
                 rve->f[1][b] -= (gk_real)(f * uy);
                 el += 0.5 * M->stiffness * (L - M->rest[e]) * (L - M->rest[e]);
+                /* stress: an inner force of the particles, f L u (x) u (tension) */
+                sc->wall_love[0] += f * L * ux * ux;
+                sc->wall_love[1] += f * L * ux * uy;
+                sc->wall_love[3] += f * L * uy * ux;
+                sc->wall_love[4] += f * L * uy * uy;
+            }
+        }
+        for (e = 0; e < 2 && M->n > 0; ++e) { /* anchors: the segment to the platen and its link */
+            int end = e ? M->n - 1 : 0, a = gk_scene_index(sc, M->ids[end]);
+            double xa[3], A[3], nw[3], ex, ey, L;
+            gk_wall *W;
+            M->af[e][0] = M->af[e][1] = 0.0;
+            if (M->anchor[e] < 0 || a < 0) continue;
+            W = &sc->walls[M->anchor[e]];
+            gk_scene_position(sc, a, xa);
+            L = gk__wall_geom(W, sc->dim, xa, A, nw); /* A: the member's foot on the wall */
+            /* chain order: anchor -> first member, last member -> anchor */
+            ex = e ? A[0] - xa[0] : xa[0] - A[0];
+            ey = e ? A[1] - xa[1] : xa[1] - A[1];
+            M->fx[end] += 0.5 * M->pressure * t * -ey;
+            M->fy[end] += 0.5 * M->pressure * t * ex;
+            if (M->stiffness > 0.0 && L > M->arest[e]) {
+                double f = M->stiffness * (L - M->arest[e]), ux = -nw[0], uy = -nw[1];
+                rve->f[0][a] += (gk_real)(f * ux);
+                rve->f[1][a] += (gk_real)(f * uy);
+                M->af[e][0] = f * ux; /* the wall holds it; not in W->force (its contacts only) */
+                M->af[e][1] = f * uy;
+                el += 0.5 * M->stiffness * (L - M->arest[e]) * (L - M->arest[e]);
+                if (sc->energy_on) sc->en.walls += f * (ux * W->vel[0] + uy * W->vel[1]) * rve->dt;
             }
         }
         for (e = 0; e < M->n; ++e) {
@@ -1273,8 +1458,8 @@ static gk_result gk__scene_lost(gk_scene *sc) {
     }
     if (nlost) {
         gk_err_set(&sc->rve.err, GK_ERR_OUTSIDE,
-                   "%d particle(s) left the open domain at step %ld (def.lost = GK_LOST_DELETE deletes them)", nlost,
-                   sc->rve.step);
+                   "%d particle(s) left the open domain at step %ld (def.lost = GK_LOST_DELETE deletes them)",
+                   nlost, sc->rve.step);
         return GK_ERR_OUTSIDE;
     }
     return GK_OK;
@@ -1311,10 +1496,11 @@ static gk_result gk__hook_pre(gk_scene *sc) {
         if (sc->open && (r = gk__scene_lost(sc)) != GK_OK) return r;
         sc->seen_rebuilds = rve->rebuilds;
         if (sc->nwalls && gk__walls_dt_critical(sc) < rve->dt)
-            return gk_err_set(&rve->err, GK_ERR_DT,
-                              "time step %g s now exceeds the critical %g s of the wall contacts at their current "
-                              "overlaps: restore a saved state and use a smaller dt",
-                              rve->dt, gk__walls_dt_critical(sc));
+            return gk_err_set(
+                &rve->err, GK_ERR_DT,
+                "time step %g s now exceeds the critical %g s of the wall contacts at their current "
+                "overlaps: restore a saved state and use a smaller dt",
+                rve->dt, gk__walls_dt_critical(sc));
     }
     for (w = 0; w < sc->nwalls; ++w) {
         gk_wall *W = &sc->walls[w];
@@ -1341,9 +1527,11 @@ static void gk__hook_post_forces(gk_scene *sc) {
         for (k = 0; k < 3; ++k)
             if (rve->w[k])
                 for (p = 0; p < n; ++p) sc->wold[k][p] = (double)rve->w[k][p];
-        sc->el_step = 0.0;
+        sc->el_step = sc->erest_now = sc->slip_step = 0.0;
+        sc->nrec = 0;
         gk__energy_pairs(sc);
     }
+    for (k = 0; k < 9; ++k) sc->wall_love[k] = 0.0;
     for (w = 0; w < sc->nwalls; ++w) gk__wall_contacts(sc, &sc->walls[w]);
     if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0)
         for (k = 0; k < dim; ++k)
@@ -1364,8 +1552,10 @@ static void gk__hook_post_forces(gk_scene *sc) {
             if (rve->t[k])
                 for (p = 0; p < n; ++p) sc->ttot[k][p] = (double)rve->t[k][p];
         sc->en.elastic = sc->el_step;
-        if (sc->energy_pending) {
+        sc->en.slip += sc->slip_step;
+        if (sc->energy_pending) { /* the springs' energy when tracking started */
             sc->en.initial += sc->el_step;
+            sc->erest_prev = sc->erest_now;
             sc->energy_pending = 0;
         }
     }
@@ -1428,6 +1618,7 @@ static void gk__hook_post_step(gk_scene *sc) {
         sc->en.prescribed += wpr;
         sc->en.damping += dmp;
         sc->en.pressure += wm;
+        gk__price_records(sc);
         sc->en.kinetic = gk__kinetic(sc);
         ++sc->en.steps;
     }
@@ -1441,12 +1632,15 @@ static void gk__hook_post_step(gk_scene *sc) {
 
 static gk_result gk__scene_hook(gk_rve *rve, int stage, void *user) {
     gk_scene *sc = (gk_scene *)user;
-    (void)rve;
     if (stage == GK_HOOK_PRE_FORCES) return gk__hook_pre(sc);
     if (stage == GK_HOOK_POST_FORCES)
         gk__hook_post_forces(sc);
     else
         gk__hook_post_step(sc);
+    if (sc->rec_failed) {
+        sc->rec_failed = 0;
+        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for the energy bookkeeping");
+    }
     return GK_OK;
 }
 
@@ -1460,12 +1654,18 @@ GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps) {
     if (nsteps < 0) return gk_err_set(&sc->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
     for (k = 0; k < 9; ++k)
         if (sc->rve.L[k] != 0.0 || sc->rve.servo_on)
-            return gk_err_set(&sc->err, GK_ERR_STATE, "a scene's cell is a fixed frame: no velocity gradient or servo");
+            return gk_err_set(&sc->err, GK_ERR_STATE,
+                              "a scene's cell is a fixed frame: no velocity gradient or servo");
     for (w = 0; w < sc->nwalls; ++w) {
         gk_wall *W = &sc->walls[w];
         if ((r = gk__wall_check(sc, &W->def)) != GK_OK) return r;
         if (sc->rve.step == 0 || W->def.drive == GK_DRIVE_VELOCITY) gk__wall_drive(sc, W);
     }
+    for (w = 0; w < sc->nmem; ++w)
+        if (!isfinite(sc->mem[w].pressure) || !(sc->mem[w].stiffness >= 0.0) ||
+            !isfinite(sc->mem[w].stiffness))
+            return gk_err_set(&sc->err, GK_ERR_ARG, "membrane %d: pressure %g / stiffness %g invalid", w,
+                              sc->mem[w].pressure, sc->mem[w].stiffness);
     sc->rve.hook = gk__scene_hook;
     sc->rve.hook_user = sc; /* the scene may have moved since the last call */
     done0 = sc->rve.step;
@@ -1483,7 +1683,8 @@ GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps) {
                 drop[p] = 0;
                 for (k = 0; k < sc->dim; ++k) {
                     double D = sc->def.hi[k] - sc->def.lo[k], m = 0.5 * D - cut;
-                    if ((sc->open & (1u << k)) && (x[k] < sc->def.lo[k] - m || x[k] > sc->def.hi[k] + m)) drop[p] = 1;
+                    if ((sc->open & (1u << k)) && (x[k] < sc->def.lo[k] - m || x[k] > sc->def.hi[k] + m))
+                        drop[p] = 1;
                 }
                 nd += drop[p];
             }
@@ -1501,7 +1702,8 @@ GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps) {
 
 /* ------------------------------------------------------------- per particle */
 static gk_result gk__scene_p(gk_scene *sc, int p) {
-    if (p < 0 || p >= sc->rve.n) return gk_err_set(&sc->err, GK_ERR_ARG, "particle index %d outside [0, %d)", p, sc->rve.n);
+    if (p < 0 || p >= sc->rve.n)
+        return gk_err_set(&sc->err, GK_ERR_ARG, "particle index %d outside [0, %d)", p, sc->rve.n);
     return GK_OK;
 }
 
@@ -1511,9 +1713,11 @@ GKDEF gk_result gk_scene_set_external(gk_scene *sc, int p, const double f[3], co
     int k;
     gk_result r;
     if ((r = gk__scene_p(sc, p)) != GK_OK) return r;
-    if (!gk__finite3(f) || !gk__finite3(t)) return gk_err_set(&sc->err, GK_ERR_NAN, "external load: non-finite value");
+    if (!gk__finite3(f) || !gk__finite3(t))
+        return gk_err_set(&sc->err, GK_ERR_NAN, "external load: non-finite value");
     for (k = 0; k < 3; ++k)
-        if ((r = gk__sc_new(sc, &sc->fext[k])) != GK_OK || (r = gk__sc_new(sc, &sc->text[k])) != GK_OK) return r;
+        if ((r = gk__sc_new(sc, &sc->fext[k])) != GK_OK || (r = gk__sc_new(sc, &sc->text[k])) != GK_OK)
+            return r;
     for (k = 0; k < 3; ++k) {
         sc->fext[k][p] = f && k < sc->dim ? f[k] : 0.0;
         sc->text[k][p] = t && (sc->dim == 3 || k == 2) ? t[k] : 0.0;
@@ -1525,7 +1729,8 @@ GKDEF gk_result gk_scene_prescribe(gk_scene *sc, int p, const double v[3], const
     int k;
     gk_result r;
     if ((r = gk__scene_p(sc, p)) != GK_OK) return r;
-    if (!gk__finite3(v) || !gk__finite3(w)) return gk_err_set(&sc->err, GK_ERR_NAN, "prescribed motion: non-finite value");
+    if (!gk__finite3(v) || !gk__finite3(w))
+        return gk_err_set(&sc->err, GK_ERR_NAN, "prescribed motion: non-finite value");
     for (k = 0; k < 3; ++k)
         if ((r = gk__sc_new(sc, &sc->vp[k])) != GK_OK || (r = gk__sc_new(sc, &sc->wp[k])) != GK_OK ||
             (r = gk__sc_new(sc, &sc->load[k])) != GK_OK || (r = gk__sc_new(sc, &sc->loadt[k])) != GK_OK)
@@ -1563,7 +1768,8 @@ GKDEF gk_result gk_scene_set_velocity(gk_scene *sc, int p, const double v[3], co
     int k;
     gk_result r;
     if ((r = gk__scene_p(sc, p)) != GK_OK) return r;
-    if (!gk__finite3(v) || !gk__finite3(w)) return gk_err_set(&sc->err, GK_ERR_NAN, "velocity: non-finite value");
+    if (!gk__finite3(v) || !gk__finite3(w))
+        return gk_err_set(&sc->err, GK_ERR_NAN, "velocity: non-finite value");
     for (k = 0; k < 3; ++k) {
         if (v && k < sc->dim) sc->rve.v[k][p] = (gk_real)v[k];
         if (w && sc->rve.w[k]) sc->rve.w[k][p] = (gk_real)w[k];
@@ -1572,18 +1778,32 @@ GKDEF gk_result gk_scene_set_velocity(gk_scene *sc, int p, const double v[3], co
 }
 
 /* ------------------------------------------------------------- membranes */
-GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, double pressure, double stiffness,
-                                      int *index) {
+GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, double pressure,
+                                      double stiffness, int anchor_first, int anchor_last, int *index) {
     gk_membrane M;
-    int e;
+    int e, a;
     if (sc->dim != 2) return gk_err_set(&sc->err, GK_ERR_UNSUPPORTED, "membranes are 2D");
     if (k < 2 || !ids) return gk_err_set(&sc->err, GK_ERR_ARG, "a membrane needs at least 2 members");
     if (!isfinite(pressure) || !(stiffness >= 0.0) || !isfinite(stiffness))
-        return gk_err_set(&sc->err, GK_ERR_ARG, "membrane pressure %g / stiffness %g invalid", pressure, stiffness);
+        return gk_err_set(&sc->err, GK_ERR_ARG, "membrane pressure %g / stiffness %g invalid", pressure,
+                          stiffness);
     for (e = 0; e < k; ++e)
         if (gk_scene_index(sc, ids[e]) < 0)
-            return gk_err_set(&sc->err, GK_ERR_ARG, "membrane member %d: no particle with id %d", e, (int)ids[e]);
+            return gk_err_set(&sc->err, GK_ERR_ARG, "membrane member %d: no particle with id %d", e,
+                              (int)ids[e]);
+    if (anchor_first < -1 || anchor_first >= sc->nwalls || anchor_last < -1 || anchor_last >= sc->nwalls)
+        return gk_err_set(&sc->err, GK_ERR_ARG, "membrane anchors %d, %d: not walls of this scene",
+                          anchor_first, anchor_last);
     memset(&M, 0, sizeof M);
+    M.anchor[0] = anchor_first;
+    M.anchor[1] = anchor_last;
+    for (a = 0; a < 2; ++a)
+        if (M.anchor[a] >= 0) {
+            gk_wall *W = &sc->walls[M.anchor[a]];
+            double x[3], c[3], nn[3];
+            gk_scene_position(sc, gk_scene_index(sc, ids[a ? k - 1 : 0]), x);
+            M.arest[a] = gk__wall_geom(W, sc->dim, x, c, nn);
+        }
     M.n = M.cap = k;
     M.pressure = pressure;
     M.stiffness = stiffness;
@@ -1592,8 +1812,9 @@ GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, d
     M.fx = (double *)gk_alloc(gk__sc_alloc(sc), (size_t)k * sizeof(double));
     M.fy = (double *)gk_alloc(gk__sc_alloc(sc), (size_t)k * sizeof(double));
     if (!M.ids || !M.rest || !M.fx || !M.fy ||
-        (sc->nmem == sc->capmem && gk_realloc(gk__sc_alloc(sc), (void **)&sc->mem, (size_t)sc->nmem,
-                                               (size_t)(sc->capmem ? 2 * sc->capmem : 4), sizeof(gk_membrane)))) {
+        (sc->nmem == sc->capmem &&
+         gk_realloc(gk__sc_alloc(sc), (void **)&sc->mem, (size_t)sc->nmem,
+                    (size_t)(sc->capmem ? 2 * sc->capmem : 4), sizeof(gk_membrane)))) {
         gk__sc_free(sc, M.ids);
         gk__sc_free(sc, M.rest);
         gk__sc_free(sc, M.fx);
@@ -1617,34 +1838,34 @@ GKDEF gk_result gk_scene_add_membrane(gk_scene *sc, int k, const int32_t *ids, d
     return GK_OK;
 }
 
-GKDEF gk_result gk_scene_side_chain(const gk_scene *sc, int axis, int side, double band, int32_t *ids, int cap,
+GKDEF gk_result gk_scene_side_chain(gk_scene *sc, int axis, int side, double band, int32_t *ids, int cap,
                                     int *k) {
     int other = 1 - axis, nb, b, p, cnt = 0;
     double lo = 1e300, hi = -1e300;
     int32_t *best;
     double *bx;
-    if (sc->dim != 2) return gk_err_set((gk_err *)&sc->err, GK_ERR_UNSUPPORTED, "side chains are 2D");
+    if (sc->dim != 2) return gk_err_set(&sc->err, GK_ERR_UNSUPPORTED, "side chains are 2D");
     if ((axis != 0 && axis != 1) || (side != -1 && side != 1) || !(band > 0.0) || !ids || !k)
-        return gk_err_set((gk_err *)&sc->err, GK_ERR_ARG, "side chain: axis 0|1, side -1|1, band > 0 and output");
+        return gk_err_set(&sc->err, GK_ERR_ARG, "side chain: axis 0|1, side -1|1, band > 0 and output");
     for (p = 0; p < sc->rve.n; ++p) {
         double x[3];
         gk_scene_position(sc, p, x);
         if (x[other] < lo) lo = x[other];
         if (x[other] > hi) hi = x[other];
     }
-    nb = (int)((hi - lo) / band) + 1;
+    nb = (int)((hi - lo) / band + 0.5) + 1; /* bands centred on lo + k band */
     best = (int32_t *)gk_alloc(&sc->def.rve.alloc, (size_t)nb * sizeof(int32_t));
     bx = (double *)gk_alloc(&sc->def.rve.alloc, (size_t)nb * sizeof(double));
     if (!best || !bx) {
         gk_free(&sc->def.rve.alloc, best);
         gk_free(&sc->def.rve.alloc, bx);
-        return gk_err_set((gk_err *)&sc->err, GK_ERR_ALLOC, "out of memory for a side chain");
+        return gk_err_set(&sc->err, GK_ERR_ALLOC, "out of memory for a side chain");
     }
     for (b = 0; b < nb; ++b) best[b] = -1;
     for (p = 0; p < sc->rve.n; ++p) {
         double x[3], e;
         gk_scene_position(sc, p, x);
-        b = (int)((x[other] - lo) / band);
+        b = (int)((x[other] - lo) / band + 0.5);
         if (b >= nb) b = nb - 1;
         e = side * (x[axis] + side * (double)sc->rve.r[p]); /* outer edge, larger is further out */
         if (best[b] < 0 || e > bx[b]) {
@@ -1660,7 +1881,7 @@ GKDEF gk_result gk_scene_side_chain(const gk_scene *sc, int axis, int side, doub
         if (cnt >= cap) {
             gk_free(&sc->def.rve.alloc, best);
             gk_free(&sc->def.rve.alloc, bx);
-            return gk_err_set((gk_err *)&sc->err, GK_ERR_ARG, "side chain: more than %d members", cap);
+            return gk_err_set(&sc->err, GK_ERR_ARG, "side chain: more than %d members", cap);
         }
         ids[cnt++] = sc->rve.id[best[q]];
     }
@@ -1701,8 +1922,9 @@ GKDEF gk_result gk_scene_insert(gk_scene *sc, int k, const double *const x[3], c
             if (!(sc->open & (1u << a))) {
                 u = sc->def.lo[a] + (u - sc->def.lo[a]) - D * floor((u - sc->def.lo[a]) / D);
             } else if (u < sc->def.lo[a] || u > sc->def.hi[a]) {
-                res = gk_err_set(&sc->err, GK_ERR_OUTSIDE, "insert: particle %d at %g on axis %d is outside [%g, %g]",
-                                 q, u, a, sc->def.lo[a], sc->def.hi[a]);
+                res = gk_err_set(&sc->err, GK_ERR_OUTSIDE,
+                                 "insert: particle %d at %g on axis %d is outside [%g, %g]", q, u, a,
+                                 sc->def.lo[a], sc->def.hi[a]);
                 break;
             }
             s[a][q] = (u - sc->origin[a]) / rve->cell.h[4 * a];
@@ -1764,10 +1986,11 @@ out:
 }
 
 /* elastic energy stored in the contacts of the particles marked in drop */
-static double gk__dropped_elastic(gk_scene *sc, const unsigned char *drop) {
+static double gk__dropped_elastic(gk_scene *sc, const unsigned char *drop, double *erest) {
     gk_rve *rve = &sc->rve;
     int c, k, w, e, dim = sc->dim, nh = dim == 2 ? 1 : 3;
-    double el = 0.0;
+    double el = 0.0, rest;
+    *erest = 0.0;
     for (c = 0; c < rve->pl.n; ++c) {
         int i = rve->pl.i[c], j = rve->pl.j[c];
         gk_real d[3], v[3], wi[3], wj[3], ft[3] = {0, 0, 0}, mr[3] = {0, 0, 0}, dist;
@@ -1779,7 +2002,9 @@ static double gk__dropped_elastic(gk_scene *sc, const unsigned char *drop) {
             if (rve->mr[dim == 2 ? 2 : k]) mr[dim == 2 ? 0 : k] = rve->mr[dim == 2 ? 2 : k][c];
         }
         el += gk__contact_elastic(&rve->K, rve->def.mat.law, rve->phys, dim, rve->r[i], rve->r[j],
-                                  rve->r[i] + rve->r[j] - dist, ft, mr);
+                                  rve->r[i] + rve->r[j] - dist, ft, mr, &rest);
+        el += rest;
+        *erest += rest;
     }
     for (w = 0; w < sc->nwalls; ++w) {
         gk_wall *W = &sc->walls[w];
@@ -1797,7 +2022,9 @@ static double gk__dropped_elastic(gk_scene *sc, const unsigned char *drop) {
             }
             gk__wall_consts(W, (double)rve->r[p], &K);
             el += gk__contact_elastic(&K, W->def.mat.law, W->phys, dim, rve->r[p], rve->r[p],
-                                      (gk_real)((double)rve->r[p] - dist), ft, mr);
+                                      (gk_real)((double)rve->r[p] - dist), ft, mr, &rest);
+            el += rest;
+            *erest += rest;
         }
     }
     return el;
@@ -1807,7 +2034,7 @@ static gk_result gk__scene_delete(gk_scene *sc, const unsigned char *drop) {
     gk_rve *rve = &sc->rve;
     int n = rve->n, p, q, k, w, m, e;
     gk_result r;
-    double ke = 0.0, el = 0.0;
+    double ke = 0.0, el = 0.0, erest = 0.0;
     for (p = 0, q = 0; p < n; ++p) q += !drop[p];
     if (q == n) return GK_OK;
     if (q < 1) return gk_err_set(&sc->err, GK_ERR_ARG, "cannot remove every particle");
@@ -1820,7 +2047,8 @@ static gk_result gk__scene_delete(gk_scene *sc, const unsigned char *drop) {
                     if (rve->w[k]) ke += 0.5 * I * (double)rve->w[k][p] * (double)rve->w[k][p];
                 }
             }
-        el = gk__dropped_elastic(sc, drop);
+        el = gk__dropped_elastic(sc, drop, &erest);
+        sc->erest_prev -= erest; /* their springs leave the books, not as dissipation */
     }
     /* the scene's arrays first (the RVE's compaction keeps the same order) */
     for (p = 0, q = 0; p < n; ++p) {
@@ -1912,7 +2140,8 @@ GKDEF gk_result gk_scene_energy_track(gk_scene *sc, int on) {
 
 GKDEF void gk_scene_energy(const gk_scene *sc, gk_energy *e) {
     const gk_energy *a = &sc->en;
-    double in = a->gravity + a->walls + a->external + a->pressure + a->prescribed, out = a->friction + a->viscous + a->damping;
+    double in = a->gravity + a->walls + a->external + a->pressure + a->prescribed,
+           out = a->friction + a->viscous + a->damping;
     *e = *a;
     e->balance = a->kinetic + a->elastic - (a->initial + in - out + a->inserted - a->removed);
     e->scale = fabs(a->initial) + fabs(a->gravity) + fabs(a->walls) + fabs(a->external) + fabs(a->pressure) +
@@ -1929,6 +2158,7 @@ typedef struct gk__scene_hdr {
     int32_t have_presc, have_ext, pad0, pad1;
     int64_t lost;
     gk_energy en;
+    double wall_love[9], erest_prev;
     uint64_t rve_bytes;
 } gk__scene_hdr;
 
@@ -1950,22 +2180,26 @@ static size_t gk__scene_bytes(const gk_scene *sc, size_t rve_bytes) {
         if (W->ft[0]) b += n * R * (size_t)nh;
         if (W->mr[0]) b += n * R * (size_t)nh;
     }
-    for (m = 0; m < sc->nmem; ++m) b += 3 * sizeof(double) + sizeof(int32_t) + (size_t)sc->mem[m].n * (sizeof(int32_t) + 3 * sizeof(double));
+    for (m = 0; m < sc->nmem; ++m)
+        b += 4 * sizeof(double) + 2 * sizeof(int) + sizeof(int32_t) +
+             (size_t)sc->mem[m].n * (sizeof(int32_t) + 3 * sizeof(double));
     return b;
 }
 
-GKDEF size_t gk_scene_state_size(const gk_scene *sc) { return gk__scene_bytes(sc, gk_rve_state_size(&sc->rve)); }
+GKDEF size_t gk_scene_state_size(const gk_scene *sc) {
+    return gk__scene_bytes(sc, gk_rve_state_size(&sc->rve));
+}
 
-#define GK__SPUT(ptr, bytes)              \
-    do {                                  \
-        memcpy(o + off, (ptr), (bytes));  \
-        off += (bytes);                   \
+#define GK__SPUT(ptr, bytes)             \
+    do {                                 \
+        memcpy(o + off, (ptr), (bytes)); \
+        off += (bytes);                  \
     } while (0)
-#define GK__SGET(ptr, bytes)              \
-    do {                                  \
+#define GK__SGET(ptr, bytes)                \
+    do {                                    \
         if (off + (bytes) > size) goto bad; \
-        memcpy((ptr), in + off, (bytes)); \
-        off += (bytes);                   \
+        memcpy((ptr), in + off, (bytes));   \
+        off += (bytes);                     \
     } while (0)
 
 GKDEF gk_result gk_scene_save(const gk_scene *sc, void *buf, size_t cap, size_t *written) {
@@ -1993,6 +2227,8 @@ GKDEF gk_result gk_scene_save(const gk_scene *sc, void *buf, size_t cap, size_t 
     hd.have_ext = sc->fext[0] != NULL;
     hd.lost = sc->lost;
     hd.en = sc->en;
+    for (k = 0; k < 9; ++k) hd.wall_love[k] = sc->wall_love[k];
+    hd.erest_prev = sc->erest_prev;
     hd.rve_bytes = rb;
     GK__SPUT(&hd, sizeof hd);
     GK__SPUT(sc->rve.r, n * R);
@@ -2042,7 +2278,8 @@ GKDEF gk_result gk_scene_save(const gk_scene *sc, void *buf, size_t cap, size_t 
         GK__SPUT(&nm, sizeof nm);
         GK__SPUT(&M->pressure, sizeof(double));
         GK__SPUT(&M->stiffness, sizeof(double));
-        GK__SPUT(&M->pressure, sizeof(double)); /* reserved */
+        GK__SPUT(M->arest, 2 * sizeof(double));
+        GK__SPUT(M->anchor, 2 * sizeof(int));
         GK__SPUT(M->ids, (size_t)M->n * sizeof(int32_t));
         GK__SPUT(M->rest, (size_t)M->n * sizeof(double));
         GK__SPUT(M->fx, (size_t)M->n * sizeof(double));
@@ -2062,16 +2299,38 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
     gk_result r;
     if (!buf || size < sizeof hd) return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state buffer too small");
     memcpy(&hd, buf, sizeof hd);
-    if (memcmp(hd.magic, GK__SCENE_MAGIC, 8) != 0 || hd.endian != 0x01020304 || hd.version != GK__SCENE_VERSION)
+    if (memcmp(hd.magic, GK__SCENE_MAGIC, 8) != 0 || hd.endian != 0x01020304 ||
+        hd.version != GK__SCENE_VERSION)
         return gk_err_set(&sc->err, GK_ERR_FORMAT, "not a grainkit scene state of this version");
     if (hd.dim != sc->dim || hd.real_size != (int32_t)R || hd.nwalls != sc->nwalls || hd.nmem != sc->nmem ||
         hd.n < 1 || hd.next_id < hd.n)
-        return gk_err_set(&sc->err, GK_ERR_FORMAT,
-                          "scene state is for dim %d, %d-byte reals, %d walls, %d membranes; this scene has %d, %d, "
-                          "%d, %d",
-                          hd.dim, hd.real_size, hd.nwalls, hd.nmem, sc->dim, (int)R, sc->nwalls, sc->nmem);
+        return gk_err_set(
+            &sc->err, GK_ERR_FORMAT,
+            "scene state is for dim %d, %d-byte reals, %d walls, %d membranes; this scene has %d, %d, "
+            "%d, %d",
+            hd.dim, hd.real_size, hd.nwalls, hd.nmem, sc->dim, (int)R, sc->nwalls, sc->nmem);
     if (hd.rve_bytes > size) return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state has the wrong size");
     n = (size_t)hd.n;
+    { /* the whole layout before anything changes: walk it (membrane lengths are inside) */
+        size_t want = sizeof hd + n * (3 * R + sizeof(int32_t) + sizeof(double) + 1);
+        if (hd.have_presc) want += n * 12 * sizeof(double);
+        if (hd.have_ext) want += n * 6 * sizeof(double);
+        for (w = 0; w < sc->nwalls; ++w) {
+            const gk_wall *W = &sc->walls[w];
+            want += sizeof(gk__wall_rec) + n;
+            if (W->ft[0]) want += n * R * (size_t)nh;
+            if (W->mr[0]) want += n * R * (size_t)nh;
+        }
+        for (m = 0; m < sc->nmem; ++m) {
+            int32_t nm;
+            if (want + sizeof nm > size) goto bad;
+            memcpy(&nm, in + want, sizeof nm);
+            if (nm < 0 || nm > sc->mem[m].cap) goto bad;
+            want += 4 * sizeof(double) + 2 * sizeof(int) + sizeof(int32_t) +
+                    (size_t)nm * (sizeof(int32_t) + 3 * sizeof(double));
+        }
+        if (want + hd.rve_bytes != size) goto bad;
+    }
     /* particle count of the state: append or drop at the end, then overwrite everything */
     if (hd.n > sc->rve.n) {
         int add = hd.n - sc->rve.n, a;
@@ -2082,7 +2341,8 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
         rr = (double *)gk_alloc(gk__sc_alloc(sc), (size_t)add * sizeof(double));
         ids = (int32_t *)gk_alloc(gk__sc_alloc(sc), (size_t)add * sizeof(int32_t));
         for (a = 0; a < 3; ++a) s[a] = (double *)gk_alloc(gk__sc_alloc(sc), (size_t)add * sizeof(double));
-        if (!rr || !ids || !s[0] || !s[1] || !s[2]) r = gk_err_set(&sc->err, GK_ERR_ALLOC, "out of memory restoring");
+        if (!rr || !ids || !s[0] || !s[1] || !s[2])
+            r = gk_err_set(&sc->err, GK_ERR_ALLOC, "out of memory restoring");
         for (p = 0; !r && p < add; ++p) {
             gk_real rv;
             if (roff + (size_t)(sc->rve.n + p + 1) * R > size) {
@@ -2122,8 +2382,8 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
     GK__SGET(sc->flags, n);
     if (hd.have_presc)
         for (k = 0; k < 3; ++k) {
-            if ((r = gk__sc_new(sc, &sc->vp[k])) || (r = gk__sc_new(sc, &sc->wp[k])) || (r = gk__sc_new(sc, &sc->load[k])) ||
-                (r = gk__sc_new(sc, &sc->loadt[k])))
+            if ((r = gk__sc_new(sc, &sc->vp[k])) || (r = gk__sc_new(sc, &sc->wp[k])) ||
+                (r = gk__sc_new(sc, &sc->load[k])) || (r = gk__sc_new(sc, &sc->loadt[k])))
                 return r;
             GK__SGET(sc->vp[k], n * sizeof(double));
             GK__SGET(sc->wp[k], n * sizeof(double));
@@ -2165,26 +2425,33 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
     for (m = 0; m < sc->nmem; ++m) {
         gk_membrane *M = &sc->mem[m];
         int32_t nm;
-        double resv;
+        int anc[2];
         GK__SGET(&nm, sizeof nm);
-        if (nm < 0 || nm > M->cap) return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state membrane %d is invalid", m);
+        if (nm < 0 || nm > M->cap)
+            return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state membrane %d is invalid", m);
         M->n = nm;
         GK__SGET(&M->pressure, sizeof(double));
         GK__SGET(&M->stiffness, sizeof(double));
-        GK__SGET(&resv, sizeof(double));
+        GK__SGET(M->arest, 2 * sizeof(double));
+        GK__SGET(anc, 2 * sizeof(int));
+        if (anc[0] != M->anchor[0] || anc[1] != M->anchor[1])
+            return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state membrane %d has other anchors", m);
         GK__SGET(M->ids, (size_t)nm * sizeof(int32_t));
         GK__SGET(M->rest, (size_t)nm * sizeof(double));
         GK__SGET(M->fx, (size_t)nm * sizeof(double));
         GK__SGET(M->fy, (size_t)nm * sizeof(double));
     }
     if (off + hd.rve_bytes != size) goto bad;
-    if ((r = gk_rve_restore(&sc->rve, in + off, (size_t)hd.rve_bytes)) != GK_OK) return gk__scene_rve_err(sc, r);
+    if ((r = gk_rve_restore(&sc->rve, in + off, (size_t)hd.rve_bytes)) != GK_OK)
+        return gk__scene_rve_err(sc, r);
     gk_rve_update_totals(&sc->rve);
     sc->next_id = hd.next_id;
     if ((r = gk__scene_index(sc)) != GK_OK) return r;
     sc->nprescribed = hd.nprescribed;
     sc->lost = hd.lost;
     sc->en = hd.en;
+    for (k = 0; k < 9; ++k) sc->wall_love[k] = hd.wall_love[k];
+    sc->erest_prev = hd.erest_prev;
     sc->energy_pending = hd.energy_pending;
     if (hd.energy_on && !sc->energy_on) {
         gk_energy keep = sc->en;
@@ -2213,7 +2480,8 @@ GKDEF gk_result gk_scene_write_vtk(const gk_scene *sc, const char *path, gk_err 
     spin = (double *)gk_alloc(a, (size_t)n * sizeof(double));
     id = (double *)gk_alloc(a, (size_t)n * sizeof(double));
     conn = (int *)gk_alloc(a, (size_t)n * sizeof(int));
-    if (!xyz || !vel || !rad || !spin || !id || !conn) r = gk_err_set(err, GK_ERR_ALLOC, "out of memory writing %s", path);
+    if (!xyz || !vel || !rad || !spin || !id || !conn)
+        r = gk_err_set(err, GK_ERR_ALLOC, "out of memory writing %s", path);
     for (p = 0; !r && p < n; ++p) {
         double w2 = 0.0;
         gk_scene_position(sc, p, xyz + 3 * p);
@@ -2403,7 +2671,8 @@ GKDEF gk_result gk_scene_write_svg(const gk_scene *sc, const char *path, const c
                        : sqrt((double)sc->rve.v[0][p] * (double)sc->rve.v[0][p] +
                               (double)sc->rve.v[1][p] * (double)sc->rve.v[1][p]);
     }
-    r = gk_svg_field(path, title, label ? label : (value ? "value" : "speed [m/s]"), n, NV, xy, val, 0.0, err);
+    r = gk_svg_field(path, title, label ? label : (value ? "value" : "speed [m/s]"), n, NV, xy, val, 0.0,
+                     err);
     gk_free(a, xy);
     gk_free(a, val);
     return r;

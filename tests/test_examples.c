@@ -248,6 +248,29 @@ TEST(femdem_single_reference_holds_the_lateral_stress) {
     printf("    RVE alone: %d runs for 30 increments, sigma_xx held to 1e-3 p\n", runs);
 }
 
+/* the RVE alone can slip during a run far after the peak: with bench/data/tradeoff/rve400.txt and the
+ * adaptive rule its sigma_xx jumps across p between nearby lateral strains at 8.8 %, where the one-run
+ * secant iteration stopped with an error after 40 runs; the increment is now completed in two legs (the
+ * slipped run, then the lateral strain alone), so every row to 10 % holds 1e-3 p, that row after more
+ * than 40 runs */
+TEST(femdem_single_reference_through_a_slip) {
+    double v[101 * 8];
+    char header[512];
+    int n, k, held = 1, two_legs = 0;
+    CHECK(system("build/femdem_biaxial --test single --steps 100 --dem-rule adaptive --packing "
+                 "bench/data/tradeoff/rve400.txt --threads 2 --vtk-every 0 --out build/t_fdslip "
+                 "> build/t_fdslip.out 2>&1") == 0);
+    n = read_csv("build/t_fdslip/single_element.csv", 8, v, 101, header, sizeof header);
+    CHECK_EQ_INT(n, 101);
+    for (k = 1; k < n; ++k) {
+        held &= fabs(v[8 * k + 4] - 1e5) <= 1e-3 * 1e5;
+        two_legs += v[8 * k + 7] > 40;
+    }
+    CHECK(held);
+    CHECK(two_legs >= 1);
+    printf("    RVE alone to 10 %%: sigma_xx held to 1e-3 p in every row, %d increment(s) in two legs\n", two_legs);
+}
+
 #define CYC_HEADER                                                                                      \
     "step,cycle,gamma,tau,sigma_yy,sigma_xx,p,q,eps_v_rve,top_uy,iterations,seconds,E_d,E_f,increment," \
     "failed_gp,dem_steps_mean,dem_steps_max,dem_steps,tangents_reused,tangents_computed\n"
@@ -262,7 +285,7 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
     char header[512];
     double v[64 * C_NCOL], evmax = 0, uymax = 0, tau_pos = 0, tau_neg = 0;
     int n, k, turns = 0;
-    CHECK(run_threads_and_restart("build/femdem_biaxial --test cyclic-strain --nx 2 --ny 1 --element q4 "
+    CHECK(run_threads_and_restart("build/femdem_cyclic --test cyclic-strain --nx 2 --ny 1 --element q4 "
                                   "--increment 0.002",
                                   "--cycles 1", "--cycles 0.5", "t_fc"));
     n = read_csv("build/t_fcA/cyclic.csv", C_NCOL, v, 64, header, sizeof header);
@@ -298,15 +321,18 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
     CHECK(gk_test_file_has("build/t_fcA/gp_0020.vtk", "void_ratio"));
     check_threads_and_restart("t_fc", "cyclic.csv", 11); /* columns step..iterations */
     /* bad input: a message and status 2; a checkpoint of the other control mode is refused */
-    CHECK(system("build/femdem_biaxial --test cyclic-foo > build/t_bad.out 2>&1") != 0);
+    CHECK(system("build/femdem_cyclic --test cyclic-foo > build/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_bad.out", "cyclic-strain or cyclic-stress"));
-    CHECK(system("build/femdem_biaxial --test cyclic-strain --amplitude 0 > build/t_bad.out 2>&1") != 0);
+    CHECK(system("build/femdem_cyclic --test cyclic-strain --amplitude 0 > build/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_bad.out", "out of range"));
-    CHECK(system("build/femdem_biaxial --test cyclic-stress --nx 2 --ny 1 --element q4 --restart build/t_fcA "
+    CHECK(system("build/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --restart build/t_fcA "
                  "--out build/t_fcC > build/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_bad.out", "not a checkpoint"));
-    CHECK(system("build/femdem_biaxial --help > build/t_bad.out 2>&1") == 0);
+    CHECK(system("build/femdem_cyclic --help > build/t_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/t_bad.out", "--tau-amplitude"));
+    /* the biaxial driver points there */
+    CHECK(system("build/femdem_biaxial --test cyclic-strain > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "build/femdem_cyclic --test cyclic-strain"));
 }
 
 /* stress control: the platen turns when |tau| reaches the amplitude (the
@@ -315,7 +341,7 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
  * --gamma-limit the run stops at the first step beyond it */
 TEST(femdem_cyclic_stress_turns_at_the_amplitude) {
     const char *base =
-        "build/femdem_biaxial --test cyclic-stress --nx 2 --ny 1 --element q4 --tau-amplitude 1.5e4 "
+        "build/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --tau-amplitude 1.5e4 "
         "--stress-steps 2 --threads 2";
     char cmd[1024], header[512];
     double v[128 * C_NCOL], tmax = 0, amp = 1.5e4, g_lim = 0.002;
@@ -368,19 +394,20 @@ static int biaxial_csv_same(const char *pa, const char *pb, int rows) {
     return 1;
 }
 
-/* a bad value of a flag: status != 0, the message, and no output directory */
-static int fd_refused(const char *flags, const char *msg) {
+/* a bad value of a flag of driver `bin`: status != 0, the message, and no output directory */
+static int refused(const char *bin, const char *flags, const char *msg) {
     char cmd[512];
     FILE *fp;
     int ok;
     system("rm -rf build/t_fdbad");
-    snprintf(cmd, sizeof cmd, "build/femdem_biaxial %s --out build/t_fdbad > build/t_bad.out 2>&1", flags);
+    snprintf(cmd, sizeof cmd, "build/%s %s --out build/t_fdbad > build/t_bad.out 2>&1", bin, flags);
     ok = system(cmd) != 0 && gk_test_file_has("build/t_bad.out", msg);
-    fp = fopen("build/t_fdbad/biaxial.csv", "r");
+    fp = fopen("build/t_fdbad", "r");
     if (fp) fclose(fp), ok = 0;
-    if (!ok) printf("    not refused as expected: %s\n", flags);
+    if (!ok) printf("    not refused as expected: %s %s\n", bin, flags);
     return ok;
 }
+static int fd_refused(const char *flags, const char *msg) { return refused("femdem_biaxial", flags, msg); }
 
 /* every numeric flag is parsed strictly: a value with trailing text, an empty one, one out of the
  * type's range or not finite is refused by name (atoi/atof took '8x' as 8 and 'abc' as 0) */
@@ -388,31 +415,42 @@ TEST(femdem_refuses_malformed_numbers) {
     CHECK(fd_refused("--nx 8x", "--nx '8x' is not a whole number"));
     CHECK(fd_refused("--ny 2.5", "--ny '2.5' is not a whole number"));
     CHECK(fd_refused("--steps ''", "--steps '' is not a whole number"));
-    CHECK(fd_refused("--threads 99999999999", "is not a whole number"));
+    CHECK(fd_refused("--threads 99999999999", "--threads 99999999999 is out of range"));
     CHECK(fd_refused("--max-iter ten", "--max-iter 'ten' is not a whole number"));
     CHECK(fd_refused("--tol abc", "--tol 'abc' is not a finite number"));
     CHECK(fd_refused("--pressure 1e5Pa", "--pressure '1e5Pa' is not a finite number"));
     CHECK(fd_refused("--increment 1e999", "is not a finite number"));
-    CHECK(fd_refused("--test cyclic-strain --amplitude nan", "--amplitude 'nan' is not a finite number"));
+    CHECK(refused("femdem_cyclic", "--test cyclic-strain --amplitude nan", "--amplitude 'nan' is not a finite number"));
     CHECK(fd_refused("--nx 0", "out of range")); /* well-formed but out of range: the range check */
+    /* ... named, whatever the value; an option written with '=' is refused with a hint; a step count
+     * at the end of int's range cannot overflow a row count */
+    CHECK(fd_refused("--nx -1", "--nx -1 is out of range: needs a whole number in [1, 1000]"));
+    CHECK(fd_refused("--nx=8", "--nx=8: write the value after the option"));
+    CHECK(fd_refused("--steps 2147483647", "--steps 2147483647 is out of range"));
+    CHECK(fd_refused("--increment 0.5", "--increment 0.5 is out of range"));
+    CHECK(system("build/femdem_biaxial --nx > build/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/t_bad.out", "--nx needs a value"));
+    CHECK(fd_refused("--bogus 1", "unknown option --bogus"));
 }
 
 /* --noise-probe: a line of residual changes per step for the 5 values of eps, and the run itself is
  * unchanged (every CSV column but the seconds, DEM work counts included); refused with tangent reuse */
 TEST(femdem_noise_probe_leaves_the_run_unchanged) {
     const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
+    const char *probe = "build/femdem_probe --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
     char cmd[512];
     snprintf(cmd, sizeof cmd, "%s --out build/t_fnp0 > build/t_fnp0.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --noise-probe 2 --out build/t_fnp1 > build/t_fnp1.out 2>&1", base);
+    snprintf(cmd, sizeof cmd, "%s --noise-probe 2 --out build/t_fnp1 > build/t_fnp1.out 2>&1", probe);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has("build/t_fnp1.out", "noise probe at iteration 2 (E_f "));
     CHECK(gk_test_file_has("build/t_fnp1.out", " 1e-06: "));
     CHECK(gk_test_file_has("build/t_fnp1.out", " 1e-02: "));
     CHECK(!gk_test_file_has("build/t_fnp0.out", "noise probe"));
     CHECK(biaxial_csv_same("build/t_fnp0/biaxial.csv", "build/t_fnp1/biaxial.csv", 4));
-    CHECK(fd_refused("--noise-probe 2 --tangent-reuse 0.1", "use one of them"));
-    CHECK(fd_refused("--noise-probe -1", "out of range"));
+    CHECK(refused("femdem_probe", "--noise-probe 2 --tangent-reuse 0.1", "use one of them"));
+    CHECK(refused("femdem_probe", "--noise-probe -1", "out of range"));
+    CHECK(fd_refused("--noise-probe 2", "unknown option --noise-probe")); /* the probes left femdem_biaxial */
 }
 
 /* --krylov-probe: GMRES with the RVEs' own responses at one iterate. Its model residual is the GMRES
@@ -423,6 +461,7 @@ TEST(femdem_noise_probe_leaves_the_run_unchanged) {
  * iterate is re-evaluated at u: the same CSV, bit for bit); bad values are refused */
 TEST(femdem_krylov_probe_leaves_the_run_unchanged) {
     const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
+    const char *probe = "build/femdem_probe --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
     char cmd[512], line[256];
     double prev = 1.0 + 1e-12, ef0 = 0.0, worst3 = 0.0;
     int lines = 0, monotone = 1;
@@ -430,7 +469,7 @@ TEST(femdem_krylov_probe_leaves_the_run_unchanged) {
     snprintf(cmd, sizeof cmd, "%s --out build/t_fkp0 > build/t_fkp0.out 2>&1", base);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s --krylov-probe 2 --krylov-scale 0.02 --out build/t_fkp1 > build/t_fkp1.out 2>&1", base);
+             "%s --krylov-probe 2 --krylov-scale 0.02 --out build/t_fkp1 > build/t_fkp1.out 2>&1", probe);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has("build/t_fkp1.out", "krylov probe at iteration 2 (E_f "));
     fp = fopen("build/t_fkp1.out", "r");
@@ -456,10 +495,10 @@ TEST(femdem_krylov_probe_leaves_the_run_unchanged) {
      * residual and the E_f found there is below a tenth of the iterate's */
     CHECK(worst3 < 0.01);
     CHECK(biaxial_csv_same("build/t_fkp0/biaxial.csv", "build/t_fkp1/biaxial.csv", 4));
-    CHECK(fd_refused("--krylov-probe 2 --tangent-reuse 0.1", "use one of them"));
-    CHECK(fd_refused("--krylov-probe -1", "out of range"));
-    CHECK(fd_refused("--krylov-probe 2 --krylov-scale 0", "out of range"));
-    CHECK(fd_refused("--krylov-probe 2 --krylov-scale 1.5", "out of range"));
+    CHECK(refused("femdem_probe", "--krylov-probe 2 --tangent-reuse 0.1", "use one of them"));
+    CHECK(refused("femdem_probe", "--krylov-probe -1", "out of range"));
+    CHECK(refused("femdem_probe", "--krylov-probe 2 --krylov-scale 0", "out of range"));
+    CHECK(refused("femdem_probe", "--krylov-probe 2 --krylov-scale 1.5", "out of range"));
 }
 
 /* --predictor extrapolate: the first iterate of a step is the last converged increment, scaled. The run
@@ -487,7 +526,7 @@ TEST(femdem_extrapolated_predictor) {
     }
     CHECK(differs);
     CHECK(fd_refused("--predictor linear", "tangent or extrapolate"));
-    CHECK(fd_refused("--test cyclic-strain --predictor extrapolate", "biaxial and single"));
+    CHECK(refused("femdem_cyclic", "--test cyclic-strain --predictor extrapolate", "biaxial and single"));
 }
 
 /* --ed newton: E_d is the Newton correction before relaxation; every accepted row of the CSV meets
@@ -503,7 +542,7 @@ TEST(femdem_ed_newton_accepts_by_the_criterion) {
     n = read_csv("build/t_fed/biaxial.csv", F_NCOL, a, 4, header, sizeof header);
     CHECK_EQ_INT(n, 4);
     for (r = 1; r < n; ++r) CHECK(a[r * F_NCOL + 7] < 0.01 || a[r * F_NCOL + 8] < 0.003);
-    CHECK(fd_refused("--ed raw", "--ed must be step or newton"));
+    CHECK(fd_refused("--ed raw", "--ed 'raw' must be step or newton"));
 }
 
 /* --tangent relaxed (GK_TANGENT_RELAXED at every Gauss point): the same for 1 and 2 threads and
@@ -619,7 +658,7 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
     if (n == 3) /* DEM steps per tangent at step 1: 6 runs (trial, 4 perturbed, trial again) vs 1 */
         CHECK(c[F_NCOL + F_DALL] / c[F_NCOL + F_COMP] > 5.5 * a[F_NCOL + F_DALL] / a[F_NCOL + F_COMP]);
     /* bad values: refused with a message, nothing written */
-    CHECK(fd_refused("--dem-rule fast", "use adaptive or strain"));
+    CHECK(fd_refused("--dem-rule fast", "must be adaptive or strain"));
     CHECK(fd_refused("--dem-inertial 0", "needs a positive number"));
     CHECK(fd_refused("--dem-unbalanced -1e-3", "needs a positive number"));
     CHECK(fd_refused("--dem-strain 1e-5x", "needs a positive number"));
@@ -706,7 +745,43 @@ TEST(femdem_heterogeneous_packings) {
                  "--out build/t_fhx > build/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/t_bad.out", "nosuch.txt"));
     CHECK(system("build/femdem_biaxial --packing-seed -3 > build/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_bad.out", "--packing-seed must be a non-negative integer"));
+    CHECK(gk_test_file_has("build/t_bad.out", "--packing-seed '-3' is not a non-negative whole number"));
+}
+
+/* lines of a file containing needle */
+static int count_has(const char *path, const char *needle) {
+    FILE *fp = fopen(path, "r");
+    char buf[4096];
+    int n = 0;
+    while (fp && fgets(buf, sizeof buf, fp)) n += strstr(buf, needle) != NULL;
+    if (fp) fclose(fp);
+    return n;
+}
+
+/* every failed write of a result is an error exit, said once: the CSV, a VTK file, the checkpoint (a
+ * directory stands where the file would go), and --out naming an existing file */
+TEST(femdem_failed_writes_are_errors) {
+    const char *base = "build/femdem_biaxial --nx 1 --ny 1 --element q4 --steps 1 --threads 2";
+    char cmd[512];
+    int k;
+    static const char *what[3][2] = {{"biaxial.csv", "--vtk-every 0"},
+                                     {"gp_0001.vtk", "--vtk-every 1"},
+                                     {"checkpoint.bin", "--vtk-every 0"}};
+    for (k = 0; k < 3; ++k) {
+        char want[128];
+        snprintf(cmd, sizeof cmd, "rm -rf build/t_fw && mkdir -p build/t_fw/%s", what[k][0]);
+        CHECK(system(cmd) == 0);
+        snprintf(cmd, sizeof cmd, "%s %s --out build/t_fw > build/t_fw.out 2>&1", base, what[k][1]);
+        CHECK(system(cmd) != 0);
+        snprintf(want, sizeof want, "cannot write build/t_fw/%s", what[k][0]);
+        CHECK_EQ_INT(count_has("build/t_fw.out", want), 1);
+        CHECK(!gk_test_file_has("build/t_fw.out", "RESULT "));
+    }
+    CHECK(system("rm -rf build/t_fw && touch build/t_fw") == 0);
+    snprintf(cmd, sizeof cmd, "%s --out build/t_fw > build/t_fw.out 2>&1", base);
+    CHECK(system(cmd) != 0);
+    CHECK_EQ_INT(count_has("build/t_fw.out", "--out build/t_fw: cannot create that directory"), 1);
+    remove("build/t_fw");
 }
 
 int main(int argc, char **argv) {
@@ -716,6 +791,7 @@ int main(int argc, char **argv) {
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
     RUN(femdem_single_element_matches_rve_alone);
     RUN(femdem_single_reference_holds_the_lateral_stress);
+    RUN(femdem_single_reference_through_a_slip);
     RUN(femdem_refuses_malformed_numbers);
     RUN(femdem_noise_probe_leaves_the_run_unchanged);
     RUN(femdem_krylov_probe_leaves_the_run_unchanged);
@@ -726,5 +802,6 @@ int main(int argc, char **argv) {
     RUN(femdem_heterogeneous_packings);
     RUN(femdem_cyclic_strain_constant_volume_and_contractive);
     RUN(femdem_cyclic_stress_turns_at_the_amplitude);
+    RUN(femdem_failed_writes_are_errors);
     return gk_test_done();
 }

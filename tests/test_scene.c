@@ -2,12 +2,15 @@
  * particle-level benchmarks of Chung & Ooi (2011), walls and their servo,
  * gravity, prescribed particles, the membrane, insertion and deletion, the
  * energy balance, save/restore and thread invariance, packing tiles and
- * subsets, and smoke runs of the two scene drivers. */
+ * subsets, and smoke runs of the two scene drivers (build/dem_biaxial,
+ * build/dem_collapse: `make test` builds the examples first). */
 #define GK_DEM_PAR_MIN 64 /* let small scenes use threads, to test thread invariance */
 #define GK_IMPLEMENTATION
+#define GK_TEST_DRIVERS
 #include "gk_scene.h"
 #include "gk_test.h"
 #include <stdlib.h>
+#include <sys/wait.h>
 
 #ifdef GK_TEST_QUICK /* sanitizer builds: fewer steps */
 #define QUICK(full, quick) (quick)
@@ -166,8 +169,8 @@ TEST(chung_ooi_1_two_spheres_normal) {
         gk_scene_set_velocity(&sc, gk_scene_index(&sc, 0), vel, NULL);
         gk_scene_set_velocity(&sc, gk_scene_index(&sc, 1), vel2, NULL);
         CHECK(run_impact(&sc, gk_scene_index(&sc, 0), gk_scene_index(&sc, 1), &o, 100000) == 0);
-        printf("    %-9s F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n", ms[t]->name,
-               o.fmax, fm, o.dmax, dm, o.tc, tc);
+        printf("    %-9s F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n",
+               ms[t]->name, o.fmax, fm, o.dmax, dm, o.tc, tc);
         CHECK_REL(o.fmax, fm, 2e-3);
         CHECK_REL(o.dmax, dm, 2e-3);
         CHECK_REL(o.tc, tc, 2e-3);
@@ -208,7 +211,8 @@ TEST(chung_ooi_2_sphere_on_wall_normal) {
     int t;
     for (t = 0; t < 2; ++t) {
         double R = 0.1, v = 0.2, m = sphere_mass(ms[t]->rho, R), Es = estar(ms[t], NULL);
-        double tc = hertz_tc(m, R, Es, v), dm = hertz_dmax(m, R, Es, v), fm = 4.0 / 3.0 * Es * sqrt(R) * pow(dm, 1.5);
+        double tc = hertz_tc(m, R, Es, v), dm = hertz_dmax(m, R, Es, v),
+               fm = 4.0 / 3.0 * Es * sqrt(R) * pow(dm, 1.5);
         double vel[3] = {0, -0.2, 0}, fwall = 0.0;
         gk_material mat = hertz_mat(ms[t], 0.0);
         gk_scene sc;
@@ -219,8 +223,8 @@ TEST(chung_ooi_2_sphere_on_wall_normal) {
             continue;
         }
         CHECK(run_impact(&sc, 0, -1, &o, 100000) == 0);
-        printf("    %-9s F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n", ms[t]->name,
-               o.fmax, fm, o.dmax, dm, o.tc, tc);
+        printf("    %-9s F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n",
+               ms[t]->name, o.fmax, fm, o.dmax, dm, o.tc, tc);
         CHECK_REL(o.fmax, fm, 2e-3);
         CHECK_REL(o.dmax, dm, 2e-3);
         CHECK_REL(o.tc, tc, 2e-3);
@@ -245,8 +249,10 @@ static double restitution(const gk_material *m, double R, double v, double dt) {
     double vel[3] = {0, 0, 0}, e;
     vel[1] = -v;
     if (sphere_on_plane(&sc, m, R, vel, NULL, dt)) return -1.0;
-    if (run_impact(&sc, 0, -1, &o, 1000000)) e = -1.0;
-    else e = (double)sc.rve.v[1][0] / v;
+    if (run_impact(&sc, 0, -1, &o, 1000000))
+        e = -1.0;
+    else
+        e = (double)sc.rve.v[1][0] / v;
     gk_scene_destroy(&sc);
     return e;
 }
@@ -266,7 +272,8 @@ static double hertz_dashpot_e(double zeta) {
         double k3x = u + 0.5 * h * k2u, k3u = GK_T_ACC(x + 0.5 * h * k2x, u + 0.5 * h * k2u);
         double k4x = u + h * k3u, k4u = GK_T_ACC(x + h * k3x, u + h * k3u);
 #undef GK_T_ACC
-        double xn = x + h / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x), un = u + h / 6.0 * (k1u + 2 * k2u + 2 * k3u + k4u);
+        double xn = x + h / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x),
+               un = u + h / 6.0 * (k1u + 2 * k2u + 2 * k3u + k4u);
         if (it > 10 && xn <= 0.0) return -(u + (un - u) * x / (x - xn)); /* interpolate the crossing */
         x = xn;
         u = un;
@@ -285,7 +292,8 @@ TEST(chung_ooi_3_restitution) {
     const double es[5] = {0.2, 0.4, 0.6, 0.8, 1.0};
     int t, i;
     for (t = 0; t < 2; ++t) {
-        double R = 2.5e-3, m = sphere_mass(ms[t]->rho, R), Es = estar(ms[t], NULL), tc = hertz_tc(m, R, Es, 3.9);
+        double R = 2.5e-3, m = sphere_mass(ms[t]->rho, R), Es = estar(ms[t], NULL),
+               tc = hertz_tc(m, R, Es, 3.9);
         for (i = 0; i < 5; ++i) {
             gk_material lin = gk_material_default();
             double e, kn = 4.0 * ms[t]->E * R; /* the wall's linear k_n = E x 2 R* with the pair's 2 E */
@@ -305,8 +313,8 @@ TEST(chung_ooi_3_restitution) {
             e1 = restitution(&hz, R, 3.9, tc / 1000.0);
             e2 = restitution(&hz, R, 39.0, hertz_tc(m, R, Es, 39.0) / 1000.0);
             em = hertz_dashpot_e(0.2);
-            printf("    %-9s Hertz, zeta 0.2: e = %.5f, %.5f, %.5f at 0.39, 3.9, 39 m/s; model %.5f\n", ms[t]->name, e0,
-                   e1, e2, em);
+            printf("    %-9s Hertz, zeta 0.2: e = %.5f, %.5f, %.5f at 0.39, 3.9, 39 m/s; model %.5f\n",
+                   ms[t]->name, e0, e1, e2, em);
             CHECK_NEAR(e0, em, 2e-3);
             CHECK_NEAR(e1, em, 2e-3);
             CHECK_NEAR(e2, em, 2e-3);
@@ -315,8 +323,8 @@ TEST(chung_ooi_3_restitution) {
 }
 
 /* one oblique impact on the plane: rebound velocity and spin */
-static int oblique(const gk_material *m, double R, const double v[3], const double w[3], double dt, double vout[3],
-                   double wout[3]) {
+static int oblique(const gk_material *m, double R, const double v[3], const double w[3], double dt,
+                   double vout[3], double wout[3]) {
     gk_scene sc;
     impact_rec o;
     int k, bad;
@@ -346,7 +354,8 @@ TEST(chung_ooi_4_oblique_constant_speed) {
     gk_material mat = hertz_mat(&AL_OXIDE, mu);
     int a;
     for (a = 0; a < 7; ++a) {
-        double th = ang[a] * GK_PI / 180.0, vn = V * cos(th), vt = V * sin(th), v[3], vo[3], wo[3], et, L0, L1;
+        double th = ang[a] * GK_PI / 180.0, vn = V * cos(th), vt = V * sin(th), v[3], vo[3], wo[3], et, L0,
+               L1;
         v[0] = vt;
         v[1] = -vn;
         v[2] = 0.0;
@@ -354,11 +363,13 @@ TEST(chung_ooi_4_oblique_constant_speed) {
         et = vo[0] / vt;
         L0 = -m * R * vt;
         L1 = I * wo[2] - m * R * vo[0];
-        printf("    theta %4.1f: e_t %.4f, omega %9.3f rad/s, rebound angle %6.2f deg, contact point %+.4f m/s\n", ang[a],
-               et, wo[2], atan2(vo[0], vo[1]) * 180.0 / GK_PI, vo[0] + R * wo[2]);
+        printf("    theta %4.1f: e_t %.4f, omega %9.3f rad/s, rebound angle %6.2f deg, contact point %+.4f "
+               "m/s\n",
+               ang[a], et, wo[2], atan2(vo[0], vo[1]) * 180.0 / GK_PI, vo[0] + R * wo[2]);
         CHECK_NEAR(L1, L0, 2e-3 * fabs(L0));
         CHECK_NEAR(vo[1], vn, 1e-3 * vn);
-        CHECK(0.5 * m * (vo[0] * vo[0] + vo[1] * vo[1]) + 0.5 * I * wo[2] * wo[2] <= 0.5 * m * V * V * (1.0 + 1e-6));
+        CHECK(0.5 * m * (vo[0] * vo[0] + vo[1] * vo[1]) + 0.5 * I * wo[2] * wo[2] <=
+              0.5 * m * V * V * (1.0 + 1e-6));
         if (tan(th) >= 7.0 * mu * 1.01) {
             CHECK_NEAR(et, 1.0 - 2.0 * mu / tan(th), 2e-3);
             CHECK_NEAR(wo[2], -5.0 * mu * vn / R, 2e-3 * 5.0 * mu * vn / R);
@@ -433,7 +444,8 @@ TEST(chung_ooi_6_spinning_sphere_on_wall) {
     double R = 0.1, mu = 0.4, vn = 0.2;
     int t, i;
     for (t = 0; t < 2; ++t) {
-        double m = sphere_mass(ms[t]->rho, R), I = 0.4 * m * R * R, dt = hertz_tc(m, R, estar(ms[t], NULL), vn) / 1000.0;
+        double m = sphere_mass(ms[t]->rho, R), I = 0.4 * m * R * R,
+               dt = hertz_tc(m, R, estar(ms[t], NULL), vn) / 1000.0;
         gk_material mat = hertz_mat(ms[t], mu);
         for (i = 0; i < 5; ++i) {
             double v[3] = {0, 0, 0}, w[3] = {0, 0, 0}, vo[3], wo[3];
@@ -462,8 +474,8 @@ TEST(chung_ooi_6_spinning_sphere_on_wall) {
         /* vx + R wz = -R w0 and I wz - m R vx = I w0 */
         wz = (I * w0 - m * R * R * w0) / (I + m * R * R);
         vx = -R * w0 - R * wz;
-        printf("    linear k_t/k_n = 2/7, w0 %.3f: v_x' %+.6f (exact %+.6f), w' %+.5f (%+.5f)\n", w0, vo[0], vx, wo[2],
-               wz);
+        printf("    linear k_t/k_n = 2/7, w0 %.3f: v_x' %+.6f (exact %+.6f), w' %+.5f (%+.5f)\n", w0, vo[0],
+               vx, wo[2], wz);
         CHECK_NEAR(vo[0], vx, 3e-3 * R * w0);
         CHECK_NEAR(wo[2], wz, 3e-3 * w0);
     }
@@ -473,8 +485,8 @@ TEST(chung_ooi_6_spinning_sphere_on_wall) {
  * spinning at w0 about z: the contact points slide at 2 R w0 for equal radii
  * (R_A w0 + R_B w0 in general) while the centres have no tangential speed,
  * so the line of centres stays put */
-static int two_spheres(gk_scene *sc, const gk_material *m, double RA, double RB, double mB, double vn, double w0,
-                       double dt) {
+static int two_spheres(gk_scene *sc, const gk_material *m, double RA, double RB, double mB, double vn,
+                       double w0, double dt) {
     double x[2][3] = {{0, 0, 0}, {0, 0, 0}}, r[2];
     double mA, vA[3] = {0, 0, 0}, vB[3] = {0, 0, 0}, w[3] = {0, 0, 0};
     x[0][1] = -RA * (1.0 + 1e-4);
@@ -507,7 +519,8 @@ TEST(chung_ooi_7_two_spheres_oblique) {
     int t, i;
     for (t = 0; t < 2; ++t) {
         double m = sphere_mass(ms[t]->rho, R), I = 0.4 * m * R * R, Es = estar(ms[t], ms[t]);
-        double dt = hertz_tc(0.5 * m, 0.5 * R, Es, vn) / 1000.0, tol = hertz_dmax(0.5 * m, 0.5 * R, Es, vn) / R + 2e-3;
+        double dt = hertz_tc(0.5 * m, 0.5 * R, Es, vn) / 1000.0,
+               tol = hertz_dmax(0.5 * m, 0.5 * R, Es, vn) / R + 2e-3;
         gk_material mat = hertz_mat(ms[t], mu);
         for (i = 0; i < 4; ++i) {
             gk_scene sc;
@@ -522,11 +535,14 @@ TEST(chung_ooi_7_two_spheres_oblique) {
             b = gk_scene_index(&sc, 1);
             CHECK(run_impact(&sc, a, b, &o, 1000000) == 0);
             /* B's contact point (at -R y) relative to A's (at +R y) */
-            vc = ((double)sc.rve.v[0][b] + R * (double)sc.rve.w[2][b]) - ((double)sc.rve.v[0][a] - R * (double)sc.rve.w[2][a]);
+            vc = ((double)sc.rve.v[0][b] + R * (double)sc.rve.w[2][b]) -
+                 ((double)sc.rve.v[0][a] - R * (double)sc.rve.w[2][a]);
             /* about the initial contact point: A at -R y, B at +R y */
-            Lz = I * ((double)sc.rve.w[2][a] + (double)sc.rve.w[2][b]) + m * R * ((double)sc.rve.v[0][a] - (double)sc.rve.v[0][b]);
-            printf("    %-9s w0 %6.3f: A v_x %+.5f w %+.5f, B v_x %+.5f w %+.5f, contact %+.5f (from %+.4f)\n",
-                   ms[t]->name, w0s[i], sc.rve.v[0][a], sc.rve.w[2][a], sc.rve.v[0][b], sc.rve.w[2][b], vc, vc0);
+            Lz = I * ((double)sc.rve.w[2][a] + (double)sc.rve.w[2][b]) +
+                 m * R * ((double)sc.rve.v[0][a] - (double)sc.rve.v[0][b]);
+            printf(
+                "    %-9s w0 %6.3f: A v_x %+.5f w %+.5f, B v_x %+.5f w %+.5f, contact %+.5f (from %+.4f)\n",
+                ms[t]->name, w0s[i], sc.rve.v[0][a], sc.rve.w[2][a], sc.rve.v[0][b], sc.rve.w[2][b], vc, vc0);
             CHECK_NEAR(Lz, 2.0 * I * w0s[i], 2e-3 * 2.0 * I * w0s[i]);
             CHECK(fabs(vc) <= vc0 * (1.0 + 1e-3));
             /* normal rebound along y, to the turn of the line of centres (tangential travel / 2R) */
@@ -554,9 +570,10 @@ TEST(chung_ooi_7_two_spheres_oblique) {
             a = gk_scene_index(&sc, 0);
             b = gk_scene_index(&sc, 1);
             CHECK(run_impact(&sc, a, b, &o, 1000000) == 0);
-            vc = ((double)sc.rve.v[0][b] + R * (double)sc.rve.w[2][b]) - ((double)sc.rve.v[0][a] - R * (double)sc.rve.w[2][a]);
-            printf("    linear k_t/k_n = 2/7, w0 %.3f: relative contact velocity %+.6f (exact %+.6f)\n", w0, vc,
-                   -2.0 * R * w0);
+            vc = ((double)sc.rve.v[0][b] + R * (double)sc.rve.w[2][b]) -
+                 ((double)sc.rve.v[0][a] - R * (double)sc.rve.w[2][a]);
+            printf("    linear k_t/k_n = 2/7, w0 %.3f: relative contact velocity %+.6f (exact %+.6f)\n", w0,
+                   vc, -2.0 * R * w0);
             CHECK_NEAR(vc, -2.0 * R * w0, 3e-3 * 2.0 * R * w0);
             gk_scene_destroy(&sc);
         } else {
@@ -574,9 +591,11 @@ TEST(chung_ooi_7_two_spheres_oblique) {
  * impulse mu J_n = mu m* 2 v_n and spins down by R J_t / I (to delta_max /
  * R_B). */
 TEST(chung_ooi_8_different_spheres) {
-    double RA = 0.1, RB = 0.05, vn = 0.2, mu = 0.3, mA = sphere_mass(AL_ALLOY.rho, RA), mB = sphere_mass(MG_ALLOY.rho, RB);
+    double RA = 0.1, RB = 0.05, vn = 0.2, mu = 0.3, mA = sphere_mass(AL_ALLOY.rho, RA),
+           mB = sphere_mass(MG_ALLOY.rho, RB);
     double ms = mA * mB / (mA + mB), Rs = RA * RB / (RA + RB), Es = estar(&AL_ALLOY, &MG_ALLOY), w0 = 20.0;
-    double tc = hertz_tc(ms, Rs, Es, vn), dm = hertz_dmax(ms, Rs, Es, vn), fm = 4.0 / 3.0 * Es * sqrt(Rs) * pow(dm, 1.5);
+    double tc = hertz_tc(ms, Rs, Es, vn), dm = hertz_dmax(ms, Rs, Es, vn),
+           fm = 4.0 / 3.0 * Es * sqrt(Rs) * pow(dm, 1.5);
     double tol = dm / RB + 2e-3;
     gk_material a = hertz_mat(&AL_ALLOY, mu), b = hertz_mat(&MG_ALLOY, mu), pair;
     gk_scene sc;
@@ -591,8 +610,8 @@ TEST(chung_ooi_8_different_spheres) {
     ia = gk_scene_index(&sc, 0);
     ib = gk_scene_index(&sc, 1);
     CHECK(run_impact(&sc, ia, ib, &o, 1000000) == 0);
-    printf("    normal: F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n", o.fmax, fm, o.dmax, dm,
-           o.tc, tc);
+    printf("    normal: F_max %.6g N (Hertz %.6g), delta_max %.6g m (%.6g), t_c %.6g s (%.6g)\n", o.fmax, fm,
+           o.dmax, dm, o.tc, tc);
     CHECK_REL(o.fmax, fm, 2e-3);
     CHECK_REL(o.dmax, dm, 2e-3);
     CHECK_REL(o.tc, tc, 2e-3);
@@ -611,10 +630,1037 @@ TEST(chung_ooi_8_different_spheres) {
                sc.rve.v[0][ib], sc.rve.w[2][ib]);
         CHECK_NEAR(sc.rve.v[0][ia], Jt / mA, tol * Jt / mA);
         CHECK_NEAR(sc.rve.v[0][ib], -Jt / mB, tol * Jt / mB);
-        CHECK_NEAR(sc.rve.w[2][ia], w0 - RA * Jt / (0.4 * mA * RA * RA), tol * RA * Jt / (0.4 * mA * RA * RA));
-        CHECK_NEAR(sc.rve.w[2][ib], w0 - RB * Jt / (0.4 * mB * RB * RB), tol * RB * Jt / (0.4 * mB * RB * RB));
+        CHECK_NEAR(sc.rve.w[2][ia], w0 - RA * Jt / (0.4 * mA * RA * RA),
+                   tol * RA * Jt / (0.4 * mA * RA * RA));
+        CHECK_NEAR(sc.rve.w[2][ib], w0 - RB * Jt / (0.4 * mB * RB * RB),
+                   tol * RB * Jt / (0.4 * mB * RB * RB));
     }
     gk_scene_destroy(&sc);
+}
+
+/* ================================================================ scenes */
+/* nx x ny (x nz) polydisperse particles (radii uniform in [0.8, 1] r) on a
+ * square lattice of spacing 2.2 r starting at (x0, y0, z0), shifted
+ * sideways by up to jitter r (0.1: the columns do not stand) */
+static int lattice(gk_packing *pk, int dim, int nx, int ny, int nz, double r, double x0, double y0, double z0,
+                   double jitter, uint64_t seed) {
+    gk_rng rng;
+    gk_err e;
+    int a, b, c, q = 0, n = nx * ny * (dim == 3 ? nz : 1);
+    if (gk_packing_alloc(pk, dim, n, NULL, &e)) return 1;
+    gk_rng_seed(&rng, seed);
+    for (c = 0; c < (dim == 3 ? nz : 1); ++c)
+        for (b = 0; b < ny; ++b)
+            for (a = 0; a < nx; ++a) {
+                pk->x[q] = x0 + 2.2 * r * (a + 0.5) + jitter * r * (2.0 * gk_rng_uniform(&rng) - 1.0);
+                pk->y[q] = y0 + 2.2 * r * (b + 0.5);
+                pk->z[q] = dim == 3
+                               ? z0 + 2.2 * r * (c + 0.5) + jitter * r * (2.0 * gk_rng_uniform(&rng) - 1.0)
+                               : 0.0;
+                pk->r[q] = r * (0.8 + 0.2 * gk_rng_uniform(&rng));
+                ++q;
+            }
+    return 0;
+}
+
+/* a 2D (or 3D) box [0, W] x [0, H] (x [0, W]) of particles settling under
+ * gravity on a frictional floor and walls; linear law, viscous damping */
+static int box_scene(gk_scene *sc, int dim, int nx, int ny, double W, double H, double damping,
+                     unsigned periodic) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_packing pk;
+    gk_material wm;
+    int k;
+    double r = W / (2.2 * nx);
+    d.dim = dim;
+    d.hi[0] = W;
+    d.hi[1] = H;
+    d.hi[2] = W;
+    d.periodic = periodic;
+    d.gravity[1] = -9.81;
+    d.rve.mat.friction = 0.5;
+    d.rve.mat.zeta_n = 0.3;
+    d.rve.mat.density = 2650;
+    d.rve.mat.young = 5e7; /* soft: a larger time step */
+    d.rve.damping = damping;
+    d.rve.dt_factor = 0.2;
+    if (lattice(&pk, dim, nx, ny, dim == 3 ? nx : 1, r, 0.0, 0.0, 0.0, 0.1, 7)) return 1;
+    k = gk_scene_create(sc, &d, &pk);
+    gk_packing_free(&pk);
+    if (k) {
+        printf("    create: %s\n", gk_scene_error(sc));
+        return 1;
+    }
+    wm = d.rve.mat;
+    if (gk_scene_add_box(sc, &wm, GK_BOX_ALL & ~(2u << 2), NULL)) { /* no lid */
+        printf("    box: %s\n", gk_scene_error(sc));
+        gk_scene_destroy(sc);
+        return 1;
+    }
+    return 0;
+}
+
+static double total_weight(const gk_scene *sc) {
+    double w = 0.0;
+    int p;
+    for (p = 0; p < sc->rve.n; ++p) w += sc->mass[p] * 9.81;
+    return w;
+}
+
+/* Statics: particles poured into a box come to rest; the walls together
+ * carry their whole weight (sum of the wall forces = -sum m g e_y, to 1e-3:
+ * the floor most of it, the frictional side walls the rest, as in a
+ * silo) and the side walls' pushes cancel (2D and 3D). */
+TEST(gravity_floor_carries_the_weight) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        gk_scene sc;
+        double wt;
+        if (box_scene(&sc, dim, dim == 2 ? 12 : 4, dim == 2 ? 12 : 4, 0.12, 0.3, 0.6, 0)) {
+            CHECK(0);
+            continue;
+        }
+        CHECK(gk_scene_step(&sc, dim == 2 ? 40000 : 100000) ==
+              GK_OK); /* to rest (also in the quick builds) */
+        wt = total_weight(&sc);
+        {
+            double F[3] = {0, 0, 0};
+            int w, k;
+            for (w = 0; w < sc.nwalls; ++w)
+                for (k = 0; k < 3; ++k) F[k] += sc.walls[w].force[k];
+            printf("    %dD: walls carry %.6g N (floor %.6g N), weight %.6g N, side walls %.4g / %.4g N, "
+                   "kinetic %.3g J\n",
+                   dim, -F[1], sc.walls[2].resistance, wt, sc.walls[0].resistance, sc.walls[1].resistance,
+                   gk_rve_kinetic_energy(&sc.rve));
+            CHECK_REL(-F[1], wt, 1e-3);
+            CHECK_NEAR(F[0], 0.0, 1e-3 * wt);
+            CHECK_NEAR(F[2], 0.0, 1e-3 * wt);
+            CHECK(sc.walls[2].resistance > 0.8 * wt && sc.walls[0].resistance > 0.0);
+        }
+        gk_scene_destroy(&sc);
+    }
+}
+
+/* A servo lid: a plane driven to a target force settles on it (to 1e-3),
+ * and the floor then carries the lid force plus the weight minus what the
+ * side walls hold (vertical balance of the walls' forces, to 1e-3). */
+TEST(servo_wall_reaches_its_target) {
+    gk_scene sc;
+    gk_wall_def lid = gk_wall_def_default();
+    double target, F = 0.0;
+    int w, iw;
+    if (box_scene(&sc, 2, 10, 10, 0.1, 0.3, 0.3, 0)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_scene_step(&sc, QUICK(20000, 10000)) == GK_OK); /* settle */
+    target = 5.0 * total_weight(&sc);
+    lid.point[1] = 0.3;
+    lid.normal[1] = -1.0;
+    lid.mat = sc.def.rve.mat;
+    lid.drive = GK_DRIVE_FORCE;
+    lid.target = target;
+    lid.max_speed = 0.5;
+    lid.gain = 0.02;
+    CHECK(gk_scene_add_wall(&sc, &lid, &iw) == GK_OK);
+    CHECK(gk_scene_step(&sc, QUICK(40000, 30000)) == GK_OK);
+    for (w = 0; w < sc.nwalls; ++w) F += sc.walls[w].force[1];
+    printf("    lid %.6g N (target %.6g N) at y = %.5f m; walls' vertical sum %.6g N, weight %.6g N\n",
+           sc.walls[iw].resistance, target, sc.walls[iw].pos[1], -F, total_weight(&sc));
+    CHECK_REL(sc.walls[iw].resistance, target, 1e-3);
+    CHECK_REL(-F, total_weight(&sc), 1e-3);
+    CHECK(sc.walls[iw].pos[1] < 0.3);
+    /* a stress target over an area is the same servo */
+    sc.walls[iw].def.drive = GK_DRIVE_STRESS;
+    sc.walls[iw].def.area = 0.1 * sc.rve.volume_factor;
+    sc.walls[iw].def.target = 2.0 * target / sc.walls[iw].def.area;
+    CHECK(gk_scene_step(&sc, QUICK(40000, 30000)) == GK_OK);
+    CHECK_REL(sc.walls[iw].resistance, 2.0 * target, 1e-3);
+    gk_scene_destroy(&sc);
+}
+
+/* Prescribed particles: the bottom row is held fixed and the top row moves
+ * down at 5 mm/s (no walls, no gravity): after n steps the top row has
+ * moved exactly n dt v, the bottom row not at all, and in the slow
+ * compression the loads on the two rows balance (to 2 %) and push back
+ * (the top row's load points up). */
+TEST(prescribed_particles_move_and_report_their_load) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_scene sc;
+    gk_packing pk;
+    int p, nx = 8, ny = 8;
+    double r = 0.005, y0[64], v[3] = {0, -0.005, 0}, zero[3] = {0, 0, 0}, top = 0.0, bot = 0.0;
+    long n = 16000;
+    d.dim = 2;
+    d.hi[0] = d.hi[1] = 0.2;
+    d.rve.mat.young = 5e7;
+    d.rve.mat.zeta_n = 0.3;
+    d.rve.damping = 0.3;
+    d.rve.dt_factor = 0.2;
+    CHECK(lattice(&pk, 2, nx, ny, 1, r, 0.02, 0.02, 0.0, 0.0, 11) == 0);
+    for (p = 0; p < pk.n; ++p) pk.r[p] = 1.09 * r; /* gaps of 0.02 r */
+    CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    for (p = 0; p < sc.rve.n; ++p) {
+        int row = sc.rve.id[p] / nx;
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        y0[sc.rve.id[p]] = x[1];
+        if (row == 0) gk_scene_prescribe(&sc, p, zero, zero);
+        if (row == ny - 1) gk_scene_prescribe(&sc, p, v, zero);
+    }
+    CHECK(sc.nprescribed == 2 * nx);
+    if (gk_scene_step(&sc, n)) {
+        printf("    step: %s\n", gk_scene_error(&sc));
+        CHECK(0);
+    }
+    for (p = 0; p < sc.rve.n; ++p) {
+        int row = sc.rve.id[p] / nx;
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        if (row == 0) {
+            CHECK(x[1] == y0[sc.rve.id[p]]);
+            bot += sc.load[1][p];
+        }
+        if (row == ny - 1) {
+            CHECK_NEAR(x[1], y0[sc.rve.id[p]] + n * sc.rve.dt * v[1], 1e-12);
+            top += sc.load[1][p];
+        }
+    }
+    printf("    load on the moving row %.5g N, on the fixed row %.5g N\n", top, bot);
+    CHECK(top > 0.0);
+    CHECK_NEAR(top, -bot, 0.02 * top);
+    /* released, a particle moves freely again */
+    gk_scene_release(&sc, gk_scene_index(&sc, (ny - 1) * nx));
+    CHECK(sc.nprescribed == 2 * nx - 1);
+    gk_scene_destroy(&sc);
+}
+
+/* The follower-pressure membrane (2D biaxial cell: smooth rigid floor and
+ * servo lid at stress p, membranes on both sides at pressure p, loaded in ten
+ * stages): once in equilibrium the mean stress of the particles
+ * (gk_scene_stress over the area A the chains' centre lines and the walls
+ * enclose) is what the boundary applies, (1/A) sum load (x) position over
+ * the membrane loads (pressure and anchor links), the lid and the one
+ * particle held in place (smooth platens), to 1 % (static equilibrium:
+ * Love-Weber; the chains' tension-only links count as inner forces);
+ * sigma_xx is -p to 3 % (the anchored chains carry the pressure from
+ * platen to platen) and within 10 % of sigma_yy (isotropic loading; the
+ * lid pushes on the full width W, the chains act on their centre lines, a
+ * radius further in); the lid holds p W; no particle leaks. */
+TEST(membrane_confines_at_its_pressure) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_scene sc;
+    gk_packing pk;
+    gk_wall_def lid = gk_wall_def_default(), flo = gk_wall_def_default();
+    int32_t left[64], right[64];
+    int nl, nr, p, e, bad = 0;
+    double pr = 2e4, W = 0.1, H = 0.2, sig[9], area = 0.0, r = 0.0025, hchain = 0.0;
+    d.dim = 2;
+    d.lo[0] = -0.1;
+    d.hi[0] = 0.2;
+    d.hi[1] = 0.25;
+    d.rve.mat.young = 5e7;
+    d.rve.mat.friction = 0.3;
+    d.rve.damping = 0.5;
+    d.rve.dt_factor = 0.2;
+    CHECK(lattice(&pk, 2, 18, 36, 1, r, 0.0, 0.0, 0.0, 0.0, 3) == 0);
+    for (p = 0; p < pk.n; ++p) pk.r[p] = 1.05 * r + 0.04 * r * (double)(p % 3); /* nearly touching */
+    CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    flo.normal[1] = 1.0;
+    flo.mat = d.rve.mat;
+    flo.mat.friction = 0.0; /* lubricated platens */
+    lid.point[1] = 36 * 2.2 * r;
+    lid.normal[1] = -1.0;
+    lid.mat = flo.mat;
+    lid.drive = GK_DRIVE_STRESS;
+    lid.target = pr;
+    lid.area = W * sc.rve.volume_factor;
+    lid.max_speed = 0.05;
+    CHECK(gk_scene_add_wall(&sc, &flo, NULL) == GK_OK);
+    CHECK(gk_scene_add_wall(&sc, &lid, NULL) == GK_OK);
+    CHECK(gk_scene_side_chain(&sc, 0, -1, 2.2 * r, left, 64, &nl) == GK_OK);
+    CHECK(gk_scene_side_chain(&sc, 0, 1, 2.2 * r, right, 64, &nr) == GK_OK);
+    CHECK(nl == 36 && nr == 36);
+    /* the left chain runs top to bottom (lid to floor), the right one bottom to top */
+    CHECK(gk_scene_add_membrane(&sc, nl, left, pr, 1e5, 1, 0, NULL) == GK_OK);
+    CHECK(gk_scene_add_membrane(&sc, nr, right, pr, 1e5, 0, 1, NULL) == GK_OK);
+    /* smooth platens leave the specimen free to slide: hold one particle of the bottom row */
+    CHECK(gk_scene_prescribe(&sc, gk_scene_index(&sc, 9), NULL, NULL) == GK_OK);
+    for (e = 1; e <= 20; ++e) { /* load in 10 stages, then hold */
+        sc.mem[0].pressure = sc.mem[1].pressure = pr * (e < 10 ? e : 10) / 10.0;
+        sc.walls[1].def.target = pr * (e < 10 ? e : 10) / 10.0;
+        if (gk_scene_step(&sc, QUICK(3000, 2000))) {
+            printf("    step: %s\n", gk_scene_error(&sc));
+            CHECK(0);
+            break;
+        }
+    }
+    /* the boundary the loads act on: the chains' centre lines, closed along
+     * the floor and the lid; the membranes load only the chain's height */
+    {
+        double xs[200], ys[200], x[3], yb, yt;
+        int m = 0, k;
+        H = sc.walls[1].pos[1];
+        gk_scene_position(&sc, gk_scene_index(&sc, right[0]), x);
+        xs[m] = x[0], ys[m++] = 0.0;
+        yb = x[1];
+        for (e = 0; e < nr; ++e) {
+            gk_scene_position(&sc, gk_scene_index(&sc, right[e]), x);
+            xs[m] = x[0], ys[m++] = x[1];
+        }
+        yt = x[1];
+        xs[m] = x[0], ys[m++] = H;
+        gk_scene_position(&sc, gk_scene_index(&sc, left[0]), x);
+        xs[m] = x[0], ys[m++] = H;
+        for (e = 0; e < nl; ++e) {
+            gk_scene_position(&sc, gk_scene_index(&sc, left[e]), x);
+            xs[m] = x[0], ys[m++] = x[1];
+        }
+        xs[m] = x[0], ys[m++] = 0.0;
+        for (k = 0; k < m; ++k) area += 0.5 * (xs[k] * ys[(k + 1) % m] - xs[(k + 1) % m] * ys[k]);
+        hchain = yt - yb;
+    }
+    /* what the boundary applies: sum of load (x) position over the membrane
+     * loads (at the chain centres) and the lid (at y = H; the floor's lever is 0) */
+    {
+        double bx = 0.0, by = -sc.walls[1].force[1] * H, x[3];
+        int m, q = gk_scene_index(&sc, 9);
+        gk_scene_position(&sc, q, x); /* the hold: minus its load, at its centre */
+        bx -= sc.load[0][q] * x[0];
+        by -= sc.load[1][q] * x[1];
+        for (m = 0; m < 2; ++m)
+            for (e = 0; e < sc.mem[m].n; ++e) {
+                int end = e == 0 ? 0 : (e == sc.mem[m].n - 1 ? 1 : -1);
+                gk_scene_position(&sc, gk_scene_index(&sc, sc.mem[m].ids[e]), x);
+                bx += (sc.mem[m].fx[e] + (end >= 0 ? sc.mem[m].af[end][0] : 0.0)) * x[0];
+                by += (sc.mem[m].fy[e] + (end >= 0 ? sc.mem[m].af[end][1] : 0.0)) * x[1];
+            }
+        gk_scene_stress(&sc, area, sig);
+        bx /= area * sc.rve.volume_factor;
+        by /= area * sc.rve.volume_factor;
+        printf("    sigma_xx %.5g (boundary %.5g), sigma_yy %.5g (%.5g), sigma_xy %.3g Pa over %.5g m^2; p = "
+               "%g Pa, chain "
+               "height %.4f of %.4f m\n",
+               sig[0], bx, sig[4], by, sig[1], area, pr, hchain, H);
+        CHECK_REL(sig[0], bx, 0.01);
+        CHECK_REL(sig[4], by, 0.01);
+        CHECK_REL(sig[0], -pr, 0.03);
+        CHECK(sig[0] / sig[4] > 0.9 && sig[0] / sig[4] < 1.1);
+    }
+    CHECK_REL(sc.walls[1].resistance, pr * W * sc.rve.volume_factor, 1e-3);
+    for (p = 0; p < sc.rve.n; ++p) {
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        if (!(x[0] > -0.02 && x[0] < 0.12)) ++bad;
+    }
+    CHECK(bad == 0);
+    gk_scene_destroy(&sc);
+}
+
+/* position of the particle with stable id `id` */
+static void pos_of(const gk_scene *sc, int32_t id, double x[3]) {
+    gk_scene_position(sc, gk_scene_index(sc, id), x);
+}
+
+/* Insertion and deletion leave the others alone: a pile with one extra,
+ * held, far-away particle (A) and the same pile from which that particle is
+ * removed after 3000 steps (B), or into which it is inserted then (C), run
+ * on to the same bits for every other particle (survivors keep their ids,
+ * their pair and wall contact histories and their order, so every sum is
+ * the same); ids are never reused. */
+TEST(insert_and_remove_leave_the_others_alone) {
+    gk_scene A, B, C;
+    double far[3] = {0.01, 0.28, 0.0}, zero[3] = {0, 0, 0}, xa[3], xb[3], xc[3];
+    int32_t idx, newid = -1;
+    int p, diffB = 0, diffC = 0;
+    if (box_scene(&A, 2, 8, 8, 0.1, 0.3, 0.2, 0) || box_scene(&B, 2, 8, 8, 0.1, 0.3, 0.2, 0) ||
+        box_scene(&C, 2, 8, 8, 0.1, 0.3, 0.2, 0)) {
+        CHECK(0);
+        return;
+    }
+    {
+        const double *xs[3];
+        double rr = 0.004, X = far[0], Y = far[1], Z = 0.0;
+        xs[0] = &X;
+        xs[1] = &Y;
+        xs[2] = &Z;
+        CHECK(gk_scene_insert(&A, 1, xs, &rr, NULL, &idx) == GK_OK);
+        CHECK(gk_scene_insert(&B, 1, xs, &rr, NULL, &idx) == GK_OK);
+        CHECK(idx == 64 && A.rve.n == 65);
+        CHECK(gk_scene_prescribe(&A, gk_scene_index(&A, idx), zero, zero) == GK_OK);
+        CHECK(gk_scene_prescribe(&B, gk_scene_index(&B, idx), zero, zero) == GK_OK);
+        CHECK(gk_scene_step(&A, 3000) == GK_OK && gk_scene_step(&B, 3000) == GK_OK &&
+              gk_scene_step(&C, 3000) == GK_OK);
+        CHECK(gk_scene_remove(&B, 1, &idx) == GK_OK);
+        CHECK(B.rve.n == 64 && gk_scene_index(&B, idx) == -1 && B.nprescribed == 0);
+        CHECK(gk_scene_insert(&C, 1, xs, &rr, NULL, &newid) == GK_OK);
+        CHECK(newid == 64);
+        CHECK(gk_scene_prescribe(&C, gk_scene_index(&C, newid), zero, zero) == GK_OK);
+    }
+    CHECK(gk_scene_step(&A, 3000) == GK_OK && gk_scene_step(&B, 3000) == GK_OK &&
+          gk_scene_step(&C, 3000) == GK_OK);
+    for (p = 0; p < 64; ++p) {
+        pos_of(&A, p, xa);
+        pos_of(&B, p, xb);
+        pos_of(&C, p, xc);
+        if (memcmp(xa, xb, sizeof xa)) ++diffB;
+        if (memcmp(xa, xc, sizeof xa)) ++diffC;
+    }
+    printf("    particles differing from the run with the extra particle: %d (removed), %d (inserted)\n",
+           diffB, diffC);
+    CHECK(diffB == 0 && diffC == 0);
+    CHECK(A.walls[2].force[1] == B.walls[2].force[1] && A.walls[2].force[1] == C.walls[2].force[1]);
+    /* an unknown id is refused and changes nothing */
+    CHECK(gk_scene_remove(&B, 1, &idx) == GK_ERR_ARG && B.rve.n == 64);
+    /* ids are not reused: the next insertion into B gets 65 */
+    {
+        const double *xs[3];
+        double rr = 0.004, X = 0.09, Y = 0.28, Z = 0.0;
+        xs[0] = &X;
+        xs[1] = &Y;
+        xs[2] = &Z;
+        CHECK(gk_scene_insert(&B, 1, xs, &rr, NULL, &newid) == GK_OK && newid == 65);
+        Y = 0.5; /* outside the open domain: refused, nothing changed */
+        CHECK(gk_scene_insert(&B, 1, xs, &rr, NULL, &newid) == GK_ERR_OUTSIDE && B.rve.n == 65);
+    }
+    gk_scene_destroy(&A);
+    gk_scene_destroy(&B);
+    gk_scene_destroy(&C);
+}
+
+/* the energy balance of a scene run, printed */
+static double report_energy(const gk_scene *sc, const char *what) {
+    gk_energy e;
+    gk_scene_energy(sc, &e);
+    printf("    %s: kinetic %.5g, elastic %.5g | gravity %.5g, walls %.5g, external %.5g, pressure %.5g, "
+           "prescribed %.5g | friction %.5g (slips %.5g), viscous %.5g, damping %.5g | balance %.3g of %.5g "
+           "J (%.2e)\n",
+           what, e.kinetic, e.elastic, e.gravity, e.walls, e.external, e.pressure, e.prescribed, e.friction,
+           e.slip, e.viscous, e.damping, e.balance, e.scale, fabs(e.balance) / e.scale);
+    return fabs(e.balance) / e.scale;
+}
+
+/* Energy bookkeeping: particles fall into a box (gravity), collide
+ * (Coulomb friction, dashpots, local damping; Hertz-Mindlin also with
+ * rolling resistance and tangential dashpots), a lid then comes down at
+ * constant speed, one particle is pushed by an external force and one is
+ * dragged at a prescribed velocity. kinetic + elastic - initial = works -
+ * dissipation to 1e-3 of the energy moved (what is left is the leap-frog's
+ * own energy error: dt = 0.1 dt_crit linear, 2e-5 s Hertz), 2D and 3D;
+ * with the linear law the friction booked agrees with the slip estimate to
+ * 5 % (Hertz-Mindlin's friction also holds the energy its tangential
+ * spring gains or loses as its stiffness follows the overlap); every pair
+ * re-evaluated for the books gives the kernel's bits. */
+TEST(energy_balance_closes) {
+    int dim, hz;
+    for (hz = 0; hz < 2; ++hz)
+        for (dim = 2; dim <= 3; ++dim) {
+            gk_scene sc;
+            gk_wall_def lid = gk_wall_def_default();
+            double f[3] = {0.5, 0, 0}, v[3] = {0.02, 0, 0}, rel;
+            gk_scene_def dummy = gk_scene_def_default();
+            char what[64];
+            int n = dim == 2 ? 10 : 4;
+            (void)dummy;
+            if (box_scene(&sc, dim, n, n, 0.1, 0.25, 0.1, 0)) {
+                CHECK(0);
+                continue;
+            }
+            if (hz) { /* the same scene with Hertz-Mindlin contacts (pairs and walls) */
+                gk_scene_destroy(&sc);
+                {
+                    gk_scene_def d = gk_scene_def_default();
+                    gk_packing pk;
+                    gk_material wm;
+                    double r = 0.1 / (2.2 * n);
+                    d.dim = dim;
+                    d.hi[0] = d.hi[2] = 0.1;
+                    d.hi[1] = 0.25;
+                    d.gravity[1] = -9.81;
+                    d.rve.mat.law = GK_LAW_HERTZ;
+                    d.rve.mat.young = 5e7;
+                    d.rve.mat.poisson = 0.3;
+                    d.rve.mat.friction = 0.5;
+                    d.rve.mat.zeta_n = 0.3;
+                    d.rve.mat.zeta_t = 0.1;
+                    d.rve.mat.roll_beta = 0.5;
+                    d.rve.mat.roll_eta = 0.2;
+                    d.rve.damping = 0.1;
+                    d.rve.dt = 2e-5;
+                    CHECK(lattice(&pk, dim, n, n, n, r, 0, 0, 0, 0.1, 5) == 0);
+                    CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+                    gk_packing_free(&pk);
+                    wm = d.rve.mat;
+                    CHECK(gk_scene_add_box(&sc, &wm, GK_BOX_ALL & ~(2u << 2), NULL) == GK_OK);
+                }
+            }
+            if (!hz) CHECK(gk_rve_set_dt(&sc.rve, 0.5 * sc.rve.dt) == GK_OK); /* 0.1 dt_crit */
+            CHECK(gk_scene_energy_track(&sc, 1) == GK_OK);
+            CHECK(gk_scene_set_external(&sc, 3, f, NULL) == GK_OK);
+            CHECK(gk_scene_prescribe(&sc, 5, v, NULL) == GK_OK);
+            CHECK(gk_scene_step(&sc, 15000) == GK_OK);
+            {
+                double top = 0.0, x[3];
+                int p;
+                for (p = 0; p < sc.rve.n; ++p) {
+                    gk_scene_position(&sc, p, x);
+                    if (x[1] + (double)sc.rve.r[p] > top) top = x[1] + (double)sc.rve.r[p];
+                }
+                lid.point[1] = top + 0.002;
+            }
+            lid.normal[1] = -1.0;
+            lid.mat = sc.def.rve.mat;
+            lid.velocity[1] = -0.05;
+            CHECK(gk_scene_add_wall(&sc, &lid, NULL) == GK_OK);
+            CHECK(gk_scene_step(&sc, 15000) == GK_OK);
+            snprintf(what, sizeof what, "%dD %s", dim, hz ? "Hertz" : "linear");
+            rel = report_energy(&sc, what);
+            CHECK(rel < 1e-3);
+            CHECK(sc.energy_mismatch == 0);
+            CHECK(sc.en.friction > 0 && sc.en.viscous > 0 && sc.en.damping > 0 && sc.en.walls > 0);
+            if (!hz) CHECK_REL(sc.en.slip, sc.en.friction, 0.05);
+            gk_scene_destroy(&sc);
+        }
+}
+
+/* a scene with every moving part: 2D biaxial cell (floor, servo lid),
+ * anchored membranes, one held particle, one pushed one, energy books */
+static int full_scene(gk_scene *sc, int threads) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_packing pk;
+    gk_wall_def lid = gk_wall_def_default(), flo = gk_wall_def_default();
+    int32_t left[64], right[64];
+    int nl, nr, p;
+    double r = 0.0025, f[3] = {0.3, 0.0, 0.0};
+    d.dim = 2;
+    d.lo[0] = -0.1;
+    d.hi[0] = 0.2;
+    d.hi[1] = 0.25;
+    d.gravity[1] = -9.81;
+    d.rve.mat.young = 5e7;
+    d.rve.mat.friction = 0.3;
+    d.rve.mat.zeta_n = 0.2;
+    d.rve.damping = 0.2;
+    d.rve.dt_factor = 0.2;
+    d.rve.threads = threads;
+    if (lattice(&pk, 2, 16, 24, 1, r, 0.0, 0.0, 0.0, 0.0, 3)) return 1;
+    for (p = 0; p < pk.n; ++p) pk.r[p] = 1.05 * r + 0.04 * r * (double)(p % 3);
+    if (gk_scene_create(sc, &d, &pk)) {
+        gk_packing_free(&pk);
+        return 1;
+    }
+    gk_packing_free(&pk);
+    flo.normal[1] = 1.0;
+    flo.mat = d.rve.mat;
+    lid.point[1] = 24 * 2.2 * r;
+    lid.normal[1] = -1.0;
+    lid.mat = d.rve.mat;
+    lid.drive = GK_DRIVE_STRESS;
+    lid.target = 2e4;
+    lid.area = 16 * 2.2 * r * sc->rve.volume_factor;
+    lid.max_speed = 0.05;
+    if (gk_scene_add_wall(sc, &flo, NULL) || gk_scene_add_wall(sc, &lid, NULL) ||
+        gk_scene_side_chain(sc, 0, -1, 2.2 * r, left, 64, &nl) ||
+        gk_scene_side_chain(sc, 0, 1, 2.2 * r, right, 64, &nr) ||
+        gk_scene_add_membrane(sc, nl, left, 1e4, 1e5, 1, 0, NULL) ||
+        gk_scene_add_membrane(sc, nr, right, 1e4, 1e5, 0, 1, NULL) || gk_scene_prescribe(sc, 8, NULL, NULL) ||
+        gk_scene_set_external(sc, 100, f, NULL) || gk_scene_energy_track(sc, 1))
+        return 1;
+    return 0;
+}
+
+static unsigned char *state_of(const gk_scene *sc, size_t *n) {
+    unsigned char *b;
+    *n = gk_scene_state_size(sc);
+    b = (unsigned char *)malloc(*n);
+    if (b && gk_scene_save(sc, b, *n, NULL)) {
+        free(b);
+        return NULL;
+    }
+    return b;
+}
+
+/* gk_scene_save / gk_scene_restore continue a run bit for bit (walls,
+ * servo, membranes, prescribed and pushed particles, energy books), also
+ * across a change of the particle count (a state saved before a deletion
+ * restored after it); 1 and 2 threads give the same bits. */
+TEST(save_restore_and_threads_are_bitwise) {
+    gk_scene A, B;
+    unsigned char *s0, *s1, *s2;
+    size_t n0, n1, n2;
+    long st = QUICK(3000, 1500);
+    int32_t gone[2] = {40, 41};
+    /* threads: a short run (OpenMP on a shared machine is slow, not different) */
+    if (full_scene(&A, 1) || full_scene(&B, 2)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_scene_step(&A, 600) == GK_OK && gk_scene_step(&B, 600) == GK_OK);
+    CHECK(B.rve.pl.n >= GK_DEM_PAR_MIN); /* B's pair forces did run on 2 threads */
+    s1 = state_of(&A, &n1);
+    s2 = state_of(&B, &n2);
+    CHECK(s1 && s2 && n1 == n2 && memcmp(s1, s2, n1) == 0);
+    printf("    1 vs 2 threads after 600 steps: %s\n",
+           s1 && s2 && n1 == n2 && !memcmp(s1, s2, n1) ? "identical" : "DIFFER");
+    free(s1);
+    free(s2);
+    gk_scene_destroy(&B);
+    if (full_scene(&B, 1)) {
+        CHECK(0);
+        gk_scene_destroy(&A);
+        return;
+    }
+    CHECK(gk_scene_step(&A, st) == GK_OK && gk_scene_step(&B, st + 600) == GK_OK);
+    s0 = state_of(&A, &n0);
+    CHECK(s0 != NULL);
+    CHECK(gk_scene_step(&A, st) == GK_OK);
+    s1 = state_of(&A, &n1);
+    /* restore in B (remove two particles first: the count changes back) and run on */
+    CHECK(gk_scene_remove(&B, 2, gone) == GK_OK && B.rve.n == A.rve.n - 2);
+    CHECK(gk_scene_restore(&B, s0, n0) == GK_OK);
+    CHECK(B.rve.n == A.rve.n && gk_scene_index(&B, 40) >= 0);
+    CHECK(gk_scene_step(&B, st) == GK_OK);
+    s2 = state_of(&B, &n2);
+    CHECK(s2 && n1 == n2 && memcmp(s1, s2, n1) == 0);
+    printf("    state %zu bytes; the restored run %s the uninterrupted one\n", n1,
+           s2 && n1 == n2 && !memcmp(s1, s2, n1) ? "matches" : "DIFFERS from");
+    /* a damaged state is refused */
+    s0[0] ^= 1;
+    CHECK(gk_scene_restore(&B, s0, n0) == GK_ERR_FORMAT);
+    CHECK(gk_scene_restore(&B, s0, 10) == GK_ERR_FORMAT);
+    free(s0);
+    free(s1);
+    free(s2);
+    gk_scene_destroy(&A);
+    gk_scene_destroy(&B);
+}
+
+/* Periodic in x, walls in y: a layer sheared between a fixed rough floor
+ * and a rough lid moving along x (servo in y to a normal force): particles
+ * wrap in x and stay in the period; in steady shear the floor and the lid
+ * hold equal and opposite shear forces (means over 20 000 steps, 5 %), the
+ * servo holds the normal force (2 %), the shear resistance is
+ * frictional (between 0.05 and the contact friction 0.5 times the normal
+ * force). */
+TEST(periodic_shear_between_walls) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_scene sc;
+    gk_packing pk;
+    gk_wall_def lid = gk_wall_def_default(), flo = gk_wall_def_default();
+    double r = 0.0025, W = 20 * 2.2 * r, N = 200.0, ratio, shear, floor_shear, normal;
+    int p, bad = 0;
+    d.dim = 2;
+    d.hi[0] = W;
+    d.hi[1] = 0.1;
+    d.periodic = 1u;
+    d.rve.mat.young = 5e7;
+    d.rve.mat.friction = 0.5;
+    d.rve.mat.zeta_n = 0.2;
+    d.rve.damping = 0.1;
+    d.rve.dt_factor = 0.2;
+    CHECK(lattice(&pk, 2, 20, 12, 1, r, 0.0, 0.0, 0.0, 0.1, 13) == 0);
+    CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    flo.normal[1] = 1.0;
+    flo.mat = d.rve.mat;
+    flo.mat.friction = 1.0;
+    lid = flo;
+    lid.point[1] = 12 * 2.2 * r + 0.002;
+    lid.normal[1] = -1.0;
+    lid.drive = GK_DRIVE_FORCE;
+    lid.target = N;
+    lid.max_speed = 0.05;
+    CHECK(gk_scene_add_wall(&sc, &flo, NULL) == GK_OK && gk_scene_add_wall(&sc, &lid, NULL) == GK_OK);
+    CHECK(gk_scene_step(&sc, 10000) == GK_OK); /* consolidate */
+    sc.walls[1].def.velocity[0] = 0.05;        /* servo in y, sliding at 5 cm/s in x */
+    CHECK(gk_scene_step(&sc, 15000) == GK_OK);
+    { /* averages over the next 20000 steps (the forces fluctuate) */
+        int k;
+        double sl = 0.0, sf = 0.0, sn = 0.0;
+        for (k = 0; k < 100; ++k) {
+            CHECK(gk_scene_step(&sc, 200) == GK_OK);
+            sl -= sc.walls[1].force[0]; /* the particles resist the lid's motion */
+            sf += sc.walls[0].force[0];
+            sn += sc.walls[1].resistance;
+        }
+        shear = sl / 100;
+        floor_shear = sf / 100;
+        normal = sn / 100;
+    }
+    ratio = shear / normal;
+    printf("    lid normal %.4g N (target %g), shear %.4g N, floor shear %.4g N, ratio %.3f (means)\n",
+           normal, N, shear, floor_shear, ratio);
+    CHECK_NEAR(floor_shear, shear, 0.05 * fabs(shear));
+    CHECK_REL(normal, N, 0.02);
+    CHECK(ratio > 0.05 && ratio < 0.5);
+    for (p = 0; p < sc.rve.n; ++p) {
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        if (!(x[0] >= 0.0 && x[0] < W)) ++bad;
+    }
+    CHECK(bad == 0);
+    gk_scene_destroy(&sc);
+}
+
+/* gk_packing_tile: the seed 000 RVE repeated 2 x 1 is the same periodic
+ * material - its Love stress (after a force refresh) is the original's to
+ * 1e-9 - with twice the particles and cell; gk_packing_subset: exactly the
+ * particles (wholly) inside the box, in order, shifted to its corner. */
+TEST(packing_tile_and_subset) {
+    gk_packing pk, t, sub;
+    gk_err e;
+    gk_rve a, b;
+    gk_rve_def def = gk_rve_def_default();
+    double sa[9], sb[9], lo[3] = {0.02, 0.03, 0}, hi[3] = {0.15, 0.12, 0};
+    int p, cnt = 0, q = 0, ok = 1;
+    if (gk_packing_read("examples/data/rve400.txt", &pk, NULL, &e)) {
+        printf("    %s\n", e.msg);
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_packing_tile(&pk, 2, 1, 1, &t, NULL, &e) == GK_OK);
+    CHECK(t.n == 800 && t.h[0] == 2.0 * pk.h[0] && t.h[4] == pk.h[4]);
+    CHECK(gk_rve_create(&a, &def, &pk) == GK_OK && gk_rve_create(&b, &def, &t) == GK_OK);
+    CHECK(gk_rve_refresh(&a) == GK_OK && gk_rve_refresh(&b) == GK_OK);
+    gk_rve_stress(&a, sa);
+    gk_rve_stress(&b, sb);
+    printf("    sigma_xx %.10g vs tiled %.10g Pa, sigma_xy %.6g vs %.6g\n", sa[0], sb[0], sa[1], sb[1]);
+    CHECK_REL(sb[0], sa[0], 1e-9);
+    CHECK_REL(sb[4], sa[4], 1e-9);
+    CHECK_NEAR(sb[1], sa[1], 1e-9 * fabs(sa[0]));
+    gk_rve_destroy(&a);
+    gk_rve_destroy(&b);
+    CHECK(gk_packing_subset(&t, lo, hi, 1, &sub, NULL, &e) == GK_OK);
+    for (p = 0; p < t.n; ++p)
+        if (t.x[p] - t.r[p] >= lo[0] && t.x[p] + t.r[p] <= hi[0] && t.y[p] - t.r[p] >= lo[1] &&
+            t.y[p] + t.r[p] <= hi[1]) {
+            ++cnt;
+            if (q < sub.n && (sub.x[q] != t.x[p] - lo[0] || sub.y[q] != t.y[p] - lo[1] || sub.r[q] != t.r[p]))
+                ok = 0;
+            ++q;
+        }
+    CHECK(sub.n == cnt && ok);
+    CHECK(sub.h[0] == hi[0] - lo[0] && sub.h[4] == hi[1] - lo[1]);
+    printf("    subset: %d of %d particles in the box\n", sub.n, t.n);
+    /* bad boxes and counts are refused */
+    CHECK(gk_packing_subset(&t, hi, lo, 1, &sub, NULL, &e) == GK_ERR_ARG);
+    CHECK(gk_packing_tile(&pk, 0, 1, 1, &t, NULL, &e) == GK_ERR_ARG);
+    gk_packing_free(&sub);
+    gk_packing_free(&t);
+    gk_packing_free(&pk);
+}
+
+/* Bodies: a disk (2D pipe) pushed down at constant speed into a settled bed
+ * meets a resistance that grows with its depth (means over 3000 steps); a drum (particles inside a
+ * disk) turning counter-clockwise drags its bed up on its right (centre of
+ * mass to +x) and the bed's moment on it opposes the turn; a sphere resting
+ * on a 3D rectangle or inside a horizontal cylinder presses on it with its
+ * weight; one beyond the rectangle's edge falls past it. */
+TEST(bodies_pipe_drum_rectangle_cylinder) {
+    gk_scene sc;
+    gk_wall_def pipe = gk_wall_def_default(), drum = gk_wall_def_default();
+    int ip, k, p;
+    double f1, f2;
+    /* pipe */
+    if (box_scene(&sc, 2, 16, 10, 0.16, 0.3, 0.3, 0)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_scene_step(&sc, QUICK(15000, 8000)) == GK_OK);
+    pipe.kind = GK_WALL_DISK;
+    pipe.radius = 0.02;
+    pipe.point[0] = 0.08;
+    for (p = 0; p < sc.rve.n; ++p) { /* just above the bed */
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        if (x[1] + (double)sc.rve.r[p] + pipe.radius + 0.001 > pipe.point[1])
+            pipe.point[1] = x[1] + (double)sc.rve.r[p] + pipe.radius + 0.001;
+    }
+    pipe.mat = sc.def.rve.mat;
+    pipe.velocity[1] = -0.2;
+    CHECK(gk_scene_add_wall(&sc, &pipe, &ip) == GK_OK);
+    f1 = f2 = 0.0;
+    for (k = 0; k < 60; ++k) { /* mean uplift over the first and the second 3000 steps */
+        CHECK(gk_scene_step(&sc, 100) == GK_OK);
+        if (k < 30)
+            f1 += sc.walls[ip].force[1] / 30;
+        else
+            f2 += sc.walls[ip].force[1] / 30;
+    }
+    printf("    pipe: mean uplift %.4g N, then %.4g N (now at y = %.4f m)\n", f1, f2, sc.walls[ip].pos[1]);
+    CHECK(f1 > 0.0 && f2 > f1);
+    gk_scene_destroy(&sc);
+    /* drum */
+    {
+        gk_scene_def d = gk_scene_def_default();
+        gk_packing pk;
+        double cm = 0.0, M = 0.0;
+        d.dim = 2;
+        d.lo[0] = d.lo[1] = -0.1;
+        d.hi[0] = d.hi[1] = 0.1;
+        d.gravity[1] = -9.81;
+        d.rve.mat.young = 5e7;
+        d.rve.mat.friction = 0.5;
+        d.rve.mat.zeta_n = 0.3;
+        d.rve.dt_factor = 0.2;
+        CHECK(lattice(&pk, 2, 10, 5, 1, 0.004, -0.044, -0.07, 0, 0.1, 17) == 0);
+        CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+        gk_packing_free(&pk);
+        drum.kind = GK_WALL_DISK;
+        drum.inside = 1;
+        drum.radius = 0.09;
+        drum.mat = d.rve.mat;
+        drum.mat.friction = 0.8;
+        drum.spin[2] = 2.0;
+        CHECK(gk_scene_add_wall(&sc, &drum, &ip) == GK_OK);
+        CHECK(gk_scene_step(&sc, QUICK(20000, 12000)) == GK_OK);
+        for (p = 0; p < sc.rve.n; ++p) {
+            double x[3];
+            gk_scene_position(&sc, p, x);
+            cm += sc.mass[p] * x[0];
+            M += sc.mass[p];
+        }
+        printf("    drum: centre of mass x = %.4f m, moment on the drum %.4g N m\n", cm / M,
+               sc.walls[ip].moment[2]);
+        CHECK(cm / M > 0.005);
+        CHECK(sc.walls[ip].moment[2] < 0.0);
+        for (p = 0; p < sc.rve.n; ++p) {
+            double x[3];
+            gk_scene_position(&sc, p, x);
+            CHECK(x[0] * x[0] + x[1] * x[1] < 0.09 * 0.09);
+        }
+        gk_scene_destroy(&sc);
+    }
+    /* 3D: a rectangle and a cylinder */
+    for (k = 0; k < 3; ++k) {
+        gk_scene_def d = gk_scene_def_default();
+        gk_packing pk;
+        gk_err e;
+        gk_wall_def w = gk_wall_def_default();
+        double m;
+        d.dim = 3;
+        for (p = 0; p < 3; ++p) {
+            d.lo[p] = -0.2;
+            d.hi[p] = 0.2;
+        }
+        d.gravity[1] = -9.81;
+        d.rve.mat.young = 5e7;
+        d.rve.mat.zeta_n = 0.5;
+        d.rve.damping = 0.3;
+        d.rve.dt_factor = 0.2;
+        CHECK(gk_packing_alloc(&pk, 3, 1, NULL, &e) == GK_OK);
+        pk.r[0] = 0.01;
+        pk.x[0] = k == 1 ? 0.06 : 0.0; /* k = 1: beyond the rectangle's edge */
+        pk.y[0] = k == 2 ? -0.05 : 0.012;
+        CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+        gk_packing_free(&pk);
+        w.mat = d.rve.mat;
+        if (k < 2) {
+            w.kind = GK_WALL_RECT;
+            w.point[0] = -0.05;
+            w.point[2] = -0.05;
+            w.e1[0] = 0.1;
+            w.e2[2] = 0.1;
+        } else {
+            w.kind = GK_WALL_CYLINDER;
+            w.inside = 1;
+            w.radius = 0.08;
+            w.axis[2] = 1.0;
+        }
+        CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_OK);
+        CHECK(gk_scene_step(&sc, k == 1 ? 6000 : QUICK(20000, 10000)) == GK_OK);
+        m = sc.mass[0];
+        if (k == 1) {
+            double x[3];
+            gk_scene_position(&sc, 0, x);
+            CHECK(sc.walls[0].ncontacts == 0 && x[1] < -0.02);
+        } else {
+            printf("    sphere on a %s: force %.6g N, weight %.6g N\n", k ? "cylinder" : "rectangle",
+                   -sc.walls[0].force[1], m * 9.81);
+            CHECK_REL(-sc.walls[0].force[1], m * 9.81, 1e-3);
+        }
+        gk_scene_destroy(&sc);
+    }
+}
+
+/* A particle thrown out of an open domain is an error (nothing moves on)
+ * or, with GK_LOST_DELETE, is deleted and counted; the run goes on. */
+TEST(lost_particles) {
+    int pol;
+    for (pol = 0; pol < 2; ++pol) {
+        gk_scene sc;
+        double v[3] = {0, 30.0, 0};
+        gk_result r;
+        if (box_scene(&sc, 2, 6, 6, 0.1, 0.3, 0.0, 0)) {
+            CHECK(0);
+            continue;
+        }
+        sc.def.lost = pol ? GK_LOST_DELETE : GK_LOST_ERROR;
+        CHECK(gk_scene_set_velocity(&sc, gk_scene_index(&sc, 35), v, NULL) == GK_OK);
+        r = gk_scene_step(&sc, 5000);
+        if (pol == 0) {
+            printf("    error: %s\n", gk_scene_error(&sc));
+            CHECK(r == GK_ERR_OUTSIDE && strstr(gk_scene_error(&sc), "left the open domain") != NULL);
+            CHECK(sc.rve.n == 36);
+        } else {
+            CHECK(r == GK_OK && sc.lost == 1 && sc.rve.n == 35 && gk_scene_index(&sc, 35) == -1);
+        }
+        gk_scene_destroy(&sc);
+    }
+}
+
+/* Bad input gets a clear error and changes nothing. */
+TEST(bad_input_is_refused) {
+    gk_scene sc;
+    gk_scene_def d = gk_scene_def_default();
+    gk_wall_def w = gk_wall_def_default();
+    gk_packing pk;
+    gk_material m = gk_material_default(), out;
+    gk_err e;
+    int nw;
+    double nanv[3] = {NAN, 0, 0};
+    CHECK(lattice(&pk, 2, 4, 4, 1, 0.005, 0.0, 0.0, 0.0, 0.0, 1) == 0);
+    d.dim = 2;
+    d.hi[0] = d.hi[1] = 0.1;
+    {
+        gk_scene_def b = d;
+        b.cookie = 0;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_ARG);
+        b = d;
+        b.hi[0] = -1.0;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_CELL);
+        b = d;
+        b.hi[0] = 0.03; /* particles beyond the open domain */
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_OUTSIDE);
+        b = d;
+        b.dim = 3;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_ARG);
+        b = d;
+        b.gravity[1] = NAN;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_NAN);
+        b = d;
+        b.periodic = 4u;
+        CHECK(gk_scene_create(&sc, &b, &pk) == GK_ERR_ARG);
+    }
+    CHECK(gk_scene_create(&sc, &d, &pk) == GK_OK);
+    gk_packing_free(&pk);
+    nw = sc.nwalls;
+    w.normal[1] = 2.0; /* not a unit vector */
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_ARG);
+    w.normal[1] = 1.0;
+    w.kind = GK_WALL_RECT; /* 3D only */
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_ARG);
+    w.kind = GK_WALL_PLANE;
+    w.drive = GK_DRIVE_FORCE; /* no max_speed */
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_ARG);
+    w.drive = GK_DRIVE_VELOCITY;
+    w.point[0] = NAN;
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_NAN);
+    w.point[0] = 0.0;
+    w.mat.young = 6e12; /* far stiffer than the time step allows */
+    d.rve.dt = sc.rve.dt;
+    sc.def.rve.dt = sc.rve.dt; /* an explicit dt is checked, not reduced */
+    CHECK(gk_scene_add_wall(&sc, &w, NULL) == GK_ERR_DT);
+    printf("    %s\n", gk_scene_error(&sc));
+    CHECK(sc.nwalls == nw);
+    CHECK(gk_scene_prescribe(&sc, 99, NULL, NULL) == GK_ERR_ARG);
+    CHECK(gk_scene_set_external(&sc, 0, nanv, NULL) == GK_ERR_NAN);
+    CHECK(gk_scene_set_mass(&sc, 0, -1.0, 1.0) == GK_ERR_MASS);
+    {
+        int32_t ids[2] = {0, 1};
+        CHECK(gk_scene_add_membrane(&sc, 1, ids, 1e4, 0.0, -1, -1, NULL) == GK_ERR_ARG);
+        CHECK(gk_scene_add_membrane(&sc, 2, ids, 1e4, 0.0, 5, -1, NULL) == GK_ERR_ARG);
+        ids[1] = 99;
+        CHECK(gk_scene_add_membrane(&sc, 2, ids, 1e4, 0.0, -1, -1, NULL) == GK_ERR_ARG);
+    }
+    CHECK(gk_scene_step(&sc, -1) == GK_ERR_ARG);
+    m.law = GK_LAW_HERTZ;
+    m.poisson = 0.3;
+    CHECK(gk_scene_pair_material(&m, &sc.def.rve.mat, &out, &e) == GK_ERR_ARG); /* laws differ */
+    CHECK(sc.rve.n == 16 && sc.nwalls == nw && sc.nmem == 0 && sc.nprescribed == 0);
+    gk_scene_destroy(&sc);
+}
+
+/* examples/dem_biaxial.c on one 400-disk tile to 1 % strain: it writes its
+ * documented outputs and RESULT; the platen stress at consolidation is the
+ * confining pressure (2 %) and the membranes hold sigma_xx there (10 % in
+ * this 400-disk specimen); the
+ * specimen hardens (sigma_yy grows, the stress ratio mobilises friction:
+ * 0.1 to 0.8); bad arguments are refused by name, a failed write exits 1. */
+TEST(dem_biaxial_smoke) {
+    double ratio, n;
+    int rc;
+    rc = system("build/dem_biaxial --tiles 1x1 --strain 0.01 --every 0.002 --pictures 0.004 --quiet "
+                "--out build/t_dembx > build/t_dembx.out 2>&1");
+    CHECK(rc == 0);
+    CHECK(gk_test_file_has(
+        "build/t_dembx/biaxial.csv",
+        "eps_axial,sigma_yy_lid,sigma_xx,sigma_yy,eps_vol,stress_ratio,phi_deg,coordination"));
+    CHECK(gk_test_file_has("build/t_dembx/particles_001.vtk", "POINT_DATA"));
+    CHECK(gk_test_file_has("build/t_dembx/walls_end.vtk", "CELL_DATA"));
+    CHECK(gk_test_file_has("build/t_dembx/particles_000.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_dembx/biaxial_stress.svg", "<svg"));
+    ratio = gk_test_result("build/t_dembx.out", "peak_ratio");
+    n = gk_test_result("build/t_dembx.out", "n");
+    printf("    n %g, peak stress ratio %.4f at %.4f, sigma_yy peak %.4g Pa\n", n, ratio,
+           gk_test_result("build/t_dembx.out", "eps_peak"), gk_test_result("build/t_dembx.out", "syy_peak"));
+    CHECK(n == 400);
+    CHECK(ratio > 0.1 && ratio < 0.8);
+    CHECK(gk_test_result("build/t_dembx.out", "syy_peak") > 1.2e5);
+    {
+        FILE *fp = fopen("build/t_dembx/biaxial.csv", "r");
+        char line[512];
+        double e, lid, sxx;
+        int ok = fp && fgets(line, sizeof line, fp) && fgets(line, sizeof line, fp) &&
+                 sscanf(line, "%lf,%lf,%lf", &e, &lid, &sxx) == 3;
+        if (fp) fclose(fp);
+        CHECK(ok);
+        CHECK_REL(lid, 1e5, 0.02);
+        CHECK_REL(sxx, 1e5, 0.1);
+    }
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --strain abc > build/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_dembx.err", "--strain abc: not a number"));
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --tiles 0x2 > build/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_dembx.err", "--tiles"));
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --bogus 1 > build/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_dembx.err", "unknown option --bogus"));
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --tiles 1x1 --strain 0.002 --every 0.001 --quiet "
+                             "--out /proc/no_such_dir > build/t_dembx.err 2>&1")) == 1);
+    CHECK(system("build/dem_biaxial --help > build/t_dembx.err 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_dembx.err", "RESULT"));
+}
+
+/* examples/dem_collapse.c on a small column (8 disks across, 0.6 s): the
+ * outputs and RESULT; the column spreads (d* > 0.3) and loses height,
+ * energy is dissipated, not created (0 < E_d <= 1), the scene's books
+ * close (balance below 1e-3 of E_p0); bad arguments are refused by name. */
+TEST(dem_collapse_smoke) {
+    double ds, ed, bal, h;
+    CHECK(system("build/dem_collapse --diameters 8 --t-end 0.6 --every 0.02 --snapshots 0.3 --quiet "
+                 "--out build/t_demcl > build/t_demcl.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/t_demcl/collapse.csv",
+                           "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0"));
+    CHECK(gk_test_file_has("build/t_demcl/particles_001.vtk", "POINT_DATA"));
+    CHECK(gk_test_file_has("build/t_demcl/walls_000.vtk", "CELL_DATA"));
+    CHECK(gk_test_file_has("build/t_demcl/collapse_front.svg", "<svg"));
+    CHECK(gk_test_file_has("build/t_demcl/collapse_energy.svg", "<svg"));
+    ds = gk_test_result("build/t_demcl.out", "dstar");
+    ed = gk_test_result("build/t_demcl.out", "Ed_final_over_Ep0");
+    bal = gk_test_result("build/t_demcl.out", "energy_balance");
+    h = gk_test_result("build/t_demcl.out", "height_over_H0");
+    printf("    d* %.4f, E_d %.4f E_p0, height %.4f H0, balance %.2e E_p0\n", ds, ed, h, bal);
+    CHECK(ds > 0.3);
+    CHECK(ed > 0.0 && ed <= 1.0);
+    CHECK(h < 1.0);
+    CHECK(fabs(bal) < 1e-3);
+    CHECK(WEXITSTATUS(system("build/dem_collapse --a 20 > build/t_demcl.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_demcl.err", "--a: need an aspect ratio"));
+    CHECK(WEXITSTATUS(system("build/dem_collapse --snapshots 1,0.5 > build/t_demcl.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/t_demcl.err", "--snapshots"));
+    CHECK(WEXITSTATUS(system("build/dem_collapse --diameters 8 --t-end 0.02 --quiet --out /proc/no_such_dir "
+                             "> build/t_demcl.err 2>&1")) == 1);
 }
 
 int main(int argc, char **argv) {
@@ -627,5 +1673,19 @@ int main(int argc, char **argv) {
     RUN(chung_ooi_6_spinning_sphere_on_wall);
     RUN(chung_ooi_7_two_spheres_oblique);
     RUN(chung_ooi_8_different_spheres);
+    RUN(gravity_floor_carries_the_weight);
+    RUN(servo_wall_reaches_its_target);
+    RUN(prescribed_particles_move_and_report_their_load);
+    RUN(membrane_confines_at_its_pressure);
+    RUN(insert_and_remove_leave_the_others_alone);
+    RUN(energy_balance_closes);
+    RUN(save_restore_and_threads_are_bitwise);
+    RUN(periodic_shear_between_walls);
+    RUN(packing_tile_and_subset);
+    RUN(bodies_pipe_drum_rectangle_cylinder);
+    RUN(lost_particles);
+    RUN(bad_input_is_refused);
+    RUN(dem_biaxial_smoke);
+    RUN(dem_collapse_smoke);
     return gk_test_done();
 }

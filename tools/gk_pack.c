@@ -36,7 +36,7 @@ static void usage(FILE *fp) {
             "  --consolidation-friction M Coulomb coefficient while consolidating (0: densest)\n"
             "  --target-void-ratio E      search the consolidation friction that gives void ratio E\n"
             "  --friction-deg A           contact friction angle after consolidation [degrees, 0 to 85]\n"
-            "                             (28.65 = 0.5 rad, seed 000)\n"
+            "                             (28.65 = 0.5 rad, Guo & Zhao 2014)\n"
             "  --E, --kt-ratio, --density, --thickness, --damping   material (seed 000 defaults)\n"
             "  --seed S                   random seed (1)\n"
             "  --tol T                    relative stress tolerance (1e-3)\n"

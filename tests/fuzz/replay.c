@@ -4,7 +4,10 @@
  *   tests/fuzz/fuzz_NAME.c        a harness: LLVMFuzzerTestOneInput(data, size)
  *                                 on one reader; a broken promise aborts
  *                                 (fuzz_check.h)
- *   tests/fuzz/corpus/NAME/       its seed inputs (small valid files)
+ *   tests/fuzz/corpus/NAME/       its seed inputs (small valid files, named) and
+ *                                 the inputs of past runs that reached new code,
+ *                                 minimised by libFuzzer (SHA-1 names):
+ *                                   build/fuzz/fuzz_NAME -merge=1 tests/fuzz/corpus/NAME build/fuzz/NAME
  *   tests/fuzz/crashers/NAME/     every input that ever crashed it or broke a
  *                                 promise, kept after the fix
  * `make test` builds build/fuzz_replay_NAME = this file + fuzz_NAME.c with

@@ -1,0 +1,502 @@
+/* dem_collapse.c - the 2D granular column collapse in plain DEM: a column of
+ * disks d_0 wide and H_0 = a d_0 high, held by a gate on its right against
+ * a smooth symmetry wall on its left, stands on a rough floor (a row of
+ * fixed disks); the gate is withdrawn at t = 0 and the column spreads under
+ * gravity. The single-scale reference of examples/mpmdem_collapse.c (same
+ * column, symmetry plane and base), and the experiments' scaling of the
+ * run-out d* = (d_f - d_0) / d_0 (Lube, Huppert, Sparks & Freundt 2005;
+ * Lajeunesse, Monnier & Homsy 2005: for a < 3, d* ~ 1.2 a to 1.6 a).
+ *
+ *   build/dem_collapse                         # a = 1, 24 disks across, ~700 disks
+ *   build/dem_collapse --a 2 --diameters 40    # a taller, finer column
+ *
+ * Preparation. Disks with radii uniform in [0.6, 1] r_max (r_max from
+ * --diameters: mean diameter = d_0 / diameters) are placed on a square
+ * lattice in [0, d_0] above the floor (twice as high as the column will
+ * be) and settle under gravity with local
+ * damping 0.3 until their kinetic energy is below 1e-6 of their potential
+ * energy; those whose centre lies above H_0 are then removed (so the column
+ * is H_0 high), the rest settle again, and local damping is switched off
+ * for the collapse (the contact dashpots, --restitution, dissipate).
+ *
+ * Model (gk_scene.h): linear contacts E r* (--young), k_t / k_n 0.8,
+ * Coulomb --mu, optional rolling resistance (--roll-beta, --roll-eta),
+ * normal dashpot for --restitution, density 2650, disks of thickness 0.1 m
+ * (gk_dem.h GK_MASS_CYLINDER); floor: one row of fixed disks of the mean
+ * radius, touching; left: a smooth plane (the symmetry plane); the gate: a
+ * smooth segment at x = d_0 from the floor disks' tops up, pulled away at
+ * 20 m/s at t = 0. The domain runs to
+ * (2 + 2.5 a) d_0; disks thrown beyond it are deleted and counted (lost).
+ * dt = 0.2 x the critical step (seed 000 eq 19).
+ *
+ * Measures (a CSV row every --every s): the front d_f = the furthest edge
+ * x + r of the deposit, scanned from the wall along x and stopped at the
+ * first gap wider than one mean diameter (flyers and scattered disks do
+ * not count); d* = (d_f - d_0) / d_0; the height of the deposit at the
+ * wall; energies over E_p0 (the potential energy of the released column
+ * above the floor): E_k, E_p, E_d = E_p0 - E_p - E_k, and the dissipation
+ * the scene's books keep (friction, dashpots) with their balance. At rest
+ * when E_k < --rest-frac E_p0 after the peak of E_k; the run stops
+ * --rest-hold s later (or at --t-end).
+ *
+ * Outputs in --out DIR: collapse.csv, collapse_front.svg,
+ * collapse_energy.svg, particles_NNN.svg/.vtk and walls_NNN.vtk at
+ * release, at --snapshots times and at the end; a RESULT line.
+ */
+#define _POSIX_C_SOURCE 200809L
+#define GK_IMPLEMENTATION
+#include "gk_io.h"
+#include "gk_scene.h"
+#include "dem_scene.h"
+
+#define DC_MAX_SNAP 16
+
+typedef struct dc_opts {
+    double a, width, diameters, mu, roll_beta, roll_eta, restitution, young, gravity, t_end, every, rest_frac,
+        rest_hold;
+    int threads, quiet, nsnap;
+    unsigned long seed;
+    double snap[DC_MAX_SNAP];
+    const char *out;
+} dc_opts;
+
+typedef struct dc_row {
+    double t, front, height, ek, ep, ed, friction, viscous, balance;
+} dc_row;
+
+static void usage(FILE *fp) {
+    fprintf(
+        fp,
+        "dem_collapse - 2D granular column collapse in DEM (gk_scene.h): a column d0 wide and a d0 high\n"
+        "on a rough floor (fixed disks), a smooth symmetry wall on its left, the gate on its right pulled\n"
+        "away at t = 0; run-out d* = (d_f - d0)/d0 against the experiments (Lube et al. 2005,\n"
+        "Lajeunesse et al. 2005: d* ~ 1.2 a to 1.6 a for a < 3) and examples/mpmdem_collapse.c.\n\n"
+        "usage: dem_collapse [options]\n"
+        "  --a A                  aspect ratio H0/d0 (default 1)\n"
+        "  --width D0             column width [m] (default 1, as mpmdem_collapse)\n"
+        "  --diameters N          mean disk diameters across the column (default 24)\n"
+        "  --mu M                 Coulomb friction of the disks and the floor disks (default 0.5)\n"
+        "  --roll-beta B --roll-eta E   rolling resistance (default 0 0: none)\n"
+        "  --restitution E        normal restitution of the contact dashpots (default 0.5)\n"
+        "  --young E              contact modulus, k_n = E r* [Pa] (default 6e8, seed 000/003)\n"
+        "  --gravity G            [m/s^2] (default 9.81)\n"
+        "  --t-end T              simulated time after release [s] (default 4)\n"
+        "  --every DT             time between CSV rows [s] (default 0.01)\n"
+        "  --snapshots T1,T2,...  picture times [s] (default 0.2,0.5,1)\n"
+        "  --rest-frac F          at rest when E_k < F E_p0 after its peak (default 5e-3)\n"
+        "  --rest-hold T          stop T s after coming to rest (default 0.05)\n"
+        "  --seed S               radii and lattice jitter (default 1)\n"
+        "  --threads T            threads of the pair forces (default 1; results do not depend on it)\n"
+        "  --out DIR              output directory (default build/dem_collapse)\n"
+        "  --quiet                no progress lines\n"
+        "  --help                 this text\n\n"
+        "ends with: RESULT a=... dstar=... dstar_lube=1.2a dstar_lajeunesse_hi=1.6a height_over_H0=...\n"
+        "           Ek_peak_over_Ep0=... t_Ek_peak=... Ed_final_over_Ep0=... t_rest=... (-1: not at rest)\n"
+        "           energy_balance=... (of E_p0) n=... lost=... steps=... dt=... seconds=...\n"
+        "exit status: 0 done, 1 setup, simulation or output failed (message), 2 bad arguments\n");
+}
+
+static int parse(int argc, char **argv, dc_opts *o) {
+    int i, k;
+    o->a = 1.0, o->width = 1.0, o->diameters = 24, o->mu = 0.5, o->roll_beta = 0.0, o->roll_eta = 0.0;
+    o->restitution = 0.5, o->young = 6e8, o->gravity = 9.81, o->t_end = 4.0, o->every = 0.01;
+    o->rest_frac = 5e-3, o->rest_hold = 0.05, o->threads = 1, o->quiet = 0, o->seed = 1;
+    o->out = "build/dem_collapse";
+    o->nsnap = dsc_list("0.2,0.5,1", o->snap, DC_MAX_SNAP, 0);
+    for (i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        double v;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) return usage(stdout), -1;
+        if (!strcmp(a, "--quiet")) {
+            o->quiet = 1;
+            continue;
+        }
+        if (i + 1 >= argc) return fprintf(stderr, "dem_collapse: %s needs a value (see --help)\n", a), 2;
+        if (!strcmp(a, "--out")) {
+            o->out = argv[++i];
+            continue;
+        }
+        if (!strcmp(a, "--snapshots")) {
+            if ((o->nsnap = dsc_list(argv[++i], o->snap, DC_MAX_SNAP, 0)) < 0)
+                return fprintf(stderr,
+                               "dem_collapse: --snapshots %s: need up to %d increasing times >= 0, "
+                               "comma-separated\n",
+                               argv[i], DC_MAX_SNAP),
+                       2;
+            continue;
+        }
+        if (dsc_num(argv[i + 1], &v))
+            return fprintf(stderr, "dem_collapse: %s %s: not a number\n", a, argv[i + 1]), 2;
+        if (!strcmp(a, "--a"))
+            o->a = v;
+        else if (!strcmp(a, "--width"))
+            o->width = v;
+        else if (!strcmp(a, "--diameters"))
+            o->diameters = v;
+        else if (!strcmp(a, "--mu"))
+            o->mu = v;
+        else if (!strcmp(a, "--roll-beta"))
+            o->roll_beta = v;
+        else if (!strcmp(a, "--roll-eta"))
+            o->roll_eta = v;
+        else if (!strcmp(a, "--restitution"))
+            o->restitution = v;
+        else if (!strcmp(a, "--young"))
+            o->young = v;
+        else if (!strcmp(a, "--gravity"))
+            o->gravity = v;
+        else if (!strcmp(a, "--t-end"))
+            o->t_end = v;
+        else if (!strcmp(a, "--every"))
+            o->every = v;
+        else if (!strcmp(a, "--rest-frac"))
+            o->rest_frac = v;
+        else if (!strcmp(a, "--rest-hold"))
+            o->rest_hold = v;
+        else if (!strcmp(a, "--seed"))
+            o->seed = v >= 0 && v == floor(v) ? (unsigned long)v : 0, o->seed += v < 0;
+        else if (!strcmp(a, "--threads"))
+            o->threads = v == floor(v) && v >= 1 && v <= 256 ? (int)v : -1;
+        else
+            return fprintf(stderr, "dem_collapse: unknown option %s (see --help)\n", a), 2;
+        ++i;
+    }
+    {
+        struct {
+            const char *flag, *need;
+            int ok;
+        } chk[] = {
+            {"--a", "an aspect ratio in [0.2, 10]", o->a >= 0.2 && o->a <= 10},
+            {"--width", "a positive length", o->width > 0},
+            {"--diameters", "a number of diameters in [4, 400]", o->diameters >= 4 && o->diameters <= 400},
+            {"--mu", "a friction coefficient >= 0", o->mu >= 0},
+            {"--roll-beta", "a value >= 0", o->roll_beta >= 0},
+            {"--roll-eta", "a value >= 0", o->roll_eta >= 0},
+            {"--restitution", "a value in (0, 1]", o->restitution > 0 && o->restitution <= 1},
+            {"--young", "a positive modulus", o->young > 0},
+            {"--gravity", "a positive value", o->gravity > 0},
+            {"--t-end", "a positive time", o->t_end > 0},
+            {"--every", "a positive time", o->every > 0},
+            {"--rest-frac", "a value >= 0", o->rest_frac >= 0},
+            {"--rest-hold", "a time >= 0", o->rest_hold >= 0},
+            {"--threads", "an integer in [1, 256]", o->threads >= 1}};
+        for (k = 0; k < (int)(sizeof chk / sizeof *chk); ++k)
+            if (!chk[k].ok)
+                return fprintf(stderr, "dem_collapse: %s: need %s\n", chk[k].flag, chk[k].need), 2;
+    }
+    return 0;
+}
+
+/* the front: disks sorted by x, scanned from the wall while the gaps are
+ * below one mean diameter; returns the furthest edge reached */
+static double front_of(const gk_scene *sc, double gap, double *xs, double *rs, int *idx) {
+    int n = sc->rve.n, m = 0, p, k;
+    double f = 0.0;
+    for (p = 0; p < n; ++p) {
+        double x[3];
+        if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) continue; /* the floor */
+        gk_scene_position(sc, p, x);
+        xs[m] = x[0];
+        rs[m] = (double)sc->rve.r[p];
+        idx[m] = m;
+        ++m;
+    }
+    /* insertion sort by x (n ~ 1e3, once per row) */
+    for (p = 1; p < m; ++p) {
+        int v = idx[p];
+        k = p - 1;
+        while (k >= 0 && xs[idx[k]] > xs[v]) {
+            idx[k + 1] = idx[k];
+            --k;
+        }
+        idx[k + 1] = v;
+    }
+    for (p = 0; p < m; ++p) {
+        double lo = xs[idx[p]] - rs[idx[p]];
+        if (p > 0 && lo - f > gap) break;
+        if (xs[idx[p]] + rs[idx[p]] > f) f = xs[idx[p]] + rs[idx[p]];
+    }
+    return f;
+}
+
+/* potential energy above the floor top and the deposit's height at the wall */
+static void measure(const gk_scene *sc, double g, double y0, double dmean, double *ep, double *height) {
+    int p;
+    *ep = 0.0;
+    *height = 0.0;
+    for (p = 0; p < sc->rve.n; ++p) {
+        double x[3];
+        if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) continue;
+        gk_scene_position(sc, p, x);
+        *ep += sc->mass[p] * g * (x[1] - y0);
+        if (x[0] < dmean && x[1] + (double)sc->rve.r[p] - y0 > *height)
+            *height = x[1] + (double)sc->rve.r[p] - y0;
+    }
+}
+
+int main(int argc, char **argv) {
+    dc_opts o;
+    gk_scene sc;
+    gk_scene_def d = gk_scene_def_default();
+    gk_packing pk;
+    gk_err err;
+    gk_wall_def wall = gk_wall_def_default(), gate = gk_wall_def_default();
+    dc_row *rows = NULL;
+    int nrows = 0, caprows = 0, status = 0, created = 0, isnap = 0, igate, p, k;
+    double rmax, rmean, rf, W, H, L, Ep0 = 0.0, ek_peak = 0.0, t_ek_peak = 0.0, t_rest = -1.0, t = 0.0,
+                                     next = 0.0;
+    double *xs = NULL, *rs = NULL, t0 = gk_wtime();
+    int *idx = NULL, at_rest = 0;
+    long steps = 0;
+    char path[1200];
+    FILE *csv = NULL;
+    k = parse(argc, argv, &o);
+    if (k) return k < 0 ? 0 : k;
+    if (dsc_mkdir("dem_collapse", o.out)) return 1;
+    W = o.width;
+    H = o.a * W;
+    rmax = W / o.diameters / 1.6; /* mean radius 0.8 r_max */
+    rmean = 0.8 * rmax;
+    rf = rmean;
+    L = (2.0 + 2.5 * o.a) * W;
+    /* ---- the scene: column on a lattice, floor of fixed disks */
+    {
+        /* a square lattice fills about half the area a settled column does */
+        int nx = (int)floor(W / (2.2 * rmax)), ny = (int)ceil(2.0 * H / (2.2 * rmax)),
+            nf = (int)floor(L / (2.0 * rf));
+        gk_rng rng;
+        int q = 0, a, b;
+        d.dim = 2;
+        d.lo[0] = 0.0;
+        d.hi[0] = L;
+        d.lo[1] = -rf;
+        d.hi[1] = rf + (ny + 1) * 2.2 * rmax;
+        d.gravity[1] = -o.gravity;
+        d.lost = GK_LOST_DELETE;
+        d.rve.mat.young = o.young;
+        d.rve.mat.friction = o.mu;
+        d.rve.mat.roll_beta = o.roll_beta;
+        d.rve.mat.roll_eta = o.roll_eta;
+        d.rve.mat.zeta_n = gk_restitution_to_zeta(o.restitution);
+        d.rve.mat.density = 2650.0;
+        d.rve.dt_factor = 0.2;
+        d.rve.damping = 0.3; /* preparation only */
+        d.rve.threads = o.threads;
+        if (gk_packing_alloc(&pk, 2, nx * ny + nf, NULL, &err))
+            return fprintf(stderr, "dem_collapse: %s\n", err.msg), 1;
+        gk_rng_seed(&rng, (uint64_t)o.seed);
+        for (a = 0; a < nf; ++a, ++q) { /* floor first: ids 0 .. nf-1 */
+            pk.x[q] = rf * (2 * a + 1);
+            pk.y[q] = 0.0;
+            pk.r[q] = rf;
+        }
+        for (b = 0; b < ny; ++b)
+            for (a = 0; a < nx; ++a, ++q) {
+                pk.x[q] = 2.2 * rmax * (a + 0.5) + 0.1 * rmax * (2.0 * gk_rng_uniform(&rng) - 1.0);
+                pk.y[q] = rf + 2.2 * rmax * (b + 0.5);
+                pk.r[q] = rmax * (0.6 + 0.4 * gk_rng_uniform(&rng));
+            }
+        if (gk_scene_create(&sc, &d, &pk)) {
+            fprintf(stderr, "dem_collapse: %s\n", gk_scene_error(&sc));
+            gk_packing_free(&pk);
+            return 1;
+        }
+        created = 1;
+        gk_packing_free(&pk);
+        for (p = 0; p < sc.rve.n; ++p)
+            if (sc.rve.id[p] < nf && gk_scene_prescribe(&sc, p, NULL, NULL)) goto fail;
+        wall.mat = d.rve.mat;
+        wall.mat.friction = 0.0; /* the symmetry plane is smooth */
+        wall.mat.roll_beta = wall.mat.roll_eta = 0.0;
+        wall.normal[0] = 1.0;
+        gate = wall; /* a segment from the floor's top up: the floor disks run on beyond it */
+        gate.kind = GK_WALL_SEGMENT;
+        gate.point[0] = W;
+        gate.point[1] = 1.01 * rf;
+        gate.e1[1] = d.hi[1] - gate.point[1];
+        gate.normal[0] = 0.0;
+        if (gk_scene_add_wall(&sc, &wall, NULL) || gk_scene_add_wall(&sc, &gate, &igate)) goto fail;
+        if (!o.quiet)
+            printf("dem_collapse: %d disks in the column (r %.4g-%.4g m), %d floor disks, dt %.3g s\n",
+                   sc.rve.n - nf, 0.6 * rmax, rmax, nf, sc.rve.dt);
+    }
+    /* ---- preparation: settle, cut at H0, settle again */
+    {
+        int round;
+        for (round = 0; round < 2; ++round) {
+            long guard = 0;
+            for (;;) {
+                double ep, h;
+                if (gk_scene_step(&sc, 2000)) goto fail;
+                guard += 2000;
+                measure(&sc, o.gravity, 0.0, rmean, &ep, &h);
+                if (gk_rve_kinetic_energy(&sc.rve) < 1e-6 * ep || guard > 2000000) break;
+            }
+            if (round == 0) {
+                int32_t *cut = (int32_t *)malloc((size_t)sc.rve.n * sizeof *cut);
+                int nc = 0;
+                if (!cut) {
+                    fprintf(stderr, "dem_collapse: out of memory\n");
+                    status = 1;
+                    goto done;
+                }
+                for (p = 0; p < sc.rve.n; ++p) {
+                    double x[3];
+                    gk_scene_position(&sc, p, x);
+                    if (!(sc.flags[p] & GK_PARTICLE_PRESCRIBED) && x[1] > H) cut[nc++] = sc.rve.id[p];
+                }
+                k = gk_scene_remove(&sc, nc, cut);
+                free(cut);
+                if (k) goto fail;
+            }
+        }
+        measure(&sc, o.gravity, 0.0, rmean, &Ep0, &H);
+        if (!o.quiet)
+            printf("dem_collapse: column of %d disks, %.4g m high (a = %.3g), settled\n",
+                   sc.rve.n - (int)floor(L / (2.0 * rf)), H, H / W);
+    }
+    /* ---- release */
+    if (gk_rve_set_damping(&sc.rve, 0.0, GK_DAMP_COMPONENT) || gk_scene_energy_track(&sc, 1)) goto fail;
+    sc.walls[igate].def.velocity[0] = 20.0;
+    xs = (double *)malloc((size_t)sc.rve.n * sizeof *xs);
+    rs = (double *)malloc((size_t)sc.rve.n * sizeof *rs);
+    idx = (int *)malloc((size_t)sc.rve.n * sizeof *idx);
+    snprintf(path, sizeof path, "%s/collapse.csv", o.out);
+    csv = fopen(path, "w");
+    if (!xs || !rs || !idx || !csv) {
+        fprintf(stderr, "dem_collapse: cannot write %s (or out of memory)\n", path);
+        status = 1;
+        goto done;
+    }
+    fprintf(csv,
+            "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0,friction_over_Ep0,viscous_over_Ep0,"
+            "balance_over_Ep0,n,lost\n");
+    if (dsc_pictures("dem_collapse", &sc, o.out, "000", "column at release")) {
+        status = 1;
+        goto done;
+    }
+    for (;;) {
+        double ep, h, ek = gk_rve_kinetic_energy(&sc.rve), f = front_of(&sc, 2.0 * rmean, xs, rs, idx);
+        gk_energy en;
+        dc_row r;
+        measure(&sc, o.gravity, 0.0, rmean, &ep, &h);
+        gk_scene_energy(&sc, &en);
+        r.t = t, r.front = f, r.height = h, r.ek = ek / Ep0, r.ep = ep / Ep0, r.ed = (Ep0 - ep - ek) / Ep0;
+        r.friction = en.friction / Ep0, r.viscous = en.viscous / Ep0, r.balance = en.balance / Ep0;
+        if (nrows == caprows) {
+            dc_row *nr = (dc_row *)realloc(rows, (size_t)(caprows ? 2 * caprows : 256) * sizeof *rows);
+            if (!nr) {
+                fprintf(stderr, "dem_collapse: out of memory\n");
+                status = 1;
+                goto done;
+            }
+            rows = nr;
+            caprows = caprows ? 2 * caprows : 256;
+        }
+        rows[nrows++] = r;
+        fprintf(csv, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.3g,%d,%ld\n", t, f, (f - W) / W, h, r.ek,
+                r.ep, r.ed, r.friction, r.viscous, r.balance, sc.rve.n, sc.lost);
+        if (r.ek > ek_peak) ek_peak = r.ek, t_ek_peak = t;
+        if (!at_rest && t > t_ek_peak && ek_peak > 0 && r.ek < o.rest_frac) at_rest = 1, t_rest = t;
+        if (!o.quiet && nrows % 20 == 1)
+            printf("t %.3f s  d* %.3f  height %.3f H0  E_k %.4f  E_d %.4f E_p0  (books %.3g)\n", t,
+                   (f - W) / W, h / H, r.ek, r.ed, r.balance);
+        if (isnap < o.nsnap && t >= o.snap[isnap] - 1e-12) {
+            char tag[32], title[64];
+            snprintf(tag, sizeof tag, "%03d", isnap + 1);
+            snprintf(title, sizeof title, "column collapse, t = %.2f s", t);
+            if (dsc_pictures("dem_collapse", &sc, o.out, tag, title)) {
+                status = 1;
+                goto done;
+            }
+            ++isnap;
+        }
+        if (t >= o.t_end - 1e-12 || (at_rest && t >= t_rest + o.rest_hold)) break;
+        next += o.every;
+        {
+            long n = (long)ceil((next - t) / sc.rve.dt - 1e-9);
+            if (n < 1) n = 1;
+            if (gk_scene_step(&sc, n)) goto fail;
+            steps += n;
+            t += n * sc.rve.dt;
+        }
+        if (sc.walls[igate].pos[0] > L + W) sc.walls[igate].def.velocity[0] = 0.0; /* far enough */
+    }
+    if (fclose(csv)) {
+        csv = NULL;
+        fprintf(stderr, "dem_collapse: error writing %s/collapse.csv\n", o.out);
+        status = 1;
+        goto done;
+    }
+    csv = NULL;
+    if (dsc_pictures("dem_collapse", &sc, o.out, "end", "column collapse: deposit")) {
+        status = 1;
+        goto done;
+    }
+    {
+        double *x = (double *)malloc((size_t)nrows * sizeof *x), *y[4] = {NULL, NULL, NULL, NULL};
+        const char *lab[4];
+        double ref[4];
+        const char *rl[4];
+        for (k = 0; k < 4; ++k) y[k] = (double *)malloc((size_t)nrows * sizeof(double));
+        if (!x || !y[0] || !y[1] || !y[2] || !y[3]) status = 1;
+        for (k = 0; !status && k < nrows; ++k) {
+            x[k] = rows[k].t;
+            y[0][k] = (rows[k].front - W) / W;
+        }
+        if (!status) {
+            lab[0] = "DEM: d* = (d_f - d0)/d0";
+            lab[1] = lab[2] = lab[3] = NULL;
+            ref[0] = 1.2 * o.a, rl[0] = "Lube et al. 2005: 1.2 a";
+            ref[1] = 1.6 * o.a, rl[1] = "1.6 a";
+            ref[2] = 1.62, rl[2] = "mpmdem_collapse (a = 1): 1.62";
+            snprintf(path, sizeof path, "%s/collapse_front.svg", o.out);
+            {
+                const double *yy[4];
+                yy[0] = y[0], yy[1] = yy[2] = yy[3] = NULL;
+                status = dsc_plot("dem_collapse", path, "DEM column collapse: run-out",
+                                  "time after release [s]", "d* = (d_f - d0) / d0", x, nrows, yy, lab,
+                                  fabs(o.a - 1.0) < 1e-9 ? 3 : 2, ref, rl);
+            }
+        }
+        for (k = 0; !status && k < nrows; ++k) {
+            y[0][k] = rows[k].ep, y[1][k] = rows[k].ek, y[2][k] = rows[k].ed,
+            y[3][k] = rows[k].friction + rows[k].viscous;
+        }
+        if (!status) {
+            const double *yy[4];
+            lab[0] = "E_p", lab[1] = "E_k", lab[2] = "E_d = E_p0 - E_p - E_k", lab[3] = "dissipation booked";
+            for (k = 0; k < 4; ++k) yy[k] = y[k];
+            ref[0] = 1.0 - 0.74 / (2.0 * o.a), rl[0] = "Lajeunesse et al.: E_d = 1 - 0.74/(2a)";
+            snprintf(path, sizeof path, "%s/collapse_energy.svg", o.out);
+            status = dsc_plot("dem_collapse", path, "DEM column collapse: energies / E_p0",
+                              "time after release [s]", "energy / E_p0", x, nrows, yy, lab, 1, ref, rl);
+        } else {
+            fprintf(stderr, "dem_collapse: out of memory for the plots\n");
+        }
+        free(x);
+        for (k = 0; k < 4; ++k) free(y[k]);
+        if (status) goto done;
+    }
+    {
+        const dc_row *e = &rows[nrows - 1];
+        printf("RESULT a=%.4g dstar=%.4g dstar_lube=%.4g dstar_lajeunesse_hi=%.4g height_over_H0=%.4g "
+               "Ek_peak_over_Ep0=%.4g t_Ek_peak=%.4g Ed_final_over_Ep0=%.4g t_rest=%.4g energy_balance=%.3g "
+               "n=%d "
+               "lost=%ld steps=%ld dt=%.4g seconds=%.2f\n",
+               H / W, (e->front - W) / W, 1.2 * H / W, 1.6 * H / W, e->height / H, ek_peak, t_ek_peak, e->ed,
+               t_rest, e->balance, sc.rve.n, sc.lost, steps, sc.rve.dt, gk_wtime() - t0);
+    }
+    goto done;
+fail:
+    fprintf(stderr, "dem_collapse: %s\n", gk_scene_error(&sc));
+    status = 1;
+done:
+    if (csv) fclose(csv);
+    free(rows);
+    free(xs);
+    free(rs);
+    free(idx);
+    if (created) gk_scene_destroy(&sc);
+    return status;
+}

@@ -1,0 +1,299 @@
+/* femdem_biaxial.h - the biaxial test of the FEMxDEM model (examples, not library): its options, its
+ * loading loop, its outputs and its checkpoint; shared by femdem_biaxial.c (which adds the
+ * single-element test) and femdem_probe.c (which adds the Newton diagnostics). See femdem_biaxial.c
+ * for the test and its outputs.
+ */
+#ifndef FEMDEM_BIAXIAL_H
+#define FEMDEM_BIAXIAL_H
+
+#include "femdem_io.h"
+#include "femdem_newton.h"
+
+#define FDB_TAG "GKFEMDEM4" /* checkpoint block of the biaxial and single-element tests */
+
+/* the biaxial defaults (seed 000: 50 x 100 mm, 100 kPa, the authors' 8 x 16 Q8 mesh and RVE) */
+static void fdb_defaults(fd_model *M) {
+    fd_opts *o = &M->o;
+    fd_opts_default(o);
+    o->nx = 8, o->ny = 16, o->width = 0.05, o->height = 0.1, o->pressure = 1e5, o->vtk_every = 1;
+    o->packing = "examples/data/rve400.txt", o->test = "biaxial";
+}
+
+/* the biaxial test's own options */
+static const cli_opt *fdb_opts(fd_opts *o) {
+    static cli_opt t[4];
+    const cli_opt src[] = {{"--steps", CLI_INT, &o->steps, 1, 1000000, NULL, NULL, 0},
+                           {"--test", CLI_STR, &o->test, 0, 0, NULL, NULL, 0},
+                           {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    memcpy(t, src, sizeof src);
+    return t;
+}
+
+/* after parsing: --test biaxial|single (single: one Q4 element, 2 x 2 Gauss points). 0, or 2 */
+static int fdb_check(fd_model *M) {
+    fd_opts *o = &M->o;
+    if (!strncmp(o->test, "cyclic", 6)) {
+        fd_say(M, "%s: the cyclic simple-shear tests are build/femdem_cyclic --test %s\n", M->prog, o->test);
+        return 2;
+    }
+    if (!strcmp(o->test, "single"))
+        o->nx = 1, o->ny = 1, o->elem_kind = 0 /* q4 */, o->quad = 2;
+    else if (strcmp(o->test, "biaxial")) {
+        fd_say(M, "%s: --test '%s' must be biaxial or single\n", M->prog, o->test);
+        return 2;
+    }
+    if (strchr(o->packing, ',') && !strcmp(o->test, "single")) {
+        fd_say(M, "%s: --test single compares the mesh with one RVE alone: give one --packing\n", M->prog);
+        return 2;
+    }
+    return fd_opts_finish(M->root ? M->prog : NULL, o);
+}
+
+static void fdb_csv_row(FILE *fp, const fd_model *M, int k, const void *user) {
+    const fd_row *c = &M->curve[k];
+    (void)user;
+    fprintf(fp, "%d,%.9g,%.9g,%.9g,%.9g,%d,%.4f,%.4g,%.4g,%.6g,%d,", k, c->eps, c->syy, c->sxx, c->ev, c->iters, c->secs,
+            c->Ed, c->Ef, c->inc, c->failed);
+    fd_csv_work(fp, c);
+}
+
+static int fdb_write_csv(const fd_model *M) {
+    return fd_write_csv(M, "biaxial.csv",
+                        "step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds,E_d,E_f,increment,failed_gp," FD_WORK_COLS
+                        "\n",
+                        fdb_csv_row, NULL);
+}
+
+static int fdb_checkpoint(fd_model *M) {
+    fd_buf x;
+    int bad;
+    memset(&x, 0, sizeof x);
+    fd_put(&x, &M->inclast, sizeof(double)); /* the extrapolated predictor's last increment (always kept) */
+    fd_put(&x, M->ulast, (size_t)M->ndof * sizeof(double));
+    bad = x.bad || fd_ck_save(M, FDB_TAG, &x);
+    free(x.b);
+    return bad;
+}
+
+static int fdb_restart(fd_model *M, gk_err *err) {
+    fd_buf B;
+    int bad = fd_ck_load(M, M->o.restart, FDB_TAG, &B, err);
+    if (!bad && (fd_get(&B, &M->inclast, sizeof(double)) || fd_get(&B, M->ulast, (size_t)M->ndof * sizeof(double))))
+        bad = 1, gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the driver's block is truncated", M->o.restart);
+    free(B.b);
+    if (!bad)
+        fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n", M->prog, M->o.restart,
+               M->step, 100 * M->eps_done);
+    return bad;
+}
+
+/* boundary stresses (compression positive) and volumetric strain */
+static void fdb_macro_state(const fd_model *M, double *syy, double *sxx, double *ev) {
+    double fy = 0, fx = 0, w, h, area = 0.0, xr = 0, xl = 0, yt = 0;
+    int a, e, g, nl = 0;
+    for (a = 0; a < M->ntop; ++a) fy += M->fint[2 * M->top[a] + 1];
+    for (a = 0; a < M->nright; ++a) fx += M->fint[2 * M->right[a]];
+    /* current width and height: mean over the top and right node sets */
+    for (a = 0; a < M->nright; ++a) xr += M->mesh.x[2 * M->right[a]];
+    for (a = 0; a < M->mesh.nnode; ++a)
+        if (fabs(M->A0x[2 * a]) < 1e-12) xl += M->mesh.x[2 * a], ++nl;
+    for (a = 0; a < M->ntop; ++a) yt += M->mesh.x[2 * M->top[a] + 1];
+    w = xr / M->nright - xl / nl;
+    h = yt / M->ntop;
+    *syy = -fy / w;
+    *sxx = -fx / h;
+    for (e = 0; e < M->mesh.nelem; ++e)
+        for (g = 0; g < M->q.n; ++g) {
+            double dN[16], dJ;
+            gk_fem_jacobian(&M->mesh, e, M->q.xi[g], NULL, dN, &dJ, NULL);
+            area += M->q.w[g] * dJ;
+        }
+    *ev = -(area - M->area0) / M->area0;
+}
+
+/* shear band from the eps_q field: points above the median + half the range; angle of their principal
+ * axis from the horizontal (weighted by excess eps_q), width = sqrt(12 var) of the perpendicular
+ * distances (a uniform band of width W has variance W^2/12). No band (NAN) if max eps_q < 1.5 x
+ * median. */
+static int fdb_cmp_d(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+static void fdb_band(fd_model *M, double *angle, double *width) {
+    double *all = fd_gp_fields(M), *v = (double *)malloc((size_t)M->ngp * sizeof(double)),
+           *s = (double *)malloc((size_t)M->ngp * sizeof(double));
+    double med, mx, thr, sw = 0, cx = 0, cy = 0, sxx = 0, syy = 0, sxy = 0, th, nx, ny, var = 0;
+    int g;
+    *angle = *width = NAN;
+    if (!all || !v || !s) goto out;
+    for (g = 0; g < M->ngp; ++g) v[g] = s[g] = all[FD_NFIELD * g];
+    qsort(s, (size_t)M->ngp, sizeof(double), fdb_cmp_d);
+    med = s[M->ngp / 2], mx = s[M->ngp - 1];
+    if (M->ngp < 8 || !(mx > 1.5 * med)) goto out;
+    thr = med + 0.5 * (mx - med);
+    for (g = 0; g < M->ngp; ++g) {
+        double x[3], w = v[g] - thr;
+        if (w <= 0) continue;
+        gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], x);
+        sw += w, cx += w * x[0], cy += w * x[1];
+    }
+    cx /= sw, cy /= sw;
+    for (g = 0; g < M->ngp; ++g) {
+        double x[3], w = v[g] - thr;
+        if (w <= 0) continue;
+        gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], x);
+        sxx += w * (x[0] - cx) * (x[0] - cx), syy += w * (x[1] - cy) * (x[1] - cy), sxy += w * (x[0] - cx) * (x[1] - cy);
+    }
+    th = 0.5 * atan2(2 * sxy, sxx - syy); /* major axis */
+    nx = -sin(th), ny = cos(th);
+    for (g = 0; g < M->ngp; ++g) {
+        double x[3], w = v[g] - thr, d;
+        if (w <= 0) continue;
+        gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], x);
+        d = (x[0] - cx) * nx + (x[1] - cy) * ny;
+        var += w * d * d;
+    }
+    *angle = fabs(th * 180.0 / FD_PI);
+    if (*angle > 90) *angle = 180 - *angle;
+    *width = sqrt(12.0 * var / sw);
+out:
+    free(all), free(v), free(s);
+}
+
+/* the initial row: the reactions of the confined specimen */
+static void fdb_first_row(fd_model *M, gk_err *err) {
+    double syy, sxx, ev;
+    fd_external_force(M, err);
+    fd_residual(M, M->sig_n, err);
+    fdb_macro_state(M, &syy, &sxx, &ev);
+    memset(&M->curve[0], 0, sizeof M->curve[0]);
+    M->curve[0].syy = syy, M->curve[0].sxx = sxx;
+    M->ncurve = 1;
+}
+
+/* the loading loop to --steps x --increment: load steps, cut-backs, rows, VTK and checkpoints.
+ * 0, 1 (an error: said), or 3 (gave up after cut-backs) */
+static int fdb_loop(fd_model *M, double t_start, gk_err *err) {
+    const fd_opts *o = &M->o;
+    double target = o->steps * o->inc;
+    int good_in_row = 0;
+    while (M->eps_done < target - 1e-12 * target) {
+        double inc = o->inc * M->scale, t0 = gk_wtime(), Ed = 0, Ef = 0, syy, sxx, ev;
+        int iters = 0, r, g, nf = 0;
+        fd_row *c;
+        char what[200];
+        if (M->eps_done + inc > target) inc = target - M->eps_done;
+        if ((r = fd_load_step(M, inc, &iters, &Ed, &Ef, err)) == 2) return 1;
+        if (r == 1) {
+            good_in_row = 0;
+            if (fd_cut_back(M, "axial strain", M->eps_done, o->inc, iters, Ed, err)) return 3;
+            continue;
+        }
+        if (fd_commit(M, err)) return fd_say(M, "%s: %s\n", M->prog, err->msg), 1;
+        memcpy(M->ulast, M->u, (size_t)M->ndof * sizeof(double));
+        M->inclast = inc;
+        M->eps_done += inc;
+        ++M->step;
+        fd_residual(M, M->sig_n, err);
+        fdb_macro_state(M, &syy, &sxx, &ev);
+        for (g = 0; g < M->ngp; ++g) nf += M->failed[g];
+        if (fd_row_room(M)) return fd_say(M, "%s: out of memory\n", M->prog), 1;
+        c = &M->curve[M->ncurve++];
+        c->eps = M->eps_done, c->syy = syy, c->sxx = sxx, c->ev = ev, c->iters = iters;
+        c->secs = gk_wtime() - t0, c->Ed = Ed, c->Ef = Ef, c->inc = inc, c->failed = nf;
+        fd_row_work(M, c);
+        if (++good_in_row >= 2 && M->scale < 1.0) M->scale *= 2, good_in_row = 0;
+        if (fdb_write_csv(M)) return 1;
+        if (o->vtk_every && M->step % o->vtk_every == 0 && fd_write_vtk(M, M->step)) return 1;
+        if (o->checkpoint && M->step % o->checkpoint == 0 && fdb_checkpoint(M)) return 1;
+        snprintf(what, sizeof what,
+                 "eps %.2f %%  sigma_yy %.1f kPa  sigma_xx %.1f kPa  eps_v %.3f %%  %d iter  DEM steps/RVE %.0f (max %d)  "
+                 "%.2f s",
+                 100 * M->eps_done, syy / 1e3, sxx / 1e3, 100 * ev, iters, c->dem_mean, c->dem_max, gk_wtime() - t0);
+        if (M->root) gk_progress(stderr, (long)floor(M->eps_done / o->inc + 0.5), o->steps, t_start, what);
+    }
+    return 0;
+}
+
+/* after the loop (status 0 or 3): the CSV, the plots, the eps_q map, the checkpoint (status 0: a
+ * give-up has written the converged state already), the band and the RESULT line. The status, or 1
+ * when an output failed. */
+static int fdb_finish(fd_model *M, int status) {
+    const fd_opts *o = &M->o;
+    double *x = (double *)malloc((size_t)M->ncurve * sizeof(double)),
+           *y1 = (double *)malloc((size_t)M->ncurve * sizeof(double)),
+           *y2 = (double *)malloc((size_t)M->ncurve * sizeof(double)), peak = 0, epk = 0, ang, wid, tot = 0;
+    int k, itmax = 0, itsum = 0, bad = !x || !y1 || !y2;
+    char title[200];
+    gk_plot pl;
+    bad = bad || fdb_write_csv(M);
+    for (k = 0; k < M->ncurve && !bad; ++k)
+        x[k] = 100 * M->curve[k].eps, y1[k] = M->curve[k].syy / 1e3, y2[k] = M->curve[k].sxx / 1e3;
+    if (!bad) {
+        gk_plot_init(&pl, "FEMxDEM biaxial test (seed 000)", "axial strain [%]", "stress [kPa] (compression positive)");
+        gk_plot_add(&pl, x, y1, M->ncurve, "sigma_yy (top reaction / width)");
+        gk_plot_add(&pl, x, y2, M->ncurve, "sigma_xx (side reaction / height)");
+        bad = fd_plot(M, &pl, "biaxial_stress.svg");
+    }
+    for (k = 0; k < M->ncurve && !bad; ++k) y1[k] = 100 * M->curve[k].ev;
+    if (!bad) {
+        gk_plot_init(&pl, "FEMxDEM biaxial test: volume", "axial strain [%]",
+                     "volumetric strain [%] (contraction positive)");
+        gk_plot_add(&pl, x, y1, M->ncurve, NULL);
+        bad = fd_plot(M, &pl, "biaxial_volume.svg");
+    }
+    free(x), free(y1), free(y2);
+    snprintf(title, sizeof title, "eps_q at axial strain %.2f %% (x, y in mm)", 100 * M->eps_done);
+    bad = bad || fd_write_field_svg(M, 0, "eps_q_field.svg", title);
+    bad = bad || (status != 3 && fdb_checkpoint(M));
+    if (bad) return 1;
+    for (k = 0; k < M->ncurve; ++k) {
+        if (M->curve[k].syy > peak) peak = M->curve[k].syy, epk = M->curve[k].eps;
+        if (M->curve[k].iters > itmax) itmax = M->curve[k].iters;
+        if (k > 0) itsum += M->curve[k].iters, tot += M->curve[k].secs;
+    }
+    fdb_band(M, &ang, &wid);
+    if (!M->root) return status;
+    printf("wrote %s/biaxial.csv, %s/gp_*.vtk and mesh_*.vtk (ParaView), %s/biaxial_stress.svg, biaxial_volume.svg, "
+           "eps_q_field.svg, checkpoint.bin\n",
+           o->out, o->out, o->out);
+    if (ang == ang)
+        printf("shear band: angle %.1f deg from the horizontal, width %.1f mm\n", ang, 1e3 * wid);
+    else
+        printf("shear band: none (max eps_q < 1.5 x median)\n");
+    printf("RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g band_angle_deg=%.3g band_width_mm=%.3g max_iterations=%d "
+           "steps=%d seconds_per_step=%.3f total_seconds=%.2f mean_iterations=%.2f",
+           peak, epk, ang, 1e3 * wid, itmax, M->ncurve - 1, M->ncurve > 1 ? tot / (M->ncurve - 1) : 0.0, tot,
+           M->ncurve > 1 ? (double)itsum / (M->ncurve - 1) : 0.0);
+    fd_print_work_totals(M);
+#ifdef GK_TWOSCALE_MPI
+    printf("MPI ranks=%d rve_runs=%lld rank0_bytes_in_per_run=%.0f rank0_bytes_out_per_run=%.0f point_moves=%lld "
+           "rank0_bytes_in_all=%lld\n",
+           M->ts.nranks, M->ts.stats.runs, (double)M->ts.stats.run_bytes_in / (M->ts.stats.runs ? M->ts.stats.runs : 1),
+           (double)M->ts.stats.run_bytes_out / (M->ts.stats.runs ? M->ts.stats.runs : 1), M->ts.stats.migrated,
+           M->ts.stats.bytes_in);
+#endif
+    return status;
+}
+
+/* setup, restart or initial row, the header line, the loop: the status so far (0, 1, 3) */
+static int fdb_run(fd_model *M) {
+    gk_err err;
+    int status;
+    M->checkpoint = fdb_checkpoint;
+    if (fd_mkdir_out(M)) return 1;
+    if (fd_setup(M, &err)) return fd_say(M, "%s: %s\n", M->prog, err.msg), 1;
+    if (M->o.restart ? fdb_restart(M, &err) : (fdb_first_row(M, &err), 0))
+        return fd_say(M, "%s: %s\n", M->prog, err.msg), 1;
+    if (M->root) {
+        printf("%s: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n", M->prog,
+               M->o.test, M->o.nx, M->o.ny, M->o.elem == GK_Q8 ? "Q8" : "Q4", M->ngp, M->ts.pk[0].n, M->o.tangent,
+               M->o.threads);
+        if (M->o.extrapolate) printf("%s: predictor: the last converged increment, scaled\n", M->prog);
+        fflush(stdout);
+    }
+    status = fdb_loop(M, gk_wtime(), &err);
+    return status == 1 ? 1 : fdb_finish(M, status);
+}
+
+#endif /* FEMDEM_BIAXIAL_H */

@@ -1,0 +1,248 @@
+/* femdem_io.h - the outputs and the checkpoint of the FEMxDEM drivers (examples, not library).
+ *
+ * For the model of femdem.h: the Gauss-point fields (fd_gp_fields, from gk_twoscale_fields), the VTK of
+ * the Gauss points and of the deformed mesh, SVG maps and plots, the CSV writer of the drivers' rows,
+ * and the checkpoint: the RVE set's own file (gk_twoscale_save: versioned, checksummed) carrying this
+ * model's block (fd_ck_save / fd_ck_load; a driver appends its own bytes). Rank 0 writes (M->root);
+ * every function returns non-zero after saying once that a write failed, on every rank.
+ */
+#ifndef FEMDEM_IO_H
+#define FEMDEM_IO_H
+
+#include "femdem.h"
+
+/* ------------------------------------------------------------- outputs */
+static const char *fd_field_names[FD_NFIELD] = {"eps_q", "eps_v", "void_ratio",        "rotation_deg", "spin_deg",
+                                                "p",     "q",     "fabric_anisotropy", "coordination", "dem_steps"};
+
+/* the Gauss-point fields of the converged state, FD_NFIELD per point (all ranks call it): eps_q,
+ * eps_v compression-positive as the seed, void ratio, particle rotation and spin [deg], p, q,
+ * |F_a|, Z, DEM steps. NULL when out of memory. */
+static double *fd_gp_fields(fd_model *M) {
+    gk_twoscale_field *f = (gk_twoscale_field *)malloc((size_t)M->ngp * sizeof *f);
+    double *v = (double *)malloc((size_t)M->ngp * FD_NFIELD * sizeof *v);
+    int g, bad = !f || !v;
+    if (gk_twoscale_fields(&M->ts, bad ? NULL : f)) bad = 1;
+    for (g = 0; g < M->ngp && !bad; ++g) {
+        double *x = v + FD_NFIELD * (size_t)g;
+        x[0] = f[g].eps_q, x[1] = -f[g].eps_v, x[2] = f[g].void_ratio;
+        x[3] = f[g].rotation * 180.0 / FD_PI, x[4] = f[g].spin * 180.0 / FD_PI;
+        x[5] = f[g].p, x[6] = f[g].q, x[7] = f[g].fabric, x[8] = f[g].coordination, x[9] = f[g].dem_steps;
+    }
+    free(f);
+    if (bad) free(v), v = NULL;
+    return v;
+}
+
+/* gp_NNNN.vtk (the fields at the Gauss points) and mesh_NNNN.vtk (the deformed mesh, displacement) */
+static int fd_write_vtk(fd_model *M, int step) {
+    char path[1200];
+    gk_vtk v;
+    int nn = M->mesh.nnode, big = M->ngp > nn ? M->ngp : nn, g, k, a, bad = 0;
+    double *all = fd_gp_fields(M), *xyz = (double *)malloc((size_t)big * 3 * sizeof(double)),
+           *val = (double *)malloc((size_t)M->ngp * sizeof(double)), *d3 = (double *)malloc((size_t)nn * 3 * sizeof(double));
+    int *conn = (int *)malloc((size_t)M->ngp * sizeof(int));
+    if (!all || !xyz || !val || !d3 || !conn) {
+        fd_say(M, "%s: out of memory writing VTK\n", M->prog);
+        bad = 1;
+    }
+    if (!bad && M->root) {
+        for (g = 0; g < M->ngp; ++g) {
+            gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], xyz + 3 * g);
+            conn[g] = g;
+        }
+        snprintf(path, sizeof path, "%s/gp_%04d.vtk", M->o.out, step);
+        bad = gk_vtk_open(&v, path, "grainkit FEMxDEM Gauss points") != GK_OK || gk_vtk_points(&v, M->ngp, xyz) ||
+              gk_vtk_cells(&v, M->ngp, 1, conn, GK_VTK_VERTEX);
+        for (k = 0; k < FD_NFIELD && !bad; ++k) {
+            for (g = 0; g < M->ngp; ++g) val[g] = all[FD_NFIELD * g + k];
+            bad = gk_vtk_point_scalar(&v, fd_field_names[k], val) != GK_OK;
+        }
+        if (v.fp) bad |= gk_vtk_close(&v) != GK_OK;
+        if (!bad) {
+            for (a = 0; a < nn; ++a) {
+                xyz[3 * a] = M->mesh.x[2 * a], xyz[3 * a + 1] = M->mesh.x[2 * a + 1], xyz[3 * a + 2] = 0.0;
+                d3[3 * a] = M->utot[2 * a], d3[3 * a + 1] = M->utot[2 * a + 1], d3[3 * a + 2] = 0.0;
+            }
+            snprintf(path, sizeof path, "%s/mesh_%04d.vtk", M->o.out, step);
+            bad = gk_vtk_open(&v, path, "grainkit FEMxDEM mesh") || gk_vtk_points(&v, nn, xyz) ||
+                  gk_vtk_cells(&v, M->mesh.nelem, M->npe, M->mesh.conn, M->npe == 8 ? GK_VTK_QUAD8 : GK_VTK_QUAD) ||
+                  gk_vtk_point_vector(&v, "displacement", d3);
+            if (v.fp) bad |= gk_vtk_close(&v) != GK_OK;
+        }
+        if (bad) fprintf(stderr, "%s: cannot write %s\n", M->prog, path);
+    }
+    free(all), free(xyz), free(val), free(d3), free(conn);
+    return fd_agree(M, bad);
+}
+
+/* a Gauss-point field (fd_gp_fields index) as a map: each Gauss point owns the sub-quad of its
+ * element around it */
+static int fd_write_field_svg(fd_model *M, int field, const char *file, const char *title) {
+    int per = M->o.quad, e, i, j, c, g = 0, bad = 0;
+    double *all = fd_gp_fields(M), *xy = (double *)malloc((size_t)M->ngp * 8 * sizeof(double)),
+           *val = (double *)malloc((size_t)M->ngp * sizeof(double));
+    char path[1200];
+    gk_err err;
+    if (!all || !xy || !val) bad = 1;
+    if (!bad && M->root) {
+        for (e = 0; e < M->mesh.nelem; ++e)
+            for (j = 0; j < per; ++j)
+                for (i = 0; i < per; ++i, ++g) {
+                    static const int ci[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+                    for (c = 0; c < 4; ++c) {
+                        double xi[3], x[3];
+                        xi[0] = -1 + 2.0 * (i + ci[c][0]) / per, xi[1] = -1 + 2.0 * (j + ci[c][1]) / per, xi[2] = 0;
+                        gk_mesh_point(&M->mesh, e, xi, x);
+                        xy[8 * g + 2 * c] = x[0] * 1e3, xy[8 * g + 2 * c + 1] = x[1] * 1e3;
+                    }
+                    val[g] = all[FD_NFIELD * g + field];
+                }
+        snprintf(path, sizeof path, "%s/%s", M->o.out, file);
+        bad = gk_svg_field(path, title, fd_field_names[field], M->ngp, 4, xy, val, 0.0, &err) != GK_OK;
+    }
+    if (bad) fd_say(M, "%s: cannot write %s/%s\n", M->prog, M->o.out, file);
+    free(all), free(xy), free(val);
+    return fd_agree(M, bad);
+}
+
+/* an x-y plot, said once when it cannot be written */
+static int fd_plot(const fd_model *M, const gk_plot *pl, const char *file) {
+    char path[1200];
+    gk_err err;
+    int bad = 0;
+    if (M->root) {
+        snprintf(path, sizeof path, "%s/%s", M->o.out, file);
+        bad = gk_plot_svg(pl, path, &err) != GK_OK;
+        if (bad) fprintf(stderr, "%s: cannot write %s\n", M->prog, path);
+    }
+    return fd_agree(M, bad);
+}
+
+/* the columns both CSVs end with, and their values */
+#define FD_WORK_COLS "dem_steps_mean,dem_steps_max,dem_steps,tangents_reused,tangents_computed"
+static void fd_csv_work(FILE *fp, const fd_row *c) {
+    fprintf(fp, "%.2f,%d,%lld,%lld,%lld\n", c->dem_mean, c->dem_max, c->dem_total, c->t_reused, c->t_computed);
+}
+
+/* a CSV written by rank 0 through row(fp, M, k, user) after its header; said once when it fails */
+static int fd_write_csv(const fd_model *M, const char *file, const char *header,
+                        void (*row)(FILE *fp, const fd_model *M, int k, const void *user), const void *user) {
+    char path[1200];
+    FILE *fp;
+    int k, bad = 0;
+    if (M->root) {
+        snprintf(path, sizeof path, "%s/%s", M->o.out, file);
+        fp = fopen(path, "w");
+        bad = !fp;
+        if (fp) {
+            fputs(header, fp);
+            for (k = 0; k < M->ncurve; ++k) row(fp, M, k, user);
+            bad = ferror(fp) != 0;
+            bad |= fclose(fp) != 0;
+        }
+        if (bad) fprintf(stderr, "%s: cannot write %s\n", M->prog, path);
+    }
+    return fd_agree(M, bad);
+}
+
+/* ---------------------------------------------------------- checkpoint */
+/* DIR/checkpoint.bin: the set's file (every RVE's converged state, accumulated dH, tangent-reuse
+ * reference; gk_twoscale_save) with this model's block: a tag naming the test and its format, the mesh
+ * options, the step counters, the rows, the mesh, the displacements, the converged stresses and
+ * tangents, the driver's own bytes (cyclic state, predictor increment). A block of another test or
+ * mesh is refused by name. */
+typedef struct fd_buf {
+    unsigned char *b;
+    size_t n, cap, pos;
+    int bad;
+} fd_buf;
+
+static void fd_put(fd_buf *B, const void *p, size_t n) {
+    if (B->bad || !n) return;
+    if (B->n + n > B->cap) {
+        size_t c = 2 * (B->n + n) + 256;
+        unsigned char *x = (unsigned char *)realloc(B->b, c);
+        if (!x) {
+            B->bad = 1;
+            return;
+        }
+        B->b = x, B->cap = c;
+    }
+    memcpy(B->b + B->n, p, n);
+    B->n += n;
+}
+static int fd_get(fd_buf *B, void *p, size_t n) {
+    if (B->bad || n > B->n - B->pos) return B->bad = 1, 1;
+    memcpy(p, B->b + B->pos, n);
+    B->pos += n;
+    return 0;
+}
+
+static int fd_ck_save(fd_model *M, const char *tag, const fd_buf *extra) {
+    char path[1200];
+    char tg[16];
+    fd_buf B;
+    int bad;
+    size_t n = (size_t)M->ndof, g9 = 9 * (size_t)M->ngp, g16 = 16 * (size_t)M->ngp;
+    memset(&B, 0, sizeof B);
+    memset(tg, 0, sizeof tg);
+    strncpy(tg, tag, sizeof tg - 1);
+    fd_put(&B, tg, 16);
+    fd_put(&B, &M->o.nx, sizeof(int)), fd_put(&B, &M->o.ny, sizeof(int));
+    fd_put(&B, &M->o.elem, sizeof M->o.elem), fd_put(&B, &M->o.quad, sizeof(int));
+    fd_put(&B, &M->step, sizeof(int)), fd_put(&B, &M->eps_done, sizeof(double));
+    fd_put(&B, &M->scale, sizeof(double)), fd_put(&B, &M->ncurve, sizeof(int));
+    fd_put(&B, M->curve, (size_t)M->ncurve * sizeof(fd_row));
+    fd_put(&B, M->mesh.x, n * sizeof(double)), fd_put(&B, M->utot, n * sizeof(double));
+    fd_put(&B, M->sig_n, g9 * sizeof(double)), fd_put(&B, M->D_n, g16 * sizeof(double));
+    if (extra) fd_put(&B, extra->b, extra->n);
+    snprintf(path, sizeof path, "%s/checkpoint.bin", M->o.out);
+    bad = B.bad;
+    if (!bad && gk_twoscale_save(&M->ts, path, B.b, B.n)) bad = 1;
+    if (bad && B.bad) fd_say(M, "%s: cannot write %s: out of memory\n", M->prog, path);
+    else if (bad) fd_say(M, "%s: %s\n", M->prog, gk_twoscale_error(&M->ts)); /* names the file */
+    free(B.b);
+    return bad;
+}
+
+/* the checkpoint of DIR into the set and the model; B keeps the block positioned at the driver's own
+ * part (free B->b after reading it). 0, or 1 with err set. */
+static int fd_ck_load(fd_model *M, const char *dir, const char *tag, fd_buf *B, gk_err *err) {
+    char path[1200], tg[16];
+    void *blk = NULL;
+    size_t nb = 0, n = (size_t)M->ndof, g9 = 9 * (size_t)M->ngp, g16 = 16 * (size_t)M->ngp;
+    int nx, ny, quad, nc, ok;
+    gk_elem_type el;
+    memset(B, 0, sizeof *B);
+    snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
+    if (gk_twoscale_load(&M->ts, path, &blk, &nb))
+        return gk_err_set(err, GK_ERR_FORMAT, "%s", gk_twoscale_error(&M->ts)), 1;
+    B->b = (unsigned char *)malloc(nb + 1), B->n = B->cap = nb;
+    if (!B->b) return gk_twoscale_free(&M->ts, blk), gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+    memcpy(B->b, blk, nb);
+    gk_twoscale_free(&M->ts, blk);
+    ok = !fd_get(B, tg, 16) && !memcmp(tg, tag, strlen(tag) + 1);
+    ok = ok && !fd_get(B, &nx, sizeof nx) && !fd_get(B, &ny, sizeof ny) && !fd_get(B, &el, sizeof el) &&
+         !fd_get(B, &quad, sizeof quad);
+    if (!ok || nx != M->o.nx || ny != M->o.ny || el != M->o.elem || quad != M->o.quad)
+        return gk_err_set(err, GK_ERR_FORMAT,
+                          "%s: not a checkpoint of this test and mesh (%s %dx%d, element, quad must match)", path,
+                          tag, M->o.nx, M->o.ny),
+               1;
+    ok = !fd_get(B, &M->step, sizeof(int)) && !fd_get(B, &M->eps_done, sizeof(double)) &&
+         !fd_get(B, &M->scale, sizeof(double)) && !fd_get(B, &nc, sizeof nc) && nc >= 1 &&
+         (size_t)nc <= (B->n - B->pos) / sizeof(fd_row);
+    if (ok) {
+        fd_row *c = (fd_row *)realloc(M->curve, ((size_t)nc + 16) * sizeof *c);
+        ok = c != NULL;
+        if (c) M->curve = c, M->cap = nc + 16, M->ncurve = nc;
+    }
+    ok = ok && !fd_get(B, M->curve, (size_t)nc * sizeof(fd_row)) && !fd_get(B, M->mesh.x, n * sizeof(double)) &&
+         !fd_get(B, M->utot, n * sizeof(double)) && !fd_get(B, M->sig_n, g9 * sizeof(double)) &&
+         !fd_get(B, M->D_n, g16 * sizeof(double));
+    if (!ok) return gk_err_set(err, GK_ERR_FORMAT, "%s: the driver's block is truncated", path), 1;
+    return 0;
+}
+
+#endif /* FEMDEM_IO_H */
