@@ -31,10 +31,12 @@
  * then no image is ever nearer than the particle itself. open = 0 (what
  * gk_cells_init sets) is the periodic cell of the RVE, unchanged.
  *
- * VERLET SKIN. gk_cells_skin_ok tells whether a list built at reduced
- * positions s0 in cell h0 still contains every touching pair: it bounds the
- * change of any pair distance by the affine map A = h h0^-1 (through its
- * smallest singular value) plus twice the largest non-affine displacement.
+ * VERLET SKIN. gk_cells_skin_margin bounds how much closer than when a list
+ * was built (reduced positions s0 in cell h0) any pair can now be: through
+ * the smallest singular value of the affine map A = h h0^-1 and twice the
+ * largest non-affine displacement (gk_cells_disp2_max). While the margin is
+ * positive the list still holds every touching pair; gk_dem.h tests its
+ * inner and outer lists with it, gk_cells_skin_ok is the yes/no form.
  *
  * LICENCE: MIT (see gk_base.h).
  */
@@ -42,6 +44,7 @@
 #define GK_CELLS_H
 
 #include "gk_base.h"
+#include "gk_pcell.h"
 
 typedef struct gk_cells {
     int dim, n;
@@ -93,9 +96,19 @@ GKDEF void gk_pairlist_init(gk_pairlist *p, const gk_allocator *alloc);
 GKDEF void gk_pairlist_free(gk_pairlist *p);
 GKDEF gk_result gk_pairlist_reserve(gk_pairlist *p, size_t npairs, size_t np);
 
+/* Verlet margin of a list built in cell h0 with this skin, now in cell h,
+ * when no particle has moved more than sqrt(dispmax2) apart from the affine
+ * map: a pair listed out (at least r_i + r_j + skin apart, r_i + r_j <= 2 rmax)
+ * is now at least r_i + r_j + margin apart. Negative (-1) if h0 is singular
+ * or dispmax2 is not finite: the list must be rebuilt. */
+GKDEF double gk_cells_skin_margin(int dim, const double h0[9], const double h[9], double skin, double rmax,
+                                  double dispmax2);
+/* largest squared non-affine displacement |h (s - s0)|^2 over n particles */
+GKDEF double gk_cells_disp2_max(int dim, const double h[9], int n, const double *const s0[3],
+                                const double *const s[3]);
 /* Verlet criterion: 1 if a list built at s0 in cell h0 (with this skin and
- * largest radius rmax) is still complete at s in cell h. dispmax2 receives
- * the largest squared non-affine displacement |h (s - s0)|^2. */
+ * largest radius rmax) is still complete at s in cell h (margin > 0).
+ * dispmax2 receives the largest squared non-affine displacement. */
 GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n, const double *const s0[3],
                            const double *const s[3], double skin, double rmax, double *dispmax2);
 
@@ -330,20 +343,14 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
                         continue; /* no wrap across an open axis */
                     for (e = c->bin_start[nb]; e < c->bin_start[nb + 1]; ++e) {
                         int q2 = c->order[e];
-                        double dx, dy, dz, ex, ey, ez, cut;
+                        double ds[3], d[3], cut;
                         if (q2 <= p) continue;
-                        dx = s[0][q2] - spx;
-                        dy = s[1][q2] - spy;
-                        dz = dim == 3 ? s[2][q2] - spz : 0.0;
-                        dx -= rint(dx);
-                        dy -= rint(dy);
-                        dz -= rint(dz);
-                        ex = h[0] * dx + h[1] * dy + h[2] * dz;
-                        ey = h[3] * dx + h[4] * dy + h[5] * dz;
-                        ez = h[6] * dx + h[7] * dy + h[8] * dz;
-                        if (dim == 2) ez = 0.0;
+                        ds[0] = s[0][q2] - spx;
+                        ds[1] = s[1][q2] - spy;
+                        ds[2] = dim == 3 ? s[2][q2] - spz : 0.0;
+                        gk_pcell_image(h, dim, ds, d);
                         cut = rp + (double)r[q2] + skin;
-                        if (ex * ex + ey * ey + ez * ez < cut * cut) {
+                        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut) {
                             if ((size_t)cnt >= c->cap_buf &&
                                 gk__cells_grow(c, &c->buf, &c->cap_buf, c->cap_buf * 2))
                                 return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the pair buffer");
@@ -385,34 +392,44 @@ static double gk__sigma_min(int dim, const double A[9]) {
     gk_m3_mul(At, A, AtA);
     if (dim == 2) {
         double a = AtA[0], b = AtA[1], d = AtA[4];
-        double tr = a + d, disc = sqrt(0.25 * (a - d) * (a - d) + b * b);
-        double lmin = 0.5 * tr - disc;
+        double lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
         return lmin > 0.0 ? sqrt(lmin) : 0.0;
     }
     gk_m3_sym_eigen(AtA, val, vec);
     return val[0] > 0.0 ? sqrt(val[0]) : 0.0;
 }
 
-GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n, const double *const s0[3],
-                           const double *const s[3], double skin, double rmax, double *dispmax2) {
-    double h0i[9], A[9], smin, m2 = 0.0, margin;
-    int p;
-    if (!(gk_m3_inverse(h0, h0i) > 0.0)) return 0;
+GKDEF double gk_cells_skin_margin(int dim, const double h0[9], const double h[9], double skin, double rmax,
+                                  double dispmax2) {
+    double h0i[9], A[9], smin;
+    if (!(gk_m3_inverse(h0, h0i) > 0.0) || !isfinite(dispmax2)) return -1.0;
     gk_m3_mul(h, h0i, A);
     smin = gk__sigma_min(dim, A);
+    /* a pair listed out had |d0| >= R + skin; now |d| >= smin (R + skin) - 2 disp,
+     * and |d| - R >= smin skin - (1 - smin) R - 2 disp with R <= 2 rmax */
+    return smin * skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rmax : 0.0) - 2.0 * sqrt(dispmax2);
+}
+
+GKDEF double gk_cells_disp2_max(int dim, const double h[9], int n, const double *const s0[3],
+                                const double *const s[3]) {
+    double m2 = 0.0;
+    int p;
     for (p = 0; p < n; ++p) {
         double dx = s[0][p] - s0[0][p], dy = s[1][p] - s0[1][p], dz = dim == 3 ? s[2][p] - s0[2][p] : 0.0;
         double ex = h[0] * dx + h[1] * dy + h[2] * dz;
         double ey = h[3] * dx + h[4] * dy + h[5] * dz;
         double ez = dim == 3 ? h[6] * dx + h[7] * dy + h[8] * dz : 0.0;
         double d2 = ex * ex + ey * ey + ez * ez;
-        if (d2 > m2) m2 = d2;
+        if (d2 > m2 || d2 != d2) m2 = d2; /* a NaN is kept: the margin refuses it */
     }
+    return m2;
+}
+
+GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n, const double *const s0[3],
+                           const double *const s[3], double skin, double rmax, double *dispmax2) {
+    double m2 = gk_cells_disp2_max(dim, h, n, s0, s);
     if (dispmax2) *dispmax2 = m2;
-    /* a pair listed out had |d0| >= R + skin; now |d| >= smin (R + skin) - 2 disp.
-     * It stays apart (|d| > R) for every R <= 2 rmax if this margin is positive. */
-    margin = smin * skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rmax : 0.0) - 2.0 * sqrt(m2);
-    return margin > 0.0;
+    return gk_cells_skin_margin(dim, h0, h, skin, rmax, m2) > 0.0;
 }
 
 #endif /* GK_CELLS implementation */

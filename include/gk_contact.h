@@ -1,8 +1,11 @@
 /* gk_contact.h - contact laws and their history for grainkit.    (grainkit v0.1)
  *
- * Pointwise laws for one contact between spheres (3D) or disks (2D). These
- * scalar functions are the REFERENCE: gk_dem.h's SIMD kernels perform the
- * same operations in the same order and are tested bit for bit against them.
+ * Pointwise laws for one contact between spheres (3D) or disks (2D). The
+ * scalar functions are the REFERENCE; each has its wide twin next to it
+ * (suffix _w, GK_VR_W contacts at a time on the SIMD type of gk_base.h),
+ * which performs the same operations in the same order and is tested bit for
+ * bit against it (tests/test_contact.c). gk_dem.h gathers, calls the twins
+ * and scatters; it holds no contact law of its own.
  *
  * DO THIS: #define GK_IMPLEMENTATION (or GK_CONTACT_IMPLEMENTATION) in one file.
  *
@@ -22,7 +25,8 @@
  *   about z, the tangent is t = (-n_y, n_x) and the tangential history is the
  *   scalar F_t along t (it turns with n exactly).
  *
- * LAWS (choose with gk_material.law)
+ * LAWS (choose with gk_material.law; each is one line of GK_LAW_TABLE and
+ * one block of gk_law_<name>_* functions, see LAWS below)
  *   GK_LAW_LINEAR  seed 000 eqs 14-17: k_n = E r* (or a constant k_n),
  *                  r* = 2 r_i r_j / (r_i + r_j); k_t = kt_ratio k_n;
  *                  F_n = k_n delta; F_t incremental: F_t <- F_t - k_t v_t dt,
@@ -75,7 +79,23 @@
 
 #include "gk_base.h"
 
-typedef enum gk_law { GK_LAW_LINEAR = 0, GK_LAW_HERTZ = 1 } gk_law;
+/* THE LAW TABLE: one line per contact law, X(enum, name). Everything
+ * law-specific in the DEM is the law's block further down (LAWS): the check
+ * of its material, its constants, the stiffness (scalar reference and wide
+ * twin) and the stiffness bound of the critical time step. The enum, the
+ * dispatchers, gk_material_check, gk_law_consts_make and the kernel
+ * instantiation in gk_dem.h are all generated from this table, so a new law
+ * is one line here, one block, and its test. */
+#define GK_LAW_TABLE(X)                                                                                                \
+    X(GK_LAW_LINEAR, linear) /* = 0 */                                                                                 \
+    X(GK_LAW_HERTZ, hertz)   /* = 1 */
+
+typedef enum gk_law {
+#define GK__LAW_ENUM(E, name) E,
+    GK_LAW_TABLE(GK__LAW_ENUM)
+#undef GK__LAW_ENUM
+        GK_LAW_COUNT
+} gk_law;
 
 /* physics flags (compile-time constants inside the kernels) */
 #define GK_PHYS_TANGENT 1u  /* tangential spring + Coulomb (friction or shear cohesion) */
@@ -109,10 +129,11 @@ typedef struct gk_material {
     double density;    /* particle density [kg/m^3]                                    */
 } gk_material;
 
-/* Per-law constants in the working precision, derived once from a material. */
+/* Contact constants in the working precision, derived once from a material
+ * (gk_law_consts_make): each law's own (set by its block) and the shared ones. */
 typedef struct gk_law_consts {
-    gk_real young, kn_const, kt_ratio; /* linear                                */
-    gk_real hn, ht;                    /* Hertz: G/(1-nu), 2G/(2-nu)            */
+    gk_real young, kn_const, kt_ratio; /* GK_LAW_LINEAR                          */
+    gk_real hn, ht;                    /* GK_LAW_HERTZ: G/(1-nu), 2G/(2-nu)      */
     gk_real mu, beta, eta;
     gk_real zn2, zt2; /* 2 zeta_n, 2 zeta_t */
     gk_real cn, ct;
@@ -126,6 +147,11 @@ typedef struct gk_contact_out {
     gk_real fn;    /* normal force magnitude (signed: < 0 in bond tension) */
     gk_real delta; /* overlap                                              */
 } gk_contact_out;
+
+/* The same for GK_VR_W contacts (the wide twins gk_contact_2d_w, _3d_w). */
+typedef struct gk_contact_out_w {
+    gk_vr f[3], ti[3], tj[3];
+} gk_contact_out_w;
 
 #ifdef __cplusplus
 extern "C" {
@@ -145,25 +171,150 @@ GKDEF double gk_restitution_to_zeta(double e);
 }
 #endif
 
-/* ---- the reference laws (inline; `flags` and `law` are constants in the kernels) */
+/* ================================================================ LAWS
+ * One block per line of GK_LAW_TABLE, all functions named gk_law_<name>_*:
+ *   _check(m, err)        the law's own material checks (gk_material_check)
+ *   _consts(m, K)         its fields of gk_law_consts (gk_law_consts_make)
+ *   _stiffness(K, ri, rj, delta, kn, fn, kt)    k_n, F_n and k_t at overlap
+ *                         delta > 0: the scalar reference
+ *   _stiffness_w(...)     its wide twin, GK_VR_W contacts, bit-identical lanes
+ *   _kn_max(m, rmax, dmax) the largest k_n of two particles of radius <= rmax
+ *                         at overlap <= dmax (critical time step, seed 000 eq 19)
+ *   _stiffens()           1 if k_n grows with the overlap: the RVE re-checks
+ *                         its time step at every list rebuild
+ * `law` and `flags` are compile-time constants in the kernels, so a switch on
+ * the law costs nothing. */
 
-/* normal stiffness, force and tangential stiffness for overlap delta (>0) */
-GK_FORCE_INLINE void gk_contact_stiffness(const gk_law_consts *K, gk_law law, gk_real ri, gk_real rj,
-                                          gk_real delta, gk_real *kn, gk_real *fn, gk_real *kt) {
+/* ---- GK_LAW_LINEAR: seed 000 eqs 14-17, k_n = E r* (or a constant), k_t = kt_ratio k_n */
+GK_INLINE gk_result gk_law_linear_check(const gk_material *m, gk_err *err) {
+    if (!(m->kn > 0.0) && !(m->young > 0.0))
+        return gk_err_set(err, GK_ERR_ARG, "linear law needs young > 0 or kn > 0 (young %g, kn %g)", m->young,
+                          m->kn);
+    return GK_OK;
+}
+GK_INLINE void gk_law_linear_consts(const gk_material *m, gk_law_consts *k) {
+    k->young = (gk_real)m->young;
+    k->kn_const = (gk_real)m->kn;
+    k->kt_ratio = (gk_real)m->kt_ratio;
+}
+GK_FORCE_INLINE void gk_law_linear_stiffness(const gk_law_consts *K, gk_real ri, gk_real rj, gk_real delta,
+                                             gk_real *kn, gk_real *fn, gk_real *kt) {
     gk_real rr = ri * rj, rs = (rr + rr) / (ri + rj); /* r* = 2 ri rj / (ri + rj) */
-    if (law == GK_LAW_LINEAR) {
-        gk_real k = K->kn_const > 0 ? K->kn_const : K->young * rs;
-        *kn = k;
-        *fn = k * delta;
-        *kt = K->kt_ratio * k;
-    } else {
-        gk_real a = (rs + rs) * delta, sq = a > 0 ? (gk_real)sqrt(a) : (gk_real)0;
-        gk_real k = K->hn * sq;
-        *kn = k;
-        *fn = (gk_real)(2.0 / 3.0) * (k * delta);
-        *kt = K->ht * sq;
+    gk_real k = K->kn_const > 0 ? K->kn_const : K->young * rs;
+    *kn = k;
+    *fn = k * delta;
+    *kt = K->kt_ratio * k;
+}
+GK_FORCE_INLINE void gk_law_linear_stiffness_w(const gk_law_consts *K, gk_vr ri, gk_vr rj, gk_vr delta, gk_vr *kn,
+                                               gk_vr *fn, gk_vr *kt) {
+    gk_vr rr = gk_vr_mul(ri, rj), rs = gk_vr_div(gk_vr_add(rr, rr), gk_vr_add(ri, rj));
+    gk_vr k = K->kn_const > 0 ? gk_vr_set1(K->kn_const) : gk_vr_mul(gk_vr_set1(K->young), rs);
+    *kn = k;
+    *fn = gk_vr_mul(k, delta);
+    *kt = gk_vr_mul(gk_vr_set1(K->kt_ratio), k);
+}
+GK_INLINE double gk_law_linear_kn_max(const gk_material *m, double rmax, double dmax) {
+    (void)dmax;
+    return m->kn > 0 ? m->kn : m->young * rmax; /* r* <= r_max */
+}
+GK_INLINE int gk_law_linear_stiffens(void) { return 0; }
+
+/* ---- GK_LAW_HERTZ: seed 004 eqs 53-55, incremental Hertz-Mindlin (see LAWS above) */
+GK_INLINE gk_result gk_law_hertz_check(const gk_material *m, gk_err *err) {
+    if (!(m->young > 0.0)) return gk_err_set(err, GK_ERR_ARG, "Hertz law needs young > 0 (got %g)", m->young);
+    if (!(m->poisson > -1.0 && m->poisson < 0.5))
+        return gk_err_set(err, GK_ERR_ARG, "Poisson ratio %g outside (-1, 0.5)", m->poisson);
+    if (m->coh_n > 0.0 || m->coh_t > 0.0)
+        return gk_err_set(err, GK_ERR_UNSUPPORTED, "cohesion is implemented for the linear law only");
+    return GK_OK;
+}
+GK_INLINE void gk_law_hertz_consts(const gk_material *m, gk_law_consts *k) {
+    double G = m->young / (2.0 * (1.0 + m->poisson));
+    k->hn = (gk_real)(G / (1.0 - m->poisson));
+    k->ht = (gk_real)(2.0 * G / (2.0 - m->poisson));
+}
+GK_FORCE_INLINE void gk_law_hertz_stiffness(const gk_law_consts *K, gk_real ri, gk_real rj, gk_real delta,
+                                            gk_real *kn, gk_real *fn, gk_real *kt) {
+    gk_real rr = ri * rj, rs = (rr + rr) / (ri + rj); /* R_e = r* */
+    gk_real a = (rs + rs) * delta, sq = a > 0 ? (gk_real)sqrt(a) : (gk_real)0;
+    gk_real k = K->hn * sq;
+    *kn = k;
+    *fn = (gk_real)(2.0 / 3.0) * (k * delta);
+    *kt = K->ht * sq;
+}
+GK_FORCE_INLINE void gk_law_hertz_stiffness_w(const gk_law_consts *K, gk_vr ri, gk_vr rj, gk_vr delta, gk_vr *kn,
+                                              gk_vr *fn, gk_vr *kt) {
+    gk_vr rr = gk_vr_mul(ri, rj), rs = gk_vr_div(gk_vr_add(rr, rr), gk_vr_add(ri, rj));
+    gk_vr a = gk_vr_mul(gk_vr_add(rs, rs), delta);
+    gk_vr sq = gk_vr_select(gk_vr_gt(a, gk_vr_zero()), gk_vr_sqrt(a), gk_vr_zero());
+    gk_vr k = gk_vr_mul(gk_vr_set1(K->hn), sq);
+    *kn = k;
+    *fn = gk_vr_mul(gk_vr_set1((gk_real)(2.0 / 3.0)), gk_vr_mul(k, delta));
+    *kt = gk_vr_mul(gk_vr_set1(K->ht), sq);
+}
+GK_INLINE double gk_law_hertz_kn_max(const gk_material *m, double rmax, double dmax) {
+    double G = m->young / (2.0 * (1.0 + m->poisson));
+    return G / (1.0 - m->poisson) * sqrt(2.0 * rmax * dmax); /* R_e <= r_max */
+}
+GK_INLINE int gk_law_hertz_stiffens(void) { return 1; }
+
+/* ---- the dispatchers, generated from GK_LAW_TABLE */
+GK_INLINE const char *gk_law_name(gk_law law) {
+    switch (law) {
+#define GK__LAW_CASE(E, name)                                                                                          \
+    case E: return #name;
+        GK_LAW_TABLE(GK__LAW_CASE)
+#undef GK__LAW_CASE
+    default: return "unknown";
     }
 }
+GK_INLINE int gk_law_stiffens(gk_law law) {
+    switch (law) {
+#define GK__LAW_CASE(E, name)                                                                                          \
+    case E: return gk_law_##name##_stiffens();
+        GK_LAW_TABLE(GK__LAW_CASE)
+#undef GK__LAW_CASE
+    default: return 0;
+    }
+}
+GK_INLINE double gk_law_kn_max(const gk_material *m, double rmax, double dmax) {
+    switch (m->law) {
+#define GK__LAW_CASE(E, name)                                                                                          \
+    case E: return gk_law_##name##_kn_max(m, rmax, dmax);
+        GK_LAW_TABLE(GK__LAW_CASE)
+#undef GK__LAW_CASE
+    default: return 0.0;
+    }
+}
+/* normal stiffness, force and tangential stiffness for overlap delta (> 0) */
+GK_FORCE_INLINE void gk_contact_stiffness(const gk_law_consts *K, gk_law law, gk_real ri, gk_real rj,
+                                          gk_real delta, gk_real *kn, gk_real *fn, gk_real *kt) {
+    switch (law) {
+#define GK__LAW_CASE(E, name)                                                                                          \
+    case E: gk_law_##name##_stiffness(K, ri, rj, delta, kn, fn, kt); return;
+        GK_LAW_TABLE(GK__LAW_CASE)
+#undef GK__LAW_CASE
+    default: *kn = *fn = *kt = 0;
+    }
+}
+GK_FORCE_INLINE void gk_contact_stiffness_w(const gk_law_consts *K, gk_law law, gk_vr ri, gk_vr rj, gk_vr delta,
+                                            gk_vr *kn, gk_vr *fn, gk_vr *kt) {
+    switch (law) {
+#define GK__LAW_CASE(E, name)                                                                                          \
+    case E: gk_law_##name##_stiffness_w(K, ri, rj, delta, kn, fn, kt); return;
+        GK_LAW_TABLE(GK__LAW_CASE)
+#undef GK__LAW_CASE
+    default: *kn = *fn = *kt = gk_vr_zero();
+    }
+}
+
+/* ================================================================ THE PAIR LAW
+ * Shared by every law: normal force (+ dashpot), tangential spring with its
+ * history and the Coulomb cap, rolling resistance, cohesion. Each scalar
+ * reference is followed by its wide twin (GK_VR_W pairs at a time, every
+ * operation in the same order, no FMA, correctly rounded sqrt and division,
+ * exact negation: each lane is bit-identical to the reference; cohesion has
+ * no wide twin and runs through the reference). */
 
 /* 2D law. d: branch (i -> j); v: relative centre velocity of j w.r.t. i
  * (affine part included); wi, wj: total spins; ft, mr, st: history in/out.
@@ -263,6 +414,79 @@ GK_FORCE_INLINE int gk_contact_2d(const gk_law_consts *K, gk_law law, unsigned f
     return 1;
 }
 
+/* Wide twin of gk_contact_2d (no cohesion): GK_VR_W pairs. mi, mj are read
+ * only with GK_PHYS_VISCOUS, ft and mr (history in, out; zero where apart)
+ * only with TANGENT and ROLLING. Returns the lanes in contact; *slide gets
+ * those on the Coulomb cap. The caller broadcasts K from a local copy so
+ * that its constants stay in registers. */
+GK_FORCE_INLINE gk_vrm gk_contact_2d_w(const gk_law_consts *K, gk_law law, unsigned flags, gk_vr dx, gk_vr dy,
+                                       gk_vr ri, gk_vr rj, gk_vr mi, gk_vr mj, gk_vr vx, gk_vr vy, gk_vr wi,
+                                       gk_vr wj, gk_vr dt, gk_vr *ft, gk_vr *mr, gk_vrm *slide,
+                                       gk_contact_out_w *o) {
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5);
+    gk_vr R = gk_vr_add(ri, rj), d2 = gk_vr_add(gk_vr_mul(dx, dx), gk_vr_mul(dy, dy)), dist, inv, nx, ny, delta;
+    gk_vr kn, fn, kt, vn, mstar = zero, hd, li, lj, fx, fy, ti = zero, tj = zero;
+    gk_vrm in = gk_vr_lt(d2, gk_vr_mul(R, R));
+    *slide = gk_vr_lt(one, zero);
+    dist = gk_vr_sqrt(d2);
+    inv = gk_vr_div(one, dist);
+    nx = gk_vr_mul(dx, inv);
+    ny = gk_vr_mul(dy, inv);
+    delta = gk_vr_sub(R, dist);
+    gk_contact_stiffness_w(K, law, ri, rj, delta, &kn, &fn, &kt);
+    vn = gk_vr_add(gk_vr_mul(vx, nx), gk_vr_mul(vy, ny));
+    if (flags & GK_PHYS_VISCOUS) {
+        mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
+        fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(gk_vr_set1(K->zn2), gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
+    }
+    hd = gk_vr_mul(half, delta);
+    li = gk_vr_sub(ri, hd);
+    lj = gk_vr_sub(rj, hd);
+    if (flags & GK_PHYS_TANGENT) {
+        gk_vr tx = gk_vr_neg(ny), ty = nx, vt, f, cap, gt = zero, ftot;
+        vt = gk_vr_sub(gk_vr_add(gk_vr_mul(vx, tx), gk_vr_mul(vy, ty)), gk_vr_add(gk_vr_mul(li, wi), gk_vr_mul(lj, wj)));
+        f = gk_vr_sub(*ft, gk_vr_mul(gk_vr_mul(kt, vt), dt));
+        ftot = f;
+        if (flags & GK_PHYS_VISCOUS) {
+            gt = gk_vr_mul(gk_vr_set1(K->zt2), gk_vr_sqrt(gk_vr_mul(mstar, kt)));
+            ftot = gk_vr_sub(f, gk_vr_mul(gt, vt));
+        }
+        cap = gk_vr_mul(gk_vr_set1(K->mu), gk_vr_max(fn, zero));
+        *slide = gk_vr_gt(gk_vr_abs(ftot), cap);
+        ftot = gk_vr_select(*slide, gk_vr_select(gk_vr_gt(ftot, zero), cap, gk_vr_neg(cap)), ftot);
+        if (flags & GK_PHYS_VISCOUS)
+            f = gk_vr_select(*slide, gk_vr_add(ftot, gk_vr_mul(gt, vt)), f);
+        else
+            f = gk_vr_select(*slide, ftot, f);
+        *ft = gk_vr_select(in, f, zero);
+        fx = gk_vr_add(gk_vr_mul(fn, nx), gk_vr_mul(ftot, tx));
+        fy = gk_vr_add(gk_vr_mul(fn, ny), gk_vr_mul(ftot, ty));
+        ti = gk_vr_mul(gk_vr_neg(li), ftot);
+        tj = gk_vr_mul(gk_vr_neg(lj), ftot);
+    } else {
+        fx = gk_vr_mul(fn, nx);
+        fy = gk_vr_mul(fn, ny);
+    }
+    if (flags & GK_PHYS_ROLLING) {
+        gk_vr kr = gk_vr_mul(gk_vr_mul(gk_vr_set1(K->beta), kt), gk_vr_mul(ri, rj)), capr, m;
+        gk_vrm over;
+        m = gk_vr_sub(*mr, gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wj, wi)), dt));
+        capr = gk_vr_mul(gk_vr_mul(gk_vr_set1(K->eta), gk_vr_min(ri, rj)), gk_vr_max(fn, zero));
+        over = gk_vr_gt(gk_vr_abs(m), capr);
+        m = gk_vr_select(over, gk_vr_select(gk_vr_gt(m, zero), capr, gk_vr_neg(capr)), m);
+        *mr = gk_vr_select(in, m, zero);
+        ti = gk_vr_sub(ti, m);
+        tj = gk_vr_add(tj, m);
+    }
+    o->f[0] = gk_vr_select(in, fx, zero);
+    o->f[1] = gk_vr_select(in, fy, zero);
+    o->f[2] = zero;
+    o->ti[0] = o->ti[1] = o->tj[0] = o->tj[1] = zero;
+    o->ti[2] = gk_vr_select(in, ti, zero);
+    o->tj[2] = gk_vr_select(in, tj, zero);
+    return in;
+}
+
 /* rotate a 3D history vector: twist about n by angle a, project onto the
  * plane normal to n, rescale to the magnitude it had before */
 GK_FORCE_INLINE void gk_contact_rotate_history(gk_real nx, gk_real ny, gk_real nz, gk_real a, gk_real *h) {
@@ -285,6 +509,25 @@ GK_FORCE_INLINE void gk_contact_rotate_history(gk_real nx, gk_real ny, gk_real n
     } else {
         h[0] = h[1] = h[2] = 0;
     }
+}
+
+/* wide twin of gk_contact_rotate_history */
+GK_FORCE_INLINE void gk_contact_rotate_history_w(const gk_vr n[3], gk_vr a, gk_vr h[3]) {
+    const gk_vr zero = gk_vr_zero();
+    gk_vr m2, p[3], dn, p2, sc;
+    gk_vrm has, pos;
+    int k;
+    m2 = gk_vr_add(gk_vr_add(gk_vr_mul(h[0], h[0]), gk_vr_mul(h[1], h[1])), gk_vr_mul(h[2], h[2]));
+    p[0] = gk_vr_add(h[0], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[1], h[2]), gk_vr_mul(n[2], h[1]))));
+    p[1] = gk_vr_add(h[1], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[2], h[0]), gk_vr_mul(n[0], h[2]))));
+    p[2] = gk_vr_add(h[2], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[0], h[1]), gk_vr_mul(n[1], h[0]))));
+    dn = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], n[0]), gk_vr_mul(p[1], n[1])), gk_vr_mul(p[2], n[2]));
+    for (k = 0; k < 3; ++k) p[k] = gk_vr_sub(p[k], gk_vr_mul(dn, n[k]));
+    p2 = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], p[0]), gk_vr_mul(p[1], p[1])), gk_vr_mul(p[2], p[2]));
+    sc = gk_vr_sqrt(gk_vr_div(m2, p2));
+    has = gk_vr_gt(m2, zero);
+    pos = gk_vr_gt(p2, zero);
+    for (k = 0; k < 3; ++k) h[k] = gk_vr_select(has, gk_vr_select(pos, gk_vr_mul(p[k], sc), zero), h[k]);
 }
 
 /* 3D law; same conventions; w*: spin vectors; ft, mr: 3-vectors. */
@@ -412,11 +655,117 @@ GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned f
     return 1;
 }
 
+/* Wide twin of gk_contact_3d (no cohesion); conventions as gk_contact_2d_w,
+ * d, v, wi, wj, ft and mr are 3-vectors of lanes. */
+GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsigned flags, const gk_vr d[3], gk_vr ri,
+                                       gk_vr rj, gk_vr mi, gk_vr mj, const gk_vr v[3], const gk_vr wi[3],
+                                       const gk_vr wj[3], gk_vr dt, gk_vr ft[3], gk_vr mr[3], gk_vrm *slide,
+                                       gk_contact_out_w *o) {
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5);
+    gk_vr n[3], F[3], R, d2, dist, inv, delta, kn, fn, kt, vn, mstar = zero, hd, li, lj, twist = zero;
+    gk_vrm in;
+    int k;
+    R = gk_vr_add(ri, rj);
+    d2 = gk_vr_add(gk_vr_add(gk_vr_mul(d[0], d[0]), gk_vr_mul(d[1], d[1])), gk_vr_mul(d[2], d[2]));
+    in = gk_vr_lt(d2, gk_vr_mul(R, R));
+    *slide = gk_vr_lt(one, zero);
+    dist = gk_vr_sqrt(d2);
+    inv = gk_vr_div(one, dist);
+    for (k = 0; k < 3; ++k) n[k] = gk_vr_mul(d[k], inv);
+    delta = gk_vr_sub(R, dist);
+    gk_contact_stiffness_w(K, law, ri, rj, delta, &kn, &fn, &kt);
+    for (k = 0; k < 3; ++k) o->ti[k] = o->tj[k] = zero;
+    vn = gk_vr_add(gk_vr_add(gk_vr_mul(v[0], n[0]), gk_vr_mul(v[1], n[1])), gk_vr_mul(v[2], n[2]));
+    if (flags & GK_PHYS_VISCOUS) {
+        mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
+        fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(gk_vr_set1(K->zn2), gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
+    }
+    hd = gk_vr_mul(half, delta);
+    li = gk_vr_sub(ri, hd);
+    lj = gk_vr_sub(rj, hd);
+    if (flags & (GK_PHYS_TANGENT | GK_PHYS_ROLLING))
+        twist = gk_vr_mul(gk_vr_mul(half, dt), gk_vr_add(gk_vr_add(gk_vr_mul(gk_vr_add(wi[0], wj[0]), n[0]),
+                                                                   gk_vr_mul(gk_vr_add(wi[1], wj[1]), n[1])),
+                                                         gk_vr_mul(gk_vr_add(wi[2], wj[2]), n[2])));
+    if (flags & GK_PHYS_TANGENT) {
+        gk_vr sw[3], vc[3], vcn, vt[3], f[3], tot[3], cc[3], cap, gt = zero, m2;
+        for (k = 0; k < 3; ++k) sw[k] = gk_vr_add(gk_vr_mul(li, wi[k]), gk_vr_mul(lj, wj[k]));
+        vc[0] = gk_vr_sub(v[0], gk_vr_sub(gk_vr_mul(sw[1], n[2]), gk_vr_mul(sw[2], n[1])));
+        vc[1] = gk_vr_sub(v[1], gk_vr_sub(gk_vr_mul(sw[2], n[0]), gk_vr_mul(sw[0], n[2])));
+        vc[2] = gk_vr_sub(v[2], gk_vr_sub(gk_vr_mul(sw[0], n[1]), gk_vr_mul(sw[1], n[0])));
+        vcn = gk_vr_add(gk_vr_add(gk_vr_mul(vc[0], n[0]), gk_vr_mul(vc[1], n[1])), gk_vr_mul(vc[2], n[2]));
+        for (k = 0; k < 3; ++k) vt[k] = gk_vr_sub(vc[k], gk_vr_mul(vcn, n[k]));
+        gk_contact_rotate_history_w(n, twist, ft);
+        for (k = 0; k < 3; ++k) {
+            f[k] = gk_vr_sub(ft[k], gk_vr_mul(gk_vr_mul(kt, vt[k]), dt));
+            tot[k] = f[k];
+        }
+        if (flags & GK_PHYS_VISCOUS) {
+            gt = gk_vr_mul(gk_vr_set1(K->zt2), gk_vr_sqrt(gk_vr_mul(mstar, kt)));
+            for (k = 0; k < 3; ++k) tot[k] = gk_vr_sub(f[k], gk_vr_mul(gt, vt[k]));
+        }
+        cap = gk_vr_mul(gk_vr_set1(K->mu), gk_vr_max(fn, zero));
+        m2 = gk_vr_add(gk_vr_add(gk_vr_mul(tot[0], tot[0]), gk_vr_mul(tot[1], tot[1])), gk_vr_mul(tot[2], tot[2]));
+        *slide = gk_vr_gt(m2, gk_vr_mul(cap, cap));
+        if (gk_vrm_any(*slide)) {
+            gk_vr sc = gk_vr_div(cap, gk_vr_sqrt(m2));
+            for (k = 0; k < 3; ++k) {
+                gk_vr t = gk_vr_mul(tot[k], sc);
+                tot[k] = gk_vr_select(*slide, t, tot[k]);
+                f[k] = gk_vr_select(*slide, (flags & GK_PHYS_VISCOUS) ? gk_vr_add(tot[k], gk_vr_mul(gt, vt[k])) : tot[k],
+                                    f[k]);
+            }
+        }
+        for (k = 0; k < 3; ++k) {
+            ft[k] = gk_vr_select(in, f[k], zero);
+            F[k] = gk_vr_add(gk_vr_mul(fn, n[k]), tot[k]);
+        }
+        cc[0] = gk_vr_sub(gk_vr_mul(n[1], tot[2]), gk_vr_mul(n[2], tot[1]));
+        cc[1] = gk_vr_sub(gk_vr_mul(n[2], tot[0]), gk_vr_mul(n[0], tot[2]));
+        cc[2] = gk_vr_sub(gk_vr_mul(n[0], tot[1]), gk_vr_mul(n[1], tot[0]));
+        for (k = 0; k < 3; ++k) {
+            o->ti[k] = gk_vr_mul(gk_vr_neg(li), cc[k]);
+            o->tj[k] = gk_vr_mul(gk_vr_neg(lj), cc[k]);
+        }
+    } else {
+        for (k = 0; k < 3; ++k) F[k] = gk_vr_mul(fn, n[k]);
+    }
+    if (flags & GK_PHYS_ROLLING) {
+        gk_vr wr[3], wrn, kr = gk_vr_mul(gk_vr_mul(gk_vr_set1(K->beta), kt), gk_vr_mul(ri, rj)), capr, m2;
+        gk_vrm over;
+        capr = gk_vr_mul(gk_vr_mul(gk_vr_set1(K->eta), gk_vr_min(ri, rj)), gk_vr_max(fn, zero));
+        for (k = 0; k < 3; ++k) wr[k] = gk_vr_sub(wj[k], wi[k]);
+        wrn = gk_vr_add(gk_vr_add(gk_vr_mul(wr[0], n[0]), gk_vr_mul(wr[1], n[1])), gk_vr_mul(wr[2], n[2]));
+        gk_contact_rotate_history_w(n, twist, mr);
+        for (k = 0; k < 3; ++k)
+            mr[k] = gk_vr_sub(mr[k], gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wr[k], gk_vr_mul(wrn, n[k]))), dt));
+        m2 = gk_vr_add(gk_vr_add(gk_vr_mul(mr[0], mr[0]), gk_vr_mul(mr[1], mr[1])), gk_vr_mul(mr[2], mr[2]));
+        over = gk_vr_gt(m2, gk_vr_mul(capr, capr));
+        if (gk_vrm_any(over)) {
+            gk_vr sc = gk_vr_div(capr, gk_vr_sqrt(m2));
+            for (k = 0; k < 3; ++k) mr[k] = gk_vr_select(over, gk_vr_mul(mr[k], sc), mr[k]);
+        }
+        for (k = 0; k < 3; ++k) {
+            o->ti[k] = gk_vr_sub(o->ti[k], mr[k]);
+            o->tj[k] = gk_vr_add(o->tj[k], mr[k]);
+            mr[k] = gk_vr_select(in, mr[k], zero);
+        }
+    }
+    for (k = 0; k < 3; ++k) {
+        o->f[k] = gk_vr_select(in, F[k], zero);
+        o->ti[k] = gk_vr_select(in, o->ti[k], zero);
+        o->tj[k] = gk_vr_select(in, o->tj[k], zero);
+    }
+    return in;
+}
+
 #endif /* GK_CONTACT_H */
 
 /* ======================================================== IMPLEMENTATION */
 #if (defined(GK_IMPLEMENTATION) || defined(GK_CONTACT_IMPLEMENTATION)) && !defined(GK_CONTACT_IMPL_ONCE)
 #define GK_CONTACT_IMPL_ONCE
+
+#include <string.h>
 
 GKDEF gk_material gk_material_default(void) {
     gk_material m;
@@ -455,16 +804,18 @@ GKDEF gk_result gk_material_check(const gk_material *m, gk_err *err) {
     GK__FIN(coh_t);
     GK__FIN(density);
 #undef GK__FIN
-    if (m->law != GK_LAW_LINEAR && m->law != GK_LAW_HERTZ)
-        return gk_err_set(err, GK_ERR_ARG, "unknown contact law %d", (int)m->law);
-    if (m->law == GK_LAW_LINEAR && !(m->kn > 0.0) && !(m->young > 0.0))
-        return gk_err_set(err, GK_ERR_ARG, "linear law needs young > 0 or kn > 0 (young %g, kn %g)", m->young,
-                          m->kn);
+    switch (m->law) {
+#define GK__LAW_CASE(E, name)                                                                                          \
+    case E: {                                                                                                          \
+        gk_result r_ = gk_law_##name##_check(m, err);                                                                  \
+        if (r_) return r_;                                                                                             \
+        break;                                                                                                         \
+    }
+        GK_LAW_TABLE(GK__LAW_CASE)
+#undef GK__LAW_CASE
+    default: return gk_err_set(err, GK_ERR_ARG, "unknown contact law %d", (int)m->law);
+    }
     if (m->kn < 0.0) return gk_err_set(err, GK_ERR_ARG, "kn %g < 0", m->kn);
-    if (m->law == GK_LAW_HERTZ && !(m->young > 0.0))
-        return gk_err_set(err, GK_ERR_ARG, "Hertz law needs young > 0 (got %g)", m->young);
-    if (m->law == GK_LAW_HERTZ && !(m->poisson > -1.0 && m->poisson < 0.5))
-        return gk_err_set(err, GK_ERR_ARG, "Poisson ratio %g outside (-1, 0.5)", m->poisson);
     if (m->kt_ratio < 0.0) return gk_err_set(err, GK_ERR_ARG, "kt_ratio %g < 0", m->kt_ratio);
     if (m->friction < 0.0) return gk_err_set(err, GK_ERR_ARG, "friction %g < 0", m->friction);
     if (m->roll_beta < 0.0 || m->roll_eta < 0.0)
@@ -473,8 +824,6 @@ GKDEF gk_result gk_material_check(const gk_material *m, gk_err *err) {
         return gk_err_set(err, GK_ERR_ARG, "viscous damping ratios %g, %g must be in [0, 1)", m->zeta_n, m->zeta_t);
     if (m->coh_n < 0.0 || m->coh_t < 0.0)
         return gk_err_set(err, GK_ERR_ARG, "cohesion %g, %g must be >= 0", m->coh_n, m->coh_t);
-    if ((m->coh_n > 0.0 || m->coh_t > 0.0) && m->law != GK_LAW_LINEAR)
-        return gk_err_set(err, GK_ERR_UNSUPPORTED, "cohesion is implemented for the linear law only");
     if (!(m->density > 0.0)) return gk_err_set(err, GK_ERR_MASS, "density %g must be > 0", m->density);
     return GK_OK;
 }
@@ -489,12 +838,14 @@ GKDEF unsigned gk_material_flags(const gk_material *m) {
 }
 
 GKDEF void gk_law_consts_make(const gk_material *m, gk_law_consts *k) {
-    double G = m->young / (2.0 * (1.0 + m->poisson));
-    k->young = (gk_real)m->young;
-    k->kn_const = (gk_real)m->kn;
-    k->kt_ratio = (gk_real)m->kt_ratio;
-    k->hn = (gk_real)(G / (1.0 - m->poisson));
-    k->ht = (gk_real)(2.0 * G / (2.0 - m->poisson));
+    memset(k, 0, sizeof *k);
+    switch (m->law) {
+#define GK__LAW_CASE(E, name)                                                                                          \
+    case E: gk_law_##name##_consts(m, k); break;
+        GK_LAW_TABLE(GK__LAW_CASE)
+#undef GK__LAW_CASE
+    default: break;
+    }
     k->mu = (gk_real)m->friction;
     k->beta = (gk_real)m->roll_beta;
     k->eta = (gk_real)m->roll_eta;

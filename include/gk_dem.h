@@ -62,6 +62,27 @@
  *     before it changes anything; a bad buffer is refused with a message
  *     and the RVE stays as it was.
  *
+ * DRIVING THE CELL. One control yields the cell map of every step; the
+ * drivers are thin wrappers around it:
+ *   gk_rve_deform(dH, n)     the path I + dH split over n steps (def.path:
+ *                            constant velocity gradient or objective)
+ *   gk_rve_step(n)           the velocity gradient of gk_rve_set_velocity_
+ *                            gradient; with a servo (gk_rve_set_servo) its
+ *                            diagonal (and shear) follow the stress each step
+ *   gk_rve_relax(uf, every, max)   L = 0 in runs of `every` steps until the
+ *                            unbalanced force ratio is at most uf
+ *   gk_rve_consolidate       the isotropic servo until the target pressure
+ *                            and balance hold (gk_consolidate_def)
+ *   gk_rve_deform_adaptive   gk_rve_deform with the step count chosen by the
+ *       physics: n = ceil(I_1 / I_max) clamped to [n_min, n_max], I_1 the
+ *       inertial number (seed 000 eq 20) of dH applied in one step at the
+ *       RVE's current pressure (p <= 0: n_max), so the deformation runs at
+ *       I <= I_max; then gk_rve_relax to uf_max with the steps left to n_max
+ *       (reported as capped if the ratio is still above). Quasi-static by
+ *       construction: more steps where p is low (near liquefaction), fewer
+ *       where it is high. Bad input (NaN dH, bounds <= 0, n_min > n_max) ->
+ *       GK_ERR_ARG before anything runs.
+ *
  * KINEMATICS. Positions are stored as reduced coordinates s (double, also in
  * the float build) and x = h s; velocities v and spins w are the
  * FLUCTUATIONS about the affine field of the cell (translational L x and
@@ -290,6 +311,23 @@ typedef struct gk_consolidate_def {
     int box;                  /* 1: the cell stays a box (shear stresses not driven)      */
 } gk_consolidate_def;
 
+/* gk_rve_deform_adaptive: zero means default */
+typedef struct gk_adapt_def {
+    double inertial_max;   /* I bound of the deformation (seed 000 eq 20); 0 -> 5e-4   */
+    double unbalanced_max; /* unbalanced force ratio to reach after it; 0 -> 5e-3     */
+    int n_min, n_max;      /* bounds on the total DEM steps; 0 -> 10 and 5000          */
+    int every;             /* relaxation steps between checks; 0 -> 20                 */
+    int rms;               /* 1: the RMS ratio I_uf (Liu, Sun, Yuan & Fish 2016 eq 57)
+                              instead of the mean ratio (gk_rve_unbalanced_rms)        */
+} gk_adapt_def;
+
+typedef struct gk_adapt_report {
+    int n_deform, n_relax; /* steps of the deformation and of the relaxation         */
+    double inertial;       /* I of the deformation (at the pressure before it)       */
+    double unbalanced;     /* unbalanced force ratio at the end (mean, or eq 57's RMS) */
+    int capped;            /* 1 if n_max stopped the relaxation above uf_max          */
+} gk_adapt_report;
+
 typedef struct gk_consolidate_report {
     long steps;
     double stress[9], unbalanced, void_ratio;
@@ -314,6 +352,22 @@ GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *servo); /* NULL sw
 GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps);
 GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps);
 GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk_consolidate_report *rep);
+/* relaxation at a fixed cell (velocity gradient 0, no servo): runs of `every`
+ * DEM steps while gk_rve_unbalanced exceeds uf_max, at most max_steps in all;
+ * *steps (may be NULL) gets the steps run */
+GKDEF gk_result gk_rve_relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps);
+/* gk_rve_deform with the step count chosen by the physics (see DRIVING THE CELL) */
+GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk_adapt_def *ad,
+                                       gk_adapt_report *rep);
+/* unbalanced force ratio (YADE's unbalancedForce): mean |sum of the contact
+ * forces on a particle| / mean |contact force|; 0 without contacts */
+GKDEF double gk_rve_unbalanced(const gk_rve *rve);
+/* the RMS ratio I_uf = sqrt(mean |sum F_p|^2) / sqrt(mean |F_c|^2) of Liu, Sun,
+ * Yuan & Fish (2016) eq 57; 0 without contacts */
+GKDEF double gk_rve_unbalanced_rms(const gk_rve *rve);
+/* inertial number I = 2 gdot r_mean sqrt(rho / p), gdot = sqrt(sym(rate):sym(rate))
+ * (seed 000 eq 20); p <= 0 -> +inf (not NaN) */
+GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p);
 /* Love stress of the last step (seed 000 eq 5), tension-positive, 3x3 */
 GKDEF void gk_rve_stress(const gk_rve *rve, double sigma[9]);
 /* recompute forces at the current positions without advancing (zero-length
@@ -383,51 +437,146 @@ GKDEF gk_rve_def gk_rve_def_default(void) {
 
 GKDEF const char *gk_rve_error(const gk_rve *rve) { return rve->err.msg; }
 
+/* ---------------------------------------------------------------- the field table
+ * Every per-particle and per-pair array of a gk_rve, in the order of the
+ * saved state, with its element size, what it is indexed by and when it
+ * exists. Allocation, growth and release, the rebuild's history merge and
+ * swap, particle removal, gk_rve_refresh, save, restore and the state size
+ * all walk this table: a new array is one line here. */
+#define GK__HAS_ROT(rve) (((rve)->phys & GK_PHYS_ROTATION) != 0)
+#define GK__HAS_ROLL(rve) (((rve)->phys & GK_PHYS_ROLLING) != 0)
+
+enum { GK__PART, GK__PAIR, GK__OUTER }; /* indexed by: particle, pair, outer-list pair            */
+enum { GK__ALL, GK__DIM, GK__ROT, GK__ROLL, GK__TAN, GK__2D, GK__TRACK3 }; /* exists: always, k < dim,
+    with rotation (2D: k = 2 only), with rolling (2D: k = 2), 2D k = 0 or 3D, in 2D only, in 3D with
+    GK_RVE_TRACK_ROTATION */
+#define GK__SAVE 1u    /* in the saved state                                                   */
+#define GK__SPARE 2u   /* per-pair with a twin in rve->spare: carried across rebuilds by pair  */
+#define GK__HIST 4u    /* contact history: gk_rve_refresh leaves it as it was                  */
+#define GK__LIST 8u    /* index array of a gk_pairlist (allocated by it); i, then j            */
+#define GK__DERIVED 16u /* rebuilt from the pair list: never copied                             */
+
+typedef struct gk__field {
+    size_t off, spare;  /* offsetof the array pointer in gk_rve, of its twin in rve->spare      */
+    unsigned char size; /* element bytes                                                         */
+    unsigned char set, when, k, flags;
+    const char *what;   /* named when a restored value is not finite                              */
+} gk__field;
+
+#define GK__R ((unsigned char)sizeof(gk_real))
+#define GK__F(f, k, size, set, when, fl, what) {offsetof(gk_rve, f), 0, size, set, when, k, fl, what}
+#define GK__F3(f, size, when, fl, what)                                                                                \
+    GK__F(f[0], 0, size, GK__PART, when, fl, what), GK__F(f[1], 1, size, GK__PART, when, fl, what),                    \
+        GK__F(f[2], 2, size, GK__PART, when, fl, what)
+#define GK__S(f, k, when, fl, what) {offsetof(gk_rve, f[k]), offsetof(gk_rve, spare.f[k]), GK__R, GK__PAIR, when, k,  \
+                                     GK__SAVE | GK__SPARE | (fl), what}
+
+static const gk__field gk__fields[] = {
+    /* per particle: positions, velocities, forces, spins, torques, rotation */
+    GK__F3(s, 8, GK__DIM, GK__SAVE, "position"),
+    GK__F3(s0, 8, GK__DIM, GK__SAVE, "position"),
+    GK__F3(v, GK__R, GK__DIM, GK__SAVE, "velocity"),
+    GK__F3(f, GK__R, GK__DIM, GK__SAVE, "force"),
+    GK__F(w[0], 0, GK__R, GK__PART, GK__ROT, GK__SAVE, "spin"),
+    GK__F(t[0], 0, GK__R, GK__PART, GK__ROT, GK__SAVE, "torque"),
+    GK__F(w[1], 1, GK__R, GK__PART, GK__ROT, GK__SAVE, "spin"),
+    GK__F(t[1], 1, GK__R, GK__PART, GK__ROT, GK__SAVE, "torque"),
+    GK__F(w[2], 2, GK__R, GK__PART, GK__ROT, GK__SAVE, "spin"),
+    GK__F(t[2], 2, GK__R, GK__PART, GK__ROT, GK__SAVE, "torque"),
+    GK__F(theta, 0, 8, GK__PART, GK__2D, GK__SAVE, "rotation"),
+    GK__F(theta, 0, 24, GK__PART, GK__TRACK3, GK__SAVE, "rotation"), /* 3 doubles per particle */
+    /* per pair: the list, state bits, history, forces and torques of the last step */
+    GK__F(pl.i, 0, 4, GK__PAIR, GK__ALL, GK__SAVE | GK__LIST, "pair"),
+    GK__F(pl.j, 0, 4, GK__PAIR, GK__ALL, GK__SAVE | GK__LIST, "pair"),
+    {offsetof(gk_rve, cs), offsetof(gk_rve, spare.cs), 1, GK__PAIR, GK__ALL, 0, GK__SAVE | GK__SPARE, "state"},
+    GK__S(ft, 0, GK__TAN, GK__HIST, "tangential history"),
+    GK__S(ft, 1, GK__TAN, GK__HIST, "tangential history"),
+    GK__S(ft, 2, GK__TAN, GK__HIST, "tangential history"),
+    GK__S(fc, 0, GK__DIM, 0, "contact force"),
+    GK__S(fc, 1, GK__DIM, 0, "contact force"),
+    GK__S(fc, 2, GK__DIM, 0, "contact force"),
+    GK__S(tci, 0, GK__ROT, 0, "contact torque"),
+    GK__S(tcj, 0, GK__ROT, 0, "contact torque"),
+    GK__S(tci, 1, GK__ROT, 0, "contact torque"),
+    GK__S(tcj, 1, GK__ROT, 0, "contact torque"),
+    GK__S(tci, 2, GK__ROT, 0, "contact torque"),
+    GK__S(tcj, 2, GK__ROT, 0, "contact torque"),
+    GK__S(mr, 0, GK__ROLL, GK__HIST, "rolling history"),
+    GK__S(mr, 1, GK__ROLL, GK__HIST, "rolling history"),
+    GK__S(mr, 2, GK__ROLL, GK__HIST, "rolling history"),
+    /* the outer (candidate) list and the positions it was built at */
+    GK__F(outer.i, 0, 4, GK__OUTER, GK__ALL, GK__SAVE | GK__LIST, "pair"),
+    GK__F(outer.j, 0, 4, GK__OUTER, GK__ALL, GK__SAVE | GK__LIST, "pair"),
+    GK__F3(o0, 8, GK__DIM, GK__SAVE, "outer-list reference position"),
+    /* not saved: constants of the particles (the RVE's own) and the j index */
+    GK__F(r, 0, GK__R, GK__PART, GK__ALL, 0, "radius"),
+    GK__F(minv, 0, GK__R, GK__PART, GK__ALL, 0, "mass"),
+    GK__F(Iinv, 0, GK__R, GK__PART, GK__ALL, 0, "inertia"),
+    GK__F(id, 0, 4, GK__PART, GK__ALL, 0, "id"),
+    GK__F(jlist, 0, 4, GK__PAIR, GK__ALL, GK__DERIVED, "pair")};
+#define GK__NFIELDS ((int)(sizeof gk__fields / sizeof gk__fields[0]))
+#undef GK__F
+#undef GK__F3
+#undef GK__S
+
+static int gk__field_on(const gk_rve *rve, const gk__field *f) {
+    int dim = rve->dim, k = f->k;
+    switch (f->when) {
+    case GK__DIM: return k < dim;
+    case GK__ROT: return GK__HAS_ROT(rve) && (dim == 3 || k == 2);
+    case GK__ROLL: return GK__HAS_ROLL(rve) && (dim == 3 || k == 2);
+    case GK__TAN: return dim == 3 || k == 0;
+    case GK__2D: return dim == 2;
+    case GK__TRACK3: return dim == 3 && (rve->def.flags & GK_RVE_TRACK_ROTATION) != 0;
+    default: return 1;
+    }
+}
+/* the array of a field (live or its spare twin) */
+static void *gk__fget(const gk_rve *rve, size_t off) {
+    void *p;
+    memcpy(&p, (const char *)rve + off, sizeof p);
+    return p;
+}
+static void gk__fset(gk_rve *rve, size_t off, void *p) { memcpy((char *)rve + off, &p, sizeof p); }
+static size_t gk__fcount(const gk_rve *rve, const gk__field *f, size_t npairs, size_t nouter) {
+    return f->set == GK__PART ? (size_t)rve->n : (f->set == GK__PAIR ? npairs : nouter);
+}
+
+/* grow the arrays of set (GK__PART or GK__PAIR, live ones, or with spare = 1
+ * the spare twins) to cap elements, keeping the first ncopy */
+static gk_result gk__fields_grow(gk_rve *rve, int set, int spare, size_t cap, size_t ncopy) {
+    const gk_allocator *a = &rve->def.alloc;
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        size_t off = spare ? f->spare : f->off;
+        void *p;
+        if (f->set != set || (f->flags & GK__LIST) || (spare && !f->spare) || !gk__field_on(rve, f)) continue;
+        p = gk__fget(rve, off);
+        if (gk_realloc(a, &p, spare || (f->flags & GK__DERIVED) ? 0 : ncopy, cap, f->size)) return GK_ERR_ALLOC;
+        gk__fset(rve, off, p);
+    }
+    if (set == GK__PART && gk_realloc(a, (void **)&rve->jstart, ncopy ? ncopy + 1 : 0, cap + 1, sizeof(int32_t)))
+        return GK_ERR_ALLOC;
+    return GK_OK;
+}
+
 static void gk__rve_free_arrays(gk_rve *rve) {
     const gk_allocator *a = &rve->def.alloc;
-    int k;
-    for (k = 0; k < 3; ++k) {
-        gk_free(a, rve->s[k]);
-        gk_free(a, rve->s0[k]);
-        gk_free(a, rve->v[k]);
-        gk_free(a, rve->w[k]);
-        gk_free(a, rve->f[k]);
-        gk_free(a, rve->t[k]);
-        gk_free(a, rve->ft[k]);
-        gk_free(a, rve->mr[k]);
-        gk_free(a, rve->fc[k]);
-        gk_free(a, rve->tci[k]);
-        gk_free(a, rve->tcj[k]);
-        rve->s[k] = rve->s0[k] = NULL;
-        rve->v[k] = rve->w[k] = rve->f[k] = rve->t[k] = NULL;
-        rve->ft[k] = rve->mr[k] = rve->fc[k] = rve->tci[k] = rve->tcj[k] = NULL;
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if (f->flags & GK__LIST) continue;
+        gk_free(a, gk__fget(rve, f->off));
+        gk__fset(rve, f->off, NULL);
+        if (f->spare) {
+            gk_free(a, gk__fget(rve, f->spare));
+            gk__fset(rve, f->spare, NULL);
+        }
     }
-    gk_free(a, rve->r);
-    gk_free(a, rve->minv);
-    gk_free(a, rve->Iinv);
-    gk_free(a, rve->theta);
-    gk_free(a, rve->id);
-    gk_free(a, rve->cs);
     gk_free(a, rve->jstart);
-    gk_free(a, rve->jlist);
-    rve->r = rve->minv = rve->Iinv = NULL;
-    rve->theta = NULL;
-    rve->id = rve->jstart = rve->jlist = NULL;
-    rve->cs = NULL;
-    for (k = 0; k < 3; ++k) {
-        gk_free(a, rve->o0[k]);
-        gk_free(a, rve->spare.ft[k]);
-        gk_free(a, rve->spare.mr[k]);
-        gk_free(a, rve->spare.fc[k]);
-        gk_free(a, rve->spare.tci[k]);
-        gk_free(a, rve->spare.tcj[k]);
-        rve->o0[k] = NULL;
-        rve->spare.ft[k] = rve->spare.mr[k] = rve->spare.fc[k] = NULL;
-        rve->spare.tci[k] = rve->spare.tcj[k] = NULL;
-    }
-    gk_free(a, rve->spare.cs);
-    rve->spare.cs = NULL;
-    rve->spare.cap = 0;
+    rve->jstart = NULL;
+    rve->pcap = rve->spare.cap = 0;
     gk_pairlist_free(&rve->spare.pl);
     gk_pairlist_free(&rve->pl);
     gk_pairlist_free(&rve->outer);
@@ -439,61 +588,113 @@ GKDEF void gk_rve_destroy(gk_rve *rve) {
     rve->n = 0;
 }
 
-/* which per-pair arrays exist */
-#define GK__HAS_ROT(rve) (((rve)->phys & GK_PHYS_ROTATION) != 0)
-#define GK__HAS_ROLL(rve) (((rve)->phys & GK_PHYS_ROLLING) != 0)
+/* capacity doubling from 64 */
+static size_t gk__grown(size_t have, size_t need) {
+    size_t c = have ? have : 64;
+    while (c < need) c *= 2;
+    return c;
+}
 
-/* allocate per-pair arrays for cap pairs, copying the first ncopy */
+/* per-pair arrays for cap pairs, copying the first ncopy */
 static gk_result gk__pairs_reserve(gk_rve *rve, size_t cap, size_t ncopy) {
-    const gk_allocator *a = &rve->def.alloc;
-    int dim = rve->dim, k, nft = dim == 2 ? 1 : 3;
-    size_t sz = sizeof(gk_real);
     if (cap <= rve->pcap) return GK_OK;
-    {
-        size_t c = rve->pcap ? rve->pcap : 64;
-        while (c < cap) c *= 2;
-        cap = c;
-    }
-    for (k = 0; k < 3; ++k) {
-        if (k < nft && gk_realloc(a, (void **)&rve->ft[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
-        if (k < dim && gk_realloc(a, (void **)&rve->fc[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
-        if (GK__HAS_ROT(rve) && (dim == 3 || k == 2)) {
-            if (gk_realloc(a, (void **)&rve->tci[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
-            if (gk_realloc(a, (void **)&rve->tcj[k], ncopy, cap, sz)) return GK_ERR_ALLOC;
-        }
-        if (GK__HAS_ROLL(rve) && (dim == 3 || k == 2) && gk_realloc(a, (void **)&rve->mr[k], ncopy, cap, sz))
-            return GK_ERR_ALLOC;
-    }
-    if (gk_realloc(a, (void **)&rve->cs, ncopy, cap, 1)) return GK_ERR_ALLOC;
-    if (gk_realloc(a, (void **)&rve->jlist, 0, cap, sizeof(int32_t))) return GK_ERR_ALLOC;
+    cap = gk__grown(rve->pcap, cap);
+    if (gk__fields_grow(rve, GK__PAIR, 0, cap, ncopy)) return GK_ERR_ALLOC;
     rve->pcap = cap;
     return GK_OK;
 }
 
 /* the spare per-pair arrays (same set as the current ones) for cap pairs */
 static gk_result gk__spare_reserve(gk_rve *rve, size_t cap) {
-    const gk_allocator *a = &rve->def.alloc;
-    int dim = rve->dim, k, nft = dim == 2 ? 1 : 3;
-    size_t sz = sizeof(gk_real);
     if (cap <= rve->spare.cap) return GK_OK;
-    {
-        size_t c = rve->spare.cap ? rve->spare.cap : 64;
-        while (c < cap) c *= 2;
-        cap = c;
-    }
-    for (k = 0; k < 3; ++k) {
-        if (k < nft && gk_realloc(a, (void **)&rve->spare.ft[k], 0, cap, sz)) return GK_ERR_ALLOC;
-        if (k < dim && gk_realloc(a, (void **)&rve->spare.fc[k], 0, cap, sz)) return GK_ERR_ALLOC;
-        if (GK__HAS_ROT(rve) && (dim == 3 || k == 2)) {
-            if (gk_realloc(a, (void **)&rve->spare.tci[k], 0, cap, sz)) return GK_ERR_ALLOC;
-            if (gk_realloc(a, (void **)&rve->spare.tcj[k], 0, cap, sz)) return GK_ERR_ALLOC;
-        }
-        if (GK__HAS_ROLL(rve) && (dim == 3 || k == 2) && gk_realloc(a, (void **)&rve->spare.mr[k], 0, cap, sz))
-            return GK_ERR_ALLOC;
-    }
-    if (gk_realloc(a, (void **)&rve->spare.cs, 0, cap, 1)) return GK_ERR_ALLOC;
+    cap = gk__grown(rve->spare.cap, cap);
+    if (gk__fields_grow(rve, GK__PAIR, 1, cap, 0)) return GK_ERR_ALLOC;
     rve->spare.cap = cap;
     return GK_OK;
+}
+
+/* pl.start (CSR by i) and the j index (jstart, jlist: pairs where p is j in
+ * ascending pair order) from the pair list */
+static void gk__pair_index(gk_rve *rve) {
+    int n = rve->n, p, c;
+    for (p = 0; p <= n; ++p) rve->pl.start[p] = rve->jstart[p] = 0;
+    for (c = 0; c < rve->pl.n; ++c) {
+        ++rve->pl.start[rve->pl.i[c] + 1];
+        ++rve->jstart[rve->pl.j[c] + 1];
+    }
+    for (p = 0; p < n; ++p) {
+        rve->pl.start[p + 1] += rve->pl.start[p];
+        rve->jstart[p + 1] += rve->jstart[p];
+    }
+    for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
+    for (p = n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
+    rve->jstart[0] = 0;
+    rve->pl.np = n;
+}
+
+/* dst[c] = src[map[c]] (0 where map[c] < 0) for elements of size bytes */
+static void gk__gather_by(void *dst, const void *src, const int32_t *map, int n, int size) {
+    int c;
+    if (size == 8) {
+        double *d = (double *)dst;
+        const double *s = (const double *)src;
+        for (c = 0; c < n; ++c) d[c] = map[c] >= 0 ? s[map[c]] : 0.0;
+    } else if (size == 4) {
+        float *d = (float *)dst;
+        const float *s = (const float *)src;
+        for (c = 0; c < n; ++c) d[c] = map[c] >= 0 ? s[map[c]] : 0.0f;
+    } else {
+        unsigned char *d = (unsigned char *)dst;
+        const unsigned char *s = (const unsigned char *)src;
+        for (c = 0; c < n; ++c) d[c] = map[c] >= 0 ? s[map[c]] : 0;
+    }
+}
+
+/* every per-pair array carried by pair (GK__SPARE) into its spare twin:
+ * pair c of the new list takes old pair map[c], or zero */
+static void gk__pairs_gather(gk_rve *rve, const int32_t *map, int n) {
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if (!(f->flags & GK__SPARE) || !gk__field_on(rve, f)) continue;
+        gk__gather_by(gk__fget(rve, f->spare), gk__fget(rve, f->off), map, n, f->size);
+    }
+}
+
+/* zero the per-particle arrays for particles [p0, p1) */
+static void gk__fields_zero(gk_rve *rve, int p0, int p1) {
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if (f->set != GK__PART || !gk__field_on(rve, f)) continue;
+        memset((unsigned char *)gk__fget(rve, f->off) + (size_t)f->size * p0, 0, (size_t)f->size * (p1 - p0));
+    }
+}
+
+/* keep the elements with keep[e] != 0 of every array of set, in order */
+static void gk__fields_compact(gk_rve *rve, int set, const unsigned char *keep, int n) {
+    int q, e;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        unsigned char *b;
+        size_t m = 0;
+        if (f->set != set || (f->flags & (GK__LIST | GK__DERIVED)) || !gk__field_on(rve, f)) continue;
+        b = (unsigned char *)gk__fget(rve, f->off);
+        for (e = 0; e < n; ++e)
+            if (keep[e]) memmove(b + f->size * m++, b + (size_t)f->size * e, f->size);
+    }
+}
+
+/* mass and moment of inertia of a particle of radius r (see MASSES) */
+static void gk__particle_mass(const gk_rve *rve, double r, double *m, double *I) {
+    const gk_rve_def *d = &rve->def;
+    if (rve->dim == 2 && d->mass2d == GK_MASS_CYLINDER) {
+        *m = d->mat.density * d->thickness * GK_PI * r * r;
+        *I = 0.5 * *m * r * r;
+    } else {
+        *m = d->mat.density * 4.0 / 3.0 * GK_PI * r * r * r;
+        *I = 0.4 * *m * r * r;
+    }
 }
 
 /* critical time step, seed 000 eq 19, at the geometry (h, reduced positions
@@ -501,16 +702,10 @@ static gk_result gk__spare_reserve(gk_rve *rve, size_t cap) {
  * state being checked before it is restored */
 static double gk__dt_critical_at(const gk_rve *rve, const double h[9], const unsigned char *const sb[3],
                                  const unsigned char *ib, const unsigned char *jb, int np) {
-    double knmax;
     const gk_material *m = &rve->def.mat;
-    if (m->law == GK_LAW_LINEAR) {
-        knmax = m->kn > 0 ? m->kn : m->young * rve->rmax; /* r* <= r_max */
-    } else {
-        double dmax = 1e-3 * rve->rmin, G = m->young / (2.0 * (1.0 + m->poisson));
-        gk_pcell cell;
-        int c;
-        cell.dim = rve->dim;
-        gk_m3_copy(h, cell.h);
+    double dmax = 1e-3 * rve->rmin;
+    int c;
+    if (gk_law_stiffens(m->law))
         for (c = 0; c < np; ++c) { /* current largest overlap, from the geometry */
             int32_t i, j;
             int k;
@@ -525,14 +720,11 @@ static double gk__dt_critical_at(const gk_rve *rve, const double h[9], const uns
                 }
                 ds[k] = sj - si;
             }
-            gk_pcell_min_image(&cell, ds, d);
-            if (rve->dim == 2) d[2] = 0.0;
+            gk_pcell_image(h, rve->dim, ds, d);
             dd = (double)rve->r[i] + (double)rve->r[j] - sqrt(gk_v3_dot(d, d));
             if (2.0 * dd > dmax) dmax = 2.0 * dd;
         }
-        knmax = G / (1.0 - m->poisson) * sqrt(2.0 * rve->rmax * dmax);
-    }
-    return sqrt(rve->mmin / knmax);
+    return sqrt(rve->mmin / gk_law_kn_max(m, rve->rmax, dmax));
 }
 
 static double gk__dt_critical(const gk_rve *rve) {
@@ -655,31 +847,9 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
             gk_free(&def->alloc, perm);
             return res;
         }
-        /* allocate */
-        for (k = 0; k < 3; ++k) {
-            if (k < dim) {
-                R.s[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
-                R.s0[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
-                R.o0[k] = (double *)gk_alloc(&def->alloc, (size_t)n * sizeof(double));
-                R.v[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-                R.f[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-                if (!R.s[k] || !R.s0[k] || !R.o0[k] || !R.v[k] || !R.f[k]) res = GK_ERR_ALLOC;
-            }
-            if (GK__HAS_ROT(&R) && (dim == 3 || k == 2)) {
-                R.w[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-                R.t[k] = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-                if (!R.w[k] || !R.t[k]) res = GK_ERR_ALLOC;
-            }
-        }
-        R.r = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-        R.minv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-        R.Iinv = (gk_real *)gk_alloc(&def->alloc, (size_t)n * sizeof(gk_real));
-        R.id = (int32_t *)gk_alloc(&def->alloc, (size_t)n * sizeof(int32_t));
-        R.jstart = (int32_t *)gk_alloc(&def->alloc, ((size_t)n + 1) * sizeof(int32_t));
-        if (dim == 2 || (def->flags & GK_RVE_TRACK_ROTATION))
-            R.theta = (double *)gk_alloc(&def->alloc, (size_t)n * (dim == 2 ? 1 : 3) * sizeof(double));
-        if (!R.r || !R.minv || !R.Iinv || !R.id || !R.jstart || ((dim == 2 || (def->flags & GK_RVE_TRACK_ROTATION)) && !R.theta))
-            res = GK_ERR_ALLOC;
+        /* allocate (zeroed) */
+        if (!res && gk__fields_grow(&R, GK__PART, 0, (size_t)n, 0)) res = GK_ERR_ALLOC;
+        if (!res) gk__fields_zero(&R, 0, n);
         gk_pairlist_init(&R.pl, &def->alloc);
         gk_pairlist_init(&R.outer, &def->alloc);
         gk_pairlist_init(&R.spare.pl, &def->alloc);
@@ -691,24 +861,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
             for (p = 0; p < n; ++p) {
                 int q = perm[p];
                 double rq = pk->r[q], m, I;
-                for (k = 0; k < dim; ++k) {
-                    R.s[k][p] = tmp[k][q];
-                    R.s0[k][p] = tmp[k][q];
-                    R.v[k][p] = 0;
-                    R.f[k][p] = 0;
-                }
-                for (k = 0; k < 3; ++k)
-                    if (R.w[k]) R.w[k][p] = R.t[k][p] = 0;
-                if (dim == 3) {
-                    m = def->mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
-                    I = 0.4 * m * rq * rq;
-                } else if (def->mass2d == GK_MASS_CYLINDER) {
-                    m = def->mat.density * def->thickness * GK_PI * rq * rq;
-                    I = 0.5 * m * rq * rq;
-                } else {
-                    m = def->mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
-                    I = 0.4 * m * rq * rq;
-                }
+                for (k = 0; k < dim; ++k) R.s[k][p] = R.s0[k][p] = tmp[k][q];
+                gk__particle_mass(&R, rq, &m, &I);
                 R.r[p] = (gk_real)rq;
                 R.minv[p] = (gk_real)(1.0 / m);
                 R.Iinv[p] = (gk_real)(1.0 / I);
@@ -723,8 +877,6 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                     break;
                 }
                 R.id[p] = q;
-                if (R.theta)
-                    for (k = 0; k < (dim == 2 ? 1 : 3); ++k) R.theta[(dim == 2 ? 1 : 3) * p + k] = 0.0;
                 if (rq < R.rmin) R.rmin = rq;
                 if (rq > R.rmax) R.rmax = rq;
                 if (m < R.mmin) R.mmin = m;
@@ -793,41 +945,31 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     return GK_OK;
 }
 
-/* Verlet margin of a list built at (href, sref): a pair listed out was at least
- * r_i + r_j + skin apart; it is now at least r_i + r_j + margin apart
- * (smallest singular value of the affine map and largest non-affine
- * displacement, as gk_cells_skin_ok). */
-static double gk__list_margin(const gk_rve *rve, const double href[9], double *const sref[3], double skin) {
-    double hi[9], A[9], At[9], AtA[9], smin, m2 = 0.0;
-    const double *h = rve->cell.h;
-    int p, dim = rve->dim;
-    if (!(gk_m3_inverse(href, hi) > 0.0)) return -1.0;
-    gk_m3_mul(h, hi, A);
-    gk_m3_transpose(A, At);
-    gk_m3_mul(At, A, AtA);
-    if (dim == 2) {
-        double a = AtA[0], b = AtA[1], d = AtA[4], lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
-        smin = lmin > 0.0 ? sqrt(lmin) : 0.0;
-    } else {
-        double val[3], vec[9];
-        gk_m3_sym_eigen(AtA, val, vec);
-        smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
+/* inner list: the outer pairs closer than r_i + r_j + skin_in, in outer
+ * order, into nl */
+GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const int dim) {
+    const double *h = rve->cell.h, skin = rve->skin_in;
+    const int32_t *oi = rve->outer.i, *oj = rve->outer.j;
+    const gk_real *r = rve->r;
+    int c, k, no = rve->outer.n;
+    for (c = 0; c < no; ++c) {
+        int i = oi[c], j = oj[c];
+        double ds[3], d[3], cut = (double)r[i] + (double)r[j] + skin;
+        for (k = 0; k < dim; ++k) ds[k] = rve->s[k][j] - rve->s[k][i];
+        gk_pcell_image(h, dim, ds, d);
+        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut) {
+            nl->i[nl->n] = i;
+            nl->j[nl->n] = j;
+            ++nl->n;
+        }
     }
-    for (p = 0; p < rve->n; ++p) {
-        double e0 = rve->s[0][p] - sref[0][p], e1 = rve->s[1][p] - sref[1][p], e2 = dim == 3 ? rve->s[2][p] - sref[2][p] : 0;
-        double u0 = h[0] * e0 + h[1] * e1 + h[2] * e2, u1 = h[3] * e0 + h[4] * e1 + h[5] * e2;
-        double u2 = dim == 3 ? h[6] * e0 + h[7] * e1 + h[8] * e2 : 0.0, d2 = u0 * u0 + u1 * u1 + u2 * u2;
-        if (d2 > m2) m2 = d2;
-    }
-    if (!isfinite(m2)) return -1.0;
-    return smin * skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(m2);
 }
 
 /* rebuild the pair list at the current positions, carrying history over by merge */
 static gk_result gk__rve_rebuild(gk_rve *rve) {
     gk_pairlist nl;
-    if (rve->def.mat.law == GK_LAW_HERTZ && rve->pl.n > 0) {
-        /* Hertz stiffens with load: the critical step shrinks as overlaps grow */
+    if (gk_law_stiffens(rve->def.mat.law) && rve->pl.n > 0) {
+        /* k_n grows with the overlap (Hertz): the critical step shrinks as overlaps grow */
         double dtc = gk__dt_critical(rve);
         if (rve->dt > dtc)
             return gk_err_set(&rve->err, GK_ERR_DT,
@@ -836,7 +978,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
                               rve->dt, dtc);
         rve->dt_crit = dtc;
     }
-    int dim = rve->dim, n = rve->n, k, p, c, oc, nft = dim == 2 ? 1 : 3;
+    int dim = rve->dim, n = rve->n, k, c, oc;
     double w[3];
     gk_result res;
     const double *sp[3];
@@ -848,7 +990,10 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
                               "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
                               "too far for this many particles)",
                               w[k], 2.0 * rve->rmax + rve->skin);
-    if (!rve->outer_valid || gk__list_margin(rve, rve->ho0, rve->o0, rve->skin) <= rve->skin_in) {
+    if (!rve->outer_valid ||
+        !(gk_cells_skin_margin(dim, rve->ho0, rve->cell.h, rve->skin, rve->rmax,
+                               gk_cells_disp2_max(dim, rve->cell.h, n, (const double *const *)rve->o0,
+                                                  (const double *const *)rve->s)) > rve->skin_in)) {
         /* outer list from the cell grid (positions are in [0,1): gk__wrap) */
         for (k = 0; k < 3; ++k) sp[k] = rve->s[k < dim ? k : 0];
         res = gk_cells_bin(&rve->cells, dim, rve->cell.h, n, sp, 2.0 * rve->rmax + rve->skin, &rve->err);
@@ -872,93 +1017,36 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
     }
     nl.np = n;
     nl.n = 0;
-    for (p = 0; p <= n; ++p) nl.start[p] = 0;
+    if (dim == 2)
+        gk__inner_filter(rve, &nl, 2);
+    else
+        gk__inner_filter(rve, &nl, 3);
+    /* history into the spare arrays by a merge with the current list (both
+     * sorted by (i, j)): map[c] = the old index of new pair c, or -1 (jlist
+     * is the scratch, rebuilt below) */
     {
-        const double *h = rve->cell.h, skin = rve->skin_in;
-        const int32_t *oi = rve->outer.i, *oj = rve->outer.j;
-        const gk_real *r = rve->r;
-        int no = rve->outer.n;
-        if (dim == 2) {
-            const double *sx = rve->s[0], *sy = rve->s[1];
-            for (c = 0; c < no; ++c) {
-                int i = oi[c], j = oj[c];
-                double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i], dx, dy, cut = (double)r[i] + (double)r[j] + skin;
-                dsx -= rint(dsx);
-                dsy -= rint(dsy);
-                dx = h[0] * dsx + h[1] * dsy;
-                dy = h[3] * dsx + h[4] * dsy;
-                if (dx * dx + dy * dy < cut * cut) {
-                    nl.i[nl.n] = i;
-                    nl.j[nl.n] = j;
-                    ++nl.n;
-                    ++nl.start[i + 1];
-                }
-            }
-        } else {
-            const double *sx = rve->s[0], *sy = rve->s[1], *sz = rve->s[2];
-            for (c = 0; c < no; ++c) {
-                int i = oi[c], j = oj[c];
-                double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i], dsz = sz[j] - sz[i], dx, dy, dz;
-                double cut = (double)r[i] + (double)r[j] + skin;
-                dsx -= rint(dsx);
-                dsy -= rint(dsy);
-                dsz -= rint(dsz);
-                dx = h[0] * dsx + h[1] * dsy + h[2] * dsz;
-                dy = h[3] * dsx + h[4] * dsy + h[5] * dsz;
-                dz = h[6] * dsx + h[7] * dsy + h[8] * dsz;
-                if (dx * dx + dy * dy + dz * dz < cut * cut) {
-                    nl.i[nl.n] = i;
-                    nl.j[nl.n] = j;
-                    ++nl.n;
-                    ++nl.start[i + 1];
-                }
-            }
+        int32_t *map = rve->jlist;
+        oc = 0;
+        for (c = 0; c < nl.n; ++c) {
+            int32_t ni = nl.i[c], nj = nl.j[c];
+            while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj))) ++oc;
+            map[c] = oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj ? oc : -1;
         }
-    }
-    for (p = 0; p < n; ++p) nl.start[p + 1] += nl.start[p];
-    /* history into the spare arrays by a merge with the current list (both sorted by (i, j)) */
-    oc = 0;
-    for (c = 0; c < nl.n; ++c) {
-        int32_t ni = nl.i[c], nj = nl.j[c];
-        while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj))) ++oc;
-        if (oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj) {
-            for (k = 0; k < nft; ++k) rve->spare.ft[k][c] = rve->ft[k][oc];
-            for (k = 0; k < dim; ++k) rve->spare.fc[k][c] = rve->fc[k][oc];
-            for (k = 0; k < 3; ++k) {
-                if (rve->spare.tci[k]) {
-                    rve->spare.tci[k][c] = rve->tci[k][oc];
-                    rve->spare.tcj[k][c] = rve->tcj[k][oc];
-                }
-                if (rve->spare.mr[k]) rve->spare.mr[k][c] = rve->mr[k][oc];
-            }
-            rve->spare.cs[c] = rve->cs[oc];
-        } else {
-            for (k = 0; k < nft; ++k) rve->spare.ft[k][c] = 0;
-            for (k = 0; k < dim; ++k) rve->spare.fc[k][c] = 0;
-            for (k = 0; k < 3; ++k) {
-                if (rve->spare.tci[k]) rve->spare.tci[k][c] = rve->spare.tcj[k][c] = 0;
-                if (rve->spare.mr[k]) rve->spare.mr[k][c] = 0;
-            }
-            rve->spare.cs[c] = 0;
-        }
+        gk__pairs_gather(rve, map, nl.n);
     }
     /* swap the spare set in */
     {
         gk_pairlist t = rve->pl;
         size_t cap = rve->pcap;
-        unsigned char *cs = rve->cs;
-        for (k = 0; k < 3; ++k) {
-            gk_real *x;
-#define GK__SWAP(f) x = rve->f[k], rve->f[k] = rve->spare.f[k], rve->spare.f[k] = x
-            GK__SWAP(ft);
-            GK__SWAP(mr);
-            GK__SWAP(fc);
-            GK__SWAP(tci);
-            GK__SWAP(tcj);
-#undef GK__SWAP
+        int q;
+        for (q = 0; q < GK__NFIELDS; ++q) {
+            const gk__field *f = &gk__fields[q];
+            void *x;
+            if (!f->spare) continue;
+            x = gk__fget(rve, f->off);
+            gk__fset(rve, f->off, gk__fget(rve, f->spare));
+            gk__fset(rve, f->spare, x);
         }
-        rve->cs = rve->spare.cs;
-        rve->spare.cs = cs;
         rve->pcap = rve->spare.cap;
         rve->spare.cap = cap;
         rve->pl = nl;
@@ -966,13 +1054,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         if (rve->pcap > cap && gk_realloc(&rve->def.alloc, (void **)&rve->jlist, 0, rve->pcap, sizeof(int32_t)))
             return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", nl.n);
     }
-    /* pairs where p is j, ascending pair index (counting sort by j) */
-    for (p = 0; p <= n; ++p) rve->jstart[p] = 0;
-    for (c = 0; c < rve->pl.n; ++c) ++rve->jstart[rve->pl.j[c] + 1];
-    for (p = 0; p < n; ++p) rve->jstart[p + 1] += rve->jstart[p];
-    for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
-    for (p = n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
-    rve->jstart[0] = 0;
+    gk__pair_index(rve);
     for (k = 0; k < dim; ++k) memcpy(rve->s0[k], rve->s[k], (size_t)n * sizeof(double));
     gk_m3_copy(rve->cell.h, rve->h0);
     rve->need_rebuild = 0;
@@ -1003,13 +1085,14 @@ GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0
     int c;
     for (c = c0; c < c1; ++c) {
         int i = pi[c], j = pj[c];
-        double dsx = sx[j] - sx[i], dsy = sy[j] - sy[i];
+        double ds[3], dd[3];
         gk_real dx, dy, rvx, rvy, wi, wj;
         gk_contact_out o;
-        dsx -= rint(dsx);
-        dsy -= rint(dsy);
-        dx = (gk_real)(x->hd[0] * dsx + x->hd[1] * dsy);
-        dy = (gk_real)(x->hd[3] * dsx + x->hd[4] * dsy);
+        ds[0] = sx[j] - sx[i];
+        ds[1] = sy[j] - sy[i];
+        gk_pcell_image(x->hd, 2, ds, dd);
+        dx = (gk_real)dd[0];
+        dy = (gk_real)dd[1];
         rvx = (vx[j] - vx[i]) + (x->G[0] * dx + x->G[1] * dy);
         rvy = (vy[j] - vy[i]) + (x->G[3] * dx + x->G[4] * dy);
         wi = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[i] : x->wa[2];
@@ -1044,14 +1127,12 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
     int c, k;
     for (c = c0; c < c1; ++c) {
         int i = pi[c], j = pj[c];
-        double ds[3];
+        double ds[3], dd[3];
         gk_real d[3], vr[3], wi[3], wj[3], hist[3], mh[3];
         gk_contact_out o;
-        for (k = 0; k < 3; ++k) {
-            ds[k] = rve->s[k][j] - rve->s[k][i];
-            ds[k] -= rint(ds[k]);
-        }
-        for (k = 0; k < 3; ++k) d[k] = (gk_real)(x->hd[3 * k] * ds[0] + x->hd[3 * k + 1] * ds[1] + x->hd[3 * k + 2] * ds[2]);
+        for (k = 0; k < 3; ++k) ds[k] = rve->s[k][j] - rve->s[k][i];
+        gk_pcell_image(x->hd, 3, ds, dd);
+        for (k = 0; k < 3; ++k) d[k] = (gk_real)dd[k];
         for (k = 0; k < 3; ++k)
             vr[k] = (rve->v[k][j] - rve->v[k][i]) + (x->G[3 * k] * d[0] + x->G[3 * k + 1] * d[1] + x->G[3 * k + 2] * d[2]);
         for (k = 0; k < 3; ++k) {
@@ -1086,14 +1167,14 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
 }
 
 /* ---------------------------------------------------------------- SIMD forces
- * The same law as gk_contact_2d/3d, GK_VR_W pairs at a time, every operation
- * in the same order (no FMA, correctly rounded sqrt and division, exact
- * negation), so each lane is bit-identical to the scalar reference. The
+ * GK_VR_W pairs at a time: gather, the wide twin of the law
+ * (gk_contact_2d_w / _3d_w, bit-identical lanes), store and scatter. The
  * remainder of a range (fewer than GK_VR_W pairs) and cohesive contacts go
  * through the scalar reference. */
 #if GK_VR_W > 1
 /* branch vectors d = h (ds - round(ds)) of GK_VR_W pairs, from double
- * positions; H = the cell matrix broadcast once per call */
+ * positions (the wide twin of gk_pcell_image); H = the cell matrix broadcast
+ * once per call */
 GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const int32_t *ii, const int32_t *jj,
                                      int dim, gk_vr d[3]) {
     gk_vd dd[2][3];
@@ -1116,25 +1197,6 @@ GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const 
 #else
         d[k] = dd[0][k];
 #endif
-    }
-}
-
-/* stiffness of GK_VR_W contacts (gk_contact_stiffness) */
-GK_FORCE_INLINE void gk__simd_stiffness(const gk_law_consts *K, gk_law law, gk_vr ri, gk_vr rj, gk_vr delta, gk_vr *kn,
-                                        gk_vr *fn, gk_vr *kt) {
-    gk_vr rr = gk_vr_mul(ri, rj), rs = gk_vr_div(gk_vr_add(rr, rr), gk_vr_add(ri, rj));
-    if (law == GK_LAW_LINEAR) {
-        gk_vr k = K->kn_const > 0 ? gk_vr_set1(K->kn_const) : gk_vr_mul(gk_vr_set1(K->young), rs);
-        *kn = k;
-        *fn = gk_vr_mul(k, delta);
-        *kt = gk_vr_mul(gk_vr_set1(K->kt_ratio), k);
-    } else {
-        gk_vr a = gk_vr_mul(gk_vr_add(rs, rs), delta);
-        gk_vr sq = gk_vr_select(gk_vr_gt(a, gk_vr_zero()), gk_vr_sqrt(a), gk_vr_zero());
-        gk_vr k = gk_vr_mul(gk_vr_set1(K->hn), sq);
-        *kn = k;
-        *fn = gk_vr_mul(gk_vr_set1((gk_real)(2.0 / 3.0)), gk_vr_mul(k, delta));
-        *kt = gk_vr_mul(gk_vr_set1(K->ht), sq);
     }
 }
 
@@ -1200,12 +1262,11 @@ GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const in
 }
 
 GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
-    const gk_law_consts *K = &rve->K;
+    const gk_law_consts K = rve->K; /* a local copy: its broadcasts stay out of the loop */
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
-    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5), dt = gk_vr_set1(x->dt);
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), dt = gk_vr_set1(x->dt);
     const gk_vr G0 = gk_vr_set1(x->G[0]), G1 = gk_vr_set1(x->G[1]), G3 = gk_vr_set1(x->G[3]), G4 = gk_vr_set1(x->G[4]);
-    const gk_vr wa = gk_vr_set1(x->wa[2]), mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
-    const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta);
+    const gk_vr wa = gk_vr_set1(x->wa[2]);
     gk_real bx[GK_VR_W], by[GK_VR_W], bi[GK_VR_W], bj[GK_VR_W];
     gk_vd H[9];
     const uint64_t *lut = gk__bitbytes;
@@ -1213,100 +1274,47 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
     for (k = 0; k < 9; ++k) H[k] = gk_vd_set1(x->hd[k]); /* hoisted: stores to doubles could alias x->hd */
     for (; c + GK_VR_W <= c1; c += GK_VR_W) {
         const int32_t *ii = pi + c, *jj = pj + c;
-        gk_vr d[3], ri, rj, R, d2, dist, inv, nx, ny, delta, kn, fn, kt, vx, vy, vn, mstar = zero, li, lj, hd;
-        gk_vr fx, fy, ti = zero, tj = zero, wi = wa, wj = wa, fnp = zero, ftot = zero, fh = zero, m = zero;
-        gk_vrm in, slide = gk_vr_lt(one, zero);
+        gk_vr d[3], ri, rj, vx, vy, mi = zero, mj = zero, wi = wa, wj = wa, fh = zero, m = zero;
+        gk_vrm in, slide;
+        gk_contact_out_w o;
         gk__simd_branch(rve, H, ii, jj, 2, d);
         ri = gk_vr_gather(rve->r, ii);
         rj = gk_vr_gather(rve->r, jj);
-        R = gk_vr_add(ri, rj);
-        d2 = gk_vr_add(gk_vr_mul(d[0], d[0]), gk_vr_mul(d[1], d[1]));
-        in = gk_vr_lt(d2, gk_vr_mul(R, R));
-        dist = gk_vr_sqrt(d2);
-        inv = gk_vr_div(one, dist);
-        nx = gk_vr_mul(d[0], inv);
-        ny = gk_vr_mul(d[1], inv);
-        delta = gk_vr_sub(R, dist);
-        gk__simd_stiffness(K, law, ri, rj, delta, &kn, &fn, &kt);
         vx = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[0], jj), gk_vr_gather(rve->v[0], ii)),
                        gk_vr_add(gk_vr_mul(G0, d[0]), gk_vr_mul(G1, d[1])));
         vy = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[1], jj), gk_vr_gather(rve->v[1], ii)),
                        gk_vr_add(gk_vr_mul(G3, d[0]), gk_vr_mul(G4, d[1])));
-        vn = gk_vr_add(gk_vr_mul(vx, nx), gk_vr_mul(vy, ny));
         if (fl & GK_PHYS_VISCOUS) {
-            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)), mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
-            mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
-            fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(zn2, gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
+            mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii));
+            mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
         }
-        hd = gk_vr_mul(half, delta);
-        li = gk_vr_sub(ri, hd);
-        lj = gk_vr_sub(rj, hd);
         if (fl & GK_PHYS_ROTATION) {
             wi = gk_vr_add(wa, gk_vr_gather(rve->w[2], ii));
             wj = gk_vr_add(wa, gk_vr_gather(rve->w[2], jj));
         }
-        if (fl & GK_PHYS_TANGENT) {
-            gk_vr tx = gk_vr_neg(ny), ty = nx, vt, f, cap, gt = zero;
-            vt = gk_vr_sub(gk_vr_add(gk_vr_mul(vx, tx), gk_vr_mul(vy, ty)),
-                           gk_vr_add(gk_vr_mul(li, wi), gk_vr_mul(lj, wj)));
-            f = gk_vr_sub(gk_vr_load(rve->ft[0] + c), gk_vr_mul(gk_vr_mul(kt, vt), dt));
-            ftot = f;
-            if (fl & GK_PHYS_VISCOUS) {
-                gt = gk_vr_mul(zt2, gk_vr_sqrt(gk_vr_mul(mstar, kt)));
-                ftot = gk_vr_sub(f, gk_vr_mul(gt, vt));
-            }
-            fnp = gk_vr_max(fn, zero);
-            cap = gk_vr_mul(mu, fnp);
-            slide = gk_vr_gt(gk_vr_abs(ftot), cap);
-            ftot = gk_vr_select(slide, gk_vr_select(gk_vr_gt(ftot, zero), cap, gk_vr_neg(cap)), ftot);
-            if (fl & GK_PHYS_VISCOUS)
-                f = gk_vr_select(slide, gk_vr_add(ftot, gk_vr_mul(gt, vt)), f);
-            else
-                f = gk_vr_select(slide, ftot, f);
-            fh = f;
-            fx = gk_vr_add(gk_vr_mul(fn, nx), gk_vr_mul(ftot, tx));
-            fy = gk_vr_add(gk_vr_mul(fn, ny), gk_vr_mul(ftot, ty));
-            ti = gk_vr_mul(gk_vr_neg(li), ftot);
-            tj = gk_vr_mul(gk_vr_neg(lj), ftot);
-        } else {
-            fx = gk_vr_mul(fn, nx);
-            fy = gk_vr_mul(fn, ny);
-        }
-        if (fl & GK_PHYS_ROLLING) {
-            gk_vr kr = gk_vr_mul(gk_vr_mul(beta, kt), gk_vr_mul(ri, rj)), capr;
-            gk_vrm over;
-            m = gk_vr_sub(gk_vr_load(rve->mr[2] + c), gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wj, wi)), dt));
-            fnp = gk_vr_max(fn, zero);
-            capr = gk_vr_mul(gk_vr_mul(eta, gk_vr_min(ri, rj)), fnp);
-            over = gk_vr_gt(gk_vr_abs(m), capr);
-            m = gk_vr_select(over, gk_vr_select(gk_vr_gt(m, zero), capr, gk_vr_neg(capr)), m);
-            ti = gk_vr_sub(ti, m);
-            tj = gk_vr_add(tj, m);
-        }
-        fx = gk_vr_select(in, fx, zero);
-        fy = gk_vr_select(in, fy, zero);
-        ti = gk_vr_select(in, ti, zero);
-        tj = gk_vr_select(in, tj, zero);
-        if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[0] + c, gk_vr_select(in, fh, zero));
-        if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[2] + c, gk_vr_select(in, m, zero));
+        if (fl & GK_PHYS_TANGENT) fh = gk_vr_load(rve->ft[0] + c);
+        if (fl & GK_PHYS_ROLLING) m = gk_vr_load(rve->mr[2] + c);
+        in = gk_contact_2d_w(&K, law, fl, d[0], d[1], ri, rj, mi, mj, vx, vy, wi, wj, dt, &fh, &m, &slide, &o);
+        if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[0] + c, fh);
+        if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[2] + c, m);
         gk__simd_state(rve->cs + c, in, slide, lut);
         if (x->store) {
-            gk_vr_store(rve->fc[0] + c, fx);
-            gk_vr_store(rve->fc[1] + c, fy);
+            gk_vr_store(rve->fc[0] + c, o.f[0]);
+            gk_vr_store(rve->fc[1] + c, o.f[1]);
             if (fl & GK_PHYS_ROTATION) {
-                gk_vr_store(rve->tci[2] + c, ti);
-                gk_vr_store(rve->tcj[2] + c, tj);
+                gk_vr_store(rve->tci[2] + c, o.ti[2]);
+                gk_vr_store(rve->tcj[2] + c, o.tj[2]);
             }
         }
         if (x->scatter) {
             /* scatter the previous block now (its buffer stores have retired: no
              * store-forwarding stall) and buffer this one; pair order is kept */
             if (pend >= 0) gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
-            gk_vr_storeu(bx, fx);
-            gk_vr_storeu(by, fy);
+            gk_vr_storeu(bx, o.f[0]);
+            gk_vr_storeu(by, o.f[1]);
             if (fl & GK_PHYS_ROTATION) {
-                gk_vr_storeu(bi, ti);
-                gk_vr_storeu(bj, tj);
+                gk_vr_storeu(bi, o.ti[2]);
+                gk_vr_storeu(bj, o.tj[2]);
             }
             pend = c;
         }
@@ -1315,31 +1323,10 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
     gk__forces_ref_2d(rve, x, c, c1, law, fl);
 }
 
-/* gk_contact_rotate_history on GK_VR_W lanes */
-GK_FORCE_INLINE void gk__simd_rotate(const gk_vr n[3], gk_vr a, gk_vr h[3]) {
-    const gk_vr zero = gk_vr_zero();
-    gk_vr m2, p[3], dn, p2, sc;
-    gk_vrm has, pos;
-    int k;
-    m2 = gk_vr_add(gk_vr_add(gk_vr_mul(h[0], h[0]), gk_vr_mul(h[1], h[1])), gk_vr_mul(h[2], h[2]));
-    p[0] = gk_vr_add(h[0], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[1], h[2]), gk_vr_mul(n[2], h[1]))));
-    p[1] = gk_vr_add(h[1], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[2], h[0]), gk_vr_mul(n[0], h[2]))));
-    p[2] = gk_vr_add(h[2], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[0], h[1]), gk_vr_mul(n[1], h[0]))));
-    dn = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], n[0]), gk_vr_mul(p[1], n[1])), gk_vr_mul(p[2], n[2]));
-    for (k = 0; k < 3; ++k) p[k] = gk_vr_sub(p[k], gk_vr_mul(dn, n[k]));
-    p2 = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], p[0]), gk_vr_mul(p[1], p[1])), gk_vr_mul(p[2], p[2]));
-    sc = gk_vr_sqrt(gk_vr_div(m2, p2));
-    has = gk_vr_gt(m2, zero);
-    pos = gk_vr_gt(p2, zero);
-    for (k = 0; k < 3; ++k) h[k] = gk_vr_select(has, gk_vr_select(pos, gk_vr_mul(p[k], sc), zero), h[k]);
-}
-
 GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
-    const gk_law_consts *K = &rve->K;
+    const gk_law_consts K = rve->K; /* a local copy: its broadcasts stay out of the loop */
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
-    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5), dt = gk_vr_set1(x->dt);
-    const gk_vr mu = gk_vr_set1(K->mu), zn2 = gk_vr_set1(K->zn2), zt2 = gk_vr_set1(K->zt2);
-    const gk_vr beta = gk_vr_set1(K->beta), eta = gk_vr_set1(K->eta), halfdt = gk_vr_mul(half, dt);
+    const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), dt = gk_vr_set1(x->dt);
     gk_vr G[9], wa[3];
     gk_vd H[9];
     gk_real bF[3][GK_VR_W], bI[3][GK_VR_W], bJ[3][GK_VR_W];
@@ -1352,124 +1339,34 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
     for (k = 0; k < 3; ++k) wa[k] = gk_vr_set1(x->wa[k]);
     for (; c + GK_VR_W <= c1; c += GK_VR_W) {
         const int32_t *ii = pi + c, *jj = pj + c;
-        gk_vr d[3], n[3], v[3], wi[3], wj[3], F[3], ti[3], tj[3], fh[3], mh[3];
-        gk_vr ri, rj, R, d2, dist, inv, delta, kn, fn, kt, vn, mstar = zero, hd, li, lj, twist = zero, fnp;
-        gk_vrm in, slide = gk_vr_lt(one, zero);
+        gk_vr d[3], v[3], wi[3], wj[3], fh[3], mh[3], ri, rj, mi = zero, mj = zero;
+        gk_vrm in, slide;
+        gk_contact_out_w o;
         gk__simd_branch(rve, H, ii, jj, 3, d);
         ri = gk_vr_gather(rve->r, ii);
         rj = gk_vr_gather(rve->r, jj);
-        R = gk_vr_add(ri, rj);
-        d2 = gk_vr_add(gk_vr_add(gk_vr_mul(d[0], d[0]), gk_vr_mul(d[1], d[1])), gk_vr_mul(d[2], d[2]));
-        in = gk_vr_lt(d2, gk_vr_mul(R, R));
-        dist = gk_vr_sqrt(d2);
-        inv = gk_vr_div(one, dist);
-        for (k = 0; k < 3; ++k) n[k] = gk_vr_mul(d[k], inv);
-        delta = gk_vr_sub(R, dist);
-        gk__simd_stiffness(K, law, ri, rj, delta, &kn, &fn, &kt);
-        for (k = 0; k < 3; ++k)
+        for (k = 0; k < 3; ++k) {
             v[k] = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[k], jj), gk_vr_gather(rve->v[k], ii)),
                              gk_vr_add(gk_vr_add(gk_vr_mul(G[3 * k], d[0]), gk_vr_mul(G[3 * k + 1], d[1])),
                                        gk_vr_mul(G[3 * k + 2], d[2])));
-        for (k = 0; k < 3; ++k) {
             wi[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather(rve->w[k], ii)) : wa[k];
             wj[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather(rve->w[k], jj)) : wa[k];
-            ti[k] = tj[k] = zero;
+            fh[k] = (fl & GK_PHYS_TANGENT) ? gk_vr_load(rve->ft[k] + c) : zero;
+            mh[k] = (fl & GK_PHYS_ROLLING) ? gk_vr_load(rve->mr[k] + c) : zero;
         }
-        vn = gk_vr_add(gk_vr_add(gk_vr_mul(v[0], n[0]), gk_vr_mul(v[1], n[1])), gk_vr_mul(v[2], n[2]));
         if (fl & GK_PHYS_VISCOUS) {
-            gk_vr mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii)), mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
-            mstar = gk_vr_div(gk_vr_mul(mi, mj), gk_vr_add(mi, mj));
-            fn = gk_vr_sub(fn, gk_vr_mul(gk_vr_mul(zn2, gk_vr_sqrt(gk_vr_mul(mstar, kn))), vn));
+            mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii));
+            mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
         }
-        hd = gk_vr_mul(half, delta);
-        li = gk_vr_sub(ri, hd);
-        lj = gk_vr_sub(rj, hd);
-        if (fl & (GK_PHYS_TANGENT | GK_PHYS_ROLLING))
-            twist = gk_vr_mul(halfdt, gk_vr_add(gk_vr_add(gk_vr_mul(gk_vr_add(wi[0], wj[0]), n[0]),
-                                                          gk_vr_mul(gk_vr_add(wi[1], wj[1]), n[1])),
-                                                gk_vr_mul(gk_vr_add(wi[2], wj[2]), n[2])));
-        if (fl & GK_PHYS_TANGENT) {
-            gk_vr sw[3], vc[3], vcn, vt[3], f[3], tot[3], cc[3], cap, gt = zero, m2;
-            for (k = 0; k < 3; ++k) sw[k] = gk_vr_add(gk_vr_mul(li, wi[k]), gk_vr_mul(lj, wj[k]));
-            vc[0] = gk_vr_sub(v[0], gk_vr_sub(gk_vr_mul(sw[1], n[2]), gk_vr_mul(sw[2], n[1])));
-            vc[1] = gk_vr_sub(v[1], gk_vr_sub(gk_vr_mul(sw[2], n[0]), gk_vr_mul(sw[0], n[2])));
-            vc[2] = gk_vr_sub(v[2], gk_vr_sub(gk_vr_mul(sw[0], n[1]), gk_vr_mul(sw[1], n[0])));
-            vcn = gk_vr_add(gk_vr_add(gk_vr_mul(vc[0], n[0]), gk_vr_mul(vc[1], n[1])), gk_vr_mul(vc[2], n[2]));
-            for (k = 0; k < 3; ++k) {
-                vt[k] = gk_vr_sub(vc[k], gk_vr_mul(vcn, n[k]));
-                fh[k] = gk_vr_load(rve->ft[k] + c);
-            }
-            gk__simd_rotate(n, twist, fh);
-            for (k = 0; k < 3; ++k) {
-                f[k] = gk_vr_sub(fh[k], gk_vr_mul(gk_vr_mul(kt, vt[k]), dt));
-                tot[k] = f[k];
-            }
-            if (fl & GK_PHYS_VISCOUS) {
-                gt = gk_vr_mul(zt2, gk_vr_sqrt(gk_vr_mul(mstar, kt)));
-                for (k = 0; k < 3; ++k) tot[k] = gk_vr_sub(f[k], gk_vr_mul(gt, vt[k]));
-            }
-            fnp = gk_vr_max(fn, zero);
-            cap = gk_vr_mul(mu, fnp);
-            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(tot[0], tot[0]), gk_vr_mul(tot[1], tot[1])), gk_vr_mul(tot[2], tot[2]));
-            slide = gk_vr_gt(m2, gk_vr_mul(cap, cap));
-            if (gk_vrm_any(slide)) {
-                gk_vr sc = gk_vr_div(cap, gk_vr_sqrt(m2));
-                for (k = 0; k < 3; ++k) {
-                    gk_vr t = gk_vr_mul(tot[k], sc);
-                    tot[k] = gk_vr_select(slide, t, tot[k]);
-                    f[k] = gk_vr_select(slide, (fl & GK_PHYS_VISCOUS) ? gk_vr_add(tot[k], gk_vr_mul(gt, vt[k])) : tot[k],
-                                        f[k]);
-                }
-            }
-            for (k = 0; k < 3; ++k) {
-                fh[k] = f[k];
-                F[k] = gk_vr_add(gk_vr_mul(fn, n[k]), tot[k]);
-            }
-            cc[0] = gk_vr_sub(gk_vr_mul(n[1], tot[2]), gk_vr_mul(n[2], tot[1]));
-            cc[1] = gk_vr_sub(gk_vr_mul(n[2], tot[0]), gk_vr_mul(n[0], tot[2]));
-            cc[2] = gk_vr_sub(gk_vr_mul(n[0], tot[1]), gk_vr_mul(n[1], tot[0]));
-            for (k = 0; k < 3; ++k) {
-                ti[k] = gk_vr_mul(gk_vr_neg(li), cc[k]);
-                tj[k] = gk_vr_mul(gk_vr_neg(lj), cc[k]);
-            }
-        } else {
-            for (k = 0; k < 3; ++k) F[k] = gk_vr_mul(fn, n[k]);
-        }
-        if (fl & GK_PHYS_ROLLING) {
-            gk_vr wr[3], wrn, kr = gk_vr_mul(gk_vr_mul(beta, kt), gk_vr_mul(ri, rj)), capr, m2;
-            gk_vrm over;
-            fnp = gk_vr_max(fn, zero);
-            capr = gk_vr_mul(gk_vr_mul(eta, gk_vr_min(ri, rj)), fnp);
-            for (k = 0; k < 3; ++k) {
-                wr[k] = gk_vr_sub(wj[k], wi[k]);
-                mh[k] = gk_vr_load(rve->mr[k] + c);
-            }
-            wrn = gk_vr_add(gk_vr_add(gk_vr_mul(wr[0], n[0]), gk_vr_mul(wr[1], n[1])), gk_vr_mul(wr[2], n[2]));
-            gk__simd_rotate(n, twist, mh);
-            for (k = 0; k < 3; ++k)
-                mh[k] = gk_vr_sub(mh[k], gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wr[k], gk_vr_mul(wrn, n[k]))), dt));
-            m2 = gk_vr_add(gk_vr_add(gk_vr_mul(mh[0], mh[0]), gk_vr_mul(mh[1], mh[1])), gk_vr_mul(mh[2], mh[2]));
-            over = gk_vr_gt(m2, gk_vr_mul(capr, capr));
-            if (gk_vrm_any(over)) {
-                gk_vr sc = gk_vr_div(capr, gk_vr_sqrt(m2));
-                for (k = 0; k < 3; ++k) mh[k] = gk_vr_select(over, gk_vr_mul(mh[k], sc), mh[k]);
-            }
-            for (k = 0; k < 3; ++k) {
-                ti[k] = gk_vr_sub(ti[k], mh[k]);
-                tj[k] = gk_vr_add(tj[k], mh[k]);
-            }
-        }
+        in = gk_contact_3d_w(&K, law, fl, d, ri, rj, mi, mj, v, wi, wj, dt, fh, mh, &slide, &o);
         for (k = 0; k < 3; ++k) {
-            F[k] = gk_vr_select(in, F[k], zero);
-            ti[k] = gk_vr_select(in, ti[k], zero);
-            tj[k] = gk_vr_select(in, tj[k], zero);
-            if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[k] + c, gk_vr_select(in, fh[k], zero));
-            if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[k] + c, gk_vr_select(in, mh[k], zero));
+            if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[k] + c, fh[k]);
+            if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[k] + c, mh[k]);
             if (x->store) {
-                gk_vr_store(rve->fc[k] + c, F[k]);
+                gk_vr_store(rve->fc[k] + c, o.f[k]);
                 if (fl & GK_PHYS_ROTATION) {
-                    gk_vr_store(rve->tci[k] + c, ti[k]);
-                    gk_vr_store(rve->tcj[k] + c, tj[k]);
+                    gk_vr_store(rve->tci[k] + c, o.ti[k]);
+                    gk_vr_store(rve->tcj[k] + c, o.tj[k]);
                 }
             }
         }
@@ -1477,10 +1374,10 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
         if (x->scatter) { /* pipelined as in 2D */
             if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, bF, bI, bJ, fl & GK_PHYS_ROTATION);
             for (k = 0; k < 3; ++k) {
-                gk_vr_storeu(bF[k], F[k]);
+                gk_vr_storeu(bF[k], o.f[k]);
                 if (fl & GK_PHYS_ROTATION) {
-                    gk_vr_storeu(bI[k], ti[k]);
-                    gk_vr_storeu(bJ[k], tj[k]);
+                    gk_vr_storeu(bI[k], o.ti[k]);
+                    gk_vr_storeu(bJ[k], o.tj[k]);
                 }
             }
             pend = c;
@@ -1491,47 +1388,54 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
 }
 #endif /* GK_VR_W > 1 */
 
-/* instantiate the kernel with constant law and flags (pay only for what is on) */
-#define GK__DISPATCH(fn, rve, x, c0, c1)                                                                              \
+/* instantiate a kernel with constant law and flags (pay only for what is on):
+ * the common flag sets get their own copy, the rest share one with fl */
+#define GK__FLAG_SETS(fn, rve, x, c0, c1, LAW, fl)                                                                    \
     do {                                                                                                               \
-        unsigned fl_ = (rve)->phys;                                                                                    \
-        gk_law law_ = (rve)->def.mat.law;                                                                              \
-        if (law_ == GK_LAW_LINEAR) {                                                                                   \
-            if (fl_ == 0u)                                                                                             \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, 0u);                                                                 \
-            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT);                                                    \
-            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                 \
-            else                                                                                                       \
-                fn(rve, x, c0, c1, GK_LAW_LINEAR, fl_);                                                                \
-        } else {                                                                                                       \
-            if (fl_ == 0u)                                                                                             \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, 0u);                                                                  \
-            else if (fl_ == GK_PHYS_TANGENT)                                                                           \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT);                                                     \
-            else if (fl_ == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                      \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                  \
-            else                                                                                                       \
-                fn(rve, x, c0, c1, GK_LAW_HERTZ, fl_);                                                                 \
-        }                                                                                                              \
+        if ((fl) == 0u)                                                                                                \
+            fn(rve, x, c0, c1, LAW, 0u);                                                                               \
+        else if ((fl) == GK_PHYS_TANGENT)                                                                              \
+            fn(rve, x, c0, c1, LAW, GK_PHYS_TANGENT);                                                                  \
+        else if ((fl) == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                         \
+            fn(rve, x, c0, c1, LAW, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                               \
+        else                                                                                                           \
+            fn(rve, x, c0, c1, LAW, fl);                                                                               \
     } while (0)
 
-static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
+/* one kernel of each law of GK_LAW_TABLE (gk_contact.h) for the dimension and path */
 #if GK_VR_W > 1
-    if (!(rve->def.flags & GK_RVE_SCALAR) && !(rve->phys & GK_PHYS_COHESION)) {
-        if (rve->dim == 2)
-            GK__DISPATCH(gk__forces_simd_2d, rve, x, c0, c1);
-        else
-            GK__DISPATCH(gk__forces_simd_3d, rve, x, c0, c1);
-        return;
-    }
+#define GK__WIDE(rve, x, c0, c1, LAW, fl)                                                                              \
+    if (wide) {                                                                                                        \
+        if ((rve)->dim == 2)                                                                                           \
+            GK__FLAG_SETS(gk__forces_simd_2d, rve, x, c0, c1, LAW, fl);                                                \
+        else                                                                                                           \
+            GK__FLAG_SETS(gk__forces_simd_3d, rve, x, c0, c1, LAW, fl);                                                \
+    } else
+#else
+#define GK__WIDE(rve, x, c0, c1, LAW, fl)
 #endif
-    if (rve->dim == 2)
-        GK__DISPATCH(gk__forces_ref_2d, rve, x, c0, c1);
-    else
-        GK__DISPATCH(gk__forces_ref_3d, rve, x, c0, c1);
+#define GK__LAW_KERNELS(E, name)                                                                                       \
+    case E:                                                                                                            \
+        GK__WIDE(rve, x, c0, c1, E, fl)                                                                                \
+        if (rve->dim == 2)                                                                                             \
+            GK__FLAG_SETS(gk__forces_ref_2d, rve, x, c0, c1, E, fl);                                                   \
+        else                                                                                                           \
+            GK__FLAG_SETS(gk__forces_ref_3d, rve, x, c0, c1, E, fl);                                                   \
+        break;
+
+/* pair forces of [c0, c1): the wide kernels unless GK_RVE_SCALAR or cohesion */
+static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
+    unsigned fl = rve->phys;
+    int wide = !(rve->def.flags & GK_RVE_SCALAR) && !(fl & GK_PHYS_COHESION);
+    (void)wide;
+    switch (rve->def.mat.law) {
+        GK_LAW_TABLE(GK__LAW_KERNELS)
+    default: break;
+    }
 }
+#undef GK__LAW_KERNELS
+#undef GK__WIDE
+#undef GK__FLAG_SETS
 
 static int gk__nthreads(const gk_rve *rve);
 
@@ -1990,49 +1894,25 @@ static void gk__stiff_pass(gk_rve *rve) {
 }
 
 /* Love stress (seed 000 eq 5) -(1/V) sum F (x) d over the contacts, their
- * number and mean force. 2D has its own loop (4 products, no min-image
- * call): the same sums in the same order, so the same bits. */
+ * number and mean force, in pair order. */
 static void gk__stress_pass(gk_rve *rve) {
     int dim = rve->dim, c, k, l, nc = 0;
     double S[9], V = gk_rve_volume(rve), fsum = 0.0;
     gk_m3_zero(S);
-    if (dim == 2) {
-        const double *h = rve->cell.h, *sx = rve->s[0], *sy = rve->s[1];
-        const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
-        const gk_real *fx = rve->fc[0], *fy = rve->fc[1];
-        double s00 = 0, s01 = 0, s10 = 0, s11 = 0;
-        for (c = 0; c < rve->pl.n; ++c) {
-            double dsx, dsy, dx, dy, Fx, Fy;
-            if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
-            dsx = sx[pj[c]] - sx[pi[c]];
-            dsy = sy[pj[c]] - sy[pi[c]];
-            dsx -= rint(dsx);
-            dsy -= rint(dsy);
-            dx = h[0] * dsx + h[1] * dsy + 0.0;
-            dy = h[3] * dsx + h[4] * dsy + 0.0;
-            Fx = (double)fx[c], Fy = (double)fy[c];
-            s00 += Fx * dx, s01 += Fx * dy, s10 += Fy * dx, s11 += Fy * dy;
-            fsum += sqrt(Fx * Fx + Fy * Fy + 0.0);
-            ++nc;
+    for (c = 0; c < rve->pl.n; ++c) {
+        int i = rve->pl.i[c], j = rve->pl.j[c];
+        double ds[3], d[3], F[3] = {0.0, 0.0, 0.0};
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        for (k = 0; k < dim; ++k) {
+            ds[k] = rve->s[k][j] - rve->s[k][i];
+            F[k] = (double)rve->fc[k][c];
         }
-        S[0] = s00, S[1] = s01, S[3] = s10, S[4] = s11;
-    } else
-        for (c = 0; c < rve->pl.n; ++c) {
-            int i, j;
-            double ds[3], d[3], F[3];
-            if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
-            i = rve->pl.i[c];
-            j = rve->pl.j[c];
-            for (k = 0; k < 3; ++k) {
-                ds[k] = rve->s[k][j] - rve->s[k][i];
-                F[k] = (double)rve->fc[k][c];
-            }
-            gk_pcell_min_image(&rve->cell, ds, d);
-            for (k = 0; k < 3; ++k)
-                for (l = 0; l < 3; ++l) S[3 * k + l] += F[k] * d[l];
-            fsum += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
-            ++nc;
-        }
+        gk_pcell_image(rve->cell.h, dim, ds, d);
+        for (k = 0; k < dim; ++k)
+            for (l = 0; l < dim; ++l) S[3 * k + l] += F[k] * d[l];
+        fsum += sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
+        ++nc;
+    }
     for (k = 0; k < 9; ++k) rve->stress[k] = -S[k] / V;
     if (rve->servo_on) gk__stiff_pass(rve);
     rve->ncontacts = nc;
@@ -2121,24 +2001,9 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
                           "non-finite velocity or position at step %ld (time step too large or unstable input?)",
                           rve->step);
     }
-    if (!rve->need_rebuild) {
-        double h0i[9], A[9], smin, margin, At[9], AtA[9];
-        gk_m3_inverse(rve->h0, h0i);
-        gk_m3_mul(rve->cell.h, h0i, A);
-        gk_m3_transpose(A, At);
-        gk_m3_mul(At, A, AtA);
-        if (rve->dim == 2) {
-            double a = AtA[0], b = AtA[1], d = AtA[4];
-            double lmin = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
-            smin = lmin > 0.0 ? sqrt(lmin) : 0.0;
-        } else {
-            double val[3], vec[9];
-            gk_m3_sym_eigen(AtA, val, vec);
-            smin = val[0] > 0.0 ? sqrt(val[0]) : 0.0;
-        }
-        margin = smin * rve->skin_in - (smin < 1.0 ? (1.0 - smin) * 2.0 * rve->rmax : 0.0) - 2.0 * sqrt(dispmax2);
-        if (!(margin > 0.0)) rve->need_rebuild = 1;
-    }
+    if (!rve->need_rebuild &&
+        !(gk_cells_skin_margin(rve->dim, rve->h0, rve->cell.h, rve->skin_in, rve->rmax, dispmax2) > 0.0))
+        rve->need_rebuild = 1;
     if (rve->hook) return rve->hook(rve, GK_HOOK_POST_STEP, rve->hook_user);
     return GK_OK;
 }
@@ -2218,10 +2083,45 @@ static double gk__step_stretch_max(const gk_rve *rve) {
     return GK_RVE_STEP_OVERLAP_MAX * rve->rmin / (rve->rmin + rve->rmax);
 }
 
+/* ---------------------------------------------------------------- driving the cell
+ * One control drives the cell in every run of steps: it yields the map E of
+ * each step (h <- E h) and whether that step computes the stress (the last
+ * of a run; every step under a servo, which reads it). The public drivers
+ * are thin wrappers (see DRIVING THE CELL in the manual above). */
+enum { GK__DRIVE_PATH, GK__DRIVE_RATE, GK__DRIVE_SERVO };
+typedef struct gk__drive {
+    int kind;     /* PATH: I + dH split by a gk_path; RATE: constant L; SERVO  */
+    long n;       /* steps in the run                                          */
+    gk_path path; /* PATH                                                      */
+    double L[9];  /* RATE, SERVO (the servo rewrites its diagonal, shear)       */
+} gk__drive;
+
+static gk_result gk__drive_run(gk_rve *rve, gk__drive *d) {
+    double E[9], A[9];
+    long k;
+    int i;
+    gk_result res;
+    if (d->kind == GK__DRIVE_RATE) {
+        for (i = 0; i < 9; ++i) A[i] = d->L[i] * rve->dt;
+        gk_m3_exp(A, E);
+    }
+    for (k = 1; k <= d->n; ++k) {
+        if (d->kind == GK__DRIVE_PATH) {
+            gk_path_step(&d->path, (int)k, E);
+        } else if (d->kind == GK__DRIVE_SERVO) {
+            if (k == 1 && rve->step == 0) gk_rve_refresh(rve); /* the servo reads the stress */
+            gk_servo_rates(&rve->servo, rve->dim, rve->stress, rve->stiff, rve->dt, d->L);
+            for (i = 0; i < 9; ++i) A[i] = d->L[i] * rve->dt;
+            gk_m3_exp(A, E);
+        }
+        res = gk__step_once(rve, E, d->kind == GK__DRIVE_SERVO || k == d->n);
+        if (res) return res;
+    }
+    return GK_OK;
+}
+
 GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
-    double E[9], A[9], Lcur[9];
-    long st;
-    int k, have = 0;
+    gk__drive d;
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
     if (nsteps < 0) return gk_err_set(&rve->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
@@ -2247,22 +2147,10 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
                 rve->servo_on ? " (with the servo's max_rate)" : "", f * (rve->rmin + rve->rmax) / rve->rmin,
                 rve->dt, GK_RVE_STEP_OVERLAP_MAX);
     }
-    gk_m3_copy(rve->L, Lcur);
-    for (st = 0; st < nsteps; ++st) {
-        if (rve->servo_on) {
-            if (st == 0 && rve->step == 0) gk_rve_refresh(rve);
-            gk_servo_rates(&rve->servo, rve->dim, rve->stress, rve->stiff, rve->dt, Lcur);
-            have = 0;
-        }
-        if (!have) {
-            for (k = 0; k < 9; ++k) A[k] = Lcur[k] * rve->dt;
-            gk_m3_exp(A, E);
-            have = 1;
-        }
-        res = gk__step_once(rve, E, rve->servo_on || st == nsteps - 1);
-        if (res) return res;
-    }
-    return GK_OK;
+    d.kind = rve->servo_on ? GK__DRIVE_SERVO : GK__DRIVE_RATE;
+    d.n = nsteps;
+    gk_m3_copy(rve->L, d.L);
+    return gk__drive_run(rve, &d);
 }
 
 /* the largest per-step stretch of dH carried out in n steps on the RVE's path */
@@ -2281,8 +2169,8 @@ static double gk__deform_stretch(const gk_rve *rve, const double dH[9], int n) {
 }
 
 GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
+    gk__drive d;
     gk_path path;
-    double E[9];
     int k;
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
@@ -2322,55 +2210,166 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
                                   "dH would leave a cell %g wide, below twice the interaction distance %g", w[k],
                                   2.0 * rve->rmax + rve->skin);
     }
-    for (k = 1; k <= nsteps; ++k) {
-        gk_path_step(&path, k, E);
-        res = gk__step_once(rve, E, k == nsteps);
-        if (res) return res;
+    d.kind = GK__DRIVE_PATH;
+    d.n = nsteps;
+    d.path = path;
+    return gk__drive_run(rve, &d);
+}
+
+GKDEF double gk_rve_unbalanced(const gk_rve *rve) {
+    double fp = 0.0, fc = 0.0;
+    int p, c, k, nc = 0;
+    for (p = 0; p < rve->n; ++p) {
+        double f2 = 0.0;
+        for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
+        fp += sqrt(f2);
     }
+    for (c = 0; c < rve->pl.n; ++c) {
+        double f2 = 0.0;
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        for (k = 0; k < rve->dim; ++k) f2 += (double)rve->fc[k][c] * (double)rve->fc[k][c];
+        fc += sqrt(f2);
+        ++nc;
+    }
+    return (nc && fc > 0.0) ? (fp / rve->n) / (fc / nc) : 0.0; /* nothing to balance: 0, not NaN */
+}
+
+GKDEF double gk_rve_unbalanced_rms(const gk_rve *rve) {
+    double fp2 = 0.0, fc2 = 0.0;
+    int p, c, k, nc = 0;
+    for (p = 0; p < rve->n; ++p)
+        for (k = 0; k < rve->dim; ++k) fp2 += (double)rve->f[k][p] * (double)rve->f[k][p];
+    for (c = 0; c < rve->pl.n; ++c) {
+        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
+        for (k = 0; k < rve->dim; ++k) fc2 += (double)rve->fc[k][c] * (double)rve->fc[k][c];
+        ++nc;
+    }
+    return (nc && fc2 > 0.0) ? sqrt(fp2 / rve->n) / sqrt(fc2 / nc) : 0.0; /* nothing to balance: 0 */
+}
+
+static gk_result gk__relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps, int rms);
+GKDEF gk_result gk_rve_relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps) {
+    return gk__relax(rve, uf_max, every, max_steps, steps, 0);
+}
+/* gk_rve_relax on the mean (rms = 0) or the RMS (rms = 1) unbalanced ratio */
+static gk_result gk__relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps, int rms) {
+    gk__drive d;
+    long done = 0;
+    gk_result res = gk__rve_ready(rve);
+    if (steps) *steps = 0;
+    if (res) return res;
+    if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before relax");
+    if (!(uf_max > 0.0) || every < 1 || max_steps < 0)
+        return gk_err_set(&rve->err, GK_ERR_ARG, "relax: uf_max %g (> 0), every %d (>= 1), max_steps %ld (>= 0)",
+                          uf_max, every, max_steps);
+    memset(&d, 0, sizeof d);
+    d.kind = GK__DRIVE_RATE; /* L = 0: the cell stands still */
+    while (done < max_steps && (rms ? gk_rve_unbalanced_rms(rve) : gk_rve_unbalanced(rve)) > uf_max) {
+        d.n = every < max_steps - done ? every : max_steps - done;
+        res = gk__drive_run(rve, &d);
+        if (res) break;
+        done += d.n;
+    }
+    if (steps) *steps = done;
+    return res;
+}
+
+GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p) {
+    double g = 0.0;
+    int i, j;
+    for (i = 0; i < dim; ++i)
+        for (j = 0; j < dim; ++j) {
+            double e = 0.5 * (rate[3 * i + j] + rate[3 * j + i]);
+            g += e * e;
+        }
+    g = sqrt(g);
+    if (g == 0.0) return 0.0;
+    if (!(p > 0.0)) return HUGE_VAL;
+    return 2.0 * g * r_mean * sqrt(density / p);
+}
+
+GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk_adapt_def *ad_in,
+                                       gk_adapt_report *rep) {
+    gk_adapt_def ad;
+    gk_adapt_report R;
+    double rate[9], p, rmean = 0.0, I1, n;
+    long nr = 0;
+    int k;
+    gk_result res;
+    memset(&ad, 0, sizeof ad);
+    if (ad_in) ad = *ad_in;
+    if (ad.inertial_max == 0.0) ad.inertial_max = 5e-4;
+    if (ad.unbalanced_max == 0.0) ad.unbalanced_max = 5e-3;
+    if (ad.n_min == 0) ad.n_min = 10;
+    if (ad.n_max == 0) ad.n_max = 5000;
+    if (ad.every == 0) ad.every = 20;
+    if (!gk_m3_isfinite(dH)) return gk_err_set(&rve->err, GK_ERR_ARG, "dH has a NaN or infinite entry");
+    if (!(ad.inertial_max > 0.0) || !(ad.unbalanced_max > 0.0) || ad.n_min < 1 || ad.n_max < ad.n_min ||
+        ad.every < 1)
+        return gk_err_set(&rve->err, GK_ERR_ARG,
+                          "adaptive bounds: I_max %g, uf_max %g (> 0), n_min %d <= n_max %d, every %d (>= 1)",
+                          ad.inertial_max, ad.unbalanced_max, ad.n_min, ad.n_max, ad.every);
+    memset(&R, 0, sizeof R);
+    for (k = 0; k < rve->n; ++k) rmean += (double)rve->r[k];
+    rmean /= rve->n > 0 ? rve->n : 1;
+    p = -gk_m3_trace(rve->stress) / rve->dim; /* compression-positive mean stress (gk_stress_p) */
+    for (k = 0; k < 9; ++k) rate[k] = dH[k] / rve->dt;
+    I1 = gk_inertial_number(rate, rve->dim, rmean, rve->def.mat.density, p);
+    n = isfinite(I1) ? ceil(I1 / ad.inertial_max) : (double)ad.n_max;
+    if (n < ad.n_min) n = ad.n_min;
+    if (n > ad.n_max) n = ad.n_max;
+    R.n_deform = (int)n;
+    R.inertial = isfinite(I1) ? I1 / n : I1;
+    res = gk_rve_deform(rve, dH, R.n_deform);
+    if (res) return res;
+    res = gk__relax(rve, ad.unbalanced_max, ad.every, ad.n_max - R.n_deform, &nr, ad.rms);
+    if (res) return res;
+    R.n_relax = (int)nr;
+    R.unbalanced = ad.rms ? gk_rve_unbalanced_rms(rve) : gk_rve_unbalanced(rve);
+    R.capped = R.unbalanced > ad.unbalanced_max;
+    if (rep) *rep = R;
     return GK_OK;
+}
+
+/* copy the contact history (GK__HIST fields) of np pairs into its spare
+ * twin (to = 1) or back (to = 0) */
+static void gk__history_copy(gk_rve *rve, int to, size_t np) {
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        void *live, *spare;
+        if (!(f->flags & GK__HIST) || !gk__field_on(rve, f)) continue;
+        live = gk__fget(rve, f->off);
+        spare = gk__fget(rve, f->spare);
+        memcpy(to ? spare : live, to ? live : spare, np * f->size);
+    }
 }
 
 GKDEF gk_result gk_rve_refresh(gk_rve *rve) {
     /* Forces at the current positions as a zero-length step: with dt = 0 and
      * E = I every history increment vanishes. The tangential and rolling
-     * history is copied back afterwards so that a refresh never changes the
-     * future (a 3D projection or a cap could otherwise touch it). */
+     * history is copied back afterwards (kept meanwhile in the spare arrays,
+     * which hold nothing between list rebuilds) so that a refresh never
+     * changes the future (a 3D projection or a cap could otherwise touch it). */
     gk__stepctx x;
     double I[9], dtsave = rve->dt;
     gk_result res = gk__rve_ready(rve);
-    int k;
-    size_t np;
-    gk_real *save[6] = {NULL, NULL, NULL, NULL, NULL, NULL};
     if (res) return res;
     if (rve->need_rebuild) {
         res = gk__rve_rebuild(rve);
         if (res) return res;
     }
-    np = (size_t)rve->pl.n;
-    for (k = 0; k < 3; ++k) {
-        if (rve->ft[k] && !(save[k] = (gk_real *)gk_alloc(&rve->def.alloc, (np + 1) * sizeof(gk_real)))) res = GK_ERR_ALLOC;
-        if (rve->mr[k] && !(save[3 + k] = (gk_real *)gk_alloc(&rve->def.alloc, (np + 1) * sizeof(gk_real))))
-            res = GK_ERR_ALLOC;
-    }
-    if (!res) {
-        for (k = 0; k < 3; ++k) {
-            if (save[k]) memcpy(save[k], rve->ft[k], np * sizeof(gk_real));
-            if (save[3 + k]) memcpy(save[3 + k], rve->mr[k], np * sizeof(gk_real));
-        }
-        gk_m3_identity(I);
-        rve->dt = 1.0; /* G = (E - I)/dt = 0 */
-        gk__ctx_make(rve, I, &x);
-        rve->dt = dtsave;
-        x.dt = 0;
-        gk__forces(rve, &x, 1);
-        gk__stress_pass(rve);
-        for (k = 0; k < 3; ++k) {
-            if (save[k]) memcpy(rve->ft[k], save[k], np * sizeof(gk_real));
-            if (save[3 + k]) memcpy(rve->mr[k], save[3 + k], np * sizeof(gk_real));
-        }
-    }
-    for (k = 0; k < 6; ++k) gk_free(&rve->def.alloc, save[k]);
-    if (res) return gk_err_set(&rve->err, res, "out of memory refreshing forces");
+    if (gk__spare_reserve(rve, (size_t)rve->pl.n + 1))
+        return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory refreshing forces");
+    gk__history_copy(rve, 1, (size_t)rve->pl.n);
+    gk_m3_identity(I);
+    rve->dt = 1.0; /* G = (E - I)/dt = 0 */
+    gk__ctx_make(rve, I, &x);
+    rve->dt = dtsave;
+    x.dt = 0;
+    gk__forces(rve, &x, 1);
+    gk__stress_pass(rve);
+    gk__history_copy(rve, 0, (size_t)rve->pl.n);
     return GK_OK;
 }
 
@@ -2520,7 +2519,7 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
     res = gk_rve_set_servo(rve, &sv);
     if (res) return res;
     while (st < maxs) {
-        double un, errmax = 0.0, fsum = 0.0;
+        double un, errmax = 0.0;
         res = gk_rve_step(rve, 100);
         st += 100;
         if (res) break;
@@ -2533,12 +2532,7 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
                 if (e > errmax) errmax = e;
             }
         }
-        for (p = 0; p < rve->n; ++p) {
-            double f2 = 0.0;
-            for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
-            fsum += sqrt(f2);
-        }
-        un = rve->fc_mean > 0 ? fsum / rve->n / rve->fc_mean : 1.0;
+        un = rve->fc_mean > 0 ? gk_rve_unbalanced(rve) : 1.0;
         if (errmax < tol && un < utol) {
             if (++calm >= 3) break;
         } else {
@@ -2557,15 +2551,9 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
                 for (c = 0; c < rve->pl.n; ++c) rve->ft[k][c] = 0;
     }
     if (rep) {
-        double fsum = 0.0;
         rep->steps = st;
         gk_m3_copy(rve->stress, rep->stress);
-        for (p = 0; p < rve->n; ++p) {
-            double f2 = 0.0;
-            for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
-            fsum += sqrt(f2);
-        }
-        rep->unbalanced = rve->fc_mean > 0 ? fsum / rve->n / rve->fc_mean : 1.0;
+        rep->unbalanced = rve->fc_mean > 0 ? gk_rve_unbalanced(rve) : 1.0;
         rep->void_ratio = gk_rve_volume(rve) / rve->solid_volume - 1.0;
     }
     if (res) return res;
@@ -2594,25 +2582,9 @@ GKDEF void gk_rve_update_totals(gk_rve *rve) {
 }
 
 GKDEF gk_result gk_rve_reserve(gk_rve *rve, int cap) {
-    const gk_allocator *a = &rve->def.alloc;
-    size_t n = (size_t)rve->n, c, R = sizeof(gk_real);
-    int k, have = rve->ncap > rve->n ? rve->ncap : rve->n;
+    int have = rve->ncap > rve->n ? rve->ncap : rve->n;
     if (cap <= have) return GK_OK;
-    c = (size_t)cap;
-    for (k = 0; k < 3; ++k) {
-        if (rve->s[k] && (gk_realloc(a, (void **)&rve->s[k], n, c, sizeof(double)) ||
-                          gk_realloc(a, (void **)&rve->s0[k], n, c, sizeof(double)) ||
-                          gk_realloc(a, (void **)&rve->o0[k], n, c, sizeof(double)) ||
-                          gk_realloc(a, (void **)&rve->v[k], n, c, R) || gk_realloc(a, (void **)&rve->f[k], n, c, R)))
-            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
-        if (rve->w[k] && (gk_realloc(a, (void **)&rve->w[k], n, c, R) || gk_realloc(a, (void **)&rve->t[k], n, c, R)))
-            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
-    }
-    if (gk_realloc(a, (void **)&rve->r, n, c, R) || gk_realloc(a, (void **)&rve->minv, n, c, R) ||
-        gk_realloc(a, (void **)&rve->Iinv, n, c, R) || gk_realloc(a, (void **)&rve->id, n, c, sizeof(int32_t)) ||
-        gk_realloc(a, (void **)&rve->jstart, n + 1, c + 1, sizeof(int32_t)) ||
-        (rve->theta && gk_realloc(a, (void **)&rve->theta, n * (rve->dim == 2 ? 1 : 3), c * (rve->dim == 2 ? 1 : 3),
-                                  sizeof(double))))
+    if (gk__fields_grow(rve, GK__PART, 0, (size_t)cap, (size_t)rve->n))
         return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d particles", cap);
     rve->ncap = cap;
     return GK_OK;
@@ -2642,25 +2614,13 @@ GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], cons
     for (q = 0; q < k; ++q) {
         int p = n0 + q;
         double rq = r[q], m, I;
-        for (a = 0; a < dim; ++a) {
-            rve->s[a][p] = rve->s0[a][p] = rve->o0[a][p] = s[a][q] - floor(s[a][q]);
-            rve->v[a][p] = rve->f[a][p] = 0;
-        }
-        for (a = 0; a < 3; ++a)
-            if (rve->w[a]) rve->w[a][p] = rve->t[a][p] = 0;
-        if (dim == 3 || rve->def.mass2d == GK_MASS_SPHERE) {
-            m = rve->def.mat.density * 4.0 / 3.0 * GK_PI * rq * rq * rq;
-            I = 0.4 * m * rq * rq;
-        } else {
-            m = rve->def.mat.density * rve->def.thickness * GK_PI * rq * rq;
-            I = 0.5 * m * rq * rq;
-        }
+        gk__fields_zero(rve, p, p + 1);
+        for (a = 0; a < dim; ++a) rve->s[a][p] = rve->s0[a][p] = rve->o0[a][p] = s[a][q] - floor(s[a][q]);
+        gk__particle_mass(rve, rq, &m, &I);
         rve->r[p] = (gk_real)rq;
         rve->minv[p] = (gk_real)(1.0 / m);
         rve->Iinv[p] = (gk_real)(1.0 / I);
         rve->id[p] = id[q];
-        if (rve->theta)
-            for (a = 0; a < (dim == 2 ? 1 : 3); ++a) rve->theta[(dim == 2 ? 1 : 3) * p + a] = 0.0;
     }
     rve->n = n0 + k;
     gk_rve_update_totals(rve);
@@ -2670,72 +2630,37 @@ GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], cons
 }
 
 GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop) {
-    int n = rve->n, dim = rve->dim, p, q = 0, c, m = 0, k, nft = dim == 2 ? 1 : 3;
-    int32_t *map = NULL;
+    int n = rve->n, np = rve->pl.n, p, q = 0, c, m = 0;
+    int32_t *map;
+    unsigned char *keep, *keepc;
     if (!drop) return gk_err_set(&rve->err, GK_ERR_ARG, "remove: no mask");
     for (p = 0; p < n; ++p)
         if (!drop[p]) ++q;
     if (q == n) return GK_OK;
     if (q < 1) return gk_err_set(&rve->err, GK_ERR_ARG, "remove: would leave no particle");
-    map = (int32_t *)gk_alloc(&rve->def.alloc, (size_t)n * sizeof(int32_t));
+    map = (int32_t *)gk_alloc(&rve->def.alloc, (size_t)n * (sizeof(int32_t) + 1) + (size_t)np);
     if (!map) return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory removing particles");
+    keep = (unsigned char *)(map + n);
+    keepc = keep + n;
     for (p = 0, q = 0; p < n; ++p) {
-        map[p] = drop[p] ? -1 : q;
-        if (drop[p]) continue;
-        for (k = 0; k < dim; ++k) {
-            rve->s[k][q] = rve->s[k][p];
-            rve->s0[k][q] = rve->s0[k][p];
-            rve->o0[k][q] = rve->o0[k][p];
-            rve->v[k][q] = rve->v[k][p];
-            rve->f[k][q] = rve->f[k][p];
-        }
-        for (k = 0; k < 3; ++k)
-            if (rve->w[k]) {
-                rve->w[k][q] = rve->w[k][p];
-                rve->t[k][q] = rve->t[k][p];
-            }
-        rve->r[q] = rve->r[p];
-        rve->minv[q] = rve->minv[p];
-        rve->Iinv[q] = rve->Iinv[p];
-        rve->id[q] = rve->id[p];
-        if (rve->theta)
-            for (k = 0; k < (dim == 2 ? 1 : 3); ++k) rve->theta[(dim == 2 ? 1 : 3) * q + k] = rve->theta[(dim == 2 ? 1 : 3) * p + k];
-        ++q;
+        keep[p] = !drop[p];
+        map[p] = keep[p] ? q++ : -1;
     }
     /* survivors keep their order: the remapped pair list stays sorted by (i, j) */
-    for (c = 0; c < rve->pl.n; ++c) {
+    for (c = 0; c < np; ++c) {
         int32_t i = map[rve->pl.i[c]], j = map[rve->pl.j[c]];
-        if (i < 0 || j < 0) continue;
+        keepc[c] = i >= 0 && j >= 0;
+        if (!keepc[c]) continue;
         rve->pl.i[m] = i;
         rve->pl.j[m] = j;
-        for (k = 0; k < nft; ++k) rve->ft[k][m] = rve->ft[k][c];
-        for (k = 0; k < dim; ++k) rve->fc[k][m] = rve->fc[k][c];
-        for (k = 0; k < 3; ++k) {
-            if (rve->tci[k]) {
-                rve->tci[k][m] = rve->tci[k][c];
-                rve->tcj[k][m] = rve->tcj[k][c];
-            }
-            if (rve->mr[k]) rve->mr[k][m] = rve->mr[k][c];
-        }
-        rve->cs[m] = rve->cs[c];
         ++m;
     }
+    gk__fields_compact(rve, GK__PART, keep, n);
+    gk__fields_compact(rve, GK__PAIR, keepc, np);
     gk_free(&rve->def.alloc, map);
     rve->n = q;
     rve->pl.n = m;
-    rve->pl.np = q;
-    for (p = 0; p <= q; ++p) rve->pl.start[p] = rve->jstart[p] = 0;
-    for (c = 0; c < m; ++c) {
-        ++rve->pl.start[rve->pl.i[c] + 1];
-        ++rve->jstart[rve->pl.j[c] + 1];
-    }
-    for (p = 0; p < q; ++p) {
-        rve->pl.start[p + 1] += rve->pl.start[p];
-        rve->jstart[p + 1] += rve->jstart[p];
-    }
-    for (c = 0; c < m; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
-    for (p = q; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
-    rve->jstart[0] = 0;
+    gk__pair_index(rve);
     gk_rve_update_totals(rve);
     rve->need_rebuild = 1;
     rve->outer_valid = 0;
@@ -2760,14 +2685,13 @@ typedef struct gk__state_hdr {
 } gk__state_hdr;
 
 static size_t gk__state_bytes(const gk_rve *rve, int npairs, int nouter) {
-    int dim = rve->dim, nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0, nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
-    size_t n = (size_t)rve->n, np = (size_t)npairs, R = sizeof(gk_real), b = sizeof(gk__state_hdr);
-    b += n * (2 * dim * sizeof(double)); /* s, s0 */
-    b += n * R * (2 * dim + 2 * nr);      /* v, f, w, t */
-    b += rve->theta ? n * (dim == 2 ? 1 : 3) * sizeof(double) : 0; /* theta */
-    b += np * (2 * sizeof(int32_t) + 1);   /* i, j, cs */
-    b += np * R * ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll); /* ft, fc, tci, tcj, mr */
-    b += (size_t)nouter * 2 * sizeof(int32_t) + n * dim * sizeof(double); /* outer list, o0 */
+    size_t b = sizeof(gk__state_hdr);
+    int q;
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if ((f->flags & GK__SAVE) && gk__field_on(rve, f))
+            b += gk__fcount(rve, f, (size_t)npairs, (size_t)nouter) * f->size;
+    }
     return b;
 }
 
@@ -2787,8 +2711,8 @@ GKDEF size_t gk_rve_state_size(const gk_rve *rve) { return gk__state_bytes(rve, 
 GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *written) {
     gk__state_hdr hd;
     unsigned char *o = (unsigned char *)buf;
-    size_t off = 0, need = gk_rve_state_size(rve), n = (size_t)rve->n, np = (size_t)rve->pl.n, R = sizeof(gk_real);
-    int k, dim = rve->dim;
+    size_t off = 0, need = gk_rve_state_size(rve), np = (size_t)rve->pl.n, R = sizeof(gk_real);
+    int k, q, dim = rve->dim;
     if (written) *written = need;
     if (!buf || cap < need) return GK_ERR_ARG;
     memset(&hd, 0, sizeof hd);
@@ -2827,31 +2751,11 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
     gk_m3_copy(rve->ho0, hd.ho0);
     hd.skin_in = rve->skin_in;
     GK__PUT(&hd, sizeof hd);
-    for (k = 0; k < dim; ++k) GK__PUT(rve->s[k], n * sizeof(double));
-    for (k = 0; k < dim; ++k) GK__PUT(rve->s0[k], n * sizeof(double));
-    for (k = 0; k < dim; ++k) GK__PUT(rve->v[k], n * R);
-    for (k = 0; k < dim; ++k) GK__PUT(rve->f[k], n * R);
-    for (k = 0; k < 3; ++k)
-        if (rve->w[k]) {
-            GK__PUT(rve->w[k], n * R);
-            GK__PUT(rve->t[k], n * R);
-        }
-    if (rve->theta) GK__PUT(rve->theta, n * (dim == 2 ? 1 : 3) * sizeof(double));
-    GK__PUT(rve->pl.i, np * sizeof(int32_t));
-    GK__PUT(rve->pl.j, np * sizeof(int32_t));
-    GK__PUT(rve->cs, np);
-    for (k = 0; k < (dim == 2 ? 1 : 3); ++k) GK__PUT(rve->ft[k], np * R);
-    for (k = 0; k < dim; ++k) GK__PUT(rve->fc[k], np * R);
-    for (k = 0; k < 3; ++k)
-        if (rve->tci[k]) {
-            GK__PUT(rve->tci[k], np * R);
-            GK__PUT(rve->tcj[k], np * R);
-        }
-    for (k = 0; k < 3; ++k)
-        if (rve->mr[k]) GK__PUT(rve->mr[k], np * R);
-    GK__PUT(rve->outer.i, (size_t)rve->outer.n * sizeof(int32_t));
-    GK__PUT(rve->outer.j, (size_t)rve->outer.n * sizeof(int32_t));
-    for (k = 0; k < dim; ++k) GK__PUT(rve->o0[k], n * sizeof(double));
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if ((f->flags & GK__SAVE) && gk__field_on(rve, f))
+            GK__PUT(gk__fget(rve, f->off), gk__fcount(rve, f, np, (size_t)rve->outer.n) * f->size);
+    }
     GK_ASSERT(off == need);
     return GK_OK;
 }
@@ -2903,7 +2807,7 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     gk__state_hdr hd;
     const unsigned char *in = (const unsigned char *)buf;
     size_t off = 0, n, np, R = sizeof(gk_real);
-    int k, dim = rve->dim, p, c, nr, nroll;
+    int k, q, dim = rve->dim, c;
     gk_err *err = &rve->err;
     if (rve->n < 1 || !rve->s[0])
         return gk_err_set(err, GK_ERR_STATE, "restore into an RVE that was not created");
@@ -2924,8 +2828,6 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         return gk_err_set(err, GK_ERR_FORMAT, "RVE state has the wrong size");
     n = (size_t)rve->n;
     np = (size_t)hd.npairs;
-    nr = GK__HAS_ROT(rve) ? (dim == 2 ? 1 : 3) : 0;
-    nroll = GK__HAS_ROLL(rve) ? (dim == 2 ? 1 : 3) : 0;
     /* ---- header scalars */
     if (!(hd.dt > 0.0) || !isfinite(hd.dt))
         return gk_err_set(err, GK_ERR_DT, "RVE state time step %g", hd.dt);
@@ -2974,44 +2876,40 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
             return gk_err_set(err, GK_ERR_STATE, "RVE state has friction %g for an RVE created frictionless",
                               hd.mu);
     }
-    /* ---- arrays, in the order gk_rve_save writes them */
+    /* ---- arrays, in the order gk_rve_save writes them: reals finite, pair
+     * lists sorted and in range, contact bits known */
     off = sizeof hd;
     {
-        const unsigned char *sb[3] = {NULL, NULL, NULL}, *ib, *jb, *cs;
+        const unsigned char *sb[3] = {NULL, NULL, NULL}, *ib = NULL, *pib = NULL, *pjb = NULL;
         double dtc;
-        size_t dbl = 8;
-        for (k = 0; k < dim; ++k) sb[k] = in + off + (size_t)k * n * dbl;
-        if (!gk__finite_bytes(in + off, 2 * dim * n, dbl))
-            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite position");
-        off += 2 * dim * n * dbl;
-        if (!gk__finite_bytes(in + off, (2 * dim + 2 * nr) * n, R))
-            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite velocity, force, spin or torque");
-        off += (2 * dim + 2 * nr) * n * R;
-        if (rve->theta) {
-            if (!gk__finite_bytes(in + off, n * (dim == 2 ? 1 : 3), dbl))
-                return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite rotation");
-            off += n * (dim == 2 ? 1 : 3) * dbl;
+        for (q = 0; q < GK__NFIELDS; ++q) {
+            const gk__field *f = &gk__fields[q];
+            const unsigned char *b = in + off;
+            size_t cnt;
+            if (!(f->flags & GK__SAVE) || !gk__field_on(rve, f)) continue;
+            cnt = gk__fcount(rve, f, np, (size_t)hd.nouter);
+            off += cnt * f->size;
+            if (f->off == offsetof(gk_rve, s[0]) + f->k * sizeof(double *)) sb[f->k] = b;
+            if (f->flags & GK__LIST) {
+                if (!ib) {
+                    ib = b; /* the i array; j follows */
+                    continue;
+                }
+                if ((c = gk__pairs_valid(ib, b, (int)cnt, rve->n)) >= 0)
+                    return gk_err_set(err, GK_ERR_FORMAT, "RVE state %s %d has invalid or unsorted particles",
+                                      f->set == GK__OUTER ? "outer pair" : "pair", c);
+                if (f->set == GK__PAIR) pib = ib, pjb = b;
+                ib = NULL;
+            } else if (f->size == 1) {
+                for (c = 0; c < (int)cnt; ++c)
+                    if (b[c] & ~(GK_CS_CONTACT | GK_CS_SLIDING | GK_CS_BONDED | GK_CS_BROKEN))
+                        return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has unknown contact bits 0x%x", c,
+                                          b[c]);
+            } else if (!gk__finite_bytes(b, cnt * (f->size % 8 ? 1 : f->size / 8), f->size % 8 ? f->size : 8)) {
+                return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite %s", f->what);
+            }
         }
-        ib = in + off;
-        jb = ib + 4 * np;
-        cs = jb + 4 * np;
-        if ((c = gk__pairs_valid(ib, jb, hd.npairs, rve->n)) >= 0)
-            return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has invalid or unsorted particles", c);
-        for (c = 0; c < hd.npairs; ++c)
-            if (cs[c] & ~(GK_CS_CONTACT | GK_CS_SLIDING | GK_CS_BONDED | GK_CS_BROKEN))
-                return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has unknown contact bits 0x%x", c,
-                                  cs[c]);
-        off += np * 9;
-        if (!gk__finite_bytes(in + off, ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np, R))
-            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite contact force or history");
-        off += ((dim == 2 ? 1 : 3) + dim + 2 * nr + nroll) * np * R;
-        if ((c = gk__pairs_valid(in + off, in + off + 4 * (size_t)hd.nouter, hd.nouter, rve->n)) >= 0)
-            return gk_err_set(err, GK_ERR_FORMAT, "RVE state outer pair %d has invalid or unsorted particles",
-                              c);
-        off += 8 * (size_t)hd.nouter;
-        if (!gk__finite_bytes(in + off, dim * n, dbl))
-            return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite outer-list reference position");
-        dtc = gk__dt_critical_at(rve, hd.h, sb, ib, jb, hd.npairs);
+        dtc = gk__dt_critical_at(rve, hd.h, sb, pib, pjb, hd.npairs);
         if (!(hd.dt <= dtc))
             return gk_err_set(
                 err, GK_ERR_DT,
@@ -3024,48 +2922,18 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
         gk_pairlist_reserve(&rve->outer, (size_t)hd.nouter + 1, n))
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory restoring %d pairs", hd.npairs);
     off = sizeof hd;
-    for (k = 0; k < dim; ++k) GK__GET(rve->s[k], n * sizeof(double));
-    for (k = 0; k < dim; ++k) GK__GET(rve->s0[k], n * sizeof(double));
-    for (k = 0; k < dim; ++k) GK__GET(rve->v[k], n * R);
-    for (k = 0; k < dim; ++k) GK__GET(rve->f[k], n * R);
-    for (k = 0; k < 3; ++k)
-        if (rve->w[k]) {
-            GK__GET(rve->w[k], n * R);
-            GK__GET(rve->t[k], n * R);
-        }
-    if (rve->theta) GK__GET(rve->theta, n * (dim == 2 ? 1 : 3) * sizeof(double));
-    GK__GET(rve->pl.i, np * sizeof(int32_t));
-    GK__GET(rve->pl.j, np * sizeof(int32_t));
-    GK__GET(rve->cs, np);
-    for (k = 0; k < (dim == 2 ? 1 : 3); ++k) GK__GET(rve->ft[k], np * R);
-    for (k = 0; k < dim; ++k) GK__GET(rve->fc[k], np * R);
-    for (k = 0; k < 3; ++k)
-        if (rve->tci[k]) {
-            GK__GET(rve->tci[k], np * R);
-            GK__GET(rve->tcj[k], np * R);
-        }
-    for (k = 0; k < 3; ++k)
-        if (rve->mr[k]) GK__GET(rve->mr[k], np * R);
-    GK__GET(rve->outer.i, (size_t)hd.nouter * sizeof(int32_t));
-    GK__GET(rve->outer.j, (size_t)hd.nouter * sizeof(int32_t));
-    for (k = 0; k < dim; ++k) GK__GET(rve->o0[k], n * sizeof(double));
+    for (q = 0; q < GK__NFIELDS; ++q) {
+        const gk__field *f = &gk__fields[q];
+        if ((f->flags & GK__SAVE) && gk__field_on(rve, f))
+            GK__GET(gk__fget(rve, f->off), gk__fcount(rve, f, np, (size_t)hd.nouter) * f->size);
+    }
     rve->outer.n = hd.nouter;
     rve->outer.np = rve->n;
     rve->outer_valid = hd.outer_valid;
     gk_m3_copy(hd.ho0, rve->ho0);
     rve->skin_in = hd.skin_in;
     rve->pl.n = hd.npairs;
-    rve->pl.np = rve->n;
-    /* CSR by i and the j index are functions of the pair list */
-    for (p = 0; p <= rve->n; ++p) rve->pl.start[p] = 0;
-    for (c = 0; c < rve->pl.n; ++c) ++rve->pl.start[rve->pl.i[c] + 1];
-    for (p = 0; p < rve->n; ++p) rve->pl.start[p + 1] += rve->pl.start[p];
-    for (p = 0; p <= rve->n; ++p) rve->jstart[p] = 0;
-    for (c = 0; c < rve->pl.n; ++c) ++rve->jstart[rve->pl.j[c] + 1];
-    for (p = 0; p < rve->n; ++p) rve->jstart[p + 1] += rve->jstart[p];
-    for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
-    for (p = rve->n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
-    rve->jstart[0] = 0;
+    gk__pair_index(rve); /* CSR by i and the j index are functions of the pair list */
     rve->dt = hd.dt;
     rve->time = hd.time;
     rve->dt_crit = hd.dt_crit;

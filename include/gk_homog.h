@@ -75,22 +75,9 @@
  *                              [seed 000 eq 13]; 3D eps_q = sqrt(2/3 e:e)
  *   gk_rotation_angle          rotation of the polar decomposition of F
  *                              [seed 003 eqs 36-40], radians (2D: signed)
- *   gk_inertial_number         I = 2 gdot r_mean sqrt(rho / p),
- *                              gdot = sqrt(rate:rate) [seed 000 eq 20];
- *                              p <= 0 -> +inf (not NaN)
- *   gk_rve_deform_adaptive     gk_rve_deform with the step count chosen by
- *                              the physics instead of fixed (issue 6):
- *       n = ceil(I_1 / I_max) clamped to [n_min, n_max], I_1 the inertial
- *       number (eq 20) of dH applied in one step at the RVE's current
- *       pressure (p <= 0: n_max), so the deformation runs at I <= I_max;
- *       then, if the unbalanced force ratio (mean, as YADE; or with
- *       rms = 1 the RMS ratio I_uf of Liu et al. 2016 eq 57) exceeds
- *       uf_max, relaxation steps at fixed cell (L = 0) in chunks of
- *       `every` until it does not or the total reaches n_max (reported as
- *       capped). Quasi-static by construction; more steps where p is
- *       low (near liquefaction), fewer where it is high. The report gives
- *       the steps used, the final I and ratio. Bad input (NaN dH, bounds
- *       <= 0, n_min > n_max) -> GK_ERR_ARG before anything runs.
+ *   gk_inertial_number, gk_rve_unbalanced, gk_rve_deform_adaptive,
+ *   gk_rve_relax               are in gk_dem.h (they drive the RVE); gk_homog_unbalanced
+ *                              gives gk_rve_unbalanced's mean ratio and the RMS one
  *   gk_tangent_voigt           D -> Voigt matrix (3x3 in 2D, 6x6 in 3D), with
  *                              engineering shear strain columns
  *
@@ -124,27 +111,9 @@ GKDEF gk_result gk_homog_coordination(const gk_rve *rve, gk_coordination *out);
 GKDEF double gk_homog_void_ratio(const gk_rve *rve);
 GKDEF void gk_homog_unbalanced(const gk_rve *rve, double *mean_ratio, double *rms_ratio);
 GKDEF double gk_homog_mean_rotation(const gk_rve *rve);
-GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p);
 GKDEF double gk_rotation_angle(const double F[9], int dim);
 GKDEF void gk_tangent_voigt(const double *D, int dim, double *V);
 
-typedef struct gk_adapt_def {
-    double inertial_max;   /* I bound of the deformation (seed 000 eq 20); 0 -> 5e-4   */
-    double unbalanced_max; /* unbalanced force ratio to reach after it; 0 -> 5e-3     */
-    int n_min, n_max;      /* bounds on the total DEM steps; 0 -> 10 and 5000          */
-    int every;             /* relaxation steps between checks; 0 -> 20                 */
-    int rms;               /* 1: the RMS ratio I_uf (Liu, Sun, Yuan & Fish 2016 eq 57) */
-} gk_adapt_def;
-
-typedef struct gk_adapt_report {
-    int n_deform, n_relax; /* steps of the deformation and of the relaxation         */
-    double inertial;       /* I of the deformation (at the pressure before it)       */
-    double unbalanced;     /* unbalanced force ratio at the end (mean, or eq 57's RMS)  */
-    int capped;            /* 1 if n_max stopped the relaxation above uf_max          */
-} gk_adapt_report;
-
-GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk_adapt_def *ad,
-                                       gk_adapt_report *rep);
 
 #ifdef __cplusplus
 }
@@ -585,25 +554,8 @@ GKDEF gk_result gk_homog_coordination(const gk_rve *rve, gk_coordination *out) {
 GKDEF double gk_homog_void_ratio(const gk_rve *rve) { return gk_rve_volume(rve) / rve->solid_volume - 1.0; }
 
 GKDEF void gk_homog_unbalanced(const gk_rve *rve, double *mean_ratio, double *rms_ratio) {
-    double fp = 0.0, fp2 = 0.0, fc = 0.0, fc2 = 0.0;
-    int p, c, k, nc = 0;
-    for (p = 0; p < rve->n; ++p) {
-        double f2 = 0.0;
-        for (k = 0; k < rve->dim; ++k) f2 += (double)rve->f[k][p] * (double)rve->f[k][p];
-        fp += sqrt(f2);
-        fp2 += f2;
-    }
-    for (c = 0; c < rve->pl.n; ++c) {
-        double f2 = 0.0;
-        if (!(rve->cs[c] & GK_CS_CONTACT)) continue;
-        for (k = 0; k < rve->dim; ++k) f2 += (double)rve->fc[k][c] * (double)rve->fc[k][c];
-        fc += sqrt(f2);
-        fc2 += f2;
-        ++nc;
-    }
-    /* no contacts: nothing to balance; report 0 (not NaN) */
-    if (mean_ratio) *mean_ratio = (nc && fc > 0.0) ? (fp / rve->n) / (fc / nc) : 0.0;
-    if (rms_ratio) *rms_ratio = (nc && fc2 > 0.0) ? sqrt(fp2 / rve->n) / sqrt(fc2 / nc) : 0.0;
+    if (mean_ratio) *mean_ratio = gk_rve_unbalanced(rve);
+    if (rms_ratio) *rms_ratio = gk_rve_unbalanced_rms(rve);
 }
 
 GKDEF double gk_homog_mean_rotation(const gk_rve *rve) {
@@ -615,19 +567,6 @@ GKDEF double gk_homog_mean_rotation(const gk_rve *rve) {
     return s / rve->n;
 }
 
-GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p) {
-    double g = 0.0;
-    int i, j;
-    for (i = 0; i < dim; ++i)
-        for (j = 0; j < dim; ++j) {
-            double e = 0.5 * (rate[3 * i + j] + rate[3 * j + i]);
-            g += e * e;
-        }
-    g = sqrt(g);
-    if (g == 0.0) return 0.0;
-    if (!(p > 0.0)) return HUGE_VAL;
-    return 2.0 * g * r_mean * sqrt(density / p);
-}
 
 GKDEF double gk_rotation_angle(const double F[9], int dim) {
     double R[9], U[9], w[3];
@@ -655,59 +594,5 @@ GKDEF void gk_tangent_voigt(const double *D, int dim, double *V) {
         }
 }
 
-GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk_adapt_def *ad_in,
-                                       gk_adapt_report *rep) {
-    gk_adapt_def ad;
-    gk_adapt_report R;
-    double rate[9], s[9], p, rmean = 0.0, I1, L0[9], Lsave[9], n;
-    int k;
-    gk_result res;
-    memset(&ad, 0, sizeof ad);
-    if (ad_in) ad = *ad_in;
-    if (ad.inertial_max == 0.0) ad.inertial_max = 5e-4;
-    if (ad.unbalanced_max == 0.0) ad.unbalanced_max = 5e-3;
-    if (ad.n_min == 0) ad.n_min = 10;
-    if (ad.n_max == 0) ad.n_max = 5000;
-    if (ad.every == 0) ad.every = 20;
-    if (!gk_m3_isfinite(dH)) return gk_err_set(&rve->err, GK_ERR_ARG, "dH has a NaN or infinite entry");
-    if (!(ad.inertial_max > 0.0) || !(ad.unbalanced_max > 0.0) || ad.n_min < 1 || ad.n_max < ad.n_min ||
-        ad.every < 1)
-        return gk_err_set(&rve->err, GK_ERR_ARG,
-                          "adaptive bounds: I_max %g, uf_max %g (> 0), n_min %d <= n_max %d, every %d (>= 1)",
-                          ad.inertial_max, ad.unbalanced_max, ad.n_min, ad.n_max, ad.every);
-    memset(&R, 0, sizeof R);
-    for (k = 0; k < rve->n; ++k) rmean += (double)rve->r[k];
-    rmean /= rve->n > 0 ? rve->n : 1;
-    gk_rve_stress(rve, s);
-    p = gk_stress_p(s, rve->dim);
-    for (k = 0; k < 9; ++k) rate[k] = dH[k] / rve->dt;
-    I1 = gk_inertial_number(rate, rve->dim, rmean, rve->def.mat.density, p);
-    n = isfinite(I1) ? ceil(I1 / ad.inertial_max) : (double)ad.n_max;
-    if (n < ad.n_min) n = ad.n_min;
-    if (n > ad.n_max) n = ad.n_max;
-    R.n_deform = (int)n;
-    R.inertial = isfinite(I1) ? I1 / n : I1;
-    res = gk_rve_deform(rve, dH, R.n_deform);
-    if (res) return res;
-    gk_homog_unbalanced(rve, ad.rms ? NULL : &R.unbalanced, ad.rms ? &R.unbalanced : NULL);
-    if (R.unbalanced > ad.unbalanced_max && R.n_deform < ad.n_max) {
-        gk_m3_copy(rve->L, Lsave);
-        gk_m3_zero(L0);
-        gk_rve_set_velocity_gradient(rve, L0);
-        while (R.unbalanced > ad.unbalanced_max && R.n_deform + R.n_relax < ad.n_max) {
-            int m = ad.every;
-            if (R.n_deform + R.n_relax + m > ad.n_max) m = ad.n_max - R.n_deform - R.n_relax;
-            res = gk_rve_step(rve, m);
-            if (res) break;
-            R.n_relax += m;
-            gk_homog_unbalanced(rve, ad.rms ? NULL : &R.unbalanced, ad.rms ? &R.unbalanced : NULL);
-        }
-        gk_rve_set_velocity_gradient(rve, Lsave);
-        if (res) return res;
-    }
-    R.capped = R.unbalanced > ad.unbalanced_max;
-    if (rep) *rep = R;
-    return GK_OK;
-}
 
 #endif /* GK_HOMOG implementation */

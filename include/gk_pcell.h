@@ -131,12 +131,27 @@ GKDEF void gk_servo_rates(const gk_servo *s, int dim, const double sigma[9], con
 
 GK_INLINE double gk_pcell_volume(const gk_pcell *c) { return gk_m3_det(c->h); }
 
-/* branch vector d = h (ds - round(ds)) for a reduced difference ds = s_j - s_i */
-GK_INLINE void gk_pcell_min_image(const gk_pcell *c, const double ds_in[3], double d[3]) {
-    double ds[3];
-    int k;
-    for (k = 0; k < 3; ++k) ds[k] = k < c->dim ? ds_in[k] - rint(ds_in[k]) : 0.0;
-    gk_m3_matvec(c->h, ds, d);
+/* Branch vector to the nearest image, d = h (ds - round(ds)), of a reduced
+ * difference ds = s_j - s_i: the one place grainkit rounds to the nearest
+ * image (the DEM kernels inline it; their SIMD twin is gk__simd_branch in
+ * gk_dem.h). dim 2: the upper-left block of h, d[2] = 0. */
+GK_FORCE_INLINE void gk_pcell_image(const double h[9], int dim, const double ds[3], double d[3]) {
+    double a = ds[0] - rint(ds[0]), b = ds[1] - rint(ds[1]), c;
+    if (dim == 2) {
+        d[0] = h[0] * a + h[1] * b;
+        d[1] = h[3] * a + h[4] * b;
+        d[2] = 0.0;
+        return;
+    }
+    c = ds[2] - rint(ds[2]);
+    d[0] = h[0] * a + h[1] * b + h[2] * c;
+    d[1] = h[3] * a + h[4] * b + h[5] * c;
+    d[2] = h[6] * a + h[7] * b + h[8] * c;
+}
+
+/* gk_pcell_image in the cell c */
+GK_INLINE void gk_pcell_min_image(const gk_pcell *c, const double ds[3], double d[3]) {
+    gk_pcell_image(c->h, c->dim, ds, d);
 }
 
 /* simple shear velocity gradient (Lees-Edwards): v_i = rate * x_j, i != j */

@@ -337,6 +337,168 @@ TEST(material_checks) {
     CHECK(gk_material_flags(&bad) == 0u);
 }
 
+/* a material of each law with every optional term on (cohesion is linear-only
+ * and has no wide twin: it is tested through the RVE) */
+static gk_material law_material(gk_law law) {
+    gk_material m = gk_material_default();
+    m.law = law;
+    m.young = 5e8;
+    m.poisson = 0.3;
+    m.friction = 0.4;
+    m.roll_beta = 0.8;
+    m.roll_eta = 0.2;
+    m.zeta_n = 0.1;
+    m.zeta_t = 0.05;
+    return m;
+}
+
+/* The wide twins gk_contact_2d_w / _3d_w (GK_VR_W pairs at a time) give every
+ * lane exactly the bits of the scalar reference gk_contact_2d / _3d: forces,
+ * torques, history and the contact/sliding state, for every law of
+ * GK_LAW_TABLE and the flag sets the kernels instantiate, on random pairs
+ * that are apart, touching, sticking and sliding. */
+TEST(wide_twins_equal_scalar_reference_bitwise) {
+    static const unsigned FL[] = {0u,
+                                  GK_PHYS_TANGENT,
+                                  GK_PHYS_TANGENT | GK_PHYS_ROTATION,
+                                  GK_PHYS_TANGENT | GK_PHYS_VISCOUS,
+                                  GK_PHYS_TANGENT | GK_PHYS_ROTATION | GK_PHYS_ROLLING | GK_PHYS_VISCOUS};
+    gk_rng rng;
+    int law, f, it, l, k, bad = 0, sliding = 0, apart = 0, total = 0;
+    gk_rng_seed(&rng, 7);
+    for (law = 0; law < GK_LAW_COUNT; ++law) {
+        gk_material m = law_material((gk_law)law);
+        gk_law_consts K = consts_of(&m);
+        CHECK(gk_material_check(&m, NULL) == GK_OK);
+        for (f = 0; f < (int)(sizeof FL / sizeof FL[0]); ++f)
+            for (it = 0; it < 200; ++it) {
+                unsigned fl = FL[f];
+                int dim = 2 + (it & 1);
+                gk_real d[3][GK_VR_W], v[3][GK_VR_W], wi[3][GK_VR_W], wj[3][GK_VR_W], ft[3][GK_VR_W],
+                    mr[3][GK_VR_W], ri[GK_VR_W], rj[GK_VR_W], mi[GK_VR_W], mj[GK_VR_W], out[9][GK_VR_W];
+                gk_vr D[3], V[3], WI[3], WJ[3], FT[3], MR[3], dt = gk_vr_set1((gk_real)2e-5);
+                gk_vrm in, slide;
+                gk_contact_out_w o;
+                unsigned bin, bsl;
+                for (l = 0; l < GK_VR_W; ++l) {
+                    double a = 1e-3 * (0.5 + gk_rng_uniform(&rng)), b = 1e-3 * (0.5 + gk_rng_uniform(&rng));
+                    double gap = (a + b) * (0.97 + 0.05 * gk_rng_uniform(&rng)), n[3], nn = 0.0;
+                    for (k = 0; k < 3; ++k) n[k] = k < dim ? gk_rng_normal(&rng) : 0.0;
+                    for (k = 0; k < 3; ++k) nn += n[k] * n[k];
+                    ri[l] = (gk_real)a;
+                    rj[l] = (gk_real)b;
+                    mi[l] = (gk_real)(2650.0 * a * a * a * 4.19);
+                    mj[l] = (gk_real)(2650.0 * b * b * b * 4.19);
+                    for (k = 0; k < 3; ++k) {
+                        d[k][l] = (gk_real)(gap * n[k] / sqrt(nn));
+                        v[k][l] = (gk_real)(k < dim ? 0.05 * gk_rng_normal(&rng) : 0.0);
+                        wi[k][l] = (gk_real)(k == 2 || dim == 3 ? 50.0 * gk_rng_normal(&rng) : 0.0);
+                        wj[k][l] = (gk_real)(k == 2 || dim == 3 ? 50.0 * gk_rng_normal(&rng) : 0.0);
+                        ft[k][l] = (gk_real)(k < dim ? 2.0 * gk_rng_normal(&rng) : 0.0);
+                        mr[k][l] = (gk_real)(k == 2 || dim == 3 ? 1e-3 * gk_rng_normal(&rng) : 0.0);
+                    }
+                }
+                for (k = 0; k < 3; ++k) {
+                    D[k] = gk_vr_loadu(d[k]);
+                    V[k] = gk_vr_loadu(v[k]);
+                    WI[k] = gk_vr_loadu(wi[k]);
+                    WJ[k] = gk_vr_loadu(wj[k]);
+                    FT[k] = gk_vr_loadu(ft[k]);
+                    MR[k] = gk_vr_loadu(mr[k]);
+                }
+                if (dim == 2)
+                    in = gk_contact_2d_w(&K, (gk_law)law, fl, D[0], D[1], gk_vr_loadu(ri), gk_vr_loadu(rj),
+                                         gk_vr_loadu(mi), gk_vr_loadu(mj), V[0], V[1], WI[2], WJ[2], dt, &FT[0],
+                                         &MR[2], &slide, &o);
+                else
+                    in = gk_contact_3d_w(&K, (gk_law)law, fl, D, gk_vr_loadu(ri), gk_vr_loadu(rj), gk_vr_loadu(mi),
+                                         gk_vr_loadu(mj), V, WI, WJ, dt, FT, MR, &slide, &o);
+                for (k = 0; k < 3; ++k) {
+                    gk_vr_storeu(out[k], o.f[k]);
+                    gk_vr_storeu(out[3 + k], o.ti[k]);
+                    gk_vr_storeu(out[6 + k], o.tj[k]);
+                }
+                bin = gk_vrm_bits(in);
+                bsl = gk_vrm_bits(gk_vrm_and(in, slide));
+                for (l = 0; l < GK_VR_W; ++l) {
+                    gk_real hf[3], hm[3], wf[GK_VR_W], wm[GK_VR_W];
+                    unsigned char st = GK_CS_CONTACT;
+                    gk_contact_out so;
+                    int kk, ok = 1;
+                    for (k = 0; k < 3; ++k) {
+                        hf[k] = ft[k][l];
+                        hm[k] = mr[k][l];
+                    }
+                    if (dim == 2) {
+                        gk_contact_2d(&K, (gk_law)law, fl, d[0][l], d[1][l], ri[l], rj[l], mi[l], mj[l], v[0][l],
+                                      v[1][l], wi[2][l], wj[2][l], (gk_real)2e-5, &hf[0], &hm[2], &st, &so);
+                        so.f[2] = so.ti[0] = so.ti[1] = so.tj[0] = so.tj[1] = 0; /* the twin's zero lanes */
+                    } else {
+                        gk_real dl[3], vl[3], wil[3], wjl[3];
+                        for (k = 0; k < 3; ++k) {
+                            dl[k] = d[k][l];
+                            vl[k] = v[k][l];
+                            wil[k] = wi[k][l];
+                            wjl[k] = wj[k][l];
+                        }
+                        gk_contact_3d(&K, (gk_law)law, fl, dl, ri[l], rj[l], mi[l], mj[l], vl, wil, wjl,
+                                      (gk_real)2e-5, hf, hm, &st, &so);
+                    }
+                    for (k = 0; k < 3; ++k) {
+                        ok &= memcmp(&so.f[k], &out[k][l], sizeof(gk_real)) == 0;
+                        ok &= memcmp(&so.ti[k], &out[3 + k][l], sizeof(gk_real)) == 0;
+                        ok &= memcmp(&so.tj[k], &out[6 + k][l], sizeof(gk_real)) == 0;
+                    }
+                    for (k = 0; k < 3; ++k) {
+                        kk = dim == 2 ? (k == 0 ? 0 : 2) : k; /* 2D: ft[0] and mr[2] */
+                        if (dim == 2 && k == 1) continue;
+                        gk_vr_storeu(wf, FT[kk]);
+                        gk_vr_storeu(wm, MR[kk]);
+                        if (fl & GK_PHYS_TANGENT) ok &= memcmp(&hf[kk], &wf[l], sizeof(gk_real)) == 0;
+                        if (fl & GK_PHYS_ROLLING) ok &= memcmp(&hm[kk], &wm[l], sizeof(gk_real)) == 0;
+                    }
+                    ok &= st == (unsigned char)((((bin >> l) & 1u) ? GK_CS_CONTACT : 0u) |
+                                                (((bsl >> l) & 1u) ? GK_CS_SLIDING : 0u));
+                    bad += !ok;
+                    sliding += (st & GK_CS_SLIDING) != 0;
+                    apart += !(st & GK_CS_CONTACT);
+                    ++total;
+                }
+            }
+    }
+    printf("    %d pairs (%d apart, %d sliding), %d lanes differ\n", total, apart, sliding, bad);
+    CHECK(bad == 0);
+    CHECK(apart > total / 10 && sliding > total / 10);
+}
+
+/* gk_law_kn_max bounds the normal stiffness of every law for radii up to
+ * r_max and overlaps up to d_max (the critical time step of seed 000 eq 19
+ * rests on it), and a law that stiffens says so. */
+TEST(law_kn_max_bounds_the_stiffness) {
+    gk_rng rng;
+    int law, it;
+    gk_rng_seed(&rng, 11);
+    for (law = 0; law < GK_LAW_COUNT; ++law) {
+        gk_material m = law_material((gk_law)law);
+        gk_law_consts K = consts_of(&m);
+        double rmax = 2e-3, dmax = 4e-5, bound = gk_law_kn_max(&m, rmax, dmax), worst = 0.0;
+        gk_real kn0, kn1, fn, kt;
+        for (it = 0; it < 1000; ++it) {
+            double ri = rmax * (0.1 + 0.9 * gk_rng_uniform(&rng)), rj = rmax * (0.1 + 0.9 * gk_rng_uniform(&rng));
+            gk_contact_stiffness(&K, (gk_law)law, (gk_real)ri, (gk_real)rj, (gk_real)(dmax * gk_rng_uniform(&rng)),
+                                 &kn0, &fn, &kt);
+            if ((double)kn0 > worst) worst = (double)kn0;
+        }
+        gk_contact_stiffness(&K, (gk_law)law, (gk_real)rmax, (gk_real)rmax, (gk_real)dmax, &kn1, &fn, &kt);
+        printf("    %s: largest k_n %.6g, bound %.6g, at r_max and d_max %.6g\n", gk_law_name((gk_law)law), worst,
+               bound, (double)kn1);
+        CHECK(worst <= bound * (1.0 + 1e-6));
+        CHECK_REL((double)kn1, bound, 1e-6); /* the bound is reached */
+        gk_contact_stiffness(&K, (gk_law)law, (gk_real)rmax, (gk_real)rmax, (gk_real)(0.5 * dmax), &kn0, &fn, &kt);
+        CHECK(gk_law_stiffens((gk_law)law) == ((double)kn0 < (double)kn1));
+    }
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(impact_conserves_energy_without_damping);
@@ -348,5 +510,7 @@ int main(int argc, char **argv) {
     RUN(cohesion_tension_limit);
     RUN(history_rotates_with_rigid_spin_3d);
     RUN(material_checks);
+    RUN(wide_twins_equal_scalar_reference_bitwise);
+    RUN(law_kn_max_bounds_the_stiffness);
     return gk_test_done();
 }

@@ -1095,6 +1095,47 @@ TEST(hertz_rolling_rve_runs) {
     gk_rve_destroy(&rve);
 }
 
+/* gk_rve_relax: runs of `every` steps at a fixed cell (the cell matrix does
+ * not change) until the unbalanced force ratio is at most uf_max or max_steps
+ * ran; the same state bit for bit as gk_rve_step with L = 0 in the same runs;
+ * bad arguments and an active servo are refused. */
+TEST(relax_holds_the_cell_until_balanced) {
+    gk_rve a, b;
+    gk_rve_def def = gk_rve_def_default();
+    double dH[9] = {0, 2e-3, 0, 0, 0, 0, 0, 0, 0}, L0[9] = {0}, h[9], uf = 2e-3;
+    long steps = -1, done = 0;
+    gk_servo sv;
+    if (load_rve(&a, &def, RVE400) || load_rve(&b, &def, RVE400)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_rve_deform(&a, dH, 20) == GK_OK); /* fast: far from balance */
+    CHECK(gk_rve_deform(&b, dH, 20) == GK_OK);
+    CHECK(gk_rve_unbalanced(&a) > uf);
+    gk_m3_copy(a.cell.h, h);
+    CHECK(gk_rve_relax(&a, uf, 20, 3000, &steps) == GK_OK);
+    printf("    %ld relaxation steps, unbalanced ratio %.3g\n", steps, gk_rve_unbalanced(&a));
+    CHECK(steps > 0 && (steps % 20 == 0 || steps == 3000));
+    CHECK(gk_rve_unbalanced(&a) <= uf || steps == 3000);
+    CHECK(memcmp(h, a.cell.h, sizeof h) == 0);
+    CHECK(gk_rve_set_velocity_gradient(&b, L0) == GK_OK);
+    while (done < 3000 && gk_rve_unbalanced(&b) > uf) {
+        CHECK(gk_rve_step(&b, 20) == GK_OK);
+        done += 20;
+    }
+    CHECK(done == steps);
+    CHECK(same_state(&a, &b));
+    CHECK(gk_rve_relax(&a, uf, 20, 3000, &steps) == GK_OK && steps == 0); /* already balanced */
+    CHECK(gk_rve_relax(&a, 0.0, 20, 100, &steps) == GK_ERR_ARG);
+    CHECK(gk_rve_relax(&a, uf, 0, 100, &steps) == GK_ERR_ARG);
+    memset(&sv, 0, sizeof sv);
+    sv.max_rate = 1.0;
+    CHECK(gk_rve_set_servo(&a, &sv) == GK_OK);
+    CHECK(gk_rve_relax(&a, uf, 20, 100, &steps) == GK_ERR_STATE && steps == 0);
+    gk_rve_destroy(&a);
+    gk_rve_destroy(&b);
+}
+
 /* gk_rve_deform_adaptive (gk_homog.h): the deformation runs n = ceil(I_1 /
  * I_max) steps, I_1 = 2 |sym dH / dt| r_mean sqrt(rho / p) (seed 000 eq 20)
  * of the whole dH in one step, so n doubles with |dH| and with 1/sqrt(p);
@@ -1190,5 +1231,6 @@ int main(int argc, char **argv) {
     RUN(generate_from_size_table);
     RUN(hertz_rolling_rve_runs);
     RUN(adaptive_deform_follows_the_inertial_number);
+    RUN(relax_holds_the_cell_until_balanced);
     return gk_test_done();
 }

@@ -6,8 +6,9 @@
 #
 # CASEFILE: one case per line, "name | reference command | new command | csv files", the commands
 # relative to the build directories ({B} stands for the build directory), the csv files relative to the
-# output directory ({O} in the commands). A csv file named biaxial.csv or cyclic.csv has its seconds
-# column (7 and 12) left out; other files are compared whole. Lines starting with # are skipped.
+# output directory ({O} in the commands). A .csv file whose header names a column "seconds" (the
+# drivers' wall-clock time) has that column left out; other files are compared whole. Lines starting
+# with # are skipped.
 # Prints one line per case and file (SAME / DIFFERS / MISSING) and ends with "N same, N differ";
 # exit status 1 if any differs.
 #
@@ -18,10 +19,10 @@ set -u
 ref=$1 new=$2 work=$3 cases=$4
 mkdir -p "$work" || exit 2
 same=0 differ=0
-strip() { # file -> stdout without the seconds column of the driver CSVs
-    case "$(basename "$1")" in
-    biaxial.csv) cut -d, -f1-6,8- "$1" ;;
-    cyclic.csv) cut -d, -f1-11,13- "$1" ;;
+strip() { # file -> stdout without the column named "seconds" of a driver CSV
+    case "$1" in
+    *.csv) awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "seconds") s = i }
+        { o = ""; for (i = 1; i <= NF; ++i) if (i != s) o = o (o == "" ? "" : ",") $i; print o }' "$1" ;;
     *) cat "$1" ;;
     esac
 }
