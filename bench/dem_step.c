@@ -6,7 +6,7 @@
  *                        [--real double|float] [--scalar] [--repeats R]
  *                        [--packing FILE] [--write-packing FILE]
  *
- * Cases: rve400 (the seed 000 400-disk RVE, its own material, simple shear at
+ * Cases: rve400 (the Guo & Zhao 2014 400-disk RVE, its own material, simple shear at
  * 1e-5 per step), 2d_10k and 2d_100k (bench/data/bench2d_10k.txt, tiled 5x2),
  * 3d_1k (bench/data/bench3d_1k.txt), 3d_10k (bench/data/bench3d_20k.txt:
  * 20 000 spheres, the packing the peers were measured on) and 3d_100k (that,

@@ -28,7 +28,7 @@ typedef struct bench_out {
 int bench_run_double(const bench_case *c, bench_out *o);
 int bench_run_float(const bench_case *c, bench_out *o);
 
-/* the seed 000 RVE sheared along the rve_path loading (nincr increments of
+/* the Guo & Zhao 2014 RVE sheared along the rve_path loading (nincr increments of
  * dH01 = 1e-3 over 100 steps): compression-positive p and q after each */
 int bench_path_double(int nincr, double *p, double *q);
 int bench_path_float(int nincr, double *p, double *q);

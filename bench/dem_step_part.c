@@ -122,7 +122,7 @@ int BENCH_RUN(const bench_case *bc, bench_out *o) {
         snprintf(o->err, sizeof o->err, "%s", e.msg);
         return 1;
     }
-    if (rve400) { /* the seed 000 RVE and material (YADE FEMxDEM prepareRVE.py) */
+    if (rve400) { /* the Guo & Zhao 2014 RVE and material (YADE FEMxDEM prepareRVE.py) */
         def.mat.young = 6e8;
         def.mat.kt_ratio = 0.8;
         def.mat.friction = tan(0.5);

@@ -1,4 +1,4 @@
-/* bench_rve_batch - the seed 000 workload per Newton iteration: 512 copies of
+/* bench_rve_batch - the Guo & Zhao 2014 workload per Newton iteration: 512 copies of
  * the 400-disk RVE, each restored to its last converged state, deformed by
  * one increment dH = 1e-3 over 100 DEM steps, then asked for its Love stress
  * and Taylor tangent. RVEs run in parallel (OpenMP, one RVE per task).
@@ -61,7 +61,7 @@ int main(int argc, char **argv) {
     rves = (gk_rve *)malloc((size_t)nrve * sizeof *rves);
     saved = (gk_rve_state *)malloc((size_t)nrve * sizeof *saved);
     if (!rves || !saved) return 1;
-    /* the seed 000 RVE and material; dt = YADE's 3.16e-5 s */
+    /* the Guo & Zhao 2014 RVE and material; dt = YADE's 3.16e-5 s */
     def.dt = 3.1602315723728926e-05;
     for (i = 0; i < nrve; ++i) {
         if (gk_rve_create(&rves[i], &def, &pk)) {

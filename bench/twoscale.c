@@ -1,5 +1,5 @@
-/* bench_twoscale - gk_twoscale.h per Newton iteration: N RVEs (default 512, the 8 x 16 Q8 mesh of seed
- * 000, the authors' 400-disk RVE), each run from its accepted state by its dH with the adaptive DEM step
+/* bench_twoscale - gk_twoscale.h per Newton iteration: N RVEs (default 512, the 8 x 16 Q8 mesh of the
+ * Guo & Zhao (2014) model, the authors' 400-disk RVE), each run from its accepted state by its dH with the adaptive DEM step
  * rule and asked for stress and eq 9 tangent; and a scaling model from what it measures.
  *
  *   build/bench_twoscale [--points 512] [--steps 3] [--iterations 3] [--threads T] [--band 0.1]

@@ -11,9 +11,9 @@
  *   build/dem_biaxial --generate 228 --tiles 1x2 # a 456-disk DNS like the paper's 441
  *   build/dem_biaxial --generate 228 --tiles 2x4 --strain 0.1   # like its 1681
  *
- * Specimen. --packing FILE (default examples/data/rve400.txt, the seed 000
+ * Specimen. --packing FILE (default examples/data/rve400.txt, the Guo & Zhao 2014
  * RVE consolidated at 100 kPa) or --generate N (a periodic packing of N
- * disks with R_max / R_min = 1.5, the seed 001 size ratio, generated and
+ * disks with R_max / R_min = 1.5, the Liu, Bosco & Suiker 2018 size ratio, generated and
  * consolidated isotropically to --pressure frictionless, gk_rve_consolidate)
  * is tiled --tiles NXxNY times (gk_packing_tile) and opened: the tiled
  * cell's box, dilated by 1 % to open the contacts of the stressed packing
@@ -28,7 +28,7 @@
  * band one mean diameter high (gk_scene_side_chain), anchored to both
  * platens, loaded by the follower pressure --pressure and tied by
  * tension-only links (--link-stiffness, default 0.05 k_n of the mean
- * contact): the stress a rubber sleeve applies, the membrane of seed 002
+ * contact): the stress a rubber sleeve applies, the membrane of Chen et al. 2021
  * App. B. Local damping --damping (quasi-static loading).
  *
  * Stages. 1: consolidation at the confining pressure until the lid's stress
@@ -43,7 +43,7 @@
  * and the mean stress of the particles over A (gk_scene_stress: sigma_xx,
  * sigma_yy from the contacts, compression positive); volumetric strain
  * (A0 - A) / A0; the stress ratio sigma_bar = |s_yy - s_xx| / (s_yy + s_xx)
- * of seed 001 eq 40 and the mobilised friction angle asin(sigma_bar); the
+ * of Liu, Bosco & Suiker 2018 eq 40 and the mobilised friction angle asin(sigma_bar); the
  * coordination number 2 C / n.
  *
  * Outputs in --out DIR: biaxial.csv, biaxial_stress.svg (stress ratio and
@@ -261,7 +261,7 @@ int main(int argc, char **argv) {
     if (k) return k < 0 ? 0 : k;
     if (dsc_mkdir("dem_biaxial", o.out)) return 1;
     d.rve =
-        gk_rve_def_default(); /* the seed 000 material (linear, E 6e8, kt/kn 0.8, mu tan 0.5, 2D t = 0.1) */
+        gk_rve_def_default(); /* the Guo & Zhao 2014 material (linear, E 6e8, kt/kn 0.8, mu tan 0.5, 2D t = 0.1) */
     d.rve.damping = o.damping;
     d.rve.threads = o.threads;
     if (o.generate) {
@@ -470,7 +470,7 @@ int main(int argc, char **argv) {
             x[k] = rows[k].eps, y0[k] = rows[k].ratio, y1[k] = 10.0 * rows[k].ev;
         if (!status) {
             yy[0] = y0, yy[1] = y1, yy[2] = yy[3] = NULL;
-            lab[0] = "stress ratio |s_yy - s_xx| / (s_yy + s_xx) (seed 001 eq 40)";
+            lab[0] = "stress ratio |s_yy - s_xx| / (s_yy + s_xx) (Liu, Bosco & Suiker 2018 eq 40)";
             lab[1] = "10 x volumetric strain (compaction +)";
             lab[2] = lab[3] = NULL;
             snprintf(path, sizeof path, "%s/biaxial_stress.svg", o.out);

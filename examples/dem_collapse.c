@@ -27,7 +27,7 @@
  * smooth segment at x = d_0 from the floor disks' tops up, pulled away at
  * 20 m/s at t = 0. The domain runs to
  * (2 + 2.5 a) d_0; disks thrown beyond it are deleted and counted (lost).
- * dt = 0.2 x the critical step (seed 000 eq 19).
+ * dt = 0.2 x the critical step (Guo & Zhao 2014 eq 19).
  *
  * Measures (a CSV row every --every s): the front d_f = the furthest edge
  * x + r of the deposit, scanned from the wall along x and stopped at the
@@ -78,7 +78,7 @@ static void usage(FILE *fp) {
         "  --mu M                 Coulomb friction of the disks and the floor disks (default 0.5)\n"
         "  --roll-beta B --roll-eta E   rolling resistance (default 0 0: none)\n"
         "  --restitution E        normal restitution of the contact dashpots (default 0.5)\n"
-        "  --young E              contact modulus, k_n = E r* [Pa] (default 6e8, seed 000/003)\n"
+        "  --young E              contact modulus, k_n = E r* [Pa] (default 6e8, Guo & Zhao 2014, Liang & Zhao 2019)\n"
         "  --gravity G            [m/s^2] (default 9.81)\n"
         "  --t-end T              simulated time after release [s] (default 4)\n"
         "  --every DT             time between CSV rows [s] (default 0.01)\n"

@@ -4,7 +4,7 @@
  * femdem_probe.c (the noise and Krylov diagnostics) are one 2D plane-strain FEM mesh (Q4 or Q8,
  * gk_fem.h) with a periodic DEM RVE at every Gauss point, the RVEs being a gk_twoscale set
  * (gk_twoscale.h): per Newton iteration every Gauss point gets the whole-step displacement
- * gradient dH = grad u (stretch and spin, seed 000 eq 10), its RVE re-runs from the last
+ * gradient dH = grad u (stretch and spin, Guo & Zhao 2014 eq 10), its RVE re-runs from the last
  * converged state and returns its Love stress (eq 5) and tangent (eq 9, or eq 8). This header
  * holds the model: options shared by the drivers (fd_common_opts, fd_usage_common), the mesh and
  * its boundary sets, the set of RVEs (fd_setup), the linear solve and the residual, the RVE
@@ -245,7 +245,7 @@ static void fd_usage_common(FILE *fp) {
         "                         RVE's contact network with the particles relaxed, GK_TANGENT_RELAXED:\n"
         "                         its quasi-static response without slip; 8 x 16 mesh: fewer iterations\n"
         "                         before the peak, 10 x the time per step), perturbation (eq 8)\n"
-        "  --xi X                 perturbation size of eq 8 (default 5e-5, seed Fig 6)\n"
+        "  --xi X                 perturbation size of eq 8 (default 5e-5, Guo & Zhao 2014 Fig 6)\n"
         "  --restart DIR          continue from DIR/checkpoint.bin (same mesh and packings)\n"
         "  --checkpoint K         write DIR/checkpoint.bin every K steps (default 10; always at the end)\n"
         "  --packing FILE[,FILE]  RVE at every Gauss point. A comma-separated list seeds heterogeneity:\n"
@@ -272,7 +272,7 @@ static void fd_usage_common(FILE *fp) {
         "                         Newton iteration\n"
         "\nDEM steps per RVE run and tangent reuse:\n"
         "  --dem-rule R           DEM steps per RVE run: adaptive (default) = gk_rve_deform_adaptive: dH over\n"
-        "                         n = ceil(I_1 / I_max) steps, I_1 the inertial number (seed eq 20) of dH in\n"
+        "                         n = ceil(I_1 / I_max) steps, I_1 the inertial number (eq 20) of dH in\n"
         "                         one DEM step at the RVE's pressure, then relaxation at fixed cell while the\n"
         "                         unbalanced force ratio > U; strain = the authors' rule n_s = max|dH| / S,\n"
         "                         no relaxation. Both clamped to [--dem-min, --dem-max] in all\n");
@@ -356,7 +356,7 @@ static int fd_consolidated(fd_model *M, const gk_rve_def *def, const gk_packing 
     return 0;
 }
 
-/* the set of RVEs, one per Gauss point: the same packing everywhere (seed 000: uniform RVE, no
+/* the set of RVEs, one per Gauss point: the same packing everywhere (Guo & Zhao 2014: uniform RVE, no
  * imperfection), or with --packing A,B,... each Gauss point draws one of the files (gk_twoscale_draw:
  * seeded by --packing-seed, in Gauss-point order, so every run and restart gets the same assignment
  * whatever the thread or rank count); then the initial stresses and tangents */

@@ -1,4 +1,4 @@
-/* femdem_biaxial - the seed 000 FEMxDEM two-scale biaxial test (Guo & Zhao 2014).
+/* femdem_biaxial - the Guo & Zhao 2014 FEMxDEM two-scale biaxial test (Guo & Zhao 2014).
  *
  *   build/femdem_biaxial --nx 8 --ny 16 --element q8 --steps 100 --threads 2 --out DIR
  *                        [--tangent taylor|yade|relaxed|perturbation] [--restart DIR]
@@ -6,10 +6,10 @@
  *   mpirun -np R build/femdem_biaxial_mpi ...   (make mpi: the RVEs over R ranks, the same numbers)
  *
  * A 2D plane-strain mesh (Q4 or Q8) of a 50 x 100 mm specimen with a periodic 400-disk RVE
- * (examples/data/rve400.txt, the seed authors' own) at every Gauss point. Smooth top and bottom
+ * (examples/data/rve400.txt, the Guo & Zhao (2014) authors' own) at every Gauss point. Smooth top and bottom
  * platens, bottom-centre node pinned in x, 100 kPa confining traction on both sides, top displaced by
  * 0.1 % of the height per load step. Per Newton iteration every Gauss point receives the whole-step
- * displacement gradient dH (stretch and spin, seed 000 eq 10), re-runs its RVE from the last
+ * displacement gradient dH (stretch and spin, Guo & Zhao 2014 eq 10), re-runs its RVE from the last
  * converged state over n_s DEM steps, and returns its total Love stress (eq 5) and tangent (eq 9, or
  * eq 8 by perturbation); the macro solve is full Newton-Raphson (sec 2.3) with the displacement
  * criterion E_d < 0.01 (eq 21). The RVEs are a gk_twoscale set (gk_twoscale.h), the model and its
@@ -18,7 +18,7 @@
  *
  * DEM STEPS PER RVE RUN (as examples/mpmdem.h, same flag names; gk_twoscale_rule)
  *   --dem-rule adaptive (default): gk_rve_deform_adaptive (gk_homog.h): dH over n = clamp(ceil(I_1 /
- *     I_max)) steps, I_1 the inertial number (seed eq 20) of dH in one DEM step at the RVE's converged
+ *     I_max)) steps, I_1 the inertial number (eq 20) of dH in one DEM step at the RVE's converged
  *     pressure, so the RVE deforms at I <= I_max (--dem-inertial, 5e-4: ~100 steps per 0.1 % at 100
  *     kPa, falling to ~80 at the peak stress), then relaxation at fixed cell in chunks of 20 steps while
  *     the unbalanced force ratio exceeds --dem-unbalanced, within --dem-max steps in all.
@@ -55,7 +55,7 @@
  *     network with every particle relaxed (GK_TANGENT_RELAXED: softer than eq 9 where the network is
  *     near a mechanism); 'perturbation' = eq 8 with xi.
  *   - convergence: E_d < --tol (eq 21), or E_f < --ftol (default 0.003, a force criterion stricter than
- *     the ABAQUS/ANSYS 0.005 quoted by the seed; both are the seed's footnote's pairs of displacement
+ *     the ABAQUS/ANSYS 0.005 quoted by the seed; both are the paper's footnote's pairs of displacement
  *     and force criteria). Both E_d and E_f of the accepted iterate are in the CSV; --ftol 0 restores
  *     the pure eq 21 criterion. build/femdem_probe measures how much DEM noise moves the residual
  *     (--noise-probe) and whether any deformation near an iterate reduces it (--krylov-probe).
@@ -280,7 +280,7 @@ static int single_element(fd_model *M) {
             if (d > maxdiff) maxdiff = d;
         }
         for (k = 0; k < n; ++k) x[k] = 100 * e[k], y[k] = M->curve[k].syy / 1e3, yr[k] = s[k] / 1e3;
-        gk_plot_init(&pl, "Single-element test vs the RVE alone (seed 000 Fig 6)", "axial strain [%]", "sigma_yy [kPa]");
+        gk_plot_init(&pl, "Single-element test vs the RVE alone (Guo & Zhao 2014 Fig 6)", "axial strain [%]", "sigma_yy [kPa]");
         gk_plot_add(&pl, x, y, n, "FEM, 1 Q4 element, 4 RVEs");
         gk_plot_add(&pl, x, yr, n, "RVE alone, sigma_xx held by a secant iteration on the lateral strain");
         bad = bad || fd_plot(M, &pl, "single_element.svg");

@@ -13,7 +13,7 @@
 #define FDB_MAX_FIELDS_AT 16
 #define FDB_FABRIC_LABEL "F_a [-]"
 
-/* the biaxial defaults (seed 000: 50 x 100 mm, 100 kPa, the authors' 8 x 16 Q8 mesh and RVE) */
+/* the biaxial defaults (Guo & Zhao 2014: 50 x 100 mm, 100 kPa, the authors' 8 x 16 Q8 mesh and RVE) */
 static void fdb_defaults(fd_model *M) {
     fd_opts *o = &M->o;
     fd_opts_default(o);
@@ -403,7 +403,7 @@ static int fdb_finish(fd_model *M, int status) {
     for (k = 0; k < M->ncurve && !bad; ++k)
         x[k] = 100 * M->curve[k].eps, y1[k] = M->curve[k].syy / 1e3, y2[k] = M->curve[k].sxx / 1e3;
     if (!bad) {
-        gk_plot_init(&pl, "FEMxDEM biaxial test (seed 000)", "axial strain [%]", "stress [kPa] (compression positive)");
+        gk_plot_init(&pl, "FEMxDEM biaxial test (Guo & Zhao 2014)", "axial strain [%]", "stress [kPa] (compression positive)");
         gk_plot_add(&pl, x, y1, M->ncurve, "sigma_yy (top reaction / width)");
         gk_plot_add(&pl, x, y2, M->ncurve, "sigma_xx (side reaction / height)");
         bad = fd_plot(M, &pl, "biaxial_stress.svg");

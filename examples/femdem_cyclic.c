@@ -1,9 +1,9 @@
-/* femdem_cyclic - the seed 000 FEMxDEM cyclic simple-shear tests (Guo & Zhao 2014, sec 5).
+/* femdem_cyclic - the Guo & Zhao 2014 FEMxDEM cyclic simple-shear tests (Guo & Zhao 2014, sec 5).
  *
  *   build/femdem_cyclic --test cyclic-strain|cyclic-stress [--nx 15 --ny 10] [--amplitude 0.01 |
  *                       --tau-amplitude 3e4] [--cycles 20] [--threads 2] --out DIR
  *
- * A 100 x 50 mm specimen (the seed's mesh: --nx 15 --ny 10, Q8, 600 Gauss points; default 2 x 2, 16
+ * A 100 x 50 mm specimen (the paper's mesh: --nx 15 --ny 10, Q8, 600 Gauss points; default 2 x 2, 16
  * RVEs), bottom fixed, the top moved horizontally by a rough platen whose vertical displacement is
  * held, left and right sides PERIODIC (every right node tied to the left node at the same height
  * through a gk_dofmap; the Newton system is condensed, K_r = T^T K T). Height and width are fixed, so
@@ -21,14 +21,14 @@
  *     --stress-steps steps (at most --increment).
  * Liquefaction: p' (mean stress of the volume-averaged RVE stress) below --liq-ratio (0.1) x its
  * initial value. cyclic-strain stops there; cyclic-stress stops when |gamma| reaches --gamma-limit (5
- * %, the seed's criterion) and also reports when p' first collapsed. Both stop after --cycles cycles. A
+ * %, the paper's criterion) and also reports when p' first collapsed. Both stop after --cycles cycles. A
  * cycle is 0 -> +A -> 0 -> -A -> 0 (fractional values interpolate within the current loading branch).
  *
  * OUTPUTS in DIR (a failed write is an error: status 1)
  *   cyclic.csv    step,cycle,gamma,tau,sigma_yy,sigma_xx,p,q,eps_v_rve,top_uy,iterations,seconds,E_d,E_f,
  *                 increment,failed_gp,dem_steps_mean,dem_steps_max,dem_steps,tangents_reused,
  *                 tangents_computed - tau = sigma_xy from the top reaction [Pa] (positive with gamma),
- *                 sigma_yy from the top reaction, sigma_xx, p, q (seed eq 7) from the volume-averaged RVE
+ *                 sigma_yy from the top reaction, sigma_xx, p, q (eq 7) from the volume-averaged RVE
  *                 stress, normal stresses COMPRESSION POSITIVE; eps_v_rve the area-weighted mean RVE
  *                 volume change (contraction positive, ~0 at constant volume); top_uy the mean platen
  *                 lift (0)
@@ -75,9 +75,9 @@ static void usage(FILE *fp) {
             "                     [--cycles 20] [--nx 2 --ny 2] [--threads 2] [--out DIR]\n\n"
             "cyclic simple shear: 100 x 50 mm, bottom fixed, rough top platen moved horizontally with its\n"
             "vertical displacement held, left/right sides periodic. Defaults: --nx 2 --ny 2 (Q8, 16 RVEs; the\n"
-            "seed's mesh is --nx 15 --ny 10, 600 RVEs), --width 0.1 --height 0.05, --increment 0.001 (shear\n"
+            "paper's mesh is --nx 15 --ny 10, 600 RVEs), --width 0.1 --height 0.05, --increment 0.001 (shear\n"
             "strain per step), --vtk-every 0 (VTK of the final state only), --packing\n"
-            "examples/data/rve400_e0223.txt (cyclic-strain) or rve400_e0209.txt (cyclic-stress), the seed's\n"
+            "examples/data/rve400_e0223.txt (cyclic-strain) or rve400_e0209.txt (cyclic-stress), the paper's\n"
             "void ratios.\n"
             "  --test KIND            cyclic-strain (default) or cyclic-stress\n"
             "  --amplitude A          cyclic-strain: shear strain amplitude gamma_A (default 0.01 = 1 %%)\n"
@@ -86,7 +86,7 @@ static void usage(FILE *fp) {
             "                         strain increment is then at most --increment and at least 1/64 of it\n"
             "  --cycles N             stop after N cycles (default 20)\n"
             "  --liq-ratio R          liquefaction when p' < R x p'_0 (default 0.1); cyclic-strain stops there\n"
-            "  --gamma-limit G        cyclic-stress: stop when |gamma| >= G (default 0.05, the seed's 5 %%)\n"
+            "  --gamma-limit G        cyclic-stress: stop when |gamma| >= G (default 0.05, the paper's 5 %%)\n"
             "  --paper-mesh           Guo & Zhao 2014's mesh: 15 x 10 Q4 elements, 2 x 2 Gauss points (600 RVEs;\n"
             "                         its cost: examples/README.md, cyclic simple shear)\n"
             "  --pressure P           initial isotropic stress [Pa]: when it differs from the packing's own by\n"
@@ -129,7 +129,7 @@ static int cyclic_state(cyc_model *C, fd_row *c, cyc_extra *x) {
     sxx = -sa[0] / area, syy = -sa[1] / area, sxy = sa[2] / area;
     c->eps = C->cs.gamma, c->syy = -fy / M->o.width, c->sxx = sxx, c->ev = ev / area;
     x->tau = top_tau(M), x->p = 0.5 * (sxx + syy);
-    x->q = sqrt(0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy); /* seed eq 7 */
+    x->q = sqrt(0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy); /* Guo & Zhao 2014 eq 7 */
     x->top_uy = uy / M->ntop;
     return 0;
 }
@@ -270,7 +270,7 @@ static int after_step(cyc_model *C, double inc, int iters, double Ed, double Ef,
     return 0;
 }
 
-/* the cyclic loading loop (seed 000 sec 5); 0, 1 (an error, said) or 3 (gave up after cut-backs) */
+/* the cyclic loading loop (Guo & Zhao 2014 sec 5); 0, 1 (an error, said) or 3 (gave up after cut-backs) */
 static int run_cyclic(cyc_model *C, double t_start, gk_err *err) {
     fd_model *M = &C->m;
     const fd_opts *o = &M->o;
@@ -347,10 +347,10 @@ static int cyclic_summary(cyc_model *C, int status) {
             p[k] = C->cx[k].p / 1e3, q[k] = C->cx[k].q / 1e3, cy[k] = C->cx[k].cycle;
         }
         if (C->test == 0)
-            snprintf(title, sizeof title, "Cyclic simple shear, constant volume, gamma = +-%.2g %% (seed 000 Fig 20)",
+            snprintf(title, sizeof title, "Cyclic simple shear, constant volume, gamma = +-%.2g %% (Guo & Zhao 2014 Fig 20)",
                      100 * C->amp);
         else
-            snprintf(title, sizeof title, "Cyclic simple shear, constant volume, tau = +-%.3g kPa (seed 000 Fig 22)",
+            snprintf(title, sizeof title, "Cyclic simple shear, constant volume, tau = +-%.3g kPa (Guo & Zhao 2014 Fig 22)",
                      C->tau_amp / 1e3);
         gk_plot_init(&pl, title, "sigma_yy or p [kPa] (compression positive)", "tau or q [kPa]");
         gk_plot_add(&pl, sy, t, M->ncurve, "tau vs sigma_yy (top platen reaction)");

@@ -1,6 +1,6 @@
 /* femdem_newton.h - the Newton iteration of the FEMxDEM drivers (examples, not library).
  *
- * fd_load_step solves one load (sub)step of the model of femdem.h: full Newton-Raphson (seed 000
+ * fd_load_step solves one load (sub)step of the model of femdem.h: full Newton-Raphson (Guo & Zhao 2014
  * sec 2.3) on the RVEs' stresses and tangents, converged when E_d = |du| / |u| < --tol (eq 21) or
  * E_f = |R_free| / |f_int| < --ftol:
  *   - predictor: the tangent solve K(D_n) u = f_ext - f_int(sigma_n) with the prescribed platen

@@ -8,17 +8,17 @@
  *
  * Applies dH (row-major, H01 = du_x/dy; 9 numbers for a 3D packing) N times,
  * each over S DEM steps as a constant velocity gradient L = dH / (S dt) -
- * exactly how the seed 000 authors' code (YADE FEMxDEM) loads an RVE - and
+ * exactly how the Guo & Zhao 2014 authors' code (YADE FEMxDEM) loads an RVE - and
  * writes after every increment one CSV row:
  *   2D: inc,H00,H01,H10,H11,sxx,syy,sxy,p,q,e_void,Z
  *   3D: inc,H00,...,H22,sxx,syy,szz,syz,sxz,sxy,p,q,e_void,Z
- * H is the accumulated applied gradient (sum of the increments, the seed's
+ * H is the accumulated applied gradient (sum of the increments, the paper's
  * convention); stresses in Pa, COMPRESSION POSITIVE (grainkit is tension-
- * positive inside; the sign is flipped here); p = -tr(sigma)/dim, q as seed
- * 000 eq 7 (2D) or sqrt(3/2 s:s) (3D); Z = 2 contacts / particles.
- * Defaults are the seed 000 material; with no --dt it uses 0.5 x the critical
- * step of seed 000 eq 19. It also writes an SVG plot of q/p against the
- * deviatoric strain eps_q of the accumulated H (seed 000 eq 13).
+ * positive inside; the sign is flipped here); p = -tr(sigma)/dim, q as Guo & Zhao 2014
+ * eq 7 (2D) or sqrt(3/2 s:s) (3D); Z = 2 contacts / particles.
+ * Defaults are the Guo & Zhao 2014 material; with no --dt it uses 0.5 x the critical
+ * step of Guo & Zhao 2014 eq 19. It also writes an SVG plot of q/p against the
+ * deviatoric strain eps_q of the accumulated H (Guo & Zhao 2014 eq 13).
  * A result that cannot be written completely (--out /dev/full, a full disk)
  * is an error: exit status 1. */
 #define _POSIX_C_SOURCE 200809L
@@ -51,11 +51,11 @@ static void usage(FILE *fp) {
             "  --density                particle density [kg/m^3] (2650)\n"
             "  --thickness              2D disk thickness [m]: m = rho t pi r^2, volume = area t (0.1)\n"
             "  --damping                local non-viscous damping alpha (0.1)\n"
-            "  --damping-form           component (YADE/PFC, default) or vector (seed 000 eq 18)\n"
-            "  --dt                     time step [s] (default 0.5 x critical, seed 000 eq 19)\n"
-            "  --law                    linear (seed 000) or hertz (Hertz-Mindlin, G = E/(2(1+poisson)))\n"
+            "  --damping-form           component (YADE/PFC, default) or vector (Guo & Zhao 2014 eq 18)\n"
+            "  --dt                     time step [s] (default 0.5 x critical, Guo & Zhao 2014 eq 19)\n"
+            "  --law                    linear (Guo & Zhao 2014) or hertz (Hertz-Mindlin, G = E/(2(1+poisson)))\n"
             "  --poisson                Poisson ratio for the Hertz law (0.25)\n"
-            "  --path                   constant-L (default, the seed's) or objective (ends exactly at I + dH)\n"
+            "  --path                   constant-L (default, the paper authors') or objective (ends exactly at I + dH)\n"
             "  --threads T              threads inside the RVE (results identical for any T)\n"
             "  --out FILE.csv           CSV output (default rve_path.csv)\n"
             "  --svg FILE.svg           q/p plot (default: the CSV name with .svg)\n");
@@ -294,7 +294,7 @@ int main(int argc, char **argv) {
             }
             svg = svgname;
         }
-        gk_plot_init(&pl, "RVE stress ratio along the applied path", "deviatoric strain eps_q (seed 000 eq 13)",
+        gk_plot_init(&pl, "RVE stress ratio along the applied path", "deviatoric strain eps_q (Guo & Zhao 2014 eq 13)",
                      "q / p");
         gk_plot_add(&pl, xs, qp, (int)ninc + 1, NULL);
         if (gk_plot_svg(&pl, svg, &err)) {

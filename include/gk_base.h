@@ -34,7 +34,7 @@
  *
  * CONVENTIONS (all headers)
  *   - SI units throughout: m, kg, s, N, Pa.
- *   - Stress is tension-positive inside grainkit. The seed papers and the
+ *   - Stress is tension-positive inside grainkit. The papers and the
  *     example outputs are compression-positive: the conversion happens at
  *     output and is stated there.
  *   - Tensors are 3x3 row-major double[9], a[3*i+j] = a_ij. A 2D problem uses

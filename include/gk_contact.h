@@ -27,19 +27,19 @@
  *
  * LAWS (choose with gk_material.law; each is one line of GK_LAW_TABLE and
  * one block of gk_law_<name>_* functions, see LAWS below)
- *   GK_LAW_LINEAR  seed 000 eqs 14-17: k_n = E r* (or a constant k_n),
+ *   GK_LAW_LINEAR  Guo & Zhao 2014 eqs 14-17: k_n = E r* (or a constant k_n),
  *                  r* = 2 r_i r_j / (r_i + r_j); k_t = kt_ratio k_n;
  *                  F_n = k_n delta; F_t incremental: F_t <- F_t - k_t v_t dt,
  *                  Coulomb cap |F_t| <= mu F_n (Cundall-Strack, as YADE's
  *                  Law2_ScGeom_FrictPhys_CundallStrack).
- *   GK_LAW_HERTZ   seed 004 eqs 53-55 (incremental Hertz-Mindlin), with
+ *   GK_LAW_HERTZ   Liu et al. 2016 eqs 53-55 (incremental Hertz-Mindlin), with
  *                  G = E / (2 (1 + nu)), R_e = r*:
  *                  k_n = G/(1-nu) sqrt(2 R_e delta)  = dF_n/d delta,
  *                  F_n = (2/3) k_n delta            (exact Hertz force),
  *                  k_t = 2G/(2-nu) sqrt(2 R_e delta) (Mindlin, no-slip),
  *                  F_t incremental with the current k_t; same Coulomb cap.
- *                  (seed 000 sec 2.2 gives the same k_n, k_t.)
- *   Rolling        seed 003 eqs 24-25, 28: moment on j
+ *                  (Guo & Zhao 2014 sec 2.2 gives the same k_n, k_t.)
+ *   Rolling        Liang & Zhao 2019 eqs 24-25, 28: moment on j
  *                  M_r <- M_r - k_r w_roll dt, k_r = beta k_t r_i r_j,
  *                  |M_r| <= eta min(r_i, r_j) F_n; w_roll = w_j - w_i
  *                  (its part normal to n in 3D). Spring-slider, history kept.
@@ -52,7 +52,7 @@
  *                  dashpot then has the analytic restitution. The Coulomb
  *                  cap uses max(F_n, 0) and caps spring + dashpot, keeping
  *                  the spring so that their sum sits on the cap.
- *   Cohesion       seed 002 (Jiang et al.): a bond forms when a contact starts
+ *   Cohesion       Chen et al. 2021 (Jiang et al.): a bond forms when a contact starts
  *                  (delta > 0 after being apart); while bonded the normal
  *                  spring also pulls, down to F_n = -coh_n, and the cap is
  *                  mu max(F_n, 0) + coh_t. The bond breaks when the tension
@@ -117,7 +117,7 @@ typedef struct gk_material {
     gk_law law;
     double young;      /* E [Pa]: linear k_n = E r*; Hertz G = E / (2 (1 + poisson))  */
     double kn;         /* > 0: linear law with this constant k_n [N/m] instead of E r* */
-    double kt_ratio;   /* linear: k_t = kt_ratio k_n (seed 000 nu_c = 0.8)            */
+    double kt_ratio;   /* linear: k_t = kt_ratio k_n (Guo & Zhao 2014 nu_c = 0.8)            */
     double poisson;    /* Hertz-Mindlin Poisson ratio nu                               */
     double friction;   /* Coulomb coefficient mu = tan(phi) (0: frictionless)          */
     double roll_beta;  /* rolling stiffness factor beta: k_r = beta k_t r_i r_j        */
@@ -157,7 +157,7 @@ typedef struct gk_contact_out_w {
 extern "C" {
 #endif
 
-/* seed 000 material (YADE FEMxDEM prepareRVE.py): linear, E = 6e8 Pa,
+/* Guo & Zhao 2014 material (YADE FEMxDEM prepareRVE.py): linear, E = 6e8 Pa,
  * kt/kn = 0.8, mu = tan(0.5 rad), density 2650, no rolling/viscous/cohesion */
 GKDEF gk_material gk_material_default(void);
 GKDEF gk_result gk_material_check(const gk_material *m, gk_err *err);
@@ -179,13 +179,13 @@ GKDEF double gk_restitution_to_zeta(double e);
  *                         delta > 0: the scalar reference
  *   _stiffness_w(...)     its wide twin, GK_VR_W contacts, bit-identical lanes
  *   _kn_max(m, rmax, dmax) the largest k_n of two particles of radius <= rmax
- *                         at overlap <= dmax (critical time step, seed 000 eq 19)
+ *                         at overlap <= dmax (critical time step, Guo & Zhao 2014 eq 19)
  *   _stiffens()           1 if k_n grows with the overlap: the RVE re-checks
  *                         its time step at every list rebuild
  * `law` and `flags` are compile-time constants in the kernels, so a switch on
  * the law costs nothing. */
 
-/* ---- GK_LAW_LINEAR: seed 000 eqs 14-17, k_n = E r* (or a constant), k_t = kt_ratio k_n */
+/* ---- GK_LAW_LINEAR: Guo & Zhao 2014 eqs 14-17, k_n = E r* (or a constant), k_t = kt_ratio k_n */
 GK_INLINE gk_result gk_law_linear_check(const gk_material *m, gk_err *err) {
     if (!(m->kn > 0.0) && !(m->young > 0.0))
         return gk_err_set(err, GK_ERR_ARG, "linear law needs young > 0 or kn > 0 (young %g, kn %g)", m->young,
@@ -219,7 +219,7 @@ GK_INLINE double gk_law_linear_kn_max(const gk_material *m, double rmax, double 
 }
 GK_INLINE int gk_law_linear_stiffens(void) { return 0; }
 
-/* ---- GK_LAW_HERTZ: seed 004 eqs 53-55, incremental Hertz-Mindlin (see LAWS above) */
+/* ---- GK_LAW_HERTZ: Liu et al. 2016 eqs 53-55, incremental Hertz-Mindlin (see LAWS above) */
 GK_INLINE gk_result gk_law_hertz_check(const gk_material *m, gk_err *err) {
     if (!(m->young > 0.0)) return gk_err_set(err, GK_ERR_ARG, "Hertz law needs young > 0 (got %g)", m->young);
     if (!(m->poisson > -1.0 && m->poisson < 0.5))

@@ -34,7 +34,7 @@
  *     at most GK_RVE_STEP_OVERLAP_MAX (0.1) times the smaller radius:
  *       s(E) (r_min + r_max) <= 0.1 r_min,  s(E) = max_k |sigma_k(E) - 1|
  *     over the singular values sigma_k of E (a rotation costs nothing). For
- *     the 400-disk seed packing (r 3 to 7 mm) that is a stretch of 0.030 per
+ *     the 400-disk Guo & Zhao packing (r 3 to 7 mm) that is a stretch of 0.030 per
  *     step: a shear of 0.5 needs at least 9 steps. A larger increment is
  *     refused before anything moves, GK_ERR_ARG with the step count that
  *     would do; gk_rve_step applies the same bound to exp(L dt) (with a
@@ -42,13 +42,13 @@
  *     because the step count is the loading rate (dt is fixed): sub-steps
  *     would silently change the time and the inertial number the caller
  *     asked for. gk_rve_deform_adaptive (gk_homog.h) picks the count from
- *     the inertial number instead. (The old behaviour, measured on the seed
+ *     the inertial number instead. (The old behaviour, measured on the Guo & Zhao
  *     packing: 50 % shear in one step returned GK_OK with overlaps of 0.7 r.)
  *   gk_rve_stress after gk_rve_deform or gk_rve_step: the Love stress of the
  *     forces of the LAST step, computed at the positions before that step
  *     moved them (with the step's tangential increment): it lags the end
  *     state by about one step's increment, dH/n. With n = 1 that is most of
- *     dH (a shear of 1e-5 on the seed packing: sigma_xy 617 Pa before, 690
+ *     dH (a shear of 1e-5 on the Guo & Zhao packing: sigma_xy 617 Pa before, 690
  *     after the deform, 782 after gk_rve_refresh). gk_rve_refresh gives the
  *     stress of the end state (one force pass, history unchanged).
  *   gk_homog_tangent (gk_homog.h): the tangent at the current contacts.
@@ -75,7 +75,7 @@
  *                            and balance hold (gk_consolidate_def)
  *   gk_rve_deform_adaptive   gk_rve_deform with the step count chosen by the
  *       physics: n = ceil(I_1 / I_max) clamped to [n_min, n_max], I_1 the
- *       inertial number (seed 000 eq 20) of dH applied in one step at the
+ *       inertial number (Guo & Zhao 2014 eq 20) of dH applied in one step at the
  *       RVE's current pressure (p <= 0: n_max), so the deformation runs at
  *       I <= I_max; then gk_rve_relax to uf_max with the steps left to n_max
  *       (reported as capped if the ratio is still above). Quasi-static by
@@ -96,13 +96,13 @@
  * order I^2 in the quasi-static regime this code is for), as in YADE.
  *
  * LOCAL (NON-VISCOUS) DAMPING, factor alpha in [0, 1):
- *   GK_DAMP_COMPONENT (default; YADE, PFC, the seed 000 data): per component
+ *   GK_DAMP_COMPONENT (default; YADE, PFC, the Guo & Zhao 2014 data): per component
  *     a_k <- a_k (1 - alpha sign(a_k (v_k + a_k dt/2)))   (YADE cundallDamp2nd)
- *   GK_DAMP_VECTOR (seed 000 eq 18): F_damp = -alpha |F| v/|v|, with the same
+ *   GK_DAMP_VECTOR (Guo & Zhao 2014 eq 18): F_damp = -alpha |F| v/|v|, with the same
  *     mid-step velocity estimate v + a dt/2.
  *   Applied to the fluctuating velocity and spin.
  *
- * TIME STEP. gk_rve_dt_critical() is seed 000 eq 19, dt_cr = sqrt(m_min /
+ * TIME STEP. gk_rve_dt_critical() is Guo & Zhao 2014 eq 19, dt_cr = sqrt(m_min /
  * k_n,max) (Hertz: k_n at twice the current largest overlap, at least 1e-3
  * r_min). dt = 0 in the def means 0.5 dt_cr; a dt above dt_cr is an error.
  * Hertz contacts stiffen with load, so the RVE re-checks dt_cr at every
@@ -115,13 +115,13 @@
  * (every disk spinning alike, omega^2 = 4 Z k_t / m) - so the default 0.5
  * is unstable there, and a consolidated packing of equal frictional disks
  * at 0.5 dt_cr shears 11 % stiff with 400x the kinetic energy; nothing
- * flags it (tests/test_extremes.c). The polydisperse seed packing (Z ~ 4)
+ * flags it (tests/test_extremes.c). The polydisperse Guo & Zhao packing (Z ~ 4)
  * is stable to 0.9 dt_cr. Equal spheres, face-centred cubic (Z = 12,
  * omega^2 = (10/3) Z k_t / m): 0.354 dt_cr. For equal or nearly equal
  * particles use dt_factor <= 0.4 (2D disks), <= 0.3 (dense 3D packings).
  *
  * MASSES. 3D spheres: m = rho 4/3 pi r^3, I = 2/5 m r^2. 2D disks, default
- * GK_MASS_CYLINDER: cylinders of thickness t (seed 000: 0.1 m),
+ * GK_MASS_CYLINDER: cylinders of thickness t (Guo & Zhao 2014: 0.1 m),
  * m = rho t pi r^2, I = m r^2 / 2, stress volume = cell area x t;
  * GK_MASS_SPHERE: sphere masses for the disks (as LAMMPS in 2D), stress volume
  * = area x t (t = 1 if 0: stress in N/m).
@@ -206,7 +206,7 @@ typedef struct gk_rve_def {
     double dt;                /* time step [s]; 0 -> dt_factor x critical           */
     double dt_factor;         /* used when dt = 0; 0 -> 0.5                          */
     double skin;              /* Verlet skin [m]; 0 -> 0.1 x mean radius            */
-    double thickness;         /* 2D: disk thickness [m] (seed 000: 0.1)             */
+    double thickness;         /* 2D: disk thickness [m] (Guo & Zhao 2014: 0.1)             */
     gk_mass_model mass2d;
     double damping;           /* local non-viscous damping alpha in [0, 1)          */
     gk_damp_form damping_form;
@@ -313,7 +313,7 @@ typedef struct gk_consolidate_def {
 
 /* gk_rve_deform_adaptive: zero means default */
 typedef struct gk_adapt_def {
-    double inertial_max;   /* I bound of the deformation (seed 000 eq 20); 0 -> 5e-4   */
+    double inertial_max;   /* I bound of the deformation (Guo & Zhao 2014 eq 20); 0 -> 5e-4   */
     double unbalanced_max; /* unbalanced force ratio to reach after it; 0 -> 5e-3     */
     int n_min, n_max;      /* bounds on the total DEM steps; 0 -> 10 and 5000          */
     int every;             /* relaxation steps between checks; 0 -> 20                 */
@@ -366,9 +366,9 @@ GKDEF double gk_rve_unbalanced(const gk_rve *rve);
  * Yuan & Fish (2016) eq 57; 0 without contacts */
 GKDEF double gk_rve_unbalanced_rms(const gk_rve *rve);
 /* inertial number I = 2 gdot r_mean sqrt(rho / p), gdot = sqrt(sym(rate):sym(rate))
- * (seed 000 eq 20); p <= 0 -> +inf (not NaN) */
+ * (Guo & Zhao 2014 eq 20); p <= 0 -> +inf (not NaN) */
 GKDEF double gk_inertial_number(const double rate[9], int dim, double r_mean, double density, double p);
-/* Love stress of the last step (seed 000 eq 5), tension-positive, 3x3 */
+/* Love stress of the last step (Guo & Zhao 2014 eq 5), tension-positive, 3x3 */
 GKDEF void gk_rve_stress(const gk_rve *rve, double sigma[9]);
 /* recompute forces at the current positions without advancing (zero-length
  * step: history and positions unchanged), then stress etc. are current */
@@ -697,7 +697,7 @@ static void gk__particle_mass(const gk_rve *rve, double r, double *m, double *I)
     }
 }
 
-/* critical time step, seed 000 eq 19, at the geometry (h, reduced positions
+/* critical time step, Guo & Zhao 2014 eq 19, at the geometry (h, reduced positions
  * sb[k], pairs ib/jb of np) given as bytes: the live RVE's arrays or a saved
  * state being checked before it is restored */
 static double gk__dt_critical_at(const gk_rve *rve, const double h[9], const unsigned char *const sb[3],
@@ -928,7 +928,7 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                 dtc, R.rmin, R.rmax);
         else if (def->dt > 0.0) {
             if (def->dt > dtc)
-                res = gk_err_set(&R.err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)",
+                res = gk_err_set(&R.err, GK_ERR_DT, "time step %g s is above the critical %g s (Guo & Zhao 2014 eq 19)",
                                  def->dt, dtc);
             R.dt = def->dt;
         } else {
@@ -1863,7 +1863,7 @@ static double gk__integrate(gk_rve *rve, const gk__stepctx *x, const double hinv
 }
 
 /* ---------------------------------------------------------------- stress */
-/* Love stress sigma = -(1/V) sum F (x) d (seed 000 eq 5; F on j, d = x_j - x_i),
+/* Love stress sigma = -(1/V) sum F (x) d (Guo & Zhao 2014 eq 5; F on j, d = x_j - x_i),
  * the Voigt stiffness diagonal and contact statistics, in pair order. */
 /* Voigt stiffness estimate D_kkkk = (1/V) sum k_n d_k^4 / |d|^2 over the
  * contacts: only the servo uses it, so it is computed only while a servo is
@@ -1893,7 +1893,7 @@ static void gk__stiff_pass(gk_rve *rve) {
     for (k = 0; k < 3; ++k) rve->stiff[k] = st[k] / V;
 }
 
-/* Love stress (seed 000 eq 5) -(1/V) sum F (x) d over the contacts, their
+/* Love stress (Guo & Zhao 2014 eq 5) -(1/V) sum F (x) d over the contacts, their
  * number and mean force, in pair order. */
 static void gk__stress_pass(gk_rve *rve) {
     int dim = rve->dim, c, k, l, nc = 0;
@@ -2377,7 +2377,7 @@ GKDEF gk_result gk_rve_set_dt(gk_rve *rve, double dt) {
     double dtc = gk__dt_critical(rve);
     if (!(dt > 0.0) || !isfinite(dt)) return gk_err_set(&rve->err, GK_ERR_DT, "time step %g must be > 0", dt);
     if (dt > dtc)
-        return gk_err_set(&rve->err, GK_ERR_DT, "time step %g s is above the critical %g s (seed 000 eq 19)", dt, dtc);
+        return gk_err_set(&rve->err, GK_ERR_DT, "time step %g s is above the critical %g s (Guo & Zhao 2014 eq 19)", dt, dtc);
     rve->dt = dt;
     rve->dt_crit = dtc;
     return GK_OK;
@@ -2498,7 +2498,7 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
     maxs = cd->max_steps > 0 ? cd->max_steps : 2000000;
     for (p = 0; p < rve->n; ++p) rmean += (double)rve->r[p];
     rmean /= rve->n;
-    /* inertial number I = 2 rate r sqrt(rho/p) (seed 000 eq 20) kept at 1e-2 */
+    /* inertial number I = 2 rate r sqrt(rho/p) (Guo & Zhao 2014 eq 20) kept at 1e-2 */
     rate = cd->max_strain_rate > 0 ? cd->max_strain_rate
                                    : 1e-2 * sqrt(cd->pressure / rve->def.mat.density) / (2.0 * rmean);
     memset(&sv, 0, sizeof sv);

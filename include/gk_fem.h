@@ -3,7 +3,7 @@
  * Small-strain / updated-Lagrangian continuum elements whose material is a
  * tangent D and a stress sigma handed in per Gauss point (e.g. from a DEM RVE
  * through gk_homog.h), sparse assembly, boundary conditions and a
- * dependency-free linear solver. Seed 000 (Guo & Zhao 2014) eqs 1-4, 21.
+ * dependency-free linear solver. Guo & Zhao (2014) eqs 1-4, 21.
  *
  * DO THIS: #define GK_IMPLEMENTATION (or GK_FEM_IMPLEMENTATION) in one file.
  *
@@ -11,7 +11,7 @@
  *   GK_Q4    4-node bilinear quad, plane strain. Corners counter-clockwise
  *            from (-1,-1). Gauss 2x2 (default) or 1, 3.
  *   GK_Q8    8-node serendipity quad: corners as Q4, then mid-side nodes of
- *            edges 0-1, 1-2, 2-3, 3-0. Gauss 2x2 (reduced; the seed 000
+ *            edges 0-1, 1-2, 2-3, 3-0. Gauss 2x2 (reduced; the Guo & Zhao 2014
  *            authors' escript setting: 4 RVEs per element) or 3x3 (full).
  *   GK_HEX8  8-node trilinear hexahedron: the Q4 corners at zeta = -1, then at
  *            zeta = +1. Gauss 2x2x2, or 1 point with gk_fem_hex8_hourglass
@@ -23,7 +23,7 @@
  *   gk_fem_shape            N and dN/dxi of an element at a reference point
  *   gk_fem_jacobian         dN/dx and det J at a point of a mesh element;
  *                           det J <= 0 -> GK_ERR_MESH (inverted/degenerate)
- *   gk_fem_grad             H_ij = du_i/dx_j at a point (seed 000 eq 10 input)
+ *   gk_fem_grad             H_ij = du_i/dx_j at a point (Guo & Zhao 2014 eq 10 input)
  *   gk_fem_elem_stiffness   K_e = int B^T D B dV with D a full 4th-order
  *                           tangent D_ijkl (NOT assumed symmetric), layout
  *                           D[((i*dim+j)*dim+k)*dim+l] as gk_homog_tangent:

@@ -4,10 +4,10 @@
  *
  * DO THIS: #define GK_IMPLEMENTATION (or GK_HOMOG_IMPLEMENTATION) in one file.
  *
- * WHAT IS HERE (seed equations in brackets)
+ * WHAT IS HERE (paper equations in brackets)
  *   gk_rve_stress (gk_dem.h)   Love-Weber stress  sigma = -(1/V) sum F (x) d
- *                              [seed 000 eq 5, seed 003 eq 30, seed 004 eq 44b]
- *   gk_homog_tangent           Taylor (Voigt) tangent [seed 000 eq 9]:
+ *                              [Guo & Zhao 2014 eq 5, Liang & Zhao 2019 eq 30, Liu et al. 2016 eq 44b]
+ *   gk_homog_tangent           Taylor (Voigt) tangent [Guo & Zhao 2014 eq 9]:
  *        D_ijkl = (1/V) sum_c [k_n n_i n_k + k_t (delta_ik - n_i n_k)] d_j d_l
  *     (in 2D delta_ik - n_i n_k = t_i t_k, exactly eq 9; in 3D the whole
  *     tangent plane instead of YADE's single shear-force direction).
@@ -55,7 +55,7 @@
  *                              [Liu, Bosco & Suiker 2018 eq 38]
  *   gk_homog_fabric            phi = (1/N_c) sum n (x) n; 2D anisotropy
  *                              F_a = 4 dev phi, |F_a| = sqrt(F_a:F_a / 2)
- *                              [seed 000 eqs 22-25, seed 003 eqs 41-43];
+ *                              [Guo & Zhao 2014 eqs 22-25, Liang & Zhao 2019 eqs 41-43];
  *                              3D: F_a = 15/2 dev phi, |F_a| = sqrt(3/2 F_a:F_a)
  *   gk_homog_coordination      Z = 2 N_c / N_p; YADE's avgNumInteractions
  *                              (skipFree=True) = (2 N_c - N_1)/(N_p - N_0 - N_1)
@@ -63,18 +63,18 @@
  *                              removing rattlers (< dim + 1 contacts) iteratively
  *   gk_homog_void_ratio        e = (V_cell - V_solid) / V_solid (2D: areas)
  *   gk_homog_unbalanced        mean |sum F_p| / mean |F_c| (YADE), and the
- *                              RMS ratio I_uf of seed 004 eq 57
+ *                              RMS ratio I_uf of Liu et al. 2016 eq 57
  *   gk_homog_mean_rotation     2D mean particle rotation (incl. cell spin);
  *                              3D (GK_RVE_TRACK_ROTATION): mean magnitude of
  *                              the particles' accumulated rotation vectors
  *   gk_stress_p, gk_stress_q   p = -tr sigma / dim (compression-positive);
- *                              2D q = sqrt(s:s / 2) [seed 000 eq 7];
+ *                              2D q = sqrt(s:s / 2) [Guo & Zhao 2014 eq 7];
  *                              3D q = sqrt(3/2 s:s)
  *   gk_strain_v, gk_strain_q   eps_v = tr eps (tension-positive: dilation > 0;
  *                              the seeds flip it); 2D eps_q = sqrt(2 e:e)
- *                              [seed 000 eq 13]; 3D eps_q = sqrt(2/3 e:e)
+ *                              [Guo & Zhao 2014 eq 13]; 3D eps_q = sqrt(2/3 e:e)
  *   gk_rotation_angle          rotation of the polar decomposition of F
- *                              [seed 003 eqs 36-40], radians (2D: signed)
+ *                              [Liang & Zhao 2019 eqs 36-40], radians (2D: signed)
  *   gk_inertial_number, gk_rve_unbalanced, gk_rve_deform_adaptive,
  *   gk_rve_relax               are in gk_dem.h (they drive the RVE); gk_homog_unbalanced
  *                              gives gk_rve_unbalanced's mean ratio and the RMS one

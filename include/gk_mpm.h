@@ -12,8 +12,8 @@
  * DO THIS: #define GK_IMPLEMENTATION (or GK_MPM_IMPLEMENTATION) in one file
  * before including; see gk_base.h.
  *
- * WHAT IS HERE (seed equations in brackets; seed 003 = Liang & Zhao MPMxDEM,
- * seed 002 = Chen et al. hybrid; notes in ../shared/notes/)
+ * WHAT IS HERE (paper equations in brackets: Liang & Zhao 2019, the MPMxDEM
+ * model; Chen et al. 2021, the hybrid continuum-grain model)
  *   gk_mpm_grid_create/_destroy   regular grid: origin, spacing h, n[3] nodes;
  *                                 node arrays (struct of arrays) m, p, v, vn,
  *                                 fint, fext through the gk_allocator
@@ -26,7 +26,7 @@
  *   gk_mpm_shape                  nodes, weights, gradients of one point
  *   gk_mpm_p2g                    mass, momentum (PIC/FLIP or APIC), v = p/m,
  *                                 internal force -sum V sigma.grad N, external
- *                                 force sum N (m g + f_p)   [seed 003 eqs 10-13]
+ *                                 force sum N (m g + f_p)   [Liang & Zhao 2019 eqs 10-13]
  *   gk_mpm_grid_update            vn = (p + dt f)/m, local damping, face BCs,
  *                                 rigid bodies and their reaction forces
  *   gk_mpm_g2p                    velocity (PIC/FLIP blend or APIC), position,
@@ -36,11 +36,11 @@
  *   gk_mpm_step                   one step in USF, USL or MUSL order
  *   gk_mpm_bodies_advance         move rigid bodies by v dt
  *   gk_mpm_wave_speed             P-wave speed, for the time step
- *   gk_mpm_point_dH               dH = dt L, what an RVE receives [seed 003 (b)]
- *   gk_mpm_point_polar            F = R U via gk_m3_polar [seed 003 eqs 36-40]
+ *   gk_mpm_point_dH               dH = dt L, what an RVE receives [Liang & Zhao 2019 (b)]
+ *   gk_mpm_point_polar            F = R U via gk_m3_polar [Liang & Zhao 2019 eqs 36-40]
  *   gk_mpm_elastic_update         hypoelastic increment (objective rotation)
  *   gk_mpm_dp_*                   Drucker-Prager return map with apex return
- *                                 and critical-state softening [seed 002 eqs 4-8]
+ *                                 and critical-state softening [Chen et al. 2021 eqs 4-8]
  *
  * GRID. Node (i,j,k) sits at origin + h (i,j,k), index i + n0 (j + n1 k);
  * 0 <= i < n[0]. Cells are the n-1 intervals between nodes. In 2D n[2] = 1
@@ -60,9 +60,9 @@
  * entries (at most GK_MPM_MAX_STENCIL = 64), zero weights included.
  *
  * TRANSFERS
- *   PIC/FLIP [seed 003 eqs 17-19]: v_p <- alpha v_PIC + (1-alpha) v_FLIP,
+ *   PIC/FLIP [Liang & Zhao 2019 eqs 17-19]: v_p <- alpha v_PIC + (1-alpha) v_FLIP,
  *     v_PIC = sum N vn_I, v_FLIP = v_p + sum N (vn_I - v_I); alpha = 1 is
- *     PIC, 0 is FLIP; seed 003 uses 0.1 (5e-4 for the column collapse).
+ *     PIC, 0 is FLIP; Liang & Zhao 2019 uses 0.1 (5e-4 for the column collapse).
  *   APIC (Jiang et al. 2015): the point carries C = B D^-1 (field C, the
  *     affine velocity; B D^-1 with D = h^2/4 I (quadratic), h^2/3 I (cubic);
  *     for linear and uGIMP, whose D is not constant, C = sum vn_I (x) grad N,
@@ -74,7 +74,7 @@
  *
  * ORDERINGS (gk_mpm_step does exactly these calls; write them out to
  * interleave a DEM stress update differently)
- *   USF  [seed 003 Sec 2.3]: p2g(MOMENTUM) -> g2p(GRADIENT_OLD: L from the
+ *   USF  [Liang & Zhao 2019 Sec 2.3]: p2g(MOMENTUM) -> g2p(GRADIENT_OLD: L from the
  *        P2G velocities v) -> stress -> p2g(FORCE) -> grid_update ->
  *        g2p(VELOCITY | POSITION)
  *   USL: p2g(MOMENTUM | FORCE) -> grid_update -> g2p(GRADIENT_NEW | VELOCITY
@@ -111,7 +111,7 @@
  *
  * DAMPING (optional, def.damping in [0,1)): Cundall local non-viscous
  * damping on the grid, f_k -= damping |f_k| sign(v_k) per node (the form of
- * seed 003 eq 29, applied to nodes) for quasi-static runs.
+ * Liang & Zhao 2019 eq 29, applied to nodes) for quasi-static runs.
  *
  * THREADS AND DETERMINISM. P2G scatters without atomics: points are
  * counting-sorted into blocks of 4^dim cells, the blocks are coloured
@@ -124,20 +124,20 @@
  *
  * STRESS UPDATE. gk_mpm_step calls a user function after L is known; each
  * point's dH = dt L (stretch + spin) goes to its RVE, whose Love-Weber
- * stress (tension-positive) goes back to sigma [seed 003 (b)]. For continuum
+ * stress (tension-positive) goes back to sigma [Liang & Zhao 2019 (b)]. For continuum
  * points: gk_mpm_elastic_update and gk_mpm_dp_update. Both rotate sigma by
  * R = exp(dt W), W = skew L, then add the small-strain increment of
- * d eps = sym(dH) (hypoelastic; seed 002 writes the same law in Hencky
+ * d eps = sym(dH) (hypoelastic; Chen et al. 2021 writes the same law in Hencky
  * strains, identical to first order in dH).
  *
- * DRUCKER-PRAGER [seed 002 eqs 4-8], p = tr sigma / dim (tension-positive),
+ * DRUCKER-PRAGER [Chen et al. 2021 eqs 4-8], p = tr sigma / dim (tension-positive),
  * s = sigma - p I, q = sqrt(J2) = sqrt(s:s/2):
  *   f = q + eta p - zeta c,  g = q + etabar p (plastic potential)
  *   trial: sigma_tr = sigma + K tr(de) I + 2 G dev(de)
  *   f_tr <= 0 elastic; else dlambda = f_tr / (G + K eta etabar),
  *   s = s_tr (1 - G dlambda / q_tr), p = p_tr - K etabar dlambda;
  *   apex when q_tr < G dlambda: s = 0, p = zeta c / eta.
- *   2D (seed 002): eta = sin phi, etabar = sin psi, zeta = cos phi (exactly
+ *   2D (Chen et al. 2021): eta = sin phi, etabar = sin psi, zeta = cos phi (exactly
  *   Mohr-Coulomb in plane). 3D: the compression-meridian cone,
  *   eta = 6 sin phi / (sqrt3 (3 - sin phi)), zeta = 6 cos phi / (...).
  *   Critical state (chi > 0): tan phi = tan phi_cs + (Phi - Phi_cs) chi,
@@ -297,7 +297,7 @@ typedef struct gk_mpm_dp {
     double etabar; /* dilatancy coefficient of g (2D: sin psi) */
     double zeta;   /* cohesion factor (2D: cos phi) */
     double c;      /* cohesion [Pa] (>= 0) */
-    /* critical-state softening [seed 002 eqs 7-8]; off when chi <= 0 */
+    /* critical-state softening [Chen et al. 2021 eqs 7-8]; off when chi <= 0 */
     double tan_phi_cs, Phi_cs, chi, xi;
 } gk_mpm_dp;
 
@@ -354,7 +354,7 @@ GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def
                             gk_mpm_stress_fn stress, void *user, gk_err *err);
 GKDEF void gk_mpm_bodies_advance(gk_mpm_body *body, int nbody, double dt);
 
-/* F = R U of point p [seed 003 eqs 36-40]; GK_ERR_SINGULAR if det F <= 0 */
+/* F = R U of point p [Liang & Zhao 2019 eqs 36-40]; GK_ERR_SINGULAR if det F <= 0 */
 GKDEF gk_result gk_mpm_point_polar(const gk_mpm_points *pts, int p, double R[9], double U[9], gk_err *err);
 
 /* hypoelastic update: sigma <- R sigma R^T + K tr(de) I + 2G dev(de) */
@@ -434,7 +434,7 @@ GK_INLINE double gk_mpm_kernel_1d(gk_mpm_basis b, double r, double l, double *dN
 }
 
 /* dH = dt L of point p: the incremental displacement gradient (stretch and
- * spin) an RVE receives for this step [seed 003 step (b)] */
+ * spin) an RVE receives for this step [Liang & Zhao 2019 step (b)] */
 GK_INLINE void gk_mpm_point_dH(const gk_mpm_points *pts, int p, double dt, double dH[9]) {
     int k;
     for (k = 0; k < 9; ++k) dH[k] = dt * pts->L[9 * p + k];
@@ -707,7 +707,7 @@ GKDEF gk_mpm_def gk_mpm_def_default(void) {
     d.basis = GK_MPM_LINEAR;
     d.transfer = GK_MPM_PIC_FLIP;
     d.scheme = GK_MPM_USF;
-    d.alpha = 0.1; /* seed 003 */
+    d.alpha = 0.1; /* Liang & Zhao 2019 */
     d.threads = 1;
     return d;
 }

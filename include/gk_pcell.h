@@ -6,7 +6,7 @@
  * cell (h <- E h) moves every particle affinely with it; the DEM integrates
  * only the fluctuation around that affine field (gk_dem.h). This is the
  * deforming-cell (Parrinello-Rahman kinematics, strain-controlled) form used
- * by YADE's Cell and by the seed 000 authors' code.
+ * by YADE's Cell and by the Guo & Zhao 2014 authors' code.
  *
  * DO THIS: #define GK_IMPLEMENTATION (or GK_PCELL_IMPLEMENTATION) in one file
  * before including; see gk_base.h.
@@ -20,7 +20,7 @@
  *   gk_path_init/_step     a displacement-gradient increment dH split over
  *                          n steps (det(I + dH) <= 0 is refused on both):
  *                          GK_PATH_CONSTANT_L  constant velocity gradient
- *                                              L = dH/(n dt) (seed 000 [C],
+ *                                              L = dH/(n dt) (Guo & Zhao 2014 [C],
  *                                              YADE); end map exp(dH) =
  *                                              I + dH + dH^2/2 + ...
  *                          GK_PATH_OBJECTIVE   rotation by angle and stretch

@@ -39,7 +39,7 @@
  *   gk_scene_position, gk_scene_dt_critical
  *
  * TIME STEP. def.rve.dt = 0: dt_factor (0 -> 0.5) x the smallest critical
- * step (seed 000 eq 19) of the pair and the wall contacts, lowered as walls
+ * step (Guo & Zhao 2014 eq 19) of the pair and the wall contacts, lowered as walls
  * are added; an explicit dt is checked against both and refused if above.
  * Hertz contacts are re-checked at every list rebuild (GK_ERR_DT when the
  * overlaps have grown too much; choose dt explicitly for Hertz scenes).
@@ -104,8 +104,8 @@
  * (and spin) of particle p from the next step on; its load (the sum of every
  * force and moment on it except the constraint's: contacts, walls, gravity,
  * external) is in sc.load[k][p], sc.loadt[k][p] after each step;
- * gk_scene_release frees it. (Seed 001's frame of boundary particles and
- * seed 002's trained grains are prescribed particles.)
+ * gk_scene_release frees it. (Liu, Bosco & Suiker 2018's frame of boundary particles and
+ * Chen et al. 2021's trained grains are prescribed particles.)
  *
  * MEMBRANE (2D). gk_scene_add_membrane(sc, k, ids, pressure, stiffness,
  * anchor_first, anchor_last): a chain of particles (stable ids, the
@@ -115,7 +115,7 @@
  * 2D thickness of gk_rve: the same t the stress is divided by). With
  * stiffness > 0, consecutive members are also tied by tension-only springs
  * of that stiffness and rest length their initial distance (the mass-spring
- * membrane of seed 002 App. B), so the chain cannot open gaps an inner
+ * membrane of Chen et al. 2021 App. B), so the chain cannot open gaps an inner
  * particle could escape through. An anchor (a wall index, -1 for none)
  * closes the chain at that end on a platen, as the rubber sleeve of a
  * biaxial cell is clamped to it: the end member is tied (same spring) to
@@ -953,7 +953,7 @@ static gk_result gk__wall_check(gk_scene *sc, const gk_wall_def *d) {
     return GK_OK;
 }
 
-/* critical time step of the stiffest wall contact (seed 000 eq 19 with the
+/* critical time step of the stiffest wall contact (Guo & Zhao 2014 eq 19 with the
  * wall's k_n; Hertz at twice the largest current overlap, >= 1e-3 r_min) */
 static double gk__walls_dt_critical(const gk_scene *sc) {
     double dtc = 1e300;
@@ -1047,7 +1047,7 @@ GKDEF gk_result gk_scene_add_wall(gk_scene *sc, const gk_wall_def *wd, int *inde
             gk__wall_free(sc, &sc->walls[--sc->nwalls]);
             return gk_err_set(
                 &sc->err, GK_ERR_DT,
-                "time step %g s is above the critical %g s of this wall's contacts (seed 000 eq 19)",
+                "time step %g s is above the critical %g s of this wall's contacts (Guo & Zhao 2014 eq 19)",
                 sc->rve.dt, dtc);
         }
     } else {

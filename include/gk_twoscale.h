@@ -57,13 +57,13 @@
  * THE DEM STEPS OF A RUN (gk_twoscale_rule; the one implementation)
  *   GK_TWOSCALE_ADAPTIVE (default): gk_rve_deform_adaptive (gk_homog.h) - dH
  *     over n = clamp(ceil(I_1 / I_max), n_min, n_max) steps, I_1 the inertial
- *     number (seed 000 eq 20) of dH in one DEM step at the RVE's pressure,
+ *     number (Guo & Zhao 2014 eq 20) of dH in one DEM step at the RVE's pressure,
  *     then relaxation at fixed cell in chunks of `every` steps while the
  *     unbalanced force ratio exceeds unbalanced_max, n_max steps in all
  *     (the mean ratio, as YADE; unbalanced_rms = 1: the RMS ratio I_uf of
  *     Liu, Sun, Yuan & Fish 2016 eq 57).
  *   GK_TWOSCALE_STRAIN: n = clamp(ceil(max|dH_ij| / strain), n_min, n_max),
- *     no relaxation (seed 000's scripts: strain = 1e-5).
+ *     no relaxation (Guo & Zhao 2014's scripts: strain = 1e-5).
  *   run_def.scale < 1 marks a cut-back increment: the bound is scaled with it
  *   (strain x scale, I_max x scale), so a cut-back increment keeps the step
  *   count of the full one - a slower ramp, not fewer and noisier steps.
@@ -88,7 +88,7 @@
  *
  * THE TANGENT (D != NULL in gk_twoscale_run)
  *   GK_TWOSCALE_TANGENT_HOMOG (default): gk_homog_tangent with tangent_opts:
- *     0 = eq 9 of seed 000 (Taylor, sliding contacts k_t = 0),
+ *     0 = eq 9 of Guo & Zhao 2014 (Taylor, sliding contacts k_t = 0),
  *     GK_TANGENT_SLIDING_KEEP (the authors' YADE form), GK_TANGENT_RELAXED
  *     (the particles relaxed), see gk_homog.h.
  *   GK_TWOSCALE_TANGENT_PERTURBATION: eq 8 of Guo & Zhao (2014), finite
@@ -109,11 +109,11 @@
  * CONVENTIONS (as every grainkit header; gk_base.h)
  *   SI units. Stress and the tangent are TENSION-POSITIVE (the seeds are
  *   compression-positive: convert at output). Tensors are 3x3 row-major,
- *   dH[9 p + 3 i + j] = d(u_i)/d(x_j) of point p (stretch AND spin: seed 000
+ *   dH[9 p + 3 i + j] = d(u_i)/d(x_j) of point p (stretch AND spin: Guo & Zhao 2014
  *   eq 10); in 2D the out-of-plane entries (2, 5, 6, 7, 8) must be 0 (a dH
  *   with one is refused, not clipped). sigma[9 p + 3 i + j] is the Love
- *   stress (seed 000 eq 5), D[dim^4 p + ((i dim + j) dim + k) dim + l]
- *   = d sigma_ij / d dH_kl. Fields: p = -tr(sigma)/dim and q (seed 000 eq 7)
+ *   stress (Guo & Zhao 2014 eq 5), D[dim^4 p + ((i dim + j) dim + k) dim + l]
+ *   = d sigma_ij / d dH_kl. Fields: p = -tr(sigma)/dim and q (Guo & Zhao 2014 eq 7)
  *   compression-positive, eps_v = tr sym(H) tension-positive, rotations in
  *   radians counter-clockwise.
  *
@@ -161,9 +161,9 @@
  * CONFIGURATION: GK_TWOSCALE_MPI (above).
  * REFERENCES: Guo N., Zhao J. (2014) A coupled FEM/DEM approach for
  *   hierarchical multiscale modelling of granular media. Int J Numer Meth
- *   Eng 99:789-818 (seed 000: eqs 5, 7, 8, 9, 10, 20). Liang W., Zhao J.
+ *   Eng 99:789-818 (Guo & Zhao 2014: eqs 5, 7, 8, 9, 10, 20). Liang W., Zhao J.
  *   (2019) Multiscale modeling of large deformation in geomechanics
- *   (seed 003: MPMxDEM, the explicit use).
+ *   (Liang & Zhao 2019: MPMxDEM, the explicit use).
  * LICENCE: MIT (see gk_base.h).
  */
 #ifndef GK_TWOSCALE_H
@@ -218,7 +218,7 @@ typedef struct gk_twoscale_def {
     unsigned tangent_opts; /* GK_TANGENT_* of gk_homog_tangent (also eq 8's start tangent)  */
     gk_twoscale_proc_fn proc; /* the caller's procedure instead of the rule (above); NULL: none */
     void *proc_user;          /* its first argument                                          */
-    double xi;             /* eq 8 perturbation of dH; 0 -> 5e-5 (seed 000 Fig 6)          */
+    double xi;             /* eq 8 perturbation of dH; 0 -> 5e-5 (Guo & Zhao 2014 Fig 6)          */
     double reuse;          /* tangent reuse bound, 0 <= X < 1; 0: off                      */
     int threads;           /* OpenMP threads over a rank's points; 0 -> 1                  */
     double balance_tol;    /* MPI: accepted load imbalance; 0 -> 0.05                      */
@@ -243,7 +243,7 @@ typedef struct gk_twoscale_point {
 
 /* per-point fields of the ACCEPTED state (for VTK and the like); all doubles */
 typedef struct gk_twoscale_field {
-    double p, q;         /* -tr(sigma)/dim and q of seed 000 eq 7 [Pa], compression +      */
+    double p, q;         /* -tr(sigma)/dim and q of Guo & Zhao 2014 eq 7 [Pa], compression +      */
     double void_ratio;   /* gk_homog_void_ratio                                            */
     double coordination; /* Z = 2 contacts / particles                                     */
     double fabric;       /* |F_a| of the contact normals (gk_homog_fabric)                 */

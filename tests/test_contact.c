@@ -87,7 +87,7 @@ TEST(impact_restitution_matches_analytic) {
     CHECK_NEAR(exp(-GK_PI * gk_restitution_to_zeta(0.3) / sqrt(1 - pow(gk_restitution_to_zeta(0.3), 2))), 0.3, 1e-14);
 }
 
-/* Coulomb stick and slip (seed 000 eq 17, incremental form): F_t grows by
+/* Coulomb stick and slip (Guo & Zhao 2014 eq 17, incremental form): F_t grows by
  * -k_t v_t dt while |F_t| < mu F_n, then stays on the cap; reversing the
  * motion unloads elastically with k_t. 2D law called directly. */
 TEST(coulomb_stick_and_slip_2d) {
@@ -163,7 +163,7 @@ TEST(coulomb_stick_and_slip_3d) {
     CHECK_REL((double)ft[2] / mag, 0.8, 1e-12);
 }
 
-/* Rolling resistance (seed 003 eqs 24-25): M_r = -k_r theta_r with
+/* Rolling resistance (Liang & Zhao 2019 eqs 24-25): M_r = -k_r theta_r with
  * k_r = beta k_t r_i r_j, capped at eta min(r_i, r_j) F_n. */
 TEST(rolling_moment_cap) {
     gk_material m = gk_material_default();
@@ -194,7 +194,7 @@ TEST(rolling_moment_cap) {
     CHECK_REL((double)o.ti[2] - (-(ri - 0.5 * delta) * (double)ft), -(double)mr, 1e-9);
 }
 
-/* Hertz-Mindlin (seed 004 eqs 53-55): F_n = (2/3) k_n delta and
+/* Hertz-Mindlin (Liu et al. 2016 eqs 53-55): F_n = (2/3) k_n delta and
  * k_n = dF_n/d delta = G/(1-nu) sqrt(2 R_e delta), k_t = 2G/(2-nu) sqrt(2 R_e delta). */
 TEST(hertz_force_is_integral_of_stiffness) {
     gk_material m = gk_material_default();
@@ -216,7 +216,7 @@ TEST(hertz_force_is_integral_of_stiffness) {
     CHECK_REL(fn, 4.0 / 3.0 * m.young / (2 * (1 - nu * nu)) * sqrt(Re / 2) * pow(delta, 1.5), 1e-13);
 }
 
-/* Cohesion (seed 002): a bond forms on contact, holds tension up to coh_n,
+/* Cohesion (Chen et al. 2021): a bond forms on contact, holds tension up to coh_n,
  * then breaks; the broken pair is cohesionless until it separates. */
 TEST(cohesion_tension_limit) {
     gk_material m = gk_material_default();
@@ -472,7 +472,7 @@ TEST(wide_twins_equal_scalar_reference_bitwise) {
 }
 
 /* gk_law_kn_max bounds the normal stiffness of every law for radii up to
- * r_max and overlaps up to d_max (the critical time step of seed 000 eq 19
+ * r_max and overlaps up to d_max (the critical time step of Guo & Zhao 2014 eq 19
  * rests on it), and a law that stiffens says so. */
 TEST(law_kn_max_bounds_the_stiffness) {
     gk_rng rng;

@@ -42,7 +42,7 @@ static int same_state(const gk_rve *a, const gk_rve *b) {
     return same;
 }
 
-/* The seed 000 packing: its Love stress (seed 000 eq 5), void ratio and
+/* The Guo & Zhao 2014 packing: its Love stress (Guo & Zhao 2014 eq 5), void ratio and
  * coordination equal what YADE's getStress(), voidratio and
  * avgNumInteractions report in the file header, to the printed digits. */
 TEST(seed_packing_reproduces_yade) {
@@ -68,7 +68,7 @@ TEST(seed_packing_reproduces_yade) {
     CHECK(z.z_mech >= z.z);
     /* the seed's time step 3.16e-5 s is below our eq-19 critical step */
     CHECK(rve.dt_crit > 3.1602e-5);
-    /* p and q (seed 000 eqs 6, 7): compression-positive p, q = |s1 - s2| / 2 */
+    /* p and q (Guo & Zhao 2014 eqs 6, 7): compression-positive p, q = |s1 - s2| / 2 */
     CHECK_NEAR(gk_stress_p(s, 2), 0.5 * (100028.513620 + 99924.255780), 1e-5);
     {
         double a = -100028.513620, b = -99924.255780, c = 617.394902;
@@ -188,7 +188,7 @@ static double contract(const double *D, int dim, const double H[9], int i, int j
     return s;
 }
 
-/* Taylor tangent, seed 000 eq 9: at vanishing preload it IS the derivative of
+/* Taylor tangent, Guo & Zhao 2014 eq 9: at vanishing preload it IS the derivative of
  * the Love stress under an affine, no-slip map (hexagonal lattice, overlap
  * 1e-7 r: the initial-stress terms are 1e-7 of k_n). */
 TEST(taylor_tangent_is_fd_tangent_at_vanishing_preload) {
@@ -675,7 +675,7 @@ static double contact_energy(const gk_rve *rve) {
     return e;
 }
 
-/* dt = 0.9 dt_crit (seed 000 eq 19), no damping: leap-frog stays stable; the
+/* dt = 0.9 dt_crit (Guo & Zhao 2014 eq 19), no damping: leap-frog stays stable; the
  * kinetic energy never exceeds the elastic energy stored at the start. */
 TEST(dt_at_0_9_critical_stays_bounded) {
     gk_rve rve;
@@ -1137,7 +1137,7 @@ TEST(relax_holds_the_cell_until_balanced) {
 }
 
 /* gk_rve_deform_adaptive (gk_homog.h): the deformation runs n = ceil(I_1 /
- * I_max) steps, I_1 = 2 |sym dH / dt| r_mean sqrt(rho / p) (seed 000 eq 20)
+ * I_max) steps, I_1 = 2 |sym dH / dt| r_mean sqrt(rho / p) (Guo & Zhao 2014 eq 20)
  * of the whole dH in one step, so n doubles with |dH| and with 1/sqrt(p);
  * then relaxation at fixed cell until the unbalanced ratio is below uf_max
  * (which it must then be) or n_max is reached (then reported as capped). */

@@ -259,7 +259,7 @@ TEST(hexagonal_rve_is_isotropic_at_100_kPa) {
     CHECK_NEAR(v[11], 6.0, 1e-12);
 }
 
-/* femdem_biaxial (seed 000): documented CSV header and RESULT line, VTK and
+/* femdem_biaxial (Guo & Zhao 2014): documented CSV header and RESULT line, VTK and
  * SVG outputs; the same result for 1 and 2 threads; a restart from a
  * checkpoint continues to the identical curve; the initial state carries the
  * confining pressure (sigma_xx = sigma_yy = 100 kPa from the reactions of
@@ -299,7 +299,7 @@ TEST(femdem_biaxial_runs_restarts_and_is_thread_independent) {
     CHECK(gk_test_file_has("build/t_bad.out", "--restart"));
 }
 
-/* single-element test (seed 000 sec 3.3, Fig 6): one Q4 element with 4
+/* single-element test (Guo & Zhao 2014 sec 3.3, Fig 6): one Q4 element with 4
  * identical RVEs follows the RVE loaded alone under the same drained path */
 TEST(femdem_single_element_matches_rve_alone) {
     double d = 1.0;
@@ -388,7 +388,7 @@ TEST(femdem_single_reference_through_a_slip) {
     "failed_gp,dem_steps_mean,dem_steps_max,dem_steps,tangents_reused,tangents_computed\n"
 enum { C_STEP, C_CYCLE, C_GAMMA, C_TAU, C_SYY, C_SXX, C_P, C_Q, C_EVR, C_UY, C_ITER, C_NCOL = 16 };
 
-/* cyclic simple shear, strain control (seed 000 sec 5): documented CSV and
+/* cyclic simple shear, strain control (Guo & Zhao 2014 sec 5): documented CSV and
  * RESULT line; constant volume (platen lift 0, mean RVE volume change ~0:
  * the periodic ties keep the width); tau has the sign of gamma at the turning
  * points; the loose packing loses mean stress over a cycle (contractive); the

@@ -172,7 +172,7 @@ static void m3_rot2(double th, double R[9]) {
 }
 
 /* ===================================================== 1. time step
- * dt from 0.1 to 0.95 of gk_rve_dt_critical() (seed 000 eq 19,
+ * dt from 0.1 to 0.95 of gk_rve_dt_critical() (Guo & Zhao 2014 eq 19,
  * dt_cr = sqrt(m_min / k_n,max)), then beyond it.
  *
  * (a) Seed packing (400 disks, radii 3-7 mm, friction, rotating), no
@@ -463,7 +463,7 @@ TEST(dt_beyond_critical_is_refused_or_reported) {
  * to 2 % (a small shear of a packing at equilibrium), shear stress
  * sigma_xy > 0 (du_x/dy > 0, tension-positive), growing with k_t/k_n (a
  * stiffer tangential spring stiffens the packing), and below the Taylor
- * bound D:dH (seed 000 eq 9, affine: an upper bound on a relaxed response).
+ * bound D:dH (Guo & Zhao 2014 eq 9, affine: an upper bound on a relaxed response).
  * k_t = 0: the tangential spring never loads, so every contact force is
  * exactly normal (F = F_n n: |F_t| / |F| at rounding level), the stored
  * tangential history is exactly 0, and no torque acts (fluctuating spins
@@ -1235,7 +1235,7 @@ TEST(far_from_origin_reduced_coordinates) {
 
 /* ===================================================== 11. Newton cut-back
  * A macro Newton iteration that cannot converge is cut back (increment
- * halving) rather than producing NaN. examples/femdem_biaxial (seed 000
+ * halving) rather than producing NaN. examples/femdem_biaxial (Guo & Zhao 2014
  * FEMxDEM driver; `make test` builds it first) documents: a load step not
  * converged in --max-iter iterations (or with failed RVEs) restarts from
  * the last converged state with half the increment, down to 1/16; the

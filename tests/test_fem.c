@@ -618,7 +618,7 @@ static double *uniform_tangent(const gk_mesh *m, const gk_quad *q, double E, dou
     return Dall;
 }
 
-/* Periodic simple shear (seed 000 sec 5 boundary conditions): left/right
+/* Periodic simple shear (Guo & Zhao 2014 sec 5 boundary conditions): left/right
  * tied, bottom fixed, top moved by gamma H with u_y = 0. On a distorted mesh
  * the solution is the homogeneous simple shear u_x = gamma y, u_y = 0 to
  * round-off, and the top reaction is mu gamma W. With free sides instead the

@@ -526,7 +526,7 @@ TEST(wall_and_body_contact_laws) {
     }
 }
 
-/* Drucker-Prager [seed 002 eqs 5-6, return map of its Sec 2.2]: an elastic
+/* Drucker-Prager [Chen et al. 2021 eqs 5-6, return map of its Sec 2.2]: an elastic
  * trial is untouched; a cone return lands on f = 0, keeps the direction of
  * s and moves p by -K etabar dlambda; a tensile trial goes to the apex
  * p = zeta c / eta, s = 0. 2D and 3D. */
@@ -589,7 +589,7 @@ TEST(drucker_prager_return_map) {
 
 /* dp_update: a pure spin rotates the stress (sigma' = R sigma R^T, no yield
  * change); shearing a dense packing (Phi > Phi_cs) at yield dilates it:
- * Phi decreases towards Phi_cs [seed 002 eq 8] and the stress stays on f = 0. */
+ * Phi decreases towards Phi_cs [Chen et al. 2021 eq 8] and the stress stays on f = 0. */
 TEST(drucker_prager_update_spin_and_critical_state) {
     gk_mpm_dp dp;
     gk_err e;
@@ -684,7 +684,7 @@ TEST(threads_give_identical_bits) {
 }
 
 /* L from an affine grid velocity is exact; F = (I + dt L) F, V = det F V0;
- * polar decomposition of F [seed 003 eqs 36-40] recovers the rotation. */
+ * polar decomposition of F [Liang & Zhao 2019 eqs 36-40] recovers the rotation. */
 TEST(velocity_gradient_F_and_polar) {
     gk_mpm_grid g = make_grid(2, 0.0, 0.0, 0.0, 0.1, 12, 12, 1);
     gk_mpm_points P;

@@ -1352,7 +1352,7 @@ TEST(periodic_shear_between_walls) {
     gk_scene_destroy(&sc);
 }
 
-/* gk_packing_tile: the seed 000 RVE repeated 2 x 1 is the same periodic
+/* gk_packing_tile: the Guo & Zhao 2014 RVE repeated 2 x 1 is the same periodic
  * material - its Love stress (after a force refresh) is the original's to
  * 1e-9 - with twice the particles and cell; gk_packing_subset: exactly the
  * particles (wholly) inside the box, in order, shifted to its corner. */

@@ -1,5 +1,5 @@
 /* test_simd.c - the SIMD force kernels equal the scalar reference bit for bit
- * (DESIGN.md principle 3), for every law and physics switch, 2D and 3D.
+ * (the scalar law is the reference; SIMD is a faster way to the same bits), for every law and physics switch, 2D and 3D.
  * tests/test_simd_float.c compiles this file again with GK_REAL_FLOAT. */
 #ifndef GK_TEST_SIMD_NO_IMPL
 #define GK_IMPLEMENTATION

@@ -59,7 +59,7 @@ static void step_dH(int n, int k, double amp, double *dH) {
 static int same(const double *a, const double *b, size_t n) { return memcmp(a, b, n * sizeof(double)) == 0; }
 
 /* the public contact iterator: every contact once, ids ordered, and the Love stress rebuilt from its
- * forces and branch vectors, sigma = -(1/V) sum f (x) d (seed 000 eq 5), is the RVE's own */
+ * forces and branch vectors, sigma = -(1/V) sum f (x) d (Guo & Zhao 2014 eq 5), is the RVE's own */
 TEST(contact_iterator_gives_the_love_stress) {
     gk_rve r;
     gk_rve_def d = gk_rve_def_default();
@@ -151,7 +151,7 @@ TEST(run_is_the_rve_contract) {
     gk_twoscale_destroy(&ts);
 }
 
-/* the strain rule: n = ceil(max|dH| / strain) clamped (seed 000's scripts: 1e-5 per step); a cut-back
+/* the strain rule: n = ceil(max|dH| / strain) clamped (Guo & Zhao 2014's scripts: 1e-5 per step); a cut-back
  * run (scale 1/4) keeps the full increment's count */
 TEST(strain_rule_counts_and_cut_back_scale) {
     gk_twoscale ts;

@@ -8,8 +8,8 @@
  *
  * A random loose cloud (no overlaps) is compressed by a stress servo until
  * every normal stress is within the tolerance of the target and the
- * unbalanced-force ratio is small (as YADE's PeriTriaxController in the seed
- * 000 authors' prepareRVE.py). Friction while consolidating selects the
+ * unbalanced-force ratio is small (as YADE's PeriTriaxController in the Guo &
+ * Zhao (2014) authors' prepareRVE.py). Friction while consolidating selects the
  * density: 0 gives the densest state; larger values give looser ones.
  * --target-void-ratio searches that friction by bisection (each trial is a
  * full consolidation from the same cloud); a target it cannot reach within
@@ -60,7 +60,7 @@ static void usage(FILE *fp) {
             "  --target-void-ratio E      search the consolidation friction that gives void ratio E\n"
             "  --friction-deg A           contact friction angle after consolidation [degrees, 0 to 85]\n"
             "                             (28.65 = 0.5 rad, Guo & Zhao 2014)\n"
-            "  --E, --kt-ratio, --density, --thickness, --damping   material (seed 000 defaults)\n"
+            "  --E, --kt-ratio, --density, --thickness, --damping   material (Guo & Zhao 2014 defaults)\n"
             "  --law linear|hertz         contact law (linear); hertz: Hertz-Mindlin from --G and --poisson\n"
             "  --G, --poisson             Hertz-Mindlin grain shear modulus [Pa] and Poisson ratio (sets E = 2G(1+nu))\n"
             "  --contact-damping Z        tangential viscous damping, fraction of critical (0)\n"
