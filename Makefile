@@ -53,7 +53,7 @@ FUZZ_NAMES := $(patsubst tests/fuzz/fuzz_%.c,%,$(FUZZ_SRC))
 FUZZ_REPLAY := $(patsubst %,$(BUILD)/fuzz_replay_%,$(FUZZ_NAMES))
 
 .PHONY: all mpi test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
-        check-headers check-asan check-nosimd check-smoke tradeoff fuzz
+        check-headers check-asan check-nosimd check-smoke check-build tradeoff fuzz
 
 all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
 
@@ -65,6 +65,7 @@ help:
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
 	@echo "make mpi        the MPI programs (mpicc; gk_twoscale.h with GK_TWOSCALE_MPI) into $(BUILD)/mpi/"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability, tool smoke runs"
+	@echo "make check-build  every program make check runs, built (make -j2 check-build: in parallel)"
 	@echo "make fuzz       each libFuzzer harness of tests/fuzz for FUZZ_SECONDS (60) s, one at a time (clang)"
 	@echo "make bench      performance programs (2 cores)"
 	@echo "make tradeoff   accuracy against cost of the drivers, the whole sweep (10-15 min; build/tradeoff/)"
@@ -201,6 +202,10 @@ check-headers: | $(BUILD)/hdr
 	done
 
 check: check-headers check-nosimd check-asan check-smoke
+
+# every program make check runs, built and not run: `make -j2 check-build && make check`
+# compiles two at a time, then runs the checks one after the other
+check-build: $(ASAN_TESTS) $(NOSIMD_TESTS) $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) $(EXAMPLES) $(TOOLS)
 
 # ---------------------------------------------------------------- run / bench
 # the FEMxDEM biaxial test of Guo & Zhao (2014) at a size that runs in about a minute on
