@@ -604,7 +604,7 @@ static int gk__ts_keys(const gk_allocator *a, gk__tspt *pt) {
         if (n == pt->cap && gk__ts_reserve_keys(a, pt, 2 * pt->cap + 64)) return -1;
         pt->cur[n++] = (((unsigned long long)k.i << 32 | (unsigned long long)k.j) << 1) | (unsigned)k.sliding;
     }
-    qsort(pt->cur, (size_t)n, sizeof *pt->cur, gk__ts_cmp_u64);
+    if (n > 1) qsort(pt->cur, (size_t)n, sizeof *pt->cur, gk__ts_cmp_u64); /* cur is NULL without contacts */
     pt->ncur = n;
     return n;
 }
@@ -1193,6 +1193,22 @@ static gk_result gk__ts_rec_parse(gk_twoscale *ts, int id, const unsigned char *
     if (ref > n - GK__TS_REC_MIN)
         return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d is shorter than its %d contact keys", id,
                           (int)v[3]);
+    if (v[3] >= 0) { /* the reference: a finite tangent, keys as gk__ts_keys makes them (sorted, ids i <= j) */
+        unsigned long long key, prev = 0;
+        double d;
+        for (k = 0; k < ts->nd4; ++k) {
+            memcpy(&d, b + off + (size_t)k * 8, 8);
+            if (!isfinite(d))
+                return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d has a NaN reference tangent", id);
+        }
+        for (k = 0; k < v[3]; ++k, prev = key) {
+            memcpy(&key, b + off + (size_t)ts->nd4 * 8 + (size_t)k * 8, 8);
+            if (key < prev || (key >> 33) > ((key >> 1) & 0xffffffffu) || ((key >> 1) & 0xffffffffu) > 0x7fffffffu)
+                return gk_err_set(&ts->err, GK_ERR_FORMAT,
+                                  "the record of point %d: contact key %d is out of order or not a particle pair", id,
+                                  k);
+        }
+    }
     memcpy(&ss, b + off + ref, sizeof ss);
     if (ss != n - GK__TS_REC_MIN - ref)
         return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d holds a state of %llu bytes in %lu",
@@ -1699,6 +1715,13 @@ static gk_result gk__ts_check_file(gk_twoscale *ts, const char *path, gk__ckf *c
     return GK_OK;
 }
 
+/* a refused record: its message prefixed with the file's name; returns 0 (not ok) */
+static int gk__ts_rec_refused(gk_twoscale *ts, const char *path) {
+    gk_err e = ts->err;
+    gk_err_set(&ts->err, e.code ? e.code : GK_ERR_FORMAT, "%s: %s", path, e.msg);
+    return 0;
+}
+
 GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block, size_t *nblock) {
     const gk_allocator *a = &ts->def.alloc;
     gk__ckf c;
@@ -1731,7 +1754,7 @@ GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block
             if (!got && ok) ok = 0, gk_err_set(&ts->err, GK_ERR_IO, "%s changed while it was read", path);
             if (ts->owner[p] == 0) {
                 stage[k] = NULL;
-                if (ok) ok = gk__ts_rec_parse(ts, p, rb, (size_t)n, &stage[k]) == GK_OK;
+                if (ok && gk__ts_rec_parse(ts, p, rb, (size_t)n, &stage[k])) ok = gk__ts_rec_refused(ts, path);
                 ++k;
             }
 #ifdef GK_TWOSCALE_MPI
@@ -1754,9 +1777,9 @@ GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block
         for (j = 0; j < ts->nlocal; ++j) {
             unsigned long long n;
             stage[k] = NULL;
-            if (gk__ts_xrecv(ts, 0, &rb, &rcap, &n, stage != NULL) && ok)
-                ok = gk__ts_rec_parse(ts, ts->pt[j]->id, rb, (size_t)n, &stage[k]) == GK_OK;
-            else
+            if (gk__ts_xrecv(ts, 0, &rb, &rcap, &n, stage != NULL) && ok) {
+                if (gk__ts_rec_parse(ts, ts->pt[j]->id, rb, (size_t)n, &stage[k])) ok = gk__ts_rec_refused(ts, path);
+            } else
                 ok = 0;
             ++k;
         }

@@ -17,11 +17,14 @@
 #include "gk_io.h"
 #include "gk_mpm.h"
 #include "gk_test.h"
+#include "gk_twoscale.h"
 #include <stddef.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
 static const char *RVE400 = "examples/data/rve400.txt";
+#define LOG(name) " > build/tests/t_untrusted_" name ".out 2>&1"
+#define OUT(name) "build/tests/t_untrusted_" name
 
 /* ------------------------------------------------------------- helpers */
 /* an allocator that records the largest request and refuses anything above cap */
@@ -725,11 +728,112 @@ TEST(writers_report_a_full_disk) {
     }
 }
 
+/* ========================================================= checkpoints */
+/* bytes of a file (malloc'd), or NULL */
+static unsigned char *file_image(const char *path, size_t *n) {
+    FILE *fp = fopen(path, "rb");
+    unsigned char *b = NULL;
+    long end;
+    *n = 0;
+    if (!fp) return NULL;
+    if (fseek(fp, 0, SEEK_END) == 0 && (end = ftell(fp)) > 0 && fseek(fp, 0, SEEK_SET) == 0 &&
+        (b = (unsigned char *)malloc((size_t)end)) != NULL && fread(b, 1, (size_t)end, fp) == (size_t)end)
+        *n = (size_t)end;
+    fclose(fp);
+    return b;
+}
+
+/* the file's last 8 bytes: the FNV-1a hash of the rest (the checkpoint's checksum, made right) */
+static void spill_resealed(const char *path, unsigned char *b, size_t n) {
+    uint64_t h = UINT64_C(0xcbf29ce484222325);
+    size_t k;
+    FILE *fp;
+    for (k = 0; k + 8 < n; ++k) h = (h ^ b[k]) * UINT64_C(0x100000001b3);
+    memcpy(b + n - 8, &h, 8);
+    fp = fopen(path, "wb");
+    if (fp) fwrite(b, 1, n, fp), fclose(fp);
+}
+
+/* a two-scale checkpoint with a valid checksum but a NaN reference tangent
+ * (the tangent-reuse reference of a point) was accepted, and the next run
+ * returned GK_OK with that NaN as the point's tangent; contact keys out of
+ * order (the reference network) were accepted and gave a wrong reuse
+ * decision. Both refused by name now, the set unchanged. A point without
+ * contacts (a loose packing) with reuse on passed NULL to qsort (UBSan). */
+TEST(twoscale_checkpoint_reference_is_checked) {
+    gk_gen_def g;
+    gk_packing pk;
+    gk_err e;
+    gk_twoscale ts;
+    gk_twoscale_def def;
+    gk_twoscale_proto proto;
+    double dH[18] = {0, 1e-5, 0, 0, 0, 0, 0, 0, 0, 0, 1e-5, 0, 0, 0, 0, 0, 0, 0}, S[18], D[32];
+    const char *ck = OUT("ck.bin"), *bad = OUT("ck_bad.bin"), *again = OUT("ck_again.bin");
+    unsigned char *img, *x, *y;
+    size_t n, nx, ny, rec, ref;
+    void *blk = NULL;
+    size_t nb = 0;
+    uint64_t key;
+    int32_t nkey;
+    memset(&g, 0, sizeof g);
+    g.dim = 2, g.n = 12, g.r_min = 0.4e-3, g.r_max = 0.6e-3, g.seed = 11;
+    CHECK(gk_packing_generate(&pk, &g, NULL, &e) == GK_OK);
+    memset(&def, 0, sizeof def);
+    proto.packing = &pk, proto.state = NULL;
+    def.npoints = 2, def.protos = &proto, def.nprotos = 1, def.reuse = 0.3;
+    def.rule.kind = GK_TWOSCALE_STRAIN, def.rule.n_min = 2, def.rule.n_max = 4;
+    CHECK(gk_twoscale_create(&ts, &def) == GK_OK);
+    /* the loose cloud: no contacts, reuse on (the NULL qsort) */
+    CHECK(gk_twoscale_run(&ts, dH, NULL, S, D) == GK_OK && gk_twoscale_accept(&ts) == GK_OK);
+    CHECK(gk_twoscale_save(&ts, ck, NULL, 0) == GK_OK);
+    img = file_image(ck, &n);
+    x = (unsigned char *)malloc(n);
+    CHECK(img != NULL && x != NULL && n > 200);
+    if (!img || !x || n <= 200) return;
+    rec = 8 + 32 + 4 + 2 * 4 + 8; /* magic, header, 1 prototype, 2 picks, record size: point 0's record */
+    ref = rec + 16 + 2 * 9 * 8;   /* its reference tangent */
+    memcpy(&nkey, img + rec + 12, 4);
+    CHECK_EQ_INT(nkey, 0); /* a reference with no contacts */
+    memcpy(x, img, n);     /* a NaN in the reference tangent */
+    memset(x + ref + 8 * 5, 0xff, 8);
+    spill_resealed(bad, x, n);
+    CHECK_EQ_INT(gk_twoscale_load(&ts, bad, &blk, &nb), GK_ERR_FORMAT);
+    CHECK(strstr(gk_twoscale_error(&ts), bad) && strstr(gk_twoscale_error(&ts), "NaN reference tangent"));
+    CHECK(gk_twoscale_save(&ts, again, NULL, 0) == GK_OK);
+    y = file_image(again, &ny);
+    CHECK(y && ny == n && memcmp(y, img, n) == 0); /* unchanged */
+    free(y);
+    /* contact keys: one record with two keys out of order (the record grown by 16 bytes) */
+    nx = n + 16;
+    free(x);
+    x = (unsigned char *)malloc(nx);
+    CHECK(x != NULL);
+    if (!x) return;
+    {
+        size_t keys = ref + 16 * 8; /* after the 2D tangent's 16 entries */
+        uint64_t sz;
+        memcpy(x, img, keys);
+        memcpy(x + keys + 16, img + keys, n - keys);
+        memcpy(&sz, x + rec - 8, 8), sz += 16, memcpy(x + rec - 8, &sz, 8);
+        nkey = 2, memcpy(x + rec + 12, &nkey, 4);
+        key = ((uint64_t)3 << 32 | 7) << 1, memcpy(x + keys, &key, 8);
+        key = ((uint64_t)1 << 32 | 2) << 1, memcpy(x + keys + 8, &key, 8);
+        spill_resealed(bad, x, nx);
+        CHECK_EQ_INT(gk_twoscale_load(&ts, bad, &blk, &nb), GK_ERR_FORMAT);
+        CHECK(strstr(gk_twoscale_error(&ts), "contact key 1 is out of order"));
+        key = ((uint64_t)5 << 32 | 7) << 1, memcpy(x + keys + 8, &key, 8); /* in order: accepted */
+        spill_resealed(bad, x, nx);
+        CHECK_EQ_INT(gk_twoscale_load(&ts, bad, &blk, &nb), GK_OK);
+        gk_twoscale_free(&ts, blk);
+    }
+    free(x), free(img);
+    gk_twoscale_destroy(&ts);
+    gk_packing_free(&pk);
+}
+
 /* =============================================================== tools */
 #define RVE_PATH "build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
 #define GK_PACK "build/gk_pack --n 60 "
-#define LOG(name) " > build/tests/t_untrusted_" name ".out 2>&1"
-#define OUT(name) "build/tests/t_untrusted_" name
 
 /* gk_pack --target-void-ratio 2.5 (no 2D disk packing gets there) ended
  * with exit 0 and e = 0.24; now exit 1 and no file */
@@ -822,6 +926,7 @@ int main(int argc, char **argv) {
     RUN(fem_pcg_refuses_infinite_tolerance_and_nan);
     RUN(mpm_step_refusing_det_F_leaves_the_points);
     RUN(writers_report_a_full_disk);
+    RUN(twoscale_checkpoint_reference_is_checked);
     RUN(gk_pack_fails_on_a_void_ratio_it_cannot_reach);
     RUN(friction_angle_in_degrees_with_a_plausible_range);
     RUN(rve_path_exits_nonzero_when_its_result_is_lost);
