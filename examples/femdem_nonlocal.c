@@ -1704,168 +1704,195 @@ static int run_rve_test(const opts *o, micro *mi, double t0) {
     return 0;
 }
 
+/* everything the model and the micro side hold (each pointer NULL or allocated) */
+static void model_free(model *md) {
+    free(md->u), free(md->v), free(md->fint), free(md->fext), free(md->f), free(md->mass), free(md->vhom);
+    free(md->ur), free(md->vr), free(md->fr), free(md->mr), free(md->fix), free(md->fixr), free(md->vpre);
+    free(md->dNdX), free(md->V0), free(md->hg), free(md->Hn), free(md->H), free(md->deps), free(md->depsnl);
+    free(md->dH), free(md->Rh), free(md->R1), free(md->sigR), free(md->sig), free(md->fld), free(md->top);
+    free(md->bot), free(md->right), free(md->pf), free(md->rows), free(md->gam_peak), free(md->prof12);
+    free(md->prof_end), free(md->arrival);
+    gk_mesh_free(&md->ref), gk_mesh_free(&md->cur), gk_dofmap_free(&md->dm), gk_nonlocal_free(&md->nl);
+    gk_twoscale_destroy(&md->ts);
+}
+static void micro_free(micro *mi) {
+    gk_packing_free(&mi->pk), gk_packing_free(&mi->pk_imp), gk_rve_state_free(&mi->st_imp);
+}
+
+static int run(opts *o, micro *mi, model *md, int **pickp, double t0);
+
 int main(int argc, char **argv) {
     opts o;
     micro mi;
     model md;
+    int *pick = NULL, rc;
+    double t0 = gk_wtime();
+    rc = parse(argc, argv, &o);
+    if (rc) return rc;
+    memset(&mi, 0, sizeof mi);
+    memset(&md, 0, sizeof md);
+    gk_rve_state_init(&mi.st_imp, NULL);
+    rc = run(&o, &mi, &md, &pick, t0);
+    free(pick);
+    model_free(&md);
+    micro_free(&mi);
+    return rc;
+}
+
+/* the run; main frees what it leaves in mi, md and *pickp, whatever it returns */
+static int run(opts *o, micro *mi, model *md, int **pickp, double t0) {
     gk_err err;
     gk_twoscale_def d;
     gk_twoscale_proto pr[2];
     int *pick = NULL, rc, e, k;
-    double t0 = gk_wtime();
     uint64_t fpr;
     char path[1024];
-    rc = parse(argc, argv, &o);
-    if (rc) return rc;
-    if (mkdir(o.out, 0777) && errno != EEXIST)
-        return fprintf(stderr, "femdem_nonlocal: cannot create %s\n", o.out), 1;
-    memset(&mi, 0, sizeof mi);
-    memset(&md, 0, sizeof md);
-    gk_rve_state_init(&mi.st_imp, NULL);
-    if (gk_packing_read(o.packing, &mi.pk, NULL, &err))
+    if (mkdir(o->out, 0777) && errno != EEXIST)
+        return fprintf(stderr, "femdem_nonlocal: cannot create %s\n", o->out), 1;
+    if (gk_packing_read(o->packing, &mi->pk, NULL, &err))
         return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
-    if (mi.pk.dim != 3)
-        return fprintf(stderr, "femdem_nonlocal: %s is a %dD packing (3D needed)\n", o.packing, mi.pk.dim), 1;
-    if (o.imperfection == -2) /* the paper's 25 of 4096 particles, in proportion */
-        o.imperfection =
-            (int)floor(25.0 * mi.pk.n / 4096.0 + 0.5) > 1 ? (int)floor(25.0 * mi.pk.n / 4096.0 + 0.5) : 1;
-    rve_def_make(&o, &mi.rd);
-    if (rve_frequency(&mi)) return 1;
-    if (o.test == T_RVE) return run_rve_test(&o, &mi, t0);
-    if (rve_moduli(&o, &mi, NULL)) return 1;
+    if (mi->pk.dim != 3)
+        return fprintf(stderr, "femdem_nonlocal: %s is a %dD packing (3D needed)\n", o->packing, mi->pk.dim), 1;
+    if (o->imperfection == -2) /* the paper's 25 of 4096 particles, in proportion */
+        o->imperfection =
+            (int)floor(25.0 * mi->pk.n / 4096.0 + 0.5) > 1 ? (int)floor(25.0 * mi->pk.n / 4096.0 + 0.5) : 1;
+    rve_def_make(o, &mi->rd);
+    if (rve_frequency(mi)) return 1;
+    if (o->test == T_RVE) return run_rve_test(o, mi, t0);
+    if (rve_moduli(o, mi, NULL)) return 1;
     printf(
         "RVE (%d spheres): p %.0f Pa, porosity %.4f, Z %.3f, density %.1f kg/m^3, K %.1f MPa, G %.1f MPa\n",
-        mi.pk.n, mi.p0, mi.porosity0, mi.Z0, mi.rho, mi.K / 1e6, mi.G / 1e6);
-    md.o = &o;
-    md.mi = &mi;
-    if (macro_setup(&md)) return 1;
+        mi->pk.n, mi->p0, mi->porosity0, mi->Z0, mi->rho, mi->K / 1e6, mi->G / 1e6);
+    md->o = o;
+    md->mi = mi;
+    if (macro_setup(md)) return 1;
     /* the micro side: one RVE per Gauss point, the imperfect one where asked */
-    pr[0].packing = &mi.pk, pr[0].state = NULL;
-    if (o.imperfection > 0) {
-        int row = (int)(0.75 * o.mesh[1]), col = o.mesh[0] / 2;
-        if (rve_imperfect(&o, &mi)) return 1;
-        pr[1].packing = &mi.pk_imp, pr[1].state = &mi.st_imp;
-        pick = (int *)xcalloc((size_t)md.ne, sizeof(int));
-        if (row > o.mesh[1] - 1) row = o.mesh[1] - 1;
-        pick[row * o.mesh[0] + col] = 1; /* front layer (k = 0) */
+    pr[0].packing = &mi->pk, pr[0].state = NULL;
+    if (o->imperfection > 0) {
+        int row = (int)(0.75 * o->mesh[1]), col = o->mesh[0] / 2;
+        if (rve_imperfect(o, mi)) return 1;
+        pr[1].packing = &mi->pk_imp, pr[1].state = &mi->st_imp;
+        pick = *pickp = (int *)xcalloc((size_t)md->ne, sizeof(int));
+        if (row > o->mesh[1] - 1) row = o->mesh[1] - 1;
+        pick[row * o->mesh[0] + col] = 1; /* front layer (k = 0) */
     }
-    ts_def_make(&o, &mi, pr, o.imperfection > 0 ? 2 : 1, pick, md.ne, &d);
-    if (gk_twoscale_create(&md.ts, &d))
-        return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&md.ts)), 1;
+    ts_def_make(o, mi, pr, o->imperfection > 0 ? 2 : 1, pick, md->ne, &d);
+    if (gk_twoscale_create(&md->ts, &d))
+        return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&md->ts)), 1;
     /* time steps: eq 65 from the element bound with the RVE's K, G; eq 66 */
-    md.omega_c = macro_omega(&md);
-    if (!(md.omega_c > 0))
-        return fprintf(stderr, "femdem_nonlocal: no stable step (element frequency %g)\n", md.omega_c), 1;
-    md.dt = o.dt_safety * gk_explicit_dt_critical(md.omega_c, 0.0);
-    if (o.dt > 0) {
-        if (o.dt > gk_explicit_dt_critical(md.omega_c, 0.0))
+    md->omega_c = macro_omega(md);
+    if (!(md->omega_c > 0))
+        return fprintf(stderr, "femdem_nonlocal: no stable step (element frequency %g)\n", md->omega_c), 1;
+    md->dt = o->dt_safety * gk_explicit_dt_critical(md->omega_c, 0.0);
+    if (o->dt > 0) {
+        if (o->dt > gk_explicit_dt_critical(md->omega_c, 0.0))
             return fprintf(stderr,
                            "femdem_nonlocal: --dt %g is above the stable step %g of eq 65 for this mesh\n",
-                           o.dt, gk_explicit_dt_critical(md.omega_c, 0.0)),
+                           o->dt, gk_explicit_dt_critical(md->omega_c, 0.0)),
                    2;
-        md.dt = o.dt;
+        md->dt = o->dt;
     }
-    md.nsteps = o.steps;
-    md.vload = o.strain * md.L[1] / (md.nsteps * md.dt);
+    md->nsteps = o->steps;
+    md->vload = o->strain * md->L[1] / (md->nsteps * md->dt);
     {
-        double rho = mi.rho * o.mass_scale, E = 9.0 * mi.K * mi.G / (3.0 * mi.K + mi.G);
-        double c = (o.test == T_ESHEAR || o.test == T_SSHEAR) ? sqrt(mi.G / rho) : sqrt(E / rho);
-        md.omega1 = 0.5 * GK_PI * c / md.L[1];
-        md.alpha = 2.0 * o.xi * md.omega1;
+        double rho = mi->rho * o->mass_scale, E = 9.0 * mi->K * mi->G / (3.0 * mi->K + mi->G);
+        double c = (o->test == T_ESHEAR || o->test == T_SSHEAR) ? sqrt(mi->G / rho) : sqrt(E / rho);
+        md->omega1 = 0.5 * GK_PI * c / md->L[1];
+        md->alpha = 2.0 * o->xi * md->omega1;
     }
     printf("mesh %dx%dx%d (%d Gauss points), nonlocal %s (R %g m, %d neighbour pairs), dt %.4g s (eq 65: "
            "omega_max "
            "%.4g rad/s), eq 66: %.1f DEM critical steps per coarse step (omega_f %.4g rad/s, DEM dt %.3g s), "
            "damping alpha %.4g 1/s\nDEM runs: I_uf < %g (eq 57) within %d-%d steps, %ld coarse steps\n",
-           o.mesh[0], o.mesh[1], o.mesh[2], md.ne, o.R > 0 ? "on" : "off", o.R, md.nl.start[md.ne], md.dt,
-           md.omega_c, gk_explicit_substeps(md.omega_c, 0.0, mi.omega_f, 0.0), mi.omega_f, mi.dt_f, md.alpha,
-           o.iuf, o.dem_min, o.dem_max, md.nsteps);
-    fpr = fingerprint(&o, &mi.pk);
+           o->mesh[0], o->mesh[1], o->mesh[2], md->ne, o->R > 0 ? "on" : "off", o->R, md->nl.start[md->ne], md->dt,
+           md->omega_c, gk_explicit_substeps(md->omega_c, 0.0, mi->omega_f, 0.0), mi->omega_f, mi->dt_f, md->alpha,
+           o->iuf, o->dem_min, o->dem_max, md->nsteps);
+    fpr = fingerprint(o, &mi->pk);
     /* initial state: the RVEs' stresses, R = I */
-    gk_twoscale_accepted(&md.ts, md.sig, NULL);
-    md.peak = -HUGE_VAL;
-    if (o.restart) {
-        if (load_checkpoint(&md, fpr)) return 1;
+    gk_twoscale_accepted(&md->ts, md->sig, NULL);
+    md->peak = -HUGE_VAL;
+    if (o->restart) {
+        if (load_checkpoint(md, fpr)) return 1;
     } else {
         /* the loading's own homogeneous velocity field from the start: a steady
          * homogeneous deformation needs no acceleration, so no start-up wave */
-        for (k = 0; k < md.nn; ++k) {
-            const double *x = md.ref.x + 3 * k;
-            if (o.test == T_ESHEAR || o.test == T_SSHEAR) md.v[3 * k] = md.vload * x[1] / md.L[1];
-            if (o.test == T_EBIAX || o.test == T_BIAX) md.v[3 * k + 1] = -md.vload * x[1] / md.L[1];
+        for (k = 0; k < md->nn; ++k) {
+            const double *x = md->ref.x + 3 * k;
+            if (o->test == T_ESHEAR || o->test == T_SSHEAR) md->v[3 * k] = md->vload * x[1] / md->L[1];
+            if (o->test == T_EBIAX || o->test == T_BIAX) md->v[3 * k + 1] = -md->vload * x[1] / md->L[1];
         }
-        for (k = 0; k < md.nd; ++k) md.vr[md.dm.red[k]] = md.v[k];
-        external_force(&md);
-        if (internal_force(&md)) return 1;
-        track(&md);
-        if (record(&md, 0.0)) return 1;
+        for (k = 0; k < md->nd; ++k) md->vr[md->dm.red[k]] = md->v[k];
+        external_force(md);
+        if (internal_force(md)) return 1;
+        track(md);
+        if (record(md, 0.0)) return 1;
     }
     /* the loop */
     {
-        long stop = o.stop_after > 0 ? o.stop_after : md.nsteps,
-             every_print = md.nsteps / 20 > 0 ? md.nsteps / 20 : 1;
+        long stop = o->stop_after > 0 ? o->stop_after : md->nsteps,
+             every_print = md->nsteps / 20 > 0 ? md->nsteps / 20 : 1;
         char csv[1024];
-        snprintf(csv, sizeof csv, "%s/%s.csv", o.out, test_name[o.test]);
-        while (md.step < stop) {
-            rc = macro_step(&md);
+        snprintf(csv, sizeof csv, "%s/%s.csv", o->out, test_name[o->test]);
+        while (md->step < stop) {
+            rc = macro_step(md);
             if (rc) {
-                save_checkpoint(&md, fpr);
+                save_checkpoint(md, fpr);
                 fprintf(stderr,
                         "femdem_nonlocal: stopped at step %ld (checkpoint of the last state written)\n",
-                        md.step);
-                write_rows(csv, csv_head, md.rows, md.nrow, NCOL, 0);
+                        md->step);
+                write_rows(csv, csv_head, md->rows, md->nrow, NCOL, 0);
                 return rc;
             }
-            track(&md);
-            if (md.step % o.every == 0 || md.step == md.nsteps)
-                if (record(&md, gk_wtime() - t0)) return 1;
-            if (o.vtk_every && md.step % o.vtk_every == 0) {
-                snprintf(path, sizeof path, "%s/mesh_%06ld.vtk", o.out, md.step);
-                if (write_vtk(&md, path)) return 1;
+            track(md);
+            if (md->step % o->every == 0 || md->step == md->nsteps)
+                if (record(md, gk_wtime() - t0)) return 1;
+            if (o->vtk_every && md->step % o->vtk_every == 0) {
+                snprintf(path, sizeof path, "%s/mesh_%06ld.vtk", o->out, md->step);
+                if (write_vtk(md, path)) return 1;
             }
-            if (o.checkpoint && md.step % o.checkpoint == 0 && save_checkpoint(&md, fpr)) return 1;
-            if (md.step % every_print == 0) {
-                const double *row = md.rows + NCOL * (md.nrow - 1);
+            if (o->checkpoint && md->step % o->checkpoint == 0 && save_checkpoint(md, fpr)) return 1;
+            if (md->step % every_print == 0) {
+                const double *row = md->rows + NCOL * (md->nrow - 1);
                 char what[256];
                 snprintf(what, sizeof what, "strain %.4g stress %.4g Pa, DEM steps %.0f", row[2], row[3],
                          row[10]);
-                gk_progress(stdout, md.step, md.nsteps, t0, what);
+                gk_progress(stdout, md->step, md->nsteps, t0, what);
             }
         }
-        if (write_rows(csv, csv_head, md.rows, md.nrow, NCOL, 0) || save_checkpoint(&md, fpr)) return 1;
-        if (md.step < md.nsteps) {
+        if (write_rows(csv, csv_head, md->rows, md->nrow, NCOL, 0) || save_checkpoint(md, fpr)) return 1;
+        if (md->step < md->nsteps) {
             printf("stopped after step %ld of %ld (--stop-after); checkpoint written: continue with "
                    "--restart %s\n",
-                   md.step, md.nsteps, o.out);
+                   md->step, md->nsteps, o->out);
             return 0;
         }
     }
     /* final outputs */
     {
-        long r, n = md.nrow, ipk = 0;
+        long r, n = md->nrow, ipk = 0;
         double *x = (double *)xcalloc((size_t)n, sizeof(double)),
                *y = (double *)xcalloc((size_t)n, sizeof(double));
         double *y2 = (double *)xcalloc((size_t)n, sizeof(double)),
-               *val = (double *)xcalloc((size_t)md.ne, sizeof(double));
+               *val = (double *)xcalloc((size_t)md->ne, sizeof(double));
         double pk = -HUGE_VAL, epk = NAN, bc = NAN, bw = NAN;
         char extra[1024], svg[1024];
         const char *xl = "strain", *yl = "stress [kPa]";
         extra[0] = 0;
         for (r = 0; r < n; ++r) {
-            const double *row = md.rows + NCOL * r;
-            x[r] = o.test == T_WAVE ? row[1] * 1e3 : row[2];
+            const double *row = md->rows + NCOL * r;
+            x[r] = o->test == T_WAVE ? row[1] * 1e3 : row[2];
             y[r] = row[3] / 1e3;
             if (row[3] > pk) pk = row[3], epk = row[2], ipk = r;
         }
         (void)ipk;
-        snprintf(path, sizeof path, "%s/mesh_%06ld.vtk", o.out, md.step);
-        if (write_vtk(&md, path)) return 1;
-        if (o.test == T_EBIAX || o.test == T_ESHEAR) {
-            int nl = o.lone;
+        snprintf(path, sizeof path, "%s/mesh_%06ld.vtk", o->out, md->step);
+        if (write_vtk(md, path)) return 1;
+        if (o->test == T_EBIAX || o->test == T_ESHEAR) {
+            int nl = o->lone;
             double *lone = (double *)xcalloc((size_t)8 * (nl + 1), sizeof(double)), *lx, *ly, dev, pkr;
             printf("the RVE alone on the same path (%d increments)...\n", nl);
-            if (rve_alone(&o, &mi, nl, lone)) return 1;
-            snprintf(path, sizeof path, "%s/rve_alone.csv", o.out);
+            if (rve_alone(o, mi, nl, lone)) return 1;
+            snprintf(path, sizeof path, "%s/rve_alone.csv", o->out);
             {
                 FILE *fp = fopen(path, "w");
                 int k2, bad;
@@ -1878,16 +1905,16 @@ int main(int argc, char **argv) {
                 bad = ferror(fp);
                 if (fclose(fp) || bad) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", path), 1;
             }
-            dev = curve_deviation(md.rows, md.nrow, lone, nl, o.strain, &pkr);
+            dev = curve_deviation(md->rows, md->nrow, lone, nl, o->strain, &pkr);
             lx = (double *)xcalloc((size_t)nl + 1, sizeof(double)),
             ly = (double *)xcalloc((size_t)nl + 1, sizeof(double));
             for (k = 0; k <= nl; ++k) lx[k] = lone[8 * k], ly[k] = lone[8 * k + 1] / 1e3;
-            snprintf(svg, sizeof svg, "%s/%s_curve.svg", o.out, test_name[o.test]);
+            snprintf(svg, sizeof svg, "%s/%s_curve.svg", o->out, test_name[o->test]);
             if (plot2(svg,
-                      o.test == T_EBIAX ? "one element, biaxial (Fig 6a)"
+                      o->test == T_EBIAX ? "one element, biaxial (Fig 6a)"
                                         : "one element, simple shear (Fig 6b)",
-                      o.test == T_EBIAX ? "axial strain" : "shear strain u_top / h",
-                      o.test == T_EBIAX ? "axial stress [kPa]" : "shear stress [kPa]", x, y, (int)n,
+                      o->test == T_EBIAX ? "axial strain" : "shear strain u_top / h",
+                      o->test == T_EBIAX ? "axial stress [kPa]" : "shear stress [kPa]", x, y, (int)n,
                       "FEM x DEM, 1 element", lx, ly, nl + 1, "RVE alone"))
                 return 1;
             snprintf(extra, sizeof extra, "rve_alone_dev_pct=%.3f peak_ratio=%.4f", 100.0 * dev, pkr);
@@ -1896,20 +1923,20 @@ int main(int argc, char **argv) {
                 "peak; peaks %.4f\n",
                 100.0 * dev, pkr);
             free(lone), free(lx), free(ly);
-        } else if (o.test == T_WAVE) {
-            double *ae = (double *)xcalloc((size_t)md.ne, sizeof(double)), cm, ce, cs;
+        } else if (o->test == T_WAVE) {
+            double *ae = (double *)xcalloc((size_t)md->ne, sizeof(double)), cm, ce, cs;
             FILE *fp;
             int bad;
-            wave_elastic(&md, ae);
-            cm = front_speed(&md, md.arrival), ce = front_speed(&md, ae),
-            cs = sqrt(mi.G / (mi.rho * o.mass_scale));
-            snprintf(path, sizeof path, "%s/wave_arrival.csv", o.out);
+            wave_elastic(md, ae);
+            cm = front_speed(md, md->arrival), ce = front_speed(md, ae),
+            cs = sqrt(mi->G / (mi->rho * o->mass_scale));
+            snprintf(path, sizeof path, "%s/wave_arrival.csv", o->out);
             fp = fopen(path, "w");
             if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
             fprintf(fp, "element,distance_mm,arrival_us,arrival_elastic_us,arrival_sqrtGrho_us\n");
-            for (e = 0; e < md.ne; ++e) {
-                double dd = md.L[0] - (e + 0.5) * md.L[0] / md.ne;
-                fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g\n", e + 1, 1e3 * dd, 1e6 * md.arrival[e], 1e6 * ae[e],
+            for (e = 0; e < md->ne; ++e) {
+                double dd = md->L[0] - (e + 0.5) * md->L[0] / md->ne;
+                fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g\n", e + 1, 1e3 * dd, 1e6 * md->arrival[e], 1e6 * ae[e],
                         1e6 * dd / cs);
             }
             bad = ferror(fp);
@@ -1919,70 +1946,68 @@ int main(int argc, char **argv) {
             printf("shear-wave front: %.1f m/s (multiscale), %.1f m/s (elastic, same mesh), sqrt(G/rho) = "
                    "%.1f m/s\n",
                    cm, ce, cs);
-            for (r = 0; r < n; ++r) x[r] = md.rows[NCOL * r + 2], y[r] = md.rows[NCOL * r + 3] / 1e3;
-            snprintf(svg, sizeof svg, "%s/wave_curve.svg", o.out);
+            for (r = 0; r < n; ++r) x[r] = md->rows[NCOL * r + 2], y[r] = md->rows[NCOL * r + 3] / 1e3;
+            snprintf(svg, sizeof svg, "%s/wave_curve.svg", o->out);
             if (plot2(svg, "wave column: element 9 (Fig 8a)", "shear strain", "shear stress [kPa]", x, y,
                       (int)n, "element 9", NULL, NULL, 0, NULL))
                 return 1;
             free(ae);
         } else {
-            if (o.test == T_SSHEAR) {
-                int ny = o.mesh[1], j, bad;
+            if (o->test == T_SSHEAR) {
+                int ny = o->mesh[1], j, bad;
                 FILE *fp;
                 double *pe = (double *)xcalloc((size_t)2 * ny, sizeof(double));
-                gk_twoscale_fields(&md.ts, md.fld);
-                row_profile(&md, pe);
-                band(&md, md.have12 ? md.prof12 : pe, &bc, &bw);
-                snprintf(path, sizeof path, "%s/profile.csv", o.out);
+                gk_twoscale_fields(&md->ts, md->fld);
+                row_profile(md, pe);
+                band(md, md->have12 ? md->prof12 : pe, &bc, &bw);
+                snprintf(path, sizeof path, "%s/profile.csv", o->out);
                 fp = fopen(path, "w");
                 if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
                 fprintf(fp, "row,y_mm,gamma_peak,gamma_12,porosity_12,gamma_end,porosity_end\n");
                 for (j = 0; j < ny; ++j)
-                    fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", j, 1e3 * (j + 0.5) * md.L[1] / ny,
-                            md.gam_peak[j], md.have12 ? md.prof12[j] : NAN,
-                            md.have12 ? md.prof12[ny + j] : NAN, pe[j], pe[ny + j]);
+                    fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", j, 1e3 * (j + 0.5) * md->L[1] / ny,
+                            md->gam_peak[j], md->have12 ? md->prof12[j] : NAN,
+                            md->have12 ? md->prof12[ny + j] : NAN, pe[j], pe[ny + j]);
                 bad = ferror(fp);
                 if (fclose(fp) || bad) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", path), 1;
                 printf("band (shear strain gained since the peak, at %s): centre %.1f mm, width %.1f mm\n",
-                       md.have12 ? "12 %" : "the end", bc, bw);
+                       md->have12 ? "12 %" : "the end", bc, bw);
                 free(pe);
             }
-            snprintf(svg, sizeof svg, "%s/%s_curve.svg", o.out, test_name[o.test]);
+            snprintf(svg, sizeof svg, "%s/%s_curve.svg", o->out, test_name[o->test]);
             if (plot2(svg,
-                      o.test == T_SSHEAR ? "simple shear (Fig 10)" : "plane-strain biaxial (Figs 16, 18)",
-                      o.test == T_SSHEAR ? "shear strain u_top / h" : "axial strain",
-                      o.test == T_SSHEAR ? "shear stress [kPa]" : "axial stress [kPa]", x, y, (int)n,
+                      o->test == T_SSHEAR ? "simple shear (Fig 10)" : "plane-strain biaxial (Figs 16, 18)",
+                      o->test == T_SSHEAR ? "shear strain u_top / h" : "axial strain",
+                      o->test == T_SSHEAR ? "shear stress [kPa]" : "axial stress [kPa]", x, y, (int)n,
                       "FEM x DEM", NULL, NULL, 0, NULL))
                 return 1;
         }
         (void)xl, (void)yl;
         /* state curves: porosity and Z */
-        for (r = 0; r < n; ++r) y[r] = md.rows[NCOL * r + 7], y2[r] = md.rows[NCOL * r + 8] / 10.0;
-        snprintf(svg, sizeof svg, "%s/%s_state.svg", o.out, test_name[o.test]);
+        for (r = 0; r < n; ++r) y[r] = md->rows[NCOL * r + 7], y2[r] = md->rows[NCOL * r + 8] / 10.0;
+        snprintf(svg, sizeof svg, "%s/%s_state.svg", o->out, test_name[o->test]);
         if (plot2(svg, "porosity and coordination (Figs 8b, 12, 13)",
-                  o.test == T_WAVE ? "time [ms]" : "strain", "porosity, Z / 10", x, y, (int)n, "porosity", x,
+                  o->test == T_WAVE ? "time [ms]" : "strain", "porosity, Z / 10", x, y, (int)n, "porosity", x,
                   y2, (int)n, "Z / 10"))
             return 1;
-        for (e = 0; e < md.ne; ++e) val[e] = md.H[9 * e + 1] + md.H[9 * e + 3];
-        if (o.test == T_BIAX || o.test == T_EBIAX)
-            for (e = 0; e < md.ne; ++e) {
+        for (e = 0; e < md->ne; ++e) val[e] = md->H[9 * e + 1] + md->H[9 * e + 3];
+        if (o->test == T_BIAX || o->test == T_EBIAX)
+            for (e = 0; e < md->ne; ++e) {
                 double eps[9];
-                gk_m3_sym(md.H + 9 * e, eps);
+                gk_m3_sym(md->H + 9 * e, eps);
                 val[e] = gk_strain_q(eps, 3);
             }
-        snprintf(svg, sizeof svg, "%s/%s_field.svg", o.out, test_name[o.test]);
-        if (write_field(&md, svg, "deformed mesh",
-                        o.test == T_BIAX || o.test == T_EBIAX ? "eps_q" : "shear strain", val))
+        snprintf(svg, sizeof svg, "%s/%s_field.svg", o->out, test_name[o->test]);
+        if (write_field(md, svg, "deformed mesh",
+                        o->test == T_BIAX || o->test == T_EBIAX ? "eps_q" : "shear strain", val))
             return 1;
         {
             char ex2[1200];
             snprintf(ex2, sizeof ex2, "%s%sdem_steps_total=%ld dt=%.4g", extra, extra[0] ? " " : "",
-                     md.dem_total, md.dt);
-            result_line(&mi, ex2, pk, epk, bc, bw, gk_wtime() - t0);
+                     md->dem_total, md->dt);
+            result_line(mi, ex2, pk, epk, bc, bw, gk_wtime() - t0);
         }
         free(x), free(y), free(y2), free(val);
     }
-    gk_twoscale_destroy(&md.ts);
-    gk_nonlocal_free(&md.nl);
     return 0;
 }
