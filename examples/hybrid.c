@@ -1125,8 +1125,9 @@ static int enrich(run *R) {
     gk_mpm_grid *g = &R->g;
     gk_err e;
     size_t I, nn = g->nnode;
-    int p, k, n = R->P.n, ng, nsel = 0, ndrop = 0, nb = 0;
-    double *num = NULL, *val = NULL, *X0w[3], *xs[3], umax = 0.0, *u[2] = {NULL, NULL}, *vg[2] = {NULL, NULL};
+    int p, k, n = R->P.n, ng, nsel = 0, ndrop = 0, nb = 0, status = 1;
+    double *num = NULL, *val = NULL, *X0w[3] = {NULL, NULL, NULL}, *xs[3], umax = 0.0, *u[2] = {NULL, NULL},
+           *vg[2] = {NULL, NULL};
     unsigned char *bnd = NULL, *gz = NULL;
     int32_t *drop = NULL;
     gk_packing sub;
@@ -1134,6 +1135,7 @@ static int enrich(run *R) {
     gk_hybrid_enrich_report rep;
     long ntrain, nrelax;
     double t0 = wtime();
+    memset(&sub, 0, sizeof sub);
     /* the distance to the flagged nodes on every node, zones of the points */
     R->dist = (double *)malloc(nn * sizeof(double));
     num = (double *)malloc(4 * nn * sizeof(double));
@@ -1141,7 +1143,10 @@ static int enrich(run *R) {
     X0w[0] = (double *)malloc((size_t)n * sizeof(double));
     X0w[1] = (double *)malloc((size_t)n * sizeof(double));
     X0w[2] = NULL;
-    if (!R->dist || !num || !val || !X0w[0] || !X0w[1]) return fprintf(stderr, "error: out of memory\n"), 1;
+    if (!R->dist || !num || !val || !X0w[0] || !X0w[1]) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
     {
         double ylo = HUGE_VAL, yhi = -HUGE_VAL;
         for (I = 0; I < nn; ++I) {
@@ -1157,7 +1162,8 @@ static int enrich(run *R) {
     }
     for (p = 0; p < n; ++p) {
         double x[3] = {R->P.x[0][p], R->P.x[1][p], 0.0};
-        R->C.zone[p] = (unsigned char)gk_hybrid_zone(gk_hybrid_distance(g, &R->per, R->orc.flag, x), o->phi0, R->h);
+        R->C.zone[p] =
+            (unsigned char)gk_hybrid_zone(gk_hybrid_distance(g, &R->per, R->orc.flag, x), o->phi0, R->h);
     }
     /* the continuum's reference configuration on the nodes: displacement and zone fractions */
     for (p = 0; p < n; ++p) {
@@ -1169,25 +1175,35 @@ static int enrich(run *R) {
         X0w[1][p] = R->C.X0[1][p];
         if (o->test == T_PLANAR) X0w[0][p] -= R->W * floor(X0w[0][p] / R->W);
     }
-    if (gk_hybrid_rasterize(g, &R->per, R->md.basis, R->P.lp[0], n, (const double *const *)X0w, R->P.m, val, 4, NULL,
-                            num, R->nden, &e))
-        return fprintf(stderr, "error: enrichment: %s\n", e.msg), 1;
+    if (gk_hybrid_rasterize(g, &R->per, R->md.basis, R->P.lp[0], n, (const double *const *)X0w, R->P.m, val,
+                            4, NULL, num, R->nden, &e)) {
+        fprintf(stderr, "error: enrichment: %s\n", e.msg);
+        goto done;
+    }
     for (k = 0; k < 4; ++k)
-        for (I = 0; I < nn; ++I) num[(size_t)k * nn + I] = R->nden[I] > 0.0 ? num[(size_t)k * nn + I] / R->nden[I] : 0.0;
+        for (I = 0; I < nn; ++I)
+            num[(size_t)k * nn + I] = R->nden[I] > 0.0 ? num[(size_t)k * nn + I] / R->nden[I] : 0.0;
     /* the reference packing's grains that go to the discrete zone */
-    if (gk_packing_alloc(&sub, 2, R->pk.n, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+    if (gk_packing_alloc(&sub, 2, R->pk.n, NULL, &e)) {
+        fprintf(stderr, "error: %s\n", e.msg);
+        goto done;
+    }
     sub.h[0] = R->pk.h[0];
     sub.h[4] = R->pk.h[4];
     u[0] = (double *)malloc((size_t)R->pk.n * sizeof(double));
     u[1] = (double *)malloc((size_t)R->pk.n * sizeof(double));
     bnd = (unsigned char *)malloc((size_t)R->pk.n);
-    if (!u[0] || !u[1] || !bnd) return fprintf(stderr, "error: out of memory\n"), 1;
+    if (!u[0] || !u[1] || !bnd) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
     for (k = 0; k < R->pk.n; ++k) {
         double X[3] = {R->pk.x[k], R->pk.y[k], 0.0}, f[4];
         int surface;
         if (!gk_hybrid_interp(g, &R->per, num, 4, R->nden, X, f)) continue;
         if (f[2] + f[3] < 0.5) continue;
-        surface = o->test == T_BIAXIAL && (X[0] < 1.5 * DIAM || X[0] > R->W - 1.5 * DIAM || role_of(R, X[1]) != 0);
+        surface =
+            o->test == T_BIAXIAL && (X[0] < 1.5 * DIAM || X[0] > R->W - 1.5 * DIAM || role_of(R, X[1]) != 0);
         sub.x[nsel] = X[0];
         sub.y[nsel] = X[1];
         sub.r[nsel] = R->pk.r[k];
@@ -1199,19 +1215,30 @@ static int enrich(run *R) {
         nb += bnd[nsel];
         ++nsel;
     }
-    if (nsel < 10) return fprintf(stderr, "error: enrichment: only %d grains in the discrete zone\n", nsel), 1;
+    if (nsel < 10) {
+        fprintf(stderr, "error: enrichment: only %d grains in the discrete zone\n", nsel);
+        goto done;
+    }
     sub.n = nsel;
     /* the training scene (the hybrid's scene from now on) */
-    if (gk_scene_create(&R->sc, &sd, &sub)) return fprintf(stderr, "error: scene: %s\n", gk_scene_error(&R->sc)), 1;
+    if (gk_scene_create(&R->sc, &sd, &sub)) {
+        fprintf(stderr, "error: scene: %s\n", gk_scene_error(&R->sc));
+        goto done;
+    }
     R->have_sc = 1;
     ng = R->sc.rve.n;
     {
         /* the scene stores the grains in its own order: id = index in sub */
         double *ua[2];
+        int bad;
         unsigned char *bm = (unsigned char *)malloc((size_t)ng);
         ua[0] = (double *)malloc((size_t)ng * sizeof(double));
         ua[1] = (double *)malloc((size_t)ng * sizeof(double));
-        if (!bm || !ua[0] || !ua[1]) return fprintf(stderr, "error: out of memory\n"), 1;
+        if (!bm || !ua[0] || !ua[1]) {
+            fprintf(stderr, "error: out of memory\n");
+            free(bm), free(ua[0]), free(ua[1]);
+            goto done;
+        }
         for (p = 0; p < ng; ++p) {
             int q = R->sc.rve.id[p];
             bm[p] = bnd[q];
@@ -1223,32 +1250,46 @@ static int enrich(run *R) {
         if (ntrain < 1000) ntrain = 1000;
         nrelax = ntrain / 10 > 500 ? ntrain / 10 : 500;
         if (!o->quiet)
-            printf("enrichment at strain %.4g: %d flagged nodes, %d grains (%d on the trained boundary), training "
+            printf("enrichment at strain %.4g: %d flagged nodes, %d grains (%d on the trained boundary), "
+                   "training "
                    "%ld + %ld steps (largest boundary displacement %.3g mm)\n",
                    R->strain, R->orc.nflag, ng, nb, ntrain, nrelax, 1e3 * umax);
-        if (gk_hybrid_train(&R->sc, bm, (const double *const *)ua, ntrain, nrelax, &e))
-            return fprintf(stderr, "error: %s\n", e.msg), 1;
-        R->grain_steps += (long)ng * (ntrain + nrelax);
+        bad = gk_hybrid_train(&R->sc, bm, (const double *const *)ua, ntrain, nrelax, &e) != GK_OK;
         free(bm);
         free(ua[0]);
         free(ua[1]);
+        if (bad) {
+            fprintf(stderr, "error: %s\n", e.msg);
+            goto done;
+        }
+        R->grain_steps += (long)ng * (ntrain + nrelax);
     }
     /* the grains that ended in the continuum zone leave */
     drop = (int32_t *)malloc((size_t)ng * sizeof(int32_t));
-    if (!drop) return fprintf(stderr, "error: out of memory\n"), 1;
+    if (!drop) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
     for (p = 0; p < ng; ++p) {
         double x[3];
         gk_scene_position(&R->sc, p, x);
-        if (gk_hybrid_zone(gk_hybrid_distance(g, &R->per, R->orc.flag, x), o->phi0, R->h) == GK_ZONE_CONTINUUM)
+        if (gk_hybrid_zone(gk_hybrid_distance(g, &R->per, R->orc.flag, x), o->phi0, R->h) ==
+            GK_ZONE_CONTINUUM)
             drop[ndrop++] = R->sc.rve.id[p];
     }
-    if (ndrop && gk_scene_remove(&R->sc, ndrop, drop)) return fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc)), 1;
+    if (ndrop && gk_scene_remove(&R->sc, ndrop, drop)) {
+        fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc));
+        goto done;
+    }
     ng = R->sc.rve.n;
     /* the continuum's velocity at the grains; their zones */
     gz = (unsigned char *)malloc((size_t)ng);
     vg[0] = (double *)malloc((size_t)ng * sizeof(double));
     vg[1] = (double *)malloc((size_t)ng * sizeof(double));
-    if (!gz || !vg[0] || !vg[1]) return fprintf(stderr, "error: out of memory\n"), 1;
+    if (!gz || !vg[0] || !vg[1]) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
     for (p = 0; p < n; ++p) {
         val[2 * p] = R->P.v[0][p];
         val[2 * p + 1] = R->P.v[1][p];
@@ -1256,11 +1297,14 @@ static int enrich(run *R) {
     xs[0] = R->P.x[0];
     xs[1] = R->P.x[1];
     xs[2] = NULL;
-    if (gk_hybrid_rasterize(g, &R->per, R->md.basis, R->P.lp[0], n, (const double *const *)xs, R->P.m, val, 2, NULL, num,
-                            R->nden, &e))
-        return fprintf(stderr, "error: enrichment: %s\n", e.msg), 1;
+    if (gk_hybrid_rasterize(g, &R->per, R->md.basis, R->P.lp[0], n, (const double *const *)xs, R->P.m, val, 2,
+                            NULL, num, R->nden, &e)) {
+        fprintf(stderr, "error: enrichment: %s\n", e.msg);
+        goto done;
+    }
     for (k = 0; k < 2; ++k)
-        for (I = 0; I < nn; ++I) num[(size_t)k * nn + I] = R->nden[I] > 0.0 ? num[(size_t)k * nn + I] / R->nden[I] : 0.0;
+        for (I = 0; I < nn; ++I)
+            num[(size_t)k * nn + I] = R->nden[I] > 0.0 ? num[(size_t)k * nn + I] / R->nden[I] : 0.0;
     for (p = 0; p < ng; ++p) {
         double x[3], v[2] = {0.0, 0.0};
         gk_scene_position(&R->sc, p, x);
@@ -1274,26 +1318,33 @@ static int enrich(run *R) {
         int stride[2] = {1, 9};
         extra[0] = R->side;
         extra[1] = R->Fw;
-        if (gk_hybrid_enrich(&R->P, &R->C, &R->sc, gz, (const double *const *)vg, 0.5, THICK, 2, extra, stride, &rep,
-                             &e))
-            return fprintf(stderr, "error: %s\n", e.msg), 1;
+        if (gk_hybrid_enrich(&R->P, &R->C, &R->sc, gz, (const double *const *)vg, 0.5, THICK, 2, extra,
+                             stride, &rep, &e)) {
+            fprintf(stderr, "error: %s\n", e.msg);
+            goto done;
+        }
         R->grain_scale = rep.mass_scale;
     }
     if (!o->quiet)
-        printf("swap: %d points deleted, %d in the overlap; %d grains (%d in the overlap, %d left the zone); mass "
+        printf("swap: %d points deleted, %d in the overlap; %d grains (%d in the overlap, %d left the zone); "
+               "mass "
                "%.6g -> %.6g kg/m (grain mass x %.4f)\n",
-               rep.points_deleted, rep.points_overlap, ng, rep.grains_overlap, ndrop, rep.mass_before, rep.mass_after,
-               rep.mass_scale);
+               rep.points_deleted, rep.points_overlap, ng, rep.grains_overlap, ndrop, rep.mass_before,
+               rep.mass_after, rep.mass_scale);
     /* the boundary of the grains: platen layers, top wall, membranes */
     for (p = 0; p < ng; ++p) {
         int role = R->role[R->sc.rve.id[p]];
         double z[3] = {0.0, 0.0, 0.0};
-        if (role && o->test == T_PLANAR)
-            return fprintf(stderr,
-                           "error: the discrete zone reaches a platen (--phi0 %g m too large for a %g m specimen)\n",
-                           o->phi0, R->H),
-                   1;
-        if (role == 1 && gk_scene_prescribe(&R->sc, p, z, z)) return fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc)), 1;
+        if (role && o->test == T_PLANAR) {
+            fprintf(stderr,
+                    "error: the discrete zone reaches a platen (--phi0 %g m too large for a %g m specimen)\n",
+                    o->phi0, R->H);
+            goto done;
+        }
+        if (role == 1 && gk_scene_prescribe(&R->sc, p, z, z)) {
+            fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc));
+            goto done;
+        }
     }
     if (o->test == T_BIAXIAL) {
         int nrow = extent_nrow(R);
@@ -1312,24 +1363,38 @@ static int enrich(run *R) {
             w.mat.friction = 0.0;
             w.drive = GK_DRIVE_VELOCITY;
             w.velocity[1] = R->body.v[1];
-            if (gk_scene_add_wall(&R->sc, &w, &R->top_wall)) return fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc)), 1;
+            if (gk_scene_add_wall(&R->sc, &w, &R->top_wall)) {
+        fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc));
+        goto done;
+    }
         }
         /* the specimen's sides at enrichment: the extent of the continuum's outer points per row */
         l = (double *)malloc((size_t)nrow * sizeof(double));
         r = (double *)malloc((size_t)nrow * sizeof(double));
-        if (!l || !r) return fprintf(stderr, "error: out of memory\n"), 1;
+        if (!l || !r) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
         extent_rows(R, nrow, row_h, l, r);
-        if (add_membranes(R, l, r, nrow, row_h)) return 1;
+        if (add_membranes(R, l, r, nrow, row_h)) {
+            free(l), free(r);
+            goto done;
+        }
         free(l);
         free(r);
     }
     /* the coupling */
-    if (gk_hybrid_coupling_init(&R->cpl, g, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+    if (gk_hybrid_coupling_init(&R->cpl, g, NULL, &e)) {
+        fprintf(stderr, "error: %s\n", e.msg);
+        goto done;
+    }
     for (I = 0; I < nn; ++I) R->nden[I] = 1.0; /* every node carries a distance */
-    if (grow_grain_arrays(R, ng)) return 1;
+    if (grow_grain_arrays(R, ng)) goto done;
     R->enriched = 1;
     R->strain_enrich = R->strain;
     gk_hybrid_history_free(&R->hist);
+    status = 0;
+done: /* every exit: the scratch freed */
     gk_packing_free(&sub);
     free(num);
     free(val);
@@ -1343,7 +1408,7 @@ static int enrich(run *R) {
     free(vg[1]);
     free(drop);
     R->sec_dem += wtime() - t0;
-    return 0;
+    return status;
 }
 
 /* one step of the hybrid: continuum to vn, grains one step, coupling, continuum G2P */

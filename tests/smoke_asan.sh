@@ -55,5 +55,21 @@ run 2 "$B/mpmdem_biaxial" $BX --nx 3
 run 0 "$B/mpmdem_footing" --width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 \
     --every 0.005 --smooth 0.01 --phi-deg 30 --final 0.01 --quiet --threads 2 --out "$T/ft"
 run 0 "$B/mpmdem_collapse" --nx 4 --every 0.025 --snapshots 0.05 --t-end 0.05 --quiet --threads 2 --out "$T/cl"
+# the 3D explicit nonlocal FEMxDEM driver on one element: a run stopped half way, its restart, a
+# truncated checkpoint, a refused option
+NL="--test element-shear --packing examples/data/rve160_hm.txt --steps 4 --strain 0.001 --threads 2"
+run 0 "$B/femdem_nonlocal" $NL --stop-after 2 --out "$T/nl"
+run 0 "$B/femdem_nonlocal" $NL --restart "$T/nl" --out "$T/nl"
+mkdir -p "$T/nlc" && head -c 2000 "$T/nl/checkpoint.bin" > "$T/nlc/checkpoint.bin"
+run 1 "$B/femdem_nonlocal" $NL --restart "$T/nlc" --out "$T/nl2"
+run 2 "$B/femdem_nonlocal" $NL --steps 0 --out "$T/nl3"
+# the dynamic-relaxation FEMxDEM driver (periodic frame RVE) and a refused option
+run 0 "$B/femdem_dr" --test rve --frame periodic --steps 4 --strain 0.02 --out "$T/dr"
+run 2 "$B/femdem_dr" --test rve --frame periodic --steps -1 --out "$T/dr2"
+# the hybrid continuum-grain driver: a small planar shear through its enrichment, and one refused at
+# the enrichment (the discrete zone reaches a platen)
+HY="--test planar --mode hybrid --width 0.008 --cell 0.002 --strain 0.002 --out-every 0.001 --window 0.001 0.002"
+run 0 "$B/hybrid" $HY --height 0.016 --phi0 0.003 --threads 2 --out "$T/hy"
+run 1 "$B/hybrid" $HY --height 0.012 --phi0 0.004 --threads 2 --out "$T/hy2"
 echo "# smoke_asan: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
