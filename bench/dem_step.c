@@ -19,10 +19,32 @@
  * BENCH case=... dim=... n=... threads=... law=... real=... simd=... steps=...
  *       particle_steps_per_s=... contact_steps_per_s=... contacts_per_particle=... */
 #include "dem_step.h"
+#include "../examples/cli.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+static const char *cases[] = {"rve400", "2d_10k", "2d_100k", "3d_1k", "3d_10k", "3d_100k"};
+
+/* --physics: a comma list of known switches (a typo is refused, not ignored) */
+static int physics_ok(const char *list) {
+    static const char *names = "norot|frictionless|rolling|viscous|cohesion";
+    const char *p = list;
+    for (;;) {
+        const char *e = strchr(p, ',');
+        char word[32];
+        size_t l = e ? (size_t)(e - p) : strlen(p);
+        if (l == 0 || l >= sizeof word) break;
+        memcpy(word, p, l), word[l] = 0;
+        if (cli_choice_index(names, word) < 0) break;
+        if (!e) return 1;
+        p = e + 1;
+    }
+    fprintf(stderr, "bench_dem_step: --physics '%s' must be a comma list of norot, frictionless, rolling, viscous, "
+                    "cohesion\n", list);
+    return 0;
+}
 
 static void usage(FILE *fp) {
     fprintf(fp, "usage: bench_dem_step [--case rve400|2d_10k|2d_100k|3d_1k|3d_10k|3d_100k] [--threads T]\n"
@@ -86,51 +108,37 @@ static int float_error_report(void) {
 
 int main(int argc, char **argv) {
     bench_case c;
-    int i, use_float = 0, rc = 0, float_error = 0;
-    const char *cname = NULL;
+    int ci = -1, use_float = 0, rc = 0, float_error = 0, help = 0, steps = 0, hertz = 0;
+    const cli_opt opts[] = {{"--case", CLI_CHOICE, &ci, 0, 0, NULL, "rve400|2d_10k|2d_100k|3d_1k|3d_10k|3d_100k", 0},
+                            {"--threads", CLI_INT, &c.threads, 1, 1024, NULL, NULL, 0},
+                            {"--steps", CLI_INT, &steps, 1, 1000000000, NULL, NULL, 0},
+                            {"--repeats", CLI_INT, &c.repeats, 1, 64, NULL, NULL, 0},
+                            {"--law", CLI_CHOICE, &hertz, 0, 0, NULL, "linear|hertz", 0},
+                            {"--real", CLI_CHOICE, &use_float, 0, 0, NULL, "double|float", 0},
+                            {"--scalar", CLI_FLAG, &c.scalar, 0, 0, NULL, NULL, 0},
+                            {"--float-error", CLI_FLAG, &float_error, 0, 0, NULL, NULL, 0},
+                            {"--packing", CLI_STR, &c.packing, 0, 0, NULL, NULL, 0},
+                            {"--write-packing", CLI_STR, &c.write_packing, 0, 0, NULL, NULL, 0},
+                            {"--physics", CLI_STR, &c.physics, 0, 0, NULL, NULL, 0},
+                            {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    const cli_opt *tables[2];
     memset(&c, 0, sizeof c);
     c.threads = 1;
-    for (i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage(stdout);
-            return 0;
-        }
-        if (!strcmp(a, "--scalar")) {
-            c.scalar = 1;
-            continue;
-        }
-        if (!strcmp(a, "--float-error")) {
-            float_error = 1;
-            continue;
-        }
-        if (!v) {
-            fprintf(stderr, "bench_dem_step: %s needs a value\n", a);
-            return 2;
-        }
-        if (!strcmp(a, "--case")) cname = v;
-        else if (!strcmp(a, "--threads")) c.threads = atoi(v);
-        else if (!strcmp(a, "--steps")) c.steps = atol(v);
-        else if (!strcmp(a, "--repeats")) c.repeats = atoi(v);
-        else if (!strcmp(a, "--law")) c.hertz = !strcmp(v, "hertz");
-        else if (!strcmp(a, "--real")) use_float = !strcmp(v, "float");
-        else if (!strcmp(a, "--packing")) c.packing = v;
-        else if (!strcmp(a, "--write-packing")) c.write_packing = v;
-        else if (!strcmp(a, "--physics")) c.physics = v;
-        else {
-            fprintf(stderr, "bench_dem_step: unknown option %s (see --help)\n", a);
-            return 2;
-        }
-        ++i;
+    tables[0] = opts, tables[1] = NULL;
+    if (cli_parse("bench_dem_step", argc, argv, tables, &help)) return 2;
+    if (help) {
+        usage(stdout);
+        return 0;
     }
-    if (cname) {
-        c.name = cname;
+    if (c.physics && !physics_ok(c.physics)) return 2;
+    c.steps = steps, c.hertz = hertz;
+    if (ci >= 0) {
+        c.name = cases[ci];
         header();
         return run_one(&c, use_float, 0);
     }
     if (float_error) return float_error_report();
     {
-        static const char *cases[] = {"rve400", "2d_10k", "2d_100k", "3d_1k", "3d_10k", "3d_100k"};
         int k, law, fl, sc, th;
         header();
         for (k = 0; k < 6; ++k)

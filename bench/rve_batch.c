@@ -13,6 +13,7 @@
 #define GK_IMPLEMENTATION
 #include "gk_homog.h"
 #include "gk_io.h"
+#include "../examples/cli.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,36 +24,24 @@ static int cmp_double(const void *a, const void *b) {
 }
 
 int main(int argc, char **argv) {
-    int nrve = 512, steps = 100, reps = 5, only_threads = 0, i, t;
+    int nrve = 512, steps = 100, reps = 5, only_threads = 0, help = 0, i, t;
     gk_packing pk;
     gk_err e;
     gk_rve *rves;
     gk_rve_state *saved;
     gk_rve_def def = gk_rve_def_default();
     double dH[9] = {5e-4, 0, 0, 0, -1e-3, 0, 0, 0, 0}, ms1 = 0.0;
-    for (i = 1; i < argc; ++i) {
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(argv[i], "--help")) {
-            printf("usage: bench_rve_batch [--rves N] [--steps S] [--repeats R] [--threads T]\n");
-            return 0;
-        }
-        if (!v) {
-            fprintf(stderr, "bench_rve_batch: %s needs a value\n", argv[i]);
-            return 2;
-        }
-        if (!strcmp(argv[i], "--rves")) nrve = atoi(v);
-        else if (!strcmp(argv[i], "--steps")) steps = atoi(v);
-        else if (!strcmp(argv[i], "--repeats")) reps = atoi(v);
-        else if (!strcmp(argv[i], "--threads")) only_threads = atoi(v);
-        else {
-            fprintf(stderr, "bench_rve_batch: unknown option %s\n", argv[i]);
-            return 2;
-        }
-        ++i;
-    }
-    if (nrve < 1 || steps < 1 || reps < 1 || reps > 99) {
-        fprintf(stderr, "bench_rve_batch: bad arguments\n");
-        return 2;
+    const cli_opt opts[] = {{"--rves", CLI_INT, &nrve, 1, 1000000, NULL, NULL, 0},
+                            {"--steps", CLI_INT, &steps, 1, 100000000, NULL, NULL, 0},
+                            {"--repeats", CLI_INT, &reps, 1, 99, NULL, NULL, 0},
+                            {"--threads", CLI_INT, &only_threads, 1, 2, NULL, NULL, 0},
+                            {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    const cli_opt *tables[2];
+    tables[0] = opts, tables[1] = NULL;
+    if (cli_parse("bench_rve_batch", argc, argv, tables, &help)) return 2;
+    if (help) {
+        printf("usage: bench_rve_batch [--rves N] [--steps S] [--repeats R (1..99)] [--threads 1|2]\n");
+        return 0;
     }
     if (gk_packing_read("examples/data/rve400.txt", &pk, NULL, &e)) {
         fprintf(stderr, "bench_rve_batch: %s\n", e.msg);
