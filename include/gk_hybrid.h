@@ -633,7 +633,7 @@ GKDEF gk_result gk_hybrid_dp_stress(gk_mpm_points *pts, double dt, void *user, g
         gk_mpm_dp_info info;
         gk_result r;
         int i, j;
-        gk_mpm_point_dH(pts, p, dt, dH);
+        gk_mpm_point_dh(pts, p, dt, dH);
         {
             /* the objective rotation R = exp(dt W) in closed form (2D), then the
              * symmetric dH alone to the return map (whose own rotation then has

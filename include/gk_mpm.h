@@ -36,7 +36,7 @@
  *   gk_mpm_step                   one step in USF, USL or MUSL order
  *   gk_mpm_bodies_advance         move rigid bodies by v dt
  *   gk_mpm_wave_speed             P-wave speed, for the time step
- *   gk_mpm_point_dH               dH = dt L, what an RVE receives [Liang & Zhao 2019 (b)]
+ *   gk_mpm_point_dh               dH = dt L, what an RVE receives [Liang & Zhao 2019 (b)]
  *   gk_mpm_point_polar            F = R U via gk_m3_polar [Liang & Zhao 2019 eqs 36-40]
  *   gk_mpm_elastic_update         hypoelastic increment (objective rotation)
  *   gk_mpm_dp_*                   Drucker-Prager return map with apex return
@@ -435,7 +435,7 @@ GK_INLINE double gk_mpm_kernel_1d(gk_mpm_basis b, double r, double l, double *dN
 
 /* dH = dt L of point p: the incremental displacement gradient (stretch and
  * spin) an RVE receives for this step [Liang & Zhao 2019 step (b)] */
-GK_INLINE void gk_mpm_point_dH(const gk_mpm_points *pts, int p, double dt, double dH[9]) {
+GK_INLINE void gk_mpm_point_dh(const gk_mpm_points *pts, int p, double dt, double dH[9]) {
     int k;
     for (k = 0; k < 9; ++k) dH[k] = dt * pts->L[9 * p + k];
 }
