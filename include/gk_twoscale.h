@@ -1186,9 +1186,12 @@ static gk_result gk__ts_rec_parse(gk_twoscale *ts, int id, const unsigned char *
                           "the record of point %d names point %d, prototype %d (expected %d), %d DEM steps, %d "
                           "contact keys",
                           id, (int)v[0], (int)v[1], ts->pick[id], (int)v[2], (int)v[3]);
-    for (k = 0; k < 9; ++k)
-        if (!isfinite(H[k]) || !isfinite(S[k]))
-            return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d has a NaN dH or stress", id);
+    for (k = 0; k < 9; ++k) /* finite, and small enough for the fields' squares (eps_q, q) to stay finite */
+        if (!(fabs(H[k]) <= 1e6) || !(fabs(S[k]) <= 1e100))
+            return gk_err_set(&ts->err, GK_ERR_FORMAT,
+                              "the record of point %d has a NaN or impossible accumulated dH (|H| > 1e6) or stress "
+                              "(|sigma| > 1e100 Pa)",
+                              id);
     ref = v[3] >= 0 ? (size_t)ts->nd4 * 8 + (size_t)v[3] * 8 : 0;
     if (ref > n - GK__TS_REC_MIN)
         return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d is shorter than its %d contact keys", id,

@@ -756,7 +756,8 @@ static void spill_resealed(const char *path, unsigned char *b, size_t n) {
 
 /* a two-scale checkpoint with a valid checksum but a NaN reference tangent
  * (the tangent-reuse reference of a point) was accepted, and the next run
- * returned GK_OK with that NaN as the point's tangent; contact keys out of
+ * returned GK_OK with that NaN as the point's tangent; an accumulated dH of
+ * 1e300 was accepted and gave an infinite eps_q field; contact keys out of
  * order (the reference network) were accepted and gave a wrong reuse
  * decision. Both refused by name now, the set unchanged. A point without
  * contacts (a loose packing) with reuse on passed NULL to qsort (UBSan). */
@@ -803,6 +804,14 @@ TEST(twoscale_checkpoint_reference_is_checked) {
     y = file_image(again, &ny);
     CHECK(y && ny == n && memcmp(y, img, n) == 0); /* unchanged */
     free(y);
+    memcpy(x, img, n); /* a finite but impossible accumulated dH: its field eps_q was Inf */
+    {
+        double huge = 1e300;
+        memcpy(x + rec + 16 + 8, &huge, 8);
+        spill_resealed(bad, x, n);
+        CHECK_EQ_INT(gk_twoscale_load(&ts, bad, &blk, &nb), GK_ERR_FORMAT);
+        CHECK(strstr(gk_twoscale_error(&ts), "impossible accumulated dH"));
+    }
     /* contact keys: one record with two keys out of order (the record grown by 16 bytes) */
     nx = n + 16;
     free(x);
