@@ -138,8 +138,9 @@
  *   reference, accepted RVE state), then the DRIVER'S OWN BLOCK (any bytes: the macro state),
  *   then a 64-bit FNV-1a checksum of all of it. Written to PATH.tmp and
  *   renamed. Loading checks the checksum over the whole file, every size
- *   and count against the file and the set, and restores all points into
- *   staging first: a truncated, corrupted, foreign or other-version file is
+ *   and count against the file and the set, every value of a record (finite,
+ *   |H| <= 1e6, |sigma| <= 1e100 Pa, a finite reference tangent, sorted
+ *   contact keys), and restores all points into staging first: a truncated, corrupted, foreign or other-version file is
  *   refused by name and the set is unchanged.
  *
  * MPI (optional, like OpenMP). Define GK_TWOSCALE_MPI (and build with mpicc)
