@@ -54,6 +54,7 @@ typedef struct fd_opts {
     int relax_kind;             /* --relaxation aitken|anderson|none */
     unsigned long packing_seed; /* --packing A,B,...: seed of the per-Gauss-point draw */
     const char *fields_at;      /* --fields-at: axial strains [%] of the fabric maps (biaxial) */
+    const char *cost_log;       /* --cost-log: the DEM steps of every Gauss point at every run (biaxial) */
 } fd_opts;
 
 /* one row of a driver's CSV: the state after a converged step and the work of the step */
@@ -98,6 +99,7 @@ typedef struct fd_model {
     int *rfix;
     double *rvals, *rr, *ur;
     fd_probe_fn probe;                      /* diagnostics at a Newton iteration (NULL: none) */
+    FILE *cost_log;                         /* --cost-log (rank 0; NULL: none)                  */
     int (*checkpoint)(struct fd_model *M); /* the driver's checkpoint (cut-back give-up)      */
 } fd_model;
 
@@ -520,6 +522,7 @@ static void fd_free(fd_model *M) {
                  M->lface, M->rface, M->rfix, M->rvals, M->rr,   M->ur,   M->curve, M->hist};
     size_t k;
     for (k = 0; k < sizeof p / sizeof *p; ++k) free(p[k]);
+    if (M->cost_log) fclose(M->cost_log); /* an error path: the driver closed it otherwise */
     gk_twoscale_destroy(&M->ts);
     gk_dofmap_free(&M->dm);
     gk_csr_free(&M->Kr);
@@ -629,6 +632,11 @@ static int fd_eval(fd_model *M, const double *u, gk_err *err) {
         M->pend_dem += pts[g].work;
         M->pend_reused += pts[g].tangent == 2, M->pend_computed += pts[g].tangent == 1;
         nbad += pts[g].code != 0;
+    }
+    if (M->cost_log) { /* --cost-log: the load step being solved, its increment scale, every point's work */
+        fprintf(M->cost_log, "%d %.17g", M->step + 1, M->scale);
+        for (g = 0; g < M->ngp; ++g) fprintf(M->cost_log, " %d", pts[g].work);
+        fprintf(M->cost_log, "\n");
     }
     if (nbad) gk_err_set(err, GK_ERR_STATE, "%s", gk_twoscale_error(&M->ts));
     return nbad;
