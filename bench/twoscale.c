@@ -113,15 +113,34 @@ static double fem_seconds(int dim, int ngp) {
     return best;
 }
 
-/* gk_twoscale's balance on cost c[0..n) over R ranks: first contiguous ranges of equal particle
- * counts (all equal here), then moves from the most to the least loaded rank, each the point whose
- * cost is nearest half their gap, until within tol of the mean (or no move helps); the most loaded
- * rank's load over the mean, with the costs `next` of the following iteration (the balance only
- * knows the last ones) */
-static double imbalance(const double *c, const double *next, int n, int R, double tol) {
-    int *own = (int *)malloc((size_t)n * sizeof(int)), p, r, it;
-    double *L = (double *)calloc((size_t)R, sizeof(double)), mean = 0.0, mx = 0.0, out;
-    for (p = 0; p < n; ++p) own[p] = (int)((p + 0.5) * R / n), L[own[p]] += c[p], mean += c[p];
+/* measured cost pairs: a[k] a Gauss point's DEM steps at one run, b[k] at a later one */
+typedef struct pairs {
+    double *a, *b;
+    int n, cap;
+} pairs;
+
+static int pairs_add(pairs *P, double a, double b) {
+    if (P->n == P->cap) {
+        int cap = 2 * P->cap + 1024;
+        double *na = (double *)realloc(P->a, (size_t)cap * sizeof *na), *nb;
+        if (!na) return 1;
+        P->a = na;
+        if (!(nb = (double *)realloc(P->b, (size_t)cap * sizeof *nb))) return 1;
+        P->b = nb, P->cap = cap;
+    }
+    P->a[P->n] = a, P->b[P->n++] = b;
+    return 0;
+}
+
+/* gk_twoscale's balance (gk__ts_balance) of cost c[0..n) over R ranks from the assignment own
+ * (changed): moves from the most to the least loaded rank, each the point whose cost is nearest half
+ * their gap, until within tol of the mean (or no move helps). The moves; mv[r] the records rank r
+ * sent or received */
+static int balance(const double *c, int *own, int n, int R, double tol, int *mv) {
+    double *L = (double *)calloc((size_t)R, sizeof(double)), mean = 0.0;
+    int p, r, it, moves = 0;
+    for (r = 0; r < R; ++r) mv[r] = 0;
+    for (p = 0; p < n; ++p) L[own[p]] += c[p], mean += c[p];
     mean /= R;
     for (it = 0; it < n; ++it) {
         int rmax = 0, rmin = 0, best = -1;
@@ -139,89 +158,216 @@ static double imbalance(const double *c, const double *next, int n, int R, doubl
             }
         if (best < 0) break;
         own[best] = rmin, L[rmax] -= c[best], L[rmin] += c[best];
+        ++mv[rmax], ++mv[rmin], ++moves;
     }
-    for (r = 0; r < R; ++r) L[r] = 0;
-    mean = 0;
-    for (p = 0; p < n; ++p) L[own[p]] += next[p], mean += next[p];
-    mean /= R;
+    free(L);
+    return moves;
+}
+
+/* the most loaded rank's cost over the mean */
+static double max_over_mean(const double *c, const int *own, int n, int R) {
+    double *L = (double *)calloc((size_t)R, sizeof(double)), mean = 0.0, mx = 0.0;
+    int p, r;
+    for (p = 0; p < n; ++p) L[own[p]] += c[p], mean += c[p];
     for (r = 0; r < R; ++r)
         if (L[r] > mx) mx = L[r];
-    out = mx / mean;
-    free(own), free(L);
-    return out;
+    free(L);
+    return mx * R / mean;
 }
 
-/* the table: costs drawn (deterministically) from the measured pairs of consecutive per-point work
- * (w0: a step's, w1: the next step's, nw pairs). Per case and rank count: the RVE time per iteration of
- * the most loaded rank, the FEM time (replicated on every rank), the message time, the imbalance
- * (most loaded rank / mean) when the balance knows the costs (same) and when it knows only the last
- * step's (next), the efficiency of the micro side alone (E_micro: RVEs and messages) and of the
- * whole iteration (E: with the replicated FEM); then the fewest RVEs per rank for E_micro >= 90 %. */
-static double micro_eff(const double *c, const double *c1, int n, int R, double tot, double tol, double alpha,
-                        double bytes, double bw, double *imb_out) {
-    double imb = imbalance(c, c1, n, R, tol), lg = ceil(log2((double)R > 1 ? R : 2));
+/* a balance that runs on other costs than it was made from: the assignment balanced on c (from the
+ * first one, contiguous ranges of equal particle counts), run on `next`; out: the imbalance then,
+ * and the rebalance on `next` that follows (its moves, the busiest rank's records in and out) */
+typedef struct verdict {
+    double imb;
+    int moves, busiest;
+} verdict;
+static verdict predict(const double *c, const double *next, int n, int R, double tol) {
+    int *own = (int *)malloc((size_t)n * sizeof(int)), *mv = (int *)malloc((size_t)R * sizeof(int)), p, r;
+    verdict v;
+    for (p = 0; p < n; ++p) own[p] = (int)((p + 0.5) * R / n);
+    balance(c, own, n, R, tol, mv);
+    v.imb = max_over_mean(next, own, n, R);
+    v.moves = balance(next, own, n, R, tol, mv);
+    for (v.busiest = 0, r = 0; r < R; ++r)
+        if (mv[r] > v.busiest) v.busiest = mv[r];
+    free(own), free(mv);
+    return v;
+}
+
+/* n costs [s] drawn (deterministically, from `seed`) from the pairs: c0 what the balance sees, c1
+ * what the ranks then run; their sum */
+static double draw(const pairs *P, int n, double per_step, uint64_t seed, double *c0, double *c1) {
+    gk_rng rng;
+    double tot = 0.0;
+    int p;
+    gk_rng_seed(&rng, seed);
+    for (p = 0; p < n; ++p) {
+        int i = (int)(gk_rng_u64(&rng) % (uint64_t)P->n);
+        c0[p] = (P->a[i] + 1.0) * per_step, c1[p] = (P->b[i] + 1.0) * per_step;
+        tot += c1[p];
+    }
+    return tot;
+}
+
+/* one case at R ranks under both rules. Per load step of m runs (Newton iterations): rule ACCEPT
+ * (gk_twoscale's default) runs every iteration on the assignment made from the last step's costs
+ * (imbalance imb1, from the pairs across steps B) and rebalances once; rule RUN runs the first
+ * iteration so and the m - 1 others on the previous iteration's costs (imb_it, from the pairs within
+ * a step W), rebalancing before every run. Each rebalance costs the busiest rank 3 messages and a
+ * record of rec bytes per point it sends or receives. Out: E_micro (RVEs, messages, migrations) and
+ * E (with the FEM replicated on every rank) of both rules, and the records moved per step (RUN). */
+typedef struct outcome {
+    double same, imb1, imb_it, Em_acc, Em_run, E_acc, E_run, t_rve_acc, t_rve_run, moved_step;
+} outcome;
+static outcome evaluate(const pairs *B, const pairs *W, double m, int n, int R, double per_step, double rec,
+                        double tfem, double tol, double alpha, double bytes, double bw) {
+    double *c0 = (double *)malloc((size_t)n * sizeof(double)), *c1 = (double *)malloc((size_t)n * sizeof(double));
+    double tot, lg = ceil(log2((double)R > 1 ? R : 2)), tmsg, tmig1, tmig_it = 0.0, mean;
+    verdict v1, vi = {1.0, 0, 0}, vs;
+    outcome o;
     /* a broadcast (dH) and an allgather (results) by recursive doubling: log2 R latencies each; every
      * rank receives every point's dH and results once */
-    double tmsg = 2.0 * lg * alpha + bytes / bw;
-    if (imb_out) *imb_out = imb;
-    return tot / (R * (imb * tot / R + tmsg));
+    tmsg = 2.0 * lg * alpha + bytes / bw;
+    tot = draw(B, n, per_step, 7, c0, c1);
+    vs = predict(c0, c0, n, R, tol);
+    v1 = predict(c0, c1, n, R, tol);
+    tmig1 = v1.busiest * (3.0 * alpha + rec / bw);
+    if (W->n > 0) {
+        draw(W, n, per_step, 11, c0, c1);
+        vi = predict(c0, c1, n, R, tol);
+        tmig_it = vi.busiest * (3.0 * alpha + rec / bw);
+    }
+    o.same = vs.imb, o.imb1 = v1.imb, o.imb_it = vi.imb;
+    o.t_rve_acc = v1.imb * tot / R;
+    o.Em_acc = tot / (R * (o.t_rve_acc + tmsg + tmig1 / m));
+    o.E_acc = (tot + tfem) / (R * (o.t_rve_acc + tmsg + tmig1 / m + tfem));
+    mean = (v1.imb + (m - 1.0) * vi.imb) / m;
+    o.t_rve_run = mean * tot / R;
+    o.Em_run = tot / (R * (o.t_rve_run + tmsg + (tmig1 + (m - 1.0) * tmig_it) / m));
+    o.E_run = (tot + tfem) / (R * (o.t_rve_run + tmsg + (tmig1 + (m - 1.0) * tmig_it) / m + tfem));
+    o.moved_step = v1.moves + (m - 1.0) * vi.moves;
+    free(c0), free(c1);
+    return o;
 }
 
-static void model(const double *w0, const double *w1, int nw, double rate2d, double rate3d, double alpha,
-                  double bw, double tol) {
-    static const int ranks[3] = {64, 1000, 10000}, per[10] = {1, 2, 4, 6, 8, 12, 16, 24, 32, 64};
+/* the table: per case and rank count the RVE time per iteration of the most loaded rank (rule
+ * ACCEPT), the FEM time (replicated on every rank), the message time, the imbalances (most loaded
+ * rank / mean) when the balance knows the costs (imb=), knows the last step's (imb+1) and the last
+ * iteration's (imb_it), E_micro (RVEs, messages, migrations) and E (with the replicated FEM) of both
+ * rules, the bytes that move per load step under RUN; then, per rule, the fewest RVEs per rank for
+ * E_micro >= 90 %. W empty: RUN is not evaluated. rec2d: a 400-disk point's record (migrations). */
+static void model(const pairs *B, const pairs *W, double m, double rate2d, double rate3d, double alpha, double bw,
+                  double tol, double rec2d) {
+    static const int ranks[3] = {64, 1000, 10000}, per[12] = {1, 2, 4, 6, 8, 10, 12, 16, 24, 32, 64, 128};
     struct {
         const char *name;
         int dim, n, particles;
-        double rate;
+        double rate, rec;
     } cs[2];
-    int k, j, p;
+    int k, j, rule;
     cs[0].name = "2D 7776 x 400 disks", cs[0].dim = 2, cs[0].n = 7776, cs[0].particles = 400, cs[0].rate = rate2d;
     cs[1].name = "3D 1000 x 4096 spheres", cs[1].dim = 3, cs[1].n = 1000, cs[1].particles = 4096, cs[1].rate = rate3d;
+    /* a 3D record: assumed twice the 2D bytes per particle (3 components instead of 2, 3 rotations
+     * instead of 1, more contacts per particle) */
+    cs[0].rec = rec2d, cs[1].rec = 2.0 * rec2d / 400.0 * 4096.0;
     printf("\nscaling model (rates %.3g and %.3g particle-steps/s per core, alpha %.1e s, bandwidth %.2g B/s, balance "
-           "tolerance %.2f):\n",
-           rate2d, rate3d, alpha, bw, tol);
-    printf("%-23s %6s %7s %9s %9s %8s %6s %6s %9s %8s %6s\n", "case", "ranks", "rve/rk", "T_rve ms", "T_fem ms",
-           "T_msg ms", "imb=", "imb+1", "bytes/it", "E_micro", "E");
+           "tolerance %.2f,\n  %.2f runs per load step, point records %.0f and %.0f bytes; ACCEPT: balance at every "
+           "accept, RUN: before every run):\n",
+           rate2d, rate3d, alpha, bw, tol, m, cs[0].rec, cs[1].rec);
+    printf("%-23s %6s %7s %9s %9s %8s %6s %6s %6s %8s %8s %6s %6s %10s\n", "case", "ranks", "rve/rk", "T_rve ms",
+           "T_fem ms", "T_msg ms", "imb=", "imb+1", "imb_it", "Em_ACC", "Em_RUN", "E_ACC", "E_RUN", "MB/step RUN");
     for (k = 0; k < 2; ++k) {
         int n = cs[k].n, nd4 = cs[k].dim * cs[k].dim * cs[k].dim * cs[k].dim;
-        double *c = (double *)malloc((size_t)n * sizeof(double)), *c1 = (double *)malloc((size_t)n * sizeof(double));
-        double tot = 0.0, tfem = fem_seconds(cs[k].dim, n), bytes = 8.0 * n * (9 + 9 + nd4 + 7);
-        gk_rng rng;
-        gk_rng_seed(&rng, 7);
-        for (p = 0; p < n; ++p) {
-            int i = (int)(gk_rng_u64(&rng) % (uint64_t)nw);
-            c[p] = (w0[i] + 1.0) * cs[k].particles / cs[k].rate;
-            c1[p] = (w1[i] + 1.0) * cs[k].particles / cs[k].rate;
-            tot += c1[p];
-        }
+        double tfem = fem_seconds(cs[k].dim, n), bytes = 8.0 * n * (9 + 9 + nd4 + 7), ps = cs[k].particles / cs[k].rate;
         for (j = 0; j < 3; ++j) {
             int R = ranks[j];
-            double same, imb, Em = micro_eff(c, c1, n, R, tot, tol, alpha, bytes, bw, &imb), lg = ceil(log2((double)R));
-            double tmsg = 2.0 * lg * alpha + bytes / bw, trve = imb * tot / R;
-            same = imbalance(c, c, n, R, tol);
-            printf("%-23s %6d %7.2f %9.2f %9.2f %8.3f %6.3f %6.3f %9.0f %7.1f%% %5.1f%%\n", cs[k].name, R, (double)n / R,
-                   1e3 * trve, 1e3 * tfem, 1e3 * tmsg, same, imb, bytes, 100 * Em,
-                   100 * (tot + tfem) / (R * (trve + tfem + tmsg)));
+            double lg = ceil(log2((double)R));
+            outcome o = evaluate(B, W, m, n, R, ps, cs[k].rec, tfem, tol, alpha, bytes, bw);
+            printf("%-23s %6d %7.2f %9.2f %9.2f %8.3f %6.3f %6.3f ", cs[k].name, R, (double)n / R, 1e3 * o.t_rve_acc,
+                   1e3 * tfem, 1e3 * (2.0 * lg * alpha + bytes / bw), o.same, o.imb1);
+            if (W->n > 0)
+                printf("%6.3f %7.1f%% %7.1f%% %5.1f%% %5.1f%% %10.2f\n", o.imb_it, 100 * o.Em_acc, 100 * o.Em_run,
+                       100 * o.E_acc, 100 * o.E_run, 1e-6 * o.moved_step * cs[k].rec);
+            else
+                printf("%6s %7.1f%% %8s %5.1f%% %6s %10s\n", "-", 100 * o.Em_acc, "-", 100 * o.E_acc, "-", "-");
         }
-        for (j = 0; j < 10; ++j) {
-            int R = n / per[j] > 1 ? n / per[j] : 2;
-            if (micro_eff(c, c1, n, R, tot, tol, alpha, bytes, bw, NULL) >= 0.9) {
-                printf("%-23s E_micro >= 90 %% from %d RVEs per rank (%d ranks); the FEM replicated on every rank "
-                       "keeps E >= 90 %% while T_fem <= %.1f ms, i.e. up to %d ranks\n",
-                       cs[k].name, per[j], R, 1e3 * 0.1 * tot / R,
-                       (int)(0.1 * tot / (tfem > 0 ? tfem : 1e-30)) < n ? (int)(0.1 * tot / (tfem > 0 ? tfem : 1e-30)) : n);
-                break;
+        for (rule = 0; rule < (W->n > 0 ? 2 : 1); ++rule) {
+            outcome o = evaluate(B, W, m, n, n / 8, ps, cs[k].rec, tfem, tol, alpha, bytes, bw);
+            printf("%-23s %-6s: E_micro %.1f %% at 8 RVEs per rank (%d ranks); ", cs[k].name, rule ? "RUN" : "ACCEPT",
+                   100 * (rule ? o.Em_run : o.Em_acc), n / 8);
+            for (j = 0; j < 12; ++j) {
+                int R = n / per[j] > 1 ? n / per[j] : 2;
+                o = evaluate(B, W, m, n, R, ps, cs[k].rec, tfem, tol, alpha, bytes, bw);
+                if ((rule ? o.Em_run : o.Em_acc) >= 0.9) break;
             }
+            if (j < 12)
+                printf(">= 90 %% from %d RVEs per rank (%d ranks: %.1f %%)\n", per[j], n / per[j] > 1 ? n / per[j] : 2,
+                       100 * (rule ? o.Em_run : o.Em_acc));
+            else
+                printf("below 90 %% up to %d RVEs per rank\n", per[11]);
         }
-        free(c), free(c1);
     }
 }
 
+/* femdem_biaxial --cost-log FILE: a line per run "STEP SCALE W_0 ... W_n-1". Pairs across steps (B:
+ * the last run of a step, the accepted one, and the first run of the next), within a step (W:
+ * consecutive runs of one step and scale, i.e. Newton iterations) and the runs per attempt of a step
+ * (*m). 0, or 1 after a message naming the line */
+static int read_cost_log(const char *path, pairs *B, pairs *W, double *m) {
+    FILE *fp = fopen(path, "r");
+    char *line = NULL;
+    size_t cap = 0;
+    double *prev = NULL, *cur = NULL, pscale = 0.0;
+    int npt = 0, room = 0, lines = 0, attempts = 0, pstep = 0, bad = 0;
+    if (!fp) return fprintf(stderr, "bench_twoscale: cannot open %s\n", path), 1;
+    while (!bad && getline(&line, &cap, fp) > 0) {
+        char *s = line, *end;
+        long step = strtol(s, &end, 10);
+        double scale = 0.0, *t;
+        int k = 0;
+        bad = end == s || step < 1 || step > 100000000 || (lines > 0 && (step < pstep || step > pstep + 1));
+        if (!bad) s = end, scale = strtod(s, &end), bad = end == s || !(scale > 0 && scale <= 1);
+        for (s = end; !bad; s = end) { /* the points' work */
+            double w = strtod(s, &end);
+            if (end == s) break;
+            bad = !(w >= 0 && w < 1e12) || (lines > 0 && k == npt);
+            if (!bad && k == room) {
+                bad = !(t = (double *)realloc(cur, (size_t)(room + 1024) * sizeof *t));
+                if (!bad) cur = t, room += 1024;
+            }
+            if (!bad) cur[k++] = w;
+        }
+        while (!bad && (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n')) ++s;
+        bad = bad || *s || k == 0 || (lines > 0 && k != npt);
+        if (bad) break;
+        if (lines == 0) npt = k;
+        if (lines > 0 && step == pstep && scale == pscale) /* the next iteration of the same step */
+            for (k = 0; k < npt && !bad; ++k) bad = pairs_add(W, prev[k], cur[k]);
+        else { /* a new attempt at a step: the first run of the next step, or of a cut-back */
+            ++attempts;
+            if (lines > 0 && step == pstep + 1)
+                for (k = 0; k < npt && !bad; ++k) bad = pairs_add(B, prev[k], cur[k]);
+        }
+        if (!prev && !(prev = (double *)malloc((size_t)room * sizeof *prev))) bad = 1;
+        if (!bad) t = prev, prev = cur, cur = t;
+        pstep = (int)step, pscale = scale, ++lines;
+    }
+    bad = bad || ferror(fp) || B->n == 0;
+    if (bad)
+        fprintf(stderr, "bench_twoscale: %s, line %d: not a femdem_biaxial --cost-log line (\"STEP SCALE W_0 ... W_n-1\", "
+                "steps 1, 2, ... and the same point count on every line), or no two load steps\n",
+                path, lines + 1);
+    *m = attempts > 0 ? (double)lines / attempts : 1.0;
+    fclose(fp);
+    free(line), free(prev), free(cur);
+    return bad;
+}
+
 int main(int argc, char **argv) {
-    int n = 512, steps = 3, iters = 3, threads = 1, do_model = 0, s, it, p, rank = 0, nranks = 1, help = 0, nt = 0;
-    double band = 0.1, alpha = 2e-6, bw = 1e10, rate3d = 1.05e7, tol = 0.05;
-    const char *costs = NULL;
+    int n = 512, steps = 3, iters = 3, threads = 1, do_model = 0, balance_rule = 0, s, it, p, rank = 0, nranks = 1, help = 0, nt = 0;
+    double band = 0.1, alpha = 2e-6, bw = 1e10, rate3d = 1.05e7, tol = 0.05, rate2d = 0;
+    const char *costs = NULL, *cost_log = NULL;
     const cli_opt opts[] = {{"--points", CLI_INT, &n, 1, 1000000, NULL, NULL, 0},
                             {"--steps", CLI_INT, &steps, 2, 1000, NULL, NULL, 0},
                             {"--iterations", CLI_INT, &iters, 1, 1000, NULL, NULL, 0},
@@ -231,8 +377,11 @@ int main(int argc, char **argv) {
                             {"--alpha", CLI_REAL, &alpha, 0, 1, NULL, NULL, 0},
                             {"--bandwidth", CLI_REAL, &bw, 0, HUGE_VAL, NULL, NULL, CLI_LO_OPEN | CLI_HI_OPEN},
                             {"--rate3d", CLI_REAL, &rate3d, 0, HUGE_VAL, NULL, NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+                            {"--rate2d", CLI_REAL, &rate2d, 0, HUGE_VAL, NULL, NULL, CLI_HI_OPEN},
                             {"--tol", CLI_REAL, &tol, 0, 1, NULL, NULL, CLI_LO_OPEN},
                             {"--costs", CLI_STR, &costs, 0, 0, NULL, NULL, 0},
+                            {"--cost-log", CLI_STR, &cost_log, 0, 0, NULL, NULL, 0},
+                            {"--balance", CLI_CHOICE, &balance_rule, 0, 0, NULL, "accept|run", 0},
                             {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     const cli_opt *tables[2];
     gk_packing pk;
@@ -242,7 +391,7 @@ int main(int argc, char **argv) {
     gk_twoscale_def d;
     double *dH, *sig, *D, *times, *work, work_ps = 0.0, t0;
     long long b_in = 0, b_out = 0;
-    gk_twoscale_stats st0 = {0, 0, 0, 0, 0, 0, 0};
+    gk_twoscale_stats st0;
 #ifdef GK_TWOSCALE_MPI
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -261,8 +410,10 @@ int main(int argc, char **argv) {
         return 1;
     }
     memset(&d, 0, sizeof d);
+    memset(&st0, 0, sizeof st0);
     pr.packing = &pk, pr.state = NULL;
     d.npoints = n, d.protos = &pr, d.nprotos = 1, d.threads = threads;
+    d.balance = balance_rule ? GK_TWOSCALE_BALANCE_RUN : GK_TWOSCALE_BALANCE_ACCEPT;
     d.rve = gk_rve_def_default();
     d.rve.dt = 3.1602315723728926e-05;
     d.rule.n_min = 2, d.rule.n_max = 400, d.rule.unbalanced_max = 2e-2; /* femdem_biaxial's defaults */
@@ -308,7 +459,7 @@ int main(int argc, char **argv) {
         }
     b_in = ts.stats.run_bytes_in - st0.run_bytes_in, b_out = ts.stats.run_bytes_out - st0.run_bytes_out;
     if (rank == 0) {
-        int m = (steps - 1) * iters * n, k, npair = 0;
+        int m = (steps - 1) * iters * n, k;
         double med, tsum = 0, q[5], *wa = (double *)malloc((size_t)m * sizeof(double));
         if (!wa) return 1;
         memcpy(wa, work + (size_t)iters * n, (size_t)m * sizeof(double));
@@ -323,44 +474,49 @@ int main(int argc, char **argv) {
                1e3 * times[nt - 1], nt);
         printf("DEM steps per RVE run: min %.0f  median %.0f  mean %.1f  p90 %.0f  max %.0f (max/mean %.2f)\n", q[0], q[1],
                q[2], q[3], q[4], q[4] / q[2]);
-        printf("per iteration, rank 0: %.0f bytes in, %.0f bytes out; %lld point moves in all\n", (double)b_in / nt,
-               (double)b_out / nt, ts.stats.migrated);
+        printf("per iteration, rank 0: %.0f bytes in, %.0f bytes out; %lld point moves in %lld rebalances (balance at "
+               "%s), %lld bytes moved in all\n",
+               (double)b_in / nt, (double)b_out / nt, ts.stats.migrated, ts.stats.balances,
+               balance_rule ? "every run" : "every accept", ts.stats.migrated_bytes);
         printf("BENCH case=twoscale ranks=%d threads=%d points=%d ms_per_iteration=%.2f rve_runs_per_s=%.1f "
                "particle_steps_per_s=%.4g bytes_in_per_iteration=%.0f bytes_out_per_iteration=%.0f\n",
                nranks, threads, n, 1e3 * med, n / med, work_ps / tsum, (double)b_in / nt, (double)b_out / nt);
         if (do_model && nranks == 1) {
-            /* cost pairs: a point's work at the last iteration of a step (what the balance sees) and at the
-             * first iteration of the next (what the ranks then run); the 2D rate per core from this run */
-            double *a = (double *)malloc((size_t)(steps - 1) * n * sizeof(double)),
-                   *b = (double *)malloc((size_t)(steps - 1) * n * sizeof(double));
-            if (!a || !b) return 1;
+            /* cost pairs: across steps (B), a point's work at the last iteration of a step (what the
+             * balance at accept sees) and at the first iteration of the next (what the ranks then run);
+             * within a step (W), at one iteration and the next; the 2D rate per core from this run */
+            pairs B = {NULL, NULL, 0, 0}, W = {NULL, NULL, 0, 0};
+            double m = iters, rec = (double)gk__ts_rec_size(&ts, ts.pt[0]); /* a point's record: 1 rank */
+            int bad = 0;
             for (s = 0; s + 1 < steps; ++s)
-                for (p = 0; p < n; ++p, ++npair) {
-                    a[npair] = work[((size_t)s * iters + iters - 1) * n + p];
-                    b[npair] = work[((size_t)(s + 1) * iters) * n + p];
+                for (p = 0; p < n; ++p) {
+                    bad |= pairs_add(&B, work[((size_t)s * iters + iters - 1) * n + p], work[((size_t)(s + 1) * iters) * n + p]);
+                    for (it = 0; s > 0 && it + 1 < iters; ++it)
+                        bad |= pairs_add(&W, work[((size_t)s * iters + it) * n + p], work[((size_t)s * iters + it + 1) * n + p]);
                 }
-            if (costs) { /* measured elsewhere: pairs "w0 w1" per line (bench/README.md) */
+            if (cost_log) { /* measured by femdem_biaxial --cost-log (bench/README.md) */
+                B.n = W.n = 0;
+                bad = bad || read_cost_log(cost_log, &B, &W, &m);
+                if (!bad) printf("cost pairs from %s: %d across load steps, %d within (%.2f runs per step)\n", cost_log,
+                                 B.n, W.n, m);
+            } else if (costs) { /* pairs "w0 w1" per line across steps (tools/gp_costs.sh); none within */
                 FILE *fp = fopen(costs, "r");
                 double x, y;
-                double *a2 = NULL, *b2 = NULL;
-                int cap = 0;
-                npair = 0;
-                while (fp && fscanf(fp, "%lf %lf", &x, &y) == 2) {
-                    if (npair == cap) {
-                        cap = 2 * cap + 1024;
-                        a2 = (double *)realloc(a2, (size_t)cap * sizeof *a2), b2 = (double *)realloc(b2, (size_t)cap * sizeof *b2);
-                        if (!a2 || !b2) return 1;
-                    }
-                    a2[npair] = x, b2[npair++] = y;
+                int got;
+                B.n = W.n = 0;
+                while (fp && !bad && (got = fscanf(fp, "%lf %lf", &x, &y)) == 2)
+                    bad = !(x >= 0 && y >= 0 && x < 1e12 && y < 1e12) || pairs_add(&B, x, y);
+                if (!fp || bad || !feof(fp) || ferror(fp) || B.n == 0) {
+                    fprintf(stderr, "bench_twoscale: %s: not a file of cost pairs \"w0 w1\" (non-negative) per line\n",
+                            costs);
+                    bad = 1;
                 }
                 if (fp) fclose(fp);
-                if (npair == 0) return fprintf(stderr, "bench_twoscale: no cost pairs in %s\n", costs), 1;
-                free(a), free(b);
-                a = a2, b = b2;
-                printf("cost pairs: %d from %s\n", npair, costs);
+                if (!bad) printf("cost pairs: %d from %s (across steps only: rule RUN not evaluated)\n", B.n, costs);
             }
-            model(a, b, npair, work_ps / tsum / threads, rate3d, alpha, bw, tol);
-            free(a), free(b);
+            if (bad) return 1;
+            model(&B, &W, m, rate2d > 0 ? rate2d : work_ps / tsum / threads, rate3d, alpha, bw, tol, rec);
+            free(B.a), free(B.b), free(W.a), free(W.b);
         }
     }
     gk_twoscale_destroy(&ts);
