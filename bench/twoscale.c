@@ -143,6 +143,26 @@ static int pairs_add(pairs *P, double a, double b) {
     return 0;
 }
 
+/* how well the first cost of the pairs predicts the second: Pearson's r, and the median and 90th
+ * percentile of |b - a| / (a + 1) */
+static void pair_stats(const char *what, const pairs *P) {
+    double ma = 0, mb = 0, sab = 0, saa = 0, sbb = 0, *rel = (double *)malloc(((size_t)P->n + 1) * sizeof(double));
+    int k;
+    if (!rel || P->n < 2) {
+        free(rel);
+        return;
+    }
+    for (k = 0; k < P->n; ++k) ma += P->a[k] / P->n, mb += P->b[k] / P->n;
+    for (k = 0; k < P->n; ++k) {
+        sab += (P->a[k] - ma) * (P->b[k] - mb), saa += (P->a[k] - ma) * (P->a[k] - ma);
+        sbb += (P->b[k] - mb) * (P->b[k] - mb), rel[k] = fabs(P->b[k] - P->a[k]) / (P->a[k] + 1.0);
+    }
+    qsort(rel, (size_t)P->n, sizeof *rel, cmp_d);
+    printf("  %-44s %7d pairs: r = %.3f, |w1 - w0| / (w0 + 1) median %.3f, p90 %.3f\n", what, P->n,
+           saa > 0 && sbb > 0 ? sab / sqrt(saa * sbb) : 1.0, rel[P->n / 2], rel[(int)(0.9 * P->n)]);
+    free(rel);
+}
+
 /* gk_twoscale's balance (gk__ts_balance) of cost c[0..n) over R ranks from the assignment own
  * (changed): moves from the most to the least loaded rank, each the point whose cost is nearest half
  * their gap, until within tol of the mean (or no move helps) */
@@ -300,6 +320,10 @@ static void model(const cost_data *C, double rate2d, double rate3d, double alpha
            "tolerance %.2f,\n  %.2f runs per load step, point records %.0f and %.0f bytes; ACCEPT: balance at every "
            "accept, RUN: before every run):\n",
            rate2d, rate3d, alpha, bw, tol, C->m, cs[0].rec, cs[1].rec);
+    printf("how a point's DEM steps w1 at a run follow its w0 at the run the balance knew:\n");
+    pair_stats("last step's accepted run -> each run (ACCEPT)", &C->A);
+    pair_stats("last step's accepted run -> first run", &C->B);
+    pair_stats("Newton iteration -> the next (RUN)", &C->W);
     printf("%-23s %6s %7s %9s %9s %8s %6s %6s %6s %6s %6s %7s %7s %6s %6s %8s\n", "case", "ranks", "rve/rk",
            "T_rve ms", "T_fem ms", "T_msg ms", "imb=", "ACC", "first", "it=", "imb_it", "Em_ACC", "Em_RUN", "E_ACC",
            "E_RUN", "MB/step");
