@@ -443,10 +443,10 @@ static int fdb_finish(fd_model *M, int status) {
     fd_print_work_totals(M);
 #ifdef GK_TWOSCALE_MPI
     printf("MPI ranks=%d rve_runs=%lld rank0_bytes_in_per_run=%.0f rank0_bytes_out_per_run=%.0f point_moves=%lld "
-           "rank0_bytes_in_all=%lld\n",
+           "bytes_moved=%lld rank0_bytes_in_all=%lld balance=%s\n",
            M->ts.nranks, M->ts.stats.runs, (double)M->ts.stats.run_bytes_in / (M->ts.stats.runs ? M->ts.stats.runs : 1),
            (double)M->ts.stats.run_bytes_out / (M->ts.stats.runs ? M->ts.stats.runs : 1), M->ts.stats.migrated,
-           M->ts.stats.bytes_in);
+           M->ts.stats.migrated_bytes, M->ts.stats.bytes_in, o->balance_run ? "run" : "accept");
 #endif
     return status;
 }

@@ -160,10 +160,10 @@
  *       costs of the accepted run - the next load step runs on the last
  *       step's costs;
  *     GK_TWOSCALE_BALANCE_RUN: before every run, on the costs of the
- *       previous run, accepted or not - so the Newton iterations of a load
- *       step after its first run on the costs of the previous iteration,
- *       which predict them much better (same accepted state, nearly the
- *       same dH; bench/README.md). A pending trial state is not moved: the
+ *       previous run, accepted or not - so every Newton iteration of a
+ *       load step after the first runs on the costs of the previous one,
+ *       which predict it much better than the last step's (the same
+ *       accepted state, nearly the same dH; bench/README.md). A pending trial state is not moved: the
  *       run recomputes every point from its accepted state anyway, and an
  *       accept takes the trials of the ranks that ran them. A refused run
  *       (bad argument) moves nothing.
