@@ -31,8 +31,9 @@
  * RVEs of 4096 spheres at --rate3d particle-steps/s per core, bench_dem_step's 3d_10k).
  * The pairs come from this run's synthetic load path, or from a real run:
  *   --cost-log FILE  femdem_biaxial --cost-log FILE: every run's DEM steps per Gauss point; pairs
- *                    across steps (the accepted run of a step, the first of the next), within a step
- *                    (one Newton iteration, the next) and the runs per step;
+ *                    across steps (the accepted run of a step and every run of the next, or its
+ *                    first run), within a step (one Newton iteration, the next) and the runs per
+ *                    step;
  *   --costs FILE     "w0 w1" per line across steps only (tools/gp_costs.sh, from gp_NNNN.vtk): rule
  *                    RUN not evaluated.
  */
