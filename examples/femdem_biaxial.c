@@ -93,7 +93,8 @@
  *   checkpoint.bin every --checkpoint K steps and at the end (gk_twoscale_save: checksummed)
  *   --cost-log FILE (anywhere; only when asked): a line per RVE run of all Gauss points, "STEP SCALE
  *                 W_0 ... W_ngp-1": the load step being solved, its increment scale, each point's DEM
- *                 steps (gk_twoscale_point.work); the input of tools/gp_costs.sh --log (bench/README.md)
+ *                 steps (gk_twoscale_point.work); the input of bench_twoscale --model --cost-log
+ *                 (bench/README.md)
  * and prints per step a progress line with ETA and finally
  *   LOCAL inside_gp=... inside_eps_q=... edge_gp=... edge_void_ratio=... outside_gp=... outside_eps_q=...
  *         outside_eps_q_max=... first_failed_eps=... (nan: none) failed_fraction_mean=... (from the first
@@ -132,7 +133,7 @@ static void usage(FILE *fp) {
             "                         the load step being solved (1, 2, ...), the increment's scale (1, or\n"
             "                         less after a cut-back), then each Gauss point's DEM steps (the work\n"
             "                         of gk_twoscale_points); consecutive lines of one step and scale are\n"
-            "                         its Newton iterations (tools/gp_costs.sh --log makes cost pairs of it)\n"
+            "                         its Newton iterations (read by bench_twoscale --model --cost-log)\n"
             "  (defaults: --nx 8 --ny 16 --vtk-every 1 --packing examples/data/rve400.txt)\n");
     fd_usage_common(fp);
     fprintf(fp, "\nbiaxial.csv ends with dem_steps_mean,dem_steps_max (per Gauss point, accepted iterate),\n"
