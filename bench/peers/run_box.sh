@@ -2,20 +2,21 @@
 # run_box.sh - the grainkit scene benchmark (bench_scene_box: spheres poured
 # into a box under gravity, then compressed by a moving lid) next to the same
 # scene in LAMMPS (bench/peers/lammps_box.in). LAMMPS is skipped with a
-# message when `lmp` is not installed (exit status 0); only a failing
-# grainkit run makes the script fail.
+# SKIP line when `lmp` is not installed (exit status 0); a failing grainkit
+# run or write makes the script fail (exit status 1).
 #
-# Both codes start from the exact same atoms (bench_scene_box --write-data)
-# with the same law, dt and walls (bench/scene_box.c, header). Compared: the
-# packing height after pouring (2 x the mean centre height, and the highest
-# centre), the lid force at 20 points of the compression (equal travel from
-# 1 mm above each code's own 2<z> + R) and the lid's height (the compressed
-# packing's) at equal lid forces - the two pours differ chaotically, so the
-# bed jams at slightly different lid heights and the steep force curve
-# magnifies that at equal travel, not at equal force; speed as
+# Both codes pour the exact same atoms (bench_scene_box --write-data) with
+# the same law, dt and walls (bench/scene_box.c, header), and both compress
+# the exact same settled packing: the one grainkit poured, as a data file
+# (--write-settled: positions and radii; velocities and spins zero, no
+# contact history in either code), under the same lid (start and speed).
+# Compared: the packing height after pouring (2 x the mean centre height,
+# and the highest centre; the two pours diverge chaotically, so this is a
+# statistical comparison), the lid force at 20 points of the compression
+# (equal lid travel), and the bed's stiffness once jammed; speed as
 # particle-steps/s per core (grainkit 1 thread, LAMMPS 1 MPI rank), wall
 # clock and CPU time of each phase, measured one after the other in this
-# run (paired): on a shared machine quote the ratio of a quiet run.
+# run (paired): quote the ratios of a run on a quiet machine.
 #
 # Environment: BOX_NX (10), BOX_NZ (20), BOX_POUR (40000), BOX_COMP (30000),
 # BOX_WORK (build/peers_box).
@@ -32,11 +33,13 @@ if [ ! -x "$BENCH" ]; then
     exit 1
 fi
 mkdir -p "$WORK" || exit 1
+NPROC=$(nproc 2>/dev/null || echo 0)
 loadavg() { cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo '?'; }
 kv() { printf '%s\n' "$2" | tr ' ' '\n' | sed -n "s/^$1=//p" | head -n 1; }
-echo "run_box: $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc 2>/dev/null || echo '?') cores, load average $(loadavg); $NX x $NX x $NZ spheres, $POUR + $COMP steps"
+echo "run_box: $(date -u '+%Y-%m-%d %H:%M UTC'), $NPROC cores, load average $(loadavg); $NX x $NX x $NZ spheres, $POUR + $COMP steps"
 
-"$BENCH" --nx "$NX" --nz "$NZ" --pour "$POUR" --compress "$COMP" --write-data "$WORK/box.data" >"$WORK/grainkit.out" 2>&1 || {
+"$BENCH" --nx "$NX" --nz "$NZ" --pour "$POUR" --compress "$COMP" --write-data "$WORK/box.data" \
+    --write-settled "$WORK/settled.data" >"$WORK/grainkit.out" 2>&1 || {
     echo "run_box: grainkit failed:" >&2
     cat "$WORK/grainkit.out" >&2
     exit 1
@@ -55,51 +58,64 @@ ETAP=$(awk 'BEGIN {pi = 3.141592653589793; m = 2650 * 4 / 3 * pi * 1e-9; l = log
                    printf "%.17g", 2 * z * sqrt(2 * 1e4 / m)}')
 ETAW=$(awk 'BEGIN {pi = 3.141592653589793; m = 2650 * 4 / 3 * pi * 1e-9; l = log(0.5); z = -l / sqrt(pi * pi + l * l);
                    printf "%.17g", 2 * z * sqrt(1e4 / m)}')
-OMP_NUM_THREADS=1 lmp -log none -echo none -in bench/peers/lammps_box.in -var data "$WORK/box.data" -var L "$L" \
-    -var kn 1e4 -var kt 5e3 -var mu 0.5 -var etap "$ETAP" -var etaw "$ETAW" -var dt 5e-6 -var skin 1e-4 \
-    -var pour "$POUR" -var comp "$COMP" -var vlid 0.02 -var R 1e-3 >"$WORK/lammps.log" 2>&1
-if ! grep -q '^LIDEND' "$WORK/lammps.log"; then
-    echo "FAIL peer=lammps: no result, see $WORK/lammps.log"
-    grep -E 'ERROR' "$WORK/lammps.log" | head -n 3
-    exit 0
-fi
-# loop times and the lid force at the thermo lines of the second run
-LT=$(grep '^Loop time of' "$WORK/lammps.log" | awk '{print $4}')
-TP=$(echo "$LT" | sed -n 1p)
-TC=$(echo "$LT" | sed -n 2p)
-POURL=$(grep '^POUR' "$WORK/lammps.log")
-LF=$(awk '/^ *Step +Atoms +v_F/ {on = 1; next} on && /^Loop time/ {on = 0} on && NF == 4 && $1 > 0 {print $3}' "$WORK/lammps.log")
-# CPU seconds of each run: "Loop time" x the "% CPU use" LAMMPS reports
-CP=$(awk '/^Loop time of/ {t = $4} /CPU use with/ {for (i = 1; i <= NF; ++i) if ($i ~ /%$/) {c = $i; sub("%", "", c); print t * c / 100}}' "$WORK/lammps.log")
-CPP=$(echo "$CP" | sed -n 1p)
-CPC=$(echo "$CP" | sed -n 2p)
+OMP_NUM_THREADS=1 lmp -log none -echo none -in bench/peers/lammps_box.in -var phase pour -var data "$WORK/box.data" \
+    -var L "$L" -var kn 1e4 -var kt 5e3 -var mu 0.5 -var etap "$ETAP" -var etaw "$ETAW" -var dt 5e-6 \
+    -var skin 1e-4 -var pour "$POUR" >"$WORK/lammps_pour.log" 2>&1
+OMP_NUM_THREADS=1 lmp -log none -echo none -in bench/peers/lammps_box.in -var phase compress \
+    -var data "$WORK/settled.data" -var L "$L" -var kn 1e4 -var kt 5e3 -var mu 0.5 -var etap "$ETAP" \
+    -var etaw "$ETAW" -var dt 5e-6 -var skin 1e-4 -var comp "$COMP" -var z0 "$(kv lid_start "$GC")" \
+    -var vlid 0.02 >"$WORK/lammps_compress.log" 2>&1
+for f in pour:POUR compress:LIDEND; do
+    if ! grep -q "^${f#*:}" "$WORK/lammps_${f%%:*}.log"; then
+        echo "FAIL peer=lammps: no result, see $WORK/lammps_${f%%:*}.log"
+        grep -E 'ERROR' "$WORK/lammps_${f%%:*}.log" | head -n 3
+        exit 0
+    fi
+done
+# loop time and CPU seconds ("Loop time" x the "% CPU use" LAMMPS reports) of a log
+looptime() { grep '^Loop time of' "$1" | awk '{print $4}'; }
+cputime() { awk '/^Loop time of/ {t = $4} /CPU use with/ {for (i = 1; i <= NF; ++i) if ($i ~ /%$/) {c = $i; sub("%", "", c); print t * c / 100}}' "$1"; }
+TP=$(looptime "$WORK/lammps_pour.log")
+TC=$(looptime "$WORK/lammps_compress.log")
+CPP=$(cputime "$WORK/lammps_pour.log")
+CPC=$(cputime "$WORK/lammps_compress.log")
+POURL=$(grep '^POUR' "$WORK/lammps_pour.log")
+# the lid force at the thermo lines after step 0
+LF=$(awk '/^ *Step +Atoms +v_F/ {on = 1; next} on && /^Loop time/ {on = 0} on && NF == 4 && $1 > 0 {print $3}' "$WORK/lammps_compress.log")
 n=$(kv n "$GP")
 echo "LAMMPS phase=pour seconds=$TP particle_steps_per_s=$(awk -v n="$n" -v s="$POUR" -v t="$TP" 'BEGIN {printf "%.4g", n*s/t}') $(echo "$POURL" | cut -d' ' -f2-)"
-echo "LAMMPS phase=compress seconds=$TC particle_steps_per_s=$(awk -v n="$n" -v s="$COMP" -v t="$TC" 'BEGIN {printf "%.4g", n*s/t}') lid_forces=$(echo $LF | tr ' ' ',')"
+echo "LAMMPS phase=compress seconds=$TC particle_steps_per_s=$(awk -v n="$n" -v s="$COMP" -v t="$TC" 'BEGIN {printf "%.4g", n*s/t}') start=settled lid_forces=$(echo $LF | tr ' ' ',')"
 echo
-echo "Physics (grainkit vs LAMMPS, same atoms, law, dt):"
+echo "Physics, grainkit vs LAMMPS (same law and dt):"
 awk -v gz="$(kv zmean "$GP")" -v gx="$(kv zmax "$GP")" -v lz="$(kv zmean "$POURL")" -v lx="$(kv zmax "$POURL")" 'BEGIN {
-    printf "  packing height 2<z>: %.6g vs %.6g m (%+.2f %%); highest centre %.6g vs %.6g m (%+.2f %%)\n",
-        2*gz, 2*lz, 100*(gz-lz)/lz, gx, lx, 100*(gx-lx)/lx }'
-# the lid force at equal travel, and the lid height (the compressed packing's height) at equal force
+    printf "  pour (same starting atoms): packing height 2<z> %.6g vs %.6g mm (%+.2f %%); highest centre %.6g vs %.6g mm (%+.2f %%)\n",
+        2e3*gz, 2e3*lz, 100*(gz-lz)/lz, 1e3*gx, 1e3*lx, 100*(gx-lx)/lx }'
 GF=$(k=1; while [ $k -le 20 ]; do kv "lid_force_$k" "$GC"; k=$((k + 1)); done | tr '\n' ' ')
-awk -v g="$GF" -v l="$LF" -v gz0="$(kv lid_start "$GC")" -v lz0="$(kv zmean "$POURL")" -v steps="$COMP" 'BEGIN {
-    ng = split(g, G, " "); nl = split(l, Lf, " "); dz = 0.02 * 5e-6 * steps / 20; lz0 = 2 * lz0 + 1e-3 + 1e-3
-    printf "  lid force at equal travel (every %.3g mm), grainkit vs LAMMPS:\n   ", 1e3 * dz
-    for (k = 1; k <= ng && k <= nl; ++k) printf " %.4g/%.4g", G[k], Lf[k]
-    printf " N\n"
-    split("2 5 10 20 30", F, " ")
-    for (q = 1; q <= 5; ++q) {
-        zg = zl = 0
-        for (k = 2; k <= ng; ++k) if (!zg && G[k] >= F[q]) zg = gz0 - dz * (k - 1 + (F[q] - G[k-1]) / (G[k] - G[k-1]))
-        for (k = 2; k <= nl; ++k) if (!zl && Lf[k] >= F[q]) zl = lz0 - dz * (k - 1 + (F[q] - Lf[k-1]) / (Lf[k] - Lf[k-1]))
-        if (zg && zl) printf "  lid height at a lid force of %g N: %.5g vs %.5g mm (%+.2f %%)\n", F[q], 1e3 * zg, 1e3 * zl, 100 * (zg - zl) / zl
+awk -v g="$GF" -v l="$LF" -v steps="$COMP" 'BEGIN {
+    ng = split(g, G, " "); nl = split(l, Lf, " "); dz = 0.02 * 5e-6 * steps / 20
+    printf "  compression (same settled packing, same lid): lid force at equal travel\n"
+    printf "    %8s %12s %12s %9s\n", "travel", "grainkit", "LAMMPS", "diff"
+    for (k = 1; k <= ng && k <= nl; ++k) {
+        d = (Lf[k] >= 1 ? sprintf("%+.2f %%", 100 * (G[k] - Lf[k]) / Lf[k]) : "")
+        printf "    %5.2f mm %10.4g N %10.4g N %9s\n", 1e3 * k * dz, G[k], Lf[k], d
     }
+    # stiffness once jammed: least-squares slope of force vs travel over the last 5 points
+    for (c = 0; c < 2; ++c) {
+        sx = sy = sxx = sxy = 0
+        for (k = ng - 4; k <= ng; ++k) {
+            x = 1e3 * k * dz; y = c ? Lf[k] : G[k]
+            sx += x; sy += y; sxx += x * x; sxy += x * y
+        }
+        S[c] = (5 * sxy - sx * sy) / (5 * sxx - sx * sx)
+    }
+    printf "  stiffness once jammed (slope over the last 5 points, %.2f-%.2f mm): %.4g vs %.4g N/mm (%+.2f %%)\n",
+        1e3 * (ng - 4) * dz, 1e3 * ng * dz, S[0], S[1], 100 * (S[0] - S[1]) / S[1]
 }'
 echo "Speed, particle-steps/s per core, grainkit / LAMMPS (wall clock; CPU time in brackets, less hurt by a shared machine):"
 awk -v a="$(kv particle_steps_per_s "$GP")" -v n="$n" -v s="$POUR" -v t="$TP" -v gc="$(kv cpu_seconds "$GP")" -v lc="$CPP" 'BEGIN {
     b = n*s/t; printf "  pour:     %.4g vs %.4g: %.2fx  (CPU %.4g vs %.4g s: %.2fx)\n", a, b, a/b, gc, lc, lc/gc}'
 awk -v a="$(kv particle_steps_per_s "$GC")" -v n="$n" -v s="$COMP" -v t="$TC" -v gc="$(kv cpu_seconds "$GC")" -v lc="$CPC" 'BEGIN {
     b = n*s/t; printf "  compress: %.4g vs %.4g: %.2fx  (CPU %.4g vs %.4g s: %.2fx)\n", a, b, a/b, gc, lc, lc/gc}'
-echo "run_box: load average at the end $(loadavg) (above the core count: other jobs shared the cores)"
+awk -v l="$(loadavg)" -v c="$NPROC" 'BEGIN {
+    printf "run_box: load average at the end %s%s\n", l, (c > 0 && l + 0 > c) ? " (above the core count: other jobs shared the cores)" : "" }'
 exit 0
