@@ -7,7 +7,10 @@
  *   build/bench_scene_box [--nx 10] [--nz 20] [--pour S] [--compress S] [--threads T]
  *                         [--write-data FILE]      the starting atoms (before the pour)
  *                         [--write-settled FILE]   the settled packing (after the pour)
- *   (both LAMMPS data files, atom_style sphere: id type diameter density x y z)
+ *                         [--from FILE]            no pour: compress the packing of FILE
+ *   (LAMMPS data files, atom_style sphere: id type diameter density x y z,
+ *   as written by the two --write options; --from needs the box of the same
+ *   --nx, --nz)
  *
  * The compression starts from the settled packing as a LAMMPS run can read
  * it: positions and radii only, every velocity and spin zero, no contact
@@ -66,30 +69,31 @@ static int write_data(const char *path, const gk_packing *pk, double L, double L
     return 0;
 }
 
-/* read back the atoms of a file written by write_data into pk (pk->n atoms
- * expected, ids 1..n in any order) */
+/* the atoms of a data file as written by write_data (ids 1..n in any
+ * order; the header's "n atoms" line before the Atoms section) into pk,
+ * allocated here */
 static int read_data(const char *path, gk_packing *pk) {
     FILE *fp = fopen(path, "r");
-    char line[512];
-    int n = -1, q, got = 0, atoms = 0, bad = 0;
-    unsigned char *seen = (unsigned char *)calloc((size_t)pk->n, 1);
-    if (!fp || !seen) {
-        if (fp) fclose(fp);
-        free(seen);
-        return fprintf(stderr, "bench_scene_box: cannot read %s\n", path), 1;
+    char line[512], word[16];
+    int n = 0, q, got = 0, bad = 0;
+    unsigned char *seen = NULL;
+    gk_err err;
+    if (!fp) return fprintf(stderr, "bench_scene_box: cannot read %s\n", path), 1;
+    while (fgets(line, sizeof line, fp) && !(sscanf(line, "%15s", word) == 1 && !strcmp(word, "Atoms")))
+        if (sscanf(line, "%d %15s", &q, word) == 2 && !strcmp(word, "atoms")) n = q;
+    if (n < 1 || n > 10000000 || gk_packing_alloc(pk, 3, n, NULL, &err)) {
+        fclose(fp);
+        return fprintf(stderr, "bench_scene_box: %s: no \"N atoms\" line (1 <= N <= 1e7) before Atoms\n",
+                       path),
+               1;
     }
-    while (!bad && got < pk->n && fgets(line, sizeof line, fp)) {
+    seen = (unsigned char *)calloc((size_t)n, 1);
+    while (seen && !bad && got < n && fgets(line, sizeof line, fp)) {
         int id, type;
         double dia, rho, x, y, z;
-        char word[16];
-        if (!atoms) {
-            if (sscanf(line, "%d %15s", &q, word) == 2 && !strcmp(word, "atoms")) n = q;
-            if (sscanf(line, "%15s", word) == 1 && !strcmp(word, "Atoms")) atoms = 1;
-            continue;
-        }
         if (sscanf(line, "%15s", word) != 1) continue; /* blank line */
         if (sscanf(line, "%d %d %lf %lf %lf %lf %lf", &id, &type, &dia, &rho, &x, &y, &z) != 7 || id < 1 ||
-            id > pk->n || seen[id - 1] || !(dia > 0.0) || !isfinite(dia) || !isfinite(x) || !isfinite(y) ||
+            id > n || seen[id - 1] || !(dia > 0.0) || !isfinite(dia) || !isfinite(x) || !isfinite(y) ||
             !isfinite(z)) {
             bad = 1;
             break;
@@ -103,10 +107,12 @@ static int read_data(const char *path, gk_packing *pk) {
     }
     fclose(fp);
     free(seen);
-    if (bad || n != pk->n || got != pk->n)
-        return fprintf(stderr, "bench_scene_box: %s: expected %d atoms (ids 1..%d), found %s\n", path, pk->n,
-                       pk->n, bad ? "a malformed or repeated atom line" : "fewer"),
+    if (got != n) {
+        gk_packing_free(pk);
+        return fprintf(stderr, "bench_scene_box: %s: expected %d atoms (ids 1..%d), found %s\n", path, n, n,
+                       bad ? "a malformed or repeated atom line" : "fewer"),
                1;
+    }
     return 0;
 }
 
@@ -135,23 +141,70 @@ static int make_scene(gk_scene *sc, const gk_packing *pk, double L, double Lz, i
     return 0;
 }
 
+/* the pour: the jittered lattice (written to `data` if given) falls into the
+ * box; pk gets the settled packing in world coordinates, in index order */
+static int pour_bed(gk_packing *pk, int nx, int nz, long steps, int threads, const char *data) {
+    double L = nx * 2.4 * SB_R, Lz = 2.0 * (nz + 1) * 2.4 * SB_R, t0, tp, cpu, ke, zmean = 0.0, zmax = -1.0;
+    int a, b, c, q = 0, p;
+    clock_t c0;
+    gk_scene sc;
+    gk_material wm;
+    gk_err err;
+    gk_rng rng;
+    if (gk_packing_alloc(pk, 3, nx * nx * nz, NULL, &err)) return fprintf(stderr, "%s\n", err.msg), 1;
+    gk_rng_seed(&rng, 42);
+    for (c = 0; c < nz; ++c)
+        for (b = 0; b < nx; ++b)
+            for (a = 0; a < nx; ++a, ++q) {
+                pk->x[q] = 2.4 * SB_R * (a + 0.5) + 0.15 * SB_R * (2.0 * gk_rng_uniform(&rng) - 1.0);
+                pk->y[q] = 2.4 * SB_R * (b + 0.5) + 0.15 * SB_R * (2.0 * gk_rng_uniform(&rng) - 1.0);
+                pk->z[q] = 2.4 * SB_R * (c + 0.5);
+                pk->r[q] = SB_R;
+            }
+    if ((data && write_data(data, pk, L, Lz)) || make_scene(&sc, pk, L, Lz, threads, &wm))
+        return gk_packing_free(pk), 1;
+    t0 = gk_wtime();
+    c0 = clock();
+    if (gk_scene_step(&sc, steps)) {
+        fprintf(stderr, "bench_scene_box: %s\n", gk_scene_error(&sc));
+        return gk_scene_destroy(&sc), gk_packing_free(pk), 1;
+    }
+    tp = gk_wtime() - t0;
+    cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
+    ke = gk_rve_kinetic_energy(&sc.rve);
+    for (p = 0; p < sc.rve.n; ++p) {
+        double x[3];
+        gk_scene_position(&sc, p, x);
+        pk->x[p] = x[0];
+        pk->y[p] = x[1];
+        pk->z[p] = x[2];
+        pk->r[p] = (double)sc.rve.r[p];
+        zmean += x[2] / sc.rve.n;
+        if (x[2] > zmax) zmax = x[2];
+    }
+    printf(
+        "SCENE phase=pour n=%d steps=%ld seconds=%.4g cpu_seconds=%.4g particle_steps_per_s=%.4g zmean=%.8g "
+        "zmax=%.8g height_2zmean=%.8g kinetic=%.4g\n",
+        sc.rve.n, steps, tp, cpu, sc.rve.n * (double)steps / tp, zmean, zmax, 2.0 * zmean, ke);
+    gk_scene_destroy(&sc);
+    return 0;
+}
+
 int main(int argc, char **argv) {
-    int nx = 10, nz = 20, threads = 1, i, a, b, c, q = 0, p, k;
+    int nx = 10, nz = 20, threads = 1, i, q, p, k;
     long pour = 40000, comp = 30000;
-    const char *data = NULL, *settled = NULL;
-    double L, H, zmean = 0.0, zmax = -1.0, lid0, t0, tp, tc, force[SB_NF], ke, cpu_p, cpu_c;
+    const char *data = NULL, *settled = NULL, *from = NULL;
+    double L, H, zmean = 0.0, zmax = -1.0, lid0, t0, tc, force[SB_NF], cpu_c;
     clock_t c0;
     gk_scene sc;
     gk_packing pk;
-    gk_err err;
     gk_material wm;
     gk_wall_def lid = gk_wall_def_default();
-    gk_rng rng;
     for (i = 1; i < argc; ++i) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(o, "--help")) {
             puts("usage: bench_scene_box [--nx N] [--nz N] [--pour S] [--compress S] [--threads T] "
-                 "[--write-data FILE] [--write-settled FILE]");
+                 "[--write-data FILE] [--write-settled FILE] [--from FILE]");
             return 0;
         }
         if (!v) return fprintf(stderr, "bench_scene_box: %s needs a value\n", o), 2;
@@ -169,6 +222,8 @@ int main(int argc, char **argv) {
             data = v;
         else if (!strcmp(o, "--write-settled"))
             settled = v;
+        else if (!strcmp(o, "--from"))
+            from = v;
         else
             return fprintf(stderr, "bench_scene_box: unknown option %s\n", o), 2;
         ++i;
@@ -181,64 +236,32 @@ int main(int argc, char **argv) {
                2;
     L = nx * 2.4 * SB_R;
     H = (nz + 1) * 2.4 * SB_R;
-    if (gk_packing_alloc(&pk, 3, nx * nx * nz, NULL, &err)) return fprintf(stderr, "%s\n", err.msg), 1;
-    gk_rng_seed(&rng, 42);
-    for (c = 0; c < nz; ++c)
-        for (b = 0; b < nx; ++b)
-            for (a = 0; a < nx; ++a, ++q) {
-                pk.x[q] = 2.4 * SB_R * (a + 0.5) + 0.15 * SB_R * (2.0 * gk_rng_uniform(&rng) - 1.0);
-                pk.y[q] = 2.4 * SB_R * (b + 0.5) + 0.15 * SB_R * (2.0 * gk_rng_uniform(&rng) - 1.0);
-                pk.z[q] = 2.4 * SB_R * (c + 0.5);
-                pk.r[q] = SB_R;
-            }
-    if ((data && write_data(data, &pk, L, 2.0 * H)) || make_scene(&sc, &pk, L, 2.0 * H, threads, &wm))
-        return gk_packing_free(&pk), 1;
-
-    /* the pour */
-    t0 = gk_wtime();
-    c0 = clock();
-    if (gk_scene_step(&sc, pour)) {
-        fprintf(stderr, "bench_scene_box: %s\n", gk_scene_error(&sc));
-        return gk_scene_destroy(&sc), gk_packing_free(&pk), 1;
+    if (from) {
+        if (read_data(from, &pk)) return 1;
+    } else if (pour_bed(&pk, nx, nz, pour, threads, data)) {
+        return 1;
     }
-    tp = gk_wtime() - t0;
-    cpu_p = (double)(clock() - c0) / CLOCKS_PER_SEC;
-    ke = gk_rve_kinetic_energy(&sc.rve);
-    for (p = 0; p < sc.rve.n; ++p) { /* the settled packing in world coordinates, in index order */
-        double x[3];
-        gk_scene_position(&sc, p, x);
-        pk.x[p] = x[0];
-        pk.y[p] = x[1];
-        pk.z[p] = x[2];
-        pk.r[p] = (double)sc.rve.r[p];
-        zmean += x[2] / sc.rve.n;
-        if (x[2] > zmax) zmax = x[2];
+    for (p = 0; p < pk.n; ++p) {
+        zmean += pk.z[p] / pk.n;
+        if (pk.z[p] > zmax) zmax = pk.z[p];
     }
-    printf(
-        "SCENE phase=pour n=%d steps=%ld seconds=%.4g cpu_seconds=%.4g particle_steps_per_s=%.4g zmean=%.8g "
-        "zmax=%.8g height_2zmean=%.8g kinetic=%.4g\n",
-        sc.rve.n, pour, tp, cpu_p, sc.rve.n * (double)pour / tp, zmean, zmax, 2.0 * zmean, ke);
-    gk_scene_destroy(&sc);
-
     /* the compression, from the settled packing as a data file carries it */
     if (settled) {
         gk_packing back;
         int same = 1;
         if (write_data(settled, &pk, L, 2.0 * H)) return gk_packing_free(&pk), 1;
-        if (gk_packing_alloc(&back, 3, pk.n, NULL, &err))
-            return fprintf(stderr, "%s\n", err.msg), gk_packing_free(&pk), 1;
-        if (read_data(settled, &back)) return gk_packing_free(&back), gk_packing_free(&pk), 1;
+        if (read_data(settled, &back)) return gk_packing_free(&pk), 1;
         for (q = 0; q < pk.n; ++q)
-            same &=
-                back.x[q] == pk.x[q] && back.y[q] == pk.y[q] && back.z[q] == pk.z[q] && back.r[q] == pk.r[q];
+            same &= back.n == pk.n && back.x[q] == pk.x[q] && back.y[q] == pk.y[q] && back.z[q] == pk.z[q] &&
+                    back.r[q] == pk.r[q];
         gk_packing_free(&pk);
         pk = back;
         if (!same) return fprintf(stderr, "bench_scene_box: %s does not read back exactly\n", settled), 1;
     }
     if (make_scene(&sc, &pk, L, 2.0 * H, threads, &wm)) return gk_packing_free(&pk), 1;
     gk_packing_free(&pk);
-    lid0 = 2.0 * zmean + SB_R +
-           1e-3; /* 1 mm above the bed's mean top (2<z> + R): bulk, not the highest sphere */
+    /* the lid 1 mm above the bed's mean top 2<z> + R (the bulk, not the highest sphere) */
+    lid0 = 2.0 * zmean + SB_R + 1e-3;
     lid.point[2] = lid0;
     lid.normal[2] = -1.0;
     lid.mat = wm;
@@ -259,9 +282,9 @@ int main(int argc, char **argv) {
     tc = gk_wtime() - t0;
     cpu_c = (double)(clock() - c0) / CLOCKS_PER_SEC;
     printf("SCENE phase=compress n=%d steps=%ld seconds=%.4g cpu_seconds=%.4g particle_steps_per_s=%.4g "
-           "start=settled lid_start=%.17g lid_end=%.8g",
+           "start=%s lid_start=%.17g lid_end=%.8g",
            sc.rve.n, (comp / SB_NF) * SB_NF, tc, cpu_c, sc.rve.n * (double)((comp / SB_NF) * SB_NF) / tc,
-           lid0, sc.walls[sc.nwalls - 1].pos[2]);
+           from ? "file" : "settled", lid0, sc.walls[sc.nwalls - 1].pos[2]);
     for (k = 0; k < SB_NF; ++k) printf(" lid_force_%d=%.8g", k + 1, force[k]);
     printf(" simd=%s\n", GK_SIMD_NAME);
     gk_scene_destroy(&sc);

@@ -18,8 +18,17 @@
 # clock and CPU time of each phase, measured one after the other in this
 # run (paired): quote the ratios of a run on a quiet machine.
 #
+# The compression is itself chaotic (force chains buckle): moving one sphere
+# of the settled packing by 1 nm changes the lid force at a given travel by
+# a few per cent in either code. BOX_ENSEMBLE=k (default 0) therefore also
+# compresses k copies of the settled packing, copy s with sphere
+# 1 + (617 s mod n) moved by (-1)^(s+1) nm along y, in both codes, and
+# compares the means over the k + 1 starts (mean +- standard deviation;
+# the difference of the means +- its standard error). Cost per member:
+# one compression in each code (about 10 + 12 CPU seconds).
+#
 # Environment: BOX_NX (10), BOX_NZ (20), BOX_POUR (40000), BOX_COMP (30000),
-# BOX_WORK (build/peers_box).
+# BOX_ENSEMBLE (0), BOX_WORK (build/peers_box).
 set -u
 cd "$(dirname "$0")/../.." || exit 1
 BENCH=build/bench_scene_box
@@ -28,10 +37,16 @@ NX=${BOX_NX:-10}
 NZ=${BOX_NZ:-20}
 POUR=${BOX_POUR:-40000}
 COMP=${BOX_COMP:-30000}
+ENS=${BOX_ENSEMBLE:-0}
 if [ ! -x "$BENCH" ]; then
     echo "run_box: $BENCH missing (make $BENCH)" >&2
     exit 1
 fi
+case "$ENS" in '' | *[!0-9]*)
+    echo "run_box: BOX_ENSEMBLE must be a count (got '$ENS')" >&2
+    exit 1
+    ;;
+esac
 mkdir -p "$WORK" || exit 1
 NPROC=$(nproc 2>/dev/null || echo 0)
 loadavg() { cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo '?'; }
@@ -58,13 +73,19 @@ ETAP=$(awk 'BEGIN {pi = 3.141592653589793; m = 2650 * 4 / 3 * pi * 1e-9; l = log
                    printf "%.17g", 2 * z * sqrt(2 * 1e4 / m)}')
 ETAW=$(awk 'BEGIN {pi = 3.141592653589793; m = 2650 * 4 / 3 * pi * 1e-9; l = log(0.5); z = -l / sqrt(pi * pi + l * l);
                    printf "%.17g", 2 * z * sqrt(1e4 / m)}')
-OMP_NUM_THREADS=1 lmp -log none -echo none -in bench/peers/lammps_box.in -var phase pour -var data "$WORK/box.data" \
-    -var L "$L" -var kn 1e4 -var kt 5e3 -var mu 0.5 -var etap "$ETAP" -var etaw "$ETAW" -var dt 5e-6 \
-    -var skin 1e-4 -var pour "$POUR" >"$WORK/lammps_pour.log" 2>&1
-OMP_NUM_THREADS=1 lmp -log none -echo none -in bench/peers/lammps_box.in -var phase compress \
-    -var data "$WORK/settled.data" -var L "$L" -var kn 1e4 -var kt 5e3 -var mu 0.5 -var etap "$ETAP" \
-    -var etaw "$ETAW" -var dt 5e-6 -var skin 1e-4 -var comp "$COMP" -var z0 "$(kv lid_start "$GC")" \
-    -var vlid 0.02 >"$WORK/lammps_compress.log" 2>&1
+lammps() { # phase data-file log [-var name value ...]
+    ph=$1 dat=$2 log=$3
+    shift 3
+    OMP_NUM_THREADS=1 lmp -log none -echo none -in bench/peers/lammps_box.in -var phase "$ph" -var data "$dat" \
+        -var L "$L" -var kn 1e4 -var kt 5e3 -var mu 0.5 -var etap "$ETAP" -var etaw "$ETAW" -var dt 5e-6 \
+        -var skin 1e-4 "$@" >"$log" 2>&1
+}
+Z0=$(kv lid_start "$GC")
+# the lid force at the thermo lines of a compression log after step 0, on one line
+lammps_forces() { awk '/^ *Step +Atoms +v_F/ {on = 1; next} on && /^Loop time/ {on = 0} on && NF == 4 && $1 > 0 {printf "%s ", $3}' "$1"; }
+grainkit_forces() { k=1; while [ $k -le 20 ]; do printf '%s ' "$(kv "lid_force_$k" "$1")"; k=$((k + 1)); done; }
+lammps pour "$WORK/box.data" "$WORK/lammps_pour.log" -var pour "$POUR"
+lammps compress "$WORK/settled.data" "$WORK/lammps_compress.log" -var comp "$COMP" -var z0 "$Z0" -var vlid 0.02
 for f in pour:POUR compress:LIDEND; do
     if ! grep -q "^${f#*:}" "$WORK/lammps_${f%%:*}.log"; then
         echo "FAIL peer=lammps: no result, see $WORK/lammps_${f%%:*}.log"
@@ -80,8 +101,7 @@ TC=$(looptime "$WORK/lammps_compress.log")
 CPP=$(cputime "$WORK/lammps_pour.log")
 CPC=$(cputime "$WORK/lammps_compress.log")
 POURL=$(grep '^POUR' "$WORK/lammps_pour.log")
-# the lid force at the thermo lines after step 0
-LF=$(awk '/^ *Step +Atoms +v_F/ {on = 1; next} on && /^Loop time/ {on = 0} on && NF == 4 && $1 > 0 {print $3}' "$WORK/lammps_compress.log")
+LF=$(lammps_forces "$WORK/lammps_compress.log")
 n=$(kv n "$GP")
 echo "LAMMPS phase=pour seconds=$TP particle_steps_per_s=$(awk -v n="$n" -v s="$POUR" -v t="$TP" 'BEGIN {printf "%.4g", n*s/t}') $(echo "$POURL" | cut -d' ' -f2-)"
 echo "LAMMPS phase=compress seconds=$TC particle_steps_per_s=$(awk -v n="$n" -v s="$COMP" -v t="$TC" 'BEGIN {printf "%.4g", n*s/t}') start=settled lid_forces=$(echo $LF | tr ' ' ',')"
@@ -90,7 +110,7 @@ echo "Physics, grainkit vs LAMMPS (same law and dt):"
 awk -v gz="$(kv zmean "$GP")" -v gx="$(kv zmax "$GP")" -v lz="$(kv zmean "$POURL")" -v lx="$(kv zmax "$POURL")" 'BEGIN {
     printf "  pour (same starting atoms): packing height 2<z> %.6g vs %.6g mm (%+.2f %%); highest centre %.6g vs %.6g mm (%+.2f %%)\n",
         2e3*gz, 2e3*lz, 100*(gz-lz)/lz, 1e3*gx, 1e3*lx, 100*(gx-lx)/lx }'
-GF=$(k=1; while [ $k -le 20 ]; do kv "lid_force_$k" "$GC"; k=$((k + 1)); done | tr '\n' ' ')
+GF=$(grainkit_forces "$GC")
 awk -v g="$GF" -v l="$LF" -v steps="$COMP" 'BEGIN {
     ng = split(g, G, " "); nl = split(l, Lf, " "); dz = 0.02 * 5e-6 * steps / 20
     printf "  compression (same settled packing, same lid): lid force at equal travel\n"
@@ -108,14 +128,60 @@ awk -v g="$GF" -v l="$LF" -v steps="$COMP" 'BEGIN {
         }
         S[c] = (5 * sxy - sx * sy) / (5 * sxx - sx * sx)
     }
-    printf "  stiffness once jammed (slope over the last 5 points, %.2f-%.2f mm): %.4g vs %.4g N/mm (%+.2f %%)\n",
-        1e3 * (ng - 4) * dz, 1e3 * ng * dz, S[0], S[1], 100 * (S[0] - S[1]) / S[1]
+    printf "  stiffness once jammed (slope over the last 5 points, %.2f-%.2f mm): %.4g vs %.4g N/mm %s\n",
+        1e3 * (ng - 4) * dz, 1e3 * ng * dz, S[0], S[1], (S[1] > 0 ? sprintf("(%+.2f %%)", 100 * (S[0] - S[1]) / S[1]) : "")
 }'
 echo "Speed, particle-steps/s per core, grainkit / LAMMPS (wall clock; CPU time in brackets, less hurt by a shared machine):"
 awk -v a="$(kv particle_steps_per_s "$GP")" -v n="$n" -v s="$POUR" -v t="$TP" -v gc="$(kv cpu_seconds "$GP")" -v lc="$CPP" 'BEGIN {
     b = n*s/t; printf "  pour:     %.4g vs %.4g: %.2fx  (CPU %.4g vs %.4g s: %.2fx)\n", a, b, a/b, gc, lc, lc/gc}'
 awk -v a="$(kv particle_steps_per_s "$GC")" -v n="$n" -v s="$COMP" -v t="$TC" -v gc="$(kv cpu_seconds "$GC")" -v lc="$CPC" 'BEGIN {
     b = n*s/t; printf "  compress: %.4g vs %.4g: %.2fx  (CPU %.4g vs %.4g s: %.2fx)\n", a, b, a/b, gc, lc, lc/gc}'
+if [ "$ENS" -gt 0 ]; then
+    echo "Ensemble: the settled packing and $ENS copies with one sphere moved by 1 nm, compressed in both codes:"
+    { echo "g $GF"; echo "l $LF"; } >"$WORK/ensemble.txt"
+    s=1
+    while [ "$s" -le "$ENS" ]; do
+        m="$WORK/member$s.data"
+        awk -v id=$((1 + (617 * s) % n)) -v e="$([ $((s % 2)) -eq 1 ] && echo 1e-9 || echo -1e-9)" \
+            'on && NF == 7 && $1 == id {$6 = sprintf("%.17g", $6 + e)} /^Atoms/ {on = 1} {print}' \
+            "$WORK/settled.data" >"$m" || exit 1
+        "$BENCH" --nx "$NX" --nz "$NZ" --compress "$COMP" --from "$m" >"$WORK/member$s.out" 2>&1 || {
+            echo "run_box: grainkit failed on $m:" >&2
+            cat "$WORK/member$s.out" >&2
+            exit 1
+        }
+        lammps compress "$m" "$WORK/lammps_member$s.log" -var comp "$COMP" -var z0 "$Z0" -var vlid 0.02
+        if ! grep -q '^LIDEND' "$WORK/lammps_member$s.log"; then
+            echo "FAIL peer=lammps: no result, see $WORK/lammps_member$s.log"
+            exit 0
+        fi
+        echo "g $(grainkit_forces "$(grep 'phase=compress' "$WORK/member$s.out")")" >>"$WORK/ensemble.txt"
+        echo "l $(lammps_forces "$WORK/lammps_member$s.log")" >>"$WORK/ensemble.txt"
+        s=$((s + 1))
+    done
+    awk -v steps="$COMP" -v want=$((ENS + 1)) '
+    { c = ($1 == "l"); if (NF != 21) next; ++N[c]
+      for (k = 1; k <= 20; ++k) { S[c, k] += $(k + 1); Q[c, k] += $(k + 1) ^ 2 }
+      sx = sy = sxx = sxy = 0
+      for (k = 16; k <= 20; ++k) { x = 1e3 * k * dz; y = $(k + 1); sx += x; sy += y; sxx += x * x; sxy += x * y }
+      st = (5 * sxy - sx * sy) / (5 * sxx - sx * sx); S[c, 0] += st; Q[c, 0] += st ^ 2 }
+    BEGIN { dz = 0.02 * 5e-6 * steps / 20 }
+    function line(label, k, unit,   m0, m1, s0, s1, e) {
+        m0 = S[0, k] / N[0]; m1 = S[1, k] / N[1]
+        s0 = sqrt((Q[0, k] - N[0] * m0 ^ 2) / (N[0] - 1)); s1 = sqrt((Q[1, k] - N[1] * m1 ^ 2) / (N[1] - 1))
+        e = sqrt(s0 ^ 2 / N[0] + s1 ^ 2 / N[1])
+        printf "    %-10s %8.4g +- %-7.3g %8.4g +- %-7.3g %s\n", label, m0, s0, m1, s1,
+            (m1 > 0 ? sprintf("%+6.2f +- %.2f %%", 100 * (m0 - m1) / m1, 100 * e / m1) : "-")
+    }
+    END {
+        if (N[0] != want || N[1] != want) { printf "  ensemble incomplete (%d and %d of %d members)\n", N[0], N[1], want; exit 1 }
+        printf "  means over %d starts (+- standard deviation), difference of the means (+- its standard error):\n", want
+        printf "    %-10s %19s %19s %16s\n", "travel", "grainkit [N]", "LAMMPS [N]", "difference"
+        for (k = 13; k <= 20; ++k) line(sprintf("%.2f mm", 1e3 * k * dz), k)
+        line("stiffness", 0)
+        printf "    (stiffness in N/mm: slope over the last 5 points)\n"
+    }' "$WORK/ensemble.txt" || exit 1
+fi
 awk -v l="$(loadavg)" -v c="$NPROC" 'BEGIN {
     printf "run_box: load average at the end %s%s\n", l, (c > 0 && l + 0 > c) ? " (above the core count: other jobs shared the cores)" : "" }'
 exit 0
