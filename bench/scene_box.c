@@ -117,12 +117,13 @@ static int read_data(const char *path, gk_packing *pk) {
 }
 
 /* a scene of pk in the box (floor and sides, no lid) with the law above */
-static int make_scene(gk_scene *sc, const gk_packing *pk, double L, double Lz, int threads, gk_material *wm) {
+static int make_scene(gk_scene *sc, const gk_packing *pk, double L, double Lz, double g, int threads,
+                      gk_material *wm) {
     gk_scene_def d = gk_scene_def_default();
     d.dim = 3;
     d.hi[0] = d.hi[1] = L;
     d.hi[2] = Lz;
-    d.gravity[2] = -9.81;
+    d.gravity[2] = -g;
     d.rve.mat.law = GK_LAW_LINEAR;
     d.rve.mat.kn = SB_KN;
     d.rve.mat.kt_ratio = 0.5;
@@ -161,7 +162,7 @@ static int pour_bed(gk_packing *pk, int nx, int nz, long steps, int threads, con
                 pk->z[q] = 2.4 * SB_R * (c + 0.5);
                 pk->r[q] = SB_R;
             }
-    if ((data && write_data(data, pk, L, Lz)) || make_scene(&sc, pk, L, Lz, threads, &wm))
+    if ((data && write_data(data, pk, L, Lz)) || make_scene(&sc, pk, L, Lz, 9.81, threads, &wm))
         return gk_packing_free(pk), 1;
     t0 = gk_wtime();
     c0 = clock();
@@ -190,8 +191,45 @@ static int pour_bed(gk_packing *pk, int nx, int nz, long steps, int threads, con
     return 0;
 }
 
+/* the law isolated from the packing's chaos: without gravity, sphere 1
+ * hits the floor obliquely, (vx, vz) = (0.05, -0.1) m/s, and sphere 2,
+ * moving at vx = 0.1 m/s, hits sphere 3 (at rest, 1 mm higher: 30 degrees
+ * off centre); after 4000 steps prints each one's velocity and spin */
+static int impact(int threads, const char *data) {
+    const double L = 24e-3; /* a cube of side L, the floor at z = 0 */
+    static const double X[3][3] = {{5e-3, 5e-3, 1.5e-3}, {9.5e-3, 12e-3, 10e-3}, {12e-3, 12e-3, 11e-3}};
+    static const double V[3][3] = {{0.05, 0.0, -0.1}, {0.1, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+    gk_packing pk;
+    gk_scene sc;
+    gk_material wm;
+    gk_err err;
+    int p;
+    if (gk_packing_alloc(&pk, 3, 3, NULL, &err)) return fprintf(stderr, "%s\n", err.msg), 1;
+    for (p = 0; p < 3; ++p) {
+        pk.x[p] = X[p][0];
+        pk.y[p] = X[p][1];
+        pk.z[p] = X[p][2];
+        pk.r[p] = SB_R;
+    }
+    if ((data && write_data(data, &pk, L, L)) || make_scene(&sc, &pk, L, L, 0.0, threads, &wm))
+        return gk_packing_free(&pk), 1;
+    gk_packing_free(&pk);
+    for (p = 0; p < 3; ++p) gk_scene_set_velocity(&sc, p, V[p], NULL);
+    if (gk_scene_step(&sc, 4000)) {
+        fprintf(stderr, "bench_scene_box: %s\n", gk_scene_error(&sc));
+        return gk_scene_destroy(&sc), 1;
+    }
+    printf("IMPACT");
+    for (p = 0; p < 3; ++p)
+        printf(" vx%d=%.8g vz%d=%.8g wy%d=%.8g", p + 1, (double)sc.rve.v[0][p], p + 1, (double)sc.rve.v[2][p],
+               p + 1, (double)sc.rve.w[1][p]);
+    printf("\n");
+    gk_scene_destroy(&sc);
+    return ferror(stdout) ? 1 : 0;
+}
+
 int main(int argc, char **argv) {
-    int nx = 10, nz = 20, threads = 1, i, q, p, k;
+    int nx = 10, nz = 20, threads = 1, i, q, p, k, imp = 0;
     long pour = 40000, comp = 30000;
     const char *data = NULL, *settled = NULL, *from = NULL;
     double L, H, zmean = 0.0, zmax = -1.0, lid0, t0, tc, force[SB_NF], cpu_c;
@@ -204,8 +242,12 @@ int main(int argc, char **argv) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(o, "--help")) {
             puts("usage: bench_scene_box [--nx N] [--nz N] [--pour S] [--compress S] [--threads T] "
-                 "[--write-data FILE] [--write-settled FILE] [--from FILE]");
+                 "[--write-data FILE] [--write-settled FILE] [--from FILE] [--impact]");
             return 0;
+        }
+        if (!strcmp(o, "--impact")) {
+            imp = 1;
+            continue;
         }
         if (!v) return fprintf(stderr, "bench_scene_box: %s needs a value\n", o), 2;
         if (!strcmp(o, "--nx"))
@@ -236,6 +278,7 @@ int main(int argc, char **argv) {
                2;
     L = nx * 2.4 * SB_R;
     H = (nz + 1) * 2.4 * SB_R;
+    if (imp) return impact(threads, data);
     if (from) {
         if (read_data(from, &pk)) return 1;
     } else if (pour_bed(&pk, nx, nz, pour, threads, data)) {
@@ -258,7 +301,7 @@ int main(int argc, char **argv) {
         pk = back;
         if (!same) return fprintf(stderr, "bench_scene_box: %s does not read back exactly\n", settled), 1;
     }
-    if (make_scene(&sc, &pk, L, 2.0 * H, threads, &wm)) return gk_packing_free(&pk), 1;
+    if (make_scene(&sc, &pk, L, 2.0 * H, 9.81, threads, &wm)) return gk_packing_free(&pk), 1;
     gk_packing_free(&pk);
     /* the lid 1 mm above the bed's mean top 2<z> + R (the bulk, not the highest sphere) */
     lid0 = 2.0 * zmean + SB_R + 1e-3;

@@ -59,9 +59,15 @@ echo "run_box: $(date -u '+%Y-%m-%d %H:%M UTC'), $NPROC cores, load average $(lo
     cat "$WORK/grainkit.out" >&2
     exit 1
 }
+"$BENCH" --impact --write-data "$WORK/impact.data" >>"$WORK/grainkit.out" 2>&1 || {
+    echo "run_box: grainkit failed (impacts):" >&2
+    cat "$WORK/grainkit.out" >&2
+    exit 1
+}
 cat "$WORK/grainkit.out"
 GP=$(grep 'phase=pour' "$WORK/grainkit.out")
 GC=$(grep 'phase=compress' "$WORK/grainkit.out")
+GI=$(grep '^IMPACT' "$WORK/grainkit.out")
 
 if ! command -v lmp >/dev/null 2>&1; then
     echo "SKIP peer=lammps: lmp not found (Debian: apt-get install lammps)"
@@ -77,16 +83,17 @@ lammps() { # phase data-file log [-var name value ...]
     ph=$1 dat=$2 log=$3
     shift 3
     OMP_NUM_THREADS=1 lmp -log none -echo none -in bench/peers/lammps_box.in -var phase "$ph" -var data "$dat" \
-        -var L "$L" -var kn 1e4 -var kt 5e3 -var mu 0.5 -var etap "$ETAP" -var etaw "$ETAW" -var dt 5e-6 \
+        -var kn 1e4 -var kt 5e3 -var mu 0.5 -var etap "$ETAP" -var etaw "$ETAW" -var dt 5e-6 \
         -var skin 1e-4 "$@" >"$log" 2>&1
 }
 Z0=$(kv lid_start "$GC")
 # the lid force at the thermo lines of a compression log after step 0, on one line
 lammps_forces() { awk '/^ *Step +Atoms +v_F/ {on = 1; next} on && /^Loop time/ {on = 0} on && NF == 4 && $1 > 0 {printf "%s ", $3}' "$1"; }
 grainkit_forces() { k=1; while [ $k -le 20 ]; do printf '%s ' "$(kv "lid_force_$k" "$1")"; k=$((k + 1)); done; }
-lammps pour "$WORK/box.data" "$WORK/lammps_pour.log" -var pour "$POUR"
-lammps compress "$WORK/settled.data" "$WORK/lammps_compress.log" -var comp "$COMP" -var z0 "$Z0" -var vlid 0.02
-for f in pour:POUR compress:LIDEND; do
+lammps pour "$WORK/box.data" "$WORK/lammps_pour.log" -var L "$L" -var pour "$POUR"
+lammps compress "$WORK/settled.data" "$WORK/lammps_compress.log" -var L "$L" -var comp "$COMP" -var z0 "$Z0" -var vlid 0.02
+lammps impact "$WORK/impact.data" "$WORK/lammps_impact.log" -var L 0.024
+for f in pour:POUR compress:LIDEND impact:IMPACT; do
     if ! grep -q "^${f#*:}" "$WORK/lammps_${f%%:*}.log"; then
         echo "FAIL peer=lammps: no result, see $WORK/lammps_${f%%:*}.log"
         grep -E 'ERROR' "$WORK/lammps_${f%%:*}.log" | head -n 3
@@ -107,6 +114,13 @@ echo "LAMMPS phase=pour seconds=$TP particle_steps_per_s=$(awk -v n="$n" -v s="$
 echo "LAMMPS phase=compress seconds=$TC particle_steps_per_s=$(awk -v n="$n" -v s="$COMP" -v t="$TC" 'BEGIN {printf "%.4g", n*s/t}') start=settled lid_forces=$(echo $LF | tr ' ' ',')"
 echo
 echo "Physics, grainkit vs LAMMPS (same law and dt):"
+LI=$(grep '^IMPACT' "$WORK/lammps_impact.log")
+echo "  the law alone (no gravity; sphere 1 hits the floor, 2 hits 3 obliquely): velocities [m/s], spins [rad/s] after the impacts"
+for q in vx1 vz1 wy1 vx2 vz2 wy2 vx3 vz3 wy3; do
+    awk -v q="$q" -v g="$(kv "$q" "$GI")" -v l="$(kv "$q" "$LI")" 'BEGIN {
+        printf "    %-4s %12.8g %12.8g  %+.4f %%\n", q, g, l, (l != 0 ? 100 * (g - l) / (l < 0 ? -l : l) : 0) }'
+done
+echo "    (the definitions that differ: bench/peers/RESULTS_box.md, \"Same law\")"
 awk -v gz="$(kv zmean "$GP")" -v gx="$(kv zmax "$GP")" -v lz="$(kv zmean "$POURL")" -v lx="$(kv zmax "$POURL")" 'BEGIN {
     printf "  pour (same starting atoms): packing height 2<z> %.6g vs %.6g mm (%+.2f %%); highest centre %.6g vs %.6g mm (%+.2f %%)\n",
         2e3*gz, 2e3*lz, 100*(gz-lz)/lz, 1e3*gx, 1e3*lx, 100*(gx-lx)/lx }'
@@ -150,7 +164,7 @@ if [ "$ENS" -gt 0 ]; then
             cat "$WORK/member$s.out" >&2
             exit 1
         }
-        lammps compress "$m" "$WORK/lammps_member$s.log" -var comp "$COMP" -var z0 "$Z0" -var vlid 0.02
+        lammps compress "$m" "$WORK/lammps_member$s.log" -var L "$L" -var comp "$COMP" -var z0 "$Z0" -var vlid 0.02
         if ! grep -q '^LIDEND' "$WORK/lammps_member$s.log"; then
             echo "FAIL peer=lammps: no result, see $WORK/lammps_member$s.log"
             exit 0
