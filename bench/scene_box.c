@@ -8,6 +8,7 @@
  *                         [--write-data FILE]      the starting atoms (before the pour)
  *                         [--write-settled FILE]   the settled packing (after the pour)
  *                         [--from FILE]            no pour: compress the packing of FILE
+ *   build/bench_scene_box --impact [--write-data FILE]   the law alone (below)
  *   (LAMMPS data files, atom_style sphere: id type diameter density x y z,
  *   as written by the two --write options; --from needs the box of the same
  *   --nx, --nz)
@@ -31,6 +32,12 @@
  * planes x = 0, L; y = 0, L; z = 0 with the same law; the lid: a plane
  * starting 1 mm above the settled bed's mean top 2<z> + R, moving down at
  * 0.02 m/s (3 mm in the default 30 000 steps: ~2 mm into the bed).
+ *
+ * --impact: the contact law without the packing's chaos. No gravity;
+ * sphere 1 hits the floor at (vx, vz) = (0.05, -0.1) m/s, sphere 2, moving
+ * at vx = 0.1 m/s, hits sphere 3 at rest 30 degrees off centre; prints
+ * "IMPACT vx1=... vz1=... wy1=... (spheres 1..3)" after 4000 steps (LAMMPS:
+ * phase impact of bench/peers/lammps_box.in).
  *
  * Prints "SCENE phase=pour ... zmean=... zmax=... particle_steps_per_s=..."
  * and "SCENE phase=compress ... lid_start=... lid_force_k=...

@@ -10,7 +10,9 @@
 # the exact same settled packing: the one grainkit poured, as a data file
 # (--write-settled: positions and radii; velocities and spins zero, no
 # contact history in either code), under the same lid (start and speed).
-# Compared: the packing height after pouring (2 x the mean centre height,
+# Compared: the law alone (bench_scene_box --impact: an oblique sphere-floor
+# and an oblique sphere-sphere impact without gravity, velocities and spins
+# after them), the packing height after pouring (2 x the mean centre height,
 # and the highest centre; the two pours diverge chaotically, so this is a
 # statistical comparison), the lid force at 20 points of the compression
 # (equal lid travel), and the bed's stiffness once jammed; speed as
@@ -25,7 +27,7 @@
 # 1 + (617 s mod n) moved by (-1)^(s+1) nm along y, in both codes, and
 # compares the means over the k + 1 starts (mean +- standard deviation;
 # the difference of the means +- its standard error). Cost per member:
-# one compression in each code (about 10 + 12 CPU seconds).
+# one compression in each code (about 20 CPU seconds together).
 #
 # Environment: BOX_NX (10), BOX_NZ (20), BOX_POUR (40000), BOX_COMP (30000),
 # BOX_ENSEMBLE (0), BOX_WORK (build/peers_box).
