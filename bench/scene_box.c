@@ -82,13 +82,15 @@ static int write_data(const char *path, const gk_packing *pk, double L, double L
 static int read_data(const char *path, gk_packing *pk) {
     FILE *fp = fopen(path, "r");
     char line[512], word[16];
-    int n = 0, q, got = 0, bad = 0;
+    int n = 0, got = 0, bad = 0;
+    long q;
     unsigned char *seen = NULL;
     gk_err err;
     if (!fp) return fprintf(stderr, "bench_scene_box: cannot read %s\n", path), 1;
     while (fgets(line, sizeof line, fp) && !(sscanf(line, "%15s", word) == 1 && !strcmp(word, "Atoms")))
-        if (sscanf(line, "%d %15s", &q, word) == 2 && !strcmp(word, "atoms")) n = q;
-    if (n < 1 || n > 10000000 || gk_packing_alloc(pk, 3, n, NULL, &err)) {
+        if (sscanf(line, "%ld %15s", &q, word) == 2 && !strcmp(word, "atoms"))
+            n = q >= 1 && q <= 10000000 ? (int)q : -1;
+    if (n < 1 || gk_packing_alloc(pk, 3, n, NULL, &err)) {
         fclose(fp);
         return fprintf(stderr, "bench_scene_box: %s: no \"N atoms\" line (1 <= N <= 1e7) before Atoms\n",
                        path),
