@@ -140,8 +140,9 @@
  *   renamed. Loading checks the checksum over the whole file, every size
  *   and count against the file and the set, every value of a record (finite,
  *   |H| <= 1e6, |sigma| <= 1e100 Pa, a finite reference tangent, sorted
- *   contact keys), and restores all points into staging first: a truncated, corrupted, foreign or other-version file is
- *   refused by name and the set is unchanged.
+ *   contact keys), and restores all points into staging first: a truncated,
+ *   corrupted, foreign or other-version file is refused by name and the set
+ *   is unchanged.
  *
  * MPI (optional, like OpenMP). Define GK_TWOSCALE_MPI (and build with mpicc)
  *   and create the set with gk_twoscale_create_mpi(&ts, &def, comm) (or
@@ -629,7 +630,7 @@ static int gk__ts_keys(const gk_allocator *a, gk__tspt *pt) {
         if (n == pt->cap && gk__ts_reserve_keys(a, pt, 2 * pt->cap + 64)) return -1;
         pt->cur[n++] = (((unsigned long long)k.i << 32 | (unsigned long long)k.j) << 1) | (unsigned)k.sliding;
     }
-    if (n > 1) qsort(pt->cur, (size_t)n, sizeof *pt->cur, gk__ts_cmp_u64); /* cur is NULL without contacts */
+    if (n > 1) qsort(pt->cur, (size_t)n, sizeof *pt->cur, gk__ts_cmp_u64); /* cur: NULL without contacts */
     pt->ncur = n;
     return n;
 }
@@ -1236,7 +1237,7 @@ static gk_result gk__ts_rec_parse(gk_twoscale *ts, int id, const unsigned char *
         return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d is shorter than its %d contact keys", id,
                           (int)v[3]);
     if (v[3] >= 0) { /* the reference: a finite tangent, keys as gk__ts_keys makes them (sorted, ids i <= j) */
-        unsigned long long key, prev = 0;
+        unsigned long long key, prev = 0, lo, hi;
         double d;
         for (k = 0; k < ts->nd4; ++k) {
             memcpy(&d, b + off + (size_t)k * 8, 8);
@@ -1245,7 +1246,8 @@ static gk_result gk__ts_rec_parse(gk_twoscale *ts, int id, const unsigned char *
         }
         for (k = 0; k < v[3]; ++k, prev = key) {
             memcpy(&key, b + off + (size_t)ts->nd4 * 8 + (size_t)k * 8, 8);
-            if (key < prev || (key >> 33) > ((key >> 1) & 0xffffffffu) || ((key >> 1) & 0xffffffffu) > 0x7fffffffu)
+            lo = key >> 33, hi = (key >> 1) & 0xffffffffu;
+            if (key < prev || lo > hi || hi > 0x7fffffffu)
                 return gk_err_set(&ts->err, GK_ERR_FORMAT,
                                   "the record of point %d: contact key %d is out of order or not a particle pair", id,
                                   k);
