@@ -7,13 +7,17 @@
  * their values). gk_test_done() prints "# <program>: P passed, F failed" and
  * returns non-zero on failure; tests/run_tests.sh sums these lines.
  * A program given a test name as argv[1] runs only the tests whose names
- * contain it. */
+ * contain it.
+ *
+ * Tests run from the repository's root and write only under build/tests/
+ * (gk_test_init creates it; `make test` leaves nothing else behind). */
 #ifndef GK_TEST_H
 #define GK_TEST_H
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #ifdef _OPENMP
 #include <omp.h>
@@ -160,6 +164,8 @@ static void gk_test_init(int argc, char **argv) {
         if (p) gk__t_prog = p + 1;
     }
     if (argc > 1) gk__t_filter = argv[1];
+    mkdir("build", 0755); /* where the outputs go (already there under make test) */
+    mkdir("build/tests", 0755);
 }
 static int gk_test_done(void) {
     printf("# %s: %d passed, %d failed\n", gk__t_prog, gk__t_passed, gk__t_failed);
