@@ -95,6 +95,31 @@ static void gk__t_run(const char *name, void (*fn)(void)) {
 }
 #define RUN(name) gk__t_run(#name, name)
 
+#if defined(__GNUC__) || defined(__clang__)
+#define GK__T_UNUSED __attribute__((unused))
+#else
+#define GK__T_UNUSED
+#endif
+
+/* the whole file in a NUL-terminated buffer to free (NULL if unreadable) */
+GK__T_UNUSED static char *gk_test_slurp(const char *path) {
+    FILE *fp = fopen(path, "rb");
+    char *buf = NULL;
+    long n;
+    if (!fp) return NULL;
+    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0 &&
+        (buf = (char *)malloc((size_t)n + 1)) != NULL) {
+        if (fread(buf, 1, (size_t)n, fp) != (size_t)n) {
+            free(buf);
+            buf = NULL;
+        } else {
+            buf[n] = 0;
+        }
+    }
+    fclose(fp);
+    return buf;
+}
+
 /* ---- for smoke tests of the example drivers: #define GK_TEST_DRIVERS
  * before including this file */
 #ifdef GK_TEST_DRIVERS
@@ -123,12 +148,10 @@ static double gk_test_result(const char *path, const char *key) {
     q = strstr(last, pat);
     return q ? atof(q + strlen(pat)) : NAN;
 }
-/* 1 if two CSV files have the same rows (at least two) in their first ncol
- * columns (e.g. all but a trailing `seconds` column) */
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((unused))
-#endif
-static int gk_test_csv_same(const char *a, const char *b, int ncol) {
+/* 1 if two CSV files have the same lines, at least min_lines of them (the
+ * header counts), in their first ncol columns (e.g. all but a trailing
+ * `seconds` column) */
+GK__T_UNUSED static int gk_test_csv_same(const char *a, const char *b, int ncol, int min_lines) {
     FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
     char la[4096], lb[4096];
     int same = fa && fb, rows = 0;
@@ -147,7 +170,7 @@ static int gk_test_csv_same(const char *a, const char *b, int ncol) {
     }
     if (fa) fclose(fa);
     if (fb) fclose(fb);
-    return same && rows > 2;
+    return same && rows >= min_lines;
 }
 #endif
 

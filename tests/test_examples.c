@@ -124,29 +124,6 @@ TEST(gk_pack_makes_a_framed_packing) {
     CHECK(gk_test_file_has("build/tests/t_bad.out", "2D only"));
 }
 
-/* the first `ncol` columns of every data row of two CSV files are identical */
-static int csv_same(const char *a, const char *b, int ncol) {
-    FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
-    char la[2048], lb[2048];
-    int same = fa && fb, rows = 0;
-    while (same) {
-        char *pa = fgets(la, sizeof la, fa), *pb = fgets(lb, sizeof lb, fb);
-        int k, c = 0;
-        if (!pa || !pb) {
-            same = !pa && !pb;
-            break;
-        }
-        for (k = 0; la[k] && lb[k] && c < ncol; ++k) {
-            if (la[k] != lb[k]) same = 0;
-            if (la[k] == ',') ++c;
-        }
-        ++rows;
-    }
-    if (fa) fclose(fa);
-    if (fb) fclose(fb);
-    return same && rows > 1;
-}
-
 /* a driver run `base full` with 2 and with 1 thread (build/tests/<tag>A, <tag>1),
  * and `base part` continued by a restart to `full` (build/tests/<tag>B); 1 when
  * every run exits 0 */
@@ -170,9 +147,9 @@ static void check_threads_and_restart(const char *tag, const char *csv, int ncol
     char a[256], b[256];
     snprintf(a, sizeof a, "build/tests/%sA/%s", tag, csv);
     snprintf(b, sizeof b, "build/tests/%s1/%s", tag, csv);
-    CHECK(csv_same(a, b, ncol));
+    CHECK(gk_test_csv_same(a, b, ncol, 2));
     snprintf(b, sizeof b, "build/tests/%sB/%s", tag, csv);
-    CHECK(csv_same(a, b, ncol));
+    CHECK(gk_test_csv_same(a, b, ncol, 2));
     snprintf(b, sizeof b, "build/tests/%sB2.out", tag);
     CHECK(gk_test_file_has(b, "restarted from"));
 }

@@ -114,9 +114,9 @@ static void threads_and_restart(const char *args, const char *tag, const char *c
     CHECK(system(cmd) == 0);
     snprintf(a, sizeof a, "build/tests/%sA/%s", tag, csv);
     snprintf(b, sizeof b, "build/tests/%s1/%s", tag, csv);
-    CHECK(gk_test_csv_same(a, b, 14));
+    CHECK(gk_test_csv_same(a, b, 14, 3));
     snprintf(b, sizeof b, "build/tests/%sB/%s", tag, csv);
-    CHECK(gk_test_csv_same(a, b, 14));
+    CHECK(gk_test_csv_same(a, b, 14, 3));
     snprintf(b, sizeof b, "build/tests/%sB2.out", tag);
     CHECK(gk_test_file_has(b, "restarted from"));
 }
