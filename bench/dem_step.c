@@ -62,7 +62,7 @@ static void header(void) {
            "Mpart/s", "Mcont/s", "Z", "pairs");
 }
 
-/* float against double along the seed-000 RVE shear path: what float costs in accuracy */
+/* float against double along the Guo & Zhao RVE shear path: what float costs in accuracy */
 static int float_error_report(void) {
     enum { NI = 50 };
     double pd[NI], qd[NI], pf[NI], qf[NI], emax = 0, erat = 0;
@@ -76,7 +76,7 @@ static int float_error_report(void) {
         if (e > emax) emax = e;
         if (r > erat) erat = r;
     }
-    printf("float vs double along the seed-000 RVE shear path (50 x dH01 = 1e-3, 100 steps each):\n"
+    printf("float vs double along the Guo & Zhao RVE shear path (50 x dH01 = 1e-3, 100 steps each):\n"
            "  largest relative difference in p: %.3g; largest difference in q/p: %.3g (q/p at the end %.4f)\n",
            emax, erat, qd[NI - 1] / pd[NI - 1]);
     printf("BENCH case=float_error increments=%d max_rel_p=%.4g max_abs_q_over_p=%.4g final_q_over_p=%.4f\n", NI,

@@ -172,7 +172,7 @@ int BENCH_RUN(const bench_case *bc, bench_out *o) {
         return 1;
     }
     gk_packing_free(&pk);
-    /* slow simple shear (Lees-Edwards): the seed's 1e-5 strain per step for the
+    /* slow simple shear (Lees-Edwards): Guo & Zhao's 1e-5 strain per step for the
      * RVE, the peers' 1.5 /s for the large packings */
     gk_m3_zero(L);
     rate = rve400 ? 1e-5 / rve.dt : 1.5;

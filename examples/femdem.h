@@ -35,7 +35,7 @@
 #define FD_DEM_MIN 2
 #define FD_DEM_MAX 20000
 #define FD_DEM_EVERY 20            /* adaptive rule: relaxation steps between unbalanced-force checks */
-#define FD_SEED_DT 3.1602315723728926e-05 /* the seed authors' YADE time step (PWaveTimeStep of rve400) */
+#define FD_SEED_DT 3.1602315723728926e-05 /* the Guo & Zhao authors' YADE time step (PWaveTimeStep of rve400) */
 #define FD_MAX_PACKINGS 64
 #define FD_NFIELD 10
 #define FD_PI 3.14159265358979323846

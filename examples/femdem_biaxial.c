@@ -14,7 +14,7 @@
  * eq 8 by perturbation); the macro solve is full Newton-Raphson (sec 2.3) with the displacement
  * criterion E_d < 0.01 (eq 21). The RVEs are a gk_twoscale set (gk_twoscale.h), the model and its
  * outputs examples/femdem.h, the Newton iteration examples/femdem_newton.h; the cyclic simple-shear
- * tests of seed sec 5 are build/femdem_cyclic, the Newton diagnostics build/femdem_probe.
+ * tests of Guo & Zhao (2014) Sec 5 are build/femdem_cyclic, the Newton diagnostics build/femdem_probe.
  *
  * DEM STEPS PER RVE RUN (as examples/mpmdem.h, same flag names; gk_twoscale_rule)
  *   --dem-rule adaptive (default): gk_rve_deform_adaptive (gk_homog.h): dH over n = clamp(ceil(I_1 /
@@ -55,7 +55,7 @@
  *     network with every particle relaxed (GK_TANGENT_RELAXED: softer than eq 9 where the network is
  *     near a mechanism); 'perturbation' = eq 8 with xi.
  *   - convergence: E_d < --tol (eq 21), or E_f < --ftol (default 0.003, a force criterion stricter than
- *     the ABAQUS/ANSYS 0.005 quoted by the seed; both are the paper's footnote's pairs of displacement
+ *     the ABAQUS/ANSYS 0.005 quoted by Guo & Zhao (2014); both are the paper's footnote's pairs of displacement
  *     and force criteria). Both E_d and E_f of the accepted iterate are in the CSV; --ftol 0 restores
  *     the pure eq 21 criterion. build/femdem_probe measures how much DEM noise moves the residual
  *     (--noise-probe) and whether any deformation near an iterate reduces it (--krylov-probe).
@@ -113,7 +113,7 @@ static void usage(FILE *fp) {
             "                      [--test biaxial|single]\n"
             "       (the cyclic simple-shear tests: build/femdem_cyclic; diagnostics: build/femdem_probe)\n\n"
             "  --steps N              load steps (default 100: 10 %% axial strain at 0.1 %% per step)\n"
-            "  --test KIND            biaxial (default); single: the single-element test of seed sec 3.3, one\n"
+            "  --test KIND            biaxial (default); single: the single-element test of the paper, Sec 3.3, one\n"
             "                         Q4 element, 4 Gauss points, compared with the RVE alone under the same\n"
             "                         drained path (writes single_element.csv and .svg; one --packing)\n"
             "  --predictor KIND       first iterate of a load step: tangent (default; K(D_n) u = f_ext -\n"

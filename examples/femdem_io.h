@@ -16,7 +16,7 @@ static const char *fd_field_names[FD_NFIELD] = {"eps_q", "eps_v", "void_ratio", 
                                                 "p",     "q",     "fabric_anisotropy", "coordination", "dem_steps"};
 
 /* the Gauss-point fields of the converged state, FD_NFIELD per point (all ranks call it): eps_q,
- * eps_v compression-positive as the seed, void ratio, particle rotation and spin [deg], p, q,
+ * eps_v compression-positive as the paper, void ratio, particle rotation and spin [deg], p, q,
  * |F_a|, Z, DEM steps. NULL when out of memory. */
 static double *fd_gp_fields(fd_model *M) {
     gk_twoscale_field *f = (gk_twoscale_field *)malloc((size_t)M->ngp * sizeof *f);

@@ -500,7 +500,7 @@ static gk_result mpd_stress(gk_mpm_points *pts, double dt, void *user, gk_err *e
     long long b0 = m->ts.stats.bytes_out;
     for (p = 0; p < pts->n; ++p) {
         double *dH = m->dH + 9 * (size_t)p;
-        gk_mpm_point_dH(pts, p, dt, dH);
+        gk_mpm_point_dh(pts, p, dt, dH);
         dH[2] = dH[5] = dH[6] = dH[7] = dH[8] = 0.0; /* plane */
     }
     res = gk_twoscale_run(&m->ts, m->dH, NULL, m->sig, NULL);

@@ -633,7 +633,7 @@ GKDEF gk_result gk_hybrid_dp_stress(gk_mpm_points *pts, double dt, void *user, g
         gk_mpm_dp_info info;
         gk_result r;
         int i, j;
-        gk_mpm_point_dH(pts, p, dt, dH);
+        gk_mpm_point_dh(pts, p, dt, dH);
         {
             /* the objective rotation R = exp(dt W) in closed form (2D), then the
              * symmetric dH alone to the return map (whose own rotation then has
@@ -1561,16 +1561,7 @@ GKDEF void gk_hybrid_bc_mask(const gk_mpm_grid *g, unsigned char *mask) {
     }
     for (bi = 0; bi < g->nbody; ++bi) {
         const gk_mpm_body *B = &g->body[bi];
-        for (k = 0; k < 3; ++k) {
-            if (k < g->dim) {
-                double a = ceil((B->lo[k] - g->origin[k]) * g->inv_h - 1e-9);
-                double b = floor((B->hi[k] - g->origin[k]) * g->inv_h + 1e-9);
-                lo[k] = a < 0.0 ? 0 : (a > g->n[k] ? g->n[k] : (int)a);
-                hi[k] = b > g->n[k] - 1 ? g->n[k] - 1 : (b < -1.0 ? -1 : (int)b);
-            } else {
-                lo[k] = hi[k] = 0;
-            }
-        }
+        gk_mpm_body_nodes(g, B, lo, hi);
         for (l = lo[2]; l <= hi[2]; ++l)
             for (j = lo[1]; j <= hi[1]; ++j)
                 for (i = lo[0]; i <= hi[0]; ++i)

@@ -35,8 +35,9 @@
  *                                 gravity, damping, mass threshold, threads
  *   gk_mpm_step                   one step in USF, USL or MUSL order
  *   gk_mpm_bodies_advance         move rigid bodies by v dt
+ *   gk_mpm_body_nodes             the grid nodes a rigid body's box covers
  *   gk_mpm_wave_speed             P-wave speed, for the time step
- *   gk_mpm_point_dH               dH = dt L, what an RVE receives [Liang & Zhao 2019 (b)]
+ *   gk_mpm_point_dh               dH = dt L, what an RVE receives [Liang & Zhao 2019 (b)]
  *   gk_mpm_point_polar            F = R U via gk_m3_polar [Liang & Zhao 2019 eqs 36-40]
  *   gk_mpm_elastic_update         hypoelastic increment (objective rotation)
  *   gk_mpm_dp_*                   Drucker-Prager return map with apex return
@@ -353,6 +354,9 @@ GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *pts, const gk_mp
 GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def *def, double dt,
                             gk_mpm_stress_fn stress, void *user, gk_err *err);
 GKDEF void gk_mpm_bodies_advance(gk_mpm_body *body, int nbody, double dt);
+/* the grid nodes inside body B's box [lo, hi] (1e-9 of a cell of slack), clipped to the grid:
+ * nodes lo[k]..hi[k] along each axis (none when hi[k] < lo[k]); lo = hi = 0 on unused axes */
+GKDEF void gk_mpm_body_nodes(const gk_mpm_grid *g, const gk_mpm_body *B, int lo[3], int hi[3]);
 
 /* F = R U of point p [Liang & Zhao 2019 eqs 36-40]; GK_ERR_SINGULAR if det F <= 0 */
 GKDEF gk_result gk_mpm_point_polar(const gk_mpm_points *pts, int p, double R[9], double U[9], gk_err *err);
@@ -435,7 +439,7 @@ GK_INLINE double gk_mpm_kernel_1d(gk_mpm_basis b, double r, double l, double *dN
 
 /* dH = dt L of point p: the incremental displacement gradient (stretch and
  * spin) an RVE receives for this step [Liang & Zhao 2019 step (b)] */
-GK_INLINE void gk_mpm_point_dH(const gk_mpm_points *pts, int p, double dt, double dH[9]) {
+GK_INLINE void gk_mpm_point_dh(const gk_mpm_points *pts, int p, double dt, double dH[9]) {
     int k;
     for (k = 0; k < 9; ++k) dH[k] = dt * pts->L[9 * p + k];
 }
@@ -1040,16 +1044,7 @@ static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt, double d
     for (bi = 0; bi < g->nbody; ++bi) {
         gk_mpm_body *B = &g->body[bi];
         if (dt > 0.0) B->force[0] = B->force[1] = B->force[2] = 0.0;
-        for (k = 0; k < 3; ++k) {
-            if (k < dim) {
-                double a = ceil((B->lo[k] - g->origin[k]) * g->inv_h - 1e-9);
-                double b = floor((B->hi[k] - g->origin[k]) * g->inv_h + 1e-9);
-                lo[k] = a < 0.0 ? 0 : (a > g->n[k] ? g->n[k] : (int)a);
-                hi[k] = b > g->n[k] - 1 ? g->n[k] - 1 : (b < -1.0 ? -1 : (int)b);
-            } else {
-                lo[k] = hi[k] = 0;
-            }
-        }
+        gk_mpm_body_nodes(g, B, lo, hi);
         for (l = lo[2]; l <= hi[2]; ++l)
             for (j = lo[1]; j <= hi[1]; ++j)
                 for (i = lo[0]; i <= hi[0]; ++i) {
@@ -1310,6 +1305,20 @@ GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_
     for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p, 0);
     if (bad) return gk_err_set(err, GK_ERR_DIVERGED, "%d points inverted (det F <= 0)", bad);
     return GK_OK;
+}
+
+GKDEF void gk_mpm_body_nodes(const gk_mpm_grid *g, const gk_mpm_body *B, int lo[3], int hi[3]) {
+    int k;
+    for (k = 0; k < 3; ++k) {
+        if (k < g->dim) {
+            double a = ceil((B->lo[k] - g->origin[k]) * g->inv_h - 1e-9);
+            double b = floor((B->hi[k] - g->origin[k]) * g->inv_h + 1e-9);
+            lo[k] = a < 0.0 ? 0 : (a > g->n[k] ? g->n[k] : (int)a);
+            hi[k] = b > g->n[k] - 1 ? g->n[k] - 1 : (b < -1.0 ? -1 : (int)b);
+        } else {
+            lo[k] = hi[k] = 0;
+        }
+    }
 }
 
 GKDEF void gk_mpm_bodies_advance(gk_mpm_body *body, int nbody, double dt) {

@@ -155,7 +155,7 @@ GK_INLINE void gk_pcell_min_image(const gk_pcell *c, const double ds[3], double 
 }
 
 /* simple shear velocity gradient (Lees-Edwards): v_i = rate * x_j, i != j */
-GK_INLINE void gk_pcell_shear_L(double L[9], int i, int j, double rate) {
+GK_INLINE void gk_pcell_shear_velgrad(double L[9], int i, int j, double rate) {
     gk_m3_zero(L);
     L[3 * i + j] = rate;
 }

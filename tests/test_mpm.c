@@ -26,7 +26,7 @@ static gk_result elastic_cb(gk_mpm_points *P, double dt, void *user, gk_err *err
     for (p = 0; p < P->n; ++p) {
         double dH[9];
         gk_result r;
-        gk_mpm_point_dH(P, p, dt, dH);
+        gk_mpm_point_dh(P, p, dt, dH);
         r = gk_mpm_elastic_update(e->K, e->G, P->dim, dH, P->sigma + 9 * p, err);
         if (r) return r;
     }
@@ -705,7 +705,7 @@ TEST(velocity_gradient_F_and_polar) {
         CHECK_NEAR(P.F[9 * p + 8], 1.0, 0);
         CHECK_REL(P.vol[p], gk_m3_det(P.F + 9 * p) * P.vol0[p], 1e-15);
     }
-    gk_mpm_point_dH(&P, 0, dt, dH);
+    gk_mpm_point_dh(&P, 0, dt, dH);
     CHECK_NEAR(dH[1], dt * Lx[1], 1e-14);
     /* a pure rotation by 0.3 rad */
     gk_m3_identity(P.F);
