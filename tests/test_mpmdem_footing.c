@@ -121,7 +121,7 @@ TEST(footing_bad_arguments) {
     const char *o = " > build/tests/t_mpmft_bad.out 2>&1";
     char cmd[512];
 #define BAD(args, msg)                                               \
-    snprintf(cmd, sizeof cmd, "build/mpmdem_footing %s%s", args, o); \
+    snprintf(cmd, sizeof cmd, "build/mpmdem_footing --out build/tests/t_mpmft_bad %s%s", args, o); \
     CHECK(system(cmd) != 0);                                         \
     CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", msg))
     BAD("--nx 0", "out of range");
