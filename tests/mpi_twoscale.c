@@ -132,9 +132,11 @@ TEST(checkpoints_move_between_rank_counts) {
     MPI_Barrier(MPI_COMM_WORLD);
     CHECK(make_set(&w2, MPI_COMM_WORLD, GK_TWOSCALE_TANGENT_HOMOG, 0.3) == GK_OK);
     CHECK(make_set(&s2, MPI_COMM_SELF, GK_TWOSCALE_TANGENT_HOMOG, 0.3) == GK_OK);
-    CHECK(gk_twoscale_load(&w2, "build/tests/t_tsm_s.bin", &b, &nb) == GK_OK && nb == 1 && ((char *)b)[0] == 's');
+    CHECK(gk_twoscale_load(&w2, "build/tests/t_tsm_s.bin", &b, &nb) == GK_OK && nb == 1 &&
+          ((char *)b)[0] == 's');
     gk_twoscale_free(&w2, b);
-    CHECK(gk_twoscale_load(&s2, "build/tests/t_tsm_w.bin", &b, &nb) == GK_OK && nb == 1 && ((char *)b)[0] == 'w');
+    CHECK(gk_twoscale_load(&s2, "build/tests/t_tsm_w.bin", &b, &nb) == GK_OK && nb == 1 &&
+          ((char *)b)[0] == 'w');
     gk_twoscale_free(&s2, b);
     if (rank == 0) { /* a truncated copy */
         FILE *in = fopen("build/tests/t_tsm_w.bin", "rb"), *out = fopen("build/tests/t_tsm_bad.bin", "wb");

@@ -39,14 +39,20 @@ TEST(femdem_biaxial_two_ranks_equal_two_threads) {
         return;
     }
     system("rm -rf build/tests/t_fmT build/tests/t_fmM");
-    snprintf(cmd, sizeof cmd, "build/femdem_biaxial %s --threads 2 --out build/tests/t_fmT > build/tests/t_fmT.out 2>&1", args);
+    snprintf(cmd, sizeof cmd,
+             "build/femdem_biaxial %s --threads 2 --out build/tests/t_fmT > build/tests/t_fmT.out 2>&1",
+             args);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s -np 2 build/femdem_biaxial_mpi %s --threads 1 --out build/tests/t_fmM > build/tests/t_fmM.out 2>&1",
+    snprintf(cmd, sizeof cmd,
+             "%s -np 2 build/femdem_biaxial_mpi %s --threads 1 --out build/tests/t_fmM > "
+             "build/tests/t_fmM.out 2>&1",
              mpirun, args);
     CHECK(system(cmd) == 0);
-    CHECK(same_but_seconds("build/tests/t_fmT/biaxial.csv", "build/tests/t_fmM/biaxial.csv", 11)); /* rows 0-10 */
+    CHECK(same_but_seconds("build/tests/t_fmT/biaxial.csv", "build/tests/t_fmM/biaxial.csv",
+                           11)); /* rows 0-10 */
     CHECK(gk_test_file_has("build/tests/t_fmM.out", "RESULT peak_sigma_yy="));
-    CHECK(gk_test_result("build/tests/t_fmM.out", "peak_sigma_yy") == gk_test_result("build/tests/t_fmT.out", "peak_sigma_yy"));
+    CHECK(gk_test_result("build/tests/t_fmM.out", "peak_sigma_yy") ==
+          gk_test_result("build/tests/t_fmT.out", "peak_sigma_yy"));
     CHECK(gk_test_file_has("build/tests/t_fmM.out", "MPI ranks=2 ")); /* the traffic line of the MPI build */
     /* rank 0 alone prints: one RESULT line */
     {
@@ -59,11 +65,13 @@ TEST(femdem_biaxial_two_ranks_equal_two_threads) {
     }
     /* the checkpoint is the same file for any rank count: each build goes on from the other's */
     snprintf(cmd, sizeof cmd,
-             "build/femdem_biaxial --nx 4 --ny 8 --element q8 --steps 11 --threads 2 --restart build/tests/t_fmM --out build/tests/t_fmMT "
+             "build/femdem_biaxial --nx 4 --ny 8 --element q8 --steps 11 --threads 2 --restart "
+             "build/tests/t_fmM --out build/tests/t_fmMT "
              "> build/tests/t_fmMT.out 2>&1");
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s -np 2 build/femdem_biaxial_mpi --nx 4 --ny 8 --element q8 --steps 11 --threads 1 --restart build/tests/t_fmT "
+             "%s -np 2 build/femdem_biaxial_mpi --nx 4 --ny 8 --element q8 --steps 11 --threads 1 --restart "
+             "build/tests/t_fmT "
              "--out build/tests/t_fmTM > build/tests/t_fmTM.out 2>&1",
              mpirun);
     CHECK(system(cmd) == 0);

@@ -19,13 +19,15 @@ static int both(const char *mpirun, const char *driver, const char *name, const 
     char cmd[1024];
     int ok;
     snprintf(cmd, sizeof cmd,
-             "rm -rf build/tests/t_mpiT_%s build/tests/t_mpiM_%s && build/%s %s --threads 2 --out build/tests/t_mpiT_%s "
+             "rm -rf build/tests/t_mpiT_%s build/tests/t_mpiM_%s && build/%s %s --threads 2 --out "
+             "build/tests/t_mpiT_%s "
              "> build/tests/t_mpiT_%s.out 2>&1",
              name, name, driver, args, name, name);
     ok = system(cmd) == 0;
-    snprintf(cmd, sizeof cmd,
-             "%s -np 2 build/%s_mpi %s --threads 1 --out build/tests/t_mpiM_%s > build/tests/t_mpiM_%s.out 2>&1", mpirun,
-             driver, args, name, name);
+    snprintf(
+        cmd, sizeof cmd,
+        "%s -np 2 build/%s_mpi %s --threads 1 --out build/tests/t_mpiM_%s > build/tests/t_mpiM_%s.out 2>&1",
+        mpirun, driver, args, name, name);
     return ok && system(cmd) == 0;
 }
 
@@ -33,8 +35,10 @@ static int both(const char *mpirun, const char *driver, const char *name, const 
 static int same_csv(const char *name, const char *csv, int ncol) {
     char cmd[512];
     snprintf(cmd, sizeof cmd,
-             "cut -d, -f1-%d build/tests/t_mpiT_%s/%s > build/tests/t_mpiT_%s.c && cut -d, -f1-%d build/tests/t_mpiM_%s/%s "
-             "> build/tests/t_mpiM_%s.c && cmp -s build/tests/t_mpiT_%s.c build/tests/t_mpiM_%s.c && test -s build/tests/t_mpiT_%s.c",
+             "cut -d, -f1-%d build/tests/t_mpiT_%s/%s > build/tests/t_mpiT_%s.c && cut -d, -f1-%d "
+             "build/tests/t_mpiM_%s/%s "
+             "> build/tests/t_mpiM_%s.c && cmp -s build/tests/t_mpiT_%s.c build/tests/t_mpiM_%s.c && test -s "
+             "build/tests/t_mpiT_%s.c",
              ncol, name, csv, name, ncol, name, csv, name, name, name, name);
     return system(cmd) == 0;
 }
@@ -61,7 +65,8 @@ TEST(biaxial_two_ranks_equal_two_threads) {
     CHECK(both(m, "mpmdem_biaxial", "bx", BX "--strain 0.002"));
     CHECK(same_csv("bx", "biaxial.csv", 7));
     CHECK(system("cmp -s build/tests/t_mpiT_bx/points_000000.vtk build/tests/t_mpiM_bx/points_000000.vtk && "
-                 "cmp -s build/tests/t_mpiT_bx/points_000278.vtk build/tests/t_mpiM_bx/points_000278.vtk") == 0);
+                 "cmp -s build/tests/t_mpiT_bx/points_000278.vtk build/tests/t_mpiM_bx/points_000278.vtk") ==
+          0);
     CHECK(gk_test_result("build/tests/t_mpiM_bx.out", "peak_sigma_yy") ==
           gk_test_result("build/tests/t_mpiT_bx.out", "peak_sigma_yy"));
     CHECK(gk_test_file_has("build/tests/t_mpiM_bx.out", "MPI ranks=2 threads=1 "));
@@ -97,11 +102,14 @@ TEST(footing_and_collapse_two_ranks_equal_two_threads) {
     if (!m) return;
     CHECK(both(m, "mpmdem_footing", "ft", FT));
     CHECK(same_csv("ft", "footing.csv", 8));
-    CHECK(gk_test_result("build/tests/t_mpiM_ft.out", "q_ult") == gk_test_result("build/tests/t_mpiT_ft.out", "q_ult"));
+    CHECK(gk_test_result("build/tests/t_mpiM_ft.out", "q_ult") ==
+          gk_test_result("build/tests/t_mpiT_ft.out", "q_ult"));
     CHECK(both(m, "mpmdem_collapse", "cl", CL));
     CHECK(same_csv("cl", "collapse.csv", 14));
-    CHECK(system("cmp -s build/tests/t_mpiT_cl/points_000000.vtk build/tests/t_mpiM_cl/points_000000.vtk") == 0);
-    CHECK(gk_test_result("build/tests/t_mpiM_cl.out", "dstar") == gk_test_result("build/tests/t_mpiT_cl.out", "dstar"));
+    CHECK(system("cmp -s build/tests/t_mpiT_cl/points_000000.vtk build/tests/t_mpiM_cl/points_000000.vtk") ==
+          0);
+    CHECK(gk_test_result("build/tests/t_mpiM_cl.out", "dstar") ==
+          gk_test_result("build/tests/t_mpiT_cl.out", "dstar"));
 }
 
 int main(int argc, char **argv) {

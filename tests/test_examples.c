@@ -20,10 +20,11 @@ static int count_lines(const char *path) {
 /* rve_path: documented CSV header, one row per increment plus the initial
  * state, which is the seed packing's YADE stress (p = 99976.38 Pa) */
 TEST(rve_path_writes_csv_and_svg) {
-    const char *cmd = "build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 5 "
-                      "--steps-per-increment 50 --E 6e8 --kt-ratio 0.8 --friction-angle 0.5 --density 2650 "
-                      "--thickness 0.1 --damping 0.1 --damping-form component --out build/tests/t_rve_path.csv "
-                      "> build/tests/t_rve_path.out 2>&1";
+    const char *cmd =
+        "build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 5 "
+        "--steps-per-increment 50 --E 6e8 --kt-ratio 0.8 --friction-angle 0.5 --density 2650 "
+        "--thickness 0.1 --damping 0.1 --damping-form component --out build/tests/t_rve_path.csv "
+        "> build/tests/t_rve_path.out 2>&1";
     FILE *fp;
     char line[1024];
     double p0 = 0;
@@ -48,8 +49,10 @@ TEST(rve_path_writes_csv_and_svg) {
     CHECK(gk_test_file_has("build/tests/t_rve_path.svg", "<svg"));
     CHECK(gk_test_file_has("build/tests/t_rve_path.out", "RESULT p="));
     /* bad arguments: a message and a non-zero status */
-    CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 1\" > build/tests/t_bad.out 2>&1") !=
-          0);
+    CHECK(
+        system(
+            "build/rve_path --packing examples/data/rve400.txt --dH \"0 1\" > build/tests/t_bad.out 2>&1") !=
+        0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "needs 4 numbers"));
     CHECK(system("build/rve_path --packing no_such_file --dH \"0 0 0 0\" > build/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "no_such_file"));
@@ -72,10 +75,8 @@ TEST(gk_pack_makes_a_consolidated_packing) {
     gk_packing pk;
     gk_err e;
     FILE *fp;
-    CHECK(
-        system(
-            "build/gk_pack --dim 2 --n 120 --pressure 1e5 --out build/tests/t_pack.txt > build/tests/t_pack.out 2>&1") ==
-        0);
+    CHECK(system("build/gk_pack --dim 2 --n 120 --pressure 1e5 --out build/tests/t_pack.txt > "
+                 "build/tests/t_pack.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_pack.out", "RESULT void_ratio="));
     CHECK(gk_packing_read("build/tests/t_pack.txt", &pk, NULL, &e) == GK_OK);
     CHECK(pk.n == 120 && pk.dim == 2);
@@ -83,12 +84,16 @@ TEST(gk_pack_makes_a_consolidated_packing) {
     gk_packing_free(&pk);
     /* numbers are parsed strictly, and nothing is written for a refused one */
     remove("build/tests/t_pack_bad.txt");
-    CHECK(system("build/gk_pack --dim 2 --n 120x --out build/tests/t_pack_bad.txt > build/tests/t_bad.out 2>&1") != 0);
+    CHECK(
+        system(
+            "build/gk_pack --dim 2 --n 120x --out build/tests/t_pack_bad.txt > build/tests/t_bad.out 2>&1") !=
+        0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "--n '120x' is not a whole number"));
     CHECK(system("build/gk_pack --dim 2 --pressure 1e5Pa --out build/tests/t_pack_bad.txt "
                  "> build/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "--pressure '1e5Pa' is not a finite number"));
-    CHECK(system("build/gk_pack --dim 2 --seed -1 --out build/tests/t_pack_bad.txt > build/tests/t_bad.out 2>&1") != 0);
+    CHECK(system("build/gk_pack --dim 2 --seed -1 --out build/tests/t_pack_bad.txt > build/tests/t_bad.out "
+                 "2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "--seed '-1' is not a non-negative whole number"));
     fp = fopen("build/tests/t_pack_bad.txt", "r");
     CHECK(!fp);
@@ -102,8 +107,10 @@ TEST(gk_pack_makes_a_framed_packing) {
     gk_packing pk;
     gk_err e;
     int p, nx = 0, ny = 0, corner = 0;
-    CHECK(system("build/gk_pack --dim 2 --n 60 --rmin 3e-4 --rmax 4.5e-4 --pressure 1500 --kn 1.5e8 --frame 3 "
-                 "--stress-ratio 1.3 --out build/tests/t_pack_frame.txt > build/tests/t_pack_frame.out 2>&1") == 0);
+    CHECK(
+        system("build/gk_pack --dim 2 --n 60 --rmin 3e-4 --rmax 4.5e-4 --pressure 1500 --kn 1.5e8 --frame 3 "
+               "--stress-ratio 1.3 --out build/tests/t_pack_frame.txt > build/tests/t_pack_frame.out 2>&1") ==
+        0);
     CHECK(gk_test_file_has("build/tests/t_pack_frame.out", "RESULT void_ratio="));
     CHECK(gk_test_file_has("build/tests/t_pack_frame.out", "anisotropy="));
     CHECK(gk_test_file_has("build/tests/t_pack_frame.txt", "sigma_yy to 1.3 sigma_xx and back"));
@@ -120,7 +127,8 @@ TEST(gk_pack_makes_a_framed_packing) {
     CHECK_EQ_INT(ny, 3);
     CHECK_EQ_INT(corner, 1);
     gk_packing_free(&pk);
-    CHECK(system("build/gk_pack --dim 3 --frame 3 --out build/tests/t_pack_bad.txt > build/tests/t_bad.out 2>&1") != 0);
+    CHECK(system("build/gk_pack --dim 3 --frame 3 --out build/tests/t_pack_bad.txt > build/tests/t_bad.out "
+                 "2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "2D only"));
 }
 
@@ -130,13 +138,17 @@ TEST(gk_pack_makes_a_framed_packing) {
 static int run_threads_and_restart(const char *base, const char *full, const char *part, const char *tag) {
     char cmd[1024];
     int ok = 1;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/tests/%sA > build/tests/%sA.out 2>&1", base, full, tag, tag);
+    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/tests/%sA > build/tests/%sA.out 2>&1", base,
+             full, tag, tag);
     ok &= system(cmd) == 0;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 1 --out build/tests/%s1 > build/tests/%s1.out 2>&1", base, full, tag, tag);
+    snprintf(cmd, sizeof cmd, "%s %s --threads 1 --out build/tests/%s1 > build/tests/%s1.out 2>&1", base,
+             full, tag, tag);
     ok &= system(cmd) == 0;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/tests/%sB > build/tests/%sB.out 2>&1", base, part, tag, tag);
+    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/tests/%sB > build/tests/%sB.out 2>&1", base,
+             part, tag, tag);
     ok &= system(cmd) == 0;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/tests/%sB --restart build/tests/%sB > build/tests/%sB2.out 2>&1",
+    snprintf(cmd, sizeof cmd,
+             "%s %s --threads 2 --out build/tests/%sB --restart build/tests/%sB > build/tests/%sB2.out 2>&1",
              base, full, tag, tag, tag);
     ok &= system(cmd) == 0;
     return ok;
@@ -282,8 +294,10 @@ TEST(femdem_single_element_matches_rve_alone) {
     double d = 1.0;
     FILE *fp;
     char line[1024];
-    CHECK(system("build/femdem_biaxial --test single --steps 6 --threads 2 --vtk-every 0 --out build/tests/t_fds "
-                 "> build/tests/t_fds.out 2>&1") == 0);
+    CHECK(
+        system(
+            "build/femdem_biaxial --test single --steps 6 --threads 2 --vtk-every 0 --out build/tests/t_fds "
+            "> build/tests/t_fds.out 2>&1") == 0);
     fp = fopen("build/tests/t_fds.out", "r");
     while (fp && fgets(line, sizeof line, fp))
         if (!strncmp(line, "SINGLE max_rel_diff_to_peak=", 28)) d = atof(line + 28);
@@ -323,9 +337,9 @@ TEST(femdem_single_reference_holds_the_lateral_stress) {
     double v[31 * 8];
     char header[512];
     int n, k, runs = 0;
-    CHECK(
-        system("build/femdem_biaxial --test single --steps 30 --threads 2 --vtk-every 0 --out build/tests/t_fds30 "
-               "> build/tests/t_fds30.out 2>&1") == 0);
+    CHECK(system("build/femdem_biaxial --test single --steps 30 --threads 2 --vtk-every 0 --out "
+                 "build/tests/t_fds30 "
+                 "> build/tests/t_fds30.out 2>&1") == 0);
     n = read_csv("build/tests/t_fds30/single_element.csv", 8, v, 31, header, sizeof header);
     CHECK(n == 31);
     CHECK(strstr(header, "eps_v_rve,rve_runs") != NULL);
@@ -414,8 +428,10 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
     CHECK(gk_test_file_has("build/tests/t_bad.out", "cyclic-strain or cyclic-stress"));
     CHECK(system("build/femdem_cyclic --test cyclic-strain --amplitude 0 > build/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "out of range"));
-    CHECK(system("build/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --restart build/tests/t_fcA "
-                 "--out build/tests/t_fcC > build/tests/t_bad.out 2>&1") != 0);
+    CHECK(
+        system(
+            "build/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --restart build/tests/t_fcA "
+            "--out build/tests/t_fcC > build/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "not a checkpoint"));
     CHECK(system("build/femdem_cyclic --help > build/tests/t_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "--tau-amplitude"));
@@ -453,15 +469,16 @@ TEST(femdem_cyclic_stress_turns_at_the_amplitude) {
     CHECK_EQ_INT(turns, 3);
     CHECK(tmax <= 1.02 * amp);
     CHECK(gk_test_file_has("build/tests/t_fcS.out", "RESULT test=cyclic-stress"));
-    snprintf(cmd, sizeof cmd, "%s --gamma-limit %g --out build/tests/t_fcG > build/tests/t_fcG.out 2>&1", base, g_lim);
+    snprintf(cmd, sizeof cmd, "%s --gamma-limit %g --out build/tests/t_fcG > build/tests/t_fcG.out 2>&1",
+             base, g_lim);
     CHECK(system(cmd) == 0);
     n = read_csv("build/tests/t_fcG/cyclic.csv", C_NCOL, v, 128, header, sizeof header);
     CHECK(n > 2);
     if (n <= 2) return;
     for (k = 0; k + 1 < n; ++k) CHECK(fabs(v[k * C_NCOL + C_GAMMA]) < g_lim);
     CHECK(fabs(v[(n - 1) * C_NCOL + C_GAMMA]) >= g_lim);
-    CHECK_NEAR(gk_test_result("build/tests/t_fcG.out", "cycles_to_gamma_limit"), v[(n - 1) * C_NCOL + C_CYCLE],
-               1e-3);
+    CHECK_NEAR(gk_test_result("build/tests/t_fcG.out", "cycles_to_gamma_limit"),
+               v[(n - 1) * C_NCOL + C_CYCLE], 1e-3);
 }
 
 /* biaxial.csv columns (the header is checked in the test below) */
@@ -489,7 +506,8 @@ static int refused(const char *bin, const char *flags, const char *msg) {
     FILE *fp;
     int ok;
     system("rm -rf build/tests/t_fdbad");
-    snprintf(cmd, sizeof cmd, "build/%s %s --out build/tests/t_fdbad > build/tests/t_bad.out 2>&1", bin, flags);
+    snprintf(cmd, sizeof cmd, "build/%s %s --out build/tests/t_fdbad > build/tests/t_bad.out 2>&1", bin,
+             flags);
     ok = system(cmd) != 0 && gk_test_file_has("build/tests/t_bad.out", msg);
     fp = fopen("build/tests/t_fdbad", "r");
     if (fp) fclose(fp), ok = 0;
@@ -530,7 +548,8 @@ TEST(femdem_noise_probe_leaves_the_run_unchanged) {
     char cmd[512];
     snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fnp0 > build/tests/t_fnp0.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --noise-probe 2 --out build/tests/t_fnp1 > build/tests/t_fnp1.out 2>&1", probe);
+    snprintf(cmd, sizeof cmd, "%s --noise-probe 2 --out build/tests/t_fnp1 > build/tests/t_fnp1.out 2>&1",
+             probe);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has("build/tests/t_fnp1.out", "noise probe at iteration 2 (E_f "));
     CHECK(gk_test_file_has("build/tests/t_fnp1.out", " 1e-06: "));
@@ -558,7 +577,8 @@ TEST(femdem_krylov_probe_leaves_the_run_unchanged) {
     snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fkp0 > build/tests/t_fkp0.out 2>&1", base);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s --krylov-probe 2 --krylov-scale 0.02 --out build/tests/t_fkp1 > build/tests/t_fkp1.out 2>&1", probe);
+             "%s --krylov-probe 2 --krylov-scale 0.02 --out build/tests/t_fkp1 > build/tests/t_fkp1.out 2>&1",
+             probe);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has("build/tests/t_fkp1.out", "krylov probe at iteration 2 (E_f "));
     fp = fopen("build/tests/t_fkp1.out", "r");
@@ -647,7 +667,8 @@ TEST(femdem_relaxed_tangent_converges_to_the_same_curve) {
         run_threads_and_restart(base, "--steps 3 --tangent relaxed", "--steps 2 --tangent relaxed", "t_fdx"));
     check_threads_and_restart("t_fdx", "biaxial.csv", 6);
     CHECK(gk_test_file_has("build/tests/t_fdxA.out", "tangent relaxed"));
-    snprintf(cmd, sizeof cmd, "%s --steps 3 --threads 2 --out build/tests/t_fdxT > build/tests/t_fdxT.out 2>&1", base);
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 3 --threads 2 --out build/tests/t_fdxT > build/tests/t_fdxT.out 2>&1", base);
     CHECK(system(cmd) == 0);
     n = read_csv("build/tests/t_fdxA/biaxial.csv", F_NCOL, a, 8, header, sizeof header);
     CHECK_EQ_INT(n, 4);
@@ -669,7 +690,8 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
     double a[8 * F_NCOL], b[8 * F_NCOL], c[8 * F_NCOL], dmax = 0;
     int n, k, exact = 1, nfix = 37;
     /* the adaptive rule is the default and reports its steps: per point (mean <= max), in all */
-    snprintf(cmd, sizeof cmd, "%s --steps 4 --vtk-every 4 --out build/tests/t_fdr > build/tests/t_fdr.out 2>&1", base);
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 4 --vtk-every 4 --out build/tests/t_fdr > build/tests/t_fdr.out 2>&1", base);
     CHECK(system(cmd) == 0);
     n = read_csv("build/tests/t_fdr/biaxial.csv", F_NCOL, a, 8, header, sizeof header);
     CHECK(strcmp(header, FD_HEADER) == 0);
@@ -686,8 +708,8 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
     }
     CHECK_NEAR(gk_test_result("build/tests/t_fdr.out", "dem_steps_total"), dmax, 0.5);
     /* a 4x larger inertial-number bound: about 4x fewer deformation steps */
-    snprintf(cmd, sizeof cmd, "%s --steps 4 --dem-inertial 2e-3 --out build/tests/t_fdr2 > build/tests/t_fdr2.out 2>&1",
-             base);
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 4 --dem-inertial 2e-3 --out build/tests/t_fdr2 > build/tests/t_fdr2.out 2>&1", base);
     CHECK(system(cmd) == 0);
     CHECK_EQ_INT(read_csv("build/tests/t_fdr2/biaxial.csv", F_NCOL, b, 8, header, sizeof header), 5);
     printf(
@@ -698,10 +720,10 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
     CHECK(gk_test_result("build/tests/t_fdr2.out", "dem_steps_total") <
           0.5 * gk_test_result("build/tests/t_fdr.out", "dem_steps_total"));
     /* the strain rule with --dem-min N --dem-max N: exactly N steps per RVE run, every run */
-    snprintf(
-        cmd, sizeof cmd,
-        "%s --steps 3 --dem-rule strain --dem-min %d --dem-max %d --out build/tests/t_fdn > build/tests/t_fdn.out 2>&1",
-        base, nfix, nfix);
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 3 --dem-rule strain --dem-min %d --dem-max %d --out build/tests/t_fdn > "
+             "build/tests/t_fdn.out 2>&1",
+             base, nfix, nfix);
     CHECK(system(cmd) == 0);
     n = read_csv("build/tests/t_fdn/biaxial.csv", F_NCOL, c, 8, header, sizeof header);
     CHECK_EQ_INT(n, 4);
@@ -714,8 +736,8 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
     /* tangent reuse: the same converged curve within the Newton tolerance - both runs stop at E_f <
      * --ftol = 0.3 % of the internal force, so two converged states may differ by a few tenths of a
      * percent in the reactions; 1 % allows that and no more - and it does reuse */
-    snprintf(cmd, sizeof cmd, "%s --steps 4 --tangent-reuse 0.3 --out build/tests/t_fdt > build/tests/t_fdt.out 2>&1",
-             base);
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 4 --tangent-reuse 0.3 --out build/tests/t_fdt > build/tests/t_fdt.out 2>&1", base);
     CHECK(system(cmd) == 0);
     n = read_csv("build/tests/t_fdt/biaxial.csv", F_NCOL, b, 8, header, sizeof header);
     CHECK_EQ_INT(n, 5);
@@ -834,7 +856,8 @@ TEST(femdem_heterogeneous_packings) {
                  "--out build/tests/t_fhx > build/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "nosuch.txt"));
     CHECK(system("build/femdem_biaxial --packing-seed -3 > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--packing-seed '-3' is not a non-negative whole number"));
+    CHECK(
+        gk_test_file_has("build/tests/t_bad.out", "--packing-seed '-3' is not a non-negative whole number"));
 }
 
 /* lines of a file containing needle */
@@ -860,7 +883,8 @@ TEST(femdem_failed_writes_are_errors) {
         char want[128];
         snprintf(cmd, sizeof cmd, "rm -rf build/tests/t_fw && mkdir -p build/tests/t_fw/%s", what[k][0]);
         CHECK(system(cmd) == 0);
-        snprintf(cmd, sizeof cmd, "%s %s --out build/tests/t_fw > build/tests/t_fw.out 2>&1", base, what[k][1]);
+        snprintf(cmd, sizeof cmd, "%s %s --out build/tests/t_fw > build/tests/t_fw.out 2>&1", base,
+                 what[k][1]);
         CHECK(system(cmd) != 0);
         snprintf(want, sizeof want, "cannot write build/tests/t_fw/%s", what[k][0]);
         CHECK_EQ_INT(count_has("build/tests/t_fw.out", want), 1);
@@ -869,7 +893,8 @@ TEST(femdem_failed_writes_are_errors) {
     CHECK(system("rm -rf build/tests/t_fw && touch build/tests/t_fw") == 0);
     snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fw > build/tests/t_fw.out 2>&1", base);
     CHECK(system(cmd) != 0);
-    CHECK_EQ_INT(count_has("build/tests/t_fw.out", "--out build/tests/t_fw: cannot create that directory"), 1);
+    CHECK_EQ_INT(count_has("build/tests/t_fw.out", "--out build/tests/t_fw: cannot create that directory"),
+                 1);
     remove("build/tests/t_fw");
 }
 

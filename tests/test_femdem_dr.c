@@ -59,7 +59,8 @@ TEST(isotropic_stage_and_one_element_against_the_rve) {
     static double a[MAXR][12], b[MAXR][12];
     int na, nb, i;
     double peak = 0.0, dmax = 0.0;
-    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.02 --out build/tests/t_fdr_rve > build/tests/t_fdr_rve.out "
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.02 --out build/tests/t_fdr_rve > "
+                     "build/tests/t_fdr_rve.out "
                      "2>&1") == 0);
     CHECK(system(FDR "--nx 1 --ny 1 --frame periodic --steps 4 --strain 0.02 --out build/tests/t_fdr_11 "
                      "> build/tests/t_fdr_11.out 2>&1") == 0);
@@ -96,10 +97,14 @@ TEST(isotropic_stage_and_one_element_against_the_rve) {
 TEST(locked_rotation_is_stronger) {
     static double f[MAXR][12], l[MAXR][12];
     int nf, nl;
-    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --out build/tests/t_fdr_free > build/tests/t_fdr_free.out "
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --out build/tests/t_fdr_free > "
+                     "build/tests/t_fdr_free.out "
                      "2>&1") == 0);
-    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --no-rotation --out build/tests/t_fdr_lock "
-                     "> build/tests/t_fdr_lock.out 2>&1") == 0);
+    CHECK(
+        system(
+            FDR
+            "--test rve --frame periodic --steps 4 --strain 0.04 --no-rotation --out build/tests/t_fdr_lock "
+            "> build/tests/t_fdr_lock.out 2>&1") == 0);
     nf = rows("build/tests/t_fdr_free/dr.csv", f);
     nl = rows("build/tests/t_fdr_lock/dr.csv", l);
     CHECK(nf == 15 && nl == 15);
@@ -114,15 +119,19 @@ TEST(locked_rotation_is_stronger) {
 TEST(threads_and_restart_give_the_same_rows) {
     const char *base = FDR "--nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 ";
     char cmd[1024];
-    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 2 --out build/tests/t_fdrA > build/tests/t_fdrA.out 2>&1", base);
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 2 --threads 2 --out build/tests/t_fdrA > build/tests/t_fdrA.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 1 --out build/tests/t_fdr1 > build/tests/t_fdr1.out 2>&1", base);
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 2 --threads 1 --out build/tests/t_fdr1 > build/tests/t_fdr1.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 2 --stop-after 2 --out build/tests/t_fdrB > build/tests/t_fdrB.out 2>&1",
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 2 --threads 2 --stop-after 2 --out build/tests/t_fdrB > build/tests/t_fdrB.out 2>&1",
              base);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --steps 2 --threads 2 --restart build/tests/t_fdrB --out build/tests/t_fdrC "
-                              "> build/tests/t_fdrC.out 2>&1",
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 2 --threads 2 --restart build/tests/t_fdrB --out build/tests/t_fdrC "
+             "> build/tests/t_fdrC.out 2>&1",
              base);
     CHECK(system(cmd) == 0);
     CHECK(same_rows("build/tests/t_fdrA/dr.csv", "build/tests/t_fdr1/dr.csv"));
@@ -136,7 +145,8 @@ TEST(threads_and_restart_give_the_same_rows) {
 TEST(dns_runs) {
     static double r[MAXR][12];
     int n;
-    CHECK(system(FDR "--test dns --iso-steps 2 --steps 1 --strain 0.01 --out build/tests/t_fdr_dns > build/tests/t_fdr_dns.out "
+    CHECK(system(FDR "--test dns --iso-steps 2 --steps 1 --strain 0.01 --out build/tests/t_fdr_dns > "
+                     "build/tests/t_fdr_dns.out "
                      "2>&1") == 0);
     n = rows("build/tests/t_fdr_dns/dr.csv", r);
     CHECK_EQ_INT(n, 4);
@@ -156,7 +166,8 @@ TEST(default_and_paper_sizes) {
     snprintf(cmd, sizeof cmd, FDR "%s --out build/tests/t_fdr_def > build/tests/t_fdr_def.out 2>&1", cut);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has("build/tests/t_fdr_def.out", " 8 Gauss points"));
-    snprintf(cmd, sizeof cmd, FDR "--ny 2 --paper %s --out build/tests/t_fdr_pap > build/tests/t_fdr_pap.out 2>&1", cut);
+    snprintf(cmd, sizeof cmd,
+             FDR "--ny 2 --paper %s --out build/tests/t_fdr_pap > build/tests/t_fdr_pap.out 2>&1", cut);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has("build/tests/t_fdr_pap.out", " 16 Gauss points"));
     CHECK(gk_test_file_has("build/tests/t_fdr_pap.out", "stopped after step 1"));
@@ -174,19 +185,24 @@ TEST(bad_input_and_failed_writes) {
     CHECK(gk_test_file_has("build/tests/t_bad.out", "--strain 'nan' is not a finite number"));
     CHECK(system(FDR "--material clay --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "--material 'clay' must be paper or guo-zhao"));
-    CHECK(system(FDR "--material guo-zhao --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "needs --frame periodic")); /* the servo's gains are per k_n */
+    CHECK(system(FDR "--material guo-zhao --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") ==
+          2 * 256);
+    CHECK(gk_test_file_has("build/tests/t_bad.out",
+                           "needs --frame periodic")); /* the servo's gains are per k_n */
     CHECK(system(FDR "--bogus 1 > build/tests/t_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "unknown option --bogus"));
     CHECK(system(FDR "--test rve > build/tests/t_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "--out DIR is required"));
-    CHECK(system(FDR "--test rve --packing examples/data/rve400.txt --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(FDR "--test rve --packing examples/data/rve400.txt --out build/tests/t_fdr_bad > "
+                     "build/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "corner"));
-    CHECK(system(FDR "--test rve --restart build/tests/no_such_dir --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(FDR "--test rve --restart build/tests/no_such_dir --out build/tests/t_fdr_bad > "
+                     "build/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "no_such_dir"));
     /* --out names a file: the directory exists as a file, nothing can be written in it */
     CHECK(system("touch build/tests/t_fdr_file") == 0);
-    CHECK(system(FDR "--test rve --frame periodic --iso-steps 1 --steps 1 --out build/tests/t_fdr_file > build/tests/t_bad.out "
+    CHECK(system(FDR "--test rve --frame periodic --iso-steps 1 --steps 1 --out build/tests/t_fdr_file > "
+                     "build/tests/t_bad.out "
                      "2>&1") == 1 * 256);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "cannot write"));
     CHECK(system(FDR "--help > build/tests/t_bad.out 2>&1") == 0);

@@ -98,8 +98,12 @@ TEST(hybrid_planar_enriches_and_is_thread_independent) {
     CHECK(gk_test_file_has("build/tests/t_hyA/stress_strain.svg", "<svg"));
     CHECK(gk_test_file_has("build/tests/t_hyA/volume.svg", "<svg"));
     CHECK(gk_test_file_has("build/tests/t_hyA/band.svg", "<svg"));
-    CHECK(system(PLANAR "--mode hybrid --strain 0.005 --out-every 0.0025 --window 0.001 0.005 --threads 1 "
-                        "--packing build/tests/t_hyA/packing.txt --out build/tests/t_hy1 > build/tests/t_hy1.out 2>&1") == 0);
+    CHECK(
+        system(
+            PLANAR
+            "--mode hybrid --strain 0.005 --out-every 0.0025 --window 0.001 0.005 --threads 1 "
+            "--packing build/tests/t_hyA/packing.txt --out build/tests/t_hy1 > build/tests/t_hy1.out 2>&1") ==
+        0);
     CHECK(same_but_seconds("build/tests/t_hyA/hybrid.csv", "build/tests/t_hy1/hybrid.csv"));
 }
 
@@ -146,7 +150,8 @@ static int refused(const char *flags, const char *msg) {
     FILE *fp;
     int ok;
     system("rm -rf build/tests/t_hybad");
-    snprintf(cmd, sizeof cmd, "build/hybrid %s --out build/tests/t_hybad > build/tests/t_bad.out 2>&1", flags);
+    snprintf(cmd, sizeof cmd, "build/hybrid %s --out build/tests/t_hybad > build/tests/t_bad.out 2>&1",
+             flags);
     ok = system(cmd) != 0 && gk_test_file_has("build/tests/t_bad.out", msg);
     fp = fopen("build/tests/t_hybad", "r");
     if (fp) fclose(fp), ok = 0;
@@ -166,12 +171,14 @@ TEST(hybrid_refuses_bad_arguments) {
     CHECK(refused("--test planar --mode dem --speed", "--speed"));
     CHECK(refused("--test planar --mode dem --bogus 1", "--bogus"));
     /* an unreadable packing: an error, not a crash (the directory may exist) */
-    CHECK(system("build/hybrid --test planar --mode dem --packing build/tests/no_such_packing.txt --out build/tests/t_hybad "
+    CHECK(system("build/hybrid --test planar --mode dem --packing build/tests/no_such_packing.txt --out "
+                 "build/tests/t_hybad "
                  "> build/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "no_such_packing"));
     /* --out naming an existing file */
     CHECK(system("rm -rf build/tests/t_hyfile && touch build/tests/t_hyfile") == 0);
-    CHECK(system("build/hybrid --test planar --mode dem --out build/tests/t_hyfile > build/tests/t_bad.out 2>&1") != 0);
+    CHECK(system("build/hybrid --test planar --mode dem --out build/tests/t_hyfile > build/tests/t_bad.out "
+                 "2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_bad.out", "t_hyfile"));
     remove("build/tests/t_hyfile");
 }

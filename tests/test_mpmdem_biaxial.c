@@ -75,7 +75,8 @@ TEST(biaxial_thread_independent) {
  * array and RVE state is in the checkpoint) */
 TEST(biaxial_restart_identical) {
     int rc = system(
-        "build/mpmdem_biaxial --nx 2 --ny 4 --strain 0.001 --every 0.0005 --quiet --out build/tests/t_mpmbx_a "
+        "build/mpmdem_biaxial --nx 2 --ny 4 --strain 0.001 --every 0.0005 --quiet --out "
+        "build/tests/t_mpmbx_a "
         "> build/tests/t_mpmbx_a.out 2>&1 && " BX
         "--restart build/tests/t_mpmbx_a --out build/tests/t_mpmbx_b > build/tests/t_mpmbx_b.out 2>&1");
     CHECK(rc == 0);
@@ -93,10 +94,11 @@ TEST(biaxial_bad_arguments) {
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "square"));
     CHECK(system("build/mpmdem_biaxial --alpha 2 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--alpha"));
-    CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --packing /nonexistent > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --packing /nonexistent > "
+                 "build/tests/t_mpmbx_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "nonexistent"));
-    CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --restart /nonexistent --nx 2 --ny 4 > build/tests/t_mpmbx_bad.out 2>&1") !=
-          0);
+    CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --restart /nonexistent --nx 2 --ny 4 > "
+                 "build/tests/t_mpmbx_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "cannot open"));
     CHECK(system("build/mpmdem_biaxial --help > build/tests/t_mpmbx_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--dem-strain"));
@@ -119,9 +121,11 @@ TEST(biaxial_bad_arguments) {
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--dem-inertial"));
     CHECK(system(BX "--strain 0.0005 --dem-rule strain --dem-strain 2e-5 --out build/tests/t_mpmbx_rule "
                     "> build/tests/t_mpmbx_rule.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_rule.out", "DEM steps per MPM step: <= 2e-05 strain per DEM step"));
-    CHECK(system(BX "--strain 0.0005 --dem-inertial 1e-3 --dem-unbalanced 1e-2 --out build/tests/t_mpmbx_rule "
-                    "> build/tests/t_mpmbx_rule.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_rule.out",
+                           "DEM steps per MPM step: <= 2e-05 strain per DEM step"));
+    CHECK(system(BX
+                 "--strain 0.0005 --dem-inertial 1e-3 --dem-unbalanced 1e-2 --out build/tests/t_mpmbx_rule "
+                 "> build/tests/t_mpmbx_rule.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_rule.out",
                            "adaptive, I <= 0.001 then relaxation to an unbalanced force "
                            "ratio < 0.01"));
@@ -158,22 +162,29 @@ TEST(biaxial_bad_checkpoint_refused) {
     CHECK(fp != NULL);
     if (!fp) return;
     fseek(fp, 0, SEEK_END), size = ftell(fp), fclose(fp);
-    CHECK(system("rm -rf build/tests/t_mpmbx_ck build/tests/t_mpmbx_ckout && mkdir -p build/tests/t_mpmbx_ck") == 0);
-    CHECK(copy_damaged("build/tests/t_mpmbx_a/checkpoint.bin", "build/tests/t_mpmbx_ck/checkpoint.bin", -1, size / 2));
-    CHECK(system(BX "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > build/tests/t_mpmbx_ck.out 2>&1; "
+    CHECK(system(
+              "rm -rf build/tests/t_mpmbx_ck build/tests/t_mpmbx_ckout && mkdir -p build/tests/t_mpmbx_ck") ==
+          0);
+    CHECK(copy_damaged("build/tests/t_mpmbx_a/checkpoint.bin", "build/tests/t_mpmbx_ck/checkpoint.bin", -1,
+                       size / 2));
+    CHECK(system(BX "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > "
+                    "build/tests/t_mpmbx_ck.out 2>&1; "
                     "test $? -eq 1") == 0);
-    CHECK(
-        gk_test_file_has("build/tests/t_mpmbx_ck.out", "checkpoint.bin: checksum mismatch (the file is corrupt)"));
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out",
+                           "checkpoint.bin: checksum mismatch (the file is corrupt)"));
     CHECK(!gk_test_file_has("build/tests/t_mpmbx_ckout/biaxial.csv", "time")); /* nothing ran */
-    CHECK(copy_damaged("build/tests/t_mpmbx_a/checkpoint.bin", "build/tests/t_mpmbx_ck/checkpoint.bin", size - 100, -1));
-    CHECK(system(BX "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > build/tests/t_mpmbx_ck.out 2>&1; "
+    CHECK(copy_damaged("build/tests/t_mpmbx_a/checkpoint.bin", "build/tests/t_mpmbx_ck/checkpoint.bin",
+                       size - 100, -1));
+    CHECK(system(BX "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > "
+                    "build/tests/t_mpmbx_ck.out 2>&1; "
                     "test $? -eq 1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out", "truncated"));
     CHECK(system("build/mpmdem_biaxial --nx 2 --ny 2 --height 1 --quiet --restart build/tests/t_mpmbx_a "
                  "--out build/tests/t_mpmbx_ckout > build/tests/t_mpmbx_ck.out 2>&1; test $? -eq 1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out", "holds 8 points"));
     CHECK(system("printf 'GKMPMDEM1biaxial' > build/tests/t_mpmbx_ck/checkpoint.bin && " BX
-                 "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > build/tests/t_mpmbx_ck.out 2>&1; test $? "
+                 "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > "
+                 "build/tests/t_mpmbx_ck.out 2>&1; test $? "
                  "-eq 1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out", "is not a grainkit two-scale checkpoint"));
 }
@@ -201,7 +212,8 @@ TEST(biaxial_failed_write_exits) {
         snprintf(msg, sizeof msg, "mpmdem_biaxial: cannot write %s", cases[k][1]);
         CHECK(gk_test_file_has("build/tests/t_mpmbx_w.out", msg));
         CHECK(count_lines("build/tests/t_mpmbx_w.out", "cannot write") == 1);
-        CHECK(!gk_test_file_has("build/tests/t_mpmbx_w.out", "wrote ")); /* no claim of what was not written */
+        CHECK(
+            !gk_test_file_has("build/tests/t_mpmbx_w.out", "wrote ")); /* no claim of what was not written */
     }
 }
 
@@ -211,14 +223,18 @@ TEST(biaxial_failed_write_exits) {
 TEST(biaxial_out_folder) {
     CHECK(system("rm -rf build/tests/t_mpmbx_f && echo x > build/tests/t_mpmbx_file && " BX
                  "--out build/tests/t_mpmbx_file > build/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_f.out",
-                           "--out build/tests/t_mpmbx_file: build/tests/t_mpmbx_file is a file, not a folder"));
+    CHECK(
+        gk_test_file_has("build/tests/t_mpmbx_f.out",
+                         "--out build/tests/t_mpmbx_file: build/tests/t_mpmbx_file is a file, not a folder"));
     CHECK(gk_test_file_has("build/tests/t_mpmbx_file", "x")); /* untouched */
-    CHECK(system(BX "--out build/tests/t_mpmbx_file/sub > build/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
+    CHECK(system(BX "--out build/tests/t_mpmbx_file/sub > build/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") ==
+          0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_f.out", "is a file, not a folder"));
-    CHECK(system("rm -rf build/tests/t_mpmbx_cwd && mkdir build/tests/t_mpmbx_cwd && cd build/tests/t_mpmbx_cwd && "
-                 "../../mpmdem_biaxial --packing ../../../examples/data/rve400.txt --nx 2 --ny 4 --every 0.0005 "
-                 "--quiet --strain 0.0005 > ../t_mpmbx_f.out 2>&1") == 0);
+    CHECK(system(
+              "rm -rf build/tests/t_mpmbx_cwd && mkdir build/tests/t_mpmbx_cwd && cd build/tests/t_mpmbx_cwd "
+              "&& "
+              "../../mpmdem_biaxial --packing ../../../examples/data/rve400.txt --nx 2 --ny 4 --every 0.0005 "
+              "--quiet --strain 0.0005 > ../t_mpmbx_f.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_cwd/build/mpm_biaxial/biaxial.csv", "time,eps_axial"));
     CHECK(system(BX "--strain 0.0005 --out build/tests/t_mpmbx_f/a/b > build/tests/t_mpmbx_f.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_f/a/b/biaxial.csv", "time,eps_axial"));

@@ -56,7 +56,8 @@ static int read_rows(const char *path, double rows[][NCOL], int max) {
 TEST(collapse_runs_and_conserves) {
     double r[32][NCOL];
     int n, k;
-    CHECK(system(CL "--t-end " CL_T_END " --threads 2 --out build/tests/t_mpmcl > build/tests/t_mpmcl.out 2>&1") == 0);
+    CHECK(system(CL "--t-end " CL_T_END
+                    " --threads 2 --out build/tests/t_mpmcl > build/tests/t_mpmcl.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl/collapse.csv",
                            "time,front,dstar,front_box,front_raw,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0,"
                            "mass,mass_grid,loose_rves,frozen_rves,dem_steps_per_point,seconds"));
@@ -108,7 +109,8 @@ TEST(collapse_thread_independent) {
     CHECK(system(CL "--t-end " CL_T_END " --threads 1 --thin-cell stop --out build/tests/t_mpmcl1 "
                     "> build/tests/t_mpmcl1.out 2>&1") == 0);
     CHECK(system("cmp -s build/tests/t_mpmcl1/points_000000.vtk build/tests/t_mpmcl/points_000000.vtk") == 0);
-    CHECK(gk_test_result("build/tests/t_mpmcl1.out", "dstar") == gk_test_result("build/tests/t_mpmcl.out", "dstar"));
+    CHECK(gk_test_result("build/tests/t_mpmcl1.out", "dstar") ==
+          gk_test_result("build/tests/t_mpmcl.out", "dstar"));
     CHECK(system("cut -d, -f1-14 build/tests/t_mpmcl1/collapse.csv > build/tests/t_mpmcl1.c && "
                  "cut -d, -f1-14 build/tests/t_mpmcl/collapse.csv > build/tests/t_mpmcl2.c && "
                  "cmp -s build/tests/t_mpmcl1.c build/tests/t_mpmcl2.c") == 0);
@@ -117,12 +119,14 @@ TEST(collapse_thread_independent) {
 /* half-way, then --restart: the same history and final state (every point
  * array, RVE state and row is in the checkpoint) */
 TEST(collapse_restart_identical) {
-    int rc = system(CL "--t-end " CL_T_HALF " --out build/tests/t_mpmcl_a > build/tests/t_mpmcl_a.out 2>&1 && " CL
-                       "--t-end " CL_T_END " --restart build/tests/t_mpmcl_a --out build/tests/t_mpmcl_b "
-                       "> build/tests/t_mpmcl_b.out 2>&1");
+    int rc =
+        system(CL "--t-end " CL_T_HALF " --out build/tests/t_mpmcl_a > build/tests/t_mpmcl_a.out 2>&1 && " CL
+                  "--t-end " CL_T_END " --restart build/tests/t_mpmcl_a --out build/tests/t_mpmcl_b "
+                  "> build/tests/t_mpmcl_b.out 2>&1");
     CHECK(rc == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_b.out", "restarted from"));
-    CHECK(gk_test_result("build/tests/t_mpmcl_b.out", "dstar") == gk_test_result("build/tests/t_mpmcl.out", "dstar"));
+    CHECK(gk_test_result("build/tests/t_mpmcl_b.out", "dstar") ==
+          gk_test_result("build/tests/t_mpmcl.out", "dstar"));
     CHECK(gk_test_result("build/tests/t_mpmcl_b.out", "Ed_final_over_Ep0") ==
           gk_test_result("build/tests/t_mpmcl.out", "Ed_final_over_Ep0"));
     CHECK(system("cut -d, -f1-14 build/tests/t_mpmcl_b/collapse.csv > build/tests/t_mpmcl_b.c && "
@@ -149,9 +153,11 @@ TEST(collapse_bad_arguments) {
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "unknown option --bogus"));
     CHECK(system("build/mpmdem_collapse --levels > build/tests/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "needs a value"));
-    CHECK(system("build/mpmdem_collapse --out build/tests/t_mpmcl_bad --packing /nonexistent > build/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(system("build/mpmdem_collapse --out build/tests/t_mpmcl_bad --packing /nonexistent > "
+                 "build/tests/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "nonexistent"));
-    CHECK(system("build/mpmdem_collapse --out build/tests/t_mpmcl_bad --nx 4 --restart /nonexistent > build/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(system("build/mpmdem_collapse --out build/tests/t_mpmcl_bad --nx 4 --restart /nonexistent > "
+                 "build/tests/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "cannot open"));
     CHECK(system("build/mpmdem_collapse --help > build/tests/t_mpmcl_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--thin-cell"));
@@ -166,17 +172,20 @@ TEST(collapse_bad_files) {
         system(
             "rm -rf build/tests/t_mpmcl_k && mkdir -p build/tests/t_mpmcl_k && "
             "cp build/tests/t_mpmcl_a/checkpoint.bin build/tests/t_mpmcl_k/ && "
-            "printf 'X' | dd of=build/tests/t_mpmcl_k/checkpoint.bin bs=1 seek=5000 conv=notrunc 2>/dev/null && " CL
-            "--t-end " CL_T_END
+            "printf 'X' | dd of=build/tests/t_mpmcl_k/checkpoint.bin bs=1 seek=5000 conv=notrunc 2>/dev/null "
+            "&& " CL "--t-end " CL_T_END
             " --restart build/tests/t_mpmcl_k --out build/tests/t_mpmcl_k2 > build/tests/t_mpmcl_k.out 2>&1; "
             "test $? -eq 1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_k.out", "checksum mismatch"));
-    CHECK(system("rm -rf build/tests/t_mpmcl_w && mkdir -p build/tests/t_mpmcl_w/collapse.csv && " CL
-                 "--t-end 0.03 --out build/tests/t_mpmcl_w > build/tests/t_mpmcl_w.out 2>&1; test $? -eq 1") == 0);
+    CHECK(
+        system("rm -rf build/tests/t_mpmcl_w && mkdir -p build/tests/t_mpmcl_w/collapse.csv && " CL
+               "--t-end 0.03 --out build/tests/t_mpmcl_w > build/tests/t_mpmcl_w.out 2>&1; test $? -eq 1") ==
+        0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_w.out",
                            "mpmdem_collapse: cannot write build/tests/t_mpmcl_w/collapse.csv"));
     CHECK(system("grep -c 'cannot write' build/tests/t_mpmcl_w.out | grep -qx 1") == 0);
-    CHECK(system("echo x > build/tests/t_mpmcl_file && " CL "--out build/tests/t_mpmcl_file > build/tests/t_mpmcl_f.out 2>&1; "
+    CHECK(system("echo x > build/tests/t_mpmcl_file && " CL
+                 "--out build/tests/t_mpmcl_file > build/tests/t_mpmcl_f.out 2>&1; "
                  "test $? -eq 1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_f.out", "is a file, not a folder"));
 }

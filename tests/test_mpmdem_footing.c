@@ -40,8 +40,9 @@ static int read_rows(const char *path, double rows[][NCOL], int max) {
 TEST(footing_runs_and_loads) {
     double r[16][NCOL], phi, nq, nqa, pi = 3.14159265358979323846, t;
     int n, k;
-    CHECK(system(FT "--final 0.02 --phi-pressures 20 --phi-strain 0.025 --threads 1 --out build/tests/t_mpmft "
-                    "> build/tests/t_mpmft.out 2>&1") == 0);
+    CHECK(system(FT
+                 "--final 0.02 --phi-pressures 20 --phi-strain 0.025 --threads 1 --out build/tests/t_mpmft "
+                 "> build/tests/t_mpmft.out 2>&1") == 0);
     CHECK(
         gk_test_file_has("build/tests/t_mpmft/footing.csv",
                          "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds"));
@@ -94,11 +95,13 @@ TEST(footing_ultimate_found) {
 /* RVEs and the MPM run in parallel: one and two threads give the same curve */
 TEST(footing_thread_independent) {
     /* passive waiting: spinning OpenMP threads crawl on a machine busy with other jobs */
-    CHECK(system("OMP_WAIT_POLICY=passive " FT "--final 0.02 --phi-deg 30 --threads 2 --out build/tests/t_mpmft2 "
+    CHECK(system("OMP_WAIT_POLICY=passive " FT
+                 "--final 0.02 --phi-deg 30 --threads 2 --out build/tests/t_mpmft2 "
                  "> build/tests/t_mpmft2.out 2>&1") == 0);
-    CHECK(system(FT "--final 0.02 --phi-deg 30 --threads 1 --out build/tests/t_mpmft1 > build/tests/t_mpmft1.out 2>&1") ==
-          0);
-    CHECK(gk_test_result("build/tests/t_mpmft1.out", "Nq") == gk_test_result("build/tests/t_mpmft2.out", "Nq"));
+    CHECK(system(FT "--final 0.02 --phi-deg 30 --threads 1 --out build/tests/t_mpmft1 > "
+                    "build/tests/t_mpmft1.out 2>&1") == 0);
+    CHECK(gk_test_result("build/tests/t_mpmft1.out", "Nq") ==
+          gk_test_result("build/tests/t_mpmft2.out", "Nq"));
     CHECK(system("cut -d, -f1-8 build/tests/t_mpmft1/footing.csv > build/tests/t_mpmft1.c && "
                  "cut -d, -f1-8 build/tests/t_mpmft2/footing.csv > build/tests/t_mpmft2.c && "
                  "cmp -s build/tests/t_mpmft1.c build/tests/t_mpmft2.c") == 0);
@@ -107,11 +110,14 @@ TEST(footing_thread_independent) {
 /* a checkpoint half-way, then --restart: the same curve to the last digit */
 TEST(footing_restart_identical) {
     int rc = system(
-        FT "--final 0.01 --phi-deg 30 --threads 1 --out build/tests/t_mpmft_a > build/tests/t_mpmft_a.out 2>&1 && " FT
-           "--final 0.02 --phi-deg 30 --threads 1 --restart build/tests/t_mpmft_a --out build/tests/t_mpmft_b "
-           "> build/tests/t_mpmft_b.out 2>&1");
+        FT
+        "--final 0.01 --phi-deg 30 --threads 1 --out build/tests/t_mpmft_a > build/tests/t_mpmft_a.out 2>&1 "
+        "&& " FT
+        "--final 0.02 --phi-deg 30 --threads 1 --restart build/tests/t_mpmft_a --out build/tests/t_mpmft_b "
+        "> build/tests/t_mpmft_b.out 2>&1");
     CHECK(rc == 0);
-    CHECK(gk_test_result("build/tests/t_mpmft_b.out", "Nq") == gk_test_result("build/tests/t_mpmft1.out", "Nq"));
+    CHECK(gk_test_result("build/tests/t_mpmft_b.out", "Nq") ==
+          gk_test_result("build/tests/t_mpmft1.out", "Nq"));
     CHECK(system("cut -d, -f1-8 build/tests/t_mpmft_b/footing.csv > build/tests/t_mpmft_b.c && "
                  "cmp -s build/tests/t_mpmft_b.c build/tests/t_mpmft1.c") == 0);
 }
@@ -120,9 +126,9 @@ TEST(footing_restart_identical) {
 TEST(footing_bad_arguments) {
     const char *o = " > build/tests/t_mpmft_bad.out 2>&1";
     char cmd[512];
-#define BAD(args, msg)                                               \
+#define BAD(args, msg)                                                                             \
     snprintf(cmd, sizeof cmd, "build/mpmdem_footing --out build/tests/t_mpmft_bad %s%s", args, o); \
-    CHECK(system(cmd) != 0);                                         \
+    CHECK(system(cmd) != 0);                                                                       \
     CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", msg))
     BAD("--nx 0", "out of range");
     BAD("--nx 31 --ny 15", "square");

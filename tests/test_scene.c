@@ -1653,7 +1653,8 @@ TEST(dem_biaxial_smoke) {
     ratio = gk_test_result("build/tests/t_dembx.out", "peak_ratio");
     n = gk_test_result("build/tests/t_dembx.out", "n");
     printf("    n %g, peak stress ratio %.4f at %.4f, sigma_yy peak %.4g Pa\n", n, ratio,
-           gk_test_result("build/tests/t_dembx.out", "eps_peak"), gk_test_result("build/tests/t_dembx.out", "syy_peak"));
+           gk_test_result("build/tests/t_dembx.out", "eps_peak"),
+           gk_test_result("build/tests/t_dembx.out", "syy_peak"));
     CHECK(n == 400);
     CHECK(ratio > 0.1 && ratio < 0.8);
     CHECK(gk_test_result("build/tests/t_dembx.out", "syy_peak") > 1.2e5);
