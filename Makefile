@@ -160,10 +160,12 @@ $(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/
 
 # tools and drivers under ASan + UBSan for tests/smoke_asan.sh (a driver joins
 # by its name in SMOKE and its runs in the script)
-SMOKE := rve_path gk_pack mpmdem_biaxial mpmdem_footing mpmdem_collapse
+SMOKE := rve_path gk_pack mpmdem_biaxial mpmdem_footing mpmdem_collapse bench_scene_box
 $(BUILD)/asan/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)/asan
 	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
 $(BUILD)/asan/%: tools/%.c $(HEADERS) | $(BUILD)/asan
+	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
+$(BUILD)/asan/bench_%: bench/%.c $(HEADERS) | $(BUILD)/asan
 	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
 
 check-smoke: $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) | $(BUILD)/tests

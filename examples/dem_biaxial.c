@@ -9,7 +9,7 @@
  *
  *   build/dem_biaxial                            # rve400 tiled 1 x 2: 800 disks, to 4 %
  *   build/dem_biaxial --generate 228 --tiles 1x2 # a 456-disk DNS like the paper's 441
- *   build/dem_biaxial --generate 228 --tiles 2x4 --strain 0.1   # like its 1681
+ *   build/dem_biaxial --generate 228 --tiles 2x4 --strain 0.1   # 1824 disks, like its 1681
  *
  * Specimen. --packing FILE (default examples/data/rve400.txt, the Guo & Zhao 2014
  * RVE consolidated at 100 kPa) or --generate N (a periodic packing of N
@@ -56,6 +56,7 @@
 #include "gk_io.h"
 #include "gk_scene.h"
 #include "dem_scene.h"
+#include "cli.h"
 
 typedef struct db_opts {
     const char *packing, *out;
@@ -98,93 +99,45 @@ static void usage(FILE *fp) {
 }
 
 static int parse(int argc, char **argv, db_opts *o) {
-    int i, k;
+    const char *tiles = "1x2", *pics = "0.02";
+    int help = 0, r;
+    char c;
+    const cli_opt opts[] = {
+        {"--packing", CLI_STR, &o->packing, 0, 0, NULL, NULL, 0},
+        {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
+        {"--tiles", CLI_STR, &tiles, 0, 0, NULL, NULL, 0},
+        {"--pictures", CLI_STR, &pics, 0, 0, NULL, NULL, 0},
+        {"--quiet", CLI_FLAG, &o->quiet, 0, 0, NULL, NULL, 0},
+        {"--generate", CLI_INT, &o->generate, 16, 1000000, NULL, NULL, 0},
+        {"--pressure", CLI_REAL, &o->pressure, 0, HUGE_VAL, "a positive stress", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--strain", CLI_REAL, &o->strain, 0, 0.5, "a strain in (0, 0.5]", NULL, CLI_LO_OPEN},
+        {"--rate", CLI_REAL, &o->rate, 0, HUGE_VAL, "a rate >= 0 (0: automatic)", NULL, CLI_HI_OPEN},
+        {"--every", CLI_REAL, &o->every, 0, 0.5, "a strain in (0, --strain]", NULL, CLI_LO_OPEN},
+        {"--damping", CLI_REAL, &o->damping, 0, 1, "a value in [0, 1)", NULL, CLI_HI_OPEN},
+        {"--platen-mu", CLI_REAL, &o->platen_mu, 0, HUGE_VAL, "a friction coefficient >= 0", NULL, CLI_HI_OPEN},
+        {"--link-stiffness", CLI_REAL, &o->link_k, 0, HUGE_VAL, "a stiffness >= 0 (0: automatic)", NULL, CLI_HI_OPEN},
+        {"--max-consolidation", CLI_REAL, &o->max_cons, 1000, HUGE_VAL, "a step count >= 1000", NULL, CLI_HI_OPEN},
+        {"--seed", CLI_ULONG, &o->seed, 0, 0, NULL, NULL, 0},
+        {"--threads", CLI_INT, &o->threads, 1, 256, NULL, NULL, 0},
+        {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    const cli_opt *const tables[] = {opts, NULL};
     memset(o, 0, sizeof *o);
     o->packing = "examples/data/rve400.txt";
     o->out = "build/dem_biaxial";
-    o->tx = 1, o->ty = 2, o->threads = 1, o->seed = 1;
+    o->threads = 1, o->seed = 1;
     o->pressure = 1e5, o->strain = 0.04, o->rate = 0.0, o->every = 0.001, o->damping = 0.3,
-    o->platen_mu = -1.0;
+    o->platen_mu = -1.0; /* -1: the disks' friction */
     o->link_k = 0.0, o->max_cons = 200000;
-    o->npic = dsc_list("0.02", o->pic, 8, 1);
-    for (i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        double v;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) return usage(stdout), -1;
-        if (!strcmp(a, "--quiet")) {
-            o->quiet = 1;
-            continue;
-        }
-        if (i + 1 >= argc) return fprintf(stderr, "dem_biaxial: %s needs a value (see --help)\n", a), 2;
-        if (!strcmp(a, "--packing")) {
-            o->packing = argv[++i];
-            continue;
-        }
-        if (!strcmp(a, "--out")) {
-            o->out = argv[++i];
-            continue;
-        }
-        if (!strcmp(a, "--tiles")) {
-            char c;
-            if (sscanf(argv[++i], "%dx%d%c", &o->tx, &o->ty, &c) != 2 || o->tx < 1 || o->ty < 1 ||
-                o->tx > 64 || o->ty > 64)
-                return fprintf(stderr, "dem_biaxial: --tiles %s: need NXxNY with 1 <= NX, NY <= 64\n",
-                               argv[i]),
-                       2;
-            continue;
-        }
-        if (!strcmp(a, "--pictures")) {
-            if ((o->npic = dsc_list(argv[++i], o->pic, 8, 1)) < 0)
-                return fprintf(stderr, "dem_biaxial: --pictures %s: need up to 8 increasing strains > 0\n",
-                               argv[i]),
-                       2;
-            continue;
-        }
-        if (dsc_num(argv[i + 1], &v))
-            return fprintf(stderr, "dem_biaxial: %s %s: not a number\n", a, argv[i + 1]), 2;
-        if (!strcmp(a, "--generate"))
-            o->generate = v == floor(v) && v >= 16 && v <= 1000000 ? (int)v : -1;
-        else if (!strcmp(a, "--pressure"))
-            o->pressure = v;
-        else if (!strcmp(a, "--strain"))
-            o->strain = v;
-        else if (!strcmp(a, "--rate"))
-            o->rate = v;
-        else if (!strcmp(a, "--every"))
-            o->every = v;
-        else if (!strcmp(a, "--damping"))
-            o->damping = v;
-        else if (!strcmp(a, "--platen-mu"))
-            o->platen_mu = v;
-        else if (!strcmp(a, "--link-stiffness"))
-            o->link_k = v;
-        else if (!strcmp(a, "--max-consolidation"))
-            o->max_cons = v;
-        else if (!strcmp(a, "--seed"))
-            o->seed = v >= 0 && v == floor(v) ? (unsigned long)v : 0;
-        else if (!strcmp(a, "--threads"))
-            o->threads = v == floor(v) && v >= 1 && v <= 256 ? (int)v : -1;
-        else
-            return fprintf(stderr, "dem_biaxial: unknown option %s (see --help)\n", a), 2;
-        ++i;
-    }
-    {
-        struct {
-            const char *flag, *need;
-            int ok;
-        } chk[] = {{"--generate", "an integer in [16, 1e6]", o->generate >= 0},
-                   {"--pressure", "a positive stress", o->pressure > 0},
-                   {"--strain", "a strain in (0, 0.5]", o->strain > 0 && o->strain <= 0.5},
-                   {"--rate", "a rate >= 0 (0: automatic)", o->rate >= 0},
-                   {"--every", "a strain in (0, --strain]", o->every > 0 && o->every <= o->strain},
-                   {"--damping", "a value in [0, 1)", o->damping >= 0 && o->damping < 1},
-                   {"--platen-mu", "a friction coefficient >= 0", o->platen_mu >= 0 || o->platen_mu == -1.0},
-                   {"--link-stiffness", "a stiffness >= 0 (0: automatic)", o->link_k >= 0},
-                   {"--max-consolidation", "a step count >= 1000", o->max_cons >= 1000},
-                   {"--threads", "an integer in [1, 256]", o->threads >= 1}};
-        for (k = 0; k < (int)(sizeof chk / sizeof *chk); ++k)
-            if (!chk[k].ok) return fprintf(stderr, "dem_biaxial: %s: need %s\n", chk[k].flag, chk[k].need), 2;
-    }
+    if ((r = cli_parse("dem_biaxial", argc, argv, tables, &help)) != 0) return r;
+    if (help) return usage(stdout), -1;
+    if (sscanf(tiles, "%dx%d%c", &o->tx, &o->ty, &c) != 2 || o->tx < 1 || o->ty < 1 || o->tx > 64 || o->ty > 64)
+        return fprintf(stderr, "dem_biaxial: --tiles %s: need NXxNY with 1 <= NX, NY <= 64\n", tiles), 2;
+    if ((o->npic = dsc_list(pics, o->pic, 8, 1)) < 0)
+        return fprintf(stderr, "dem_biaxial: --pictures %s: need up to 8 increasing strains > 0\n", pics), 2;
+    if (o->every > o->strain)
+        return fprintf(stderr, "dem_biaxial: --every %g: need a strain in (0, --strain] (--strain %g)\n", o->every,
+                       o->strain),
+               2;
     return 0;
 }
 
@@ -214,6 +167,7 @@ static int generate(const db_opts *o, const gk_rve_def *base, gk_packing *out) {
     memset(&cd, 0, sizeof cd);
     cd.pressure = o->pressure;
     cd.friction = 0.0;
+    cd.box = 1; /* the cell stays a rectangle: the specimen is cut from it between flat platens */
     r = gk_rve_consolidate(&rve, &cd, &rep);
     if (!r) r = gk_rve_to_packing(&rve, out, NULL, &err);
     if (r)

@@ -48,6 +48,7 @@
 #include "gk_io.h"
 #include "gk_scene.h"
 #include "dem_scene.h"
+#include "cli.h"
 
 #define DC_MAX_SNAP 16
 
@@ -97,93 +98,39 @@ static void usage(FILE *fp) {
 }
 
 static int parse(int argc, char **argv, dc_opts *o) {
-    int i, k;
+    const char *snaps = "0.2,0.5,1";
+    int help = 0, r;
+    const cli_opt opts[] = {
+        {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
+        {"--snapshots", CLI_STR, &snaps, 0, 0, NULL, NULL, 0},
+        {"--quiet", CLI_FLAG, &o->quiet, 0, 0, NULL, NULL, 0},
+        {"--a", CLI_REAL, &o->a, 0.2, 10, "an aspect ratio in [0.2, 10]", NULL, 0},
+        {"--width", CLI_REAL, &o->width, 0, HUGE_VAL, "a positive length", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--diameters", CLI_REAL, &o->diameters, 4, 400, "a number of diameters in [4, 400]", NULL, 0},
+        {"--mu", CLI_REAL, &o->mu, 0, HUGE_VAL, "a friction coefficient >= 0", NULL, CLI_HI_OPEN},
+        {"--roll-beta", CLI_REAL, &o->roll_beta, 0, HUGE_VAL, "a value >= 0", NULL, CLI_HI_OPEN},
+        {"--roll-eta", CLI_REAL, &o->roll_eta, 0, HUGE_VAL, "a value >= 0", NULL, CLI_HI_OPEN},
+        {"--restitution", CLI_REAL, &o->restitution, 0, 1, "a value in (0, 1]", NULL, CLI_LO_OPEN},
+        {"--young", CLI_REAL, &o->young, 0, HUGE_VAL, "a positive modulus", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--gravity", CLI_REAL, &o->gravity, 0, HUGE_VAL, "a positive value", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--t-end", CLI_REAL, &o->t_end, 0, HUGE_VAL, "a positive time", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--every", CLI_REAL, &o->every, 0, HUGE_VAL, "a positive time", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--rest-frac", CLI_REAL, &o->rest_frac, 0, HUGE_VAL, "a value >= 0", NULL, CLI_HI_OPEN},
+        {"--rest-hold", CLI_REAL, &o->rest_hold, 0, HUGE_VAL, "a time >= 0", NULL, CLI_HI_OPEN},
+        {"--seed", CLI_ULONG, &o->seed, 0, 0, NULL, NULL, 0},
+        {"--threads", CLI_INT, &o->threads, 1, 256, NULL, NULL, 0},
+        {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    const cli_opt *const tables[] = {opts, NULL};
     o->a = 1.0, o->width = 1.0, o->diameters = 24, o->mu = 0.5, o->roll_beta = 0.0, o->roll_eta = 0.0;
     o->restitution = 0.5, o->young = 6e8, o->gravity = 9.81, o->t_end = 4.0, o->every = 0.01;
     o->rest_frac = 5e-3, o->rest_hold = 0.05, o->threads = 1, o->quiet = 0, o->seed = 1;
     o->out = "build/dem_collapse";
-    o->nsnap = dsc_list("0.2,0.5,1", o->snap, DC_MAX_SNAP, 0);
-    for (i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        double v;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) return usage(stdout), -1;
-        if (!strcmp(a, "--quiet")) {
-            o->quiet = 1;
-            continue;
-        }
-        if (i + 1 >= argc) return fprintf(stderr, "dem_collapse: %s needs a value (see --help)\n", a), 2;
-        if (!strcmp(a, "--out")) {
-            o->out = argv[++i];
-            continue;
-        }
-        if (!strcmp(a, "--snapshots")) {
-            if ((o->nsnap = dsc_list(argv[++i], o->snap, DC_MAX_SNAP, 0)) < 0)
-                return fprintf(stderr,
-                               "dem_collapse: --snapshots %s: need up to %d increasing times >= 0, "
-                               "comma-separated\n",
-                               argv[i], DC_MAX_SNAP),
-                       2;
-            continue;
-        }
-        if (dsc_num(argv[i + 1], &v))
-            return fprintf(stderr, "dem_collapse: %s %s: not a number\n", a, argv[i + 1]), 2;
-        if (!strcmp(a, "--a"))
-            o->a = v;
-        else if (!strcmp(a, "--width"))
-            o->width = v;
-        else if (!strcmp(a, "--diameters"))
-            o->diameters = v;
-        else if (!strcmp(a, "--mu"))
-            o->mu = v;
-        else if (!strcmp(a, "--roll-beta"))
-            o->roll_beta = v;
-        else if (!strcmp(a, "--roll-eta"))
-            o->roll_eta = v;
-        else if (!strcmp(a, "--restitution"))
-            o->restitution = v;
-        else if (!strcmp(a, "--young"))
-            o->young = v;
-        else if (!strcmp(a, "--gravity"))
-            o->gravity = v;
-        else if (!strcmp(a, "--t-end"))
-            o->t_end = v;
-        else if (!strcmp(a, "--every"))
-            o->every = v;
-        else if (!strcmp(a, "--rest-frac"))
-            o->rest_frac = v;
-        else if (!strcmp(a, "--rest-hold"))
-            o->rest_hold = v;
-        else if (!strcmp(a, "--seed"))
-            o->seed = v >= 0 && v == floor(v) ? (unsigned long)v : 0, o->seed += v < 0;
-        else if (!strcmp(a, "--threads"))
-            o->threads = v == floor(v) && v >= 1 && v <= 256 ? (int)v : -1;
-        else
-            return fprintf(stderr, "dem_collapse: unknown option %s (see --help)\n", a), 2;
-        ++i;
-    }
-    {
-        struct {
-            const char *flag, *need;
-            int ok;
-        } chk[] = {
-            {"--a", "an aspect ratio in [0.2, 10]", o->a >= 0.2 && o->a <= 10},
-            {"--width", "a positive length", o->width > 0},
-            {"--diameters", "a number of diameters in [4, 400]", o->diameters >= 4 && o->diameters <= 400},
-            {"--mu", "a friction coefficient >= 0", o->mu >= 0},
-            {"--roll-beta", "a value >= 0", o->roll_beta >= 0},
-            {"--roll-eta", "a value >= 0", o->roll_eta >= 0},
-            {"--restitution", "a value in (0, 1]", o->restitution > 0 && o->restitution <= 1},
-            {"--young", "a positive modulus", o->young > 0},
-            {"--gravity", "a positive value", o->gravity > 0},
-            {"--t-end", "a positive time", o->t_end > 0},
-            {"--every", "a positive time", o->every > 0},
-            {"--rest-frac", "a value >= 0", o->rest_frac >= 0},
-            {"--rest-hold", "a time >= 0", o->rest_hold >= 0},
-            {"--threads", "an integer in [1, 256]", o->threads >= 1}};
-        for (k = 0; k < (int)(sizeof chk / sizeof *chk); ++k)
-            if (!chk[k].ok)
-                return fprintf(stderr, "dem_collapse: %s: need %s\n", chk[k].flag, chk[k].need), 2;
-    }
+    if ((r = cli_parse("dem_collapse", argc, argv, tables, &help)) != 0) return r;
+    if (help) return usage(stdout), -1;
+    if ((o->nsnap = dsc_list(snaps, o->snap, DC_MAX_SNAP, 0)) < 0)
+        return fprintf(stderr, "dem_collapse: --snapshots %s: need up to %d increasing times >= 0, comma-separated\n",
+                       snaps, DC_MAX_SNAP),
+               2;
     return 0;
 }
 

@@ -54,6 +54,8 @@ typedef struct fd_opts {
     int relax_kind;             /* --relaxation aitken|anderson|none */
     unsigned long packing_seed; /* --packing A,B,...: seed of the per-Gauss-point draw */
     const char *fields_at;      /* --fields-at: axial strains [%] of the fabric maps (biaxial) */
+    const char *cost_log;       /* --cost-log: the DEM steps of every Gauss point at every run (biaxial) */
+    int balance_run;            /* --balance: MPI rebalance at every accept (0) or before every run (1) */
 } fd_opts;
 
 /* one row of a driver's CSV: the state after a converged step and the work of the step */
@@ -98,6 +100,7 @@ typedef struct fd_model {
     int *rfix;
     double *rvals, *rr, *ur;
     fd_probe_fn probe;                      /* diagnostics at a Newton iteration (NULL: none) */
+    FILE *cost_log;                         /* --cost-log (rank 0; NULL: none)                  */
     int (*checkpoint)(struct fd_model *M); /* the driver's checkpoint (cut-back give-up)      */
 } fd_model;
 
@@ -194,6 +197,7 @@ static const cli_opt *fd_common_opts(fd_opts *o) {
         {"--dem-min", CLI_INT, &o->dem_min, 1, 10000000, NULL, NULL, 0},
         {"--dem-max", CLI_INT, &o->dem_max, 1, 10000000, NULL, NULL, 0},
         {"--tangent-reuse", CLI_REAL, &o->tangent_reuse, 0, 1, "a fraction 0 <= X < 1 (0: off)", NULL, CLI_HI_OPEN},
+        {"--balance", CLI_CHOICE, &o->balance_run, 0, 0, NULL, "accept|run", 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     memcpy(t, src, sizeof src);
     return t;
@@ -289,7 +293,10 @@ static void fd_usage_common(FILE *fp) {
             "                         changed by less than the fraction X since (default 0: off; 0 <= X < 1).\n"
             "                         Change = (contacts created + contacts lost + contacts whose sliding state\n"
             "                         flipped) / contacts when the tangent was computed; contacts are pairs of\n"
-            "                         particle ids. The stored tangents and networks are in the checkpoint\n",
+            "                         particle ids. The stored tangents and networks are in the checkpoint\n"
+            "  --balance accept|run   MPI build: move RVEs between ranks by their cost after every accepted\n"
+            "                         step (accept, default) or before every Newton iteration, by the last\n"
+            "                         one's costs (run; gk_twoscale_def.balance). The results are the same\n",
             FD_DEM_INERTIAL, FD_DEM_UNBALANCED, FD_DEM_STRAIN, FD_DEM_MIN, FD_DEM_MAX, FD_DEM_MAX_FACTOR);
 }
 
@@ -400,6 +407,7 @@ static int fd_make_rves(fd_model *M, gk_err *err) {
     /* perturbation: eq 9 where eq 8 is not run (the first tangent) */
     d.tangent_opts = o->tmode == 1 ? GK_TANGENT_SLIDING_KEEP : o->tmode == 3 ? GK_TANGENT_RELAXED : 0u;
     d.xi = o->xi, d.reuse = o->tangent_reuse;
+    d.balance = o->balance_run ? GK_TWOSCALE_BALANCE_RUN : GK_TWOSCALE_BALANCE_ACCEPT;
     if ((res = gk_twoscale_create(&M->ts, &d)) != GK_OK) {
         gk_err_set(err, res, "RVEs: %s", gk_twoscale_error(&M->ts));
         goto out;
@@ -520,6 +528,7 @@ static void fd_free(fd_model *M) {
                  M->lface, M->rface, M->rfix, M->rvals, M->rr,   M->ur,   M->curve, M->hist};
     size_t k;
     for (k = 0; k < sizeof p / sizeof *p; ++k) free(p[k]);
+    if (M->cost_log) fclose(M->cost_log); /* an error path: the driver closed it otherwise */
     gk_twoscale_destroy(&M->ts);
     gk_dofmap_free(&M->dm);
     gk_csr_free(&M->Kr);
@@ -629,6 +638,11 @@ static int fd_eval(fd_model *M, const double *u, gk_err *err) {
         M->pend_dem += pts[g].work;
         M->pend_reused += pts[g].tangent == 2, M->pend_computed += pts[g].tangent == 1;
         nbad += pts[g].code != 0;
+    }
+    if (M->cost_log) { /* --cost-log: the load step being solved, its increment scale, every point's work */
+        fprintf(M->cost_log, "%d %.17g", M->step + 1, M->scale);
+        for (g = 0; g < M->ngp; ++g) fprintf(M->cost_log, " %d", pts[g].work);
+        fprintf(M->cost_log, "\n");
     }
     if (nbad) gk_err_set(err, GK_ERR_STATE, "%s", gk_twoscale_error(&M->ts));
     return nbad;

@@ -91,6 +91,10 @@
  *                 (F_a = 2 when all normals are parallel; above 1: the top colour)
  *   single_element.csv/svg (--test single: FEM element vs the RVE alone)
  *   checkpoint.bin every --checkpoint K steps and at the end (gk_twoscale_save: checksummed)
+ *   --cost-log FILE (anywhere; only when asked): a line per RVE run of all Gauss points, "STEP SCALE
+ *                 W_0 ... W_ngp-1": the load step being solved, its increment scale, each point's DEM
+ *                 steps (gk_twoscale_point.work); the input of bench_twoscale --model --cost-log
+ *                 (bench/README.md)
  * and prints per step a progress line with ETA and finally
  *   LOCAL inside_gp=... inside_eps_q=... edge_gp=... edge_void_ratio=... outside_gp=... outside_eps_q=...
  *         outside_eps_q_max=... first_failed_eps=... (nan: none) failed_fraction_mean=... (from the first
@@ -125,6 +129,11 @@ static void usage(FILE *fp) {
             "  --fields-at A,B        also write fabric_field_NNNN.svg at these axial strains [%%] (Guo & Zhao\n"
             "                         2014 Fig 18: 4,4.8); gp_history.csv, failed_fraction.svg and\n"
             "                         fabric_field.svg (final) are always written\n"
+            "  --cost-log FILE        write every RVE run's cost to FILE, a line per run of the Gauss points:\n"
+            "                         the load step being solved (1, 2, ...), the increment's scale (1, or\n"
+            "                         less after a cut-back), then each Gauss point's DEM steps (the work\n"
+            "                         of gk_twoscale_points); consecutive lines of one step and scale are\n"
+            "                         its Newton iterations (read by bench_twoscale --model --cost-log)\n"
             "  (defaults: --nx 8 --ny 16 --vtk-every 1 --packing examples/data/rve400.txt)\n");
     fd_usage_common(fp);
     fprintf(fp, "\nbiaxial.csv ends with dem_steps_mean,dem_steps_max (per Gauss point, accepted iterate),\n"

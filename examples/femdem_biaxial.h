@@ -23,10 +23,11 @@ static void fdb_defaults(fd_model *M) {
 
 /* the biaxial test's own options */
 static const cli_opt *fdb_opts(fd_opts *o) {
-    static cli_opt t[4];
+    static cli_opt t[5];
     const cli_opt src[] = {{"--steps", CLI_INT, &o->steps, 1, 1000000, NULL, NULL, 0},
                            {"--test", CLI_STR, &o->test, 0, 0, NULL, NULL, 0},
                            {"--fields-at", CLI_STR, &o->fields_at, 0, 0, NULL, NULL, 0},
+                           {"--cost-log", CLI_STR, &o->cost_log, 0, 0, NULL, NULL, 0},
                            {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     memcpy(t, src, sizeof src);
     return t;
@@ -442,10 +443,10 @@ static int fdb_finish(fd_model *M, int status) {
     fd_print_work_totals(M);
 #ifdef GK_TWOSCALE_MPI
     printf("MPI ranks=%d rve_runs=%lld rank0_bytes_in_per_run=%.0f rank0_bytes_out_per_run=%.0f point_moves=%lld "
-           "rank0_bytes_in_all=%lld\n",
+           "bytes_moved=%lld rank0_bytes_in_all=%lld balance=%s\n",
            M->ts.nranks, M->ts.stats.runs, (double)M->ts.stats.run_bytes_in / (M->ts.stats.runs ? M->ts.stats.runs : 1),
            (double)M->ts.stats.run_bytes_out / (M->ts.stats.runs ? M->ts.stats.runs : 1), M->ts.stats.migrated,
-           M->ts.stats.bytes_in);
+           M->ts.stats.migrated_bytes, M->ts.stats.bytes_in, o->balance_run ? "run" : "accept");
 #endif
     return status;
 }
@@ -467,7 +468,19 @@ static int fdb_run(fd_model *M) {
         if (M->o.extrapolate) printf("%s: predictor: the last converged increment, scaled\n", M->prog);
         fflush(stdout);
     }
+    if (M->o.cost_log) { /* rank 0 writes it */
+        int bad = M->root && !(M->cost_log = fopen(M->o.cost_log, "w"));
+        if (bad) fd_say(M, "%s: --cost-log %s: cannot write that file\n", M->prog, M->o.cost_log);
+        if (fd_agree(M, bad)) return 1;
+    }
     status = fdb_loop(M, gk_wtime(), &err);
+    if (M->cost_log) {
+        int bad = ferror(M->cost_log) != 0;
+        bad |= fclose(M->cost_log) != 0;
+        M->cost_log = NULL;
+        if (bad) fd_say(M, "%s: cannot write %s\n", M->prog, M->o.cost_log), status = 1;
+    }
+    if (M->o.cost_log && fd_agree(M, status == 1)) return 1;
     return status == 1 ? 1 : fdb_finish(M, status);
 }
 

@@ -150,13 +150,27 @@
  *   is broadcast (so only rank 0's counts; the others may pass NULL), each
  *   rank runs its points on its threads, and stress, tangent and the point
  *   reports are gathered to EVERY rank (MPI_Allgatherv). Points are
- *   assigned by cost: at first by particle count; at every accept, when
- *   the ranks' costs of the last run ((DEM steps + 1) x particles, summed)
- *   are more than balance_tol (default 5 %) above their mean, points move
- *   from the most to the least loaded rank (each move the point whose cost
- *   is nearest half the gap, until within the tolerance) and their accepted
- *   states migrate. The checkpoint is written and read by rank 0. Without
- *   GK_TWOSCALE_MPI nothing here needs MPI.
+ *   assigned by cost: at first by particle count; then, when the ranks'
+ *   costs of the last run ((DEM steps + 1) x particles, summed) are more
+ *   than balance_tol (default 5 %) above their mean, points move from the
+ *   most to the least loaded rank (each move the point whose cost is
+ *   nearest half the gap, until within the tolerance) and their accepted
+ *   states migrate (with their tangent-reuse reference). When (def.balance):
+ *     GK_TWOSCALE_BALANCE_ACCEPT (default): after every accept, on the
+ *       costs of the accepted run - the next load step runs on the last
+ *       step's costs;
+ *     GK_TWOSCALE_BALANCE_RUN: before every run, on the costs of the
+ *       previous run, accepted or not - so every Newton iteration of a
+ *       load step after the first runs on the costs of the previous one,
+ *       which predict it much better than the last step's (the same
+ *       accepted state, nearly the same dH; bench/README.md). A pending trial state is not moved: the
+ *       run recomputes every point from its accepted state anyway, and an
+ *       accept takes the trials of the ranks that ran them. A refused run
+ *       (bad argument) moves nothing.
+ *   gk_twoscale_stats counts the moves and their bytes (migrated,
+ *   migrated_bytes; under BALANCE_RUN they are also part of run_bytes_*).
+ *   The checkpoint is written and read by rank 0. Without GK_TWOSCALE_MPI
+ *   nothing here needs MPI.
  *
  * CONFIGURATION: GK_TWOSCALE_MPI (above).
  * REFERENCES: Guo N., Zhao J. (2014) A coupled FEM/DEM approach for
@@ -194,6 +208,12 @@ typedef enum gk_twoscale_tangent_kind {
     GK_TWOSCALE_TANGENT_PERTURBATION = 1 /* eq 8: finite differences of dim^2 perturbed runs */
 } gk_twoscale_tangent_kind;
 
+/* when the points are rebalanced over the MPI ranks (MPI, above) */
+typedef enum gk_twoscale_balance_kind {
+    GK_TWOSCALE_BALANCE_ACCEPT = 0, /* after every accept, on the costs of the accepted run           */
+    GK_TWOSCALE_BALANCE_RUN = 1     /* before every run, on the costs of the previous run (accepted or not) */
+} gk_twoscale_balance_kind;
+
 /* a run of one point by the caller's procedure (THE CALLER'S PROCEDURE) */
 typedef gk_result (*gk_twoscale_proc_fn)(void *user, int point, int proto, gk_rve *rve, const double H[9],
                                          const double dH[9], double scale, double stress[9], int *steps);
@@ -222,6 +242,7 @@ typedef struct gk_twoscale_def {
     double reuse;          /* tangent reuse bound, 0 <= X < 1; 0: off                      */
     int threads;           /* OpenMP threads over a rank's points; 0 -> 1                  */
     double balance_tol;    /* MPI: accepted load imbalance; 0 -> 0.05                      */
+    gk_twoscale_balance_kind balance; /* MPI: when to rebalance; 0: at every accept (above)  */
     gk_allocator alloc;
 } gk_twoscale_def;
 
@@ -267,6 +288,8 @@ typedef struct gk_twoscale_stats {
     long long bytes_in;      /* bytes received in all calls                              */
     long long collectives;   /* collective calls                                         */
     long long migrated;      /* points that moved to another rank (all ranks counted)    */
+    long long migrated_bytes; /* ... the bytes of their records (all ranks counted)       */
+    long long balances;      /* rebalances that moved points                             */
 } gk_twoscale_stats;
 
 struct gk__tspt; /* one local point (implementation) */
@@ -315,7 +338,8 @@ GKDEF const char *gk_twoscale_error(const gk_twoscale *ts);
 GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twoscale_run_def *rd, double *stress,
                                 double *D);
 /* the trial states of the points whose last run succeeded become their accepted states (the
- * others keep theirs); under MPI then rebalances. GK_ERR_STATE if there is no run to accept */
+ * others keep theirs); under MPI then rebalances (def.balance 0). GK_ERR_STATE if there is no run to
+ * accept */
 GKDEF gk_result gk_twoscale_accept(gk_twoscale *ts);
 GKDEF void gk_twoscale_reject(gk_twoscale *ts);
 /* the reports of the last run (N), and a failed point's message ("" if it did not fail) */
@@ -846,6 +870,8 @@ static gk_result gk__ts_check(gk_twoscale *ts, const gk_twoscale_def *def, gk_tw
     if (!(d->balance_tol >= 0 && isfinite(d->balance_tol)))
         return gk_err_set(e, GK_ERR_ARG, "balance tolerance %g", d->balance_tol);
     if (d->balance_tol == 0) d->balance_tol = 0.05;
+    if (d->balance != GK_TWOSCALE_BALANCE_ACCEPT && d->balance != GK_TWOSCALE_BALANCE_RUN)
+        return gk_err_set(e, GK_ERR_ARG, "unknown balance rule %d", (int)d->balance);
     ts->dim = dim;
     return GK_OK;
 }
@@ -1057,6 +1083,10 @@ static gk_result gk__ts_check_dH(gk_twoscale *ts, const double *dH) {
     return GK_OK;
 }
 
+#ifdef GK_TWOSCALE_MPI
+static gk_result gk__ts_balance(gk_twoscale *ts);
+#endif
+
 GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twoscale_run_def *rd, double *stress,
                                 double *D) {
     double scale = rd && rd->scale != 0.0 ? rd->scale : 1.0;
@@ -1088,6 +1118,14 @@ GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twos
     if ((res = gk__ts_check_dH(ts, H)) != GK_OK) return res;
     nrec = 9 + (want_D ? ts->nd4 : 0) + GK__TS_NREP;
     if (gk__ts_agree(ts, gk__ts_bufs(ts, nrec))) return ts->err.code;
+#ifdef GK_TWOSCALE_MPI
+    /* GK_TWOSCALE_BALANCE_RUN: the accepted states move by the costs of the previous run (the trial
+     * states of a pending run are dropped: this run recomputes every point from its accepted state).
+     * Here, after every check, so that a run that moves points always runs. A failed move changes
+     * nothing: this run on the old assignment. */
+    if (ts->nranks > 1 && ts->def.balance == GK_TWOSCALE_BALANCE_RUN && ts->stats.runs > 0 && gk__ts_balance(ts))
+        gk_err_clear(&ts->err);
+#endif
     {
         int nth = ts->def.threads;
         GK_OMP(parallel for num_threads(nth) schedule(dynamic, 1))
@@ -1278,6 +1316,7 @@ static gk_result gk__ts_migrate(gk_twoscale *ts, const int *nown) {
     gk__tspt **in;
     unsigned char *rb = NULL;
     size_t rcap = 0;
+    long long sent = ts->stats.bytes_out, all;
     for (p = 0; p < ts->n; ++p) {
         nin += ts->owner[p] != ts->rank && nown[p] == ts->rank;
         moved += ts->owner[p] != nown[p];
@@ -1320,7 +1359,10 @@ static gk_result gk__ts_migrate(gk_twoscale *ts, const int *nown) {
     gk_free(a, in);
     memcpy(ts->owner, nown, (size_t)ts->n * sizeof(int));
     gk__ts_layout(ts);
-    ts->stats.migrated += moved;
+    sent = ts->stats.bytes_out - sent;
+    MPI_Allreduce(&sent, &all, 1, MPI_LONG_LONG, MPI_SUM, ts->comm);
+    ++ts->stats.collectives;
+    ts->stats.migrated += moved, ts->stats.migrated_bytes += all, ++ts->stats.balances;
     return GK_OK;
 }
 
@@ -1405,7 +1447,7 @@ GKDEF gk_result gk_twoscale_accept(gk_twoscale *ts) {
     }
     ts->pending = 0;
 #ifdef GK_TWOSCALE_MPI
-    if (ts->nranks > 1) return gk__ts_balance(ts);
+    if (ts->nranks > 1 && ts->def.balance == GK_TWOSCALE_BALANCE_ACCEPT) return gk__ts_balance(ts);
 #endif
     return GK_OK;
 }

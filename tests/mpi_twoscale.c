@@ -5,7 +5,9 @@
  * points; a balance tolerance of 1e-9 makes the points migrate at every accept) and whole on
  * MPI_COMM_SELF (one rank, the threaded build's path). Their stresses, tangents, reports and fields
  * must agree bit for bit on every rank, across migrations, a failed point on the other rank, a
- * checkpoint written by 2 ranks and read by 1 (and back), and a refused corrupt one. */
+ * checkpoint written by 2 ranks and read by 1 (and back), and a refused corrupt one; and with the
+ * balance before every run (GK_TWOSCALE_BALANCE_RUN), across the Newton iterations of a load step,
+ * a reject and a refused run. */
 #define GK_IMPLEMENTATION
 #define GK_TWOSCALE_MPI
 #include "gk_twoscale.h"
@@ -17,7 +19,8 @@
 static gk_packing pk100, pk200;
 static int rank;
 
-static gk_result make_set(gk_twoscale *ts, MPI_Comm comm, gk_twoscale_tangent_kind tan, double reuse) {
+static gk_result make_set_b(gk_twoscale *ts, MPI_Comm comm, gk_twoscale_tangent_kind tan, double reuse,
+                            gk_twoscale_balance_kind bal) {
     gk_twoscale_proto pr[2];
     gk_twoscale_def d;
     pr[0].packing = &pk100, pr[0].state = NULL;
@@ -27,8 +30,11 @@ static gk_result make_set(gk_twoscale *ts, MPI_Comm comm, gk_twoscale_tangent_ki
     d.rve = gk_rve_def_default();
     d.rve.dt = DT;
     d.rule.n_min = 20, d.rule.n_max = 300, d.rule.unbalanced_max = 2e-2;
-    d.tangent = tan, d.reuse = reuse, d.balance_tol = 1e-9;
+    d.tangent = tan, d.reuse = reuse, d.balance_tol = 1e-9, d.balance = bal;
     return gk_twoscale_create_mpi(ts, &d, comm);
+}
+static gk_result make_set(gk_twoscale *ts, MPI_Comm comm, gk_twoscale_tangent_kind tan, double reuse) {
+    return make_set_b(ts, comm, tan, reuse, GK_TWOSCALE_BALANCE_ACCEPT);
 }
 
 /* the first points (rank 0's at first) deform 3x more: more DEM steps, so the ranks' costs differ and
@@ -167,6 +173,59 @@ TEST(checkpoints_move_between_rank_counts) {
     gk_twoscale_destroy(&w), gk_twoscale_destroy(&s), gk_twoscale_destroy(&w2), gk_twoscale_destroy(&s2);
 }
 
+/* GK_TWOSCALE_BALANCE_RUN: points move before every run on the previous run's costs, also between
+ * the iterations of a step (the trial states of the pending run dropped, then recomputed): 2 ranks =
+ * 1 rank bit for bit through iterations, a reject, a refused run (which must move nothing: the
+ * pending trial is then accepted) and eq 8 with tangent reuse (the reference moves with its point) */
+TEST(balance_before_every_run) {
+    int mode;
+    for (mode = 0; mode < 2; ++mode) {
+        gk_twoscale w, s;
+        double dH[9 * NP];
+        int k, it, ok = 1, ok_refused = 1, moves_in_step = 0;
+        long long bal0, mig0;
+        gk_twoscale_tangent_kind t = mode ? GK_TWOSCALE_TANGENT_PERTURBATION : GK_TWOSCALE_TANGENT_HOMOG;
+        CHECK(make_set_b(&w, MPI_COMM_WORLD, t, mode ? 0.5 : 0, GK_TWOSCALE_BALANCE_RUN) == GK_OK);
+        CHECK(make_set_b(&s, MPI_COMM_SELF, t, mode ? 0.5 : 0, GK_TWOSCALE_BALANCE_RUN) == GK_OK);
+        for (k = 0; k < 3; ++k) {
+            for (it = 0; it < 3; ++it) { /* the iterations of a step: the heavy half alternates */
+                int p, c;
+                step_dH(k + 2 * it, 5e-4 * (1.0 + 0.1 * it), dH);
+                if (it % 2) /* the second half heavy: the first half's dH / 3, the second's x 3 */
+                    for (p = 0; p < NP; ++p)
+                        for (c = 0; c < 9; ++c) dH[9 * p + c] *= p < NP / 2 ? 1.0 / 3.0 : 3.0;
+                bal0 = w.stats.balances;
+                ok &= run_both(&w, &s, dH, GK_OK);
+                if (it > 0) moves_in_step += w.stats.balances > bal0;
+            }
+            if (k == 1) { /* a reject: the step again from the accepted states, points moving */
+                gk_twoscale_reject(&w), gk_twoscale_reject(&s);
+                step_dH(k, 4e-4, dH);
+                ok &= run_both(&w, &s, dH, GK_OK);
+            }
+            if (k == 2) { /* a refused run (rank 0's dH has a NaN) moves nothing; the pending trial stays */
+                double bad[9 * NP];
+                memcpy(bad, dH, sizeof bad);
+                bad[9 * 3 + 4] = NAN;
+                bal0 = w.stats.balances, mig0 = w.stats.migrated;
+                ok_refused &= gk_twoscale_run(&w, rank == 0 ? bad : NULL, NULL, NULL, NULL) == GK_ERR_NAN;
+                ok_refused &= w.stats.balances == bal0 && w.stats.migrated == mig0;
+            }
+            ok &= gk_twoscale_accept(&w) == GK_OK && gk_twoscale_accept(&s) == GK_OK;
+        }
+        CHECK(ok);
+        CHECK(ok_refused);
+        CHECK(fields_same(&w, &s));
+        CHECK(moves_in_step > 0); /* points moved between the iterations of a step */
+        CHECK(w.stats.migrated > 0 && w.stats.migrated_bytes > 0);
+        if (rank == 0)
+            printf("    %s: %lld rebalances (%d within a step), %lld point moves, %lld bytes moved\n",
+                   mode ? "eq 8 + reuse" : "eq 9", w.stats.balances, moves_in_step, w.stats.migrated,
+                   w.stats.migrated_bytes);
+        gk_twoscale_destroy(&w), gk_twoscale_destroy(&s);
+    }
+}
+
 /* the checks of every rank count */
 static void run_all(const char *name, void (*fn)(void)) {
     int mine, all;
@@ -197,6 +256,7 @@ int main(int argc, char **argv) {
     run_all("two_ranks_equal_one_rank", two_ranks_equal_one_rank);
     run_all("a_failed_point_on_another_rank_is_reported_everywhere", a_failed_point_on_another_rank_is_reported_everywhere);
     run_all("checkpoints_move_between_rank_counts", checkpoints_move_between_rank_counts);
+    run_all("balance_before_every_run", balance_before_every_run);
     gk_packing_free(&pk100), gk_packing_free(&pk200);
     status = gk__t_failed ? 1 : 0;
     if (rank == 0) status = gk_test_done();

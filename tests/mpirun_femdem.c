@@ -29,7 +29,8 @@ static int same_but_seconds(const char *a, const char *b, int rows) {
 }
 
 /* the issue's command: 4 x 8 Q8, 128 RVEs, 10 steps, on 2 ranks x 1 thread and on 1 process x 2 threads;
- * then each run's checkpoint continued one step by the other build: the same rows again */
+ * then each run's checkpoint continued one step by the other build (the MPI one rebalancing before
+ * every Newton iteration, --balance run): the same rows again */
 TEST(femdem_biaxial_two_ranks_equal_two_threads) {
     const char *mpirun = getenv("GK_MPIRUN"), *args = "--nx 4 --ny 8 --element q8 --steps 10";
     char cmd[1024];
@@ -71,11 +72,11 @@ TEST(femdem_biaxial_two_ranks_equal_two_threads) {
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
              "%s -np 2 build/femdem_biaxial_mpi --nx 4 --ny 8 --element q8 --steps 11 --threads 1 --restart "
-             "build/tests/t_fmT "
-             "--out build/tests/t_fmTM > build/tests/t_fmTM.out 2>&1",
+             "build/tests/t_fmT --balance run --out build/tests/t_fmTM > build/tests/t_fmTM.out 2>&1",
              mpirun);
     CHECK(system(cmd) == 0);
     CHECK(same_but_seconds("build/tests/t_fmMT/biaxial.csv", "build/tests/t_fmTM/biaxial.csv", 12));
+    CHECK(gk_test_file_has("build/tests/t_fmTM.out", "balance=run"));
 }
 
 int main(int argc, char **argv) {

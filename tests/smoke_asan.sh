@@ -55,5 +55,24 @@ run 2 "$B/mpmdem_biaxial" $BX --nx 3
 run 0 "$B/mpmdem_footing" --width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 \
     --every 0.005 --smooth 0.01 --phi-deg 30 --final 0.01 --quiet --threads 2 --out "$T/ft"
 run 0 "$B/mpmdem_collapse" --nx 4 --every 0.025 --snapshots 0.05 --t-end 0.05 --quiet --threads 2 --out "$T/cl"
+# bench_scene_box (bench/peers/run_box.sh): a pour that writes the settled packing, a compression
+# read back from it, the impacts, a write that fails, untrusted data files, a refused option
+SB="--nx 2 --nz 2 --pour 200 --compress 20"
+run 0 "$B/bench_scene_box" $SB --write-data "$T/sb0.data" --write-settled "$T/sb.data"
+run 0 "$B/bench_scene_box" $SB --from "$T/sb.data"
+run 0 "$B/bench_scene_box" --impact --write-data "$T/sbi.data"
+run 1 "$B/bench_scene_box" $SB --write-settled /dev/full
+run 1 "$B/bench_scene_box" $SB --from tests
+printf '99999999999 atoms\n\nAtoms\n\n1 1 0.002 2650 0.001 0.001 0.001\n' >"$T/sb_n.data"
+run 1 "$B/bench_scene_box" $SB --from "$T/sb_n.data"
+printf '2 atoms\n\nAtoms\n\n1 1 0.002 2650 0.001 0.001 0.001\n1 1 0.002 2650 0.003 0.001 0.001\n' >"$T/sb_id.data"
+run 1 "$B/bench_scene_box" $SB --from "$T/sb_id.data"
+printf '1 atoms\n\nAtoms\n\n1 1 0.002 2650 0.001 nan 0.001\n' >"$T/sb_nan.data"
+run 1 "$B/bench_scene_box" $SB --from "$T/sb_nan.data"
+printf '1 atoms\n\nAtoms\n\n1 1 0.002 2650 0.001 0.001 5\n' >"$T/sb_out.data"
+run 1 "$B/bench_scene_box" $SB --from "$T/sb_out.data"
+printf '1 atoms\n\nAtoms\n\n1 1 1e300 2650 0.001 0.001 0.001\n' >"$T/sb_big.data"
+run 1 "$B/bench_scene_box" $SB --from "$T/sb_big.data"
+run 2 "$B/bench_scene_box" --nx 1
 echo "# smoke_asan: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

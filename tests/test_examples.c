@@ -898,6 +898,41 @@ TEST(femdem_failed_writes_are_errors) {
     remove("build/tests/t_fw");
 }
 
+/* --cost-log: one line per RVE run, "STEP SCALE W_0 .. W_7" for the 8 Gauss points of 1 x 2 Q4,
+ * as many lines per step as the step's Newton iterations (biaxial.csv; no cut-back at this size);
+ * a failed write is status 1 */
+TEST(femdem_cost_log_has_every_run) {
+    const char *base = "build/femdem_biaxial --nx 1 --ny 2 --element q4 --steps 2 --threads 1 --vtk-every 0";
+    char cmd[512], line[1024];
+    FILE *fp;
+    int lines = 0, good = 0, iters = 0, row = 0;
+    snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fcl --cost-log build/tests/t_fcl.log > build/tests/t_fcl.out 2>&1", base);
+    CHECK(system(cmd) == 0);
+    fp = fopen("build/tests/t_fcl.log", "r");
+    while (fp && fgets(line, sizeof line, fp)) {
+        int step, w[9], n;
+        double scale;
+        n = sscanf(line, "%d %lf %d %d %d %d %d %d %d %d %d", &step, &scale, w, w + 1, w + 2, w + 3, w + 4, w + 5,
+                   w + 6, w + 7, w + 8);
+        ++lines;
+        good += n == 10 && step >= 1 && step <= 2 && (lines > 1 || step == 1) && scale == 1.0 && w[0] > 0;
+    }
+    if (fp) fclose(fp);
+    fp = fopen("build/tests/t_fcl/biaxial.csv", "r");
+    while (fp && fgets(line, sizeof line, fp)) { /* column 6: iterations */
+        char *c = line;
+        int k;
+        for (k = 0; k < 5 && c; ++k) c = strchr(c + 1, ',');
+        if (row++ > 1 && c) iters += atoi(c + 1); /* the header and row 0 (the initial state) skipped */
+    }
+    if (fp) fclose(fp);
+    CHECK(lines > 2 && good == lines);
+    CHECK_EQ_INT(lines, iters);
+    snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fcl --cost-log /dev/full > build/tests/t_fcl.out 2>&1", base);
+    CHECK(system(cmd) != 0);
+    CHECK(gk_test_file_has("build/tests/t_fcl.out", "cannot write /dev/full"));
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(rve_path_writes_csv_and_svg);
@@ -920,5 +955,6 @@ int main(int argc, char **argv) {
     RUN(femdem_cyclic_strain_constant_volume_and_contractive);
     RUN(femdem_cyclic_stress_turns_at_the_amplitude);
     RUN(femdem_failed_writes_are_errors);
+    RUN(femdem_cost_log_has_every_run);
     return gk_test_done();
 }

@@ -599,6 +599,9 @@ TEST(bad_arguments_are_refused) {
     CHECK(gk_twoscale_create(&ts, &d) == GK_ERR_ARG && strstr(gk_twoscale_error(&ts), "reuse"));
     d.reuse = 0, d.rule.inertial_max = NAN;
     CHECK(gk_twoscale_create(&ts, &d) == GK_ERR_ARG);
+    d.rule.inertial_max = 0, d.balance = (gk_twoscale_balance_kind)2; /* neither ACCEPT nor RUN */
+    CHECK(gk_twoscale_create(&ts, &d) == GK_ERR_ARG && strstr(gk_twoscale_error(&ts), "balance rule 2"));
+    d.balance = GK_TWOSCALE_BALANCE_ACCEPT;
     d.rule.inertial_max = 0, d.rve = gk_rve_def_default(), d.rve.dt = 1.0; /* above the critical step */
     CHECK(gk_twoscale_create(&ts, &d) == GK_ERR_DT && strstr(gk_twoscale_error(&ts), "prototype 0"));
     d.rve.dt = DT;

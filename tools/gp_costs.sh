@@ -6,6 +6,8 @@
 #   build/femdem_biaxial --nx 4 --ny 8 --element q8 --steps 40 --out build/costs_run
 #   tools/gp_costs.sh build/costs_run > build/costs.txt
 #   build/bench_twoscale --model --costs build/costs.txt
+# These pairs are across load steps only (they evaluate the balance at accept). For every run,
+# Newton iterations included, use femdem_biaxial --cost-log FILE and bench_twoscale --cost-log FILE.
 set -eu
 [ $# -eq 1 ] && [ -d "$1" ] || { echo "usage: tools/gp_costs.sh DIR (a femdem_biaxial output directory)" >&2; exit 2; }
 tmp=$(mktemp -d) || exit 1
