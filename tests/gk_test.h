@@ -7,17 +7,19 @@
  * their values). gk_test_done() prints "# <program>: P passed, F failed" and
  * returns non-zero on failure; tests/run_tests.sh sums these lines.
  * A program given a test name as argv[1] runs only the tests whose names
- * contain it. */
+ * contain it.
+ *
+ * Tests run from the repository's root and write only under build/tests/
+ * (gk_test_init creates it; `make test` leaves nothing else behind). */
 #ifndef GK_TEST_H
 #define GK_TEST_H
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include <sys/stat.h>
+#include <sys/times.h>
+#include <unistd.h>
 
 static int gk__t_checks_failed;
 static int gk__t_passed, gk__t_failed;
@@ -68,15 +70,12 @@ static const char *gk__t_prog = "test";
 
 #define TEST(name) static void name(void)
 
-/* seconds for the per-test times: wall clock where OpenMP gives one (a test
- * that waits for a driver it launched counts that wait), else this
- * process's CPU time */
+/* seconds for the per-test times: wall clock (a test that waits for a
+ * driver it launched counts that wait), in every build, with or without
+ * OpenMP. POSIX times() is declared in strict C99 mode too; 10 ms steps. */
 static double gk__t_now(void) {
-#ifdef _OPENMP
-    return omp_get_wtime();
-#else
-    return (double)clock() / CLOCKS_PER_SEC;
-#endif
+    struct tms t;
+    return (double)times(&t) / (double)sysconf(_SC_CLK_TCK);
 }
 
 static void gk__t_run(const char *name, void (*fn)(void)) {
@@ -95,6 +94,31 @@ static void gk__t_run(const char *name, void (*fn)(void)) {
     fflush(stdout);
 }
 #define RUN(name) gk__t_run(#name, name)
+
+#if defined(__GNUC__) || defined(__clang__)
+#define GK__T_UNUSED __attribute__((unused))
+#else
+#define GK__T_UNUSED
+#endif
+
+/* the whole file in a NUL-terminated buffer to free (NULL if unreadable) */
+GK__T_UNUSED static char *gk_test_slurp(const char *path) {
+    FILE *fp = fopen(path, "rb");
+    char *buf = NULL;
+    long n;
+    if (!fp) return NULL;
+    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0 &&
+        (buf = (char *)malloc((size_t)n + 1)) != NULL) {
+        if (fread(buf, 1, (size_t)n, fp) != (size_t)n) {
+            free(buf);
+            buf = NULL;
+        } else {
+            buf[n] = 0;
+        }
+    }
+    fclose(fp);
+    return buf;
+}
 
 /* ---- for smoke tests of the example drivers: #define GK_TEST_DRIVERS
  * before including this file */
@@ -124,12 +148,10 @@ static double gk_test_result(const char *path, const char *key) {
     q = strstr(last, pat);
     return q ? atof(q + strlen(pat)) : NAN;
 }
-/* 1 if two CSV files have the same rows (at least two) in their first ncol
- * columns (e.g. all but a trailing `seconds` column) */
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((unused))
-#endif
-static int gk_test_csv_same(const char *a, const char *b, int ncol) {
+/* 1 if two CSV files have the same lines, at least min_lines of them (the
+ * header counts), in their first ncol columns (e.g. all but a trailing
+ * `seconds` column) */
+GK__T_UNUSED static int gk_test_csv_same(const char *a, const char *b, int ncol, int min_lines) {
     FILE *fa = fopen(a, "r"), *fb = fopen(b, "r");
     char la[4096], lb[4096];
     int same = fa && fb, rows = 0;
@@ -148,7 +170,7 @@ static int gk_test_csv_same(const char *a, const char *b, int ncol) {
     }
     if (fa) fclose(fa);
     if (fb) fclose(fb);
-    return same && rows > 2;
+    return same && rows >= min_lines;
 }
 #endif
 
@@ -160,6 +182,8 @@ static void gk_test_init(int argc, char **argv) {
         if (p) gk__t_prog = p + 1;
     }
     if (argc > 1) gk__t_filter = argv[1];
+    mkdir("build", 0755); /* where the outputs go (already there under make test) */
+    mkdir("build/tests", 0755);
 }
 static int gk_test_done(void) {
     printf("# %s: %d passed, %d failed\n", gk__t_prog, gk__t_passed, gk__t_failed);

@@ -13,19 +13,21 @@
     "--phi-deg 30 --final 0.01 --quiet "
 #define CL "--nx 4 --every 0.01 --snapshots 0.02 --t-end 0.03 --quiet "
 
-/* runs `build/DRIVER ARGS --threads 2 --out build/t_mpiT_NAME` and the MPI build on 2 ranks into
- * build/t_mpiM_NAME; 1 if both succeed */
+/* runs `build/DRIVER ARGS --threads 2 --out build/tests/t_mpiT_NAME` and the MPI build on 2 ranks into
+ * build/tests/t_mpiM_NAME; 1 if both succeed */
 static int both(const char *mpirun, const char *driver, const char *name, const char *args) {
     char cmd[1024];
     int ok;
     snprintf(cmd, sizeof cmd,
-             "rm -rf build/t_mpiT_%s build/t_mpiM_%s && build/%s %s --threads 2 --out build/t_mpiT_%s "
-             "> build/t_mpiT_%s.out 2>&1",
+             "rm -rf build/tests/t_mpiT_%s build/tests/t_mpiM_%s && build/%s %s --threads 2 --out "
+             "build/tests/t_mpiT_%s "
+             "> build/tests/t_mpiT_%s.out 2>&1",
              name, name, driver, args, name, name);
     ok = system(cmd) == 0;
-    snprintf(cmd, sizeof cmd,
-             "%s -np 2 build/%s_mpi %s --threads 1 --out build/t_mpiM_%s > build/t_mpiM_%s.out 2>&1", mpirun,
-             driver, args, name, name);
+    snprintf(
+        cmd, sizeof cmd,
+        "%s -np 2 build/%s_mpi %s --threads 1 --out build/tests/t_mpiM_%s > build/tests/t_mpiM_%s.out 2>&1",
+        mpirun, driver, args, name, name);
     return ok && system(cmd) == 0;
 }
 
@@ -33,8 +35,10 @@ static int both(const char *mpirun, const char *driver, const char *name, const 
 static int same_csv(const char *name, const char *csv, int ncol) {
     char cmd[512];
     snprintf(cmd, sizeof cmd,
-             "cut -d, -f1-%d build/t_mpiT_%s/%s > build/t_mpiT_%s.c && cut -d, -f1-%d build/t_mpiM_%s/%s "
-             "> build/t_mpiM_%s.c && cmp -s build/t_mpiT_%s.c build/t_mpiM_%s.c && test -s build/t_mpiT_%s.c",
+             "cut -d, -f1-%d build/tests/t_mpiT_%s/%s > build/tests/t_mpiT_%s.c && cut -d, -f1-%d "
+             "build/tests/t_mpiM_%s/%s "
+             "> build/tests/t_mpiM_%s.c && cmp -s build/tests/t_mpiT_%s.c build/tests/t_mpiM_%s.c && test -s "
+             "build/tests/t_mpiT_%s.c",
              ncol, name, csv, name, ncol, name, csv, name, name, name, name);
     return system(cmd) == 0;
 }
@@ -60,13 +64,14 @@ TEST(biaxial_two_ranks_equal_two_threads) {
     if (!m) return;
     CHECK(both(m, "mpmdem_biaxial", "bx", BX "--strain 0.002"));
     CHECK(same_csv("bx", "biaxial.csv", 7));
-    CHECK(system("cmp -s build/t_mpiT_bx/points_000000.vtk build/t_mpiM_bx/points_000000.vtk && "
-                 "cmp -s build/t_mpiT_bx/points_000278.vtk build/t_mpiM_bx/points_000278.vtk") == 0);
-    CHECK(gk_test_result("build/t_mpiM_bx.out", "peak_sigma_yy") ==
-          gk_test_result("build/t_mpiT_bx.out", "peak_sigma_yy"));
-    CHECK(gk_test_file_has("build/t_mpiM_bx.out", "MPI ranks=2 threads=1 "));
-    CHECK(gk_test_file_has("build/t_mpiT_bx.out", "MPI ranks=1 threads=2 bytes_sent_per_step=0 "));
-    CHECK_EQ_INT(count_lines("build/t_mpiM_bx.out", "RESULT "), 1); /* rank 0 alone speaks */
+    CHECK(system("cmp -s build/tests/t_mpiT_bx/points_000000.vtk build/tests/t_mpiM_bx/points_000000.vtk && "
+                 "cmp -s build/tests/t_mpiT_bx/points_000278.vtk build/tests/t_mpiM_bx/points_000278.vtk") ==
+          0);
+    CHECK(gk_test_result("build/tests/t_mpiM_bx.out", "peak_sigma_yy") ==
+          gk_test_result("build/tests/t_mpiT_bx.out", "peak_sigma_yy"));
+    CHECK(gk_test_file_has("build/tests/t_mpiM_bx.out", "MPI ranks=2 threads=1 "));
+    CHECK(gk_test_file_has("build/tests/t_mpiT_bx.out", "MPI ranks=1 threads=2 bytes_sent_per_step=0 "));
+    CHECK_EQ_INT(count_lines("build/tests/t_mpiM_bx.out", "RESULT "), 1); /* rank 0 alone speaks */
 }
 
 /* the checkpoint is one file whatever the rank count: each build goes on from the other's half-way
@@ -79,14 +84,14 @@ TEST(biaxial_restart_across_builds) {
     CHECK(both(m, "mpmdem_biaxial", "bxh", BX "--strain 0.001"));
     snprintf(cmd, sizeof cmd,
              "build/mpmdem_biaxial " BX
-             "--strain 0.002 --threads 2 --restart build/t_mpiM_bxh --out build/t_mpiT_bxr "
-             "> build/t_mpiT_bxr.out 2>&1 && %s -np 2 build/mpmdem_biaxial_mpi " BX
-             "--strain 0.002 --threads 1 --restart build/t_mpiT_bxh --out build/t_mpiM_bxr > "
-             "build/t_mpiM_bxr.out 2>&1",
+             "--strain 0.002 --threads 2 --restart build/tests/t_mpiM_bxh --out build/tests/t_mpiT_bxr "
+             "> build/tests/t_mpiT_bxr.out 2>&1 && %s -np 2 build/mpmdem_biaxial_mpi " BX
+             "--strain 0.002 --threads 1 --restart build/tests/t_mpiT_bxh --out build/tests/t_mpiM_bxr > "
+             "build/tests/t_mpiM_bxr.out 2>&1",
              m);
     CHECK(system(cmd) == 0);
-    CHECK(system("cut -d, -f1-7 build/t_mpiT_bxr/biaxial.csv | cmp -s - build/t_mpiT_bx.c && "
-                 "cut -d, -f1-7 build/t_mpiM_bxr/biaxial.csv | cmp -s - build/t_mpiT_bx.c") == 0);
+    CHECK(system("cut -d, -f1-7 build/tests/t_mpiT_bxr/biaxial.csv | cmp -s - build/tests/t_mpiT_bx.c && "
+                 "cut -d, -f1-7 build/tests/t_mpiM_bxr/biaxial.csv | cmp -s - build/tests/t_mpiT_bx.c") == 0);
 }
 
 /* the footing (one prototype, edge loads, a rigid footing) and the collapse (one prototype per
@@ -97,11 +102,14 @@ TEST(footing_and_collapse_two_ranks_equal_two_threads) {
     if (!m) return;
     CHECK(both(m, "mpmdem_footing", "ft", FT));
     CHECK(same_csv("ft", "footing.csv", 8));
-    CHECK(gk_test_result("build/t_mpiM_ft.out", "q_ult") == gk_test_result("build/t_mpiT_ft.out", "q_ult"));
+    CHECK(gk_test_result("build/tests/t_mpiM_ft.out", "q_ult") ==
+          gk_test_result("build/tests/t_mpiT_ft.out", "q_ult"));
     CHECK(both(m, "mpmdem_collapse", "cl", CL));
     CHECK(same_csv("cl", "collapse.csv", 14));
-    CHECK(system("cmp -s build/t_mpiT_cl/points_000000.vtk build/t_mpiM_cl/points_000000.vtk") == 0);
-    CHECK(gk_test_result("build/t_mpiM_cl.out", "dstar") == gk_test_result("build/t_mpiT_cl.out", "dstar"));
+    CHECK(system("cmp -s build/tests/t_mpiT_cl/points_000000.vtk build/tests/t_mpiM_cl/points_000000.vtk") ==
+          0);
+    CHECK(gk_test_result("build/tests/t_mpiM_cl.out", "dstar") ==
+          gk_test_result("build/tests/t_mpiT_cl.out", "dstar"));
 }
 
 int main(int argc, char **argv) {

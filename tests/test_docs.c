@@ -11,25 +11,6 @@
 
 #include "gk_test.h"
 
-/* whole file into a NUL-terminated buffer (NULL if unreadable) */
-static char *slurp(const char *path) {
-    FILE *fp = fopen(path, "rb");
-    char *buf = NULL;
-    long n;
-    if (!fp) return NULL;
-    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0 &&
-        (buf = (char *)malloc((size_t)n + 1)) != NULL) {
-        if (fread(buf, 1, (size_t)n, fp) != (size_t)n) {
-            free(buf);
-            buf = NULL;
-        } else {
-            buf[n] = 0;
-        }
-    }
-    fclose(fp);
-    return buf;
-}
-
 /* the text between two markers (exclusive), as a new string; NULL if absent */
 static char *between(const char *text, const char *from, const char *to) {
     const char *a = strstr(text, from), *b;
@@ -46,7 +27,7 @@ static char *between(const char *text, const char *from, const char *to) {
 }
 
 TEST(readme_snippet_is_the_quickstart_program) {
-    char *readme = slurp("README.md"), *prog = slurp("examples/quickstart.c");
+    char *readme = gk_test_slurp("README.md"), *prog = gk_test_slurp("examples/quickstart.c");
     char *snip = NULL, *body = NULL, *head = NULL;
     CHECK(readme && prog);
     if (readme && prog) {
@@ -71,7 +52,7 @@ TEST(quickstart_runs_and_restores_bit_for_bit) {
     char *out;
     int rc = system("build/quickstart > build/tests/quickstart.out 2>&1");
     CHECK(rc == 0);
-    out = slurp("build/tests/quickstart.out");
+    out = gk_test_slurp("build/tests/quickstart.out");
     CHECK(out != NULL);
     if (out) {
         CHECK(strstr(out, "initial  sxx -100028.5") != NULL); /* YADE's getStress() of the packing */
@@ -107,7 +88,7 @@ static int listed_in(const char *dir, const char *prefix, const char *suffix, co
 }
 
 TEST(readme_names_every_header_and_driver) {
-    char *readme = slurp("README.md");
+    char *readme = gk_test_slurp("README.md");
     CHECK(readme != NULL);
     if (readme) {
         CHECK_EQ_INT(listed_in("include", "gk_", ".h", readme, "| `%s.h` |"), 0);
@@ -123,7 +104,7 @@ static int clean(const char *path) {
     static const char *bad[] = {"../shared", "DESIGN.md", "issue 1", "issue 2", "issue 3", "issue 4",
                                 "issue 5",   "issue 6",   "issue 7", "issue 8", "issue 9", "the issue's",
                                 "seed 00"};
-    char *t = slurp(path);
+    char *t = gk_test_slurp(path);
     int k, found = 0;
     if (!t) return 1; /* a missing file is not dirty */
     for (k = 0; k < (int)(sizeof bad / sizeof bad[0]); ++k)

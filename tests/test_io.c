@@ -11,24 +11,6 @@
 
 #define OUT "build/tests/"
 
-static char *slurp(const char *path) {
-    FILE *fp = fopen(path, "rb");
-    char *buf = NULL;
-    long n;
-    if (!fp) return NULL;
-    if (fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0 &&
-        (buf = (char *)malloc((size_t)n + 1)) != NULL) {
-        if (fread(buf, 1, (size_t)n, fp) != (size_t)n) {
-            free(buf);
-            buf = NULL;
-        } else {
-            buf[n] = 0;
-        }
-    }
-    fclose(fp);
-    return buf;
-}
-
 static double attr(const char *tag, const char *name) {
     char pat[64];
     const char *q;
@@ -40,7 +22,7 @@ static double attr(const char *tag, const char *name) {
 /* number of sampled points of the drawn series that fall inside the legend
  * box (-1 if the file has no legend) */
 static int points_under_legend(const char *path) {
-    char *svg = slurp(path);
+    char *svg = gk_test_slurp(path);
     const char *r, *s;
     double bx, by, bw, bh;
     int inside = 0;
@@ -117,7 +99,7 @@ TEST(equal_aspect_draws_a_round_circle) {
     p.equal_aspect = 1;
     gk_plot_add(&p, cx, cy, 361, NULL);
     CHECK(gk_plot_svg(&p, OUT "io_circle.svg", &e) == GK_OK);
-    svg = slurp(OUT "io_circle.svg");
+    svg = gk_test_slurp(OUT "io_circle.svg");
     CHECK(svg != NULL);
     if (svg) {
         const char *q = strstr(svg, "points=\"");
@@ -158,7 +140,7 @@ TEST(field_plot_axes_outline_colorbar_and_fixed_range) {
     d.fixed_range = 1, d.vmin = 0.0, d.vmax = 10.0;
     d.nlines = 1, d.line_len = len, d.line_xy = platen;
     CHECK(gk_field_svg(OUT "io_field.svg", &d, 4, 4, xy, val, &e) == GK_OK);
-    svg = slurp(OUT "io_field.svg");
+    svg = gk_test_slurp(OUT "io_field.svg");
     CHECK(svg != NULL);
     if (svg) {
         CHECK(strstr(svg, "fill=\"rgb(68,1,84)\" stroke") != NULL);    /* vmin: viridis' first colour */
@@ -176,7 +158,7 @@ TEST(field_plot_axes_outline_colorbar_and_fixed_range) {
     remove(OUT "io_field_bad.svg");
     CHECK(gk_field_svg(OUT "io_field_bad.svg", &d, 4, 4, xy, val, &e) == GK_ERR_ARG);
     CHECK(strstr(e.msg, "colour range") != NULL);
-    svg = slurp(OUT "io_field_bad.svg");
+    svg = gk_test_slurp(OUT "io_field_bad.svg");
     CHECK(svg == NULL);
     free(svg);
 }

@@ -38,11 +38,11 @@ static int read_rows(const char *path, double rows[][8], int max) {
 TEST(biaxial_runs_and_loads) {
     double r[16][8];
     int n, k;
-    CHECK(system(BX "--threads 2 --out build/t_mpmbx > build/t_mpmbx.out 2>&1") == 0);
+    CHECK(system(BX "--threads 2 --out build/tests/t_mpmbx > build/tests/t_mpmbx.out 2>&1") == 0);
     CHECK(gk_test_file_has(
-        "build/t_mpmbx/biaxial.csv",
+        "build/tests/t_mpmbx/biaxial.csv",
         "time,eps_axial,sigma_yy,sigma_yy_base,eps_v,kinetic_energy,dem_steps_per_point,seconds"));
-    n = read_rows("build/t_mpmbx/biaxial.csv", r, 16);
+    n = read_rows("build/tests/t_mpmbx/biaxial.csv", r, 16);
     CHECK_EQ_INT(n, 4);
     if (n != 4) return;
     for (k = 0; k < n; ++k) {
@@ -52,77 +52,81 @@ TEST(biaxial_runs_and_loads) {
     CHECK(r[0][2] > 0.95e5 && r[0][2] < 1.2e5);
     for (k = 1; k < n; ++k) CHECK(r[k][2] > r[k - 1][2]);
     CHECK(r[n - 1][4] > 0.0);
-    CHECK(gk_test_file_has("build/t_mpmbx/biaxial_stress.svg", "<svg"));
-    CHECK(gk_test_file_has("build/t_mpmbx/rotation_end.svg", "<svg"));
-    CHECK(gk_test_file_has("build/t_mpmbx/points_000000.vtk", "SCALARS eps_q"));
-    CHECK_NEAR(gk_test_result("build/t_mpmbx.out", "n_rves"), 8, 0);
-    CHECK_REL(gk_test_result("build/t_mpmbx.out", "peak_sigma_yy"), r[n - 1][2],
+    CHECK(gk_test_file_has("build/tests/t_mpmbx/biaxial_stress.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_mpmbx/rotation_end.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_mpmbx/points_000000.vtk", "SCALARS eps_q"));
+    CHECK_NEAR(gk_test_result("build/tests/t_mpmbx.out", "n_rves"), 8, 0);
+    CHECK_REL(gk_test_result("build/tests/t_mpmbx.out", "peak_sigma_yy"), r[n - 1][2],
               1e-5); /* printed with 6 digits */
 }
 
 /* RVEs run in parallel: one thread gives the same curve to the last digit */
 TEST(biaxial_thread_independent) {
-    CHECK(system(BX "--threads 1 --out build/t_mpmbx1 > build/t_mpmbx1.out 2>&1") == 0);
-    CHECK(system("cmp -s build/t_mpmbx1/points_000000.vtk build/t_mpmbx/points_000000.vtk") == 0);
-    CHECK(gk_test_result("build/t_mpmbx1.out", "peak_sigma_yy") ==
-          gk_test_result("build/t_mpmbx.out", "peak_sigma_yy"));
-    CHECK(system("cut -d, -f1-7 build/t_mpmbx1/biaxial.csv > build/t_mpmbx1.c && "
-                 "cut -d, -f1-7 build/t_mpmbx/biaxial.csv > build/t_mpmbx2.c && "
-                 "cmp -s build/t_mpmbx1.c build/t_mpmbx2.c") == 0);
+    CHECK(system(BX "--threads 1 --out build/tests/t_mpmbx1 > build/tests/t_mpmbx1.out 2>&1") == 0);
+    CHECK(system("cmp -s build/tests/t_mpmbx1/points_000000.vtk build/tests/t_mpmbx/points_000000.vtk") == 0);
+    CHECK(gk_test_result("build/tests/t_mpmbx1.out", "peak_sigma_yy") ==
+          gk_test_result("build/tests/t_mpmbx.out", "peak_sigma_yy"));
+    CHECK(system("cut -d, -f1-7 build/tests/t_mpmbx1/biaxial.csv > build/tests/t_mpmbx1.c && "
+                 "cut -d, -f1-7 build/tests/t_mpmbx/biaxial.csv > build/tests/t_mpmbx2.c && "
+                 "cmp -s build/tests/t_mpmbx1.c build/tests/t_mpmbx2.c") == 0);
 }
 
 /* a checkpoint half-way, then --restart: the same final state (every point
  * array and RVE state is in the checkpoint) */
 TEST(biaxial_restart_identical) {
     int rc = system(
-        "build/mpmdem_biaxial --nx 2 --ny 4 --strain 0.001 --every 0.0005 --quiet --out build/t_mpmbx_a "
-        "> build/t_mpmbx_a.out 2>&1 && " BX
-        "--restart build/t_mpmbx_a --out build/t_mpmbx_b > build/t_mpmbx_b.out 2>&1");
+        "build/mpmdem_biaxial --nx 2 --ny 4 --strain 0.001 --every 0.0005 --quiet --out "
+        "build/tests/t_mpmbx_a "
+        "> build/tests/t_mpmbx_a.out 2>&1 && " BX
+        "--restart build/tests/t_mpmbx_a --out build/tests/t_mpmbx_b > build/tests/t_mpmbx_b.out 2>&1");
     CHECK(rc == 0);
-    CHECK(gk_test_result("build/t_mpmbx_b.out", "peak_sigma_yy") ==
-          gk_test_result("build/t_mpmbx.out", "peak_sigma_yy"));
-    CHECK(system("cut -d, -f1-7 build/t_mpmbx_b/biaxial.csv > build/t_mpmbx_b.c && "
-                 "cmp -s build/t_mpmbx_b.c build/t_mpmbx2.c") == 0);
+    CHECK(gk_test_result("build/tests/t_mpmbx_b.out", "peak_sigma_yy") ==
+          gk_test_result("build/tests/t_mpmbx.out", "peak_sigma_yy"));
+    CHECK(system("cut -d, -f1-7 build/tests/t_mpmbx_b/biaxial.csv > build/tests/t_mpmbx_b.c && "
+                 "cmp -s build/tests/t_mpmbx_b.c build/tests/t_mpmbx2.c") == 0);
 }
 
 /* bad input: a message and a non-zero exit, nothing run */
 TEST(biaxial_bad_arguments) {
-    CHECK(system("build/mpmdem_biaxial --nx 0 > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "out of range"));
-    CHECK(system("build/mpmdem_biaxial --nx 3 --ny 4 > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "square"));
-    CHECK(system("build/mpmdem_biaxial --alpha 2 > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--alpha"));
-    CHECK(system("build/mpmdem_biaxial --packing /nonexistent > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "nonexistent"));
-    CHECK(system("build/mpmdem_biaxial --restart /nonexistent --nx 2 --ny 4 > build/t_mpmbx_bad.out 2>&1") !=
-          0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "cannot open"));
-    CHECK(system("build/mpmdem_biaxial --help > build/t_mpmbx_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--dem-strain"));
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "(default build/mpm_biaxial)"));
+    CHECK(system("build/mpmdem_biaxial --nx 0 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "out of range"));
+    CHECK(system("build/mpmdem_biaxial --nx 3 --ny 4 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "square"));
+    CHECK(system("build/mpmdem_biaxial --alpha 2 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--alpha"));
+    CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --packing /nonexistent > "
+                 "build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "nonexistent"));
+    CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --restart /nonexistent --nx 2 --ny 4 > "
+                 "build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "cannot open"));
+    CHECK(system("build/mpmdem_biaxial --help > build/tests/t_mpmbx_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--dem-strain"));
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "(default build/mpm_biaxial)"));
     /* values parsed strictly; the message names the option */
-    CHECK(system("build/mpmdem_biaxial --nx -1 > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--nx -1 is out of range"));
-    CHECK(system("build/mpmdem_biaxial --nx=8 > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--nx=8: write the value after the option"));
-    CHECK(system("build/mpmdem_biaxial --nx 99999999999 > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--nx 99999999999 is out of range"));
-    CHECK(system("build/mpmdem_biaxial --nx 8x > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--nx '8x' is not a whole number"));
-    CHECK(system("build/mpmdem_biaxial --strain 1e999 > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--strain '1e999' is not a finite number"));
+    CHECK(system("build/mpmdem_biaxial --nx -1 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--nx -1 is out of range"));
+    CHECK(system("build/mpmdem_biaxial --nx=8 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--nx=8: write the value after the option"));
+    CHECK(system("build/mpmdem_biaxial --nx 99999999999 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--nx 99999999999 is out of range"));
+    CHECK(system("build/mpmdem_biaxial --nx 8x > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--nx '8x' is not a whole number"));
+    CHECK(system("build/mpmdem_biaxial --strain 1e999 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--strain '1e999' is not a finite number"));
     /* the DEM-rule flags of mpmdem.h are taken (they were listed in --help but refused), bad ones not */
-    CHECK(system("build/mpmdem_biaxial --dem-rule foo > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "adaptive or strain"));
-    CHECK(system("build/mpmdem_biaxial --dem-inertial -1 > build/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_bad.out", "--dem-inertial"));
-    CHECK(system(BX "--strain 0.0005 --dem-rule strain --dem-strain 2e-5 --out build/t_mpmbx_rule "
-                    "> build/t_mpmbx_rule.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_rule.out", "DEM steps per MPM step: <= 2e-05 strain per DEM step"));
-    CHECK(system(BX "--strain 0.0005 --dem-inertial 1e-3 --dem-unbalanced 1e-2 --out build/t_mpmbx_rule "
-                    "> build/t_mpmbx_rule.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_rule.out",
+    CHECK(system("build/mpmdem_biaxial --dem-rule foo > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "adaptive or strain"));
+    CHECK(system("build/mpmdem_biaxial --dem-inertial -1 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--dem-inertial"));
+    CHECK(system(BX "--strain 0.0005 --dem-rule strain --dem-strain 2e-5 --out build/tests/t_mpmbx_rule "
+                    "> build/tests/t_mpmbx_rule.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_rule.out",
+                           "DEM steps per MPM step: <= 2e-05 strain per DEM step"));
+    CHECK(system(BX
+                 "--strain 0.0005 --dem-inertial 1e-3 --dem-unbalanced 1e-2 --out build/tests/t_mpmbx_rule "
+                 "> build/tests/t_mpmbx_rule.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_rule.out",
                            "adaptive, I <= 0.001 then relaxation to an unbalanced force "
                            "ratio < 0.01"));
 }
@@ -154,72 +158,86 @@ static int copy_damaged(const char *src, const char *dst, long keep, long flip) 
  * format is refused by name with status 1, before anything is run or written */
 TEST(biaxial_bad_checkpoint_refused) {
     long size;
-    FILE *fp = fopen("build/t_mpmbx_a/checkpoint.bin", "rb");
+    FILE *fp = fopen("build/tests/t_mpmbx_a/checkpoint.bin", "rb");
     CHECK(fp != NULL);
     if (!fp) return;
     fseek(fp, 0, SEEK_END), size = ftell(fp), fclose(fp);
-    CHECK(system("rm -rf build/t_mpmbx_ck build/t_mpmbx_ckout && mkdir -p build/t_mpmbx_ck") == 0);
-    CHECK(copy_damaged("build/t_mpmbx_a/checkpoint.bin", "build/t_mpmbx_ck/checkpoint.bin", -1, size / 2));
-    CHECK(system(BX "--restart build/t_mpmbx_ck --out build/t_mpmbx_ckout > build/t_mpmbx_ck.out 2>&1; "
+    CHECK(system(
+              "rm -rf build/tests/t_mpmbx_ck build/tests/t_mpmbx_ckout && mkdir -p build/tests/t_mpmbx_ck") ==
+          0);
+    CHECK(copy_damaged("build/tests/t_mpmbx_a/checkpoint.bin", "build/tests/t_mpmbx_ck/checkpoint.bin", -1,
+                       size / 2));
+    CHECK(system(BX "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > "
+                    "build/tests/t_mpmbx_ck.out 2>&1; "
                     "test $? -eq 1") == 0);
-    CHECK(
-        gk_test_file_has("build/t_mpmbx_ck.out", "checkpoint.bin: checksum mismatch (the file is corrupt)"));
-    CHECK(!gk_test_file_has("build/t_mpmbx_ckout/biaxial.csv", "time")); /* nothing ran */
-    CHECK(copy_damaged("build/t_mpmbx_a/checkpoint.bin", "build/t_mpmbx_ck/checkpoint.bin", size - 100, -1));
-    CHECK(system(BX "--restart build/t_mpmbx_ck --out build/t_mpmbx_ckout > build/t_mpmbx_ck.out 2>&1; "
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out",
+                           "checkpoint.bin: checksum mismatch (the file is corrupt)"));
+    CHECK(!gk_test_file_has("build/tests/t_mpmbx_ckout/biaxial.csv", "time")); /* nothing ran */
+    CHECK(copy_damaged("build/tests/t_mpmbx_a/checkpoint.bin", "build/tests/t_mpmbx_ck/checkpoint.bin",
+                       size - 100, -1));
+    CHECK(system(BX "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > "
+                    "build/tests/t_mpmbx_ck.out 2>&1; "
                     "test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_ck.out", "truncated"));
-    CHECK(system("build/mpmdem_biaxial --nx 2 --ny 2 --height 1 --quiet --restart build/t_mpmbx_a "
-                 "--out build/t_mpmbx_ckout > build/t_mpmbx_ck.out 2>&1; test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_ck.out", "holds 8 points"));
-    CHECK(system("printf 'GKMPMDEM1biaxial' > build/t_mpmbx_ck/checkpoint.bin && " BX
-                 "--restart build/t_mpmbx_ck --out build/t_mpmbx_ckout > build/t_mpmbx_ck.out 2>&1; test $? "
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out", "truncated"));
+    CHECK(system("build/mpmdem_biaxial --nx 2 --ny 2 --height 1 --quiet --restart build/tests/t_mpmbx_a "
+                 "--out build/tests/t_mpmbx_ckout > build/tests/t_mpmbx_ck.out 2>&1; test $? -eq 1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out", "holds 8 points"));
+    CHECK(system("printf 'GKMPMDEM1biaxial' > build/tests/t_mpmbx_ck/checkpoint.bin && " BX
+                 "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > "
+                 "build/tests/t_mpmbx_ck.out 2>&1; test $? "
                  "-eq 1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_ck.out", "is not a grainkit two-scale checkpoint"));
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out", "is not a grainkit two-scale checkpoint"));
 }
 
 /* a result that cannot be written (its path taken by a folder, or a full disk: /dev/full) ends the
  * run with status 1, said once, naming the file */
 TEST(biaxial_failed_write_exits) {
     static const char *cases[][2] = {
-        {"mkdir -p build/t_mpmbx_w/biaxial.csv", "build/t_mpmbx_w/biaxial.csv"},
-        {"mkdir -p build/t_mpmbx_w && ln -s /dev/full build/t_mpmbx_w/biaxial.csv",
-         "build/t_mpmbx_w/biaxial.csv"},
-        {"mkdir -p build/t_mpmbx_w/checkpoint.bin.tmp", "build/t_mpmbx_w/checkpoint.bin"},
-        {"mkdir -p build/t_mpmbx_w && ln -s /dev/full build/t_mpmbx_w/rotation_end.svg",
-         "build/t_mpmbx_w/rotation_end.svg"},
-        {"mkdir -p build/t_mpmbx_w/points_000000.vtk", "build/t_mpmbx_w/points_000000.vtk"}};
+        {"mkdir -p build/tests/t_mpmbx_w/biaxial.csv", "build/tests/t_mpmbx_w/biaxial.csv"},
+        {"mkdir -p build/tests/t_mpmbx_w && ln -s /dev/full build/tests/t_mpmbx_w/biaxial.csv",
+         "build/tests/t_mpmbx_w/biaxial.csv"},
+        {"mkdir -p build/tests/t_mpmbx_w/checkpoint.bin.tmp", "build/tests/t_mpmbx_w/checkpoint.bin"},
+        {"mkdir -p build/tests/t_mpmbx_w && ln -s /dev/full build/tests/t_mpmbx_w/rotation_end.svg",
+         "build/tests/t_mpmbx_w/rotation_end.svg"},
+        {"mkdir -p build/tests/t_mpmbx_w/points_000000.vtk", "build/tests/t_mpmbx_w/points_000000.vtk"}};
     char cmd[1024], msg[256];
     int k;
     for (k = 0; k < (int)(sizeof cases / sizeof *cases); ++k) {
         snprintf(cmd, sizeof cmd,
-                 "rm -rf build/t_mpmbx_w && %s && " BX
-                 "--strain 0.0005 --out build/t_mpmbx_w > build/t_mpmbx_w.out "
+                 "rm -rf build/tests/t_mpmbx_w && %s && " BX
+                 "--strain 0.0005 --out build/tests/t_mpmbx_w > build/tests/t_mpmbx_w.out "
                  "2>&1; test $? -eq 1",
                  cases[k][0]);
         CHECK(system(cmd) == 0);
         snprintf(msg, sizeof msg, "mpmdem_biaxial: cannot write %s", cases[k][1]);
-        CHECK(gk_test_file_has("build/t_mpmbx_w.out", msg));
-        CHECK(count_lines("build/t_mpmbx_w.out", "cannot write") == 1);
-        CHECK(!gk_test_file_has("build/t_mpmbx_w.out", "wrote ")); /* no claim of what was not written */
+        CHECK(gk_test_file_has("build/tests/t_mpmbx_w.out", msg));
+        CHECK(count_lines("build/tests/t_mpmbx_w.out", "cannot write") == 1);
+        CHECK(
+            !gk_test_file_has("build/tests/t_mpmbx_w.out", "wrote ")); /* no claim of what was not written */
     }
 }
 
 /* --out must be a folder (created with its parents): a file there is refused, and the default
- * (no --out) is build/mpm_biaxial, where the results land */
+ * (no --out) is build/mpm_biaxial under the working directory, where the results land (run from
+ * build/tests/t_mpmbx_cwd, so that the test writes only under build/tests) */
 TEST(biaxial_out_folder) {
-    CHECK(system("rm -rf build/t_mpmbx_f && echo x > build/t_mpmbx_file && " BX
-                 "--out build/t_mpmbx_file > build/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_f.out",
-                           "--out build/t_mpmbx_file: build/t_mpmbx_file is a file, not a folder"));
-    CHECK(gk_test_file_has("build/t_mpmbx_file", "x")); /* untouched */
-    CHECK(system(BX "--out build/t_mpmbx_file/sub > build/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_f.out", "is a file, not a folder"));
-    CHECK(system("rm -rf build/mpm_biaxial/biaxial.csv && " BX
-                 "--strain 0.0005 > build/t_mpmbx_f.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/mpm_biaxial/biaxial.csv", "time,eps_axial"));
-    CHECK(system(BX "--strain 0.0005 --out build/t_mpmbx_f/a/b > build/t_mpmbx_f.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmbx_f/a/b/biaxial.csv", "time,eps_axial"));
+    CHECK(system("rm -rf build/tests/t_mpmbx_f && echo x > build/tests/t_mpmbx_file && " BX
+                 "--out build/tests/t_mpmbx_file > build/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
+    CHECK(
+        gk_test_file_has("build/tests/t_mpmbx_f.out",
+                         "--out build/tests/t_mpmbx_file: build/tests/t_mpmbx_file is a file, not a folder"));
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_file", "x")); /* untouched */
+    CHECK(system(BX "--out build/tests/t_mpmbx_file/sub > build/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") ==
+          0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_f.out", "is a file, not a folder"));
+    CHECK(system(
+              "rm -rf build/tests/t_mpmbx_cwd && mkdir build/tests/t_mpmbx_cwd && cd build/tests/t_mpmbx_cwd "
+              "&& "
+              "../../mpmdem_biaxial --packing ../../../examples/data/rve400.txt --nx 2 --ny 4 --every 0.0005 "
+              "--quiet --strain 0.0005 > ../t_mpmbx_f.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_cwd/build/mpm_biaxial/biaxial.csv", "time,eps_axial"));
+    CHECK(system(BX "--strain 0.0005 --out build/tests/t_mpmbx_f/a/b > build/tests/t_mpmbx_f.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmbx_f/a/b/biaxial.csv", "time,eps_axial"));
 }
 
 int main(int argc, char **argv) {

@@ -40,12 +40,13 @@ static int read_rows(const char *path, double rows[][NCOL], int max) {
 TEST(footing_runs_and_loads) {
     double r[16][NCOL], phi, nq, nqa, pi = 3.14159265358979323846, t;
     int n, k;
-    CHECK(system(FT "--final 0.02 --phi-pressures 20 --phi-strain 0.025 --threads 1 --out build/t_mpmft "
-                    "> build/t_mpmft.out 2>&1") == 0);
+    CHECK(system(FT
+                 "--final 0.02 --phi-pressures 20 --phi-strain 0.025 --threads 1 --out build/tests/t_mpmft "
+                 "> build/tests/t_mpmft.out 2>&1") == 0);
     CHECK(
-        gk_test_file_has("build/t_mpmft/footing.csv",
+        gk_test_file_has("build/tests/t_mpmft/footing.csv",
                          "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds"));
-    n = read_rows("build/t_mpmft/footing.csv", r, 16);
+    n = read_rows("build/tests/t_mpmft/footing.csv", r, 16);
     CHECK_EQ_INT(n, 5);
     if (n != 5) return;
     CHECK(r[0][2] < 1e-3);                               /* first row: d ~ 0 */
@@ -56,36 +57,36 @@ TEST(footing_runs_and_loads) {
         CHECK(r[k][3] > r[k - 1][3]); /* the load grows with the settlement at first */
     }
     CHECK(r[n - 1][4] > 5.0);
-    phi = gk_test_result("build/t_mpmft.out", "phi_deg");
+    phi = gk_test_result("build/tests/t_mpmft.out", "phi_deg");
     CHECK(phi > 25.0 && phi < 40.0);
     t = tan(pi / 4 + phi * pi / 360.0);
-    nqa = gk_test_result("build/t_mpmft.out", "Nq_analytic");
+    nqa = gk_test_result("build/tests/t_mpmft.out", "Nq_analytic");
     CHECK_REL(nqa, t * t * exp(pi * tan(phi * pi / 180.0)), 2e-4);
-    nq = gk_test_result("build/t_mpmft.out", "Nq");
+    nq = gk_test_result("build/tests/t_mpmft.out", "Nq");
     CHECK(nq > 1.0 && nq < 100.0);
-    CHECK_NEAR(gk_test_result("build/t_mpmft.out", "n_rves"), 12, 0);
-    CHECK_NEAR(gk_test_result("build/t_mpmft.out", "ultimate_reached"), 0, 0); /* 0.02 B: too early */
-    CHECK(gk_test_file_has("build/t_mpmft.out", "ultimate load NOT reached"));
-    CHECK(gk_test_result("build/t_mpmft.out", "mpm_steps") > 10);
-    CHECK(gk_test_result("build/t_mpmft.out", "seconds_per_step_per_1000_rves") > 0);
-    CHECK(gk_test_file_has("build/t_mpmft/footing_load.svg", "<svg"));
-    CHECK(gk_test_file_has("build/t_mpmft/rve_mohr.svg", "<svg"));
-    CHECK(gk_test_file_has("build/t_mpmft/rve_biaxial.svg", "<svg"));
-    CHECK(gk_test_file_has("build/t_mpmft/eps_q_end.svg", "<svg"));
-    CHECK(gk_test_file_has("build/t_mpmft/displacement_end.svg", "<svg"));
-    CHECK(gk_test_file_has("build/t_mpmft/points_000000.vtk", "SCALARS eps_q"));
+    CHECK_NEAR(gk_test_result("build/tests/t_mpmft.out", "n_rves"), 12, 0);
+    CHECK_NEAR(gk_test_result("build/tests/t_mpmft.out", "ultimate_reached"), 0, 0); /* 0.02 B: too early */
+    CHECK(gk_test_file_has("build/tests/t_mpmft.out", "ultimate load NOT reached"));
+    CHECK(gk_test_result("build/tests/t_mpmft.out", "mpm_steps") > 10);
+    CHECK(gk_test_result("build/tests/t_mpmft.out", "seconds_per_step_per_1000_rves") > 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmft/footing_load.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_mpmft/rve_mohr.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_mpmft/rve_biaxial.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_mpmft/eps_q_end.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_mpmft/displacement_end.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_mpmft/points_000000.vtk", "SCALARS eps_q"));
 }
 
 /* the ultimate-load rule on a curve that peaks: a longer run of the same
  * model reaches a peak (this coarse footing at d/B ~ 0.04) and reports it */
 TEST(footing_ultimate_found) {
     double du, nq, qu;
-    CHECK(system(FT "--final 0.08 --smooth 0.02 --phi-deg 30 --threads 1 --out build/t_mpmft_u "
-                    "> build/t_mpmft_u.out 2>&1") == 0);
-    CHECK_NEAR(gk_test_result("build/t_mpmft_u.out", "ultimate_reached"), 1, 0);
-    du = gk_test_result("build/t_mpmft_u.out", "d_ult_over_B");
-    nq = gk_test_result("build/t_mpmft_u.out", "Nq");
-    qu = gk_test_result("build/t_mpmft_u.out", "q_ult");
+    CHECK(system(FT "--final 0.08 --smooth 0.02 --phi-deg 30 --threads 1 --out build/tests/t_mpmft_u "
+                    "> build/tests/t_mpmft_u.out 2>&1") == 0);
+    CHECK_NEAR(gk_test_result("build/tests/t_mpmft_u.out", "ultimate_reached"), 1, 0);
+    du = gk_test_result("build/tests/t_mpmft_u.out", "d_ult_over_B");
+    nq = gk_test_result("build/tests/t_mpmft_u.out", "Nq");
+    qu = gk_test_result("build/tests/t_mpmft_u.out", "q_ult");
     CHECK(du > 0.0 && du < 0.08 - 0.02);
     CHECK_REL(nq, qu / 2e4, 1e-4);
     CHECK(nq > 3.0 && nq < 60.0);
@@ -94,36 +95,41 @@ TEST(footing_ultimate_found) {
 /* RVEs and the MPM run in parallel: one and two threads give the same curve */
 TEST(footing_thread_independent) {
     /* passive waiting: spinning OpenMP threads crawl on a machine busy with other jobs */
-    CHECK(system("OMP_WAIT_POLICY=passive " FT "--final 0.02 --phi-deg 30 --threads 2 --out build/t_mpmft2 "
-                 "> build/t_mpmft2.out 2>&1") == 0);
-    CHECK(system(FT "--final 0.02 --phi-deg 30 --threads 1 --out build/t_mpmft1 > build/t_mpmft1.out 2>&1") ==
-          0);
-    CHECK(gk_test_result("build/t_mpmft1.out", "Nq") == gk_test_result("build/t_mpmft2.out", "Nq"));
-    CHECK(system("cut -d, -f1-8 build/t_mpmft1/footing.csv > build/t_mpmft1.c && "
-                 "cut -d, -f1-8 build/t_mpmft2/footing.csv > build/t_mpmft2.c && "
-                 "cmp -s build/t_mpmft1.c build/t_mpmft2.c") == 0);
+    CHECK(system("OMP_WAIT_POLICY=passive " FT
+                 "--final 0.02 --phi-deg 30 --threads 2 --out build/tests/t_mpmft2 "
+                 "> build/tests/t_mpmft2.out 2>&1") == 0);
+    CHECK(system(FT "--final 0.02 --phi-deg 30 --threads 1 --out build/tests/t_mpmft1 > "
+                    "build/tests/t_mpmft1.out 2>&1") == 0);
+    CHECK(gk_test_result("build/tests/t_mpmft1.out", "Nq") ==
+          gk_test_result("build/tests/t_mpmft2.out", "Nq"));
+    CHECK(system("cut -d, -f1-8 build/tests/t_mpmft1/footing.csv > build/tests/t_mpmft1.c && "
+                 "cut -d, -f1-8 build/tests/t_mpmft2/footing.csv > build/tests/t_mpmft2.c && "
+                 "cmp -s build/tests/t_mpmft1.c build/tests/t_mpmft2.c") == 0);
 }
 
 /* a checkpoint half-way, then --restart: the same curve to the last digit */
 TEST(footing_restart_identical) {
     int rc = system(
-        FT "--final 0.01 --phi-deg 30 --threads 1 --out build/t_mpmft_a > build/t_mpmft_a.out 2>&1 && " FT
-           "--final 0.02 --phi-deg 30 --threads 1 --restart build/t_mpmft_a --out build/t_mpmft_b "
-           "> build/t_mpmft_b.out 2>&1");
+        FT
+        "--final 0.01 --phi-deg 30 --threads 1 --out build/tests/t_mpmft_a > build/tests/t_mpmft_a.out 2>&1 "
+        "&& " FT
+        "--final 0.02 --phi-deg 30 --threads 1 --restart build/tests/t_mpmft_a --out build/tests/t_mpmft_b "
+        "> build/tests/t_mpmft_b.out 2>&1");
     CHECK(rc == 0);
-    CHECK(gk_test_result("build/t_mpmft_b.out", "Nq") == gk_test_result("build/t_mpmft1.out", "Nq"));
-    CHECK(system("cut -d, -f1-8 build/t_mpmft_b/footing.csv > build/t_mpmft_b.c && "
-                 "cmp -s build/t_mpmft_b.c build/t_mpmft1.c") == 0);
+    CHECK(gk_test_result("build/tests/t_mpmft_b.out", "Nq") ==
+          gk_test_result("build/tests/t_mpmft1.out", "Nq"));
+    CHECK(system("cut -d, -f1-8 build/tests/t_mpmft_b/footing.csv > build/tests/t_mpmft_b.c && "
+                 "cmp -s build/tests/t_mpmft_b.c build/tests/t_mpmft1.c") == 0);
 }
 
 /* bad input: a message and a non-zero exit, nothing run */
 TEST(footing_bad_arguments) {
-    const char *o = " > build/t_mpmft_bad.out 2>&1";
+    const char *o = " > build/tests/t_mpmft_bad.out 2>&1";
     char cmd[512];
-#define BAD(args, msg)                                               \
-    snprintf(cmd, sizeof cmd, "build/mpmdem_footing %s%s", args, o); \
-    CHECK(system(cmd) != 0);                                         \
-    CHECK(gk_test_file_has("build/t_mpmft_bad.out", msg))
+#define BAD(args, msg)                                                                             \
+    snprintf(cmd, sizeof cmd, "build/mpmdem_footing --out build/tests/t_mpmft_bad %s%s", args, o); \
+    CHECK(system(cmd) != 0);                                                                       \
+    CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", msg))
     BAD("--nx 0", "out of range");
     BAD("--nx 31 --ny 15", "square");
     BAD("--material wet", "dense, medium or soft");
@@ -140,12 +146,12 @@ TEST(footing_bad_arguments) {
     BAD("--phi-pressures 10,,20", "--phi-pressures");
     BAD("--phi-pressures 10,20,", "--phi-pressures");
     BAD("--every 0.5 --final 0.2", "--every 0.5 is out of range");
-    BAD("--out build/t_mpmft_bad.out", "is a file, not a folder");
+    BAD("--out build/tests/t_mpmft_bad.out", "is a file, not a folder");
 #undef BAD
-    CHECK(system("build/mpmdem_footing --help > build/t_mpmft_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_mpmft_bad.out", "--phi-pressures"));
-    CHECK(gk_test_file_has("build/t_mpmft_bad.out", "--paper"));
-    CHECK(gk_test_file_has("build/t_mpmft_bad.out", "--dem-rule"));
+    CHECK(system("build/mpmdem_footing --help > build/tests/t_mpmft_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", "--phi-pressures"));
+    CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", "--paper"));
+    CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", "--dem-rule"));
 }
 
 int main(int argc, char **argv) {

@@ -1641,24 +1641,25 @@ TEST(dem_biaxial_smoke) {
     double ratio, n;
     int rc;
     rc = system("build/dem_biaxial --tiles 1x1 --strain 0.01 --every 0.002 --pictures 0.004 --quiet "
-                "--out build/t_dembx > build/t_dembx.out 2>&1");
+                "--out build/tests/t_dembx > build/tests/t_dembx.out 2>&1");
     CHECK(rc == 0);
     CHECK(gk_test_file_has(
-        "build/t_dembx/biaxial.csv",
+        "build/tests/t_dembx/biaxial.csv",
         "eps_axial,sigma_yy_lid,sigma_xx,sigma_yy,eps_vol,stress_ratio,phi_deg,coordination"));
-    CHECK(gk_test_file_has("build/t_dembx/particles_001.vtk", "POINT_DATA"));
-    CHECK(gk_test_file_has("build/t_dembx/walls_end.vtk", "CELL_DATA"));
-    CHECK(gk_test_file_has("build/t_dembx/particles_000.svg", "<svg"));
-    CHECK(gk_test_file_has("build/t_dembx/biaxial_stress.svg", "<svg"));
-    ratio = gk_test_result("build/t_dembx.out", "peak_ratio");
-    n = gk_test_result("build/t_dembx.out", "n");
+    CHECK(gk_test_file_has("build/tests/t_dembx/particles_001.vtk", "POINT_DATA"));
+    CHECK(gk_test_file_has("build/tests/t_dembx/walls_end.vtk", "CELL_DATA"));
+    CHECK(gk_test_file_has("build/tests/t_dembx/particles_000.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_dembx/biaxial_stress.svg", "<svg"));
+    ratio = gk_test_result("build/tests/t_dembx.out", "peak_ratio");
+    n = gk_test_result("build/tests/t_dembx.out", "n");
     printf("    n %g, peak stress ratio %.4f at %.4f, sigma_yy peak %.4g Pa\n", n, ratio,
-           gk_test_result("build/t_dembx.out", "eps_peak"), gk_test_result("build/t_dembx.out", "syy_peak"));
+           gk_test_result("build/tests/t_dembx.out", "eps_peak"),
+           gk_test_result("build/tests/t_dembx.out", "syy_peak"));
     CHECK(n == 400);
     CHECK(ratio > 0.1 && ratio < 0.8);
-    CHECK(gk_test_result("build/t_dembx.out", "syy_peak") > 1.2e5);
+    CHECK(gk_test_result("build/tests/t_dembx.out", "syy_peak") > 1.2e5);
     {
-        FILE *fp = fopen("build/t_dembx/biaxial.csv", "r");
+        FILE *fp = fopen("build/tests/t_dembx/biaxial.csv", "r");
         char line[512];
         double e, lid, sxx;
         int ok = fp && fgets(line, sizeof line, fp) && fgets(line, sizeof line, fp) &&
@@ -1668,16 +1669,16 @@ TEST(dem_biaxial_smoke) {
         CHECK_REL(lid, 1e5, 0.02);
         CHECK_REL(sxx, 1e5, 0.1);
     }
-    CHECK(WEXITSTATUS(system("build/dem_biaxial --strain abc > build/t_dembx.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/t_dembx.err", "--strain abc: not a number"));
-    CHECK(WEXITSTATUS(system("build/dem_biaxial --tiles 0x2 > build/t_dembx.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/t_dembx.err", "--tiles"));
-    CHECK(WEXITSTATUS(system("build/dem_biaxial --bogus 1 > build/t_dembx.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/t_dembx.err", "unknown option --bogus"));
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --strain abc > build/tests/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/tests/t_dembx.err", "--strain abc: not a number"));
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --tiles 0x2 > build/tests/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/tests/t_dembx.err", "--tiles"));
+    CHECK(WEXITSTATUS(system("build/dem_biaxial --bogus 1 > build/tests/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/tests/t_dembx.err", "unknown option --bogus"));
     CHECK(WEXITSTATUS(system("build/dem_biaxial --tiles 1x1 --strain 0.002 --every 0.001 --quiet "
-                             "--out /proc/no_such_dir > build/t_dembx.err 2>&1")) == 1);
-    CHECK(system("build/dem_biaxial --help > build/t_dembx.err 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_dembx.err", "RESULT"));
+                             "--out /proc/no_such_dir > build/tests/t_dembx.err 2>&1")) == 1);
+    CHECK(system("build/dem_biaxial --help > build/tests/t_dembx.err 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_dembx.err", "RESULT"));
 }
 
 /* examples/dem_collapse.c on a small column (8 disks across, 0.6 s): the
@@ -1687,28 +1688,28 @@ TEST(dem_biaxial_smoke) {
 TEST(dem_collapse_smoke) {
     double ds, ed, bal, h;
     CHECK(system("build/dem_collapse --diameters 8 --t-end 0.6 --every 0.02 --snapshots 0.3 --quiet "
-                 "--out build/t_demcl > build/t_demcl.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/t_demcl/collapse.csv",
+                 "--out build/tests/t_demcl > build/tests/t_demcl.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_demcl/collapse.csv",
                            "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0"));
-    CHECK(gk_test_file_has("build/t_demcl/particles_001.vtk", "POINT_DATA"));
-    CHECK(gk_test_file_has("build/t_demcl/walls_000.vtk", "CELL_DATA"));
-    CHECK(gk_test_file_has("build/t_demcl/collapse_front.svg", "<svg"));
-    CHECK(gk_test_file_has("build/t_demcl/collapse_energy.svg", "<svg"));
-    ds = gk_test_result("build/t_demcl.out", "dstar");
-    ed = gk_test_result("build/t_demcl.out", "Ed_final_over_Ep0");
-    bal = gk_test_result("build/t_demcl.out", "energy_balance");
-    h = gk_test_result("build/t_demcl.out", "height_over_H0");
+    CHECK(gk_test_file_has("build/tests/t_demcl/particles_001.vtk", "POINT_DATA"));
+    CHECK(gk_test_file_has("build/tests/t_demcl/walls_000.vtk", "CELL_DATA"));
+    CHECK(gk_test_file_has("build/tests/t_demcl/collapse_front.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_demcl/collapse_energy.svg", "<svg"));
+    ds = gk_test_result("build/tests/t_demcl.out", "dstar");
+    ed = gk_test_result("build/tests/t_demcl.out", "Ed_final_over_Ep0");
+    bal = gk_test_result("build/tests/t_demcl.out", "energy_balance");
+    h = gk_test_result("build/tests/t_demcl.out", "height_over_H0");
     printf("    d* %.4f, E_d %.4f E_p0, height %.4f H0, balance %.2e E_p0\n", ds, ed, h, bal);
     CHECK(ds > 0.3);
     CHECK(ed > 0.0 && ed <= 1.0);
     CHECK(h < 1.0);
     CHECK(fabs(bal) < 1e-3);
-    CHECK(WEXITSTATUS(system("build/dem_collapse --a 20 > build/t_demcl.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/t_demcl.err", "--a: need an aspect ratio"));
-    CHECK(WEXITSTATUS(system("build/dem_collapse --snapshots 1,0.5 > build/t_demcl.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/t_demcl.err", "--snapshots"));
+    CHECK(WEXITSTATUS(system("build/dem_collapse --a 20 > build/tests/t_demcl.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/tests/t_demcl.err", "--a: need an aspect ratio"));
+    CHECK(WEXITSTATUS(system("build/dem_collapse --snapshots 1,0.5 > build/tests/t_demcl.err 2>&1")) == 2);
+    CHECK(gk_test_file_has("build/tests/t_demcl.err", "--snapshots"));
     CHECK(WEXITSTATUS(system("build/dem_collapse --diameters 8 --t-end 0.02 --quiet --out /proc/no_such_dir "
-                             "> build/t_demcl.err 2>&1")) == 1);
+                             "> build/tests/t_demcl.err 2>&1")) == 1);
 }
 
 int main(int argc, char **argv) {
