@@ -352,8 +352,9 @@ static int run(bx *X, int argc, char **argv) {
     int status = parse(X, argc, argv), bad = 0;
     gk_err err;
     if (status) return status == 1 ? 0 : status;
-    if (mpd_out_dir(&X->run)) return 1;
+    /* the inputs (packing, checkpoint) first: bad input leaves no output folder behind */
     if (setup(X, &err)) return fprintf(stderr, "mpmdem_biaxial: %s\n", err.msg), 1;
+    if (mpd_out_dir(&X->run)) return 1;
     nsteps_total = (long)ceil((b->strain * b->height / b->velocity + 0.5 * b->ramp) / X->dt);
     printf("mpmdem_biaxial: %d x %d cells, h = %.4g m, %d points (= RVEs of %d disks), basis %d, alpha %g\n",
            b->nx, b->ny, X->h, X->pts.n, X->P.pk.n, (int)X->def.basis, X->o.alpha);

@@ -612,9 +612,10 @@ static int run(cl *X, int argc, char **argv) {
     int status = parse(X, argc, argv), bad = 0;
     gk_err err;
     if (status) return status == 1 ? 0 : status;
-    if (mpd_out_dir(&X->run)) return 1;
+    /* the inputs (packing, checkpoint) first: bad input leaves no output folder behind */
     if ((status = setup(X, &err)) != 0)
         return status == 2 ? 2 : (fprintf(stderr, "mpmdem_collapse: %s\n", err.msg), 1);
+    if (mpd_out_dir(&X->run)) return 1;
     nsteps_total = (long)ceil(b->t_end / S->dt - 1e-9);
     print_setup(X, nsteps_total);
     t_start = gk_wtime();

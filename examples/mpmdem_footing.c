@@ -348,6 +348,20 @@ static int setup(ft *X, gk_err *err) {
     double h = X->h, org[3], lo[3] = {0, 0, 0}, hi[3];
     int n[3], i, gl = mpd_ghost_layers(&X->o), up = gl + (int)ceil(fmax(f->final_dB * f->B, 2 * h) / h);
     if (mpd_proto_open(&X->P, &X->o, err)) return 1;
+    /* the packing read and the checkpoint there to read: now the output folder (the friction-angle
+     * measurement writes into it; the checkpoint is read after it) */
+    if (X->o.restart) { /* rank 0 reads the checkpoint: its verdict on every rank */
+        char path[MPD_PATH];
+        FILE *fp = NULL;
+        if (X->run.rank == 0 && snprintf(path, sizeof path, "%s/checkpoint.bin", X->o.restart) < (int)sizeof path)
+            fp = fopen(path, "rb");
+        if (fp) fclose(fp);
+        if (mpd_agree(&X->run, X->run.rank == 0 && !fp))
+            return gk_err_set(err, GK_ERR_IO, "--restart %s: cannot open %s/checkpoint.bin", X->o.restart,
+                              X->o.restart),
+                   1;
+    }
+    if (mpd_out_dir(&X->run)) return gk_err_set(err, GK_ERR_IO, "no output folder (above)"), 1;
     printf("mpmdem_footing: Liang & Zhao Table 2 '%s': E = %g MPa, kt/kn = %g, friction %g deg, beta %g, eta "
            "%g, "
            "damping %g; DEM dt = %.3g s\n",
@@ -705,7 +719,6 @@ static int run(ft *X, int argc, char **argv) {
     int status = parse(X, argc, argv), bad = 0;
     gk_err err;
     if (status) return status == 1 ? 0 : status;
-    if (mpd_out_dir(&X->run)) return 1;
     if (setup(X, &err)) return fprintf(stderr, "mpmdem_footing: %s\n", err.msg), 1;
     nsteps_total = (long)ceil((f->final_dB * f->B / f->velocity + 0.5 * f->ramp) / X->dt);
     if (f->max_steps && f->max_steps < nsteps_total) nsteps_total = f->max_steps;

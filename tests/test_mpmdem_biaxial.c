@@ -94,12 +94,15 @@ TEST(biaxial_bad_arguments) {
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "square"));
     CHECK(system("build/mpmdem_biaxial --alpha 2 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--alpha"));
+    /* bad input changes nothing: no output folder is made before the inputs are read */
+    CHECK(system("rm -rf build/tests/t_mpmbx_bad") == 0);
     CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --packing /nonexistent > "
                  "build/tests/t_mpmbx_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "nonexistent"));
     CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --restart /nonexistent --nx 2 --ny 4 > "
                  "build/tests/t_mpmbx_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "cannot open"));
+    CHECK(system("test -e build/tests/t_mpmbx_bad") != 0);
     CHECK(system("build/mpmdem_biaxial --help > build/tests/t_mpmbx_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--dem-strain"));
     CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "(default build/mpm_biaxial)"));

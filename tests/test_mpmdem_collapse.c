@@ -153,12 +153,15 @@ TEST(collapse_bad_arguments) {
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "unknown option --bogus"));
     CHECK(system("build/mpmdem_collapse --levels > build/tests/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "needs a value"));
+    /* bad input changes nothing: no output folder is made before the inputs are read */
+    CHECK(system("rm -rf build/tests/t_mpmcl_bad") == 0);
     CHECK(system("build/mpmdem_collapse --out build/tests/t_mpmcl_bad --packing /nonexistent > "
                  "build/tests/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "nonexistent"));
     CHECK(system("build/mpmdem_collapse --out build/tests/t_mpmcl_bad --nx 4 --restart /nonexistent > "
                  "build/tests/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "cannot open"));
+    CHECK(system("test -e build/tests/t_mpmcl_bad") != 0);
     CHECK(system("build/mpmdem_collapse --help > build/tests/t_mpmcl_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--thin-cell"));
     CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--rest-frac"));

@@ -141,8 +141,11 @@ TEST(footing_bad_arguments) {
     BAD("--velocity", "needs a value");
     BAD("--bogus 1", "unknown option");
     BAD("--alpha 2", "--alpha");
+    /* bad input changes nothing: no output folder is made before the inputs are read */
+    CHECK(system("rm -rf build/tests/t_mpmft_bad") == 0);
     BAD("--packing /nonexistent", "nonexistent");
     BAD("--phi-deg 30 --restart /nonexistent", "cannot open");
+    CHECK(system("test -e build/tests/t_mpmft_bad") != 0);
     BAD("--phi-pressures 10,,20", "--phi-pressures");
     BAD("--phi-pressures 10,20,", "--phi-pressures");
     BAD("--every 0.5 --final 0.2", "--every 0.5 is out of range");
