@@ -99,9 +99,10 @@ TEST(readme_names_every_header_and_driver) {
 }
 
 /* what a user of the project never has: the developers' shared folder, the
- * design brief, issue numbers */
+ * design brief, issue numbers (the first two split in the source so that
+ * this file does not name them either) */
 static int clean(const char *path) {
-    static const char *bad[] = {"../shared", "DESIGN.md", "issue 1", "issue 2", "issue 3", "issue 4",
+    static const char *bad[] = {"../sha" "red", "DESI" "GN.md", "issue 1", "issue 2", "issue 3", "issue 4",
                                 "issue 5",   "issue 6",   "issue 7", "issue 8", "issue 9", "the issue's",
                                 "seed 00"};
     char *t = gk_test_slurp(path);
