@@ -353,8 +353,7 @@ static int setup(ft *X, gk_err *err) {
     if (X->o.restart) { /* rank 0 reads the checkpoint: its verdict on every rank */
         char path[MPD_PATH];
         FILE *fp = NULL;
-        if (X->run.rank == 0 && snprintf(path, sizeof path, "%s/checkpoint.bin", X->o.restart) < (int)sizeof path)
-            fp = fopen(path, "rb");
+        if (X->run.rank == 0 && !mpd_checkpoint_path(X->o.restart, path)) fp = fopen(path, "rb");
         if (fp) fclose(fp);
         if (mpd_agree(&X->run, X->run.rank == 0 && !fp))
             return gk_err_set(err, GK_ERR_IO, "--restart %s: cannot open %s/checkpoint.bin", X->o.restart,

@@ -356,14 +356,18 @@ static int mpd_save(const mpd_run *run, mpd_micro *m, gk_mpm_points *pts, const 
 }
 
 /* DIR/checkpoint.bin back into the set, the points and the driver's state, rows and snapshots */
+/* DIR/checkpoint.bin into path (MPD_PATH bytes); 1 if it does not fit */
+static int mpd_checkpoint_path(const char *dir, char *path) {
+    return snprintf(path, MPD_PATH, "%s/checkpoint.bin", dir) >= MPD_PATH;
+}
+
 static gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, const char *tag, void *S,
                           size_t nS, mpd_rows *R, mpd_snaps *sn, gk_err *err) {
     char path[MPD_PATH];
     void *blk = NULL;
     size_t nblk = 0;
     mpd_buf B;
-    if (snprintf(path, sizeof path, "%s/checkpoint.bin", dir) >= (int)sizeof path)
-        return gk_err_set(err, GK_ERR_ARG, "--restart %s: path too long", dir);
+    if (mpd_checkpoint_path(dir, path)) return gk_err_set(err, GK_ERR_ARG, "--restart %s: path too long", dir);
     if (gk_twoscale_load(&m->ts, path, &blk, &nblk))
         return gk_err_set(err, m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
     memset(&B, 0, sizeof B);
