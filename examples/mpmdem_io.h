@@ -367,7 +367,8 @@ static gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, con
     void *blk = NULL;
     size_t nblk = 0;
     mpd_buf B;
-    if (mpd_checkpoint_path(dir, path)) return gk_err_set(err, GK_ERR_ARG, "--restart %s: path too long", dir);
+    if (mpd_checkpoint_path(dir, path))
+        return gk_err_set(err, GK_ERR_ARG, "--restart %s: path too long", dir);
     if (gk_twoscale_load(&m->ts, path, &blk, &nblk))
         return gk_err_set(err, m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
     memset(&B, 0, sizeof B);
