@@ -165,10 +165,11 @@
  *       previous run, accepted or not - so every Newton iteration of a
  *       load step after the first runs on the costs of the previous one,
  *       which predict it much better than the last step's (the same
- *       accepted state, nearly the same dH; bench/README.md). A pending trial state is not moved: the
- *       run recomputes every point from its accepted state anyway, and an
- *       accept takes the trials of the ranks that ran them. A refused run
- *       (bad argument) moves nothing.
+ *       accepted state, nearly the same dH: correlation 0.975 against
+ *       0.47-0.85 on the biaxial test). A pending trial state is not moved:
+ *       the run recomputes every point from its accepted state anyway, and
+ *       an accept takes the trials of the ranks that ran them. A refused
+ *       run (bad argument) moves nothing.
  *   gk_twoscale_stats counts the moves and their bytes (migrated,
  *   migrated_bytes; under BALANCE_RUN they are also part of run_bytes_*).
  *   The checkpoint is written and read by rank 0. Without GK_TWOSCALE_MPI
