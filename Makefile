@@ -149,24 +149,27 @@ $(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_
 
 # ---------------------------------------------------------------- check
 SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+# -g1 (line tables): sanitizer reports still name file:line and inlined frames,
+# at half the compile time of -g; rebuild one program with -g to debug it
+SANFLAGS := $(WARN) -O1 -g1 $(ARCH) $(FPFLAGS) $(SAN)
 ASAN_TESTS   := $(patsubst tests/%.c,$(BUILD)/asan/%,$(TEST_SRC)) $(patsubst %,$(BUILD)/asan/fuzz_replay_%,$(FUZZ_NAMES))
 NOSIMD_TESTS := $(patsubst tests/%.c,$(BUILD)/nosimd/%,$(TEST_SRC))
 
 $(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/asan
-	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -Itests -DGK_TEST_QUICK -o $@ $< $(LDLIBS)
+	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK -o $@ $< $(LDLIBS)
 
 $(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)/asan
-	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(LDLIBS)
+	$(CC) $(SANFLAGS) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(LDLIBS)
 
 # tools and drivers under ASan + UBSan for tests/smoke_asan.sh (a driver joins
 # by its name in SMOKE and its runs in the script)
 SMOKE := rve_path gk_pack mpmdem_biaxial mpmdem_footing mpmdem_collapse bench_scene_box femdem_nonlocal femdem_dr hybrid
 $(BUILD)/asan/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)/asan
-	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
+	$(CC) $(SANFLAGS) -Iinclude -o $@ $< $(LDLIBS)
 $(BUILD)/asan/%: tools/%.c $(HEADERS) | $(BUILD)/asan
-	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
+	$(CC) $(SANFLAGS) -Iinclude -o $@ $< $(LDLIBS)
 $(BUILD)/asan/bench_%: bench/%.c $(HEADERS) | $(BUILD)/asan
-	$(CC) $(WARN) -O1 -g $(ARCH) $(FPFLAGS) $(SAN) -Iinclude -o $@ $< $(LDLIBS)
+	$(CC) $(SANFLAGS) -Iinclude -o $@ $< $(LDLIBS)
 
 check-smoke: $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) | $(BUILD)/tests
 	@echo "== tool and driver smoke runs under AddressSanitizer + UndefinedBehaviorSanitizer, leaks included"
