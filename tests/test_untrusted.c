@@ -863,6 +863,7 @@ TEST(driver_checkpoint_blocks_are_checked) {
     size_t n, at;
     int32_t step = -5;
     double v;
+    remove(OUT("fd_b/biaxial.csv")), remove(OUT("mp_b/biaxial.csv")); /* of an earlier run */
     CHECK_EQ_INT(run_status("build/gk_pack --n 60 --out " OUT("ck_pk.txt") LOG("ck_pk")), 0);
     /* FEMxDEM: the block starts with its tag, 4 ints of the mesh options, then the step */
     CHECK_EQ_INT(run_status(FD_CK "--out " OUT("fd_a") LOG("fd_a")), 0);
