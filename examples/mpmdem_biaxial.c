@@ -143,8 +143,8 @@ static int bx_check(const void *state, const mpd_rows *R, char *why, size_t nwhy
             if (!isfinite(b->lo[j]) || !isfinite(b->hi[j]) || !isfinite(b->v[j]) || !isfinite(b->force[j]) ||
                 !(b->lo[j] <= b->hi[j]))
                 return snprintf(why, nwhy, "plate %d is not a finite box", k), 1;
-        if ((int)b->contact < 0 || (int)b->contact > (int)GK_MPM_CONTACT_SMOOTH || !(b->mu >= 0 && b->mu < 1e6) ||
-            b->face < 0 || b->face > 6)
+        if ((int)b->contact < 0 || (int)b->contact > (int)GK_MPM_CONTACT_SMOOTH ||
+            !(b->mu >= 0 && b->mu < 1e6) || b->face < 0 || b->face > 6)
             return snprintf(why, nwhy, "plate %d: contact law out of range", k), 1;
     }
     for (k = 0; k < R->n; ++k) {

@@ -380,8 +380,9 @@ static int mpd_block_check(const mpd_micro *m, const gk_mpm_points *pts, const m
         for (k = 0; k < 10; ++k)
             if (!isfinite(v[k])) return snprintf(why, nwhy, "point %d: a non-finite value", p), 1;
         for (k = 0; k < 9; ++k)
-            if (!isfinite(F[k]) || !isfinite(pts->L[9 * (size_t)p + k]) || !isfinite(pts->sigma[9 * (size_t)p + k]) ||
-                !isfinite(pts->C[9 * (size_t)p + k]) || !isfinite(m->eps[9 * (size_t)p + k]))
+            if (!isfinite(F[k]) || !isfinite(pts->L[9 * (size_t)p + k]) ||
+                !isfinite(pts->sigma[9 * (size_t)p + k]) || !isfinite(pts->C[9 * (size_t)p + k]) ||
+                !isfinite(m->eps[9 * (size_t)p + k]))
                 return snprintf(why, nwhy, "point %d: a non-finite tensor", p), 1;
         det = F[0] * F[4] - F[1] * F[3];
         if (!(v[6] > 0) || !(v[7] > 0) || !(v[8] > 0) || v[9] < 0 || !(det > 0) ||
@@ -394,7 +395,8 @@ static int mpd_block_check(const mpd_micro *m, const gk_mpm_points *pts, const m
         int used = 0;
         if (!(s->dot > 0) || !isfinite(s->dot)) return snprintf(why, nwhy, "snapshot %d: dot size", k), 1;
         for (j = 0; j < s->ol.nlines; ++j) {
-            if (s->ol.len[j] < 0 || s->ol.len[j] > MPD_MAXLPT) return snprintf(why, nwhy, "snapshot %d: outline", k), 1;
+            if (s->ol.len[j] < 0 || s->ol.len[j] > MPD_MAXLPT)
+                return snprintf(why, nwhy, "snapshot %d: outline", k), 1;
             used += s->ol.len[j];
         }
         for (j = 0; j < 2 * used; ++j)
@@ -435,9 +437,11 @@ static gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, con
     mpd_block(&B, tag, m, pts, S, nS, &R2, &sn2, 0);
     gk_twoscale_free(&m->ts, blk);
     if (B.bad)
-        snprintf(why, sizeof why, "its driver block is not that of an mpmdem_%s run of %d points with these flags",
-                 tag, pts->n);
-    if (B.bad || mpd_block_check(m, pts, &sn2, why, sizeof why) || (check && check(S, &R2, why, sizeof why))) {
+        snprintf(why, sizeof why,
+                 "its driver block is not that of an mpmdem_%s run of %d points with these flags", tag,
+                 pts->n);
+    if (B.bad || mpd_block_check(m, pts, &sn2, why, sizeof why) ||
+        (check && check(S, &R2, why, sizeof why))) {
         K.cap = K.n, K.n = 0; /* read back what was there */
         mpd_block(&K, tag, m, pts, S, nS, &Rk, &snk, 0);
         free(K.b), free(R2.r), free(Rk.r), mpd_snaps_free(&sn2), mpd_snaps_free(&snk);

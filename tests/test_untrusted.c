@@ -855,10 +855,12 @@ static size_t find_tag(const unsigned char *b, size_t n, const char *tag) {
  * position and one of negative mass and ran on them. Refused now, by name, before the run starts
  * (the seeds of fuzz_femdem_ckpt and fuzz_mpmdem_ckpt found the FEMxDEM ones). */
 TEST(driver_checkpoint_blocks_are_checked) {
-#define FD_CK "build/femdem_biaxial --test single --steps 1 --increment 1e-4 --checkpoint 1 --vtk-every 0 " \
-              "--threads 1 --packing " OUT("ck_pk.txt") " "
-#define MP_CK "build/mpmdem_biaxial --nx 1 --ny 2 --width 1 --height 2 --velocity 1 --ramp 0 --every 0.008 " \
-              "--threads 1 --dem-max 50 --quiet --packing " OUT("ck_pk.txt") " "
+#define FD_CK                                                                                     \
+    "build/femdem_biaxial --test single --steps 1 --increment 1e-4 --checkpoint 1 --vtk-every 0 " \
+    "--threads 1 --packing " OUT("ck_pk.txt") " "
+#define MP_CK                                                                                      \
+    "build/mpmdem_biaxial --nx 1 --ny 2 --width 1 --height 2 --velocity 1 --ramp 0 --every 0.008 " \
+    "--threads 1 --dem-max 50 --quiet --packing " OUT("ck_pk.txt") " "
     unsigned char *b;
     size_t n, at;
     int32_t step = -5;
@@ -900,14 +902,16 @@ TEST(driver_checkpoint_blocks_are_checked) {
     v = NAN;
     memcpy(b + at + 44, &v, 8);
     spill_resealed(OUT("mp_bad/checkpoint.bin"), b, n);
-    CHECK_EQ_INT(run_status(MP_CK "--strain 0.016 --restart " OUT("mp_bad") " --out " OUT("mp_b") LOG("mp_b")), 1);
+    CHECK_EQ_INT(
+        run_status(MP_CK "--strain 0.016 --restart " OUT("mp_bad") " --out " OUT("mp_b") LOG("mp_b")), 1);
     CHECK(gk_test_file_has(OUT("mp_b.out"), "point 0: a non-finite value"));
     free(b);
     b = file_image(OUT("mp_a/checkpoint.bin"), &n);
     v = -1.0;
     memcpy(b + at + 44 + 6 * 2 * 8, &v, 8);
     spill_resealed(OUT("mp_bad/checkpoint.bin"), b, n);
-    CHECK_EQ_INT(run_status(MP_CK "--strain 0.016 --restart " OUT("mp_bad") " --out " OUT("mp_b") LOG("mp_b")), 1);
+    CHECK_EQ_INT(
+        run_status(MP_CK "--strain 0.016 --restart " OUT("mp_bad") " --out " OUT("mp_b") LOG("mp_b")), 1);
     CHECK(gk_test_file_has(OUT("mp_b.out"), "point 0: mass, volume"));
     CHECK(!exists(OUT("mp_b/biaxial.csv")));
     free(b);

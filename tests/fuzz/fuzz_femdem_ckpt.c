@@ -270,21 +270,22 @@ int main(int argc, char **argv) {
     /* the driver's block starts with its tag; its size: the model's block plus the driver's part */
     for (b0 = 0; b0 + 16 < n && memcmp(b + b0, FDB_TAG, sizeof FDB_TAG); ++b0) continue;
     blk = 16 + 4 * sizeof(int) + sizeof(int) + 2 * sizeof(double) + sizeof(int) + 2 * sizeof(fd_row) +
-          (2 * (size_t)M.ndof + 25 * (size_t)M.ngp) * sizeof(double) + sizeof(double) + (size_t)M.ndof * sizeof(double) +
-          2 * (size_t)M.ngp * FD_NFIELD * sizeof(double);
+          (2 * (size_t)M.ndof + 25 * (size_t)M.ngp) * sizeof(double) + sizeof(double) +
+          (size_t)M.ndof * sizeof(double) + 2 * (size_t)M.ngp * FD_NFIELD * sizeof(double);
     FUZZ_CHECK(b0 + blk + 8 <= n);
     seed(argv[1], "ckpt_truncated_block", 0, b, n - blk / 2);
     c = (unsigned char *)malloc(n);
     FUZZ_CHECK(c != NULL);
     for (k = 0; k < 6; ++k) {
-        static const char *names[6] = {"ckpt_flip_step", "ckpt_flip_row",  "ckpt_flip_node",
+        static const char *names[6] = {"ckpt_flip_step",   "ckpt_flip_row",     "ckpt_flip_node",
                                        "ckpt_flip_stress", "ckpt_flip_inclast", "ckpt_flip_field"};
         size_t at[6];
         at[0] = b0 + 16 + 4 * sizeof(int) + 3;
         at[1] = b0 + 16 + 6 * sizeof(int) + 2 * sizeof(double) + 7;
         at[2] = b0 + 16 + 6 * sizeof(int) + 2 * sizeof(double) + 2 * sizeof(fd_row) + 8 * 3 + 7;
         at[3] = at[2] + 2 * (size_t)M.ndof * sizeof(double);
-        at[4] = b0 + blk - 2 * (size_t)M.ngp * FD_NFIELD * sizeof(double) - (size_t)M.ndof * sizeof(double) - 1;
+        at[4] =
+            b0 + blk - 2 * (size_t)M.ngp * FD_NFIELD * sizeof(double) - (size_t)M.ndof * sizeof(double) - 1;
         at[5] = b0 + blk - 3;
         memcpy(c, b, n);
         c[at[k]] ^= 0x40;

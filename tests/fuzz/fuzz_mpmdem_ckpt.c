@@ -112,10 +112,11 @@ static void fuzz_setup(void) {
     FUZZ_CHECK(gk_packing_write(pk_path, &pk, "fuzz_mpmdem_ckpt", &err) == GK_OK);
     gk_packing_free(&pk);
     {
-        const char *a[] = {"mpmdem_biaxial", "--nx", "1", "--ny", "2", "--width", "1", "--height", "2",
-                           "--velocity", "1", "--ramp", "0", "--strain", "0.016", "--every", "0.008",
-                           "--threads", "1", "--dem-max", "50", "--dem-dt", "0", "--packing", pk_path,
-                           "--quiet", "--out", ref_dir};
+        const char *a[] = {
+            "mpmdem_biaxial", "--nx",    "1",          "--ny",      "2",       "--width",   "1",
+            "--height",       "2",       "--velocity", "1",         "--ramp",  "0",         "--strain",
+            "0.016",          "--every", "0.008",      "--threads", "1",       "--dem-max", "50",
+            "--dem-dt",       "0",       "--packing",  pk_path,     "--quiet", "--out",     ref_dir};
         for (argc = 0; argc < (int)(sizeof a / sizeof *a); ++argc) argv[argc] = (char *)a[argc];
         argv[argc] = NULL;
     }
@@ -164,7 +165,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     FUZZ_CHECK(bx_check(&X.S, &X.rows, why, sizeof why) == 0);
     FUZZ_CHECK(mpd_block_check(&X.M, &X.pts, &X.snaps, why, sizeof why) == 0);
     for (k = 0; k < 2; ++k) all_finite(X.pts.x[k], (size_t)n), all_finite(X.pts.v[k], (size_t)n);
-    all_finite(X.pts.sigma, 9 * (size_t)n), all_finite(X.pts.F, 9 * (size_t)n), all_finite(X.M.eps, 9 * (size_t)n);
+    all_finite(X.pts.sigma, 9 * (size_t)n), all_finite(X.pts.F, 9 * (size_t)n),
+        all_finite(X.M.eps, 9 * (size_t)n);
     FUZZ_CHECK((f = (double *)malloc((size_t)MPD_NFIELD * n * sizeof *f)) != NULL);
     FUZZ_CHECK(mpd_fields(&X.M, &X.pts, f, &err) == GK_OK);
     all_finite(f, (size_t)MPD_NFIELD * n);
@@ -213,8 +215,10 @@ int main(int argc, char **argv) {
     for (b0 = 0; b0 + 16 < n && memcmp(b + b0, MPD_BLOCK_TAG, sizeof MPD_BLOCK_TAG - 1); ++b0) continue;
     FUZZ_CHECK(b0 + 16 < n);
     for (k = 0; k < 4; ++k) {
-        static const char *names[4] = {"ckpt_flip_position", "ckpt_flip_mass", "ckpt_flip_plate", "ckpt_flip_row"};
-        size_t np = (size_t)X.pts.n, at[4], pts_end = b0 + 44 + 10 * np * 8 + 36 * np * 8 + 9 * np * 8 + 4 * np + 8;
+        static const char *names[4] = {"ckpt_flip_position", "ckpt_flip_mass", "ckpt_flip_plate",
+                                       "ckpt_flip_row"};
+        size_t np = (size_t)X.pts.n, at[4],
+               pts_end = b0 + 44 + 10 * np * 8 + 36 * np * 8 + 9 * np * 8 + 4 * np + 8;
         at[0] = b0 + 44 + 7;
         at[1] = b0 + 44 + 6 * np * 8 + 7;
         at[2] = pts_end + offsetof(bx_state, body) + sizeof(gk_mpm_body) + offsetof(gk_mpm_body, contact);
@@ -225,8 +229,8 @@ int main(int argc, char **argv) {
     }
     { /* the first snapshot's first outline polyline said to have 1000 points */
         size_t np = (size_t)X.pts.n, at = b0 + 44 + 10 * np * 8 + 36 * np * 8 + 9 * np * 8 + 4 * np + 8 +
-                                          sizeof(bx_state) + 8 + (size_t)X.rows.n * sizeof(bx_row) + 4 + 4 + 48 +
-                                          160 + 48 + 8 + offsetof(mpd_outline, len);
+                                          sizeof(bx_state) + 8 + (size_t)X.rows.n * sizeof(bx_row) + 4 + 4 +
+                                          48 + 160 + 48 + 8 + offsetof(mpd_outline, len);
         int32_t big = 1000;
         FUZZ_CHECK(X.snaps.n >= 1 && at + 4 < n);
         memcpy(c, b, n);
