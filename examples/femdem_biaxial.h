@@ -108,22 +108,49 @@ static int fdb_checkpoint(fd_model *M) {
     return bad;
 }
 
+/* --restart DIR: the checkpoint into the set and the model. The model's block and the driver's part
+ * (the predictor's last increment, at most 1 and zero or above 1e-12, and its displacements; the
+ * fields of every row) are read and checked before anything of the model changes: a refused file
+ * leaves the model as it was (the set holds the file's RVE states, which gk_twoscale_load accepted).
+ * 0, or 1 with err set. */
 static int fdb_restart(fd_model *M, gk_err *err) {
     fd_buf B;
-    int bad = fd_ck_load(M, M->o.restart, FDB_TAG, &B, err);
-    size_t nh = (size_t)M->ngp * FD_NFIELD;
-    if (!bad && !(M->hist = (double *)malloc((size_t)M->ncurve * nh * sizeof(double))))
-        bad = 1, gk_err_set(err, GK_ERR_ALLOC, "out of memory");
-    if (!bad &&
-        (fd_get(&B, &M->inclast, sizeof(double)) || fd_get(&B, M->ulast, (size_t)M->ndof * sizeof(double)) ||
-         fd_get(&B, M->hist, (size_t)M->ncurve * nh * sizeof(double)) || B.pos != B.n))
+    fd_ck ck;
+    double inclast = 0.0, *ulast = NULL, *hist = NULL, L = 0.0;
+    size_t nh = (size_t)M->ngp * FD_NFIELD, n = (size_t)M->ndof, k;
+    int bad = fd_ck_read(M, M->o.restart, FDB_TAG, &B, &ck, err);
+    if (bad) return 1;
+    for (k = 0; k < n; ++k) L = fmax(L, fabs(M->A0x[k]));
+    /* the exact length first: no allocation from a row count the rest of the file does not hold */
+    if ((B.n - B.pos) / sizeof(double) != 1 + n + (size_t)ck.nc * nh || (B.n - B.pos) % sizeof(double))
         bad = 1, gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the driver's block has the wrong length",
                             M->o.restart);
+    else if (!(ulast = (double *)malloc(n * sizeof(double) + 1)) ||
+             !(hist = (double *)malloc((size_t)ck.nc * nh * sizeof(double) + 1)))
+        bad = 1, gk_err_set(err, GK_ERR_ALLOC, "out of memory");
+    else {
+        fd_get(&B, &inclast, sizeof(double)), fd_get(&B, ulast, n * sizeof(double));
+        fd_get(&B, hist, (size_t)ck.nc * nh * sizeof(double));
+        if (!(fabs(inclast) <= 1.0) || (inclast != 0.0 && !(fabs(inclast) >= 1e-12)) ||
+            !fd_ck_bounded(ulast, n, 10 * L) || !fd_ck_bounded(hist, (size_t)ck.nc * nh, 1e100))
+            bad = 1, gk_err_set(err, GK_ERR_FORMAT,
+                                "%s/checkpoint.bin: the last increment, its displacements or a row's fields are out "
+                                "of range",
+                                M->o.restart);
+    }
     free(B.b);
-    if (!bad)
-        fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n", M->prog, M->o.restart,
-               M->step, 100 * M->eps_done);
-    return bad;
+    if (!bad && fd_ck_apply(M, &ck, err)) bad = 1;
+    if (bad) {
+        fd_ck_free(&ck), free(ulast), free(hist);
+        return 1;
+    }
+    M->inclast = inclast;
+    memcpy(M->ulast, ulast, n * sizeof(double));
+    free(ulast), free(M->hist);
+    M->hist = hist;
+    fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n", M->prog, M->o.restart,
+           M->step, 100 * M->eps_done);
+    return 0;
 }
 
 /* boundary stresses (compression positive) and volumetric strain */

@@ -187,14 +187,39 @@ static int checkpoint(fd_model *M) {
     return bad;
 }
 
+/* --restart DIR: the model's block and this driver's part (the cyclic state, a cyc_extra per row: the
+ * exact length, every real finite) checked before the model changes (femdem_biaxial.h's fdb_restart) */
 static int restart(cyc_model *C, gk_err *err) {
     fd_model *M = &C->m;
     fd_buf B;
-    int bad = fd_ck_load(M, M->o.restart, ck_tag(C), &B, err);
-    if (!bad && cx_room(C)) bad = 1, gk_err_set(err, GK_ERR_ALLOC, "out of memory");
-    if (!bad && (fd_get(&B, &C->cs, sizeof C->cs) || fd_get(&B, C->cx, (size_t)M->ncurve * sizeof(cyc_extra))))
-        bad = 1, gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the driver's block is truncated", M->o.restart);
+    fd_ck ck;
+    cyc_state cs;
+    cyc_extra *cx = NULL;
+    double d[10];
+    int bad = fd_ck_read(M, M->o.restart, ck_tag(C), &B, &ck, err), k;
+    if (bad) return 1;
+    if (B.n - B.pos != sizeof cs + (size_t)ck.nc * sizeof(cyc_extra))
+        bad = 1, gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the driver's block has the wrong length",
+                            M->o.restart);
+    else if (!(cx = (cyc_extra *)malloc((size_t)ck.nc * sizeof *cx)))
+        bad = 1, gk_err_set(err, GK_ERR_ALLOC, "out of memory");
+    else {
+        fd_get(&B, &cs, sizeof cs), fd_get(&B, cx, (size_t)ck.nc * sizeof *cx);
+        d[0] = cs.gamma, d[1] = cs.g_start, d[2] = cs.t_start, d[3] = cs.tau, d[4] = cs.h, d[5] = cs.p0;
+        d[6] = cs.cyc_liq, d[7] = cs.cyc_gamma, d[8] = cs.G0, d[9] = cs.Gu;
+        bad = !fd_ck_bounded(d, 10, 1e100) || (cs.dir != 1 && cs.dir != -1);
+        for (k = 0; k < ck.nc && !bad; ++k) {
+            double e[5];
+            e[0] = cx[k].cycle, e[1] = cx[k].tau, e[2] = cx[k].p, e[3] = cx[k].q, e[4] = cx[k].top_uy;
+            bad = !fd_ck_bounded(e, 5, 1e100);
+        }
+        if (bad) gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the cyclic state is out of range", M->o.restart);
+    }
     free(B.b);
+    if (!bad && fd_ck_apply(M, &ck, err)) bad = 1;
+    if (!bad && cx_room(C)) bad = 1, gk_err_set(err, GK_ERR_ALLOC, "out of memory");
+    if (!bad) C->cs = cs, memcpy(C->cx, cx, (size_t)ck.nc * sizeof *cx);
+    fd_ck_free(&ck), free(cx);
     if (!bad)
         fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (shear strain %.3f %%, %.2f cycles)\n", M->prog,
                M->o.restart, M->step, 100 * C->cs.gamma, C->cx[M->ncurve - 1].cycle);

@@ -3,7 +3,7 @@
  * For the model of femdem.h: the Gauss-point fields (fd_gp_fields, from gk_twoscale_fields), the VTK of
  * the Gauss points and of the deformed mesh, SVG maps and plots, the CSV writer of the drivers' rows,
  * and the checkpoint: the RVE set's own file (gk_twoscale_save: versioned, checksummed) carrying this
- * model's block (fd_ck_save / fd_ck_load; a driver appends its own bytes). Rank 0 writes (M->root);
+ * model's block (fd_ck_save / fd_ck_read and fd_ck_apply; a driver appends its own bytes). Rank 0 writes (M->root);
  * every function returns non-zero after saying once that a write failed, on every rank.
  */
 #ifndef FEMDEM_IO_H
@@ -222,15 +222,83 @@ static int fd_ck_save(fd_model *M, const char *tag, const fd_buf *extra) {
     return bad;
 }
 
-/* the checkpoint of DIR into the set and the model; B keeps the block positioned at the driver's own
- * part (free B->b after reading it). 0, or 1 with err set. */
-static int fd_ck_load(fd_model *M, const char *dir, const char *tag, fd_buf *B, gk_err *err) {
-    char path[1200], tg[16];
+/* every entry of v[n] finite and within lim */
+static int fd_ck_bounded(const double *v, size_t n, double lim) {
+    size_t k;
+    for (k = 0; k < n; ++k)
+        if (!(fabs(v[k]) <= lim)) return 0;
+    return 1;
+}
+
+/* the model's block of a checkpoint, read and checked, not yet in the model */
+typedef struct fd_ck {
+    int step, nc;
+    double eps, scale;
+    fd_row *rows;
+    double *v; /* the node coordinates, the displacements (ndof each), sig_n (9 ngp), D_n (16 ngp) */
+} fd_ck;
+
+static void fd_ck_free(fd_ck *ck) {
+    free(ck->rows), free(ck->v);
+    ck->rows = NULL, ck->v = NULL;
+}
+
+/* the block's values checked: the step counters and rows in range (their sums without overflow),
+ * the nodes where the initial ones plus the displacements put them (at most 10 specimen sizes away;
+ * the two sums of the same increments differ by rounding only) with every element's det J > 0, the
+ * stresses and tangents finite within 1e100. 0, or 1 with the reason in why. */
+static int fd_ck_check(const fd_model *M, const fd_ck *ck, char *why, size_t nwhy) {
+    size_t n = (size_t)M->ndof, k;
+    const double *x = ck->v, *u = ck->v + n;
+    double L = 0.0;
+    long long sum[3] = {0, 0, 0};
+    int c;
+    gk_mesh m;
+    gk_err e;
+    /* the loop adds 1 to the step and runs from eps to --steps x --increment; the cut-back scale
+     * halves from 1 and the driver gives up below 1/16 */
+    if (ck->step < 0 || ck->step > 1000000000 || !(ck->eps >= 0.0 && ck->eps < 1.0) ||
+        !(ck->scale >= 1.0 / 64 && ck->scale <= 1.0))
+        return snprintf(why, nwhy, "step %d, axial strain %g or increment scale %g out of range", ck->step, ck->eps,
+                        ck->scale),
+               1;
+    for (c = 0; c < ck->nc; ++c) {
+        const fd_row *r = &ck->rows[c];
+        double d[9];
+        long long w[3];
+        int bad;
+        d[0] = r->eps, d[1] = r->syy, d[2] = r->sxx, d[3] = r->ev, d[4] = r->secs, d[5] = r->Ed, d[6] = r->Ef;
+        d[7] = r->inc, d[8] = r->dem_mean;
+        w[0] = r->dem_total, w[1] = r->t_reused, w[2] = r->t_computed;
+        bad = !fd_ck_bounded(d, 9, 1e100) || r->iters < 0 || r->failed < 0 || r->failed > M->ngp || r->dem_max < 0;
+        for (k = 0; k < 3 && !bad; ++k) { /* the run's totals are their sums */
+            bad = w[k] < 0 || w[k] > LLONG_MAX / 2 - sum[k];
+            sum[k] += bad ? 0 : w[k];
+        }
+        if (bad) return snprintf(why, nwhy, "row %d is out of range", c), 1;
+    }
+    for (k = 0; k < n; ++k) L = fmax(L, fabs(M->A0x[k]));
+    for (k = 0; k < n; ++k)
+        if (!(fabs(u[k]) <= 10 * L) || !(fabs(x[k] - (M->A0x[k] + u[k])) <= 1e-8 * L))
+            return snprintf(why, nwhy, "the mesh does not match its displacements (dof %d)", (int)k), 1;
+    m = M->mesh, m.x = ck->v;
+    if (gk_mesh_check(&m, &M->q, &e) != GK_OK) return snprintf(why, nwhy, "the deformed mesh: %.150s", e.msg), 1;
+    if (!fd_ck_bounded(ck->v + 2 * n, 25 * (size_t)M->ngp, 1e100))
+        return snprintf(why, nwhy, "a stress or tangent is not finite or beyond 1e100"), 1;
+    return 0;
+}
+
+/* the checkpoint of DIR into the set, and its model block read and checked into ck (the model is not
+ * touched: fd_ck_apply puts it there); B keeps the block positioned at the driver's own part (free
+ * B->b after reading it). 0, or 1 with err set naming the file. */
+static int fd_ck_read(fd_model *M, const char *dir, const char *tag, fd_buf *B, fd_ck *ck, gk_err *err) {
+    char path[1200], tg[16], why[200];
     void *blk = NULL;
-    size_t nb = 0, n = (size_t)M->ndof, g9 = 9 * (size_t)M->ngp, g16 = 16 * (size_t)M->ngp;
-    int nx, ny, quad, nc, ok;
+    size_t nb = 0, n = (size_t)M->ndof, nv = 2 * n + 25 * (size_t)M->ngp;
+    int nx, ny, quad, ok;
     gk_elem_type el;
     memset(B, 0, sizeof *B);
+    memset(ck, 0, sizeof *ck);
     snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
     if (gk_twoscale_load(&M->ts, path, &blk, &nb))
         return gk_err_set(err, GK_ERR_FORMAT, "%s", gk_twoscale_error(&M->ts)), 1;
@@ -241,23 +309,43 @@ static int fd_ck_load(fd_model *M, const char *dir, const char *tag, fd_buf *B, 
     ok = !fd_get(B, tg, 16) && !memcmp(tg, tag, strlen(tag) + 1);
     ok = ok && !fd_get(B, &nx, sizeof nx) && !fd_get(B, &ny, sizeof ny) && !fd_get(B, &el, sizeof el) &&
          !fd_get(B, &quad, sizeof quad);
-    if (!ok || nx != M->o.nx || ny != M->o.ny || el != M->o.elem || quad != M->o.quad)
+    if (!ok || nx != M->o.nx || ny != M->o.ny || el != M->o.elem || quad != M->o.quad) {
+        free(B->b), memset(B, 0, sizeof *B);
         return gk_err_set(err, GK_ERR_FORMAT,
                           "%s: not a checkpoint of this test and mesh (%s %dx%d, element, quad must match)", path,
                           tag, M->o.nx, M->o.ny),
                1;
-    ok = !fd_get(B, &M->step, sizeof(int)) && !fd_get(B, &M->eps_done, sizeof(double)) &&
-         !fd_get(B, &M->scale, sizeof(double)) && !fd_get(B, &nc, sizeof nc) && nc >= 1 &&
-         (size_t)nc <= (B->n - B->pos) / sizeof(fd_row);
-    if (ok) {
-        fd_row *c = (fd_row *)realloc(M->curve, ((size_t)nc + 16) * sizeof *c);
-        ok = c != NULL;
-        if (c) M->curve = c, M->cap = nc + 16, M->ncurve = nc;
     }
-    ok = ok && !fd_get(B, M->curve, (size_t)nc * sizeof(fd_row)) && !fd_get(B, M->mesh.x, n * sizeof(double)) &&
-         !fd_get(B, M->utot, n * sizeof(double)) && !fd_get(B, M->sig_n, g9 * sizeof(double)) &&
-         !fd_get(B, M->D_n, g16 * sizeof(double));
-    if (!ok) return gk_err_set(err, GK_ERR_FORMAT, "%s: the driver's block is truncated", path), 1;
+    ok = !fd_get(B, &ck->step, sizeof(int)) && !fd_get(B, &ck->eps, sizeof(double)) &&
+         !fd_get(B, &ck->scale, sizeof(double)) && !fd_get(B, &ck->nc, sizeof(int)) && ck->nc >= 1 &&
+         (size_t)ck->nc <= (B->n - B->pos) / sizeof(fd_row) &&
+         nv <= (B->n - B->pos - (size_t)ck->nc * sizeof(fd_row)) / sizeof(double);
+    if (ok && (!(ck->rows = (fd_row *)malloc((size_t)ck->nc * sizeof(fd_row))) ||
+               !(ck->v = (double *)malloc(nv * sizeof(double))))) {
+        fd_ck_free(ck), free(B->b), memset(B, 0, sizeof *B);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+    }
+    ok = ok && !fd_get(B, ck->rows, (size_t)ck->nc * sizeof(fd_row)) && !fd_get(B, ck->v, nv * sizeof(double));
+    if (!ok) snprintf(why, sizeof why, "the driver's block is truncated");
+    if (!ok || fd_ck_check(M, ck, why, sizeof why)) {
+        fd_ck_free(ck), free(B->b), memset(B, 0, sizeof *B);
+        return gk_err_set(err, GK_ERR_FORMAT, "%s: %s", path, why), 1;
+    }
+    return 0;
+}
+
+/* ck into the model (and freed); 0, or 1 (out of memory: the model as it was, err set) */
+static int fd_ck_apply(fd_model *M, fd_ck *ck, gk_err *err) {
+    size_t n = (size_t)M->ndof, g9 = 9 * (size_t)M->ngp;
+    fd_row *c = (fd_row *)realloc(M->curve, ((size_t)ck->nc + 16) * sizeof *c);
+    if (!c) return fd_ck_free(ck), gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+    M->curve = c, M->cap = ck->nc + 16, M->ncurve = ck->nc;
+    memcpy(M->curve, ck->rows, (size_t)ck->nc * sizeof(fd_row));
+    M->step = ck->step, M->eps_done = ck->eps, M->scale = ck->scale;
+    memcpy(M->mesh.x, ck->v, n * sizeof(double)), memcpy(M->utot, ck->v + n, n * sizeof(double));
+    memcpy(M->sig_n, ck->v + 2 * n, g9 * sizeof(double));
+    memcpy(M->D_n, ck->v + 2 * n + g9, 16 * (size_t)M->ngp * sizeof(double));
+    fd_ck_free(ck);
     return 0;
 }
 

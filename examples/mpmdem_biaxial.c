@@ -124,6 +124,40 @@ static int parse(bx *X, int argc, char **argv) {
     return 0;
 }
 
+/* a checkpoint's state and rows in range (mpd_load): counters >= 0 (the stage an index of bx_stages),
+ * times, plates and sums finite, each plate a box with a known contact law and face */
+static int bx_check(const void *state, const mpd_rows *R, char *why, size_t nwhy) {
+    const bx_state *S = (const bx_state *)state;
+    double v[7];
+    int k, j;
+    v[0] = S->t, v[1] = S->disp, v[2] = S->acc_top, v[3] = S->acc_base, v[4] = S->acc_dt, v[5] = S->acc_ek;
+    v[6] = S->acc_dem;
+    for (k = 0; k < 7; ++k)
+        if (!isfinite(v[k])) return snprintf(why, nwhy, "a non-finite time, displacement or sum"), 1;
+    if (S->step < 0 || S->step > 1000000000000L || S->nacc < 0 || S->nacc > S->step || S->nstage < 0 ||
+        S->nstage > 3 || !(S->next_out > 0 && S->next_out < 1e6) || !(S->t >= 0))
+        return snprintf(why, nwhy, "a step, stage or output counter out of range"), 1;
+    for (k = 0; k < 2; ++k) {
+        const gk_mpm_body *b = &S->body[k];
+        for (j = 0; j < 3; ++j)
+            if (!isfinite(b->lo[j]) || !isfinite(b->hi[j]) || !isfinite(b->v[j]) || !isfinite(b->force[j]) ||
+                !(b->lo[j] <= b->hi[j]))
+                return snprintf(why, nwhy, "plate %d is not a finite box", k), 1;
+        if ((int)b->contact < 0 || (int)b->contact > (int)GK_MPM_CONTACT_SMOOTH ||
+            !(b->mu >= 0 && b->mu < 1e6) || b->face < 0 || b->face > 6)
+            return snprintf(why, nwhy, "plate %d: contact law out of range", k), 1;
+    }
+    for (k = 0; k < R->n; ++k) {
+        const bx_row *r = (const bx_row *)mpd_row(R, k);
+        double w[8];
+        w[0] = r->t, w[1] = r->eps, w[2] = r->syy_top, w[3] = r->syy_base, w[4] = r->ev, w[5] = r->ek;
+        w[6] = r->dem_mean, w[7] = r->secs;
+        for (j = 0; j < 8; ++j)
+            if (!isfinite(w[j])) return snprintf(why, nwhy, "row %d: a non-finite value", k), 1;
+    }
+    return 0;
+}
+
 /* the prepared RVE at every point, the grid with its two plates, the points and their edge loads */
 static int setup(bx *X, gk_err *err) {
     bx_opts *b = &X->b;
@@ -165,7 +199,7 @@ static int setup(bx *X, gk_err *err) {
     S->next_out = b->every;
     X->rows.size = sizeof(bx_row);
     if (X->o.restart &&
-        mpd_load(X->o.restart, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps, err))
+        mpd_load(X->o.restart, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps, bx_check, err))
         return 1;
     X->g.body = S->body, X->g.nbody = 2;
     return 0;

@@ -320,7 +320,7 @@ static int setup(cl *X, gk_err *err) {
     S->t_rest = -1;
     X->rows.size = sizeof(cl_row);
     if (X->o.restart) {
-        if (mpd_load(X->o.restart, &X->M, &X->pts, "collapse", S, sizeof *S, &X->rows, &X->snaps, err))
+        if (mpd_load(X->o.restart, &X->M, &X->pts, "collapse", S, sizeof *S, &X->rows, &X->snaps, NULL, err))
             return 1;
         if (X->rows.n < 1)
             return gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin holds no rows", X->o.restart), 1;

@@ -418,7 +418,7 @@ static int setup(ft *X, gk_err *err) {
     S->next_out = 0.0; /* a row after the first step (d ~ 0) */
     X->rows.size = sizeof(ft_row);
     if (X->o.restart &&
-        mpd_load(X->o.restart, &X->M, &X->pts, "footing", S, sizeof *S, &X->rows, &X->snaps, err))
+        mpd_load(X->o.restart, &X->M, &X->pts, "footing", S, sizeof *S, &X->rows, &X->snaps, NULL, err))
         return 1;
     X->g.body = &S->body, X->g.nbody = 1;
     return 0;

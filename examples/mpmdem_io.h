@@ -361,25 +361,94 @@ static int mpd_checkpoint_path(const char *dir, char *path) {
     return snprintf(path, MPD_PATH, "%s/checkpoint.bin", dir) >= MPD_PATH;
 }
 
+/* the driver's own check of its state and rows as read (0 in range, or 1 with the reason in why) */
+typedef int (*mpd_check_fn)(const void *S, const mpd_rows *R, char *why, size_t nwhy);
+
+/* the block as read, checked: every point value finite, mass, volumes, half-size >= 0 (mass and volume
+ * > 0), det F > 0 and vol = det(F) vol0 (to 1e-9 relative: gk_mpm keeps them so), refusal counts and
+ * DEM steps >= 0; every snapshot's points finite, its dot > 0 and its outline's polylines within
+ * MPD_MAXLPT points. 0, or 1 with the reason in why. */
+static int mpd_block_check(const mpd_micro *m, const gk_mpm_points *pts, const mpd_snaps *sn, char *why,
+                           size_t nwhy) {
+    int n = pts->n, p, k, j;
+    for (p = 0; p < n; ++p) {
+        const double *F = pts->F + 9 * (size_t)p;
+        double v[10], det;
+        v[0] = pts->x[0][p], v[1] = pts->x[1][p], v[2] = pts->v[0][p], v[3] = pts->v[1][p];
+        v[4] = pts->fext[0][p], v[5] = pts->fext[1][p], v[6] = pts->m[p], v[7] = pts->vol0[p];
+        v[8] = pts->vol[p], v[9] = pts->lp[p];
+        for (k = 0; k < 10; ++k)
+            if (!isfinite(v[k])) return snprintf(why, nwhy, "point %d: a non-finite value", p), 1;
+        for (k = 0; k < 9; ++k)
+            if (!isfinite(F[k]) || !isfinite(pts->L[9 * (size_t)p + k]) ||
+                !isfinite(pts->sigma[9 * (size_t)p + k]) || !isfinite(pts->C[9 * (size_t)p + k]) ||
+                !isfinite(m->eps[9 * (size_t)p + k]))
+                return snprintf(why, nwhy, "point %d: a non-finite tensor", p), 1;
+        det = F[0] * F[4] - F[1] * F[3];
+        if (!(v[6] > 0) || !(v[7] > 0) || !(v[8] > 0) || v[9] < 0 || !(det > 0) ||
+            !(fabs(v[8] - det * v[7]) <= 1e-9 * v[8]) || m->thin[p] < 0)
+            return snprintf(why, nwhy, "point %d: mass, volume, det F or half-size out of range", p), 1;
+    }
+    if (m->dem_steps < 0) return snprintf(why, nwhy, "a negative DEM-step count"), 1;
+    for (k = 0; k < sn->n; ++k) {
+        const mpd_snap *s = &sn->s[k];
+        int used = 0;
+        if (!(s->dot > 0) || !isfinite(s->dot)) return snprintf(why, nwhy, "snapshot %d: dot size", k), 1;
+        for (j = 0; j < s->ol.nlines; ++j) {
+            if (s->ol.len[j] < 0 || s->ol.len[j] > MPD_MAXLPT)
+                return snprintf(why, nwhy, "snapshot %d: outline", k), 1;
+            used += s->ol.len[j];
+        }
+        for (j = 0; j < 2 * used; ++j)
+            if (!isfinite(s->ol.xy[j])) return snprintf(why, nwhy, "snapshot %d: outline", k), 1;
+        for (j = 0; j < 2 * s->n; ++j)
+            if (!isfinite(s->xy[j])) return snprintf(why, nwhy, "snapshot %d: a non-finite point", k), 1;
+    }
+    return 0;
+}
+
+/* DIR/checkpoint.bin into the set, the points, the driver's state S, its rows and snapshots (the
+ * rows and snapshots it had are freed). The block is read and checked (mpd_block_check, then the
+ * driver's check when not NULL) before it replaces anything: a refused block leaves the points, the
+ * strains, S, the rows and the snapshots as they were (the set holds the file's RVE states, which
+ * gk_twoscale_load accepted). */
 static gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, const char *tag, void *S,
-                          size_t nS, mpd_rows *R, mpd_snaps *sn, gk_err *err) {
-    char path[MPD_PATH];
+                          size_t nS, mpd_rows *R, mpd_snaps *sn, mpd_check_fn check, gk_err *err) {
+    char path[MPD_PATH], why[200];
     void *blk = NULL;
     size_t nblk = 0;
-    mpd_buf B;
+    mpd_buf B, K;
+    mpd_rows R2 = *R, Rk = *R;
+    mpd_snaps sn2, snk;
     if (mpd_checkpoint_path(dir, path))
         return gk_err_set(err, GK_ERR_ARG, "--restart %s: path too long", dir);
     if (gk_twoscale_load(&m->ts, path, &blk, &nblk))
         return gk_err_set(err, m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
+    /* what the block overwrites, kept (the same format, without rows and snapshots) */
+    memset(&K, 0, sizeof K), memset(&sn2, 0, sizeof sn2), memset(&snk, 0, sizeof snk);
+    R2.r = NULL, R2.n = R2.cap = 0, Rk.r = NULL, Rk.n = Rk.cap = 0;
+    mpd_block(&K, tag, m, pts, S, nS, &Rk, &snk, 1);
+    if (K.bad) {
+        free(K.b), gk_twoscale_free(&m->ts, blk);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory");
+    }
     memset(&B, 0, sizeof B);
     B.b = (unsigned char *)blk, B.cap = nblk;
-    mpd_block(&B, tag, m, pts, S, nS, R, sn, 0);
+    mpd_block(&B, tag, m, pts, S, nS, &R2, &sn2, 0);
     gk_twoscale_free(&m->ts, blk);
     if (B.bad)
-        return gk_err_set(
-            err, GK_ERR_FORMAT,
-            "%s: its driver block is not that of an mpmdem_%s run of %d points with these flags", path, tag,
-            pts->n);
+        snprintf(why, sizeof why,
+                 "its driver block is not that of an mpmdem_%s run of %d points with these flags", tag,
+                 pts->n);
+    if (B.bad || mpd_block_check(m, pts, &sn2, why, sizeof why) ||
+        (check && check(S, &R2, why, sizeof why))) {
+        K.cap = K.n, K.n = 0; /* read back what was there */
+        mpd_block(&K, tag, m, pts, S, nS, &Rk, &snk, 0);
+        free(K.b), free(R2.r), free(Rk.r), mpd_snaps_free(&sn2), mpd_snaps_free(&snk);
+        return gk_err_set(err, GK_ERR_FORMAT, "%s: %s", path, why);
+    }
+    free(K.b), free(R->r), mpd_snaps_free(sn);
+    *R = R2, *sn = sn2;
     return GK_OK;
 }
 

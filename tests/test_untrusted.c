@@ -840,6 +840,85 @@ TEST(twoscale_checkpoint_reference_is_checked) {
     gk_packing_free(&pk);
 }
 
+/* offset of the first occurrence of tag in b[n], or n */
+static size_t find_tag(const unsigned char *b, size_t n, const char *tag) {
+    size_t k, len = strlen(tag);
+    for (k = 0; k + len <= n; ++k)
+        if (!memcmp(b + k, tag, len)) return k;
+    return n;
+}
+
+/* the drivers' blocks inside a checkpoint (after gk_twoscale_load accepted the file) were not
+ * checked: the FEMxDEM biaxial driver accepted a negative step count (the step counter of its
+ * rows), a mesh whose nodes no longer were the initial ones plus the displacements, and read them
+ * into the model before refusing anything; the MPMxDEM biaxial driver accepted a point at a NaN
+ * position and one of negative mass and ran on them. Refused now, by name, before the run starts
+ * (the seeds of fuzz_femdem_ckpt and fuzz_mpmdem_ckpt found the FEMxDEM ones). */
+TEST(driver_checkpoint_blocks_are_checked) {
+#define FD_CK                                                                                     \
+    "build/femdem_biaxial --test single --steps 1 --increment 1e-4 --checkpoint 1 --vtk-every 0 " \
+    "--threads 1 --packing " OUT("ck_pk.txt") " "
+#define MP_CK                                                                                      \
+    "build/mpmdem_biaxial --nx 1 --ny 2 --width 1 --height 2 --velocity 1 --ramp 0 --every 0.008 " \
+    "--threads 1 --dem-max 50 --quiet --packing " OUT("ck_pk.txt") " "
+    unsigned char *b;
+    size_t n, at;
+    int32_t step = -5;
+    double v;
+    remove(OUT("fd_b/biaxial.csv")), remove(OUT("mp_b/biaxial.csv")); /* of an earlier run */
+    CHECK_EQ_INT(run_status("build/gk_pack --n 60 --out " OUT("ck_pk.txt") LOG("ck_pk")), 0);
+    /* FEMxDEM: the block starts with its tag, 4 ints of the mesh options, then the step */
+    CHECK_EQ_INT(run_status(FD_CK "--out " OUT("fd_a") LOG("fd_a")), 0);
+    b = file_image(OUT("fd_a/checkpoint.bin"), &n);
+    CHECK(b != NULL && (at = find_tag(b, n, "GKFEMDEM5")) < n);
+    if (!b || at == n) return;
+    mkdir(OUT("fd_bad"), 0755);
+    memcpy(b + at + 16 + 4 * sizeof(int), &step, 4);
+    spill_resealed(OUT("fd_bad/checkpoint.bin"), b, n);
+    CHECK_EQ_INT(run_status(FD_CK "--steps 2 --restart " OUT("fd_bad") " --out " OUT("fd_b") LOG("fd_b")), 1);
+    CHECK(gk_test_file_has(OUT("fd_b.out"), "step -5"));
+    CHECK(!exists(OUT("fd_b/biaxial.csv")));
+    free(b);
+    b = file_image(OUT("fd_a/checkpoint.bin"), &n);
+    /* the first node's y: after the step, the axial strain, the increment scale, the row count, two
+     * rows (112 bytes each) and the node's x */
+    at += 16 + 4 * sizeof(int) + sizeof(int) + 2 * sizeof(double) + sizeof(int) + 2 * 112 + 8;
+    CHECK(at + 8 < n);
+    memcpy(&v, b + at, 8);
+    CHECK(v == 0.0); /* the bottom-left node, on the fixed base */
+    v = 1e-3;
+    memcpy(b + at, &v, 8);
+    spill_resealed(OUT("fd_bad/checkpoint.bin"), b, n);
+    CHECK_EQ_INT(run_status(FD_CK "--steps 2 --restart " OUT("fd_bad") " --out " OUT("fd_b") LOG("fd_b")), 1);
+    CHECK(gk_test_file_has(OUT("fd_b.out"), "does not match its displacements"));
+    free(b);
+    /* MPMxDEM: the block's tag (32 bytes), the point count, the state size, then x of every point, ...
+     * the masses sixth */
+    CHECK_EQ_INT(run_status(MP_CK "--strain 0.008 --out " OUT("mp_a") LOG("mp_a")), 0);
+    b = file_image(OUT("mp_a/checkpoint.bin"), &n);
+    CHECK(b != NULL && (at = find_tag(b, n, "GKMPMDEM2 biaxial")) < n);
+    if (!b || at == n) return;
+    mkdir(OUT("mp_bad"), 0755);
+    v = NAN;
+    memcpy(b + at + 44, &v, 8);
+    spill_resealed(OUT("mp_bad/checkpoint.bin"), b, n);
+    CHECK_EQ_INT(
+        run_status(MP_CK "--strain 0.016 --restart " OUT("mp_bad") " --out " OUT("mp_b") LOG("mp_b")), 1);
+    CHECK(gk_test_file_has(OUT("mp_b.out"), "point 0: a non-finite value"));
+    free(b);
+    b = file_image(OUT("mp_a/checkpoint.bin"), &n);
+    v = -1.0;
+    memcpy(b + at + 44 + 6 * 2 * 8, &v, 8);
+    spill_resealed(OUT("mp_bad/checkpoint.bin"), b, n);
+    CHECK_EQ_INT(
+        run_status(MP_CK "--strain 0.016 --restart " OUT("mp_bad") " --out " OUT("mp_b") LOG("mp_b")), 1);
+    CHECK(gk_test_file_has(OUT("mp_b.out"), "point 0: mass, volume"));
+    CHECK(!exists(OUT("mp_b/biaxial.csv")));
+    free(b);
+#undef FD_CK
+#undef MP_CK
+}
+
 /* =============================================================== tools */
 #define RVE_PATH "build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
 #define GK_PACK "build/gk_pack --n 60 "
@@ -936,6 +1015,7 @@ int main(int argc, char **argv) {
     RUN(mpm_step_refusing_det_F_leaves_the_points);
     RUN(writers_report_a_full_disk);
     RUN(twoscale_checkpoint_reference_is_checked);
+    RUN(driver_checkpoint_blocks_are_checked);
     RUN(gk_pack_fails_on_a_void_ratio_it_cannot_reach);
     RUN(friction_angle_in_degrees_with_a_plausible_range);
     RUN(rve_path_exits_nonzero_when_its_result_is_lost);

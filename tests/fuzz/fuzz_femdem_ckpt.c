@@ -1,0 +1,308 @@
+/* fuzz_femdem_ckpt.c - libFuzzer harness: the FEMxDEM biaxial driver's
+ * --restart reader (fdb_restart of examples/femdem_biaxial.h: gk_twoscale_load,
+ * then the model's block, fd_ck_read and fd_ck_apply of examples/femdem_io.h,
+ * then the driver's own part) on arbitrary bytes, through the driver's own
+ * functions.
+ *
+ * One small model is built once, deterministically: the single-element test
+ * (one Q4 element, 2 x 2 Gauss points) on a 12-disk 2D packing consolidated
+ * to 100 kPa, increment 1e-4, at most 2 Newton iterations; one load step is
+ * run by the driver's loop (fdb_loop), which writes the pristine checkpoint
+ * every input starts from.
+ *
+ * Input: one mode byte, then the file (DIR/checkpoint.bin). As in
+ * fuzz_twoscale.c, an even mode byte makes the harness write the right
+ * FNV-1a checksum into the file's last 8 bytes, so the fuzzer gets past
+ * gk_twoscale_load to the driver's block; an odd one gives the bytes as
+ * they are. Each input:
+ *   - refused: a message, and the model (step, strain, increment scale,
+ *     rows, mesh, displacements, stresses, tangents, last increment, fields
+ *     of the rows) byte for byte as before;
+ *   - accepted: every one of those in range and finite, the deformed mesh
+ *     valid (gk_mesh_check), the Gauss-point fields finite, and the driver's
+ *     next load step (fd_load_step) runs: converged with finite
+ *     displacements, stresses and tangents, or not converged, or an error
+ *     with a message. The model then returns to the pristine checkpoint.
+ * Seeds (tests/fuzz/corpus/femdem_ckpt): the pristine checkpoint, one a step
+ * later, one of the cyclic driver's tag, and truncated and bit-flipped
+ * copies (checksum mended), written by this file compiled with
+ * -DFUZZ_MAKE_SEEDS:
+ *   cc -O2 -Iinclude -Itests/fuzz -DFUZZ_MAKE_SEEDS tests/fuzz/fuzz_femdem_ckpt.c -lm -o build/seeds && build/seeds DIR
+ * Its folders are in $TMPDIR (default /tmp), named by the process id,
+ * removed at exit. Build and run: make fuzz (tests/fuzz/replay.c). */
+#define _POSIX_C_SOURCE 200809L
+#define GK_IMPLEMENTATION
+#if defined(__GNUC__)
+#pragma GCC diagnostic ignored "-Wunused-function" /* the driver's header has more than this uses */
+#endif
+#include "gk_fem.h"
+#include "gk_io.h"
+#include "gk_twoscale.h"
+#include "../../examples/femdem_biaxial.h"
+#include "fuzz_check.h"
+#include <unistd.h>
+
+static fd_model M;
+static char in_dir[400], ref_dir[400], out_dir[400], pk_path[400];
+static unsigned char *snap0; /* the pristine model's state */
+static size_t nsnap;
+static int ready;
+
+static void cleanup(void) {
+    static const char *files[2] = {"checkpoint.bin", "biaxial.csv"};
+    const char *dirs[3] = {in_dir, ref_dir, out_dir};
+    char p[600];
+    int d, f;
+    for (d = 0; d < 3; ++d) {
+        for (f = 0; f < 2; ++f) snprintf(p, sizeof p, "%s/%s", dirs[d], files[f]), remove(p);
+        rmdir(dirs[d]);
+    }
+    remove(pk_path);
+    if (ready) fd_free(&M), free(snap0);
+}
+
+/* the model's state a checkpoint carries, as bytes (malloc'ed) */
+static unsigned char *model_bytes(size_t *n) {
+    size_t nd = (size_t)M.ndof * sizeof(double), ng = (size_t)M.ngp, nr = (size_t)M.ncurve;
+    size_t parts[12], k, at = 0;
+    const void *src[12];
+    unsigned char *b;
+    src[0] = &M.step, parts[0] = sizeof M.step;
+    src[1] = &M.eps_done, parts[1] = sizeof M.eps_done;
+    src[2] = &M.scale, parts[2] = sizeof M.scale;
+    src[3] = &M.ncurve, parts[3] = sizeof M.ncurve;
+    src[4] = M.curve, parts[4] = nr * sizeof(fd_row);
+    src[5] = M.mesh.x, parts[5] = nd;
+    src[6] = M.utot, parts[6] = nd;
+    src[7] = M.sig_n, parts[7] = 9 * ng * sizeof(double);
+    src[8] = M.D_n, parts[8] = 16 * ng * sizeof(double);
+    src[9] = &M.inclast, parts[9] = sizeof M.inclast;
+    src[10] = M.ulast, parts[10] = nd;
+    src[11] = M.hist, parts[11] = nr * ng * FD_NFIELD * sizeof(double);
+    for (*n = 0, k = 0; k < 12; ++k) *n += parts[k];
+    FUZZ_CHECK((b = (unsigned char *)malloc(*n)) != NULL);
+    for (k = 0; k < 12; ++k) memcpy(b + at, src[k], parts[k]), at += parts[k];
+    return b;
+}
+
+static int same_as_pristine(void) {
+    size_t n;
+    unsigned char *b = model_bytes(&n);
+    int same = n == nsnap && memcmp(b, snap0, n) == 0;
+    free(b);
+    return same;
+}
+
+static void all_finite(const double *v, size_t n) {
+    size_t k;
+    for (k = 0; k < n; ++k) FUZZ_CHECK(isfinite(v[k]));
+}
+
+static void make_dir(char *dir, size_t cap, const char *tmp, const char *what) {
+    snprintf(dir, cap, "%s/gk_fuzz_femdem_%ld_%s", tmp, (long)getpid(), what);
+    FUZZ_CHECK(mkdir(dir, 0777) == 0 || errno == EEXIST);
+}
+
+/* back to the pristine checkpoint */
+static void restore(void) {
+    gk_err err;
+    M.o.restart = ref_dir;
+    FUZZ_CHECK(fdb_restart(&M, &err) == 0);
+    M.pend_dem = M.pend_reused = M.pend_computed = 0;
+}
+
+static void setup(void) {
+    const char *tmp = getenv("TMPDIR");
+    gk_packing pk, out;
+    gk_gen_def g;
+    gk_rve rve;
+    gk_consolidate_def cd;
+    gk_rve_def def = gk_rve_def_default();
+    gk_err err;
+    if (ready) return;
+    if (!tmp || !*tmp) tmp = "/tmp";
+    make_dir(in_dir, sizeof in_dir, tmp, "in");
+    make_dir(ref_dir, sizeof ref_dir, tmp, "ref");
+    make_dir(out_dir, sizeof out_dir, tmp, "out");
+    snprintf(pk_path, sizeof pk_path, "%s/gk_fuzz_femdem_%ld.pk", tmp, (long)getpid());
+    atexit(cleanup);
+    /* the packing: 12 disks consolidated to 100 kPa */
+    memset(&g, 0, sizeof g);
+    g.dim = 2, g.n = 12, g.r_min = 0.4e-3, g.r_max = 0.6e-3, g.seed = 11;
+    FUZZ_CHECK(gk_packing_generate(&pk, &g, NULL, &err) == GK_OK);
+    FUZZ_CHECK(gk_rve_create(&rve, &def, &pk) == GK_OK);
+    memset(&cd, 0, sizeof cd);
+    cd.pressure = 1e5, cd.max_steps = 200000;
+    FUZZ_CHECK(gk_rve_consolidate(&rve, &cd, NULL) == GK_OK);
+    FUZZ_CHECK(gk_rve_to_packing(&rve, &out, NULL, &err) == GK_OK);
+    FUZZ_CHECK(gk_packing_write(pk_path, &out, "fuzz_femdem_ckpt", &err) == GK_OK);
+    gk_rve_destroy(&rve), gk_packing_free(&pk), gk_packing_free(&out);
+    /* the model: the driver's defaults, its single-element test, one load step */
+    memset(&M, 0, sizeof M);
+    M.prog = "fuzz_femdem_ckpt", M.root = 1;
+    fdb_defaults(&M);
+    M.o.test = "single", M.o.packing = pk_path, M.o.dt = def.dt, M.o.threads = 1, M.o.inc = 1e-4;
+    M.o.steps = 1, M.o.max_iter = 2, M.o.checkpoint = 1, M.o.vtk_every = 0, M.o.out = ref_dir;
+    FUZZ_CHECK(fdb_check(&M) == 0);
+    M.checkpoint = fdb_checkpoint;
+    FUZZ_CHECK(fd_setup(&M, &err) == 0);
+    fdb_first_row(&M, &err);
+    FUZZ_CHECK(fdb_record(&M) == 0);
+    M.root = 0; /* quiet from here on (fd_say; no writes depend on it without MPI) */
+    FUZZ_CHECK(fdb_loop(&M, gk_wtime(), &err) == 0 && M.ncurve == 2);
+    M.o.out = out_dir;
+    restore();
+    snap0 = model_bytes(&nsnap);
+    ready = 1;
+}
+
+static uint64_t fnv1a(const unsigned char *b, size_t n) {
+    uint64_t h = UINT64_C(0xcbf29ce484222325);
+    while (n--) h = (h ^ *b++) * UINT64_C(0x100000001b3);
+    return h;
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    char path[600];
+    unsigned char *file;
+    size_t len, n = 0, k;
+    gk_err err;
+    gk_mesh m;
+    double *f, L = 0.0, syy, sxx, ev, Ed = 0, Ef = 0;
+    int c, r, iters = 0;
+    FILE *fp;
+    if (size < 1) return 0;
+    setup();
+    len = size - 1;
+    FUZZ_CHECK((file = (unsigned char *)malloc(len + 1)) != NULL);
+    memcpy(file, data + 1, len);
+    if (!(data[0] & 1) && len >= 8) {
+        uint64_t h = fnv1a(file, len - 8);
+        memcpy(file + len - 8, &h, 8);
+    }
+    snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
+    FUZZ_CHECK((fp = fopen(path, "wb")) != NULL && fwrite(file, 1, len, fp) == len && fclose(fp) == 0);
+    free(file);
+    err.msg[0] = '\0';
+    M.o.restart = in_dir;
+    if (fdb_restart(&M, &err)) {
+        FUZZ_CHECK(err.msg[0] != '\0');
+        FUZZ_CHECK(same_as_pristine());
+        restore();
+        return 0;
+    }
+    /* accepted: every value in range and finite */
+    n = (size_t)M.ndof;
+    for (k = 0; k < n; ++k) L = fmax(L, fabs(M.A0x[k]));
+    FUZZ_CHECK(M.step >= 0 && M.step <= 1000000000 && M.eps_done >= 0 && M.eps_done < 1);
+    FUZZ_CHECK(M.scale >= 1.0 / 64 && M.scale <= 1 && M.ncurve >= 1 && M.ncurve <= M.cap);
+    for (c = 0; c < M.ncurve; ++c) {
+        const fd_row *w = &M.curve[c];
+        double d[9];
+        d[0] = w->eps, d[1] = w->syy, d[2] = w->sxx, d[3] = w->ev, d[4] = w->secs, d[5] = w->Ed, d[6] = w->Ef;
+        d[7] = w->inc, d[8] = w->dem_mean;
+        all_finite(d, 9);
+        FUZZ_CHECK(w->iters >= 0 && w->failed >= 0 && w->failed <= M.ngp && w->dem_max >= 0);
+        FUZZ_CHECK(w->dem_total >= 0 && w->t_reused >= 0 && w->t_computed >= 0);
+    }
+    all_finite(M.mesh.x, n), all_finite(M.utot, n), all_finite(M.ulast, n);
+    for (k = 0; k < n; ++k) FUZZ_CHECK(fabs(M.utot[k]) <= 10 * L && fabs(M.ulast[k]) <= 10 * L);
+    all_finite(M.sig_n, 9 * (size_t)M.ngp), all_finite(M.D_n, 16 * (size_t)M.ngp);
+    all_finite(M.hist, (size_t)M.ncurve * M.ngp * FD_NFIELD);
+    FUZZ_CHECK(isfinite(M.inclast) && fabs(M.inclast) <= 1);
+    m = M.mesh;
+    FUZZ_CHECK(gk_mesh_check(&m, &M.q, &err) == GK_OK);
+    FUZZ_CHECK((f = fd_gp_fields(&M)) != NULL);
+    all_finite(f, (size_t)M.ngp * FD_NFIELD);
+    free(f);
+    /* the reactions of the restored state (the row the driver would print), then its next load step */
+    FUZZ_CHECK(fd_external_force(&M, &err) == 0);
+    fd_residual(&M, M.sig_n, &err);
+    fdb_macro_state(&M, &syy, &sxx, &ev);
+    FUZZ_CHECK(isfinite(syy) && isfinite(sxx) && isfinite(ev));
+    err.msg[0] = '\0';
+    r = fd_load_step(&M, M.o.inc * M.scale, &iters, &Ed, &Ef, &err);
+    FUZZ_CHECK(r == 0 || r == 1 || (r == 2 && err.msg[0] != '\0'));
+    if (r == 0) {
+        all_finite(M.u, n), all_finite(M.sig, 9 * (size_t)M.ngp), all_finite(M.D, 16 * (size_t)M.ngp);
+        FUZZ_CHECK(isfinite(Ed) && isfinite(Ef));
+    }
+    if (r != 2) gk_twoscale_reject(&M.ts); /* fd_load_step rejected on 2 */
+    restore();
+    FUZZ_CHECK(same_as_pristine());
+    return 0;
+}
+
+#ifdef FUZZ_MAKE_SEEDS
+static unsigned char *slurp(const char *path, size_t *n) {
+    FILE *fp = fopen(path, "rb");
+    unsigned char *b = NULL;
+    long end;
+    FUZZ_CHECK(fp && fseek(fp, 0, SEEK_END) == 0 && (end = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0);
+    FUZZ_CHECK((b = (unsigned char *)malloc((size_t)end + 1)) != NULL);
+    FUZZ_CHECK(fread(b, 1, (size_t)end, fp) == (size_t)end);
+    fclose(fp);
+    *n = (size_t)end;
+    return b;
+}
+
+static void seed(const char *dir, const char *name, unsigned char mode, const unsigned char *b, size_t n) {
+    char path[1024];
+    FILE *fp;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    fp = fopen(path, "wb");
+    FUZZ_CHECK(fp && fwrite(&mode, 1, 1, fp) == 1 && fwrite(b, 1, n, fp) == n && fclose(fp) == 0);
+}
+
+/* the pristine checkpoint, truncated and bit-flipped copies (in the model's block: the step, a row,
+ * a node, a stress; in the driver's part: the last increment, a field), one a step later, and one
+ * with the cyclic driver's tag */
+int main(int argc, char **argv) {
+    char path[600];
+    unsigned char *b, *c;
+    size_t n, k, blk, b0;
+    gk_err err;
+    if (argc < 2) return 2;
+    setup();
+    snprintf(path, sizeof path, "%s/checkpoint.bin", ref_dir);
+    b = slurp(path, &n);
+    seed(argv[1], "ckpt_step1", 0, b, n);
+    /* the driver's block starts with its tag; its size: the model's block plus the driver's part */
+    for (b0 = 0; b0 + 16 < n && memcmp(b + b0, FDB_TAG, sizeof FDB_TAG); ++b0) continue;
+    blk = 16 + 4 * sizeof(int) + sizeof(int) + 2 * sizeof(double) + sizeof(int) + 2 * sizeof(fd_row) +
+          (2 * (size_t)M.ndof + 25 * (size_t)M.ngp) * sizeof(double) + sizeof(double) +
+          (size_t)M.ndof * sizeof(double) + 2 * (size_t)M.ngp * FD_NFIELD * sizeof(double);
+    FUZZ_CHECK(b0 + blk + 8 <= n);
+    seed(argv[1], "ckpt_truncated_block", 0, b, n - blk / 2);
+    c = (unsigned char *)malloc(n);
+    FUZZ_CHECK(c != NULL);
+    for (k = 0; k < 6; ++k) {
+        static const char *names[6] = {"ckpt_flip_step",   "ckpt_flip_row",     "ckpt_flip_node",
+                                       "ckpt_flip_stress", "ckpt_flip_inclast", "ckpt_flip_field"};
+        size_t at[6];
+        at[0] = b0 + 16 + 4 * sizeof(int) + 3;
+        at[1] = b0 + 16 + 6 * sizeof(int) + 2 * sizeof(double) + 7;
+        at[2] = b0 + 16 + 6 * sizeof(int) + 2 * sizeof(double) + 2 * sizeof(fd_row) + 8 * 3 + 7;
+        at[3] = at[2] + 2 * (size_t)M.ndof * sizeof(double);
+        at[4] =
+            b0 + blk - 2 * (size_t)M.ngp * FD_NFIELD * sizeof(double) - (size_t)M.ndof * sizeof(double) - 1;
+        at[5] = b0 + blk - 3;
+        memcpy(c, b, n);
+        c[at[k]] ^= 0x40;
+        seed(argv[1], names[k], 0, c, n);
+    }
+    free(c), free(b);
+    /* a step later */
+    M.o.steps = 2, M.o.out = ref_dir;
+    FUZZ_CHECK(fdb_loop(&M, gk_wtime(), &err) == 0 && M.ncurve == 3);
+    b = slurp(path, &n);
+    seed(argv[1], "ckpt_step2", 0, b, n);
+    free(b);
+    /* another driver's tag */
+    FUZZ_CHECK(fd_ck_save(&M, "GKFEMCYC2", NULL) == 0);
+    b = slurp(path, &n);
+    seed(argv[1], "ckpt_other_tag", 0, b, n);
+    free(b);
+    return 0; /* the model is freed at exit */
+}
+#endif
