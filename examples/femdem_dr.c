@@ -946,6 +946,17 @@ static int load_checkpoint(model *m) {
         }
     need += 8 * (3 * (size_t)m->ndof + 18 * (size_t)m->ngp + (size_t)NCOL * iv[6]);
     if (nb != need) goto bad;
+    /* a checksum only proves the file is what some writer wrote: check what
+     * this run will trust (every real finite, counters in range) */
+    if (iv[5] > m->o.iso_steps + m->o.steps || (iv[7] != 0 && iv[7] != 1)) goto bad_value;
+    for (i = 0; i < 8; ++i)
+        if (!isfinite(dv[i]) || (i >= 3 && dv[i] < 0.0)) goto bad_value;
+    for (b += 4 + sizeof iv + sizeof dv; b < (const unsigned char *)blk + nb; b += 8) {
+        double x;
+        memcpy(&x, b, 8);
+        if (!isfinite(x)) goto bad_value;
+    }
+    b = (const unsigned char *)blk;
     b += 4 + sizeof iv + sizeof dv;
     memcpy(m->u, b, 8 * (size_t)m->ndof), b += 8 * (size_t)m->ndof;
     memcpy(m->v, b, 8 * (size_t)m->ndof), b += 8 * (size_t)m->ndof;
@@ -968,6 +979,11 @@ static int load_checkpoint(model *m) {
     return 0;
 bad:
     fprintf(stderr, PROG ": %s is not a checkpoint of this run (another test, mesh, frame or rotation)\n", path);
+    gk_twoscale_free(&m->ts, blk);
+    return 1;
+bad_value:
+    fprintf(stderr, PROG ": %s: the run's block holds a non-finite or out-of-range value; not restarted\n",
+            path);
     gk_twoscale_free(&m->ts, blk);
     return 1;
 }

@@ -1416,6 +1416,17 @@ static int load_checkpoint(model *md, uint64_t fp) {
     need = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->ne + NCOL * (size_t)hd.nrow +
                                          3 * ny + md->ne);
     if (nb != need) goto bad;
+    /* a checksum only proves the file is what some writer wrote: check what
+     * this run will trust (every real finite, counters in range) */
+    if (!isfinite(hd.time) || hd.time < 0.0 || !(isfinite(hd.peak) || hd.peak == -HUGE_VAL) ||
+        hd.dem_total < 0 || (hd.have12 != 0 && hd.have12 != 1))
+        goto bad_value;
+    for (q = (const unsigned char *)blk + sizeof hd; q < (const unsigned char *)blk + nb;
+         q += sizeof(double)) {
+        double x;
+        memcpy(&x, q, sizeof x);
+        if (!isfinite(x)) goto bad_value;
+    }
     q = (const unsigned char *)blk + sizeof hd;
 #define GET(p, n)            \
     do {                     \
@@ -1451,6 +1462,13 @@ bad:
                    "femdem_nonlocal: restart: %s was written by another run (test, mesh, options or packing "
                    "differ) "
                    "or is damaged\n",
+                   path),
+           1;
+bad_value:
+    gk_twoscale_free(&md->ts, blk);
+    return fprintf(stderr,
+                   "femdem_nonlocal: restart: %s: the run's block holds a non-finite or out-of-range value; "
+                   "not restarted\n",
                    path),
            1;
 }

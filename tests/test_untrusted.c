@@ -919,6 +919,51 @@ TEST(driver_checkpoint_blocks_are_checked) {
 #undef MP_CK
 }
 
+/* the dynamic-relaxation and nonlocal drivers checked their checkpoint's
+ * structure (tag, sizes, options, mesh) but took every real in their own
+ * block on trust: a NaN written under a valid checksum was restarted from.
+ * Refused now by name, with exit 1 and no new rows. */
+TEST(dr_and_nonlocal_checkpoints_refuse_non_finite_values) {
+#define DR_CK                                                                                              \
+    "build/femdem_dr --nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 " \
+    "--steps 2 --threads 1 "
+#define NL_CK                                                                                     \
+    "build/femdem_nonlocal --test element-shear --packing examples/data/rve160_hm.txt --steps 4 " \
+    "--strain 0.0004 --lone-increments 2 --threads 1 "
+    unsigned char *b;
+    size_t n, at;
+    double v = NAN;
+    remove(OUT("dr_b/dr.csv")), remove(OUT("nl_b/element-shear.csv")); /* of an earlier run */
+    /* femdem_dr: tag "FDR1", 8 ints, then h_ic, the first of its reals */
+    CHECK_EQ_INT(run_status(DR_CK "--stop-after 1 --out " OUT("dr_a") LOG("dr_a")), 0);
+    b = file_image(OUT("dr_a/checkpoint.bin"), &n);
+    CHECK(b != NULL && (at = find_tag(b, n, "FDR1")) < n);
+    if (!b || at == n) return;
+    CHECK_EQ_INT(run_status(DR_CK "--restart " OUT("dr_a") " --out " OUT("dr_ok") LOG("dr_ok")), 0);
+    mkdir(OUT("dr_bad"), 0755);
+    memcpy(b + at + 4 + 8 * 4, &v, 8);
+    spill_resealed(OUT("dr_bad/checkpoint.bin"), b, n);
+    CHECK_EQ_INT(run_status(DR_CK "--restart " OUT("dr_bad") " --out " OUT("dr_b") LOG("dr_b")), 1);
+    CHECK(gk_test_file_has(OUT("dr_b.out"), "non-finite or out-of-range value"));
+    CHECK(!exists(OUT("dr_b/dr.csv")));
+    free(b);
+    /* femdem_nonlocal: tag "GKFNL01" (8 bytes), 10 ints, 3 int64, the fingerprint, then the time */
+    CHECK_EQ_INT(run_status(NL_CK "--stop-after 2 --out " OUT("nl_a") LOG("nl_a")), 0);
+    b = file_image(OUT("nl_a/checkpoint.bin"), &n);
+    CHECK(b != NULL && (at = find_tag(b, n, "GKFNL01")) < n);
+    if (!b || at == n) return;
+    CHECK_EQ_INT(run_status(NL_CK "--restart " OUT("nl_a") " --out " OUT("nl_ok") LOG("nl_ok")), 0);
+    mkdir(OUT("nl_bad"), 0755);
+    memcpy(b + at + 8 + 10 * 4 + 4 * 8, &v, 8);
+    spill_resealed(OUT("nl_bad/checkpoint.bin"), b, n);
+    CHECK_EQ_INT(run_status(NL_CK "--restart " OUT("nl_bad") " --out " OUT("nl_b") LOG("nl_b")), 1);
+    CHECK(gk_test_file_has(OUT("nl_b.out"), "non-finite or out-of-range value"));
+    CHECK(!exists(OUT("nl_b/element-shear.csv")));
+    free(b);
+#undef DR_CK
+#undef NL_CK
+}
+
 /* =============================================================== tools */
 #define RVE_PATH "build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
 #define GK_PACK "build/gk_pack --n 60 "
@@ -1016,6 +1061,7 @@ int main(int argc, char **argv) {
     RUN(writers_report_a_full_disk);
     RUN(twoscale_checkpoint_reference_is_checked);
     RUN(driver_checkpoint_blocks_are_checked);
+    RUN(dr_and_nonlocal_checkpoints_refuse_non_finite_values);
     RUN(gk_pack_fails_on_a_void_ratio_it_cannot_reach);
     RUN(friction_angle_in_degrees_with_a_plausible_range);
     RUN(rve_path_exits_nonzero_when_its_result_is_lost);
