@@ -187,7 +187,10 @@ check-nosimd: $(NOSIMD_TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 	@tests/run_tests.sh $(NOSIMD_TESTS)
 
 # every header alone, declarations and implementation, as C99 with gcc and
-# clang, as C++ with g++ and clang++, double and float
+# clang, as C++ with g++ and clang++, double and float; and the headers of
+# STANDALONE with only their own GK_X_IMPLEMENTATION: every grainkit function
+# they call is then defined (the FEM family implements what it includes)
+STANDALONE := gk_sparse.h gk_mesh.h gk_dofmap.h gk_nonlocal.h gk_fem.h
 check-headers: | $(BUILD)/hdr
 	@echo "== header portability"
 	@set -e; for h in $(notdir $(HEADERS)); do \
@@ -204,6 +207,21 @@ check-headers: | $(BUILD)/hdr
 	    done; \
 	  done; \
 	  echo "ok   $$h (gcc, clang: c99 -pedantic; g++, clang++: c++11; float; no-SIMD)"; \
+	done
+	@set -e; for h in $(STANDALONE); do \
+	  m=GK_$$(echo $$h | sed 's/^gk_//; s/\.h$$//' | tr a-z A-Z)_IMPLEMENTATION; \
+	  for cc in "gcc -std=c99 -pedantic -x c" "g++ -std=c++11 -x c++"; do \
+	    printf '#include "%s"\nint gk__dummy;\n' $$h | $$cc -Wall -Wextra -Werror -Wshadow $(ARCH) \
+	      -DGK_BASE_IMPLEMENTATION -D$$m -Iinclude -c - -o $(BUILD)/hdr/x.o \
+	      || { echo "FAILED: $$cc -D$$m $$h"; exit 1; }; \
+	    u=$$(nm -u $(BUILD)/hdr/x.o | awk '$$2 ~ /^_?gk_/ {print $$2}' | tr '\n' ' '); \
+	    [ -z "$$u" ] || { echo "FAILED: $$h with $$m alone leaves undefined: $$u"; exit 1; }; \
+	    for f in $$(sed -n 's/^GKDEF[^(]*[ *]\(gk_[a-z0-9_]*\)(.*/\1/p' include/$$h); do \
+	      nm --defined-only $(BUILD)/hdr/x.o | grep -q " T _\{0,1\}$$f$$" \
+	        || { echo "FAILED: $$h with $$m alone does not define $$f"; exit 1; }; \
+	    done; \
+	  done; \
+	  echo "ok   $$h alone with GK_BASE_IMPLEMENTATION + $$m: defines all it declares, calls nothing undefined"; \
 	done
 
 check: check-headers check-nosimd check-asan check-smoke

@@ -34,7 +34,7 @@
  *   after the peak (252.9 against 253.1 kPa) with half the DEM steps,
  *   although 90 % of the runs then stop above the I_uf bound (the CSV's
  *   dem_capped counts them); --dem-max 4000 restores the paper's rule.
- *   Nonlocal (eq 58, Appendix A; gk_fem.h): the whole strain increment at
+ *   Nonlocal (eq 58, Appendix A; gk_nonlocal.h): the whole strain increment at
  *   every Gauss point is replaced by its bell-weighted average over the
  *   points within R (--nonlocal R, or off), normalised per point without
  *   volumes as the paper writes it, with every periodic image, truncated at
@@ -250,6 +250,7 @@
 #define GK_IMPLEMENTATION
 #include "gk_explicit.h"
 #include "gk_fem.h"
+#include "gk_nonlocal.h"
 #include "gk_io.h"
 #include "gk_twoscale.h"
 #include <errno.h>

@@ -2,10 +2,11 @@
  *
  * Compressed sparse rows (CSR) and the solvers the macro scale needs, on
  * plain arrays: a FEM or any other caller assembles into a gk_csr (whose
- * pattern it builds, e.g. gk_csr_from_mesh in gk_fem.h) and solves.
+ * pattern it builds, e.g. gk_csr_from_mesh in gk_mesh.h) and solves.
  *
- * DO THIS: #define GK_IMPLEMENTATION (or GK_SPARSE_IMPLEMENTATION, or
- * GK_FEM_IMPLEMENTATION) in one file.
+ * DO THIS: #define GK_IMPLEMENTATION (or GK_SPARSE_IMPLEMENTATION, or the
+ * GK_FEM_, GK_MESH_ or GK_DOFMAP_IMPLEMENTATION of a header that includes
+ * this one) in one file.
  *
  * MATRICES
  *   gk_csr                  n x n, rows sorted by column; owns its arrays
@@ -85,7 +86,8 @@ GKDEF gk_result gk_pcg(const gk_csr *A, const double *b, double *x, double rtol,
 #endif /* GK_SPARSE_H */
 
 /* ======================================================== IMPLEMENTATION */
-#if (defined(GK_IMPLEMENTATION) || defined(GK_SPARSE_IMPLEMENTATION) || defined(GK_FEM_IMPLEMENTATION)) && \
+#if (defined(GK_IMPLEMENTATION) || defined(GK_SPARSE_IMPLEMENTATION) || defined(GK_FEM_IMPLEMENTATION) || \
+     defined(GK_MESH_IMPLEMENTATION) || defined(GK_DOFMAP_IMPLEMENTATION)) &&                             \
     !defined(GK_SPARSE_IMPL_ONCE)
 #define GK_SPARSE_IMPL_ONCE
 

@@ -1,10 +1,11 @@
 /* test_explicit.c - gk_explicit.h (central differences, adaptive dynamic
- * relaxation, corotational update) and the nonlocal averaging of gk_fem.h,
+ * relaxation, corotational update) and the nonlocal averaging of gk_nonlocal.h,
  * on elastic meshes. */
 #define _POSIX_C_SOURCE 200809L
 #define GK_IMPLEMENTATION
 #include "gk_explicit.h"
 #include "gk_fem.h"
+#include "gk_nonlocal.h"
 #include "gk_test.h"
 #include <stdlib.h>
 

@@ -1,8 +1,11 @@
-/* test_fem.c - gk_fem.h: shape functions, patch tests, convergence, assembly,
- * boundary conditions, solvers, Gmsh reading and bad meshes. */
+/* test_fem.c - gk_fem.h, gk_mesh.h and gk_dofmap.h: shape functions, patch
+ * tests, convergence, assembly, boundary conditions, tied dofs, solvers, Gmsh
+ * reading and bad meshes. */
 #define _POSIX_C_SOURCE 200809L
 #define GK_IMPLEMENTATION
+#include "gk_dofmap.h"
 #include "gk_fem.h"
+#include "gk_mesh.h"
 #include "gk_test.h"
 #include <stdlib.h>
 

@@ -8,7 +8,8 @@
  * elements) or build its matrix pattern and assemble an elastic stiffness.
  * Build and run: make fuzz (tests/fuzz/replay.c explains the layout). */
 #define GK_IMPLEMENTATION
-#include "gk_fem.h"
+#include "gk_fem.h"  /* the FEM on top: gk_quad_rule, gk_fem_assemble */
+#include "gk_mesh.h" /* the parser under test */
 #include "fuzz_check.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
