@@ -79,6 +79,9 @@ $(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests $(BUILD)/fuzz
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
+# test_mpmdem_footing also tests the footing driver's examples/footing_mech.h directly
+$(BUILD)/test_mpmdem_footing $(BUILD)/asan/test_mpmdem_footing $(BUILD)/nosimd/test_mpmdem_footing: examples/footing_mech.h
+
 $(BUILD)/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 

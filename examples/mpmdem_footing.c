@@ -61,7 +61,8 @@
  * the dense RVE peaks at ~0.7 % and loses ~7 deg, and a footing on it fails
  * progressively, so its N_q lies between eq 46 of phi_res and of phi; the
  * output also gives the phi whose eq 46 is the computed N_q. Nothing is
- * cached: every run measures (or --phi-deg X skips it).
+ * cached: every run measures (or --phi-deg X skips it); --phi-only measures,
+ * prepares the RVE at q_s (its e0) and exits: the cheap way to tune a packing.
  *
  * ULTIMATE LOAD (Vesic's rule, as the paper: the first point where the slope
  * of the load-settlement curve reaches zero, or its steady minimum). The
@@ -76,6 +77,14 @@
  * (steady minimum slope), again one window before the end. If neither is
  * found the output says "ultimate load NOT reached" and N_q is the value at
  * the last row (RESULT ultimate_reached=0).
+ *
+ * MECHANISM (footing_mech.h), at every CSV row from the points: the wedge
+ * angle (in each column of cells under the footing, the depth of the largest
+ * eps_q; the line through the footing's corner fitted to them), and the
+ * heave (the surface row's largest uplift beyond the footing, and the
+ * outermost x where it is still 10 % of that); printed and in RESULT at the
+ * ultimate load's row and at the end, next to Prandtl's pi/4 + phi/2 and
+ * the x where his passive zone meets the ground.
  *
  * TIME STEP, DEM STEPS: mpmdem.h (dt = cfl h / c from the RVE's Taylor
  * tangent; DEM steps per MPM step by its --dem-rule, default adaptive).
@@ -110,6 +119,7 @@
 #define GK_IMPLEMENTATION
 #include "mpmdem.h"
 #include "mpmdem_phi.h"
+#include "footing_mech.h"
 
 #define FT_NSTAGE 6
 #define FT_DEM_DT_REF 3.16e-5 /* Guo & Zhao's DEM step at E = 600 MPa */
@@ -124,10 +134,12 @@ typedef struct ft_opts {
     double phi_strain;   /* largest axial strain of a biaxial RVE test */
     double grid_damping; /* local non-viscous grid damping (0: none, as the paper) */
     int max_steps;       /* 0: no limit */
+    int phi_only;        /* 1: measure the angle, prepare one RVE at q_s, print, exit */
 } ft_opts;
 
-typedef struct ft_row { /* one CSV row: means over an output interval */
+typedef struct ft_row { /* one CSV row: means over an output interval; the mechanism at its end */
     double t, d, q, load, ek, dem_mean, secs;
+    double wedge, heave_x, heave_u; /* footing_mech.h: wedge angle [deg], heave's outer x and top [m] */
 } ft_row;
 
 /* what a checkpoint carries besides points and RVEs */
@@ -239,6 +251,8 @@ static void usage(FILE *fp) {
         "  --grid-damping A       local non-viscous damping on the grid nodes in [0, 1) (default %g: none,\n"
         "                         as the paper; reactions never include it)\n"
         "  --max-steps N          stop after N MPM steps (timing / memory probe; default: no limit)\n"
+        "  --phi-only             only the friction-angle measurement and the RVE at q_s (e0), then exit\n"
+        "                         (RESULT phi_deg=... phi_res_deg=... e0=... p0=... seconds=...)\n"
         "  --help                 this text\n",
         FT_MAXPHI, X.f.phi_strain, X.f.grid_damping);
     mpd_usage_common(fp, &X.o);
@@ -247,7 +261,8 @@ static void usage(FILE *fp) {
         "  (footing: --dem-dt defaults to 3.16e-5 s x sqrt(6e8 / E), Guo & Zhao's fraction of the critical "
         "step)\n"
         "\noutputs in --out: footing.csv (time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,\n"
-        "  dem_steps_per_point,seconds), footing_load.svg, rve_biaxial.svg, rve_mohr.svg, eps_q_dB*.svg,\n"
+        "  dem_steps_per_point,seconds,wedge_deg,heave_x_over_B,heave_over_B), footing_load.svg, "
+        "rve_biaxial.svg, rve_mohr.svg, eps_q_dB*.svg,\n"
         "  eps_q_end.svg, rotation_end.svg, void_ratio_end.svg, displacement_end.svg, points_*.vtk,\n"
         "  checkpoint.bin\n"
         "ends with: RESULT Nq=... Nq_analytic=... Nq_analytic_local=... phi_deg=... phi_res_deg=...\n"
@@ -255,7 +270,10 @@ static void usage(FILE *fp) {
         "ultimate_reached=...\n"
         "           n_rves=... mpm_steps=... dt=... seconds_per_step=... seconds_per_step_per_1000_rves=...\n"
         "           seconds_per_step_per_1000_rves_after_first=... mem_per_rve_kb=... vmhwm_mb=... "
-        "total_seconds=...\n");
+        "total_seconds=...\n"
+        "           wedge_deg=... wedge_prandtl_deg=... heave_x_over_B=... heave_width_over_B=... "
+        "heave_over_B=...\n"
+        "           prandtl_reach_over_B=... wedge_end_deg=... heave_x_end_over_B=...\n");
 }
 
 /* the flags, twice: the presets (--material, --paper) first, then every flag given over them */
@@ -282,6 +300,7 @@ static int parse(ft *X, int argc, char **argv) {
         {"--phi-strain", CLI_REAL, &f->phi_strain, 0.01, FT_PHI_STRAIN_MAX, NULL, NULL, 0},
         {"--grid-damping", CLI_REAL, &f->grid_damping, 0, 1, NULL, NULL, CLI_HI_OPEN},
         {"--max-steps", CLI_INT, &f->max_steps, 1, 2000000000, NULL, NULL, 0},
+        {"--phi-only", CLI_FLAG, &f->phi_only, 0, 0, NULL, NULL, 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     int r, k;
     defaults(X, 0, 0);
@@ -299,6 +318,11 @@ static int parse(ft *X, int argc, char **argv) {
             return 2;
         for (k = 0; k < f->nphi; ++k) f->phi_p[k] *= 1e3;
     }
+    if (f->phi_only && f->phi_deg > 0)
+        return fprintf(stderr, "mpmdem_footing: --phi-only measures the angle: it cannot take --phi-deg\n"),
+               2;
+    if (f->phi_only && X->o.restart)
+        return fprintf(stderr, "mpmdem_footing: --phi-only starts fresh: it cannot take --restart\n"), 2;
     if (f->every > f->final_dB)
         return fprintf(stderr, "mpmdem_footing: --every %g is out of range: exceeds --final %g\n", f->every,
                        f->final_dB),
@@ -379,6 +403,7 @@ static int setup(ft *X, gk_err *err) {
     else
         X->measured = 1;
     if (mpd_prepare_rve(&X->P, f->surcharge, &X->st0, err)) return 1;
+    if (f->phi_only) return 0; /* no grid, no points: run() prints and stops */
     X->c = sqrt(X->P.M / X->P.rho);
     X->dt = X->o.cfl * h / X->c;
     /* grid: ghost layers; room above the ground for the heave */
@@ -463,11 +488,13 @@ static int displacement_field(ft *X) {
 static void put_csv(FILE *fp, const void *user) {
     const ft *X = (const ft *)user;
     int k;
-    fprintf(fp, "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds\n");
+    fprintf(fp, "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds,"
+                "wedge_deg,heave_x_over_B,heave_over_B\n");
     for (k = 0; k < X->rows.n; ++k) {
         const ft_row *r = (const ft_row *)mpd_row(&X->rows, k);
-        fprintf(fp, "%.6g,%.6g,%.6g,%.9g,%.6g,%.9g,%.6g,%.4g,%.3f\n", r->t, r->d, r->d / X->f.B, r->q,
-                r->q / X->f.surcharge, r->load, r->ek, r->dem_mean, r->secs);
+        fprintf(fp, "%.6g,%.6g,%.6g,%.9g,%.6g,%.9g,%.6g,%.4g,%.3f,%.5g,%.5g,%.5g\n", r->t, r->d,
+                r->d / X->f.B, r->q, r->q / X->f.surcharge, r->load, r->ek, r->dem_mean, r->secs, r->wedge,
+                r->heave_x / X->f.B, r->heave_u / X->f.B);
     }
 }
 
@@ -546,6 +573,24 @@ static int load_plot(const ft *X, const double *qsm, int ku, double nq46, double
     return bad;
 }
 
+/* the failure mechanism of the points now (footing_mech.h): wedge angle, heave; 0 or 1 (out of memory) */
+static int mechanism(const ft *X, double *wedge, double *hx, double *hu) {
+    int n = X->pts.n, p, ns = 0;
+    double *eq = (double *)malloc(3 * (size_t)n * sizeof *eq + 1), *xs = eq + n, *uy = xs + n;
+    double h = X->h, top = X->f.depth - 0.5 * h;
+    *wedge = *hx = *hu = NAN;
+    if (!eq) return fprintf(stderr, "mpmdem_footing: out of memory\n"), 1;
+    for (p = 0; p < n; ++p) {
+        eq[p] = gk_strain_q(X->M.eps + 9 * (size_t)p, 2);
+        if (X->x0[2 * p + 1] > top) /* the surface row of points */
+            xs[ns] = X->pts.x[0][p], uy[ns] = X->pts.x[1][p] - X->x0[2 * p + 1], ++ns;
+    }
+    *wedge = fm_wedge_angle(X->pts.x[0], X->pts.x[1], eq, n, h, X->b, X->f.depth - X->S.disp, NULL);
+    *hx = fm_heave(xs, uy, ns, X->b, hu);
+    free(eq);
+    return 0;
+}
+
 /* after a step: the interval sums, and a CSV row (with the stage field) when due; 0 or 1 (said) */
 static int after_step(ft *X, double vf, double t_start, long step0, long nsteps_total) {
     const ft_opts *f = &X->f;
@@ -567,6 +612,7 @@ static int after_step(ft *X, double vf, double t_start, long step0, long nsteps_
     r.t = S->t, r.d = S->disp, r.load = S->acc_load / S->acc_dt, r.q = r.load / X->b;
     r.ek = S->acc_ek / S->nacc, r.dem_mean = S->acc_dem / S->nacc;
     r.secs = S->wall + gk_wtime() - t_start;
+    if (mechanism(X, &r.wedge, &r.heave_x, &r.heave_u)) return 1;
     S->acc_load = S->acc_dt = 0, S->acc_ek = S->acc_dem = 0, S->nacc = 0;
     while (S->next_out * f->B <= S->disp * (1 + 1e-9)) S->next_out += f->every;
     bad = mpd_rows_push(&X->run, &X->rows, &r) || mpd_write(&X->run, "footing.csv", put_csv, X);
@@ -603,6 +649,7 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
     int n = X->rows.n, ku = -1, reached = 0, k, excl = X->S.step == steps_run && steps_run > 1, np = X->pts.n;
     double *x = (double *)malloc(3 * (size_t)n * sizeof *x + 1), *q = x + n, *qsm = q + n, nq = NAN, qu = NAN,
            du = NAN;
+    double wu = NAN, hxu = NAN, huu = NAN, we = NAN, hxe = NAN;
     double nq46 = nq_prandtl(X->phi), nq47 = nq_prandtl(phi_reduced(X->phi)), hwm, per_rve, ck_mb = 0;
     /* cost per RVE per step without the first step's one-off relaxation of every RVE */
     double per_step_rve = steps_run ? (secs - (excl ? X->t_first : 0)) / (steps_run - excl) / np : 0.0;
@@ -669,6 +716,19 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
     printf("Liang & Zhao '%s': N_q %.1f (MPMxDEM) vs %.1f (analytic, phi = %.1f deg)\n",
            material_names[f->material], paper_nq[f->material], paper_nq_analytic[f->material],
            paper_phi[f->material]);
+    if (n > 0) {
+        const ft_row *ru = (const ft_row *)mpd_row(&X->rows, ku),
+                     *rl = (const ft_row *)mpd_row(&X->rows, n - 1);
+        wu = ru->wedge, hxu = ru->heave_x, huu = ru->heave_u, we = rl->wedge, hxe = rl->heave_x;
+        printf(
+            "mechanism at the %s (d/B = %.4f): wedge angle %.1f deg (Prandtl pi/4 + phi/2 = %.2f; Liang & "
+            "Zhao 54.8 vs 59.05); heave up to %.3g B, reaching x = %.2f B from the axis = %.2f B beyond the "
+            "footing edge (Prandtl's passive zone: x = %.2f B; Liang & Zhao: heave about 2.5 B wide)\n",
+            reached ? "ultimate load" : "last row", du, wu, fm_prandtl_wedge(X->phi), huu / f->B, hxu / f->B,
+            (hxu - X->b) / f->B, fm_prandtl_reach(X->b, X->phi) / f->B);
+        printf("mechanism at the end (d/B = %.4f): wedge angle %.1f deg; heave reaching x = %.2f B\n",
+               rl->d / f->B, we, hxe / f->B);
+    }
     hwm = proc_kb("VmHWM");
     per_rve = X->rss_after > 0 && X->rss_before > 0 ? (X->rss_after - X->rss_before) / np : NAN;
     printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step); %.4g s "
@@ -700,11 +760,14 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
            "dt=%.4g "
            "seconds_per_step=%.4g seconds_per_step_per_1000_rves=%.4g "
            "seconds_per_step_per_1000_rves_after_first=%.4g "
-           "mem_per_rve_kb=%.4g vmhwm_mb=%.5g total_seconds=%.2f\n",
+           "mem_per_rve_kb=%.4g vmhwm_mb=%.5g total_seconds=%.2f wedge_deg=%.4g wedge_prandtl_deg=%.4g "
+           "heave_x_over_B=%.4g heave_width_over_B=%.4g heave_over_B=%.4g prandtl_reach_over_B=%.4g "
+           "wedge_end_deg=%.4g heave_x_end_over_B=%.4g\n",
            nq, nq46, nq47, X->phi, X->phi_res, X->measured ? nq_prandtl(X->phi_res) : NAN, phi_of_nq(nq), qu,
            du, reached, np, steps_run, X->dt, steps_run ? secs / steps_run : 0.0,
-           steps_run ? secs / steps_run * 1000.0 / np : 0.0, 1000.0 * per_step_rve, per_rve, hwm / 1024,
-           secs);
+           steps_run ? secs / steps_run * 1000.0 / np : 0.0, 1000.0 * per_step_rve, per_rve, hwm / 1024, secs,
+           wu, fm_prandtl_wedge(X->phi), hxu / f->B, (hxu - X->b) / f->B, huu / f->B,
+           fm_prandtl_reach(X->b, X->phi) / f->B, we, hxe / f->B);
     free(x);
     return bad;
 }
@@ -718,7 +781,15 @@ static int run(ft *X, int argc, char **argv) {
     int status = parse(X, argc, argv), bad = 0;
     gk_err err;
     if (status) return status == 1 ? 0 : status;
+    t_start = gk_wtime();
     if (setup(X, &err)) return fprintf(stderr, "mpmdem_footing: %s\n", err.msg), 1;
+    if (f->phi_only) {
+        printf("RVE at q_s = %g kPa: p0 = %.4g kPa, e0 = %.4f (Table 2: %.4f)\n", f->surcharge / 1e3,
+               X->P.p0 / 1e3, X->P.e0, table2_e0[f->material]);
+        printf("RESULT phi_deg=%.4g phi_res_deg=%.4g Nq_analytic=%.5g e0=%.5g p0=%.6g seconds=%.2f\n", X->phi,
+               X->phi_res, nq_prandtl(X->phi), X->P.e0, X->P.p0, gk_wtime() - t_start);
+        return 0;
+    }
     nsteps_total = (long)ceil((f->final_dB * f->B / f->velocity + 0.5 * f->ramp) / X->dt);
     if (f->max_steps && f->max_steps < nsteps_total) nsteps_total = f->max_steps;
     printf("grid: %d x %d cells over %g x %g m (half model), h = %.4g m; footing B = %g m, half-width b = %g "

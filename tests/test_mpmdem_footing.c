@@ -10,6 +10,8 @@
 #include "gk_test.h"
 #include <stdlib.h>
 
+#include "../examples/footing_mech.h"
+
 #define FT                                                                                                  \
     "build/mpmdem_footing --width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 --every " \
     "0.005 --smooth 0.01 --quiet "
@@ -43,9 +45,9 @@ TEST(footing_runs_and_loads) {
     CHECK(system(FT
                  "--final 0.02 --phi-pressures 20 --phi-strain 0.025 --threads 1 --out build/tests/t_mpmft "
                  "> build/tests/t_mpmft.out 2>&1") == 0);
-    CHECK(
-        gk_test_file_has("build/tests/t_mpmft/footing.csv",
-                         "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds"));
+    CHECK(gk_test_file_has("build/tests/t_mpmft/footing.csv",
+                           "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds,"
+                           "wedge_deg,heave_x_over_B,heave_over_B"));
     n = read_rows("build/tests/t_mpmft/footing.csv", r, 16);
     CHECK_EQ_INT(n, 5);
     if (n != 5) return;
@@ -75,6 +77,73 @@ TEST(footing_runs_and_loads) {
     CHECK(gk_test_file_has("build/tests/t_mpmft/eps_q_end.svg", "<svg"));
     CHECK(gk_test_file_has("build/tests/t_mpmft/displacement_end.svg", "<svg"));
     CHECK(gk_test_file_has("build/tests/t_mpmft/points_000000.vtk", "SCALARS eps_q"));
+    /* the mechanism is measured: a wedge angle (this footing has one column under it: coarse) and
+     * Prandtl's pi/4 + phi/2 of the measured angle next to it */
+    t = gk_test_result("build/tests/t_mpmft.out", "wedge_deg");
+    CHECK(t > 30.0 && t < 80.0);
+    CHECK_NEAR(gk_test_result("build/tests/t_mpmft.out", "wedge_prandtl_deg"), 45.0 + 0.5 * phi,
+               0.01); /* both printed to 4 digits */
+}
+
+/* --phi-only: the same measurement as the full run above (same options), then the RVE at q_s, and
+ * exit before the footing (no footing.csv) */
+TEST(footing_phi_only) {
+    double phi, e0;
+    CHECK(system("rm -rf build/tests/t_mpmft_phi && build/mpmdem_footing --phi-only --phi-pressures 20 "
+                 "--phi-strain 0.025 --threads 1 --out build/tests/t_mpmft_phi > build/tests/t_mpmft_phi.out "
+                 "2>&1") == 0);
+    phi = gk_test_result("build/tests/t_mpmft_phi.out", "phi_deg");
+    CHECK(phi == gk_test_result("build/tests/t_mpmft.out", "phi_deg"));
+    CHECK(gk_test_result("build/tests/t_mpmft_phi.out", "phi_res_deg") ==
+          gk_test_result("build/tests/t_mpmft.out", "phi_res_deg"));
+    e0 = gk_test_result("build/tests/t_mpmft_phi.out", "e0");
+    CHECK(e0 > 0.15 && e0 < 0.25); /* the dense packing at 20 kPa */
+    CHECK_REL(gk_test_result("build/tests/t_mpmft_phi.out", "p0"), 2e4, 5e-3);
+    CHECK(gk_test_file_has("build/tests/t_mpmft_phi/rve_mohr.svg", "<svg"));
+    CHECK(system("test -e build/tests/t_mpmft_phi/footing.csv") != 0);
+    CHECK(system("test -e build/tests/t_mpmft_phi/checkpoint.bin") != 0);
+}
+
+/* footing_mech.h on synthetic fields with known answers */
+TEST(footing_mechanism_synthetic) {
+    enum { NX = 30, NY = 20 };
+    static double x[NX * NY], y[NX * NY], eq[NX * NY];
+    double h = 0.1, b = 0.45, yb = 2.0, xs[NX], uy[NX], pi = 3.14159265358979323846, umax, a, xo;
+    int i, j, n = 0, nc, k;
+    const double angles[3] = {45.0, 54.8, 62.0};
+    /* a band of eps_q along the line from the corner (b, yb) down to the axis at angle alpha: the fitted
+     * wedge is alpha (the parabola refinement recovers the depth between the points) */
+    for (k = 0; k < 3; ++k) {
+        double ta = tan(angles[k] * pi / 180.0);
+        n = 0;
+        for (j = 0; j < NY; ++j)
+            for (i = 0; i < NX; ++i) {
+                double px = (i + 0.5) * h, py = yb - (j + 0.5) * h, z = yb - py, zl = (b - px) * ta;
+                double dist = (z - zl) * cos(angles[k] * pi / 180.0); /* normal distance to the line */
+                x[n] = px, y[n] = py, eq[n] = 0.01 + exp(-dist * dist / (2 * 0.08 * 0.08)), ++n;
+            }
+        a = fm_wedge_angle(x, y, eq, n, h, b, yb, &nc);
+        CHECK_EQ_INT(nc, 4); /* the 4 columns wholly under b = 4.5 h */
+        CHECK_NEAR(a, angles[k], 1.0);
+    }
+    /* no point below the footing: no wedge */
+    CHECK(isnan(fm_wedge_angle(x, y, eq, n, h, b, -1.0, &nc)));
+    CHECK_EQ_INT(nc, 0);
+    /* heave: uplift falling linearly from 10 mm at the edge to 0 at x = 2.5 m; the largest sampled
+     * (at x = 0.55) is 9.75 mm: 10 % of that at x = 0.5 + 2 (1 - 0.0975) = 2.305 m (exact: linear) */
+    for (i = 0; i < NX; ++i) {
+        xs[i] = (NX - 1 - i) * 0.1 + 0.05; /* any order */
+        uy[i] = xs[i] <= b ? -0.02 : fmax(0.0, 0.01 * (1.0 - (xs[i] - 0.5) / 2.0));
+    }
+    xo = fm_heave(xs, uy, NX, b, &umax);
+    CHECK_NEAR(xo, 2.305, 1e-9);
+    CHECK_NEAR(umax, 0.01 * (1.0 - 0.05 / 2.0), 1e-12);
+    for (i = 0; i < NX; ++i) uy[i] = -0.001;
+    CHECK(isnan(fm_heave(xs, uy, NX, b, &umax)) && isnan(umax));
+    /* Prandtl at phi = 0: the wedge at 45 deg, the passive triangle's base = B: reach 3 b from the axis */
+    CHECK_NEAR(fm_prandtl_wedge(0.0), 45.0, 1e-12);
+    CHECK_NEAR(fm_prandtl_reach(0.5, 0.0), 1.5, 1e-12);
+    CHECK_NEAR(fm_prandtl_wedge(28.1), 59.05, 1e-12); /* Liang & Zhao's 59.05 deg */
 }
 
 /* the ultimate-load rule on a curve that peaks: a longer run of the same
@@ -102,8 +171,8 @@ TEST(footing_thread_independent) {
                     "build/tests/t_mpmft1.out 2>&1") == 0);
     CHECK(gk_test_result("build/tests/t_mpmft1.out", "Nq") ==
           gk_test_result("build/tests/t_mpmft2.out", "Nq"));
-    CHECK(system("cut -d, -f1-8 build/tests/t_mpmft1/footing.csv > build/tests/t_mpmft1.c && "
-                 "cut -d, -f1-8 build/tests/t_mpmft2/footing.csv > build/tests/t_mpmft2.c && "
+    CHECK(system("cut -d, -f1-8,10- build/tests/t_mpmft1/footing.csv > build/tests/t_mpmft1.c && "
+                 "cut -d, -f1-8,10- build/tests/t_mpmft2/footing.csv > build/tests/t_mpmft2.c && "
                  "cmp -s build/tests/t_mpmft1.c build/tests/t_mpmft2.c") == 0);
 }
 
@@ -118,7 +187,7 @@ TEST(footing_restart_identical) {
     CHECK(rc == 0);
     CHECK(gk_test_result("build/tests/t_mpmft_b.out", "Nq") ==
           gk_test_result("build/tests/t_mpmft1.out", "Nq"));
-    CHECK(system("cut -d, -f1-8 build/tests/t_mpmft_b/footing.csv > build/tests/t_mpmft_b.c && "
+    CHECK(system("cut -d, -f1-8,10- build/tests/t_mpmft_b/footing.csv > build/tests/t_mpmft_b.c && "
                  "cmp -s build/tests/t_mpmft_b.c build/tests/t_mpmft1.c") == 0);
 }
 
@@ -141,6 +210,7 @@ TEST(footing_bad_arguments) {
     BAD("--velocity", "needs a value");
     BAD("--bogus 1", "unknown option");
     BAD("--alpha 2", "--alpha");
+    BAD("--phi-only --phi-deg 30", "cannot take --phi-deg");
     /* bad input changes nothing: no output folder is made before the inputs are read */
     CHECK(system("rm -rf build/tests/t_mpmft_bad") == 0);
     BAD("--packing /nonexistent", "nonexistent");
@@ -160,6 +230,8 @@ TEST(footing_bad_arguments) {
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(footing_runs_and_loads);
+    RUN(footing_phi_only);
+    RUN(footing_mechanism_synthetic);
     RUN(footing_ultimate_found);
     RUN(footing_thread_independent);
     RUN(footing_restart_identical);
