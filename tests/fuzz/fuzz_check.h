@@ -17,4 +17,38 @@
     } while (0)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+/* The checkpoint harnesses' input: byte 0 is a mode, the rest is the file.
+ * An even mode writes the right checksum into the file (gk_twoscale's: the
+ * last 8 bytes are the FNV-1a hash of the rest), so that the fuzzer gets past
+ * the checksum to the header and field checks. */
+static inline uint64_t fuzz_fnv1a(const unsigned char *b, size_t n) {
+    uint64_t h = UINT64_C(0xcbf29ce484222325);
+    while (n--) h = (h ^ *b++) * UINT64_C(0x100000001b3);
+    return h;
+}
+
+static inline void fuzz_write_checkpoint(const char *path, const uint8_t *data, size_t size) {
+    size_t len = size - 1;
+    unsigned char *file = (unsigned char *)malloc(len + 1);
+    FILE *fp;
+    FUZZ_CHECK(size >= 1 && file != NULL);
+    memcpy(file, data + 1, len);
+    if (!(data[0] & 1) && len >= 8) {
+        uint64_t h = fuzz_fnv1a(file, len - 8);
+        memcpy(file + len - 8, &h, 8);
+    }
+    FUZZ_CHECK((fp = fopen(path, "wb")) != NULL && fwrite(file, 1, len, fp) == len && fclose(fp) == 0);
+    free(file);
+}
+
+/* a seed file for a checkpoint harness: the mode byte, then the bytes */
+static inline void fuzz_write_seed(const char *dir, const char *name, unsigned char mode,
+                                   const unsigned char *b, size_t n) {
+    char path[1024];
+    FILE *fp;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    fp = fopen(path, "wb");
+    FUZZ_CHECK(fp && fwrite(&mode, 1, 1, fp) == 1 && fwrite(b, 1, n, fp) == n && fclose(fp) == 0);
+}
 #endif

@@ -156,33 +156,17 @@ static void setup(void) {
     ready = 1;
 }
 
-static uint64_t fnv1a(const unsigned char *b, size_t n) {
-    uint64_t h = UINT64_C(0xcbf29ce484222325);
-    while (n--) h = (h ^ *b++) * UINT64_C(0x100000001b3);
-    return h;
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     char path[600];
-    unsigned char *file;
-    size_t len, n = 0, k;
+    size_t n = 0, k;
     gk_err err;
     gk_mesh m;
     double *f, L = 0.0, syy, sxx, ev, Ed = 0, Ef = 0;
     int c, r, iters = 0;
-    FILE *fp;
     if (size < 1) return 0;
     setup();
-    len = size - 1;
-    FUZZ_CHECK((file = (unsigned char *)malloc(len + 1)) != NULL);
-    memcpy(file, data + 1, len);
-    if (!(data[0] & 1) && len >= 8) {
-        uint64_t h = fnv1a(file, len - 8);
-        memcpy(file + len - 8, &h, 8);
-    }
     snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
-    FUZZ_CHECK((fp = fopen(path, "wb")) != NULL && fwrite(file, 1, len, fp) == len && fclose(fp) == 0);
-    free(file);
+    fuzz_write_checkpoint(path, data, size);
     err.msg[0] = '\0';
     M.o.restart = in_dir;
     if (fdb_restart(&M, &err)) {
@@ -246,14 +230,6 @@ static unsigned char *slurp(const char *path, size_t *n) {
     return b;
 }
 
-static void seed(const char *dir, const char *name, unsigned char mode, const unsigned char *b, size_t n) {
-    char path[1024];
-    FILE *fp;
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    fp = fopen(path, "wb");
-    FUZZ_CHECK(fp && fwrite(&mode, 1, 1, fp) == 1 && fwrite(b, 1, n, fp) == n && fclose(fp) == 0);
-}
-
 /* the pristine checkpoint, truncated and bit-flipped copies (in the model's block: the step, a row,
  * a node, a stress; in the driver's part: the last increment, a field), one a step later, and one
  * with the cyclic driver's tag */
@@ -266,14 +242,14 @@ int main(int argc, char **argv) {
     setup();
     snprintf(path, sizeof path, "%s/checkpoint.bin", ref_dir);
     b = slurp(path, &n);
-    seed(argv[1], "ckpt_step1", 0, b, n);
+    fuzz_write_seed(argv[1], "ckpt_step1", 0, b, n);
     /* the driver's block starts with its tag; its size: the model's block plus the driver's part */
     for (b0 = 0; b0 + 16 < n && memcmp(b + b0, FDB_TAG, sizeof FDB_TAG); ++b0) continue;
     blk = 16 + 4 * sizeof(int) + sizeof(int) + 2 * sizeof(double) + sizeof(int) + 2 * sizeof(fd_row) +
           (2 * (size_t)M.ndof + 25 * (size_t)M.ngp) * sizeof(double) + sizeof(double) +
           (size_t)M.ndof * sizeof(double) + 2 * (size_t)M.ngp * FD_NFIELD * sizeof(double);
     FUZZ_CHECK(b0 + blk + 8 <= n);
-    seed(argv[1], "ckpt_truncated_block", 0, b, n - blk / 2);
+    fuzz_write_seed(argv[1], "ckpt_truncated_block", 0, b, n - blk / 2);
     c = (unsigned char *)malloc(n);
     FUZZ_CHECK(c != NULL);
     for (k = 0; k < 6; ++k) {
@@ -289,19 +265,19 @@ int main(int argc, char **argv) {
         at[5] = b0 + blk - 3;
         memcpy(c, b, n);
         c[at[k]] ^= 0x40;
-        seed(argv[1], names[k], 0, c, n);
+        fuzz_write_seed(argv[1], names[k], 0, c, n);
     }
     free(c), free(b);
     /* a step later */
     M.o.steps = 2, M.o.out = ref_dir;
     FUZZ_CHECK(fdb_loop(&M, gk_wtime(), &err) == 0 && M.ncurve == 3);
     b = slurp(path, &n);
-    seed(argv[1], "ckpt_step2", 0, b, n);
+    fuzz_write_seed(argv[1], "ckpt_step2", 0, b, n);
     free(b);
     /* another driver's tag */
     FUZZ_CHECK(fd_ck_save(&M, "GKFEMCYC2", NULL) == 0);
     b = slurp(path, &n);
-    seed(argv[1], "ckpt_other_tag", 0, b, n);
+    fuzz_write_seed(argv[1], "ckpt_other_tag", 0, b, n);
     free(b);
     return 0; /* the model is freed at exit */
 }

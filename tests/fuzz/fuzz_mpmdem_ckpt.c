@@ -127,32 +127,16 @@ static void fuzz_setup(void) {
     snap0 = model_bytes(&nsnap);
 }
 
-static uint64_t fnv1a(const unsigned char *b, size_t n) {
-    uint64_t h = UINT64_C(0xcbf29ce484222325);
-    while (n--) h = (h ^ *b++) * UINT64_C(0x100000001b3);
-    return h;
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     char path[600], why[200];
-    unsigned char *file;
-    size_t len, k;
+    size_t k;
     gk_err err;
     double *f;
     int n, r;
-    FILE *fp;
     if (size < 1) return 0;
     fuzz_setup();
-    len = size - 1;
-    FUZZ_CHECK((file = (unsigned char *)malloc(len + 1)) != NULL);
-    memcpy(file, data + 1, len);
-    if (!(data[0] & 1) && len >= 8) {
-        uint64_t h = fnv1a(file, len - 8);
-        memcpy(file + len - 8, &h, 8);
-    }
     snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
-    FUZZ_CHECK((fp = fopen(path, "wb")) != NULL && fwrite(file, 1, len, fp) == len && fclose(fp) == 0);
-    free(file);
+    fuzz_write_checkpoint(path, data, size);
     err.msg[0] = '\0';
     if (load(in_dir, &err) != GK_OK) {
         FUZZ_CHECK(err.msg[0] != '\0');
@@ -186,14 +170,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 }
 
 #ifdef FUZZ_MAKE_SEEDS
-static void seed(const char *dir, const char *name, unsigned char mode, const unsigned char *b, size_t n) {
-    char p[1024];
-    FILE *fp;
-    snprintf(p, sizeof p, "%s/%s", dir, name);
-    fp = fopen(p, "wb");
-    FUZZ_CHECK(fp && fwrite(&mode, 1, 1, fp) == 1 && fwrite(b, 1, n, fp) == n && fclose(fp) == 0);
-}
-
 /* the pristine checkpoint, truncated copies, bit flips in the block (a position, the mass, the plate's
  * contact law, a row), and one with another driver's tag */
 int main(int argc, char **argv) {
@@ -210,8 +186,8 @@ int main(int argc, char **argv) {
     FUZZ_CHECK((b = (unsigned char *)malloc(n)) && (c = (unsigned char *)malloc(n)));
     rewind(fp);
     FUZZ_CHECK(fread(b, 1, n, fp) == n && fclose(fp) == 0);
-    seed(argv[1], "ckpt_biaxial", 0, b, n);
-    seed(argv[1], "ckpt_truncated", 0, b, n / 2);
+    fuzz_write_seed(argv[1], "ckpt_biaxial", 0, b, n);
+    fuzz_write_seed(argv[1], "ckpt_truncated", 0, b, n / 2);
     for (b0 = 0; b0 + 16 < n && memcmp(b + b0, MPD_BLOCK_TAG, sizeof MPD_BLOCK_TAG - 1); ++b0) continue;
     FUZZ_CHECK(b0 + 16 < n);
     for (k = 0; k < 4; ++k) {
@@ -225,7 +201,7 @@ int main(int argc, char **argv) {
         at[3] = pts_end + sizeof(bx_state) + 8 + 8 + 7;
         memcpy(c, b, n);
         c[at[k]] ^= 0x40;
-        seed(argv[1], names[k], 0, c, n);
+        fuzz_write_seed(argv[1], names[k], 0, c, n);
     }
     { /* the first snapshot's first outline polyline said to have 1000 points */
         size_t np = (size_t)X.pts.n, at = b0 + 44 + 10 * np * 8 + 36 * np * 8 + 9 * np * 8 + 4 * np + 8 +
@@ -235,11 +211,11 @@ int main(int argc, char **argv) {
         FUZZ_CHECK(X.snaps.n >= 1 && at + 4 < n);
         memcpy(c, b, n);
         memcpy(c + at, &big, 4);
-        seed(argv[1], "ckpt_outline_1000_points", 0, c, n);
+        fuzz_write_seed(argv[1], "ckpt_outline_1000_points", 0, c, n);
     }
     memcpy(c, b, n);
     memcpy(c + b0 + 10, "footing\0", 8);
-    seed(argv[1], "ckpt_other_tag", 0, c, n);
+    fuzz_write_seed(argv[1], "ckpt_other_tag", 0, c, n);
     free(b), free(c);
     return 0;
 }

@@ -55,11 +55,6 @@ static unsigned char *slurp(const char *path, size_t *n) {
     return b;
 }
 
-static void spill(const char *path, const void *b, size_t n) {
-    FILE *fp = fopen(path, "wb");
-    FUZZ_CHECK(fp && fwrite(b, 1, n, fp) == n && fclose(fp) == 0);
-}
-
 static void cleanup(void) {
     remove(in_path), remove(out_path), remove(ref_path);
 }
@@ -127,15 +122,8 @@ static void setup(void) {
     ready = 1;
 }
 
-static uint64_t fnv1a(const unsigned char *b, size_t n) {
-    uint64_t h = UINT64_C(0xcbf29ce484222325);
-    while (n--) h = (h ^ *b++) * UINT64_C(0x100000001b3);
-    return h;
-}
-
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-    unsigned char *file;
-    size_t len, nb = 0;
+    size_t nb = 0;
     void *blk = NULL;
     gk_result r;
     double dH[9 * NPT], S[9 * NPT], D[16 * NPT];
@@ -144,16 +132,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     int k;
     if (size < 1) return 0;
     setup();
-    len = size - 1;
-    file = (unsigned char *)malloc(len + 1);
-    FUZZ_CHECK(file != NULL);
-    memcpy(file, data + 1, len);
-    if (!(data[0] & 1) && len >= 8) {
-        uint64_t h = fnv1a(file, len - 8);
-        memcpy(file + len - 8, &h, 8);
-    }
-    spill(in_path, file, len);
-    free(file);
+    fuzz_write_checkpoint(in_path, data, size);
     ts.err.msg[0] = '\0';
     r = gk_twoscale_load(&ts, in_path, &blk, &nb);
     if (r != GK_OK) {
@@ -194,14 +173,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 }
 
 #ifdef FUZZ_MAKE_SEEDS
-static void seed(const char *dir, const char *name, unsigned char mode, const unsigned char *b, size_t n) {
-    char path[1024];
-    FILE *fp;
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    fp = fopen(path, "wb");
-    FUZZ_CHECK(fp && fwrite(&mode, 1, 1, fp) == 1 && fwrite(b, 1, n, fp) == n && fclose(fp) == 0);
-}
-
 /* the pristine checkpoint (with a driver block), one without tangent references (a fresh set), one
  * after two more runs, and truncated and bit-flipped copies of the first */
 int main(int argc, char **argv) {
@@ -215,10 +186,10 @@ int main(int argc, char **argv) {
     setup();
     FUZZ_CHECK(gk_twoscale_save(&ts, out_path, block, sizeof block) == GK_OK);
     b = slurp(out_path, &n);
-    seed(argv[1], "ckpt_accepted", 0, b, n);
-    seed(argv[1], "ckpt_truncated_header", 0, b, 24);
-    seed(argv[1], "ckpt_truncated_record", 0, b, n / 2);
-    seed(argv[1], "ckpt_truncated_checksum", 1, b, n - 3);
+    fuzz_write_seed(argv[1], "ckpt_accepted", 0, b, n);
+    fuzz_write_seed(argv[1], "ckpt_truncated_header", 0, b, 24);
+    fuzz_write_seed(argv[1], "ckpt_truncated_record", 0, b, n / 2);
+    fuzz_write_seed(argv[1], "ckpt_truncated_checksum", 1, b, n - 3);
     c = (unsigned char *)malloc(n);
     FUZZ_CHECK(c != NULL);
     for (k = 0; k < 4; ++k) { /* one bit flipped: in the header, the first record, a state, the block */
@@ -228,7 +199,8 @@ int main(int argc, char **argv) {
         at[0] = 20, at[1] = 8 + 32 + 4 * (2 + NPT) + 8 + 5, at[2] = n / 3, at[3] = n - 8 - sizeof block + 3;
         memcpy(c, b, n);
         c[at[k]] ^= 0x10;
-        seed(argv[1], names[k], (unsigned char)(k & 1), c, n); /* header and state: checksum mended */
+        fuzz_write_seed(argv[1], names[k], (unsigned char)(k & 1), c,
+                        n); /* header and state: checksum mended */
     }
     free(c);
     free(b);
@@ -245,14 +217,14 @@ int main(int argc, char **argv) {
         gk_twoscale_destroy(&fresh);
     }
     b = slurp(out_path, &n);
-    seed(argv[1], "ckpt_fresh", 0, b, n);
+    fuzz_write_seed(argv[1], "ckpt_fresh", 0, b, n);
     free(b);
     for (k = 0; k < 9 * NPT; ++k) dH[k] = 3.0 * dH0[k % 9];
     for (k = 0; k < 2; ++k)
         FUZZ_CHECK(gk_twoscale_run(&ts, dH, NULL, S, D) == GK_OK && gk_twoscale_accept(&ts) == GK_OK);
     FUZZ_CHECK(gk_twoscale_save(&ts, out_path, NULL, 0) == GK_OK);
     b = slurp(out_path, &n);
-    seed(argv[1], "ckpt_three_runs", 0, b, n);
+    fuzz_write_seed(argv[1], "ckpt_three_runs", 0, b, n);
     free(b);
     gk_twoscale_destroy(&ts);
     return 0;
