@@ -3,6 +3,7 @@
  * it as a crash with the condition and the line. */
 #ifndef FUZZ_CHECK_H
 #define FUZZ_CHECK_H
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +18,25 @@
     } while (0)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+/* every value finite, or abort */
+static inline void fuzz_all_finite(const double *v, size_t n) {
+    size_t k;
+    for (k = 0; k < n; ++k) FUZZ_CHECK(isfinite(v[k]));
+}
+
+/* the bytes of a file (malloc'd, one spare byte), or abort */
+static inline unsigned char *fuzz_slurp(const char *path, size_t *n) {
+    FILE *fp = fopen(path, "rb");
+    unsigned char *b = NULL;
+    long end;
+    FUZZ_CHECK(fp && fseek(fp, 0, SEEK_END) == 0 && (end = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0);
+    FUZZ_CHECK((b = (unsigned char *)malloc((size_t)end + 1)) != NULL);
+    FUZZ_CHECK(fread(b, 1, (size_t)end, fp) == (size_t)end);
+    fclose(fp);
+    *n = (size_t)end;
+    return b;
+}
 
 /* The checkpoint harnesses' input: byte 0 is a mode, the rest is the file.
  * An even mode writes the right checksum into the file (gk_twoscale's: the

@@ -93,11 +93,6 @@ static int same_as_pristine(void) {
     return same;
 }
 
-static void all_finite(const double *v, size_t n) {
-    size_t k;
-    for (k = 0; k < n; ++k) FUZZ_CHECK(isfinite(v[k]));
-}
-
 static void make_dir(char *dir, size_t cap, const char *tmp, const char *what) {
     snprintf(dir, cap, "%s/gk_fuzz_femdem_%ld_%s", tmp, (long)getpid(), what);
     FUZZ_CHECK(mkdir(dir, 0777) == 0 || errno == EEXIST);
@@ -185,19 +180,19 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         double d[9];
         d[0] = w->eps, d[1] = w->syy, d[2] = w->sxx, d[3] = w->ev, d[4] = w->secs, d[5] = w->Ed, d[6] = w->Ef;
         d[7] = w->inc, d[8] = w->dem_mean;
-        all_finite(d, 9);
+        fuzz_all_finite(d, 9);
         FUZZ_CHECK(w->iters >= 0 && w->failed >= 0 && w->failed <= M.ngp && w->dem_max >= 0);
         FUZZ_CHECK(w->dem_total >= 0 && w->t_reused >= 0 && w->t_computed >= 0);
     }
-    all_finite(M.mesh.x, n), all_finite(M.utot, n), all_finite(M.ulast, n);
+    fuzz_all_finite(M.mesh.x, n), fuzz_all_finite(M.utot, n), fuzz_all_finite(M.ulast, n);
     for (k = 0; k < n; ++k) FUZZ_CHECK(fabs(M.utot[k]) <= 10 * L && fabs(M.ulast[k]) <= 10 * L);
-    all_finite(M.sig_n, 9 * (size_t)M.ngp), all_finite(M.D_n, 16 * (size_t)M.ngp);
-    all_finite(M.hist, (size_t)M.ncurve * M.ngp * FD_NFIELD);
+    fuzz_all_finite(M.sig_n, 9 * (size_t)M.ngp), fuzz_all_finite(M.D_n, 16 * (size_t)M.ngp);
+    fuzz_all_finite(M.hist, (size_t)M.ncurve * M.ngp * FD_NFIELD);
     FUZZ_CHECK(isfinite(M.inclast) && fabs(M.inclast) <= 1);
     m = M.mesh;
     FUZZ_CHECK(gk_mesh_check(&m, &M.q, &err) == GK_OK);
     FUZZ_CHECK((f = fd_gp_fields(&M)) != NULL);
-    all_finite(f, (size_t)M.ngp * FD_NFIELD);
+    fuzz_all_finite(f, (size_t)M.ngp * FD_NFIELD);
     free(f);
     /* the reactions of the restored state (the row the driver would print), then its next load step */
     FUZZ_CHECK(fd_external_force(&M, &err) == 0);
@@ -208,7 +203,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     r = fd_load_step(&M, M.o.inc * M.scale, &iters, &Ed, &Ef, &err);
     FUZZ_CHECK(r == 0 || r == 1 || (r == 2 && err.msg[0] != '\0'));
     if (r == 0) {
-        all_finite(M.u, n), all_finite(M.sig, 9 * (size_t)M.ngp), all_finite(M.D, 16 * (size_t)M.ngp);
+        fuzz_all_finite(M.u, n), fuzz_all_finite(M.sig, 9 * (size_t)M.ngp),
+            fuzz_all_finite(M.D, 16 * (size_t)M.ngp);
         FUZZ_CHECK(isfinite(Ed) && isfinite(Ef));
     }
     if (r != 2) gk_twoscale_reject(&M.ts); /* fd_load_step rejected on 2 */
@@ -218,18 +214,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 }
 
 #ifdef FUZZ_MAKE_SEEDS
-static unsigned char *slurp(const char *path, size_t *n) {
-    FILE *fp = fopen(path, "rb");
-    unsigned char *b = NULL;
-    long end;
-    FUZZ_CHECK(fp && fseek(fp, 0, SEEK_END) == 0 && (end = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0);
-    FUZZ_CHECK((b = (unsigned char *)malloc((size_t)end + 1)) != NULL);
-    FUZZ_CHECK(fread(b, 1, (size_t)end, fp) == (size_t)end);
-    fclose(fp);
-    *n = (size_t)end;
-    return b;
-}
-
 /* the pristine checkpoint, truncated and bit-flipped copies (in the model's block: the step, a row,
  * a node, a stress; in the driver's part: the last increment, a field), one a step later, and one
  * with the cyclic driver's tag */
@@ -241,7 +225,7 @@ int main(int argc, char **argv) {
     if (argc < 2) return 2;
     setup();
     snprintf(path, sizeof path, "%s/checkpoint.bin", ref_dir);
-    b = slurp(path, &n);
+    b = fuzz_slurp(path, &n);
     fuzz_write_seed(argv[1], "ckpt_step1", 0, b, n);
     /* the driver's block starts with its tag; its size: the model's block plus the driver's part */
     for (b0 = 0; b0 + 16 < n && memcmp(b + b0, FDB_TAG, sizeof FDB_TAG); ++b0) continue;
@@ -271,12 +255,12 @@ int main(int argc, char **argv) {
     /* a step later */
     M.o.steps = 2, M.o.out = ref_dir;
     FUZZ_CHECK(fdb_loop(&M, gk_wtime(), &err) == 0 && M.ncurve == 3);
-    b = slurp(path, &n);
+    b = fuzz_slurp(path, &n);
     fuzz_write_seed(argv[1], "ckpt_step2", 0, b, n);
     free(b);
     /* another driver's tag */
     FUZZ_CHECK(fd_ck_save(&M, "GKFEMCYC2", NULL) == 0);
-    b = slurp(path, &n);
+    b = fuzz_slurp(path, &n);
     fuzz_write_seed(argv[1], "ckpt_other_tag", 0, b, n);
     free(b);
     return 0; /* the model is freed at exit */

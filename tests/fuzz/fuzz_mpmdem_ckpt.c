@@ -77,11 +77,6 @@ static int same_as_pristine(void) {
     return same;
 }
 
-static void all_finite(const double *v, size_t n) {
-    size_t k;
-    for (k = 0; k < n; ++k) FUZZ_CHECK(isfinite(v[k]));
-}
-
 /* the driver's call (setup) on DIR */
 static gk_result load(const char *dir, gk_err *err) {
     return mpd_load(dir, &X.M, &X.pts, "biaxial", &X.S, sizeof X.S, &X.rows, &X.snaps, bx_check, err);
@@ -148,20 +143,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     n = X.pts.n;
     FUZZ_CHECK(bx_check(&X.S, &X.rows, why, sizeof why) == 0);
     FUZZ_CHECK(mpd_block_check(&X.M, &X.pts, &X.snaps, why, sizeof why) == 0);
-    for (k = 0; k < 2; ++k) all_finite(X.pts.x[k], (size_t)n), all_finite(X.pts.v[k], (size_t)n);
-    all_finite(X.pts.sigma, 9 * (size_t)n), all_finite(X.pts.F, 9 * (size_t)n),
-        all_finite(X.M.eps, 9 * (size_t)n);
+    for (k = 0; k < 2; ++k) fuzz_all_finite(X.pts.x[k], (size_t)n), fuzz_all_finite(X.pts.v[k], (size_t)n);
+    fuzz_all_finite(X.pts.sigma, 9 * (size_t)n), fuzz_all_finite(X.pts.F, 9 * (size_t)n),
+        fuzz_all_finite(X.M.eps, 9 * (size_t)n);
     FUZZ_CHECK((f = (double *)malloc((size_t)MPD_NFIELD * n * sizeof *f)) != NULL);
     FUZZ_CHECK(mpd_fields(&X.M, &X.pts, f, &err) == GK_OK);
-    all_finite(f, (size_t)MPD_NFIELD * n);
+    fuzz_all_finite(f, (size_t)MPD_NFIELD * n);
     free(f);
     /* the driver's next MPM step */
     err.msg[0] = '\0';
     X.S.body[1].v[1] = -X.b.velocity;
     r = mpd_step(&X.g, &X.pts, &X.def, X.dt, &X.M, X.edge, X.nedge, &err);
     if (r == GK_OK) {
-        for (k = 0; k < 2; ++k) all_finite(X.pts.x[k], (size_t)n), all_finite(X.pts.v[k], (size_t)n);
-        all_finite(X.pts.sigma, 9 * (size_t)n);
+        for (k = 0; k < 2; ++k)
+            fuzz_all_finite(X.pts.x[k], (size_t)n), fuzz_all_finite(X.pts.v[k], (size_t)n);
+        fuzz_all_finite(X.pts.sigma, 9 * (size_t)n);
     } else
         FUZZ_CHECK(err.msg[0] != '\0');
     restore();

@@ -43,18 +43,6 @@ static char in_path[512], out_path[512], ref_path[512];
 static int ready;
 static const double dH0[9] = {0, 1e-5, 0, -0.5e-5, 0, 0, 0, 0, 0};
 
-static unsigned char *slurp(const char *path, size_t *n) {
-    FILE *fp = fopen(path, "rb");
-    unsigned char *b = NULL;
-    long end;
-    FUZZ_CHECK(fp && fseek(fp, 0, SEEK_END) == 0 && (end = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0);
-    FUZZ_CHECK((b = (unsigned char *)malloc((size_t)end + 1)) != NULL);
-    FUZZ_CHECK(fread(b, 1, (size_t)end, fp) == (size_t)end);
-    fclose(fp);
-    *n = (size_t)end;
-    return b;
-}
-
 static void cleanup(void) {
     remove(in_path), remove(out_path), remove(ref_path);
 }
@@ -65,15 +53,10 @@ static int same_as_pristine(void) {
     size_t n;
     int same;
     FUZZ_CHECK(gk_twoscale_save(&ts, out_path, NULL, 0) == GK_OK);
-    b = slurp(out_path, &n);
+    b = fuzz_slurp(out_path, &n);
     same = n == npristine && memcmp(b, pristine, n) == 0;
     free(b);
     return same;
-}
-
-static void all_finite(const double *v, size_t n) {
-    size_t k;
-    for (k = 0; k < n; ++k) FUZZ_CHECK(isfinite(v[k]));
 }
 
 static void setup(void) {
@@ -118,7 +101,7 @@ static void setup(void) {
     for (k = 0; k < 9 * NPT; ++k) dH[k] = dH0[k % 9];
     FUZZ_CHECK(gk_twoscale_run(&ts, dH, NULL, S, D) == GK_OK && gk_twoscale_accept(&ts) == GK_OK);
     FUZZ_CHECK(gk_twoscale_save(&ts, ref_path, NULL, 0) == GK_OK);
-    pristine = slurp(ref_path, &npristine);
+    pristine = fuzz_slurp(ref_path, &npristine);
     ready = 1;
 }
 
@@ -143,10 +126,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     FUZZ_CHECK(blk != NULL && nb < size);
     /* the accepted states: finite stress, tangent and fields; written and read back */
     FUZZ_CHECK(gk_twoscale_accepted(&ts, S, D) == GK_OK);
-    all_finite(S, 9 * NPT), all_finite(D, 16 * NPT);
+    fuzz_all_finite(S, 9 * NPT), fuzz_all_finite(D, 16 * NPT);
     FUZZ_CHECK(gk_twoscale_fields(&ts, f) == GK_OK);
     memcpy(fv, f, sizeof fv);
-    all_finite(fv, sizeof fv / sizeof fv[0]);
+    fuzz_all_finite(fv, sizeof fv / sizeof fv[0]);
     FUZZ_CHECK(gk_twoscale_save(&ts, out_path, blk, nb) == GK_OK);
     gk_twoscale_free(&ts, blk);
     blk = NULL;
@@ -156,7 +139,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     for (k = 0; k < 9 * NPT; ++k) dH[k] = dH0[k % 9];
     r = gk_twoscale_run(&ts, dH, NULL, S, D);
     if (r == GK_OK) {
-        all_finite(S, 9 * NPT), all_finite(D, 16 * NPT);
+        fuzz_all_finite(S, 9 * NPT), fuzz_all_finite(D, 16 * NPT);
     } else {
         const gk_twoscale_point *pts = gk_twoscale_points(&ts);
         FUZZ_CHECK(r == GK_ERR_STATE && gk_twoscale_error(&ts)[0] != '\0');
@@ -164,7 +147,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     FUZZ_CHECK(gk_twoscale_accept(&ts) == GK_OK);
     FUZZ_CHECK(gk_twoscale_accepted(&ts, S, D) == GK_OK);
-    all_finite(S, 9 * NPT), all_finite(D, 16 * NPT);
+    fuzz_all_finite(S, 9 * NPT), fuzz_all_finite(D, 16 * NPT);
     /* back to the pristine set for the next input */
     FUZZ_CHECK(gk_twoscale_load(&ts, ref_path, &blk, &nb) == GK_OK);
     gk_twoscale_free(&ts, blk);
@@ -185,7 +168,7 @@ int main(int argc, char **argv) {
     if (argc < 2) return 2;
     setup();
     FUZZ_CHECK(gk_twoscale_save(&ts, out_path, block, sizeof block) == GK_OK);
-    b = slurp(out_path, &n);
+    b = fuzz_slurp(out_path, &n);
     fuzz_write_seed(argv[1], "ckpt_accepted", 0, b, n);
     fuzz_write_seed(argv[1], "ckpt_truncated_header", 0, b, 24);
     fuzz_write_seed(argv[1], "ckpt_truncated_record", 0, b, n / 2);
@@ -216,14 +199,14 @@ int main(int argc, char **argv) {
         FUZZ_CHECK(gk_twoscale_save(&fresh, out_path, NULL, 0) == GK_OK);
         gk_twoscale_destroy(&fresh);
     }
-    b = slurp(out_path, &n);
+    b = fuzz_slurp(out_path, &n);
     fuzz_write_seed(argv[1], "ckpt_fresh", 0, b, n);
     free(b);
     for (k = 0; k < 9 * NPT; ++k) dH[k] = 3.0 * dH0[k % 9];
     for (k = 0; k < 2; ++k)
         FUZZ_CHECK(gk_twoscale_run(&ts, dH, NULL, S, D) == GK_OK && gk_twoscale_accept(&ts) == GK_OK);
     FUZZ_CHECK(gk_twoscale_save(&ts, out_path, NULL, 0) == GK_OK);
-    b = slurp(out_path, &n);
+    b = fuzz_slurp(out_path, &n);
     fuzz_write_seed(argv[1], "ckpt_three_runs", 0, b, n);
     free(b);
     gk_twoscale_destroy(&ts);
