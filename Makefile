@@ -166,7 +166,7 @@ $(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/
 
 # tools and drivers under ASan + UBSan for tests/smoke_asan.sh (a driver joins
 # by its name in SMOKE and its runs in the script)
-SMOKE := rve_path gk_pack mpmdem_biaxial mpmdem_footing mpmdem_collapse bench_scene_box femdem_nonlocal femdem_dr hybrid
+SMOKE := rve_path gk_pack mpmdem_biaxial mpmdem_single mpmdem_footing mpmdem_collapse bench_scene_box femdem_nonlocal femdem_dr hybrid
 $(BUILD)/asan/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) -Iinclude -o $@ $< $(LDLIBS)
 $(BUILD)/asan/%: tools/%.c $(HEADERS) | $(BUILD)/asan

@@ -409,6 +409,50 @@ static gk_result mpd_prepare_rve(mpd_proto *P, double p, gk_rve_state *st, gk_er
     return GK_OK;
 }
 
+/* A drained biaxial test of ONE RVE (the "pure DEM" of the MPMxDEM drivers:
+ * mpmdem_footing's friction angle, mpmdem_single's reference): *r created
+ * from the prepared state st, driven by gk_rve_set_servo with axis 0
+ * stress-controlled at -s3 (s3 compression positive) and axis 1 compressed
+ * at a constant rate, *rate [1/s]: the inertial number --dem-inertial at s3
+ * with the adaptive DEM rule, --dem-strain per DEM step with the strain
+ * rule, i.e. as the MPM's RVEs deform. gk_rve_step advances it; the axial
+ * strain is 1 - F_yy of its cell. 0, or 1 with msg (*r destroyed). */
+static int mpd_rve_biaxial(gk_rve *r, const mpd_proto *P, const gk_rve_state *st, const mpd_opts *o, double s3,
+                           double *rate, char *msg, size_t nmsg) {
+    gk_servo sv;
+    double L[9];
+    int k;
+    if (gk_rve_create(r, &P->def, &P->pk)) return snprintf(msg, nmsg, "RVE: %s", gk_rve_error(r)), 1;
+    if (gk_rve_state_restore(st, r)) {
+        snprintf(msg, nmsg, "RVE: %s", gk_rve_error(r));
+        gk_rve_destroy(r);
+        return 1;
+    }
+    if (o->dem_rule == 0) { /* the inertial number the coupling's RVEs deform at, at s3 */
+        double one[9], rmean = 0;
+        for (k = 0; k < r->n; ++k) rmean += (double)r->r[k];
+        rmean /= r->n;
+        gk_m3_zero(one);
+        one[4] = 1.0;
+        *rate = o->dem_inertial / gk_inertial_number(one, 2, rmean, r->def.mat.density, s3);
+    } else {
+        *rate = o->dem_strain / r->dt; /* the coupling's strain per DEM step */
+    }
+    memset(&sv, 0, sizeof sv);
+    sv.mode[0] = GK_SERVO_STRESS, sv.target[0] = -s3;
+    sv.mode[1] = GK_SERVO_STRAIN, sv.rate[1] = -*rate;
+    sv.mode[2] = GK_SERVO_STRAIN;
+    sv.max_rate = 10.0 * *rate; /* lateral strain rate: dilatancy can exceed the axial one */
+    sv.gain = 0.5;
+    gk_m3_zero(L);
+    if (gk_rve_set_velocity_gradient(r, L) || gk_rve_set_servo(r, &sv)) {
+        snprintf(msg, nmsg, "servo: %s", gk_rve_error(r));
+        gk_rve_destroy(r);
+        return 1;
+    }
+    return 0;
+}
+
 /* ------------------------------------------------------- RVE per point */
 typedef struct mpd_micro {
     gk_twoscale ts;            /* the RVEs (gk_twoscale.h)                                         */

@@ -51,7 +51,7 @@ static int mpd_plot(const mpd_run *run, const gk_plot *pl, const char *name) {
 
 /* ------------------------------------------------------------- VTK */
 /* the points as VTK vertices: the fields above, velocity, stress; 0 or 1 (said) */
-static int mpd_write_vtk(const mpd_run *run, long step, mpd_micro *m, const gk_mpm_points *pts) {
+GK_INLINE int mpd_write_vtk(const mpd_run *run, long step, mpd_micro *m, const gk_mpm_points *pts) {
     char path[MPD_PATH], name[64];
     gk_vtk v;
     gk_err err;
@@ -96,7 +96,7 @@ typedef struct mpd_outline {
 } mpd_outline;
 
 /* a polyline of npts (x, y) points added to the outline */
-static void mpd_outline_add(mpd_outline *o, int npts, const double *xy) {
+GK_INLINE void mpd_outline_add(mpd_outline *o, int npts, const double *xy) {
     int used = 0, k;
     if (o->nlines == MPD_MAXLINE || npts > MPD_MAXLPT) return;
     for (k = 0; k < o->nlines; ++k) used += o->len[k];
@@ -192,8 +192,8 @@ static int mpd_snap_add(const mpd_run *run, mpd_snaps *S, const char *file, cons
 }
 
 /* one field of mpd_fields as a snapshot, strains in % */
-static int mpd_snap_field(const mpd_run *run, mpd_snaps *S, mpd_micro *m, const gk_mpm_points *pts, int k,
-                          const char *file, const char *title, double dot, const mpd_outline *ol) {
+GK_INLINE int mpd_snap_field(const mpd_run *run, mpd_snaps *S, mpd_micro *m, const gk_mpm_points *pts, int k,
+                             const char *file, const char *title, double dot, const mpd_outline *ol) {
     static const char *labels[MPD_NFIELD] = {
         "eps_q [%]",      "eps_v [%]",        "rotation [deg]",     "p [Pa]",       "q [Pa]",
         "void ratio [-]", "fabric |F_a| [-]", "coordination Z [-]", "DEM steps [-]"};
@@ -341,8 +341,8 @@ static void mpd_block(mpd_buf *B, const char *tag, mpd_micro *m, gk_mpm_points *
 }
 
 /* DIR/checkpoint.bin: the RVEs and the driver's block; 0 or 1 (said) */
-static int mpd_save(const mpd_run *run, mpd_micro *m, gk_mpm_points *pts, const char *tag, void *S, size_t nS,
-                    mpd_rows *R, mpd_snaps *sn) {
+GK_INLINE int mpd_save(const mpd_run *run, mpd_micro *m, gk_mpm_points *pts, const char *tag, void *S,
+                       size_t nS, mpd_rows *R, mpd_snaps *sn) {
     mpd_buf B;
     char path[MPD_PATH];
     int bad = mpd_path(run, path, "checkpoint.bin");
@@ -412,8 +412,8 @@ static int mpd_block_check(const mpd_micro *m, const gk_mpm_points *pts, const m
  * driver's check when not NULL) before it replaces anything: a refused block leaves the points, the
  * strains, S, the rows and the snapshots as they were (the set holds the file's RVE states, which
  * gk_twoscale_load accepted). */
-static gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, const char *tag, void *S,
-                          size_t nS, mpd_rows *R, mpd_snaps *sn, mpd_check_fn check, gk_err *err) {
+GK_INLINE gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, const char *tag, void *S,
+                             size_t nS, mpd_rows *R, mpd_snaps *sn, mpd_check_fn check, gk_err *err) {
     char path[MPD_PATH], why[200];
     void *blk = NULL;
     size_t nblk = 0;
@@ -478,7 +478,7 @@ static void mpd_free_all(mpd_micro *m, mpd_proto *P, gk_mpm_points *pts, gk_mpm_
 /* the line of the RVEs' traffic over the ranks (collective): bytes sent per MPM step by all ranks
  * together in this run's steps (checkpoints left out), migrations of accepted RVE states by the load
  * balance (zeros without MPI) */
-static void mpd_print_traffic(const mpd_run *run, const mpd_micro *m, long steps, int threads) {
+GK_INLINE void mpd_print_traffic(const mpd_run *run, const mpd_micro *m, long steps, int threads) {
     long long b = m->bytes, all = b;
 #ifdef GK_TWOSCALE_MPI
     MPI_Allreduce(&b, &all, 1, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);

@@ -101,9 +101,8 @@ static int phi_test(const mpd_proto *P0, const mpd_opts *o, double max_strain, f
     mpd_proto P = *P0; /* mpd_prepare_rve writes rho, M, p0, e0: keep the caller's */
     gk_rve_state st;
     gk_rve r;
-    gk_servo sv;
     gk_err err;
-    double rate, L[9], *s1 = NULL, *s3 = NULL, *wa = NULL, *wb = NULL;
+    double rate, *s1 = NULL, *s3 = NULL, *wa = NULL, *wb = NULL;
     int chunk, cap, n = 0, k, bad = 0;
     gk_rve_state_init(&st, NULL);
     if (mpd_prepare_rve(&P, out->s3, &st, &err)) {
@@ -112,29 +111,9 @@ static int phi_test(const mpd_proto *P0, const mpd_opts *o, double max_strain, f
         return out->status = 1;
     }
     out->e0 = P.e0, out->p0 = P.p0;
-    if (gk_rve_create(&r, &P.def, &P.pk) || gk_rve_state_restore(&st, &r)) {
-        snprintf(out->msg, sizeof out->msg, "RVE: %s", gk_rve_error(&r));
-        gk_rve_state_free(&st);
-        return out->status = 1;
-    }
+    bad = mpd_rve_biaxial(&r, &P, &st, o, out->s3, &rate, out->msg, sizeof out->msg);
     gk_rve_state_free(&st);
-    if (o->dem_rule == 0) { /* the inertial number the coupling's RVEs deform at, at sigma_3 */
-        double one[9], rmean = 0;
-        for (k = 0; k < r.n; ++k) rmean += (double)r.r[k];
-        rmean /= r.n;
-        gk_m3_zero(one);
-        one[4] = 1.0;
-        rate = o->dem_inertial / gk_inertial_number(one, 2, rmean, r.def.mat.density, out->s3);
-    } else {
-        rate = o->dem_strain / r.dt; /* the coupling's strain per DEM step */
-    }
-    memset(&sv, 0, sizeof sv);
-    sv.mode[0] = GK_SERVO_STRESS, sv.target[0] = -out->s3;
-    sv.mode[1] = GK_SERVO_STRAIN, sv.rate[1] = -rate;
-    sv.mode[2] = GK_SERVO_STRAIN;
-    sv.max_rate = 10.0 * rate; /* lateral strain rate: dilatancy can exceed the axial one */
-    sv.gain = 0.5;
-    gk_m3_zero(L);
+    if (bad) return out->status = 1;
     out->rate = rate;
     chunk = (int)ceil(1e-4 / (rate * r.dt)); /* a sample every 1e-4 of axial strain */
     cap = (int)ceil(1.5 * FT_PHI_STRAIN_MAX / (chunk * rate * r.dt)) + 10; /* the servo moves F_11 a little */
@@ -146,10 +125,6 @@ static int phi_test(const mpd_proto *P0, const mpd_opts *o, double max_strain, f
     wb = (double *)malloc((size_t)cap * sizeof(double));
     if (!out->eps || !out->ratio || !s1 || !s3 || !wa || !wb) {
         snprintf(out->msg, sizeof out->msg, "out of memory");
-        bad = 1;
-    }
-    if (!bad && (gk_rve_set_velocity_gradient(&r, L) || gk_rve_set_servo(&r, &sv))) {
-        snprintf(out->msg, sizeof out->msg, "servo: %s", gk_rve_error(&r));
         bad = 1;
     }
     /* to --phi-strain, then on until the peak lies 1 % of strain behind (a hardening RVE) */

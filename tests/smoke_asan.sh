@@ -54,6 +54,10 @@ run 1 "$B/mpmdem_biaxial" $BX --strain 0.0005 --out "$T/bxw"
 run 2 "$B/mpmdem_biaxial" $BX --nx 3
 run 0 "$B/mpmdem_footing" --width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 \
     --every 0.005 --smooth 0.01 --phi-deg 30 --final 0.01 --quiet --threads 2 --out "$T/ft"
+run 0 "$B/mpmdem_single" --strain 0.003 --packing "$T/pack.txt" --quiet --threads 2 --out "$T/sg"
+rm -rf "$T/sgw" && mkdir -p "$T/sgw" && ln -s /dev/full "$T/sgw/single.csv"
+run 1 "$B/mpmdem_single" --strain 0.003 --packing "$T/pack.txt" --quiet --threads 2 --out "$T/sgw"
+run 2 "$B/mpmdem_single" --margin -1
 run 0 "$B/mpmdem_collapse" --nx 4 --every 0.025 --snapshots 0.05 --t-end 0.05 --quiet --threads 2 --out "$T/cl"
 # the 3D explicit nonlocal FEMxDEM driver on one element: a run stopped half way, its restart, a
 # truncated checkpoint, a refused option

@@ -243,6 +243,82 @@ TEST(biaxial_out_folder) {
     CHECK(gk_test_file_has("build/tests/t_mpmbx_f/a/b/biaxial.csv", "time,eps_axial"));
 }
 
+/* examples/mpmdem_single.c, Liang & Zhao (2019) Sec 3.1: one MPM cell, 2 x 2 points, smooth rollers
+ * left and bottom, a smooth plate on top, a follower pressure on the right, against the RVE alone in
+ * a drained biaxial test at the same lateral stress. With smooth walls all around the velocity field
+ * of the cell is bilinear with equal right-node velocities, so every point receives the same dH and
+ * the element is homogeneous ("the global response measured from the element should match the local
+ * responses extracted from the pure DEM simulations", Sec 3.1): the element and the RVE alone may
+ * differ only by the MPM's dynamics (the cell's inertia, the ramp, the PIC/FLIP transfer) and by the
+ * DEM's noise. A 60-disk packing to 1 % axial strain (a fraction of a second). Tolerances:
+ * - sigma_yy within 2 %: the DEM noise of a 60-disk RVE on this path is what the 4 points' own
+ *   sigma_yy spread shows (max - min <= 3 % of their mean, asserted below: about +-1.5 % of one RVE
+ *   about the mean); the element measured 0.9 %. A dynamic error fails it: pure PIC (--alpha 1),
+ *   whose transfer damps the lateral expansion, gives 3.9 %;
+ * - eps_v within 2e-4 (4 % of the 4.7e-3 reached): measured 6e-5; pure PIC gives 1.0e-3;
+ * - homogeneity: F of the 4 points equal within 1e-3 (the strain is 1e-2; they differ only as
+ *   their RVEs' noise feeds back into the internal forces); the work-conjugate plate reaction R h / V
+ *   equals the points' mean stress within 1 % (quasi-static: the cell's inertia is small);
+ * - the start: sigma_yy of the first row (0.1 % strain) between the consolidation pressure and 1.2 x
+ *   it, sigma_xx of the RVE alone held at the lateral 100 kPa within 1 % by its servo. */
+#define SG "build/mpmdem_single --strain 0.01 --packing build/tests/t_sg_pack.txt --quiet "
+TEST(single_element_follows_the_rve_alone) {
+    double r[16][13];
+    int n = 0, k;
+    FILE *fp;
+    char line[1024];
+    CHECK(system("build/gk_pack --dim 2 --n 60 --pressure 1e5 --out build/tests/t_sg_pack.txt > "
+                 "build/tests/t_sg_pack.out 2>&1") == 0);
+    CHECK(system(SG "--threads 2 --out build/tests/t_sg > build/tests/t_sg.out 2>&1") == 0);
+    CHECK(gk_test_file_has("build/tests/t_sg/single.csv",
+                           "time,plate_displacement,eps_axial,sigma_yy,sigma_yy_points,point_spread,eps_v,"
+                           "eps_axial_dem,sigma_yy_dem,sigma_xx_dem,eps_v_dem,dem_steps_per_point,seconds"));
+    CHECK(gk_test_file_has("build/tests/t_sg/single_stress.svg", "<svg"));
+    CHECK(gk_test_file_has("build/tests/t_sg/single_volume.svg", "<svg"));
+    CHECK((fp = fopen("build/tests/t_sg/single.csv", "r")) != NULL);
+    if (!fp) return;
+    if (fgets(line, sizeof line, fp))
+        while (n < 16 && fgets(line, sizeof line, fp)) {
+            double *q = r[n];
+            if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &q[0], &q[1], &q[2],
+                       &q[3], &q[4], &q[5], &q[6], &q[7], &q[8], &q[9], &q[10], &q[11], &q[12]) != 13)
+                break;
+            ++n;
+        }
+    fclose(fp);
+    CHECK_EQ_INT(n, 10);
+    if (n != 10) return;
+    CHECK(r[0][3] > 1e5 && r[0][3] < 1.2e5);
+    for (k = 0; k < n; ++k) {
+        CHECK_NEAR(r[k][2], 0.001 * (k + 1), 5e-5); /* a row every 0.1 % */
+        CHECK_NEAR(r[k][7], r[k][2], 2e-5);         /* the RVE alone at the element's strain */
+        CHECK_REL(r[k][3], r[k][8], 0.02);          /* sigma_yy: element vs RVE alone */
+        CHECK_NEAR(r[k][6], r[k][10], 2e-4);        /* eps_v */
+        CHECK_REL(r[k][3], r[k][4], 0.01);          /* plate reaction vs the points */
+        CHECK(r[k][5] < 0.03);                      /* the 4 points' sigma_yy spread */
+        CHECK_REL(r[k][9], 1e5, 0.01);              /* the servo's lateral stress */
+        if (k) CHECK(r[k][3] > r[k - 1][3]);        /* hardening before the peak */
+    }
+    CHECK(r[n - 1][6] > 0.0); /* the dense packing contracts first */
+    CHECK(gk_test_result("build/tests/t_sg.out", "f_spread") < 1e-3);
+    CHECK(gk_test_result("build/tests/t_sg.out", "max_rel_diff_sigma_yy") < 0.02);
+    CHECK_NEAR(gk_test_result("build/tests/t_sg.out", "n_rves"), 4, 0);
+    /* the same curves with one thread (the time column aside) */
+    CHECK(system(SG "--threads 1 --out build/tests/t_sg1 > build/tests/t_sg1.out 2>&1") == 0);
+    CHECK(system("cut -d, -f1-12 build/tests/t_sg/single.csv > build/tests/t_sg.c && "
+                 "cut -d, -f1-12 build/tests/t_sg1/single.csv > build/tests/t_sg1.c && "
+                 "cmp -s build/tests/t_sg.c build/tests/t_sg1.c") == 0);
+    /* bad input: refused with a message, no output folder */
+    CHECK(
+        system("rm -rf build/tests/t_sg_bad && build/mpmdem_single --margin -1 --out build/tests/t_sg_bad > "
+               "build/tests/t_sg_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has("build/tests/t_sg_bad.out", "--margin -1 is out of range"));
+    CHECK(system("build/mpmdem_single --packing /nonexistent --out build/tests/t_sg_bad > "
+                 "build/tests/t_sg_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has("build/tests/t_sg_bad.out", "nonexistent"));
+    CHECK(system("test -e build/tests/t_sg_bad") != 0);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(biaxial_runs_and_loads);
@@ -252,5 +328,6 @@ int main(int argc, char **argv) {
     RUN(biaxial_bad_checkpoint_refused);
     RUN(biaxial_failed_write_exits);
     RUN(biaxial_out_folder);
+    RUN(single_element_follows_the_rve_alone);
     return gk_test_done();
 }
