@@ -417,8 +417,8 @@ static gk_result mpd_prepare_rve(mpd_proto *P, double p, gk_rve_state *st, gk_er
  * with the adaptive DEM rule, --dem-strain per DEM step with the strain
  * rule, i.e. as the MPM's RVEs deform. gk_rve_step advances it; the axial
  * strain is 1 - F_yy of its cell. 0, or 1 with msg (*r destroyed). */
-static int mpd_rve_biaxial(gk_rve *r, const mpd_proto *P, const gk_rve_state *st, const mpd_opts *o, double s3,
-                           double *rate, char *msg, size_t nmsg) {
+GK_INLINE int mpd_rve_biaxial(gk_rve *r, const mpd_proto *P, const gk_rve_state *st, const mpd_opts *o,
+                              double s3, double *rate, char *msg, size_t nmsg) {
     gk_servo sv;
     double L[9];
     int k;
