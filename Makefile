@@ -76,8 +76,10 @@ help:
 $(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests $(BUILD)/fuzz $(BUILD)/mpi:
 	@mkdir -p $@
 
+# the tests launch the programs of $(BUILD) and write under $(BUILD)/tests
+TESTDEF := -DBUILD='"$(BUILD)"'
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
-	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
+	$(CC) $(CFLAGS) $(TESTDEF) -o $@ $< $(LDLIBS)
 
 # test_mpmdem_footing also tests the footing driver's examples/footing_mech.h directly
 $(BUILD)/test_mpmdem_footing $(BUILD)/asan/test_mpmdem_footing $(BUILD)/nosimd/test_mpmdem_footing: examples/footing_mech.h
@@ -106,11 +108,11 @@ $(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
 
 # ---------------------------------------------------------------- MPI
 $(BUILD)/mpi/mpi_%: tests/mpi_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/mpi
-	$(MPICC) $(CFLAGS) -o $@ $< $(LDLIBS)
+	$(MPICC) $(CFLAGS) $(TESTDEF) -o $@ $< $(LDLIBS)
 
 .PRECIOUS: $(BUILD)/mpi/mpi_% $(BUILD)/mpi/mpirun_%
 $(BUILD)/mpi/mpirun_%: tests/mpirun_%.c tests/gk_test.h | $(BUILD)/mpi
-	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
+	$(CC) $(CFLAGS) $(TESTDEF) -o $@ $< $(LDLIBS)
 
 # a runner script per MPI test, so that tests/run_tests.sh runs it as any other test program
 $(BUILD)/mpi/run_%: $(BUILD)/mpi/mpi_% | $(BUILD)/mpi
@@ -159,7 +161,7 @@ ASAN_TESTS   := $(patsubst tests/%.c,$(BUILD)/asan/%,$(TEST_SRC)) $(patsubst %,$
 NOSIMD_TESTS := $(patsubst tests/%.c,$(BUILD)/nosimd/%,$(TEST_SRC))
 
 $(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/asan
-	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK -o $@ $< $(LDLIBS)
+	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK $(TESTDEF) -o $@ $< $(LDLIBS)
 
 $(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(LDLIBS)
@@ -176,10 +178,10 @@ $(BUILD)/asan/bench_%: bench/%.c $(HEADERS) | $(BUILD)/asan
 
 check-smoke: $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) | $(BUILD)/tests
 	@echo "== tool and driver smoke runs under AddressSanitizer + UndefinedBehaviorSanitizer, leaks included"
-	@tests/run_tests.sh tests/smoke_asan.sh
+	@B=$(BUILD)/asan T=$(BUILD)/tests/smoke tests/run_tests.sh tests/smoke_asan.sh
 
 $(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/nosimd
-	$(CC) $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude -Itests -o $@ $< $(LDLIBS)
+	$(CC) $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude -Itests $(TESTDEF) -o $@ $< $(LDLIBS)
 
 check-asan: $(ASAN_TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 	@echo "== tests under AddressSanitizer + UndefinedBehaviorSanitizer"

@@ -9,8 +9,10 @@
  * A program given a test name as argv[1] runs only the tests whose names
  * contain it.
  *
- * Tests run from the repository's root and write only under build/tests/
- * (gk_test_init creates it; `make test` leaves nothing else behind). */
+ * Tests run from the repository's root and write only under BUILD/tests/
+ * (gk_test_init creates it; `make test` leaves nothing else behind). BUILD is
+ * the build folder, where the tests also find the programs they launch: the
+ * Makefile passes its $(BUILD) (default "build"), e.g. `make BUILD=out test`. */
 #ifndef GK_TEST_H
 #define GK_TEST_H
 #include <math.h>
@@ -20,6 +22,10 @@
 #include <sys/stat.h>
 #include <sys/times.h>
 #include <unistd.h>
+
+#ifndef BUILD
+#define BUILD "build"
+#endif
 
 static int gk__t_checks_failed;
 static int gk__t_passed, gk__t_failed;
@@ -182,8 +188,8 @@ static void gk_test_init(int argc, char **argv) {
         if (p) gk__t_prog = p + 1;
     }
     if (argc > 1) gk__t_filter = argv[1];
-    mkdir("build", 0755); /* where the outputs go (already there under make test) */
-    mkdir("build/tests", 0755);
+    mkdir(BUILD, 0755); /* where the outputs go (already there under make test) */
+    mkdir(BUILD "/tests", 0755);
 }
 static int gk_test_done(void) {
     printf("# %s: %d passed, %d failed\n", gk__t_prog, gk__t_passed, gk__t_failed);

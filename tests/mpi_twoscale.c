@@ -133,19 +133,19 @@ TEST(checkpoints_move_between_rank_counts) {
         ok &= gk_twoscale_accept(&w) == GK_OK && gk_twoscale_accept(&s) == GK_OK;
     }
     CHECK(ok);
-    CHECK(gk_twoscale_save(&w, "build/tests/t_tsm_w.bin", "w", 1) == GK_OK);
-    if (rank == 0) CHECK(gk_twoscale_save(&s, "build/tests/t_tsm_s.bin", "s", 1) == GK_OK);
+    CHECK(gk_twoscale_save(&w, BUILD "/tests/t_tsm_w.bin", "w", 1) == GK_OK);
+    if (rank == 0) CHECK(gk_twoscale_save(&s, BUILD "/tests/t_tsm_s.bin", "s", 1) == GK_OK);
     MPI_Barrier(MPI_COMM_WORLD);
     CHECK(make_set(&w2, MPI_COMM_WORLD, GK_TWOSCALE_TANGENT_HOMOG, 0.3) == GK_OK);
     CHECK(make_set(&s2, MPI_COMM_SELF, GK_TWOSCALE_TANGENT_HOMOG, 0.3) == GK_OK);
-    CHECK(gk_twoscale_load(&w2, "build/tests/t_tsm_s.bin", &b, &nb) == GK_OK && nb == 1 &&
+    CHECK(gk_twoscale_load(&w2, BUILD "/tests/t_tsm_s.bin", &b, &nb) == GK_OK && nb == 1 &&
           ((char *)b)[0] == 's');
     gk_twoscale_free(&w2, b);
-    CHECK(gk_twoscale_load(&s2, "build/tests/t_tsm_w.bin", &b, &nb) == GK_OK && nb == 1 &&
+    CHECK(gk_twoscale_load(&s2, BUILD "/tests/t_tsm_w.bin", &b, &nb) == GK_OK && nb == 1 &&
           ((char *)b)[0] == 'w');
     gk_twoscale_free(&s2, b);
     if (rank == 0) { /* a truncated copy */
-        FILE *in = fopen("build/tests/t_tsm_w.bin", "rb"), *out = fopen("build/tests/t_tsm_bad.bin", "wb");
+        FILE *in = fopen(BUILD "/tests/t_tsm_w.bin", "rb"), *out = fopen(BUILD "/tests/t_tsm_bad.bin", "wb");
         char buf[1000];
         size_t n = in ? fread(buf, 1, sizeof buf, in) : 0;
         if (out) fwrite(buf, 1, n, out), fclose(out);
@@ -153,7 +153,7 @@ TEST(checkpoints_move_between_rank_counts) {
     }
     MPI_Barrier(MPI_COMM_WORLD);
     b = NULL;
-    CHECK(gk_twoscale_load(&w, "build/tests/t_tsm_bad.bin", &b, &nb) == GK_ERR_FORMAT && b == NULL);
+    CHECK(gk_twoscale_load(&w, BUILD "/tests/t_tsm_bad.bin", &b, &nb) == GK_ERR_FORMAT && b == NULL);
     CHECK(strstr(gk_twoscale_error(&w), "t_tsm_bad.bin") != NULL);
     for (k = 2; k < 4; ++k) { /* each set runs once per step: a run moves its tangent-reuse reference */
         double sg[4][9 * NP], Dg[4][16 * NP];

@@ -39,25 +39,25 @@ TEST(femdem_biaxial_two_ranks_equal_two_threads) {
         CHECK(mpirun != NULL);
         return;
     }
-    system("rm -rf build/tests/t_fmT build/tests/t_fmM");
+    system("rm -rf " BUILD "/tests/t_fmT " BUILD "/tests/t_fmM");
     snprintf(cmd, sizeof cmd,
-             "build/femdem_biaxial %s --threads 2 --out build/tests/t_fmT > build/tests/t_fmT.out 2>&1",
+             BUILD "/femdem_biaxial %s --threads 2 --out " BUILD "/tests/t_fmT > " BUILD "/tests/t_fmT.out 2>&1",
              args);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s -np 2 build/femdem_biaxial_mpi %s --threads 1 --out build/tests/t_fmM > "
-             "build/tests/t_fmM.out 2>&1",
+             "%s -np 2 " BUILD "/femdem_biaxial_mpi %s --threads 1 --out " BUILD "/tests/t_fmM > "
+             BUILD "/tests/t_fmM.out 2>&1",
              mpirun, args);
     CHECK(system(cmd) == 0);
-    CHECK(same_but_seconds("build/tests/t_fmT/biaxial.csv", "build/tests/t_fmM/biaxial.csv",
+    CHECK(same_but_seconds(BUILD "/tests/t_fmT/biaxial.csv", BUILD "/tests/t_fmM/biaxial.csv",
                            11)); /* rows 0-10 */
-    CHECK(gk_test_file_has("build/tests/t_fmM.out", "RESULT peak_sigma_yy="));
-    CHECK(gk_test_result("build/tests/t_fmM.out", "peak_sigma_yy") ==
-          gk_test_result("build/tests/t_fmT.out", "peak_sigma_yy"));
-    CHECK(gk_test_file_has("build/tests/t_fmM.out", "MPI ranks=2 ")); /* the traffic line of the MPI build */
+    CHECK(gk_test_file_has(BUILD "/tests/t_fmM.out", "RESULT peak_sigma_yy="));
+    CHECK(gk_test_result(BUILD "/tests/t_fmM.out", "peak_sigma_yy") ==
+          gk_test_result(BUILD "/tests/t_fmT.out", "peak_sigma_yy"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fmM.out", "MPI ranks=2 ")); /* the traffic line of the MPI build */
     /* rank 0 alone prints: one RESULT line */
     {
-        FILE *fp = fopen("build/tests/t_fmM.out", "r");
+        FILE *fp = fopen(BUILD "/tests/t_fmM.out", "r");
         char line[4096];
         int n = 0;
         while (fp && fgets(line, sizeof line, fp)) n += !strncmp(line, "RESULT ", 7);
@@ -66,17 +66,17 @@ TEST(femdem_biaxial_two_ranks_equal_two_threads) {
     }
     /* the checkpoint is the same file for any rank count: each build goes on from the other's */
     snprintf(cmd, sizeof cmd,
-             "build/femdem_biaxial --nx 4 --ny 8 --element q8 --steps 11 --threads 2 --restart "
-             "build/tests/t_fmM --out build/tests/t_fmMT "
-             "> build/tests/t_fmMT.out 2>&1");
+             BUILD "/femdem_biaxial --nx 4 --ny 8 --element q8 --steps 11 --threads 2 --restart "
+             BUILD "/tests/t_fmM --out " BUILD "/tests/t_fmMT "
+             "> " BUILD "/tests/t_fmMT.out 2>&1");
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s -np 2 build/femdem_biaxial_mpi --nx 4 --ny 8 --element q8 --steps 11 --threads 1 --restart "
-             "build/tests/t_fmT --balance run --out build/tests/t_fmTM > build/tests/t_fmTM.out 2>&1",
+             "%s -np 2 " BUILD "/femdem_biaxial_mpi --nx 4 --ny 8 --element q8 --steps 11 --threads 1 --restart "
+             BUILD "/tests/t_fmT --balance run --out " BUILD "/tests/t_fmTM > " BUILD "/tests/t_fmTM.out 2>&1",
              mpirun);
     CHECK(system(cmd) == 0);
-    CHECK(same_but_seconds("build/tests/t_fmMT/biaxial.csv", "build/tests/t_fmTM/biaxial.csv", 12));
-    CHECK(gk_test_file_has("build/tests/t_fmTM.out", "balance=run"));
+    CHECK(same_but_seconds(BUILD "/tests/t_fmMT/biaxial.csv", BUILD "/tests/t_fmTM/biaxial.csv", 12));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fmTM.out", "balance=run"));
 }
 
 int main(int argc, char **argv) {

@@ -1026,8 +1026,8 @@ TEST(packing_roundtrip_and_input_order) {
     CHECK(gk_rve_deform(&rve, dH, 300) == GK_OK);
     CHECK(gk_rve_to_packing(&rve, &pk, NULL, &e) == GK_OK);
     CHECK(pk.h[1] != 0.0);
-    CHECK(gk_packing_write("build/tests/test_roundtrip.txt", &pk, "sheared\nby test_dem", &e) == GK_OK);
-    CHECK(gk_packing_read("build/tests/test_roundtrip.txt", &back, NULL, &e) == GK_OK);
+    CHECK(gk_packing_write(BUILD "/tests/test_roundtrip.txt", &pk, "sheared\nby test_dem", &e) == GK_OK);
+    CHECK(gk_packing_read(BUILD "/tests/test_roundtrip.txt", &back, NULL, &e) == GK_OK);
     CHECK(back.n == pk.n);
     for (p = 0; p < 9; ++p) CHECK(back.h[p] == pk.h[p]);
     for (p = 0; p < pk.n; ++p) CHECK(back.x[p] == pk.x[p] && back.y[p] == pk.y[p] && back.r[p] == pk.r[p]);

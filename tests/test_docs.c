@@ -50,9 +50,9 @@ TEST(readme_snippet_is_the_quickstart_program) {
 
 TEST(quickstart_runs_and_restores_bit_for_bit) {
     char *out;
-    int rc = system("build/quickstart > build/tests/quickstart.out 2>&1");
+    int rc = system(BUILD "/quickstart > " BUILD "/tests/quickstart.out 2>&1");
     CHECK(rc == 0);
-    out = gk_test_slurp("build/tests/quickstart.out");
+    out = gk_test_slurp(BUILD "/tests/quickstart.out");
     CHECK(out != NULL);
     if (out) {
         CHECK(strstr(out, "initial  sxx -100028.5") != NULL); /* YADE's getStress() of the packing */

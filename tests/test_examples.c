@@ -21,15 +21,15 @@ static int count_lines(const char *path) {
  * state, which is the seed packing's YADE stress (p = 99976.38 Pa) */
 TEST(rve_path_writes_csv_and_svg) {
     const char *cmd =
-        "build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 5 "
+        BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 5 "
         "--steps-per-increment 50 --E 6e8 --kt-ratio 0.8 --friction-angle 0.5 --density 2650 "
-        "--thickness 0.1 --damping 0.1 --damping-form component --out build/tests/t_rve_path.csv "
-        "> build/tests/t_rve_path.out 2>&1";
+        "--thickness 0.1 --damping 0.1 --damping-form component --out " BUILD "/tests/t_rve_path.csv "
+        "> " BUILD "/tests/t_rve_path.out 2>&1";
     FILE *fp;
     char line[1024];
     double p0 = 0;
     CHECK(system(cmd) == 0);
-    fp = fopen("build/tests/t_rve_path.csv", "r");
+    fp = fopen(BUILD "/tests/t_rve_path.csv", "r");
     CHECK(fp != NULL);
     if (!fp) return;
     CHECK(fgets(line, sizeof line, fp) != NULL);
@@ -45,29 +45,29 @@ TEST(rve_path_writes_csv_and_svg) {
     }
     CHECK_NEAR(p0, 99976.3847, 1e-3);
     fclose(fp);
-    CHECK_EQ_INT(count_lines("build/tests/t_rve_path.csv"), 7);
-    CHECK(gk_test_file_has("build/tests/t_rve_path.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_rve_path.out", "RESULT p="));
+    CHECK_EQ_INT(count_lines(BUILD "/tests/t_rve_path.csv"), 7);
+    CHECK(gk_test_file_has(BUILD "/tests/t_rve_path.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_rve_path.out", "RESULT p="));
     /* bad arguments: a message and a non-zero status */
     CHECK(
         system(
-            "build/rve_path --packing examples/data/rve400.txt --dH \"0 1\" > build/tests/t_bad.out 2>&1") !=
+            BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 1\" > " BUILD "/tests/t_bad.out 2>&1") !=
         0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "needs 4 numbers"));
-    CHECK(system("build/rve_path --packing no_such_file --dH \"0 0 0 0\" > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "no_such_file"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "needs 4 numbers"));
+    CHECK(system(BUILD "/rve_path --packing no_such_file --dH \"0 0 0 0\" > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "no_such_file"));
     /* numbers are parsed strictly (atof took '6e8x' as 6e8) */
-    CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --E 6e8x "
-                 "> build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--E '6e8x' is not a finite number"));
-    CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 5.5 "
-                 "> build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--increments '5.5' is not a whole number"));
-    CHECK(system("build/rve_path --packing examples/data/rve400.txt --dH \"0 nan 0 0\" "
-                 "> build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "is not a list of finite numbers"));
-    CHECK(system("build/rve_path --help > build/tests/t_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--steps-per-increment"));
+    CHECK(system(BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --E 6e8x "
+                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--E '6e8x' is not a finite number"));
+    CHECK(system(BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 5.5 "
+                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--increments '5.5' is not a whole number"));
+    CHECK(system(BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 nan 0 0\" "
+                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "is not a list of finite numbers"));
+    CHECK(system(BUILD "/rve_path --help > " BUILD "/tests/t_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--steps-per-increment"));
 }
 
 /* gk_pack: a small packing, consolidated to 100 kPa, readable back */
@@ -75,27 +75,27 @@ TEST(gk_pack_makes_a_consolidated_packing) {
     gk_packing pk;
     gk_err e;
     FILE *fp;
-    CHECK(system("build/gk_pack --dim 2 --n 120 --pressure 1e5 --out build/tests/t_pack.txt > "
-                 "build/tests/t_pack.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_pack.out", "RESULT void_ratio="));
-    CHECK(gk_packing_read("build/tests/t_pack.txt", &pk, NULL, &e) == GK_OK);
+    CHECK(system(BUILD "/gk_pack --dim 2 --n 120 --pressure 1e5 --out " BUILD "/tests/t_pack.txt > "
+                 BUILD "/tests/t_pack.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_pack.out", "RESULT void_ratio="));
+    CHECK(gk_packing_read(BUILD "/tests/t_pack.txt", &pk, NULL, &e) == GK_OK);
     CHECK(pk.n == 120 && pk.dim == 2);
-    CHECK(gk_test_file_has("build/tests/t_pack.txt", "RVE state: stress"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_pack.txt", "RVE state: stress"));
     gk_packing_free(&pk);
     /* numbers are parsed strictly, and nothing is written for a refused one */
-    remove("build/tests/t_pack_bad.txt");
+    remove(BUILD "/tests/t_pack_bad.txt");
     CHECK(
         system(
-            "build/gk_pack --dim 2 --n 120x --out build/tests/t_pack_bad.txt > build/tests/t_bad.out 2>&1") !=
+            BUILD "/gk_pack --dim 2 --n 120x --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out 2>&1") !=
         0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--n '120x' is not a whole number"));
-    CHECK(system("build/gk_pack --dim 2 --pressure 1e5Pa --out build/tests/t_pack_bad.txt "
-                 "> build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--pressure '1e5Pa' is not a finite number"));
-    CHECK(system("build/gk_pack --dim 2 --seed -1 --out build/tests/t_pack_bad.txt > build/tests/t_bad.out "
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--n '120x' is not a whole number"));
+    CHECK(system(BUILD "/gk_pack --dim 2 --pressure 1e5Pa --out " BUILD "/tests/t_pack_bad.txt "
+                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--pressure '1e5Pa' is not a finite number"));
+    CHECK(system(BUILD "/gk_pack --dim 2 --seed -1 --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out "
                  "2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--seed '-1' is not a non-negative whole number"));
-    fp = fopen("build/tests/t_pack_bad.txt", "r");
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--seed '-1' is not a non-negative whole number"));
+    fp = fopen(BUILD "/tests/t_pack_bad.txt", "r");
     CHECK(!fp);
     if (fp) fclose(fp);
 }
@@ -108,14 +108,14 @@ TEST(gk_pack_makes_a_framed_packing) {
     gk_err e;
     int p, nx = 0, ny = 0, corner = 0;
     CHECK(
-        system("build/gk_pack --dim 2 --n 60 --rmin 3e-4 --rmax 4.5e-4 --pressure 1500 --kn 1.5e8 --frame 3 "
-               "--stress-ratio 1.3 --out build/tests/t_pack_frame.txt > build/tests/t_pack_frame.out 2>&1") ==
+        system(BUILD "/gk_pack --dim 2 --n 60 --rmin 3e-4 --rmax 4.5e-4 --pressure 1500 --kn 1.5e8 --frame 3 "
+               "--stress-ratio 1.3 --out " BUILD "/tests/t_pack_frame.txt > " BUILD "/tests/t_pack_frame.out 2>&1") ==
         0);
-    CHECK(gk_test_file_has("build/tests/t_pack_frame.out", "RESULT void_ratio="));
-    CHECK(gk_test_file_has("build/tests/t_pack_frame.out", "anisotropy="));
-    CHECK(gk_test_file_has("build/tests/t_pack_frame.txt", "sigma_yy to 1.3 sigma_xx and back"));
-    CHECK(gk_test_file_has("build/tests/t_pack_frame.txt", "frame: 7 particles"));
-    CHECK(gk_packing_read("build/tests/t_pack_frame.txt", &pk, NULL, &e) == GK_OK);
+    CHECK(gk_test_file_has(BUILD "/tests/t_pack_frame.out", "RESULT void_ratio="));
+    CHECK(gk_test_file_has(BUILD "/tests/t_pack_frame.out", "anisotropy="));
+    CHECK(gk_test_file_has(BUILD "/tests/t_pack_frame.txt", "sigma_yy to 1.3 sigma_xx and back"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_pack_frame.txt", "frame: 7 particles"));
+    CHECK(gk_packing_read(BUILD "/tests/t_pack_frame.txt", &pk, NULL, &e) == GK_OK);
     if (pk.n != 60) return;
     CHECK(pk.h[1] == 0.0 && pk.h[3] == 0.0); /* a box */
     for (p = 0; p < pk.n; ++p) {
@@ -127,9 +127,9 @@ TEST(gk_pack_makes_a_framed_packing) {
     CHECK_EQ_INT(ny, 3);
     CHECK_EQ_INT(corner, 1);
     gk_packing_free(&pk);
-    CHECK(system("build/gk_pack --dim 3 --frame 3 --out build/tests/t_pack_bad.txt > build/tests/t_bad.out "
+    CHECK(system(BUILD "/gk_pack --dim 3 --frame 3 --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out "
                  "2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "2D only"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "2D only"));
 }
 
 /* a driver run `base full` with 2 and with 1 thread (build/tests/<tag>A, <tag>1),
@@ -138,17 +138,17 @@ TEST(gk_pack_makes_a_framed_packing) {
 static int run_threads_and_restart(const char *base, const char *full, const char *part, const char *tag) {
     char cmd[1024];
     int ok = 1;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/tests/%sA > build/tests/%sA.out 2>&1", base,
+    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out " BUILD "/tests/%sA > " BUILD "/tests/%sA.out 2>&1", base,
              full, tag, tag);
     ok &= system(cmd) == 0;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 1 --out build/tests/%s1 > build/tests/%s1.out 2>&1", base,
+    snprintf(cmd, sizeof cmd, "%s %s --threads 1 --out " BUILD "/tests/%s1 > " BUILD "/tests/%s1.out 2>&1", base,
              full, tag, tag);
     ok &= system(cmd) == 0;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out build/tests/%sB > build/tests/%sB.out 2>&1", base,
+    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out " BUILD "/tests/%sB > " BUILD "/tests/%sB.out 2>&1", base,
              part, tag, tag);
     ok &= system(cmd) == 0;
     snprintf(cmd, sizeof cmd,
-             "%s %s --threads 2 --out build/tests/%sB --restart build/tests/%sB > build/tests/%sB2.out 2>&1",
+             "%s %s --threads 2 --out " BUILD "/tests/%sB --restart " BUILD "/tests/%sB > " BUILD "/tests/%sB2.out 2>&1",
              base, full, tag, tag, tag);
     ok &= system(cmd) == 0;
     return ok;
@@ -157,12 +157,12 @@ static int run_threads_and_restart(const char *base, const char *full, const cha
 /* ... and their CSVs agree in the first ncol columns (the seconds differ) */
 static void check_threads_and_restart(const char *tag, const char *csv, int ncol) {
     char a[256], b[256];
-    snprintf(a, sizeof a, "build/tests/%sA/%s", tag, csv);
-    snprintf(b, sizeof b, "build/tests/%s1/%s", tag, csv);
+    snprintf(a, sizeof a, BUILD "/tests/%sA/%s", tag, csv);
+    snprintf(b, sizeof b, BUILD "/tests/%s1/%s", tag, csv);
     CHECK(gk_test_csv_same(a, b, ncol, 2));
-    snprintf(b, sizeof b, "build/tests/%sB/%s", tag, csv);
+    snprintf(b, sizeof b, BUILD "/tests/%sB/%s", tag, csv);
     CHECK(gk_test_csv_same(a, b, ncol, 2));
-    snprintf(b, sizeof b, "build/tests/%sB2.out", tag);
+    snprintf(b, sizeof b, BUILD "/tests/%sB2.out", tag);
     CHECK(gk_test_file_has(b, "restarted from"));
 }
 
@@ -178,9 +178,9 @@ TEST(femdem_biaxial_local_histories) {
     char line[1024], name[16];
     double v[3][2][13], eq_last[3] = {0, 0, 0}, e_last[3] = {0, 0, 0};
     int rows = 0, gp, step, i;
-    CHECK(system("build/femdem_biaxial --nx 2 --ny 2 --element q4 --steps 4 --threads 2 --vtk-every 0 "
-                 "--fields-at 0.2 --out build/tests/t_fdl > build/tests/t_fdl.out 2>&1") == 0);
-    fp = fopen("build/tests/t_fdl/gp_history.csv", "r");
+    CHECK(system(BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --steps 4 --threads 2 --vtk-every 0 "
+                 "--fields-at 0.2 --out " BUILD "/tests/t_fdl > " BUILD "/tests/t_fdl.out 2>&1") == 0);
+    fp = fopen(BUILD "/tests/t_fdl/gp_history.csv", "r");
     CHECK(fp != NULL);
     if (!fp) return;
     CHECK(fgets(line, sizeof line, fp) != NULL);
@@ -211,13 +211,13 @@ TEST(femdem_biaxial_local_histories) {
         CHECK(dp > 3e4); /* sigma_yy rises by about 95 kPa */
         CHECK_NEAR(dq / dp, 1.0, 0.03);
     }
-    CHECK(gk_test_file_has("build/tests/t_fdl.out", "LOCAL inside_gp="));
-    CHECK(gk_test_file_has("build/tests/t_fdl.out", "first_failed_eps=nan failed_fraction_mean=0 "));
-    CHECK(gk_test_file_has("build/tests/t_fdl/failed_fraction.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_fdl/gp_history_path.svg", "q [kPa]"));
-    CHECK(gk_test_file_has("build/tests/t_fdl/fabric_field.svg", "fabric anisotropy F_a"));
-    CHECK(gk_test_file_has("build/tests/t_fdl/fabric_field_0002.svg", "axial strain 0.20 %"));
-    CHECK(!gk_test_file_has("build/tests/t_fdl/fabric_field_0003.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdl.out", "LOCAL inside_gp="));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdl.out", "first_failed_eps=nan failed_fraction_mean=0 "));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdl/failed_fraction.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdl/gp_history_path.svg", "q [kPa]"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdl/fabric_field.svg", "fabric anisotropy F_a"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdl/fabric_field_0002.svg", "axial strain 0.20 %"));
+    CHECK(!gk_test_file_has(BUILD "/tests/t_fdl/fabric_field_0003.svg", "<svg"));
     CHECK(refused("femdem_biaxial", "--fields-at 4,x", "--fields-at '4,x' is not a list"));
     CHECK(refused("femdem_biaxial", "--fields-at -1", "is not a list"));
 }
@@ -231,9 +231,9 @@ TEST(hexagonal_rve_is_isotropic_at_100_kPa) {
     char line[1024];
     double v[12];
     int ok = 0;
-    CHECK(system("build/rve_path --packing examples/data/rve400_hex.txt --dH \"0 0 0 0\" --increments 1 "
-                 "--steps-per-increment 10 --out build/tests/t_hex.csv > build/tests/t_hex.out 2>&1") == 0);
-    fp = fopen("build/tests/t_hex.csv", "r");
+    CHECK(system(BUILD "/rve_path --packing examples/data/rve400_hex.txt --dH \"0 0 0 0\" --increments 1 "
+                 "--steps-per-increment 10 --out " BUILD "/tests/t_hex.csv > " BUILD "/tests/t_hex.out 2>&1") == 0);
+    fp = fopen(BUILD "/tests/t_hex.csv", "r");
     CHECK(fp != NULL);
     if (!fp) return;
     while (fgets(line, sizeof line, fp))
@@ -256,9 +256,9 @@ TEST(hexagonal_rve_is_isotropic_at_100_kPa) {
 TEST(femdem_biaxial_runs_restarts_and_is_thread_independent) {
     FILE *fp;
     char line[1024];
-    CHECK(run_threads_and_restart("build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 1",
+    CHECK(run_threads_and_restart(BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 1",
                                   "--steps 4", "--steps 2", "t_fd"));
-    fp = fopen("build/tests/t_fdA/biaxial.csv", "r");
+    fp = fopen(BUILD "/tests/t_fdA/biaxial.csv", "r");
     CHECK(fp != NULL);
     if (!fp) return;
     CHECK(fgets(line, sizeof line, fp) != NULL);
@@ -271,21 +271,21 @@ TEST(femdem_biaxial_runs_restarts_and_is_thread_independent) {
         CHECK_NEAR(v[3], 1e5, 500.0); /* sigma_xx */
     }
     fclose(fp);
-    CHECK_EQ_INT(count_lines("build/tests/t_fdA/biaxial.csv"), 6);
-    CHECK(gk_test_file_has("build/tests/t_fdA.out", "RESULT peak_sigma_yy="));
-    CHECK(gk_test_file_has("build/tests/t_fdA.out", "total_seconds="));
-    CHECK(gk_test_file_has("build/tests/t_fdA/gp_0004.vtk", "eps_q"));
-    CHECK(gk_test_file_has("build/tests/t_fdA/gp_0004.vtk", "fabric_anisotropy"));
-    CHECK(gk_test_file_has("build/tests/t_fdA/mesh_0004.vtk", "displacement"));
-    CHECK(gk_test_file_has("build/tests/t_fdA/biaxial_stress.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_fdA/eps_q_field.svg", "<svg"));
+    CHECK_EQ_INT(count_lines(BUILD "/tests/t_fdA/biaxial.csv"), 6);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdA.out", "RESULT peak_sigma_yy="));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdA.out", "total_seconds="));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdA/gp_0004.vtk", "eps_q"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdA/gp_0004.vtk", "fabric_anisotropy"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdA/mesh_0004.vtk", "displacement"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdA/biaxial_stress.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdA/eps_q_field.svg", "<svg"));
     check_threads_and_restart("t_fd", "biaxial.csv", 6); /* columns step..iterations */
     check_threads_and_restart("t_fd", "gp_history.csv", 15); /* the histories survive the checkpoint */
     /* bad input: a message and status 2 */
-    CHECK(system("build/femdem_biaxial --element q9 > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "q4 or q8"));
-    CHECK(system("build/femdem_biaxial --help > build/tests/t_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--restart"));
+    CHECK(system(BUILD "/femdem_biaxial --element q9 > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "q4 or q8"));
+    CHECK(system(BUILD "/femdem_biaxial --help > " BUILD "/tests/t_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--restart"));
 }
 
 /* single-element test (Guo & Zhao 2014 sec 3.3, Fig 6): one Q4 element with 4
@@ -296,15 +296,15 @@ TEST(femdem_single_element_matches_rve_alone) {
     char line[1024];
     CHECK(
         system(
-            "build/femdem_biaxial --test single --steps 6 --threads 2 --vtk-every 0 --out build/tests/t_fds "
-            "> build/tests/t_fds.out 2>&1") == 0);
-    fp = fopen("build/tests/t_fds.out", "r");
+            BUILD "/femdem_biaxial --test single --steps 6 --threads 2 --vtk-every 0 --out " BUILD "/tests/t_fds "
+            "> " BUILD "/tests/t_fds.out 2>&1") == 0);
+    fp = fopen(BUILD "/tests/t_fds.out", "r");
     while (fp && fgets(line, sizeof line, fp))
         if (!strncmp(line, "SINGLE max_rel_diff_to_peak=", 28)) d = atof(line + 28);
     if (fp) fclose(fp);
     printf("    max relative difference of sigma_yy, FEM element vs RVE alone: %.4f\n", d);
     CHECK(d < 0.01); /* before the peak the curves agree (seed Fig 6) */
-    CHECK(gk_test_file_has("build/tests/t_fds/single_element.csv", "sigma_yy_fem,sigma_yy_rve"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fds/single_element.csv", "sigma_yy_fem,sigma_yy_rve"));
 }
 
 /* data rows of a CSV file with ncol numeric columns into v[row * ncol + col];
@@ -337,10 +337,10 @@ TEST(femdem_single_reference_holds_the_lateral_stress) {
     double v[31 * 8];
     char header[512];
     int n, k, runs = 0;
-    CHECK(system("build/femdem_biaxial --test single --steps 30 --threads 2 --vtk-every 0 --out "
-                 "build/tests/t_fds30 "
-                 "> build/tests/t_fds30.out 2>&1") == 0);
-    n = read_csv("build/tests/t_fds30/single_element.csv", 8, v, 31, header, sizeof header);
+    CHECK(system(BUILD "/femdem_biaxial --test single --steps 30 --threads 2 --vtk-every 0 --out "
+                 BUILD "/tests/t_fds30 "
+                 "> " BUILD "/tests/t_fds30.out 2>&1") == 0);
+    n = read_csv(BUILD "/tests/t_fds30/single_element.csv", 8, v, 31, header, sizeof header);
     CHECK(n == 31);
     CHECK(strstr(header, "eps_v_rve,rve_runs") != NULL);
     for (k = 1; k < n; ++k) {
@@ -360,10 +360,10 @@ TEST(femdem_single_reference_through_a_slip) {
     double v[101 * 8];
     char header[512];
     int n, k, held = 1, two_legs = 0;
-    CHECK(system("build/femdem_biaxial --test single --steps 100 --dem-rule adaptive --packing "
-                 "bench/data/tradeoff/rve400.txt --threads 2 --vtk-every 0 --out build/tests/t_fdslip "
-                 "> build/tests/t_fdslip.out 2>&1") == 0);
-    n = read_csv("build/tests/t_fdslip/single_element.csv", 8, v, 101, header, sizeof header);
+    CHECK(system(BUILD "/femdem_biaxial --test single --steps 100 --dem-rule adaptive --packing "
+                 "bench/data/tradeoff/rve400.txt --threads 2 --vtk-every 0 --out " BUILD "/tests/t_fdslip "
+                 "> " BUILD "/tests/t_fdslip.out 2>&1") == 0);
+    n = read_csv(BUILD "/tests/t_fdslip/single_element.csv", 8, v, 101, header, sizeof header);
     CHECK_EQ_INT(n, 101);
     for (k = 1; k < n; ++k) {
         held &= fabs(v[8 * k + 4] - 1e5) <= 1e-3 * 1e5;
@@ -388,10 +388,10 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
     char header[512];
     double v[64 * C_NCOL], evmax = 0, uymax = 0, tau_pos = 0, tau_neg = 0;
     int n, k, turns = 0;
-    CHECK(run_threads_and_restart("build/femdem_cyclic --test cyclic-strain --nx 2 --ny 1 --element q4 "
+    CHECK(run_threads_and_restart(BUILD "/femdem_cyclic --test cyclic-strain --nx 2 --ny 1 --element q4 "
                                   "--increment 0.002",
                                   "--cycles 1", "--cycles 0.5", "t_fc"));
-    n = read_csv("build/tests/t_fcA/cyclic.csv", C_NCOL, v, 64, header, sizeof header);
+    n = read_csv(BUILD "/tests/t_fcA/cyclic.csv", C_NCOL, v, 64, header, sizeof header);
     CHECK(strcmp(header, CYC_HEADER) == 0);
     CHECK_EQ_INT(n, 21); /* the initial state and 1 cycle of 4 x 1 % in steps of 0.2 % */
     if (n != 21) return;
@@ -414,30 +414,30 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
     CHECK(v[20 * C_NCOL + C_P] < 0.97 * v[C_P]); /* contractive: p' falls over a cycle */
     CHECK_NEAR(v[20 * C_NCOL + C_CYCLE], 1.0, 1e-9);
     CHECK_NEAR(v[20 * C_NCOL + C_GAMMA], 0.0, 1e-12);
-    CHECK_NEAR(gk_test_result("build/tests/t_fcA.out", "cycles"), 1.0, 1e-9);
-    CHECK(gk_test_result("build/tests/t_fcA.out", "liquefied") == 0.0);
-    CHECK_REL(gk_test_result("build/tests/t_fcA.out", "p_final"), v[20 * C_NCOL + C_P], 1e-5);
-    CHECK(gk_test_result("build/tests/t_fcA.out", "total_seconds") > 0);
-    CHECK(gk_test_file_has("build/tests/t_fcA/cyclic_stress_path.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_fcA/cyclic_stress_strain.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_fcA/void_ratio_field.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_fcA/gp_0020.vtk", "void_ratio"));
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_fcA.out", "cycles"), 1.0, 1e-9);
+    CHECK(gk_test_result(BUILD "/tests/t_fcA.out", "liquefied") == 0.0);
+    CHECK_REL(gk_test_result(BUILD "/tests/t_fcA.out", "p_final"), v[20 * C_NCOL + C_P], 1e-5);
+    CHECK(gk_test_result(BUILD "/tests/t_fcA.out", "total_seconds") > 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fcA/cyclic_stress_path.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fcA/cyclic_stress_strain.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fcA/void_ratio_field.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fcA/gp_0020.vtk", "void_ratio"));
     check_threads_and_restart("t_fc", "cyclic.csv", 11); /* columns step..iterations */
     /* bad input: a message and status 2; a checkpoint of the other control mode is refused */
-    CHECK(system("build/femdem_cyclic --test cyclic-foo > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "cyclic-strain or cyclic-stress"));
-    CHECK(system("build/femdem_cyclic --test cyclic-strain --amplitude 0 > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "out of range"));
+    CHECK(system(BUILD "/femdem_cyclic --test cyclic-foo > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "cyclic-strain or cyclic-stress"));
+    CHECK(system(BUILD "/femdem_cyclic --test cyclic-strain --amplitude 0 > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "out of range"));
     CHECK(
         system(
-            "build/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --restart build/tests/t_fcA "
-            "--out build/tests/t_fcC > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "not a checkpoint"));
-    CHECK(system("build/femdem_cyclic --help > build/tests/t_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--tau-amplitude"));
+            BUILD "/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --restart " BUILD "/tests/t_fcA "
+            "--out " BUILD "/tests/t_fcC > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "not a checkpoint"));
+    CHECK(system(BUILD "/femdem_cyclic --help > " BUILD "/tests/t_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--tau-amplitude"));
     /* the biaxial driver points there */
-    CHECK(system("build/femdem_biaxial --test cyclic-strain > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "build/femdem_cyclic --test cyclic-strain"));
+    CHECK(system(BUILD "/femdem_biaxial --test cyclic-strain > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", BUILD "/femdem_cyclic --test cyclic-strain"));
 }
 
 /* stress control: the platen turns when |tau| reaches the amplitude (the
@@ -446,14 +446,14 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
  * --gamma-limit the run stops at the first step beyond it */
 TEST(femdem_cyclic_stress_turns_at_the_amplitude) {
     const char *base =
-        "build/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --tau-amplitude 1.5e4 "
+        BUILD "/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --tau-amplitude 1.5e4 "
         "--stress-steps 2 --threads 2";
     char cmd[1024], header[512];
     double v[128 * C_NCOL], tmax = 0, amp = 1.5e4, g_lim = 0.002;
     int n, k, turns = 0;
-    snprintf(cmd, sizeof cmd, "%s --cycles 1.5 --out build/tests/t_fcS > build/tests/t_fcS.out 2>&1", base);
+    snprintf(cmd, sizeof cmd, "%s --cycles 1.5 --out " BUILD "/tests/t_fcS > " BUILD "/tests/t_fcS.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    n = read_csv("build/tests/t_fcS/cyclic.csv", C_NCOL, v, 128, header, sizeof header);
+    n = read_csv(BUILD "/tests/t_fcS/cyclic.csv", C_NCOL, v, 128, header, sizeof header);
     CHECK(strcmp(header, CYC_HEADER) == 0);
     for (k = 1; k < n; ++k) {
         const double *r = v + k * C_NCOL;
@@ -468,16 +468,16 @@ TEST(femdem_cyclic_stress_turns_at_the_amplitude) {
            n > 0 ? v[(n - 1) * C_NCOL + C_CYCLE] : 0.0);
     CHECK_EQ_INT(turns, 3);
     CHECK(tmax <= 1.02 * amp);
-    CHECK(gk_test_file_has("build/tests/t_fcS.out", "RESULT test=cyclic-stress"));
-    snprintf(cmd, sizeof cmd, "%s --gamma-limit %g --out build/tests/t_fcG > build/tests/t_fcG.out 2>&1",
+    CHECK(gk_test_file_has(BUILD "/tests/t_fcS.out", "RESULT test=cyclic-stress"));
+    snprintf(cmd, sizeof cmd, "%s --gamma-limit %g --out " BUILD "/tests/t_fcG > " BUILD "/tests/t_fcG.out 2>&1",
              base, g_lim);
     CHECK(system(cmd) == 0);
-    n = read_csv("build/tests/t_fcG/cyclic.csv", C_NCOL, v, 128, header, sizeof header);
+    n = read_csv(BUILD "/tests/t_fcG/cyclic.csv", C_NCOL, v, 128, header, sizeof header);
     CHECK(n > 2);
     if (n <= 2) return;
     for (k = 0; k + 1 < n; ++k) CHECK(fabs(v[k * C_NCOL + C_GAMMA]) < g_lim);
     CHECK(fabs(v[(n - 1) * C_NCOL + C_GAMMA]) >= g_lim);
-    CHECK_NEAR(gk_test_result("build/tests/t_fcG.out", "cycles_to_gamma_limit"),
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_fcG.out", "cycles_to_gamma_limit"),
                v[(n - 1) * C_NCOL + C_CYCLE], 1e-3);
 }
 
@@ -505,11 +505,11 @@ static int refused(const char *bin, const char *flags, const char *msg) {
     char cmd[512];
     FILE *fp;
     int ok;
-    system("rm -rf build/tests/t_fdbad");
-    snprintf(cmd, sizeof cmd, "build/%s %s --out build/tests/t_fdbad > build/tests/t_bad.out 2>&1", bin,
+    system("rm -rf " BUILD "/tests/t_fdbad");
+    snprintf(cmd, sizeof cmd, BUILD "/%s %s --out " BUILD "/tests/t_fdbad > " BUILD "/tests/t_bad.out 2>&1", bin,
              flags);
-    ok = system(cmd) != 0 && gk_test_file_has("build/tests/t_bad.out", msg);
-    fp = fopen("build/tests/t_fdbad", "r");
+    ok = system(cmd) != 0 && gk_test_file_has(BUILD "/tests/t_bad.out", msg);
+    fp = fopen(BUILD "/tests/t_fdbad", "r");
     if (fp) fclose(fp), ok = 0;
     if (!ok) printf("    not refused as expected: %s %s\n", bin, flags);
     return ok;
@@ -535,27 +535,27 @@ TEST(femdem_refuses_malformed_numbers) {
     CHECK(fd_refused("--nx=8", "--nx=8: write the value after the option"));
     CHECK(fd_refused("--steps 2147483647", "--steps 2147483647 is out of range"));
     CHECK(fd_refused("--increment 0.5", "--increment 0.5 is out of range"));
-    CHECK(system("build/femdem_biaxial --nx > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--nx needs a value"));
+    CHECK(system(BUILD "/femdem_biaxial --nx > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--nx needs a value"));
     CHECK(fd_refused("--bogus 1", "unknown option --bogus"));
 }
 
 /* --noise-probe: a line of residual changes per step for the 5 values of eps, and the run itself is
  * unchanged (every CSV column but the seconds, DEM work counts included); refused with tangent reuse */
 TEST(femdem_noise_probe_leaves_the_run_unchanged) {
-    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
-    const char *probe = "build/femdem_probe --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
+    const char *base = BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
+    const char *probe = BUILD "/femdem_probe --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
     char cmd[512];
-    snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fnp0 > build/tests/t_fnp0.out 2>&1", base);
+    snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fnp0 > " BUILD "/tests/t_fnp0.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --noise-probe 2 --out build/tests/t_fnp1 > build/tests/t_fnp1.out 2>&1",
+    snprintf(cmd, sizeof cmd, "%s --noise-probe 2 --out " BUILD "/tests/t_fnp1 > " BUILD "/tests/t_fnp1.out 2>&1",
              probe);
     CHECK(system(cmd) == 0);
-    CHECK(gk_test_file_has("build/tests/t_fnp1.out", "noise probe at iteration 2 (E_f "));
-    CHECK(gk_test_file_has("build/tests/t_fnp1.out", " 1e-06: "));
-    CHECK(gk_test_file_has("build/tests/t_fnp1.out", " 1e-02: "));
-    CHECK(!gk_test_file_has("build/tests/t_fnp0.out", "noise probe"));
-    CHECK(biaxial_csv_same("build/tests/t_fnp0/biaxial.csv", "build/tests/t_fnp1/biaxial.csv", 4));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnp1.out", "noise probe at iteration 2 (E_f "));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnp1.out", " 1e-06: "));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnp1.out", " 1e-02: "));
+    CHECK(!gk_test_file_has(BUILD "/tests/t_fnp0.out", "noise probe"));
+    CHECK(biaxial_csv_same(BUILD "/tests/t_fnp0/biaxial.csv", BUILD "/tests/t_fnp1/biaxial.csv", 4));
     CHECK(refused("femdem_probe", "--noise-probe 2 --tangent-reuse 0.1", "use one of them"));
     CHECK(refused("femdem_probe", "--noise-probe -1", "out of range"));
     CHECK(fd_refused("--noise-probe 2", "unknown option --noise-probe")); /* the probes left femdem_biaxial */
@@ -568,20 +568,20 @@ TEST(femdem_noise_probe_leaves_the_run_unchanged) {
  * difference step or sign breaks that); the probe's RVE runs leave the run itself unchanged (the
  * iterate is re-evaluated at u: the same CSV, bit for bit); bad values are refused */
 TEST(femdem_krylov_probe_leaves_the_run_unchanged) {
-    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
-    const char *probe = "build/femdem_probe --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
+    const char *base = BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
+    const char *probe = BUILD "/femdem_probe --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3";
     char cmd[512], line[256];
     double prev = 1.0 + 1e-12, ef0 = 0.0, worst3 = 0.0;
     int lines = 0, monotone = 1;
     FILE *fp;
-    snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fkp0 > build/tests/t_fkp0.out 2>&1", base);
+    snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fkp0 > " BUILD "/tests/t_fkp0.out 2>&1", base);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s --krylov-probe 2 --krylov-scale 0.02 --out build/tests/t_fkp1 > build/tests/t_fkp1.out 2>&1",
+             "%s --krylov-probe 2 --krylov-scale 0.02 --out " BUILD "/tests/t_fkp1 > " BUILD "/tests/t_fkp1.out 2>&1",
              probe);
     CHECK(system(cmd) == 0);
-    CHECK(gk_test_file_has("build/tests/t_fkp1.out", "krylov probe at iteration 2 (E_f "));
-    fp = fopen("build/tests/t_fkp1.out", "r");
+    CHECK(gk_test_file_has(BUILD "/tests/t_fkp1.out", "krylov probe at iteration 2 (E_f "));
+    fp = fopen(BUILD "/tests/t_fkp1.out", "r");
     while (fp && fgets(line, sizeof line, fp)) {
         int m;
         double model, ef;
@@ -603,7 +603,7 @@ TEST(femdem_krylov_probe_leaves_the_run_unchanged) {
     /* hardening specimen: the RVE map is locally linear, 3 directions remove 99 % of the modelled
      * residual and the E_f found there is below a tenth of the iterate's */
     CHECK(worst3 < 0.01);
-    CHECK(biaxial_csv_same("build/tests/t_fkp0/biaxial.csv", "build/tests/t_fkp1/biaxial.csv", 4));
+    CHECK(biaxial_csv_same(BUILD "/tests/t_fkp0/biaxial.csv", BUILD "/tests/t_fkp1/biaxial.csv", 4));
     CHECK(refused("femdem_probe", "--krylov-probe 2 --tangent-reuse 0.1", "use one of them"));
     CHECK(refused("femdem_probe", "--krylov-probe -1", "out of range"));
     CHECK(refused("femdem_probe", "--krylov-probe 2 --krylov-scale 0", "out of range"));
@@ -618,15 +618,15 @@ TEST(femdem_extrapolated_predictor) {
     char header[512];
     double a[5 * F_NCOL], b[5 * F_NCOL];
     int na, nb, r, differs = 0;
-    CHECK(run_threads_and_restart("build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --predictor "
+    CHECK(run_threads_and_restart(BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --predictor "
                                   "extrapolate",
                                   "--steps 4", "--steps 2", "t_fx"));
     check_threads_and_restart("t_fx", "biaxial.csv", 6);
-    CHECK(gk_test_file_has("build/tests/t_fxA.out", "predictor: the last converged increment"));
-    CHECK(system("build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --steps 4 --threads 2 --out "
-                 "build/tests/t_fxT > build/tests/t_fxT.out 2>&1") == 0);
-    na = read_csv("build/tests/t_fxA/biaxial.csv", F_NCOL, a, 5, header, sizeof header);
-    nb = read_csv("build/tests/t_fxT/biaxial.csv", F_NCOL, b, 5, header, sizeof header);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fxA.out", "predictor: the last converged increment"));
+    CHECK(system(BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --steps 4 --threads 2 --out "
+                 BUILD "/tests/t_fxT > " BUILD "/tests/t_fxT.out 2>&1") == 0);
+    na = read_csv(BUILD "/tests/t_fxA/biaxial.csv", F_NCOL, a, 5, header, sizeof header);
+    nb = read_csv(BUILD "/tests/t_fxT/biaxial.csv", F_NCOL, b, 5, header, sizeof header);
     CHECK_EQ_INT(na, 5);
     CHECK_EQ_INT(nb, 5);
     for (r = 1; r < 5 && na == 5 && nb == 5; ++r) {
@@ -646,9 +646,9 @@ TEST(femdem_ed_newton_accepts_by_the_criterion) {
     int n, r;
     CHECK(
         system(
-            "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3 --ed newton "
-            "--out build/tests/t_fed > build/tests/t_fed.out 2>&1") == 0);
-    n = read_csv("build/tests/t_fed/biaxial.csv", F_NCOL, a, 4, header, sizeof header);
+            BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3 --ed newton "
+            "--out " BUILD "/tests/t_fed > " BUILD "/tests/t_fed.out 2>&1") == 0);
+    n = read_csv(BUILD "/tests/t_fed/biaxial.csv", F_NCOL, a, 4, header, sizeof header);
     CHECK_EQ_INT(n, 4);
     for (r = 1; r < n; ++r) CHECK(a[r * F_NCOL + 7] < 0.01 || a[r * F_NCOL + 8] < 0.003);
     CHECK(fd_refused("--ed raw", "--ed 'raw' must be step or newton"));
@@ -659,20 +659,20 @@ TEST(femdem_ed_newton_accepts_by_the_criterion) {
  * E_f < --ftol = 0.3 % of the internal force; 1 % allows that and no more), a different tangent does
  * not change the equilibrium it converges to. 2 x 2 Q4, 16 RVEs. */
 TEST(femdem_relaxed_tangent_converges_to_the_same_curve) {
-    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0";
+    const char *base = BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0";
     char cmd[512], header[512];
     double a[8 * F_NCOL], b[8 * F_NCOL];
     int k, n;
     CHECK(
         run_threads_and_restart(base, "--steps 3 --tangent relaxed", "--steps 2 --tangent relaxed", "t_fdx"));
     check_threads_and_restart("t_fdx", "biaxial.csv", 6);
-    CHECK(gk_test_file_has("build/tests/t_fdxA.out", "tangent relaxed"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdxA.out", "tangent relaxed"));
     snprintf(cmd, sizeof cmd,
-             "%s --steps 3 --threads 2 --out build/tests/t_fdxT > build/tests/t_fdxT.out 2>&1", base);
+             "%s --steps 3 --threads 2 --out " BUILD "/tests/t_fdxT > " BUILD "/tests/t_fdxT.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    n = read_csv("build/tests/t_fdxA/biaxial.csv", F_NCOL, a, 8, header, sizeof header);
+    n = read_csv(BUILD "/tests/t_fdxA/biaxial.csv", F_NCOL, a, 8, header, sizeof header);
     CHECK_EQ_INT(n, 4);
-    CHECK_EQ_INT(read_csv("build/tests/t_fdxT/biaxial.csv", F_NCOL, b, 8, header, sizeof header), 4);
+    CHECK_EQ_INT(read_csv(BUILD "/tests/t_fdxT/biaxial.csv", F_NCOL, b, 8, header, sizeof header), 4);
     if (n != 4) return;
     for (k = 1; k < n; ++k) {
         printf("    step %d: sigma_yy relaxed %.0f Pa (%.0f iterations), Taylor %.0f Pa (%.0f)\n", k,
@@ -685,20 +685,20 @@ TEST(femdem_relaxed_tangent_converges_to_the_same_curve) {
 /* issue 6: the DEM step rule (adaptive by default) and tangent reuse in femdem_biaxial. 2 x 2 Q4, 16
  * RVEs, a few 0.1 % steps. */
 TEST(femdem_dem_rule_and_tangent_reuse) {
-    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2";
+    const char *base = BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2";
     char cmd[1024], header[512];
     double a[8 * F_NCOL], b[8 * F_NCOL], c[8 * F_NCOL], dmax = 0;
     int n, k, exact = 1, nfix = 37;
     /* the adaptive rule is the default and reports its steps: per point (mean <= max), in all */
     snprintf(cmd, sizeof cmd,
-             "%s --steps 4 --vtk-every 4 --out build/tests/t_fdr > build/tests/t_fdr.out 2>&1", base);
+             "%s --steps 4 --vtk-every 4 --out " BUILD "/tests/t_fdr > " BUILD "/tests/t_fdr.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    n = read_csv("build/tests/t_fdr/biaxial.csv", F_NCOL, a, 8, header, sizeof header);
+    n = read_csv(BUILD "/tests/t_fdr/biaxial.csv", F_NCOL, a, 8, header, sizeof header);
     CHECK(strcmp(header, FD_HEADER) == 0);
     CHECK_EQ_INT(n, 5);
     if (n != 5) return;
-    CHECK(gk_test_file_has("build/tests/t_fdr.out", "dem_rule=adaptive"));
-    CHECK(gk_test_file_has("build/tests/t_fdr/gp_0004.vtk", "dem_steps"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr.out", "dem_rule=adaptive"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr/gp_0004.vtk", "dem_steps"));
     for (k = 1; k < n; ++k) {
         const double *r = a + k * F_NCOL;
         CHECK(r[F_DMEAN] > 50 && r[F_DMEAN] <= r[F_DMAX]);
@@ -706,65 +706,65 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
         CHECK(r[F_DALL] >= 16 * r[F_ITER] * 2 && r[F_COMP] == 16 * r[F_ITER] && r[F_REUSED] == 0);
         dmax += r[F_DALL];
     }
-    CHECK_NEAR(gk_test_result("build/tests/t_fdr.out", "dem_steps_total"), dmax, 0.5);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_fdr.out", "dem_steps_total"), dmax, 0.5);
     /* a 4x larger inertial-number bound: about 4x fewer deformation steps */
     snprintf(cmd, sizeof cmd,
-             "%s --steps 4 --dem-inertial 2e-3 --out build/tests/t_fdr2 > build/tests/t_fdr2.out 2>&1", base);
+             "%s --steps 4 --dem-inertial 2e-3 --out " BUILD "/tests/t_fdr2 > " BUILD "/tests/t_fdr2.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    CHECK_EQ_INT(read_csv("build/tests/t_fdr2/biaxial.csv", F_NCOL, b, 8, header, sizeof header), 5);
+    CHECK_EQ_INT(read_csv(BUILD "/tests/t_fdr2/biaxial.csv", F_NCOL, b, 8, header, sizeof header), 5);
     printf(
         "    adaptive rule: DEM steps per RVE at step 1: %.1f (I_max 5e-4), %.1f (2e-3); all: %.0f, %.0f\n",
-        a[F_NCOL + F_DMEAN], b[F_NCOL + F_DMEAN], gk_test_result("build/tests/t_fdr.out", "dem_steps_total"),
-        gk_test_result("build/tests/t_fdr2.out", "dem_steps_total"));
+        a[F_NCOL + F_DMEAN], b[F_NCOL + F_DMEAN], gk_test_result(BUILD "/tests/t_fdr.out", "dem_steps_total"),
+        gk_test_result(BUILD "/tests/t_fdr2.out", "dem_steps_total"));
     CHECK(b[F_NCOL + F_DMEAN] < 0.4 * a[F_NCOL + F_DMEAN]);
-    CHECK(gk_test_result("build/tests/t_fdr2.out", "dem_steps_total") <
-          0.5 * gk_test_result("build/tests/t_fdr.out", "dem_steps_total"));
+    CHECK(gk_test_result(BUILD "/tests/t_fdr2.out", "dem_steps_total") <
+          0.5 * gk_test_result(BUILD "/tests/t_fdr.out", "dem_steps_total"));
     /* the strain rule with --dem-min N --dem-max N: exactly N steps per RVE run, every run */
     snprintf(cmd, sizeof cmd,
-             "%s --steps 3 --dem-rule strain --dem-min %d --dem-max %d --out build/tests/t_fdn > "
-             "build/tests/t_fdn.out 2>&1",
+             "%s --steps 3 --dem-rule strain --dem-min %d --dem-max %d --out " BUILD "/tests/t_fdn > "
+             BUILD "/tests/t_fdn.out 2>&1",
              base, nfix, nfix);
     CHECK(system(cmd) == 0);
-    n = read_csv("build/tests/t_fdn/biaxial.csv", F_NCOL, c, 8, header, sizeof header);
+    n = read_csv(BUILD "/tests/t_fdn/biaxial.csv", F_NCOL, c, 8, header, sizeof header);
     CHECK_EQ_INT(n, 4);
     for (k = 1; k < n; ++k) {
         const double *r = c + k * F_NCOL;
         exact &= r[F_DMEAN] == nfix && r[F_DMAX] == nfix && r[F_DALL] == 16.0 * nfix * r[F_ITER];
     }
     CHECK(exact);
-    CHECK(gk_test_file_has("build/tests/t_fdn.out", "dem_rule=strain"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdn.out", "dem_rule=strain"));
     /* tangent reuse: the same converged curve within the Newton tolerance - both runs stop at E_f <
      * --ftol = 0.3 % of the internal force, so two converged states may differ by a few tenths of a
      * percent in the reactions; 1 % allows that and no more - and it does reuse */
     snprintf(cmd, sizeof cmd,
-             "%s --steps 4 --tangent-reuse 0.3 --out build/tests/t_fdt > build/tests/t_fdt.out 2>&1", base);
+             "%s --steps 4 --tangent-reuse 0.3 --out " BUILD "/tests/t_fdt > " BUILD "/tests/t_fdt.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    n = read_csv("build/tests/t_fdt/biaxial.csv", F_NCOL, b, 8, header, sizeof header);
+    n = read_csv(BUILD "/tests/t_fdt/biaxial.csv", F_NCOL, b, 8, header, sizeof header);
     CHECK_EQ_INT(n, 5);
     if (n != 5) return;
     for (k = 1; k < n; ++k) CHECK_REL(b[k * F_NCOL + F_SYY], a[k * F_NCOL + F_SYY], 0.01);
     printf("    tangent reuse 0.3: %.0f reused, %.0f computed; sigma_yy at 0.4 %%: %.0f Pa (no reuse %.0f)\n",
-           gk_test_result("build/tests/t_fdt.out", "tangents_reused"),
-           gk_test_result("build/tests/t_fdt.out", "tangents_computed"), b[4 * F_NCOL + F_SYY],
+           gk_test_result(BUILD "/tests/t_fdt.out", "tangents_reused"),
+           gk_test_result(BUILD "/tests/t_fdt.out", "tangents_computed"), b[4 * F_NCOL + F_SYY],
            a[4 * F_NCOL + F_SYY]);
-    CHECK(gk_test_result("build/tests/t_fdt.out", "tangents_reused") > 0);
+    CHECK(gk_test_result(BUILD "/tests/t_fdt.out", "tangents_reused") > 0);
     /* ... thread-independent and restart-safe: with X = 0.3 tangents are kept across load steps, so the
      * restart needs the stored tangents and networks of the checkpoint (without them it diverges) */
     CHECK(run_threads_and_restart(base, "--steps 4 --tangent-reuse 0.3", "--steps 2 --tangent-reuse 0.3",
                                   "t_fdq"));
     check_threads_and_restart("t_fdq", "biaxial.csv", 6);
-    CHECK(gk_test_result("build/tests/t_fdqB2.out", "tangents_reused") ==
-          gk_test_result("build/tests/t_fdqA.out", "tangents_reused"));
-    CHECK(gk_test_result("build/tests/t_fdq1.out", "dem_steps_total") ==
-          gk_test_result("build/tests/t_fdqA.out", "dem_steps_total"));
-    CHECK(gk_test_result("build/tests/t_fdqB2.out", "dem_steps_total") ==
-          gk_test_result("build/tests/t_fdqA.out", "dem_steps_total"));
+    CHECK(gk_test_result(BUILD "/tests/t_fdqB2.out", "tangents_reused") ==
+          gk_test_result(BUILD "/tests/t_fdqA.out", "tangents_reused"));
+    CHECK(gk_test_result(BUILD "/tests/t_fdq1.out", "dem_steps_total") ==
+          gk_test_result(BUILD "/tests/t_fdqA.out", "dem_steps_total"));
+    CHECK(gk_test_result(BUILD "/tests/t_fdqB2.out", "dem_steps_total") ==
+          gk_test_result(BUILD "/tests/t_fdqA.out", "dem_steps_total"));
     /* eq 8 with the adaptive rule (trial run first, perturbed runs with its counts): the same for 1 and 2
      * threads, and at least 5 RVE runs per tangent */
     CHECK(run_threads_and_restart(base, "--steps 2 --tangent perturbation",
                                   "--steps 1 --tangent perturbation", "t_fdp"));
     check_threads_and_restart("t_fdp", "biaxial.csv", 6);
-    n = read_csv("build/tests/t_fdpA/biaxial.csv", F_NCOL, c, 8, header, sizeof header);
+    n = read_csv(BUILD "/tests/t_fdpA/biaxial.csv", F_NCOL, c, 8, header, sizeof header);
     CHECK_EQ_INT(n, 3);
     if (n == 3) /* DEM steps per tangent at step 1: 6 runs (trial, 4 perturbed, trial again) vs 1 */
         CHECK(c[F_NCOL + F_DALL] / c[F_NCOL + F_COMP] > 5.5 * a[F_NCOL + F_DALL] / a[F_NCOL + F_COMP]);
@@ -777,9 +777,9 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
     CHECK(fd_refused("--dem-min 50 --dem-max 40", "exceeds"));
     CHECK(fd_refused("--tangent-reuse 1", "0 <= X < 1"));
     CHECK(fd_refused("--tangent-reuse nan", "0 <= X < 1"));
-    CHECK(system("build/femdem_biaxial --help > build/tests/t_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--dem-unbalanced"));
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--tangent-reuse"));
+    CHECK(system(BUILD "/femdem_biaxial --help > " BUILD "/tests/t_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--dem-unbalanced"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--tangent-reuse"));
 }
 
 /* the values of one SCALARS field of a legacy VTK file; the count, or -1 */
@@ -812,11 +812,11 @@ TEST(femdem_heterogeneous_packings) {
     int n, k, nlo = 0, nhi = 0, a = -1, b = -1;
     FILE *fp;
     char line[512];
-    const char *base = "build/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 1 "
+    const char *base = BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 1 "
                        "--packing examples/data/rve400.txt,bench/data/tradeoff/rve400.txt";
     CHECK(run_threads_and_restart(base, "--steps 3", "--steps 1", "t_fh"));
     check_threads_and_restart("t_fh", "biaxial.csv", 6);
-    n = vtk_scalars("build/tests/t_fhA/gp_0001.vtk", "void_ratio", v, 64);
+    n = vtk_scalars(BUILD "/tests/t_fhA/gp_0001.vtk", "void_ratio", v, 64);
     CHECK_EQ_INT(n, 16);
     for (k = 0; k < n; ++k) {
         if (v[k] < lo) lo = v[k];
@@ -825,7 +825,7 @@ TEST(femdem_heterogeneous_packings) {
     for (k = 0; k < n; ++k) nlo += v[k] < 0.5 * (lo + hi), nhi += v[k] >= 0.5 * (lo + hi);
     CHECK(lo > 0.165 && hi < 0.18); /* both dense packings, after one 0.1 % step */
     CHECK(hi - lo > 0.002);         /* two populations, 0.004 apart at the start */
-    fp = fopen("build/tests/t_fhA.out", "r");
+    fp = fopen(BUILD "/tests/t_fhA.out", "r");
     CHECK(fp != NULL);
     if (fp) {
         while (fgets(line, sizeof line, fp))
@@ -837,27 +837,27 @@ TEST(femdem_heterogeneous_packings) {
     }
     CHECK(a > 0 && b > 0 && a + b == 16);
     CHECK((a == nhi && b == nlo) || (a == nlo && b == nhi)); /* the draw is what the RVEs got */
-    CHECK(system("build/femdem_biaxial --nx 2 --ny 2 --element q4 --steps 1 --vtk-every 1 --packing-seed 7 "
-                 "--packing examples/data/rve400.txt,bench/data/tradeoff/rve400.txt --out build/tests/t_fh7 "
-                 "> build/tests/t_fh7.out 2>&1") == 0);
+    CHECK(system(BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --steps 1 --vtk-every 1 --packing-seed 7 "
+                 "--packing examples/data/rve400.txt,bench/data/tradeoff/rve400.txt --out " BUILD "/tests/t_fh7 "
+                 "> " BUILD "/tests/t_fh7.out 2>&1") == 0);
     {
         double w[64];
-        int m = vtk_scalars("build/tests/t_fh7/gp_0001.vtk", "void_ratio", w, 64), diff = 0;
+        int m = vtk_scalars(BUILD "/tests/t_fh7/gp_0001.vtk", "void_ratio", w, 64), diff = 0;
         CHECK_EQ_INT(m, 16);
         for (k = 0; k < m && k < n; ++k) diff += w[k] != v[k];
         CHECK(diff > 0);
     }
     CHECK(
         system(
-            "build/femdem_biaxial --test single --packing examples/data/rve400.txt,examples/data/rve400.txt "
-            "> build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "give one --packing"));
-    CHECK(system("build/femdem_biaxial --nx 1 --ny 1 --steps 1 --packing examples/data/rve400.txt,nosuch.txt "
-                 "--out build/tests/t_fhx > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "nosuch.txt"));
-    CHECK(system("build/femdem_biaxial --packing-seed -3 > build/tests/t_bad.out 2>&1") != 0);
+            BUILD "/femdem_biaxial --test single --packing examples/data/rve400.txt,examples/data/rve400.txt "
+            "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "give one --packing"));
+    CHECK(system(BUILD "/femdem_biaxial --nx 1 --ny 1 --steps 1 --packing examples/data/rve400.txt,nosuch.txt "
+                 "--out " BUILD "/tests/t_fhx > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "nosuch.txt"));
+    CHECK(system(BUILD "/femdem_biaxial --packing-seed -3 > " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(
-        gk_test_file_has("build/tests/t_bad.out", "--packing-seed '-3' is not a non-negative whole number"));
+        gk_test_file_has(BUILD "/tests/t_bad.out", "--packing-seed '-3' is not a non-negative whole number"));
 }
 
 /* lines of a file containing needle */
@@ -873,7 +873,7 @@ static int count_has(const char *path, const char *needle) {
 /* every failed write of a result is an error exit, said once: the CSV, a VTK file, the checkpoint (a
  * directory stands where the file would go), and --out naming an existing file */
 TEST(femdem_failed_writes_are_errors) {
-    const char *base = "build/femdem_biaxial --nx 1 --ny 1 --element q4 --steps 1 --threads 2";
+    const char *base = BUILD "/femdem_biaxial --nx 1 --ny 1 --element q4 --steps 1 --threads 2";
     char cmd[512];
     int k;
     static const char *what[3][2] = {{"biaxial.csv", "--vtk-every 0"},
@@ -881,34 +881,34 @@ TEST(femdem_failed_writes_are_errors) {
                                      {"checkpoint.bin", "--vtk-every 0"}};
     for (k = 0; k < 3; ++k) {
         char want[128];
-        snprintf(cmd, sizeof cmd, "rm -rf build/tests/t_fw && mkdir -p build/tests/t_fw/%s", what[k][0]);
+        snprintf(cmd, sizeof cmd, "rm -rf " BUILD "/tests/t_fw && mkdir -p " BUILD "/tests/t_fw/%s", what[k][0]);
         CHECK(system(cmd) == 0);
-        snprintf(cmd, sizeof cmd, "%s %s --out build/tests/t_fw > build/tests/t_fw.out 2>&1", base,
+        snprintf(cmd, sizeof cmd, "%s %s --out " BUILD "/tests/t_fw > " BUILD "/tests/t_fw.out 2>&1", base,
                  what[k][1]);
         CHECK(system(cmd) != 0);
-        snprintf(want, sizeof want, "cannot write build/tests/t_fw/%s", what[k][0]);
-        CHECK_EQ_INT(count_has("build/tests/t_fw.out", want), 1);
-        CHECK(!gk_test_file_has("build/tests/t_fw.out", "RESULT "));
+        snprintf(want, sizeof want, "cannot write " BUILD "/tests/t_fw/%s", what[k][0]);
+        CHECK_EQ_INT(count_has(BUILD "/tests/t_fw.out", want), 1);
+        CHECK(!gk_test_file_has(BUILD "/tests/t_fw.out", "RESULT "));
     }
-    CHECK(system("rm -rf build/tests/t_fw && touch build/tests/t_fw") == 0);
-    snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fw > build/tests/t_fw.out 2>&1", base);
+    CHECK(system("rm -rf " BUILD "/tests/t_fw && touch " BUILD "/tests/t_fw") == 0);
+    snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fw > " BUILD "/tests/t_fw.out 2>&1", base);
     CHECK(system(cmd) != 0);
-    CHECK_EQ_INT(count_has("build/tests/t_fw.out", "--out build/tests/t_fw: cannot create that directory"),
+    CHECK_EQ_INT(count_has(BUILD "/tests/t_fw.out", "--out " BUILD "/tests/t_fw: cannot create that directory"),
                  1);
-    remove("build/tests/t_fw");
+    remove(BUILD "/tests/t_fw");
 }
 
 /* --cost-log: one line per RVE run, "STEP SCALE W_0 .. W_7" for the 8 Gauss points of 1 x 2 Q4,
  * as many lines per step as the step's Newton iterations (biaxial.csv; no cut-back at this size);
  * a failed write is status 1 */
 TEST(femdem_cost_log_has_every_run) {
-    const char *base = "build/femdem_biaxial --nx 1 --ny 2 --element q4 --steps 2 --threads 1 --vtk-every 0";
+    const char *base = BUILD "/femdem_biaxial --nx 1 --ny 2 --element q4 --steps 2 --threads 1 --vtk-every 0";
     char cmd[512], line[1024];
     FILE *fp;
     int lines = 0, good = 0, iters = 0, row = 0;
-    snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fcl --cost-log build/tests/t_fcl.log > build/tests/t_fcl.out 2>&1", base);
+    snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fcl --cost-log " BUILD "/tests/t_fcl.log > " BUILD "/tests/t_fcl.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    fp = fopen("build/tests/t_fcl.log", "r");
+    fp = fopen(BUILD "/tests/t_fcl.log", "r");
     while (fp && fgets(line, sizeof line, fp)) {
         int step, w[9], n;
         double scale;
@@ -918,7 +918,7 @@ TEST(femdem_cost_log_has_every_run) {
         good += n == 10 && step >= 1 && step <= 2 && (lines > 1 || step == 1) && scale == 1.0 && w[0] > 0;
     }
     if (fp) fclose(fp);
-    fp = fopen("build/tests/t_fcl/biaxial.csv", "r");
+    fp = fopen(BUILD "/tests/t_fcl/biaxial.csv", "r");
     while (fp && fgets(line, sizeof line, fp)) { /* column 6: iterations */
         char *c = line;
         int k;
@@ -928,9 +928,9 @@ TEST(femdem_cost_log_has_every_run) {
     if (fp) fclose(fp);
     CHECK(lines > 2 && good == lines);
     CHECK_EQ_INT(lines, iters);
-    snprintf(cmd, sizeof cmd, "%s --out build/tests/t_fcl --cost-log /dev/full > build/tests/t_fcl.out 2>&1", base);
+    snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fcl --cost-log /dev/full > " BUILD "/tests/t_fcl.out 2>&1", base);
     CHECK(system(cmd) != 0);
-    CHECK(gk_test_file_has("build/tests/t_fcl.out", "cannot write /dev/full"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fcl.out", "cannot write /dev/full"));
 }
 
 int main(int argc, char **argv) {

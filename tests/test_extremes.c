@@ -1299,7 +1299,7 @@ static int text_has(const char *path, const char *needle) {
 }
 
 TEST(newton_divergence_is_cut_back) {
-    const char *exe = "build/femdem_biaxial";
+    const char *exe = BUILD "/femdem_biaxial";
     const char *base = "--nx 1 --ny 1 --element q4 --steps 1 --threads 1 --vtk-every 0";
     char cmd[1024];
     int st, rows;
@@ -1313,13 +1313,13 @@ TEST(newton_divergence_is_cut_back) {
     fclose(fp);
     /* (a) cut back, then converge */
     snprintf(cmd, sizeof cmd,
-             "%s %s --increment 0.099 --max-iter 6 --dem-max 50 --out build/tests/t_ext_cutA > "
-             "build/tests/t_ext_cutA.out 2>&1",
+             "%s %s --increment 0.099 --max-iter 6 --dem-max 50 --out " BUILD "/tests/t_ext_cutA > "
+             BUILD "/tests/t_ext_cutA.out 2>&1",
              exe, base);
     st = system(cmd);
     CHECK(st != -1 && WIFEXITED(st) && WEXITSTATUS(st) == 0);
-    CHECK(text_has("build/tests/t_ext_cutA.out", "increment cut to"));
-    CHECK(csv_all_finite("build/tests/t_ext_cutA/biaxial.csv", &rows, &last, &minc));
+    CHECK(text_has(BUILD "/tests/t_ext_cutA.out", "increment cut to"));
+    CHECK(csv_all_finite(BUILD "/tests/t_ext_cutA/biaxial.csv", &rows, &last, &minc));
     printf(
         "    (a) 9.9 %% in one step, 6 iterations: exit %d, %d rows, reached %.4f, smallest increment %.4f\n",
         WIFEXITED(st) ? WEXITSTATUS(st) : -1, rows, last, minc);
@@ -1327,18 +1327,18 @@ TEST(newton_divergence_is_cut_back) {
     CHECK(minc < 0.099 && rows > 2);
     /* (b) cut back to 1/16, then stop cleanly */
     snprintf(cmd, sizeof cmd,
-             "%s %s --increment 0.09 --max-iter 2 --dem-max 500 --out build/tests/t_ext_cutB > "
-             "build/tests/t_ext_cutB.out 2>&1",
+             "%s %s --increment 0.09 --max-iter 2 --dem-max 500 --out " BUILD "/tests/t_ext_cutB > "
+             BUILD "/tests/t_ext_cutB.out 2>&1",
              exe, base);
     st = system(cmd);
     CHECK(st != -1 && WIFEXITED(st) && WEXITSTATUS(st) == 3);
-    CHECK(text_has("build/tests/t_ext_cutB.out", "increment cut to"));
-    CHECK(text_has("build/tests/t_ext_cutB.out", "giving up"));
-    CHECK(text_has("build/tests/t_ext_cutB.out", "checkpoint.bin"));
-    fp = fopen("build/tests/t_ext_cutB/checkpoint.bin", "rb");
+    CHECK(text_has(BUILD "/tests/t_ext_cutB.out", "increment cut to"));
+    CHECK(text_has(BUILD "/tests/t_ext_cutB.out", "giving up"));
+    CHECK(text_has(BUILD "/tests/t_ext_cutB.out", "checkpoint.bin"));
+    fp = fopen(BUILD "/tests/t_ext_cutB/checkpoint.bin", "rb");
     CHECK(fp != NULL);
     if (fp) fclose(fp);
-    CHECK(csv_all_finite("build/tests/t_ext_cutB/biaxial.csv", &rows, &last, &minc));
+    CHECK(csv_all_finite(BUILD "/tests/t_ext_cutB/biaxial.csv", &rows, &last, &minc));
     printf("    (b) 9 %% in one step, 2 iterations: exit %d, %d rows, reached %.4f\n",
            WIFEXITED(st) ? WEXITSTATUS(st) : -1, rows, last);
     CHECK(last < 0.09);

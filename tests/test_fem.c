@@ -520,19 +520,19 @@ TEST(gmsh_v2_and_v4_read) {
     gk_mesh a, b;
     gk_err err;
     int k;
-    CHECK(write_text("build/tests/test_fem_v2.msh", v2) && write_text("build/tests/test_fem_v4.msh", v4) &&
-          write_text("build/tests/test_fem_bad.msh", bad));
-    CHECK(gk_mesh_read_gmsh("build/tests/test_fem_v2.msh", &a, NULL, &err) == GK_OK);
-    CHECK(gk_mesh_read_gmsh("build/tests/test_fem_v4.msh", &b, NULL, &err) == GK_OK);
+    CHECK(write_text(BUILD "/tests/test_fem_v2.msh", v2) && write_text(BUILD "/tests/test_fem_v4.msh", v4) &&
+          write_text(BUILD "/tests/test_fem_bad.msh", bad));
+    CHECK(gk_mesh_read_gmsh(BUILD "/tests/test_fem_v2.msh", &a, NULL, &err) == GK_OK);
+    CHECK(gk_mesh_read_gmsh(BUILD "/tests/test_fem_v4.msh", &b, NULL, &err) == GK_OK);
     CHECK(a.type == GK_Q4 && a.nelem == 2 && a.nnode == 6 && a.tag[0] == 7);
     CHECK(b.type == GK_Q4 && b.nelem == 2 && b.nnode == 6 && b.tag[1] == 1);
     for (k = 0; k < 12; ++k) CHECK(a.x[k] == b.x[k]);
     for (k = 0; k < 8; ++k) CHECK(a.conn[k] == b.conn[k]);
     CHECK_NEAR(a.x[2 * a.conn[6]], 2.0, 0);
     gk_mesh_free(&a), gk_mesh_free(&b);
-    CHECK(gk_mesh_read_gmsh("build/tests/test_fem_bad.msh", &a, NULL, &err) == GK_ERR_FORMAT);
+    CHECK(gk_mesh_read_gmsh(BUILD "/tests/test_fem_bad.msh", &a, NULL, &err) == GK_ERR_FORMAT);
     printf("    bad file: %s\n", err.msg);
-    CHECK(gk_mesh_read_gmsh("build/tests/does_not_exist.msh", &a, NULL, &err) == GK_ERR_IO);
+    CHECK(gk_mesh_read_gmsh(BUILD "/tests/does_not_exist.msh", &a, NULL, &err) == GK_ERR_IO);
 }
 
 /* bad meshes and systems give clear errors and change nothing */

@@ -10,7 +10,7 @@
 #include "gk_test.h"
 #include <stdlib.h>
 
-#define FDR "build/femdem_dr "
+#define FDR BUILD "/femdem_dr "
 #define MAXR 64
 
 /* the numeric rows of dr.csv (12 columns); -1 if the header is not the documented one */
@@ -59,13 +59,13 @@ TEST(isotropic_stage_and_one_element_against_the_rve) {
     static double a[MAXR][12], b[MAXR][12];
     int na, nb, i;
     double peak = 0.0, dmax = 0.0;
-    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.02 --out build/tests/t_fdr_rve > "
-                     "build/tests/t_fdr_rve.out "
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.02 --out " BUILD "/tests/t_fdr_rve > "
+                     BUILD "/tests/t_fdr_rve.out "
                      "2>&1") == 0);
-    CHECK(system(FDR "--nx 1 --ny 1 --frame periodic --steps 4 --strain 0.02 --out build/tests/t_fdr_11 "
-                     "> build/tests/t_fdr_11.out 2>&1") == 0);
-    na = rows("build/tests/t_fdr_rve/dr.csv", a);
-    nb = rows("build/tests/t_fdr_11/dr.csv", b);
+    CHECK(system(FDR "--nx 1 --ny 1 --frame periodic --steps 4 --strain 0.02 --out " BUILD "/tests/t_fdr_11 "
+                     "> " BUILD "/tests/t_fdr_11.out 2>&1") == 0);
+    na = rows(BUILD "/tests/t_fdr_rve/dr.csv", a);
+    nb = rows(BUILD "/tests/t_fdr_11/dr.csv", b);
     CHECK_EQ_INT(na, 15);
     CHECK_EQ_INT(nb, 15);
     if (na != 15 || nb != 15) return;
@@ -84,12 +84,12 @@ TEST(isotropic_stage_and_one_element_against_the_rve) {
            b[14][3], 100.0 * dmax / peak);
     CHECK(peak > 0.2);
     CHECK(dmax <= 0.02 * peak);
-    CHECK_NEAR(gk_test_result("build/tests/t_fdr_11.out", "peak_sigma_bar"), peak, 0.02 * peak); /* RESULT */
-    CHECK(gk_test_file_has("build/tests/t_fdr_11.out", "dr_iterations_mean="));
-    CHECK(gk_test_file_has("build/tests/t_fdr_11/mesh_0014.vtk", "displacement"));
-    CHECK(gk_test_file_has("build/tests/t_fdr_11/gp_0014.vtk", "anisotropy"));
-    CHECK(gk_test_file_has("build/tests/t_fdr_11/dr_stress.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_fdr_11/deq_field.svg", "deq"));
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_fdr_11.out", "peak_sigma_bar"), peak, 0.02 * peak); /* RESULT */
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_11.out", "dr_iterations_mean="));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_11/mesh_0014.vtk", "displacement"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_11/gp_0014.vtk", "anisotropy"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_11/dr_stress.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_11/deq_field.svg", "deq"));
 }
 
 /* Liu, Bosco & Suiker 2018 Figs 10-11: with particle rotation locked (theta_p = 0) the RVE is stronger:
@@ -97,21 +97,21 @@ TEST(isotropic_stage_and_one_element_against_the_rve) {
 TEST(locked_rotation_is_stronger) {
     static double f[MAXR][12], l[MAXR][12];
     int nf, nl;
-    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --out build/tests/t_fdr_free > "
-                     "build/tests/t_fdr_free.out "
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --out " BUILD "/tests/t_fdr_free > "
+                     BUILD "/tests/t_fdr_free.out "
                      "2>&1") == 0);
     CHECK(
         system(
             FDR
-            "--test rve --frame periodic --steps 4 --strain 0.04 --no-rotation --out build/tests/t_fdr_lock "
-            "> build/tests/t_fdr_lock.out 2>&1") == 0);
-    nf = rows("build/tests/t_fdr_free/dr.csv", f);
-    nl = rows("build/tests/t_fdr_lock/dr.csv", l);
+            "--test rve --frame periodic --steps 4 --strain 0.04 --no-rotation --out " BUILD "/tests/t_fdr_lock "
+            "> " BUILD "/tests/t_fdr_lock.out 2>&1") == 0);
+    nf = rows(BUILD "/tests/t_fdr_free/dr.csv", f);
+    nl = rows(BUILD "/tests/t_fdr_lock/dr.csv", l);
     CHECK(nf == 15 && nl == 15);
     if (nf != 15 || nl != 15) return;
     printf("    sigma_bar at 4 %%: free %.4f, locked %.4f\n", f[14][3], l[14][3]);
     CHECK(l[14][3] > f[14][3] * 1.05);
-    CHECK(gk_test_file_has("build/tests/t_fdr_lock.out", "rotation=locked"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_lock.out", "rotation=locked"));
 }
 
 /* the servo frame (the paper's RVE) on a 1 x 2 mesh: 2 threads and 1 thread give the same rows bit for
@@ -120,24 +120,24 @@ TEST(threads_and_restart_give_the_same_rows) {
     const char *base = FDR "--nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 ";
     char cmd[1024];
     snprintf(cmd, sizeof cmd,
-             "%s --steps 2 --threads 2 --out build/tests/t_fdrA > build/tests/t_fdrA.out 2>&1", base);
+             "%s --steps 2 --threads 2 --out " BUILD "/tests/t_fdrA > " BUILD "/tests/t_fdrA.out 2>&1", base);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s --steps 2 --threads 1 --out build/tests/t_fdr1 > build/tests/t_fdr1.out 2>&1", base);
+             "%s --steps 2 --threads 1 --out " BUILD "/tests/t_fdr1 > " BUILD "/tests/t_fdr1.out 2>&1", base);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s --steps 2 --threads 2 --stop-after 2 --out build/tests/t_fdrB > build/tests/t_fdrB.out 2>&1",
+             "%s --steps 2 --threads 2 --stop-after 2 --out " BUILD "/tests/t_fdrB > " BUILD "/tests/t_fdrB.out 2>&1",
              base);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s --steps 2 --threads 2 --restart build/tests/t_fdrB --out build/tests/t_fdrC "
-             "> build/tests/t_fdrC.out 2>&1",
+             "%s --steps 2 --threads 2 --restart " BUILD "/tests/t_fdrB --out " BUILD "/tests/t_fdrC "
+             "> " BUILD "/tests/t_fdrC.out 2>&1",
              base);
     CHECK(system(cmd) == 0);
-    CHECK(same_rows("build/tests/t_fdrA/dr.csv", "build/tests/t_fdr1/dr.csv"));
-    CHECK(gk_test_file_has("build/tests/t_fdrA.out", "frame=servo"));
-    CHECK(gk_test_file_has("build/tests/t_fdrC.out", "restarted from"));
-    CHECK(same_rows("build/tests/t_fdrA/dr.csv", "build/tests/t_fdrC/dr.csv"));
+    CHECK(same_rows(BUILD "/tests/t_fdrA/dr.csv", BUILD "/tests/t_fdr1/dr.csv"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdrA.out", "frame=servo"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdrC.out", "restarted from"));
+    CHECK(same_rows(BUILD "/tests/t_fdrA/dr.csv", BUILD "/tests/t_fdrC/dr.csv"));
 }
 
 /* the DNS: the packing tiled 1 x 2 (444 disks) between platens and membranes; the isotropic stage
@@ -145,17 +145,17 @@ TEST(threads_and_restart_give_the_same_rows) {
 TEST(dns_runs) {
     static double r[MAXR][12];
     int n;
-    CHECK(system(FDR "--test dns --iso-steps 2 --steps 1 --strain 0.01 --out build/tests/t_fdr_dns > "
-                     "build/tests/t_fdr_dns.out "
+    CHECK(system(FDR "--test dns --iso-steps 2 --steps 1 --strain 0.01 --out " BUILD "/tests/t_fdr_dns > "
+                     BUILD "/tests/t_fdr_dns.out "
                      "2>&1") == 0);
-    n = rows("build/tests/t_fdr_dns/dr.csv", r);
+    n = rows(BUILD "/tests/t_fdr_dns/dr.csv", r);
     CHECK_EQ_INT(n, 4);
     if (n != 4) return;
     CHECK_REL(r[2][4], 1.5e5, 1e-9); /* the membranes' pressure */
     CHECK_REL(r[2][5], 1.5e5, 0.02); /* the platen's */
     CHECK(r[3][3] > 0.05);
-    CHECK(gk_test_file_has("build/tests/t_fdr_dns.out", "444 disks"));
-    CHECK(gk_test_file_has("build/tests/t_fdr_dns/dns_0003.vtk", "POINTS"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_dns.out", "444 disks"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_dns/dns_0003.vtk", "POINTS"));
 }
 
 /* the sizes: the reduced default is the 1 x 2 mesh (8 Gauss points); --paper is the paper's 2 x 4 mesh,
@@ -163,50 +163,50 @@ TEST(dns_runs) {
 TEST(default_and_paper_sizes) {
     const char *cut = "--frame periodic --iso-steps 1 --steps 1 --strain 0.001 --stop-after 1 --vtk-every 0";
     char cmd[512];
-    snprintf(cmd, sizeof cmd, FDR "%s --out build/tests/t_fdr_def > build/tests/t_fdr_def.out 2>&1", cut);
+    snprintf(cmd, sizeof cmd, FDR "%s --out " BUILD "/tests/t_fdr_def > " BUILD "/tests/t_fdr_def.out 2>&1", cut);
     CHECK(system(cmd) == 0);
-    CHECK(gk_test_file_has("build/tests/t_fdr_def.out", " 8 Gauss points"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_def.out", " 8 Gauss points"));
     snprintf(cmd, sizeof cmd,
-             FDR "--ny 2 --paper %s --out build/tests/t_fdr_pap > build/tests/t_fdr_pap.out 2>&1", cut);
+             FDR "--ny 2 --paper %s --out " BUILD "/tests/t_fdr_pap > " BUILD "/tests/t_fdr_pap.out 2>&1", cut);
     CHECK(system(cmd) == 0);
-    CHECK(gk_test_file_has("build/tests/t_fdr_pap.out", " 16 Gauss points"));
-    CHECK(gk_test_file_has("build/tests/t_fdr_pap.out", "stopped after step 1"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_pap.out", " 16 Gauss points"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_pap.out", "stopped after step 1"));
 }
 
 /* bad input: a message naming the option and status 2; an output that cannot be written: status 1 */
 TEST(bad_input_and_failed_writes) {
-    CHECK(system(FDR "--nx 2x --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--nx '2x' is not a whole number"));
-    CHECK(system(FDR "--frame square --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--frame 'square' must be servo or periodic"));
-    CHECK(system(FDR "--pressure -1 --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--pressure -1 must be > 0"));
-    CHECK(system(FDR "--strain nan --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--strain 'nan' is not a finite number"));
-    CHECK(system(FDR "--material clay --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--material 'clay' must be paper or guo-zhao"));
-    CHECK(system(FDR "--material guo-zhao --out build/tests/t_fdr_bad > build/tests/t_bad.out 2>&1") ==
+    CHECK(system(FDR "--nx 2x --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--nx '2x' is not a whole number"));
+    CHECK(system(FDR "--frame square --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--frame 'square' must be servo or periodic"));
+    CHECK(system(FDR "--pressure -1 --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--pressure -1 must be > 0"));
+    CHECK(system(FDR "--strain nan --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--strain 'nan' is not a finite number"));
+    CHECK(system(FDR "--material clay --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--material 'clay' must be paper or guo-zhao"));
+    CHECK(system(FDR "--material guo-zhao --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
           2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out",
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out",
                            "needs --frame periodic")); /* the servo's gains are per k_n */
-    CHECK(system(FDR "--bogus 1 > build/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "unknown option --bogus"));
-    CHECK(system(FDR "--test rve > build/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--out DIR is required"));
-    CHECK(system(FDR "--test rve --packing examples/data/rve400.txt --out build/tests/t_fdr_bad > "
-                     "build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "corner"));
-    CHECK(system(FDR "--test rve --restart build/tests/no_such_dir --out build/tests/t_fdr_bad > "
-                     "build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "no_such_dir"));
+    CHECK(system(FDR "--bogus 1 > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "unknown option --bogus"));
+    CHECK(system(FDR "--test rve > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--out DIR is required"));
+    CHECK(system(FDR "--test rve --packing examples/data/rve400.txt --out " BUILD "/tests/t_fdr_bad > "
+                     BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "corner"));
+    CHECK(system(FDR "--test rve --restart " BUILD "/tests/no_such_dir --out " BUILD "/tests/t_fdr_bad > "
+                     BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "no_such_dir"));
     /* --out names a file: the directory exists as a file, nothing can be written in it */
-    CHECK(system("touch build/tests/t_fdr_file") == 0);
-    CHECK(system(FDR "--test rve --frame periodic --iso-steps 1 --steps 1 --out build/tests/t_fdr_file > "
-                     "build/tests/t_bad.out "
+    CHECK(system("touch " BUILD "/tests/t_fdr_file") == 0);
+    CHECK(system(FDR "--test rve --frame periodic --iso-steps 1 --steps 1 --out " BUILD "/tests/t_fdr_file > "
+                     BUILD "/tests/t_bad.out "
                      "2>&1") == 1 * 256);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "cannot write"));
-    CHECK(system(FDR "--help > build/tests/t_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--frame servo|periodic"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "cannot write"));
+    CHECK(system(FDR "--help > " BUILD "/tests/t_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--frame servo|periodic"));
 }
 
 int main(int argc, char **argv) {

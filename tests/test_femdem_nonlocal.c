@@ -99,29 +99,29 @@ TEST(adaptive_rule_on_eq57) {
 static void threads_and_restart(const char *args, const char *tag, const char *csv, int stop) {
     char cmd[2048], a[256], b[256];
     snprintf(cmd, sizeof cmd,
-             "build/femdem_nonlocal %s --threads 2 --out build/tests/%sA > build/tests/%sA.out 2>&1", args,
+             BUILD "/femdem_nonlocal %s --threads 2 --out " BUILD "/tests/%sA > " BUILD "/tests/%sA.out 2>&1", args,
              tag, tag);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "build/femdem_nonlocal %s --threads 1 --out build/tests/%s1 > build/tests/%s1.out 2>&1", args,
+             BUILD "/femdem_nonlocal %s --threads 1 --out " BUILD "/tests/%s1 > " BUILD "/tests/%s1.out 2>&1", args,
              tag, tag);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "build/femdem_nonlocal %s --threads 2 --stop-after %d --out build/tests/%sB > "
-             "build/tests/%sB.out 2>&1",
+             BUILD "/femdem_nonlocal %s --threads 2 --stop-after %d --out " BUILD "/tests/%sB > "
+             BUILD "/tests/%sB.out 2>&1",
              args, stop, tag, tag);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "build/femdem_nonlocal %s --threads 2 --restart build/tests/%sB --out build/tests/%sB > "
-             "build/tests/%sB2.out 2>&1",
+             BUILD "/femdem_nonlocal %s --threads 2 --restart " BUILD "/tests/%sB --out " BUILD "/tests/%sB > "
+             BUILD "/tests/%sB2.out 2>&1",
              args, tag, tag, tag);
     CHECK(system(cmd) == 0);
-    snprintf(a, sizeof a, "build/tests/%sA/%s", tag, csv);
-    snprintf(b, sizeof b, "build/tests/%s1/%s", tag, csv);
+    snprintf(a, sizeof a, BUILD "/tests/%sA/%s", tag, csv);
+    snprintf(b, sizeof b, BUILD "/tests/%s1/%s", tag, csv);
     CHECK(gk_test_csv_same(a, b, 14, 3));
-    snprintf(b, sizeof b, "build/tests/%sB/%s", tag, csv);
+    snprintf(b, sizeof b, BUILD "/tests/%sB/%s", tag, csv);
     CHECK(gk_test_csv_same(a, b, 14, 3));
-    snprintf(b, sizeof b, "build/tests/%sB2.out", tag);
+    snprintf(b, sizeof b, BUILD "/tests/%sB2.out", tag);
     CHECK(gk_test_file_has(b, "restarted from"));
 }
 
@@ -134,21 +134,21 @@ TEST(element_shear_runs_threads_restart) {
     double K, G;
     threads_and_restart(args, "t_fnle", "element-shear.csv", 17);
     CHECK(gk_test_file_has(
-        "build/tests/t_fnleA/element-shear.csv",
+        BUILD "/tests/t_fnleA/element-shear.csv",
         "step,time,strain,stress,stress_2,p,q,porosity,Z,u_probe,dem_steps_mean,dem_steps_max,"
         "dem_capped,kinetic,seconds"));
-    K = gk_test_result("build/tests/t_fnleA.out", "K_MPa"),
-    G = gk_test_result("build/tests/t_fnleA.out", "G_MPa");
+    K = gk_test_result(BUILD "/tests/t_fnleA.out", "K_MPa"),
+    G = gk_test_result(BUILD "/tests/t_fnleA.out", "G_MPa");
     CHECK(K > 100 && K < 1000 && G > 100 && G < 1000); /* Table II scale: 335, 241 MPa */
-    CHECK_NEAR(gk_test_result("build/tests/t_fnleA.out", "porosity0"), 0.3496,
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnleA.out", "porosity0"), 0.3496,
                1e-3); /* the packing's comment */
-    CHECK(gk_test_result("build/tests/t_fnleA.out", "peak_stress") > 0);
-    CHECK(isfinite(gk_test_result("build/tests/t_fnleA.out", "rve_alone_dev_pct")));
-    CHECK(gk_test_file_has("build/tests/t_fnleA/mesh_000040.vtk", "SCALARS particle_rotation"));
-    CHECK(gk_test_file_has("build/tests/t_fnleA/mesh_000040.vtk", "SCALARS porosity"));
-    CHECK(gk_test_file_has("build/tests/t_fnleA/mesh_000040.vtk", "SCALARS coordination"));
-    CHECK(gk_test_file_has("build/tests/t_fnleA/element-shear_curve.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_fnleA/rve_alone.csv", "strain,stress,stress_2"));
+    CHECK(gk_test_result(BUILD "/tests/t_fnleA.out", "peak_stress") > 0);
+    CHECK(isfinite(gk_test_result(BUILD "/tests/t_fnleA.out", "rve_alone_dev_pct")));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnleA/mesh_000040.vtk", "SCALARS particle_rotation"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnleA/mesh_000040.vtk", "SCALARS porosity"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnleA/mesh_000040.vtk", "SCALARS coordination"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnleA/element-shear_curve.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnleA/rve_alone.csv", "strain,stress,stress_2"));
 }
 
 /* a small periodic simple shear with the nonlocal operator on (every
@@ -157,10 +157,10 @@ TEST(simple_shear_nonlocal_threads_restart) {
     const char *args =
         "--test simple-shear --packing " PK160 " --mesh 2x3x1 --nonlocal 0.05 --steps 16 --strain 0.002";
     threads_and_restart(args, "t_fnls", "simple-shear.csv", 7);
-    CHECK(gk_test_file_has("build/tests/t_fnlsA.out", "imperfect RVE: 1 particles removed"));
-    CHECK(gk_test_file_has("build/tests/t_fnlsA.out", "nonlocal on"));
-    CHECK(gk_test_file_has("build/tests/t_fnlsA.out", " band_width_mm=")); /* nan here: no peak yet */
-    CHECK(gk_test_file_has("build/tests/t_fnlsA/profile.csv", "row,y_mm"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlsA.out", "imperfect RVE: 1 particles removed"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlsA.out", "nonlocal on"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlsA.out", " band_width_mm=")); /* nan here: no peak yet */
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlsA/profile.csv", "row,y_mm"));
 }
 
 /* --test rve (Table II of Liu, Sun, Yuan & Fish 2016): the 160-sphere
@@ -174,13 +174,13 @@ TEST(rve_table2_moduli) {
     FILE *fp;
     char line[1024];
     int rows = 0;
-    CHECK(system("build/femdem_nonlocal --test rve --packing " PK160
-                 " --out build/tests/t_fnlr > build/tests/t_fnlr.out 2>&1") == 0);
-    CHECK_NEAR(gk_test_result("build/tests/t_fnlr.out", "K_MPa"), 335.0, 33.5);
-    CHECK_NEAR(gk_test_result("build/tests/t_fnlr.out", "porosity0"), 0.3496,
+    CHECK(system(BUILD "/femdem_nonlocal --test rve --packing " PK160
+                 " --out " BUILD "/tests/t_fnlr > " BUILD "/tests/t_fnlr.out 2>&1") == 0);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlr.out", "K_MPa"), 335.0, 33.5);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlr.out", "porosity0"), 0.3496,
                1e-4); /* the packing's comment */
-    CHECK_NEAR(gk_test_result("build/tests/t_fnlr.out", "Z0"), 5.35, 0.01);
-    fp = fopen("build/tests/t_fnlr/rve.csv", "r");
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlr.out", "Z0"), 5.35, 0.01);
+    fp = fopen(BUILD "/tests/t_fnlr/rve.csv", "r");
     CHECK(fp != NULL);
     if (!fp) return;
     while (fgets(line, sizeof line, fp)) { /* eps_v,p,K_MPa,gamma,tau,G_MPa,... */
@@ -202,12 +202,12 @@ TEST(rve_table2_moduli) {
  * 625.6 m/s, 2.6 %), and reaches each element in order */
 TEST(wave_front_matches_elastic_column) {
     double c, ce;
-    CHECK(system("build/femdem_nonlocal --test wave --packing " PK160
-                 " --duration 1e-4 --out build/tests/t_fnlw2 > build/tests/t_fnlw2.out 2>&1") == 0);
-    c = gk_test_result("build/tests/t_fnlw2.out", "wave_speed_ms");
-    ce = gk_test_result("build/tests/t_fnlw2.out", "wave_speed_elastic_ms");
+    CHECK(system(BUILD "/femdem_nonlocal --test wave --packing " PK160
+                 " --duration 1e-4 --out " BUILD "/tests/t_fnlw2 > " BUILD "/tests/t_fnlw2.out 2>&1") == 0);
+    c = gk_test_result(BUILD "/tests/t_fnlw2.out", "wave_speed_ms");
+    ce = gk_test_result(BUILD "/tests/t_fnlw2.out", "wave_speed_elastic_ms");
     CHECK(fabs(c - ce) < 0.05 * ce);
-    CHECK(gk_test_file_has("build/tests/t_fnlw2/wave_arrival.csv",
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlw2/wave_arrival.csv",
                            "element,distance_mm,arrival_us,arrival_elastic_us,arrival_sqrtGrho_us"));
 }
 
@@ -218,26 +218,26 @@ TEST(wave_front_matches_elastic_column) {
 TEST(biaxial_local_and_nonlocal_prepeak) {
     double sl, sn;
     const char *a =
-        "build/femdem_nonlocal --test biaxial --packing " PK160 " --mesh 2x4x1 --steps 60 --strain 0.003";
+        BUILD "/femdem_nonlocal --test biaxial --packing " PK160 " --mesh 2x4x1 --steps 60 --strain 0.003";
     char cmd[512];
-    snprintf(cmd, sizeof cmd, "%s --nonlocal off --out build/tests/t_fnlbl > build/tests/t_fnlbl.out 2>&1",
+    snprintf(cmd, sizeof cmd, "%s --nonlocal off --out " BUILD "/tests/t_fnlbl > " BUILD "/tests/t_fnlbl.out 2>&1",
              a);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --nonlocal 0.025 --out build/tests/t_fnlbn > build/tests/t_fnlbn.out 2>&1",
+    snprintf(cmd, sizeof cmd, "%s --nonlocal 0.025 --out " BUILD "/tests/t_fnlbn > " BUILD "/tests/t_fnlbn.out 2>&1",
              a);
     CHECK(system(cmd) == 0);
-    sl = gk_test_result("build/tests/t_fnlbl.out", "peak_stress");
-    sn = gk_test_result("build/tests/t_fnlbn.out", "peak_stress");
+    sl = gk_test_result(BUILD "/tests/t_fnlbl.out", "peak_stress");
+    sn = gk_test_result(BUILD "/tests/t_fnlbn.out", "peak_stress");
     printf("    axial stress at 0.3 %%: local %.6g, nonlocal %.6g Pa\n", sl, sn);
     CHECK(sl > 1e6 && sn > 1e6);
     CHECK(fabs(sl - sn) < 0.02 * sl && sl != sn);
-    CHECK(gk_test_file_has("build/tests/t_fnlbn.out", "nonlocal on (R 0.025 m, 28 neighbour pairs)"));
-    CHECK(gk_test_file_has("build/tests/t_fnlbl.out", "within 10-20 steps"));
-    snprintf(cmd, sizeof cmd, "%s --steps 2 --paper --out build/tests/t_fnlbp > build/tests/t_fnlbp.out 2>&1",
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlbn.out", "nonlocal on (R 0.025 m, 28 neighbour pairs)"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlbl.out", "within 10-20 steps"));
+    snprintf(cmd, sizeof cmd, "%s --steps 2 --paper --out " BUILD "/tests/t_fnlbp > " BUILD "/tests/t_fnlbp.out 2>&1",
              a);
     CHECK(system(cmd) == 0);
-    CHECK(gk_test_file_has("build/tests/t_fnlbp.out", "within 10-4000 steps"));
-    CHECK(gk_test_file_has("build/tests/t_fnlbp.out", "RVE (160 spheres)")); /* --packing overrides --paper */
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlbp.out", "within 10-4000 steps"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlbp.out", "RVE (160 spheres)")); /* --packing overrides --paper */
 }
 
 /* every flag is parsed strictly and named when refused; a restart from
@@ -260,35 +260,35 @@ TEST(bad_input_is_refused) {
     size_t k;
     for (k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
         snprintf(cmd, sizeof cmd,
-                 "build/femdem_nonlocal %s%s --out build/tests/t_fnlbad > build/tests/t_bad.out 2>&1",
+                 BUILD "/femdem_nonlocal %s%s --out " BUILD "/tests/t_fnlbad > " BUILD "/tests/t_bad.out 2>&1",
                  bad[k][0], strstr(bad[k][0], "--packing") ? "" : " --packing " PK160);
         CHECK(system(cmd) != 0);
-        if (!gk_test_file_has("build/tests/t_bad.out", bad[k][1]))
+        if (!gk_test_file_has(BUILD "/tests/t_bad.out", bad[k][1]))
             printf("    missing message: %s\n", bad[k][1]);
-        CHECK(gk_test_file_has("build/tests/t_bad.out", bad[k][1]));
+        CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", bad[k][1]));
     }
-    CHECK(system("build/femdem_nonlocal --help > build/tests/t_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--nonlocal"));
+    CHECK(system(BUILD "/femdem_nonlocal --help > " BUILD "/tests/t_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--nonlocal"));
     /* a checkpoint of another run (other strain) is refused by name */
-    CHECK(system("build/femdem_nonlocal --test element-shear --packing " PK160
-                 " --steps 40 --strain 0.005 --restart build/tests/t_fnleB --out build/tests/t_fnlbad > "
-                 "build/tests/t_bad.out "
+    CHECK(system(BUILD "/femdem_nonlocal --test element-shear --packing " PK160
+                 " --steps 40 --strain 0.005 --restart " BUILD "/tests/t_fnleB --out " BUILD "/tests/t_fnlbad > "
+                 BUILD "/tests/t_bad.out "
                  "2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "was written by another run"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "was written by another run"));
     /* a result that cannot be written: its path is taken by a directory */
-    CHECK(system("mkdir -p build/tests/t_fnlw/element-shear.csv") == 0);
-    CHECK(system("build/femdem_nonlocal --test element-shear --packing " PK160
-                 " --steps 4 --strain 0.001 --out build/tests/t_fnlw > build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "element-shear.csv"));
-    CHECK(system("build/femdem_nonlocal --test rve --packing " PK160
-                 " --out /dev/null/x > build/tests/t_bad.out 2>&1") != 0);
+    CHECK(system("mkdir -p " BUILD "/tests/t_fnlw/element-shear.csv") == 0);
+    CHECK(system(BUILD "/femdem_nonlocal --test element-shear --packing " PK160
+                 " --steps 4 --strain 0.001 --out " BUILD "/tests/t_fnlw > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "element-shear.csv"));
+    CHECK(system(BUILD "/femdem_nonlocal --test rve --packing " PK160
+                 " --out /dev/null/x > " BUILD "/tests/t_bad.out 2>&1") != 0);
     /* gk_pack's Hertz options */
-    CHECK(system("build/gk_pack --dim 3 --law foo --out build/tests/t_pack_bad.txt > build/tests/t_bad.out "
+    CHECK(system(BUILD "/gk_pack --dim 3 --law foo --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out "
                  "2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--law 'foo' is neither linear nor hertz"));
-    CHECK(system("build/gk_pack --dim 3 --law hertz --out build/tests/t_pack_bad.txt > build/tests/t_bad.out "
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--law 'foo' is neither linear nor hertz"));
+    CHECK(system(BUILD "/gk_pack --dim 3 --law hertz --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out "
                  "2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "--law hertz needs --G"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--law hertz needs --G"));
 }
 
 int main(int argc, char **argv) {

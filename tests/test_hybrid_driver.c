@@ -9,8 +9,8 @@
 #include <stdlib.h>
 
 /* a 1.2 x 2.4 cm planar specimen (about 250 grains, 4 x 8 cells): tiny but the whole path */
-#define PLANAR "build/hybrid --test planar --width 0.012 --height 0.024 --cell 0.003 --phi0 0.005 "
-#define BIAXIAL "build/hybrid --test biaxial --width 0.012 --height 0.018 --cell 0.003 --quiet "
+#define PLANAR BUILD "/hybrid --test planar --width 0.012 --height 0.024 --cell 0.003 --phi0 0.005 "
+#define BIAXIAL BUILD "/hybrid --test biaxial --width 0.012 --height 0.018 --cell 0.003 --quiet "
 #define HEADER "time,strain,tau,sigma_n,eps_v,eps_v_band,grains,points,enriched,flagged_nodes,seconds\n"
 #define NCOL 11
 
@@ -62,10 +62,10 @@ static int same_but_seconds(const char *a, const char *b) {
 TEST(hybrid_planar_enriches_and_is_thread_independent) {
     double r[8][NCOL];
     int n, k;
-    system("rm -rf build/tests/t_hyA build/tests/t_hy1");
+    system("rm -rf " BUILD "/tests/t_hyA " BUILD "/tests/t_hy1");
     CHECK(system(PLANAR "--mode hybrid --strain 0.005 --out-every 0.0025 --window 0.001 0.005 --threads 2 "
-                        "--out build/tests/t_hyA > build/tests/t_hyA.out 2>&1") == 0);
-    n = read_rows("build/tests/t_hyA/hybrid.csv", r, 8);
+                        "--out " BUILD "/tests/t_hyA > " BUILD "/tests/t_hyA.out 2>&1") == 0);
+    n = read_rows(BUILD "/tests/t_hyA/hybrid.csv", r, 8);
     CHECK_EQ_INT(n, 3);
     if (n != 3) return;
     CHECK_NEAR(r[0][3], 4e5, 1e-6); /* sigma_n [Pa], consolidated state */
@@ -78,7 +78,7 @@ TEST(hybrid_planar_enriches_and_is_thread_independent) {
     CHECK_NEAR(r[2][1], 0.005, 1e-4);                         /* strain reached */
     for (k = 0; k < 3; ++k) CHECK(r[k][10] >= 0.0);
     {
-        FILE *fp = fopen("build/tests/t_hyA.out", "r");
+        FILE *fp = fopen(BUILD "/tests/t_hyA.out", "r");
         char line[1024];
         double m0 = -1, m1 = -2;
         while (fp && fgets(line, sizeof line, fp)) {
@@ -89,22 +89,22 @@ TEST(hybrid_planar_enriches_and_is_thread_independent) {
         CHECK(m0 > 0.0);
         CHECK_NEAR(m1, m0, 1e-4 * m0); /* printed to 5 digits */
     }
-    CHECK(gk_test_result("build/tests/t_hyA.out", "strain_at_enrichment") > 0.0);
-    CHECK(gk_test_result("build/tests/t_hyA.out", "peak_tau") > 0.0);
-    CHECK(gk_test_file_has("build/tests/t_hyA.out", "RESULT mode=hybrid peak_tau="));
-    CHECK(gk_test_file_has("build/tests/t_hyA/points_start.vtk", "POINTS"));
-    CHECK(gk_test_file_has("build/tests/t_hyA/grains_enrichment.vtk", "POINTS"));
-    CHECK(gk_test_file_has("build/tests/t_hyA/grains_end.vtk", "POINTS"));
-    CHECK(gk_test_file_has("build/tests/t_hyA/stress_strain.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_hyA/volume.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_hyA/band.svg", "<svg"));
+    CHECK(gk_test_result(BUILD "/tests/t_hyA.out", "strain_at_enrichment") > 0.0);
+    CHECK(gk_test_result(BUILD "/tests/t_hyA.out", "peak_tau") > 0.0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyA.out", "RESULT mode=hybrid peak_tau="));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyA/points_start.vtk", "POINTS"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyA/grains_enrichment.vtk", "POINTS"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyA/grains_end.vtk", "POINTS"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyA/stress_strain.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyA/volume.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyA/band.svg", "<svg"));
     CHECK(
         system(
             PLANAR
             "--mode hybrid --strain 0.005 --out-every 0.0025 --window 0.001 0.005 --threads 1 "
-            "--packing build/tests/t_hyA/packing.txt --out build/tests/t_hy1 > build/tests/t_hy1.out 2>&1") ==
+            "--packing " BUILD "/tests/t_hyA/packing.txt --out " BUILD "/tests/t_hy1 > " BUILD "/tests/t_hy1.out 2>&1") ==
         0);
-    CHECK(same_but_seconds("build/tests/t_hyA/hybrid.csv", "build/tests/t_hy1/hybrid.csv"));
+    CHECK(same_but_seconds(BUILD "/tests/t_hyA/hybrid.csv", BUILD "/tests/t_hy1/hybrid.csv"));
 }
 
 /* dem mode, biaxial: the specimen starts at the confining pressure
@@ -113,35 +113,35 @@ TEST(hybrid_planar_enriches_and_is_thread_independent) {
 TEST(hybrid_biaxial_dem_loads) {
     double r[8][NCOL];
     int n;
-    system("rm -rf build/tests/t_hyB");
+    system("rm -rf " BUILD "/tests/t_hyB");
     CHECK(system(BIAXIAL "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
-                         "--out build/tests/t_hyB > build/tests/t_hyB.out 2>&1") == 0);
-    n = read_rows("build/tests/t_hyB/hybrid.csv", r, 8);
+                         "--out " BUILD "/tests/t_hyB > " BUILD "/tests/t_hyB.out 2>&1") == 0);
+    n = read_rows(BUILD "/tests/t_hyB/hybrid.csv", r, 8);
     CHECK_EQ_INT(n, 4);
     if (n != 4) return;
     CHECK_NEAR(r[0][3], 1e5, 1e-6);
     CHECK_NEAR(r[0][2], 0.0, 1e-6);
     CHECK(r[0][6] > 100.0 && r[0][7] == 0.0);
     CHECK(r[3][2] > 0.0 && r[3][3] > 1e5);
-    CHECK(gk_test_result("build/tests/t_hyB.out", "band_thickness_D50") > 0.0);
-    CHECK(gk_test_file_has("build/tests/t_hyB/grains_end.vtk", "POINTS"));
+    CHECK(gk_test_result(BUILD "/tests/t_hyB.out", "band_thickness_D50") > 0.0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyB/grains_end.vtk", "POINTS"));
 }
 
 /* continuum mode, biaxial: MPM only, never enriched, starts at the confining pressure */
 TEST(hybrid_biaxial_continuum_runs) {
     double r[8][NCOL];
     int n, k;
-    system("rm -rf build/tests/t_hyC");
+    system("rm -rf " BUILD "/tests/t_hyC");
     CHECK(system(BIAXIAL "--mode continuum --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
-                         "--out build/tests/t_hyC > build/tests/t_hyC.out 2>&1") == 0);
-    n = read_rows("build/tests/t_hyC/hybrid.csv", r, 8);
+                         "--out " BUILD "/tests/t_hyC > " BUILD "/tests/t_hyC.out 2>&1") == 0);
+    n = read_rows(BUILD "/tests/t_hyC/hybrid.csv", r, 8);
     CHECK_EQ_INT(n, 4);
     if (n != 4) return;
     CHECK_NEAR(r[0][3], 1e5, 1e-6);
     for (k = 0; k < n; ++k) CHECK(r[k][6] == 0.0 && r[k][8] == 0.0 && r[k][7] == r[0][7]);
     CHECK(r[3][3] > 1e5);
-    CHECK(gk_test_file_has("build/tests/t_hyC.out", "RESULT mode=continuum"));
-    CHECK(gk_test_file_has("build/tests/t_hyC/points_end.vtk", "POINTS"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyC.out", "RESULT mode=continuum"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyC/points_end.vtk", "POINTS"));
 }
 
 /* a bad argument: status != 0, the message, and no output directory */
@@ -149,11 +149,11 @@ static int refused(const char *flags, const char *msg) {
     char cmd[512];
     FILE *fp;
     int ok;
-    system("rm -rf build/tests/t_hybad");
-    snprintf(cmd, sizeof cmd, "build/hybrid %s --out build/tests/t_hybad > build/tests/t_bad.out 2>&1",
+    system("rm -rf " BUILD "/tests/t_hybad");
+    snprintf(cmd, sizeof cmd, BUILD "/hybrid %s --out " BUILD "/tests/t_hybad > " BUILD "/tests/t_bad.out 2>&1",
              flags);
-    ok = system(cmd) != 0 && gk_test_file_has("build/tests/t_bad.out", msg);
-    fp = fopen("build/tests/t_hybad", "r");
+    ok = system(cmd) != 0 && gk_test_file_has(BUILD "/tests/t_bad.out", msg);
+    fp = fopen(BUILD "/tests/t_hybad", "r");
     if (fp) fclose(fp), ok = 0;
     if (!ok) printf("    not refused as expected: hybrid %s\n", flags);
     return ok;
@@ -171,16 +171,16 @@ TEST(hybrid_refuses_bad_arguments) {
     CHECK(refused("--test planar --mode dem --speed", "--speed"));
     CHECK(refused("--test planar --mode dem --bogus 1", "--bogus"));
     /* an unreadable packing: an error, not a crash (the directory may exist) */
-    CHECK(system("build/hybrid --test planar --mode dem --packing build/tests/no_such_packing.txt --out "
-                 "build/tests/t_hybad "
-                 "> build/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "no_such_packing"));
+    CHECK(system(BUILD "/hybrid --test planar --mode dem --packing " BUILD "/tests/no_such_packing.txt --out "
+                 BUILD "/tests/t_hybad "
+                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "no_such_packing"));
     /* --out naming an existing file */
-    CHECK(system("rm -rf build/tests/t_hyfile && touch build/tests/t_hyfile") == 0);
-    CHECK(system("build/hybrid --test planar --mode dem --out build/tests/t_hyfile > build/tests/t_bad.out "
+    CHECK(system("rm -rf " BUILD "/tests/t_hyfile && touch " BUILD "/tests/t_hyfile") == 0);
+    CHECK(system(BUILD "/hybrid --test planar --mode dem --out " BUILD "/tests/t_hyfile > " BUILD "/tests/t_bad.out "
                  "2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_bad.out", "t_hyfile"));
-    remove("build/tests/t_hyfile");
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "t_hyfile"));
+    remove(BUILD "/tests/t_hyfile");
 }
 
 int main(int argc, char **argv) {

@@ -9,7 +9,7 @@
 #include "gk_io.h"
 #include "gk_test.h"
 
-#define OUT "build/tests/"
+#define OUT BUILD "/tests/"
 
 static double attr(const char *tag, const char *name) {
     char pat[64];

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 
 /* a 2 x 4 cell specimen (8 RVEs): tiny but the whole path */
-#define BX "build/mpmdem_biaxial --nx 2 --ny 4 --strain 0.002 --every 0.0005 --quiet "
+#define BX BUILD "/mpmdem_biaxial --nx 2 --ny 4 --strain 0.002 --every 0.0005 --quiet "
 
 static int read_rows(const char *path, double rows[][8], int max) {
     FILE *fp = fopen(path, "r");
@@ -38,11 +38,11 @@ static int read_rows(const char *path, double rows[][8], int max) {
 TEST(biaxial_runs_and_loads) {
     double r[16][8];
     int n, k;
-    CHECK(system(BX "--threads 2 --out build/tests/t_mpmbx > build/tests/t_mpmbx.out 2>&1") == 0);
+    CHECK(system(BX "--threads 2 --out " BUILD "/tests/t_mpmbx > " BUILD "/tests/t_mpmbx.out 2>&1") == 0);
     CHECK(gk_test_file_has(
-        "build/tests/t_mpmbx/biaxial.csv",
+        BUILD "/tests/t_mpmbx/biaxial.csv",
         "time,eps_axial,sigma_yy,sigma_yy_base,eps_v,kinetic_energy,dem_steps_per_point,seconds"));
-    n = read_rows("build/tests/t_mpmbx/biaxial.csv", r, 16);
+    n = read_rows(BUILD "/tests/t_mpmbx/biaxial.csv", r, 16);
     CHECK_EQ_INT(n, 4);
     if (n != 4) return;
     for (k = 0; k < n; ++k) {
@@ -52,84 +52,84 @@ TEST(biaxial_runs_and_loads) {
     CHECK(r[0][2] > 0.95e5 && r[0][2] < 1.2e5);
     for (k = 1; k < n; ++k) CHECK(r[k][2] > r[k - 1][2]);
     CHECK(r[n - 1][4] > 0.0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx/biaxial_stress.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmbx/rotation_end.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmbx/points_000000.vtk", "SCALARS eps_q"));
-    CHECK_NEAR(gk_test_result("build/tests/t_mpmbx.out", "n_rves"), 8, 0);
-    CHECK_REL(gk_test_result("build/tests/t_mpmbx.out", "peak_sigma_yy"), r[n - 1][2],
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx/biaxial_stress.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx/rotation_end.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx/points_000000.vtk", "SCALARS eps_q"));
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmbx.out", "n_rves"), 8, 0);
+    CHECK_REL(gk_test_result(BUILD "/tests/t_mpmbx.out", "peak_sigma_yy"), r[n - 1][2],
               1e-5); /* printed with 6 digits */
 }
 
 /* RVEs run in parallel: one thread gives the same curve to the last digit */
 TEST(biaxial_thread_independent) {
-    CHECK(system(BX "--threads 1 --out build/tests/t_mpmbx1 > build/tests/t_mpmbx1.out 2>&1") == 0);
-    CHECK(system("cmp -s build/tests/t_mpmbx1/points_000000.vtk build/tests/t_mpmbx/points_000000.vtk") == 0);
-    CHECK(gk_test_result("build/tests/t_mpmbx1.out", "peak_sigma_yy") ==
-          gk_test_result("build/tests/t_mpmbx.out", "peak_sigma_yy"));
-    CHECK(system("cut -d, -f1-7 build/tests/t_mpmbx1/biaxial.csv > build/tests/t_mpmbx1.c && "
-                 "cut -d, -f1-7 build/tests/t_mpmbx/biaxial.csv > build/tests/t_mpmbx2.c && "
-                 "cmp -s build/tests/t_mpmbx1.c build/tests/t_mpmbx2.c") == 0);
+    CHECK(system(BX "--threads 1 --out " BUILD "/tests/t_mpmbx1 > " BUILD "/tests/t_mpmbx1.out 2>&1") == 0);
+    CHECK(system("cmp -s " BUILD "/tests/t_mpmbx1/points_000000.vtk " BUILD "/tests/t_mpmbx/points_000000.vtk") == 0);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmbx1.out", "peak_sigma_yy") ==
+          gk_test_result(BUILD "/tests/t_mpmbx.out", "peak_sigma_yy"));
+    CHECK(system("cut -d, -f1-7 " BUILD "/tests/t_mpmbx1/biaxial.csv > " BUILD "/tests/t_mpmbx1.c && "
+                 "cut -d, -f1-7 " BUILD "/tests/t_mpmbx/biaxial.csv > " BUILD "/tests/t_mpmbx2.c && "
+                 "cmp -s " BUILD "/tests/t_mpmbx1.c " BUILD "/tests/t_mpmbx2.c") == 0);
 }
 
 /* a checkpoint half-way, then --restart: the same final state (every point
  * array and RVE state is in the checkpoint) */
 TEST(biaxial_restart_identical) {
     int rc = system(
-        "build/mpmdem_biaxial --nx 2 --ny 4 --strain 0.001 --every 0.0005 --quiet --out "
-        "build/tests/t_mpmbx_a "
-        "> build/tests/t_mpmbx_a.out 2>&1 && " BX
-        "--restart build/tests/t_mpmbx_a --out build/tests/t_mpmbx_b > build/tests/t_mpmbx_b.out 2>&1");
+        BUILD "/mpmdem_biaxial --nx 2 --ny 4 --strain 0.001 --every 0.0005 --quiet --out "
+        BUILD "/tests/t_mpmbx_a "
+        "> " BUILD "/tests/t_mpmbx_a.out 2>&1 && " BX
+        "--restart " BUILD "/tests/t_mpmbx_a --out " BUILD "/tests/t_mpmbx_b > " BUILD "/tests/t_mpmbx_b.out 2>&1");
     CHECK(rc == 0);
-    CHECK(gk_test_result("build/tests/t_mpmbx_b.out", "peak_sigma_yy") ==
-          gk_test_result("build/tests/t_mpmbx.out", "peak_sigma_yy"));
-    CHECK(system("cut -d, -f1-7 build/tests/t_mpmbx_b/biaxial.csv > build/tests/t_mpmbx_b.c && "
-                 "cmp -s build/tests/t_mpmbx_b.c build/tests/t_mpmbx2.c") == 0);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmbx_b.out", "peak_sigma_yy") ==
+          gk_test_result(BUILD "/tests/t_mpmbx.out", "peak_sigma_yy"));
+    CHECK(system("cut -d, -f1-7 " BUILD "/tests/t_mpmbx_b/biaxial.csv > " BUILD "/tests/t_mpmbx_b.c && "
+                 "cmp -s " BUILD "/tests/t_mpmbx_b.c " BUILD "/tests/t_mpmbx2.c") == 0);
 }
 
 /* bad input: a message and a non-zero exit, nothing run */
 TEST(biaxial_bad_arguments) {
-    CHECK(system("build/mpmdem_biaxial --nx 0 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "out of range"));
-    CHECK(system("build/mpmdem_biaxial --nx 3 --ny 4 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "square"));
-    CHECK(system("build/mpmdem_biaxial --alpha 2 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--alpha"));
+    CHECK(system(BUILD "/mpmdem_biaxial --nx 0 > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "out of range"));
+    CHECK(system(BUILD "/mpmdem_biaxial --nx 3 --ny 4 > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "square"));
+    CHECK(system(BUILD "/mpmdem_biaxial --alpha 2 > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "--alpha"));
     /* bad input changes nothing: no output folder is made before the inputs are read */
-    CHECK(system("rm -rf build/tests/t_mpmbx_bad") == 0);
-    CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --packing /nonexistent > "
-                 "build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "nonexistent"));
-    CHECK(system("build/mpmdem_biaxial --out build/tests/t_mpmbx_bad --restart /nonexistent --nx 2 --ny 4 > "
-                 "build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "cannot open"));
-    CHECK(system("test -e build/tests/t_mpmbx_bad") != 0);
-    CHECK(system("build/mpmdem_biaxial --help > build/tests/t_mpmbx_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--dem-strain"));
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "(default build/mpm_biaxial)"));
+    CHECK(system("rm -rf " BUILD "/tests/t_mpmbx_bad") == 0);
+    CHECK(system(BUILD "/mpmdem_biaxial --out " BUILD "/tests/t_mpmbx_bad --packing /nonexistent > "
+                 BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "nonexistent"));
+    CHECK(system(BUILD "/mpmdem_biaxial --out " BUILD "/tests/t_mpmbx_bad --restart /nonexistent --nx 2 --ny 4 > "
+                 BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "cannot open"));
+    CHECK(system("test -e " BUILD "/tests/t_mpmbx_bad") != 0);
+    CHECK(system(BUILD "/mpmdem_biaxial --help > " BUILD "/tests/t_mpmbx_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "--dem-strain"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "(default " BUILD "/mpm_biaxial)"));
     /* values parsed strictly; the message names the option */
-    CHECK(system("build/mpmdem_biaxial --nx -1 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--nx -1 is out of range"));
-    CHECK(system("build/mpmdem_biaxial --nx=8 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--nx=8: write the value after the option"));
-    CHECK(system("build/mpmdem_biaxial --nx 99999999999 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--nx 99999999999 is out of range"));
-    CHECK(system("build/mpmdem_biaxial --nx 8x > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--nx '8x' is not a whole number"));
-    CHECK(system("build/mpmdem_biaxial --strain 1e999 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--strain '1e999' is not a finite number"));
+    CHECK(system(BUILD "/mpmdem_biaxial --nx -1 > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "--nx -1 is out of range"));
+    CHECK(system(BUILD "/mpmdem_biaxial --nx=8 > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "--nx=8: write the value after the option"));
+    CHECK(system(BUILD "/mpmdem_biaxial --nx 99999999999 > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "--nx 99999999999 is out of range"));
+    CHECK(system(BUILD "/mpmdem_biaxial --nx 8x > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "--nx '8x' is not a whole number"));
+    CHECK(system(BUILD "/mpmdem_biaxial --strain 1e999 > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "--strain '1e999' is not a finite number"));
     /* the DEM-rule flags of mpmdem.h are taken (they were listed in --help but refused), bad ones not */
-    CHECK(system("build/mpmdem_biaxial --dem-rule foo > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "adaptive or strain"));
-    CHECK(system("build/mpmdem_biaxial --dem-inertial -1 > build/tests/t_mpmbx_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_bad.out", "--dem-inertial"));
-    CHECK(system(BX "--strain 0.0005 --dem-rule strain --dem-strain 2e-5 --out build/tests/t_mpmbx_rule "
-                    "> build/tests/t_mpmbx_rule.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_rule.out",
+    CHECK(system(BUILD "/mpmdem_biaxial --dem-rule foo > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "adaptive or strain"));
+    CHECK(system(BUILD "/mpmdem_biaxial --dem-inertial -1 > " BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "--dem-inertial"));
+    CHECK(system(BX "--strain 0.0005 --dem-rule strain --dem-strain 2e-5 --out " BUILD "/tests/t_mpmbx_rule "
+                    "> " BUILD "/tests/t_mpmbx_rule.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_rule.out",
                            "DEM steps per MPM step: <= 2e-05 strain per DEM step"));
     CHECK(system(BX
-                 "--strain 0.0005 --dem-inertial 1e-3 --dem-unbalanced 1e-2 --out build/tests/t_mpmbx_rule "
-                 "> build/tests/t_mpmbx_rule.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_rule.out",
+                 "--strain 0.0005 --dem-inertial 1e-3 --dem-unbalanced 1e-2 --out " BUILD "/tests/t_mpmbx_rule "
+                 "> " BUILD "/tests/t_mpmbx_rule.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_rule.out",
                            "adaptive, I <= 0.001 then relaxation to an unbalanced force "
                            "ratio < 0.01"));
 }
@@ -161,62 +161,62 @@ static int copy_damaged(const char *src, const char *dst, long keep, long flip) 
  * format is refused by name with status 1, before anything is run or written */
 TEST(biaxial_bad_checkpoint_refused) {
     long size;
-    FILE *fp = fopen("build/tests/t_mpmbx_a/checkpoint.bin", "rb");
+    FILE *fp = fopen(BUILD "/tests/t_mpmbx_a/checkpoint.bin", "rb");
     CHECK(fp != NULL);
     if (!fp) return;
     fseek(fp, 0, SEEK_END), size = ftell(fp), fclose(fp);
     CHECK(system(
-              "rm -rf build/tests/t_mpmbx_ck build/tests/t_mpmbx_ckout && mkdir -p build/tests/t_mpmbx_ck") ==
+              "rm -rf " BUILD "/tests/t_mpmbx_ck " BUILD "/tests/t_mpmbx_ckout && mkdir -p " BUILD "/tests/t_mpmbx_ck") ==
           0);
-    CHECK(copy_damaged("build/tests/t_mpmbx_a/checkpoint.bin", "build/tests/t_mpmbx_ck/checkpoint.bin", -1,
+    CHECK(copy_damaged(BUILD "/tests/t_mpmbx_a/checkpoint.bin", BUILD "/tests/t_mpmbx_ck/checkpoint.bin", -1,
                        size / 2));
-    CHECK(system(BX "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > "
-                    "build/tests/t_mpmbx_ck.out 2>&1; "
+    CHECK(system(BX "--restart " BUILD "/tests/t_mpmbx_ck --out " BUILD "/tests/t_mpmbx_ckout > "
+                    BUILD "/tests/t_mpmbx_ck.out 2>&1; "
                     "test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out",
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_ck.out",
                            "checkpoint.bin: checksum mismatch (the file is corrupt)"));
-    CHECK(!gk_test_file_has("build/tests/t_mpmbx_ckout/biaxial.csv", "time")); /* nothing ran */
-    CHECK(copy_damaged("build/tests/t_mpmbx_a/checkpoint.bin", "build/tests/t_mpmbx_ck/checkpoint.bin",
+    CHECK(!gk_test_file_has(BUILD "/tests/t_mpmbx_ckout/biaxial.csv", "time")); /* nothing ran */
+    CHECK(copy_damaged(BUILD "/tests/t_mpmbx_a/checkpoint.bin", BUILD "/tests/t_mpmbx_ck/checkpoint.bin",
                        size - 100, -1));
-    CHECK(system(BX "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > "
-                    "build/tests/t_mpmbx_ck.out 2>&1; "
+    CHECK(system(BX "--restart " BUILD "/tests/t_mpmbx_ck --out " BUILD "/tests/t_mpmbx_ckout > "
+                    BUILD "/tests/t_mpmbx_ck.out 2>&1; "
                     "test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out", "truncated"));
-    CHECK(system("build/mpmdem_biaxial --nx 2 --ny 2 --height 1 --quiet --restart build/tests/t_mpmbx_a "
-                 "--out build/tests/t_mpmbx_ckout > build/tests/t_mpmbx_ck.out 2>&1; test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out", "holds 8 points"));
-    CHECK(system("printf 'GKMPMDEM1biaxial' > build/tests/t_mpmbx_ck/checkpoint.bin && " BX
-                 "--restart build/tests/t_mpmbx_ck --out build/tests/t_mpmbx_ckout > "
-                 "build/tests/t_mpmbx_ck.out 2>&1; test $? "
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_ck.out", "truncated"));
+    CHECK(system(BUILD "/mpmdem_biaxial --nx 2 --ny 2 --height 1 --quiet --restart " BUILD "/tests/t_mpmbx_a "
+                 "--out " BUILD "/tests/t_mpmbx_ckout > " BUILD "/tests/t_mpmbx_ck.out 2>&1; test $? -eq 1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_ck.out", "holds 8 points"));
+    CHECK(system("printf 'GKMPMDEM1biaxial' > " BUILD "/tests/t_mpmbx_ck/checkpoint.bin && " BX
+                 "--restart " BUILD "/tests/t_mpmbx_ck --out " BUILD "/tests/t_mpmbx_ckout > "
+                 BUILD "/tests/t_mpmbx_ck.out 2>&1; test $? "
                  "-eq 1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_ck.out", "is not a grainkit two-scale checkpoint"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_ck.out", "is not a grainkit two-scale checkpoint"));
 }
 
 /* a result that cannot be written (its path taken by a folder, or a full disk: /dev/full) ends the
  * run with status 1, said once, naming the file */
 TEST(biaxial_failed_write_exits) {
     static const char *cases[][2] = {
-        {"mkdir -p build/tests/t_mpmbx_w/biaxial.csv", "build/tests/t_mpmbx_w/biaxial.csv"},
-        {"mkdir -p build/tests/t_mpmbx_w && ln -s /dev/full build/tests/t_mpmbx_w/biaxial.csv",
-         "build/tests/t_mpmbx_w/biaxial.csv"},
-        {"mkdir -p build/tests/t_mpmbx_w/checkpoint.bin.tmp", "build/tests/t_mpmbx_w/checkpoint.bin"},
-        {"mkdir -p build/tests/t_mpmbx_w && ln -s /dev/full build/tests/t_mpmbx_w/rotation_end.svg",
-         "build/tests/t_mpmbx_w/rotation_end.svg"},
-        {"mkdir -p build/tests/t_mpmbx_w/points_000000.vtk", "build/tests/t_mpmbx_w/points_000000.vtk"}};
+        {"mkdir -p " BUILD "/tests/t_mpmbx_w/biaxial.csv", BUILD "/tests/t_mpmbx_w/biaxial.csv"},
+        {"mkdir -p " BUILD "/tests/t_mpmbx_w && ln -s /dev/full " BUILD "/tests/t_mpmbx_w/biaxial.csv",
+         BUILD "/tests/t_mpmbx_w/biaxial.csv"},
+        {"mkdir -p " BUILD "/tests/t_mpmbx_w/checkpoint.bin.tmp", BUILD "/tests/t_mpmbx_w/checkpoint.bin"},
+        {"mkdir -p " BUILD "/tests/t_mpmbx_w && ln -s /dev/full " BUILD "/tests/t_mpmbx_w/rotation_end.svg",
+         BUILD "/tests/t_mpmbx_w/rotation_end.svg"},
+        {"mkdir -p " BUILD "/tests/t_mpmbx_w/points_000000.vtk", BUILD "/tests/t_mpmbx_w/points_000000.vtk"}};
     char cmd[1024], msg[256];
     int k;
     for (k = 0; k < (int)(sizeof cases / sizeof *cases); ++k) {
         snprintf(cmd, sizeof cmd,
-                 "rm -rf build/tests/t_mpmbx_w && %s && " BX
-                 "--strain 0.0005 --out build/tests/t_mpmbx_w > build/tests/t_mpmbx_w.out "
+                 "rm -rf " BUILD "/tests/t_mpmbx_w && %s && " BX
+                 "--strain 0.0005 --out " BUILD "/tests/t_mpmbx_w > " BUILD "/tests/t_mpmbx_w.out "
                  "2>&1; test $? -eq 1",
                  cases[k][0]);
         CHECK(system(cmd) == 0);
         snprintf(msg, sizeof msg, "mpmdem_biaxial: cannot write %s", cases[k][1]);
-        CHECK(gk_test_file_has("build/tests/t_mpmbx_w.out", msg));
-        CHECK(count_lines("build/tests/t_mpmbx_w.out", "cannot write") == 1);
+        CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_w.out", msg));
+        CHECK(count_lines(BUILD "/tests/t_mpmbx_w.out", "cannot write") == 1);
         CHECK(
-            !gk_test_file_has("build/tests/t_mpmbx_w.out", "wrote ")); /* no claim of what was not written */
+            !gk_test_file_has(BUILD "/tests/t_mpmbx_w.out", "wrote ")); /* no claim of what was not written */
     }
 }
 
@@ -224,23 +224,23 @@ TEST(biaxial_failed_write_exits) {
  * (no --out) is build/mpm_biaxial under the working directory, where the results land (run from
  * build/tests/t_mpmbx_cwd, so that the test writes only under build/tests) */
 TEST(biaxial_out_folder) {
-    CHECK(system("rm -rf build/tests/t_mpmbx_f && echo x > build/tests/t_mpmbx_file && " BX
-                 "--out build/tests/t_mpmbx_file > build/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
+    CHECK(system("rm -rf " BUILD "/tests/t_mpmbx_f && echo x > " BUILD "/tests/t_mpmbx_file && " BX
+                 "--out " BUILD "/tests/t_mpmbx_file > " BUILD "/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
     CHECK(
-        gk_test_file_has("build/tests/t_mpmbx_f.out",
-                         "--out build/tests/t_mpmbx_file: build/tests/t_mpmbx_file is a file, not a folder"));
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_file", "x")); /* untouched */
-    CHECK(system(BX "--out build/tests/t_mpmbx_file/sub > build/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") ==
+        gk_test_file_has(BUILD "/tests/t_mpmbx_f.out",
+                         "--out " BUILD "/tests/t_mpmbx_file: " BUILD "/tests/t_mpmbx_file is a file, not a folder"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_file", "x")); /* untouched */
+    CHECK(system(BX "--out " BUILD "/tests/t_mpmbx_file/sub > " BUILD "/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") ==
           0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_f.out", "is a file, not a folder"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_f.out", "is a file, not a folder"));
     CHECK(system(
-              "rm -rf build/tests/t_mpmbx_cwd && mkdir build/tests/t_mpmbx_cwd && cd build/tests/t_mpmbx_cwd "
+              "rm -rf " BUILD "/tests/t_mpmbx_cwd && mkdir " BUILD "/tests/t_mpmbx_cwd && cd " BUILD "/tests/t_mpmbx_cwd "
               "&& "
               "../../mpmdem_biaxial --packing ../../../examples/data/rve400.txt --nx 2 --ny 4 --every 0.0005 "
               "--quiet --strain 0.0005 > ../t_mpmbx_f.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_cwd/build/mpm_biaxial/biaxial.csv", "time,eps_axial"));
-    CHECK(system(BX "--strain 0.0005 --out build/tests/t_mpmbx_f/a/b > build/tests/t_mpmbx_f.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmbx_f/a/b/biaxial.csv", "time,eps_axial"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_cwd/" BUILD "/mpm_biaxial/biaxial.csv", "time,eps_axial"));
+    CHECK(system(BX "--strain 0.0005 --out " BUILD "/tests/t_mpmbx_f/a/b > " BUILD "/tests/t_mpmbx_f.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_f/a/b/biaxial.csv", "time,eps_axial"));
 }
 
 /* examples/mpmdem_single.c, Liang & Zhao (2019) Sec 3.1: one MPM cell, 2 x 2 points, smooth rollers
@@ -261,21 +261,21 @@ TEST(biaxial_out_folder) {
  *   equals the points' mean stress within 1 % (quasi-static: the cell's inertia is small);
  * - the start: sigma_yy of the first row (0.1 % strain) between the consolidation pressure and 1.2 x
  *   it, sigma_xx of the RVE alone held at the lateral 100 kPa within 1 % by its servo. */
-#define SG "build/mpmdem_single --strain 0.01 --packing build/tests/t_sg_pack.txt --quiet "
+#define SG BUILD "/mpmdem_single --strain 0.01 --packing " BUILD "/tests/t_sg_pack.txt --quiet "
 TEST(single_element_follows_the_rve_alone) {
     double r[16][13];
     int n = 0, k;
     FILE *fp;
     char line[1024];
-    CHECK(system("build/gk_pack --dim 2 --n 60 --pressure 1e5 --out build/tests/t_sg_pack.txt > "
-                 "build/tests/t_sg_pack.out 2>&1") == 0);
-    CHECK(system(SG "--threads 2 --out build/tests/t_sg > build/tests/t_sg.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_sg/single.csv",
+    CHECK(system(BUILD "/gk_pack --dim 2 --n 60 --pressure 1e5 --out " BUILD "/tests/t_sg_pack.txt > "
+                 BUILD "/tests/t_sg_pack.out 2>&1") == 0);
+    CHECK(system(SG "--threads 2 --out " BUILD "/tests/t_sg > " BUILD "/tests/t_sg.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_sg/single.csv",
                            "time,plate_displacement,eps_axial,sigma_yy,sigma_yy_points,point_spread,eps_v,"
                            "eps_axial_dem,sigma_yy_dem,sigma_xx_dem,eps_v_dem,dem_steps_per_point,seconds"));
-    CHECK(gk_test_file_has("build/tests/t_sg/single_stress.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_sg/single_volume.svg", "<svg"));
-    CHECK((fp = fopen("build/tests/t_sg/single.csv", "r")) != NULL);
+    CHECK(gk_test_file_has(BUILD "/tests/t_sg/single_stress.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_sg/single_volume.svg", "<svg"));
+    CHECK((fp = fopen(BUILD "/tests/t_sg/single.csv", "r")) != NULL);
     if (!fp) return;
     if (fgets(line, sizeof line, fp))
         while (n < 16 && fgets(line, sizeof line, fp)) {
@@ -300,23 +300,23 @@ TEST(single_element_follows_the_rve_alone) {
         if (k) CHECK(r[k][3] > r[k - 1][3]);        /* hardening before the peak */
     }
     CHECK(r[n - 1][6] > 0.0); /* the dense packing contracts first */
-    CHECK(gk_test_result("build/tests/t_sg.out", "f_spread") < 1e-3);
-    CHECK(gk_test_result("build/tests/t_sg.out", "max_rel_diff_sigma_yy") < 0.02);
-    CHECK_NEAR(gk_test_result("build/tests/t_sg.out", "n_rves"), 4, 0);
+    CHECK(gk_test_result(BUILD "/tests/t_sg.out", "f_spread") < 1e-3);
+    CHECK(gk_test_result(BUILD "/tests/t_sg.out", "max_rel_diff_sigma_yy") < 0.02);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_sg.out", "n_rves"), 4, 0);
     /* the same curves with one thread (the time column aside) */
-    CHECK(system(SG "--threads 1 --out build/tests/t_sg1 > build/tests/t_sg1.out 2>&1") == 0);
-    CHECK(system("cut -d, -f1-12 build/tests/t_sg/single.csv > build/tests/t_sg.c && "
-                 "cut -d, -f1-12 build/tests/t_sg1/single.csv > build/tests/t_sg1.c && "
-                 "cmp -s build/tests/t_sg.c build/tests/t_sg1.c") == 0);
+    CHECK(system(SG "--threads 1 --out " BUILD "/tests/t_sg1 > " BUILD "/tests/t_sg1.out 2>&1") == 0);
+    CHECK(system("cut -d, -f1-12 " BUILD "/tests/t_sg/single.csv > " BUILD "/tests/t_sg.c && "
+                 "cut -d, -f1-12 " BUILD "/tests/t_sg1/single.csv > " BUILD "/tests/t_sg1.c && "
+                 "cmp -s " BUILD "/tests/t_sg.c " BUILD "/tests/t_sg1.c") == 0);
     /* bad input: refused with a message, no output folder */
     CHECK(
-        system("rm -rf build/tests/t_sg_bad && build/mpmdem_single --margin -1 --out build/tests/t_sg_bad > "
-               "build/tests/t_sg_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has("build/tests/t_sg_bad.out", "--margin -1 is out of range"));
-    CHECK(system("build/mpmdem_single --packing /nonexistent --out build/tests/t_sg_bad > "
-                 "build/tests/t_sg_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_sg_bad.out", "nonexistent"));
-    CHECK(system("test -e build/tests/t_sg_bad") != 0);
+        system("rm -rf " BUILD "/tests/t_sg_bad && " BUILD "/mpmdem_single --margin -1 --out " BUILD "/tests/t_sg_bad > "
+               BUILD "/tests/t_sg_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_sg_bad.out", "--margin -1 is out of range"));
+    CHECK(system(BUILD "/mpmdem_single --packing /nonexistent --out " BUILD "/tests/t_sg_bad > "
+                 BUILD "/tests/t_sg_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_sg_bad.out", "nonexistent"));
+    CHECK(system("test -e " BUILD "/tests/t_sg_bad") != 0);
 }
 
 int main(int argc, char **argv) {

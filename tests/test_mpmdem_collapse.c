@@ -19,7 +19,7 @@
 #define CL_T_HALF "0.075"
 #define CL_ROWS 7
 #endif
-#define CL "build/mpmdem_collapse --nx 4 --every 0.025 --snapshots 0.05 --quiet "
+#define CL BUILD "/mpmdem_collapse --nx 4 --every 0.025 --snapshots 0.05 --quiet "
 #define NCOL 15
 
 static int read_rows(const char *path, double rows[][NCOL], int max) {
@@ -57,11 +57,11 @@ TEST(collapse_runs_and_conserves) {
     double r[32][NCOL];
     int n, k;
     CHECK(system(CL "--t-end " CL_T_END
-                    " --threads 2 --out build/tests/t_mpmcl > build/tests/t_mpmcl.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl/collapse.csv",
+                    " --threads 2 --out " BUILD "/tests/t_mpmcl > " BUILD "/tests/t_mpmcl.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl/collapse.csv",
                            "time,front,dstar,front_box,front_raw,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0,"
                            "mass,mass_grid,loose_rves,frozen_rves,dem_steps_per_point,seconds"));
-    n = read_rows("build/tests/t_mpmcl/collapse.csv", r, 32);
+    n = read_rows(BUILD "/tests/t_mpmcl/collapse.csv", r, 32);
     CHECK_EQ_INT(n, CL_ROWS);
     if (n != CL_ROWS) return;
     CHECK_NEAR(r[0][0], 0.0, 0.0);
@@ -83,89 +83,89 @@ TEST(collapse_runs_and_conserves) {
     CHECK(r[n - 1][1] > 1.005);      /* spreading */
     CHECK(r[n - 1][6] > r[1][6]);    /* accelerating under gravity */
     CHECK(r[n - 1][7] < 1.0 - 1e-3); /* the centre of mass falls */
-    CHECK_NEAR(gk_test_result("build/tests/t_mpmcl.out", "n_rves"), 16, 0);
-    CHECK_NEAR(gk_test_result("build/tests/t_mpmcl.out", "dstar_paper"), 1.8, 0);
-    CHECK_REL(gk_test_result("build/tests/t_mpmcl.out", "dstar"), r[n - 1][2], 1e-3);
-    CHECK_REL(gk_test_result("build/tests/t_mpmcl.out", "Ed_final_over_Ep0"), r[n - 1][8], 1e-3);
-    CHECK(gk_test_result("build/tests/t_mpmcl.out", "Ek_peak_over_Ep0") >= r[n - 1][6] * (1 - 1e-3));
-    CHECK(gk_test_result("build/tests/t_mpmcl.out", "seconds_per_step_per_1000_rves") > 0);
-    CHECK(gk_test_result("build/tests/t_mpmcl.out", "mpm_steps") > 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl.out", "total_seconds="));
-    CHECK(gk_test_file_has("build/tests/t_mpmcl/collapse_energy.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmcl/collapse_front.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmcl/eps_q_0.05.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmcl/velocity_0.05.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmcl/velocity_end.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmcl/points_000000.vtk", "SCALARS eps_q"));
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmcl.out", "n_rves"), 16, 0);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmcl.out", "dstar_paper"), 1.8, 0);
+    CHECK_REL(gk_test_result(BUILD "/tests/t_mpmcl.out", "dstar"), r[n - 1][2], 1e-3);
+    CHECK_REL(gk_test_result(BUILD "/tests/t_mpmcl.out", "Ed_final_over_Ep0"), r[n - 1][8], 1e-3);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmcl.out", "Ek_peak_over_Ep0") >= r[n - 1][6] * (1 - 1e-3));
+    CHECK(gk_test_result(BUILD "/tests/t_mpmcl.out", "seconds_per_step_per_1000_rves") > 0);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmcl.out", "mpm_steps") > 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl.out", "total_seconds="));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl/collapse_energy.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl/collapse_front.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl/eps_q_0.05.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl/velocity_0.05.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl/velocity_end.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl/points_000000.vtk", "SCALARS eps_q"));
     /* geostatic levels: 4 pressures printed, the deepest ~ rho g 7/8 m */
-    CHECK(gk_test_file_has("build/tests/t_mpmcl.out", "level 3: depth 0.750-1.000 m"));
-    CHECK(gk_test_file_has("build/tests/t_mpmcl.out", "real-time count"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl.out", "level 3: depth 0.750-1.000 m"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl.out", "real-time count"));
 }
 
 /* RVEs run in parallel: one thread gives the same history to the last digit.
  * This run also takes the other thin-cell policy (--thin-cell stop instead of
  * freeze), identical while no RVE cell gets too thin. */
 TEST(collapse_thread_independent) {
-    CHECK(system(CL "--t-end " CL_T_END " --threads 1 --thin-cell stop --out build/tests/t_mpmcl1 "
-                    "> build/tests/t_mpmcl1.out 2>&1") == 0);
-    CHECK(system("cmp -s build/tests/t_mpmcl1/points_000000.vtk build/tests/t_mpmcl/points_000000.vtk") == 0);
-    CHECK(gk_test_result("build/tests/t_mpmcl1.out", "dstar") ==
-          gk_test_result("build/tests/t_mpmcl.out", "dstar"));
-    CHECK(system("cut -d, -f1-14 build/tests/t_mpmcl1/collapse.csv > build/tests/t_mpmcl1.c && "
-                 "cut -d, -f1-14 build/tests/t_mpmcl/collapse.csv > build/tests/t_mpmcl2.c && "
-                 "cmp -s build/tests/t_mpmcl1.c build/tests/t_mpmcl2.c") == 0);
+    CHECK(system(CL "--t-end " CL_T_END " --threads 1 --thin-cell stop --out " BUILD "/tests/t_mpmcl1 "
+                    "> " BUILD "/tests/t_mpmcl1.out 2>&1") == 0);
+    CHECK(system("cmp -s " BUILD "/tests/t_mpmcl1/points_000000.vtk " BUILD "/tests/t_mpmcl/points_000000.vtk") == 0);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmcl1.out", "dstar") ==
+          gk_test_result(BUILD "/tests/t_mpmcl.out", "dstar"));
+    CHECK(system("cut -d, -f1-14 " BUILD "/tests/t_mpmcl1/collapse.csv > " BUILD "/tests/t_mpmcl1.c && "
+                 "cut -d, -f1-14 " BUILD "/tests/t_mpmcl/collapse.csv > " BUILD "/tests/t_mpmcl2.c && "
+                 "cmp -s " BUILD "/tests/t_mpmcl1.c " BUILD "/tests/t_mpmcl2.c") == 0);
 }
 
 /* half-way, then --restart: the same history and final state (every point
  * array, RVE state and row is in the checkpoint) */
 TEST(collapse_restart_identical) {
     int rc =
-        system(CL "--t-end " CL_T_HALF " --out build/tests/t_mpmcl_a > build/tests/t_mpmcl_a.out 2>&1 && " CL
-                  "--t-end " CL_T_END " --restart build/tests/t_mpmcl_a --out build/tests/t_mpmcl_b "
-                  "> build/tests/t_mpmcl_b.out 2>&1");
+        system(CL "--t-end " CL_T_HALF " --out " BUILD "/tests/t_mpmcl_a > " BUILD "/tests/t_mpmcl_a.out 2>&1 && " CL
+                  "--t-end " CL_T_END " --restart " BUILD "/tests/t_mpmcl_a --out " BUILD "/tests/t_mpmcl_b "
+                  "> " BUILD "/tests/t_mpmcl_b.out 2>&1");
     CHECK(rc == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_b.out", "restarted from"));
-    CHECK(gk_test_result("build/tests/t_mpmcl_b.out", "dstar") ==
-          gk_test_result("build/tests/t_mpmcl.out", "dstar"));
-    CHECK(gk_test_result("build/tests/t_mpmcl_b.out", "Ed_final_over_Ep0") ==
-          gk_test_result("build/tests/t_mpmcl.out", "Ed_final_over_Ep0"));
-    CHECK(system("cut -d, -f1-14 build/tests/t_mpmcl_b/collapse.csv > build/tests/t_mpmcl_b.c && "
-                 "cmp -s build/tests/t_mpmcl_b.c build/tests/t_mpmcl2.c") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_b.out", "restarted from"));
+    CHECK(gk_test_result(BUILD "/tests/t_mpmcl_b.out", "dstar") ==
+          gk_test_result(BUILD "/tests/t_mpmcl.out", "dstar"));
+    CHECK(gk_test_result(BUILD "/tests/t_mpmcl_b.out", "Ed_final_over_Ep0") ==
+          gk_test_result(BUILD "/tests/t_mpmcl.out", "Ed_final_over_Ep0"));
+    CHECK(system("cut -d, -f1-14 " BUILD "/tests/t_mpmcl_b/collapse.csv > " BUILD "/tests/t_mpmcl_b.c && "
+                 "cmp -s " BUILD "/tests/t_mpmcl_b.c " BUILD "/tests/t_mpmcl2.c") == 0);
 }
 
 /* bad input: a message and a non-zero exit, nothing run */
 TEST(collapse_bad_arguments) {
-    CHECK(system("build/mpmdem_collapse --nx 0 > build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--nx"));
-    CHECK(system("build/mpmdem_collapse --nx 3 --height 0.5 > build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "whole number of cells"));
-    CHECK(system("build/mpmdem_collapse --alpha 2 > build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--alpha"));
-    CHECK(system("build/mpmdem_collapse --mu -1 > build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--mu"));
-    CHECK(system("build/mpmdem_collapse --t-end abc > build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "not a finite number"));
-    CHECK(system("build/mpmdem_collapse --snapshots 0.5,0.2 > build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--snapshots"));
-    CHECK(system("build/mpmdem_collapse --thin-cell maybe > build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "stop or freeze"));
-    CHECK(system("build/mpmdem_collapse --bogus 1 > build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "unknown option --bogus"));
-    CHECK(system("build/mpmdem_collapse --levels > build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "needs a value"));
+    CHECK(system(BUILD "/mpmdem_collapse --nx 0 > " BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "--nx"));
+    CHECK(system(BUILD "/mpmdem_collapse --nx 3 --height 0.5 > " BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "whole number of cells"));
+    CHECK(system(BUILD "/mpmdem_collapse --alpha 2 > " BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "--alpha"));
+    CHECK(system(BUILD "/mpmdem_collapse --mu -1 > " BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "--mu"));
+    CHECK(system(BUILD "/mpmdem_collapse --t-end abc > " BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "not a finite number"));
+    CHECK(system(BUILD "/mpmdem_collapse --snapshots 0.5,0.2 > " BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "--snapshots"));
+    CHECK(system(BUILD "/mpmdem_collapse --thin-cell maybe > " BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "stop or freeze"));
+    CHECK(system(BUILD "/mpmdem_collapse --bogus 1 > " BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "unknown option --bogus"));
+    CHECK(system(BUILD "/mpmdem_collapse --levels > " BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "needs a value"));
     /* bad input changes nothing: no output folder is made before the inputs are read */
-    CHECK(system("rm -rf build/tests/t_mpmcl_bad") == 0);
-    CHECK(system("build/mpmdem_collapse --out build/tests/t_mpmcl_bad --packing /nonexistent > "
-                 "build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "nonexistent"));
-    CHECK(system("build/mpmdem_collapse --out build/tests/t_mpmcl_bad --nx 4 --restart /nonexistent > "
-                 "build/tests/t_mpmcl_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "cannot open"));
-    CHECK(system("test -e build/tests/t_mpmcl_bad") != 0);
-    CHECK(system("build/mpmdem_collapse --help > build/tests/t_mpmcl_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--thin-cell"));
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--rest-frac"));
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_bad.out", "--dem-max"));
+    CHECK(system("rm -rf " BUILD "/tests/t_mpmcl_bad") == 0);
+    CHECK(system(BUILD "/mpmdem_collapse --out " BUILD "/tests/t_mpmcl_bad --packing /nonexistent > "
+                 BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "nonexistent"));
+    CHECK(system(BUILD "/mpmdem_collapse --out " BUILD "/tests/t_mpmcl_bad --nx 4 --restart /nonexistent > "
+                 BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "cannot open"));
+    CHECK(system("test -e " BUILD "/tests/t_mpmcl_bad") != 0);
+    CHECK(system(BUILD "/mpmdem_collapse --help > " BUILD "/tests/t_mpmcl_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "--thin-cell"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "--rest-frac"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "--dem-max"));
 }
 
 /* a corrupted checkpoint is refused by name (status 1); a result that cannot be written (the CSV's
@@ -173,24 +173,24 @@ TEST(collapse_bad_arguments) {
 TEST(collapse_bad_files) {
     CHECK(
         system(
-            "rm -rf build/tests/t_mpmcl_k && mkdir -p build/tests/t_mpmcl_k && "
-            "cp build/tests/t_mpmcl_a/checkpoint.bin build/tests/t_mpmcl_k/ && "
-            "printf 'X' | dd of=build/tests/t_mpmcl_k/checkpoint.bin bs=1 seek=5000 conv=notrunc 2>/dev/null "
+            "rm -rf " BUILD "/tests/t_mpmcl_k && mkdir -p " BUILD "/tests/t_mpmcl_k && "
+            "cp " BUILD "/tests/t_mpmcl_a/checkpoint.bin " BUILD "/tests/t_mpmcl_k/ && "
+            "printf 'X' | dd of=" BUILD "/tests/t_mpmcl_k/checkpoint.bin bs=1 seek=5000 conv=notrunc 2>/dev/null "
             "&& " CL "--t-end " CL_T_END
-            " --restart build/tests/t_mpmcl_k --out build/tests/t_mpmcl_k2 > build/tests/t_mpmcl_k.out 2>&1; "
+            " --restart " BUILD "/tests/t_mpmcl_k --out " BUILD "/tests/t_mpmcl_k2 > " BUILD "/tests/t_mpmcl_k.out 2>&1; "
             "test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_k.out", "checksum mismatch"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_k.out", "checksum mismatch"));
     CHECK(
-        system("rm -rf build/tests/t_mpmcl_w && mkdir -p build/tests/t_mpmcl_w/collapse.csv && " CL
-               "--t-end 0.03 --out build/tests/t_mpmcl_w > build/tests/t_mpmcl_w.out 2>&1; test $? -eq 1") ==
+        system("rm -rf " BUILD "/tests/t_mpmcl_w && mkdir -p " BUILD "/tests/t_mpmcl_w/collapse.csv && " CL
+               "--t-end 0.03 --out " BUILD "/tests/t_mpmcl_w > " BUILD "/tests/t_mpmcl_w.out 2>&1; test $? -eq 1") ==
         0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_w.out",
-                           "mpmdem_collapse: cannot write build/tests/t_mpmcl_w/collapse.csv"));
-    CHECK(system("grep -c 'cannot write' build/tests/t_mpmcl_w.out | grep -qx 1") == 0);
-    CHECK(system("echo x > build/tests/t_mpmcl_file && " CL
-                 "--out build/tests/t_mpmcl_file > build/tests/t_mpmcl_f.out 2>&1; "
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_w.out",
+                           "mpmdem_collapse: cannot write " BUILD "/tests/t_mpmcl_w/collapse.csv"));
+    CHECK(system("grep -c 'cannot write' " BUILD "/tests/t_mpmcl_w.out | grep -qx 1") == 0);
+    CHECK(system("echo x > " BUILD "/tests/t_mpmcl_file && " CL
+                 "--out " BUILD "/tests/t_mpmcl_file > " BUILD "/tests/t_mpmcl_f.out 2>&1; "
                  "test $? -eq 1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmcl_f.out", "is a file, not a folder"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_f.out", "is a file, not a folder"));
 }
 
 int main(int argc, char **argv) {

@@ -13,7 +13,7 @@
 #include "../examples/footing_mech.h"
 
 #define FT                                                                                                  \
-    "build/mpmdem_footing --width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 --every " \
+    BUILD "/mpmdem_footing --width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 --every " \
     "0.005 --smooth 0.01 --quiet "
 
 #define NCOL 9
@@ -43,12 +43,12 @@ TEST(footing_runs_and_loads) {
     double r[16][NCOL], phi, nq, nqa, pi = 3.14159265358979323846, t;
     int n, k;
     CHECK(system(FT
-                 "--final 0.02 --phi-pressures 20 --phi-strain 0.025 --threads 1 --out build/tests/t_mpmft "
-                 "> build/tests/t_mpmft.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmft/footing.csv",
+                 "--final 0.02 --phi-pressures 20 --phi-strain 0.025 --threads 1 --out " BUILD "/tests/t_mpmft "
+                 "> " BUILD "/tests/t_mpmft.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft/footing.csv",
                            "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds,"
                            "wedge_deg,heave_x_over_B,heave_over_B"));
-    n = read_rows("build/tests/t_mpmft/footing.csv", r, 16);
+    n = read_rows(BUILD "/tests/t_mpmft/footing.csv", r, 16);
     CHECK_EQ_INT(n, 5);
     if (n != 5) return;
     CHECK(r[0][2] < 1e-3);                               /* first row: d ~ 0 */
@@ -59,29 +59,29 @@ TEST(footing_runs_and_loads) {
         CHECK(r[k][3] > r[k - 1][3]); /* the load grows with the settlement at first */
     }
     CHECK(r[n - 1][4] > 5.0);
-    phi = gk_test_result("build/tests/t_mpmft.out", "phi_deg");
+    phi = gk_test_result(BUILD "/tests/t_mpmft.out", "phi_deg");
     CHECK(phi > 25.0 && phi < 40.0);
     t = tan(pi / 4 + phi * pi / 360.0);
-    nqa = gk_test_result("build/tests/t_mpmft.out", "Nq_analytic");
+    nqa = gk_test_result(BUILD "/tests/t_mpmft.out", "Nq_analytic");
     CHECK_REL(nqa, t * t * exp(pi * tan(phi * pi / 180.0)), 2e-4);
-    nq = gk_test_result("build/tests/t_mpmft.out", "Nq");
+    nq = gk_test_result(BUILD "/tests/t_mpmft.out", "Nq");
     CHECK(nq > 1.0 && nq < 100.0);
-    CHECK_NEAR(gk_test_result("build/tests/t_mpmft.out", "n_rves"), 12, 0);
-    CHECK_NEAR(gk_test_result("build/tests/t_mpmft.out", "ultimate_reached"), 0, 0); /* 0.02 B: too early */
-    CHECK(gk_test_file_has("build/tests/t_mpmft.out", "ultimate load NOT reached"));
-    CHECK(gk_test_result("build/tests/t_mpmft.out", "mpm_steps") > 10);
-    CHECK(gk_test_result("build/tests/t_mpmft.out", "seconds_per_step_per_1000_rves") > 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmft/footing_load.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmft/rve_mohr.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmft/rve_biaxial.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmft/eps_q_end.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmft/displacement_end.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_mpmft/points_000000.vtk", "SCALARS eps_q"));
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "n_rves"), 12, 0);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "ultimate_reached"), 0, 0); /* 0.02 B: too early */
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft.out", "ultimate load NOT reached"));
+    CHECK(gk_test_result(BUILD "/tests/t_mpmft.out", "mpm_steps") > 10);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmft.out", "seconds_per_step_per_1000_rves") > 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft/footing_load.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft/rve_mohr.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft/rve_biaxial.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft/eps_q_end.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft/displacement_end.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft/points_000000.vtk", "SCALARS eps_q"));
     /* the mechanism is measured: a wedge angle (this footing has one column under it: coarse) and
      * Prandtl's pi/4 + phi/2 of the measured angle next to it */
-    t = gk_test_result("build/tests/t_mpmft.out", "wedge_deg");
+    t = gk_test_result(BUILD "/tests/t_mpmft.out", "wedge_deg");
     CHECK(t > 30.0 && t < 80.0);
-    CHECK_NEAR(gk_test_result("build/tests/t_mpmft.out", "wedge_prandtl_deg"), 45.0 + 0.5 * phi,
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "wedge_prandtl_deg"), 45.0 + 0.5 * phi,
                0.01); /* both printed to 4 digits */
 }
 
@@ -89,19 +89,19 @@ TEST(footing_runs_and_loads) {
  * exit before the footing (no footing.csv) */
 TEST(footing_phi_only) {
     double phi, e0;
-    CHECK(system("rm -rf build/tests/t_mpmft_phi && build/mpmdem_footing --phi-only --phi-pressures 20 "
-                 "--phi-strain 0.025 --threads 1 --out build/tests/t_mpmft_phi > build/tests/t_mpmft_phi.out "
+    CHECK(system("rm -rf " BUILD "/tests/t_mpmft_phi && " BUILD "/mpmdem_footing --phi-only --phi-pressures 20 "
+                 "--phi-strain 0.025 --threads 1 --out " BUILD "/tests/t_mpmft_phi > " BUILD "/tests/t_mpmft_phi.out "
                  "2>&1") == 0);
-    phi = gk_test_result("build/tests/t_mpmft_phi.out", "phi_deg");
-    CHECK(phi == gk_test_result("build/tests/t_mpmft.out", "phi_deg"));
-    CHECK(gk_test_result("build/tests/t_mpmft_phi.out", "phi_res_deg") ==
-          gk_test_result("build/tests/t_mpmft.out", "phi_res_deg"));
-    e0 = gk_test_result("build/tests/t_mpmft_phi.out", "e0");
+    phi = gk_test_result(BUILD "/tests/t_mpmft_phi.out", "phi_deg");
+    CHECK(phi == gk_test_result(BUILD "/tests/t_mpmft.out", "phi_deg"));
+    CHECK(gk_test_result(BUILD "/tests/t_mpmft_phi.out", "phi_res_deg") ==
+          gk_test_result(BUILD "/tests/t_mpmft.out", "phi_res_deg"));
+    e0 = gk_test_result(BUILD "/tests/t_mpmft_phi.out", "e0");
     CHECK(e0 > 0.15 && e0 < 0.25); /* the dense packing at 20 kPa */
-    CHECK_REL(gk_test_result("build/tests/t_mpmft_phi.out", "p0"), 2e4, 5e-3);
-    CHECK(gk_test_file_has("build/tests/t_mpmft_phi/rve_mohr.svg", "<svg"));
-    CHECK(system("test -e build/tests/t_mpmft_phi/footing.csv") != 0);
-    CHECK(system("test -e build/tests/t_mpmft_phi/checkpoint.bin") != 0);
+    CHECK_REL(gk_test_result(BUILD "/tests/t_mpmft_phi.out", "p0"), 2e4, 5e-3);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft_phi/rve_mohr.svg", "<svg"));
+    CHECK(system("test -e " BUILD "/tests/t_mpmft_phi/footing.csv") != 0);
+    CHECK(system("test -e " BUILD "/tests/t_mpmft_phi/checkpoint.bin") != 0);
 }
 
 /* footing_mech.h on synthetic fields with known answers */
@@ -150,12 +150,12 @@ TEST(footing_mechanism_synthetic) {
  * model reaches a peak (this coarse footing at d/B ~ 0.04) and reports it */
 TEST(footing_ultimate_found) {
     double du, nq, qu;
-    CHECK(system(FT "--final 0.08 --smooth 0.02 --phi-deg 30 --threads 1 --out build/tests/t_mpmft_u "
-                    "> build/tests/t_mpmft_u.out 2>&1") == 0);
-    CHECK_NEAR(gk_test_result("build/tests/t_mpmft_u.out", "ultimate_reached"), 1, 0);
-    du = gk_test_result("build/tests/t_mpmft_u.out", "d_ult_over_B");
-    nq = gk_test_result("build/tests/t_mpmft_u.out", "Nq");
-    qu = gk_test_result("build/tests/t_mpmft_u.out", "q_ult");
+    CHECK(system(FT "--final 0.08 --smooth 0.02 --phi-deg 30 --threads 1 --out " BUILD "/tests/t_mpmft_u "
+                    "> " BUILD "/tests/t_mpmft_u.out 2>&1") == 0);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft_u.out", "ultimate_reached"), 1, 0);
+    du = gk_test_result(BUILD "/tests/t_mpmft_u.out", "d_ult_over_B");
+    nq = gk_test_result(BUILD "/tests/t_mpmft_u.out", "Nq");
+    qu = gk_test_result(BUILD "/tests/t_mpmft_u.out", "q_ult");
     CHECK(du > 0.0 && du < 0.08 - 0.02);
     CHECK_REL(nq, qu / 2e4, 1e-4);
     CHECK(nq > 3.0 && nq < 60.0);
@@ -165,40 +165,40 @@ TEST(footing_ultimate_found) {
 TEST(footing_thread_independent) {
     /* passive waiting: spinning OpenMP threads crawl on a machine busy with other jobs */
     CHECK(system("OMP_WAIT_POLICY=passive " FT
-                 "--final 0.02 --phi-deg 30 --threads 2 --out build/tests/t_mpmft2 "
-                 "> build/tests/t_mpmft2.out 2>&1") == 0);
-    CHECK(system(FT "--final 0.02 --phi-deg 30 --threads 1 --out build/tests/t_mpmft1 > "
-                    "build/tests/t_mpmft1.out 2>&1") == 0);
-    CHECK(gk_test_result("build/tests/t_mpmft1.out", "Nq") ==
-          gk_test_result("build/tests/t_mpmft2.out", "Nq"));
-    CHECK(system("cut -d, -f1-8,10- build/tests/t_mpmft1/footing.csv > build/tests/t_mpmft1.c && "
-                 "cut -d, -f1-8,10- build/tests/t_mpmft2/footing.csv > build/tests/t_mpmft2.c && "
-                 "cmp -s build/tests/t_mpmft1.c build/tests/t_mpmft2.c") == 0);
+                 "--final 0.02 --phi-deg 30 --threads 2 --out " BUILD "/tests/t_mpmft2 "
+                 "> " BUILD "/tests/t_mpmft2.out 2>&1") == 0);
+    CHECK(system(FT "--final 0.02 --phi-deg 30 --threads 1 --out " BUILD "/tests/t_mpmft1 > "
+                    BUILD "/tests/t_mpmft1.out 2>&1") == 0);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmft1.out", "Nq") ==
+          gk_test_result(BUILD "/tests/t_mpmft2.out", "Nq"));
+    CHECK(system("cut -d, -f1-8,10- " BUILD "/tests/t_mpmft1/footing.csv > " BUILD "/tests/t_mpmft1.c && "
+                 "cut -d, -f1-8,10- " BUILD "/tests/t_mpmft2/footing.csv > " BUILD "/tests/t_mpmft2.c && "
+                 "cmp -s " BUILD "/tests/t_mpmft1.c " BUILD "/tests/t_mpmft2.c") == 0);
 }
 
 /* a checkpoint half-way, then --restart: the same curve to the last digit */
 TEST(footing_restart_identical) {
     int rc = system(
         FT
-        "--final 0.01 --phi-deg 30 --threads 1 --out build/tests/t_mpmft_a > build/tests/t_mpmft_a.out 2>&1 "
+        "--final 0.01 --phi-deg 30 --threads 1 --out " BUILD "/tests/t_mpmft_a > " BUILD "/tests/t_mpmft_a.out 2>&1 "
         "&& " FT
-        "--final 0.02 --phi-deg 30 --threads 1 --restart build/tests/t_mpmft_a --out build/tests/t_mpmft_b "
-        "> build/tests/t_mpmft_b.out 2>&1");
+        "--final 0.02 --phi-deg 30 --threads 1 --restart " BUILD "/tests/t_mpmft_a --out " BUILD "/tests/t_mpmft_b "
+        "> " BUILD "/tests/t_mpmft_b.out 2>&1");
     CHECK(rc == 0);
-    CHECK(gk_test_result("build/tests/t_mpmft_b.out", "Nq") ==
-          gk_test_result("build/tests/t_mpmft1.out", "Nq"));
-    CHECK(system("cut -d, -f1-8,10- build/tests/t_mpmft_b/footing.csv > build/tests/t_mpmft_b.c && "
-                 "cmp -s build/tests/t_mpmft_b.c build/tests/t_mpmft1.c") == 0);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmft_b.out", "Nq") ==
+          gk_test_result(BUILD "/tests/t_mpmft1.out", "Nq"));
+    CHECK(system("cut -d, -f1-8,10- " BUILD "/tests/t_mpmft_b/footing.csv > " BUILD "/tests/t_mpmft_b.c && "
+                 "cmp -s " BUILD "/tests/t_mpmft_b.c " BUILD "/tests/t_mpmft1.c") == 0);
 }
 
 /* bad input: a message and a non-zero exit, nothing run */
 TEST(footing_bad_arguments) {
-    const char *o = " > build/tests/t_mpmft_bad.out 2>&1";
+    const char *o = " > " BUILD "/tests/t_mpmft_bad.out 2>&1";
     char cmd[512];
 #define BAD(args, msg)                                                                             \
-    snprintf(cmd, sizeof cmd, "build/mpmdem_footing --out build/tests/t_mpmft_bad %s%s", args, o); \
+    snprintf(cmd, sizeof cmd, BUILD "/mpmdem_footing --out " BUILD "/tests/t_mpmft_bad %s%s", args, o); \
     CHECK(system(cmd) != 0);                                                                       \
-    CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", msg))
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft_bad.out", msg))
     BAD("--nx 0", "out of range");
     BAD("--nx 31 --ny 15", "square");
     BAD("--material wet", "dense, medium or soft");
@@ -212,19 +212,19 @@ TEST(footing_bad_arguments) {
     BAD("--alpha 2", "--alpha");
     BAD("--phi-only --phi-deg 30", "cannot take --phi-deg");
     /* bad input changes nothing: no output folder is made before the inputs are read */
-    CHECK(system("rm -rf build/tests/t_mpmft_bad") == 0);
+    CHECK(system("rm -rf " BUILD "/tests/t_mpmft_bad") == 0);
     BAD("--packing /nonexistent", "nonexistent");
     BAD("--phi-deg 30 --restart /nonexistent", "cannot open");
-    CHECK(system("test -e build/tests/t_mpmft_bad") != 0);
+    CHECK(system("test -e " BUILD "/tests/t_mpmft_bad") != 0);
     BAD("--phi-pressures 10,,20", "--phi-pressures");
     BAD("--phi-pressures 10,20,", "--phi-pressures");
     BAD("--every 0.5 --final 0.2", "--every 0.5 is out of range");
-    BAD("--out build/tests/t_mpmft_bad.out", "is a file, not a folder");
+    BAD("--out " BUILD "/tests/t_mpmft_bad.out", "is a file, not a folder");
 #undef BAD
-    CHECK(system("build/mpmdem_footing --help > build/tests/t_mpmft_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", "--phi-pressures"));
-    CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", "--paper"));
-    CHECK(gk_test_file_has("build/tests/t_mpmft_bad.out", "--dem-rule"));
+    CHECK(system(BUILD "/mpmdem_footing --help > " BUILD "/tests/t_mpmft_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft_bad.out", "--phi-pressures"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft_bad.out", "--paper"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft_bad.out", "--dem-rule"));
 }
 
 int main(int argc, char **argv) {

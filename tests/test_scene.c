@@ -1653,42 +1653,42 @@ static int dembx_consolidated(const char *csv, double *lid, double *sxx) {
 TEST(dem_biaxial_smoke) {
     double ratio, n;
     int rc;
-    rc = system("build/dem_biaxial --tiles 1x1 --strain 0.01 --every 0.002 --pictures 0.004 --quiet "
-                "--out build/tests/t_dembx > build/tests/t_dembx.out 2>&1");
+    rc = system(BUILD "/dem_biaxial --tiles 1x1 --strain 0.01 --every 0.002 --pictures 0.004 --quiet "
+                "--out " BUILD "/tests/t_dembx > " BUILD "/tests/t_dembx.out 2>&1");
     CHECK(rc == 0);
     CHECK(gk_test_file_has(
-        "build/tests/t_dembx/biaxial.csv",
+        BUILD "/tests/t_dembx/biaxial.csv",
         "eps_axial,sigma_yy_lid,sigma_xx,sigma_yy,eps_vol,stress_ratio,phi_deg,coordination"));
-    CHECK(gk_test_file_has("build/tests/t_dembx/particles_001.vtk", "POINT_DATA"));
-    CHECK(gk_test_file_has("build/tests/t_dembx/walls_end.vtk", "CELL_DATA"));
-    CHECK(gk_test_file_has("build/tests/t_dembx/particles_000.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_dembx/biaxial_stress.svg", "<svg"));
-    ratio = gk_test_result("build/tests/t_dembx.out", "peak_ratio");
-    n = gk_test_result("build/tests/t_dembx.out", "n");
+    CHECK(gk_test_file_has(BUILD "/tests/t_dembx/particles_001.vtk", "POINT_DATA"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_dembx/walls_end.vtk", "CELL_DATA"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_dembx/particles_000.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_dembx/biaxial_stress.svg", "<svg"));
+    ratio = gk_test_result(BUILD "/tests/t_dembx.out", "peak_ratio");
+    n = gk_test_result(BUILD "/tests/t_dembx.out", "n");
     printf("    n %g, peak stress ratio %.4f at %.4f, sigma_yy peak %.4g Pa\n", n, ratio,
-           gk_test_result("build/tests/t_dembx.out", "eps_peak"),
-           gk_test_result("build/tests/t_dembx.out", "syy_peak"));
+           gk_test_result(BUILD "/tests/t_dembx.out", "eps_peak"),
+           gk_test_result(BUILD "/tests/t_dembx.out", "syy_peak"));
     CHECK(n == 400);
     CHECK(ratio > 0.1 && ratio < 0.8);
-    CHECK(gk_test_result("build/tests/t_dembx.out", "syy_peak") > 1.2e5);
+    CHECK(gk_test_result(BUILD "/tests/t_dembx.out", "syy_peak") > 1.2e5);
     {
         double lid, sxx;
-        CHECK(dembx_consolidated("build/tests/t_dembx/biaxial.csv", &lid, &sxx));
+        CHECK(dembx_consolidated(BUILD "/tests/t_dembx/biaxial.csv", &lid, &sxx));
         CHECK_REL(lid, 1e5, 0.02);
         CHECK_REL(sxx, 1e5, 0.1);
     }
-    CHECK(WEXITSTATUS(system("build/dem_biaxial --strain abc > build/tests/t_dembx.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/tests/t_dembx.err", "--strain 'abc' is not a finite number"));
-    CHECK(WEXITSTATUS(system("build/dem_biaxial --strain 0.01 --every 0.02 > build/tests/t_dembx.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/tests/t_dembx.err", "--every 0.02: need a strain in (0, --strain]"));
-    CHECK(WEXITSTATUS(system("build/dem_biaxial --tiles 0x2 > build/tests/t_dembx.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/tests/t_dembx.err", "--tiles"));
-    CHECK(WEXITSTATUS(system("build/dem_biaxial --bogus 1 > build/tests/t_dembx.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/tests/t_dembx.err", "unknown option --bogus"));
-    CHECK(WEXITSTATUS(system("build/dem_biaxial --tiles 1x1 --strain 0.002 --every 0.001 --quiet "
-                             "--out /proc/no_such_dir > build/tests/t_dembx.err 2>&1")) == 1);
-    CHECK(system("build/dem_biaxial --help > build/tests/t_dembx.err 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_dembx.err", "RESULT"));
+    CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --strain abc > " BUILD "/tests/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "--strain 'abc' is not a finite number"));
+    CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --strain 0.01 --every 0.02 > " BUILD "/tests/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "--every 0.02: need a strain in (0, --strain]"));
+    CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --tiles 0x2 > " BUILD "/tests/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "--tiles"));
+    CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --bogus 1 > " BUILD "/tests/t_dembx.err 2>&1")) == 2);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "unknown option --bogus"));
+    CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --tiles 1x1 --strain 0.002 --every 0.001 --quiet "
+                             "--out /proc/no_such_dir > " BUILD "/tests/t_dembx.err 2>&1")) == 1);
+    CHECK(system(BUILD "/dem_biaxial --help > " BUILD "/tests/t_dembx.err 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "RESULT"));
 }
 
 /* dem_biaxial --generate: a generated packing is consolidated in a box
@@ -1698,12 +1698,12 @@ TEST(dem_biaxial_smoke) {
  * the run completes with all its disks and the lid carries the confining
  * pressure at consolidation (2 %). */
 TEST(dem_biaxial_generate) {
-    CHECK(system("build/dem_biaxial --generate 228 --tiles 1x1 --strain 0.002 --every 0.001 --pictures 0.001 "
-                 "--quiet --out build/tests/t_dembx_gen > build/tests/t_dembx_gen.out 2>&1") == 0);
-    CHECK(gk_test_result("build/tests/t_dembx_gen.out", "n") == 228);
+    CHECK(system(BUILD "/dem_biaxial --generate 228 --tiles 1x1 --strain 0.002 --every 0.001 --pictures 0.001 "
+                 "--quiet --out " BUILD "/tests/t_dembx_gen > " BUILD "/tests/t_dembx_gen.out 2>&1") == 0);
+    CHECK(gk_test_result(BUILD "/tests/t_dembx_gen.out", "n") == 228);
     {
         double lid, sxx;
-        CHECK(dembx_consolidated("build/tests/t_dembx_gen/biaxial.csv", &lid, &sxx));
+        CHECK(dembx_consolidated(BUILD "/tests/t_dembx_gen/biaxial.csv", &lid, &sxx));
         CHECK_REL(lid, 1e5, 0.02);
     }
 }
@@ -1714,29 +1714,29 @@ TEST(dem_biaxial_generate) {
  * close (balance below 1e-3 of E_p0); bad arguments are refused by name. */
 TEST(dem_collapse_smoke) {
     double ds, ed, bal, h;
-    CHECK(system("build/dem_collapse --diameters 8 --t-end 0.6 --every 0.02 --snapshots 0.3 --quiet "
-                 "--out build/tests/t_demcl > build/tests/t_demcl.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_demcl/collapse.csv",
+    CHECK(system(BUILD "/dem_collapse --diameters 8 --t-end 0.6 --every 0.02 --snapshots 0.3 --quiet "
+                 "--out " BUILD "/tests/t_demcl > " BUILD "/tests/t_demcl.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_demcl/collapse.csv",
                            "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0"));
-    CHECK(gk_test_file_has("build/tests/t_demcl/particles_001.vtk", "POINT_DATA"));
-    CHECK(gk_test_file_has("build/tests/t_demcl/walls_000.vtk", "CELL_DATA"));
-    CHECK(gk_test_file_has("build/tests/t_demcl/collapse_front.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_demcl/collapse_energy.svg", "<svg"));
-    ds = gk_test_result("build/tests/t_demcl.out", "dstar");
-    ed = gk_test_result("build/tests/t_demcl.out", "Ed_final_over_Ep0");
-    bal = gk_test_result("build/tests/t_demcl.out", "energy_balance");
-    h = gk_test_result("build/tests/t_demcl.out", "height_over_H0");
+    CHECK(gk_test_file_has(BUILD "/tests/t_demcl/particles_001.vtk", "POINT_DATA"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_demcl/walls_000.vtk", "CELL_DATA"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_demcl/collapse_front.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_demcl/collapse_energy.svg", "<svg"));
+    ds = gk_test_result(BUILD "/tests/t_demcl.out", "dstar");
+    ed = gk_test_result(BUILD "/tests/t_demcl.out", "Ed_final_over_Ep0");
+    bal = gk_test_result(BUILD "/tests/t_demcl.out", "energy_balance");
+    h = gk_test_result(BUILD "/tests/t_demcl.out", "height_over_H0");
     printf("    d* %.4f, E_d %.4f E_p0, height %.4f H0, balance %.2e E_p0\n", ds, ed, h, bal);
     CHECK(ds > 0.3);
     CHECK(ed > 0.0 && ed <= 1.0);
     CHECK(h < 1.0);
     CHECK(fabs(bal) < 1e-3);
-    CHECK(WEXITSTATUS(system("build/dem_collapse --a 20 > build/tests/t_demcl.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/tests/t_demcl.err", "--a 20 is out of range: needs an aspect ratio in [0.2, 10]"));
-    CHECK(WEXITSTATUS(system("build/dem_collapse --snapshots 1,0.5 > build/tests/t_demcl.err 2>&1")) == 2);
-    CHECK(gk_test_file_has("build/tests/t_demcl.err", "--snapshots"));
-    CHECK(WEXITSTATUS(system("build/dem_collapse --diameters 8 --t-end 0.02 --quiet --out /proc/no_such_dir "
-                             "> build/tests/t_demcl.err 2>&1")) == 1);
+    CHECK(WEXITSTATUS(system(BUILD "/dem_collapse --a 20 > " BUILD "/tests/t_demcl.err 2>&1")) == 2);
+    CHECK(gk_test_file_has(BUILD "/tests/t_demcl.err", "--a 20 is out of range: needs an aspect ratio in [0.2, 10]"));
+    CHECK(WEXITSTATUS(system(BUILD "/dem_collapse --snapshots 1,0.5 > " BUILD "/tests/t_demcl.err 2>&1")) == 2);
+    CHECK(gk_test_file_has(BUILD "/tests/t_demcl.err", "--snapshots"));
+    CHECK(WEXITSTATUS(system(BUILD "/dem_collapse --diameters 8 --t-end 0.02 --quiet --out /proc/no_such_dir "
+                             "> " BUILD "/tests/t_demcl.err 2>&1")) == 1);
 }
 
 int main(int argc, char **argv) {

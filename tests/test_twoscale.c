@@ -344,9 +344,9 @@ TEST(checkpoint_round_trip_is_bit_identical) {
         step_dH(8, k, 2e-3, dH);
         ok &= gk_twoscale_run(&a, dH, NULL, sa, Da) == GK_OK && gk_twoscale_accept(&a) == GK_OK;
     }
-    CHECK(gk_twoscale_save(&a, "build/tests/t_ts_ck.bin", blk, sizeof blk) == GK_OK);
+    CHECK(gk_twoscale_save(&a, BUILD "/tests/t_ts_ck.bin", blk, sizeof blk) == GK_OK);
     CHECK(make_set(&b, 8, 1, GK_TWOSCALE_ADAPTIVE, GK_TWOSCALE_TANGENT_HOMOG, 0.3) == GK_OK);
-    CHECK(gk_twoscale_load(&b, "build/tests/t_ts_ck.bin", &got, &ng) == GK_OK);
+    CHECK(gk_twoscale_load(&b, BUILD "/tests/t_ts_ck.bin", &got, &ng) == GK_OK);
     CHECK(ng == sizeof blk && got && memcmp(got, blk, ng) == 0);
     gk_twoscale_free(&b, got);
     for (k = 2; k < 5; ++k) { /* large steps: the networks outgrow the loaded key arrays */
@@ -412,14 +412,14 @@ TEST(corrupt_checkpoints_are_refused_and_change_nothing) {
     unsigned char *img = NULL, *x;
     long n, cut;
     int k, ok;
-    const char *bad = "build/tests/t_ts_bad.bin";
+    const char *bad = BUILD "/tests/t_ts_bad.bin";
     CHECK(load_packings());
     if (!have_packings) return;
     CHECK(make_set(&a, 4, 1, GK_TWOSCALE_ADAPTIVE, GK_TWOSCALE_TANGENT_HOMOG, 0) == GK_OK);
     step_dH(4, 0, 5e-4, dH);
     CHECK(gk_twoscale_run(&a, dH, NULL, s, NULL) == GK_OK && gk_twoscale_accept(&a) == GK_OK);
-    CHECK(gk_twoscale_save(&a, "build/tests/t_ts_ck2.bin", "xyz", 3) == GK_OK);
-    n = file_bytes("build/tests/t_ts_ck2.bin", &img);
+    CHECK(gk_twoscale_save(&a, BUILD "/tests/t_ts_ck2.bin", "xyz", 3) == GK_OK);
+    n = file_bytes(BUILD "/tests/t_ts_ck2.bin", &img);
     CHECK(n > 1000);
     if (n <= 1000) return;
     x = (unsigned char *)malloc((size_t)n);
@@ -468,12 +468,12 @@ TEST(corrupt_checkpoints_are_refused_and_change_nothing) {
     CHECK(refused(&b, bad, "holds 5 points", dH, sb));
     put_bytes(bad, (const unsigned char *)"hello", 5);
     CHECK(refused(&b, bad, "not a grainkit two-scale checkpoint", dH, sb));
-    CHECK(refused(&b, "build/tests/no_such_dir/ck.bin", "cannot open", dH, sb));
+    CHECK(refused(&b, BUILD "/tests/no_such_dir/ck.bin", "cannot open", dH, sb));
     /* and the intact file still loads */
     {
         void *blk = NULL;
         size_t nb = 0;
-        CHECK(gk_twoscale_load(&b, "build/tests/t_ts_ck2.bin", &blk, &nb) == GK_OK && nb == 3);
+        CHECK(gk_twoscale_load(&b, BUILD "/tests/t_ts_ck2.bin", &blk, &nb) == GK_OK && nb == 3);
         gk_twoscale_free(&b, blk);
     }
     free(img), free(x);
@@ -555,12 +555,12 @@ TEST(caller_procedure_runs_every_point) {
     CHECK(gk_twoscale_accepted(&a, acc, NULL) == GK_OK && same(acc, s, 36));
     CHECK(gk_twoscale_accepted(&a, acc, D) == GK_ERR_ARG);
     CHECK(gk_twoscale_fields(&a, f) == GK_OK && same(f[2].stress, s + 18, 9) && f[2].p == gk_stress_p(s + 18, 2));
-    CHECK(gk_twoscale_save(&a, "build/tests/t_ts_proc.bin", "x", 1) == GK_OK);
+    CHECK(gk_twoscale_save(&a, BUILD "/tests/t_ts_proc.bin", "x", 1) == GK_OK);
     CHECK(gk_twoscale_run(&a, dH2, NULL, s2, NULL) == GK_OK);
     for (k = 0; k < 4; ++k) CHECK(lg.H4[k] == dH[9 * k + 4]); /* the accepted H */
     /* a fresh set from the checkpoint (one thread): the accepted stress and the next run, bit for bit */
     CHECK(make_proc_set(&b, 1, &lgb) == GK_OK);
-    CHECK(gk_twoscale_load(&b, "build/tests/t_ts_proc.bin", &blk, &nb) == GK_OK && nb == 1);
+    CHECK(gk_twoscale_load(&b, BUILD "/tests/t_ts_proc.bin", &blk, &nb) == GK_OK && nb == 1);
     gk_twoscale_free(&b, blk);
     CHECK(gk_twoscale_accepted(&b, acc, NULL) == GK_OK && same(acc, s, 36));
     CHECK(gk_twoscale_run(&b, dH2, NULL, sb, NULL) == GK_OK && same(sb, s2, 36));
@@ -623,7 +623,7 @@ TEST(bad_arguments_are_refused) {
     CHECK(same(s, keep, 27));                                   /* outputs untouched */
     CHECK(gk_twoscale_accept(&ts) == GK_ERR_STATE);             /* refused runs leave nothing to accept */
     CHECK(gk_twoscale_save(&ts, NULL, NULL, 0) == GK_ERR_ARG);
-    CHECK(gk_twoscale_save(&ts, "build/tests/no_such_dir/ck.bin", NULL, 0) == GK_ERR_IO);
+    CHECK(gk_twoscale_save(&ts, BUILD "/tests/no_such_dir/ck.bin", NULL, 0) == GK_ERR_IO);
     CHECK(gk_twoscale_run(&ts, dH, NULL, s, NULL) == GK_OK && same(s, s0, 27)); /* still the same set */
     gk_twoscale_destroy(&ts);
 }

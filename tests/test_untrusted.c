@@ -23,8 +23,8 @@
 #include <sys/wait.h>
 
 static const char *RVE400 = "examples/data/rve400.txt";
-#define LOG(name) " > build/tests/t_untrusted_" name ".out 2>&1"
-#define OUT(name) "build/tests/t_untrusted_" name
+#define LOG(name) " > " BUILD "/tests/t_untrusted_" name ".out 2>&1"
+#define OUT(name) BUILD "/tests/t_untrusted_" name
 
 /* ------------------------------------------------------------- helpers */
 /* an allocator that records the largest request and refuses anything above cap */
@@ -856,17 +856,17 @@ static size_t find_tag(const unsigned char *b, size_t n, const char *tag) {
  * (the seeds of fuzz_femdem_ckpt and fuzz_mpmdem_ckpt found the FEMxDEM ones). */
 TEST(driver_checkpoint_blocks_are_checked) {
 #define FD_CK                                                                                     \
-    "build/femdem_biaxial --test single --steps 1 --increment 1e-4 --checkpoint 1 --vtk-every 0 " \
+    BUILD "/femdem_biaxial --test single --steps 1 --increment 1e-4 --checkpoint 1 --vtk-every 0 " \
     "--threads 1 --packing " OUT("ck_pk.txt") " "
 #define MP_CK                                                                                      \
-    "build/mpmdem_biaxial --nx 1 --ny 2 --width 1 --height 2 --velocity 1 --ramp 0 --every 0.008 " \
+    BUILD "/mpmdem_biaxial --nx 1 --ny 2 --width 1 --height 2 --velocity 1 --ramp 0 --every 0.008 " \
     "--threads 1 --dem-max 50 --quiet --packing " OUT("ck_pk.txt") " "
     unsigned char *b;
     size_t n, at;
     int32_t step = -5;
     double v;
     remove(OUT("fd_b/biaxial.csv")), remove(OUT("mp_b/biaxial.csv")); /* of an earlier run */
-    CHECK_EQ_INT(run_status("build/gk_pack --n 60 --out " OUT("ck_pk.txt") LOG("ck_pk")), 0);
+    CHECK_EQ_INT(run_status(BUILD "/gk_pack --n 60 --out " OUT("ck_pk.txt") LOG("ck_pk")), 0);
     /* FEMxDEM: the block starts with its tag, 4 ints of the mesh options, then the step */
     CHECK_EQ_INT(run_status(FD_CK "--out " OUT("fd_a") LOG("fd_a")), 0);
     b = file_image(OUT("fd_a/checkpoint.bin"), &n);
@@ -925,10 +925,10 @@ TEST(driver_checkpoint_blocks_are_checked) {
  * Refused now by name, with exit 1 and no new rows. */
 TEST(dr_and_nonlocal_checkpoints_refuse_non_finite_values) {
 #define DR_CK                                                                                              \
-    "build/femdem_dr --nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 " \
+    BUILD "/femdem_dr --nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 " \
     "--steps 2 --threads 1 "
 #define NL_CK                                                                                     \
-    "build/femdem_nonlocal --test element-shear --packing examples/data/rve160_hm.txt --steps 4 " \
+    BUILD "/femdem_nonlocal --test element-shear --packing examples/data/rve160_hm.txt --steps 4 " \
     "--strain 0.0004 --lone-increments 2 --threads 1 "
     unsigned char *b;
     size_t n, at;
@@ -965,8 +965,8 @@ TEST(dr_and_nonlocal_checkpoints_refuse_non_finite_values) {
 }
 
 /* =============================================================== tools */
-#define RVE_PATH "build/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
-#define GK_PACK "build/gk_pack --n 60 "
+#define RVE_PATH BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
+#define GK_PACK BUILD "/gk_pack --n 60 "
 
 /* gk_pack --target-void-ratio 2.5 (no 2D disk packing gets there) ended
  * with exit 0 and e = 0.24; now exit 1 and no file */
@@ -1012,8 +1012,8 @@ TEST(bench_tradeoff_fails_when_a_run_fails) {
     const char *names[3] = {"femdem_biaxial", "femdem_biaxial_float", "mpmdem_biaxial"};
     char path[256];
     int k;
-    if (!exists("build/bench_tradeoff")) {
-        printf("    build/bench_tradeoff missing: `make test` builds it\n");
+    if (!exists(BUILD "/bench_tradeoff")) {
+        printf("    " BUILD "/bench_tradeoff missing: `make test` builds it\n");
         CHECK(0);
         return;
     }
@@ -1028,7 +1028,7 @@ TEST(bench_tradeoff_fails_when_a_run_fails) {
         fclose(fp);
         chmod(path, 0755);
     }
-    CHECK_EQ_INT(run_status("build/bench_tradeoff --bin " OUT("fakebin") " --out " OUT(
+    CHECK_EQ_INT(run_status(BUILD "/bench_tradeoff --bin " OUT("fakebin") " --out " OUT(
                      "tradeoff") " --steps 2" LOG("tradeoff")),
                  1);
     CHECK(gk_test_file_has(OUT("tradeoff.out"), "400d adaptive) failed: see"));
@@ -1037,7 +1037,7 @@ TEST(bench_tradeoff_fails_when_a_run_fails) {
 
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
-    mkdir("build/tests", 0755);
+    mkdir(BUILD "/tests", 0755);
     RUN(packing_header_of_2e9_particles_allocates_nothing);
     RUN(packing_huge_cells_bin_without_overflow);
     RUN(cells_tiny_cutoff_and_nan_positions);
