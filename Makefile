@@ -196,44 +196,47 @@ check-nosimd: $(NOSIMD_TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 # STANDALONE with only their own GK_X_IMPLEMENTATION: every grainkit function
 # they call is then defined (the FEM family implements what it includes)
 STANDALONE := gk_sparse.h gk_mesh.h gk_dofmap.h gk_nonlocal.h gk_fem.h
-check-headers: | $(BUILD)/hdr
-	@echo "== header portability"
-	@set -e; for h in $(notdir $(HEADERS)); do \
-	  for cc in gcc clang; do \
-	    for def in "" "-DGK_IMPLEMENTATION" "-DGK_IMPLEMENTATION -DGK_REAL_FLOAT" "-DGK_IMPLEMENTATION -DGK_NO_SIMD"; do \
-	      printf '#include "%s"\nint gk__dummy;\n' $$h | $$cc -std=c99 -pedantic -Wall -Wextra -Werror -Wshadow $(ARCH) $$def -Iinclude -x c -c - -o $(BUILD)/hdr/x.o \
-	        || { echo "FAILED: $$cc $$def $$h"; exit 1; }; \
-	    done; \
+# one stamp per header (make -j runs them in parallel; check-build makes them too)
+HDR_OK   := $(patsubst include/%.h,$(BUILD)/hdr/%.ok,$(HEADERS)) \
+            $(patsubst %.h,$(BUILD)/hdr/%.alone,$(STANDALONE))
+$(BUILD)/hdr/%.ok: include/%.h $(HEADERS) | $(BUILD)/hdr
+	@set -e; h=$*.h; \
+	for cc in gcc clang; do \
+	  for def in "" "-DGK_IMPLEMENTATION" "-DGK_IMPLEMENTATION -DGK_REAL_FLOAT" "-DGK_IMPLEMENTATION -DGK_NO_SIMD"; do \
+	    printf '#include "%s"\nint gk__dummy;\n' $$h | $$cc -std=c99 -pedantic -Wall -Wextra -Werror -Wshadow $(ARCH) $$def -Iinclude -x c -fsyntax-only - \
+	      || { echo "FAILED: $$cc $$def $$h"; exit 1; }; \
 	  done; \
-	  for cxx in g++ clang++; do \
-	    for def in "" "-DGK_IMPLEMENTATION"; do \
-	      printf '#include "%s"\nint gk__dummy;\n' $$h | $$cxx -std=c++11 -Wall -Wextra -Werror $(ARCH) $$def -Iinclude -x c++ -c - -o $(BUILD)/hdr/x.o \
-	        || { echo "FAILED: $$cxx $$def $$h"; exit 1; }; \
-	    done; \
+	done; \
+	for cxx in g++ clang++; do \
+	  for def in "" "-DGK_IMPLEMENTATION"; do \
+	    printf '#include "%s"\nint gk__dummy;\n' $$h | $$cxx -std=c++11 -Wall -Wextra -Werror $(ARCH) $$def -Iinclude -x c++ -fsyntax-only - \
+	      || { echo "FAILED: $$cxx $$def $$h"; exit 1; }; \
 	  done; \
-	  echo "ok   $$h (gcc, clang: c99 -pedantic; g++, clang++: c++11; float; no-SIMD)"; \
-	done
-	@set -e; for h in $(STANDALONE); do \
-	  m=GK_$$(echo $$h | sed 's/^gk_//; s/\.h$$//' | tr a-z A-Z)_IMPLEMENTATION; \
-	  for cc in "gcc -std=c99 -pedantic -x c" "g++ -std=c++11 -x c++"; do \
-	    printf '#include "%s"\nint gk__dummy;\n' $$h | $$cc -Wall -Wextra -Werror -Wshadow $(ARCH) \
-	      -DGK_BASE_IMPLEMENTATION -D$$m -Iinclude -c - -o $(BUILD)/hdr/x.o \
-	      || { echo "FAILED: $$cc -D$$m $$h"; exit 1; }; \
-	    u=$$(nm -u $(BUILD)/hdr/x.o | awk '$$2 ~ /^_?gk_/ {print $$2}' | tr '\n' ' '); \
-	    [ -z "$$u" ] || { echo "FAILED: $$h with $$m alone leaves undefined: $$u"; exit 1; }; \
-	    for f in $$(sed -n 's/^GKDEF[^(]*[ *]\(gk_[a-z0-9_]*\)(.*/\1/p' include/$$h); do \
-	      nm --defined-only $(BUILD)/hdr/x.o | grep -q " T _\{0,1\}$$f$$" \
-	        || { echo "FAILED: $$h with $$m alone does not define $$f"; exit 1; }; \
-	    done; \
+	done; \
+	echo "ok   $$h (gcc, clang: c99 -pedantic; g++, clang++: c++11; float; no-SIMD)"; touch $@
+$(BUILD)/hdr/%.alone: include/%.h $(HEADERS) | $(BUILD)/hdr
+	@set -e; h=$*.h; o=$(BUILD)/hdr/$*.o; \
+	m=GK_$$(echo $$h | sed 's/^gk_//; s/\.h$$//' | tr a-z A-Z)_IMPLEMENTATION; \
+	for cc in "gcc -std=c99 -pedantic -x c" "g++ -std=c++11 -x c++"; do \
+	  printf '#include "%s"\nint gk__dummy;\n' $$h | $$cc -Wall -Wextra -Werror -Wshadow $(ARCH) \
+	    -DGK_BASE_IMPLEMENTATION -D$$m -Iinclude -c - -o $$o \
+	    || { echo "FAILED: $$cc -D$$m $$h"; exit 1; }; \
+	  u=$$(nm -u $$o | awk '$$2 ~ /^_?gk_/ {print $$2}' | tr '\n' ' '); \
+	  [ -z "$$u" ] || { echo "FAILED: $$h with $$m alone leaves undefined: $$u"; exit 1; }; \
+	  for f in $$(sed -n 's/^GKDEF[^(]*[ *]\(gk_[a-z0-9_]*\)(.*/\1/p' include/$$h); do \
+	    nm --defined-only $$o | grep -q " T _\{0,1\}$$f$$" \
+	      || { echo "FAILED: $$h with $$m alone does not define $$f"; exit 1; }; \
 	  done; \
-	  echo "ok   $$h alone with GK_BASE_IMPLEMENTATION + $$m: defines all it declares, calls nothing undefined"; \
-	done
+	done; \
+	echo "ok   $$h alone with GK_BASE_IMPLEMENTATION + $$m: defines all it declares, calls nothing undefined"; touch $@
+check-headers: $(HDR_OK)
+	@echo "== header portability: every header alone, $(words $(HEADERS)) headers, and $(words $(STANDALONE)) of them with only their own implementation: ok"
 
 check: check-headers check-nosimd check-asan check-smoke
 
 # every program make check runs, built and not run: `make -j2 check-build && make check`
 # compiles two at a time, then runs the checks one after the other
-check-build: $(ASAN_TESTS) $(NOSIMD_TESTS) $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) $(EXAMPLES) $(TOOLS)
+check-build: $(HDR_OK) $(ASAN_TESTS) $(NOSIMD_TESTS) $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) $(EXAMPLES) $(TOOLS)
 
 # ---------------------------------------------------------------- run / bench
 # the FEMxDEM biaxial test of Guo & Zhao (2014) at a size that runs in about a minute on
