@@ -179,6 +179,7 @@ static int parse(int argc, char **argv, opts *o) {
         if (!v) return fail("%s needs a value%s", a, "");
         if (!strcmp(a, "--test")) {
             int t;
+            o->test = -1; /* the last --test counts: a misspelt one after a good one is refused too */
             for (t = 0; t < T_COUNT; ++t)
                 if (!strcmp(v, test_name[t])) o->test = t;
             if (o->test < 0)
