@@ -246,6 +246,7 @@ TEST(bad_input_is_refused) {
     static const char *bad[][2] = {
         {"--test element-shear --steps 4x", "--steps '4x' is not a whole number"},
         {"--test foo", "--test 'foo' is not one of"},
+        {"--test element-shear --test foo", "--test 'foo' is not one of"},
         {"--test element-shear --mesh 0x1x1", "--mesh '0x1x1'"},
         {"--test element-shear --mesh 2x2", "--mesh '2x2'"},
         {"--test element-shear --nonlocal -1", "--nonlocal '-1'"},

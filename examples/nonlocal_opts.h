@@ -1,0 +1,337 @@
+/* nonlocal_opts.h - the options of build/femdem_nonlocal (examples/femdem_nonlocal.c) and the
+ * tests they select (examples, not library): the test names, the options, the usage text and the
+ * strict parser with every test's defaults (femdem_nonlocal --help lists them).
+ *
+ * TESTS (units SI; stresses in the outputs compression-positive)
+ *   rve              Table II: K and G of the RVE alone from isotropic
+ *                    compression and simple shear to --strain (2e-3) in
+ *                    --steps increments; initial porosity, Z, p.
+ *   element-biaxial  one 10 mm element (Fig 5 left): bottom and left face on
+ *                    rollers, plane strain, the top pressed down, --pressure
+ *                    on the right face; and the RVE alone on the same path
+ *                    with the same corotational kinematics, its lateral
+ *                    stress held at --pressure per increment by a secant /
+ *                    regula falsi iteration (1e-3 p; where a 512-sphere
+ *                    RVE's response jumps - up to 6 % of p between
+ *                    neighbouring increments at critical state - the closest
+ *                    run within 10 % of p; rve_alone.csv has its stress_2),
+ *                    --lone-increments 400 (half of them in the first tenth
+ *                    of the strain). Compared over ten equal strain windows
+ *                    (mean stress of each curve; both fluctuate by several %
+ *                    at critical state): rve_alone_dev_pct = the largest gap
+ *                    / the RVE's peak, and peak_ratio (Fig 6a).
+ *   element-shear    one element (Fig 5 right): bottom fixed, the top moved
+ *                    horizontally as a rigid platen (one u_y) carrying the
+ *                    normal --pressure, plane strain; the RVE alone likewise
+ *                    with its normal stress held (Fig 6b).
+ *   wave             Fig 8: a 100 x 10 x 10 mm column of 10 elements, left
+ *                    end fixed, lateral faces periodic (eps_22 = eps_33 =
+ *                    eps_23 = 0), the right end moved transversally u_y = a
+ *                    sin(2 pi f t) (--amplitude 1e-4 m, --frequency 1e4 Hz,
+ *                    --dt 1e-6 s, --duration 1e-3 s), no macro damping. The
+ *                    front's arrival per element (the first time |gamma| >
+ *                    1e-3 a / h) against sqrt(G / rho) and against a linear
+ *                    elastic column of the same mesh, steps and excitation
+ *                    (the RVE's K and G, initial stress -p I), whose front
+ *                    runs ahead of sqrt(G / rho) on 4.5 elements per
+ *                    wavelength (mesh dispersion); the loops of element 9
+ *                    and its porosity and Z (Fig 8a, b).
+ *   simple-shear     Figs 9-14: 50.6 x 118 x 12.7 mm, --mesh 5x12x1 (the
+ *                    paper's "12 x 5 x 1": 12 rows over the height), bottom
+ *                    fixed, the top a rigid platen moved horizontally under
+ *                    --pressure, periodic in x and z, one imperfect RVE
+ *                    (--imperfection N particles removed at random, by
+ *                    default 25 x N_particles / 4096 as the paper's 25 of
+ *                    4096, re-consolidated to --pressure with friction) in
+ *                    the middle column of the row starting at 3/4 of the
+ *                    height. Shear stress = base reaction / base area,
+ *                    strain = u_top / 118 mm.
+ *   biaxial          Figs 15-19: 40 x 80 x 5 mm plane strain (--mesh 4x8x1),
+ *                    the top a smooth platen pressed down, --pressure on both
+ *                    sides, the bottom on rollers and rough (u_x = 0) on its
+ *                    left half: the paper's unspecified "asymmetric boundary
+ *                    condition" that starts the band; contact damping 0.
+ */
+#ifndef NONLOCAL_OPTS_H
+#define NONLOCAL_OPTS_H
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { T_RVE, T_EBIAX, T_ESHEAR, T_WAVE, T_SSHEAR, T_BIAX, T_COUNT };
+static const char *test_name[T_COUNT] = {"rve",  "element-biaxial", "element-shear",
+                                         "wave", "simple-shear",    "biaxial"};
+
+typedef struct opts {
+    int test, mesh[3], threads, steps, stop_after, checkpoint, vtk_every, every, imperfection, dem_min,
+        dem_max, lone, paper;
+    double R, pressure, strain, iuf, dem_inertial, dem_damping, contact_damping, density, xi, mass_scale,
+        kappa, dt, dt_safety;
+    double amplitude, frequency, duration;
+    const char *packing, *out, *restart;
+} opts;
+
+/* ------------------------------------------------------------ small helpers */
+static int fail(const char *fmt, const char *a, const char *b) {
+    fprintf(stderr, "femdem_nonlocal: ");
+    fprintf(stderr, fmt, a, b);
+    fputc('\n', stderr);
+    return 2;
+}
+static int real_opt(const char *a, const char *v, double *out) {
+    char *e;
+    errno = 0;
+    *out = strtod(v, &e);
+    if (e == v || *e || errno == ERANGE || !isfinite(*out))
+        return fail("%s '%s' is not a finite number", a, v);
+    return 0;
+}
+static int int_opt(const char *a, const char *v, int *out) {
+    char *e;
+    long x;
+    errno = 0;
+    x = strtol(v, &e, 10);
+    if (e == v || *e || errno == ERANGE || x < INT_MIN || x > INT_MAX)
+        return fail("%s '%s' is not a whole number", a, v);
+    *out = (int)x;
+    return 0;
+}
+static void *xcalloc(size_t n, size_t sz) {
+    void *p = calloc(n ? n : 1, sz);
+    if (!p) {
+        fprintf(stderr, "femdem_nonlocal: out of memory (%lu x %lu bytes)\n", (unsigned long)n,
+                (unsigned long)sz);
+        exit(1);
+    }
+    return p;
+}
+
+static void usage(FILE *fp) {
+    fprintf(fp,
+            "usage: femdem_nonlocal --test rve|element-biaxial|element-shear|wave|simple-shear|biaxial --out "
+            "DIR\n"
+            "  [--mesh NXxNYxNZ] [--nonlocal R|off] [--pressure P] [--strain S] [--steps N] [--packing F]\n"
+            "  [--threads T] [--restart DIR] [--stop-after N] [--checkpoint K] [--vtk-every K] [--every K]\n"
+            "  [--imperfection N] [--iuf X] [--dem-inertial I] [--dem-min N] [--dem-max N]\n"
+            "  [--dem-damping A] [--contact-damping Z] [--density RHO] [--xi X] [--mass-scale S]\n"
+            "  [--hourglass K] [--dt DT] [--dt-safety F] [--amplitude A] [--frequency F] [--duration T]\n"
+            "  [--lone-increments N] [--paper]\n");
+    fprintf(fp,
+            "defaults: --pressure 4.16e5 --packing examples/data/rve512_hm.txt --threads 1 --nonlocal off\n"
+            "  --iuf 0.01 --dem-inertial 2e-3 --dem-min 10 --dem-max 4000 (simple-shear, biaxial: 20)\n"
+            "  --dem-damping 0.2 --contact-damping 0.12 (biaxial 0) --density 2492 --xi 0.3 (wave 0)\n"
+            "  --mass-scale 1 --hourglass 0.1 --dt-safety 0.5 --lone-increments 400\n"
+            "  rve: --strain 2e-3 --steps 20; element-biaxial: --mesh 1x1x1 --strain 0.05 --steps 4000;\n"
+            "  element-shear: --mesh 1x1x1 --strain 0.1 --steps 4000; wave: --mesh 10x1x1 --dt 1e-6\n"
+            "  --duration 1e-3 --amplitude 1e-4 --frequency 1e4; simple-shear: --mesh 5x12x1 --strain 0.2\n"
+            "  --steps 4000 --imperfection 25 x N/4096; biaxial: --mesh 4x8x1 --strain 0.08 --steps 3000.\n"
+            "  --paper: the paper's size, the 4096-sphere RVE (--packing examples/data/rve4096_hm.txt) and\n"
+            "  its I_uf rule in the mesh tests too (--dem-max 4000); flags given override it. The paper's\n"
+            "  nonlocal radius: --nonlocal 6.75e-3.\n"
+            "See the top of examples/femdem_nonlocal.c for the model, the outputs and the RESULT line.\n");
+}
+
+static int parse(int argc, char **argv, opts *o) {
+    int i;
+    memset(o, 0, sizeof *o);
+    o->test = -1;
+    o->R = 0.0;
+    o->pressure = 4.16e5;
+    o->strain = -1;
+    o->steps = -1;
+    o->threads = 1;
+    o->checkpoint = 0;
+    o->vtk_every = 0;
+    o->every = -1;
+    o->imperfection = -1;
+    o->iuf = 0.01;
+    o->dem_inertial = 2e-3;
+    o->dem_min = 10;
+    o->dem_max = -1;
+    o->lone = 400;
+    o->dem_damping = 0.2;
+    o->contact_damping = -1;
+    o->density = 2492.0;
+    o->xi = -1;
+    o->mass_scale = 1.0;
+    o->kappa = 0.1;
+    o->dt = 0.0;
+    o->dt_safety = 0.5;
+    o->amplitude = 1e-4;
+    o->frequency = 1e4;
+    o->duration = 1e-3;
+    o->packing = NULL;
+    for (i = 1; i < argc; ++i) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int bad = 0;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout);
+            exit(0);
+        }
+        if (!strcmp(a, "--paper")) {
+            o->paper = 1;
+            continue;
+        }
+        if (!v) return fail("%s needs a value%s", a, "");
+        if (!strcmp(a, "--test")) {
+            int t;
+            o->test = -1; /* the last --test counts: a misspelt one after a good one is refused too */
+            for (t = 0; t < T_COUNT; ++t)
+                if (!strcmp(v, test_name[t])) o->test = t;
+            if (o->test < 0)
+                return fail(
+                    "--test '%s' is not one of rve, element-biaxial, element-shear, wave, simple-shear, "
+                    "biaxial%s",
+                    v, "");
+        } else if (!strcmp(a, "--mesh")) {
+            char *e;
+            int k;
+            const char *q = v;
+            for (k = 0; k < 3; ++k) {
+                long x;
+                errno = 0;
+                x = strtol(q, &e, 10);
+                if (e == q || errno || x < 1 || x > 1000 || (k < 2 && *e != 'x') || (k == 2 && *e))
+                    return fail("--mesh '%s' is not NXxNYxNZ with counts 1-1000%s", v, "");
+                o->mesh[k] = (int)x;
+                q = e + 1;
+            }
+        } else if (!strcmp(a, "--nonlocal")) {
+            if (!strcmp(v, "off"))
+                o->R = 0.0;
+            else if (!(bad = real_opt(a, v, &o->R)) && !(o->R > 0.0))
+                return fail("--nonlocal '%s' must be a radius > 0 [m] or off%s", v, "");
+        } else if (!strcmp(a, "--pressure"))
+            bad = real_opt(a, v, &o->pressure);
+        else if (!strcmp(a, "--strain"))
+            bad = real_opt(a, v, &o->strain);
+        else if (!strcmp(a, "--steps"))
+            bad = int_opt(a, v, &o->steps);
+        else if (!strcmp(a, "--stop-after"))
+            bad = int_opt(a, v, &o->stop_after);
+        else if (!strcmp(a, "--threads"))
+            bad = int_opt(a, v, &o->threads);
+        else if (!strcmp(a, "--checkpoint"))
+            bad = int_opt(a, v, &o->checkpoint);
+        else if (!strcmp(a, "--vtk-every"))
+            bad = int_opt(a, v, &o->vtk_every);
+        else if (!strcmp(a, "--every"))
+            bad = int_opt(a, v, &o->every);
+        else if (!strcmp(a, "--imperfection"))
+            bad = int_opt(a, v, &o->imperfection);
+        else if (!strcmp(a, "--iuf"))
+            bad = real_opt(a, v, &o->iuf);
+        else if (!strcmp(a, "--dem-inertial"))
+            bad = real_opt(a, v, &o->dem_inertial);
+        else if (!strcmp(a, "--dem-min"))
+            bad = int_opt(a, v, &o->dem_min);
+        else if (!strcmp(a, "--dem-max"))
+            bad = int_opt(a, v, &o->dem_max);
+        else if (!strcmp(a, "--lone-increments"))
+            bad = int_opt(a, v, &o->lone);
+        else if (!strcmp(a, "--dem-damping"))
+            bad = real_opt(a, v, &o->dem_damping);
+        else if (!strcmp(a, "--contact-damping"))
+            bad = real_opt(a, v, &o->contact_damping);
+        else if (!strcmp(a, "--density"))
+            bad = real_opt(a, v, &o->density);
+        else if (!strcmp(a, "--xi"))
+            bad = real_opt(a, v, &o->xi);
+        else if (!strcmp(a, "--mass-scale"))
+            bad = real_opt(a, v, &o->mass_scale);
+        else if (!strcmp(a, "--hourglass"))
+            bad = real_opt(a, v, &o->kappa);
+        else if (!strcmp(a, "--dt"))
+            bad = real_opt(a, v, &o->dt);
+        else if (!strcmp(a, "--dt-safety"))
+            bad = real_opt(a, v, &o->dt_safety);
+        else if (!strcmp(a, "--amplitude"))
+            bad = real_opt(a, v, &o->amplitude);
+        else if (!strcmp(a, "--frequency"))
+            bad = real_opt(a, v, &o->frequency);
+        else if (!strcmp(a, "--duration"))
+            bad = real_opt(a, v, &o->duration);
+        else if (!strcmp(a, "--packing"))
+            o->packing = v;
+        else if (!strcmp(a, "--out"))
+            o->out = v;
+        else if (!strcmp(a, "--restart"))
+            o->restart = v;
+        else
+            return fail("unknown option %s (see --help)%s", a, "");
+        if (bad) return 2;
+        ++i;
+    }
+    if (o->test < 0) return fail("--test is required (see --help)%s%s", "", "");
+    if (!o->out) return fail("--out DIR is required%s%s", "", "");
+    /* test defaults */
+    {
+        static const int mesh[T_COUNT][3] = {{1, 1, 1},  {1, 1, 1},  {1, 1, 1},
+                                             {10, 1, 1}, {5, 12, 1}, {4, 8, 1}};
+        static const double strain[T_COUNT] = {2e-3, 0.05, 0.1, 0.0, 0.2, 0.08};
+        static const int steps[T_COUNT] = {20, 4000, 4000, 0, 4000, 3000};
+        int t = o->test, k;
+        if (!o->mesh[0])
+            for (k = 0; k < 3; ++k) o->mesh[k] = mesh[t][k];
+        if (o->strain < 0) o->strain = strain[t];
+        if (t == T_WAVE) {
+            if (o->dt == 0.0) o->dt = 1e-6;
+            if (o->steps < 0) o->steps = (int)floor(o->duration / o->dt + 0.5);
+        }
+        if (o->steps < 0) o->steps = steps[t];
+        if (o->dem_max < 0) o->dem_max = (t == T_SSHEAR || t == T_BIAX) && !o->paper ? 20 : 4000;
+        if (!o->packing)
+            o->packing = o->paper ? "examples/data/rve4096_hm.txt" : "examples/data/rve512_hm.txt";
+        if (o->imperfection < 0)
+            o->imperfection = t == T_SSHEAR ? -2 : 0; /* -2: 25 x N / 4096 (after reading) */
+        if (o->contact_damping < 0) o->contact_damping = t == T_BIAX ? 0.0 : 0.12;
+        if (o->xi < 0) o->xi = t == T_WAVE ? 0.0 : 0.3;
+        if (o->every < 0)
+            o->every = o->steps / (t == T_EBIAX || t == T_ESHEAR ? 1000 : 200) > 1
+                           ? o->steps / (t == T_EBIAX || t == T_ESHEAR ? 1000 : 200)
+                           : 1;
+    }
+#define REQ(c, ...)                           \
+    if (!(c)) {                               \
+        fprintf(stderr, "femdem_nonlocal: "); \
+        fprintf(stderr, __VA_ARGS__);         \
+        fputc('\n', stderr);                  \
+        return 2;                             \
+    }
+    REQ(o->pressure > 0, "--pressure %g must be > 0 [Pa]", o->pressure);
+    REQ(o->strain > 0 || o->test == T_WAVE, "--strain %g must be > 0", o->strain);
+    REQ(o->strain < 0.5, "--strain %g must be below 0.5", o->strain);
+    REQ(o->steps >= 1 && o->steps <= 100000000, "--steps %d must be 1-1e8", o->steps);
+    REQ(o->stop_after >= 0 && o->stop_after <= o->steps, "--stop-after %d must be 0-%d (--steps)",
+        o->stop_after, o->steps);
+    REQ(o->threads >= 1 && o->threads <= 1024, "--threads %d must be 1-1024", o->threads);
+    REQ(o->checkpoint >= 0, "--checkpoint %d must be >= 0", o->checkpoint);
+    REQ(o->vtk_every >= 0, "--vtk-every %d must be >= 0", o->vtk_every);
+    REQ(o->every >= 1, "--every %d must be >= 1", o->every);
+    REQ(o->imperfection >= -2, "--imperfection %d must be >= 0", o->imperfection);
+    REQ(o->iuf > 0 && o->iuf < 1, "--iuf %g must be in (0, 1)", o->iuf);
+    REQ(o->dem_inertial > 0 && o->dem_inertial < 1, "--dem-inertial %g must be in (0, 1)", o->dem_inertial);
+    REQ(o->dem_min >= 1 && o->dem_max >= o->dem_min && o->dem_max <= 1000000,
+        "--dem-min %d, --dem-max %d: 1 <= min <= max <= 1e6", o->dem_min, o->dem_max);
+    REQ(o->lone >= 2 && o->lone <= 100000, "--lone-increments %d must be 2-100000", o->lone);
+    REQ(o->dem_damping >= 0 && o->dem_damping < 1, "--dem-damping %g must be in [0, 1)", o->dem_damping);
+    REQ(o->contact_damping >= 0 && o->contact_damping < 1, "--contact-damping %g must be in [0, 1)",
+        o->contact_damping);
+    REQ(o->density > 0, "--density %g must be > 0", o->density);
+    REQ(o->xi >= 0 && o->xi <= 10, "--xi %g must be in [0, 10]", o->xi);
+    REQ(o->mass_scale > 0, "--mass-scale %g must be > 0", o->mass_scale);
+    REQ(o->kappa >= 0 && o->kappa <= 1, "--hourglass %g must be in [0, 1]", o->kappa);
+    REQ(o->dt >= 0, "--dt %g must be >= 0 (0: from eq 65)", o->dt);
+    REQ(o->dt_safety > 0 && o->dt_safety <= 1, "--dt-safety %g must be in (0, 1]", o->dt_safety);
+    REQ(o->amplitude > 0 && o->frequency > 0 && o->duration > 0,
+        "--amplitude, --frequency, --duration must be > 0");
+    REQ(o->test != T_RVE || o->R == 0.0, "--nonlocal is for mesh tests, not --test rve");
+#undef REQ
+    return 0;
+}
+
+#endif /* NONLOCAL_OPTS_H */
