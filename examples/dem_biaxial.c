@@ -196,38 +196,49 @@ static double enclosed_area(const gk_scene *sc, double H) {
     return A;
 }
 
-int main(int argc, char **argv) {
+/* the whole run: the options, the scene and what the stages measure */
+typedef struct db_run {
     db_opts o;
     gk_scene sc;
-    gk_scene_def d = gk_scene_def_default();
+    gk_scene_def d;
+    int created, nrows, caprows;
+    db_row *rows;
+    int32_t *chain;
+    double W, H0, A0, rmean, peak, eps_peak, syy_peak, z0, t0;
+    long steps;
+    FILE *csv;
+} db_run;
+
+/* the scene's error, said; 1 */
+static int db_fail(db_run *R) {
+    fprintf(stderr, "dem_biaxial: %s\n", gk_scene_error(&R->sc));
+    return 1;
+}
+
+/* the specimen: the packing (read or generated) tiled and opened in a box, the scene, the platens on
+ * its extreme disks and the membranes on its sides; 0 or 1 (said) */
+static int db_setup(db_run *R) {
+    const db_opts *o = &R->o;
+    gk_scene_def *d = &R->d;
     gk_packing base, tiled;
     gk_err err;
     gk_wall_def flo = gk_wall_def_default(), lid = gk_wall_def_default();
-    db_row *rows = NULL;
-    int32_t *chain = NULL;
-    int status = 0, created = 0, nrows = 0, caprows = 0, k, p, nl, nr, ipic = 0;
-    double W, H0, H, A0, t, rmean = 0.0, rate, v, peak = 0.0, eps_peak = 0.0, syy_peak = 0.0, z0 = 0.0,
-                            t0 = gk_wtime();
-    long steps = 0;
-    char path[1200];
-    FILE *csv = NULL;
-    k = parse(argc, argv, &o);
-    if (k) return k < 0 ? 0 : k;
-    if (dsc_mkdir("dem_biaxial", o.out)) return 1;
-    d.rve =
+    double W, H0;
+    int p, nl, nr;
+    d->rve =
         gk_rve_def_default(); /* the Guo & Zhao 2014 material (linear, E 6e8, kt/kn 0.8, mu tan 0.5, 2D t = 0.1) */
-    d.rve.damping = o.damping;
-    d.rve.threads = o.threads;
-    if (o.generate) {
-        if (generate(&o, &d.rve, &base)) return 1;
-    } else if (gk_packing_read(o.packing, &base, NULL, &err)) {
+    d->rve.damping = o->damping;
+    d->rve.threads = o->threads;
+    if (o->generate) {
+        if (generate(o, &d->rve, &base)) return 1;
+    } else if (gk_packing_read(o->packing, &base, NULL, &err)) {
         return fprintf(stderr, "dem_biaxial: %s\n", err.msg), 1;
     }
     if (base.dim != 2 || base.h[1] != 0.0 || base.h[3] != 0.0) {
         gk_packing_free(&base);
         return fprintf(stderr, "dem_biaxial: the packing must be 2D in a rectangular cell\n"), 1;
     }
-    if (gk_packing_tile(&base, o.tx, o.ty, 1, &tiled, NULL, &err)) {
+    if (gk_packing_tile(&base, o->tx, o->ty, 1, &tiled, NULL, &err)) {
         gk_packing_free(&base);
         return fprintf(stderr, "dem_biaxial: %s\n", err.msg), 1;
     }
@@ -236,7 +247,7 @@ int main(int argc, char **argv) {
     H0 = 1.01 * tiled.h[4];
     for (p = 0; p < tiled.n; ++p) {
         double s;
-        rmean += tiled.r[p] / tiled.n;
+        R->rmean += tiled.r[p] / tiled.n;
         /* positions in the box, dilated by 1 %: the packing is relieved of its
          * stress (its contacts open) before the platens and membranes reload
          * it; opened under load, its edge disks would shoot out */
@@ -245,170 +256,175 @@ int main(int argc, char **argv) {
         s = tiled.y[p] / tiled.h[4];
         tiled.y[p] = H0 * (s - floor(s));
     }
-    d.dim = 2;
-    d.lo[0] = -0.5 * W;
-    d.hi[0] = 1.5 * W;
-    d.lo[1] = -0.1 * H0;
-    d.hi[1] = 1.1 * H0;
-    if (gk_scene_create(&sc, &d, &tiled)) {
+    d->dim = 2;
+    d->lo[0] = -0.5 * W;
+    d->hi[0] = 1.5 * W;
+    d->lo[1] = -0.1 * H0;
+    d->hi[1] = 1.1 * H0;
+    if (gk_scene_create(&R->sc, d, &tiled)) {
         gk_packing_free(&tiled);
-        return fprintf(stderr, "dem_biaxial: %s\n", gk_scene_error(&sc)), 1;
+        return fprintf(stderr, "dem_biaxial: %s\n", gk_scene_error(&R->sc)), 1;
     }
-    created = 1;
+    R->created = 1;
     gk_packing_free(&tiled);
     /* platens on the extreme particles' edges */
     {
         double ylo = 1e300, yhi = -1e300, x[3];
-        for (p = 0; p < sc.rve.n; ++p) {
-            gk_scene_position(&sc, p, x);
-            if (x[1] - sc.rve.r[p] < ylo) ylo = x[1] - sc.rve.r[p];
-            if (x[1] + sc.rve.r[p] > yhi) yhi = x[1] + sc.rve.r[p];
+        for (p = 0; p < R->sc.rve.n; ++p) {
+            gk_scene_position(&R->sc, p, x);
+            if (x[1] - R->sc.rve.r[p] < ylo) ylo = x[1] - R->sc.rve.r[p];
+            if (x[1] + R->sc.rve.r[p] > yhi) yhi = x[1] + R->sc.rve.r[p];
         }
         flo.point[1] = ylo;
         flo.normal[1] = 1.0;
-        flo.mat = d.rve.mat;
-        if (o.platen_mu >= 0) flo.mat.friction = o.platen_mu;
+        flo.mat = d->rve.mat;
+        if (o->platen_mu >= 0) flo.mat.friction = o->platen_mu;
         lid = flo;
         lid.point[1] = yhi;
         lid.normal[1] = -1.0;
         lid.drive = GK_DRIVE_STRESS;
-        lid.target = o.pressure;
-        lid.area = W * sc.rve.volume_factor;
+        lid.target = o->pressure;
+        lid.area = W * R->sc.rve.volume_factor;
         lid.max_speed = 0.01 * H0; /* 1 % of the height per second at most */
-        if (gk_scene_add_wall(&sc, &flo, NULL) || gk_scene_add_wall(&sc, &lid, NULL)) goto fail;
+        if (gk_scene_add_wall(&R->sc, &flo, NULL) || gk_scene_add_wall(&R->sc, &lid, NULL)) return db_fail(R);
         H0 = yhi - ylo;
     }
+    R->W = W;
+    R->H0 = H0;
     /* membranes */
-    chain = (int32_t *)malloc((size_t)sc.rve.n * sizeof *chain);
-    if (!chain) {
-        fprintf(stderr, "dem_biaxial: out of memory\n");
-        status = 1;
-        goto done;
-    }
+    R->chain = (int32_t *)malloc((size_t)R->sc.rve.n * sizeof *R->chain);
+    if (!R->chain) return fprintf(stderr, "dem_biaxial: out of memory\n"), 1;
     {
-        double kn = d.rve.mat.young * rmean, km = o.link_k > 0 ? o.link_k : 0.05 * kn;
-        if (gk_scene_side_chain(&sc, 0, -1, 2.0 * rmean, chain, sc.rve.n, &nl) ||
-            gk_scene_add_membrane(&sc, nl, chain, o.pressure, km, 1, 0, NULL) ||
-            gk_scene_side_chain(&sc, 0, 1, 2.0 * rmean, chain, sc.rve.n, &nr) ||
-            gk_scene_add_membrane(&sc, nr, chain, o.pressure, km, 0, 1, NULL))
-            goto fail;
-        if (!o.quiet)
+        double kn = d->rve.mat.young * R->rmean, km = o->link_k > 0 ? o->link_k : 0.05 * kn;
+        if (gk_scene_side_chain(&R->sc, 0, -1, 2.0 * R->rmean, R->chain, R->sc.rve.n, &nl) ||
+            gk_scene_add_membrane(&R->sc, nl, R->chain, o->pressure, km, 1, 0, NULL) ||
+            gk_scene_side_chain(&R->sc, 0, 1, 2.0 * R->rmean, R->chain, R->sc.rve.n, &nr) ||
+            gk_scene_add_membrane(&R->sc, nr, R->chain, o->pressure, km, 0, 1, NULL))
+            return db_fail(R);
+        if (!o->quiet)
             printf("dem_biaxial: %d disks, %.4g x %.4g m, membranes of %d and %d disks, dt %.3g s\n",
-                   sc.rve.n, W, H0, nl, nr, sc.rve.dt);
+                   R->sc.rve.n, W, H0, nl, nr, R->sc.rve.dt);
     }
-    /* ---- stage 1: consolidation */
+    return 0;
+}
+
+/* stage 1: consolidation at the confining pressure, then the specimen's height and area and its
+ * pictures; 0 or 1 (said) */
+static int db_consolidate(db_run *R) {
+    const db_opts *o = &R->o;
+    gk_scene *sc = &R->sc;
+    double H;
+    long st = 0, chunk = 1000;
+    int calm = 0;
+    for (;;) {
+        double a, err1;
+        if (gk_scene_step(sc, chunk)) return db_fail(R);
+        st += chunk;
+        H = sc->walls[1].pos[1] - sc->walls[0].pos[1];
+        a = enclosed_area(sc, H);
+        sc->walls[1].def.area = a / H * sc->rve.volume_factor; /* the lid's stress over the current width */
+        err1 = fabs(sc->walls[1].resistance / sc->walls[1].def.area - o->pressure) / o->pressure;
+        calm =
+            (err1 < 0.01 && gk_rve_kinetic_energy(&sc->rve) < 1e-7 * o->pressure * a * sc->rve.volume_factor)
+                ? calm + 1
+                : 0;
+        if (calm >= 3 || st >= (long)o->max_cons) break;
+    }
+    if (!o->quiet)
+        printf("dem_biaxial: consolidated in %ld steps: lid %.5g Pa, height %.5g m\n", st,
+               sc->walls[1].resistance / sc->walls[1].def.area, H);
+    R->steps += st;
+    R->H0 = sc->walls[1].pos[1] - sc->walls[0].pos[1];
+    R->A0 = enclosed_area(sc, R->H0);
+    return dsc_pictures("dem_biaxial", sc, o->out, "000", "biaxial specimen, consolidated") ? 1 : 0;
+}
+
+/* stage 2: compression at constant axial strain rate to --strain, a row of biaxial.csv every --every
+ * and the pictures at --pictures; 0 or 1 (said) */
+static int db_compress(db_run *R) {
+    const db_opts *o = &R->o;
+    gk_scene *sc = &R->sc;
+    double rate, v, t, H;
+    int k, p, ipic = 0;
+    char path[1200];
     {
-        long st = 0, chunk = 1000;
-        int calm = 0;
-        for (;;) {
-            double a, err1;
-            if (gk_scene_step(&sc, chunk)) goto fail;
-            st += chunk;
-            H = sc.walls[1].pos[1] - sc.walls[0].pos[1];
-            a = enclosed_area(&sc, H);
-            sc.walls[1].def.area = a / H * sc.rve.volume_factor; /* the lid's stress over the current width */
-            err1 = fabs(sc.walls[1].resistance / sc.walls[1].def.area - o.pressure) / o.pressure;
-            calm =
-                (err1 < 0.01 && gk_rve_kinetic_energy(&sc.rve) < 1e-7 * o.pressure * a * sc.rve.volume_factor)
-                    ? calm + 1
-                    : 0;
-            if (calm >= 3 || st >= (long)o.max_cons) break;
-        }
-        if (!o.quiet)
-            printf("dem_biaxial: consolidated in %ld steps: lid %.5g Pa, height %.5g m\n", st,
-                   sc.walls[1].resistance / sc.walls[1].def.area, H);
-        steps += st;
+        double rho = R->d.rve.mat.density;
+        rate = o->rate > 0 ? o->rate
+                           : 1e-3 * sqrt(o->pressure / rho) / (2.0 * R->rmean); /* I = rate 2r sqrt(rho/p) */
+        v = rate * R->H0;
+        sc->walls[1].def.drive = GK_DRIVE_VELOCITY;
+        sc->walls[1].def.velocity[1] = -v;
+        if (!o->quiet) printf("dem_biaxial: compression at %.4g /s (lid at %.4g m/s)\n", rate, v);
     }
-    H0 = sc.walls[1].pos[1] - sc.walls[0].pos[1];
-    A0 = enclosed_area(&sc, H0);
-    if (dsc_pictures("dem_biaxial", &sc, o.out, "000", "biaxial specimen, consolidated")) {
-        status = 1;
-        goto done;
-    }
-    /* ---- stage 2: constant axial strain rate */
-    {
-        double rho = d.rve.mat.density;
-        rate =
-            o.rate > 0 ? o.rate : 1e-3 * sqrt(o.pressure / rho) / (2.0 * rmean); /* I = rate 2r sqrt(rho/p) */
-        v = rate * H0;
-        sc.walls[1].def.drive = GK_DRIVE_VELOCITY;
-        sc.walls[1].def.velocity[1] = -v;
-        if (!o.quiet) printf("dem_biaxial: compression at %.4g /s (lid at %.4g m/s)\n", rate, v);
-    }
-    snprintf(path, sizeof path, "%s/biaxial.csv", o.out);
-    csv = fopen(path, "w");
-    if (!csv) {
-        fprintf(stderr, "dem_biaxial: cannot write %s\n", path);
-        status = 1;
-        goto done;
-    }
+    snprintf(path, sizeof path, "%s/biaxial.csv", o->out);
+    R->csv = fopen(path, "w");
+    if (!R->csv) return fprintf(stderr, "dem_biaxial: cannot write %s\n", path), 1;
     fprintf(
-        csv,
+        R->csv,
         "eps_axial,sigma_yy_lid,sigma_xx,sigma_yy,eps_vol,stress_ratio,phi_deg,coordination,n_contacts\n");
     t = 0.0;
     for (k = 0;; ++k) {
-        double eps = k * o.every, s[9], a, sxx, syy, ratio, z;
+        double eps = k * o->every, s[9], a, sxx, syy, ratio, z;
         long n;
         int nc = 0;
-        if (eps > o.strain + 1e-12) break;
-        n = (long)floor((eps * H0 / v - t) / sc.rve.dt + 0.5);
+        db_row *row;
+        if (eps > o->strain + 1e-12) break;
+        n = (long)floor((eps * R->H0 / v - t) / sc->rve.dt + 0.5);
         if (n > 0) {
-            if (gk_scene_step(&sc, n)) goto fail;
-            steps += n;
-            t += n * sc.rve.dt;
+            if (gk_scene_step(sc, n)) return db_fail(R);
+            R->steps += n;
+            t += n * sc->rve.dt;
         }
-        H = sc.walls[1].pos[1] - sc.walls[0].pos[1];
-        a = enclosed_area(&sc, H);
-        gk_scene_stress(&sc, a, s);
+        H = sc->walls[1].pos[1] - sc->walls[0].pos[1];
+        a = enclosed_area(sc, H);
+        gk_scene_stress(sc, a, s);
         sxx = -s[0], syy = -s[4];
         ratio = fabs(syy - sxx) / (syy + sxx);
-        for (p = 0; p < sc.rve.pl.n; ++p) nc += (sc.rve.cs[p] & GK_CS_CONTACT) != 0;
-        z = 2.0 * nc / sc.rve.n;
-        if (k == 0) z0 = z;
-        if (nrows == caprows) {
-            db_row *nrw = (db_row *)realloc(rows, (size_t)(caprows ? 2 * caprows : 128) * sizeof *rows);
-            if (!nrw) {
-                fprintf(stderr, "dem_biaxial: out of memory\n");
-                status = 1;
-                goto done;
-            }
-            rows = nrw;
-            caprows = caprows ? 2 * caprows : 128;
+        for (p = 0; p < sc->rve.pl.n; ++p) nc += (sc->rve.cs[p] & GK_CS_CONTACT) != 0;
+        z = 2.0 * nc / sc->rve.n;
+        if (k == 0) R->z0 = z;
+        if (R->nrows == R->caprows) {
+            db_row *nrw =
+                (db_row *)realloc(R->rows, (size_t)(R->caprows ? 2 * R->caprows : 128) * sizeof *R->rows);
+            if (!nrw) return fprintf(stderr, "dem_biaxial: out of memory\n"), 1;
+            R->rows = nrw;
+            R->caprows = R->caprows ? 2 * R->caprows : 128;
         }
-        rows[nrows].eps = (H0 - H) / H0;
-        rows[nrows].syy_lid = sc.walls[1].resistance / (a / H * sc.rve.volume_factor);
-        rows[nrows].sxx = sxx, rows[nrows].syy = syy, rows[nrows].ev = (A0 - a) / A0,
-        rows[nrows].ratio = ratio;
-        rows[nrows].z = z;
-        fprintf(csv, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.4f,%.4f,%d\n", rows[nrows].eps, rows[nrows].syy_lid,
-                sxx, syy, rows[nrows].ev, ratio, asin(ratio < 1 ? ratio : 1) * 180.0 / GK_PI, z, nc);
-        if (ratio > peak) peak = ratio, eps_peak = rows[nrows].eps, syy_peak = syy;
-        if (!o.quiet && k % 5 == 0)
+        row = &R->rows[R->nrows];
+        row->eps = (R->H0 - H) / R->H0;
+        row->syy_lid = sc->walls[1].resistance / (a / H * sc->rve.volume_factor);
+        row->sxx = sxx, row->syy = syy, row->ev = (R->A0 - a) / R->A0, row->ratio = ratio;
+        row->z = z;
+        fprintf(R->csv, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.4f,%.4f,%d\n", row->eps, row->syy_lid, sxx, syy,
+                row->ev, ratio, asin(ratio < 1 ? ratio : 1) * 180.0 / GK_PI, z, nc);
+        if (ratio > R->peak) R->peak = ratio, R->eps_peak = row->eps, R->syy_peak = syy;
+        if (!o->quiet && k % 5 == 0)
             printf("eps %.4f  sigma_yy %.5g (lid %.5g)  sigma_xx %.5g Pa  ratio %.4f  eps_v %+.5f  Z %.3f\n",
-                   rows[nrows].eps, syy, rows[nrows].syy_lid, sxx, ratio, rows[nrows].ev, z);
-        ++nrows;
-        if (ipic < o.npic && eps >= o.pic[ipic] - 1e-12) {
+                   row->eps, syy, row->syy_lid, sxx, ratio, row->ev, z);
+        ++R->nrows;
+        if (ipic < o->npic && eps >= o->pic[ipic] - 1e-12) {
             char tag[32], title[64];
             snprintf(tag, sizeof tag, "%03d", ipic + 1);
             snprintf(title, sizeof title, "biaxial DNS at %.1f %% axial strain", 100.0 * eps);
-            if (dsc_pictures("dem_biaxial", &sc, o.out, tag, title)) {
-                status = 1;
-                goto done;
-            }
+            if (dsc_pictures("dem_biaxial", sc, o->out, tag, title)) return 1;
             ++ipic;
         }
     }
-    if (fclose(csv)) {
-        csv = NULL;
-        fprintf(stderr, "dem_biaxial: error writing %s/biaxial.csv\n", o.out);
-        status = 1;
-        goto done;
+    if (fclose(R->csv)) {
+        R->csv = NULL;
+        return fprintf(stderr, "dem_biaxial: error writing %s/biaxial.csv\n", o->out), 1;
     }
-    csv = NULL;
-    if (dsc_pictures("dem_biaxial", &sc, o.out, "end", "biaxial DNS, end")) {
-        status = 1;
-        goto done;
-    }
+    R->csv = NULL;
+    return 0;
+}
+
+/* the end pictures, biaxial_stress.svg and the RESULT line; 0 or non-zero (said) */
+static int db_report(db_run *R) {
+    const db_opts *o = &R->o;
+    const db_row *rows = R->rows;
+    int k, nrows = R->nrows, status = 0;
+    char path[1200];
+    if (dsc_pictures("dem_biaxial", &R->sc, o->out, "end", "biaxial DNS, end")) return 1;
     {
         double *x = (double *)malloc((size_t)nrows * sizeof *x),
                *y0 = (double *)malloc((size_t)nrows * sizeof *y0),
@@ -427,26 +443,38 @@ int main(int argc, char **argv) {
             lab[0] = "stress ratio |s_yy - s_xx| / (s_yy + s_xx) (Liu, Bosco & Suiker 2018 eq 40)";
             lab[1] = "10 x volumetric strain (compaction +)";
             lab[2] = lab[3] = NULL;
-            snprintf(path, sizeof path, "%s/biaxial_stress.svg", o.out);
+            snprintf(path, sizeof path, "%s/biaxial_stress.svg", o->out);
             status = dsc_plot("dem_biaxial", path, "DEM biaxial DNS", "axial strain", "", x, nrows, yy, lab,
                               0, ref, rl);
         }
         free(x), free(y0), free(y1);
-        if (status) goto done;
+        if (status) return status;
     }
     printf("RESULT n=%d W=%.5g H0=%.5g peak_ratio=%.4f eps_peak=%.4f phi_peak_deg=%.2f ratio_final=%.4f "
            "syy_peak=%.5g "
            "ev_final=%.5f z0=%.3f steps=%ld dt=%.4g seconds=%.2f\n",
-           sc.rve.n, W, H0, peak, eps_peak, asin(peak < 1 ? peak : 1) * 180.0 / GK_PI, rows[nrows - 1].ratio,
-           syy_peak, rows[nrows - 1].ev, z0, steps, sc.rve.dt, gk_wtime() - t0);
-    goto done;
-fail:
-    fprintf(stderr, "dem_biaxial: %s\n", gk_scene_error(&sc));
-    status = 1;
-done:
-    if (csv) fclose(csv);
-    free(rows);
-    free(chain);
-    if (created) gk_scene_destroy(&sc);
+           R->sc.rve.n, R->W, R->H0, R->peak, R->eps_peak, asin(R->peak < 1 ? R->peak : 1) * 180.0 / GK_PI,
+           rows[nrows - 1].ratio, R->syy_peak, rows[nrows - 1].ev, R->z0, R->steps, R->sc.rve.dt,
+           gk_wtime() - R->t0);
+    return 0;
+}
+
+int main(int argc, char **argv) {
+    static db_run run; /* zeroed: nothing created, no rows, no file */
+    db_run *R = &run;
+    int k, status;
+    R->t0 = gk_wtime();
+    R->d = gk_scene_def_default();
+    k = parse(argc, argv, &R->o);
+    if (k) return k < 0 ? 0 : k;
+    if (dsc_mkdir("dem_biaxial", R->o.out)) return 1;
+    status = db_setup(R);
+    if (!status) status = db_consolidate(R);
+    if (!status) status = db_compress(R);
+    if (!status) status = db_report(R);
+    if (R->csv) fclose(R->csv);
+    free(R->rows);
+    free(R->chain);
+    if (R->created) gk_scene_destroy(&R->sc);
     return status;
 }

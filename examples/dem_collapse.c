@@ -181,57 +181,66 @@ static void measure(const gk_scene *sc, double g, double y0, double dmean, doubl
     }
 }
 
-int main(int argc, char **argv) {
+/* the whole run: the options, the scene and what the collapse measures */
+typedef struct dc_run {
     dc_opts o;
     gk_scene sc;
-    gk_scene_def d = gk_scene_def_default();
+    gk_scene_def d;
+    dc_row *rows;
+    int nrows, caprows, created, igate;
+    double rmax, rmean, rf, W, H, L, Ep0, ek_peak, t_ek_peak, t_rest, t0;
+    double *xs, *rs;
+    int *idx;
+    long steps;
+    FILE *csv;
+} dc_run;
+
+/* the scene's error, said; 1 */
+static int dc_fail(dc_run *R) {
+    fprintf(stderr, "dem_collapse: %s\n", gk_scene_error(&R->sc));
+    return 1;
+}
+
+/* the scene: the column on a lattice, a floor of fixed disks, the symmetry plane and the gate; 0 or 1
+ * (said) */
+static int dc_setup(dc_run *R) {
+    const dc_opts *o = &R->o;
+    gk_scene_def *d = &R->d;
     gk_packing pk;
     gk_err err;
     gk_wall_def wall = gk_wall_def_default(), gate = gk_wall_def_default();
-    dc_row *rows = NULL;
-    int nrows = 0, caprows = 0, status = 0, created = 0, isnap = 0, igate, p, k;
-    double rmax, rmean, rf, W, H, L, Ep0 = 0.0, ek_peak = 0.0, t_ek_peak = 0.0, t_rest = -1.0, t = 0.0,
-                                     next = 0.0;
-    double *xs = NULL, *rs = NULL, t0 = gk_wtime();
-    int *idx = NULL, at_rest = 0;
-    long steps = 0;
-    char path[1200];
-    FILE *csv = NULL;
-    k = parse(argc, argv, &o);
-    if (k) return k < 0 ? 0 : k;
-    if (dsc_mkdir("dem_collapse", o.out)) return 1;
-    W = o.width;
-    H = o.a * W;
-    rmax = W / o.diameters / 1.6; /* mean radius 0.8 r_max */
-    rmean = 0.8 * rmax;
-    rf = rmean;
-    L = (2.0 + 2.5 * o.a) * W;
-    /* ---- the scene: column on a lattice, floor of fixed disks */
+    int p;
+    double rmax, rf, W = o->width, H = o->a * W, L;
+    rmax = W / o->diameters / 1.6; /* mean radius 0.8 r_max */
+    R->rmean = 0.8 * rmax;
+    rf = R->rmean;
+    L = (2.0 + 2.5 * o->a) * W;
+    R->W = W, R->H = H, R->L = L, R->rmax = rmax, R->rf = rf;
     {
         /* a square lattice fills about half the area a settled column does */
         int nx = (int)floor(W / (2.2 * rmax)), ny = (int)ceil(2.0 * H / (2.2 * rmax)),
             nf = (int)floor(L / (2.0 * rf));
         gk_rng rng;
         int q = 0, a, b;
-        d.dim = 2;
-        d.lo[0] = 0.0;
-        d.hi[0] = L;
-        d.lo[1] = -rf;
-        d.hi[1] = rf + (ny + 1) * 2.2 * rmax;
-        d.gravity[1] = -o.gravity;
-        d.lost = GK_LOST_DELETE;
-        d.rve.mat.young = o.young;
-        d.rve.mat.friction = o.mu;
-        d.rve.mat.roll_beta = o.roll_beta;
-        d.rve.mat.roll_eta = o.roll_eta;
-        d.rve.mat.zeta_n = gk_restitution_to_zeta(o.restitution);
-        d.rve.mat.density = 2650.0;
-        d.rve.dt_factor = 0.2;
-        d.rve.damping = 0.3; /* preparation only */
-        d.rve.threads = o.threads;
+        d->dim = 2;
+        d->lo[0] = 0.0;
+        d->hi[0] = L;
+        d->lo[1] = -rf;
+        d->hi[1] = rf + (ny + 1) * 2.2 * rmax;
+        d->gravity[1] = -o->gravity;
+        d->lost = GK_LOST_DELETE;
+        d->rve.mat.young = o->young;
+        d->rve.mat.friction = o->mu;
+        d->rve.mat.roll_beta = o->roll_beta;
+        d->rve.mat.roll_eta = o->roll_eta;
+        d->rve.mat.zeta_n = gk_restitution_to_zeta(o->restitution);
+        d->rve.mat.density = 2650.0;
+        d->rve.dt_factor = 0.2;
+        d->rve.damping = 0.3; /* preparation only */
+        d->rve.threads = o->threads;
         if (gk_packing_alloc(&pk, 2, nx * ny + nf, NULL, &err))
             return fprintf(stderr, "dem_collapse: %s\n", err.msg), 1;
-        gk_rng_seed(&rng, (uint64_t)o.seed);
+        gk_rng_seed(&rng, (uint64_t)o->seed);
         for (a = 0; a < nf; ++a, ++q) { /* floor first: ids 0 .. nf-1 */
             pk.x[q] = rf * (2 * a + 1);
             pk.y[q] = 0.0;
@@ -243,16 +252,16 @@ int main(int argc, char **argv) {
                 pk.y[q] = rf + 2.2 * rmax * (b + 0.5);
                 pk.r[q] = rmax * (0.6 + 0.4 * gk_rng_uniform(&rng));
             }
-        if (gk_scene_create(&sc, &d, &pk)) {
-            fprintf(stderr, "dem_collapse: %s\n", gk_scene_error(&sc));
+        if (gk_scene_create(&R->sc, d, &pk)) {
+            fprintf(stderr, "dem_collapse: %s\n", gk_scene_error(&R->sc));
             gk_packing_free(&pk);
             return 1;
         }
-        created = 1;
+        R->created = 1;
         gk_packing_free(&pk);
-        for (p = 0; p < sc.rve.n; ++p)
-            if (sc.rve.id[p] < nf && gk_scene_prescribe(&sc, p, NULL, NULL)) goto fail;
-        wall.mat = d.rve.mat;
+        for (p = 0; p < R->sc.rve.n; ++p)
+            if (R->sc.rve.id[p] < nf && gk_scene_prescribe(&R->sc, p, NULL, NULL)) return dc_fail(R);
+        wall.mat = d->rve.mat;
         wall.mat.friction = 0.0; /* the symmetry plane is smooth */
         wall.mat.roll_beta = wall.mat.roll_eta = 0.0;
         wall.normal[0] = 1.0;
@@ -260,126 +269,132 @@ int main(int argc, char **argv) {
         gate.kind = GK_WALL_SEGMENT;
         gate.point[0] = W;
         gate.point[1] = 1.01 * rf;
-        gate.e1[1] = d.hi[1] - gate.point[1];
+        gate.e1[1] = d->hi[1] - gate.point[1];
         gate.normal[0] = 0.0;
-        if (gk_scene_add_wall(&sc, &wall, NULL) || gk_scene_add_wall(&sc, &gate, &igate)) goto fail;
-        if (!o.quiet)
+        if (gk_scene_add_wall(&R->sc, &wall, NULL) || gk_scene_add_wall(&R->sc, &gate, &R->igate))
+            return dc_fail(R);
+        if (!o->quiet)
             printf("dem_collapse: %d disks in the column (r %.4g-%.4g m), %d floor disks, dt %.3g s\n",
-                   sc.rve.n - nf, 0.6 * rmax, rmax, nf, sc.rve.dt);
+                   R->sc.rve.n - nf, 0.6 * rmax, rmax, nf, R->sc.rve.dt);
     }
-    /* ---- preparation: settle, cut at H0, settle again */
-    {
-        int round;
-        for (round = 0; round < 2; ++round) {
-            long guard = 0;
-            for (;;) {
-                double ep, h;
-                if (gk_scene_step(&sc, 2000)) goto fail;
-                guard += 2000;
-                measure(&sc, o.gravity, 0.0, rmean, &ep, &h);
-                if (gk_rve_kinetic_energy(&sc.rve) < 1e-6 * ep || guard > 2000000) break;
-            }
-            if (round == 0) {
-                int32_t *cut = (int32_t *)malloc((size_t)sc.rve.n * sizeof *cut);
-                int nc = 0;
-                if (!cut) {
-                    fprintf(stderr, "dem_collapse: out of memory\n");
-                    status = 1;
-                    goto done;
-                }
-                for (p = 0; p < sc.rve.n; ++p) {
-                    double x[3];
-                    gk_scene_position(&sc, p, x);
-                    if (!(sc.flags[p] & GK_PARTICLE_PRESCRIBED) && x[1] > H) cut[nc++] = sc.rve.id[p];
-                }
-                k = gk_scene_remove(&sc, nc, cut);
-                free(cut);
-                if (k) goto fail;
-            }
+    return 0;
+}
+
+/* preparation: settle, cut at H0, settle again; the column's height and E_p0; 0 or 1 (said) */
+static int dc_prepare(dc_run *R) {
+    const dc_opts *o = &R->o;
+    gk_scene *sc = &R->sc;
+    int round, p, k;
+    for (round = 0; round < 2; ++round) {
+        long guard = 0;
+        for (;;) {
+            double ep, h;
+            if (gk_scene_step(sc, 2000)) return dc_fail(R);
+            guard += 2000;
+            measure(sc, o->gravity, 0.0, R->rmean, &ep, &h);
+            if (gk_rve_kinetic_energy(&sc->rve) < 1e-6 * ep || guard > 2000000) break;
         }
-        measure(&sc, o.gravity, 0.0, rmean, &Ep0, &H);
-        if (!o.quiet)
-            printf("dem_collapse: column of %d disks, %.4g m high (a = %.3g), settled\n",
-                   sc.rve.n - (int)floor(L / (2.0 * rf)), H, H / W);
+        if (round == 0) {
+            int32_t *cut = (int32_t *)malloc((size_t)sc->rve.n * sizeof *cut);
+            int nc = 0;
+            if (!cut) return fprintf(stderr, "dem_collapse: out of memory\n"), 1;
+            for (p = 0; p < sc->rve.n; ++p) {
+                double x[3];
+                gk_scene_position(sc, p, x);
+                if (!(sc->flags[p] & GK_PARTICLE_PRESCRIBED) && x[1] > R->H) cut[nc++] = sc->rve.id[p];
+            }
+            k = gk_scene_remove(sc, nc, cut);
+            free(cut);
+            if (k) return dc_fail(R);
+        }
     }
-    /* ---- release */
-    if (gk_rve_set_damping(&sc.rve, 0.0, GK_DAMP_COMPONENT) || gk_scene_energy_track(&sc, 1)) goto fail;
-    sc.walls[igate].def.velocity[0] = 20.0;
-    xs = (double *)malloc((size_t)sc.rve.n * sizeof *xs);
-    rs = (double *)malloc((size_t)sc.rve.n * sizeof *rs);
-    idx = (int *)malloc((size_t)sc.rve.n * sizeof *idx);
-    snprintf(path, sizeof path, "%s/collapse.csv", o.out);
-    csv = fopen(path, "w");
-    if (!xs || !rs || !idx || !csv) {
-        fprintf(stderr, "dem_collapse: cannot write %s (or out of memory)\n", path);
-        status = 1;
-        goto done;
-    }
-    fprintf(csv,
+    measure(sc, o->gravity, 0.0, R->rmean, &R->Ep0, &R->H);
+    if (!o->quiet)
+        printf("dem_collapse: column of %d disks, %.4g m high (a = %.3g), settled\n",
+               sc->rve.n - (int)floor(R->L / (2.0 * R->rf)), R->H, R->H / R->W);
+    return 0;
+}
+
+/* the release (no damping, the energy books open, the gate lifted) and the collapse: a row of
+ * collapse.csv every --every, the pictures at release, at --snapshots and at the end; 0 or 1 (said) */
+static int dc_collapse(dc_run *R) {
+    const dc_opts *o = &R->o;
+    gk_scene *sc = &R->sc;
+    double W = R->W, t = 0.0, next = 0.0;
+    int isnap = 0, at_rest = 0;
+    char path[1200];
+    if (gk_rve_set_damping(&sc->rve, 0.0, GK_DAMP_COMPONENT) || gk_scene_energy_track(sc, 1))
+        return dc_fail(R);
+    sc->walls[R->igate].def.velocity[0] = 20.0;
+    R->xs = (double *)malloc((size_t)sc->rve.n * sizeof *R->xs);
+    R->rs = (double *)malloc((size_t)sc->rve.n * sizeof *R->rs);
+    R->idx = (int *)malloc((size_t)sc->rve.n * sizeof *R->idx);
+    snprintf(path, sizeof path, "%s/collapse.csv", o->out);
+    R->csv = fopen(path, "w");
+    if (!R->xs || !R->rs || !R->idx || !R->csv)
+        return fprintf(stderr, "dem_collapse: cannot write %s (or out of memory)\n", path), 1;
+    fprintf(R->csv,
             "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0,friction_over_Ep0,viscous_over_Ep0,"
             "balance_over_Ep0,n,lost\n");
-    if (dsc_pictures("dem_collapse", &sc, o.out, "000", "column at release")) {
-        status = 1;
-        goto done;
-    }
+    if (dsc_pictures("dem_collapse", sc, o->out, "000", "column at release")) return 1;
     for (;;) {
-        double ep, h, ek = gk_rve_kinetic_energy(&sc.rve), f = front_of(&sc, 2.0 * rmean, xs, rs, idx);
+        double ep, h, ek = gk_rve_kinetic_energy(&sc->rve),
+                      f = front_of(sc, 2.0 * R->rmean, R->xs, R->rs, R->idx);
         gk_energy en;
         dc_row r;
-        measure(&sc, o.gravity, 0.0, rmean, &ep, &h);
-        gk_scene_energy(&sc, &en);
-        r.t = t, r.front = f, r.height = h, r.ek = ek / Ep0, r.ep = ep / Ep0, r.ed = (Ep0 - ep - ek) / Ep0;
-        r.friction = en.friction / Ep0, r.viscous = en.viscous / Ep0, r.balance = en.balance / Ep0;
-        if (nrows == caprows) {
-            dc_row *nr = (dc_row *)realloc(rows, (size_t)(caprows ? 2 * caprows : 256) * sizeof *rows);
-            if (!nr) {
-                fprintf(stderr, "dem_collapse: out of memory\n");
-                status = 1;
-                goto done;
-            }
-            rows = nr;
-            caprows = caprows ? 2 * caprows : 256;
+        measure(sc, o->gravity, 0.0, R->rmean, &ep, &h);
+        gk_scene_energy(sc, &en);
+        r.t = t, r.front = f, r.height = h, r.ek = ek / R->Ep0, r.ep = ep / R->Ep0,
+        r.ed = (R->Ep0 - ep - ek) / R->Ep0;
+        r.friction = en.friction / R->Ep0, r.viscous = en.viscous / R->Ep0, r.balance = en.balance / R->Ep0;
+        if (R->nrows == R->caprows) {
+            dc_row *nr =
+                (dc_row *)realloc(R->rows, (size_t)(R->caprows ? 2 * R->caprows : 256) * sizeof *R->rows);
+            if (!nr) return fprintf(stderr, "dem_collapse: out of memory\n"), 1;
+            R->rows = nr;
+            R->caprows = R->caprows ? 2 * R->caprows : 256;
         }
-        rows[nrows++] = r;
-        fprintf(csv, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.3g,%d,%ld\n", t, f, (f - W) / W, h, r.ek,
-                r.ep, r.ed, r.friction, r.viscous, r.balance, sc.rve.n, sc.lost);
-        if (r.ek > ek_peak) ek_peak = r.ek, t_ek_peak = t;
-        if (!at_rest && t > t_ek_peak && ek_peak > 0 && r.ek < o.rest_frac) at_rest = 1, t_rest = t;
-        if (!o.quiet && nrows % 20 == 1)
+        R->rows[R->nrows++] = r;
+        fprintf(R->csv, "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.3g,%d,%ld\n", t, f, (f - W) / W, h,
+                r.ek, r.ep, r.ed, r.friction, r.viscous, r.balance, sc->rve.n, sc->lost);
+        if (r.ek > R->ek_peak) R->ek_peak = r.ek, R->t_ek_peak = t;
+        if (!at_rest && t > R->t_ek_peak && R->ek_peak > 0 && r.ek < o->rest_frac) at_rest = 1, R->t_rest = t;
+        if (!o->quiet && R->nrows % 20 == 1)
             printf("t %.3f s  d* %.3f  height %.3f H0  E_k %.4f  E_d %.4f E_p0  (books %.3g)\n", t,
-                   (f - W) / W, h / H, r.ek, r.ed, r.balance);
-        if (isnap < o.nsnap && t >= o.snap[isnap] - 1e-12) {
+                   (f - W) / W, h / R->H, r.ek, r.ed, r.balance);
+        if (isnap < o->nsnap && t >= o->snap[isnap] - 1e-12) {
             char tag[32], title[64];
             snprintf(tag, sizeof tag, "%03d", isnap + 1);
             snprintf(title, sizeof title, "column collapse, t = %.2f s", t);
-            if (dsc_pictures("dem_collapse", &sc, o.out, tag, title)) {
-                status = 1;
-                goto done;
-            }
+            if (dsc_pictures("dem_collapse", sc, o->out, tag, title)) return 1;
             ++isnap;
         }
-        if (t >= o.t_end - 1e-12 || (at_rest && t >= t_rest + o.rest_hold)) break;
-        next += o.every;
+        if (t >= o->t_end - 1e-12 || (at_rest && t >= R->t_rest + o->rest_hold)) break;
+        next += o->every;
         {
-            long n = (long)ceil((next - t) / sc.rve.dt - 1e-9);
+            long n = (long)ceil((next - t) / sc->rve.dt - 1e-9);
             if (n < 1) n = 1;
-            if (gk_scene_step(&sc, n)) goto fail;
-            steps += n;
-            t += n * sc.rve.dt;
+            if (gk_scene_step(sc, n)) return dc_fail(R);
+            R->steps += n;
+            t += n * sc->rve.dt;
         }
-        if (sc.walls[igate].pos[0] > L + W) sc.walls[igate].def.velocity[0] = 0.0; /* far enough */
+        if (sc->walls[R->igate].pos[0] > R->L + W) sc->walls[R->igate].def.velocity[0] = 0.0; /* far enough */
     }
-    if (fclose(csv)) {
-        csv = NULL;
-        fprintf(stderr, "dem_collapse: error writing %s/collapse.csv\n", o.out);
-        status = 1;
-        goto done;
+    if (fclose(R->csv)) {
+        R->csv = NULL;
+        return fprintf(stderr, "dem_collapse: error writing %s/collapse.csv\n", o->out), 1;
     }
-    csv = NULL;
-    if (dsc_pictures("dem_collapse", &sc, o.out, "end", "column collapse: deposit")) {
-        status = 1;
-        goto done;
-    }
+    R->csv = NULL;
+    return dsc_pictures("dem_collapse", sc, o->out, "end", "column collapse: deposit") ? 1 : 0;
+}
+
+/* collapse_front.svg, collapse_energy.svg and the RESULT line; 0 or non-zero (said) */
+static int dc_report(dc_run *R) {
+    const dc_opts *o = &R->o;
+    const dc_row *rows = R->rows;
+    double W = R->W, H = R->H;
+    int k, nrows = R->nrows, status = 0;
+    char path[1200];
     {
         double *x = (double *)malloc((size_t)nrows * sizeof *x), *y[4] = {NULL, NULL, NULL, NULL};
         const char *lab[4];
@@ -394,16 +409,16 @@ int main(int argc, char **argv) {
         if (!status) {
             lab[0] = "DEM: d* = (d_f - d0)/d0";
             lab[1] = lab[2] = lab[3] = NULL;
-            ref[0] = 1.2 * o.a, rl[0] = "Lube et al. 2005: 1.2 a";
-            ref[1] = 1.6 * o.a, rl[1] = "1.6 a";
+            ref[0] = 1.2 * o->a, rl[0] = "Lube et al. 2005: 1.2 a";
+            ref[1] = 1.6 * o->a, rl[1] = "1.6 a";
             ref[2] = 1.62, rl[2] = "mpmdem_collapse (a = 1): 1.62";
-            snprintf(path, sizeof path, "%s/collapse_front.svg", o.out);
+            snprintf(path, sizeof path, "%s/collapse_front.svg", o->out);
             {
                 const double *yy[4];
                 yy[0] = y[0], yy[1] = yy[2] = yy[3] = NULL;
                 status = dsc_plot("dem_collapse", path, "DEM column collapse: run-out",
                                   "time after release [s]", "d* = (d_f - d0) / d0", x, nrows, yy, lab,
-                                  fabs(o.a - 1.0) < 1e-9 ? 3 : 2, ref, rl);
+                                  fabs(o->a - 1.0) < 1e-9 ? 3 : 2, ref, rl);
             }
         }
         for (k = 0; !status && k < nrows; ++k) {
@@ -414,8 +429,8 @@ int main(int argc, char **argv) {
             const double *yy[4];
             lab[0] = "E_p", lab[1] = "E_k", lab[2] = "E_d = E_p0 - E_p - E_k", lab[3] = "dissipation booked";
             for (k = 0; k < 4; ++k) yy[k] = y[k];
-            ref[0] = 1.0 - 0.74 / (2.0 * o.a), rl[0] = "Lajeunesse et al.: E_d = 1 - 0.74/(2a)";
-            snprintf(path, sizeof path, "%s/collapse_energy.svg", o.out);
+            ref[0] = 1.0 - 0.74 / (2.0 * o->a), rl[0] = "Lajeunesse et al.: E_d = 1 - 0.74/(2a)";
+            snprintf(path, sizeof path, "%s/collapse_energy.svg", o->out);
             status = dsc_plot("dem_collapse", path, "DEM column collapse: energies / E_p0",
                               "time after release [s]", "energy / E_p0", x, nrows, yy, lab, 1, ref, rl);
         } else {
@@ -423,7 +438,7 @@ int main(int argc, char **argv) {
         }
         free(x);
         for (k = 0; k < 4; ++k) free(y[k]);
-        if (status) goto done;
+        if (status) return status;
     }
     {
         const dc_row *e = &rows[nrows - 1];
@@ -431,19 +446,32 @@ int main(int argc, char **argv) {
                "Ek_peak_over_Ep0=%.4g t_Ek_peak=%.4g Ed_final_over_Ep0=%.4g t_rest=%.4g energy_balance=%.3g "
                "n=%d "
                "lost=%ld steps=%ld dt=%.4g seconds=%.2f\n",
-               H / W, (e->front - W) / W, 1.2 * H / W, 1.6 * H / W, e->height / H, ek_peak, t_ek_peak, e->ed,
-               t_rest, e->balance, sc.rve.n, sc.lost, steps, sc.rve.dt, gk_wtime() - t0);
+               H / W, (e->front - W) / W, 1.2 * H / W, 1.6 * H / W, e->height / H, R->ek_peak, R->t_ek_peak,
+               e->ed, R->t_rest, e->balance, R->sc.rve.n, R->sc.lost, R->steps, R->sc.rve.dt,
+               gk_wtime() - R->t0);
     }
-    goto done;
-fail:
-    fprintf(stderr, "dem_collapse: %s\n", gk_scene_error(&sc));
-    status = 1;
-done:
-    if (csv) fclose(csv);
-    free(rows);
-    free(xs);
-    free(rs);
-    free(idx);
-    if (created) gk_scene_destroy(&sc);
+    return 0;
+}
+
+int main(int argc, char **argv) {
+    static dc_run run; /* zeroed: nothing created, no rows, no file */
+    dc_run *R = &run;
+    int k, status;
+    R->t0 = gk_wtime();
+    R->d = gk_scene_def_default();
+    R->t_rest = -1.0;
+    k = parse(argc, argv, &R->o);
+    if (k) return k < 0 ? 0 : k;
+    if (dsc_mkdir("dem_collapse", R->o.out)) return 1;
+    status = dc_setup(R);
+    if (!status) status = dc_prepare(R);
+    if (!status) status = dc_collapse(R);
+    if (!status) status = dc_report(R);
+    if (R->csv) fclose(R->csv);
+    free(R->rows);
+    free(R->xs);
+    free(R->rs);
+    free(R->idx);
+    if (R->created) gk_scene_destroy(&R->sc);
     return status;
 }

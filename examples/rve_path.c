@@ -99,53 +99,54 @@ static int long_opt(const char *a, const char *v, long *out) {
     return 0;
 }
 
-int main(int argc, char **argv) {
-    const char *packing = NULL, *dhs = NULL, *out = "rve_path.csv", *svg = NULL, *law = "linear", *form = "component",
-               *path = "constant-L";
-    double E = 6e8, ktr = 0.8, phi = 0.5, phi_deg = -1.0, rho = 2650, thick = 0.1, damp = 0.1, dt = 0, poisson = 0.25, dHin[9],
-           dH[9], Hacc[9], t0;
-    long ninc = 10, nsteps = 100;
-    int threads = 1, i, nd, dim, k;
-    gk_packing pk;
-    gk_err err;
-    gk_rve rve;
-    gk_rve_def def = gk_rve_def_default();
-    FILE *fp = NULL;
-    double *xs = NULL, *qp = NULL;
-    gk_result res;
-    int rc = 1;
-    char svgname[1024];
-    for (i = 1; i < argc; ++i) {
+/* the options, with their defaults */
+typedef struct rp_opts {
+    const char *packing, *dhs, *out, *svg, *law, *form, *path;
+    double E, ktr, phi, phi_deg, rho, thick, damp, dt, poisson, dHin[9];
+    long ninc, nsteps;
+    int threads, nd;
+} rp_opts;
+
+/* the options, strictly: 0 to run, -1 after --help, 2 after saying what is wrong */
+static int rp_parse(int argc, char **argv, rp_opts *o) {
+    int i;
+    o->packing = o->dhs = o->svg = NULL;
+    o->out = "rve_path.csv", o->law = "linear", o->form = "component", o->path = "constant-L";
+    o->E = 6e8, o->ktr = 0.8, o->phi = 0.5, o->phi_deg = -1.0, o->rho = 2650, o->thick = 0.1, o->damp = 0.1;
+    o->dt = 0, o->poisson = 0.25;
+    o->ninc = 10, o->nsteps = 100;
+    o->threads = 1;
+    for (i = 1; i < argc; i += 2) { /* an option and its value */
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         int bad = 0;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             usage(stdout);
-            return 0;
+            return -1;
         }
         if (!v) {
             fprintf(stderr, "rve_path: %s needs a value (see --help)\n", a);
             return 2;
         }
-        if (!strcmp(a, "--packing")) packing = v;
-        else if (!strcmp(a, "--dH")) dhs = v;
-        else if (!strcmp(a, "--increments")) bad = long_opt(a, v, &ninc);
-        else if (!strcmp(a, "--steps-per-increment")) bad = long_opt(a, v, &nsteps);
-        else if (!strcmp(a, "--E")) bad = real_opt(a, v, &E);
-        else if (!strcmp(a, "--kt-ratio")) bad = real_opt(a, v, &ktr);
-        else if (!strcmp(a, "--friction-deg")) bad = real_opt(a, v, &phi_deg);
+        if (!strcmp(a, "--packing")) o->packing = v;
+        else if (!strcmp(a, "--dH")) o->dhs = v;
+        else if (!strcmp(a, "--increments")) bad = long_opt(a, v, &o->ninc);
+        else if (!strcmp(a, "--steps-per-increment")) bad = long_opt(a, v, &o->nsteps);
+        else if (!strcmp(a, "--E")) bad = real_opt(a, v, &o->E);
+        else if (!strcmp(a, "--kt-ratio")) bad = real_opt(a, v, &o->ktr);
+        else if (!strcmp(a, "--friction-deg")) bad = real_opt(a, v, &o->phi_deg);
         else if (!strcmp(a, "--friction-angle")) { /* the old radian option, kept for old scripts */
             fprintf(stderr, "rve_path: --friction-angle (radians) is deprecated: use --friction-deg\n");
-            bad = real_opt(a, v, &phi);
+            bad = real_opt(a, v, &o->phi);
         }
-        else if (!strcmp(a, "--density")) bad = real_opt(a, v, &rho);
-        else if (!strcmp(a, "--thickness")) bad = real_opt(a, v, &thick);
-        else if (!strcmp(a, "--damping")) bad = real_opt(a, v, &damp);
-        else if (!strcmp(a, "--damping-form")) form = v;
-        else if (!strcmp(a, "--dt")) bad = real_opt(a, v, &dt);
-        else if (!strcmp(a, "--law")) law = v;
-        else if (!strcmp(a, "--poisson")) bad = real_opt(a, v, &poisson);
-        else if (!strcmp(a, "--path")) path = v;
+        else if (!strcmp(a, "--density")) bad = real_opt(a, v, &o->rho);
+        else if (!strcmp(a, "--thickness")) bad = real_opt(a, v, &o->thick);
+        else if (!strcmp(a, "--damping")) bad = real_opt(a, v, &o->damp);
+        else if (!strcmp(a, "--damping-form")) o->form = v;
+        else if (!strcmp(a, "--dt")) bad = real_opt(a, v, &o->dt);
+        else if (!strcmp(a, "--law")) o->law = v;
+        else if (!strcmp(a, "--poisson")) bad = real_opt(a, v, &o->poisson);
+        else if (!strcmp(a, "--path")) o->path = v;
         else if (!strcmp(a, "--threads")) {
             long t = 0;
             bad = long_opt(a, v, &t);
@@ -153,118 +154,140 @@ int main(int argc, char **argv) {
                 fprintf(stderr, "rve_path: --threads %ld: needs 1 to 4096\n", t);
                 bad = 1;
             }
-            threads = (int)t;
+            o->threads = (int)t;
         }
-        else if (!strcmp(a, "--out")) out = v;
-        else if (!strcmp(a, "--svg")) svg = v;
+        else if (!strcmp(a, "--out")) o->out = v;
+        else if (!strcmp(a, "--svg")) o->svg = v;
         else {
             fprintf(stderr, "rve_path: unknown option %s (see --help)\n", a);
             return 2;
         }
         if (bad) return 2;
-        ++i;
     }
-    if (!packing || !dhs) {
+    if (!o->packing || !o->dhs) {
         fprintf(stderr, "rve_path: --packing and --dH are required (see --help)\n");
         return 2;
     }
-    if (ninc < 1 || ninc > 100000000L || nsteps < 1 || nsteps > 2000000000L) {
+    if (o->ninc < 1 || o->ninc > 100000000L || o->nsteps < 1 || o->nsteps > 2000000000L) {
         fprintf(stderr, "rve_path: --increments (1 to 1e8) and --steps-per-increment (1 to 2e9) out of range\n");
         return 2;
     }
-    if (phi_deg != -1.0) phi = phi_deg * GK_PI / 180.0;
-    if (!(phi >= 0.0 && phi <= 85.0 * GK_PI / 180.0)) { /* 35 meant as radians is refused */
+    if (o->phi_deg != -1.0) o->phi = o->phi_deg * GK_PI / 180.0;
+    if (!(o->phi >= 0.0 && o->phi <= 85.0 * GK_PI / 180.0)) { /* 35 meant as radians is refused */
         fprintf(stderr, "rve_path: friction angle %g degrees: a contact friction angle is 0 to 85 degrees\n",
-                phi * 180.0 / GK_PI);
+                o->phi * 180.0 / GK_PI);
         return 2;
     }
-    nd = parse_numbers(dhs, dHin, 9);
-    if (nd < 0) {
-        fprintf(stderr, "rve_path: --dH '%s' is not a list of finite numbers\n", dhs);
+    o->nd = parse_numbers(o->dhs, o->dHin, 9);
+    if (o->nd < 0) {
+        fprintf(stderr, "rve_path: --dH '%s' is not a list of finite numbers\n", o->dhs);
         return 2;
     }
-    def.mat.young = E;
-    def.mat.kt_ratio = ktr;
-    def.mat.friction = tan(phi);
-    def.mat.density = rho;
-    def.mat.poisson = poisson;
-    if (!strcmp(law, "linear")) def.mat.law = GK_LAW_LINEAR;
-    else if (!strcmp(law, "hertz")) def.mat.law = GK_LAW_HERTZ;
+    return 0;
+}
+
+/* the material and the loading from the options, the packing read, dH checked against its dimension
+ * and the RVE created: 0, or the exit status (2 bad options, 1 a failure) after saying why */
+static int rp_setup(const rp_opts *o, gk_rve *rve, double dH[9], int *dimp) {
+    gk_rve_def def = gk_rve_def_default();
+    gk_packing pk;
+    gk_err err;
+    gk_result res;
+    int i, k, dim;
+    def.mat.young = o->E;
+    def.mat.kt_ratio = o->ktr;
+    def.mat.friction = tan(o->phi);
+    def.mat.density = o->rho;
+    def.mat.poisson = o->poisson;
+    if (!strcmp(o->law, "linear")) def.mat.law = GK_LAW_LINEAR;
+    else if (!strcmp(o->law, "hertz")) def.mat.law = GK_LAW_HERTZ;
     else {
         fprintf(stderr, "rve_path: --law must be linear or hertz\n");
         return 2;
     }
-    if (!strcmp(form, "component")) def.damping_form = GK_DAMP_COMPONENT;
-    else if (!strcmp(form, "vector")) def.damping_form = GK_DAMP_VECTOR;
+    if (!strcmp(o->form, "component")) def.damping_form = GK_DAMP_COMPONENT;
+    else if (!strcmp(o->form, "vector")) def.damping_form = GK_DAMP_VECTOR;
     else {
         fprintf(stderr, "rve_path: --damping-form must be component or vector\n");
         return 2;
     }
-    if (!strcmp(path, "constant-L")) def.path = GK_PATH_CONSTANT_L;
-    else if (!strcmp(path, "objective")) def.path = GK_PATH_OBJECTIVE;
+    if (!strcmp(o->path, "constant-L")) def.path = GK_PATH_CONSTANT_L;
+    else if (!strcmp(o->path, "objective")) def.path = GK_PATH_OBJECTIVE;
     else {
         fprintf(stderr, "rve_path: --path must be constant-L or objective\n");
         return 2;
     }
-    def.thickness = thick;
-    def.damping = damp;
-    def.dt = dt;
-    def.threads = threads;
-    if (gk_packing_read(packing, &pk, NULL, &err)) {
+    def.thickness = o->thick;
+    def.damping = o->damp;
+    def.dt = o->dt;
+    def.threads = o->threads;
+    if (gk_packing_read(o->packing, &pk, NULL, &err)) {
         fprintf(stderr, "rve_path: %s\n", err.msg);
         return 1;
     }
     dim = pk.dim;
-    if (nd != dim * dim) {
-        fprintf(stderr, "rve_path: --dH needs %d numbers for a %dD packing, got %d\n", dim * dim, dim, nd);
+    if (o->nd != dim * dim) {
+        fprintf(stderr, "rve_path: --dH needs %d numbers for a %dD packing, got %d\n", dim * dim, dim, o->nd);
         gk_packing_free(&pk);
         return 2;
     }
     gk_m3_zero(dH);
     for (i = 0; i < dim; ++i)
-        for (k = 0; k < dim; ++k) dH[3 * i + k] = dHin[dim * i + k];
-    res = gk_rve_create(&rve, &def, &pk);
+        for (k = 0; k < dim; ++k) dH[3 * i + k] = o->dHin[dim * i + k];
+    res = gk_rve_create(rve, &def, &pk);
     gk_packing_free(&pk);
     if (res) {
-        fprintf(stderr, "rve_path: %s\n", gk_rve_error(&rve));
+        fprintf(stderr, "rve_path: %s\n", gk_rve_error(rve));
         return 1;
     }
-    /* from here every exit frees what it holds (rc 1: a failed step or a result not written) */
-    xs = (double *)malloc((size_t)(ninc + 1) * sizeof(double));
-    qp = (double *)malloc((size_t)(ninc + 1) * sizeof(double));
-    fp = fopen(out, "w");
+    *dimp = dim;
+    return 0;
+}
+
+/* the increments: a CSV row after each (and one before the first), eps_q and q/p kept in xs, qp for
+ * the plot; *t0 the wall clock at the start; 0 or 1 (said) */
+static int rp_run(const rp_opts *o, gk_rve *rve, const double dH[9], int dim, double *xs, double *qp,
+                  double *t0) {
+    double Hacc[9];
+    gk_err err;
+    gk_result res;
+    int i, k;
+    FILE *fp = fopen(o->out, "w");
     if (!fp || !xs || !qp) {
         if (fp)
             fprintf(stderr, "rve_path: out of memory\n");
         else
-            fprintf(stderr, "rve_path: cannot write %s\n", out);
-        goto done;
+            fprintf(stderr, "rve_path: cannot write %s\n", o->out);
+        if (fp) fclose(fp);
+        return 1;
     }
     if (dim == 2)
         fprintf(fp, "inc,H00,H01,H10,H11,sxx,syy,sxy,p,q,e_void,Z\n");
     else
         fprintf(fp, "inc,H00,H01,H02,H10,H11,H12,H20,H21,H22,sxx,syy,szz,syz,sxz,sxy,p,q,e_void,Z\n");
-    fprintf(stderr, "rve_path: %d %s, %s law, dt %.4g s (critical %.4g s), %ld x %ld steps\n", rve.n,
-            dim == 2 ? "disks" : "spheres", law, rve.dt, rve.dt_crit, ninc, nsteps);
+    fprintf(stderr, "rve_path: %d %s, %s law, dt %.4g s (critical %.4g s), %ld x %ld steps\n", rve->n,
+            dim == 2 ? "disks" : "spheres", o->law, rve->dt, rve->dt_crit, o->ninc, o->nsteps);
     gk_m3_zero(Hacc);
-    t0 = gk_wtime();
-    if (gk_rve_refresh(&rve)) {
-        fprintf(stderr, "rve_path: %s\n", gk_rve_error(&rve));
-        goto done;
+    *t0 = gk_wtime();
+    if (gk_rve_refresh(rve)) {
+        fprintf(stderr, "rve_path: %s\n", gk_rve_error(rve));
+        fclose(fp);
+        return 1;
     }
-    for (i = 0; i <= ninc; ++i) {
+    for (i = 0; i <= o->ninc; ++i) {
         double s[9], p, q, Z;
         if (i > 0) {
-            if (gk_rve_deform(&rve, dH, (int)nsteps)) {
-                fprintf(stderr, "rve_path: increment %d: %s\n", i, gk_rve_error(&rve));
-                goto done;
+            if (gk_rve_deform(rve, dH, (int)o->nsteps)) {
+                fprintf(stderr, "rve_path: increment %d: %s\n", i, gk_rve_error(rve));
+                fclose(fp);
+                return 1;
             }
             for (k = 0; k < 9; ++k) Hacc[k] += dH[k];
         }
-        gk_rve_stress(&rve, s);
+        gk_rve_stress(rve, s);
         p = gk_stress_p(s, dim);
         q = gk_stress_q(s, dim);
-        Z = 2.0 * rve.ncontacts / rve.n;
+        Z = 2.0 * rve->ncontacts / rve->n;
         fprintf(fp, "%d", i);
         for (k = 0; k < dim * dim; ++k) fprintf(fp, ",%.9g", Hacc[3 * (k / dim) + k % dim]);
         if (dim == 2)
@@ -272,47 +295,67 @@ int main(int argc, char **argv) {
         else
             fprintf(fp, ",%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", -s[0], -s[4], -s[8], -0.5 * (s[5] + s[7]),
                     -0.5 * (s[2] + s[6]), -0.5 * (s[1] + s[3]));
-        fprintf(fp, ",%.9g,%.9g,%.9g,%.9g\n", p, q, gk_homog_void_ratio(&rve), Z);
+        fprintf(fp, ",%.9g,%.9g,%.9g,%.9g\n", p, q, gk_homog_void_ratio(rve), Z);
         xs[i] = gk_strain_q(Hacc, dim);
         qp[i] = p > 0 ? q / p : 0.0;
     }
-    res = gk_file_close(fp, out, &err);
-    fp = NULL;
+    res = gk_file_close(fp, o->out, &err);
     if (res) {
         fprintf(stderr, "rve_path: %s\n", err.msg);
-        goto done;
+        return 1;
     }
+    return 0;
+}
+
+/* the q/p plot (--svg, or the CSV's name with .svg) and the RESULT line; 0 or 1 (said) */
+static int rp_report(const rp_opts *o, gk_rve *rve, int dim, const double *xs, const double *qp, double t0) {
+    const char *svg = o->svg;
+    char svgname[1024];
+    gk_err err;
     {
         gk_plot pl;
-        size_t L = strlen(out);
+        size_t L = strlen(o->out);
         if (!svg) {
-            if (L > 4 && !strcmp(out + L - 4, ".csv") && L < sizeof svgname) {
-                memcpy(svgname, out, L - 4);
+            if (L > 4 && !strcmp(o->out + L - 4, ".csv") && L < sizeof svgname) {
+                memcpy(svgname, o->out, L - 4);
                 strcpy(svgname + L - 4, ".svg");
             } else {
-                snprintf(svgname, sizeof svgname, "%s.svg", out);
+                snprintf(svgname, sizeof svgname, "%s.svg", o->out);
             }
             svg = svgname;
         }
         gk_plot_init(&pl, "RVE stress ratio along the applied path", "deviatoric strain eps_q (Guo & Zhao 2014 eq 13)",
                      "q / p");
-        gk_plot_add(&pl, xs, qp, (int)ninc + 1, NULL);
+        gk_plot_add(&pl, xs, qp, (int)o->ninc + 1, NULL);
         if (gk_plot_svg(&pl, svg, &err)) {
             fprintf(stderr, "rve_path: %s\n", err.msg);
-            goto done;
+            return 1;
         }
     }
     {
         double s[9];
-        gk_rve_stress(&rve, s);
+        gk_rve_stress(rve, s);
         printf("RESULT p=%.6g q=%.6g q_over_p=%.6g e_void=%.6g Z=%.4g steps=%ld seconds=%.3f\n", gk_stress_p(s, dim),
                gk_stress_q(s, dim), gk_stress_p(s, dim) > 0 ? gk_stress_q(s, dim) / gk_stress_p(s, dim) : 0.0,
-               gk_homog_void_ratio(&rve), 2.0 * rve.ncontacts / rve.n, rve.step, gk_wtime() - t0);
+               gk_homog_void_ratio(rve), 2.0 * rve->ncontacts / rve->n, rve->step, gk_wtime() - t0);
     }
-    fprintf(stderr, "rve_path: wrote %s and %s\n", out, svg);
-    rc = 0;
-done:
-    if (fp) fclose(fp);
+    fprintf(stderr, "rve_path: wrote %s and %s\n", o->out, svg);
+    return 0;
+}
+
+int main(int argc, char **argv) {
+    rp_opts o;
+    gk_rve rve;
+    double dH[9], t0 = 0.0, *xs, *qp;
+    int dim = 0, rc = rp_parse(argc, argv, &o);
+    if (rc) return rc < 0 ? 0 : rc;
+    rc = rp_setup(&o, &rve, dH, &dim);
+    if (rc) return rc;
+    /* from here every exit frees what it holds (rc 1: a failed step or a result not written) */
+    xs = (double *)malloc((size_t)(o.ninc + 1) * sizeof(double));
+    qp = (double *)malloc((size_t)(o.ninc + 1) * sizeof(double));
+    rc = rp_run(&o, &rve, dH, dim, xs, qp, &t0);
+    if (!rc) rc = rp_report(&o, &rve, dim, xs, qp, t0);
     free(xs);
     free(qp);
     gk_rve_destroy(&rve);

@@ -1,0 +1,399 @@
+/* hybrid_enrich.h - the enrichment and the coupled steps of the hybrid driver (examples/hybrid.c;
+ * examples, not library), on the models of hybrid_model.h.
+ *
+ * ORACLE AND ENRICHMENT (gk_hybrid.h): every --oracle-every steps the
+ * plastic strain rate and the plastic strain of the last tau_l go to the
+ * nodes; Alg. 1 with --c0, --c1, --cl, --cg (Tables 4, 6). On the trigger
+ * (hybrid mode) the packing's grains whose reference positions lie in the
+ * discrete zone (by the continuum's reference configuration) are trained:
+ * the overlap grains (and, biaxial, those on the specimen's surface and
+ * the bottom layer) are moved by --train times the continuum displacement
+ * at --train-speed, then held for a tenth of that time; the grains that end
+ * in the continuum zone are dropped, the discrete points deleted, mass and
+ * momentum matched.
+ *
+ * A step of the run: hybrid_step (grains and continuum coupled through the one-cell overlap, eq 9)
+ * and continuum_step (the continuum alone, the oracle, and the enrichment when it triggers).
+ */
+#ifndef HYBRID_ENRICH_H
+#define HYBRID_ENRICH_H
+
+#include "hybrid_model.h"
+
+/* ------------------------------------------------------------------ enrichment */
+/* grain p of the hybrid scene: in the overlap and free (coupled this step)? */
+static void coupling_mask(run *R) {
+    gk_scene *sc = &R->sc;
+    int p;
+    for (p = 0; p < sc->rve.n; ++p) {
+        double x[3], d;
+        R->coupled[p] = 0;
+        if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) continue;
+        gk_scene_position(sc, p, x);
+        if (!gk_hybrid_interp(&R->g, &R->per, R->dist, 1, R->nden, x, &d)) continue;
+        R->coupled[p] = gk_hybrid_zone(d, R->o.phi0, R->h) == GK_ZONE_OVERLAP;
+    }
+}
+
+static int grow_grain_arrays(run *R, int n) {
+    if (n <= R->cap_g) return 0;
+    free(R->xpre[0]);
+    free(R->xpre[1]);
+    free(R->coupled);
+    R->xpre[0] = (double *)malloc((size_t)n * sizeof(double));
+    R->xpre[1] = (double *)malloc((size_t)n * sizeof(double));
+    R->coupled = (unsigned char *)malloc((size_t)n);
+    if (!R->xpre[0] || !R->xpre[1] || !R->coupled) return fprintf(stderr, "error: out of memory\n"), 1;
+    R->cap_g = n;
+    return 0;
+}
+
+/* Sec 4: zones from the flagged nodes, the reference packing's grains of the
+ * discrete zone trained (Sec 4.1.1), the swap (gk_hybrid_enrich) */
+static int enrich(run *R) {
+    const opts *o = &R->o;
+    gk_mpm_grid *g = &R->g;
+    gk_err e;
+    size_t I, nn = g->nnode;
+    int p, k, n = R->P.n, ng, nsel = 0, ndrop = 0, nb = 0, status = 1;
+    double *num = NULL, *val = NULL, *X0w[3] = {NULL, NULL, NULL}, *xs[3], umax = 0.0, *u[2] = {NULL, NULL},
+           *vg[2] = {NULL, NULL};
+    unsigned char *bnd = NULL, *gz = NULL;
+    int32_t *drop = NULL;
+    gk_packing sub;
+    gk_scene_def sd = scene_def(R);
+    gk_hybrid_enrich_report rep;
+    long ntrain, nrelax;
+    double t0 = wtime();
+    memset(&sub, 0, sizeof sub);
+    /* the distance to the flagged nodes on every node, zones of the points */
+    R->dist = (double *)malloc(nn * sizeof(double));
+    num = (double *)malloc(4 * nn * sizeof(double));
+    val = (double *)malloc(4 * (size_t)n * sizeof(double));
+    X0w[0] = (double *)malloc((size_t)n * sizeof(double));
+    X0w[1] = (double *)malloc((size_t)n * sizeof(double));
+    X0w[2] = NULL;
+    if (!R->dist || !num || !val || !X0w[0] || !X0w[1]) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
+    {
+        double ylo = HUGE_VAL, yhi = -HUGE_VAL;
+        for (I = 0; I < nn; ++I) {
+            double x[3];
+            gk_mpm_grid_node_position(g, I, x);
+            R->dist[I] = gk_hybrid_distance(g, &R->per, R->orc.flag, x);
+            if (R->orc.flag[I]) {
+                if (x[1] < ylo) ylo = x[1];
+                if (x[1] > yhi) yhi = x[1];
+            }
+        }
+        if (!o->quiet) printf("flagged nodes between y = %.4g and %.4g m\n", ylo, yhi);
+    }
+    for (p = 0; p < n; ++p) {
+        double x[3] = {R->P.x[0][p], R->P.x[1][p], 0.0};
+        R->C.zone[p] =
+            (unsigned char)gk_hybrid_zone(gk_hybrid_distance(g, &R->per, R->orc.flag, x), o->phi0, R->h);
+    }
+    /* the continuum's reference configuration on the nodes: displacement and zone fractions */
+    for (p = 0; p < n; ++p) {
+        val[4 * p] = R->P.x[0][p] - R->C.X0[0][p];
+        val[4 * p + 1] = R->P.x[1][p] - R->C.X0[1][p];
+        val[4 * p + 2] = R->C.zone[p] == GK_ZONE_DISCRETE;
+        val[4 * p + 3] = R->C.zone[p] == GK_ZONE_OVERLAP;
+        X0w[0][p] = R->C.X0[0][p];
+        X0w[1][p] = R->C.X0[1][p];
+        if (o->test == T_PLANAR) X0w[0][p] -= R->W * floor(X0w[0][p] / R->W);
+    }
+    if (gk_hybrid_rasterize(g, &R->per, R->md.basis, R->P.lp[0], n, (const double *const *)X0w, R->P.m, val,
+                            4, NULL, num, R->nden, &e)) {
+        fprintf(stderr, "error: enrichment: %s\n", e.msg);
+        goto done;
+    }
+    for (k = 0; k < 4; ++k)
+        for (I = 0; I < nn; ++I)
+            num[(size_t)k * nn + I] = R->nden[I] > 0.0 ? num[(size_t)k * nn + I] / R->nden[I] : 0.0;
+    /* the reference packing's grains that go to the discrete zone */
+    if (gk_packing_alloc(&sub, 2, R->pk.n, NULL, &e)) {
+        fprintf(stderr, "error: %s\n", e.msg);
+        goto done;
+    }
+    sub.h[0] = R->pk.h[0];
+    sub.h[4] = R->pk.h[4];
+    u[0] = (double *)malloc((size_t)R->pk.n * sizeof(double));
+    u[1] = (double *)malloc((size_t)R->pk.n * sizeof(double));
+    bnd = (unsigned char *)malloc((size_t)R->pk.n);
+    if (!u[0] || !u[1] || !bnd) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
+    for (k = 0; k < R->pk.n; ++k) {
+        double X[3] = {R->pk.x[k], R->pk.y[k], 0.0}, f[4];
+        int surface;
+        if (!gk_hybrid_interp(g, &R->per, num, 4, R->nden, X, f)) continue;
+        if (f[2] + f[3] < 0.5) continue;
+        surface =
+            o->test == T_BIAXIAL && (X[0] < 1.5 * DIAM || X[0] > R->W - 1.5 * DIAM || role_of(R, X[1]) != 0);
+        sub.x[nsel] = X[0];
+        sub.y[nsel] = X[1];
+        sub.r[nsel] = R->pk.r[k];
+        u[0][nsel] = o->train * f[0];
+        u[1][nsel] = o->train * f[1];
+        bnd[nsel] = f[3] >= f[2] || surface;
+        if (bnd[nsel] && fabs(u[0][nsel]) > umax) umax = fabs(u[0][nsel]);
+        if (bnd[nsel] && fabs(u[1][nsel]) > umax) umax = fabs(u[1][nsel]);
+        nb += bnd[nsel];
+        ++nsel;
+    }
+    if (nsel < 10) {
+        fprintf(stderr, "error: enrichment: only %d grains in the discrete zone\n", nsel);
+        goto done;
+    }
+    sub.n = nsel;
+    /* the training scene (the hybrid's scene from now on) */
+    if (gk_scene_create(&R->sc, &sd, &sub)) {
+        fprintf(stderr, "error: scene: %s\n", gk_scene_error(&R->sc));
+        goto done;
+    }
+    R->have_sc = 1;
+    ng = R->sc.rve.n;
+    {
+        /* the scene stores the grains in its own order: id = index in sub */
+        double *ua[2];
+        int bad;
+        unsigned char *bm = (unsigned char *)malloc((size_t)ng);
+        ua[0] = (double *)malloc((size_t)ng * sizeof(double));
+        ua[1] = (double *)malloc((size_t)ng * sizeof(double));
+        if (!bm || !ua[0] || !ua[1]) {
+            fprintf(stderr, "error: out of memory\n");
+            free(bm), free(ua[0]), free(ua[1]);
+            goto done;
+        }
+        for (p = 0; p < ng; ++p) {
+            int q = R->sc.rve.id[p];
+            bm[p] = bnd[q];
+            ua[0][p] = u[0][q];
+            ua[1][p] = u[1][q];
+            R->role[q] = (unsigned char)role_of(R, sub.y[q]);
+        }
+        ntrain = (long)ceil(umax / (o->train_speed * R->dt));
+        if (ntrain < 1000) ntrain = 1000;
+        nrelax = ntrain / 10 > 500 ? ntrain / 10 : 500;
+        if (!o->quiet)
+            printf("enrichment at strain %.4g: %d flagged nodes, %d grains (%d on the trained boundary), "
+                   "training "
+                   "%ld + %ld steps (largest boundary displacement %.3g mm)\n",
+                   R->strain, R->orc.nflag, ng, nb, ntrain, nrelax, 1e3 * umax);
+        bad = gk_hybrid_train(&R->sc, bm, (const double *const *)ua, ntrain, nrelax, &e) != GK_OK;
+        free(bm);
+        free(ua[0]);
+        free(ua[1]);
+        if (bad) {
+            fprintf(stderr, "error: %s\n", e.msg);
+            goto done;
+        }
+        R->grain_steps += (long)ng * (ntrain + nrelax);
+    }
+    /* the grains that ended in the continuum zone leave */
+    drop = (int32_t *)malloc((size_t)ng * sizeof(int32_t));
+    if (!drop) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
+    for (p = 0; p < ng; ++p) {
+        double x[3];
+        gk_scene_position(&R->sc, p, x);
+        if (gk_hybrid_zone(gk_hybrid_distance(g, &R->per, R->orc.flag, x), o->phi0, R->h) ==
+            GK_ZONE_CONTINUUM)
+            drop[ndrop++] = R->sc.rve.id[p];
+    }
+    if (ndrop && gk_scene_remove(&R->sc, ndrop, drop)) {
+        fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc));
+        goto done;
+    }
+    ng = R->sc.rve.n;
+    /* the continuum's velocity at the grains; their zones */
+    gz = (unsigned char *)malloc((size_t)ng);
+    vg[0] = (double *)malloc((size_t)ng * sizeof(double));
+    vg[1] = (double *)malloc((size_t)ng * sizeof(double));
+    if (!gz || !vg[0] || !vg[1]) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
+    for (p = 0; p < n; ++p) {
+        val[2 * p] = R->P.v[0][p];
+        val[2 * p + 1] = R->P.v[1][p];
+    }
+    xs[0] = R->P.x[0];
+    xs[1] = R->P.x[1];
+    xs[2] = NULL;
+    if (gk_hybrid_rasterize(g, &R->per, R->md.basis, R->P.lp[0], n, (const double *const *)xs, R->P.m, val, 2,
+                            NULL, num, R->nden, &e)) {
+        fprintf(stderr, "error: enrichment: %s\n", e.msg);
+        goto done;
+    }
+    for (k = 0; k < 2; ++k)
+        for (I = 0; I < nn; ++I)
+            num[(size_t)k * nn + I] = R->nden[I] > 0.0 ? num[(size_t)k * nn + I] / R->nden[I] : 0.0;
+    for (p = 0; p < ng; ++p) {
+        double x[3], v[2] = {0.0, 0.0};
+        gk_scene_position(&R->sc, p, x);
+        gk_hybrid_interp(g, &R->per, num, 2, R->nden, x, v);
+        vg[0][p] = v[0];
+        vg[1][p] = v[1];
+        gz[p] = (unsigned char)gk_hybrid_zone(gk_hybrid_distance(g, &R->per, R->orc.flag, x), o->phi0, R->h);
+    }
+    {
+        double *extra[2];
+        int stride[2] = {1, 9};
+        extra[0] = R->side;
+        extra[1] = R->Fw;
+        if (gk_hybrid_enrich(&R->P, &R->C, &R->sc, gz, (const double *const *)vg, 0.5, THICK, 2, extra,
+                             stride, &rep, &e)) {
+            fprintf(stderr, "error: %s\n", e.msg);
+            goto done;
+        }
+        R->grain_scale = rep.mass_scale;
+    }
+    if (!o->quiet)
+        printf("swap: %d points deleted, %d in the overlap; %d grains (%d in the overlap, %d left the zone); "
+               "mass "
+               "%.6g -> %.6g kg/m (grain mass x %.4f)\n",
+               rep.points_deleted, rep.points_overlap, ng, rep.grains_overlap, ndrop, rep.mass_before,
+               rep.mass_after, rep.mass_scale);
+    /* the boundary of the grains: platen layers, top wall, membranes */
+    for (p = 0; p < ng; ++p) {
+        int role = R->role[R->sc.rve.id[p]];
+        double z[3] = {0.0, 0.0, 0.0};
+        if (role && o->test == T_PLANAR) {
+            fprintf(stderr,
+                    "error: the discrete zone reaches a platen (--phi0 %g m too large for a %g m specimen)\n",
+                    o->phi0, R->H);
+            goto done;
+        }
+        if (role == 1 && gk_scene_prescribe(&R->sc, p, z, z)) {
+            fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc));
+            goto done;
+        }
+    }
+    if (o->test == T_BIAXIAL) {
+        int nrow = extent_nrow(R);
+        double row_h = specimen_height(R) / nrow, ytop = R->H + R->plate_y, *l, *r, gmax = -HUGE_VAL;
+        for (p = 0; p < ng; ++p) {
+            double x[3];
+            gk_scene_position(&R->sc, p, x);
+            if (x[1] + (double)R->sc.rve.r[p] > gmax) gmax = x[1] + (double)R->sc.rve.r[p];
+        }
+        if (ytop - gmax < 2.0 * DIAM) { /* grains near the platen: the frictionless wall, moving with it */
+            gk_wall_def w = gk_wall_def_default();
+            w.kind = GK_WALL_PLANE;
+            w.point[1] = gmax > ytop ? gmax : ytop;
+            w.normal[1] = -1.0;
+            w.mat = grain_material(zeta_paper(), 0.4);
+            w.mat.friction = 0.0;
+            w.drive = GK_DRIVE_VELOCITY;
+            w.velocity[1] = R->body.v[1];
+            if (gk_scene_add_wall(&R->sc, &w, &R->top_wall)) {
+        fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc));
+        goto done;
+    }
+        }
+        /* the specimen's sides at enrichment: the extent of the continuum's outer points per row */
+        l = (double *)malloc((size_t)nrow * sizeof(double));
+        r = (double *)malloc((size_t)nrow * sizeof(double));
+        if (!l || !r) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
+        extent_rows(R, nrow, row_h, l, r);
+        if (add_membranes(R, l, r, nrow, row_h)) {
+            free(l), free(r);
+            goto done;
+        }
+        free(l);
+        free(r);
+    }
+    /* the coupling */
+    if (gk_hybrid_coupling_init(&R->cpl, g, NULL, &e)) {
+        fprintf(stderr, "error: %s\n", e.msg);
+        goto done;
+    }
+    for (I = 0; I < nn; ++I) R->nden[I] = 1.0; /* every node carries a distance */
+    if (grow_grain_arrays(R, ng)) goto done;
+    R->enriched = 1;
+    R->strain_enrich = R->strain;
+    gk_hybrid_history_free(&R->hist);
+    status = 0;
+done: /* every exit: the scratch freed */
+    gk_packing_free(&sub);
+    free(num);
+    free(val);
+    free(X0w[0]);
+    free(X0w[1]);
+    free(u[0]);
+    free(u[1]);
+    free(bnd);
+    free(gz);
+    free(vg[0]);
+    free(vg[1]);
+    free(drop);
+    R->sec_dem += wtime() - t0;
+    return status;
+}
+
+/* one step of the hybrid: continuum to vn, grains one step, coupling, continuum G2P */
+static int hybrid_step(run *R) {
+    gk_scene *sc = &R->sc;
+    gk_err e;
+    gk_hybrid_couple_report rep;
+    int p, ng = sc->rve.n;
+    double t0;
+    if (grow_grain_arrays(R, ng)) return 1;
+    for (p = 0; p < ng; ++p) {
+        double x[3];
+        gk_scene_position(sc, p, x);
+        R->xpre[0][p] = x[0];
+        R->xpre[1][p] = x[1];
+    }
+    /* which grains lie in the overlap: every 20 steps (a grain moves < 1e-3 D50 per step) */
+    if (R->step % 20 == 0 || R->mask_n != ng) {
+        coupling_mask(R);
+        R->mask_n = ng;
+    }
+    if (mpm_predict(R)) return 1;
+    t0 = wtime();
+    if (gk_scene_step(sc, 1)) return fprintf(stderr, "error: DEM at t = %g s: %s\n", R->t, gk_scene_error(sc)), 1;
+    R->sec_dem += wtime() - t0;
+    R->grain_steps += ng;
+    t0 = wtime();
+    gk_hybrid_bc_mask(&R->g, R->bcmask);
+    if (gk_hybrid_couple(&R->cpl, &R->g, &R->per, R->md.basis, R->P.lp[0], sc, (const double *const *)R->xpre,
+                         R->coupled, R->bcmask, THICK, R->dt, &rep, &e))
+        return fprintf(stderr, "error: coupling at t = %g s: %s\n", R->t, e.msg), 1;
+    R->sec_cpl += wtime() - t0;
+    return mpm_finish(R);
+}
+
+/* one step of the continuum (continuum and hybrid modes), with the oracle */
+static int continuum_step(run *R) {
+    if (R->enriched) {
+        if (hybrid_step(R)) return 1;
+    } else {
+        if (mpm_predict(R) || mpm_finish(R)) return 1;
+    }
+    R->t += R->dt;
+    ++R->step;
+    mpm_measure(R);
+    if (!R->enriched && R->step % R->o.oracle_every == 0) {
+        int trig = oracle_eval(R);
+        if (trig < 0) return 1;
+        if (trig && !R->triggered) {
+            R->triggered = 1;
+            R->strain_trigger = R->strain;
+            if (!R->o.quiet) printf("oracle: %d nodes flagged and unchanged for tau_g at strain %.4g\n", R->orc.nflag, R->strain);
+        }
+        if (trig && R->o.mode == M_HYBRID && enrich(R)) return 1;
+    }
+    return 0;
+}
+#endif /* HYBRID_ENRICH_H */

@@ -1,0 +1,343 @@
+/* hybrid_model.h - the two models of the hybrid driver (examples/hybrid.c; examples, not library), on
+ * the run of hybrid_setup.h: the grains (the all-grain specimen as a gk_scene with its platens and
+ * membranes, DEM steps, the measured stresses), the MPM continuum (grid, points, the hypoelastic
+ * Drucker-Prager of gk_hybrid.h, its platen and side traction) and the oracle that flags the band
+ * (Chen et al. 2021 Alg. 1).
+ */
+#ifndef HYBRID_MODEL_H
+#define HYBRID_MODEL_H
+
+#include "hybrid_setup.h"
+
+/* ------------------------------------------------------------------ grains */
+/* the all-grain specimen: the packing with its top and bottom layers as
+ * platens (planar: rough, prescribed grains) or bottom layer and a
+ * frictionless wall (biaxial), membranes on the sides (biaxial) */
+static int setup_dem(run *R) {
+    gk_scene_def d = scene_def(R);
+    gk_scene *sc = &R->sc;
+    int p, n;
+    double z[3] = {0.0, 0.0, 0.0};
+    if (gk_scene_create(sc, &d, &R->pk)) return fprintf(stderr, "error: scene: %s\n", gk_scene_error(sc)), 1;
+    R->have_sc = 1;
+    n = sc->rve.n;
+    for (p = 0; p < n; ++p) {
+        double x[3];
+        int role;
+        gk_scene_position(sc, p, x);
+        role = role_of(R, x[1]);
+        R->role[sc->rve.id[p]] = (unsigned char)role;
+        if (role == 1 || (role == 2 && R->o.test == T_PLANAR)) {
+            double v[3] = {0.0, 0.0, 0.0};
+            if (role == 2) v[0] = platen_speed(R, 0.0);
+            if (gk_scene_prescribe(sc, p, v, z)) return fprintf(stderr, "error: %s\n", gk_scene_error(sc)), 1;
+        }
+    }
+    if (R->o.test == T_BIAXIAL) {
+        gk_wall_def w = gk_wall_def_default();
+        double ytop = -HUGE_VAL;
+        int nrow = (int)floor(R->H / (2.0 * DIAM)), k;
+        double *l = (double *)malloc((size_t)nrow * sizeof(double)), *r = (double *)malloc((size_t)nrow * sizeof(double));
+        for (p = 0; p < n; ++p) {
+            double x[3];
+            gk_scene_position(sc, p, x);
+            if (x[1] + (double)sc->rve.r[p] > ytop) ytop = x[1] + (double)sc->rve.r[p];
+        }
+        w.kind = GK_WALL_PLANE;
+        w.point[1] = ytop;
+        w.normal[1] = -1.0;
+        w.mat = grain_material(zeta_paper(), 0.4);
+        w.mat.friction = 0.0;
+        w.drive = GK_DRIVE_VELOCITY;
+        if (gk_scene_add_wall(sc, &w, &R->top_wall)) return fprintf(stderr, "error: %s\n", gk_scene_error(sc)), 1;
+        R->y_plate0 = ytop;
+        if (!l || !r) return fprintf(stderr, "error: out of memory\n"), 1;
+        for (k = 0; k < nrow; ++k) { /* the packing's sides */
+            l[k] = 0.0;
+            r[k] = R->W;
+        }
+        if (add_membranes(R, l, r, nrow, R->H / nrow)) return 1;
+        free(l);
+        free(r);
+        /* preload: the cut-open top reloaded to the confining pressure by the wall's servo */
+        sc->walls[R->top_wall].def.drive = GK_DRIVE_STRESS;
+        sc->walls[R->top_wall].def.target = R->o.pressure;
+        sc->walls[R->top_wall].def.area = R->W * THICK;
+        sc->walls[R->top_wall].def.gain = 0.05;
+        sc->walls[R->top_wall].def.max_speed = R->o.speed;
+        for (k = 0; k < 200; ++k) {
+            double s;
+            if (gk_scene_step(sc, 500)) return fprintf(stderr, "error: preload: %s\n", gk_scene_error(sc)), 1;
+            s = sc->walls[R->top_wall].force[1] / (R->W * THICK);
+            if (k >= 10 && fabs(s - R->o.pressure) < 0.01 * R->o.pressure) break;
+        }
+        sc->walls[R->top_wall].def.drive = GK_DRIVE_VELOCITY;
+        sc->walls[R->top_wall].def.velocity[1] = -platen_speed(R, 0.0);
+        R->y_plate0 = sc->walls[R->top_wall].pos[1];
+        sc->rve.time = 0.0;
+    }
+    return 0;
+}
+
+/* the platen loads of the grains (compression-positive, per the specimen width) */
+static void dem_measure(run *R) {
+    gk_scene *sc = &R->sc;
+    if (R->o.test == T_PLANAR) {
+        double fx = 0.0, fy = 0.0;
+        int p;
+        for (p = 0; p < sc->rve.n; ++p)
+            if (R->role[sc->rve.id[p]] == 2) {
+                fx += sc->load[0][p];
+                fy += sc->load[1][p];
+            }
+        R->tau = -fx / (R->W * THICK);
+        R->sig_n = fy / (R->W * THICK);
+    }
+}
+
+/* K steps of the all-grain specimen */
+static int dem_steps(run *R, long K) {
+    gk_scene *sc = &R->sc;
+    double t0 = wtime(), V = platen_speed(R, R->t);
+    int p;
+    if (R->o.test == T_PLANAR) {
+        double z[3] = {0.0, 0.0, 0.0}, v[3];
+        v[0] = V;
+        v[1] = R->plate_vy;
+        v[2] = 0.0;
+        for (p = 0; p < sc->rve.n; ++p)
+            if (R->role[sc->rve.id[p]] == 2) gk_scene_prescribe(sc, p, v, z);
+    } else {
+        sc->walls[R->top_wall].def.velocity[1] = -V;
+    }
+    if (gk_scene_step(sc, K)) return fprintf(stderr, "error: DEM: %s\n", gk_scene_error(sc)), 1;
+    R->sec_dem += wtime() - t0;
+    R->grain_steps += (long)sc->rve.n * K;
+    R->t += K * R->dt;
+    R->step += K;
+    if (R->o.test == T_PLANAR) {
+        R->plate_x += V * K * R->dt;
+        R->plate_y += R->plate_vy * K * R->dt;
+        dem_measure(R);
+        platen_velocity(R, R->sig_n * R->W * THICK, K * R->dt);
+        R->strain = R->plate_x / R->W;
+    } else {
+        double A = specimen_area(R);
+        R->plate_y = sc->walls[R->top_wall].pos[1] - R->y_plate0;
+        R->sig_n = sc->walls[R->top_wall].force[1] / THICK / (A / specimen_height(R));
+        R->tau = 0.5 * (R->sig_n - R->o.pressure);
+        R->strain = -R->plate_y / R->H;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------ continuum */
+static int setup_mpm(run *R) {
+    const opts *o = &R->o;
+    gk_mpm_dp dp;
+    gk_err e;
+    double org[3] = {0.0, 0.0, 0.0}, Phi0;
+    int n[3] = {1, 1, 1}, ncx = (int)floor(R->W / o->cell + 0.5), nxp, nyp, i, j, p, margin;
+    if (ncx < 3) return fprintf(stderr, "error: --cell %g: fewer than 3 cells across %g m\n", o->cell, R->W), 1;
+    R->h = R->W / ncx;
+    if (R->dt > 0.3 * R->h / R->c)
+        return fprintf(stderr, "error: the MPM step %g s is above 0.3 h / c = %g s\n", R->dt, 0.3 * R->h / R->c), 1;
+    margin = o->test == T_PLANAR ? 1 : 3;
+    org[0] = -margin * R->h;
+    org[1] = -R->h;
+    n[0] = ncx + 2 * margin + (o->test == T_PLANAR ? 1 : 1);
+    n[1] = (int)ceil(R->H / R->h) + 5;
+    if (gk_mpm_grid_create(&R->g, 2, org, R->h, n, NULL, &e)) return fprintf(stderr, "error: grid: %s\n", e.msg), 1;
+    memset(&R->per, 0, sizeof R->per);
+    if (o->test == T_PLANAR) {
+        R->per.ghost[0] = 1;
+        R->per.period[0] = ncx;
+    }
+    R->md = gk_mpm_def_default();
+    R->md.basis = GK_MPM_UGIMP;
+    R->md.alpha = o->alpha;
+    R->md.threads = o->threads;
+    if (gk_hybrid_periodic_check(&R->g, &R->per, R->md.basis, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+    gk_mpm_grid_set_bc(&R->g, 2, GK_MPM_BC_FIXED, 0.0, 2, &e); /* bottom: no slip */
+    /* points: ppd per cell edge on the cells' lattice (a point row that straddled
+     * a cell boundary would tie a band to its neighbours); the continuum's
+     * height is the whole number of cells nearest the packing's (its top
+     * surface on a node row, where the platen acts) */
+    nxp = ncx * o->ppd;
+    nyp = (int)floor(R->H / R->h + 0.5) * o->ppd;
+    R->dxp = R->dyp = R->h / o->ppd;
+    if (gk_mpm_points_create(&R->P, 2, nxp * nyp, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+    R->side = (double *)calloc((size_t)nxp * nyp, sizeof(double));
+    R->Fw = (double *)calloc(9 * (size_t)nxp * nyp, sizeof(double));
+    if (!R->side || !R->Fw) return fprintf(stderr, "error: out of memory\n"), 1;
+    for (j = 0, p = 0; j < nyp; ++j)
+        for (i = 0; i < nxp; ++i, ++p) {
+            R->P.x[0][p] = (i + 0.5) * R->dxp;
+            R->P.x[1][p] = (j + 0.5) * R->dyp;
+            R->P.vol0[p] = R->P.vol[p] = R->dxp * R->dyp;
+            R->P.m[p] = R->rho * R->dxp * R->dyp;
+            R->P.lp[p] = 0.5 * (R->dxp < R->dyp ? R->dxp : R->dyp);
+            R->P.sigma[9 * p] = R->P.sigma[9 * p + 4] = -o->pressure;
+            if (o->test == T_BIAXIAL) R->side[p] = i == 0 ? -1.0 : (i == nxp - 1 ? 1.0 : 0.0);
+        }
+    if (gk_mpm_dp_init(&dp, 2, K_C, G_C, 0.27, 0.0, 0.0, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+    dp.tan_phi_cs = tan(0.27);
+    dp.Phi_cs = PHI_CS;
+    dp.chi = 7.0;
+    dp.xi = o->xi;
+    Phi0 = o->phi_init > 0.0 ? o->phi_init : R->phi_pack;
+    if (gk_hybrid_cont_init(&R->C, &R->P, &dp, Phi0, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+    /* the weak points that seed the band */
+    for (p = 0; p < R->P.n; ++p) {
+        double x = R->P.x[0][p], y = R->P.x[1][p];
+        /* a whole cell row (planar) or cell (biaxial): a band of weak points that
+         * shares its cells with strong ones could not slip alone */
+        int weak = o->test == T_PLANAR ? (int)floor(y / R->h) == (int)floor(0.5 * R->H / R->h)
+                                       : (x > R->W - 2.0 * R->h && x < R->W - R->h && y > R->h && y < 2.0 * R->h);
+        if (weak) R->C.Phi[p] = Phi0 - o->weak_dphi;
+    }
+    /* the top platen: rough and servo-controlled (planar) or frictionless (biaxial) */
+    memset(&R->body, 0, sizeof R->body);
+    R->body.lo[0] = org[0] - R->h;
+    R->body.hi[0] = org[0] + (n[0] + 1) * R->h;
+    R->body.lo[1] = R->H - 1e-9; /* the nodes at and above the material's top surface */
+    R->body.hi[1] = org[1] + (n[1] + 1) * R->h;
+    if (o->test == T_PLANAR) {
+        R->body.contact = GK_MPM_CONTACT_STICK;
+        R->body.v[0] = o->speed;
+    } else {
+        R->body.contact = GK_MPM_CONTACT_SMOOTH;
+        R->body.face = 3; /* its y- face: normal -y into the material */
+        R->body.v[1] = -o->speed;
+    }
+    R->g.body = &R->body;
+    R->g.nbody = 1;
+    R->have_mpm = 1;
+    R->bcmask = (unsigned char *)malloc(R->g.nnode);
+    if (!R->bcmask) return fprintf(stderr, "error: out of memory\n"), 1;
+    return 0;
+}
+
+/* biaxial: the confining pressure as a follower traction on the outer columns
+ * of continuum points (overlap and discrete points: the grains' membrane) */
+static void mpm_traction(run *R) {
+    int p, k;
+    for (k = 0; k < 2; ++k) memset(R->P.fext[k], 0, (size_t)R->P.n * sizeof(double));
+    if (R->o.test != T_BIAXIAL) return;
+    for (p = 0; p < R->P.n; ++p)
+        if (R->side[p] != 0.0 && R->C.zone[p] == GK_ZONE_CONTINUUM) {
+            double N0[2] = {R->side[p], 0.0};
+            gk_hybrid_traction(&R->P, p, N0, R->dyp, R->o.pressure);
+        }
+}
+
+static int mpm_predict(run *R) {
+    gk_err e;
+    double t0 = wtime();
+    if (R->o.test == T_PLANAR) {
+        R->body.v[0] = platen_speed(R, R->t);
+        R->body.v[1] = R->plate_vy;
+    } else {
+        R->body.v[1] = -platen_speed(R, R->t);
+    }
+    if (R->have_sc && R->top_wall >= 0) R->sc.walls[R->top_wall].def.velocity[1] = R->body.v[1];
+    mpm_traction(R);
+    if (gk_hybrid_mpm_predict(&R->g, &R->per, &R->P, &R->md, R->dt, gk_hybrid_dp_stress, &R->C, &e))
+        return fprintf(stderr, "error: MPM at t = %g s: %s\n", R->t, e.msg), 1;
+    R->sec_mpm += wtime() - t0;
+    return 0;
+}
+
+static int mpm_finish(run *R) {
+    gk_err e;
+    double t0 = wtime();
+    if (gk_hybrid_mpm_finish(&R->g, &R->per, &R->P, &R->C, &R->md, R->dt, &e))
+        return fprintf(stderr, "error: MPM at t = %g s: %s\n", R->t, e.msg), 1;
+    R->sec_mpm += wtime() - t0;
+    R->point_steps += R->P.n;
+    return 0;
+}
+
+/* platen loads after a continuum step (plus the grains' wall in a hybrid biaxial test) */
+static void mpm_measure(run *R) {
+    double W = R->W;
+    if (R->o.test == T_PLANAR) {
+        R->plate_x += R->body.v[0] * R->dt;
+        R->plate_y += R->body.v[1] * R->dt;
+        R->tau = R->body.force[0] / W;
+        R->sig_n = -R->body.force[1] / W;
+        platen_velocity(R, R->sig_n * R->W * THICK, R->dt);
+        R->strain = R->plate_x / R->W;
+    } else {
+        double F = -R->body.force[1];
+        R->plate_y += R->body.v[1] * R->dt;
+        if (R->have_sc && R->top_wall >= 0) F += R->sc.walls[R->top_wall].force[1] / THICK;
+        W = specimen_area(R) / specimen_height(R);
+        R->sig_n = F / W;
+        R->tau = 0.5 * (R->sig_n - R->o.pressure);
+        R->strain = -R->plate_y / R->H;
+    }
+}
+
+/* ------------------------------------------------------------------ oracle */
+static int oracle_setup(run *R) {
+    gk_hybrid_oracle_def d;
+    gk_err e;
+    size_t nn = R->g.nnode;
+    int n = R->P.n;
+    d.c0 = R->o.c0;
+    d.c1 = R->o.c1;
+    d.cl = R->o.cl;
+    d.cg = R->o.cg;
+    d.D50 = DIAM;
+    if (gk_hybrid_oracle_init(&R->orc, &d, nn, NULL, &e) || gk_hybrid_history_init(&R->hist, n, 3, 512, NULL, &e))
+        return fprintf(stderr, "error: %s\n", e.msg), 1;
+    R->past = (double *)malloc(3 * (size_t)n * sizeof(double));
+    R->pval = (double *)malloc(2 * (size_t)n * sizeof(double));
+    R->nnum = (double *)malloc(2 * nn * sizeof(double));
+    R->nden = (double *)malloc(nn * sizeof(double));
+    R->nrate = (double *)malloc(nn * sizeof(double));
+    R->nrec = (double *)malloc(nn * sizeof(double));
+    R->active = (unsigned char *)malloc(nn);
+    if (!R->past || !R->pval || !R->nnum || !R->nden || !R->nrate || !R->nrec || !R->active)
+        return fprintf(stderr, "error: out of memory\n"), 1;
+    R->t_push = -HUGE_VAL;
+    return 0;
+}
+
+/* Alg. 1 at time t: returns 1 on the trigger */
+static int oracle_eval(run *R) {
+    gk_err e;
+    double gd = R->C.gdot_max, tau_l, tau_g, *xs[3];
+    size_t I, nn = R->g.nnode;
+    int p, n = R->P.n;
+    if (!(gd > 0.0)) return 0;
+    tau_l = R->o.cl / gd;
+    tau_g = R->o.cg / gd;
+    if (R->t - R->t_push >= tau_l / 256.0) {
+        if (gk_hybrid_history_push(&R->hist, R->t, R->C.ep, &e)) return fprintf(stderr, "error: %s\n", e.msg), -1;
+        R->t_push = R->t;
+    }
+    gk_hybrid_history_at(&R->hist, R->t - tau_l, R->past);
+    for (p = 0; p < n; ++p) {
+        double a = R->C.ep[3 * p] - R->past[3 * p], b = R->C.ep[3 * p + 1] - R->past[3 * p + 1],
+               c = R->C.ep[3 * p + 2] - R->past[3 * p + 2];
+        R->pval[2 * p] = R->C.rate[p];
+        R->pval[2 * p + 1] = sqrt(a * a + b * b + 2.0 * c * c);
+    }
+    xs[0] = R->P.x[0];
+    xs[1] = R->P.x[1];
+    xs[2] = NULL;
+    if (gk_hybrid_rasterize(&R->g, &R->per, R->md.basis, R->P.lp[0], n, (const double *const *)xs, R->P.m, R->pval, 2,
+                            NULL, R->nnum, R->nden, &e))
+        return fprintf(stderr, "error: oracle: %s\n", e.msg), -1;
+    gk_hybrid_bc_mask(&R->g, R->bcmask);
+    for (I = 0; I < nn; ++I) {
+        R->active[I] = R->nden[I] > 0.0 && !R->bcmask[I];
+        R->nrate[I] = R->nden[I] > 0.0 ? R->nnum[I] / R->nden[I] : 0.0;
+        R->nrec[I] = R->nden[I] > 0.0 ? R->nnum[nn + I] / R->nden[I] : 0.0;
+    }
+    return gk_hybrid_oracle_step(&R->orc, &R->g, &R->per, R->nrate, R->nrec, R->active, R->t, tau_g);
+}
+
+#endif /* HYBRID_MODEL_H */

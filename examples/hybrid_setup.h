@@ -1,0 +1,693 @@
+/* hybrid_setup.h - the set-up of the hybrid continuum-grain driver (examples/hybrid.c; examples, not
+ * library): the tests and modes, the material constants, the command-line options (defaults, usage,
+ * strict parsing), the packing (generated and consolidated, or read), the run's state (struct run)
+ * and the specimen's geometry: top platen, membranes, extent per row, band window.
+ *
+ * MATERIAL (Chen et al. Tables 1-2). Grains: disks, D50 = 1 mm, diameters
+ * normal with sd 0.08 mm cut at 2 sd; linear contacts k_n = 1.772e6 N/m,
+ * k_t = k_n / 2, mu = 0.5, dt = 5e-7 s. Normal dashpot gamma_n = 7 N s/m
+ * (e = 0.1 for the mean grain: 83.5 % of critical). The paper's disks carry
+ * its grain mass m = 1.98e-5 kg (what gamma_n = 7 and e = 0.1 imply) and
+ * its stresses are per a thickness of one diameter (what App. F's
+ * k_n/(P d) and the calibrated K = 630 MPa imply): here t = 1 mm and
+ * density 25300 kg/m^3 (m = 1.98e-5 kg). Measured on the consolidated
+ * packing at 400 kPa: K = 767 MPa, G = 417 MPa (the paper: 630, 460).
+ * Tangential dashpot: 40 % of critical (the paper's gamma_t = 7 N s/m with
+ * k_t = k_n/2 is 118 % of critical; with rotating disks at dt = 5e-7 s that
+ * keeps a packing oscillating in grainkit's leap-frog, so it is reduced).
+ * Packing: --grains disks generated in a periodic cell of the specimen's
+ * aspect, consolidated to --pressure frictionless with light damping (the
+ * paper pours with mu = 0.01), then mu = 0.5 and the paper's damping
+ * (packing fraction ~0.85: the paper's 84-86 %). Written to
+ * OUT/packing.txt; --packing reads one (the same specimen for every mode).
+ * Continuum: K = 630 MPa, G = 460 MPa, phi_cs = 0.27 rad, Phi_cs = 0.815,
+ * chi = 7, xi = 0.01, no cohesion, density = the packing's, initial stress
+ * -pressure I, initial Phi = the packing's (over-consolidated) or --phi.
+ * "Weak" points (Phi = Phi_cs, left out of the oracle) seed the band: the
+ * middle row of cells (planar), one cell at the lower right (biaxial).
+ * MPM: uGIMP, PIC fraction --alpha (0.05), 2 x 2 points per cell, USF,
+ * the grain time step.
+ */
+#ifndef HYBRID_SETUP_H
+#define HYBRID_SETUP_H
+
+#include "gk_hybrid.h"
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#define T_PLANAR 0
+#define T_BIAXIAL 1
+#define M_DEM 0
+#define M_CONT 1
+#define M_HYBRID 2
+
+static const char *test_name[] = {"planar", "biaxial"};
+static const char *mode_name[] = {"dem", "continuum", "hybrid"};
+
+/* ------------------------------------------------------------------ material */
+#define DIAM 1e-3 /* D50 [m] */
+#define THICK 1e-3      /* stress thickness: one diameter */
+#define RHO_S 25300.0   /* grain mass 1.98e-5 kg for D = 1 mm, t = 1 mm */
+#define KN 1.7720938e6  /* Table 1 */
+#define DT 5e-7
+#define PHI_CS 0.815    /* Table 2 */
+#define K_C 6.3e8
+#define G_C 4.6e8
+
+typedef struct opts {
+    int test, mode;
+    const char *out, *packing;
+    double width, height, pressure, speed, strain_end, out_every;
+    double cell, alpha, train, train_speed, phi0, c0, c1, cl, cg, phi_init, weak_dphi, xi;
+    double win0, win1, band_window, percentile, dem_seconds, platen_zeta, ramp;
+    int ppd, threads, oracle_every, quiet;
+    long grains;
+    unsigned long seed;
+} opts;
+
+/* ------------------------------------------------------------------ options */
+static void defaults(opts *o, int test) {
+    memset(o, 0, sizeof *o);
+    o->test = test;
+    o->mode = M_HYBRID;
+    o->out = "build/hybrid_out";
+    o->width = 0.03;
+    o->speed = 0.1;
+    o->cell = 0.005;
+    o->ppd = 2;
+    o->alpha = 0.0;
+    o->train = 1.0;
+    o->percentile = 98.0;
+    o->threads = 1;
+    o->oracle_every = 20;
+    o->seed = 1;
+    o->platen_zeta = 0.05;
+    o->ramp = 40.0;
+    o->weak_dphi = 0.8425 - PHI_CS;
+    o->xi = 0.01;
+    o->dem_seconds = -1.0;
+    if (test == T_PLANAR) { /* Tables 3-4 */
+        o->height = 0.06;
+        o->pressure = 4e5;
+        o->strain_end = 0.57;
+        o->out_every = 0.005;
+        o->phi0 = 0.015; /* the paper: 0.022 for its 12 cm specimen */
+        o->c0 = 1e-6;
+        o->c1 = 1e-4;
+        o->cl = 8e-4;
+        o->cg = 1.2e-3;
+        o->win0 = 0.37;
+        o->win1 = 0.57;
+        o->band_window = 0.011;
+    } else { /* Tables 5-6 */
+        o->height = 0.0471;
+        o->pressure = 1e5;
+        o->strain_end = 0.1061;
+        o->out_every = 0.001;
+        o->phi0 = 0.01;
+        o->c0 = 1e-6;
+        o->c1 = 8e-3;
+        o->cl = 2e-2;
+        o->cg = 9.6e-3;
+        o->win0 = 0.055;
+        o->win1 = 0.085;
+        o->band_window = 0.005;
+    }
+}
+
+static void usage(FILE *fp) {
+    opts p, b;
+    defaults(&p, T_PLANAR);
+    defaults(&b, T_BIAXIAL);
+    fprintf(fp,
+            "usage: hybrid --test planar|biaxial --mode dem|continuum|hybrid [options]\n"
+            "  --out DIR            output directory (default %s)\n"
+            "  --threads T          OpenMP threads (default 1; results do not depend on it)\n"
+            "  --width W --height H specimen [m] (planar %g x %g, biaxial %g x %g; paper 0.06 x 0.12, 0.06 x 0.0942)\n"
+            "  --grains N           grains of the generated packing (0: from the size, packing fraction 0.85)\n"
+            "  --packing FILE       read the packing (a periodic cell) instead of generating it\n"
+            "  --seed S             packing generator seed (default %lu)\n"
+            "  --pressure P         normal (planar) / confining (biaxial) stress [Pa] (default %g, %g)\n"
+            "  --speed V            platen speed [m/s] (default %g; paper 0.02)\n"
+            "  --strain S           run to this strain (default %g, %g)\n"
+            "  --out-every S        CSV row every S of strain (default %g, %g)\n"
+            "  --cell H             MPM cell [m] (default %g)\n"
+            "  --ppd K              MPM points per cell edge (default %d)\n"
+            "  --alpha A            MPM PIC fraction (default %g)\n"
+            "  --phi0 D             enrichment margin phi_0 [m] (default %g, %g)\n"
+            "  --c0 C --c1 C --cl C --cg C   oracle constants (defaults Tables 4 and 6)\n"
+            "  --oracle-every N     oracle evaluated every N steps (default %d)\n"
+            "  --train F            kinematic training fraction in [0, 1] (default %g; below 1: planar only)\n"
+            "  --train-speed V      speed of the trained boundary [m/s] (default: --speed)\n"
+            "  --phi PHI            initial continuum packing fraction (default: the packing's; below\n"
+            "                       Phi_cs = 0.815 the continuum is under-consolidated)\n"
+            "  --weak-dphi D        the weak points' packing fraction is the others' minus D (default %g)\n"
+            "  --xi X               rate of eq 8's relaxation of Phi to Phi_cs (default %g, Table 2)\n"
+            "  --window S0 S1       strain window of the band measurement (default %g %g, %g %g)\n"
+            "  --band-window B      half-width of the eps_v_band window [m] (default %g, %g)\n"
+            "  --percentile Q       band grains: value above the Q-th percentile (default %g)\n"
+            "  --platen-damping Z   planar top platen: damping ratio of its dashpot (default %g)\n"
+            "  --ramp K             the platen speed rises linearly over K wave transits H / c (default %g)\n"
+            "  --dem-seconds S      wall seconds of the dem run of the same test (for speedup_vs_dem)\n"
+            "  --paper              the paper's specimen and speed (Tables 3, 5): 6 x 12 cm (planar, phi_0 2.2 cm) or\n"
+            "                       6 x 9.42 cm (biaxial), 0.02 m/s; the other flags override it\n"
+            "  --quiet              no progress lines\n",
+            p.out, p.width, p.height, b.width, b.height, p.seed, p.pressure, b.pressure, p.speed, p.strain_end,
+            b.strain_end, p.out_every, b.out_every, p.cell, p.ppd, p.alpha, p.phi0, b.phi0, p.oracle_every,
+            p.train, p.weak_dphi, p.xi, p.win0, p.win1, b.win0, b.win1, p.band_window, b.band_window, p.percentile, p.platen_zeta, p.ramp);
+}
+
+static int num(const char *s, double *v) {
+    char *end;
+    errno = 0;
+    *v = strtod(s, &end);
+    return end != s && *end == '\0' && errno == 0 && isfinite(*v);
+}
+
+/* strict parsing: every flag known, every value a number in range, errors name the flag */
+static int parse(int argc, char **argv, opts *o) {
+    int i, test = -1, mode = -1, have[64];
+    double v;
+    for (i = 1; i + 1 < argc; ++i) {
+        if (!strcmp(argv[i], "--test")) {
+            if (!strcmp(argv[i + 1], "planar"))
+                test = T_PLANAR;
+            else if (!strcmp(argv[i + 1], "biaxial"))
+                test = T_BIAXIAL;
+            else if (!strcmp(argv[i + 1], "indent"))
+                return fprintf(stderr,
+                               "error: --test indent: the plate indentation (Sec 6.3) is not implemented "
+                               "(planar or biaxial)\n"),
+                       1;
+            else
+                return fprintf(stderr, "error: --test %s: use planar or biaxial\n", argv[i + 1]), 1;
+        }
+    }
+    if (test < 0) return fprintf(stderr, "error: --test planar|biaxial is required\n"), 1;
+    defaults(o, test);
+    for (i = 1; i < argc; ++i)
+        if (!strcmp(argv[i], "--paper")) { /* Tables 3-6; the other flags override it */
+            o->width = 0.06;
+            o->height = test == T_PLANAR ? 0.12 : 0.0942;
+            o->speed = 0.02;
+            if (test == T_PLANAR) {
+                o->phi0 = 0.022;
+                o->band_window = 0.022;
+            }
+        }
+    memset(have, 0, sizeof have);
+    for (i = 1; i < argc; ++i) {
+        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) return usage(stdout), 2;
+        if (!strcmp(a, "--quiet")) {
+            o->quiet = 1;
+            continue;
+        }
+        if (!strcmp(a, "--paper")) continue;
+        if (!val) return fprintf(stderr, "error: %s needs a value (or is unknown; see --help)\n", a), 1;
+        ++i;
+        if (!strcmp(a, "--test")) continue;
+        if (!strcmp(a, "--mode")) {
+            if (!strcmp(val, "dem"))
+                mode = M_DEM;
+            else if (!strcmp(val, "continuum"))
+                mode = M_CONT;
+            else if (!strcmp(val, "hybrid"))
+                mode = M_HYBRID;
+            else
+                return fprintf(stderr, "error: --mode %s: use dem, continuum or hybrid\n", val), 1;
+            continue;
+        }
+        if (!strcmp(a, "--out")) {
+            o->out = val;
+            continue;
+        }
+        if (!strcmp(a, "--packing")) {
+            o->packing = val;
+            continue;
+        }
+        if (!strcmp(a, "--window")) {
+            double v2;
+            if (i + 1 >= argc || !num(val, &v) || !num(argv[i + 1], &v2) || !(v >= 0.0 && v2 > v))
+                return fprintf(stderr, "error: --window needs two strains S0 < S1\n"), 1;
+            o->win0 = v;
+            o->win1 = v2;
+            ++i;
+            continue;
+        }
+        if (!num(val, &v)) return fprintf(stderr, "error: %s %s: not a number\n", a, val), 1;
+#define REAL(flag, field, ok, what)                                                      \
+    if (!strcmp(a, flag)) {                                                              \
+        if (!(ok)) return fprintf(stderr, "error: %s %s: need %s\n", a, val, what), 1;   \
+        o->field = v;                                                                    \
+        continue;                                                                        \
+    }
+#define INT(flag, field, lo, hi)                                                                        \
+    if (!strcmp(a, flag)) {                                                                             \
+        if (v != floor(v) || v < (lo) || v > (hi))                                                      \
+            return fprintf(stderr, "error: %s %s: need an integer in [%g, %g]\n", a, val, (double)(lo), \
+                           (double)(hi)),                                                               \
+                   1;                                                                                   \
+        o->field = v;                                                                                   \
+        continue;                                                                                       \
+    }
+        REAL("--width", width, v >= 0.005 && v <= 10.0, "a width in [0.005, 10] m")
+        REAL("--height", height, v >= 0.005 && v <= 10.0, "a height in [0.005, 10] m")
+        REAL("--pressure", pressure, v > 0.0 && v <= 1e8, "a stress in (0, 1e8] Pa")
+        REAL("--speed", speed, v > 0.0 && v <= 10.0, "a speed in (0, 10] m/s")
+        REAL("--strain", strain_end, v > 0.0 && v <= 2.0, "a strain in (0, 2]")
+        REAL("--out-every", out_every, v > 0.0, "a positive strain")
+        REAL("--cell", cell, v > 0.0, "a positive cell size")
+        REAL("--alpha", alpha, v >= 0.0 && v <= 1.0, "a value in [0, 1]")
+        REAL("--train", train, v >= 0.0 && v <= 1.0, "a fraction in [0, 1]")
+        REAL("--train-speed", train_speed, v > 0.0 && v <= 10.0, "a speed in (0, 10] m/s")
+        REAL("--phi0", phi0, v > 0.0, "a positive distance")
+        REAL("--c0", c0, v >= 0.0, "a value >= 0")
+        REAL("--c1", c1, v >= 0.0, "a value >= 0")
+        REAL("--cl", cl, v > 0.0, "a positive value")
+        REAL("--cg", cg, v > 0.0, "a positive value")
+        REAL("--phi", phi_init, v > 0.5 && v < 0.95, "a packing fraction in (0.5, 0.95)")
+        REAL("--weak-dphi", weak_dphi, v >= 0.0 && v < 0.3, "a value in [0, 0.3)")
+        REAL("--xi", xi, v >= 0.0 && v <= 1e3, "a value in [0, 1e3]")
+        REAL("--band-window", band_window, v > 0.0, "a positive half-width")
+        REAL("--percentile", percentile, v >= 50.0 && v < 100.0, "a percentile in [50, 100)")
+        REAL("--platen-damping", platen_zeta, v >= 0.0 && v <= 10.0, "a value in [0, 10]")
+        REAL("--ramp", ramp, v >= 0.0 && v <= 1e4, "a value in [0, 1e4]")
+        REAL("--dem-seconds", dem_seconds, v > 0.0, "a positive time")
+        INT("--threads", threads, 1, 256)
+        INT("--grains", grains, 0, 5000000)
+        INT("--ppd", ppd, 1, 4)
+        INT("--oracle-every", oracle_every, 1, 1000000)
+        INT("--seed", seed, 0, 4294967295.0)
+#undef REAL
+#undef INT
+        return fprintf(stderr, "error: unknown option %s (see --help)\n", a), 1;
+    }
+    if (mode < 0) return fprintf(stderr, "error: --mode dem|continuum|hybrid is required\n"), 1;
+    o->mode = mode;
+    if (o->train_speed <= 0.0) o->train_speed = o->speed;
+    if (o->win1 > o->strain_end + 1e-12)
+        return fprintf(stderr, "error: --window end %g beyond --strain %g\n", o->win1, o->strain_end), 1;
+    if (o->test == T_BIAXIAL && o->train < 1.0)
+        return fprintf(stderr, "error: --train %g: below 1 only for the planar test (the band region moves)\n",
+                       o->train),
+               1;
+    (void)have;
+    return 0;
+}
+
+static gk_material grain_material(double zeta_n, double zeta_t) {
+    gk_material m = gk_material_default();
+    m.kn = KN;
+    m.kt_ratio = 0.5;
+    m.friction = 0.5;
+    m.density = RHO_S;
+    m.zeta_n = zeta_n;
+    m.zeta_t = zeta_t;
+    return m;
+}
+/* gamma_n = 7 N s/m for two mean grains: zeta = 7 / (2 sqrt(m/2 k_n)) */
+static double zeta_paper(void) {
+    double m = RHO_S * THICK * GK_PI * 0.25 * DIAM * DIAM;
+    return 7.0 / (2.0 * sqrt(0.5 * m * KN));
+}
+
+/* ------------------------------------------------------------------ packing */
+static int make_dir(const char *d) {
+    char buf[1024];
+    size_t k, n = strlen(d);
+    struct stat st;
+    if (n + 1 > sizeof buf) return fprintf(stderr, "error: --out %s: path too long\n", d), 1;
+    memcpy(buf, d, n + 1);
+    for (k = 1; k <= n; ++k)
+        if (buf[k] == '/' || buf[k] == '\0') {
+            char c = buf[k];
+            buf[k] = '\0';
+            if (mkdir(buf, 0755) && errno != EEXIST) return fprintf(stderr, "error: cannot create %s\n", buf), 1;
+            buf[k] = c;
+        }
+    if (stat(d, &st) || !S_ISDIR(st.st_mode)) return fprintf(stderr, "error: --out %s: not a directory\n", d), 1;
+    return 0;
+}
+
+/* the servo of gk_rve at fixed shape (the cell stays a rectangle, so the
+ * specimen stays periodic) to the isotropic stress p with friction mu:
+ * until every sigma_kk is within 0.2 % and the unbalanced force ratio is
+ * below 1e-3 for three checks in a row */
+static int consolidate(gk_rve *rve, double p, double mu) {
+    gk_servo sv;
+    long st, calm = 0;
+    int k, q;
+    memset(&sv, 0, sizeof sv);
+    for (k = 0; k < 2; ++k) {
+        sv.mode[k] = GK_SERVO_STRESS;
+        sv.target[k] = -p;
+    }
+    sv.max_rate = 1e-2 * sqrt(p / RHO_S) / DIAM; /* inertial number 1e-2 */
+    sv.gain = 0.5;
+    if (gk_rve_set_friction(rve, mu) || gk_rve_set_servo(rve, &sv))
+        return fprintf(stderr, "error: consolidation: %s\n", gk_rve_error(rve)), 1;
+    for (st = 0; st < 4000000; st += 1000) {
+        double fs = 0.0, un, e0, e1;
+        if (gk_rve_step(rve, 1000)) return fprintf(stderr, "error: consolidation: %s\n", gk_rve_error(rve)), 1;
+        for (q = 0; q < rve->n; ++q) fs += sqrt((double)rve->f[0][q] * rve->f[0][q] + (double)rve->f[1][q] * rve->f[1][q]);
+        un = rve->fc_mean > 0.0 ? fs / rve->n / rve->fc_mean : 1.0;
+        e0 = fabs(rve->stress[0] + p) / p;
+        e1 = fabs(rve->stress[4] + p) / p;
+        calm = (e0 < 2e-3 && e1 < 2e-3 && un < 1e-3) ? calm + 1 : 0;
+        if (calm >= 3) break;
+    }
+    gk_rve_set_servo(rve, NULL);
+    if (calm < 3) return fprintf(stderr, "error: consolidation to %g Pa (mu %g) did not settle\n", p, mu), 1;
+    /* friction is switched on with zero tangential history */
+    for (q = 0; rve->ft[0] && q < rve->pl.n; ++q) rve->ft[0][q] = 0;
+    return 0;
+}
+
+/* the specimen: generated (or read), consolidated to the pressure with the paper's contact law */
+static int make_packing(const opts *o, gk_packing *out, double *phi) {
+    gk_packing pk;
+    gk_err e;
+    gk_rve rve;
+    gk_rve_def d = gk_rve_def_default();
+    double tr[41], tc[41], s[9];
+    int k;
+    if (o->packing) {
+        if (gk_packing_read(o->packing, out, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+        if (out->dim != 2) return fprintf(stderr, "error: %s is not a 2D packing\n", o->packing), 1;
+    } else {
+        gk_gen_def g;
+        double amean = GK_PI * 0.25 * DIAM * DIAM * (1.0 + 0.08 * 0.08);
+        for (k = 0; k < 41; ++k) { /* diameters normal (1 mm, 0.08 mm) cut at 2 sd, by number */
+            double z = -2.0 + 4.0 * k / 40.0;
+            tr[k] = 0.5 * (DIAM + 8e-5 * z);
+            tc[k] = 0.5 * (1.0 + erf(z / sqrt(2.0)));
+        }
+        for (k = 40; k >= 0; --k) tc[k] = (tc[k] - tc[0]) / (tc[40] - tc[0]);
+        tc[40] = 1.0;
+        memset(&g, 0, sizeof g);
+        g.dim = 2;
+        g.n = o->grains > 0 ? (int)o->grains : (int)floor(0.85 * o->width * o->height / amean + 0.5);
+        g.psd = GK_PSD_TABLE_NUMBER;
+        g.ntable = 41;
+        g.table_r = tr;
+        g.table_cum = tc;
+        g.aspect[0] = 1.0;
+        g.aspect[1] = o->height / o->width;
+        g.seed = o->seed;
+        if (gk_packing_generate(&pk, &g, NULL, &e)) return fprintf(stderr, "error: packing: %s\n", e.msg), 1;
+        d.mat = grain_material(0.2, 0.0); /* light damping while consolidating (see the header) */
+        d.thickness = THICK;
+        d.dt = DT;
+        d.damping = 0.2;
+        d.threads = o->threads;
+        if (gk_rve_create(&rve, &d, &pk)) return fprintf(stderr, "error: packing: %s\n", gk_rve_error(&rve)), 1;
+        gk_packing_free(&pk);
+        if (consolidate(&rve, o->pressure, 0.0) || consolidate(&rve, o->pressure, 0.5)) {
+            gk_rve_destroy(&rve);
+            return 1;
+        }
+        gk_rve_stress(&rve, s);
+        if (!o->quiet)
+            printf("packing: %d grains consolidated to %.4g, %.4g Pa in a %.4g x %.4g m cell\n", rve.n, -s[0], -s[4],
+                   rve.cell.h[0], rve.cell.h[4]);
+        if (gk_rve_to_packing(&rve, out, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+        gk_rve_destroy(&rve);
+    }
+    *phi = 0.0;
+    for (k = 0; k < out->n; ++k) *phi += GK_PI * out->r[k] * out->r[k];
+    *phi /= out->h[0] * out->h[4];
+    {
+        char path[1100];
+        snprintf(path, sizeof path, "%s/packing.txt", o->out);
+        if (gk_packing_write(path, out, "hybrid.c specimen", &e))
+            return fprintf(stderr, "error: cannot write %s\n", path), 1;
+    }
+    /* positions into [0, W) x [0, H) */
+    for (k = 0; k < out->n; ++k) {
+        out->x[k] -= out->h[0] * floor(out->x[k] / out->h[0]);
+        out->y[k] -= out->h[4] * floor(out->y[k] / out->h[4]);
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------ the run */
+typedef struct run {
+    opts o;
+    double W, H, phi_pack, rho, M, c, t, strain, dt;
+    long step;
+    gk_packing pk; /* the specimen's reference packing, positions in [0, W) x [0, H) */
+    /* grains */
+    gk_scene sc;
+    int have_sc, top_wall;
+    unsigned char *role; /* by stable id: 0 free, 1 bottom layer, 2 top layer */
+    int nrole;
+    /* platen: top displacement and velocity */
+    double plate_x, plate_y, plate_vy, y_plate0;
+    double tau, sig_n; /* last measured, compression-positive [Pa] */
+    /* continuum */
+    int have_mpm;
+    gk_mpm_grid g;
+    gk_hybrid_periodic per;
+    gk_mpm_points P;
+    gk_hybrid_cont C;
+    gk_mpm_def md;
+    gk_mpm_body body;
+    double h, dxp, dyp;
+    double *side; /* per point: -1 left column, +1 right column, 0 (biaxial traction) */
+    double *Fw;   /* per point: F at the window start (9) */
+    unsigned char *bcmask;
+    /* oracle */
+    gk_hybrid_oracle orc;
+    gk_hybrid_history hist;
+    double *past, *pval, *nnum, *nden, *nrate, *nrec, t_push;
+    unsigned char *active;
+    int triggered;
+    double strain_trigger;
+    /* hybrid */
+    int enriched;
+    double strain_enrich, *dist, *xpre[2];
+    unsigned char *coupled;
+    int cap_g, mask_n;
+    double grain_scale; /* the enrichment's grain mass factor */
+    gk_hybrid_coupling cpl;
+    /* measurements */
+    double phi0_band, A0, peak_tau, win_c[2], win_e[2], win_a;
+    int window_taken, nw, band_on_grains;
+    double *Xw[2];
+    int32_t *idw;
+    FILE *csv;
+    double t_start, next_out;
+    /* cost counters */
+    double sec_dem, sec_mpm, sec_cpl;
+    long steps_dem, grain_steps, point_steps;
+} run;
+
+static double wtime(void) { return gk_wtime(); }
+
+static gk_scene_def scene_def(const run *R) {
+    gk_scene_def d = gk_scene_def_default();
+    d.dim = 2;
+    if (R->o.test == T_PLANAR) {
+        d.periodic = 1u;
+        d.lo[0] = 0.0;
+        d.hi[0] = R->W;
+    } else {
+        d.lo[0] = -0.5 * R->W;
+        d.hi[0] = 1.5 * R->W;
+    }
+    d.lo[1] = -0.5 * R->H;
+    d.hi[1] = 1.5 * R->H;
+    d.rve.mat = grain_material(zeta_paper(), 0.4);
+    d.rve.thickness = THICK;
+    d.rve.dt = DT;
+    d.rve.damping = 0.0;
+    d.rve.threads = R->o.threads;
+    return d;
+}
+
+/* the grains' role by stable id, from their reference positions */
+static int role_of(const run *R, double y) {
+    if (y < 1.5 * DIAM) return 1;
+    if (y > R->H - 1.5 * DIAM) return 2;
+    return 0;
+}
+
+/* The planar top platen under a constant normal stress: a rigid platen of
+ * the specimen's mass M_p pressed by p W t, its vertical velocity from
+ * M_p dv/dt = F - p W t - c v (F the specimen's push on it; c = 2 zeta
+ * sqrt(k M_p), k = (K + G) W t / H, zeta = --platen-damping), the same
+ * law for the grains and the continuum. A dilating specimen lifts it with
+ * a force error c v (1-3 % of p W t at the dilation rates of these tests). */
+static double platen_velocity(run *R, double F, double dt) {
+    double A = R->W * THICK, Mp = R->rho * R->W * R->H * THICK, k = R->M * A / R->H;
+    double c = 2.0 * R->o.platen_zeta * sqrt(k * Mp);
+    R->plate_vy += dt * (F - R->o.pressure * A - c * R->plate_vy) / Mp;
+    return R->plate_vy;
+}
+
+/* the platen speed at time t: a linear rise over --ramp wave transits (a
+ * sudden start sends a stress wave rho c_s V through the specimen) */
+static double platen_speed(const run *R, double t) {
+    double tr = R->o.ramp * R->H / R->c;
+    return t >= tr ? R->o.speed : R->o.speed * t / tr;
+}
+
+/* ---- membranes on the grains at the specimen's sides (biaxial) */
+/* On each side, the outermost free grain of every band of D50 along y whose
+ * outer edge lies within 1.5 D50 of the side (left[row], right[row]
+ * for rows of row_h), chained in height order (the material on the chain's
+ * left: down the left side, up the right side), split where a gap of 3 D50
+ * opens; a chain end within 2 D50 of the top wall is tied to it. */
+static int add_membranes(run *R, const double *left, const double *right, int nrow, double row_h) {
+    gk_scene *sc = &R->sc;
+    int n = sc->rve.n, s, p, k, nb = (int)ceil(2.0 * R->H / DIAM) + 1, nsel;
+    int32_t *ids = (int32_t *)malloc((size_t)n * sizeof(int32_t));
+    int *best = (int *)malloc((size_t)nb * sizeof(int)), *ord = (int *)malloc((size_t)nb * sizeof(int));
+    double *bx = (double *)malloc((size_t)nb * sizeof(double)), *yy = (double *)malloc((size_t)nb * sizeof(double));
+    double ytop = R->top_wall >= 0 ? sc->walls[R->top_wall].pos[1] : HUGE_VAL;
+    if (!ids || !best || !ord || !bx || !yy) return fprintf(stderr, "error: out of memory\n"), 1;
+    for (s = -1; s <= 1; s += 2) {
+        for (k = 0; k < nb; ++k) best[k] = -1;
+        for (p = 0; p < n; ++p) {
+            double x[3], r = (double)sc->rve.r[p], edge;
+            int row, band;
+            if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) continue;
+            gk_scene_position(sc, p, x);
+            row = (int)floor(x[1] / row_h);
+            band = (int)floor(x[1] / DIAM);
+            if (row < 0 || row >= nrow || band < 0 || band >= nb) continue;
+            edge = s < 0 ? left[row] : right[row];
+            if (!isfinite(edge)) continue;
+            if (s < 0 ? x[0] - r < edge + 1.5 * DIAM : x[0] + r > edge - 1.5 * DIAM) {
+                double out = s < 0 ? -(x[0] - r) : x[0] + r;
+                if (best[band] < 0 || out > bx[band]) {
+                    best[band] = p;
+                    bx[band] = out;
+                }
+            }
+        }
+        nsel = 0;
+        for (k = 0; k < nb; ++k) {
+            int kk = s < 0 ? nb - 1 - k : k; /* left: top to bottom; right: bottom to top */
+            if (best[kk] >= 0) {
+                double x[3];
+                gk_scene_position(sc, best[kk], x);
+                ord[nsel] = best[kk];
+                yy[nsel++] = x[1];
+            }
+        }
+        for (p = 0; p < nsel;) {
+            int q = p + 1, m, a0 = -1, a1 = -1;
+            while (q < nsel && fabs(yy[q] - yy[q - 1]) < 3.0 * DIAM) ++q;
+            m = q - p;
+            if (m >= 2) {
+                for (k = 0; k < m; ++k) ids[k] = sc->rve.id[ord[p + k]];
+                if (s < 0 && ytop - yy[p] < 2.0 * DIAM) a0 = R->top_wall;
+                if (s > 0 && ytop - yy[q - 1] < 2.0 * DIAM) a1 = R->top_wall;
+                if (gk_scene_add_membrane(sc, m, ids, R->o.pressure, 1e4, a0, a1, NULL))
+                    return fprintf(stderr, "error: membrane: %s\n", gk_scene_error(sc)), 1;
+            }
+            p = q;
+        }
+    }
+    free(ids);
+    free(best);
+    free(ord);
+    free(bx);
+    free(yy);
+    return 0;
+}
+
+/* the material's extent per row (grains: x -+ r; points: x -+ half their size) */
+static void extent_rows(const run *R, int nrow, double row_h, double *left, double *right) {
+    int k, p;
+    for (k = 0; k < nrow; ++k) {
+        left[k] = HUGE_VAL;
+        right[k] = -HUGE_VAL;
+    }
+    if (R->have_sc)
+        for (p = 0; p < R->sc.rve.n; ++p) {
+            double x[3], r = (double)R->sc.rve.r[p];
+            gk_scene_position(&R->sc, p, x);
+            k = (int)floor(x[1] / row_h);
+            if (k < 0 || k >= nrow) continue;
+            if (x[0] - r < left[k]) left[k] = x[0] - r;
+            if (x[0] + r > right[k]) right[k] = x[0] + r;
+        }
+    if (R->have_mpm)
+        for (p = 0; p < R->P.n; ++p) {
+            double x = R->P.x[0][p], half = 0.5 * R->dxp * sqrt(R->P.vol[p] / R->P.vol0[p]);
+            k = (int)floor(R->P.x[1][p] / row_h);
+            if (k < 0 || k >= nrow) continue;
+            if (x - half < left[k]) left[k] = x - half;
+            if (x + half > right[k]) right[k] = x + half;
+        }
+}
+
+static double specimen_height(const run *R) { return R->H + R->plate_y; }
+
+/* rows for the specimen's extent: one MPM cell (two rows of points, a few grains) */
+static int extent_nrow(const run *R) {
+    int n = (int)floor(R->H / R->o.cell);
+    return n > 1 ? n : 1;
+}
+
+/* biaxial: area from the material's extent per row */
+static double specimen_area(const run *R) {
+    int nrow = extent_nrow(R), k;
+    double Hc = specimen_height(R), row_h = Hc / nrow, A = 0.0, *l, *r;
+    l = (double *)malloc((size_t)nrow * sizeof(double));
+    r = (double *)malloc((size_t)nrow * sizeof(double));
+    if (!l || !r) {
+        free(l);
+        free(r);
+        return NAN;
+    }
+    extent_rows(R, nrow, row_h, l, r);
+    for (k = 0; k < nrow; ++k)
+        if (r[k] > l[k]) A += (r[k] - l[k]) * row_h;
+    free(l);
+    free(r);
+    return A;
+}
+
+/* overlap of [x - d/2, x + d/2] with [-b, b], as a fraction of d */
+static double overlap1(double x, double d, double b) {
+    double lo = x - 0.5 * d, hi = x + 0.5 * d, a = lo > -b ? lo : -b, c = hi < b ? hi : b;
+    return c > a ? (c - a) / d : 0.0;
+}
+
+/* solid fraction inside the band window: grains by their disk area (an
+ * overlap grain, which carries w of its mass, by w of it), points by
+ * their solid area vol0 Phi0 (overlap points carry 1 - w of it); each
+ * counted by its overlap with the window (grains as squares of their
+ * area, points as their cell) */
+static double band_solid_fraction(const run *R) {
+    double S = 0.0, area, b = R->o.band_window, phi0 = R->o.phi_init > 0.0 ? R->o.phi_init : R->phi_pack;
+    int p, planar = R->o.test == T_PLANAR;
+    area = planar ? R->W * 2.0 * b : 2.0 * R->win_a * 2.0 * b;
+#define WIN_ADD(x, y, d, a)                                                                        \
+    do {                                                                                           \
+        double u = ((x)-R->win_c[0]) * R->win_e[0] + ((y)-R->win_c[1]) * R->win_e[1];              \
+        double w = -((x)-R->win_c[0]) * R->win_e[1] + ((y)-R->win_c[1]) * R->win_e[0];             \
+        S += (a)*overlap1(w, (d), b) * (planar ? 1.0 : overlap1(u, (d), R->win_a));                \
+    } while (0)
+    if (R->have_sc)
+        for (p = 0; p < R->sc.rve.n; ++p) {
+            double x[3], r = (double)R->sc.rve.r[p], a = GK_PI * r * r;
+            if (R->sc.flags[p] & GK_PARTICLE_PRESCRIBED) continue;
+            if (R->enriched) a *= R->sc.mass[p] / (R->grain_scale * RHO_S * THICK * a); /* 1 or w */
+            gk_scene_position(&R->sc, p, x);
+            WIN_ADD(x[0], x[1], sqrt(GK_PI) * r, a);
+        }
+    if (R->have_mpm)
+        for (p = 0; p < R->P.n; ++p) WIN_ADD(R->P.x[0][p], R->P.x[1][p], sqrt(R->P.vol[p]), R->P.vol0[p] * phi0);
+#undef WIN_ADD
+    return S / area;
+}
+
+#endif /* HYBRID_SETUP_H */
