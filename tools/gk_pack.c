@@ -260,7 +260,7 @@ int main(int argc, char **argv) {
     o.psd_by = "mass";
     o.ratio = 1.0;
     o.target_a = -1;
-    for (i = 1; i < argc; ++i) {
+    for (i = 1; i < argc; i += 2) { /* every option takes a value */
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         int bad = 0;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -322,7 +322,6 @@ int main(int argc, char **argv) {
             return 2;
         }
         if (bad) return 2;
-        ++i;
     }
     if (o.hertz && !(o.G > 0.0)) {
         fprintf(stderr, "gk_pack: --law hertz needs --G > 0 (grain shear modulus)\n");
