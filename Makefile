@@ -229,8 +229,14 @@ $(BUILD)/hdr/%.alone: include/%.h $(HEADERS) | $(BUILD)/hdr
 	  done; \
 	done; \
 	echo "ok   $$h alone with GK_BASE_IMPLEMENTATION + $$m: defines all it declares, calls nothing undefined"; touch $@
+# every program also compiles with clang (the build uses $(CC)): one stamp per program
+PROG_SRC := $(filter-out tests/test_%.c,$(EX_SRC) $(BENCH_SRC) $(TOOL_SRC)) $(TEST_SRC) $(MPIRUN_SRC)
+HDR_OK   += $(patsubst %.c,$(BUILD)/hdr/%.clang,$(PROG_SRC))
+$(BUILD)/hdr/%.clang: %.c $(HEADERS) $(wildcard examples/*.h bench/*.h bench/*_part.c) tests/gk_test.h | $(BUILD)/hdr
+	@mkdir -p $(@D) && clang $(WARN) $(ARCH) $(FPFLAGS) -fopenmp -Iinclude -Itests -Ibench $(TESTDEF) -fsyntax-only $< \
+	  && touch $@ || { echo "FAILED: clang $<"; exit 1; }
 check-headers: $(HDR_OK)
-	@echo "== header portability: every header alone, $(words $(HEADERS)) headers, and $(words $(STANDALONE)) of them with only their own implementation: ok"
+	@echo "== header portability: every header alone, $(words $(HEADERS)) headers, and $(words $(STANDALONE)) of them with only their own implementation; every program with clang: ok"
 
 check: check-headers check-nosimd check-asan check-smoke
 
