@@ -32,6 +32,7 @@
 #define HYBRID_SETUP_H
 
 #include "gk_hybrid.h"
+#include "cli.h"
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -167,10 +168,10 @@ static int num(const char *s, double *v) {
     return end != s && *end == '\0' && errno == 0 && isfinite(*v);
 }
 
-/* strict parsing: every flag known, every value a number in range, errors name the flag */
+/* strict parsing (examples/cli.h): every flag known, every value a number in range, errors name the
+ * flag; 0 to run, 2 after --help, 1 after a message */
 static int parse(int argc, char **argv, opts *o) {
-    int i, test = -1, mode = -1, have[64];
-    double v;
+    int i, test = -1, mode = -1;
     for (i = 1; i + 1 < argc; ++i) {
         if (!strcmp(argv[i], "--test")) {
             if (!strcmp(argv[i + 1], "planar"))
@@ -198,93 +199,84 @@ static int parse(int argc, char **argv, opts *o) {
                 o->band_window = 0.022;
             }
         }
-    memset(have, 0, sizeof have);
-    for (i = 1; i < argc; ++i) {
-        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) return usage(stdout), 2;
-        if (!strcmp(a, "--quiet")) {
-            o->quiet = 1;
-            continue;
+    {
+        int grains = (int)o->grains, paper = 0, help = 0, n = 1, r = 0;
+        const char *test_arg = NULL;
+        const cli_opt table[] = {
+            {"--test", CLI_STR, &test_arg, 0, 0, NULL, NULL, 0}, /* read above */
+            {"--mode", CLI_CHOICE, &mode, 0, 0, NULL, "dem|continuum|hybrid", 0},
+            {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
+            {"--packing", CLI_STR, &o->packing, 0, 0, NULL, NULL, 0},
+            {"--quiet", CLI_FLAG, &o->quiet, 0, 0, NULL, NULL, 0},
+            {"--paper", CLI_FLAG, &paper, 0, 0, NULL, NULL, 0}, /* applied above */
+            {"--width", CLI_REAL, &o->width, 0.005, 10.0, "a width in [0.005, 10] m", NULL, 0},
+            {"--height", CLI_REAL, &o->height, 0.005, 10.0, "a height in [0.005, 10] m", NULL, 0},
+            {"--pressure", CLI_REAL, &o->pressure, 0.0, 1e8, "a stress in (0, 1e8] Pa", NULL, CLI_LO_OPEN},
+            {"--speed", CLI_REAL, &o->speed, 0.0, 10.0, "a speed in (0, 10] m/s", NULL, CLI_LO_OPEN},
+            {"--strain", CLI_REAL, &o->strain_end, 0.0, 2.0, "a strain in (0, 2]", NULL, CLI_LO_OPEN},
+            {"--out-every", CLI_REAL, &o->out_every, 0.0, HUGE_VAL, "a positive strain", NULL, CLI_LO_OPEN},
+            {"--cell", CLI_REAL, &o->cell, 0.0, HUGE_VAL, "a positive cell size", NULL, CLI_LO_OPEN},
+            {"--alpha", CLI_REAL, &o->alpha, 0.0, 1.0, "a value in [0, 1]", NULL, 0},
+            {"--train", CLI_REAL, &o->train, 0.0, 1.0, "a fraction in [0, 1]", NULL, 0},
+            {"--train-speed", CLI_REAL, &o->train_speed, 0.0, 10.0, "a speed in (0, 10] m/s", NULL, CLI_LO_OPEN},
+            {"--phi0", CLI_REAL, &o->phi0, 0.0, HUGE_VAL, "a positive distance", NULL, CLI_LO_OPEN},
+            {"--c0", CLI_REAL, &o->c0, 0.0, HUGE_VAL, "a value >= 0", NULL, 0},
+            {"--c1", CLI_REAL, &o->c1, 0.0, HUGE_VAL, "a value >= 0", NULL, 0},
+            {"--cl", CLI_REAL, &o->cl, 0.0, HUGE_VAL, "a positive value", NULL, CLI_LO_OPEN},
+            {"--cg", CLI_REAL, &o->cg, 0.0, HUGE_VAL, "a positive value", NULL, CLI_LO_OPEN},
+            {"--phi", CLI_REAL, &o->phi_init, 0.5, 0.95, "a packing fraction in (0.5, 0.95)", NULL,
+             CLI_LO_OPEN | CLI_HI_OPEN},
+            {"--weak-dphi", CLI_REAL, &o->weak_dphi, 0.0, 0.3, "a value in [0, 0.3)", NULL, CLI_HI_OPEN},
+            {"--xi", CLI_REAL, &o->xi, 0.0, 1e3, "a value in [0, 1e3]", NULL, 0},
+            {"--band-window", CLI_REAL, &o->band_window, 0.0, HUGE_VAL, "a positive half-width", NULL, CLI_LO_OPEN},
+            {"--percentile", CLI_REAL, &o->percentile, 50.0, 100.0, "a percentile in [50, 100)", NULL, CLI_HI_OPEN},
+            {"--platen-damping", CLI_REAL, &o->platen_zeta, 0.0, 10.0, "a value in [0, 10]", NULL, 0},
+            {"--ramp", CLI_REAL, &o->ramp, 0.0, 1e4, "a value in [0, 1e4]", NULL, 0},
+            {"--dem-seconds", CLI_REAL, &o->dem_seconds, 0.0, HUGE_VAL, "a positive time", NULL, CLI_LO_OPEN},
+            {"--threads", CLI_INT, &o->threads, 1, 256, NULL, NULL, 0},
+            {"--grains", CLI_INT, &grains, 0, 5000000, NULL, NULL, 0},
+            {"--ppd", CLI_INT, &o->ppd, 1, 4, NULL, NULL, 0},
+            {"--oracle-every", CLI_INT, &o->oracle_every, 1, 1000000, NULL, NULL, 0},
+            {"--seed", CLI_ULONG, &o->seed, 0, 0, NULL, NULL, 0}, /* at most 4294967295: checked below */
+            {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+        const cli_opt *const tables[] = {table, NULL};
+        /* --window S0 S1 takes two values, which cli.h does not: the arguments are handed to
+         * cli_parse a stretch at a time, each --window read between two stretches, so that every
+         * refusal (and --help) still comes in the order of the command line */
+        char **seg = (char **)malloc((size_t)(argc + 1) * sizeof *seg);
+        if (!seg) return fprintf(stderr, "error: out of memory\n"), 1;
+        seg[0] = argv[0];
+        for (i = 1; i <= argc && !r && !help; ++i) {
+            const cli_opt *k = NULL;
+            int t;
+            if (i < argc && strcmp(argv[i], "--window")) {
+                for (t = 0; table[t].name && !k; ++t)
+                    if (!strcmp(argv[i], table[t].name)) k = &table[t];
+                seg[n++] = argv[i];
+                if (k && k->kind != CLI_FLAG && i + 1 < argc) seg[n++] = argv[++i];
+                continue;
+            }
+            /* the end, or a --window: the stretch before it */
+            if (cli_parse("hybrid", n, seg, tables, &help)) r = 1;
+            n = 1;
+            if (r || help || i == argc) break;
+            {
+                double v0, v1;
+                if (i + 2 >= argc || !num(argv[i + 1], &v0) || !num(argv[i + 2], &v1) || !(v0 >= 0.0 && v1 > v0))
+                    r = (fprintf(stderr, "error: --window needs two strains S0 < S1\n"), 1);
+                else
+                    o->win0 = v0, o->win1 = v1, i += 2;
+            }
         }
-        if (!strcmp(a, "--paper")) continue;
-        if (!val) return fprintf(stderr, "error: %s needs a value (or is unknown; see --help)\n", a), 1;
-        ++i;
-        if (!strcmp(a, "--test")) continue;
-        if (!strcmp(a, "--mode")) {
-            if (!strcmp(val, "dem"))
-                mode = M_DEM;
-            else if (!strcmp(val, "continuum"))
-                mode = M_CONT;
-            else if (!strcmp(val, "hybrid"))
-                mode = M_HYBRID;
-            else
-                return fprintf(stderr, "error: --mode %s: use dem, continuum or hybrid\n", val), 1;
-            continue;
-        }
-        if (!strcmp(a, "--out")) {
-            o->out = val;
-            continue;
-        }
-        if (!strcmp(a, "--packing")) {
-            o->packing = val;
-            continue;
-        }
-        if (!strcmp(a, "--window")) {
-            double v2;
-            if (i + 1 >= argc || !num(val, &v) || !num(argv[i + 1], &v2) || !(v >= 0.0 && v2 > v))
-                return fprintf(stderr, "error: --window needs two strains S0 < S1\n"), 1;
-            o->win0 = v;
-            o->win1 = v2;
-            ++i;
-            continue;
-        }
-        if (!num(val, &v)) return fprintf(stderr, "error: %s %s: not a number\n", a, val), 1;
-#define REAL(flag, field, ok, what)                                                      \
-    if (!strcmp(a, flag)) {                                                              \
-        if (!(ok)) return fprintf(stderr, "error: %s %s: need %s\n", a, val, what), 1;   \
-        o->field = v;                                                                    \
-        continue;                                                                        \
-    }
-#define INT(flag, field, lo, hi)                                                                        \
-    if (!strcmp(a, flag)) {                                                                             \
-        if (v != floor(v) || v < (lo) || v > (hi))                                                      \
-            return fprintf(stderr, "error: %s %s: need an integer in [%g, %g]\n", a, val, (double)(lo), \
-                           (double)(hi)),                                                               \
-                   1;                                                                                   \
-        o->field = v;                                                                                   \
-        continue;                                                                                       \
-    }
-        REAL("--width", width, v >= 0.005 && v <= 10.0, "a width in [0.005, 10] m")
-        REAL("--height", height, v >= 0.005 && v <= 10.0, "a height in [0.005, 10] m")
-        REAL("--pressure", pressure, v > 0.0 && v <= 1e8, "a stress in (0, 1e8] Pa")
-        REAL("--speed", speed, v > 0.0 && v <= 10.0, "a speed in (0, 10] m/s")
-        REAL("--strain", strain_end, v > 0.0 && v <= 2.0, "a strain in (0, 2]")
-        REAL("--out-every", out_every, v > 0.0, "a positive strain")
-        REAL("--cell", cell, v > 0.0, "a positive cell size")
-        REAL("--alpha", alpha, v >= 0.0 && v <= 1.0, "a value in [0, 1]")
-        REAL("--train", train, v >= 0.0 && v <= 1.0, "a fraction in [0, 1]")
-        REAL("--train-speed", train_speed, v > 0.0 && v <= 10.0, "a speed in (0, 10] m/s")
-        REAL("--phi0", phi0, v > 0.0, "a positive distance")
-        REAL("--c0", c0, v >= 0.0, "a value >= 0")
-        REAL("--c1", c1, v >= 0.0, "a value >= 0")
-        REAL("--cl", cl, v > 0.0, "a positive value")
-        REAL("--cg", cg, v > 0.0, "a positive value")
-        REAL("--phi", phi_init, v > 0.5 && v < 0.95, "a packing fraction in (0.5, 0.95)")
-        REAL("--weak-dphi", weak_dphi, v >= 0.0 && v < 0.3, "a value in [0, 0.3)")
-        REAL("--xi", xi, v >= 0.0 && v <= 1e3, "a value in [0, 1e3]")
-        REAL("--band-window", band_window, v > 0.0, "a positive half-width")
-        REAL("--percentile", percentile, v >= 50.0 && v < 100.0, "a percentile in [50, 100)")
-        REAL("--platen-damping", platen_zeta, v >= 0.0 && v <= 10.0, "a value in [0, 10]")
-        REAL("--ramp", ramp, v >= 0.0 && v <= 1e4, "a value in [0, 1e4]")
-        REAL("--dem-seconds", dem_seconds, v > 0.0, "a positive time")
-        INT("--threads", threads, 1, 256)
-        INT("--grains", grains, 0, 5000000)
-        INT("--ppd", ppd, 1, 4)
-        INT("--oracle-every", oracle_every, 1, 1000000)
-        INT("--seed", seed, 0, 4294967295.0)
-#undef REAL
-#undef INT
-        return fprintf(stderr, "error: unknown option %s (see --help)\n", a), 1;
+        free(seg);
+        if (r) return 1;
+        if (help) return usage(stdout), 2;
+        if (o->seed > 4294967295UL)
+            return fprintf(stderr, "hybrid: --seed %lu is out of range: needs a whole number in [0, 4294967295]\n",
+                           o->seed),
+                   1;
+        o->grains = grains;
+        (void)test_arg, (void)paper;
     }
     if (mode < 0) return fprintf(stderr, "error: --mode dem|continuum|hybrid is required\n"), 1;
     o->mode = mode;
@@ -295,7 +287,6 @@ static int parse(int argc, char **argv, opts *o) {
         return fprintf(stderr, "error: --train %g: below 1 only for the planar test (the band region moves)\n",
                        o->train),
                1;
-    (void)have;
     return 0;
 }
 

@@ -25,6 +25,7 @@
 #define GK_IMPLEMENTATION
 #include "gk_homog.h"
 #include "gk_io.h"
+#include "cli.h"
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -77,99 +78,63 @@ static int parse_numbers(const char *s, double *out, int max) {
     return n;
 }
 
-/* a real or whole-number option value, strictly ('1e9x', '', 'nan', out of range: refused by name) */
-static int real_opt(const char *a, const char *v, double *out) {
-    char *e;
-    errno = 0;
-    *out = strtod(v, &e);
-    if (e == v || *e || errno == ERANGE || !isfinite(*out)) {
-        fprintf(stderr, "rve_path: %s '%s' is not a finite number\n", a, v);
-        return 1;
-    }
-    return 0;
-}
-static int long_opt(const char *a, const char *v, long *out) {
-    char *e;
-    errno = 0;
-    *out = strtol(v, &e, 10);
-    if (e == v || *e || errno == ERANGE) {
-        fprintf(stderr, "rve_path: %s '%s' is not a whole number\n", a, v);
-        return 1;
-    }
-    return 0;
-}
-
 /* the options, with their defaults */
 typedef struct rp_opts {
     const char *packing, *dhs, *out, *svg, *law, *form, *path;
     double E, ktr, phi, phi_deg, rho, thick, damp, dt, poisson, dHin[9];
     long ninc, nsteps;
-    int threads, nd;
+    int threads, nd, law_k, form_k, path_k;
 } rp_opts;
 
-/* the options, strictly: 0 to run, -1 after --help, 2 after saying what is wrong */
+static const char *const rp_law[] = {"linear", "hertz"};
+static const char *const rp_form[] = {"component", "vector"};
+static const char *const rp_path[] = {"constant-L", "objective"};
+
+/* the options, strictly (examples/cli.h): 0 to run, -1 after --help, 2 after saying what is wrong */
 static int rp_parse(int argc, char **argv, rp_opts *o) {
-    int i;
+    int help = 0, ninc = 10, nsteps = 100;
+    double phi_rad = NAN; /* --friction-angle: the old radian option, kept for old scripts */
+    const cli_opt opts[] = {
+        {"--packing", CLI_STR, &o->packing, 0, 0, NULL, NULL, 0},
+        {"--dH", CLI_STR, &o->dhs, 0, 0, NULL, NULL, 0},
+        {"--increments", CLI_INT, &ninc, 1, 100000000.0, NULL, NULL, 0},
+        {"--steps-per-increment", CLI_INT, &nsteps, 1, 2000000000.0, NULL, NULL, 0},
+        {"--E", CLI_REAL, &o->E, -HUGE_VAL, HUGE_VAL, "a number", NULL, 0},
+        {"--kt-ratio", CLI_REAL, &o->ktr, -HUGE_VAL, HUGE_VAL, "a number", NULL, 0},
+        {"--friction-deg", CLI_REAL, &o->phi_deg, -HUGE_VAL, HUGE_VAL, "a number", NULL, 0},
+        {"--friction-angle", CLI_REAL, &phi_rad, -HUGE_VAL, HUGE_VAL, "a number", NULL, 0},
+        {"--density", CLI_REAL, &o->rho, -HUGE_VAL, HUGE_VAL, "a number", NULL, 0},
+        {"--thickness", CLI_REAL, &o->thick, -HUGE_VAL, HUGE_VAL, "a number", NULL, 0},
+        {"--damping", CLI_REAL, &o->damp, -HUGE_VAL, HUGE_VAL, "a number", NULL, 0},
+        {"--damping-form", CLI_CHOICE, &o->form_k, 0, 0, NULL, "component|vector", 0},
+        {"--dt", CLI_REAL, &o->dt, -HUGE_VAL, HUGE_VAL, "a number", NULL, 0},
+        {"--law", CLI_CHOICE, &o->law_k, 0, 0, NULL, "linear|hertz", 0},
+        {"--poisson", CLI_REAL, &o->poisson, -HUGE_VAL, HUGE_VAL, "a number", NULL, 0},
+        {"--path", CLI_CHOICE, &o->path_k, 0, 0, NULL, "constant-L|objective", 0},
+        {"--threads", CLI_INT, &o->threads, 1, 4096, NULL, NULL, 0},
+        {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
+        {"--svg", CLI_STR, &o->svg, 0, 0, NULL, NULL, 0},
+        {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    const cli_opt *const tables[] = {opts, NULL};
     o->packing = o->dhs = o->svg = NULL;
-    o->out = "rve_path.csv", o->law = "linear", o->form = "component", o->path = "constant-L";
+    o->out = "rve_path.csv";
+    o->law_k = o->form_k = o->path_k = 0; /* linear, component, constant-L */
     o->E = 6e8, o->ktr = 0.8, o->phi = 0.5, o->phi_deg = -1.0, o->rho = 2650, o->thick = 0.1, o->damp = 0.1;
     o->dt = 0, o->poisson = 0.25;
-    o->ninc = 10, o->nsteps = 100;
     o->threads = 1;
-    for (i = 1; i < argc; i += 2) { /* an option and its value */
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        int bad = 0;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage(stdout);
-            return -1;
-        }
-        if (!v) {
-            fprintf(stderr, "rve_path: %s needs a value (see --help)\n", a);
-            return 2;
-        }
-        if (!strcmp(a, "--packing")) o->packing = v;
-        else if (!strcmp(a, "--dH")) o->dhs = v;
-        else if (!strcmp(a, "--increments")) bad = long_opt(a, v, &o->ninc);
-        else if (!strcmp(a, "--steps-per-increment")) bad = long_opt(a, v, &o->nsteps);
-        else if (!strcmp(a, "--E")) bad = real_opt(a, v, &o->E);
-        else if (!strcmp(a, "--kt-ratio")) bad = real_opt(a, v, &o->ktr);
-        else if (!strcmp(a, "--friction-deg")) bad = real_opt(a, v, &o->phi_deg);
-        else if (!strcmp(a, "--friction-angle")) { /* the old radian option, kept for old scripts */
-            fprintf(stderr, "rve_path: --friction-angle (radians) is deprecated: use --friction-deg\n");
-            bad = real_opt(a, v, &o->phi);
-        }
-        else if (!strcmp(a, "--density")) bad = real_opt(a, v, &o->rho);
-        else if (!strcmp(a, "--thickness")) bad = real_opt(a, v, &o->thick);
-        else if (!strcmp(a, "--damping")) bad = real_opt(a, v, &o->damp);
-        else if (!strcmp(a, "--damping-form")) o->form = v;
-        else if (!strcmp(a, "--dt")) bad = real_opt(a, v, &o->dt);
-        else if (!strcmp(a, "--law")) o->law = v;
-        else if (!strcmp(a, "--poisson")) bad = real_opt(a, v, &o->poisson);
-        else if (!strcmp(a, "--path")) o->path = v;
-        else if (!strcmp(a, "--threads")) {
-            long t = 0;
-            bad = long_opt(a, v, &t);
-            if (!bad && (t < 1 || t > 4096)) {
-                fprintf(stderr, "rve_path: --threads %ld: needs 1 to 4096\n", t);
-                bad = 1;
-            }
-            o->threads = (int)t;
-        }
-        else if (!strcmp(a, "--out")) o->out = v;
-        else if (!strcmp(a, "--svg")) o->svg = v;
-        else {
-            fprintf(stderr, "rve_path: unknown option %s (see --help)\n", a);
-            return 2;
-        }
-        if (bad) return 2;
+    if (cli_parse("rve_path", argc, argv, tables, &help)) return 2;
+    if (help) {
+        usage(stdout);
+        return -1;
+    }
+    o->ninc = ninc, o->nsteps = nsteps;
+    o->law = rp_law[o->law_k], o->form = rp_form[o->form_k], o->path = rp_path[o->path_k];
+    if (!isnan(phi_rad)) {
+        fprintf(stderr, "rve_path: --friction-angle (radians) is deprecated: use --friction-deg\n");
+        o->phi = phi_rad;
     }
     if (!o->packing || !o->dhs) {
         fprintf(stderr, "rve_path: --packing and --dH are required (see --help)\n");
-        return 2;
-    }
-    if (o->ninc < 1 || o->ninc > 100000000L || o->nsteps < 1 || o->nsteps > 2000000000L) {
-        fprintf(stderr, "rve_path: --increments (1 to 1e8) and --steps-per-increment (1 to 2e9) out of range\n");
         return 2;
     }
     if (o->phi_deg != -1.0) o->phi = o->phi_deg * GK_PI / 180.0;
@@ -199,24 +164,9 @@ static int rp_setup(const rp_opts *o, gk_rve *rve, double dH[9], int *dimp) {
     def.mat.friction = tan(o->phi);
     def.mat.density = o->rho;
     def.mat.poisson = o->poisson;
-    if (!strcmp(o->law, "linear")) def.mat.law = GK_LAW_LINEAR;
-    else if (!strcmp(o->law, "hertz")) def.mat.law = GK_LAW_HERTZ;
-    else {
-        fprintf(stderr, "rve_path: --law must be linear or hertz\n");
-        return 2;
-    }
-    if (!strcmp(o->form, "component")) def.damping_form = GK_DAMP_COMPONENT;
-    else if (!strcmp(o->form, "vector")) def.damping_form = GK_DAMP_VECTOR;
-    else {
-        fprintf(stderr, "rve_path: --damping-form must be component or vector\n");
-        return 2;
-    }
-    if (!strcmp(o->path, "constant-L")) def.path = GK_PATH_CONSTANT_L;
-    else if (!strcmp(o->path, "objective")) def.path = GK_PATH_OBJECTIVE;
-    else {
-        fprintf(stderr, "rve_path: --path must be constant-L or objective\n");
-        return 2;
-    }
+    def.mat.law = o->law_k == 0 ? GK_LAW_LINEAR : GK_LAW_HERTZ;
+    def.damping_form = o->form_k == 0 ? GK_DAMP_COMPONENT : GK_DAMP_VECTOR;
+    def.path = o->path_k == 0 ? GK_PATH_CONSTANT_L : GK_PATH_OBJECTIVE;
     def.thickness = o->thick;
     def.damping = o->damp;
     def.dt = o->dt;

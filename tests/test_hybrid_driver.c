@@ -162,14 +162,18 @@ static int refused(const char *flags, const char *msg) {
 TEST(hybrid_refuses_bad_arguments) {
     CHECK(refused("--mode dem", "--test planar|biaxial is required"));
     CHECK(refused("--test indent --mode dem", "is not implemented"));
-    CHECK(refused("--test planar --mode foo", "--mode foo"));
+    CHECK(refused("--test planar --mode foo", "--mode 'foo' must be dem, continuum or hybrid"));
     CHECK(refused("--test planar --mode hybrid --train 2", "--train 2"));
-    CHECK(refused("--test planar --mode dem --width 0.03x", "not a number"));
-    CHECK(refused("--test planar --mode dem --threads 1.5", "--threads 1.5"));
+    CHECK(refused("--test planar --mode dem --width 0.03x", "--width '0.03x' is not a finite number"));
+    CHECK(refused("--test planar --mode dem --threads 1.5", "--threads '1.5' is not a whole number"));
     CHECK(refused("--test planar --mode dem --window 0.5 0.1", "--window"));
     CHECK(refused("--test planar --mode dem --strain 0.1", "beyond --strain"));
     CHECK(refused("--test planar --mode dem --speed", "--speed"));
     CHECK(refused("--test planar --mode dem --bogus 1", "--bogus"));
+    /* whole numbers are checked before any arithmetic (the seed is 32 bits), --window takes two values */
+    CHECK(refused("--test planar --mode dem --seed 4294967296", "--seed 4294967296 is out of range"));
+    CHECK(refused("--test planar --mode dem --window 0.1 0.2 --ppd 5", "--ppd 5 is out of range"));
+    CHECK(refused("--test planar --mode dem --window 0.1", "--window needs two strains"));
     /* an unreadable packing: an error, not a crash (the directory may exist) */
     CHECK(system(BUILD "/hybrid --test planar --mode dem --packing " BUILD "/tests/no_such_packing.txt --out "
                  BUILD "/tests/t_hybad "
