@@ -172,6 +172,8 @@ static int num(const char *s, double *v) {
  * flag; 0 to run, 2 after --help, 1 after a message */
 static int parse(int argc, char **argv, opts *o) {
     int i, test = -1, mode = -1;
+    for (i = 1; i < argc; ++i) /* --help needs no --test */
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) return usage(stdout), 2;
     for (i = 1; i + 1 < argc; ++i) {
         if (!strcmp(argv[i], "--test")) {
             if (!strcmp(argv[i + 1], "planar"))

@@ -185,6 +185,9 @@ TEST(hybrid_refuses_bad_arguments) {
                  "2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "t_hyfile"));
     remove(BUILD "/tests/t_hyfile");
+    /* --help alone (no --test) prints the usage and exits 0 */
+    CHECK(system(BUILD "/hybrid --help > " BUILD "/tests/t_hyhelp.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyhelp.out", "usage: hybrid --test planar|biaxial"));
 }
 
 int main(int argc, char **argv) {
