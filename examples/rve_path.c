@@ -115,7 +115,7 @@ int main(int argc, char **argv) {
     gk_result res;
     int rc = 1;
     char svgname[1024];
-    for (i = 1; i < argc; ++i) {
+    for (i = 1; i < argc; i += 2) { /* an option and its value */
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         int bad = 0;
@@ -162,7 +162,6 @@ int main(int argc, char **argv) {
             return 2;
         }
         if (bad) return 2;
-        ++i;
     }
     if (!packing || !dhs) {
         fprintf(stderr, "rve_path: --packing and --dH are required (see --help)\n");
