@@ -22,7 +22,8 @@
  * other ranks of an MPI run).
  *
  * CLI_REAL ranges: [lo, hi] by default; CLI_LO_OPEN / CLI_HI_OPEN in `flags` open an end
- * (hi = HUGE_VAL: no upper bound); `what` describes the range in messages.
+ * (hi = HUGE_VAL: no upper bound); `what` describes the range in messages. CLI_FUNC: a value
+ * in a format of the driver's own, parsed by its function (struct cli_func below).
  */
 #ifndef CLI_H
 #define CLI_H
@@ -35,19 +36,28 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum cli_kind { CLI_INT, CLI_REAL, CLI_STR, CLI_CHOICE, CLI_FLAG, CLI_ULONG } cli_kind;
+typedef enum cli_kind { CLI_INT, CLI_REAL, CLI_STR, CLI_CHOICE, CLI_FLAG, CLI_ULONG, CLI_FUNC } cli_kind;
 #define CLI_LO_OPEN 1u
 #define CLI_HI_OPEN 2u
 
 typedef struct cli_opt {
     const char *name;    /* "--nx" */
     cli_kind kind;
-    void *dst;           /* int*, double*, const char**, int* (choice index, flag), unsigned long* */
+    void *dst;           /* int*, double*, const char**, int* (choice index, flag), unsigned long*,
+                            cli_func* */
     double lo, hi;       /* CLI_INT / CLI_REAL range                                          */
     const char *what;    /* CLI_REAL: the range in words ("a positive number"); NULL: [lo, hi] */
     const char *choices; /* CLI_CHOICE: "a|b|c" (dst gets the index)                          */
     unsigned flags;      /* CLI_LO_OPEN, CLI_HI_OPEN                                          */
 } cli_opt;
+
+/* CLI_FUNC: a value with its own format ("2x3x1"), parsed by fn where it stands on the command
+ * line (so a refused one ends the parse like any other): fn(prog, option name, value, dst)
+ * returns 0, or 2 after a message through cli_say */
+typedef struct cli_func {
+    int (*fn)(const char *prog, const char *name, const char *v, void *dst);
+    void *dst;
+} cli_func;
 
 /* a message on stderr, unless prog is NULL (a driver's other MPI ranks stay quiet) */
 static void cli_say(const char *prog, const char *fmt, ...) {
@@ -95,6 +105,10 @@ static int cli_value(const char *prog, const cli_opt *o, const char *v) {
     if (o->kind == CLI_STR) {
         *(const char **)o->dst = v;
         return 0;
+    }
+    if (o->kind == CLI_FUNC) {
+        const cli_func *f = (const cli_func *)o->dst;
+        return f->fn(prog, o->name, v, f->dst) ? 2 : 0;
     }
     if (o->kind == CLI_CHOICE) {
         int k = cli_choice_index(o->choices, v);

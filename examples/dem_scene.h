@@ -1,10 +1,12 @@
 /* dem_scene.h - what the single-scale DEM drivers (dem_biaxial.c,
  * dem_collapse.c) share: strict number parsing, the output directory and
- * the VTK / SVG pictures of a gk_scene. Include after gk_scene.h. */
+ * the VTK / SVG pictures of a gk_scene (gk_scene.h). */
 #ifndef DEM_SCENE_H
 #define DEM_SCENE_H
 
+#include "gk_scene.h"
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

@@ -21,6 +21,9 @@
 #ifndef FEMDEM_H
 #define FEMDEM_H
 
+#include "gk_fem.h"
+#include "gk_io.h"
+#include "gk_twoscale.h"
 #include "cli.h"
 #include <errno.h>
 #include <stdarg.h>

@@ -7,7 +7,8 @@
  *       [--packing F] [--threads T] [--paper] --out DIR [--restart DIR]   (--help: every flag)
  *
  * The driver runs the tests; the rest is in four example headers, each with its manual:
- *   examples/nonlocal_opts.h   the options and the tests (geometry, loading, boundary conditions)
+ *   examples/nonlocal_opts.h   the options (on examples/cli.h) and the tests (geometry, loading,
+ *                              boundary conditions)
  *   examples/nonlocal_micro.h  the micro model: the RVEs (Table I), the RVE alone (Table II, Fig 6)
  *   examples/nonlocal_macro.h  the model: Hex8 explicit FEM, nonlocal average, time steps, damping
  *   examples/nonlocal_io.h     the outputs in DIR, the RESULT line and the checkpoint

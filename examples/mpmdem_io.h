@@ -12,6 +12,7 @@
  * Rank 0 alone writes (under MPI); every function returns 0, or 1 after
  * saying what could not be written, on every rank.
  */
+#include "mpmdem.h" /* included alone: mpmdem.h, which includes this file where it needs it */
 #ifndef MPMDEM_IO_H
 #define MPMDEM_IO_H
 

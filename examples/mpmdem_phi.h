@@ -25,6 +25,8 @@
 #ifndef MPMDEM_PHI_H
 #define MPMDEM_PHI_H
 
+#include "mpmdem.h"
+
 #define FT_MAXPHI 6
 typedef struct ft_phi_test {
     double s3;                     /* confining pressure [Pa] */

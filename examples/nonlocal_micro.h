@@ -25,6 +25,7 @@
 #ifndef NONLOCAL_MICRO_H
 #define NONLOCAL_MICRO_H
 
+#include "gk_explicit.h"
 #include "gk_io.h"
 #include "gk_twoscale.h"
 #include "nonlocal_opts.h"

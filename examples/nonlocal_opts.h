@@ -1,6 +1,7 @@
 /* nonlocal_opts.h - the options of build/femdem_nonlocal (examples/femdem_nonlocal.c) and the
  * tests they select (examples, not library): the test names, the options, the usage text and the
- * strict parser with every test's defaults (femdem_nonlocal --help lists them).
+ * parser with every test's defaults (femdem_nonlocal --help lists them), on examples/cli.h: every
+ * value is parsed strictly and a refused one is named (status 2).
  *
  * TESTS (units SI; stresses in the outputs compression-positive)
  *   rve              Table II: K and G of the RVE alone from isotropic
@@ -55,6 +56,7 @@
 #ifndef NONLOCAL_OPTS_H
 #define NONLOCAL_OPTS_H
 
+#include "cli.h"
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -76,30 +78,6 @@ typedef struct opts {
 } opts;
 
 /* ------------------------------------------------------------ small helpers */
-static int fail(const char *fmt, const char *a, const char *b) {
-    fprintf(stderr, "femdem_nonlocal: ");
-    fprintf(stderr, fmt, a, b);
-    fputc('\n', stderr);
-    return 2;
-}
-static int real_opt(const char *a, const char *v, double *out) {
-    char *e;
-    errno = 0;
-    *out = strtod(v, &e);
-    if (e == v || *e || errno == ERANGE || !isfinite(*out))
-        return fail("%s '%s' is not a finite number", a, v);
-    return 0;
-}
-static int int_opt(const char *a, const char *v, int *out) {
-    char *e;
-    long x;
-    errno = 0;
-    x = strtol(v, &e, 10);
-    if (e == v || *e || errno == ERANGE || x < INT_MIN || x > INT_MAX)
-        return fail("%s '%s' is not a whole number", a, v);
-    *out = (int)x;
-    return 0;
-}
 static void *xcalloc(size_t n, size_t sz) {
     void *p = calloc(n ? n : 1, sz);
     if (!p) {
@@ -135,8 +113,102 @@ static void usage(FILE *fp) {
             "See the top of examples/femdem_nonlocal.c for the model, the outputs and the RESULT line.\n");
 }
 
+/* --test NAME: its index in test_name (the last --test counts, a misspelt one is refused where it
+ * stands) */
+static int test_opt(const char *prog, const char *name, const char *v, void *dst) {
+    int t, *test = (int *)dst;
+    for (t = 0; t < T_COUNT; ++t)
+        if (!strcmp(v, test_name[t])) {
+            *test = t;
+            return 0;
+        }
+    cli_say(prog,
+            "%s: %s '%s' is not one of rve, element-biaxial, element-shear, wave, simple-shear, biaxial\n",
+            prog, name, v);
+    return 2;
+}
+
+/* --mesh NXxNYxNZ, counts 1-1000 (a cli.h CLI_FUNC: checked where it stands) */
+static int mesh_opt(const char *prog, const char *name, const char *v, void *dst) {
+    int *mesh = (int *)dst, k;
+    const char *q = v;
+    char *e;
+    for (k = 0; k < 3; ++k) {
+        long x;
+        errno = 0;
+        x = strtol(q, &e, 10);
+        if (e == q || errno || x < 1 || x > 1000 || (k < 2 && *e != 'x') || (k == 2 && *e)) {
+            cli_say(prog, "%s: %s '%s' is not NXxNYxNZ with counts 1-1000\n", prog, name, v);
+            return 2;
+        }
+        mesh[k] = (int)x;
+        q = e + 1;
+    }
+    return 0;
+}
+
+/* --nonlocal R|off: a radius > 0 [m], or off (0) */
+static int nonlocal_opt(const char *prog, const char *name, const char *v, void *dst) {
+    static const cli_opt real = {"--nonlocal", CLI_REAL, NULL, -HUGE_VAL, HUGE_VAL, "a radius > 0 [m] or off",
+                                 NULL,         0};
+    cli_opt o = real;
+    double *R = (double *)dst;
+    if (!strcmp(v, "off")) {
+        *R = 0.0;
+        return 0;
+    }
+    o.name = name, o.dst = R;
+    if (cli_value(prog, &o, v)) return 2;
+    if (!(*R > 0.0)) {
+        cli_say(prog, "%s: %s '%s' must be a radius > 0 [m] or off\n", prog, name, v);
+        return 2;
+    }
+    return 0;
+}
+
+/* the options (examples/cli.h: every value parsed strictly, a refused one named, status 2), then
+ * the defaults of the test and the ranges (below: they depend on the test); --help prints the
+ * usage and exits 0. 0, or 2 after a message. */
 static int parse(int argc, char **argv, opts *o) {
-    int i;
+    /* any whole number / finite number in the table; the ranges are checked below */
+    const double I0 = INT_MIN, I1 = INT_MAX, R0 = -HUGE_VAL, R1 = HUGE_VAL;
+    cli_func test_f, mesh_f, nonlocal_f;
+    const cli_opt tab[] = {
+        {"--test", CLI_FUNC, &test_f, 0, 0, NULL, NULL, 0},
+        {"--mesh", CLI_FUNC, &mesh_f, 0, 0, NULL, NULL, 0},
+        {"--nonlocal", CLI_FUNC, &nonlocal_f, 0, 0, NULL, NULL, 0},
+        {"--pressure", CLI_REAL, &o->pressure, R0, R1, "a number > 0", NULL, 0},
+        {"--strain", CLI_REAL, &o->strain, R0, R1, "a number in (0, 0.5)", NULL, 0},
+        {"--steps", CLI_INT, &o->steps, I0, I1, NULL, NULL, 0},
+        {"--stop-after", CLI_INT, &o->stop_after, I0, I1, NULL, NULL, 0},
+        {"--threads", CLI_INT, &o->threads, I0, I1, NULL, NULL, 0},
+        {"--checkpoint", CLI_INT, &o->checkpoint, I0, I1, NULL, NULL, 0},
+        {"--vtk-every", CLI_INT, &o->vtk_every, I0, I1, NULL, NULL, 0},
+        {"--every", CLI_INT, &o->every, I0, I1, NULL, NULL, 0},
+        {"--imperfection", CLI_INT, &o->imperfection, I0, I1, NULL, NULL, 0},
+        {"--iuf", CLI_REAL, &o->iuf, R0, R1, "a number in (0, 1)", NULL, 0},
+        {"--dem-inertial", CLI_REAL, &o->dem_inertial, R0, R1, "a number in (0, 1)", NULL, 0},
+        {"--dem-min", CLI_INT, &o->dem_min, I0, I1, NULL, NULL, 0},
+        {"--dem-max", CLI_INT, &o->dem_max, I0, I1, NULL, NULL, 0},
+        {"--lone-increments", CLI_INT, &o->lone, I0, I1, NULL, NULL, 0},
+        {"--dem-damping", CLI_REAL, &o->dem_damping, R0, R1, "a number in [0, 1)", NULL, 0},
+        {"--contact-damping", CLI_REAL, &o->contact_damping, R0, R1, "a number in [0, 1)", NULL, 0},
+        {"--density", CLI_REAL, &o->density, R0, R1, "a number > 0", NULL, 0},
+        {"--xi", CLI_REAL, &o->xi, R0, R1, "a number in [0, 10]", NULL, 0},
+        {"--mass-scale", CLI_REAL, &o->mass_scale, R0, R1, "a number > 0", NULL, 0},
+        {"--hourglass", CLI_REAL, &o->kappa, R0, R1, "a number in [0, 1]", NULL, 0},
+        {"--dt", CLI_REAL, &o->dt, R0, R1, "a number >= 0", NULL, 0},
+        {"--dt-safety", CLI_REAL, &o->dt_safety, R0, R1, "a number in (0, 1]", NULL, 0},
+        {"--amplitude", CLI_REAL, &o->amplitude, R0, R1, "a number > 0", NULL, 0},
+        {"--frequency", CLI_REAL, &o->frequency, R0, R1, "a number > 0", NULL, 0},
+        {"--duration", CLI_REAL, &o->duration, R0, R1, "a number > 0", NULL, 0},
+        {"--packing", CLI_STR, &o->packing, 0, 0, NULL, NULL, 0},
+        {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
+        {"--restart", CLI_STR, &o->restart, 0, 0, NULL, NULL, 0},
+        {"--paper", CLI_FLAG, &o->paper, 0, 0, NULL, NULL, 0},
+        {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    const cli_opt *const tables[] = {tab, NULL};
+    int help;
     memset(o, 0, sizeof *o);
     o->test = -1;
     o->R = 0.0;
@@ -165,109 +237,22 @@ static int parse(int argc, char **argv, opts *o) {
     o->frequency = 1e4;
     o->duration = 1e-3;
     o->packing = NULL;
-    for (i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        int bad = 0;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage(stdout);
-            exit(0);
-        }
-        if (!strcmp(a, "--paper")) {
-            o->paper = 1;
-            continue;
-        }
-        if (!v) return fail("%s needs a value%s", a, "");
-        if (!strcmp(a, "--test")) {
-            int t;
-            o->test = -1; /* the last --test counts: a misspelt one after a good one is refused too */
-            for (t = 0; t < T_COUNT; ++t)
-                if (!strcmp(v, test_name[t])) o->test = t;
-            if (o->test < 0)
-                return fail(
-                    "--test '%s' is not one of rve, element-biaxial, element-shear, wave, simple-shear, "
-                    "biaxial%s",
-                    v, "");
-        } else if (!strcmp(a, "--mesh")) {
-            char *e;
-            int k;
-            const char *q = v;
-            for (k = 0; k < 3; ++k) {
-                long x;
-                errno = 0;
-                x = strtol(q, &e, 10);
-                if (e == q || errno || x < 1 || x > 1000 || (k < 2 && *e != 'x') || (k == 2 && *e))
-                    return fail("--mesh '%s' is not NXxNYxNZ with counts 1-1000%s", v, "");
-                o->mesh[k] = (int)x;
-                q = e + 1;
-            }
-        } else if (!strcmp(a, "--nonlocal")) {
-            if (!strcmp(v, "off"))
-                o->R = 0.0;
-            else if (!(bad = real_opt(a, v, &o->R)) && !(o->R > 0.0))
-                return fail("--nonlocal '%s' must be a radius > 0 [m] or off%s", v, "");
-        } else if (!strcmp(a, "--pressure"))
-            bad = real_opt(a, v, &o->pressure);
-        else if (!strcmp(a, "--strain"))
-            bad = real_opt(a, v, &o->strain);
-        else if (!strcmp(a, "--steps"))
-            bad = int_opt(a, v, &o->steps);
-        else if (!strcmp(a, "--stop-after"))
-            bad = int_opt(a, v, &o->stop_after);
-        else if (!strcmp(a, "--threads"))
-            bad = int_opt(a, v, &o->threads);
-        else if (!strcmp(a, "--checkpoint"))
-            bad = int_opt(a, v, &o->checkpoint);
-        else if (!strcmp(a, "--vtk-every"))
-            bad = int_opt(a, v, &o->vtk_every);
-        else if (!strcmp(a, "--every"))
-            bad = int_opt(a, v, &o->every);
-        else if (!strcmp(a, "--imperfection"))
-            bad = int_opt(a, v, &o->imperfection);
-        else if (!strcmp(a, "--iuf"))
-            bad = real_opt(a, v, &o->iuf);
-        else if (!strcmp(a, "--dem-inertial"))
-            bad = real_opt(a, v, &o->dem_inertial);
-        else if (!strcmp(a, "--dem-min"))
-            bad = int_opt(a, v, &o->dem_min);
-        else if (!strcmp(a, "--dem-max"))
-            bad = int_opt(a, v, &o->dem_max);
-        else if (!strcmp(a, "--lone-increments"))
-            bad = int_opt(a, v, &o->lone);
-        else if (!strcmp(a, "--dem-damping"))
-            bad = real_opt(a, v, &o->dem_damping);
-        else if (!strcmp(a, "--contact-damping"))
-            bad = real_opt(a, v, &o->contact_damping);
-        else if (!strcmp(a, "--density"))
-            bad = real_opt(a, v, &o->density);
-        else if (!strcmp(a, "--xi"))
-            bad = real_opt(a, v, &o->xi);
-        else if (!strcmp(a, "--mass-scale"))
-            bad = real_opt(a, v, &o->mass_scale);
-        else if (!strcmp(a, "--hourglass"))
-            bad = real_opt(a, v, &o->kappa);
-        else if (!strcmp(a, "--dt"))
-            bad = real_opt(a, v, &o->dt);
-        else if (!strcmp(a, "--dt-safety"))
-            bad = real_opt(a, v, &o->dt_safety);
-        else if (!strcmp(a, "--amplitude"))
-            bad = real_opt(a, v, &o->amplitude);
-        else if (!strcmp(a, "--frequency"))
-            bad = real_opt(a, v, &o->frequency);
-        else if (!strcmp(a, "--duration"))
-            bad = real_opt(a, v, &o->duration);
-        else if (!strcmp(a, "--packing"))
-            o->packing = v;
-        else if (!strcmp(a, "--out"))
-            o->out = v;
-        else if (!strcmp(a, "--restart"))
-            o->restart = v;
-        else
-            return fail("unknown option %s (see --help)%s", a, "");
-        if (bad) return 2;
-        ++i;
+    test_f.fn = test_opt, test_f.dst = &o->test;
+    mesh_f.fn = mesh_opt, mesh_f.dst = o->mesh;
+    nonlocal_f.fn = nonlocal_opt, nonlocal_f.dst = &o->R;
+    if (cli_parse("femdem_nonlocal", argc, argv, tables, &help)) return 2;
+    if (help) {
+        usage(stdout);
+        exit(0);
     }
-    if (o->test < 0) return fail("--test is required (see --help)%s%s", "", "");
-    if (!o->out) return fail("--out DIR is required%s%s", "", "");
+    if (o->test < 0) {
+        fprintf(stderr, "femdem_nonlocal: --test is required (see --help)\n");
+        return 2;
+    }
+    if (!o->out) {
+        fprintf(stderr, "femdem_nonlocal: --out DIR is required\n");
+        return 2;
+    }
     /* test defaults */
     {
         static const int mesh[T_COUNT][3] = {{1, 1, 1},  {1, 1, 1},  {1, 1, 1},
