@@ -53,9 +53,11 @@
  *
  * SIZE AND COST. --paper is the paper's size with square cells: h = 9/188 m,
  * 188 x 52 = 9776 cells (9800 in the paper), depth 2.49 m; hours. The
- * default is reduced to finish in minutes on 2 cores: a 6 m wide domain (2.5
- * D either side of the pipe's final position: the mechanism of a 0.8 m
- * embedment reaches ~2 m sideways), h = 0.25 m (D = 4 cells: coarse, the
+ * default is reduced to finish in minutes on 2 cores: a 6 m wide domain (3
+ * m either side of the pipe's start; at the end of the default run points
+ * with eps_q > 10 % reach from x = 0.11 m to 4.65 m, i.e. the left wall:
+ * narrower than the mechanism, the smooth walls are part of the result),
+ * h = 0.25 m (D = 4 cells: coarse, the
  * reactions are noisy as points cross cells) and the pipe at 0.4 m/s down,
  * 0.2 m/s left with 0.2 s ramps (the paper does not give its speeds; see
  * RATE). Each run prints its cost per RVE per MPM step and projects the
@@ -63,9 +65,10 @@
  *
  * DEM STEPS per MPM step: the rule of mpmdem.h (--dem-rule, default
  * adaptive), capped by default at the REAL-TIME count ceil(dt / dt_DEM)
- * (as mpmdem_collapse): uncapped, the adaptive rule spent ~190 DEM steps
- * per point per MPM step here (the RVEs near the surface, at a few kPa,
- * stay unbalanced), 40 times the cost. --dem-max overrides the cap.
+ * (as mpmdem_collapse): uncapped (--dem-max 1000), the adaptive rule spent
+ * 186 DEM steps per point per MPM step on a 12 x 5 cell model of this
+ * driver (why so many was not analysed), the capped default run 11.5.
+ * --dem-max overrides the cap.
  *
  * RATE. The PIC part of the PIC/FLIP blend (alpha 0.1, the paper's) damps
  * like a viscosity of shear stress ~ rho alpha c v / cfl: ~25 kPa at 0.4
