@@ -52,7 +52,7 @@ FUZZ_SRC   := $(wildcard tests/fuzz/fuzz_*.c)
 FUZZ_NAMES := $(patsubst tests/fuzz/fuzz_%.c,%,$(FUZZ_SRC))
 FUZZ_REPLAY := $(patsubst %,$(BUILD)/fuzz_replay_%,$(FUZZ_NAMES))
 
-.PHONY: all mpi test check bench bench-peers run run-rve run-mpm run-footing run-collapse install uninstall format format-check clean help \
+.PHONY: all mpi test check bench bench-peers run run-rve run-mpm run-footing run-collapse run-pipe install uninstall format format-check clean help \
         check-headers check-asan check-nosimd check-smoke check-build tradeoff fuzz
 
 all: $(TESTS) $(EXAMPLES) $(BENCHES) $(TOOLS)
@@ -62,6 +62,7 @@ help:
 	@echo "make run        the main job: FEMxDEM biaxial test (see README.md)"
 	@echo "make run-rve    one RVE along a shear path"
 	@echo "make run-mpm | run-footing | run-collapse   MPMxDEM biaxial, footing, column collapse (Liang & Zhao 2019)"
+	@echo "make run-pipe   MPMxDEM pipe-soil interaction (Liang & Zhao 2019; a few minutes)"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
 	@echo "make mpi        the MPI programs (mpicc; gk_twoscale.h with GK_TWOSCALE_MPI) into $(BUILD)/mpi/"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability, tool smoke runs"
@@ -129,7 +130,7 @@ $(BUILD)/femdem_biaxial_mpi: examples/femdem_biaxial.c $(HEADERS) $(wildcard exa
 	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
 
 # the MPMxDEM drivers with their RVEs over MPI ranks (the same results: tests/mpirun_mpmdem.c)
-MPI_EXAMPLES := $(patsubst %,$(BUILD)/mpmdem_%_mpi,biaxial footing collapse)
+MPI_EXAMPLES := $(patsubst %,$(BUILD)/mpmdem_%_mpi,biaxial footing collapse pipe)
 MPI_PROGS    += $(MPI_EXAMPLES)
 $(MPI_EXAMPLES): $(BUILD)/%_mpi: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
 	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
@@ -168,7 +169,7 @@ $(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/
 
 # tools and drivers under ASan + UBSan for tests/smoke_asan.sh (a driver joins
 # by its name in SMOKE and its runs in the script)
-SMOKE := rve_path gk_pack mpmdem_biaxial mpmdem_single mpmdem_footing mpmdem_collapse bench_scene_box femdem_nonlocal femdem_dr hybrid
+SMOKE := rve_path gk_pack mpmdem_biaxial mpmdem_single mpmdem_footing mpmdem_collapse mpmdem_pipe bench_scene_box femdem_nonlocal femdem_dr hybrid
 $(BUILD)/asan/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) -Iinclude -o $@ $< $(LDLIBS)
 $(BUILD)/asan/%: tools/%.c $(HEADERS) | $(BUILD)/asan
@@ -259,6 +260,8 @@ run-footing: $(BUILD)/mpmdem_footing
 	$(BUILD)/mpmdem_footing --threads 2 --out $(BUILD)/mpm_footing
 run-collapse: $(BUILD)/mpmdem_collapse
 	$(BUILD)/mpmdem_collapse --threads 2 --out $(BUILD)/mpm_collapse
+run-pipe: $(BUILD)/mpmdem_pipe
+	$(BUILD)/mpmdem_pipe --threads 2 --out $(BUILD)/mpm_pipe
 
 run-rve: $(BUILD)/rve_path
 	$(BUILD)/rve_path --packing examples/data/rve400.txt --dH "0 0.001 0 0" --increments 50 \

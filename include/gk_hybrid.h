@@ -1564,8 +1564,12 @@ GKDEF void gk_hybrid_bc_mask(const gk_mpm_grid *g, unsigned char *mask) {
         gk_mpm_body_nodes(g, B, lo, hi);
         for (l = lo[2]; l <= hi[2]; ++l)
             for (j = lo[1]; j <= hi[1]; ++j)
-                for (i = lo[0]; i <= hi[0]; ++i)
-                    mask[(size_t)i + (size_t)g->n[0] * ((size_t)j + (size_t)g->n[1] * (size_t)l)] = 1;
+                for (i = lo[0]; i <= hi[0]; ++i) {
+                    size_t I = (size_t)i + (size_t)g->n[0] * ((size_t)j + (size_t)g->n[1] * (size_t)l);
+                    double x[3];
+                    gk_mpm_grid_node_position(g, I, x);
+                    if (gk_mpm_body_covers(g, B, x)) mask[I] = 1;
+                }
     }
 }
 

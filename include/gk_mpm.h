@@ -35,7 +35,8 @@
  *                                 gravity, damping, mass threshold, threads
  *   gk_mpm_step                   one step in USF, USL or MUSL order
  *   gk_mpm_bodies_advance         move rigid bodies by v dt
- *   gk_mpm_body_nodes             the grid nodes a rigid body's box covers
+ *   gk_mpm_body_nodes             the grid nodes a rigid body's bounding box covers
+ *   gk_mpm_body_covers            whether a rigid body covers a point (box or circle)
  *   gk_mpm_wave_speed             P-wave speed, for the time step
  *   gk_mpm_point_dh               dH = dt L, what an RVE receives [Liang & Zhao 2019 (b)]
  *   gk_mpm_point_polar            F = R U via gk_m3_polar [Liang & Zhao 2019 eqs 36-40]
@@ -99,10 +100,12 @@
  *             normal velocity dv_n; its tangential speed is reduced by
  *             mu dv_n (impulse ratio = mu), to zero if smaller (stick).
  * A face acts on the `layers` node layers next to it (the wall plane is the
- * innermost one). A rigid body is an axis-aligned box moving at v; it acts
- * on the active nodes inside the box: STICK (rough) v_I = v_body; SMOOTH or
- * FRICTION as the wall above on the velocity relative to the body, normal =
- * outward normal of a chosen face of the box or of the nearest face. Each
+ * innermost one). A rigid body is an axis-aligned box or a circle (a disk
+ * in 2D, a cylinder along z in 3D) moving at v; it acts on the active nodes
+ * inside it: STICK (rough) v_I = v_body; SMOOTH or FRICTION as the wall
+ * above on the velocity relative to the body, normal = outward normal of a
+ * chosen face of the box or of the nearest face; of a circle, the radial
+ * direction (x_I - centre) / |x_I - centre|. Both shapes share this code. Each
  * face and body records force = sum m_I (v_after - v_before) / dt over the
  * last grid update (v_before without grid damping, so damping never leaks
  * into a load): the force it exerted ON the material. The load on a
@@ -207,17 +210,28 @@ typedef struct gk_mpm_face {
     double force[3]; /* out: force on the material in the last grid update */
 } gk_mpm_face;
 
-/* A prescribed-velocity rigid body: an axis-aligned box (a footing, a plate).
- * Zero-initialised except lo, hi: a stick body at rest. */
+/* shape of a rigid body */
+typedef enum gk_mpm_body_shape {
+    GK_MPM_BOX = 0,   /* axis-aligned box lo..hi */
+    GK_MPM_CIRCLE = 1 /* disk of centre, radius (2D); in 3D a cylinder along z through the whole grid */
+} gk_mpm_body_shape;
+
+/* A prescribed-velocity rigid body: an axis-aligned box (a footing, a plate)
+ * or a circle (a pipe). Zero-initialised except lo, hi: a stick box at rest. */
 typedef struct gk_mpm_body {
     double lo[3], hi[3]; /* box corners [m]; nodes with lo <= x_I <= hi are covered */
     double v[3];         /* prescribed velocity [m/s] */
     gk_mpm_contact contact;
-    double mu;       /* FRICTION: Coulomb coefficient */
-    int face;        /* contact normal for SMOOTH/FRICTION: 0 = outward normal
-                        of the box face nearest to each node, 1..6 = that of
-                        face x-, x+, y-, y+, z-, z+ for every node */
-    double force[3]; /* out: force on the material in the last grid update */
+    double mu;               /* FRICTION: Coulomb coefficient */
+    int face;                /* contact normal of a box for SMOOTH/FRICTION: 0 = outward
+                        normal of the box face nearest to each node, 1..6 = that
+                        of face x-, x+, y-, y+, z-, z+ for every node (0 for a circle) */
+    double force[3];         /* out: force on the material in the last grid update */
+    gk_mpm_body_shape shape; /* GK_MPM_BOX (0, uses lo, hi) or GK_MPM_CIRCLE (uses centre, radius;
+                           nodes with |x_I - centre| <= radius in x, y are covered, contact
+                           normal (x_I - centre) / |x_I - centre|, -e_y at the centre) */
+    double centre[3];        /* CIRCLE: centre [m] (centre[2] unused) */
+    double radius;           /* CIRCLE: radius [m], finite and > 0 */
 } gk_mpm_body;
 
 typedef struct gk_mpm_grid {
@@ -355,8 +369,13 @@ GKDEF gk_result gk_mpm_step(gk_mpm_grid *g, gk_mpm_points *pts, const gk_mpm_def
                             gk_mpm_stress_fn stress, void *user, gk_err *err);
 GKDEF void gk_mpm_bodies_advance(gk_mpm_body *body, int nbody, double dt);
 /* the grid nodes inside body B's box [lo, hi] (1e-9 of a cell of slack), clipped to the grid:
- * nodes lo[k]..hi[k] along each axis (none when hi[k] < lo[k]); lo = hi = 0 on unused axes */
+ * nodes lo[k]..hi[k] along each axis (none when hi[k] < lo[k]); lo = hi = 0 on unused axes. For a
+ * circle the box is its bounding box centre -+ radius (all of z in 3D); gk_mpm_body_covers tells
+ * which of those nodes it covers. */
 GKDEF void gk_mpm_body_nodes(const gk_mpm_grid *g, const gk_mpm_body *B, int lo[3], int hi[3]);
+/* 1 when body B covers position x (a node's): a box always within its gk_mpm_body_nodes range, a
+ * circle when |x - centre| <= radius + 1e-9 h in x, y; 0 otherwise */
+GKDEF int gk_mpm_body_covers(const gk_mpm_grid *g, const gk_mpm_body *B, const double x[3]);
 
 /* F = R U of point p [Liang & Zhao 2019 eqs 36-40]; GK_ERR_SINGULAR if det F <= 0 */
 GKDEF gk_result gk_mpm_point_polar(const gk_mpm_points *pts, int p, double R[9], double U[9], gk_err *err);
@@ -825,6 +844,20 @@ static gk_result gk__mpm_check_bodies(const gk_mpm_grid *g, gk_err *err) {
                 return gk_err_set(err, GK_ERR_NAN, "rigid body %d has a NaN or infinite entry", bi);
         if ((int)B->contact < 0 || (int)B->contact > (int)GK_MPM_CONTACT_SMOOTH)
             return gk_err_set(err, GK_ERR_ARG, "rigid body %d: unknown contact kind %d", bi, (int)B->contact);
+        if ((int)B->shape < 0 || (int)B->shape > (int)GK_MPM_CIRCLE)
+            return gk_err_set(err, GK_ERR_ARG, "rigid body %d: unknown shape %d (0 box, 1 circle)", bi,
+                              (int)B->shape);
+        if (B->shape == GK_MPM_CIRCLE) {
+            if (!isfinite(B->centre[0]) || !isfinite(B->centre[1]) || !isfinite(B->radius))
+                return gk_err_set(err, GK_ERR_NAN, "rigid body %d: circle centre or radius NaN or infinite",
+                                  bi);
+            if (!(B->radius > 0.0))
+                return gk_err_set(err, GK_ERR_ARG, "rigid body %d: circle radius %g <= 0", bi, B->radius);
+            if (B->face != 0)
+                return gk_err_set(err, GK_ERR_ARG,
+                                  "rigid body %d: face %d given for a circle (its normal is radial: face 0)",
+                                  bi, B->face);
+        }
         if (B->mu < 0.0)
             return gk_err_set(err, GK_ERR_ARG, "rigid body %d: friction coefficient %g < 0", bi, B->mu);
         if (B->face < 0 || B->face > 2 * g->dim)
@@ -1049,8 +1082,12 @@ static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt, double d
             for (j = lo[1]; j <= hi[1]; ++j)
                 for (i = lo[0]; i <= hi[0]; ++i) {
                     size_t I = (size_t)i + (size_t)g->n[0] * ((size_t)j + (size_t)g->n[1] * (size_t)l);
-                    double u[3], u0[3], vb[3];
+                    double u[3], u0[3], vb[3], xI[3];
                     if (!(g->m[I] > g->mass_min)) continue;
+                    if (B->shape == GK_MPM_CIRCLE) {
+                        gk_mpm_grid_node_position(g, I, xI);
+                        if (!gk_mpm_body_covers(g, B, xI)) continue;
+                    }
                     for (k = 0; k < 3; ++k) {
                         u0[k] = k < dim ? vel[k][I] : 0.0;
                         vb[k] = k < dim ? B->v[k] : 0.0;
@@ -1059,9 +1096,16 @@ static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt, double d
                         for (k = 0; k < 3; ++k) u[k] = vb[k];
                         if (dt > 0.0) gk__mpm_undamped(g, I, dt, damp, u0);
                     } else {
-                        double nrm[3] = {0.0, 0.0, 0.0}, xI[3];
+                        double nrm[3] = {0.0, 0.0, 0.0};
                         int fc = B->face - 1;
-                        if (fc < 0 || fc >= 2 * dim) { /* nearest face of the box */
+                        if (B->shape == GK_MPM_CIRCLE) { /* radial, outward from the centre */
+                            double dx = xI[0] - B->centre[0], dy = xI[1] - B->centre[1],
+                                   r = sqrt(dx * dx + dy * dy);
+                            if (r > 0.0)
+                                nrm[0] = dx / r, nrm[1] = dy / r;
+                            else
+                                nrm[1] = -1.0;
+                        } else if (fc < 0 || fc >= 2 * dim) { /* nearest face of the box */
                             double best = HUGE_VAL;
                             int q;
                             gk_mpm_grid_node_position(g, I, xI);
@@ -1074,7 +1118,8 @@ static void gk__mpm_apply_bc(gk_mpm_grid *g, double *vel[3], double dt, double d
                                 }
                             }
                         }
-                        nrm[fc / 2] = (fc & 1) ? 1.0 : -1.0; /* outward from the body into the material */
+                        if (B->shape != GK_MPM_CIRCLE)
+                            nrm[fc / 2] = (fc & 1) ? 1.0 : -1.0; /* outward from the body into the material */
                         for (k = 0; k < 3; ++k) u[k] = u0[k] - vb[k];
                         gk__mpm_wall(u, nrm, B->mu, B->contact == GK_MPM_CONTACT_FRICTION);
                         for (k = 0; k < 3; ++k) u[k] += vb[k];
@@ -1310,9 +1355,13 @@ GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_
 GKDEF void gk_mpm_body_nodes(const gk_mpm_grid *g, const gk_mpm_body *B, int lo[3], int hi[3]) {
     int k;
     for (k = 0; k < 3; ++k) {
-        if (k < g->dim) {
-            double a = ceil((B->lo[k] - g->origin[k]) * g->inv_h - 1e-9);
-            double b = floor((B->hi[k] - g->origin[k]) * g->inv_h + 1e-9);
+        if (B->shape == GK_MPM_CIRCLE && k == 2 && g->dim == 3) { /* a cylinder along z */
+            lo[k] = 0, hi[k] = g->n[k] - 1;
+        } else if (k < g->dim) {
+            double blo = B->shape == GK_MPM_CIRCLE ? B->centre[k] - B->radius : B->lo[k],
+                   bhi = B->shape == GK_MPM_CIRCLE ? B->centre[k] + B->radius : B->hi[k];
+            double a = ceil((blo - g->origin[k]) * g->inv_h - 1e-9);
+            double b = floor((bhi - g->origin[k]) * g->inv_h + 1e-9);
             lo[k] = a < 0.0 ? 0 : (a > g->n[k] ? g->n[k] : (int)a);
             hi[k] = b > g->n[k] - 1 ? g->n[k] - 1 : (b < -1.0 ? -1 : (int)b);
         } else {
@@ -1321,12 +1370,20 @@ GKDEF void gk_mpm_body_nodes(const gk_mpm_grid *g, const gk_mpm_body *B, int lo[
     }
 }
 
+GKDEF int gk_mpm_body_covers(const gk_mpm_grid *g, const gk_mpm_body *B, const double x[3]) {
+    double dx, dy, r;
+    if (B->shape != GK_MPM_CIRCLE) return 1;
+    dx = x[0] - B->centre[0], dy = x[1] - B->centre[1], r = B->radius + 1e-9 * g->h;
+    return dx * dx + dy * dy <= r * r;
+}
+
 GKDEF void gk_mpm_bodies_advance(gk_mpm_body *body, int nbody, double dt) {
     int b, k;
     for (b = 0; b < nbody; ++b)
         for (k = 0; k < 3; ++k) {
             body[b].lo[k] += dt * body[b].v[k];
             body[b].hi[k] += dt * body[b].v[k];
+            body[b].centre[k] += dt * body[b].v[k];
         }
 }
 

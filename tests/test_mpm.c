@@ -1,5 +1,6 @@
 /* test_mpm.c - gk_mpm.h: shape functions, transfers, conservation, APIC,
  * elastic wave, geostatic column, Coulomb boundary, rigid plate reaction,
+ * circle (pipe) bodies,
  * Drucker-Prager return map, thread determinism, bad input. */
 #define GK_IMPLEMENTATION
 #include "gk_mpm.h"
@@ -526,6 +527,115 @@ TEST(wall_and_body_contact_laws) {
     }
 }
 
+/* Circle bodies (a pipe), on hand-set node states (mass 2, no force):
+ * STICK - the nodes inside the circle (|x_I - c| <= r) take the body's
+ * velocity, every other node of its bounding box keeps its own (here at
+ * rest); SMOOTH - the unilateral law of the wall on the velocity relative
+ * to the body with the radial normal n = (x_I - c)/|x_I - c|: an approaching
+ * node loses its normal component, keeps its tangential one, a separating
+ * node is free. Both: the reaction is the momentum change of the grid,
+ * force = sum m (v_after - v_before) / dt (Newton's third law, as for
+ * boxes), and the centre moves by v dt. 2D disk and 3D cylinder along z. */
+TEST(circle_body_contact) {
+    const double dt = 0.25, m = 2.0, c[2] = {5.3, 5.6}, r = 2.2;
+    int dim, kind;
+    for (dim = 2; dim <= 3; ++dim)
+        for (kind = 0; kind < 2; ++kind) { /* stick, smooth */
+            gk_mpm_grid g = make_grid(dim, 0.0, 0.0, 0.0, 1.0, 12, 12, dim == 3 ? 3 : 1);
+            gk_mpm_def d = gk_mpm_def_default();
+            gk_mpm_body body;
+            gk_err e;
+            double mom[3] = {0, 0, 0}, u[2] = {0.4, -0.9};
+            size_t I;
+            int k, ncov = 0, nbox_out = 0, lo[3], hi[3];
+            memset(&body, 0, sizeof body);
+            body.shape = GK_MPM_CIRCLE;
+            body.centre[0] = c[0], body.centre[1] = c[1], body.radius = r;
+            body.v[0] = 0.7, body.v[1] = -1.3;
+            body.contact = kind == 0 ? GK_MPM_CONTACT_STICK : GK_MPM_CONTACT_SMOOTH;
+            g.body = &body;
+            g.nbody = 1;
+            for (I = 0; I < g.nnode; ++I) { /* stick: the block at rest; smooth: moving at u */
+                g.m[I] = m;
+                for (k = 0; k < 2; ++k) g.v[k][I] = kind == 0 ? 0.0 : u[k], g.p[k][I] = m * g.v[k][I];
+            }
+            CHECK_EQ_INT(gk_mpm_grid_update(&g, &d, dt, &e), GK_OK);
+            gk_mpm_body_nodes(&g, &body, lo, hi);
+            for (I = 0; I < g.nnode; ++I) {
+                double x[3], dx, dy, dist, nrm[2], rel[2], want[2];
+                int i = (int)(I % 12), j = (int)(I / 12 % 12);
+                gk_mpm_grid_node_position(&g, I, x);
+                dx = x[0] - c[0], dy = x[1] - c[1], dist = sqrt(dx * dx + dy * dy);
+                for (k = 0; k < dim; ++k) mom[k] += m * (g.vn[k][I] - g.v[k][I]);
+                if (dist > r) { /* outside: unchanged, also inside the bounding box */
+                    nbox_out += i >= lo[0] && i <= hi[0] && j >= lo[1] && j <= hi[1];
+                    CHECK(g.vn[0][I] == g.v[0][I] && g.vn[1][I] == g.v[1][I]);
+                    continue;
+                }
+                ++ncov;
+                if (kind == 0) {
+                    CHECK(g.vn[0][I] == body.v[0] && g.vn[1][I] == body.v[1]);
+                    continue;
+                }
+                nrm[0] = dx / dist, nrm[1] = dy / dist;
+                rel[0] = u[0] - body.v[0], rel[1] = u[1] - body.v[1];
+                {
+                    double vn = rel[0] * nrm[0] + rel[1] * nrm[1], cut = vn < 0 ? vn : 0.0;
+                    want[0] = u[0] - cut * nrm[0], want[1] = u[1] - cut * nrm[1];
+                }
+                CHECK_NEAR(g.vn[0][I], want[0], 1e-14);
+                CHECK_NEAR(g.vn[1][I], want[1], 1e-14);
+                /* tangential relative velocity kept */
+                CHECK_NEAR((g.vn[0][I] - body.v[0]) * -nrm[1] + (g.vn[1][I] - body.v[1]) * nrm[0],
+                           rel[0] * -nrm[1] + rel[1] * nrm[0], 1e-14);
+            }
+            CHECK_EQ_INT(ncov, (dim == 3 ? 3 : 1) * 14); /* 14 nodes of the unit lattice in this circle */
+            CHECK(nbox_out > 0);
+            for (k = 0; k < dim; ++k) CHECK_NEAR(body.force[k], mom[k] / dt, 1e-12 * ncov);
+            if (kind == 0) CHECK_NEAR(body.force[0], ncov * m * 0.7 / dt, 1e-12 * ncov);
+            gk_mpm_bodies_advance(&body, 1, dt);
+            CHECK_NEAR(body.centre[0], c[0] + 0.7 * dt, 1e-15);
+            CHECK_NEAR(body.centre[1], c[1] - 1.3 * dt, 1e-15);
+            gk_mpm_grid_destroy(&g);
+        }
+}
+
+/* a bad circle (radius <= 0, NaN, infinite centre, a face, an unknown shape) is refused with a
+ * message; the grid velocities and the body are unchanged */
+TEST(circle_body_bad_input_refused) {
+    gk_mpm_grid g = make_grid(2, 0.0, 0.0, 0.0, 1.0, 8, 8, 1);
+    gk_mpm_def d = gk_mpm_def_default();
+    gk_mpm_body body, saved;
+    gk_err e;
+    double *vn0 = (double *)malloc(2 * g.nnode * sizeof(double));
+    size_t I;
+    int q;
+    for (I = 0; I < g.nnode; ++I) g.m[I] = 1.0, g.v[0][I] = g.p[0][I] = 0.5, g.vn[0][I] = 7.0;
+    memcpy(vn0, g.vn[0], g.nnode * sizeof(double));
+    memcpy(vn0 + g.nnode, g.vn[1], g.nnode * sizeof(double));
+    for (q = 0; q < 6; ++q) {
+        memset(&body, 0, sizeof body);
+        body.shape = GK_MPM_CIRCLE;
+        body.centre[0] = body.centre[1] = 4.0;
+        body.radius = q == 0 ? 0.0 : q == 1 ? -1.0 : q == 2 ? NAN : 1.5;
+        if (q == 3) body.centre[1] = INFINITY;
+        if (q == 4) body.face = 2;
+        if (q == 5) body.shape = (gk_mpm_body_shape)7;
+        body.v[1] = -1.0;
+        body.force[0] = 3.0;
+        saved = body;
+        g.body = &body;
+        g.nbody = 1;
+        CHECK(gk_mpm_grid_update(&g, &d, 0.1, &e) != GK_OK);
+        CHECK(strstr(e.msg, "rigid body 0") != NULL);
+        CHECK(memcmp(&body, &saved, sizeof body) == 0);
+        CHECK(memcmp(vn0, g.vn[0], g.nnode * sizeof(double)) == 0);
+        CHECK(memcmp(vn0 + g.nnode, g.vn[1], g.nnode * sizeof(double)) == 0);
+    }
+    free(vn0);
+    gk_mpm_grid_destroy(&g);
+}
+
 /* Drucker-Prager [Chen et al. 2021 eqs 5-6, return map of its Sec 2.2]: an elastic
  * trial is untouched; a cone return lands on f = 0, keeps the direction of
  * s and moves p by -K etabar dlambda; a tensile trial goes to the apex
@@ -823,6 +933,8 @@ int main(int argc, char **argv) {
     RUN(block_on_frictional_floor_decelerates_at_mu_g);
     RUN(rigid_plate_reaction_matches_confined_compression);
     RUN(wall_and_body_contact_laws);
+    RUN(circle_body_contact);
+    RUN(circle_body_bad_input_refused);
     RUN(drucker_prager_return_map);
     RUN(drucker_prager_update_spin_and_critical_state);
     RUN(threads_give_identical_bits);
