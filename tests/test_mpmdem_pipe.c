@@ -12,7 +12,7 @@
 #include <stdlib.h>
 
 #define PT                                                                                                  \
-    "build/mpmdem_pipe --width 3 --nx 12 --ny 5 --penetration 0.1 --lateral 0.05 --v-down 1 --v-lateral 1 " \
+    BUILD "/mpmdem_pipe --width 3 --nx 12 --ny 5 --penetration 0.1 --lateral 0.05 --v-down 1 --v-lateral 1 " \
     "--ramp 0.02 --every 0.02 --quiet "
 
 #define NCOL 10
@@ -43,12 +43,12 @@ static int read_rows(const char *path, double rows[][NCOL], int max) {
 TEST(pipe_runs_both_stages) {
     double r[64][NCOL], vfirst = 0, vlate = 0, hl = 0;
     int n, k, nlate = 0, nl = 0, np = 0;
-    CHECK(system("rm -rf build/tests/t_pipe1 && " PT "--threads 1 --out build/tests/t_pipe1 "
-                 "> build/tests/t_pipe1.out 2>&1") == 0);
-    CHECK(gk_test_file_has("build/tests/t_pipe1/pipe.csv",
+    CHECK(system("rm -rf " BUILD "/tests/t_pipe1 && " PT "--threads 1 --out " BUILD "/tests/t_pipe1 "
+                 "> " BUILD "/tests/t_pipe1.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_pipe1/pipe.csv",
                            "time,pipe_x,pipe_bottom_y,penetration,lateral,stage,H_kN_per_m,V_kN_per_m,"
                            "dem_steps_per_point,seconds"));
-    n = read_rows("build/tests/t_pipe1/pipe.csv", r, 64);
+    n = read_rows(BUILD "/tests/t_pipe1/pipe.csv", r, 64);
     CHECK(n >= 8);
     if (n < 8) return;
     for (k = 0; k < n; ++k) {
@@ -72,17 +72,17 @@ TEST(pipe_runs_both_stages) {
     CHECK(vlate / nlate > vfirst);
     CHECK(hl / nl > 0);
     CHECK_NEAR(r[n - 1][4], 0.05, 1e-9); /* the whole path */
-    CHECK(gk_test_result("build/tests/t_pipe1.out", "V_peak_kN") > 0);
-    CHECK_NEAR(gk_test_result("build/tests/t_pipe1.out", "penetration"), 0.1, 1e-9);
-    CHECK_NEAR(gk_test_result("build/tests/t_pipe1.out", "lateral"), 0.05, 1e-9);
-    CHECK_NEAR(gk_test_result("build/tests/t_pipe1.out", "n_rves"), 60, 0);
-    CHECK(gk_test_result("build/tests/t_pipe1.out", "seconds_per_step_per_1000_rves") > 0);
-    CHECK(gk_test_file_has("build/tests/t_pipe1/pipe_force.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_pipe1/eps_q_pen.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_pipe1/rotation_pen.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_pipe1/eps_q_end.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_pipe1/rotation_end.svg", "<svg"));
-    CHECK(gk_test_file_has("build/tests/t_pipe1/points_000000.vtk", "SCALARS eps_q"));
+    CHECK(gk_test_result(BUILD "/tests/t_pipe1.out", "V_peak_kN") > 0);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_pipe1.out", "penetration"), 0.1, 1e-9);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_pipe1.out", "lateral"), 0.05, 1e-9);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_pipe1.out", "n_rves"), 60, 0);
+    CHECK(gk_test_result(BUILD "/tests/t_pipe1.out", "seconds_per_step_per_1000_rves") > 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_pipe1/pipe_force.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_pipe1/eps_q_pen.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_pipe1/rotation_pen.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_pipe1/eps_q_end.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_pipe1/rotation_end.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_pipe1/points_000000.vtk", "SCALARS eps_q"));
 }
 
 /* stopped after 100 steps on 2 threads, then --restart on 2 threads: the
@@ -90,28 +90,28 @@ TEST(pipe_runs_both_stages) {
  * thread count change nothing) */
 TEST(pipe_restart_and_threads_identical) {
     int rc =
-        system("rm -rf build/tests/t_pipe_a build/tests/t_pipe_b && OMP_WAIT_POLICY=passive " PT
-               "--threads 2 --max-steps 100 --out build/tests/t_pipe_a > build/tests/t_pipe_a.out 2>&1 && "
-               "OMP_WAIT_POLICY=passive " PT "--threads 2 --restart build/tests/t_pipe_a "
-               "--out build/tests/t_pipe_b > build/tests/t_pipe_b.out 2>&1");
+        system("rm -rf " BUILD "/tests/t_pipe_a " BUILD "/tests/t_pipe_b && OMP_WAIT_POLICY=passive " PT
+               "--threads 2 --max-steps 100 --out " BUILD "/tests/t_pipe_a > " BUILD "/tests/t_pipe_a.out 2>&1 && "
+               "OMP_WAIT_POLICY=passive " PT "--threads 2 --restart " BUILD "/tests/t_pipe_a "
+               "--out " BUILD "/tests/t_pipe_b > " BUILD "/tests/t_pipe_b.out 2>&1");
     CHECK(rc == 0);
-    CHECK(gk_test_file_has("build/tests/t_pipe_a.out", "stopped before the end of the path"));
-    CHECK(gk_test_result("build/tests/t_pipe_b.out", "V_peak_kN") ==
-          gk_test_result("build/tests/t_pipe1.out", "V_peak_kN"));
-    CHECK(system("cut -d, -f1-9 build/tests/t_pipe_b/pipe.csv > build/tests/t_pipe_b.c && "
-                 "cut -d, -f1-9 build/tests/t_pipe1/pipe.csv > build/tests/t_pipe1.c && "
-                 "cmp -s build/tests/t_pipe_b.c build/tests/t_pipe1.c") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_pipe_a.out", "stopped before the end of the path"));
+    CHECK(gk_test_result(BUILD "/tests/t_pipe_b.out", "V_peak_kN") ==
+          gk_test_result(BUILD "/tests/t_pipe1.out", "V_peak_kN"));
+    CHECK(system("cut -d, -f1-9 " BUILD "/tests/t_pipe_b/pipe.csv > " BUILD "/tests/t_pipe_b.c && "
+                 "cut -d, -f1-9 " BUILD "/tests/t_pipe1/pipe.csv > " BUILD "/tests/t_pipe1.c && "
+                 "cmp -s " BUILD "/tests/t_pipe_b.c " BUILD "/tests/t_pipe1.c") == 0);
 }
 
 /* bad input: a message and a non-zero exit, no output folder */
 TEST(pipe_bad_arguments) {
-    const char *o = " > build/tests/t_pipe_bad.out 2>&1";
+    const char *o = " > " BUILD "/tests/t_pipe_bad.out 2>&1";
     char cmd[512];
-    CHECK(system("rm -rf build/tests/t_pipe_bad") == 0);
+    CHECK(system("rm -rf " BUILD "/tests/t_pipe_bad") == 0);
 #define BAD(args, msg)                                                                         \
-    snprintf(cmd, sizeof cmd, "build/mpmdem_pipe --out build/tests/t_pipe_bad %s%s", args, o); \
+    snprintf(cmd, sizeof cmd, BUILD "/mpmdem_pipe --out " BUILD "/tests/t_pipe_bad %s%s", args, o); \
     CHECK(system(cmd) != 0);                                                                   \
-    CHECK(gk_test_file_has("build/tests/t_pipe_bad.out", msg))
+    CHECK(gk_test_file_has(BUILD "/tests/t_pipe_bad.out", msg))
     BAD("--nx 0", "out of range");
     BAD("--diameter 0.3", "less than 2 cells");
     BAD("--diameter 0", "--diameter");
@@ -123,9 +123,9 @@ TEST(pipe_bad_arguments) {
     BAD("--max-steps 2.5", "--max-steps");
     BAD("--mu", "needs a value");
     BAD("--bogus 1", "unknown option");
-    BAD("--restart build/tests/no_such_run", "checkpoint");
+    BAD("--restart " BUILD "/tests/no_such_run", "checkpoint");
 #undef BAD
-    CHECK(system("test -e build/tests/t_pipe_bad") != 0);
+    CHECK(system("test -e " BUILD "/tests/t_pipe_bad") != 0);
 }
 
 int main(int argc, char **argv) {
