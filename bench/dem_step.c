@@ -41,8 +41,10 @@ static int physics_ok(const char *list) {
         if (!e) return 1;
         p = e + 1;
     }
-    fprintf(stderr, "bench_dem_step: --physics '%s' must be a comma list of norot, frictionless, rolling, viscous, "
-                    "cohesion\n", list);
+    fprintf(stderr,
+            "bench_dem_step: --physics '%s' must be a comma list of norot, frictionless, rolling, viscous, "
+            "cohesion\n",
+            list);
     return 0;
 }
 
@@ -66,22 +68,23 @@ static int run_one(const bench_case *c, int use_float, int quiet_header) {
         return rc;
     }
     printf("%-8s %dD %7d  %2d  %-6s %-6s %-6s %8.2f %9.2f %6.2f %6.2f %s\n", c->name, o.dim, o.n, c->threads,
-           c->hertz ? "hertz" : "linear", o.real, o.simd, o.particle_steps_per_s / 1e6, o.contact_steps_per_s / 1e6,
-           2.0 * o.contacts_per_particle, o.pairs_per_particle, c->physics ? c->physics : "");
+           c->hertz ? "hertz" : "linear", o.real, o.simd, o.particle_steps_per_s / 1e6,
+           o.contact_steps_per_s / 1e6, 2.0 * o.contacts_per_particle, o.pairs_per_particle,
+           c->physics ? c->physics : "");
     printf("BENCH case=%s dim=%d n=%d threads=%d law=%s real=%s simd=%s steps=%ld particle_steps_per_s=%.4g "
            "contact_steps_per_s=%.4g contacts_per_particle=%.3f coordination=%.3f pairs_per_particle=%.3f "
            "seconds_median=%.4g physics=%s sxx=%.6g syy=%.6g sxy=%.6g\n",
            c->name, o.dim, o.n, c->threads, c->hertz ? "hertz" : "linear", o.real, o.simd, o.steps,
-           o.particle_steps_per_s, o.contact_steps_per_s, o.contacts_per_particle, 2.0 * o.contacts_per_particle,
-           o.pairs_per_particle, o.seconds_median, c->physics ? c->physics : "default", o.sigma[0], o.sigma[4],
-           o.sigma[1]);
+           o.particle_steps_per_s, o.contact_steps_per_s, o.contacts_per_particle,
+           2.0 * o.contacts_per_particle, o.pairs_per_particle, o.seconds_median,
+           c->physics ? c->physics : "default", o.sigma[0], o.sigma[4], o.sigma[1]);
     fflush(stdout);
     return 0;
 }
 
 static void header(void) {
-    printf("%-8s %2s %7s  %2s  %-6s %-6s %-6s %8s %9s %6s %6s\n", "case", "", "n", "th", "law", "real", "simd",
-           "Mpart/s", "Mcont/s", "Z", "pairs");
+    printf("%-8s %2s %7s  %2s  %-6s %-6s %-6s %8s %9s %6s %6s\n", "case", "", "n", "th", "law", "real",
+           "simd", "Mpart/s", "Mcont/s", "Z", "pairs");
 }
 
 /* float against double along the Guo & Zhao RVE shear path: what float costs in accuracy */
@@ -98,29 +101,31 @@ static int float_error_report(void) {
         if (e > emax) emax = e;
         if (r > erat) erat = r;
     }
-    printf("float vs double along the Guo & Zhao RVE shear path (50 x dH01 = 1e-3, 100 steps each):\n"
-           "  largest relative difference in p: %.3g; largest difference in q/p: %.3g (q/p at the end %.4f)\n",
-           emax, erat, qd[NI - 1] / pd[NI - 1]);
-    printf("BENCH case=float_error increments=%d max_rel_p=%.4g max_abs_q_over_p=%.4g final_q_over_p=%.4f\n", NI,
-           emax, erat, qd[NI - 1] / pd[NI - 1]);
+    printf(
+        "float vs double along the Guo & Zhao RVE shear path (50 x dH01 = 1e-3, 100 steps each):\n"
+        "  largest relative difference in p: %.3g; largest difference in q/p: %.3g (q/p at the end %.4f)\n",
+        emax, erat, qd[NI - 1] / pd[NI - 1]);
+    printf("BENCH case=float_error increments=%d max_rel_p=%.4g max_abs_q_over_p=%.4g final_q_over_p=%.4f\n",
+           NI, emax, erat, qd[NI - 1] / pd[NI - 1]);
     return 0;
 }
 
 int main(int argc, char **argv) {
     bench_case c;
     int ci = -1, use_float = 0, rc = 0, float_error = 0, help = 0, steps = 0, hertz = 0;
-    const cli_opt opts[] = {{"--case", CLI_CHOICE, &ci, 0, 0, NULL, "rve400|2d_10k|2d_100k|3d_1k|3d_10k|3d_100k", 0},
-                            {"--threads", CLI_INT, &c.threads, 1, 1024, NULL, NULL, 0},
-                            {"--steps", CLI_INT, &steps, 1, 1000000000, NULL, NULL, 0},
-                            {"--repeats", CLI_INT, &c.repeats, 1, 64, NULL, NULL, 0},
-                            {"--law", CLI_CHOICE, &hertz, 0, 0, NULL, "linear|hertz", 0},
-                            {"--real", CLI_CHOICE, &use_float, 0, 0, NULL, "double|float", 0},
-                            {"--scalar", CLI_FLAG, &c.scalar, 0, 0, NULL, NULL, 0},
-                            {"--float-error", CLI_FLAG, &float_error, 0, 0, NULL, NULL, 0},
-                            {"--packing", CLI_STR, &c.packing, 0, 0, NULL, NULL, 0},
-                            {"--write-packing", CLI_STR, &c.write_packing, 0, 0, NULL, NULL, 0},
-                            {"--physics", CLI_STR, &c.physics, 0, 0, NULL, NULL, 0},
-                            {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    const cli_opt opts[] = {
+        {"--case", CLI_CHOICE, &ci, 0, 0, NULL, "rve400|2d_10k|2d_100k|3d_1k|3d_10k|3d_100k", 0},
+        {"--threads", CLI_INT, &c.threads, 1, 1024, NULL, NULL, 0},
+        {"--steps", CLI_INT, &steps, 1, 1000000000, NULL, NULL, 0},
+        {"--repeats", CLI_INT, &c.repeats, 1, 64, NULL, NULL, 0},
+        {"--law", CLI_CHOICE, &hertz, 0, 0, NULL, "linear|hertz", 0},
+        {"--real", CLI_CHOICE, &use_float, 0, 0, NULL, "double|float", 0},
+        {"--scalar", CLI_FLAG, &c.scalar, 0, 0, NULL, NULL, 0},
+        {"--float-error", CLI_FLAG, &float_error, 0, 0, NULL, NULL, 0},
+        {"--packing", CLI_STR, &c.packing, 0, 0, NULL, NULL, 0},
+        {"--write-packing", CLI_STR, &c.write_packing, 0, 0, NULL, NULL, 0},
+        {"--physics", CLI_STR, &c.physics, 0, 0, NULL, NULL, 0},
+        {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     const cli_opt *tables[2];
     memset(&c, 0, sizeof c);
     c.threads = 1;
@@ -159,12 +164,14 @@ int main(int argc, char **argv) {
         static const struct {
             const char *name;
             int linear_only;
-        } phys[] = {{NULL, 0},     {"norot", 1},   {"frictionless", 0},
+        } phys[] = {{NULL, 0},      {"norot", 1},   {"frictionless", 0},
                     {"rolling", 1}, {"viscous", 0}, {"cohesion", 1}};
         int k, law;
-        printf("\nphysics switches, rve400, 1 thread, double (linear default: rotation on, Coulomb friction, no\n"
-               "rolling resistance, local damping only, no cohesion; the hertz case has rolling resistance, so\n"
-               "no 'norot', and cohesion is linear-only):\n");
+        printf(
+            "\nphysics switches, rve400, 1 thread, double (linear default: rotation on, Coulomb friction, "
+            "no\n"
+            "rolling resistance, local damping only, no cohesion; the hertz case has rolling resistance, so\n"
+            "no 'norot', and cohesion is linear-only):\n");
         header();
         for (law = 0; law < 2; ++law)
             for (k = 0; k < 6; ++k) {

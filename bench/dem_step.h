@@ -9,8 +9,8 @@ typedef struct bench_case {
     const char *packing;       /* NULL: the case's default packing                 */
     const char *write_packing; /* write the exact starting packing here            */
     int threads, hertz, scalar, repeats;
-    const char *physics;       /* comma list: norot, frictionless, rolling, viscous, cohesion */
-    long steps;                /* timed steps per repeat; 0: case default          */
+    const char *physics; /* comma list: norot, frictionless, rolling, viscous, cohesion */
+    long steps;          /* timed steps per repeat; 0: case default          */
 } bench_case;
 
 typedef struct bench_out {
@@ -21,7 +21,7 @@ typedef struct bench_out {
     double contacts_per_particle;
     double pairs_per_particle;
     double seconds_min, seconds_median;
-    double sigma[9];             /* final Love stress (tension +) */
+    double sigma[9]; /* final Love stress (tension +) */
     char simd[16], real[8], err[256];
 } bench_out;
 

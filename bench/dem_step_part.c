@@ -91,13 +91,16 @@ int BENCH_RUN(const bench_case *bc, bench_out *o) {
     } else if (!strcmp(bc->name, "3d_1k") || !strcmp(bc->name, "3d_10k") || !strcmp(bc->name, "3d_100k")) {
         dim_want = 3;
         if (!path) {
-            if (!strcmp(bc->name, "3d_1k")) path = "bench/data/bench3d_1k.txt";
-            else path = "bench/data/bench3d_20k.txt";
+            if (!strcmp(bc->name, "3d_1k"))
+                path = "bench/data/bench3d_1k.txt";
+            else
+                path = "bench/data/bench3d_20k.txt";
             if (!strcmp(bc->name, "3d_100k")) tx = 5;
         }
         if (!steps) steps = !strcmp(bc->name, "3d_1k") ? 4000 : (tx > 1 ? 30 : 150);
     } else {
-        snprintf(o->err, sizeof o->err, "unknown case '%s' (rve400, 2d_10k, 2d_100k, 3d_1k, 3d_10k, 3d_100k)", bc->name);
+        snprintf(o->err, sizeof o->err, "unknown case '%s' (rve400, 2d_10k, 2d_100k, 3d_1k, 3d_10k, 3d_100k)",
+                 bc->name);
         return 2;
     }
     if (gk_packing_read(path, &base, NULL, &e)) {
@@ -118,7 +121,8 @@ int BENCH_RUN(const bench_case *bc, bench_out *o) {
     } else {
         pk = base;
     }
-    if (bc->write_packing && gk_packing_write(bc->write_packing, &pk, "grainkit bench_dem_step starting packing", &e)) {
+    if (bc->write_packing &&
+        gk_packing_write(bc->write_packing, &pk, "grainkit bench_dem_step starting packing", &e)) {
         snprintf(o->err, sizeof o->err, "%s", e.msg);
         return 1;
     }

@@ -93,7 +93,8 @@ static double run_float(void) {
 
 int main(void) {
     int real, th;
-    double lanes_d = GK_SIMD_WIDTH >= 256 ? GK_SIMD_WIDTH / 64 : 1, lanes_f = GK_SIMD_WIDTH >= 256 ? GK_SIMD_WIDTH / 32 : 1;
+    double lanes_d = GK_SIMD_WIDTH >= 256 ? GK_SIMD_WIDTH / 64 : 1,
+           lanes_f = GK_SIMD_WIDTH >= 256 ? GK_SIMD_WIDTH / 32 : 1;
     printf("peak FMA throughput (%s, %d accumulators)\n", GK_SIMD_NAME, NACC);
     for (real = 0; real < 2; ++real)
         for (th = 1; th <= 2; ++th) {
@@ -103,8 +104,8 @@ int main(void) {
             for (k = 0; k < th; ++k) sink += real ? run_float() : run_double();
             secs = gk_wtime() - t0;
             flops = 2.0 * NACC * (real ? lanes_f : lanes_d) * (double)ITER * th;
-            printf("BENCH case=peak real=%s threads=%d simd=%s gflops=%.1f (checksum %.3g)\n", real ? "float" : "double",
-                   th, GK_SIMD_NAME, flops / secs / 1e9, sink);
+            printf("BENCH case=peak real=%s threads=%d simd=%s gflops=%.1f (checksum %.3g)\n",
+                   real ? "float" : "double", th, GK_SIMD_NAME, flops / secs / 1e9, sink);
         }
     return 0;
 }

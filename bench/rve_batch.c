@@ -60,7 +60,8 @@ int main(int argc, char **argv) {
         gk_rve_state_init(&saved[i], NULL);
         gk_rve_state_save(&saved[i], &rves[i]);
     }
-    printf("rve_batch: %d RVEs x 400 disks, dH = (%g, %g; %g, %g) over %d steps, restore + deform + stress + tangent\n",
+    printf("rve_batch: %d RVEs x 400 disks, dH = (%g, %g; %g, %g) over %d steps, restore + deform + stress + "
+           "tangent\n",
            nrve, dH[0], dH[1], dH[3], dH[4], steps);
     printf("%8s %14s %16s %12s\n", "threads", "ms/batch", "ms/RVE incr.", "efficiency");
     for (t = 1; t <= 2; ++t) {
@@ -87,10 +88,13 @@ int main(int argc, char **argv) {
         med = reps % 2 ? secs[reps / 2] : 0.5 * (secs[reps / 2 - 1] + secs[reps / 2]);
         if (t == 1) ms1 = 1e3 * med / nrve;
         printf("%8d %14.2f %16.4f %12s\n", t, 1e3 * med, 1e3 * med / nrve, t == 1 ? "-" : "");
-        if (t > 1 && ms1 > 0) printf("%8s %14s %16s %11.1f%%\n", "", "", "", 100.0 * ms1 / (t * 1e3 * med / nrve));
-        printf("BENCH case=rve_batch threads=%d rves=%d steps=%d ms_per_rve_increment=%.4f rve_increments_per_s=%.1f "
+        if (t > 1 && ms1 > 0)
+            printf("%8s %14s %16s %11.1f%%\n", "", "", "", 100.0 * ms1 / (t * 1e3 * med / nrve));
+        printf("BENCH case=rve_batch threads=%d rves=%d steps=%d ms_per_rve_increment=%.4f "
+               "rve_increments_per_s=%.1f "
                "efficiency=%.3f\n",
-               t, nrve, steps, 1e3 * med / nrve, nrve / med, t == 1 || ms1 <= 0 ? 1.0 : ms1 / (t * 1e3 * med / nrve));
+               t, nrve, steps, 1e3 * med / nrve, nrve / med,
+               t == 1 || ms1 <= 0 ? 1.0 : ms1 / (t * 1e3 * med / nrve));
         fflush(stdout);
     }
     for (i = 0; i < nrve; ++i) {

@@ -78,7 +78,8 @@ static double now(void) {
 static void field(int n, int s, int it, double band, double *dH) {
     int p;
     for (p = 0; p < n; ++p) {
-        double f = (1.0 + 0.2 * sin(0.7 * p + s)) * (1.0 + 0.003 * it) * ((p * 7919 % 1000) < band * 1000 ? 3.0 : 1.0);
+        double f = (1.0 + 0.2 * sin(0.7 * p + s)) * (1.0 + 0.003 * it) *
+                   ((p * 7919 % 1000) < band * 1000 ? 3.0 : 1.0);
         double *H = dH + 9 * (size_t)p;
         memset(H, 0, 9 * sizeof(double));
         H[0] = 5e-4 * f, H[4] = -1e-3 * f, H[1] = 2e-4 * f * sin(0.3 * p), H[3] = -1e-4 * f * cos(0.3 * p);
@@ -98,10 +99,12 @@ static double fem_seconds(int dim, int ngp) {
     double org[3] = {0, 0, 0}, len[3] = {1, 1, 1}, *D, *sig, *f, *x, *v, t, best = 1e30;
     if (dim == 2) {
         n[0] = n[1] = (int)ceil(sqrt(ngp / 4.0)), n[2] = 1;
-        if (gk_mesh_structured(&m, GK_Q4, n, org, len, NULL, &err) || gk_quad_rule(&q, GK_Q4, 2, &err)) return -1;
+        if (gk_mesh_structured(&m, GK_Q4, n, org, len, NULL, &err) || gk_quad_rule(&q, GK_Q4, 2, &err))
+            return -1;
     } else {
         n[0] = n[1] = n[2] = (int)ceil(cbrt(ngp / 8.0));
-        if (gk_mesh_structured(&m, GK_HEX8, n, org, len, NULL, &err) || gk_quad_rule(&q, GK_HEX8, 2, &err)) return -1;
+        if (gk_mesh_structured(&m, GK_HEX8, n, org, len, NULL, &err) || gk_quad_rule(&q, GK_HEX8, 2, &err))
+            return -1;
     }
     ne = m.nelem * q.n, nd = dim * m.nnode;
     D = (double *)calloc((size_t)ne * dim * dim * dim * dim, sizeof(double));
@@ -109,7 +112,7 @@ static double fem_seconds(int dim, int ngp) {
     f = (double *)calloc((size_t)nd, sizeof(double)), x = (double *)calloc((size_t)nd, sizeof(double));
     if (!D || !sig || !f || !x || gk_csr_from_mesh(&K, &m, NULL, &err)) return -1;
     for (k = 0; k < ne; ++k) gk_fem_elastic_tangent(dim, 1e8, 0.2, D + (size_t)k * dim * dim * dim * dim);
-    {   /* the bottom face clamped */
+    { /* the bottom face clamped */
         int *nodes = (int *)malloc((size_t)m.nnode * sizeof(int)), nb, a, c;
         fix = (int *)malloc((size_t)nd * sizeof(int)), v = (double *)calloc((size_t)nd, sizeof(double));
         if (!nodes || !fix || !v) return -1;
@@ -161,7 +164,8 @@ static int pairs_add(pairs *P, double a, double b) {
 /* how well the first cost of the pairs predicts the second: Pearson's r, and the median and 90th
  * percentile of |b - a| / (a + 1) */
 static void pair_stats(const char *what, const pairs *P) {
-    double ma = 0, mb = 0, sab = 0, saa = 0, sbb = 0, *rel = (double *)malloc(((size_t)P->n + 1) * sizeof(double));
+    double ma = 0, mb = 0, sab = 0, saa = 0, sbb = 0,
+           *rel = (double *)malloc(((size_t)P->n + 1) * sizeof(double));
     int k;
     if (!rel || P->n < 2) {
         free(rel);
@@ -250,9 +254,10 @@ static verdict predict(const double *c, const double *next, int n, int R, double
  * rank done when no rank has unstarted points. Out: the time of the last rank to finish, and the
  * points stolen (*steals). Events in time order, ties by rank: deterministic. */
 typedef struct steal_sim {
-    double *busy, *left;   /* a rank's next event (end of its run, or a reply's arrival), predicted work not started */
+    double *busy,
+        *left; /* a rank's next event (end of its run, or a reply's arrival), predicted work not started */
     int *own, *q, *head, *tail, *reqh, *reqn, *reqt, *heap, nheap;
-    double *reqa;          /* a request's arrival at its victim */
+    double *reqa; /* a request's arrival at its victim */
 } steal_sim;
 
 static int ss_less(const steal_sim *S, int a, int b) {
@@ -288,12 +293,13 @@ static int cmp_pred(const void *a, const void *b) {
  * any rank, its own unless another's is larger; 0: its own points first, then the last of the rank with
  * the most predicted work not started) */
 static int steal_now, steal_global;
-static double steal_run(const double *c, const double *real, int n, int R, double tol, double alpha, double rec,
-                        double bw, int *steals) {
+static double steal_run(const double *c, const double *real, int n, int R, double tol, double alpha,
+                        double rec, double bw, int *steals) {
     steal_sim S;
     int p, r, k, *cnt;
     double tend = 0.0, tsend = rec / bw;
-    S.busy = (double *)calloc((size_t)R, sizeof(double)), S.left = (double *)calloc((size_t)R, sizeof(double));
+    S.busy = (double *)calloc((size_t)R, sizeof(double)),
+    S.left = (double *)calloc((size_t)R, sizeof(double));
     S.own = (int *)malloc((size_t)n * sizeof(int)), S.q = (int *)malloc((size_t)n * sizeof(int));
     S.head = (int *)calloc((size_t)R + 1, sizeof(int)), S.tail = (int *)calloc((size_t)R, sizeof(int));
     S.reqh = (int *)malloc((size_t)R * sizeof(int)), S.reqt = (int *)malloc((size_t)R * sizeof(int));
@@ -351,13 +357,16 @@ static double steal_run(const double *c, const double *real, int n, int R, doubl
                 S.busy[rr] = t + 2.0 * alpha + tsend + real[p], ss_push(&S, rr);
             } else { /* answered at v's next event; the reply brings rr back */
                 S.reqa[rr] = t + alpha, S.reqn[rr] = -1;
-                if (S.reqt[v] >= 0) S.reqn[S.reqt[v]] = rr;
-                else S.reqh[v] = rr;
+                if (S.reqt[v] >= 0)
+                    S.reqn[S.reqt[v]] = rr;
+                else
+                    S.reqh[v] = rr;
                 S.reqt[v] = rr;
             }
         }
     }
-    free(S.busy), free(S.left), free(S.own), free(S.q), free(S.head), free(S.tail), free(S.reqh), free(S.reqt);
+    free(S.busy), free(S.left), free(S.own), free(S.q), free(S.head), free(S.tail), free(S.reqh),
+        free(S.reqt);
     free(S.reqn), free(S.reqa), free(S.heap), free(cnt);
     return tend;
 }
@@ -394,12 +403,15 @@ typedef struct cost_data {
  * and the records moved per step (RUN). */
 typedef struct outcome {
     double same, same_it, imb_acc, imb1, imb_it, Em_acc, Em_run, E_acc, E_run, t_rve_acc, moved_step;
-    double st1, st_it, Em_steal, E_steal, steals_step; /* rule STEAL: RUN's assignments, stealing during the runs */
+    double st1, st_it, Em_steal, E_steal,
+        steals_step; /* rule STEAL: RUN's assignments, stealing during the runs */
 } outcome;
-static outcome evaluate(const cost_data *C, int n, int R, double per_step, double rec, double tfem, double tol,
-                        double alpha, double bytes, double bw) {
-    double *c0 = (double *)malloc((size_t)n * sizeof(double)), *c1 = (double *)malloc((size_t)n * sizeof(double));
-    double totA, totB, totW = 0.0, lg = ceil(log2((double)R > 1 ? R : 2)), tmsg, tmig1, tmig_it = 0.0, m = C->m;
+static outcome evaluate(const cost_data *C, int n, int R, double per_step, double rec, double tfem,
+                        double tol, double alpha, double bytes, double bw) {
+    double *c0 = (double *)malloc((size_t)n * sizeof(double)),
+           *c1 = (double *)malloc((size_t)n * sizeof(double));
+    double totA, totB, totW = 0.0, lg = ceil(log2((double)R > 1 ? R : 2)), tmsg, tmig1, tmig_it = 0.0,
+                       m = C->m;
     double work, t, t1s, tis = 0.0;
     int s1 = 0, sit = 0;
     verdict vA, v1, vi = {1.0, 0, 0}, vs, vsi = {1.0, 0, 0};
@@ -449,8 +461,8 @@ static outcome evaluate(const cost_data *C, int n, int R, double per_step, doubl
  * (RVEs, messages, migrations) and E (with the replicated FEM) of both rules, the bytes that move per
  * load step under RUN; then, per rule, E_micro at 8 RVEs per rank and the fewest RVEs per rank for
  * E_micro >= 90 %. No pairs W: RUN is not evaluated. rec2d: a 400-disk point's record (migrations). */
-static void model(const cost_data *C, double rate2d, double rate3d, double alpha, double bw,
-                  double tol, double rec2d) {
+static void model(const cost_data *C, double rate2d, double rate3d, double alpha, double bw, double tol,
+                  double rec2d) {
     static const int ranks[3] = {64, 1000, 10000}, per[12] = {1, 2, 4, 6, 8, 10, 12, 16, 24, 32, 64, 128};
     struct {
         const char *name;
@@ -458,45 +470,53 @@ static void model(const cost_data *C, double rate2d, double rate3d, double alpha
         double rate, rec;
     } cs[2];
     int k, j, rule;
-    cs[0].name = "2D 7776 x 400 disks", cs[0].dim = 2, cs[0].n = 7776, cs[0].particles = 400, cs[0].rate = rate2d;
-    cs[1].name = "3D 1000 x 4096 spheres", cs[1].dim = 3, cs[1].n = 1000, cs[1].particles = 4096, cs[1].rate = rate3d;
+    cs[0].name = "2D 7776 x 400 disks", cs[0].dim = 2, cs[0].n = 7776, cs[0].particles = 400,
+    cs[0].rate = rate2d;
+    cs[1].name = "3D 1000 x 4096 spheres", cs[1].dim = 3, cs[1].n = 1000, cs[1].particles = 4096,
+    cs[1].rate = rate3d;
     /* a 3D record: assumed twice the 2D bytes per particle (3 components instead of 2, 3 rotations
      * instead of 1, more contacts per particle) */
     cs[0].rec = rec2d, cs[1].rec = 2.0 * rec2d / 400.0 * 4096.0;
-    printf("\nscaling model (rates %.3g and %.3g particle-steps/s per core, alpha %.1e s, bandwidth %.2g B/s, balance "
-           "tolerance %.2f,\n  %.2f runs per load step, point records %.0f and %.0f bytes; ACCEPT: balance at every "
+    printf("\nscaling model (rates %.3g and %.3g particle-steps/s per core, alpha %.1e s, bandwidth %.2g "
+           "B/s, balance "
+           "tolerance %.2f,\n  %.2f runs per load step, point records %.0f and %.0f bytes; ACCEPT: balance "
+           "at every "
            "accept, RUN: before every run):\n",
            rate2d, rate3d, alpha, bw, tol, C->m, cs[0].rec, cs[1].rec);
     printf("how a point's DEM steps w1 at a run follow its w0 at the run the balance knew:\n");
     pair_stats("last step's accepted run -> each run (ACCEPT)", &C->A);
     pair_stats("last step's accepted run -> first run", &C->B);
     pair_stats("Newton iteration -> the next (RUN)", &C->W);
-    printf("%-23s %6s %7s %9s %9s %8s %6s %6s %6s %6s %6s %6s %6s %7s %7s %7s %6s %6s %6s %8s %8s\n", "case", "ranks",
-           "rve/rk", "T_rve ms", "T_fem ms", "T_msg ms", "imb=", "ACC", "first", "it=", "imb_it", "st1", "st_it", "Em_ACC",
-           "Em_RUN", "Em_STL", "E_ACC", "E_RUN", "E_STL", "MB/step", "stl/step");
+    printf("%-23s %6s %7s %9s %9s %8s %6s %6s %6s %6s %6s %6s %6s %7s %7s %7s %6s %6s %6s %8s %8s\n", "case",
+           "ranks", "rve/rk", "T_rve ms", "T_fem ms", "T_msg ms", "imb=", "ACC", "first", "it=", "imb_it",
+           "st1", "st_it", "Em_ACC", "Em_RUN", "Em_STL", "E_ACC", "E_RUN", "E_STL", "MB/step", "stl/step");
     for (k = 0; k < 2; ++k) {
         int n = cs[k].n, nd4 = cs[k].dim * cs[k].dim * cs[k].dim * cs[k].dim;
-        double tfem = fem_seconds(cs[k].dim, n), bytes = 8.0 * n * (9 + 9 + nd4 + 7), ps = cs[k].particles / cs[k].rate;
+        double tfem = fem_seconds(cs[k].dim, n), bytes = 8.0 * n * (9 + 9 + nd4 + 7),
+               ps = cs[k].particles / cs[k].rate;
         for (j = 0; j < 3; ++j) {
             int R = ranks[j];
             double lg = ceil(log2((double)R));
             outcome o = evaluate(C, n, R, ps, cs[k].rec, tfem, tol, alpha, bytes, bw);
             printf("%-23s %6d %7.2f %9.2f %9.2f %8.3f %6.3f %6.3f %6.3f ", cs[k].name, R, (double)n / R,
-                   1e3 * o.t_rve_acc, 1e3 * tfem, 1e3 * (2.0 * lg * alpha + bytes / bw), o.same, o.imb_acc, o.imb1);
+                   1e3 * o.t_rve_acc, 1e3 * tfem, 1e3 * (2.0 * lg * alpha + bytes / bw), o.same, o.imb_acc,
+                   o.imb1);
             if (C->W.n > 0)
-                printf("%6.3f %6.3f %6.3f %6.3f %6.1f%% %6.1f%% %6.1f%% %5.1f%% %5.1f%% %5.1f%% %8.2f %8.0f\n",
-                       o.same_it, o.imb_it, o.st1, o.st_it, 100 * o.Em_acc, 100 * o.Em_run, 100 * o.Em_steal, 100 * o.E_acc,
-                       100 * o.E_run, 100 * o.E_steal, 1e-6 * o.moved_step * cs[k].rec, o.steals_step);
+                printf(
+                    "%6.3f %6.3f %6.3f %6.3f %6.1f%% %6.1f%% %6.1f%% %5.1f%% %5.1f%% %5.1f%% %8.2f %8.0f\n",
+                    o.same_it, o.imb_it, o.st1, o.st_it, 100 * o.Em_acc, 100 * o.Em_run, 100 * o.Em_steal,
+                    100 * o.E_acc, 100 * o.E_run, 100 * o.E_steal, 1e-6 * o.moved_step * cs[k].rec,
+                    o.steals_step);
             else
-                printf("%6s %6s %6s %6s %6.1f%% %7s %7s %5.1f%% %6s %6s %8s %8s\n", "-", "-", "-", "-", 100 * o.Em_acc, "-", "-",
-                       100 * o.E_acc, "-", "-", "-", "-");
+                printf("%6s %6s %6s %6s %6.1f%% %7s %7s %5.1f%% %6s %6s %8s %8s\n", "-", "-", "-", "-",
+                       100 * o.Em_acc, "-", "-", 100 * o.E_acc, "-", "-", "-", "-");
         }
         for (rule = 0; rule < (C->W.n > 0 ? 3 : 1); ++rule) {
             static const char *rname[3] = {"ACCEPT", "RUN", "STEAL"};
             outcome o = evaluate(C, n, n / 8, ps, cs[k].rec, tfem, tol, alpha, bytes, bw);
             double em = rule == 0 ? o.Em_acc : rule == 1 ? o.Em_run : o.Em_steal;
-            printf("%-23s %-6s: E_micro %.1f %% at 8 RVEs per rank (%d ranks); ", cs[k].name, rname[rule], 100 * em,
-                   n / 8);
+            printf("%-23s %-6s: E_micro %.1f %% at 8 RVEs per rank (%d ranks); ", cs[k].name, rname[rule],
+                   100 * em, n / 8);
             for (j = 0; j < 12; ++j) {
                 int R = n / per[j] > 1 ? n / per[j] : 2;
                 o = evaluate(C, n, R, ps, cs[k].rec, tfem, tol, alpha, bytes, bw);
@@ -504,8 +524,8 @@ static void model(const cost_data *C, double rate2d, double rate3d, double alpha
                 if (em >= 0.9) break;
             }
             if (j < 12)
-                printf(">= 90 %% from %d RVEs per rank (%d ranks: %.1f %%)\n", per[j], n / per[j] > 1 ? n / per[j] : 2,
-                       100 * em);
+                printf(">= 90 %% from %d RVEs per rank (%d ranks: %.1f %%)\n", per[j],
+                       n / per[j] > 1 ? n / per[j] : 2, 100 * em);
             else
                 printf("below 90 %% up to %d RVEs per rank\n", per[11]);
         }
@@ -562,7 +582,9 @@ static int read_cost_log(const char *path, cost_data *C) {
     }
     bad = bad || ferror(fp) || C->B.n == 0;
     if (bad)
-        fprintf(stderr, "bench_twoscale: %s, line %d: not a femdem_biaxial --cost-log line (\"STEP SCALE W_0 ... W_n-1\", "
+        fprintf(stderr,
+                "bench_twoscale: %s, line %d: not a femdem_biaxial --cost-log line (\"STEP SCALE W_0 ... "
+                "W_n-1\", "
                 "steps 1, 2, ... and the same point count on every line), or no two load steps\n",
                 path, lines + 1);
     C->m = attempts > 0 ? (double)lines / attempts : 1.0;
@@ -572,26 +594,28 @@ static int read_cost_log(const char *path, cost_data *C) {
 }
 
 int main(int argc, char **argv) {
-    int n = 512, steps = 3, iters = 3, threads = 1, do_model = 0, balance_rule = 0, s, it, p, rank = 0, nranks = 1, help = 0, nt = 0;
+    int n = 512, steps = 3, iters = 3, threads = 1, do_model = 0, balance_rule = 0, s, it, p, rank = 0,
+        nranks = 1, help = 0, nt = 0;
     double band = 0.1, alpha = 2e-6, bw = 1e10, rate3d = 1.05e7, tol = 0.05, rate2d = 0;
     const char *costs = NULL, *cost_log = NULL;
-    const cli_opt opts[] = {{"--points", CLI_INT, &n, 1, 1000000, NULL, NULL, 0},
-                            {"--steps", CLI_INT, &steps, 2, 1000, NULL, NULL, 0},
-                            {"--iterations", CLI_INT, &iters, 1, 1000, NULL, NULL, 0},
-                            {"--threads", CLI_INT, &threads, 1, 1024, NULL, NULL, 0},
-                            {"--band", CLI_REAL, &band, 0, 1, NULL, NULL, 0},
-                            {"--model", CLI_FLAG, &do_model, 0, 0, NULL, NULL, 0},
-                            {"--alpha", CLI_REAL, &alpha, 0, 1, NULL, NULL, 0},
-                            {"--bandwidth", CLI_REAL, &bw, 0, HUGE_VAL, NULL, NULL, CLI_LO_OPEN | CLI_HI_OPEN},
-                            {"--rate3d", CLI_REAL, &rate3d, 0, HUGE_VAL, NULL, NULL, CLI_LO_OPEN | CLI_HI_OPEN},
-                            {"--rate2d", CLI_REAL, &rate2d, 0, HUGE_VAL, NULL, NULL, CLI_HI_OPEN},
-                            {"--tol", CLI_REAL, &tol, 0, 1, NULL, NULL, CLI_LO_OPEN},
-                            {"--costs", CLI_STR, &costs, 0, 0, NULL, NULL, 0},
-                            {"--cost-log", CLI_STR, &cost_log, 0, 0, NULL, NULL, 0},
-                            {"--balance", CLI_CHOICE, &balance_rule, 0, 0, NULL, "accept|run", 0},
-                            {"--steal-answer", CLI_CHOICE, &steal_now, 0, 0, NULL, "run|now", 0},
-                            {"--steal-order", CLI_CHOICE, &steal_global, 0, 0, NULL, "own|global", 0},
-                            {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
+    const cli_opt opts[] = {
+        {"--points", CLI_INT, &n, 1, 1000000, NULL, NULL, 0},
+        {"--steps", CLI_INT, &steps, 2, 1000, NULL, NULL, 0},
+        {"--iterations", CLI_INT, &iters, 1, 1000, NULL, NULL, 0},
+        {"--threads", CLI_INT, &threads, 1, 1024, NULL, NULL, 0},
+        {"--band", CLI_REAL, &band, 0, 1, NULL, NULL, 0},
+        {"--model", CLI_FLAG, &do_model, 0, 0, NULL, NULL, 0},
+        {"--alpha", CLI_REAL, &alpha, 0, 1, NULL, NULL, 0},
+        {"--bandwidth", CLI_REAL, &bw, 0, HUGE_VAL, NULL, NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--rate3d", CLI_REAL, &rate3d, 0, HUGE_VAL, NULL, NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--rate2d", CLI_REAL, &rate2d, 0, HUGE_VAL, NULL, NULL, CLI_HI_OPEN},
+        {"--tol", CLI_REAL, &tol, 0, 1, NULL, NULL, CLI_LO_OPEN},
+        {"--costs", CLI_STR, &costs, 0, 0, NULL, NULL, 0},
+        {"--cost-log", CLI_STR, &cost_log, 0, 0, NULL, NULL, 0},
+        {"--balance", CLI_CHOICE, &balance_rule, 0, 0, NULL, "accept|run", 0},
+        {"--steal-answer", CLI_CHOICE, &steal_now, 0, 0, NULL, "run|now", 0},
+        {"--steal-order", CLI_CHOICE, &steal_global, 0, 0, NULL, "own|global", 0},
+        {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     const cli_opt *tables[2];
     gk_packing pk;
     gk_err err;
@@ -615,7 +639,8 @@ int main(int argc, char **argv) {
 #endif
         return help ? 0 : 2;
     }
-    if (steal_global && !steal_now) { /* simulated, every free rank asking in turn: too slow at 10 000 ranks */
+    if (steal_global &&
+        !steal_now) { /* simulated, every free rank asking in turn: too slow at 10 000 ranks */
         if (rank == 0) fprintf(stderr, "bench_twoscale: --steal-order global needs --steal-answer now\n");
 #ifdef GK_TWOSCALE_MPI
         MPI_Finalize();
@@ -636,7 +661,8 @@ int main(int argc, char **argv) {
     d.rve = gk_rve_def_default();
     d.rve.dt = 3.1602315723728926e-05;
     d.rule.n_min = 2, d.rule.n_max = 400, d.rule.unbalanced_max = 2e-2; /* femdem_biaxial's defaults */
-    dH = (double *)malloc((size_t)n * 9 * sizeof(double)), sig = (double *)malloc((size_t)n * 9 * sizeof(double));
+    dH = (double *)malloc((size_t)n * 9 * sizeof(double)),
+    sig = (double *)malloc((size_t)n * 9 * sizeof(double));
     D = (double *)malloc((size_t)n * 16 * sizeof(double));
     times = (double *)malloc((size_t)steps * iters * sizeof(double));
     work = (double *)malloc((size_t)steps * iters * n * sizeof(double));
@@ -646,29 +672,34 @@ int main(int argc, char **argv) {
     }
     if (do_model && rank == 0 && nranks == 1 && cost_log) { /* femdem_biaxial --cost-log (bench/README.md) */
         if (read_cost_log(cost_log, &C)) return 1;
-        printf("cost pairs from %s: %d across load steps, %d within (%.2f runs per step)\n", cost_log, C.B.n, C.W.n,
-               C.m);
-    } else if (do_model && rank == 0 && nranks == 1 && costs) { /* "w0 w1" per line across steps; none within */
+        printf("cost pairs from %s: %d across load steps, %d within (%.2f runs per step)\n", cost_log, C.B.n,
+               C.W.n, C.m);
+    } else if (do_model && rank == 0 && nranks == 1 &&
+               costs) { /* "w0 w1" per line across steps; none within */
         FILE *fp = fopen(costs, "r");
         double x, y;
         int bad = 0;
         while (fp && !bad && fscanf(fp, "%lf %lf", &x, &y) == 2)
-            bad = !(x >= 0 && y >= 0 && x < 1e12 && y < 1e12) || pairs_add(&C.A, x, y) || pairs_add(&C.B, x, y);
+            bad =
+                !(x >= 0 && y >= 0 && x < 1e12 && y < 1e12) || pairs_add(&C.A, x, y) || pairs_add(&C.B, x, y);
         if (!fp || bad || !feof(fp) || ferror(fp) || C.B.n == 0)
-            return fprintf(stderr, "bench_twoscale: %s: not a file of cost pairs \"w0 w1\" (non-negative) per line\n",
-                           costs), 1;
+            return fprintf(stderr,
+                           "bench_twoscale: %s: not a file of cost pairs \"w0 w1\" (non-negative) per line\n",
+                           costs),
+                   1;
         fclose(fp);
         printf("cost pairs: %d from %s (across steps only: rule RUN not evaluated)\n", C.B.n, costs);
     }
     if (rank == 0)
-        printf("bench_twoscale: %d RVEs of %d disks, %d rank(s) x %d thread(s), %d steps x %d iterations\n", n, pk.n,
-               nranks, threads, steps, iters);
+        printf("bench_twoscale: %d RVEs of %d disks, %d rank(s) x %d thread(s), %d steps x %d iterations\n",
+               n, pk.n, nranks, threads, steps, iters);
     for (s = 0; s < steps; ++s)
         for (it = 0; it < iters; ++it) {
             const gk_twoscale_point *pts;
             double dt;
             field(n, s, it, band, dH);
-            if (s == 1 && it == 0) st0 = ts.stats; /* traffic from the second step on (after a first balance) */
+            if (s == 1 && it == 0)
+                st0 = ts.stats; /* traffic from the second step on (after a first balance) */
 #ifdef GK_TWOSCALE_MPI
             MPI_Barrier(MPI_COMM_WORLD);
 #endif
@@ -705,11 +736,13 @@ int main(int argc, char **argv) {
         q[0] = wa[0], q[1] = wa[nw / 2], q[3] = wa[(int)(0.9 * nw)], q[4] = wa[nw - 1], q[2] = 0;
         for (k = 0; k < nw; ++k) q[2] += wa[k] / nw;
         free(wa);
-        printf("wall per iteration: median %.1f ms (min %.1f, max %.1f) over %d iterations\n", 1e3 * med, 1e3 * times[0],
-               1e3 * times[nt - 1], nt);
-        printf("DEM steps per RVE run: min %.0f  median %.0f  mean %.1f  p90 %.0f  max %.0f (max/mean %.2f)\n", q[0], q[1],
-               q[2], q[3], q[4], q[4] / q[2]);
-        printf("per iteration, rank 0: %.0f bytes in, %.0f bytes out; %lld point moves in %lld rebalances (balance at "
+        printf("wall per iteration: median %.1f ms (min %.1f, max %.1f) over %d iterations\n", 1e3 * med,
+               1e3 * times[0], 1e3 * times[nt - 1], nt);
+        printf(
+            "DEM steps per RVE run: min %.0f  median %.0f  mean %.1f  p90 %.0f  max %.0f (max/mean %.2f)\n",
+            q[0], q[1], q[2], q[3], q[4], q[4] / q[2]);
+        printf("per iteration, rank 0: %.0f bytes in, %.0f bytes out; %lld point moves in %lld rebalances "
+               "(balance at "
                "%s), %lld bytes moved in all\n",
                (double)b_in / nt, (double)b_out / nt, ts.stats.migrated, ts.stats.balances,
                balance_rule ? "every run" : "every accept", ts.stats.migrated_bytes);

@@ -41,7 +41,7 @@ typedef enum cli_kind { CLI_INT, CLI_REAL, CLI_STR, CLI_CHOICE, CLI_FLAG, CLI_UL
 #define CLI_HI_OPEN 2u
 
 typedef struct cli_opt {
-    const char *name;    /* "--nx" */
+    const char *name; /* "--nx" */
     cli_kind kind;
     void *dst;           /* int*, double*, const char**, int* (choice index, flag), unsigned long*,
                             cli_func* */
@@ -78,8 +78,10 @@ static void cli_choices_text(const char *c, char *out, size_t cap) {
             continue;
         }
         ++seen;
-        if (seen == bars) memcpy(out + n, " or ", 4), n += 4;
-        else memcpy(out + n, ", ", 2), n += 2;
+        if (seen == bars)
+            memcpy(out + n, " or ", 4), n += 4;
+        else
+            memcpy(out + n, ", ", 2), n += 2;
     }
     out[n] = 0;
 }
@@ -141,8 +143,8 @@ static int cli_value(const char *prog, const cli_opt *o, const char *v) {
             return 2;
         }
         if (errno == ERANGE || (double)x < o->lo || (double)x > o->hi) {
-            cli_say(prog, "%s: %s %s is out of range: needs a whole number in [%.0f, %.0f]\n", prog, o->name, v,
-                    o->lo, o->hi);
+            cli_say(prog, "%s: %s %s is out of range: needs a whole number in [%.0f, %.0f]\n", prog, o->name,
+                    v, o->lo, o->hi);
             return 2;
         }
         *(int *)o->dst = (int)x;
@@ -154,8 +156,8 @@ static int cli_value(const char *prog, const cli_opt *o, const char *v) {
         if (o->what)
             snprintf(range, sizeof range, "%s", o->what);
         else
-            snprintf(range, sizeof range, "a number in %c%g, %g%c", (o->flags & CLI_LO_OPEN) ? '(' : '[', o->lo, o->hi,
-                     (o->flags & CLI_HI_OPEN) ? ')' : ']');
+            snprintf(range, sizeof range, "a number in %c%g, %g%c", (o->flags & CLI_LO_OPEN) ? '(' : '[',
+                     o->lo, o->hi, (o->flags & CLI_HI_OPEN) ? ')' : ']');
         errno = 0;
         x = strtod(v, &end);
         if (end == v || *end || errno == ERANGE || !isfinite(x)) {
@@ -194,8 +196,8 @@ static int cli_parse(const char *prog, int argc, char **argv, const cli_opt *con
         if (!o) {
             const char *eq = strchr(a, '=');
             if (a[0] == '-' && a[1] == '-' && eq)
-                cli_say(prog, "%s: %s: write the value after the option, separated by a space (%.*s %s)\n", prog,
-                        a, (int)(eq - a), a, eq + 1);
+                cli_say(prog, "%s: %s: write the value after the option, separated by a space (%.*s %s)\n",
+                        prog, a, (int)(eq - a), a, eq + 1);
             else
                 cli_say(prog, "%s: unknown option %s (see --help)\n", prog, a);
             return 2;

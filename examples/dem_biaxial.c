@@ -109,14 +109,18 @@ static int parse(int argc, char **argv, db_opts *o) {
         {"--pictures", CLI_STR, &pics, 0, 0, NULL, NULL, 0},
         {"--quiet", CLI_FLAG, &o->quiet, 0, 0, NULL, NULL, 0},
         {"--generate", CLI_INT, &o->generate, 16, 1000000, NULL, NULL, 0},
-        {"--pressure", CLI_REAL, &o->pressure, 0, HUGE_VAL, "a positive stress", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--pressure", CLI_REAL, &o->pressure, 0, HUGE_VAL, "a positive stress", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
         {"--strain", CLI_REAL, &o->strain, 0, 0.5, "a strain in (0, 0.5]", NULL, CLI_LO_OPEN},
         {"--rate", CLI_REAL, &o->rate, 0, HUGE_VAL, "a rate >= 0 (0: automatic)", NULL, CLI_HI_OPEN},
         {"--every", CLI_REAL, &o->every, 0, 0.5, "a strain in (0, --strain]", NULL, CLI_LO_OPEN},
         {"--damping", CLI_REAL, &o->damping, 0, 1, "a value in [0, 1)", NULL, CLI_HI_OPEN},
-        {"--platen-mu", CLI_REAL, &o->platen_mu, 0, HUGE_VAL, "a friction coefficient >= 0", NULL, CLI_HI_OPEN},
-        {"--link-stiffness", CLI_REAL, &o->link_k, 0, HUGE_VAL, "a stiffness >= 0 (0: automatic)", NULL, CLI_HI_OPEN},
-        {"--max-consolidation", CLI_REAL, &o->max_cons, 1000, HUGE_VAL, "a step count >= 1000", NULL, CLI_HI_OPEN},
+        {"--platen-mu", CLI_REAL, &o->platen_mu, 0, HUGE_VAL, "a friction coefficient >= 0", NULL,
+         CLI_HI_OPEN},
+        {"--link-stiffness", CLI_REAL, &o->link_k, 0, HUGE_VAL, "a stiffness >= 0 (0: automatic)", NULL,
+         CLI_HI_OPEN},
+        {"--max-consolidation", CLI_REAL, &o->max_cons, 1000, HUGE_VAL, "a step count >= 1000", NULL,
+         CLI_HI_OPEN},
         {"--seed", CLI_ULONG, &o->seed, 0, 0, NULL, NULL, 0},
         {"--threads", CLI_INT, &o->threads, 1, 256, NULL, NULL, 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
@@ -130,13 +134,14 @@ static int parse(int argc, char **argv, db_opts *o) {
     o->link_k = 0.0, o->max_cons = 200000;
     if ((r = cli_parse("dem_biaxial", argc, argv, tables, &help)) != 0) return r;
     if (help) return usage(stdout), -1;
-    if (sscanf(tiles, "%dx%d%c", &o->tx, &o->ty, &c) != 2 || o->tx < 1 || o->ty < 1 || o->tx > 64 || o->ty > 64)
+    if (sscanf(tiles, "%dx%d%c", &o->tx, &o->ty, &c) != 2 || o->tx < 1 || o->ty < 1 || o->tx > 64 ||
+        o->ty > 64)
         return fprintf(stderr, "dem_biaxial: --tiles %s: need NXxNY with 1 <= NX, NY <= 64\n", tiles), 2;
     if ((o->npic = dsc_list(pics, o->pic, 8, 1)) < 0)
         return fprintf(stderr, "dem_biaxial: --pictures %s: need up to 8 increasing strains > 0\n", pics), 2;
     if (o->every > o->strain)
-        return fprintf(stderr, "dem_biaxial: --every %g: need a strain in (0, --strain] (--strain %g)\n", o->every,
-                       o->strain),
+        return fprintf(stderr, "dem_biaxial: --every %g: need a strain in (0, --strain] (--strain %g)\n",
+                       o->every, o->strain),
                2;
     return 0;
 }

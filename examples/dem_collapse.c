@@ -79,7 +79,8 @@ static void usage(FILE *fp) {
         "  --mu M                 Coulomb friction of the disks and the floor disks (default 0.5)\n"
         "  --roll-beta B --roll-eta E   rolling resistance (default 0 0: none)\n"
         "  --restitution E        normal restitution of the contact dashpots (default 0.5)\n"
-        "  --young E              contact modulus, k_n = E r* [Pa] (default 6e8, Guo & Zhao 2014, Liang & Zhao 2019)\n"
+        "  --young E              contact modulus, k_n = E r* [Pa] (default 6e8, Guo & Zhao 2014, Liang & "
+        "Zhao 2019)\n"
         "  --gravity G            [m/s^2] (default 9.81)\n"
         "  --t-end T              simulated time after release [s] (default 4)\n"
         "  --every DT             time between CSV rows [s] (default 0.01)\n"
@@ -112,7 +113,8 @@ static int parse(int argc, char **argv, dc_opts *o) {
         {"--roll-eta", CLI_REAL, &o->roll_eta, 0, HUGE_VAL, "a value >= 0", NULL, CLI_HI_OPEN},
         {"--restitution", CLI_REAL, &o->restitution, 0, 1, "a value in (0, 1]", NULL, CLI_LO_OPEN},
         {"--young", CLI_REAL, &o->young, 0, HUGE_VAL, "a positive modulus", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
-        {"--gravity", CLI_REAL, &o->gravity, 0, HUGE_VAL, "a positive value", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--gravity", CLI_REAL, &o->gravity, 0, HUGE_VAL, "a positive value", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
         {"--t-end", CLI_REAL, &o->t_end, 0, HUGE_VAL, "a positive time", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
         {"--every", CLI_REAL, &o->every, 0, HUGE_VAL, "a positive time", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
         {"--rest-frac", CLI_REAL, &o->rest_frac, 0, HUGE_VAL, "a value >= 0", NULL, CLI_HI_OPEN},
@@ -128,7 +130,8 @@ static int parse(int argc, char **argv, dc_opts *o) {
     if ((r = cli_parse("dem_collapse", argc, argv, tables, &help)) != 0) return r;
     if (help) return usage(stdout), -1;
     if ((o->nsnap = dsc_list(snaps, o->snap, DC_MAX_SNAP, 0)) < 0)
-        return fprintf(stderr, "dem_collapse: --snapshots %s: need up to %d increasing times >= 0, comma-separated\n",
+        return fprintf(stderr,
+                       "dem_collapse: --snapshots %s: need up to %d increasing times >= 0, comma-separated\n",
                        snaps, DC_MAX_SNAP),
                2;
     return 0;

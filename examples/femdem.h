@@ -30,31 +30,33 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
-#define FD_AND_M 5                 /* Anderson memory */
-#define FD_DEM_INERTIAL 5e-4       /* adaptive rule defaults (see --help) */
-#define FD_DEM_UNBALANCED 2e-2     /* measured for these drivers: femdem_biaxial.c's header */
-#define FD_DEM_MAX_FACTOR 4        /* adaptive: --dem-max = 4 x the strain rule's count of the increment */
-#define FD_DEM_STRAIN 1e-5         /* strain rule: the authors' */
+#define FD_AND_M 5             /* Anderson memory */
+#define FD_DEM_INERTIAL 5e-4   /* adaptive rule defaults (see --help) */
+#define FD_DEM_UNBALANCED 2e-2 /* measured for these drivers: femdem_biaxial.c's header */
+#define FD_DEM_MAX_FACTOR 4    /* adaptive: --dem-max = 4 x the strain rule's count of the increment */
+#define FD_DEM_STRAIN 1e-5     /* strain rule: the authors' */
 #define FD_DEM_MIN 2
 #define FD_DEM_MAX 20000
-#define FD_DEM_EVERY 20            /* adaptive rule: relaxation steps between unbalanced-force checks */
-#define FD_SEED_DT 3.1602315723728926e-05 /* the Guo & Zhao authors' YADE time step (PWaveTimeStep of rve400) */
+#define FD_DEM_EVERY 20 /* adaptive rule: relaxation steps between unbalanced-force checks */
+#define FD_SEED_DT \
+    3.1602315723728926e-05 /* the Guo & Zhao authors' YADE time step (PWaveTimeStep of rve400) */
 #define FD_MAX_PACKINGS 64
 #define FD_NFIELD 10
 #define FD_PI 3.14159265358979323846
 
 typedef struct fd_opts {
     int nx, ny, steps, threads, quad, max_iter, checkpoint, verbose, vtk_every, dem_min, dem_max, aitken;
-    int elem_kind, tkind, tmode; /* --element q4|q8 (1); --tangent taylor|yade|relaxed|perturbation, as tmode: 0 1 3 2 */
+    int elem_kind, tkind,
+        tmode; /* --element q4|q8 (1); --tangent taylor|yade|relaxed|perturbation, as tmode: 0 1 3 2 */
     gk_elem_type elem;
     const char *out, *restart, *packing, *tangent, *test;
     double width, height, pressure, inc, tol, ftol, dt, dem_strain, xi;
-    int dem_rule;               /* --dem-rule: 0 adaptive (gk_rve_deform_adaptive), 1 strain */
+    int dem_rule; /* --dem-rule: 0 adaptive (gk_rve_deform_adaptive), 1 strain */
     double dem_inertial, dem_unbalanced, tangent_reuse;
-    int cyclic;                 /* 0 biaxial/single, 1 cyclic strain-, 2 stress-controlled */
-    int ed_newton;              /* E_d from the Newton correction before relaxation (1) or the step taken (0, eq 21) */
-    int extrapolate;            /* predictor: the last converged increment, scaled (1), or the tangent solve (0) */
-    int relax_kind;             /* --relaxation aitken|anderson|none */
+    int cyclic;      /* 0 biaxial/single, 1 cyclic strain-, 2 stress-controlled */
+    int ed_newton;   /* E_d from the Newton correction before relaxation (1) or the step taken (0, eq 21) */
+    int extrapolate; /* predictor: the last converged increment, scaled (1), or the tangent solve (0) */
+    int relax_kind;  /* --relaxation aitken|anderson|none */
     unsigned long packing_seed; /* --packing A,B,...: seed of the per-Gauss-point draw */
     const char *fields_at;      /* --fields-at: axial strains [%] of the fabric maps (biaxial) */
     const char *cost_log;       /* --cost-log: the DEM steps of every Gauss point at every run (biaxial) */
@@ -78,15 +80,15 @@ typedef int (*fd_probe_fn)(struct fd_model *M, int it, double Ef, gk_err *err);
 
 typedef struct fd_model {
     fd_opts o;
-    const char *prog;      /* for messages                                              */
-    int root;              /* this rank prints and writes                               */
+    const char *prog; /* for messages                                              */
+    int root;         /* this rank prints and writes                               */
     gk_mesh mesh;
     gk_quad q;
     int ngp, npe, ndof;
-    gk_twoscale ts;        /* the RVEs, one per Gauss point                             */
-    double *dH;            /* ngp x 9: dH of the last iterate                           */
+    gk_twoscale ts; /* the RVEs, one per Gauss point                             */
+    double *dH;     /* ngp x 9: dH of the last iterate                           */
     double *sig, *sig_n, *D, *D_n, *dNdx, *detJ, *v0;
-    int *failed;           /* Gauss points without contacts (tangent floored)          */
+    int *failed; /* Gauss points without contacts (tangent floored)          */
     long long pend_dem, pend_reused, pend_computed; /* work since the last converged step */
     gk_csr K;
     double *u, *du, *dprev, *fint, *fext, *R, *rhs, *utot, *A0x, *andF, *andG, *fprev, *Gprev;
@@ -96,14 +98,14 @@ typedef struct fd_model {
     int step;
     fd_row *curve;
     int ncurve, cap;
-    double *hist;          /* biaxial: the Gauss-point fields (FD_NFIELD each) of every row */
+    double *hist; /* biaxial: the Gauss-point fields (FD_NFIELD each) of every row */
     /* cyclic: periodic ties, condensed matrix, reduced work arrays */
     gk_dofmap dm;
     gk_csr Kr;
     int *rfix;
     double *rvals, *rr, *ur;
-    fd_probe_fn probe;                      /* diagnostics at a Newton iteration (NULL: none) */
-    FILE *cost_log;                         /* --cost-log (rank 0; NULL: none)                  */
+    fd_probe_fn probe;                     /* diagnostics at a Newton iteration (NULL: none) */
+    FILE *cost_log;                        /* --cost-log (rank 0; NULL: none)                  */
     int (*checkpoint)(struct fd_model *M); /* the driver's checkpoint (cut-back give-up)      */
 } fd_model;
 
@@ -158,7 +160,9 @@ static int fd_mkdir_out(const fd_model *M) {
             bad = 1;
         else if (stat(M->o.out, &st) != 0 || !S_ISDIR(st.st_mode))
             bad = 1;
-        if (bad) fprintf(stderr, "%s: --out %s: cannot create that directory (a file of that name?)\n", M->prog, M->o.out);
+        if (bad)
+            fprintf(stderr, "%s: --out %s: cannot create that directory (a file of that name?)\n", M->prog,
+                    M->o.out);
     }
     return fd_agree(M, bad);
 }
@@ -194,12 +198,16 @@ static const cli_opt *fd_common_opts(fd_opts *o) {
         {"--predictor", CLI_CHOICE, &o->extrapolate, 0, 0, NULL, "tangent|extrapolate", 0},
         {"--verbose", CLI_FLAG, &o->verbose, 0, 0, NULL, NULL, 0},
         {"--dem-rule", CLI_CHOICE, &o->dem_rule, 0, 0, NULL, "adaptive|strain", 0},
-        {"--dem-inertial", CLI_REAL, &o->dem_inertial, 0, HUGE_VAL, "a positive number", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
-        {"--dem-unbalanced", CLI_REAL, &o->dem_unbalanced, 0, HUGE_VAL, "a positive number", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
-        {"--dem-strain", CLI_REAL, &o->dem_strain, 0, HUGE_VAL, "a positive number", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--dem-inertial", CLI_REAL, &o->dem_inertial, 0, HUGE_VAL, "a positive number", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--dem-unbalanced", CLI_REAL, &o->dem_unbalanced, 0, HUGE_VAL, "a positive number", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--dem-strain", CLI_REAL, &o->dem_strain, 0, HUGE_VAL, "a positive number", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
         {"--dem-min", CLI_INT, &o->dem_min, 1, 10000000, NULL, NULL, 0},
         {"--dem-max", CLI_INT, &o->dem_max, 1, 10000000, NULL, NULL, 0},
-        {"--tangent-reuse", CLI_REAL, &o->tangent_reuse, 0, 1, "a fraction 0 <= X < 1 (0: off)", NULL, CLI_HI_OPEN},
+        {"--tangent-reuse", CLI_REAL, &o->tangent_reuse, 0, 1, "a fraction 0 <= X < 1 (0: off)", NULL,
+         CLI_HI_OPEN},
         {"--balance", CLI_CHOICE, &o->balance_run, 0, 0, NULL, "accept|run", 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     memcpy(t, src, sizeof src);
@@ -278,29 +286,32 @@ static void fd_usage_common(FILE *fp) {
         "  --verbose              print E_d, E_f, the DEM steps per RVE (mean, max) and the time of every\n"
         "                         Newton iteration\n"
         "\nDEM steps per RVE run and tangent reuse:\n"
-        "  --dem-rule R           DEM steps per RVE run: adaptive (default) = gk_rve_deform_adaptive: dH over\n"
+        "  --dem-rule R           DEM steps per RVE run: adaptive (default) = gk_rve_deform_adaptive: dH "
+        "over\n"
         "                         n = ceil(I_1 / I_max) steps, I_1 the inertial number (eq 20) of dH in\n"
-        "                         one DEM step at the RVE's pressure, then relaxation at fixed cell while the\n"
+        "                         one DEM step at the RVE's pressure, then relaxation at fixed cell while "
+        "the\n"
         "                         unbalanced force ratio > U; strain = the authors' rule n_s = max|dH| / S,\n"
         "                         no relaxation. Both clamped to [--dem-min, --dem-max] in all\n");
-    fprintf(fp,
-            "  --dem-inertial I       adaptive: inertial number bound I_max of the deformation (default %g)\n"
-            "  --dem-unbalanced U     adaptive: relax until the unbalanced force ratio < U (default %g)\n"
-            "  --dem-strain S         strain rule: RVE strain per DEM step (default %g: the authors' rule,\n"
-            "                         100 steps per 0.1 %%); --dem-min N --dem-max N: exactly N steps per run\n"
-            "  --dem-min, --dem-max   bounds of the DEM steps per RVE run (default %d, and %d with the strain\n"
-            "                         rule, %d x the strain rule's count of --increment with the adaptive one:\n"
-            "                         400 at 0.1 %%). A cut-back increment keeps the step count of the full one\n"
-            "                         (either rule: S or I_max is scaled by the cut-back factor)\n"
-            "  --tangent-reuse X      keep a Gauss point's last computed tangent while its contact network has\n"
-            "                         changed by less than the fraction X since (default 0: off; 0 <= X < 1).\n"
-            "                         Change = (contacts created + contacts lost + contacts whose sliding state\n"
-            "                         flipped) / contacts when the tangent was computed; contacts are pairs of\n"
-            "                         particle ids. The stored tangents and networks are in the checkpoint\n"
-            "  --balance accept|run   MPI build: move RVEs between ranks by their cost after every accepted\n"
-            "                         step (accept, default) or before every Newton iteration, by the last\n"
-            "                         one's costs (run; gk_twoscale_def.balance). The results are the same\n",
-            FD_DEM_INERTIAL, FD_DEM_UNBALANCED, FD_DEM_STRAIN, FD_DEM_MIN, FD_DEM_MAX, FD_DEM_MAX_FACTOR);
+    fprintf(
+        fp,
+        "  --dem-inertial I       adaptive: inertial number bound I_max of the deformation (default %g)\n"
+        "  --dem-unbalanced U     adaptive: relax until the unbalanced force ratio < U (default %g)\n"
+        "  --dem-strain S         strain rule: RVE strain per DEM step (default %g: the authors' rule,\n"
+        "                         100 steps per 0.1 %%); --dem-min N --dem-max N: exactly N steps per run\n"
+        "  --dem-min, --dem-max   bounds of the DEM steps per RVE run (default %d, and %d with the strain\n"
+        "                         rule, %d x the strain rule's count of --increment with the adaptive one:\n"
+        "                         400 at 0.1 %%). A cut-back increment keeps the step count of the full one\n"
+        "                         (either rule: S or I_max is scaled by the cut-back factor)\n"
+        "  --tangent-reuse X      keep a Gauss point's last computed tangent while its contact network has\n"
+        "                         changed by less than the fraction X since (default 0: off; 0 <= X < 1).\n"
+        "                         Change = (contacts created + contacts lost + contacts whose sliding state\n"
+        "                         flipped) / contacts when the tangent was computed; contacts are pairs of\n"
+        "                         particle ids. The stored tangents and networks are in the checkpoint\n"
+        "  --balance accept|run   MPI build: move RVEs between ranks by their cost after every accepted\n"
+        "                         step (accept, default) or before every Newton iteration, by the last\n"
+        "                         one's costs (run; gk_twoscale_def.balance). The results are the same\n",
+        FD_DEM_INERTIAL, FD_DEM_UNBALANCED, FD_DEM_STRAIN, FD_DEM_MIN, FD_DEM_MAX, FD_DEM_MAX_FACTOR);
 }
 
 /* -------------------------------------------------------------- setup */
@@ -332,8 +343,8 @@ static int fd_read_packings(const char *list_in, gk_packing *pks, gk_err *err) {
 
 /* the prototype of the RVEs: cyclic with --pressure P differing from the packing's own by more than
  * 0.5 %: the packing re-consolidated to P with its contact friction (the fabric kept); 0, or 1 */
-static int fd_consolidated(fd_model *M, const gk_rve_def *def, const gk_packing *pk, gk_rve_state *st, int *use,
-                           gk_err *err) {
+static int fd_consolidated(fd_model *M, const gk_rve_def *def, const gk_packing *pk, gk_rve_state *st,
+                           int *use, gk_err *err) {
     gk_rve r;
     double s0[9], p0;
     *use = 0;
@@ -358,8 +369,8 @@ static int fd_consolidated(fd_model *M, const gk_rve_def *def, const gk_packing 
             return 1;
         }
         if (M->root)
-            printf("%s: RVE consolidated from p = %.1f kPa to %.1f kPa (void ratio %.4f)\n", M->prog, p0 / 1e3,
-                   M->o.pressure / 1e3, rep.void_ratio);
+            printf("%s: RVE consolidated from p = %.1f kPa to %.1f kPa (void ratio %.4f)\n", M->prog,
+                   p0 / 1e3, M->o.pressure / 1e3, rep.void_ratio);
         *use = 1;
     }
     gk_rve_destroy(&r);
@@ -525,10 +536,10 @@ static int fd_setup(fd_model *M, gk_err *err) {
 }
 
 static void fd_free(fd_model *M) {
-    void *p[] = {M->dH,   M->sig,   M->sig_n, M->D,    M->D_n,   M->dNdx, M->detJ,  M->v0,   M->failed,
-                 M->u,    M->du,    M->dprev, M->andF, M->andG,  M->fprev, M->Gprev, M->fint, M->fext,
-                 M->R,    M->rhs,   M->utot,  M->ulast, M->A0x,  M->fix,  M->fixtop, M->top, M->right,
-                 M->lface, M->rface, M->rfix, M->rvals, M->rr,   M->ur,   M->curve, M->hist};
+    void *p[] = {M->dH,    M->sig,   M->sig_n, M->D,     M->D_n,  M->dNdx,  M->detJ,   M->v0,   M->failed,
+                 M->u,     M->du,    M->dprev, M->andF,  M->andG, M->fprev, M->Gprev,  M->fint, M->fext,
+                 M->R,     M->rhs,   M->utot,  M->ulast, M->A0x,  M->fix,   M->fixtop, M->top,  M->right,
+                 M->lface, M->rface, M->rfix,  M->rvals, M->rr,   M->ur,    M->curve,  M->hist};
     size_t k;
     for (k = 0; k < sizeof p / sizeof *p; ++k) free(p[k]);
     if (M->cost_log) fclose(M->cost_log); /* an error path: the driver closed it otherwise */
@@ -572,7 +583,8 @@ static int fd_external_force(fd_model *M, gk_err *err) {
 }
 
 /* K from tangents D, rhs with Dirichlet values; solve into x */
-static int fd_solve(fd_model *M, const double *D, const double *rhs_in, double top_value, double *x, gk_err *err) {
+static int fd_solve(fd_model *M, const double *D, const double *rhs_in, double top_value, double *x,
+                    gk_err *err) {
     gk_solver s;
     double vals[4096], *vp = vals;
     int k, r = 0;
@@ -584,16 +596,17 @@ static int fd_solve(fd_model *M, const double *D, const double *rhs_in, double t
     if (M->dm.n) { /* tied (periodic) dofs: solve K_r = T^T K T for the independent dofs */
         int nr = 0;
         if (gk_fem_assemble(&M->mesh, &M->q, D, NULL, &M->K, NULL, err) ||
-            gk_dofmap_condense(&M->dm, &M->K, &M->Kr, err) || gk_dofmap_restrict(&M->dm, NULL, M->rhs, M->rr, err) ||
+            gk_dofmap_condense(&M->dm, &M->K, &M->Kr, err) ||
+            gk_dofmap_restrict(&M->dm, NULL, M->rhs, M->rr, err) ||
             gk_dofmap_dirichlet(&M->dm, M->nfix, M->fix, vp, M->rfix, M->rvals, &nr, err) ||
-            gk_fem_dirichlet(&M->Kr, M->rr, nr, M->rfix, M->rvals, err) || gk_solver_factor(&s, &M->Kr, NULL, err) ||
-            gk_solver_solve(&s, M->rr, M->ur))
+            gk_fem_dirichlet(&M->Kr, M->rr, nr, M->rfix, M->rvals, err) ||
+            gk_solver_factor(&s, &M->Kr, NULL, err) || gk_solver_solve(&s, M->rr, M->ur))
             r = 1;
         else
             gk_dofmap_expand(&M->dm, M->ur, 0, x);
     } else if (gk_fem_assemble(&M->mesh, &M->q, D, NULL, &M->K, NULL, err) ||
-               gk_fem_dirichlet(&M->K, M->rhs, M->nfix, M->fix, vp, err) || gk_solver_factor(&s, &M->K, NULL, err) ||
-               gk_solver_solve(&s, M->rhs, x))
+               gk_fem_dirichlet(&M->K, M->rhs, M->nfix, M->fix, vp, err) ||
+               gk_solver_factor(&s, &M->K, NULL, err) || gk_solver_solve(&s, M->rhs, x))
         r = 1;
     gk_solver_free(&s);
     if (vp != vals) free(vp);
@@ -682,7 +695,8 @@ static void fd_print_work_totals(const fd_model *M) {
         if (M->curve[k].dem_max > dmax) dmax = M->curve[k].dem_max;
     }
     if (M->root)
-        printf(" dem_rule=%s dem_steps_total=%lld dem_steps_max=%d tangents_reused=%lld tangents_computed=%lld\n",
+        printf(" dem_rule=%s dem_steps_total=%lld dem_steps_max=%d tangents_reused=%lld "
+               "tangents_computed=%lld\n",
                M->o.dem_rule ? "strain" : "adaptive", dtot, dmax, reu, comp);
 }
 

@@ -111,34 +111,37 @@
 #include "femdem_biaxial.h"
 
 static void usage(FILE *fp) {
-    fprintf(fp,
-            "usage: femdem_biaxial [--nx 8] [--ny 16] [--element q8|q4] [--steps 100] [--threads 2] [--out DIR]\n"
-            "                      [--tangent taylor|yade|relaxed|perturbation] [--restart DIR]\n"
-            "                      [--test biaxial|single]\n"
-            "       (the cyclic simple-shear tests: build/femdem_cyclic; diagnostics: build/femdem_probe)\n\n"
-            "  --steps N              load steps (default 100: 10 %% axial strain at 0.1 %% per step)\n"
-            "  --test KIND            biaxial (default); single: the single-element test of the paper, Sec 3.3, one\n"
-            "                         Q4 element, 4 Gauss points, compared with the RVE alone under the same\n"
-            "                         drained path (writes single_element.csv and .svg; one --packing)\n"
-            "  --predictor KIND       first iterate of a load step: tangent (default; K(D_n) u = f_ext -\n"
-            "                         f_int with the platen's increment) or extrapolate (the last converged\n"
-            "                         increment scaled to this one, as ABAQUS does by default; a shear band,\n"
-            "                         once formed, is carried into the next step)\n"
-            "  --width, --height M    specimen size [m] (0.05 x 0.1)\n"
-            "  --pressure P           confining pressure [Pa] (1e5)\n"
-            "  --fields-at A,B        also write fabric_field_NNNN.svg at these axial strains [%%] (Guo & Zhao\n"
-            "                         2014 Fig 18: 4,4.8); gp_history.csv, failed_fraction.svg and\n"
-            "                         fabric_field.svg (final) are always written\n"
-            "  --cost-log FILE        write every RVE run's cost to FILE, a line per run of the Gauss points:\n"
-            "                         the load step being solved (1, 2, ...), the increment's scale (1, or\n"
-            "                         less after a cut-back), then each Gauss point's DEM steps (the work\n"
-            "                         of gk_twoscale_points); consecutive lines of one step and scale are\n"
-            "                         its Newton iterations (read by bench_twoscale --model --cost-log)\n"
-            "  (defaults: --nx 8 --ny 16 --vtk-every 1 --packing examples/data/rve400.txt)\n");
+    fprintf(
+        fp,
+        "usage: femdem_biaxial [--nx 8] [--ny 16] [--element q8|q4] [--steps 100] [--threads 2] [--out DIR]\n"
+        "                      [--tangent taylor|yade|relaxed|perturbation] [--restart DIR]\n"
+        "                      [--test biaxial|single]\n"
+        "       (the cyclic simple-shear tests: build/femdem_cyclic; diagnostics: build/femdem_probe)\n\n"
+        "  --steps N              load steps (default 100: 10 %% axial strain at 0.1 %% per step)\n"
+        "  --test KIND            biaxial (default); single: the single-element test of the paper, Sec 3.3, "
+        "one\n"
+        "                         Q4 element, 4 Gauss points, compared with the RVE alone under the same\n"
+        "                         drained path (writes single_element.csv and .svg; one --packing)\n"
+        "  --predictor KIND       first iterate of a load step: tangent (default; K(D_n) u = f_ext -\n"
+        "                         f_int with the platen's increment) or extrapolate (the last converged\n"
+        "                         increment scaled to this one, as ABAQUS does by default; a shear band,\n"
+        "                         once formed, is carried into the next step)\n"
+        "  --width, --height M    specimen size [m] (0.05 x 0.1)\n"
+        "  --pressure P           confining pressure [Pa] (1e5)\n"
+        "  --fields-at A,B        also write fabric_field_NNNN.svg at these axial strains [%%] (Guo & Zhao\n"
+        "                         2014 Fig 18: 4,4.8); gp_history.csv, failed_fraction.svg and\n"
+        "                         fabric_field.svg (final) are always written\n"
+        "  --cost-log FILE        write every RVE run's cost to FILE, a line per run of the Gauss points:\n"
+        "                         the load step being solved (1, 2, ...), the increment's scale (1, or\n"
+        "                         less after a cut-back), then each Gauss point's DEM steps (the work\n"
+        "                         of gk_twoscale_points); consecutive lines of one step and scale are\n"
+        "                         its Newton iterations (read by bench_twoscale --model --cost-log)\n"
+        "  (defaults: --nx 8 --ny 16 --vtk-every 1 --packing examples/data/rve400.txt)\n");
     fd_usage_common(fp);
-    fprintf(fp, "\nbiaxial.csv ends with dem_steps_mean,dem_steps_max (per Gauss point, accepted iterate),\n"
-                "dem_steps (all DEM steps of the step: every iteration, perturbed run and cut-back attempt),\n"
-                "tangents_reused,tangents_computed; the RESULT line has their totals\n");
+    fprintf(fp,
+            "\nbiaxial.csv ends with dem_steps_mean,dem_steps_max (per Gauss point, accepted iterate),\n"
+            "dem_steps (all DEM steps of the step: every iteration, perturbed run and cut-back attempt),\n"
+            "tangents_reused,tangents_computed; the RESULT line has their totals\n");
 }
 
 /* ------------------------------------------------- single-element test */
@@ -165,20 +168,23 @@ static void usage(FILE *fp) {
  * SINGLE_MAX_IT runs (*hb: the first leg of the two), -1 when a run failed. *runs counts the runs. */
 static int hold_lateral(gk_twoscale *ts, double a, double p, double *h, int *runs, double *hb, double *sig,
                         gk_err *err) {
-    double H[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, D[16], g, hp = 0.0, gp = 0.0, best = HUGE_VAL, bestpos = HUGE_VAL;
+    double H[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, D[16], g, hp = 0.0, gp = 0.0, best = HUGE_VAL,
+           bestpos = HUGE_VAL;
     int it;
     H[4] = -a;
-    if (gk_twoscale_accepted(ts, NULL, D)) return gk_err_set(err, GK_ERR_STATE, "%s", gk_twoscale_error(ts)), -1;
+    if (gk_twoscale_accepted(ts, NULL, D))
+        return gk_err_set(err, GK_ERR_STATE, "%s", gk_twoscale_error(ts)), -1;
     if (!(D[0] > 0))
         return gk_err_set(err, GK_ERR_STATE, "RVE alone: no lateral stiffness (D_xxxx %g)", D[0]), -1;
     for (it = 1;; ++it) {
         double slope = D[0];
         H[0] = *h;
         ++*runs;
-        if (gk_twoscale_run(ts, H, NULL, sig, NULL)) return gk_err_set(err, GK_ERR_STATE, "%s", gk_twoscale_error(ts)), -1;
+        if (gk_twoscale_run(ts, H, NULL, sig, NULL))
+            return gk_err_set(err, GK_ERR_STATE, "%s", gk_twoscale_error(ts)), -1;
         g = sig[0] + p;
         if (fabs(g) <= 1e-3 * (p > 0 ? p : fabs(sig[4]))) return 1;
-        if (g > 0 && g < bestpos) bestpos = g, *hb = *h;             /* slipped past -p */
+        if (g > 0 && g < bestpos) bestpos = g, *hb = *h;                     /* slipped past -p */
         if (bestpos == HUGE_VAL && fabs(g) < best) best = fabs(g), *hb = *h; /* else the closest */
         if (it == SINGLE_MAX_IT) return 0;
         if (it > 1 && *h != hp) { /* secant, while it is a stiffness of the expected sign */
@@ -190,8 +196,8 @@ static int hold_lateral(gk_twoscale *ts, double a, double p, double *h, int *run
     }
 }
 
-static int single_rve_reference(const fd_model *M, double *eps, double *syy, double *sxx, double *ev, int *nit,
-                                int n, gk_err *err) {
+static int single_rve_reference(const fd_model *M, double *eps, double *syy, double *sxx, double *ev,
+                                int *nit, int n, gk_err *err) {
     const fd_opts *o = &M->o;
     gk_packing pk;
     gk_twoscale ts;
@@ -231,7 +237,8 @@ static int single_rve_reference(const fd_model *M, double *eps, double *syy, dou
                 if ((r = hold_lateral(&ts, 0.0, p, &h2, &nit[k], &hb, sig, err)) < 0) goto out;
                 if (r == 0) {
                     gk_err_set(err, GK_ERR_STATE,
-                               "RVE alone: sigma_xx not held at %g Pa within 2 x %d runs at step %d (sigma_xx = %g Pa)",
+                               "RVE alone: sigma_xx not held at %g Pa within 2 x %d runs at step %d "
+                               "(sigma_xx = %g Pa)",
                                p, SINGLE_MAX_IT, k, -sig[0]);
                     goto out;
                 }
@@ -254,9 +261,12 @@ out:
 /* --test single: the reference, single_element.csv and .svg, the SINGLE line; 0 or 1 */
 static int single_element(fd_model *M) {
     int n = M->ncurve, k, kpk = 0, bad = 0;
-    double *e = (double *)malloc((size_t)n * sizeof(double)), *s = (double *)malloc((size_t)n * sizeof(double)),
-           *v = (double *)malloc((size_t)n * sizeof(double)), *x = (double *)malloc((size_t)n * sizeof(double)),
-           *y = (double *)malloc((size_t)n * sizeof(double)), *yr = (double *)malloc((size_t)n * sizeof(double)),
+    double *e = (double *)malloc((size_t)n * sizeof(double)),
+           *s = (double *)malloc((size_t)n * sizeof(double)),
+           *v = (double *)malloc((size_t)n * sizeof(double)),
+           *x = (double *)malloc((size_t)n * sizeof(double)),
+           *y = (double *)malloc((size_t)n * sizeof(double)),
+           *yr = (double *)malloc((size_t)n * sizeof(double)),
            *sx = (double *)malloc((size_t)n * sizeof(double)), maxdiff = 0;
     int *ni = (int *)malloc((size_t)n * sizeof(int)), ok = e && s && v && x && y && yr && sx && ni;
     char path[1200];
@@ -274,10 +284,11 @@ static int single_element(fd_model *M) {
             fp = fopen(path, "w");
             bad = !fp;
             if (fp) {
-                fprintf(fp, "eps_axial,sigma_yy_fem,sigma_yy_rve,sigma_xx_fem,sigma_xx_rve,eps_v_fem,eps_v_rve,rve_runs\n");
+                fprintf(fp, "eps_axial,sigma_yy_fem,sigma_yy_rve,sigma_xx_fem,sigma_xx_rve,eps_v_fem,eps_v_"
+                            "rve,rve_runs\n");
                 for (k = 0; k < n; ++k)
-                    fprintf(fp, "%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", M->curve[k].eps, M->curve[k].syy, s[k],
-                            M->curve[k].sxx, sx[k], M->curve[k].ev, v[k], ni[k]);
+                    fprintf(fp, "%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", M->curve[k].eps, M->curve[k].syy,
+                            s[k], M->curve[k].sxx, sx[k], M->curve[k].ev, v[k], ni[k]);
                 bad = ferror(fp) != 0;
                 bad |= fclose(fp) != 0;
             }
@@ -289,15 +300,18 @@ static int single_element(fd_model *M) {
             if (d > maxdiff) maxdiff = d;
         }
         for (k = 0; k < n; ++k) x[k] = 100 * e[k], y[k] = M->curve[k].syy / 1e3, yr[k] = s[k] / 1e3;
-        gk_plot_init(&pl, "Single-element test vs the RVE alone (Guo & Zhao 2014 Fig 6)", "axial strain [%]", "sigma_yy [kPa]");
+        gk_plot_init(&pl, "Single-element test vs the RVE alone (Guo & Zhao 2014 Fig 6)", "axial strain [%]",
+                     "sigma_yy [kPa]");
         gk_plot_add(&pl, x, y, n, "FEM, 1 Q4 element, 4 RVEs");
         gk_plot_add(&pl, x, yr, n, "RVE alone, sigma_xx held by a secant iteration on the lateral strain");
         bad = bad || fd_plot(M, &pl, "single_element.svg");
         if (!bad && M->root) {
-            printf("single element vs RVE alone: max relative difference of sigma_yy/sigma_xx up to the peak (%.2f %%) "
+            printf("single element vs RVE alone: max relative difference of sigma_yy/sigma_xx up to the peak "
+                   "(%.2f %%) "
                    "= %.4f\n",
                    100 * M->curve[kpk].eps, maxdiff);
-            printf("SINGLE max_rel_diff_to_peak=%.5f peak_fem=%.6g peak_rve=%.6g\n", maxdiff, M->curve[kpk].syy, s[kpk]);
+            printf("SINGLE max_rel_diff_to_peak=%.5f peak_fem=%.6g peak_rve=%.6g\n", maxdiff,
+                   M->curve[kpk].syy, s[kpk]);
         }
     }
     free(e), free(s), free(v), free(x), free(y), free(yr), free(sx), free(ni);

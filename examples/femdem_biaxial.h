@@ -84,16 +84,17 @@ static int fdb_check(fd_model *M) {
 static void fdb_csv_row(FILE *fp, const fd_model *M, int k, const void *user) {
     const fd_row *c = &M->curve[k];
     (void)user;
-    fprintf(fp, "%d,%.9g,%.9g,%.9g,%.9g,%d,%.4f,%.4g,%.4g,%.6g,%d,", k, c->eps, c->syy, c->sxx, c->ev, c->iters, c->secs,
-            c->Ed, c->Ef, c->inc, c->failed);
+    fprintf(fp, "%d,%.9g,%.9g,%.9g,%.9g,%d,%.4f,%.4g,%.4g,%.6g,%d,", k, c->eps, c->syy, c->sxx, c->ev,
+            c->iters, c->secs, c->Ed, c->Ef, c->inc, c->failed);
     fd_csv_work(fp, c);
 }
 
 static int fdb_write_csv(const fd_model *M) {
-    return fd_write_csv(M, "biaxial.csv",
-                        "step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds,E_d,E_f,increment,failed_gp," FD_WORK_COLS
-                        "\n",
-                        fdb_csv_row, NULL);
+    return fd_write_csv(
+        M, "biaxial.csv",
+        "step,eps_axial,sigma_yy,sigma_xx,eps_v,iterations,seconds,E_d,E_f,increment,failed_gp," FD_WORK_COLS
+        "\n",
+        fdb_csv_row, NULL);
 }
 
 static int fdb_checkpoint(fd_model *M) {
@@ -133,10 +134,11 @@ static int fdb_restart(fd_model *M, gk_err *err) {
         fd_get(&B, hist, (size_t)ck.nc * nh * sizeof(double));
         if (!(fabs(inclast) <= 1.0) || (inclast != 0.0 && !(fabs(inclast) >= 1e-12)) ||
             !fd_ck_bounded(ulast, n, 10 * L) || !fd_ck_bounded(hist, (size_t)ck.nc * nh, 1e100))
-            bad = 1, gk_err_set(err, GK_ERR_FORMAT,
-                                "%s/checkpoint.bin: the last increment, its displacements or a row's fields are out "
-                                "of range",
-                                M->o.restart);
+            bad = 1,
+            gk_err_set(err, GK_ERR_FORMAT,
+                       "%s/checkpoint.bin: the last increment, its displacements or a row's fields are out "
+                       "of range",
+                       M->o.restart);
     }
     free(B.b);
     if (!bad && fd_ck_apply(M, &ck, err)) bad = 1;
@@ -148,8 +150,8 @@ static int fdb_restart(fd_model *M, gk_err *err) {
     memcpy(M->ulast, ulast, n * sizeof(double));
     free(ulast), free(M->hist);
     M->hist = hist;
-    fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n", M->prog, M->o.restart,
-           M->step, 100 * M->eps_done);
+    fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n", M->prog,
+           M->o.restart, M->step, 100 * M->eps_done);
     return 0;
 }
 
@@ -188,7 +190,8 @@ static int fdb_cmp_d(const void *a, const void *b) {
 static void fdb_band(fd_model *M, double *angle, double *width, int *mid) {
     double *all = fd_gp_fields(M), *v = (double *)malloc((size_t)M->ngp * sizeof(double)),
            *s = (double *)malloc((size_t)M->ngp * sizeof(double));
-    double med, mx, thr, sw = 0, cx = 0, cy = 0, sxx = 0, syy = 0, sxy = 0, th, nx, ny, var = 0, dmin = HUGE_VAL;
+    double med, mx, thr, sw = 0, cx = 0, cy = 0, sxx = 0, syy = 0, sxy = 0, th, nx, ny, var = 0,
+                         dmin = HUGE_VAL;
     int g;
     *angle = *width = NAN, *mid = -1;
     if (!all || !v || !s) goto out;
@@ -208,7 +211,8 @@ static void fdb_band(fd_model *M, double *angle, double *width, int *mid) {
         double x[3], w = v[g] - thr;
         if (w <= 0) continue;
         gk_mesh_point(&M->mesh, g / M->q.n, M->q.xi[g % M->q.n], x);
-        sxx += w * (x[0] - cx) * (x[0] - cx), syy += w * (x[1] - cy) * (x[1] - cy), sxy += w * (x[0] - cx) * (x[1] - cy);
+        sxx += w * (x[0] - cx) * (x[0] - cx), syy += w * (x[1] - cy) * (x[1] - cy),
+            sxy += w * (x[0] - cx) * (x[1] - cy);
     }
     th = 0.5 * atan2(2 * sxy, sxx - syy); /* major axis */
     nx = -sin(th), ny = cos(th);
@@ -302,9 +306,11 @@ static int fdb_loop(fd_model *M, double t_start, gk_err *err) {
         if (o->vtk_every && M->step % o->vtk_every == 0 && fd_write_vtk(M, M->step)) return 1;
         if (o->checkpoint && M->step % o->checkpoint == 0 && fdb_checkpoint(M)) return 1;
         snprintf(what, sizeof what,
-                 "eps %.2f %%  sigma_yy %.1f kPa  sigma_xx %.1f kPa  eps_v %.3f %%  %d iter  DEM steps/RVE %.0f (max %d)  "
+                 "eps %.2f %%  sigma_yy %.1f kPa  sigma_xx %.1f kPa  eps_v %.3f %%  %d iter  DEM steps/RVE "
+                 "%.0f (max %d)  "
                  "%.2f s",
-                 100 * M->eps_done, syy / 1e3, sxx / 1e3, 100 * ev, iters, c->dem_mean, c->dem_max, gk_wtime() - t0);
+                 100 * M->eps_done, syy / 1e3, sxx / 1e3, 100 * ev, iters, c->dem_mean, c->dem_max,
+                 gk_wtime() - t0);
         if (M->root) gk_progress(stderr, (long)floor(M->eps_done / o->inc + 0.5), o->steps, t_start, what);
     }
     return 0;
@@ -431,7 +437,8 @@ static int fdb_finish(fd_model *M, int status) {
     for (k = 0; k < M->ncurve && !bad; ++k)
         x[k] = 100 * M->curve[k].eps, y1[k] = M->curve[k].syy / 1e3, y2[k] = M->curve[k].sxx / 1e3;
     if (!bad) {
-        gk_plot_init(&pl, "FEMxDEM biaxial test (Guo & Zhao 2014)", "axial strain [%]", "stress [kPa] (compression positive)");
+        gk_plot_init(&pl, "FEMxDEM biaxial test (Guo & Zhao 2014)", "axial strain [%]",
+                     "stress [kPa] (compression positive)");
         gk_plot_add(&pl, x, y1, M->ncurve, "sigma_yy (top reaction / width)");
         gk_plot_add(&pl, x, y2, M->ncurve, "sigma_xx (side reaction / height)");
         bad = fd_plot(M, &pl, "biaxial_stress.svg");
@@ -456,24 +463,29 @@ static int fdb_finish(fd_model *M, int status) {
         if (k > 0) itsum += M->curve[k].iters, tot += M->curve[k].secs;
     }
     if (!M->root) return status;
-    printf("wrote %s/biaxial.csv, %s/gp_*.vtk and mesh_*.vtk (ParaView), %s/biaxial_stress.svg, biaxial_volume.svg, "
+    printf("wrote %s/biaxial.csv, %s/gp_*.vtk and mesh_*.vtk (ParaView), %s/biaxial_stress.svg, "
+           "biaxial_volume.svg, "
            "eps_q_field.svg, checkpoint.bin\n",
            o->out, o->out, o->out);
     if (ang == ang)
         printf("shear band: angle %.1f deg from the horizontal, width %.1f mm\n", ang, 1e3 * wid);
     else
         printf("shear band: none (max eps_q < 1.5 x median)\n");
-    printf("RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g band_angle_deg=%.3g band_width_mm=%.3g max_iterations=%d "
-           "steps=%d seconds_per_step=%.3f total_seconds=%.2f mean_iterations=%.2f",
-           peak, epk, ang, 1e3 * wid, itmax, M->ncurve - 1, M->ncurve > 1 ? tot / (M->ncurve - 1) : 0.0, tot,
-           M->ncurve > 1 ? (double)itsum / (M->ncurve - 1) : 0.0);
+    printf(
+        "RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g band_angle_deg=%.3g band_width_mm=%.3g max_iterations=%d "
+        "steps=%d seconds_per_step=%.3f total_seconds=%.2f mean_iterations=%.2f",
+        peak, epk, ang, 1e3 * wid, itmax, M->ncurve - 1, M->ncurve > 1 ? tot / (M->ncurve - 1) : 0.0, tot,
+        M->ncurve > 1 ? (double)itsum / (M->ncurve - 1) : 0.0);
     fd_print_work_totals(M);
 #ifdef GK_TWOSCALE_MPI
-    printf("MPI ranks=%d rve_runs=%lld rank0_bytes_in_per_run=%.0f rank0_bytes_out_per_run=%.0f point_moves=%lld "
+    printf("MPI ranks=%d rve_runs=%lld rank0_bytes_in_per_run=%.0f rank0_bytes_out_per_run=%.0f "
+           "point_moves=%lld "
            "bytes_moved=%lld rank0_bytes_in_all=%lld balance=%s\n",
-           M->ts.nranks, M->ts.stats.runs, (double)M->ts.stats.run_bytes_in / (M->ts.stats.runs ? M->ts.stats.runs : 1),
-           (double)M->ts.stats.run_bytes_out / (M->ts.stats.runs ? M->ts.stats.runs : 1), M->ts.stats.migrated,
-           M->ts.stats.migrated_bytes, M->ts.stats.bytes_in, o->balance_run ? "run" : "accept");
+           M->ts.nranks, M->ts.stats.runs,
+           (double)M->ts.stats.run_bytes_in / (M->ts.stats.runs ? M->ts.stats.runs : 1),
+           (double)M->ts.stats.run_bytes_out / (M->ts.stats.runs ? M->ts.stats.runs : 1),
+           M->ts.stats.migrated, M->ts.stats.migrated_bytes, M->ts.stats.bytes_in,
+           o->balance_run ? "run" : "accept");
 #endif
     return status;
 }
@@ -489,9 +501,9 @@ static int fdb_run(fd_model *M) {
         return fd_say(M, "%s: %s\n", M->prog, err.msg), 1;
     if (!M->o.restart && fdb_record(M)) return 1;
     if (M->root) {
-        printf("%s: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n", M->prog,
-               M->o.test, M->o.nx, M->o.ny, M->o.elem == GK_Q8 ? "Q8" : "Q4", M->ngp, M->ts.pk[0].n, M->o.tangent,
-               M->o.threads);
+        printf("%s: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n",
+               M->prog, M->o.test, M->o.nx, M->o.ny, M->o.elem == GK_Q8 ? "Q8" : "Q4", M->ngp, M->ts.pk[0].n,
+               M->o.tangent, M->o.threads);
         if (M->o.extrapolate) printf("%s: predictor: the last converged increment, scaled\n", M->prog);
         fflush(stdout);
     }

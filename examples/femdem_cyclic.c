@@ -70,29 +70,31 @@ typedef struct cyc_model {
 } cyc_model;
 
 static void usage(FILE *fp) {
-    fprintf(fp,
-            "usage: femdem_cyclic --test cyclic-strain|cyclic-stress [--amplitude 0.01 | --tau-amplitude 3e4]\n"
-            "                     [--cycles 20] [--nx 2 --ny 2] [--threads 2] [--out DIR]\n\n"
-            "cyclic simple shear: 100 x 50 mm, bottom fixed, rough top platen moved horizontally with its\n"
-            "vertical displacement held, left/right sides periodic. Defaults: --nx 2 --ny 2 (Q8, 16 RVEs; the\n"
-            "paper's mesh is --nx 15 --ny 10, 600 RVEs), --width 0.1 --height 0.05, --increment 0.001 (shear\n"
-            "strain per step), --vtk-every 0 (VTK of the final state only), --packing\n"
-            "examples/data/rve400_e0223.txt (cyclic-strain) or rve400_e0209.txt (cyclic-stress), the paper's\n"
-            "void ratios.\n"
-            "  --test KIND            cyclic-strain (default) or cyclic-stress\n"
-            "  --amplitude A          cyclic-strain: shear strain amplitude gamma_A (default 0.01 = 1 %%)\n"
-            "  --tau-amplitude T      cyclic-stress: shear stress amplitude [Pa] (default 3e4)\n"
-            "  --stress-steps N       cyclic-stress: about N steps per quarter cycle (default 6); the\n"
-            "                         strain increment is then at most --increment and at least 1/64 of it\n"
-            "  --cycles N             stop after N cycles (default 20)\n"
-            "  --liq-ratio R          liquefaction when p' < R x p'_0 (default 0.1); cyclic-strain stops there\n"
-            "  --gamma-limit G        cyclic-stress: stop when |gamma| >= G (default 0.05, the paper's 5 %%)\n"
-            "  --paper-mesh           Guo & Zhao 2014's mesh: 15 x 10 Q4 elements, 2 x 2 Gauss points (600 RVEs;\n"
-            "                         its cost: examples/README.md, cyclic simple shear)\n"
-            "  --pressure P           initial isotropic stress [Pa]: when it differs from the packing's own by\n"
-            "                         more than 0.5 %% the RVE is first re-consolidated to P with its contact\n"
-            "                         friction (default: the packing as it is, 100 kPa for the shipped ones)\n"
-            "  --width, --height M    specimen size [m]\n");
+    fprintf(
+        fp,
+        "usage: femdem_cyclic --test cyclic-strain|cyclic-stress [--amplitude 0.01 | --tau-amplitude 3e4]\n"
+        "                     [--cycles 20] [--nx 2 --ny 2] [--threads 2] [--out DIR]\n\n"
+        "cyclic simple shear: 100 x 50 mm, bottom fixed, rough top platen moved horizontally with its\n"
+        "vertical displacement held, left/right sides periodic. Defaults: --nx 2 --ny 2 (Q8, 16 RVEs; the\n"
+        "paper's mesh is --nx 15 --ny 10, 600 RVEs), --width 0.1 --height 0.05, --increment 0.001 (shear\n"
+        "strain per step), --vtk-every 0 (VTK of the final state only), --packing\n"
+        "examples/data/rve400_e0223.txt (cyclic-strain) or rve400_e0209.txt (cyclic-stress), the paper's\n"
+        "void ratios.\n"
+        "  --test KIND            cyclic-strain (default) or cyclic-stress\n"
+        "  --amplitude A          cyclic-strain: shear strain amplitude gamma_A (default 0.01 = 1 %%)\n"
+        "  --tau-amplitude T      cyclic-stress: shear stress amplitude [Pa] (default 3e4)\n"
+        "  --stress-steps N       cyclic-stress: about N steps per quarter cycle (default 6); the\n"
+        "                         strain increment is then at most --increment and at least 1/64 of it\n"
+        "  --cycles N             stop after N cycles (default 20)\n"
+        "  --liq-ratio R          liquefaction when p' < R x p'_0 (default 0.1); cyclic-strain stops there\n"
+        "  --gamma-limit G        cyclic-stress: stop when |gamma| >= G (default 0.05, the paper's 5 %%)\n"
+        "  --paper-mesh           Guo & Zhao 2014's mesh: 15 x 10 Q4 elements, 2 x 2 Gauss points (600 "
+        "RVEs;\n"
+        "                         its cost: examples/README.md, cyclic simple shear)\n"
+        "  --pressure P           initial isotropic stress [Pa]: when it differs from the packing's own by\n"
+        "                         more than 0.5 %% the RVE is first re-consolidated to P with its contact\n"
+        "                         friction (default: the packing as it is, 100 kPa for the shipped ones)\n"
+        "  --width, --height M    specimen size [m]\n");
     fd_usage_common(fp);
 }
 
@@ -121,7 +123,8 @@ static int cyclic_state(cyc_model *C, fd_row *c, cyc_extra *x) {
             int id = e * M->q.n + g;
             gk_fem_jacobian(&M->mesh, e, M->q.xi[g], NULL, dN, &dJ, NULL);
             w = M->q.w[g] * dJ;
-            sa[0] += w * M->sig_n[9 * id], sa[1] += w * M->sig_n[9 * id + 4], sa[2] += w * M->sig_n[9 * id + 1];
+            sa[0] += w * M->sig_n[9 * id], sa[1] += w * M->sig_n[9 * id + 4],
+                sa[2] += w * M->sig_n[9 * id + 1];
             ev += w * (1.0 - f[id].volume / M->v0[id]);
             area += w;
         }
@@ -151,16 +154,18 @@ static double cycles_at(const cyc_model *C, double gamma, double tau) {
 static void csv_row(FILE *fp, const fd_model *M, int k, const void *user) {
     const fd_row *c = &M->curve[k];
     const cyc_extra *x = &((const cyc_extra *)user)[k];
-    fprintf(fp, "%d,%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.3g,%d,%.4f,%.4g,%.4g,%.6g,%d,", k, x->cycle, c->eps, x->tau,
-            c->syy, c->sxx, x->p, x->q, c->ev, x->top_uy, c->iters, c->secs, c->Ed, c->Ef, c->inc, c->failed);
+    fprintf(fp, "%d,%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.3g,%d,%.4f,%.4g,%.4g,%.6g,%d,", k, x->cycle,
+            c->eps, x->tau, c->syy, c->sxx, x->p, x->q, c->ev, x->top_uy, c->iters, c->secs, c->Ed, c->Ef,
+            c->inc, c->failed);
     fd_csv_work(fp, c);
 }
 
 static int write_csv(const cyc_model *C) {
-    return fd_write_csv(&C->m, "cyclic.csv",
-                        "step,cycle,gamma,tau,sigma_yy,sigma_xx,p,q,eps_v_rve,top_uy,iterations,seconds,E_d,E_f,"
-                        "increment,failed_gp," FD_WORK_COLS "\n",
-                        csv_row, C->cx);
+    return fd_write_csv(
+        &C->m, "cyclic.csv",
+        "step,cycle,gamma,tau,sigma_yy,sigma_xx,p,q,eps_v_rve,top_uy,iterations,seconds,E_d,E_f,"
+        "increment,failed_gp," FD_WORK_COLS "\n",
+        csv_row, C->cx);
 }
 
 /* room for the rows of curve in cx */
@@ -213,7 +218,9 @@ static int restart(cyc_model *C, gk_err *err) {
             e[0] = cx[k].cycle, e[1] = cx[k].tau, e[2] = cx[k].p, e[3] = cx[k].q, e[4] = cx[k].top_uy;
             bad = !fd_ck_bounded(e, 5, 1e100);
         }
-        if (bad) gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the cyclic state is out of range", M->o.restart);
+        if (bad)
+            gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the cyclic state is out of range",
+                       M->o.restart);
     }
     free(B.b);
     if (!bad && fd_ck_apply(M, &ck, err)) bad = 1;
@@ -221,8 +228,8 @@ static int restart(cyc_model *C, gk_err *err) {
     if (!bad) C->cs = cs, memcpy(C->cx, cx, (size_t)ck.nc * sizeof *cx);
     fd_ck_free(&ck), free(cx);
     if (!bad)
-        fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (shear strain %.3f %%, %.2f cycles)\n", M->prog,
-               M->o.restart, M->step, 100 * C->cs.gamma, C->cx[M->ncurve - 1].cycle);
+        fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (shear strain %.3f %%, %.2f cycles)\n",
+               M->prog, M->o.restart, M->step, 100 * C->cs.gamma, C->cx[M->ncurve - 1].cycle);
     return bad;
 }
 
@@ -256,7 +263,8 @@ static int after_step(cyc_model *C, double inc, int iters, double Ed, double Ef,
     if (fd_row_room(M) || cx_room(C)) return fd_say(M, "%s: out of memory\n", M->prog), 1;
     row = &M->curve[M->ncurve], x = &C->cx[M->ncurve++];
     if (cyclic_state(C, row, x)) return fd_say(M, "%s: %s\n", M->prog, gk_twoscale_error(&M->ts)), 1;
-    row->iters = iters, row->secs = gk_wtime() - t0, row->Ed = Ed, row->Ef = Ef, row->inc = inc, row->failed = nf;
+    row->iters = iters, row->secs = gk_wtime() - t0, row->Ed = Ed, row->Ef = Ef, row->inc = inc,
+    row->failed = nf;
     fd_row_work(M, row);
     x->cycle = cyc = cycles_at(C, c->gamma, x->tau);
     ++c->bsteps;
@@ -267,9 +275,11 @@ static int after_step(cyc_model *C, double inc, int iters, double Ed, double Ef,
         c->h = stress_increment(C, G, c->h);
     }
     c->tau = x->tau;
-    if (C->test == 0 ? fabs(c->gamma - c->dir * C->amp) <= 1e-9 * C->amp : c->dir * x->tau >= 0.98 * C->tau_amp) {
+    if (C->test == 0 ? fabs(c->gamma - c->dir * C->amp) <= 1e-9 * C->amp
+                     : c->dir * x->tau >= 0.98 * C->tau_amp) {
         if (C->test == 0) c->gamma = c->dir * C->amp; /* no drift of the turning points */
-        c->dir = -c->dir, ++c->branch, c->bsteps = 0, c->g_start = c->gamma, c->t_start = x->tau, reversed = 1;
+        c->dir = -c->dir, ++c->branch, c->bsteps = 0, c->g_start = c->gamma, c->t_start = x->tau,
+        reversed = 1;
         if (C->test == 1) /* unloading: as stiff as the last unloading (the first time: the first step) */
             c->h = stress_increment(C, c->Gu > 0.0 ? c->Gu : c->G0, o->inc);
     }
@@ -280,10 +290,11 @@ static int after_step(cyc_model *C, double inc, int iters, double Ed, double Ef,
     if (o->vtk_every && M->step % o->vtk_every == 0 && fd_write_vtk(M, M->step)) return 1;
     if (o->checkpoint && M->step % o->checkpoint == 0 && checkpoint(M)) return 1;
     fd_say(M,
-           "step %d  cycle %.2f  gamma %.3f %%  tau %.2f kPa  sigma_yy %.2f kPa  p %.2f kPa  %d iter  DEM steps/RVE %.0f "
+           "step %d  cycle %.2f  gamma %.3f %%  tau %.2f kPa  sigma_yy %.2f kPa  p %.2f kPa  %d iter  DEM "
+           "steps/RVE %.0f "
            "(max %d)  %.2f s%s | %.1f s elapsed\n",
-           M->step, cyc, 100 * c->gamma, x->tau / 1e3, row->syy / 1e3, x->p / 1e3, iters, row->dem_mean, row->dem_max,
-           row->secs, reversed ? "  (reversal)" : "", gk_wtime() - t_start);
+           M->step, cyc, 100 * c->gamma, x->tau / 1e3, row->syy / 1e3, x->p / 1e3, iters, row->dem_mean,
+           row->dem_max, row->secs, reversed ? "  (reversal)" : "", gk_wtime() - t_start);
     if (C->test == 0 && c->cyc_liq >= 0) {
         fd_say(M, "%s: liquefied (p < %.3g x p0) after %.2f cycles\n", M->prog, C->liq_ratio, cyc);
         return 4;
@@ -314,7 +325,8 @@ static int run_cyclic(cyc_model *C, double t_start, gk_err *err) {
         if ((r = fd_load_step(M, inc, &iters, &Ed, &Ef, err)) == 2) return 1;
         if (r == 1) {
             forced = 0.0, tries = 0, c->good = 0;
-            if (fd_cut_back(M, "shear strain", c->gamma, C->test == 0 ? o->inc : c->h, iters, Ed, err)) return 3;
+            if (fd_cut_back(M, "shear strain", c->gamma, C->test == 0 ? o->inc : c->h, iters, Ed, err))
+                return 3;
             continue;
         }
         if (C->test == 1) { /* overshoot of the amplitude: repeat with the secant increment */
@@ -323,7 +335,8 @@ static int run_cyclic(cyc_model *C, double t_start, gk_err *err) {
                 double ratio = (goal - c->tau) / (tt - c->tau);
                 if (!(ratio > 0.05 && ratio < 1.0)) ratio = 0.5;
                 if (o->verbose)
-                    fd_say(M, "    tau %.2f kPa overshoots %.2f kPa: step repeated with %.3g x the increment\n",
+                    fd_say(M,
+                           "    tau %.2f kPa overshoots %.2f kPa: step repeated with %.3g x the increment\n",
                            tt / 1e3, goal / 1e3, ratio);
                 forced = inc * ratio, ++tries;
                 gk_twoscale_reject(&M->ts);
@@ -344,7 +357,8 @@ static int cyclic_summary(cyc_model *C, int status) {
     const cyc_state *c = &C->cs;
     const fd_row *last = &M->curve[M->ncurve - 1];
     const cyc_extra *xl = &C->cx[M->ncurve - 1];
-    double emin = HUGE_VAL, emax = -HUGE_VAL, tot = 0, evmax = 0, uymax = 0, pmin = HUGE_VAL, *all = fd_gp_fields(M);
+    double emin = HUGE_VAL, emax = -HUGE_VAL, tot = 0, evmax = 0, uymax = 0, pmin = HUGE_VAL,
+           *all = fd_gp_fields(M);
     int g, k, itmax = 0, itsum = 0, n = M->ncurve - 1, bad = !all;
     char title[200];
     for (g = 0; g < M->ngp && !bad; ++g) {
@@ -366,16 +380,19 @@ static int cyclic_summary(cyc_model *C, int status) {
         double *v = (double *)malloc((size_t)M->ncurve * 6 * sizeof(double)), *gm, *t, *sy, *p, *q, *cy;
         gk_plot pl;
         if (!v) return fd_say(M, "%s: out of memory\n", M->prog), 1;
-        gm = v, t = v + M->ncurve, sy = t + M->ncurve, p = sy + M->ncurve, q = p + M->ncurve, cy = q + M->ncurve;
+        gm = v, t = v + M->ncurve, sy = t + M->ncurve, p = sy + M->ncurve, q = p + M->ncurve,
+        cy = q + M->ncurve;
         for (k = 0; k < M->ncurve; ++k) {
             gm[k] = 100 * M->curve[k].eps, t[k] = C->cx[k].tau / 1e3, sy[k] = M->curve[k].syy / 1e3;
             p[k] = C->cx[k].p / 1e3, q[k] = C->cx[k].q / 1e3, cy[k] = C->cx[k].cycle;
         }
         if (C->test == 0)
-            snprintf(title, sizeof title, "Cyclic simple shear, constant volume, gamma = +-%.2g %% (Guo & Zhao 2014 Fig 20)",
+            snprintf(title, sizeof title,
+                     "Cyclic simple shear, constant volume, gamma = +-%.2g %% (Guo & Zhao 2014 Fig 20)",
                      100 * C->amp);
         else
-            snprintf(title, sizeof title, "Cyclic simple shear, constant volume, tau = +-%.3g kPa (Guo & Zhao 2014 Fig 22)",
+            snprintf(title, sizeof title,
+                     "Cyclic simple shear, constant volume, tau = +-%.3g kPa (Guo & Zhao 2014 Fig 22)",
                      C->tau_amp / 1e3);
         gk_plot_init(&pl, title, "sigma_yy or p [kPa] (compression positive)", "tau or q [kPa]");
         gk_plot_add(&pl, sy, t, M->ncurve, "tau vs sigma_yy (top platen reaction)");
@@ -401,20 +418,24 @@ static int cyclic_summary(cyc_model *C, int status) {
            "void_ratio_field.svg, gp_%04d.vtk and mesh_%04d.vtk (ParaView), checkpoint.bin\n",
            o->out, M->step, M->step);
     if (c->cyc_liq >= 0)
-        printf("liquefaction (p < %.3g x p0 = %.2f kPa) after %.2f cycles\n", C->liq_ratio, C->liq_ratio * c->p0 / 1e3,
-               c->cyc_liq);
+        printf("liquefaction (p < %.3g x p0 = %.2f kPa) after %.2f cycles\n", C->liq_ratio,
+               C->liq_ratio * c->p0 / 1e3, c->cyc_liq);
     else
         printf("no liquefaction: p from %.2f kPa to %.2f kPa (lowest %.2f kPa) in %.2f cycles\n", c->p0 / 1e3,
                xl->p / 1e3, pmin / 1e3, xl->cycle);
     if (C->test == 1)
         printf("|gamma| %s %.3g %%%s\n", c->cyc_gamma >= 0 ? "reached" : "stayed below", 100 * C->gamma_stop,
                c->cyc_gamma >= 0 ? "" : " (cycle limit)");
-    printf("local void ratio %.4f - %.4f; max |mean RVE eps_v| %.2e; max |top u_y| %.1e m\n", emin, emax, evmax, uymax);
-    printf("RESULT test=%s liquefied=%d cycles=%.3f cycles_to_liquefaction=%.3f cycles_to_gamma_limit=%.3f p0=%.6g "
-           "p_final=%.6g p_min=%.6g sigma_yy_final=%.6g tau_final=%.6g gamma_final=%.6g e_min=%.5f e_max=%.5f "
-           "max_eps_v_rve=%.3g max_iterations=%d mean_iterations=%.2f steps=%d seconds_per_step=%.3f total_seconds=%.2f",
-           o->test, c->cyc_liq >= 0, xl->cycle, c->cyc_liq, c->cyc_gamma, c->p0, xl->p, pmin, last->syy, xl->tau,
-           c->gamma, emin, emax, evmax, itmax, n > 0 ? (double)itsum / n : 0.0, n, n > 0 ? tot / n : 0.0, tot);
+    printf("local void ratio %.4f - %.4f; max |mean RVE eps_v| %.2e; max |top u_y| %.1e m\n", emin, emax,
+           evmax, uymax);
+    printf(
+        "RESULT test=%s liquefied=%d cycles=%.3f cycles_to_liquefaction=%.3f cycles_to_gamma_limit=%.3f "
+        "p0=%.6g "
+        "p_final=%.6g p_min=%.6g sigma_yy_final=%.6g tau_final=%.6g gamma_final=%.6g e_min=%.5f e_max=%.5f "
+        "max_eps_v_rve=%.3g max_iterations=%d mean_iterations=%.2f steps=%d seconds_per_step=%.3f "
+        "total_seconds=%.2f",
+        o->test, c->cyc_liq >= 0, xl->cycle, c->cyc_liq, c->cyc_gamma, c->p0, xl->p, pmin, last->syy, xl->tau,
+        c->gamma, emin, emax, evmax, itmax, n > 0 ? (double)itsum / n : 0.0, n, n > 0 ? tot / n : 0.0, tot);
     fd_print_work_totals(M);
     return status;
 }
@@ -427,7 +448,8 @@ static int first_row(cyc_model *C, gk_err *err) {
     fd_residual(M, M->sig_n, err);
     memset(&M->curve[0], 0, sizeof M->curve[0]);
     memset(&C->cx[0], 0, sizeof C->cx[0]);
-    if (cyclic_state(C, &M->curve[0], &C->cx[0])) return gk_err_set(err, GK_ERR_STATE, "%s", gk_twoscale_error(&M->ts)), 1;
+    if (cyclic_state(C, &M->curve[0], &C->cx[0]))
+        return gk_err_set(err, GK_ERR_STATE, "%s", gk_twoscale_error(&M->ts)), 1;
     M->ncurve = 1;
     c->dir = 1, c->branch = 0, c->good = 0, c->bsteps = 0, c->gamma = c->g_start = 0.0, c->G0 = c->Gu = 0.0;
     c->tau = c->t_start = C->cx[0].tau, c->p0 = C->cx[0].p, c->h = M->o.inc / 8;
@@ -443,40 +465,52 @@ static int parse(cyc_model *C, int argc, char **argv, int *help) {
     int paper = 0;
     const cli_opt own[] = {
         {"--test", CLI_CHOICE, &C->test, 0, 0, NULL, "cyclic-strain|cyclic-stress", 0},
-        {"--amplitude", CLI_REAL, &C->amp, 0, 0.5, "a shear strain in (0, 0.5)", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
-        {"--tau-amplitude", CLI_REAL, &C->tau_amp, 0, HUGE_VAL, "a positive stress", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--amplitude", CLI_REAL, &C->amp, 0, 0.5, "a shear strain in (0, 0.5)", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--tau-amplitude", CLI_REAL, &C->tau_amp, 0, HUGE_VAL, "a positive stress", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
         {"--stress-steps", CLI_INT, &C->stress_steps, 1, 1000000, NULL, NULL, 0},
         {"--cycles", CLI_REAL, &C->cycles, 0, 1e5, "a number of cycles in (0, 1e5]", NULL, CLI_LO_OPEN},
-        {"--liq-ratio", CLI_REAL, &C->liq_ratio, 0, 1, "a fraction in (0, 1)", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
-        {"--gamma-limit", CLI_REAL, &C->gamma_stop, 0, HUGE_VAL, "a positive shear strain", NULL, CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--liq-ratio", CLI_REAL, &C->liq_ratio, 0, 1, "a fraction in (0, 1)", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
+        {"--gamma-limit", CLI_REAL, &C->gamma_stop, 0, HUGE_VAL, "a positive shear strain", NULL,
+         CLI_LO_OPEN | CLI_HI_OPEN},
         {"--paper-mesh", CLI_FLAG, &paper, 0, 0, NULL, NULL, 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     const cli_opt *tables[3];
     fd_opts_default(o);
     o->nx = 2, o->ny = 2, o->width = 0.1, o->height = 0.05, o->pressure = 0.0 /* the packing's own */;
     o->vtk_every = 0, o->packing = NULL;
-    C->amp = 0.01, C->tau_amp = 3e4, C->stress_steps = 6, C->cycles = 20, C->gamma_stop = 0.05, C->liq_ratio = 0.1;
+    C->amp = 0.01, C->tau_amp = 3e4, C->stress_steps = 6, C->cycles = 20, C->gamma_stop = 0.05,
+    C->liq_ratio = 0.1;
     tables[0] = fd_common_opts(o), tables[1] = own, tables[2] = NULL;
     if (cli_parse(prog, argc, argv, tables, help) || *help) return *help ? 0 : 2;
     if (paper) { /* Guo & Zhao 2014 Sec 5: 15 x 10 elements, 600 Gauss points */
         if (o->nx != 2 || o->ny != 2 || o->elem_kind != 1 || o->quad != 2) {
-            cli_say(prog, "%s: --paper-mesh is 15 x 10 Q4 elements with 2 x 2 Gauss points: give it or --nx, --ny, "
-                          "--element, --quad\n", prog);
+            cli_say(prog,
+                    "%s: --paper-mesh is 15 x 10 Q4 elements with 2 x 2 Gauss points: give it or --nx, --ny, "
+                    "--element, --quad\n",
+                    prog);
             return 2;
         }
         o->nx = 15, o->ny = 10, o->elem_kind = 0, o->quad = 2;
     }
     o->cyclic = C->test + 1;
     o->test = C->test ? "cyclic-stress" : "cyclic-strain";
-    if (!o->packing) o->packing = C->test ? "examples/data/rve400_e0209.txt" : "examples/data/rve400_e0223.txt";
+    if (!o->packing)
+        o->packing = C->test ? "examples/data/rve400_e0209.txt" : "examples/data/rve400_e0223.txt";
     if (o->extrapolate) {
-        cli_say(prog, "%s: --predictor extrapolate is for the biaxial and single tests (a cyclic reversal would "
-                      "extrapolate the wrong way)\n", prog);
+        cli_say(prog,
+                "%s: --predictor extrapolate is for the biaxial and single tests (a cyclic reversal would "
+                "extrapolate the wrong way)\n",
+                prog);
         return 2;
     }
     if (strchr(o->packing, ',') && o->pressure > 0) {
-        cli_say(prog, "%s: --pressure re-consolidates one packing; with a list of packings give them at their own "
-                      "stress\n", prog);
+        cli_say(prog,
+                "%s: --pressure re-consolidates one packing; with a list of packings give them at their own "
+                "stress\n",
+                prog);
         return 2;
     }
     return fd_opts_finish(prog, o);
@@ -499,18 +533,21 @@ int main(int argc, char **argv) {
             ;
         else if (fd_setup(M, &err) || cx_room(&C) || (M->o.restart ? restart(&C, &err) : first_row(&C, &err)))
             fd_say(M, "%s: %s\n", M->prog, C.cx ? err.msg : "out of memory");
-        else if (!(f0 = (gk_twoscale_field *)malloc((size_t)M->ngp * sizeof *f0)) || gk_twoscale_fields(&M->ts, f0))
+        else if (!(f0 = (gk_twoscale_field *)malloc((size_t)M->ngp * sizeof *f0)) ||
+                 gk_twoscale_fields(&M->ts, f0))
             fd_say(M, "%s: %s\n", M->prog, f0 ? gk_twoscale_error(&M->ts) : "out of memory");
         else {
             if (M->root) {
-                printf("%s: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n",
-                       M->prog, M->o.test, M->o.nx, M->o.ny, M->o.elem == GK_Q8 ? "Q8" : "Q4", M->ngp, M->ts.pk[0].n,
-                       M->o.tangent, M->o.threads);
-                printf("%s: %s, void ratio %.4f, p0 = %.2f kPa, sigma_yy0 = %.2f kPa; left/right periodic: %d -> %d "
+                printf(
+                    "%s: %s test, %d x %d %s elements, %d Gauss points x %d disks, tangent %s, %d threads\n",
+                    M->prog, M->o.test, M->o.nx, M->o.ny, M->o.elem == GK_Q8 ? "Q8" : "Q4", M->ngp,
+                    M->ts.pk[0].n, M->o.tangent, M->o.threads);
+                printf("%s: %s, void ratio %.4f, p0 = %.2f kPa, sigma_yy0 = %.2f kPa; left/right periodic: "
+                       "%d -> %d "
                        "dofs; %s amplitude %.4g%s, at most %.4g cycles\n",
                        M->prog, M->o.packing, f0[0].void_ratio, C.cs.p0 / 1e3, M->curve[0].syy / 1e3, M->dm.n,
-                       M->dm.nred, C.test == 0 ? "shear strain" : "shear stress", C.test == 0 ? 100 * C.amp : C.tau_amp / 1e3,
-                       C.test == 0 ? " %" : " kPa", C.cycles);
+                       M->dm.nred, C.test == 0 ? "shear strain" : "shear stress",
+                       C.test == 0 ? 100 * C.amp : C.tau_amp / 1e3, C.test == 0 ? " %" : " kPa", C.cycles);
                 fflush(stdout);
             }
             status = run_cyclic(&C, gk_wtime(), &err);

@@ -73,12 +73,14 @@ static int run_fem(model *m) {
     if (o->restart) {
         if (load_checkpoint(m)) return 1;
     } else {
-        make_row(m, 0, 1, 0, 0, &r); /* the unloaded state (no RVE has run: P = 0, as Table 1's first increment) */
+        make_row(m, 0, 1, 0, 0,
+                 &r); /* the unloaded state (no RVE has run: P = 0, as Table 1's first increment) */
         add_row(m, &r);
     }
     for (step = m->step_done + 1; step <= nsteps; ++step) {
         int stage = step <= o->iso_steps ? 1 : 2, iters = 0, g;
-        double ps = o->pressure * (stage == 1 ? (double)step / o->iso_steps : 1.0), pt = stage == 1 ? ps : 0.0;
+        double ps = o->pressure * (stage == 1 ? (double)step / o->iso_steps : 1.0),
+               pt = stage == 1 ? ps : 0.0;
         double Hs[9 * 1];
         double *Hstart = (double *)xcalloc(9 * (size_t)m->ngp, sizeof(double));
         memcpy(Hstart, m->Hacc, 9 * (size_t)m->ngp * sizeof(double));
@@ -104,7 +106,8 @@ static int run_fem(model *m) {
         }
         for (g = 0; g < m->ngp; ++g) { /* deq: |dF| over the step */
             double s2 = 0.0;
-            for (k = 0; k < 9; ++k) s2 += (m->Hacc[9 * g + k] - Hstart[9 * g + k]) * (m->Hacc[9 * g + k] - Hstart[9 * g + k]);
+            for (k = 0; k < 9; ++k)
+                s2 += (m->Hacc[9 * g + k] - Hstart[9 * g + k]) * (m->Hacc[9 * g + k] - Hstart[9 * g + k]);
             m->deq[g] = sqrt(s2);
         }
         free(Hstart);
@@ -126,8 +129,9 @@ static int run_fem(model *m) {
         m->step_done = step;
         {
             char what[256];
-            snprintf(what, sizeof what, "stage %d  eps %.3f %%  sigma_bar %.4f  s11 %.4g s22 %.4g  DR %d  DEM/run %.0f",
-                     stage, 100.0 * r.v[2], r.v[3], r.v[4], r.v[5], iters,
+            snprintf(what, sizeof what,
+                     "stage %d  eps %.3f %%  sigma_bar %.4f  s11 %.4g s22 %.4g  DR %d  DEM/run %.0f", stage,
+                     100.0 * r.v[2], r.v[3], r.v[4], r.v[5], iters,
                      (double)(m->dem_total - dem0) / (iters > 0 ? (double)iters * m->ngp : 1.0));
             gk_progress(stderr, step, nsteps, m->t0, what);
         }
@@ -172,11 +176,14 @@ int main(int argc, char **argv) {
     m.single = m.o.test == TEST_RVE;
     if (m.single) m.o.nx = m.o.ny = 1;
     if (setup(&m)) return 1;
-    if (m.o.material == 1) snprintf(kn_txt, sizeof kn_txt, "E r*");
-    else snprintf(kn_txt, sizeof kn_txt, "%.4g N/m", m.o.kn_ratio * m.o.pressure);
+    if (m.o.material == 1)
+        snprintf(kn_txt, sizeof kn_txt, "E r*");
+    else
+        snprintf(kn_txt, sizeof kn_txt, "%.4g N/m", m.o.kn_ratio * m.o.pressure);
     printf("femdem_dr: %s, %s RVE (%d particles, %d boundary), rotation %s, %d Gauss points, k_n %s, "
            "omega_max %.4g rad/s\n",
-           m.single ? "the RVE alone" : "biaxial test", m.o.frame == GK_FRAME_SERVO ? "servo-framed" : "periodic-cell",
+           m.single ? "the RVE alone" : "biaxial test",
+           m.o.frame == GK_FRAME_SERVO ? "servo-framed" : "periodic-cell",
            m.o.frame == GK_FRAME_SERVO ? m.fr.n : m.pk.n, m.o.frame == GK_FRAME_SERVO ? m.fr.nq : 0,
            m.o.no_rotation ? "locked" : "free", m.ngp, kn_txt, m.omega_max);
     rc = run_fem(&m);
@@ -184,7 +191,8 @@ int main(int argc, char **argv) {
     gk_frame_free(&m.fr);
     gk_packing_free(&m.pk);
     if (!m.single) gk_mesh_free(&m.mesh);
-    free(m.dNdX), free(m.wgp), free(m.mass), free(m.u), free(m.v), free(m.fint), free(m.fext), free(m.f0), free(m.u0);
+    free(m.dNdX), free(m.wgp), free(m.mass), free(m.u), free(m.v), free(m.fint), free(m.fext), free(m.f0),
+        free(m.u0);
     free(m.P), free(m.H), free(m.Hacc), free(m.dH), free(m.deq), free(m.fixed), free(m.top), free(m.edge);
     free(m.stats), free(m.rows);
     return rc;

@@ -116,8 +116,8 @@ static int dns_build(model *m, dns *D) {
     }
     D->width0 = W;
     gk_packing_free(&sp);
-    printf("femdem_dr: DNS of %d x %d cells: %d disks, %.4g x %.4g mm, chains of %d and %d\n", nx, ny, n, 1e3 * W,
-           1e3 * H, D->nl, D->nr);
+    printf("femdem_dr: DNS of %d x %d cells: %d disks, %.4g x %.4g mm, chains of %d and %d\n", nx, ny, n,
+           1e3 * W, 1e3 * H, D->nl, D->nr);
     return 0;
 }
 
@@ -145,11 +145,13 @@ static long dns_relax(model *m, dns *D, long *steps) {
         *steps += 50, ++checks;
         gk_frame_energy(&D->sc.rve, NULL, &ek, &ep);
         if ((ep > 0.0 ? ek <= m->o.tol_energy * ep : ek == 0.0) &&
-            (!servo || fabs(lid->resistance - lid->def.target * lid->def.area) <= 0.01 * lid->def.target * lid->def.area))
+            (!servo || fabs(lid->resistance - lid->def.target * lid->def.area) <=
+                           0.01 * lid->def.target * lid->def.area))
             return checks;
         if (*steps > 50L * m->o.max_dr) {
             ++m->unconverged;
-            fprintf(stderr, PROG ": warning: the DNS did not relax (E_kin / E_pot %.2g)\n", ep > 0 ? ek / ep : 0.0);
+            fprintf(stderr, PROG ": warning: the DNS did not relax (E_kin / E_pot %.2g)\n",
+                    ep > 0 ? ek / ep : 0.0);
             return checks;
         }
     }
@@ -193,7 +195,8 @@ static int run_dns(model *m) {
             D.sc.mem[0].pressure = D.sc.mem[1].pressure = p;
             lid->def.target = p, lid->def.area = dns_width(&D) * D.sc.rve.volume_factor;
         } else {
-            double d = o->strain * m->h_ic / o->steps, v = 1e-3 * D.sc.rve.rmin / D.sc.rve.dt; /* the RVEs' ramp */
+            double d = o->strain * m->h_ic / o->steps,
+                   v = 1e-3 * D.sc.rve.rmin / D.sc.rve.dt; /* the RVEs' ramp */
             long n = (long)ceil(d / (v * D.sc.rve.dt));
             lid->def.drive = GK_DRIVE_VELOCITY;
             lid->def.velocity[1] = -d / (n * D.sc.rve.dt);
@@ -214,8 +217,9 @@ static int run_dns(model *m) {
         add_row(m, &r);
         {
             char what[256];
-            snprintf(what, sizeof what, "stage %d  eps %.3f %%  sigma_bar %.4f  s11 %.4g s22 %.4g  DEM %ld  lost %ld",
-                     stage, 100.0 * r.v[2], r.v[3], r.v[4], r.v[5], steps, D.sc.lost);
+            snprintf(what, sizeof what,
+                     "stage %d  eps %.3f %%  sigma_bar %.4f  s11 %.4g s22 %.4g  DEM %ld  lost %ld", stage,
+                     100.0 * r.v[2], r.v[3], r.v[4], r.v[5], steps, D.sc.lost);
             gk_progress(stderr, step, nsteps, m->t0, what);
         }
         if (write_csv(m, "dr.csv")) return 1;

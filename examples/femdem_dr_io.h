@@ -81,12 +81,14 @@ static int write_csv(const model *m, const char *name) {
         fprintf(stderr, PROG ": cannot write %s\n", path);
         return 1;
     }
-    fprintf(fp, "step,stage,eps_axial,sigma_bar,sigma_11,sigma_22,J,coordination,anisotropy,dr_iterations,dem_steps,"
-                "seconds\n");
+    fprintf(
+        fp,
+        "step,stage,eps_axial,sigma_bar,sigma_11,sigma_22,J,coordination,anisotropy,dr_iterations,dem_steps,"
+        "seconds\n");
     for (i = 0; i < m->nrows; ++i) {
         const double *v = m->rows[i].v;
-        fprintf(fp, "%d,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%d,%.0f,%.3f\n", (int)v[0], (int)v[1], v[2], v[3], v[4],
-                v[5], v[6], v[7], v[8], (int)v[9], v[10], v[11]);
+        fprintf(fp, "%d,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%d,%.0f,%.3f\n", (int)v[0], (int)v[1], v[2],
+                v[3], v[4], v[5], v[6], v[7], v[8], (int)v[9], v[10], v[11]);
     }
     ok = !ferror(fp);
     if (fclose(fp) != 0) ok = 0;
@@ -138,8 +140,10 @@ static int write_vtk(const model *m, int step) {
     if (!r) r = gk_vtk_cell_scalar(&v, "sigma_bar", cell);
     if (!r) r = gk_vtk_cell_scalar(&v, "J", cell + ne);
     if (!r) r = gk_vtk_cell_scalar(&v, "deq", cell + 2 * ne);
-    if (!r) r = gk_vtk_close(&v);
-    else if (v.fp) fclose(v.fp);
+    if (!r)
+        r = gk_vtk_close(&v);
+    else if (v.fp)
+        fclose(v.fp);
     if (!r) {
         int *conn = (int *)xcalloc((size_t)m->ngp, sizeof(int));
         snprintf(path, sizeof path, "%s/gp_%04d.vtk", m->o.out, step);
@@ -167,8 +171,10 @@ static int write_vtk(const model *m, int step) {
         if (!r) r = gk_vtk_point_scalar(&v, "anisotropy", A);
         if (!r) r = gk_vtk_point_scalar(&v, "deq", m->deq);
         if (!r) r = gk_vtk_point_scalar(&v, "dem_steps", dem);
-        if (!r) r = gk_vtk_close(&v);
-        else if (v.fp) fclose(v.fp);
+        if (!r)
+            r = gk_vtk_close(&v);
+        else if (v.fp)
+            fclose(v.fp);
         free(conn);
     }
     if (r) fprintf(stderr, PROG ": %s\n", v.err.msg[0] ? v.err.msg : "cannot write the VTK files");
@@ -180,8 +186,10 @@ static int write_svgs(const model *m) {
     char path[1024];
     gk_plot p;
     gk_err err;
-    double *x = (double *)xcalloc((size_t)m->nrows + 1, sizeof(double)), *y = (double *)xcalloc((size_t)m->nrows + 1, sizeof(double));
-    double *z = (double *)xcalloc((size_t)m->nrows + 1, sizeof(double)), *a = (double *)xcalloc((size_t)m->nrows + 1, sizeof(double));
+    double *x = (double *)xcalloc((size_t)m->nrows + 1, sizeof(double)),
+           *y = (double *)xcalloc((size_t)m->nrows + 1, sizeof(double));
+    double *z = (double *)xcalloc((size_t)m->nrows + 1, sizeof(double)),
+           *a = (double *)xcalloc((size_t)m->nrows + 1, sizeof(double));
     double *jj = (double *)xcalloc((size_t)m->nrows + 1, sizeof(double));
     int i, n = 0, bad = 0;
     for (i = 0; i < m->nrows; ++i) {
@@ -192,10 +200,13 @@ static int write_svgs(const model *m) {
     }
     gk_plot_init(&p, "FEMxDEM by dynamic relaxation: stress ratio", "axial strain eps = d / h_ic [%]",
                  "sigma_bar = |s11 - s22| / |s11 + s22|");
-    gk_plot_add(&p, x, y, n, m->o.test == TEST_DNS ? "DNS" : (m->o.frame == GK_FRAME_SERVO ? "servo frame" : "periodic cell"));
+    gk_plot_add(&p, x, y, n,
+                m->o.test == TEST_DNS ? "DNS"
+                                      : (m->o.frame == GK_FRAME_SERVO ? "servo frame" : "periodic cell"));
     snprintf(path, sizeof path, "%s/dr_stress.svg", m->o.out);
     bad |= gk_plot_svg(&p, path, &err) != GK_OK;
-    gk_plot_init(&p, "volumetric deformation", "axial strain [%]", "J_rel = (det F - det F_ic) / det F_ic [%]");
+    gk_plot_init(&p, "volumetric deformation", "axial strain [%]",
+                 "J_rel = (det F - det F_ic) / det F_ic [%]");
     gk_plot_add(&p, x, jj, n, "J_rel");
     snprintf(path, sizeof path, "%s/dr_volume.svg", m->o.out);
     bad |= gk_plot_svg(&p, path, &err) != GK_OK;
@@ -204,9 +215,11 @@ static int write_svgs(const model *m) {
     gk_plot_add(&p, x, a, n, "10 x anisotropy (eq 38)");
     snprintf(path, sizeof path, "%s/dr_fabric.svg", m->o.out);
     bad |= gk_plot_svg(&p, path, &err) != GK_OK;
-    if (!m->single && m->o.test != TEST_DNS) { /* Fig 7: the incremental equivalent strain on the deformed mesh */
+    if (!m->single &&
+        m->o.test != TEST_DNS) { /* Fig 7: the incremental equivalent strain on the deformed mesh */
         int ne = m->mesh.nelem, e, k;
-        double *xy = (double *)xcalloc(8 * (size_t)ne, sizeof(double)), *val = (double *)xcalloc((size_t)ne, sizeof(double));
+        double *xy = (double *)xcalloc(8 * (size_t)ne, sizeof(double)),
+               *val = (double *)xcalloc((size_t)ne, sizeof(double));
         double ol[10];
         int ollen = 5;
         gk_field_def fd;
@@ -220,7 +233,9 @@ static int write_svgs(const model *m) {
         { /* the specimen's corners as the outline */
             int c[5];
             c[0] = 0, c[1] = m->o.nx, c[2] = m->nnode - 1, c[3] = m->nnode - 1 - m->o.nx, c[4] = 0;
-            for (k = 0; k < 5; ++k) ol[2 * k] = m->mesh.x[2 * c[k]] + m->u[2 * c[k]], ol[2 * k + 1] = m->mesh.x[2 * c[k] + 1] + m->u[2 * c[k] + 1];
+            for (k = 0; k < 5; ++k)
+                ol[2 * k] = m->mesh.x[2 * c[k]] + m->u[2 * c[k]],
+                       ol[2 * k + 1] = m->mesh.x[2 * c[k] + 1] + m->u[2 * c[k] + 1];
         }
         memset(&fd, 0, sizeof fd);
         fd.title = "incremental equivalent strain of the last step";
@@ -249,7 +264,8 @@ static void ck_opts(const model *m, double *d) {
 }
 
 static int save_checkpoint(model *m) {
-    size_t n = 4 + 4 * (CK_NI - 1) + 8 * (CK_ND + 3 * (size_t)m->ndof + 18 * (size_t)m->ngp + (size_t)NCOL * m->nrows);
+    size_t n = 4 + 4 * (CK_NI - 1) +
+               8 * (CK_ND + 3 * (size_t)m->ndof + 18 * (size_t)m->ngp + (size_t)NCOL * m->nrows);
     unsigned char *b = (unsigned char *)xcalloc(n, 1), *o = b;
     int32_t iv[CK_NI - 1];
     double dv[CK_ND];
@@ -258,7 +274,8 @@ static int save_checkpoint(model *m) {
     int i, bad;
     iv[0] = m->ngp, iv[1] = m->ndof, iv[2] = m->o.frame, iv[3] = m->o.no_rotation, iv[4] = m->o.test;
     iv[5] = m->step_done, iv[6] = m->nrows, iv[7] = m->have_f0;
-    dv[0] = m->h_ic, dv[1] = m->J_ic, dv[2] = m->dr.omega, dv[3] = (double)m->dr.total, dv[4] = (double)m->dem_total;
+    dv[0] = m->h_ic, dv[1] = m->J_ic, dv[2] = m->dr.omega, dv[3] = (double)m->dr.total,
+    dv[4] = (double)m->dem_total;
     dv[5] = (double)m->runs_total, dv[6] = (double)m->capped_total, dv[7] = (double)m->unconverged;
     ck_opts(m, dv);
     memcpy(o, &magic, 4), o += 4;
@@ -296,12 +313,15 @@ static int load_checkpoint(model *m) {
     if (nb < need) goto bad;
     memcpy(&magic, b, 4), memcpy(iv, b + 4, sizeof iv), memcpy(dv, b + 4 + sizeof iv, sizeof dv);
     ck_opts(m, want);
-    if (magic != CK_MAGIC || iv[0] != m->ngp || iv[1] != m->ndof || iv[2] != m->o.frame || iv[3] != m->o.no_rotation ||
-        iv[4] != m->o.test || iv[6] < 0 || iv[5] < 0)
+    if (magic != CK_MAGIC || iv[0] != m->ngp || iv[1] != m->ndof || iv[2] != m->o.frame ||
+        iv[3] != m->o.no_rotation || iv[4] != m->o.test || iv[6] < 0 || iv[5] < 0)
         goto bad;
     for (i = 8; i < CK_ND; ++i)
         if (dv[i] != want[i]) {
-            fprintf(stderr, PROG ": %s was written with other options (strain, pressure, friction, steps, stiffness or mesh)\n", path);
+            fprintf(stderr,
+                    PROG ": %s was written with other options (strain, pressure, friction, steps, stiffness "
+                         "or mesh)\n",
+                    path);
             gk_twoscale_free(&m->ts, blk);
             return 1;
         }
@@ -339,7 +359,8 @@ static int load_checkpoint(model *m) {
     printf("restarted from %s at step %d\n", path, m->step_done);
     return 0;
 bad:
-    fprintf(stderr, PROG ": %s is not a checkpoint of this run (another test, mesh, frame or rotation)\n", path);
+    fprintf(stderr, PROG ": %s is not a checkpoint of this run (another test, mesh, frame or rotation)\n",
+            path);
     gk_twoscale_free(&m->ts, blk);
     return 1;
 bad_value:
@@ -369,12 +390,15 @@ static void result_line(const model *m) {
         if (v[3] > peak) peak = v[3], epk = v[2];
         if (v[6] < jmin) jmin = v[6], edil = v[2];
     }
-    printf("RESULT peak_sigma_bar=%.4f eps_at_peak=%.4f sigma_bar_0073=%.4f anisotropy_0073=%.4f eps_dilation=%.4f "
-           "dr_iterations_mean=%.1f seconds=%.1f dem_steps_per_run=%.1f rve_capped_runs=%lld dr_unconverged_steps=%lld "
+    printf("RESULT peak_sigma_bar=%.4f eps_at_peak=%.4f sigma_bar_0073=%.4f anisotropy_0073=%.4f "
+           "eps_dilation=%.4f "
+           "dr_iterations_mean=%.1f seconds=%.1f dem_steps_per_run=%.1f rve_capped_runs=%lld "
+           "dr_unconverged_steps=%lld "
            "frame=%s rotation=%s\n",
-           peak, epk, interp(m, 3, 0.073), interp(m, 8, 0.073), edil, nst ? iters / nst : 0.0, gk_wtime() - m->t0,
-           m->runs_total ? (double)m->dem_total / (double)m->runs_total : 0.0, m->capped_total, m->unconverged,
-           m->o.frame == GK_FRAME_SERVO ? "servo" : "periodic", m->o.no_rotation ? "locked" : "free");
+           peak, epk, interp(m, 3, 0.073), interp(m, 8, 0.073), edil, nst ? iters / nst : 0.0,
+           gk_wtime() - m->t0, m->runs_total ? (double)m->dem_total / (double)m->runs_total : 0.0,
+           m->capped_total, m->unconverged, m->o.frame == GK_FRAME_SERVO ? "servo" : "periodic",
+           m->o.no_rotation ? "locked" : "free");
 }
 
 #endif /* FEMDEM_DR_IO_H */

@@ -75,11 +75,11 @@ typedef struct row {
 
 typedef struct model {
     opts o;
-    int single;             /* --test rve: one point, two dofs                          */
+    int single; /* --test rve: one point, two dofs                          */
     gk_mesh mesh;
     gk_quad q;
     int ngp, ndof, nnode;
-    double *dNdX, *wgp;     /* per Gauss point: 8 derivatives, detJ x weight (reference) */
+    double *dNdX, *wgp; /* per Gauss point: 8 derivatives, detJ x weight (reference) */
     double *mass, *u, *v, *fint, *fext, *f0, *u0, *P, *H, *Hacc, *dH, *deq;
     unsigned char *fixed;
     int *top, ntop, *edge, nedge; /* top nodes; loaded boundary edges (a, b, side 0 right 1 top 2 left) */
@@ -141,7 +141,8 @@ static void gradients(const model *m, const double *u, double *H) {
         H[0] = u[0] / m->o.width, H[4] = u[1] / m->o.height;
         return;
     }
-    for (g = 0; g < m->ngp; ++g) gk_fem_grad(&m->mesh, g / m->q.n, m->dNdX + 8 * (size_t)g, u, H + 9 * (size_t)g);
+    for (g = 0; g < m->ngp; ++g)
+        gk_fem_grad(&m->mesh, g / m->q.n, m->dNdX + 8 * (size_t)g, u, H + 9 * (size_t)g);
 }
 
 /* f_int = int B^T P dV0 */
@@ -191,9 +192,11 @@ static void boundary_edges(model *m) {
     m->edge = (int *)xcalloc(3 * (size_t)(2 * ny + nx), sizeof(int));
     /* node (i, j) of a structured Q4 mesh: j (nx + 1) + i (gk_mesh_structured, x fastest) */
     for (j = 0; j < ny; ++j) /* right, upwards */
-        m->edge[3 * k] = j * (nx + 1) + nx, m->edge[3 * k + 1] = (j + 1) * (nx + 1) + nx, m->edge[3 * k + 2] = 0, ++k;
+        m->edge[3 * k] = j * (nx + 1) + nx, m->edge[3 * k + 1] = (j + 1) * (nx + 1) + nx,
+                    m->edge[3 * k + 2] = 0, ++k;
     for (i = nx; i > 0; --i) /* top, leftwards */
-        m->edge[3 * k] = ny * (nx + 1) + i, m->edge[3 * k + 1] = ny * (nx + 1) + i - 1, m->edge[3 * k + 2] = 1, ++k;
+        m->edge[3 * k] = ny * (nx + 1) + i, m->edge[3 * k + 1] = ny * (nx + 1) + i - 1,
+                    m->edge[3 * k + 2] = 1, ++k;
     for (j = ny; j > 0; --j) /* left, downwards */
         m->edge[3 * k] = j * (nx + 1), m->edge[3 * k + 1] = (j - 1) * (nx + 1), m->edge[3 * k + 2] = 2, ++k;
     m->nedge = k;
@@ -231,7 +234,8 @@ static int setup(model *m) {
         double org[3] = {0, 0, 0}, len[3];
         n[0] = o->nx, n[1] = o->ny, n[2] = 1;
         len[0] = o->width, len[1] = o->height, len[2] = 0;
-        if (gk_mesh_structured(&m->mesh, GK_Q4, n, org, len, NULL, &err) || gk_quad_rule(&m->q, GK_Q4, 2, &err)) {
+        if (gk_mesh_structured(&m->mesh, GK_Q4, n, org, len, NULL, &err) ||
+            gk_quad_rule(&m->q, GK_Q4, 2, &err)) {
             fprintf(stderr, PROG ": %s\n", err.msg);
             return 1;
         }
@@ -397,13 +401,16 @@ static int dr_step(model *m, double p_side, double p_top, int *iters) {
             return 3;
         }
         if (getenv("FDR_DEBUG") && m->single)
-            fprintf(stderr, "it %ld u %.4e %.4e fint %.4e %.4e fext %.4e %.4e om %.4e dt %.3e ek %.3e max %.3e g %u\n", m->dr.iter,
-                    m->u[0], m->u[1], m->fint[0], m->fint[1], m->fext[0], m->fext[1], m->dr.omega, m->dr.dt, m->dr.ekin,
-                    m->dr.ekin_max, m->dr.guards);
+            fprintf(
+                stderr,
+                "it %ld u %.4e %.4e fint %.4e %.4e fext %.4e %.4e om %.4e dt %.3e ek %.3e max %.3e g %u\n",
+                m->dr.iter, m->u[0], m->u[1], m->fint[0], m->fint[1], m->fext[0], m->fext[1], m->dr.omega,
+                m->dr.dt, m->dr.ekin, m->dr.ekin_max, m->dr.guards);
         if (m->dr.converged) break;
         if (m->dr.iter >= m->o.max_dr) {
             ++m->unconverged;
-            fprintf(stderr, PROG ": warning: load step not relaxed in %d DR iterations (E_kin / E_kin,max %.2g)\n",
+            fprintf(stderr,
+                    PROG ": warning: load step not relaxed in %d DR iterations (E_kin / E_kin,max %.2g)\n",
                     m->o.max_dr, m->dr.ekin / m->dr.ekin_max);
             break;
         }

@@ -17,10 +17,12 @@
 enum { TEST_BIAXIAL = 0, TEST_RVE = 1, TEST_DNS = 2 };
 
 typedef struct opts {
-    int test, nx, ny, iso_steps, steps, threads, frame, no_rotation, vtk_every, checkpoint, max_dr, servo_max, rayleigh;
+    int test, nx, ny, iso_steps, steps, threads, frame, no_rotation, vtk_every, checkpoint, max_dr, servo_max,
+        rayleigh;
     int rve_max, stop_after, material, paper;
     int tiles[2];
-    double strain, pressure, friction, width, height, kn_ratio, dt_factor, damping, tol_energy, tol_dr, tol_servo;
+    double strain, pressure, friction, width, height, kn_ratio, dt_factor, damping, tol_energy, tol_dr,
+        tol_servo;
     double xi, gamma, force_tol;
     const char *out, *restart, *packing, *test_s, *frame_s, *tiles_s, *rayleigh_s, *material_s;
 } opts;
@@ -68,7 +70,8 @@ static void usage(FILE *fp) {
 static void dr_opts_default(opts *o) {
     memset(o, 0, sizeof *o);
     o->test = TEST_BIAXIAL, o->nx = 1, o->ny = 2, o->iso_steps = 10, o->steps = 20, o->threads = 1;
-    o->frame = GK_FRAME_SERVO, o->vtk_every = 10, o->checkpoint = 10, o->max_dr = 20000, o->servo_max = 20, o->rve_max = 20000;
+    o->frame = GK_FRAME_SERVO, o->vtk_every = 10, o->checkpoint = 10, o->max_dr = 20000, o->servo_max = 20,
+    o->rve_max = 20000;
     o->tiles[0] = 1, o->tiles[1] = 2;
     o->strain = 0.10, o->pressure = 1.5e5, o->friction = 0.4, o->width = 0.01, o->height = 0.02;
     o->kn_ratio = 100.0, o->dt_factor = 0.4, o->damping = 0.7, o->tol_energy = 1e-3, o->tol_dr = 1e-3;
@@ -122,7 +125,8 @@ static int parse(int argc, char **argv, opts *o) {
     double pos[4];
     int i, k, help;
     for (i = 1; i < argc; ++i) /* --paper first: the options given with it win wherever they stand */
-        if (!strcmp(argv[i], "--paper")) o->nx = 2, o->ny = 4, o->steps = 50, o->tiles[0] = 2, o->tiles[1] = 4;
+        if (!strcmp(argv[i], "--paper"))
+            o->nx = 2, o->ny = 4, o->steps = 50, o->tiles[0] = 2, o->tiles[1] = 4;
     if (cli_parse(PROG, argc, argv, tables, &help)) return 2;
     if (help) {
         usage(stdout);
@@ -140,38 +144,48 @@ static int parse(int argc, char **argv, opts *o) {
             return 2;
         }
     if (o->test_s) {
-        if (!strcmp(o->test_s, "biaxial")) o->test = TEST_BIAXIAL;
-        else if (!strcmp(o->test_s, "rve")) o->test = TEST_RVE;
-        else if (!strcmp(o->test_s, "dns")) o->test = TEST_DNS;
+        if (!strcmp(o->test_s, "biaxial"))
+            o->test = TEST_BIAXIAL;
+        else if (!strcmp(o->test_s, "rve"))
+            o->test = TEST_RVE;
+        else if (!strcmp(o->test_s, "dns"))
+            o->test = TEST_DNS;
         else {
             fprintf(stderr, PROG ": --test '%s' must be biaxial, rve or dns\n", o->test_s);
             return 2;
         }
     }
     if (o->frame_s) {
-        if (!strcmp(o->frame_s, "servo")) o->frame = GK_FRAME_SERVO;
-        else if (!strcmp(o->frame_s, "periodic")) o->frame = GK_FRAME_PERIODIC;
+        if (!strcmp(o->frame_s, "servo"))
+            o->frame = GK_FRAME_SERVO;
+        else if (!strcmp(o->frame_s, "periodic"))
+            o->frame = GK_FRAME_PERIODIC;
         else {
             fprintf(stderr, PROG ": --frame '%s' must be servo or periodic\n", o->frame_s);
             return 2;
         }
     }
     if (o->material_s) {
-        if (!strcmp(o->material_s, "paper")) o->material = 0;
-        else if (!strcmp(o->material_s, "guo-zhao")) o->material = 1;
+        if (!strcmp(o->material_s, "paper"))
+            o->material = 0;
+        else if (!strcmp(o->material_s, "guo-zhao"))
+            o->material = 1;
         else {
             fprintf(stderr, PROG ": --material '%s' must be paper or guo-zhao\n", o->material_s);
             return 2;
         }
         if (o->material == 1 && o->frame == GK_FRAME_SERVO) {
-            fprintf(stderr, PROG ": --material guo-zhao (k_n = E r*) needs --frame periodic: the servo's gains are per "
-                            "constant k_n\n");
+            fprintf(stderr, PROG
+                    ": --material guo-zhao (k_n = E r*) needs --frame periodic: the servo's gains are per "
+                    "constant k_n\n");
             return 2;
         }
     }
     if (o->rayleigh_s) {
-        if (!strcmp(o->rayleigh_s, "step")) o->rayleigh = 0;
-        else if (!strcmp(o->rayleigh_s, "total")) o->rayleigh = 1;
+        if (!strcmp(o->rayleigh_s, "step"))
+            o->rayleigh = 0;
+        else if (!strcmp(o->rayleigh_s, "total"))
+            o->rayleigh = 1;
         else {
             fprintf(stderr, PROG ": --rayleigh '%s' must be step or total\n", o->rayleigh_s);
             return 2;
@@ -179,8 +193,10 @@ static int parse(int argc, char **argv, opts *o) {
     }
     if (o->tiles_s) {
         int a = 0, b = 0, n = 0;
-        if (sscanf(o->tiles_s, "%dx%d%n", &a, &b, &n) != 2 || o->tiles_s[n] || a < 1 || b < 1 || a > 16 || b > 16) {
-            fprintf(stderr, PROG ": --dns-tiles '%s' must be NXxNY with 1 <= NX, NY <= 16 (e.g. 1x2)\n", o->tiles_s);
+        if (sscanf(o->tiles_s, "%dx%d%n", &a, &b, &n) != 2 || o->tiles_s[n] || a < 1 || b < 1 || a > 16 ||
+            b > 16) {
+            fprintf(stderr, PROG ": --dns-tiles '%s' must be NXxNY with 1 <= NX, NY <= 16 (e.g. 1x2)\n",
+                    o->tiles_s);
             return 2;
         }
         o->tiles[0] = a, o->tiles[1] = b;

@@ -12,8 +12,9 @@
 #include "femdem.h"
 
 /* ------------------------------------------------------------- outputs */
-static const char *fd_field_names[FD_NFIELD] = {"eps_q", "eps_v", "void_ratio",        "rotation_deg", "spin_deg",
-                                                "p",     "q",     "fabric_anisotropy", "coordination", "dem_steps"};
+static const char *fd_field_names[FD_NFIELD] = {"eps_q",        "eps_v",    "void_ratio", "rotation_deg",
+                                                "spin_deg",     "p",        "q",          "fabric_anisotropy",
+                                                "coordination", "dem_steps"};
 
 /* the Gauss-point fields of the converged state, FD_NFIELD per point (all ranks call it): eps_q,
  * eps_v compression-positive as the paper, void ratio, particle rotation and spin [deg], p, q,
@@ -40,7 +41,8 @@ static int fd_write_vtk(fd_model *M, int step) {
     gk_vtk v;
     int nn = M->mesh.nnode, big = M->ngp > nn ? M->ngp : nn, g, k, a, bad = 0;
     double *all = fd_gp_fields(M), *xyz = (double *)malloc((size_t)big * 3 * sizeof(double)),
-           *val = (double *)malloc((size_t)M->ngp * sizeof(double)), *d3 = (double *)malloc((size_t)nn * 3 * sizeof(double));
+           *val = (double *)malloc((size_t)M->ngp * sizeof(double)),
+           *d3 = (double *)malloc((size_t)nn * 3 * sizeof(double));
     int *conn = (int *)malloc((size_t)M->ngp * sizeof(int));
     if (!all || !xyz || !val || !d3 || !conn) {
         fd_say(M, "%s: out of memory writing VTK\n", M->prog);
@@ -52,8 +54,8 @@ static int fd_write_vtk(fd_model *M, int step) {
             conn[g] = g;
         }
         snprintf(path, sizeof path, "%s/gp_%04d.vtk", M->o.out, step);
-        bad = gk_vtk_open(&v, path, "grainkit FEMxDEM Gauss points") != GK_OK || gk_vtk_points(&v, M->ngp, xyz) ||
-              gk_vtk_cells(&v, M->ngp, 1, conn, GK_VTK_VERTEX);
+        bad = gk_vtk_open(&v, path, "grainkit FEMxDEM Gauss points") != GK_OK ||
+              gk_vtk_points(&v, M->ngp, xyz) || gk_vtk_cells(&v, M->ngp, 1, conn, GK_VTK_VERTEX);
         for (k = 0; k < FD_NFIELD && !bad; ++k) {
             for (g = 0; g < M->ngp; ++g) val[g] = all[FD_NFIELD * g + k];
             bad = gk_vtk_point_scalar(&v, fd_field_names[k], val) != GK_OK;
@@ -66,7 +68,8 @@ static int fd_write_vtk(fd_model *M, int step) {
             }
             snprintf(path, sizeof path, "%s/mesh_%04d.vtk", M->o.out, step);
             bad = gk_vtk_open(&v, path, "grainkit FEMxDEM mesh") || gk_vtk_points(&v, nn, xyz) ||
-                  gk_vtk_cells(&v, M->mesh.nelem, M->npe, M->mesh.conn, M->npe == 8 ? GK_VTK_QUAD8 : GK_VTK_QUAD) ||
+                  gk_vtk_cells(&v, M->mesh.nelem, M->npe, M->mesh.conn,
+                               M->npe == 8 ? GK_VTK_QUAD8 : GK_VTK_QUAD) ||
                   gk_vtk_point_vector(&v, "displacement", d3);
             if (v.fp) bad |= gk_vtk_close(&v) != GK_OK;
         }
@@ -97,7 +100,8 @@ static int fd_write_field_svg(fd_model *M, int field, const char *file, const ch
                     static const int ci[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
                     for (c = 0; c < 4; ++c) {
                         double xi[3], x[3];
-                        xi[0] = -1 + 2.0 * (i + ci[c][0]) / per, xi[1] = -1 + 2.0 * (j + ci[c][1]) / per, xi[2] = 0;
+                        xi[0] = -1 + 2.0 * (i + ci[c][0]) / per, xi[1] = -1 + 2.0 * (j + ci[c][1]) / per,
+                        xi[2] = 0;
                         gk_mesh_point(&M->mesh, e, xi, x);
                         xy[8 * g + 2 * c] = x[0], xy[8 * g + 2 * c + 1] = x[1];
                     }
@@ -138,7 +142,8 @@ static int fd_plot(const fd_model *M, const gk_plot *pl, const char *file) {
 /* the columns both CSVs end with, and their values */
 #define FD_WORK_COLS "dem_steps_mean,dem_steps_max,dem_steps,tangents_reused,tangents_computed"
 static void fd_csv_work(FILE *fp, const fd_row *c) {
-    fprintf(fp, "%.2f,%d,%lld,%lld,%lld\n", c->dem_mean, c->dem_max, c->dem_total, c->t_reused, c->t_computed);
+    fprintf(fp, "%.2f,%d,%lld,%lld,%lld\n", c->dem_mean, c->dem_max, c->dem_total, c->t_reused,
+            c->t_computed);
 }
 
 /* a CSV written by rank 0 through row(fp, M, k, user) after its header; said once when it fails */
@@ -216,8 +221,10 @@ static int fd_ck_save(fd_model *M, const char *tag, const fd_buf *extra) {
     snprintf(path, sizeof path, "%s/checkpoint.bin", M->o.out);
     bad = B.bad;
     if (!bad && gk_twoscale_save(&M->ts, path, B.b, B.n)) bad = 1;
-    if (bad && B.bad) fd_say(M, "%s: cannot write %s: out of memory\n", M->prog, path);
-    else if (bad) fd_say(M, "%s: %s\n", M->prog, gk_twoscale_error(&M->ts)); /* names the file */
+    if (bad && B.bad)
+        fd_say(M, "%s: cannot write %s: out of memory\n", M->prog, path);
+    else if (bad)
+        fd_say(M, "%s: %s\n", M->prog, gk_twoscale_error(&M->ts)); /* names the file */
     free(B.b);
     return bad;
 }
@@ -259,8 +266,8 @@ static int fd_ck_check(const fd_model *M, const fd_ck *ck, char *why, size_t nwh
      * halves from 1 and the driver gives up below 1/16 */
     if (ck->step < 0 || ck->step > 1000000000 || !(ck->eps >= 0.0 && ck->eps < 1.0) ||
         !(ck->scale >= 1.0 / 64 && ck->scale <= 1.0))
-        return snprintf(why, nwhy, "step %d, axial strain %g or increment scale %g out of range", ck->step, ck->eps,
-                        ck->scale),
+        return snprintf(why, nwhy, "step %d, axial strain %g or increment scale %g out of range", ck->step,
+                        ck->eps, ck->scale),
                1;
     for (c = 0; c < ck->nc; ++c) {
         const fd_row *r = &ck->rows[c];
@@ -270,7 +277,8 @@ static int fd_ck_check(const fd_model *M, const fd_ck *ck, char *why, size_t nwh
         d[0] = r->eps, d[1] = r->syy, d[2] = r->sxx, d[3] = r->ev, d[4] = r->secs, d[5] = r->Ed, d[6] = r->Ef;
         d[7] = r->inc, d[8] = r->dem_mean;
         w[0] = r->dem_total, w[1] = r->t_reused, w[2] = r->t_computed;
-        bad = !fd_ck_bounded(d, 9, 1e100) || r->iters < 0 || r->failed < 0 || r->failed > M->ngp || r->dem_max < 0;
+        bad = !fd_ck_bounded(d, 9, 1e100) || r->iters < 0 || r->failed < 0 || r->failed > M->ngp ||
+              r->dem_max < 0;
         for (k = 0; k < 3 && !bad; ++k) { /* the run's totals are their sums */
             bad = w[k] < 0 || w[k] > LLONG_MAX / 2 - sum[k];
             sum[k] += bad ? 0 : w[k];
@@ -282,7 +290,8 @@ static int fd_ck_check(const fd_model *M, const fd_ck *ck, char *why, size_t nwh
         if (!(fabs(u[k]) <= 10 * L) || !(fabs(x[k] - (M->A0x[k] + u[k])) <= 1e-8 * L))
             return snprintf(why, nwhy, "the mesh does not match its displacements (dof %d)", (int)k), 1;
     m = M->mesh, m.x = ck->v;
-    if (gk_mesh_check(&m, &M->q, &e) != GK_OK) return snprintf(why, nwhy, "the deformed mesh: %.150s", e.msg), 1;
+    if (gk_mesh_check(&m, &M->q, &e) != GK_OK)
+        return snprintf(why, nwhy, "the deformed mesh: %.150s", e.msg), 1;
     if (!fd_ck_bounded(ck->v + 2 * n, 25 * (size_t)M->ngp, 1e100))
         return snprintf(why, nwhy, "a stress or tangent is not finite or beyond 1e100"), 1;
     return 0;
@@ -312,8 +321,8 @@ static int fd_ck_read(fd_model *M, const char *dir, const char *tag, fd_buf *B, 
     if (!ok || nx != M->o.nx || ny != M->o.ny || el != M->o.elem || quad != M->o.quad) {
         free(B->b), memset(B, 0, sizeof *B);
         return gk_err_set(err, GK_ERR_FORMAT,
-                          "%s: not a checkpoint of this test and mesh (%s %dx%d, element, quad must match)", path,
-                          tag, M->o.nx, M->o.ny),
+                          "%s: not a checkpoint of this test and mesh (%s %dx%d, element, quad must match)",
+                          path, tag, M->o.nx, M->o.ny),
                1;
     }
     ok = !fd_get(B, &ck->step, sizeof(int)) && !fd_get(B, &ck->eps, sizeof(double)) &&
@@ -325,7 +334,8 @@ static int fd_ck_read(fd_model *M, const char *dir, const char *tag, fd_buf *B, 
         fd_ck_free(ck), free(B->b), memset(B, 0, sizeof *B);
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
     }
-    ok = ok && !fd_get(B, ck->rows, (size_t)ck->nc * sizeof(fd_row)) && !fd_get(B, ck->v, nv * sizeof(double));
+    ok =
+        ok && !fd_get(B, ck->rows, (size_t)ck->nc * sizeof(fd_row)) && !fd_get(B, ck->v, nv * sizeof(double));
     if (!ok) snprintf(why, sizeof why, "the driver's block is truncated");
     if (!ok || fd_ck_check(M, ck, why, sizeof why)) {
         fd_ck_free(ck), free(B->b), memset(B, 0, sizeof *B);

@@ -139,8 +139,8 @@ static int fd_newton(fd_model *M, double inc, int *iters, double *Ed_out, double
             double nmean;
             int nmax;
             fd_dem_stats(M, &nmean, &nmax);
-            fd_say(M, "    iter %2d: E_d %.3e  E_f %.3e  DEM steps per RVE mean %.1f max %d  %.2f s\n", it, Ed, Ef,
-                   nmean, nmax, gk_wtime() - t0);
+            fd_say(M, "    iter %2d: E_d %.3e  E_f %.3e  DEM steps per RVE mean %.1f max %d  %.2f s\n", it,
+                   Ed, Ef, nmean, nmax, gk_wtime() - t0);
         }
         /* cyclic: a predictor already in equilibrium is accepted at the first iteration (displacement-
          * driven shear of a uniform specimen: the predictor is exact until the RVEs drift apart) */
@@ -180,12 +180,13 @@ static int fd_cut_back(fd_model *M, const char *what, double strain, double nomi
                        gk_err *err) {
     gk_twoscale_reject(&M->ts); /* the next try starts from the converged states */
     M->scale *= 0.5;
-    fd_say(M, "%s: step at %.3f %% did not converge in %d iterations (E_d %.3g)%s%s; increment cut to %.4g %%\n",
+    fd_say(M,
+           "%s: step at %.3f %% did not converge in %d iterations (E_d %.3g)%s%s; increment cut to %.4g %%\n",
            M->prog, 100 * strain, iters, Ed, err->msg[0] ? ": " : "", err->msg, 100 * nominal * M->scale);
     err->msg[0] = 0;
     if (M->scale >= 1.0 / 16) return 0;
-    fd_say(M, "%s: giving up at %s %.3f %%; last converged state in %s/checkpoint.bin\n", M->prog, what, 100 * strain,
-           M->o.out);
+    fd_say(M, "%s: giving up at %s %.3f %%; last converged state in %s/checkpoint.bin\n", M->prog, what,
+           100 * strain, M->o.out);
     if (M->checkpoint) M->checkpoint(M);
     return 1;
 }

@@ -82,9 +82,11 @@ static int krylov_probe(probe_model *P, int it, double Ef, gk_err *err) {
     int n = M->ndof, j, i, k, nbad = 0, m;
     long long pd = M->pend_dem, pr = M->pend_reused, pc = M->pend_computed;
     double *Dp = (double *)malloc((size_t)M->ngp * 16 * sizeof(double)),
-           *u0 = (double *)malloc((size_t)n * sizeof(double)), *R0 = (double *)malloc((size_t)n * sizeof(double)),
+           *u0 = (double *)malloc((size_t)n * sizeof(double)),
+           *R0 = (double *)malloc((size_t)n * sizeof(double)),
            *V = (double *)malloc((size_t)(KRYLOV_M + 1) * n * sizeof(double)),
-           *Z = (double *)malloc((size_t)KRYLOV_M * n * sizeof(double)), *w = (double *)malloc((size_t)n * sizeof(double));
+           *Z = (double *)malloc((size_t)KRYLOV_M * n * sizeof(double)),
+           *w = (double *)malloc((size_t)n * sizeof(double));
     double Hh[KRYLOV_M + 1][KRYLOV_M], cs[KRYLOV_M], sn[KRYLOV_M], gv[KRYLOV_M + 1], beta, un;
     if (!Dp || !u0 || !R0 || !V || !Z || !w) {
         free(Dp), free(u0), free(R0), free(V), free(Z), free(w);
@@ -96,7 +98,9 @@ static int krylov_probe(probe_model *P, int it, double Ef, gk_err *err) {
     memcpy(u0, M->u, (size_t)n * sizeof(double));
     memcpy(R0, M->R, (size_t)n * sizeof(double));
     un = fd_norm(u0, n), beta = fd_norm(R0, n);
-    fd_say(M, "    krylov probe at iteration %d (E_f %.3e, |h z| = %g |u|): m, |R + J d|/|R| (model), E_f at u + d:\n",
+    fd_say(M,
+           "    krylov probe at iteration %d (E_f %.3e, |h z| = %g |u|): m, |R + J d|/|R| (model), E_f at u "
+           "+ d:\n",
            it, Ef, P->kscale);
     memset(Hh, 0, sizeof Hh);
     for (k = 0; k < n; ++k) V[k] = beta > 0 ? -R0[k] / beta : 0.0;
@@ -153,22 +157,28 @@ static int krylov_probe(probe_model *P, int it, double Ef, gk_err *err) {
 static int probe(fd_model *M, int it, double Ef, gk_err *err) {
     probe_model *P = (probe_model *)M;
     if (it == P->noise && noise_probe(M, it, Ef, err))
-        return gk_err_set(err, GK_ERR_STATE, "an RVE run failed again at the iterate after the noise probe"), 1;
+        return gk_err_set(err, GK_ERR_STATE, "an RVE run failed again at the iterate after the noise probe"),
+               1;
     if (it == P->krylov && krylov_probe(P, it, Ef, err))
-        return gk_err_set(err, GK_ERR_STATE, "an RVE run failed again at the iterate after the Krylov probe"), 1;
+        return gk_err_set(err, GK_ERR_STATE, "an RVE run failed again at the iterate after the Krylov probe"),
+               1;
     return 0;
 }
 
 static void usage(FILE *fp) {
-    fprintf(fp, "usage: femdem_probe [femdem_biaxial's options] --noise-probe K | --krylov-probe K [--krylov-scale X]\n\n"
-                "  --noise-probe K        at Newton iteration K of every step, re-run all RVEs at u (1 + eps),\n"
-                "                         eps = 1e-6 ... 1e-2, and print |R(u (1+eps)) - R(u)| / |f_int| next to E_f\n"
-                "  --krylov-probe K       at Newton iteration K of every step, GMRES on J d = -R with J the RVEs'\n"
-                "                         own responses (R(u + h z) - R(u)) / h, |h z| = X |u| (--krylov-scale X,\n"
-                "                         default 0.05), preconditioned by the iterate's tangent: for 1-6\n"
-                "                         directions, the model's |R + J d| / |R| and the E_f found at u + d\n"
-                "  The run is femdem_biaxial's, its CSV unchanged (the probes' RVE runs are not counted; the\n"
-                "  iterate is evaluated again after them). Not with --tangent-reuse.\n\n");
+    fprintf(
+        fp,
+        "usage: femdem_probe [femdem_biaxial's options] --noise-probe K | --krylov-probe K [--krylov-scale "
+        "X]\n\n"
+        "  --noise-probe K        at Newton iteration K of every step, re-run all RVEs at u (1 + eps),\n"
+        "                         eps = 1e-6 ... 1e-2, and print |R(u (1+eps)) - R(u)| / |f_int| next to "
+        "E_f\n"
+        "  --krylov-probe K       at Newton iteration K of every step, GMRES on J d = -R with J the RVEs'\n"
+        "                         own responses (R(u + h z) - R(u)) / h, |h z| = X |u| (--krylov-scale X,\n"
+        "                         default 0.05), preconditioned by the iterate's tangent: for 1-6\n"
+        "                         directions, the model's |R + J d| / |R| and the E_f found at u + d\n"
+        "  The run is femdem_biaxial's, its CSV unchanged (the probes' RVE runs are not counted; the\n"
+        "  iterate is evaluated again after them). Not with --tangent-reuse.\n\n");
     fd_usage_common(fp);
 }
 
@@ -191,7 +201,8 @@ int main(int argc, char **argv) {
         usage(stdout);
     else if (!status && (P.noise > 0 || P.krylov > 0) && M->o.tangent_reuse > 0) {
         fprintf(stderr,
-                "%s: --%s-probe re-runs the RVEs and would move the reference of --tangent-reuse: use one of them\n",
+                "%s: --%s-probe re-runs the RVEs and would move the reference of --tangent-reuse: use one of "
+                "them\n",
                 M->prog, P.noise > 0 ? "noise" : "krylov");
         status = 2;
     } else if (!status && !(status = fdb_check(M)))

@@ -100,15 +100,17 @@ int main(int argc, char **argv) {
     R->role = (unsigned char *)calloc((size_t)R->pk.n, 1);
     if (!R->role) return fprintf(stderr, "error: out of memory\n"), 1;
     if (!o->quiet)
-        printf("%s %s: specimen %.4g x %.4g m, %d grains, packing fraction %.4f, pressure %g Pa, speed %g m/s, dt %g s\n",
-               test_name[o->test], mode_name[o->mode], R->W, R->H, R->pk.n, R->phi_pack, o->pressure, o->speed, R->dt);
+        printf("%s %s: specimen %.4g x %.4g m, %d grains, packing fraction %.4f, pressure %g Pa, speed %g "
+               "m/s, dt %g s\n",
+               test_name[o->test], mode_name[o->mode], R->W, R->H, R->pk.n, R->phi_pack, o->pressure,
+               o->speed, R->dt);
     if (o->mode == M_DEM) {
         if (setup_dem(R)) return 1;
     } else {
         if (setup_mpm(R) || oracle_setup(R)) return 1;
         if (!o->quiet)
-            printf("continuum: %.4g x %.4g m, cells of %.4g m, %d points, c = %.4g m/s (0.3 h/c = %.3g s)\n", R->W, R->H,
-                   R->h, R->P.n, R->c, 0.3 * R->h / R->c);
+            printf("continuum: %.4g x %.4g m, cells of %.4g m, %d points, c = %.4g m/s (0.3 h/c = %.3g s)\n",
+                   R->W, R->H, R->h, R->P.n, R->c, 0.3 * R->h / R->c);
     }
     /* the band window: planar, the mid-height strip; biaxial, the line from the weak cell through the centre */
     R->win_c[0] = 0.5 * R->W;
@@ -119,7 +121,8 @@ int main(int argc, char **argv) {
         double dx = 0.5 * R->W - (R->W - 1.5 * hg), dy = 0.5 * R->H - 1.5 * hg, L = sqrt(dx * dx + dy * dy);
         R->win_e[0] = dx / L;
         R->win_e[1] = dy / L;
-        R->win_a = 0.3 * (fabs(R->W / R->win_e[0]) < fabs(R->H / R->win_e[1]) ? fabs(R->W / R->win_e[0]) : fabs(R->H / R->win_e[1]));
+        R->win_a = 0.3 * (fabs(R->W / R->win_e[0]) < fabs(R->H / R->win_e[1]) ? fabs(R->W / R->win_e[0])
+                                                                              : fabs(R->H / R->win_e[1]));
     }
     R->A0 = specimen_area(R);
     R->phi0_band = band_solid_fraction(R);
@@ -127,7 +130,8 @@ int main(int argc, char **argv) {
     snprintf(path, sizeof path, "%s/hybrid.csv", o->out);
     R->csv = fopen(path, "w");
     if (!R->csv) return fprintf(stderr, "error: cannot write %s\n", path), 1;
-    fprintf(R->csv, "time,strain,tau,sigma_n,eps_v,eps_v_band,grains,points,enriched,flagged_nodes,seconds\n");
+    fprintf(R->csv,
+            "time,strain,tau,sigma_n,eps_v,eps_v_band,grains,points,enriched,flagged_nodes,seconds\n");
     if (write_vtk(R, "start") || csv_row(R, &h)) return 1;
     R->next_out = o->out_every;
     while (R->strain < o->strain_end - 1e-12) {
@@ -161,15 +165,18 @@ int main(int argc, char **argv) {
         status = 1;
     }
     if (!o->quiet && R->grain_steps > 0)
-        printf("cost: %.3g s in the grains (%.3g grain-steps, %.3g us each), %.3g s in the continuum (%.3g point-steps, "
+        printf("cost: %.3g s in the grains (%.3g grain-steps, %.3g us each), %.3g s in the continuum (%.3g "
+               "point-steps, "
                "%.3g us each), %.3g s coupling\n",
                R->sec_dem, (double)R->grain_steps, 1e6 * R->sec_dem / (double)R->grain_steps, R->sec_mpm,
-               (double)R->point_steps, R->point_steps ? 1e6 * R->sec_mpm / (double)R->point_steps : 0.0, R->sec_cpl);
+               (double)R->point_steps, R->point_steps ? 1e6 * R->sec_mpm / (double)R->point_steps : 0.0,
+               R->sec_cpl);
     printf("RESULT mode=%s peak_tau=%.6g band_thickness_D50=%.4g strain_at_enrichment=%.4g seconds=%.2f "
            "speedup_vs_dem=%.3g\n",
            mode_name[o->mode], R->peak_tau, thick,
-           o->mode == M_HYBRID ? (R->enriched ? R->strain_enrich : NAN) : (R->triggered ? R->strain_trigger : NAN), secs,
-           o->dem_seconds > 0.0 ? o->dem_seconds / secs : NAN);
+           o->mode == M_HYBRID ? (R->enriched ? R->strain_enrich : NAN)
+                               : (R->triggered ? R->strain_trigger : NAN),
+           secs, o->dem_seconds > 0.0 ? o->dem_seconds / secs : NAN);
     free(h.s);
     free(h.tau);
     free(h.sn);

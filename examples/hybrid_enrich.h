@@ -294,17 +294,17 @@ static int enrich(run *R) {
             w.drive = GK_DRIVE_VELOCITY;
             w.velocity[1] = R->body.v[1];
             if (gk_scene_add_wall(&R->sc, &w, &R->top_wall)) {
-        fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc));
-        goto done;
-    }
+                fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc));
+                goto done;
+            }
         }
         /* the specimen's sides at enrichment: the extent of the continuum's outer points per row */
         l = (double *)malloc((size_t)nrow * sizeof(double));
         r = (double *)malloc((size_t)nrow * sizeof(double));
         if (!l || !r) {
-        fprintf(stderr, "error: out of memory\n");
-        goto done;
-    }
+            fprintf(stderr, "error: out of memory\n");
+            goto done;
+        }
         extent_rows(R, nrow, row_h, l, r);
         if (add_membranes(R, l, r, nrow, row_h)) {
             free(l), free(r);
@@ -362,7 +362,8 @@ static int hybrid_step(run *R) {
     }
     if (mpm_predict(R)) return 1;
     t0 = wtime();
-    if (gk_scene_step(sc, 1)) return fprintf(stderr, "error: DEM at t = %g s: %s\n", R->t, gk_scene_error(sc)), 1;
+    if (gk_scene_step(sc, 1))
+        return fprintf(stderr, "error: DEM at t = %g s: %s\n", R->t, gk_scene_error(sc)), 1;
     R->sec_dem += wtime() - t0;
     R->grain_steps += ng;
     t0 = wtime();
@@ -390,7 +391,9 @@ static int continuum_step(run *R) {
         if (trig && !R->triggered) {
             R->triggered = 1;
             R->strain_trigger = R->strain;
-            if (!R->o.quiet) printf("oracle: %d nodes flagged and unchanged for tau_g at strain %.4g\n", R->orc.nflag, R->strain);
+            if (!R->o.quiet)
+                printf("oracle: %d nodes flagged and unchanged for tau_g at strain %.4g\n", R->orc.nflag,
+                       R->strain);
         }
         if (trig && R->o.mode == M_HYBRID && enrich(R)) return 1;
     }

@@ -37,7 +37,8 @@ static int setup_dem(run *R) {
         gk_wall_def w = gk_wall_def_default();
         double ytop = -HUGE_VAL;
         int nrow = (int)floor(R->H / (2.0 * DIAM)), k;
-        double *l = (double *)malloc((size_t)nrow * sizeof(double)), *r = (double *)malloc((size_t)nrow * sizeof(double));
+        double *l = (double *)malloc((size_t)nrow * sizeof(double)),
+               *r = (double *)malloc((size_t)nrow * sizeof(double));
         for (p = 0; p < n; ++p) {
             double x[3];
             gk_scene_position(sc, p, x);
@@ -49,7 +50,8 @@ static int setup_dem(run *R) {
         w.mat = grain_material(zeta_paper(), 0.4);
         w.mat.friction = 0.0;
         w.drive = GK_DRIVE_VELOCITY;
-        if (gk_scene_add_wall(sc, &w, &R->top_wall)) return fprintf(stderr, "error: %s\n", gk_scene_error(sc)), 1;
+        if (gk_scene_add_wall(sc, &w, &R->top_wall))
+            return fprintf(stderr, "error: %s\n", gk_scene_error(sc)), 1;
         R->y_plate0 = ytop;
         if (!l || !r) return fprintf(stderr, "error: out of memory\n"), 1;
         for (k = 0; k < nrow; ++k) { /* the packing's sides */
@@ -138,16 +140,20 @@ static int setup_mpm(run *R) {
     gk_err e;
     double org[3] = {0.0, 0.0, 0.0}, Phi0;
     int n[3] = {1, 1, 1}, ncx = (int)floor(R->W / o->cell + 0.5), nxp, nyp, i, j, p, margin;
-    if (ncx < 3) return fprintf(stderr, "error: --cell %g: fewer than 3 cells across %g m\n", o->cell, R->W), 1;
+    if (ncx < 3)
+        return fprintf(stderr, "error: --cell %g: fewer than 3 cells across %g m\n", o->cell, R->W), 1;
     R->h = R->W / ncx;
     if (R->dt > 0.3 * R->h / R->c)
-        return fprintf(stderr, "error: the MPM step %g s is above 0.3 h / c = %g s\n", R->dt, 0.3 * R->h / R->c), 1;
+        return fprintf(stderr, "error: the MPM step %g s is above 0.3 h / c = %g s\n", R->dt,
+                       0.3 * R->h / R->c),
+               1;
     margin = o->test == T_PLANAR ? 1 : 3;
     org[0] = -margin * R->h;
     org[1] = -R->h;
     n[0] = ncx + 2 * margin + (o->test == T_PLANAR ? 1 : 1);
     n[1] = (int)ceil(R->H / R->h) + 5;
-    if (gk_mpm_grid_create(&R->g, 2, org, R->h, n, NULL, &e)) return fprintf(stderr, "error: grid: %s\n", e.msg), 1;
+    if (gk_mpm_grid_create(&R->g, 2, org, R->h, n, NULL, &e))
+        return fprintf(stderr, "error: grid: %s\n", e.msg), 1;
     memset(&R->per, 0, sizeof R->per);
     if (o->test == T_PLANAR) {
         R->per.ghost[0] = 1;
@@ -157,7 +163,8 @@ static int setup_mpm(run *R) {
     R->md.basis = GK_MPM_UGIMP;
     R->md.alpha = o->alpha;
     R->md.threads = o->threads;
-    if (gk_hybrid_periodic_check(&R->g, &R->per, R->md.basis, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+    if (gk_hybrid_periodic_check(&R->g, &R->per, R->md.basis, &e))
+        return fprintf(stderr, "error: %s\n", e.msg), 1;
     gk_mpm_grid_set_bc(&R->g, 2, GK_MPM_BC_FIXED, 0.0, 2, &e); /* bottom: no slip */
     /* points: ppd per cell edge on the cells' lattice (a point row that straddled
      * a cell boundary would tie a band to its neighbours); the continuum's
@@ -186,14 +193,16 @@ static int setup_mpm(run *R) {
     dp.chi = 7.0;
     dp.xi = o->xi;
     Phi0 = o->phi_init > 0.0 ? o->phi_init : R->phi_pack;
-    if (gk_hybrid_cont_init(&R->C, &R->P, &dp, Phi0, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+    if (gk_hybrid_cont_init(&R->C, &R->P, &dp, Phi0, NULL, &e))
+        return fprintf(stderr, "error: %s\n", e.msg), 1;
     /* the weak points that seed the band */
     for (p = 0; p < R->P.n; ++p) {
         double x = R->P.x[0][p], y = R->P.x[1][p];
         /* a whole cell row (planar) or cell (biaxial): a band of weak points that
          * shares its cells with strong ones could not slip alone */
-        int weak = o->test == T_PLANAR ? (int)floor(y / R->h) == (int)floor(0.5 * R->H / R->h)
-                                       : (x > R->W - 2.0 * R->h && x < R->W - R->h && y > R->h && y < 2.0 * R->h);
+        int weak = o->test == T_PLANAR
+                       ? (int)floor(y / R->h) == (int)floor(0.5 * R->H / R->h)
+                       : (x > R->W - 2.0 * R->h && x < R->W - R->h && y > R->h && y < 2.0 * R->h);
         if (weak) R->C.Phi[p] = Phi0 - o->weak_dphi;
     }
     /* the top platen: rough and servo-controlled (planar) or frictionless (biaxial) */
@@ -290,7 +299,8 @@ static int oracle_setup(run *R) {
     d.cl = R->o.cl;
     d.cg = R->o.cg;
     d.D50 = DIAM;
-    if (gk_hybrid_oracle_init(&R->orc, &d, nn, NULL, &e) || gk_hybrid_history_init(&R->hist, n, 3, 512, NULL, &e))
+    if (gk_hybrid_oracle_init(&R->orc, &d, nn, NULL, &e) ||
+        gk_hybrid_history_init(&R->hist, n, 3, 512, NULL, &e))
         return fprintf(stderr, "error: %s\n", e.msg), 1;
     R->past = (double *)malloc(3 * (size_t)n * sizeof(double));
     R->pval = (double *)malloc(2 * (size_t)n * sizeof(double));
@@ -315,7 +325,8 @@ static int oracle_eval(run *R) {
     tau_l = R->o.cl / gd;
     tau_g = R->o.cg / gd;
     if (R->t - R->t_push >= tau_l / 256.0) {
-        if (gk_hybrid_history_push(&R->hist, R->t, R->C.ep, &e)) return fprintf(stderr, "error: %s\n", e.msg), -1;
+        if (gk_hybrid_history_push(&R->hist, R->t, R->C.ep, &e))
+            return fprintf(stderr, "error: %s\n", e.msg), -1;
         R->t_push = R->t;
     }
     gk_hybrid_history_at(&R->hist, R->t - tau_l, R->past);
@@ -328,8 +339,8 @@ static int oracle_eval(run *R) {
     xs[0] = R->P.x[0];
     xs[1] = R->P.x[1];
     xs[2] = NULL;
-    if (gk_hybrid_rasterize(&R->g, &R->per, R->md.basis, R->P.lp[0], n, (const double *const *)xs, R->P.m, R->pval, 2,
-                            NULL, R->nnum, R->nden, &e))
+    if (gk_hybrid_rasterize(&R->g, &R->per, R->md.basis, R->P.lp[0], n, (const double *const *)xs, R->P.m,
+                            R->pval, 2, NULL, R->nnum, R->nden, &e))
         return fprintf(stderr, "error: oracle: %s\n", e.msg), -1;
     gk_hybrid_bc_mask(&R->g, R->bcmask);
     for (I = 0; I < nn; ++I) {

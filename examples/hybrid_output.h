@@ -35,7 +35,8 @@ static int write_vtk(run *R, const char *tag) {
     if (R->have_mpm && R->P.n > 0) {
         gk_vtk v;
         int n = R->P.n, p, ok;
-        double *xyz = (double *)malloc(3 * (size_t)n * sizeof(double)), *f = (double *)malloc(3 * (size_t)n * sizeof(double));
+        double *xyz = (double *)malloc(3 * (size_t)n * sizeof(double)),
+               *f = (double *)malloc(3 * (size_t)n * sizeof(double));
         int *conn = (int *)malloc((size_t)n * sizeof(int));
         snprintf(path, sizeof path, "%s/points_%s.vtk", R->o.out, tag);
         ok = xyz && f && conn;
@@ -50,9 +51,11 @@ static int write_vtk(run *R, const char *tag) {
             f[2 * n + p] = R->C.zone[p];
         }
         ok = ok && !gk_vtk_open(&v, path, "grainkit hybrid: material points") && !gk_vtk_points(&v, n, xyz) &&
-             !gk_vtk_cells(&v, n, 1, conn, GK_VTK_VERTEX) && !gk_vtk_point_scalar(&v, "packing_fraction", f) &&
-             !gk_vtk_point_scalar(&v, "plastic_strain", f + n) && !gk_vtk_point_scalar(&v, "zone", f + 2 * n) &&
-             !gk_vtk_point_tensor(&v, "stress", R->P.sigma) && !gk_vtk_close(&v);
+             !gk_vtk_cells(&v, n, 1, conn, GK_VTK_VERTEX) &&
+             !gk_vtk_point_scalar(&v, "packing_fraction", f) &&
+             !gk_vtk_point_scalar(&v, "plastic_strain", f + n) &&
+             !gk_vtk_point_scalar(&v, "zone", f + 2 * n) && !gk_vtk_point_tensor(&v, "stress", R->P.sigma) &&
+             !gk_vtk_close(&v);
         if (!ok) bad = fprintf(stderr, "error: cannot write %s\n", path);
         free(xyz);
         free(f);
@@ -74,8 +77,9 @@ static int csv_row(run *R, hist_t *h) {
         ev = R->plate_y / R->H;
     else
         ev = specimen_area(R) / R->A0 - 1.0;
-    if (fprintf(R->csv, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%.3f\n", R->t, R->strain, R->tau, R->sig_n, ev, evb,
-                grains, points, R->enriched, R->enriched ? 0 : R->orc.nflag, wtime() - R->t_start) < 0)
+    if (fprintf(R->csv, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%.3f\n", R->t, R->strain, R->tau, R->sig_n,
+                ev, evb, grains, points, R->enriched, R->enriched ? 0 : R->orc.nflag,
+                wtime() - R->t_start) < 0)
         return fprintf(stderr, "error: cannot write %s/hybrid.csv\n", R->o.out), 1;
     if (R->tau > R->peak_tau) R->peak_tau = R->tau;
     if (h->n == h->cap) {
@@ -101,7 +105,8 @@ static int csv_row(run *R, hist_t *h) {
     h->evb[h->n] = 100.0 * evb;
     ++h->n;
     if (!R->o.quiet)
-        printf("t %.4f s  strain %6.3f %%  tau %8.2f kPa  sigma_n %8.2f kPa  eps_v %7.3f %%  band %7.3f %%  %s%s\n",
+        printf("t %.4f s  strain %6.3f %%  tau %8.2f kPa  sigma_n %8.2f kPa  eps_v %7.3f %%  band %7.3f %%  "
+               "%s%s\n",
                R->t, 100.0 * R->strain, 1e-3 * R->tau, 1e-3 * R->sig_n, 100.0 * ev, 100.0 * evb,
                R->enriched ? "enriched" : "", R->triggered && !R->enriched ? "flagged" : "");
     return 0;
@@ -158,7 +163,8 @@ static int band_measure(run *R, double *thick_D50) {
         x[0] = (double *)malloc((size_t)n * sizeof(double));
         x[1] = (double *)malloc((size_t)n * sizeof(double));
         eps = (double *)malloc(4 * (size_t)n * sizeof(double));
-        if (!half || !X[0] || !X[1] || !x[0] || !x[1] || !eps) return fprintf(stderr, "error: out of memory\n"), 1;
+        if (!half || !X[0] || !X[1] || !x[0] || !x[1] || !eps)
+            return fprintf(stderr, "error: out of memory\n"), 1;
         for (p = 0; p < R->nw; ++p) {
             int i = gk_scene_index(&R->sc, R->idw[p]);
             double xx[3];
@@ -172,7 +178,8 @@ static int band_measure(run *R, double *thick_D50) {
             ++q;
         }
         if (R->o.test == T_PLANAR) period[0] = R->W;
-        if (gk_hybrid_cundall(q, (const double *const *)X, (const double *const *)x, period, 1.6 * DIAM, eps, NULL, &e))
+        if (gk_hybrid_cundall(q, (const double *const *)X, (const double *const *)x, period, 1.6 * DIAM, eps,
+                              NULL, &e))
             return fprintf(stderr, "error: Cundall strain: %s\n", e.msg), 1;
         for (p = 0; p < q; ++p) {
             val[p] = eps[4 * p + 3];
@@ -182,8 +189,10 @@ static int band_measure(run *R, double *thick_D50) {
         n = q;
         for (p = 0; p < n; ++p) {
             double a = half[p];
-            xy[8 * p] = px[p] - a, xy[8 * p + 1] = py[p] - a, xy[8 * p + 2] = px[p] + a, xy[8 * p + 3] = py[p] - a;
-            xy[8 * p + 4] = px[p] + a, xy[8 * p + 5] = py[p] + a, xy[8 * p + 6] = px[p] - a, xy[8 * p + 7] = py[p] + a;
+            xy[8 * p] = px[p] - a, xy[8 * p + 1] = py[p] - a, xy[8 * p + 2] = px[p] + a,
+                   xy[8 * p + 3] = py[p] - a;
+            xy[8 * p + 4] = px[p] + a, xy[8 * p + 5] = py[p] + a, xy[8 * p + 6] = px[p] - a,
+                       xy[8 * p + 7] = py[p] + a;
         }
         free(half);
         free(X[0]);
@@ -205,8 +214,10 @@ static int band_measure(run *R, double *thick_D50) {
             px[p] = R->P.x[0][p];
             py[p] = R->P.x[1][p];
             a = 0.5 * sqrt(R->P.vol[p]);
-            xy[8 * p] = px[p] - a, xy[8 * p + 1] = py[p] - a, xy[8 * p + 2] = px[p] + a, xy[8 * p + 3] = py[p] - a;
-            xy[8 * p + 4] = px[p] + a, xy[8 * p + 5] = py[p] + a, xy[8 * p + 6] = px[p] - a, xy[8 * p + 7] = py[p] + a;
+            xy[8 * p] = px[p] - a, xy[8 * p + 1] = py[p] - a, xy[8 * p + 2] = px[p] + a,
+                   xy[8 * p + 3] = py[p] - a;
+            xy[8 * p + 4] = px[p] + a, xy[8 * p + 5] = py[p] + a, xy[8 * p + 6] = px[p] - a,
+                       xy[8 * p + 7] = py[p] + a;
         }
     }
     if (gk_hybrid_band(n, px, py, val, R->o.percentile, 2.0, &b, NULL, &e) == GK_OK) {
@@ -214,19 +225,22 @@ static int band_measure(run *R, double *thick_D50) {
         if (!R->band_on_grains) b.thickness += R->dyp;
         *thick_D50 = b.thickness / DIAM;
         if (!R->o.quiet)
-            printf("band (App. A, %s, strain %.3g-%.3g): thickness %.2f D50, angle %.1f deg, centre (%.2f, %.2f) cm, %d of "
+            printf("band (App. A, %s, strain %.3g-%.3g): thickness %.2f D50, angle %.1f deg, centre (%.2f, "
+                   "%.2f) cm, %d of "
                    "%d above the %g-th percentile kept\n",
                    R->band_on_grains ? "grains, Cundall" : "points", R->o.win0, R->strain, b.thickness / DIAM,
-                   b.angle * 180.0 / GK_PI, 100.0 * b.centre[0], 100.0 * b.centre[1], b.kept, b.selected, R->o.percentile);
+                   b.angle * 180.0 / GK_PI, 100.0 * b.centre[0], 100.0 * b.centre[1], b.kept, b.selected,
+                   R->o.percentile);
     }
     {
         gk_field_def fd;
         int len[2] = {2, 2};
-        double Hc = specimen_height(R), lines[8] = {-0.05 * R->W, 0.0, 1.05 * R->W, 0.0, -0.05 * R->W, Hc, 1.05 * R->W, Hc};
+        double Hc = specimen_height(R),
+               lines[8] = {-0.05 * R->W, 0.0, 1.05 * R->W, 0.0, -0.05 * R->W, Hc, 1.05 * R->W, Hc};
         char title[200];
         memset(&fd, 0, sizeof fd);
-        snprintf(title, sizeof title, "%s %s: incremental shear strain, strain %.3g to %.3g", test_name[R->o.test],
-                 mode_name[R->o.mode], R->o.win0, R->strain);
+        snprintf(title, sizeof title, "%s %s: incremental shear strain, strain %.3g to %.3g",
+                 test_name[R->o.test], mode_name[R->o.mode], R->o.win0, R->strain);
         fd.title = title;
         fd.label = "gamma (incremental) [-]";
         fd.xlabel = "x [mm]";
@@ -236,7 +250,8 @@ static int band_measure(run *R, double *thick_D50) {
         fd.line_len = len;
         fd.line_xy = lines;
         snprintf(path, sizeof path, "%s/band.svg", R->o.out);
-        if (gk_field_svg(path, &fd, n, 4, xy, val, &e)) bad = fprintf(stderr, "error: cannot write %s\n", path);
+        if (gk_field_svg(path, &fd, n, 4, xy, val, &e))
+            bad = fprintf(stderr, "error: cannot write %s\n", path);
     }
     free(xy);
     free(val);
@@ -251,13 +266,15 @@ static int write_plots(const run *R, const hist_t *h) {
     char path[1200], title[200];
     int bad = 0;
     snprintf(title, sizeof title, "%s shear, %s", test_name[R->o.test], mode_name[R->o.mode]);
-    gk_plot_init(&pl, title, R->o.test == T_PLANAR ? "strain = platen displacement / W [%]" : "axial strain [%]",
+    gk_plot_init(&pl, title,
+                 R->o.test == T_PLANAR ? "strain = platen displacement / W [%]" : "axial strain [%]",
                  "stress [kPa]");
     gk_plot_add(&pl, h->s, h->tau, h->n, R->o.test == T_PLANAR ? "tau" : "tau = (sigma_1 - sigma_3)/2");
     gk_plot_add(&pl, h->s, h->sn, h->n, R->o.test == T_PLANAR ? "sigma_n" : "sigma_1 (axial)");
     snprintf(path, sizeof path, "%s/stress_strain.svg", R->o.out);
     if (gk_plot_svg(&pl, path, &e)) bad = fprintf(stderr, "error: cannot write %s\n", path);
-    gk_plot_init(&pl, title, R->o.test == T_PLANAR ? "strain [%]" : "axial strain [%]", "volumetric strain [%] (dilation +)");
+    gk_plot_init(&pl, title, R->o.test == T_PLANAR ? "strain [%]" : "axial strain [%]",
+                 "volumetric strain [%] (dilation +)");
     gk_plot_add(&pl, h->s, h->ev, h->n, "specimen");
     gk_plot_add(&pl, h->s, h->evb, h->n, "band window");
     snprintf(path, sizeof path, "%s/volume.svg", R->o.out);

@@ -49,12 +49,12 @@ static const char *test_name[] = {"planar", "biaxial"};
 static const char *mode_name[] = {"dem", "continuum", "hybrid"};
 
 /* ------------------------------------------------------------------ material */
-#define DIAM 1e-3 /* D50 [m] */
-#define THICK 1e-3      /* stress thickness: one diameter */
-#define RHO_S 25300.0   /* grain mass 1.98e-5 kg for D = 1 mm, t = 1 mm */
-#define KN 1.7720938e6  /* Table 1 */
+#define DIAM 1e-3      /* D50 [m] */
+#define THICK 1e-3     /* stress thickness: one diameter */
+#define RHO_S 25300.0  /* grain mass 1.98e-5 kg for D = 1 mm, t = 1 mm */
+#define KN 1.7720938e6 /* Table 1 */
 #define DT 5e-7
-#define PHI_CS 0.815    /* Table 2 */
+#define PHI_CS 0.815 /* Table 2 */
 #define K_C 6.3e8
 #define G_C 4.6e8
 
@@ -123,42 +123,46 @@ static void usage(FILE *fp) {
     opts p, b;
     defaults(&p, T_PLANAR);
     defaults(&b, T_BIAXIAL);
-    fprintf(fp,
-            "usage: hybrid --test planar|biaxial --mode dem|continuum|hybrid [options]\n"
-            "  --out DIR            output directory (default %s)\n"
-            "  --threads T          OpenMP threads (default 1; results do not depend on it)\n"
-            "  --width W --height H specimen [m] (planar %g x %g, biaxial %g x %g; paper 0.06 x 0.12, 0.06 x 0.0942)\n"
-            "  --grains N           grains of the generated packing (0: from the size, packing fraction 0.85)\n"
-            "  --packing FILE       read the packing (a periodic cell) instead of generating it\n"
-            "  --seed S             packing generator seed (default %lu)\n"
-            "  --pressure P         normal (planar) / confining (biaxial) stress [Pa] (default %g, %g)\n"
-            "  --speed V            platen speed [m/s] (default %g; paper 0.02)\n"
-            "  --strain S           run to this strain (default %g, %g)\n"
-            "  --out-every S        CSV row every S of strain (default %g, %g)\n"
-            "  --cell H             MPM cell [m] (default %g)\n"
-            "  --ppd K              MPM points per cell edge (default %d)\n"
-            "  --alpha A            MPM PIC fraction (default %g)\n"
-            "  --phi0 D             enrichment margin phi_0 [m] (default %g, %g)\n"
-            "  --c0 C --c1 C --cl C --cg C   oracle constants (defaults Tables 4 and 6)\n"
-            "  --oracle-every N     oracle evaluated every N steps (default %d)\n"
-            "  --train F            kinematic training fraction in [0, 1] (default %g; below 1: planar only)\n"
-            "  --train-speed V      speed of the trained boundary [m/s] (default: --speed)\n"
-            "  --phi PHI            initial continuum packing fraction (default: the packing's; below\n"
-            "                       Phi_cs = 0.815 the continuum is under-consolidated)\n"
-            "  --weak-dphi D        the weak points' packing fraction is the others' minus D (default %g)\n"
-            "  --xi X               rate of eq 8's relaxation of Phi to Phi_cs (default %g, Table 2)\n"
-            "  --window S0 S1       strain window of the band measurement (default %g %g, %g %g)\n"
-            "  --band-window B      half-width of the eps_v_band window [m] (default %g, %g)\n"
-            "  --percentile Q       band grains: value above the Q-th percentile (default %g)\n"
-            "  --platen-damping Z   planar top platen: damping ratio of its dashpot (default %g)\n"
-            "  --ramp K             the platen speed rises linearly over K wave transits H / c (default %g)\n"
-            "  --dem-seconds S      wall seconds of the dem run of the same test (for speedup_vs_dem)\n"
-            "  --paper              the paper's specimen and speed (Tables 3, 5): 6 x 12 cm (planar, phi_0 2.2 cm) or\n"
-            "                       6 x 9.42 cm (biaxial), 0.02 m/s; the other flags override it\n"
-            "  --quiet              no progress lines\n",
-            p.out, p.width, p.height, b.width, b.height, p.seed, p.pressure, b.pressure, p.speed, p.strain_end,
-            b.strain_end, p.out_every, b.out_every, p.cell, p.ppd, p.alpha, p.phi0, b.phi0, p.oracle_every,
-            p.train, p.weak_dphi, p.xi, p.win0, p.win1, b.win0, b.win1, p.band_window, b.band_window, p.percentile, p.platen_zeta, p.ramp);
+    fprintf(
+        fp,
+        "usage: hybrid --test planar|biaxial --mode dem|continuum|hybrid [options]\n"
+        "  --out DIR            output directory (default %s)\n"
+        "  --threads T          OpenMP threads (default 1; results do not depend on it)\n"
+        "  --width W --height H specimen [m] (planar %g x %g, biaxial %g x %g; paper 0.06 x 0.12, 0.06 x "
+        "0.0942)\n"
+        "  --grains N           grains of the generated packing (0: from the size, packing fraction 0.85)\n"
+        "  --packing FILE       read the packing (a periodic cell) instead of generating it\n"
+        "  --seed S             packing generator seed (default %lu)\n"
+        "  --pressure P         normal (planar) / confining (biaxial) stress [Pa] (default %g, %g)\n"
+        "  --speed V            platen speed [m/s] (default %g; paper 0.02)\n"
+        "  --strain S           run to this strain (default %g, %g)\n"
+        "  --out-every S        CSV row every S of strain (default %g, %g)\n"
+        "  --cell H             MPM cell [m] (default %g)\n"
+        "  --ppd K              MPM points per cell edge (default %d)\n"
+        "  --alpha A            MPM PIC fraction (default %g)\n"
+        "  --phi0 D             enrichment margin phi_0 [m] (default %g, %g)\n"
+        "  --c0 C --c1 C --cl C --cg C   oracle constants (defaults Tables 4 and 6)\n"
+        "  --oracle-every N     oracle evaluated every N steps (default %d)\n"
+        "  --train F            kinematic training fraction in [0, 1] (default %g; below 1: planar only)\n"
+        "  --train-speed V      speed of the trained boundary [m/s] (default: --speed)\n"
+        "  --phi PHI            initial continuum packing fraction (default: the packing's; below\n"
+        "                       Phi_cs = 0.815 the continuum is under-consolidated)\n"
+        "  --weak-dphi D        the weak points' packing fraction is the others' minus D (default %g)\n"
+        "  --xi X               rate of eq 8's relaxation of Phi to Phi_cs (default %g, Table 2)\n"
+        "  --window S0 S1       strain window of the band measurement (default %g %g, %g %g)\n"
+        "  --band-window B      half-width of the eps_v_band window [m] (default %g, %g)\n"
+        "  --percentile Q       band grains: value above the Q-th percentile (default %g)\n"
+        "  --platen-damping Z   planar top platen: damping ratio of its dashpot (default %g)\n"
+        "  --ramp K             the platen speed rises linearly over K wave transits H / c (default %g)\n"
+        "  --dem-seconds S      wall seconds of the dem run of the same test (for speedup_vs_dem)\n"
+        "  --paper              the paper's specimen and speed (Tables 3, 5): 6 x 12 cm (planar, phi_0 2.2 "
+        "cm) or\n"
+        "                       6 x 9.42 cm (biaxial), 0.02 m/s; the other flags override it\n"
+        "  --quiet              no progress lines\n",
+        p.out, p.width, p.height, b.width, b.height, p.seed, p.pressure, b.pressure, p.speed, p.strain_end,
+        b.strain_end, p.out_every, b.out_every, p.cell, p.ppd, p.alpha, p.phi0, b.phi0, p.oracle_every,
+        p.train, p.weak_dphi, p.xi, p.win0, p.win1, b.win0, b.win1, p.band_window, b.band_window,
+        p.percentile, p.platen_zeta, p.ramp);
 }
 
 static int num(const char *s, double *v) {
@@ -220,7 +224,8 @@ static int parse(int argc, char **argv, opts *o) {
             {"--cell", CLI_REAL, &o->cell, 0.0, HUGE_VAL, "a positive cell size", NULL, CLI_LO_OPEN},
             {"--alpha", CLI_REAL, &o->alpha, 0.0, 1.0, "a value in [0, 1]", NULL, 0},
             {"--train", CLI_REAL, &o->train, 0.0, 1.0, "a fraction in [0, 1]", NULL, 0},
-            {"--train-speed", CLI_REAL, &o->train_speed, 0.0, 10.0, "a speed in (0, 10] m/s", NULL, CLI_LO_OPEN},
+            {"--train-speed", CLI_REAL, &o->train_speed, 0.0, 10.0, "a speed in (0, 10] m/s", NULL,
+             CLI_LO_OPEN},
             {"--phi0", CLI_REAL, &o->phi0, 0.0, HUGE_VAL, "a positive distance", NULL, CLI_LO_OPEN},
             {"--c0", CLI_REAL, &o->c0, 0.0, HUGE_VAL, "a value >= 0", NULL, 0},
             {"--c1", CLI_REAL, &o->c1, 0.0, HUGE_VAL, "a value >= 0", NULL, 0},
@@ -230,8 +235,10 @@ static int parse(int argc, char **argv, opts *o) {
              CLI_LO_OPEN | CLI_HI_OPEN},
             {"--weak-dphi", CLI_REAL, &o->weak_dphi, 0.0, 0.3, "a value in [0, 0.3)", NULL, CLI_HI_OPEN},
             {"--xi", CLI_REAL, &o->xi, 0.0, 1e3, "a value in [0, 1e3]", NULL, 0},
-            {"--band-window", CLI_REAL, &o->band_window, 0.0, HUGE_VAL, "a positive half-width", NULL, CLI_LO_OPEN},
-            {"--percentile", CLI_REAL, &o->percentile, 50.0, 100.0, "a percentile in [50, 100)", NULL, CLI_HI_OPEN},
+            {"--band-window", CLI_REAL, &o->band_window, 0.0, HUGE_VAL, "a positive half-width", NULL,
+             CLI_LO_OPEN},
+            {"--percentile", CLI_REAL, &o->percentile, 50.0, 100.0, "a percentile in [50, 100)", NULL,
+             CLI_HI_OPEN},
             {"--platen-damping", CLI_REAL, &o->platen_zeta, 0.0, 10.0, "a value in [0, 10]", NULL, 0},
             {"--ramp", CLI_REAL, &o->ramp, 0.0, 1e4, "a value in [0, 1e4]", NULL, 0},
             {"--dem-seconds", CLI_REAL, &o->dem_seconds, 0.0, HUGE_VAL, "a positive time", NULL, CLI_LO_OPEN},
@@ -264,7 +271,8 @@ static int parse(int argc, char **argv, opts *o) {
             if (r || help || i == argc) break;
             {
                 double v0, v1;
-                if (i + 2 >= argc || !num(argv[i + 1], &v0) || !num(argv[i + 2], &v1) || !(v0 >= 0.0 && v1 > v0))
+                if (i + 2 >= argc || !num(argv[i + 1], &v0) || !num(argv[i + 2], &v1) ||
+                    !(v0 >= 0.0 && v1 > v0))
                     r = (fprintf(stderr, "error: --window needs two strains S0 < S1\n"), 1);
                 else
                     o->win0 = v0, o->win1 = v1, i += 2;
@@ -274,7 +282,8 @@ static int parse(int argc, char **argv, opts *o) {
         if (r) return 1;
         if (help) return usage(stdout), 2;
         if (o->seed > 4294967295UL)
-            return fprintf(stderr, "hybrid: --seed %lu is out of range: needs a whole number in [0, 4294967295]\n",
+            return fprintf(stderr,
+                           "hybrid: --seed %lu is out of range: needs a whole number in [0, 4294967295]\n",
                            o->seed),
                    1;
         o->grains = grains;
@@ -286,7 +295,8 @@ static int parse(int argc, char **argv, opts *o) {
     if (o->win1 > o->strain_end + 1e-12)
         return fprintf(stderr, "error: --window end %g beyond --strain %g\n", o->win1, o->strain_end), 1;
     if (o->test == T_BIAXIAL && o->train < 1.0)
-        return fprintf(stderr, "error: --train %g: below 1 only for the planar test (the band region moves)\n",
+        return fprintf(stderr,
+                       "error: --train %g: below 1 only for the planar test (the band region moves)\n",
                        o->train),
                1;
     return 0;
@@ -319,10 +329,12 @@ static int make_dir(const char *d) {
         if (buf[k] == '/' || buf[k] == '\0') {
             char c = buf[k];
             buf[k] = '\0';
-            if (mkdir(buf, 0755) && errno != EEXIST) return fprintf(stderr, "error: cannot create %s\n", buf), 1;
+            if (mkdir(buf, 0755) && errno != EEXIST)
+                return fprintf(stderr, "error: cannot create %s\n", buf), 1;
             buf[k] = c;
         }
-    if (stat(d, &st) || !S_ISDIR(st.st_mode)) return fprintf(stderr, "error: --out %s: not a directory\n", d), 1;
+    if (stat(d, &st) || !S_ISDIR(st.st_mode))
+        return fprintf(stderr, "error: --out %s: not a directory\n", d), 1;
     return 0;
 }
 
@@ -345,8 +357,10 @@ static int consolidate(gk_rve *rve, double p, double mu) {
         return fprintf(stderr, "error: consolidation: %s\n", gk_rve_error(rve)), 1;
     for (st = 0; st < 4000000; st += 1000) {
         double fs = 0.0, un, e0, e1;
-        if (gk_rve_step(rve, 1000)) return fprintf(stderr, "error: consolidation: %s\n", gk_rve_error(rve)), 1;
-        for (q = 0; q < rve->n; ++q) fs += sqrt((double)rve->f[0][q] * rve->f[0][q] + (double)rve->f[1][q] * rve->f[1][q]);
+        if (gk_rve_step(rve, 1000))
+            return fprintf(stderr, "error: consolidation: %s\n", gk_rve_error(rve)), 1;
+        for (q = 0; q < rve->n; ++q)
+            fs += sqrt((double)rve->f[0][q] * rve->f[0][q] + (double)rve->f[1][q] * rve->f[1][q]);
         un = rve->fc_mean > 0.0 ? fs / rve->n / rve->fc_mean : 1.0;
         e0 = fabs(rve->stress[0] + p) / p;
         e1 = fabs(rve->stress[4] + p) / p;
@@ -397,7 +411,8 @@ static int make_packing(const opts *o, gk_packing *out, double *phi) {
         d.dt = DT;
         d.damping = 0.2;
         d.threads = o->threads;
-        if (gk_rve_create(&rve, &d, &pk)) return fprintf(stderr, "error: packing: %s\n", gk_rve_error(&rve)), 1;
+        if (gk_rve_create(&rve, &d, &pk))
+            return fprintf(stderr, "error: packing: %s\n", gk_rve_error(&rve)), 1;
         gk_packing_free(&pk);
         if (consolidate(&rve, o->pressure, 0.0) || consolidate(&rve, o->pressure, 0.5)) {
             gk_rve_destroy(&rve);
@@ -405,8 +420,8 @@ static int make_packing(const opts *o, gk_packing *out, double *phi) {
         }
         gk_rve_stress(&rve, s);
         if (!o->quiet)
-            printf("packing: %d grains consolidated to %.4g, %.4g Pa in a %.4g x %.4g m cell\n", rve.n, -s[0], -s[4],
-                   rve.cell.h[0], rve.cell.h[4]);
+            printf("packing: %d grains consolidated to %.4g, %.4g Pa in a %.4g x %.4g m cell\n", rve.n, -s[0],
+                   -s[4], rve.cell.h[0], rve.cell.h[4]);
         if (gk_rve_to_packing(&rve, out, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
         gk_rve_destroy(&rve);
     }
@@ -540,7 +555,8 @@ static int add_membranes(run *R, const double *left, const double *right, int nr
     int n = sc->rve.n, s, p, k, nb = (int)ceil(2.0 * R->H / DIAM) + 1, nsel;
     int32_t *ids = (int32_t *)malloc((size_t)n * sizeof(int32_t));
     int *best = (int *)malloc((size_t)nb * sizeof(int)), *ord = (int *)malloc((size_t)nb * sizeof(int));
-    double *bx = (double *)malloc((size_t)nb * sizeof(double)), *yy = (double *)malloc((size_t)nb * sizeof(double));
+    double *bx = (double *)malloc((size_t)nb * sizeof(double)),
+           *yy = (double *)malloc((size_t)nb * sizeof(double));
     double ytop = R->top_wall >= 0 ? sc->walls[R->top_wall].pos[1] : HUGE_VAL;
     if (!ids || !best || !ord || !bx || !yy) return fprintf(stderr, "error: out of memory\n"), 1;
     for (s = -1; s <= 1; s += 2) {
@@ -663,11 +679,11 @@ static double band_solid_fraction(const run *R) {
     double S = 0.0, area, b = R->o.band_window, phi0 = R->o.phi_init > 0.0 ? R->o.phi_init : R->phi_pack;
     int p, planar = R->o.test == T_PLANAR;
     area = planar ? R->W * 2.0 * b : 2.0 * R->win_a * 2.0 * b;
-#define WIN_ADD(x, y, d, a)                                                                        \
-    do {                                                                                           \
-        double u = ((x)-R->win_c[0]) * R->win_e[0] + ((y)-R->win_c[1]) * R->win_e[1];              \
-        double w = -((x)-R->win_c[0]) * R->win_e[1] + ((y)-R->win_c[1]) * R->win_e[0];             \
-        S += (a)*overlap1(w, (d), b) * (planar ? 1.0 : overlap1(u, (d), R->win_a));                \
+#define WIN_ADD(x, y, d, a)                                                            \
+    do {                                                                               \
+        double u = ((x)-R->win_c[0]) * R->win_e[0] + ((y)-R->win_c[1]) * R->win_e[1];  \
+        double w = -((x)-R->win_c[0]) * R->win_e[1] + ((y)-R->win_c[1]) * R->win_e[0]; \
+        S += (a)*overlap1(w, (d), b) * (planar ? 1.0 : overlap1(u, (d), R->win_a));    \
     } while (0)
     if (R->have_sc)
         for (p = 0; p < R->sc.rve.n; ++p) {
@@ -678,7 +694,8 @@ static double band_solid_fraction(const run *R) {
             WIN_ADD(x[0], x[1], sqrt(GK_PI) * r, a);
         }
     if (R->have_mpm)
-        for (p = 0; p < R->P.n; ++p) WIN_ADD(R->P.x[0][p], R->P.x[1][p], sqrt(R->P.vol[p]), R->P.vol0[p] * phi0);
+        for (p = 0; p < R->P.n; ++p)
+            WIN_ADD(R->P.x[0][p], R->P.x[1][p], sqrt(R->P.vol[p]), R->P.vol0[p] * phi0);
 #undef WIN_ADD
     return S / area;
 }

@@ -279,21 +279,22 @@ static void mpd_usage_common(FILE *fp, const mpd_opts *d) {
         "  --dem-strain S         strain rule: RVE strain per DEM step bound (default %g)\n",
         d->out, d->threads, d->ppc, d->alpha, d->cfl, d->packing, d->dem_inertial, d->dem_unbalanced,
         d->dem_strain);
-    fprintf(fp,
-            "  --dem-min N --dem-max N  bounds of the DEM steps per MPM step (default %d, %d)\n"
-            "  --dem-dt DT            DEM time step [s] (default %g)\n"
-            "  --young E --kt-ratio R --friction-deg PHI --roll-beta B --roll-eta ETA\n"
-            "                         DEM contact law, Liang & Zhao eqs 26-28 (defaults %g Pa, %g, %g deg, "
-            "%g, %g)\n"
-            "  --dem-damping A        local non-viscous damping in the RVEs, eq 29 (default %g)\n"
-            "  --vtk-every N          VTK of the points every N MPM steps (default: first and last)\n"
-            "  --checkpoint N         checkpoint every N MPM steps into DIR/checkpoint.bin (0: at the end)\n"
-            "  --restart DIR          continue from DIR/checkpoint.bin (same flags) to the same result\n"
-            "  --quiet                no progress lines\n"
-            "MPI: build/<driver>_mpi (make mpi) under mpirun spreads the RVEs over the ranks (same results).\n"
-            "exit status: 0 done, 1 setup or an output failed, 2 bad arguments, 3 the simulation failed\n",
-            d->dem_min, d->dem_max, d->dem_dt, d->young, d->kt_ratio, d->friction_deg, d->roll_beta,
-            d->roll_eta, d->dem_damping);
+    fprintf(
+        fp,
+        "  --dem-min N --dem-max N  bounds of the DEM steps per MPM step (default %d, %d)\n"
+        "  --dem-dt DT            DEM time step [s] (default %g)\n"
+        "  --young E --kt-ratio R --friction-deg PHI --roll-beta B --roll-eta ETA\n"
+        "                         DEM contact law, Liang & Zhao eqs 26-28 (defaults %g Pa, %g, %g deg, "
+        "%g, %g)\n"
+        "  --dem-damping A        local non-viscous damping in the RVEs, eq 29 (default %g)\n"
+        "  --vtk-every N          VTK of the points every N MPM steps (default: first and last)\n"
+        "  --checkpoint N         checkpoint every N MPM steps into DIR/checkpoint.bin (0: at the end)\n"
+        "  --restart DIR          continue from DIR/checkpoint.bin (same flags) to the same result\n"
+        "  --quiet                no progress lines\n"
+        "MPI: build/<driver>_mpi (make mpi) under mpirun spreads the RVEs over the ranks (same results).\n"
+        "exit status: 0 done, 1 setup or an output failed, 2 bad arguments, 3 the simulation failed\n",
+        d->dem_min, d->dem_max, d->dem_dt, d->young, d->kt_ratio, d->friction_deg, d->roll_beta, d->roll_eta,
+        d->dem_damping);
 }
 
 /* parse argv against the common table and the driver's; 0, 1 after --help (printed), 2 refused (the

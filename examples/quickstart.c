@@ -21,7 +21,7 @@ int main(int argc, char **argv) {
     gk_rve rve;
     gk_rve_state saved;
     gk_err e;
-    gk_rve_def def = gk_rve_def_default(); /* linear + Coulomb, Guo & Zhao 2014 */
+    gk_rve_def def = gk_rve_def_default();         /* linear + Coulomb, Guo & Zhao 2014 */
     double dH[9] = {0, 1e-3, 0, 0, 0, 0, 0, 0, 0}; /* H01 = du_x/dy: simple shear */
     double sig[9], sig2[9], D[16];
     int rc = 1;

@@ -33,33 +33,35 @@
 #include <string.h>
 
 static void usage(FILE *fp) {
-    fprintf(fp,
-            "usage: rve_path --packing FILE --dH \"H00 H01 H10 H11\" --increments N --steps-per-increment S\n"
-            "                [--E 6e8] [--kt-ratio 0.8] [--friction-deg 28.65] [--density 2650]\n"
-            "                [--thickness 0.1] [--damping 0.1] [--damping-form component|vector]\n"
-            "                [--dt DT] [--law linear|hertz] [--poisson 0.25] [--path constant-L|objective]\n"
-            "                [--threads T] [--out FILE.csv] [--svg FILE.svg]\n"
-            "\n"
-            "  --packing FILE           packing in the shared/data format (2D: 'x y r', 3D: 'x y z r')\n"
-            "  --dH \"...\"               displacement-gradient increment, row-major, H01 = du_x/dy\n"
-            "                           (4 numbers in 2D, 9 in 3D)\n"
-            "  --increments N           how many times dH is applied (default 10)\n"
-            "  --steps-per-increment S  DEM steps per increment (default 100)\n"
-            "  --E                      contact modulus [Pa]: linear kn = E r*, r* = 2 r1 r2/(r1 + r2) (6e8)\n"
-            "  --kt-ratio               kt / kn of the linear law (0.8)\n"
-            "  --friction-deg           contact friction angle [degrees, 0 to 85], mu = tan(angle)\n"
-            "                           (28.65 = 0.5 rad, Guo & Zhao 2014)\n"
-            "  --density                particle density [kg/m^3] (2650)\n"
-            "  --thickness              2D disk thickness [m]: m = rho t pi r^2, volume = area t (0.1)\n"
-            "  --damping                local non-viscous damping alpha (0.1)\n"
-            "  --damping-form           component (YADE/PFC, default) or vector (Guo & Zhao 2014 eq 18)\n"
-            "  --dt                     time step [s] (default 0.5 x critical, Guo & Zhao 2014 eq 19)\n"
-            "  --law                    linear (Guo & Zhao 2014) or hertz (Hertz-Mindlin, G = E/(2(1+poisson)))\n"
-            "  --poisson                Poisson ratio for the Hertz law (0.25)\n"
-            "  --path                   constant-L (default, the paper authors') or objective (ends exactly at I + dH)\n"
-            "  --threads T              threads inside the RVE (results identical for any T)\n"
-            "  --out FILE.csv           CSV output (default rve_path.csv)\n"
-            "  --svg FILE.svg           q/p plot (default: the CSV name with .svg)\n");
+    fprintf(
+        fp,
+        "usage: rve_path --packing FILE --dH \"H00 H01 H10 H11\" --increments N --steps-per-increment S\n"
+        "                [--E 6e8] [--kt-ratio 0.8] [--friction-deg 28.65] [--density 2650]\n"
+        "                [--thickness 0.1] [--damping 0.1] [--damping-form component|vector]\n"
+        "                [--dt DT] [--law linear|hertz] [--poisson 0.25] [--path constant-L|objective]\n"
+        "                [--threads T] [--out FILE.csv] [--svg FILE.svg]\n"
+        "\n"
+        "  --packing FILE           packing in the shared/data format (2D: 'x y r', 3D: 'x y z r')\n"
+        "  --dH \"...\"               displacement-gradient increment, row-major, H01 = du_x/dy\n"
+        "                           (4 numbers in 2D, 9 in 3D)\n"
+        "  --increments N           how many times dH is applied (default 10)\n"
+        "  --steps-per-increment S  DEM steps per increment (default 100)\n"
+        "  --E                      contact modulus [Pa]: linear kn = E r*, r* = 2 r1 r2/(r1 + r2) (6e8)\n"
+        "  --kt-ratio               kt / kn of the linear law (0.8)\n"
+        "  --friction-deg           contact friction angle [degrees, 0 to 85], mu = tan(angle)\n"
+        "                           (28.65 = 0.5 rad, Guo & Zhao 2014)\n"
+        "  --density                particle density [kg/m^3] (2650)\n"
+        "  --thickness              2D disk thickness [m]: m = rho t pi r^2, volume = area t (0.1)\n"
+        "  --damping                local non-viscous damping alpha (0.1)\n"
+        "  --damping-form           component (YADE/PFC, default) or vector (Guo & Zhao 2014 eq 18)\n"
+        "  --dt                     time step [s] (default 0.5 x critical, Guo & Zhao 2014 eq 19)\n"
+        "  --law                    linear (Guo & Zhao 2014) or hertz (Hertz-Mindlin, G = E/(2(1+poisson)))\n"
+        "  --poisson                Poisson ratio for the Hertz law (0.25)\n"
+        "  --path                   constant-L (default, the paper authors') or objective (ends exactly at I "
+        "+ dH)\n"
+        "  --threads T              threads inside the RVE (results identical for any T)\n"
+        "  --out FILE.csv           CSV output (default rve_path.csv)\n"
+        "  --svg FILE.svg           q/p plot (default: the CSV name with .svg)\n");
 }
 
 static int parse_numbers(const char *s, double *out, int max) {
@@ -274,8 +276,8 @@ static int rp_report(const rp_opts *o, gk_rve *rve, int dim, const double *xs, c
             }
             svg = svgname;
         }
-        gk_plot_init(&pl, "RVE stress ratio along the applied path", "deviatoric strain eps_q (Guo & Zhao 2014 eq 13)",
-                     "q / p");
+        gk_plot_init(&pl, "RVE stress ratio along the applied path",
+                     "deviatoric strain eps_q (Guo & Zhao 2014 eq 13)", "q / p");
         gk_plot_add(&pl, xs, qp, (int)o->ninc + 1, NULL);
         if (gk_plot_svg(&pl, svg, &err)) {
             fprintf(stderr, "rve_path: %s\n", err.msg);
@@ -285,8 +287,9 @@ static int rp_report(const rp_opts *o, gk_rve *rve, int dim, const double *xs, c
     {
         double s[9];
         gk_rve_stress(rve, s);
-        printf("RESULT p=%.6g q=%.6g q_over_p=%.6g e_void=%.6g Z=%.4g steps=%ld seconds=%.3f\n", gk_stress_p(s, dim),
-               gk_stress_q(s, dim), gk_stress_p(s, dim) > 0 ? gk_stress_q(s, dim) / gk_stress_p(s, dim) : 0.0,
+        printf("RESULT p=%.6g q=%.6g q_over_p=%.6g e_void=%.6g Z=%.4g steps=%ld seconds=%.3f\n",
+               gk_stress_p(s, dim), gk_stress_q(s, dim),
+               gk_stress_p(s, dim) > 0 ? gk_stress_q(s, dim) / gk_stress_p(s, dim) : 0.0,
                gk_homog_void_ratio(rve), 2.0 * rve->ncontacts / rve->n, rve->step, gk_wtime() - t0);
     }
     fprintf(stderr, "rve_path: wrote %s and %s\n", o->out, svg);

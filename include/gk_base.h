@@ -347,7 +347,9 @@ GK_FORCE_INLINE gk_vd gk_vd_max(gk_vd a, gk_vd b) { return _mm512_max_pd(a, b); 
 GK_FORCE_INLINE gk_vd gk_vd_round(gk_vd a) {
     return _mm512_roundscale_pd(a, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
 }
-GK_FORCE_INLINE gk_vd gk_vd_floor(gk_vd a) { return _mm512_roundscale_pd(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
+GK_FORCE_INLINE gk_vd gk_vd_floor(gk_vd a) {
+    return _mm512_roundscale_pd(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+}
 GK_FORCE_INLINE gk_vdm gk_vd_lt(gk_vd a, gk_vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
 GK_FORCE_INLINE gk_vdm gk_vd_le(gk_vd a, gk_vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LE_OQ); }
 GK_FORCE_INLINE gk_vdm gk_vd_gt(gk_vd a, gk_vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ); }
@@ -370,7 +372,8 @@ GK_FORCE_INLINE gk_vd gk_vd_gather(const double *base, const int32_t *idx) {
 }
 GK_FORCE_INLINE unsigned gk_vdm_bits(gk_vdm m) { return (unsigned)m; }
 GK_FORCE_INLINE gk_vd gk_vd_xorsign(gk_vd a) { /* -a, exactly */
-    return _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(a), _mm512_set1_epi64((long long)0x8000000000000000ull)));
+    return _mm512_castsi512_pd(
+        _mm512_xor_si512(_mm512_castpd_si512(a), _mm512_set1_epi64((long long)0x8000000000000000ull)));
 }
 GK_FORCE_INLINE gk_vd gk_vd_abs(gk_vd a) { return _mm512_abs_pd(a); }
 GK_FORCE_INLINE gk_vf gk_vf_zero(void) { return _mm512_setzero_ps(); }
@@ -403,9 +406,9 @@ GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) {
 #ifdef GK_HW_GATHER
     return _mm512_i32gather_ps(_mm512_loadu_si512((const void *)idx), base, 4);
 #else
-    return _mm512_set_ps(base[idx[15]], base[idx[14]], base[idx[13]], base[idx[12]], base[idx[11]], base[idx[10]],
-                         base[idx[9]], base[idx[8]], base[idx[7]], base[idx[6]], base[idx[5]], base[idx[4]],
-                         base[idx[3]], base[idx[2]], base[idx[1]], base[idx[0]]);
+    return _mm512_set_ps(base[idx[15]], base[idx[14]], base[idx[13]], base[idx[12]], base[idx[11]],
+                         base[idx[10]], base[idx[9]], base[idx[8]], base[idx[7]], base[idx[6]], base[idx[5]],
+                         base[idx[4]], base[idx[3]], base[idx[2]], base[idx[1]], base[idx[0]]);
 #endif
 }
 /* float lanes 0..7 (half 0) or 8..15 (half 1) widened to double, exactly */
@@ -482,7 +485,9 @@ GK_FORCE_INLINE gk_vfm gk_vf_le(gk_vf a, gk_vf b) { return _mm256_cmp_ps(a, b, _
 GK_FORCE_INLINE gk_vfm gk_vf_gt(gk_vf a, gk_vf b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
 GK_FORCE_INLINE gk_vfm gk_vfm_and(gk_vfm a, gk_vfm b) { return _mm256_and_ps(a, b); }
 GK_FORCE_INLINE gk_vfm gk_vfm_or(gk_vfm a, gk_vfm b) { return _mm256_or_ps(a, b); }
-GK_FORCE_INLINE gk_vfm gk_vfm_not(gk_vfm a) { return _mm256_xor_ps(a, _mm256_castsi256_ps(_mm256_set1_epi32(-1))); }
+GK_FORCE_INLINE gk_vfm gk_vfm_not(gk_vfm a) {
+    return _mm256_xor_ps(a, _mm256_castsi256_ps(_mm256_set1_epi32(-1)));
+}
 GK_FORCE_INLINE int gk_vfm_any(gk_vfm a) { return _mm256_movemask_ps(a) != 0; }
 GK_FORCE_INLINE unsigned gk_vfm_bits(gk_vfm m) { return (unsigned)_mm256_movemask_ps(m); }
 GK_FORCE_INLINE gk_vf gk_vf_select(gk_vfm m, gk_vf a, gk_vf b) { return _mm256_blendv_ps(b, a, m); }
@@ -567,8 +572,12 @@ GK_FORCE_INLINE gk_vf gk_vf_select(gk_vfm m, gk_vf a, gk_vf b) { return _mm_blen
 GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) {
     return _mm_set_ps(base[idx[3]], base[idx[2]], base[idx[1]], base[idx[0]]);
 }
-GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) { return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi)); }
-GK_FORCE_INLINE gk_vd gk_vd_from_vf(gk_vf a, int half) { return _mm_cvtps_pd(half ? _mm_movehl_ps(a, a) : a); }
+GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) {
+    return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi));
+}
+GK_FORCE_INLINE gk_vd gk_vd_from_vf(gk_vf a, int half) {
+    return _mm_cvtps_pd(half ? _mm_movehl_ps(a, a) : a);
+}
 #else
 #define GK_SIMD_NAME "scalar"
 #define GK_VD_W 1

@@ -50,12 +50,12 @@ typedef struct gk_cells {
     int dim, n;
     int nbin[3];
     int nbins;
-    unsigned open;      /* bit k set: axis k is open (not periodic), see OPEN AXES */
+    unsigned open;        /* bit k set: axis k is open (not periodic), see OPEN AXES */
     double lo[3], inv[3]; /* open axis k: bin = (s - lo[k]) inv[k], clamped      */
-    int32_t *bin_start; /* nbins + 1: particles of bin b are order[bin_start[b] .. bin_start[b+1]) */
-    int32_t *order;     /* particle indices sorted by bin, ascending inside a bin */
-    int32_t *bin_of;    /* bin of each particle */
-    int32_t *buf;       /* scratch for one particle's candidates */
+    int32_t *bin_start;   /* nbins + 1: particles of bin b are order[bin_start[b] .. bin_start[b+1]) */
+    int32_t *order;       /* particle indices sorted by bin, ascending inside a bin */
+    int32_t *bin_of;      /* bin of each particle */
+    int32_t *buf;         /* scratch for one particle's candidates */
     size_t cap_bins, cap_n, cap_buf;
     gk_allocator alloc;
 } gk_cells;
@@ -86,8 +86,8 @@ GK_INLINE int gk__open_bin(double s, double lo, double inv, int nb) {
     return b >= nb ? nb - 1 : (b < 0 ? 0 : b);
 }
 
-GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3], double cutoff,
-                             gk_err *err);
+GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3],
+                             double cutoff, gk_err *err);
 /* After gk_cells_bin: all pairs with nearest-image distance < r_i + r_j + skin. */
 GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *const s[3], const gk_real *r,
                                double skin, gk_pairlist *out, gk_err *err);
@@ -197,13 +197,14 @@ GK_INLINE int gk__wrap_bin(double s, int nb) {
  * shrink step below in int */
 #define GK__CELLS_MAXBIN (1 << 29)
 
-GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3], double cutoff,
-                             gk_err *err) {
+GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3],
+                             double cutoff, gk_err *err) {
     double hinv[9], w[3], total = 1.0, det;
     int k, p, nbin[3];
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
     if (n < 0) return gk_err_set(err, GK_ERR_ARG, "particle count %d < 0", n);
-    if (!(cutoff > 0.0) || !isfinite(cutoff)) return gk_err_set(err, GK_ERR_ARG, "cutoff %g must be > 0", cutoff);
+    if (!(cutoff > 0.0) || !isfinite(cutoff))
+        return gk_err_set(err, GK_ERR_ARG, "cutoff %g must be > 0", cutoff);
     det = gk_m3_inverse(h, hinv);
     if (!(det > 0.0) || !isfinite(det) || !gk_m3_isfinite(hinv))
         return gk_err_set(err, GK_ERR_CELL, "cell matrix is singular, inverted or not finite (det %g)", det);
@@ -224,9 +225,10 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
                 if (s[k][p] > smax) smax = s[k][p];
             }
             if (n == 0 || !(smax >= smin) || !(smax - smin < 1.0))
-                return gk_err_set(err, GK_ERR_OUTSIDE,
-                                  "open axis %d: the particles span %g of the cell (must be below 1, not NaN)", k,
-                                  smax - smin);
+                return gk_err_set(
+                    err, GK_ERR_OUTSIDE,
+                    "open axis %d: the particles span %g of the cell (must be below 1, not NaN)", k,
+                    smax - smin);
             c->lo[k] = smin;
             nb = (smax - smin) * w[k] / cutoff;
             nbin[k] = nb < (double)GK__CELLS_MAXBIN ? (int)nb : GK__CELLS_MAXBIN;
@@ -277,7 +279,7 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
             int bk[3] = {0, 0, 0};
             for (k = 0; k < dim; ++k)
                 bk[k] = (c->open & (1u << k)) ? gk__open_bin(s[k][p], c->lo[k], c->inv[k], c->nbin[k])
-                                               : gk__wrap_bin(s[k][p], c->nbin[k]);
+                                              : gk__wrap_bin(s[k][p], c->nbin[k]);
             b = bk[0] + c->nbin[0] * (bk[1] + c->nbin[1] * bk[2]);
         } else {
             b = gk__wrap_bin(s[0][p], c->nbin[0]) +

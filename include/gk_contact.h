@@ -86,8 +86,8 @@
  * dispatchers, gk_material_check, gk_law_consts_make and the kernel
  * instantiation in gk_dem.h are all generated from this table, so a new law
  * is one line here, one block, and its test. */
-#define GK_LAW_TABLE(X)                                                                                                \
-    X(GK_LAW_LINEAR, linear) /* = 0 */                                                                                 \
+#define GK_LAW_TABLE(X)                \
+    X(GK_LAW_LINEAR, linear) /* = 0 */ \
     X(GK_LAW_HERTZ, hertz)   /* = 1 */
 
 typedef enum gk_law {
@@ -113,20 +113,20 @@ typedef enum gk_law {
 #define GK_MATERIAL_COOKIE 0x6b4d4154 /* set by gk_material_default() */
 
 typedef struct gk_material {
-    int cookie;        /* set by gk_material_default(); catches uninitialised structs */
+    int cookie; /* set by gk_material_default(); catches uninitialised structs */
     gk_law law;
-    double young;      /* E [Pa]: linear k_n = E r*; Hertz G = E / (2 (1 + poisson))  */
-    double kn;         /* > 0: linear law with this constant k_n [N/m] instead of E r* */
-    double kt_ratio;   /* linear: k_t = kt_ratio k_n (Guo & Zhao 2014 nu_c = 0.8)            */
-    double poisson;    /* Hertz-Mindlin Poisson ratio nu                               */
-    double friction;   /* Coulomb coefficient mu = tan(phi) (0: frictionless)          */
-    double roll_beta;  /* rolling stiffness factor beta: k_r = beta k_t r_i r_j        */
-    double roll_eta;   /* rolling cap factor eta: |M_r| <= eta min(r_i, r_j) F_n       */
-    double zeta_n;     /* normal viscous damping, fraction of critical                 */
-    double zeta_t;     /* tangential viscous damping, fraction of critical             */
-    double coh_n;      /* cohesion: largest tensile normal force of a bond [N]         */
-    double coh_t;      /* cohesion: shear strength added to the Coulomb cap [N]        */
-    double density;    /* particle density [kg/m^3]                                    */
+    double young;     /* E [Pa]: linear k_n = E r*; Hertz G = E / (2 (1 + poisson))  */
+    double kn;        /* > 0: linear law with this constant k_n [N/m] instead of E r* */
+    double kt_ratio;  /* linear: k_t = kt_ratio k_n (Guo & Zhao 2014 nu_c = 0.8)            */
+    double poisson;   /* Hertz-Mindlin Poisson ratio nu                               */
+    double friction;  /* Coulomb coefficient mu = tan(phi) (0: frictionless)          */
+    double roll_beta; /* rolling stiffness factor beta: k_r = beta k_t r_i r_j        */
+    double roll_eta;  /* rolling cap factor eta: |M_r| <= eta min(r_i, r_j) F_n       */
+    double zeta_n;    /* normal viscous damping, fraction of critical                 */
+    double zeta_t;    /* tangential viscous damping, fraction of critical             */
+    double coh_n;     /* cohesion: largest tensile normal force of a bond [N]         */
+    double coh_t;     /* cohesion: shear strength added to the Coulomb cap [N]        */
+    double density;   /* particle density [kg/m^3]                                    */
 } gk_material;
 
 /* Contact constants in the working precision, derived once from a material
@@ -205,8 +205,8 @@ GK_FORCE_INLINE void gk_law_linear_stiffness(const gk_law_consts *K, gk_real ri,
     *fn = k * delta;
     *kt = K->kt_ratio * k;
 }
-GK_FORCE_INLINE void gk_law_linear_stiffness_w(const gk_law_consts *K, gk_vr ri, gk_vr rj, gk_vr delta, gk_vr *kn,
-                                               gk_vr *fn, gk_vr *kt) {
+GK_FORCE_INLINE void gk_law_linear_stiffness_w(const gk_law_consts *K, gk_vr ri, gk_vr rj, gk_vr delta,
+                                               gk_vr *kn, gk_vr *fn, gk_vr *kt) {
     gk_vr rr = gk_vr_mul(ri, rj), rs = gk_vr_div(gk_vr_add(rr, rr), gk_vr_add(ri, rj));
     gk_vr k = K->kn_const > 0 ? gk_vr_set1(K->kn_const) : gk_vr_mul(gk_vr_set1(K->young), rs);
     *kn = k;
@@ -242,8 +242,8 @@ GK_FORCE_INLINE void gk_law_hertz_stiffness(const gk_law_consts *K, gk_real ri, 
     *fn = (gk_real)(2.0 / 3.0) * (k * delta);
     *kt = K->ht * sq;
 }
-GK_FORCE_INLINE void gk_law_hertz_stiffness_w(const gk_law_consts *K, gk_vr ri, gk_vr rj, gk_vr delta, gk_vr *kn,
-                                              gk_vr *fn, gk_vr *kt) {
+GK_FORCE_INLINE void gk_law_hertz_stiffness_w(const gk_law_consts *K, gk_vr ri, gk_vr rj, gk_vr delta,
+                                              gk_vr *kn, gk_vr *fn, gk_vr *kt) {
     gk_vr rr = gk_vr_mul(ri, rj), rs = gk_vr_div(gk_vr_add(rr, rr), gk_vr_add(ri, rj));
     gk_vr a = gk_vr_mul(gk_vr_add(rs, rs), delta);
     gk_vr sq = gk_vr_select(gk_vr_gt(a, gk_vr_zero()), gk_vr_sqrt(a), gk_vr_zero());
@@ -261,7 +261,7 @@ GK_INLINE int gk_law_hertz_stiffens(void) { return 1; }
 /* ---- the dispatchers, generated from GK_LAW_TABLE */
 GK_INLINE const char *gk_law_name(gk_law law) {
     switch (law) {
-#define GK__LAW_CASE(E, name)                                                                                          \
+#define GK__LAW_CASE(E, name) \
     case E: return #name;
         GK_LAW_TABLE(GK__LAW_CASE)
 #undef GK__LAW_CASE
@@ -270,7 +270,7 @@ GK_INLINE const char *gk_law_name(gk_law law) {
 }
 GK_INLINE int gk_law_stiffens(gk_law law) {
     switch (law) {
-#define GK__LAW_CASE(E, name)                                                                                          \
+#define GK__LAW_CASE(E, name) \
     case E: return gk_law_##name##_stiffens();
         GK_LAW_TABLE(GK__LAW_CASE)
 #undef GK__LAW_CASE
@@ -279,7 +279,7 @@ GK_INLINE int gk_law_stiffens(gk_law law) {
 }
 GK_INLINE double gk_law_kn_max(const gk_material *m, double rmax, double dmax) {
     switch (m->law) {
-#define GK__LAW_CASE(E, name)                                                                                          \
+#define GK__LAW_CASE(E, name) \
     case E: return gk_law_##name##_kn_max(m, rmax, dmax);
         GK_LAW_TABLE(GK__LAW_CASE)
 #undef GK__LAW_CASE
@@ -290,17 +290,17 @@ GK_INLINE double gk_law_kn_max(const gk_material *m, double rmax, double dmax) {
 GK_FORCE_INLINE void gk_contact_stiffness(const gk_law_consts *K, gk_law law, gk_real ri, gk_real rj,
                                           gk_real delta, gk_real *kn, gk_real *fn, gk_real *kt) {
     switch (law) {
-#define GK__LAW_CASE(E, name)                                                                                          \
+#define GK__LAW_CASE(E, name) \
     case E: gk_law_##name##_stiffness(K, ri, rj, delta, kn, fn, kt); return;
         GK_LAW_TABLE(GK__LAW_CASE)
 #undef GK__LAW_CASE
     default: *kn = *fn = *kt = 0;
     }
 }
-GK_FORCE_INLINE void gk_contact_stiffness_w(const gk_law_consts *K, gk_law law, gk_vr ri, gk_vr rj, gk_vr delta,
-                                            gk_vr *kn, gk_vr *fn, gk_vr *kt) {
+GK_FORCE_INLINE void gk_contact_stiffness_w(const gk_law_consts *K, gk_law law, gk_vr ri, gk_vr rj,
+                                            gk_vr delta, gk_vr *kn, gk_vr *fn, gk_vr *kt) {
     switch (law) {
-#define GK__LAW_CASE(E, name)                                                                                          \
+#define GK__LAW_CASE(E, name) \
     case E: gk_law_##name##_stiffness_w(K, ri, rj, delta, kn, fn, kt); return;
         GK_LAW_TABLE(GK__LAW_CASE)
 #undef GK__LAW_CASE
@@ -321,8 +321,8 @@ GK_FORCE_INLINE void gk_contact_stiffness_w(const gk_law_consts *K, gk_law law, 
  * Returns 1 if the pair is in contact (or bonded). */
 GK_FORCE_INLINE int gk_contact_2d(const gk_law_consts *K, gk_law law, unsigned flags, gk_real dx, gk_real dy,
                                   gk_real ri, gk_real rj, gk_real mi, gk_real mj, gk_real vx, gk_real vy,
-                                  gk_real wi, gk_real wj, gk_real dt, gk_real *ft, gk_real *mr, unsigned char *st,
-                                  gk_contact_out *o) {
+                                  gk_real wi, gk_real wj, gk_real dt, gk_real *ft, gk_real *mr,
+                                  unsigned char *st, gk_contact_out *o) {
     gk_real R = ri + rj, d2 = dx * dx + dy * dy, dist, inv, nx, ny, delta, kn, fn, kt;
     unsigned char s = *st;
     int bonded = (flags & GK_PHYS_COHESION) && (s & GK_CS_BONDED);
@@ -358,7 +358,8 @@ GK_FORCE_INLINE int gk_contact_2d(const gk_law_consts *K, gk_law law, unsigned f
         }
     }
     {
-        gk_real vn = vx * nx + vy * ny, gn = 0, mstar = 0, ftot = 0, li = 0, lj = 0, half = (gk_real)0.5 * delta;
+        gk_real vn = vx * nx + vy * ny, gn = 0, mstar = 0, ftot = 0, li = 0, lj = 0,
+                half = (gk_real)0.5 * delta;
         if (flags & GK_PHYS_VISCOUS) {
             mstar = (mi * mj) / (mi + mj);
             gn = K->zn2 * (gk_real)sqrt(mstar * kn);
@@ -424,7 +425,8 @@ GK_FORCE_INLINE gk_vrm gk_contact_2d_w(const gk_law_consts *K, gk_law law, unsig
                                        gk_vr wj, gk_vr dt, gk_vr *ft, gk_vr *mr, gk_vrm *slide,
                                        gk_contact_out_w *o) {
     const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5);
-    gk_vr R = gk_vr_add(ri, rj), d2 = gk_vr_add(gk_vr_mul(dx, dx), gk_vr_mul(dy, dy)), dist, inv, nx, ny, delta;
+    gk_vr R = gk_vr_add(ri, rj), d2 = gk_vr_add(gk_vr_mul(dx, dx), gk_vr_mul(dy, dy)), dist, inv, nx, ny,
+          delta;
     gk_vr kn, fn, kt, vn, mstar = zero, hd, li, lj, fx, fy, ti = zero, tj = zero;
     gk_vrm in = gk_vr_lt(d2, gk_vr_mul(R, R));
     *slide = gk_vr_lt(one, zero);
@@ -444,7 +446,8 @@ GK_FORCE_INLINE gk_vrm gk_contact_2d_w(const gk_law_consts *K, gk_law law, unsig
     lj = gk_vr_sub(rj, hd);
     if (flags & GK_PHYS_TANGENT) {
         gk_vr tx = gk_vr_neg(ny), ty = nx, vt, f, cap, gt = zero, ftot;
-        vt = gk_vr_sub(gk_vr_add(gk_vr_mul(vx, tx), gk_vr_mul(vy, ty)), gk_vr_add(gk_vr_mul(li, wi), gk_vr_mul(lj, wj)));
+        vt = gk_vr_sub(gk_vr_add(gk_vr_mul(vx, tx), gk_vr_mul(vy, ty)),
+                       gk_vr_add(gk_vr_mul(li, wi), gk_vr_mul(lj, wj)));
         f = gk_vr_sub(*ft, gk_vr_mul(gk_vr_mul(kt, vt), dt));
         ftot = f;
         if (flags & GK_PHYS_VISCOUS) {
@@ -531,10 +534,10 @@ GK_FORCE_INLINE void gk_contact_rotate_history_w(const gk_vr n[3], gk_vr a, gk_v
 }
 
 /* 3D law; same conventions; w*: spin vectors; ft, mr: 3-vectors. */
-GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned flags, const gk_real d[3], gk_real ri,
-                                  gk_real rj, gk_real mi, gk_real mj, const gk_real v[3], const gk_real wi[3],
-                                  const gk_real wj[3], gk_real dt, gk_real *ft, gk_real *mr, unsigned char *st,
-                                  gk_contact_out *o) {
+GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned flags, const gk_real d[3],
+                                  gk_real ri, gk_real rj, gk_real mi, gk_real mj, const gk_real v[3],
+                                  const gk_real wi[3], const gk_real wj[3], gk_real dt, gk_real *ft,
+                                  gk_real *mr, unsigned char *st, gk_contact_out *o) {
     gk_real R = ri + rj, d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], dist, inv, n[3], delta, kn, fn, kt;
     unsigned char s = *st;
     int bonded = (flags & GK_PHYS_COHESION) && (s & GK_CS_BONDED), k;
@@ -578,9 +581,11 @@ GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned f
             fn = fn - gn * vn;
         }
         if (flags & (GK_PHYS_TANGENT | GK_PHYS_ROLLING))
-            twist = (gk_real)0.5 * dt * ((wi[0] + wj[0]) * n[0] + (wi[1] + wj[1]) * n[1] + (wi[2] + wj[2]) * n[2]);
+            twist = (gk_real)0.5 * dt *
+                    ((wi[0] + wj[0]) * n[0] + (wi[1] + wj[1]) * n[1] + (wi[2] + wj[2]) * n[2]);
         if (flags & GK_PHYS_TANGENT) {
-            gk_real sw[3], vc[3], vcn, vt[3], f[3], tot[3], c[3], cap, fnp = fn > 0 ? fn : (gk_real)0, gt = 0, m2;
+            gk_real sw[3], vc[3], vcn, vt[3], f[3], tot[3], c[3], cap, fnp = fn > 0 ? fn : (gk_real)0, gt = 0,
+                                                                       m2;
             for (k = 0; k < 3; ++k) sw[k] = li * wi[k] + lj * wj[k];
             /* v_c = v - sw x n */
             vc[0] = v[0] - (sw[1] * n[2] - sw[2] * n[1]);
@@ -657,10 +662,10 @@ GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned f
 
 /* Wide twin of gk_contact_3d (no cohesion); conventions as gk_contact_2d_w,
  * d, v, wi, wj, ft and mr are 3-vectors of lanes. */
-GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsigned flags, const gk_vr d[3], gk_vr ri,
-                                       gk_vr rj, gk_vr mi, gk_vr mj, const gk_vr v[3], const gk_vr wi[3],
-                                       const gk_vr wj[3], gk_vr dt, gk_vr ft[3], gk_vr mr[3], gk_vrm *slide,
-                                       gk_contact_out_w *o) {
+GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsigned flags, const gk_vr d[3],
+                                       gk_vr ri, gk_vr rj, gk_vr mi, gk_vr mj, const gk_vr v[3],
+                                       const gk_vr wi[3], const gk_vr wj[3], gk_vr dt, gk_vr ft[3],
+                                       gk_vr mr[3], gk_vrm *slide, gk_contact_out_w *o) {
     const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), half = gk_vr_set1((gk_real)0.5);
     gk_vr n[3], F[3], R, d2, dist, inv, delta, kn, fn, kt, vn, mstar = zero, hd, li, lj, twist = zero;
     gk_vrm in;
@@ -705,15 +710,17 @@ GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsig
             for (k = 0; k < 3; ++k) tot[k] = gk_vr_sub(f[k], gk_vr_mul(gt, vt[k]));
         }
         cap = gk_vr_mul(gk_vr_set1(K->mu), gk_vr_max(fn, zero));
-        m2 = gk_vr_add(gk_vr_add(gk_vr_mul(tot[0], tot[0]), gk_vr_mul(tot[1], tot[1])), gk_vr_mul(tot[2], tot[2]));
+        m2 = gk_vr_add(gk_vr_add(gk_vr_mul(tot[0], tot[0]), gk_vr_mul(tot[1], tot[1])),
+                       gk_vr_mul(tot[2], tot[2]));
         *slide = gk_vr_gt(m2, gk_vr_mul(cap, cap));
         if (gk_vrm_any(*slide)) {
             gk_vr sc = gk_vr_div(cap, gk_vr_sqrt(m2));
             for (k = 0; k < 3; ++k) {
                 gk_vr t = gk_vr_mul(tot[k], sc);
                 tot[k] = gk_vr_select(*slide, t, tot[k]);
-                f[k] = gk_vr_select(*slide, (flags & GK_PHYS_VISCOUS) ? gk_vr_add(tot[k], gk_vr_mul(gt, vt[k])) : tot[k],
-                                    f[k]);
+                f[k] = gk_vr_select(
+                    *slide, (flags & GK_PHYS_VISCOUS) ? gk_vr_add(tot[k], gk_vr_mul(gt, vt[k])) : tot[k],
+                    f[k]);
             }
         }
         for (k = 0; k < 3; ++k) {
@@ -805,11 +812,11 @@ GKDEF gk_result gk_material_check(const gk_material *m, gk_err *err) {
     GK__FIN(density);
 #undef GK__FIN
     switch (m->law) {
-#define GK__LAW_CASE(E, name)                                                                                          \
-    case E: {                                                                                                          \
-        gk_result r_ = gk_law_##name##_check(m, err);                                                                  \
-        if (r_) return r_;                                                                                             \
-        break;                                                                                                         \
+#define GK__LAW_CASE(E, name)                         \
+    case E: {                                         \
+        gk_result r_ = gk_law_##name##_check(m, err); \
+        if (r_) return r_;                            \
+        break;                                        \
     }
         GK_LAW_TABLE(GK__LAW_CASE)
 #undef GK__LAW_CASE
@@ -821,7 +828,8 @@ GKDEF gk_result gk_material_check(const gk_material *m, gk_err *err) {
     if (m->roll_beta < 0.0 || m->roll_eta < 0.0)
         return gk_err_set(err, GK_ERR_ARG, "rolling beta %g, eta %g must be >= 0", m->roll_beta, m->roll_eta);
     if (m->zeta_n < 0.0 || m->zeta_n >= 1.0 || m->zeta_t < 0.0 || m->zeta_t >= 1.0)
-        return gk_err_set(err, GK_ERR_ARG, "viscous damping ratios %g, %g must be in [0, 1)", m->zeta_n, m->zeta_t);
+        return gk_err_set(err, GK_ERR_ARG, "viscous damping ratios %g, %g must be in [0, 1)", m->zeta_n,
+                          m->zeta_t);
     if (m->coh_n < 0.0 || m->coh_t < 0.0)
         return gk_err_set(err, GK_ERR_ARG, "cohesion %g, %g must be >= 0", m->coh_n, m->coh_t);
     if (!(m->density > 0.0)) return gk_err_set(err, GK_ERR_MASS, "density %g must be > 0", m->density);
@@ -840,7 +848,7 @@ GKDEF unsigned gk_material_flags(const gk_material *m) {
 GKDEF void gk_law_consts_make(const gk_material *m, gk_law_consts *k) {
     memset(k, 0, sizeof *k);
     switch (m->law) {
-#define GK__LAW_CASE(E, name)                                                                                          \
+#define GK__LAW_CASE(E, name) \
     case E: gk_law_##name##_consts(m, k); break;
         GK_LAW_TABLE(GK__LAW_CASE)
 #undef GK__LAW_CASE

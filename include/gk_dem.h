@@ -194,25 +194,25 @@
 typedef enum gk_damp_form { GK_DAMP_COMPONENT = 0, GK_DAMP_VECTOR = 1 } gk_damp_form;
 typedef enum gk_mass_model { GK_MASS_CYLINDER = 0, GK_MASS_SPHERE = 1 } gk_mass_model;
 
-#define GK_RVE_NO_ROTATION 1u /* particles do not rotate (spin with the cell only) */
-#define GK_RVE_SCALAR 2u      /* always use the scalar reference kernels          */
-#define GK_RVE_WRAP 4u        /* accept positions outside the cell (wrap them)    */
+#define GK_RVE_NO_ROTATION 1u    /* particles do not rotate (spin with the cell only) */
+#define GK_RVE_SCALAR 2u         /* always use the scalar reference kernels          */
+#define GK_RVE_WRAP 4u           /* accept positions outside the cell (wrap them)    */
 #define GK_RVE_TRACK_ROTATION 8u /* 3D: accumulate each particle's rotation vector  */
 #define GK_RVE_DEF_COOKIE 0x52564531
 
 typedef struct gk_rve_def {
-    int cookie;               /* set by gk_rve_def_default()                        */
+    int cookie; /* set by gk_rve_def_default()                        */
     gk_material mat;
-    double dt;                /* time step [s]; 0 -> dt_factor x critical           */
-    double dt_factor;         /* used when dt = 0; 0 -> 0.5                          */
-    double skin;              /* Verlet skin [m]; 0 -> 0.1 x mean radius            */
-    double thickness;         /* 2D: disk thickness [m] (Guo & Zhao 2014: 0.1)             */
+    double dt;        /* time step [s]; 0 -> dt_factor x critical           */
+    double dt_factor; /* used when dt = 0; 0 -> 0.5                          */
+    double skin;      /* Verlet skin [m]; 0 -> 0.1 x mean radius            */
+    double thickness; /* 2D: disk thickness [m] (Guo & Zhao 2014: 0.1)             */
     gk_mass_model mass2d;
-    double damping;           /* local non-viscous damping alpha in [0, 1)          */
+    double damping; /* local non-viscous damping alpha in [0, 1)          */
     gk_damp_form damping_form;
-    gk_path_kind path;        /* how gk_rve_deform splits dH over the steps         */
-    unsigned flags;           /* GK_RVE_*                                           */
-    int threads;              /* threads inside this RVE; <= 1: serial              */
+    gk_path_kind path; /* how gk_rve_deform splits dH over the steps         */
+    unsigned flags;    /* GK_RVE_*                                           */
+    int threads;       /* threads inside this RVE; <= 1: serial              */
     gk_allocator alloc;
 } gk_rve_def;
 
@@ -220,25 +220,25 @@ typedef struct gk_rve {
     int dim, n;
     gk_rve_def def;
     gk_law_consts K;
-    unsigned phys;            /* GK_PHYS_* in use                                   */
+    unsigned phys; /* GK_PHYS_* in use                                   */
     double dt, time, dt_crit;
     long step, rebuilds;
     gk_pcell cell;
-    double L[9];              /* prescribed velocity gradient for gk_rve_step      */
-    double G[9];              /* affine velocity gradient of the last step (E-I)/dt */
-    double volume_factor;     /* stress volume = det h x this (2D thickness)       */
+    double L[9];          /* prescribed velocity gradient for gk_rve_step      */
+    double G[9];          /* affine velocity gradient of the last step (E-I)/dt */
+    double volume_factor; /* stress volume = det h x this (2D thickness)       */
     /* particles: n each, stored in cell-list order */
-    double *s[3];             /* reduced positions                                  */
-    double *s0[3];            /* reduced positions at the last list build           */
-    gk_real *v[3];            /* fluctuating velocity [m/s]                         */
-    gk_real *w[3];            /* fluctuating spin [rad/s] (2D: w[2] only)           */
-    gk_real *f[3];            /* contact force sum of the last step [N]             */
-    gk_real *t[3];            /* contact torque sum of the last step (2D: t[2])     */
+    double *s[3];  /* reduced positions                                  */
+    double *s0[3]; /* reduced positions at the last list build           */
+    gk_real *v[3]; /* fluctuating velocity [m/s]                         */
+    gk_real *w[3]; /* fluctuating spin [rad/s] (2D: w[2] only)           */
+    gk_real *f[3]; /* contact force sum of the last step [N]             */
+    gk_real *t[3]; /* contact torque sum of the last step (2D: t[2])     */
     gk_real *r, *minv, *Iinv;
-    double *theta;            /* 2D: accumulated rotation [rad] (incl. cell spin);
+    double *theta; /* 2D: accumulated rotation [rad] (incl. cell spin);
                                  3D with GK_RVE_TRACK_ROTATION: 3 n, the sum of the
                                  rotation increments (w + cell spin) dt per particle */
-    int32_t *id;              /* index in the input packing                         */
+    int32_t *id;   /* index in the input packing                         */
     double rmin, rmax, mmin, solid_volume, mass_total;
     /* pairs, sorted by (i, j) */
     gk_pairlist pl;
@@ -256,26 +256,26 @@ typedef struct gk_rve {
         gk_pairlist pl;
     } spare;
     gk_cells cells;
-    double h0[9];             /* cell at the last (inner) build                     */
-    double skin;              /* Verlet skin of the outer list [m]                  */
-    double skin_in;           /* skin of the inner list the kernels run over        */
-    gk_pairlist outer;        /* candidates within skin, from the cell grid          */
-    double *o0[3];            /* reduced positions at the outer build               */
-    double ho0[9];            /* cell at the outer build                            */
+    double h0[9];      /* cell at the last (inner) build                     */
+    double skin;       /* Verlet skin of the outer list [m]                  */
+    double skin_in;    /* skin of the inner list the kernels run over        */
+    gk_pairlist outer; /* candidates within skin, from the cell grid          */
+    double *o0[3];     /* reduced positions at the outer build               */
+    double ho0[9];     /* cell at the outer build                            */
     int outer_valid;
     int need_rebuild, diverged;
     /* results of the last step that computed them (the last step of each call) */
-    double stress[9];         /* Love stress, tension-positive [Pa]                 */
-    double stiff[3];          /* Voigt stiffness D_kkkk estimate [Pa]               */
+    double stress[9]; /* Love stress, tension-positive [Pa]                 */
+    double stiff[3];  /* Voigt stiffness D_kkkk estimate [Pa]               */
     int ncontacts;
-    double fc_mean;           /* mean |F| over contacts                             */
+    double fc_mean; /* mean |F| over contacts                             */
     int servo_on;
     gk_servo servo;
     gk_err err;
     /* seam for scenes beyond the periodic cell (gk_scene.h); NULL/0 in an RVE */
     gk_result (*hook)(struct gk_rve *rve, int stage, void *user);
     void *hook_user;
-    int ncap;                 /* capacity of the per-particle arrays (0: n)         */
+    int ncap; /* capacity of the per-particle arrays (0: n)         */
 } gk_rve;
 
 /* stages at which gk_rve.hook is called in every step */
@@ -299,16 +299,16 @@ typedef struct gk_rve_contact {
 } gk_rve_contact;
 
 typedef struct gk_consolidate_def {
-    double pressure;          /* target isotropic stress, compression-positive [Pa] (> 0) */
-    double friction;          /* Coulomb coefficient while consolidating (0 = dense)      */
-    double stress_tol;        /* relative tolerance on every sigma_kk; 0 -> 1e-3           */
-    double unbalanced_tol;    /* unbalanced force ratio to reach; 0 -> 1e-3                */
-    double max_strain_rate;   /* [1/s]; 0 -> inertial number 1e-2 at the target pressure   */
-    long max_steps;           /* 0 -> 2 000 000                                            */
-    double damping;           /* local damping while consolidating; 0 -> the RVE's own     */
-    double ratio[3];          /* target sigma_kk = -pressure x ratio[k] (anisotropic
+    double pressure;        /* target isotropic stress, compression-positive [Pa] (> 0) */
+    double friction;        /* Coulomb coefficient while consolidating (0 = dense)      */
+    double stress_tol;      /* relative tolerance on every sigma_kk; 0 -> 1e-3           */
+    double unbalanced_tol;  /* unbalanced force ratio to reach; 0 -> 1e-3                */
+    double max_strain_rate; /* [1/s]; 0 -> inertial number 1e-2 at the target pressure   */
+    long max_steps;         /* 0 -> 2 000 000                                            */
+    double damping;         /* local damping while consolidating; 0 -> the RVE's own     */
+    double ratio[3];        /* target sigma_kk = -pressure x ratio[k] (anisotropic
                                  consolidation); 0 -> 1                                  */
-    int box;                  /* 1: the cell stays a box (shear stresses not driven)      */
+    int box;                /* 1: the cell stays a box (shear stresses not driven)      */
 } gk_consolidate_def;
 
 /* gk_rve_deform_adaptive: zero means default */
@@ -373,7 +373,7 @@ GKDEF void gk_rve_stress(const gk_rve *rve, double sigma[9]);
 /* recompute forces at the current positions without advancing (zero-length
  * step: history and positions unchanged), then stress etc. are current */
 GKDEF gk_result gk_rve_refresh(gk_rve *rve);
-GKDEF double gk_rve_volume(const gk_rve *rve);     /* stress volume                */
+GKDEF double gk_rve_volume(const gk_rve *rve);         /* stress volume                */
 GKDEF double gk_rve_kinetic_energy(const gk_rve *rve); /* of the fluctuations     */
 GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]);
 GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *pk, const gk_allocator *alloc, gk_err *err);
@@ -388,7 +388,8 @@ GKDEF int gk_rve_contact_next(const gk_rve *rve, int *cursor, gk_rve_contact *ou
  * material; refused (nothing changed) for a bad radius or position or one
  * too large for the cell. remove: drops every p with drop[p] != 0. */
 GKDEF gk_result gk_rve_reserve(gk_rve *rve, int cap);
-GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], const double *r, const int32_t *id);
+GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], const double *r,
+                              const int32_t *id);
 GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop);
 /* rmin, rmax, mmin, mass_total, solid_volume from r[], minv[] (after the
  * caller changed radii or masses directly) */
@@ -447,29 +448,41 @@ GKDEF const char *gk_rve_error(const gk_rve *rve) { return rve->err.msg; }
 #define GK__HAS_ROLL(rve) (((rve)->phys & GK_PHYS_ROLLING) != 0)
 
 enum { GK__PART, GK__PAIR, GK__OUTER }; /* indexed by: particle, pair, outer-list pair            */
-enum { GK__ALL, GK__DIM, GK__ROT, GK__ROLL, GK__TAN, GK__2D, GK__TRACK3 }; /* exists: always, k < dim,
+enum {
+    GK__ALL,
+    GK__DIM,
+    GK__ROT,
+    GK__ROLL,
+    GK__TAN,
+    GK__2D,
+    GK__TRACK3
+};                      /* exists: always, k < dim,
     with rotation (2D: k = 2 only), with rolling (2D: k = 2), 2D k = 0 or 3D, in 2D only, in 3D with
     GK_RVE_TRACK_ROTATION */
-#define GK__SAVE 1u    /* in the saved state                                                   */
-#define GK__SPARE 2u   /* per-pair with a twin in rve->spare: carried across rebuilds by pair  */
-#define GK__HIST 4u    /* contact history: gk_rve_refresh leaves it as it was                  */
-#define GK__LIST 8u    /* index array of a gk_pairlist (allocated by it); i, then j            */
+#define GK__SAVE 1u     /* in the saved state                                                   */
+#define GK__SPARE 2u    /* per-pair with a twin in rve->spare: carried across rebuilds by pair  */
+#define GK__HIST 4u     /* contact history: gk_rve_refresh leaves it as it was                  */
+#define GK__LIST 8u     /* index array of a gk_pairlist (allocated by it); i, then j            */
 #define GK__DERIVED 16u /* rebuilt from the pair list: never copied                             */
 
 typedef struct gk__field {
     size_t off, spare;  /* offsetof the array pointer in gk_rve, of its twin in rve->spare      */
     unsigned char size; /* element bytes                                                         */
     unsigned char set, when, k, flags;
-    const char *what;   /* named when a restored value is not finite                              */
+    const char *what; /* named when a restored value is not finite                              */
 } gk__field;
 
 #define GK__R ((unsigned char)sizeof(gk_real))
-#define GK__F(f, k, size, set, when, fl, what) {offsetof(gk_rve, f), 0, size, set, when, k, fl, what}
-#define GK__F3(f, size, when, fl, what)                                                                                \
-    GK__F(f[0], 0, size, GK__PART, when, fl, what), GK__F(f[1], 1, size, GK__PART, when, fl, what),                    \
+#define GK__F(f, k, size, set, when, fl, what) \
+    { offsetof(gk_rve, f), 0, size, set, when, k, fl, what }
+#define GK__F3(f, size, when, fl, what)                                                             \
+    GK__F(f[0], 0, size, GK__PART, when, fl, what), GK__F(f[1], 1, size, GK__PART, when, fl, what), \
         GK__F(f[2], 2, size, GK__PART, when, fl, what)
-#define GK__S(f, k, when, fl, what) {offsetof(gk_rve, f[k]), offsetof(gk_rve, spare.f[k]), GK__R, GK__PAIR, when, k,  \
-                                     GK__SAVE | GK__SPARE | (fl), what}
+#define GK__S(f, k, when, fl, what)                                                     \
+    {                                                                                   \
+        offsetof(gk_rve, f[k]), offsetof(gk_rve, spare.f[k]), GK__R, GK__PAIR, when, k, \
+            GK__SAVE | GK__SPARE | (fl), what                                           \
+    }
 
 static const gk__field gk__fields[] = {
     /* per particle: positions, velocities, forces, spins, torques, rotation */
@@ -488,7 +501,8 @@ static const gk__field gk__fields[] = {
     /* per pair: the list, state bits, history, forces and torques of the last step */
     GK__F(pl.i, 0, 4, GK__PAIR, GK__ALL, GK__SAVE | GK__LIST, "pair"),
     GK__F(pl.j, 0, 4, GK__PAIR, GK__ALL, GK__SAVE | GK__LIST, "pair"),
-    {offsetof(gk_rve, cs), offsetof(gk_rve, spare.cs), 1, GK__PAIR, GK__ALL, 0, GK__SAVE | GK__SPARE, "state"},
+    {offsetof(gk_rve, cs), offsetof(gk_rve, spare.cs), 1, GK__PAIR, GK__ALL, 0, GK__SAVE | GK__SPARE,
+     "state"},
     GK__S(ft, 0, GK__TAN, GK__HIST, "tangential history"),
     GK__S(ft, 1, GK__TAN, GK__HIST, "tangential history"),
     GK__S(ft, 2, GK__TAN, GK__HIST, "tangential history"),
@@ -553,10 +567,12 @@ static gk_result gk__fields_grow(gk_rve *rve, int set, int spare, size_t cap, si
         void *p;
         if (f->set != set || (f->flags & GK__LIST) || (spare && !f->spare) || !gk__field_on(rve, f)) continue;
         p = gk__fget(rve, off);
-        if (gk_realloc(a, &p, spare || (f->flags & GK__DERIVED) ? 0 : ncopy, cap, f->size)) return GK_ERR_ALLOC;
+        if (gk_realloc(a, &p, spare || (f->flags & GK__DERIVED) ? 0 : ncopy, cap, f->size))
+            return GK_ERR_ALLOC;
         gk__fset(rve, off, p);
     }
-    if (set == GK__PART && gk_realloc(a, (void **)&rve->jstart, ncopy ? ncopy + 1 : 0, cap + 1, sizeof(int32_t)))
+    if (set == GK__PART &&
+        gk_realloc(a, (void **)&rve->jstart, ncopy ? ncopy + 1 : 0, cap + 1, sizeof(int32_t)))
         return GK_ERR_ALLOC;
     return GK_OK;
 }
@@ -755,7 +771,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     if (res) return res;
     dim = pk->dim;
     n = pk->n;
-    if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
+    if (dim != 2 && dim != 3)
+        return gk_err_set(err, GK_ERR_ARG, "packing dimension %d (must be 2 or 3)", dim);
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "packing has %d particles", n);
     if (n > GK_RVE_MAX_PARTICLES)
         return gk_err_set(err, GK_ERR_ARG,
@@ -769,8 +786,10 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         return gk_err_set(err, GK_ERR_ARG, "unknown deformation path %d", (int)def->path);
     if (dim == 2 && def->mass2d == GK_MASS_CYLINDER && !(def->thickness > 0.0))
         return gk_err_set(err, GK_ERR_ARG, "2D cylinder masses need thickness > 0 (got %g)", def->thickness);
-    if (!(def->dt >= 0.0) || !isfinite(def->dt)) return gk_err_set(err, GK_ERR_DT, "time step %g invalid", def->dt);
-    if (!(def->skin >= 0.0) || !isfinite(def->skin)) return gk_err_set(err, GK_ERR_ARG, "skin %g invalid", def->skin);
+    if (!(def->dt >= 0.0) || !isfinite(def->dt))
+        return gk_err_set(err, GK_ERR_DT, "time step %g invalid", def->dt);
+    if (!(def->skin >= 0.0) || !isfinite(def->skin))
+        return gk_err_set(err, GK_ERR_ARG, "skin %g invalid", def->skin);
     if (!(def->dt_factor >= 0.0 && def->dt_factor <= 1.0))
         return gk_err_set(err, GK_ERR_DT, "dt_factor %g outside (0, 1]", def->dt_factor);
     gk_m3_copy(pk->h, hpk);
@@ -784,7 +803,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         double rp = pk->r[p];
         if (!isfinite(pk->x[p]) || !isfinite(pk->y[p]) || (dim == 3 && (!pk->z || !isfinite(pk->z[p]))))
             return gk_err_set(err, GK_ERR_NAN, "particle %d has a NaN or infinite position", p);
-        if (!(rp > 0.0) || !isfinite(rp)) return gk_err_set(err, GK_ERR_RADIUS, "particle %d has radius %g", p, rp);
+        if (!(rp > 0.0) || !isfinite(rp))
+            return gk_err_set(err, GK_ERR_RADIUS, "particle %d has radius %g", p, rp);
         if (!(def->flags & GK_RVE_WRAP)) {
             double x[3], s[3];
             x[0] = pk->x[p];
@@ -793,9 +813,10 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
             gk_m3_matvec(R.cell.hinv, x, s);
             for (k = 0; k < dim; ++k)
                 if (s[k] < -1e-9 || s[k] >= 1.0 + 1e-9)
-                    return gk_err_set(err, GK_ERR_OUTSIDE,
-                                      "particle %d at (%g, %g, %g) is outside the cell (set GK_RVE_WRAP to wrap)", p,
-                                      x[0], x[1], x[2]);
+                    return gk_err_set(
+                        err, GK_ERR_OUTSIDE,
+                        "particle %d at (%g, %g, %g) is outside the cell (set GK_RVE_WRAP to wrap)", p, x[0],
+                        x[1], x[2]);
         }
     }
     R.dim = dim;
@@ -806,7 +827,8 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
     if (!(def->flags & GK_RVE_NO_ROTATION) && (R.phys & (GK_PHYS_TANGENT | GK_PHYS_ROLLING)))
         R.phys |= GK_PHYS_ROTATION;
     if ((R.phys & GK_PHYS_ROLLING) && !(R.phys & GK_PHYS_ROTATION))
-        return gk_err_set(err, GK_ERR_ARG, "rolling resistance needs rotating particles (GK_RVE_NO_ROTATION is set)");
+        return gk_err_set(err, GK_ERR_ARG,
+                          "rolling resistance needs rotating particles (GK_RVE_NO_ROTATION is set)");
     R.volume_factor = dim == 2 ? (def->thickness > 0.0 ? def->thickness : 1.0) : 1.0;
     /* particle order: cell-list order for locality */
     {
@@ -928,8 +950,9 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
                 dtc, R.rmin, R.rmax);
         else if (def->dt > 0.0) {
             if (def->dt > dtc)
-                res = gk_err_set(&R.err, GK_ERR_DT, "time step %g s is above the critical %g s (Guo & Zhao 2014 eq 19)",
-                                 def->dt, dtc);
+                res = gk_err_set(&R.err, GK_ERR_DT,
+                                 "time step %g s is above the critical %g s (Guo & Zhao 2014 eq 19)", def->dt,
+                                 dtc);
             R.dt = def->dt;
         } else {
             R.dt = (def->dt_factor > 0.0 ? def->dt_factor : 0.5) * dtc;
@@ -972,10 +995,11 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         /* k_n grows with the overlap (Hertz): the critical step shrinks as overlaps grow */
         double dtc = gk__dt_critical(rve);
         if (rve->dt > dtc)
-            return gk_err_set(&rve->err, GK_ERR_DT,
-                              "time step %g s now exceeds the critical %g s at the current overlaps (Hertz stiffens "
-                              "with load): restore a saved state and use a smaller dt",
-                              rve->dt, dtc);
+            return gk_err_set(
+                &rve->err, GK_ERR_DT,
+                "time step %g s now exceeds the critical %g s at the current overlaps (Hertz stiffens "
+                "with load): restore a saved state and use a smaller dt",
+                rve->dt, dtc);
         rve->dt_crit = dtc;
     }
     int dim = rve->dim, n = rve->n, k, c, oc;
@@ -986,10 +1010,11 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
     gk_pcell_widths(&rve->cell, w);
     for (k = 0; k < dim; ++k)
         if (!(2.0 * (2.0 * rve->rmax + rve->skin) < w[k]))
-            return gk_err_set(&rve->err, GK_ERR_CELL,
-                              "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
-                              "too far for this many particles)",
-                              w[k], 2.0 * rve->rmax + rve->skin);
+            return gk_err_set(
+                &rve->err, GK_ERR_CELL,
+                "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
+                "too far for this many particles)",
+                w[k], 2.0 * rve->rmax + rve->skin);
     if (!rve->outer_valid ||
         !(gk_cells_skin_margin(dim, rve->ho0, rve->cell.h, rve->skin, rve->rmax,
                                gk_cells_disp2_max(dim, rve->cell.h, n, (const double *const *)rve->o0,
@@ -1011,7 +1036,8 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
      * written into the spare list and spare per-pair arrays */
     nl = rve->spare.pl;
     if (gk_pairlist_reserve(&nl, (size_t)rve->outer.n + 1, (size_t)n) ||
-        gk__spare_reserve(rve, (size_t)rve->outer.n + 1) || gk__pairs_reserve(rve, (size_t)rve->outer.n + 1, (size_t)rve->pl.n)) {
+        gk__spare_reserve(rve, (size_t)rve->outer.n + 1) ||
+        gk__pairs_reserve(rve, (size_t)rve->outer.n + 1, (size_t)rve->pl.n)) {
         rve->spare.pl = nl;
         return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", rve->outer.n);
     }
@@ -1029,7 +1055,8 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         oc = 0;
         for (c = 0; c < nl.n; ++c) {
             int32_t ni = nl.i[c], nj = nl.j[c];
-            while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj))) ++oc;
+            while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj)))
+                ++oc;
             map[c] = oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj ? oc : -1;
         }
         gk__pairs_gather(rve, map, nl.n);
@@ -1051,7 +1078,8 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         rve->spare.cap = cap;
         rve->pl = nl;
         rve->spare.pl = t;
-        if (rve->pcap > cap && gk_realloc(&rve->def.alloc, (void **)&rve->jlist, 0, rve->pcap, sizeof(int32_t)))
+        if (rve->pcap > cap &&
+            gk_realloc(&rve->def.alloc, (void **)&rve->jlist, 0, rve->pcap, sizeof(int32_t)))
             return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", nl.n);
     }
     gk__pair_index(rve);
@@ -1064,16 +1092,17 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
 
 /* ---------------------------------------------------------------- forces */
 typedef struct gk__stepctx {
-    double hd[9];   /* cell matrix (positions are double)                   */
-    gk_real G[9];   /* affine velocity gradient of this step                 */
-    gk_real wa[3];  /* affine spin (2D: wa[2])                               */
+    double hd[9];  /* cell matrix (positions are double)                   */
+    gk_real G[9];  /* affine velocity gradient of this step                 */
+    gk_real wa[3]; /* affine spin (2D: wa[2])                               */
     gk_real dt;
-    int scatter;    /* add pair forces to the particles in the force loop    */
-    int store;      /* keep per-pair forces and torques (stress, threads)    */
+    int scatter; /* add pair forces to the particles in the force loop    */
+    int store;   /* keep per-pair forces and torques (stress, threads)    */
 } gk__stepctx;
 
 /* pair forces, scalar reference: writes fc, tci, tcj, ft, mr, cs for pairs [c0, c1) */
-GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
+                                       unsigned fl) {
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
     const double *sx = rve->s[0], *sy = rve->s[1];
     const gk_real *vx = rve->v[0], *vy = rve->v[1], *r = rve->r, *minv = rve->minv;
@@ -1097,8 +1126,8 @@ GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0
         rvy = (vy[j] - vy[i]) + (x->G[3] * dx + x->G[4] * dy);
         wi = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[i] : x->wa[2];
         wj = (fl & GK_PHYS_ROTATION) ? x->wa[2] + wz[j] : x->wa[2];
-        gk_contact_2d(&rve->K, law, fl, dx, dy, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], rvx, rvy, wi,
-                      wj, x->dt, ft + c, (fl & GK_PHYS_ROLLING) ? mr + c : &dummy, cs + c, &o);
+        gk_contact_2d(&rve->K, law, fl, dx, dy, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], rvx,
+                      rvy, wi, wj, x->dt, ft + c, (fl & GK_PHYS_ROLLING) ? mr + c : &dummy, cs + c, &o);
         if (x->store) {
             fcx[c] = o.f[0];
             fcy[c] = o.f[1];
@@ -1120,7 +1149,8 @@ GK_FORCE_INLINE void gk__forces_ref_2d(gk_rve *rve, const gk__stepctx *x, int c0
     }
 }
 
-GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
+                                       unsigned fl) {
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
     const gk_real *r = rve->r, *minv = rve->minv;
     gk_real dummy[3] = {0, 0, 0};
@@ -1134,15 +1164,16 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
         gk_pcell_image(x->hd, 3, ds, dd);
         for (k = 0; k < 3; ++k) d[k] = (gk_real)dd[k];
         for (k = 0; k < 3; ++k)
-            vr[k] = (rve->v[k][j] - rve->v[k][i]) + (x->G[3 * k] * d[0] + x->G[3 * k + 1] * d[1] + x->G[3 * k + 2] * d[2]);
+            vr[k] = (rve->v[k][j] - rve->v[k][i]) +
+                    (x->G[3 * k] * d[0] + x->G[3 * k + 1] * d[1] + x->G[3 * k + 2] * d[2]);
         for (k = 0; k < 3; ++k) {
             wi[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][i] : x->wa[k];
             wj[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][j] : x->wa[k];
             hist[k] = rve->ft[k][c];
             mh[k] = (fl & GK_PHYS_ROLLING) ? rve->mr[k][c] : dummy[k];
         }
-        gk_contact_3d(&rve->K, law, fl, d, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], vr, wi, wj, x->dt,
-                      hist, mh, rve->cs + c, &o);
+        gk_contact_3d(&rve->K, law, fl, d, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], vr, wi, wj,
+                      x->dt, hist, mh, rve->cs + c, &o);
         for (k = 0; k < 3; ++k) {
             rve->ft[k][c] = hist[k];
             if (fl & GK_PHYS_ROLLING) rve->mr[k][c] = mh[k];
@@ -1175,14 +1206,15 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
 /* branch vectors d = h (ds - round(ds)) of GK_VR_W pairs, from double
  * positions (the wide twin of gk_pcell_image); H = the cell matrix broadcast
  * once per call */
-GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const int32_t *ii, const int32_t *jj,
-                                     int dim, gk_vr d[3]) {
+GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const int32_t *ii,
+                                     const int32_t *jj, int dim, gk_vr d[3]) {
     gk_vd dd[2][3];
     int hf, k;
     for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
         gk_vd ds[3];
         for (k = 0; k < dim; ++k) {
-            ds[k] = gk_vd_sub(gk_vd_gather(rve->s[k], jj + hf * GK_VD_W), gk_vd_gather(rve->s[k], ii + hf * GK_VD_W));
+            ds[k] = gk_vd_sub(gk_vd_gather(rve->s[k], jj + hf * GK_VD_W),
+                              gk_vd_gather(rve->s[k], ii + hf * GK_VD_W));
             ds[k] = gk_vd_sub(ds[k], gk_vd_round(ds[k]));
         }
         for (k = 0; k < dim; ++k) {
@@ -1201,9 +1233,9 @@ GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const 
 }
 
 /* 8 mask bits -> 8 bytes of 0/1 (bit l -> byte l): a constant table */
-#define GK__E(b)                                                                                                        \
-    ((uint64_t)((b) >> 0 & 1) | (uint64_t)((b) >> 1 & 1) << 8 | (uint64_t)((b) >> 2 & 1) << 16 |                       \
-     (uint64_t)((b) >> 3 & 1) << 24 | (uint64_t)((b) >> 4 & 1) << 32 | (uint64_t)((b) >> 5 & 1) << 40 |                \
+#define GK__E(b)                                                                                        \
+    ((uint64_t)((b) >> 0 & 1) | (uint64_t)((b) >> 1 & 1) << 8 | (uint64_t)((b) >> 2 & 1) << 16 |        \
+     (uint64_t)((b) >> 3 & 1) << 24 | (uint64_t)((b) >> 4 & 1) << 32 | (uint64_t)((b) >> 5 & 1) << 40 | \
      (uint64_t)((b) >> 6 & 1) << 48 | (uint64_t)((b) >> 7 & 1) << 56)
 #define GK__R4(b) GK__E(b), GK__E((b) + 1), GK__E((b) + 2), GK__E((b) + 3)
 #define GK__R16(b) GK__R4(b), GK__R4((b) + 4), GK__R4((b) + 8), GK__R4((b) + 12)
@@ -1229,7 +1261,8 @@ GK_FORCE_INLINE void gk__simd_state(unsigned char *cs, gk_vrm in, gk_vrm slide, 
 }
 
 GK_FORCE_INLINE void gk__scatter_buf_2d(gk_rve *rve, const int32_t *ii, const int32_t *jj, const gk_real *bx,
-                                        const gk_real *by, const gk_real *bi, const gk_real *bj, unsigned rot) {
+                                        const gk_real *by, const gk_real *bi, const gk_real *bj,
+                                        unsigned rot) {
     gk_real *f0 = rve->f[0], *f1 = rve->f[1], *t2 = rve->t[2];
     int l;
     for (l = 0; l < GK_VR_W; ++l) {
@@ -1245,8 +1278,9 @@ GK_FORCE_INLINE void gk__scatter_buf_2d(gk_rve *rve, const int32_t *ii, const in
     }
 }
 
-GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const int32_t *jj, gk_real bF[3][GK_VR_W],
-                                        gk_real bI[3][GK_VR_W], gk_real bJ[3][GK_VR_W], unsigned rot) {
+GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const int32_t *jj,
+                                        gk_real bF[3][GK_VR_W], gk_real bI[3][GK_VR_W],
+                                        gk_real bJ[3][GK_VR_W], unsigned rot) {
     int l, k;
     for (l = 0; l < GK_VR_W; ++l) {
         int i = ii[l], j = jj[l];
@@ -1261,11 +1295,13 @@ GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const in
     }
 }
 
-GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
+                                        unsigned fl) {
     const gk_law_consts K = rve->K; /* a local copy: its broadcasts stay out of the loop */
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
     const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), dt = gk_vr_set1(x->dt);
-    const gk_vr G0 = gk_vr_set1(x->G[0]), G1 = gk_vr_set1(x->G[1]), G3 = gk_vr_set1(x->G[3]), G4 = gk_vr_set1(x->G[4]);
+    const gk_vr G0 = gk_vr_set1(x->G[0]), G1 = gk_vr_set1(x->G[1]), G3 = gk_vr_set1(x->G[3]),
+                G4 = gk_vr_set1(x->G[4]);
     const gk_vr wa = gk_vr_set1(x->wa[2]);
     gk_real bx[GK_VR_W], by[GK_VR_W], bi[GK_VR_W], bj[GK_VR_W];
     gk_vd H[9];
@@ -1294,7 +1330,8 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
         }
         if (fl & GK_PHYS_TANGENT) fh = gk_vr_load(rve->ft[0] + c);
         if (fl & GK_PHYS_ROLLING) m = gk_vr_load(rve->mr[2] + c);
-        in = gk_contact_2d_w(&K, law, fl, d[0], d[1], ri, rj, mi, mj, vx, vy, wi, wj, dt, &fh, &m, &slide, &o);
+        in =
+            gk_contact_2d_w(&K, law, fl, d[0], d[1], ri, rj, mi, mj, vx, vy, wi, wj, dt, &fh, &m, &slide, &o);
         if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[0] + c, fh);
         if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[2] + c, m);
         gk__simd_state(rve->cs + c, in, slide, lut);
@@ -1309,7 +1346,8 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
         if (x->scatter) {
             /* scatter the previous block now (its buffer stores have retired: no
              * store-forwarding stall) and buffer this one; pair order is kept */
-            if (pend >= 0) gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
+            if (pend >= 0)
+                gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
             gk_vr_storeu(bx, o.f[0]);
             gk_vr_storeu(by, o.f[1]);
             if (fl & GK_PHYS_ROTATION) {
@@ -1323,7 +1361,8 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
     gk__forces_ref_2d(rve, x, c, c1, law, fl);
 }
 
-GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law, unsigned fl) {
+GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
+                                        unsigned fl) {
     const gk_law_consts K = rve->K; /* a local copy: its broadcasts stay out of the loop */
     const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
     const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), dt = gk_vr_set1(x->dt);
@@ -1390,37 +1429,37 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
 
 /* instantiate a kernel with constant law and flags (pay only for what is on):
  * the common flag sets get their own copy, the rest share one with fl */
-#define GK__FLAG_SETS(fn, rve, x, c0, c1, LAW, fl)                                                                    \
-    do {                                                                                                               \
-        if ((fl) == 0u)                                                                                                \
-            fn(rve, x, c0, c1, LAW, 0u);                                                                               \
-        else if ((fl) == GK_PHYS_TANGENT)                                                                              \
-            fn(rve, x, c0, c1, LAW, GK_PHYS_TANGENT);                                                                  \
-        else if ((fl) == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))                                                         \
-            fn(rve, x, c0, c1, LAW, GK_PHYS_TANGENT | GK_PHYS_ROTATION);                                               \
-        else                                                                                                           \
-            fn(rve, x, c0, c1, LAW, fl);                                                                               \
+#define GK__FLAG_SETS(fn, rve, x, c0, c1, LAW, fl)                       \
+    do {                                                                 \
+        if ((fl) == 0u)                                                  \
+            fn(rve, x, c0, c1, LAW, 0u);                                 \
+        else if ((fl) == GK_PHYS_TANGENT)                                \
+            fn(rve, x, c0, c1, LAW, GK_PHYS_TANGENT);                    \
+        else if ((fl) == (GK_PHYS_TANGENT | GK_PHYS_ROTATION))           \
+            fn(rve, x, c0, c1, LAW, GK_PHYS_TANGENT | GK_PHYS_ROTATION); \
+        else                                                             \
+            fn(rve, x, c0, c1, LAW, fl);                                 \
     } while (0)
 
 /* one kernel of each law of GK_LAW_TABLE (gk_contact.h) for the dimension and path */
 #if GK_VR_W > 1
-#define GK__WIDE(rve, x, c0, c1, LAW, fl)                                                                              \
-    if (wide) {                                                                                                        \
-        if ((rve)->dim == 2)                                                                                           \
-            GK__FLAG_SETS(gk__forces_simd_2d, rve, x, c0, c1, LAW, fl);                                                \
-        else                                                                                                           \
-            GK__FLAG_SETS(gk__forces_simd_3d, rve, x, c0, c1, LAW, fl);                                                \
+#define GK__WIDE(rve, x, c0, c1, LAW, fl)                               \
+    if (wide) {                                                         \
+        if ((rve)->dim == 2)                                            \
+            GK__FLAG_SETS(gk__forces_simd_2d, rve, x, c0, c1, LAW, fl); \
+        else                                                            \
+            GK__FLAG_SETS(gk__forces_simd_3d, rve, x, c0, c1, LAW, fl); \
     } else
 #else
 #define GK__WIDE(rve, x, c0, c1, LAW, fl)
 #endif
-#define GK__LAW_KERNELS(E, name)                                                                                       \
-    case E:                                                                                                            \
-        GK__WIDE(rve, x, c0, c1, E, fl)                                                                                \
-        if (rve->dim == 2)                                                                                             \
-            GK__FLAG_SETS(gk__forces_ref_2d, rve, x, c0, c1, E, fl);                                                   \
-        else                                                                                                           \
-            GK__FLAG_SETS(gk__forces_ref_3d, rve, x, c0, c1, E, fl);                                                   \
+#define GK__LAW_KERNELS(E, name)                                     \
+    case E:                                                          \
+        GK__WIDE(rve, x, c0, c1, E, fl)                              \
+        if (rve->dim == 2)                                           \
+            GK__FLAG_SETS(gk__forces_ref_2d, rve, x, c0, c1, E, fl); \
+        else                                                         \
+            GK__FLAG_SETS(gk__forces_ref_3d, rve, x, c0, c1, E, fl); \
         break;
 
 /* pair forces of [c0, c1): the wide kernels unless GK_RVE_SCALAR or cohesion */
@@ -1461,7 +1500,8 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
         GK_OMP(parallel for num_threads(nth) schedule(static))
         for (b = 0; b < nth * 4; ++b) {
             /* chunk starts on a multiple of 16 pairs: aligned SIMD loads, same lanes as serial */
-            long c0 = ((long)nc * b / (nth * 4)) & ~15L, c1 = b + 1 == nth * 4 ? nc : ((long)nc * (b + 1) / (nth * 4)) & ~15L;
+            long c0 = ((long)nc * b / (nth * 4)) & ~15L,
+                 c1 = b + 1 == nth * 4 ? nc : ((long)nc * (b + 1) / (nth * 4)) & ~15L;
             gk__forces_range(rve, x, (int)c0, (int)c1);
         }
         GK_OMP(parallel for num_threads(nth) schedule(static))
@@ -1479,7 +1519,8 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
  * (gk__scatter_*), in pair order, which is the same order and so gives the
  * same bits. */
 GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int dim, const int rot) {
-    const int32_t *GK_RESTRICT start = rve->pl.start, *GK_RESTRICT jst = rve->jstart, *GK_RESTRICT jl = rve->jlist;
+    const int32_t *GK_RESTRICT start = rve->pl.start, *GK_RESTRICT jst = rve->jstart,
+                               *GK_RESTRICT jl = rve->jlist;
     const gk_real *fc0 = rve->fc[0], *fc1 = rve->fc[1], *fc2 = dim == 3 ? rve->fc[2] : NULL;
     gk_real *f0 = rve->f[0], *f1 = rve->f[1], *f2 = dim == 3 ? rve->f[2] : NULL;
     int p, e, k;
@@ -1557,18 +1598,21 @@ GK_FORCE_INLINE void gk__wrap(gk_rve *rve, int p, int k) {
 /* leap-frog for particles [p0, p1) with the force sums in f, t; returns the
  * largest squared non-affine displacement since the last build; *bad if a
  * non-finite value appeared. damp: 0 none, 1 component, 2 vector. */
-GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, const double *hinv, const double *hnew,
-                                            int p0, int p1, int *bad, const int dim, const int rot, const int damp) {
+GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, const double *hinv,
+                                            const double *hnew, int p0, int p1, int *bad, const int dim,
+                                            const int rot, const int damp) {
     const gk_real dt = x->dt, alpha = (gk_real)rve->def.damping, hdt = (gk_real)0.5 * dt;
     const gk_real *GK_RESTRICT minv = rve->minv, *GK_RESTRICT Iinv = rve->Iinv;
     double *s0 = rve->s[0], *s1 = rve->s[1], *s2 = dim == 3 ? rve->s[2] : NULL;
     const double *r0 = rve->s0[0], *r1 = rve->s0[1], *r2 = dim == 3 ? rve->s0[2] : NULL;
-    gk_real *GK_RESTRICT v0 = rve->v[0], *GK_RESTRICT v1 = rve->v[1], *GK_RESTRICT v2 = dim == 3 ? rve->v[2] : NULL;
-    const gk_real *GK_RESTRICT f0 = rve->f[0], *GK_RESTRICT f1 = rve->f[1], *GK_RESTRICT f2 = dim == 3 ? rve->f[2] : NULL;
-    const double h00 = hinv[0], h01 = hinv[1], h02 = hinv[2], h10 = hinv[3], h11 = hinv[4], h12 = hinv[5], h20 = hinv[6],
-                 h21 = hinv[7], h22 = hinv[8];
-    const double g00 = hnew[0], g01 = hnew[1], g02 = hnew[2], g10 = hnew[3], g11 = hnew[4], g12 = hnew[5], g20 = hnew[6],
-                 g21 = hnew[7], g22 = hnew[8];
+    gk_real *GK_RESTRICT v0 = rve->v[0], *GK_RESTRICT v1 = rve->v[1],
+                         *GK_RESTRICT v2 = dim == 3 ? rve->v[2] : NULL;
+    const gk_real *GK_RESTRICT f0 = rve->f[0], *GK_RESTRICT f1 = rve->f[1],
+                               *GK_RESTRICT f2 = dim == 3 ? rve->f[2] : NULL;
+    const double h00 = hinv[0], h01 = hinv[1], h02 = hinv[2], h10 = hinv[3], h11 = hinv[4], h12 = hinv[5],
+                 h20 = hinv[6], h21 = hinv[7], h22 = hinv[8];
+    const double g00 = hnew[0], g01 = hnew[1], g02 = hnew[2], g10 = hnew[3], g11 = hnew[4], g12 = hnew[5],
+                 g20 = hnew[6], g21 = hnew[7], g22 = hnew[8];
     double m2 = 0.0, chk = 0.0;
     int p;
     for (p = p0; p < p1; ++p) {
@@ -1581,7 +1625,8 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
             if (dim == 3) a2 = gk__damp_component(a2, v2[p], dt, alpha);
         } else if (damp == 2) {
             gk_real w0 = v0[p] + hdt * a0, w1 = v1[p] + hdt * a1, w2 = dim == 3 ? v2[p] + hdt * a2 : 0;
-            gk_real vv = w0 * w0 + w1 * w1 + (dim == 3 ? w2 * w2 : 0), aa = a0 * a0 + a1 * a1 + (dim == 3 ? a2 * a2 : 0);
+            gk_real vv = w0 * w0 + w1 * w1 + (dim == 3 ? w2 * w2 : 0),
+                    aa = a0 * a0 + a1 * a1 + (dim == 3 ? a2 * a2 : 0);
             if (vv > 0) {
                 gk_real sc = alpha * (gk_real)sqrt(aa) / (gk_real)sqrt(vv);
                 a0 = a0 - sc * w0;
@@ -1674,7 +1719,8 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
 GK_FORCE_INLINE gk_vr gk__damp_v(gk_vr a, gk_vr v, gk_vr hdt, gk_vr alpha) {
     const gk_vr one = gk_vr_set1(1), zero = gk_vr_zero();
     gk_vr xx = gk_vr_mul(a, gk_vr_add(v, gk_vr_mul(hdt, a)));
-    gk_vr sg = gk_vr_sub(gk_vr_select(gk_vr_gt(xx, zero), one, zero), gk_vr_select(gk_vr_lt(xx, zero), one, zero));
+    gk_vr sg =
+        gk_vr_sub(gk_vr_select(gk_vr_gt(xx, zero), one, zero), gk_vr_select(gk_vr_lt(xx, zero), one, zero));
     return gk_vr_mul(a, gk_vr_sub(one, gk_vr_mul(alpha, sg)));
 }
 
@@ -1688,8 +1734,9 @@ GK_FORCE_INLINE gk_vd gk__vr_half(gk_vr a, int hf) {
 #endif
 }
 
-GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, const double *hinv, const double *hnew,
-                                          int p0, int p1, int *bad, const int dim, const int rot, const int damp) {
+GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, const double *hinv,
+                                          const double *hnew, int p0, int p1, int *bad, const int dim,
+                                          const int rot, const int damp) {
     const gk_vr dt = gk_vr_set1(x->dt), alpha = gk_vr_set1((gk_real)rve->def.damping),
                 hdt = gk_vr_set1((gk_real)0.5 * x->dt), zero = gk_vr_zero();
     const gk_vd dtd = gk_vd_set1((double)x->dt), wad = gk_vd_set1((double)x->wa[2]);
@@ -1756,14 +1803,16 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
             vm2 = gk_vd_max(u2, vm2);
         }
         if (rot && dim == 2) {
-            gk_vr aw = gk_vr_mul(gk_vr_loadu(rve->t[2] + p), gk_vr_loadu(rve->Iinv + p)), w = gk_vr_loadu(rve->w[2] + p);
+            gk_vr aw = gk_vr_mul(gk_vr_loadu(rve->t[2] + p), gk_vr_loadu(rve->Iinv + p)),
+                  w = gk_vr_loadu(rve->w[2] + p);
             if (damp) aw = gk__damp_v(aw, w, hdt, alpha);
             w = gk_vr_add(w, gk_vr_mul(dt, aw));
             gk_vr_storeu(rve->w[2] + p, w);
             vchk = gk_vr_add(vchk, gk_vr_abs(w));
             for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
                 double *th = rve->theta + p + hf * GK_VD_W;
-                gk_vd_storeu(th, gk_vd_add(gk_vd_loadu(th), gk_vd_mul(gk_vd_add(wad, gk__vr_half(w, hf)), dtd)));
+                gk_vd_storeu(th,
+                             gk_vd_add(gk_vd_loadu(th), gk_vd_mul(gk_vd_add(wad, gk__vr_half(w, hf)), dtd)));
             }
         } else if (rot) {
             gk_vr iinv = gk_vr_loadu(rve->Iinv + p), aw[3], w[3];
@@ -1777,11 +1826,14 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
                 gk_vr ve[3], vv, aa, sc;
                 gk_vrm pos;
                 for (k = 0; k < 3; ++k) ve[k] = gk_vr_add(w[k], gk_vr_mul(hdt, aw[k]));
-                vv = gk_vr_add(gk_vr_add(gk_vr_mul(ve[0], ve[0]), gk_vr_mul(ve[1], ve[1])), gk_vr_mul(ve[2], ve[2]));
-                aa = gk_vr_add(gk_vr_add(gk_vr_mul(aw[0], aw[0]), gk_vr_mul(aw[1], aw[1])), gk_vr_mul(aw[2], aw[2]));
+                vv = gk_vr_add(gk_vr_add(gk_vr_mul(ve[0], ve[0]), gk_vr_mul(ve[1], ve[1])),
+                               gk_vr_mul(ve[2], ve[2]));
+                aa = gk_vr_add(gk_vr_add(gk_vr_mul(aw[0], aw[0]), gk_vr_mul(aw[1], aw[1])),
+                               gk_vr_mul(aw[2], aw[2]));
                 pos = gk_vr_gt(vv, zero);
                 sc = gk_vr_div(gk_vr_mul(alpha, gk_vr_sqrt(aa)), gk_vr_sqrt(vv));
-                for (k = 0; k < 3; ++k) aw[k] = gk_vr_select(pos, gk_vr_sub(aw[k], gk_vr_mul(sc, ve[k])), aw[k]);
+                for (k = 0; k < 3; ++k)
+                    aw[k] = gk_vr_select(pos, gk_vr_sub(aw[k], gk_vr_mul(sc, ve[k])), aw[k]);
             }
             for (k = 0; k < 3; ++k) {
                 w[k] = gk_vr_add(w[k], gk_vr_mul(dt, aw[k]));
@@ -1812,11 +1864,12 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
 #define GK__INTEGRATE_FAST gk__integrate_kernel
 #endif
 
-static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int p0,
-                                  int p1, int *bad) {
-    int rot = GK__HAS_ROT(rve), damp = rve->def.damping > 0 ? (rve->def.damping_form == GK_DAMP_VECTOR ? 2 : 1) : 0;
-#define GK__INT(D, R, M)                                                                                               \
-    return (rve->def.flags & GK_RVE_SCALAR) ? gk__integrate_kernel(rve, x, hinv, hnew, p0, p1, bad, D, R, M)          \
+static double gk__integrate_range(gk_rve *rve, const gk__stepctx *x, const double hinv[9],
+                                  const double hnew[9], int p0, int p1, int *bad) {
+    int rot = GK__HAS_ROT(rve),
+        damp = rve->def.damping > 0 ? (rve->def.damping_form == GK_DAMP_VECTOR ? 2 : 1) : 0;
+#define GK__INT(D, R, M)                                                                                     \
+    return (rve->def.flags & GK_RVE_SCALAR) ? gk__integrate_kernel(rve, x, hinv, hnew, p0, p1, bad, D, R, M) \
                                             : GK__INTEGRATE_FAST(rve, x, hinv, hnew, p0, p1, bad, D, R, M)
     if (rve->dim == 2) {
         if (rot) {
@@ -1843,7 +1896,8 @@ static int gk__nthreads(const gk_rve *rve) {
     return rve->def.threads > 1 && rve->pl.n >= GK_DEM_PAR_MIN ? rve->def.threads : 1;
 }
 
-static double gk__integrate(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9], int *bad) {
+static double gk__integrate(gk_rve *rve, const gk__stepctx *x, const double hinv[9], const double hnew[9],
+                            int *bad) {
     int n = rve->n, nth = gk__nthreads(rve);
     double m2 = 0.0;
     if (nth <= 1) return gk__integrate_range(rve, x, hinv, hnew, 0, n, bad);
@@ -1991,15 +2045,17 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
         int p;
         for (p = 0; p < rve->n; ++p)
             for (k = 0; k < 3; ++k)
-                rve->theta[3 * p + k] += ((double)x.wa[k] + (rve->w[k] ? (double)rve->w[k][p] : 0.0)) * rve->dt;
+                rve->theta[3 * p + k] +=
+                    ((double)x.wa[k] + (rve->w[k] ? (double)rve->w[k][p] : 0.0)) * rve->dt;
     }
     rve->time += rve->dt;
     ++rve->step;
     if (bad) {
         rve->diverged = 1;
-        return gk_err_set(&rve->err, GK_ERR_DIVERGED,
-                          "non-finite velocity or position at step %ld (time step too large or unstable input?)",
-                          rve->step);
+        return gk_err_set(
+            &rve->err, GK_ERR_DIVERGED,
+            "non-finite velocity or position at step %ld (time step too large or unstable input?)",
+            rve->step);
     }
     if (!rve->need_rebuild &&
         !(gk_cells_skin_margin(rve->dim, rve->h0, rve->cell.h, rve->skin_in, rve->rmax, dispmax2) > 0.0))
@@ -2011,7 +2067,8 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
 static gk_result gk__rve_ready(gk_rve *rve) {
     if (rve->n < 1 || !rve->s[0]) return gk_err_set(&rve->err, GK_ERR_STATE, "RVE not created");
     if (rve->diverged)
-        return gk_err_set(&rve->err, GK_ERR_STATE, "RVE diverged at step %ld; restore a saved state", rve->step);
+        return gk_err_set(&rve->err, GK_ERR_STATE, "RVE diverged at step %ld; restore a saved state",
+                          rve->step);
     return GK_OK;
 }
 
@@ -2025,7 +2082,8 @@ GKDEF gk_result gk_rve_set_velocity_gradient(gk_rve *rve, const double L[9]) {
 
 static gk_result gk__servo_check(int dim, const gk_servo *s, gk_err *err) {
     int k;
-    if (s->shear && !(isfinite(s->shear_target[0]) && isfinite(s->shear_target[1]) && isfinite(s->shear_target[2])))
+    if (s->shear &&
+        !(isfinite(s->shear_target[0]) && isfinite(s->shear_target[1]) && isfinite(s->shear_target[2])))
         return gk_err_set(err, GK_ERR_NAN, "servo: non-finite shear target");
     for (k = 0; k < dim; ++k) {
         if (s->mode[k] != GK_SERVO_STRAIN && s->mode[k] != GK_SERVO_STRESS)
@@ -2174,7 +2232,8 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
     int k;
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
-    if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
+    if (rve->servo_on)
+        return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before deform");
     res = gk_path_init(&path, rve->dim, rve->def.path, dH, nsteps, &rve->err);
     if (res) return res;
     { /* refuse up front an increment too large for one DEM step (the contract) */
@@ -2196,7 +2255,7 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
                 nsteps, st * (rve->rmin + rve->rmax) / rve->rmin, GK_RVE_STEP_OVERLAP_MAX, hi);
         }
     }
-    {   /* refuse up front a map that leaves the cell too thin for the nearest image */
+    { /* refuse up front a map that leaves the cell too thin for the nearest image */
         gk_pcell end = rve->cell;
         double Mend[9], B[9], w[3];
         gk_path_map(&path, nsteps, Mend);
@@ -2207,8 +2266,8 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
         for (k = 0; k < rve->dim; ++k)
             if (!(2.0 * (2.0 * rve->rmax + rve->skin) < w[k]))
                 return gk_err_set(&rve->err, GK_ERR_CELL,
-                                  "dH would leave a cell %g wide, below twice the interaction distance %g", w[k],
-                                  2.0 * rve->rmax + rve->skin);
+                                  "dH would leave a cell %g wide, below twice the interaction distance %g",
+                                  w[k], 2.0 * rve->rmax + rve->skin);
     }
     d.kind = GK__DRIVE_PATH;
     d.n = nsteps;
@@ -2258,10 +2317,12 @@ static gk_result gk__relax(gk_rve *rve, double uf_max, int every, long max_steps
     gk_result res = gk__rve_ready(rve);
     if (steps) *steps = 0;
     if (res) return res;
-    if (rve->servo_on) return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before relax");
+    if (rve->servo_on)
+        return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before relax");
     if (!(uf_max > 0.0) || every < 1 || max_steps < 0)
-        return gk_err_set(&rve->err, GK_ERR_ARG, "relax: uf_max %g (> 0), every %d (>= 1), max_steps %ld (>= 0)",
-                          uf_max, every, max_steps);
+        return gk_err_set(&rve->err, GK_ERR_ARG,
+                          "relax: uf_max %g (> 0), every %d (>= 1), max_steps %ld (>= 0)", uf_max, every,
+                          max_steps);
     memset(&d, 0, sizeof d);
     d.kind = GK__DRIVE_RATE; /* L = 0: the cell stands still */
     while (done < max_steps && (rms ? gk_rve_unbalanced_rms(rve) : gk_rve_unbalanced(rve)) > uf_max) {
@@ -2377,7 +2438,8 @@ GKDEF gk_result gk_rve_set_dt(gk_rve *rve, double dt) {
     double dtc = gk__dt_critical(rve);
     if (!(dt > 0.0) || !isfinite(dt)) return gk_err_set(&rve->err, GK_ERR_DT, "time step %g must be > 0", dt);
     if (dt > dtc)
-        return gk_err_set(&rve->err, GK_ERR_DT, "time step %g s is above the critical %g s (Guo & Zhao 2014 eq 19)", dt, dtc);
+        return gk_err_set(&rve->err, GK_ERR_DT,
+                          "time step %g s is above the critical %g s (Guo & Zhao 2014 eq 19)", dt, dtc);
     rve->dt = dt;
     rve->dt_crit = dtc;
     return GK_OK;
@@ -2401,7 +2463,8 @@ GKDEF gk_result gk_rve_set_friction(gk_rve *rve, double mu) {
 }
 
 GKDEF gk_result gk_rve_set_damping(gk_rve *rve, double alpha, gk_damp_form form) {
-    if (!(alpha >= 0.0 && alpha < 1.0)) return gk_err_set(&rve->err, GK_ERR_ARG, "damping %g outside [0, 1)", alpha);
+    if (!(alpha >= 0.0 && alpha < 1.0))
+        return gk_err_set(&rve->err, GK_ERR_ARG, "damping %g outside [0, 1)", alpha);
     if (form != GK_DAMP_COMPONENT && form != GK_DAMP_VECTOR)
         return gk_err_set(&rve->err, GK_ERR_ARG, "unknown damping form %d", (int)form);
     rve->def.damping = alpha;
@@ -2429,7 +2492,8 @@ GKDEF void gk_rve_position(const gk_rve *rve, int p, double x[3]) {
     if (rve->dim == 2) x[2] = 0.0;
 }
 
-GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *out, const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *out, const gk_allocator *alloc,
+                                  gk_err *err) {
     gk_packing pk;
     int p, k;
     gk_result res = gk_packing_alloc(&pk, rve->dim, rve->n, alloc, err);
@@ -2511,7 +2575,7 @@ GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk
         sv.target[k] = -cd->pressure * ratio[k];
     }
     sv.max_rate = rate;
-    sv.gain = 0.1; /* of the Taylor stiffness, which overestimates the packing's own */
+    sv.gain = 0.1;       /* of the Taylor stiffness, which overestimates the packing's own */
     sv.shear = !cd->box; /* principal axes along the cell axes: the shear stresses go to zero as well */
     rve->K.mu = (gk_real)cd->friction;
     if (cd->damping > 0.0) rve->def.damping = cd->damping;
@@ -2590,7 +2654,8 @@ GKDEF gk_result gk_rve_reserve(gk_rve *rve, int cap) {
     return GK_OK;
 }
 
-GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], const double *r, const int32_t *id) {
+GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], const double *r,
+                              const int32_t *id) {
     int dim = rve->dim, q, a, n0 = rve->n;
     double rmax = rve->rmax, w[3];
     gk_result res;
@@ -2600,13 +2665,15 @@ GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], cons
         if (!(r[q] > 0.0) || !isfinite(r[q]))
             return gk_err_set(&rve->err, GK_ERR_RADIUS, "append: particle %d has radius %g", q, r[q]);
         for (a = 0; a < dim; ++a)
-            if (!isfinite(s[a][q])) return gk_err_set(&rve->err, GK_ERR_NAN, "append: particle %d has a NaN position", q);
+            if (!isfinite(s[a][q]))
+                return gk_err_set(&rve->err, GK_ERR_NAN, "append: particle %d has a NaN position", q);
         if (r[q] > rmax) rmax = r[q];
     }
     gk_pcell_widths(&rve->cell, w);
     for (a = 0; a < dim; ++a)
         if (!(2.0 * (2.0 * rmax + rve->skin) < w[a]))
-            return gk_err_set(&rve->err, GK_ERR_CELL, "append: radius %g too large for a cell %g wide", rmax, w[a]);
+            return gk_err_set(&rve->err, GK_ERR_CELL, "append: radius %g too large for a cell %g wide", rmax,
+                              w[a]);
     if (n0 + k > (rve->ncap > n0 ? rve->ncap : n0)) {
         int cap = n0 + n0 / 2 > n0 + k ? n0 + n0 / 2 : n0 + k;
         if ((res = gk_rve_reserve(rve, cap)) != GK_OK) return res;
@@ -2697,15 +2764,15 @@ static size_t gk__state_bytes(const gk_rve *rve, int npairs, int nouter) {
 
 GKDEF size_t gk_rve_state_size(const gk_rve *rve) { return gk__state_bytes(rve, rve->pl.n, rve->outer.n); }
 
-#define GK__PUT(ptr, bytes)                 \
-    do {                                    \
-        memcpy(o + off, (ptr), (bytes));    \
-        off += (bytes);                     \
+#define GK__PUT(ptr, bytes)              \
+    do {                                 \
+        memcpy(o + off, (ptr), (bytes)); \
+        off += (bytes);                  \
     } while (0)
-#define GK__GET(ptr, bytes)                 \
-    do {                                    \
-        memcpy((ptr), in + off, (bytes));   \
-        off += (bytes);                     \
+#define GK__GET(ptr, bytes)               \
+    do {                                  \
+        memcpy((ptr), in + off, (bytes)); \
+        off += (bytes);                   \
     } while (0)
 
 GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *written) {
@@ -2903,9 +2970,10 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
             } else if (f->size == 1) {
                 for (c = 0; c < (int)cnt; ++c)
                     if (b[c] & ~(GK_CS_CONTACT | GK_CS_SLIDING | GK_CS_BONDED | GK_CS_BROKEN))
-                        return gk_err_set(err, GK_ERR_FORMAT, "RVE state pair %d has unknown contact bits 0x%x", c,
-                                          b[c]);
-            } else if (!gk__finite_bytes(b, cnt * (f->size % 8 ? 1 : f->size / 8), f->size % 8 ? f->size : 8)) {
+                        return gk_err_set(err, GK_ERR_FORMAT,
+                                          "RVE state pair %d has unknown contact bits 0x%x", c, b[c]);
+            } else if (!gk__finite_bytes(b, cnt * (f->size % 8 ? 1 : f->size / 8),
+                                         f->size % 8 ? f->size : 8)) {
                 return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite %s", f->what);
             }
         }

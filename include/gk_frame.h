@@ -146,19 +146,19 @@ typedef struct gk_frame_stats {
 } gk_frame_stats;
 
 typedef struct gk_frame {
-    int n;            /* particles of the framed RVE (inner + boundary copies)      */
-    int nq, npair;    /* boundary particles Q (4 corners + E edge), edge pairs E/2 */
-    int ninner;       /* P                                                          */
-    int crossing;     /* inner particles whose disk crosses the boundary lines      */
-    double L[2];      /* the periodic cell's edges                                  */
-    double origin[2]; /* the frame's corner (0, 0) in the framed RVE's cell         */
-    double V;         /* L0 L1                                                      */
+    int n;             /* particles of the framed RVE (inner + boundary copies)      */
+    int nq, npair;     /* boundary particles Q (4 corners + E edge), edge pairs E/2 */
+    int ninner;        /* P                                                          */
+    int crossing;      /* inner particles whose disk crosses the boundary lines      */
+    double L[2];       /* the periodic cell's edges                                  */
+    double origin[2];  /* the frame's corner (0, 0) in the framed RVE's cell         */
+    double V;          /* L0 L1                                                      */
     gk_packing framed; /* the framed RVE (ids = indices in it)                       */
-    int32_t *q;       /* nq: framed index of each boundary particle, counter-clockwise */
-    int32_t *source;  /* n: index in the periodic packing of each framed particle   */
+    int32_t *q;        /* nq: framed index of each boundary particle, counter-clockwise */
+    int32_t *source;   /* n: index in the periodic packing of each framed particle   */
     double *X, *A, *R; /* nq: reference position and area vector (2 each), radius   */
-    int *pair;        /* npair x 2: boundary list indices (minus, plus)             */
-    int corner[4];    /* boundary list indices of the corners, counter-clockwise    */
+    int *pair;         /* npair x 2: boundary list indices (minus, plus)             */
+    int corner[4];     /* boundary list indices of the corners, counter-clockwise    */
     gk_allocator alloc;
 } gk_frame;
 
@@ -174,11 +174,12 @@ typedef struct gk_frame_set {
 extern "C" {
 #endif
 
-GKDEF gk_result gk_frame_build(gk_frame *fr, const gk_packing *periodic, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_frame_build(gk_frame *fr, const gk_packing *periodic, const gk_allocator *alloc,
+                               gk_err *err);
 GKDEF void gk_frame_free(gk_frame *fr);
 /* the gk_twoscale_proc_fn of both RVEs: stress = P (eq 14 or det F sigma F^-T) */
-GKDEF gk_result gk_frame_run(void *set, int point, int proto, gk_rve *rve, const double H[9], const double dH[9],
-                             double scale, double stress[9], int *steps);
+GKDEF gk_result gk_frame_run(void *set, int point, int proto, gk_rve *rve, const double H[9],
+                             const double dH[9], double scale, double stress[9], int *steps);
 /* eq 11 from the positions x (2 per boundary particle, relative to the origin) */
 GKDEF void gk_frame_gradient(const gk_frame *fr, const double *x, double F[9]);
 /* eqs 31-32: kinetic energy of the particles whose skip[id] is 0 (skip NULL: all), elastic energy of
@@ -290,9 +291,11 @@ GKDEF gk_result gk_frame_build(gk_frame *out, const gk_packing *pk, const gk_all
     }
     /* the boundary copies, each on its edge with its coordinate along the edge (counter-clockwise) */
     for (m = 0, p = 0; p < n; ++p) {
-        double x = fabs(pk->x[p] - L0) <= tol ? 0.0 : pk->x[p], y = fabs(pk->y[p] - L1) <= tol ? 0.0 : pk->y[p];
+        double x = fabs(pk->x[p] - L0) <= tol ? 0.0 : pk->x[p],
+               y = fabs(pk->y[p] - L1) <= tol ? 0.0 : pk->y[p];
         if (role[p] == 3) {
-            for (k = 0; k < 4; ++k) e[m].edge = k, e[m].src = p, e[m].corner = k, e[m].s = -1.0, e[m].c = 0.0, ++m;
+            for (k = 0; k < 4; ++k)
+                e[m].edge = k, e[m].src = p, e[m].corner = k, e[m].s = -1.0, e[m].c = 0.0, ++m;
         } else if (role[p] == 2) { /* on y = 0: bottom (x ascending) and top (x descending) */
             e[m].edge = 0, e[m].src = p, e[m].corner = -1, e[m].s = x, e[m].c = x, ++m;
             e[m].edge = 2, e[m].src = p, e[m].corner = -1, e[m].s = -x, e[m].c = x, ++m;
@@ -324,10 +327,14 @@ GKDEF gk_result gk_frame_build(gk_frame *out, const gk_packing *pk, const gk_all
             X = (c->corner == 1 || c->corner == 2) ? L0 : 0.0;
             Y = c->corner >= 2 ? L1 : 0.0;
             F.corner[c->corner] = i;
-        } else if (c->edge == 0) X = c->c;
-        else if (c->edge == 1) X = L0, Y = c->c;
-        else if (c->edge == 2) X = c->c, Y = L1;
-        else Y = c->c;
+        } else if (c->edge == 0)
+            X = c->c;
+        else if (c->edge == 1)
+            X = L0, Y = c->c;
+        else if (c->edge == 2)
+            X = c->c, Y = L1;
+        else
+            Y = c->c;
         F.X[2 * i] = X, F.X[2 * i + 1] = Y, F.R[i] = pk->r[c->src];
         F.framed.x[m] = F.origin[0] + X, F.framed.y[m] = F.origin[1] + Y, F.framed.r[m] = pk->r[c->src];
         F.source[m] = c->src;
@@ -390,7 +397,8 @@ GKDEF gk_result gk_frame_energy(const gk_rve *rve, const unsigned char *skip, do
         if (rve->w[2]) ek += 0.5 / (double)rve->Iinv[p] * (double)rve->w[2][p] * (double)rve->w[2][p];
     }
     while (gk_rve_contact_next(rve, &c, &k)) {
-        double dd = sqrt(k.d[0] * k.d[0] + k.d[1] * k.d[1] + k.d[2] * k.d[2]), fn = 0.0, f2 = 0.0, kk = kn, kt;
+        double dd = sqrt(k.d[0] * k.d[0] + k.d[1] * k.d[1] + k.d[2] * k.d[2]), fn = 0.0, f2 = 0.0, kk = kn,
+               kt;
         for (d = 0; d < 3; ++d) fn += k.f[d] * k.d[d] / dd, f2 += k.f[d] * k.f[d];
         if (rad) kk = (double)rve->K.young * 2.0 * rad[k.i] * rad[k.j] / (rad[k.i] + rad[k.j]);
         kt = (double)rve->K.kt_ratio * kk;
@@ -417,9 +425,9 @@ typedef struct gk__fw {
     gk_scene sc;
     const gk_frame *fr;
     const gk_frame_def *d;
-    int *idx;              /* nq: scene index of each boundary particle */
-    unsigned char *skip;   /* by framed id: 1 boundary                   */
-    double *dx, *dth;      /* nq x 2, nq: the next move                  */
+    int *idx;            /* nq: scene index of each boundary particle */
+    unsigned char *skip; /* by framed id: 1 boundary                   */
+    double *dx, *dth;    /* nq x 2, nq: the next move                  */
     long steps, ramp, relax;
     int rot, capped;
     double ek, ep;
@@ -487,7 +495,8 @@ static double gk__fw_residual(gk__fw *w, double *rel) {
         int a = fr->pair[2 * e], b = fr->pair[2 * e + 1], pa = w->idx[a], pb = w->idx[b];
         /* Delta a = a^- + a^+ = -(contact forces on both): the pair moves with -Delta a */
         double dax = -(sc->load[0][pa] + sc->load[0][pb]), day = -(sc->load[1][pa] + sc->load[1][pb]);
-        double dm = w->rot ? -(sc->loadt[2][pa] + sc->loadt[2][pb]) : 0.0, R = fr->R[a], at = sc->mass[pa] * R / dt2;
+        double dm = w->rot ? -(sc->loadt[2][pa] + sc->loadt[2][pb]) : 0.0, R = fr->R[a],
+               at = sc->mass[pa] * R / dt2;
         num += dax * dax + day * day + (dm / R) * (dm / R);
         ra += (dax * dax + day * day) / (at * at) + (dm / (at * R)) * (dm / (at * R));
         w->dx[2 * a] = w->dx[2 * b] = -w->d->gain_a / kn * dax;
@@ -514,9 +523,12 @@ static gk_result gk__frame_servo(const gk_frame_set *set, const gk_frame *fr, gk
     memset(&w, 0, sizeof w);
     w.fr = fr, w.d = &set->def;
     w.rot = !(rve->def.flags & GK_RVE_NO_ROTATION);
-    if (rve->n != fr->n) return gk_err_set(&rve->err, GK_ERR_ARG, "frame: the RVE has %d particles, its frame %d", rve->n, fr->n);
+    if (rve->n != fr->n)
+        return gk_err_set(&rve->err, GK_ERR_ARG, "frame: the RVE has %d particles, its frame %d", rve->n,
+                          fr->n);
     if (!(rve->K.kn_const > 0))
-        return gk_err_set(&rve->err, GK_ERR_ARG, "frame: the servo's gains need a constant k_n (gk_material.kn)");
+        return gk_err_set(&rve->err, GK_ERR_ARG,
+                          "frame: the servo's gains need a constant k_n (gk_material.kn)");
     for (i = 0; i < 4; ++i) {
         Fa[i] = H[3 * (i / 2) + i % 2] + (i == 0 || i == 3);
         Fn[i] = Fa[i] + dH[3 * (i / 2) + i % 2];
@@ -581,8 +593,8 @@ out:
 }
 
 /* ------------------------------------------------------------ periodic cell */
-static gk_result gk__frame_periodic(const gk_frame_set *set, gk_rve *rve, const double F[9], const double dH[9],
-                                    double P[9], gk_frame_stats *st) {
+static gk_result gk__frame_periodic(const gk_frame_set *set, gk_rve *rve, const double F[9],
+                                    const double dH[9], double P[9], gk_frame_stats *st) {
     double mx = 0.0, w[3], sigma[9], ek = 0.0, ep = 0.0, L0[9], Ls[9];
     long n, steps = 0;
     int k, capped = 0;
@@ -622,8 +634,8 @@ static gk_result gk__frame_periodic(const gk_frame_set *set, gk_rve *rve, const 
     return GK_OK;
 }
 
-GKDEF gk_result gk_frame_run(void *user, int point, int proto, gk_rve *rve, const double H[9], const double dH[9],
-                             double scale, double stress[9], int *steps) {
+GKDEF gk_result gk_frame_run(void *user, int point, int proto, gk_rve *rve, const double H[9],
+                             const double dH[9], double scale, double stress[9], int *steps) {
     const gk_frame_set *in = (const gk_frame_set *)user;
     gk_frame_set set;
     gk_frame_stats st;
@@ -632,7 +644,8 @@ GKDEF gk_result gk_frame_run(void *user, int point, int proto, gk_rve *rve, cons
     gk_result r;
     (void)scale;
     memset(&st, 0, sizeof st);
-    if (!in || rve->dim != 2) return gk_err_set(&rve->err, GK_ERR_ARG, "frame: a 2D RVE and its gk_frame_set are needed");
+    if (!in || rve->dim != 2)
+        return gk_err_set(&rve->err, GK_ERR_ARG, "frame: a 2D RVE and its gk_frame_set are needed");
     set = *in;
     if (set.def.tol_energy == 0) set.def.tol_energy = 1e-3;
     if (set.def.tol_servo == 0) set.def.tol_servo = 1e-4;
@@ -642,8 +655,9 @@ GKDEF gk_result gk_frame_run(void *user, int point, int proto, gk_rve *rve, cons
     if (set.def.every == 0) set.def.every = 10;
     if (set.def.max_servo == 0) set.def.max_servo = 20;
     if (set.def.max_steps == 0) set.def.max_steps = 200000;
-    if (!(set.def.tol_energy > 0) || !(set.def.tol_servo > 0) || !(set.def.gain_a > 0) || !(set.def.gain_m > 0) ||
-        !(set.def.ramp > 0) || set.def.every < 1 || set.def.max_servo < 1 || set.def.max_steps < 1)
+    if (!(set.def.tol_energy > 0) || !(set.def.tol_servo > 0) || !(set.def.gain_a > 0) ||
+        !(set.def.gain_m > 0) || !(set.def.ramp > 0) || set.def.every < 1 || set.def.max_servo < 1 ||
+        set.def.max_steps < 1)
         return gk_err_set(&rve->err, GK_ERR_ARG, "frame: tolerances, gains, ramp and caps must be > 0");
     gk_m3_identity(F);
     for (k = 0; k < 9; ++k) F[k] += H[k] + dH[k];

@@ -114,7 +114,6 @@ GKDEF double gk_homog_mean_rotation(const gk_rve *rve);
 GKDEF double gk_rotation_angle(const double F[9], int dim);
 GKDEF void gk_tangent_voigt(const double *D, int dim, double *V);
 
-
 #ifdef __cplusplus
 }
 #endif
@@ -567,7 +566,6 @@ GKDEF double gk_homog_mean_rotation(const gk_rve *rve) {
     return s / rve->n;
 }
 
-
 GKDEF double gk_rotation_angle(const double F[9], int dim) {
     double R[9], U[9], w[3];
     if (gk_m3_polar(F, dim, R, U) != GK_OK) return 0.0;
@@ -593,6 +591,5 @@ GKDEF void gk_tangent_voigt(const double *D, int dim, double *V) {
             V[a * nv + b] = x;
         }
 }
-
 
 #endif /* GK_HOMOG implementation */

@@ -195,7 +195,7 @@ typedef struct gk_hybrid_oracle {
     unsigned char *flag, *prev; /* flags of this and of the last evaluation   */
     double *H;                  /* |lap e| / e_max of the last evaluation     */
     int nflag;
-    double since;               /* time the flagged set last changed         */
+    double since; /* time the flagged set last changed         */
     int evaluated;
     gk_allocator alloc;
 } gk_hybrid_oracle;
@@ -210,18 +210,18 @@ typedef struct gk_hybrid_coupling {
 } gk_hybrid_coupling;
 
 typedef struct gk_hybrid_couple_report {
-    int grains;       /* grains coupled                                  */
-    int nodes;        /* nodes where both media have mass                */
-    double dv_max;    /* largest |v_c - v_d| before the correction [m/s] */
+    int grains;         /* grains coupled                                  */
+    int nodes;          /* nodes where both media have mass                */
+    double dv_max;      /* largest |v_c - v_d| before the correction [m/s] */
     double exchange[2]; /* Sum Lambda: momentum moved to the grains [kg m/s per m] */
 } gk_hybrid_couple_report;
 
 typedef struct gk_hybrid_enrich_report {
     int points_deleted, points_overlap, grains_discrete, grains_overlap;
-    double mass_before, mass_after;       /* per unit thickness [kg/m]     */
-    double mom_before[2], mom_after[2];   /* per unit thickness [kg/s]     */
-    double mass_scale;                    /* grain mass factor              */
-    double dv[2];                         /* velocity shift of the grains  */
+    double mass_before, mass_after;     /* per unit thickness [kg/m]     */
+    double mom_before[2], mom_after[2]; /* per unit thickness [kg/s]     */
+    double mass_scale;                  /* grain mass factor              */
+    double dv[2];                       /* velocity shift of the grains  */
 } gk_hybrid_enrich_report;
 
 typedef struct gk_hybrid_band_result {
@@ -269,8 +269,8 @@ GKDEF gk_result gk_hybrid_mpm_finish(gk_mpm_grid *g, const gk_hybrid_periodic *p
 
 /* ---- continuum state */
 /* n points, X0 = the points' positions, Phi = Phi0, dp the continuum */
-GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *c, const gk_mpm_points *pts, const gk_mpm_dp *dp, double Phi0,
-                                    const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *c, const gk_mpm_points *pts, const gk_mpm_dp *dp,
+                                    double Phi0, const gk_allocator *alloc, gk_err *err);
 GKDEF void gk_hybrid_cont_free(gk_hybrid_cont *c);
 /* gk_mpm_stress_fn (user = gk_hybrid_cont *): rotate, elastic trial, return
  * map with Phi by eqs 7-8 (gk_mpm_dp_update); accumulates ep, sets rate
@@ -293,12 +293,12 @@ GKDEF gk_result gk_hybrid_rasterize(const gk_mpm_grid *g, const gk_hybrid_period
                                     double *den, gk_err *err);
 /* field value at x: Sum N f / Sum N (linear weights) over the nodes with
  * den > 0; returns 0 when none holds data (out untouched) */
-GKDEF int gk_hybrid_interp(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const double *field, int ncomp,
-                           const double *den, const double x[3], double *out);
+GKDEF int gk_hybrid_interp(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const double *field,
+                           int ncomp, const double *den, const double x[3], double *out);
 
 /* ---- history of a per-point vector */
-GKDEF gk_result gk_hybrid_history_init(gk_hybrid_history *h, int n, int ncomp, int cap, const gk_allocator *alloc,
-                                       gk_err *err);
+GKDEF gk_result gk_hybrid_history_init(gk_hybrid_history *h, int n, int ncomp, int cap,
+                                       const gk_allocator *alloc, gk_err *err);
 GKDEF void gk_hybrid_history_free(gk_hybrid_history *h);
 /* store a snapshot at time t (t above the newest; the oldest is dropped when full) */
 GKDEF gk_result gk_hybrid_history_push(gk_hybrid_history *h, double t, const double *val, gk_err *err);
@@ -313,22 +313,22 @@ GKDEF void gk_hybrid_history_keep(gk_hybrid_history *h, const unsigned char *kee
 /* Alg. 1 line 3 at every node: rate = e, recent = R on the nodes, active =
  * nodes that hold material (and are not constrained), dX the grid spacing.
  * Writes flag[I] (0/1) and, if H is not NULL, H[I]; returns the count. */
-GKDEF int gk_hybrid_oracle_flag(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const gk_hybrid_oracle_def *d,
-                                const double *rate, const double *recent, const unsigned char *active,
-                                unsigned char *flag, double *H);
+GKDEF int gk_hybrid_oracle_flag(const gk_mpm_grid *g, const gk_hybrid_periodic *per,
+                                const gk_hybrid_oracle_def *d, const double *rate, const double *recent,
+                                const unsigned char *active, unsigned char *flag, double *H);
 GKDEF gk_result gk_hybrid_oracle_init(gk_hybrid_oracle *o, const gk_hybrid_oracle_def *d, size_t nnode,
                                       const gk_allocator *alloc, gk_err *err);
 GKDEF void gk_hybrid_oracle_free(gk_hybrid_oracle *o);
 /* evaluate the flags at time t and the persistence test with tau_g:
  * returns 1 when the flagged set is non-empty and unchanged for tau_g */
 GKDEF int gk_hybrid_oracle_step(gk_hybrid_oracle *o, const gk_mpm_grid *g, const gk_hybrid_periodic *per,
-                                const double *rate, const double *recent, const unsigned char *active, double t,
-                                double tau_g);
+                                const double *rate, const double *recent, const unsigned char *active,
+                                double t, double tau_g);
 
 /* ---- zones */
 /* distance from x to the nearest flagged node (HUGE_VAL if none) */
-GKDEF double gk_hybrid_distance(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const unsigned char *flag,
-                                const double x[3]);
+GKDEF double gk_hybrid_distance(const gk_mpm_grid *g, const gk_hybrid_periodic *per,
+                                const unsigned char *flag, const double x[3]);
 GK_INLINE int gk_hybrid_zone(double dist, double phi0, double th) {
     if (dist <= phi0 - 0.5 * th) return GK_ZONE_DISCRETE;
     if (dist <= phi0 + 0.5 * th) return GK_ZONE_OVERLAP;
@@ -339,21 +339,22 @@ GK_INLINE int gk_hybrid_zone(double dist, double phi0, double th) {
 /* kinematic training: grains with boundary[p] move by (u[0][p], u[1][p])
  * at constant velocity over nsteps, then hold still for relax steps; then
  * every trained grain is released */
-GKDEF gk_result gk_hybrid_train(gk_scene *sc, const unsigned char *boundary, const double *const u[2], long nsteps,
-                                long relax, gk_err *err);
+GKDEF gk_result gk_hybrid_train(gk_scene *sc, const unsigned char *boundary, const double *const u[2],
+                                long nsteps, long relax, gk_err *err);
 /* the swap (see ENRICHMENT): pzone / gzone are the zones of the points and
  * grains; vg the continuum velocity at each grain (2 arrays) or NULL (zero);
  * w the partition (0.5); t the disk thickness. Deletes the DISCRETE points
  * (with c and the caller's extra arrays, as gk_hybrid_points_keep), weights
  * OVERLAP points and grains, sets grain masses and velocities. Grains in
  * the CONTINUUM zone must have been removed before. */
-GKDEF gk_result gk_hybrid_enrich(gk_mpm_points *pts, gk_hybrid_cont *c, gk_scene *sc, const unsigned char *gzone,
-                                 const double *const vg[2], double w, double t, int nextra, double *const *extra,
-                                 const int *stride, gk_hybrid_enrich_report *rep, gk_err *err);
+GKDEF gk_result gk_hybrid_enrich(gk_mpm_points *pts, gk_hybrid_cont *c, gk_scene *sc,
+                                 const unsigned char *gzone, const double *const vg[2], double w, double t,
+                                 int nextra, double *const *extra, const int *stride,
+                                 gk_hybrid_enrich_report *rep, gk_err *err);
 
 /* ---- coupling */
-GKDEF gk_result gk_hybrid_coupling_init(gk_hybrid_coupling *c, const gk_mpm_grid *g, const gk_allocator *alloc,
-                                        gk_err *err);
+GKDEF gk_result gk_hybrid_coupling_init(gk_hybrid_coupling *c, const gk_mpm_grid *g,
+                                        const gk_allocator *alloc, gk_err *err);
 GKDEF void gk_hybrid_coupling_free(gk_hybrid_coupling *c);
 /* eq 9 after the continuum's grid update and the grains' step: xpre the
  * grains' positions before their step (world coordinates, by particle
@@ -371,12 +372,14 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
  * neighbours within cutoff in X; period[k] > 0: axis k periodic with that
  * length (nearest images); eps[4 p ..] = exx, eyy, exy, gamma (NaN when
  * fewer than two non-collinear neighbours) */
-GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double *const x[2], const double period[2],
-                                  double cutoff, double *eps, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double *const x[2],
+                                  const double period[2], double cutoff, double *eps,
+                                  const gk_allocator *alloc, gk_err *err);
 /* band thickness of the n positions (x, y) by value (see BAND THICKNESS);
  * values that are not finite are ignored */
-GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value, double percentile,
-                               double nsd, gk_hybrid_band_result *out, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value,
+                               double percentile, double nsd, gk_hybrid_band_result *out,
+                               const gk_allocator *alloc, gk_err *err);
 
 /* ---- boundaries */
 /* mask[I] = 1 for the nodes a face (not FREE) or a rigid body of g acts on */
@@ -422,33 +425,36 @@ static int gk__hy_has_period(const gk_hybrid_periodic *per) {
 }
 
 /* visit every copy node I with its home H, in index order */
-#define GK__HY_FOR_COPIES(g, per, BODY)                                                                        \
-    do {                                                                                                     \
-        int gk__i, gk__j, gk__k;                                                                             \
-        for (gk__k = 0; gk__k < (g)->n[2]; ++gk__k)                                                          \
-            for (gk__j = 0; gk__j < (g)->n[1]; ++gk__j)                                                      \
-                for (gk__i = 0; gk__i < (g)->n[0]; ++gk__i) {                                                \
-                    int gk__c[3], gk__a, gk__copy = 0;                                                       \
-                    size_t I, H;                                                                             \
-                    gk__c[0] = gk__i;                                                                        \
-                    gk__c[1] = gk__j;                                                                        \
-                    gk__c[2] = gk__k;                                                                        \
-                    for (gk__a = 0; gk__a < (g)->dim; ++gk__a)                                               \
-                        if ((per)->period[gk__a] > 0) {                                                      \
-                            int gk__w = gk__hy_wrap_index(gk__c[gk__a], (per)->ghost[gk__a], (per)->period[gk__a]); \
-                            gk__copy |= gk__w != gk__c[gk__a];                                               \
-                            gk__c[gk__a] = gk__w;                                                            \
-                        }                                                                                    \
-                    if (!gk__copy) {                                                                         \
-                        /* only x wraps: jump over the home range of the row */                              \
-                        if ((per)->period[1] <= 0 && (per)->period[2] <= 0 && gk__i == (per)->ghost[0])      \
-                            gk__i = (per)->ghost[0] + (per)->period[0] - 1;                                  \
-                        continue;                                                                            \
-                    }                                                                                        \
-                    I = (size_t)gk__i + (size_t)(g)->n[0] * ((size_t)gk__j + (size_t)(g)->n[1] * (size_t)gk__k); \
-                    H = (size_t)gk__c[0] + (size_t)(g)->n[0] * ((size_t)gk__c[1] + (size_t)(g)->n[1] * (size_t)gk__c[2]); \
-                    BODY;                                                                                    \
-                }                                                                                            \
+#define GK__HY_FOR_COPIES(g, per, BODY)                                                                     \
+    do {                                                                                                    \
+        int gk__i, gk__j, gk__k;                                                                            \
+        for (gk__k = 0; gk__k < (g)->n[2]; ++gk__k)                                                         \
+            for (gk__j = 0; gk__j < (g)->n[1]; ++gk__j)                                                     \
+                for (gk__i = 0; gk__i < (g)->n[0]; ++gk__i) {                                               \
+                    int gk__c[3], gk__a, gk__copy = 0;                                                      \
+                    size_t I, H;                                                                            \
+                    gk__c[0] = gk__i;                                                                       \
+                    gk__c[1] = gk__j;                                                                       \
+                    gk__c[2] = gk__k;                                                                       \
+                    for (gk__a = 0; gk__a < (g)->dim; ++gk__a)                                              \
+                        if ((per)->period[gk__a] > 0) {                                                     \
+                            int gk__w =                                                                     \
+                                gk__hy_wrap_index(gk__c[gk__a], (per)->ghost[gk__a], (per)->period[gk__a]); \
+                            gk__copy |= gk__w != gk__c[gk__a];                                              \
+                            gk__c[gk__a] = gk__w;                                                           \
+                        }                                                                                   \
+                    if (!gk__copy) {                                                                        \
+                        /* only x wraps: jump over the home range of the row */                             \
+                        if ((per)->period[1] <= 0 && (per)->period[2] <= 0 && gk__i == (per)->ghost[0])     \
+                            gk__i = (per)->ghost[0] + (per)->period[0] - 1;                                 \
+                        continue;                                                                           \
+                    }                                                                                       \
+                    I = (size_t)gk__i +                                                                     \
+                        (size_t)(g)->n[0] * ((size_t)gk__j + (size_t)(g)->n[1] * (size_t)gk__k);            \
+                    H = (size_t)gk__c[0] +                                                                  \
+                        (size_t)(g)->n[0] * ((size_t)gk__c[1] + (size_t)(g)->n[1] * (size_t)gk__c[2]);      \
+                    BODY;                                                                                   \
+                }                                                                                           \
     } while (0)
 
 GKDEF void gk_hybrid_fold(const gk_mpm_grid *g, const gk_hybrid_periodic *per, double *a) {
@@ -525,10 +531,11 @@ GKDEF gk_result gk_hybrid_periodic_check(const gk_mpm_grid *g, const gk_hybrid_p
         if (per->period[k] <= 0) continue;
         if (k >= g->dim) return gk_err_set(err, GK_ERR_ARG, "periodic axis %d of a %dD grid", k, g->dim);
         if (per->ghost[k] < need || per->ghost[k] + per->period[k] + need > g->n[k] - 1)
-            return gk_err_set(err, GK_ERR_ARG,
-                              "periodic axis %d: %d home nodes from node %d leave fewer than the %d ghost layers "
-                              "the basis needs inside the %d nodes",
-                              k, per->period[k], per->ghost[k], need, g->n[k]);
+            return gk_err_set(
+                err, GK_ERR_ARG,
+                "periodic axis %d: %d home nodes from node %d leave fewer than the %d ghost layers "
+                "the basis needs inside the %d nodes",
+                k, per->period[k], per->ghost[k], need, g->n[k]);
     }
     return GK_OK;
 }
@@ -539,7 +546,8 @@ GKDEF gk_result gk_hybrid_mpm_predict(gk_mpm_grid *g, const gk_hybrid_periodic *
                                       gk_err *err) {
     gk_result r;
     if (d && d->scheme != GK_MPM_USF)
-        return gk_err_set(err, GK_ERR_UNSUPPORTED, "the hybrid step is USF (scheme %d given)", (int)d->scheme);
+        return gk_err_set(err, GK_ERR_UNSUPPORTED, "the hybrid step is USF (scheme %d given)",
+                          (int)d->scheme);
     if ((r = gk_mpm_p2g(g, pts, d, GK_MPM_P2G_MOMENTUM, err))) return r;
     gk_hybrid_fold_momentum(g, per);
     if ((r = gk_mpm_g2p(g, pts, d, dt, GK_MPM_G2P_GRADIENT_OLD, err))) return r;
@@ -576,19 +584,24 @@ static void gk__hy_cont_free_arrays(gk_hybrid_cont *c) {
     gk_free(&c->alloc, c->zone);
 }
 
-GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *out, const gk_mpm_points *pts, const gk_mpm_dp *dp, double Phi0,
-                                    const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *out, const gk_mpm_points *pts, const gk_mpm_dp *dp,
+                                    double Phi0, const gk_allocator *alloc, gk_err *err) {
     gk_hybrid_cont c;
     int p, k, n = pts ? pts->n : 0, bad = 0;
     size_t nn;
-    if (!out || !pts || !dp) return gk_err_set(err, GK_ERR_ARG, "NULL continuum, points or Drucker-Prager def");
-    if (pts->dim != 2) return gk_err_set(err, GK_ERR_UNSUPPORTED, "the hybrid continuum is 2D (points are %dD)", pts->dim);
-    if (!(Phi0 > 0.0 && Phi0 < 1.0)) return gk_err_set(err, GK_ERR_ARG, "packing fraction %g (must be in (0, 1))", Phi0);
-    if (!(dp->chi > 0.0) || !(dp->xi >= 0.0) || !(dp->Phi_cs > 0.0 && dp->Phi_cs < 1.0) || !isfinite(dp->tan_phi_cs))
-        return gk_err_set(err, GK_ERR_ARG,
-                          "critical-state parameters chi = %g, xi = %g, Phi_cs = %g, tan phi_cs = %g (need chi > 0, "
-                          "xi >= 0, 0 < Phi_cs < 1)",
-                          dp->chi, dp->xi, dp->Phi_cs, dp->tan_phi_cs);
+    if (!out || !pts || !dp)
+        return gk_err_set(err, GK_ERR_ARG, "NULL continuum, points or Drucker-Prager def");
+    if (pts->dim != 2)
+        return gk_err_set(err, GK_ERR_UNSUPPORTED, "the hybrid continuum is 2D (points are %dD)", pts->dim);
+    if (!(Phi0 > 0.0 && Phi0 < 1.0))
+        return gk_err_set(err, GK_ERR_ARG, "packing fraction %g (must be in (0, 1))", Phi0);
+    if (!(dp->chi > 0.0) || !(dp->xi >= 0.0) || !(dp->Phi_cs > 0.0 && dp->Phi_cs < 1.0) ||
+        !isfinite(dp->tan_phi_cs))
+        return gk_err_set(
+            err, GK_ERR_ARG,
+            "critical-state parameters chi = %g, xi = %g, Phi_cs = %g, tan phi_cs = %g (need chi > 0, "
+            "xi >= 0, 0 < Phi_cs < 1)",
+            dp->chi, dp->xi, dp->Phi_cs, dp->tan_phi_cs);
     memset(&c, 0, sizeof c);
     if (alloc) c.alloc = *alloc;
     nn = (size_t)(n > 0 ? n : 1);
@@ -627,7 +640,8 @@ GKDEF gk_result gk_hybrid_dp_stress(gk_mpm_points *pts, double dt, void *user, g
     int p;
     double gmax = 0.0;
     if (!c || c->n != pts->n)
-        return gk_err_set(err, GK_ERR_STATE, "continuum state has %d points, the MPM %d", c ? c->n : -1, pts->n);
+        return gk_err_set(err, GK_ERR_STATE, "continuum state has %d points, the MPM %d", c ? c->n : -1,
+                          pts->n);
     for (p = 0; p < pts->n; ++p) {
         double dH[9], D[9], tr, dd = 0.0;
         gk_mpm_dp_info info;
@@ -731,8 +745,10 @@ GKDEF gk_result gk_hybrid_rasterize(const gk_mpm_grid *g, const gk_hybrid_period
         xx[0] = x[0][p];
         xx[1] = x[1][p];
         xx[2] = g->dim == 3 ? x[2][p] : 0.0;
-        if (!(m[p] >= 0.0) || !isfinite(m[p])) return gk_err_set(err, GK_ERR_MASS, "entry %d: mass %g", p, m[p]);
-        if ((r = gk_mpm_shape(g, basis, xx, lp, &st, err))) return gk_err_set(err, r, "entry %d: %s", p, err ? err->msg : "");
+        if (!(m[p] >= 0.0) || !isfinite(m[p]))
+            return gk_err_set(err, GK_ERR_MASS, "entry %d: mass %g", p, m[p]);
+        if ((r = gk_mpm_shape(g, basis, xx, lp, &st, err)))
+            return gk_err_set(err, r, "entry %d: %s", p, err ? err->msg : "");
     }
     memset(den, 0, nn * sizeof(double));
     if (val) memset(num, 0, (size_t)ncomp * nn * sizeof(double));
@@ -748,7 +764,8 @@ GKDEF gk_result gk_hybrid_rasterize(const gk_mpm_grid *g, const gk_hybrid_period
             if (st.w[q] == 0.0) continue;
             den[st.node[q]] += wm;
             if (val)
-                for (c = 0; c < ncomp; ++c) num[(size_t)c * nn + (size_t)st.node[q]] += wm * val[(size_t)ncomp * p + c];
+                for (c = 0; c < ncomp; ++c)
+                    num[(size_t)c * nn + (size_t)st.node[q]] += wm * val[(size_t)ncomp * p + c];
         }
     }
     gk_hybrid_fold(g, per, den);
@@ -761,8 +778,8 @@ GKDEF gk_result gk_hybrid_rasterize(const gk_mpm_grid *g, const gk_hybrid_period
     return GK_OK;
 }
 
-GKDEF int gk_hybrid_interp(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const double *field, int ncomp,
-                           const double *den, const double x[3], double *out) {
+GKDEF int gk_hybrid_interp(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const double *field,
+                           int ncomp, const double *den, const double x[3], double *out) {
     double xi[2], wsum = 0.0, acc[9];
     int b[2], a, bb, c, k;
     size_t nn = g->nnode;
@@ -781,7 +798,8 @@ GKDEF int gk_hybrid_interp(const gk_mpm_grid *g, const gk_hybrid_periodic *per, 
             double w = (1.0 - fabs(xi[0] - ij[0])) * (1.0 - fabs(xi[1] - ij[1]));
             size_t I;
             for (k = 0; k < 2; ++k)
-                if (per && per->period[k] > 0) ij[k] = gk__hy_wrap_index(ij[k], per->ghost[k], per->period[k]);
+                if (per && per->period[k] > 0)
+                    ij[k] = gk__hy_wrap_index(ij[k], per->ghost[k], per->period[k]);
             if (ij[0] < 0 || ij[0] >= g->n[0] || ij[1] < 0 || ij[1] >= g->n[1]) continue;
             if (w < 0.0) w = 0.0;
             I = (size_t)ij[0] + (size_t)g->n[0] * (size_t)ij[1];
@@ -795,13 +813,14 @@ GKDEF int gk_hybrid_interp(const gk_mpm_grid *g, const gk_hybrid_periodic *per, 
 }
 
 /* ---------------------------------------------------------- history */
-GKDEF gk_result gk_hybrid_history_init(gk_hybrid_history *out, int n, int ncomp, int cap, const gk_allocator *alloc,
-                                       gk_err *err) {
+GKDEF gk_result gk_hybrid_history_init(gk_hybrid_history *out, int n, int ncomp, int cap,
+                                       const gk_allocator *alloc, gk_err *err) {
     gk_hybrid_history h;
     if (!out) return gk_err_set(err, GK_ERR_ARG, "NULL history");
     if (n < 0 || ncomp < 1 || cap < 2 || (double)n * ncomp * cap > 2e9)
-        return gk_err_set(err, GK_ERR_ARG, "history of %d x %d values, %d snapshots (need n >= 0, ncomp >= 1, cap >= 2)",
-                          n, ncomp, cap);
+        return gk_err_set(err, GK_ERR_ARG,
+                          "history of %d x %d values, %d snapshots (need n >= 0, ncomp >= 1, cap >= 2)", n,
+                          ncomp, cap);
     memset(&h, 0, sizeof h);
     if (alloc) h.alloc = *alloc;
     h.n = n;
@@ -809,7 +828,8 @@ GKDEF gk_result gk_hybrid_history_init(gk_hybrid_history *out, int n, int ncomp,
     h.cap = cap;
     h.head = -1;
     h.t = (double *)gk_alloc(&h.alloc, (size_t)cap * sizeof(double));
-    h.val = (double *)gk_alloc(&h.alloc, (size_t)cap * (size_t)(n > 0 ? n : 1) * (size_t)ncomp * sizeof(double));
+    h.val =
+        (double *)gk_alloc(&h.alloc, (size_t)cap * (size_t)(n > 0 ? n : 1) * (size_t)ncomp * sizeof(double));
     if (!h.t || !h.val) {
         gk_free(&h.alloc, h.t);
         gk_free(&h.alloc, h.val);
@@ -872,19 +892,22 @@ GKDEF int gk_hybrid_history_at(const gk_hybrid_history *h, double t, double *out
 
 GKDEF void gk_hybrid_history_keep(gk_hybrid_history *h, const unsigned char *keep) {
     int s, q = 0, p;
-    for (s = 0; s < h->cap; ++s) gk__hy_compact(h->val + (size_t)s * (size_t)h->n * (size_t)h->ncomp, h->ncomp, h->n, keep);
+    for (s = 0; s < h->cap; ++s)
+        gk__hy_compact(h->val + (size_t)s * (size_t)h->n * (size_t)h->ncomp, h->ncomp, h->n, keep);
     for (p = 0; p < h->n; ++p) q += keep[p] != 0;
     /* the snapshots are now packed with the new count: move each slot to its new place */
     if (q != h->n) {
         size_t oldsz = (size_t)h->n * (size_t)h->ncomp, newsz = (size_t)q * (size_t)h->ncomp;
-        for (s = 1; s < h->cap; ++s) memmove(h->val + (size_t)s * newsz, h->val + (size_t)s * oldsz, newsz * sizeof(double));
+        for (s = 1; s < h->cap; ++s)
+            memmove(h->val + (size_t)s * newsz, h->val + (size_t)s * oldsz, newsz * sizeof(double));
     }
     h->n = q;
 }
 
 /* ---------------------------------------------------------- oracle */
 /* neighbour of (i,j,k) along axis a by step s, wrapped; -1 if off the grid */
-static long gk__hy_neighbour(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const int ijk[3], int a, int s) {
+static long gk__hy_neighbour(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const int ijk[3], int a,
+                             int s) {
     int c[3], k;
     for (k = 0; k < 3; ++k) c[k] = ijk[k];
     c[a] += s;
@@ -893,9 +916,9 @@ static long gk__hy_neighbour(const gk_mpm_grid *g, const gk_hybrid_periodic *per
     return (long)c[0] + (long)g->n[0] * ((long)c[1] + (long)g->n[1] * (long)c[2]);
 }
 
-GKDEF int gk_hybrid_oracle_flag(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const gk_hybrid_oracle_def *d,
-                                const double *rate, const double *recent, const unsigned char *active,
-                                unsigned char *flag, double *H) {
+GKDEF int gk_hybrid_oracle_flag(const gk_mpm_grid *g, const gk_hybrid_periodic *per,
+                                const gk_hybrid_oracle_def *d, const double *rate, const double *recent,
+                                const unsigned char *active, unsigned char *flag, double *H) {
     size_t I;
     int count = 0, dim = g->dim;
     double L = d->D50 > g->h ? d->D50 : g->h, thr = d->c0 / (L * L); /* min(c0/D50^2, c0/dX^2) */
@@ -925,8 +948,10 @@ GKDEF int gk_hybrid_oracle_flag(const gk_mpm_grid *g, const gk_hybrid_periodic *
                     int c[3] = {ijk[0] + di, ijk[1] + dj, ijk[2] + dk}, k;
                     size_t J;
                     for (k = 0; k < dim; ++k)
-                        if (per && per->period[k] > 0) c[k] = gk__hy_wrap_index(c[k], per->ghost[k], per->period[k]);
-                    if (c[0] < 0 || c[0] >= g->n[0] || c[1] < 0 || c[1] >= g->n[1] || c[2] < 0 || c[2] >= g->n[2])
+                        if (per && per->period[k] > 0)
+                            c[k] = gk__hy_wrap_index(c[k], per->ghost[k], per->period[k]);
+                    if (c[0] < 0 || c[0] >= g->n[0] || c[1] < 0 || c[1] >= g->n[1] || c[2] < 0 ||
+                        c[2] >= g->n[2])
                         continue;
                     J = (size_t)c[0] + (size_t)g->n[0] * ((size_t)c[1] + (size_t)g->n[1] * (size_t)c[2]);
                     if (active[J] && rate[J] > emax) emax = rate[J];
@@ -947,10 +972,11 @@ GKDEF gk_result gk_hybrid_oracle_init(gk_hybrid_oracle *out, const gk_hybrid_ora
     if (!out || !d) return gk_err_set(err, GK_ERR_ARG, "NULL oracle or def");
     if (!(d->c0 >= 0.0) || !(d->c1 >= 0.0) || !(d->cl > 0.0) || !(d->cg > 0.0) || !(d->D50 > 0.0) ||
         !isfinite(d->c0 + d->c1 + d->cl + d->cg + d->D50))
-        return gk_err_set(err, GK_ERR_ARG,
-                          "oracle constants c0 = %g, c1 = %g, c_l = %g, c_g = %g, D50 = %g (need c0, c1 >= 0; c_l, "
-                          "c_g, D50 > 0)",
-                          d->c0, d->c1, d->cl, d->cg, d->D50);
+        return gk_err_set(
+            err, GK_ERR_ARG,
+            "oracle constants c0 = %g, c1 = %g, c_l = %g, c_g = %g, D50 = %g (need c0, c1 >= 0; c_l, "
+            "c_g, D50 > 0)",
+            d->c0, d->c1, d->cl, d->cg, d->D50);
     memset(&o, 0, sizeof o);
     if (alloc) o.alloc = *alloc;
     o.def = *d;
@@ -962,7 +988,8 @@ GKDEF gk_result gk_hybrid_oracle_init(gk_hybrid_oracle *out, const gk_hybrid_ora
         gk_free(&o.alloc, o.flag);
         gk_free(&o.alloc, o.prev);
         gk_free(&o.alloc, o.H);
-        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for an oracle of %lu nodes", (unsigned long)nnode);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for an oracle of %lu nodes",
+                          (unsigned long)nnode);
     }
     memset(o.flag, 0, nnode);
     memset(o.prev, 0, nnode);
@@ -979,8 +1006,8 @@ GKDEF void gk_hybrid_oracle_free(gk_hybrid_oracle *o) {
 }
 
 GKDEF int gk_hybrid_oracle_step(gk_hybrid_oracle *o, const gk_mpm_grid *g, const gk_hybrid_periodic *per,
-                                const double *rate, const double *recent, const unsigned char *active, double t,
-                                double tau_g) {
+                                const double *rate, const double *recent, const unsigned char *active,
+                                double t, double tau_g) {
     o->nflag = gk_hybrid_oracle_flag(g, per, &o->def, rate, recent, active, o->flag, o->H);
     if (!o->evaluated || memcmp(o->flag, o->prev, o->nnode) != 0) {
         memcpy(o->prev, o->flag, o->nnode);
@@ -991,8 +1018,8 @@ GKDEF int gk_hybrid_oracle_step(gk_hybrid_oracle *o, const gk_mpm_grid *g, const
 }
 
 /* ---------------------------------------------------------- zones */
-GKDEF double gk_hybrid_distance(const gk_mpm_grid *g, const gk_hybrid_periodic *per, const unsigned char *flag,
-                                const double x[3]) {
+GKDEF double gk_hybrid_distance(const gk_mpm_grid *g, const gk_hybrid_periodic *per,
+                                const unsigned char *flag, const double x[3]) {
     size_t I;
     double best = HUGE_VAL;
     for (I = 0; I < g->nnode; ++I) {
@@ -1014,15 +1041,15 @@ GKDEF double gk_hybrid_distance(const gk_mpm_grid *g, const gk_hybrid_periodic *
 }
 
 /* ---------------------------------------------------------- training */
-GKDEF gk_result gk_hybrid_train(gk_scene *sc, const unsigned char *boundary, const double *const u[2], long nsteps,
-                                long relax, gk_err *err) {
+GKDEF gk_result gk_hybrid_train(gk_scene *sc, const unsigned char *boundary, const double *const u[2],
+                                long nsteps, long relax, gk_err *err) {
     int p, n = sc->rve.n;
     double dt = sc->rve.dt, zero[3] = {0.0, 0.0, 0.0};
     gk_result r;
     if (sc->dim != 2) return gk_err_set(err, GK_ERR_UNSUPPORTED, "training is 2D");
     if (nsteps < 1 || relax < 0)
-        return gk_err_set(err, GK_ERR_ARG, "training of %ld steps and %ld relaxation steps (need >= 1, >= 0)", nsteps,
-                          relax);
+        return gk_err_set(err, GK_ERR_ARG, "training of %ld steps and %ld relaxation steps (need >= 1, >= 0)",
+                          nsteps, relax);
     for (p = 0; p < n; ++p)
         if (boundary[p] && (!isfinite(u[0][p]) || !isfinite(u[1][p])))
             return gk_err_set(err, GK_ERR_NAN, "training displacement of grain %d is NaN", p);
@@ -1035,7 +1062,8 @@ GKDEF gk_result gk_hybrid_train(gk_scene *sc, const unsigned char *boundary, con
             if ((r = gk_scene_prescribe(sc, p, v, zero)) != GK_OK)
                 return gk_err_set(err, r, "training: %s", gk_scene_error(sc));
         }
-    if ((r = gk_scene_step(sc, nsteps)) != GK_OK) return gk_err_set(err, r, "training: %s", gk_scene_error(sc));
+    if ((r = gk_scene_step(sc, nsteps)) != GK_OK)
+        return gk_err_set(err, r, "training: %s", gk_scene_error(sc));
     for (p = 0; p < n; ++p)
         if (boundary[p] && (r = gk_scene_prescribe(sc, p, zero, zero)) != GK_OK)
             return gk_err_set(err, r, "training: %s", gk_scene_error(sc));
@@ -1048,9 +1076,10 @@ GKDEF gk_result gk_hybrid_train(gk_scene *sc, const unsigned char *boundary, con
 }
 
 /* ---------------------------------------------------------- enrichment */
-GKDEF gk_result gk_hybrid_enrich(gk_mpm_points *pts, gk_hybrid_cont *c, gk_scene *sc, const unsigned char *gzone,
-                                 const double *const vg[2], double w, double t, int nextra, double *const *extra,
-                                 const int *stride, gk_hybrid_enrich_report *rep_out, gk_err *err) {
+GKDEF gk_result gk_hybrid_enrich(gk_mpm_points *pts, gk_hybrid_cont *c, gk_scene *sc,
+                                 const unsigned char *gzone, const double *const vg[2], double w, double t,
+                                 int nextra, double *const *extra, const int *stride,
+                                 gk_hybrid_enrich_report *rep_out, gk_err *err) {
     gk_hybrid_enrich_report rep;
     unsigned char *keep;
     int p, k, n = pts->n, ng = sc->rve.n;
@@ -1058,7 +1087,8 @@ GKDEF gk_result gk_hybrid_enrich(gk_mpm_points *pts, gk_hybrid_cont *c, gk_scene
     gk_result r;
     if (pts->dim != 2 || sc->dim != 2) return gk_err_set(err, GK_ERR_UNSUPPORTED, "enrichment is 2D");
     if (!c || c->n != n) return gk_err_set(err, GK_ERR_STATE, "continuum state does not match the points");
-    if (!(w > 0.0 && w < 1.0)) return gk_err_set(err, GK_ERR_ARG, "partition weight %g (must be in (0, 1))", w);
+    if (!(w > 0.0 && w < 1.0))
+        return gk_err_set(err, GK_ERR_ARG, "partition weight %g (must be in (0, 1))", w);
     if (!(t > 0.0) || !isfinite(t)) return gk_err_set(err, GK_ERR_ARG, "disk thickness %g (must be > 0)", t);
     memset(&rep, 0, sizeof rep);
     for (p = 0; p < ng; ++p) {
@@ -1069,7 +1099,8 @@ GKDEF gk_result gk_hybrid_enrich(gk_mpm_points *pts, gk_hybrid_cont *c, gk_scene
             return gk_err_set(err, GK_ERR_NAN, "continuum velocity at grain %d is NaN", p);
     }
     for (p = 0; p < n; ++p)
-        if (c->zone[p] > GK_ZONE_DISCRETE) return gk_err_set(err, GK_ERR_ARG, "point %d has zone %d", p, (int)c->zone[p]);
+        if (c->zone[p] > GK_ZONE_DISCRETE)
+            return gk_err_set(err, GK_ERR_ARG, "point %d has zone %d", p, (int)c->zone[p]);
     /* what leaves the continuum */
     for (p = 0; p < n; ++p) {
         double f = c->zone[p] == GK_ZONE_DISCRETE ? 1.0 : (c->zone[p] == GK_ZONE_OVERLAP ? w : 0.0);
@@ -1084,8 +1115,8 @@ GKDEF gk_result gk_hybrid_enrich(gk_mpm_points *pts, gk_hybrid_cont *c, gk_scene
         for (k = 0; k < 2; ++k) pg[k] += f * m * (vg ? vg[k][p] : 0.0);
     }
     if (!(md > 0.0) || !(mg > 0.0))
-        return gk_err_set(err, GK_ERR_STATE, "nothing to swap: continuum mass %g, grain mass %g in the discrete zone", md,
-                          mg);
+        return gk_err_set(err, GK_ERR_STATE,
+                          "nothing to swap: continuum mass %g, grain mass %g in the discrete zone", md, mg);
     s = md / mg;
     keep = (unsigned char *)gk_alloc(&pts->alloc, (size_t)(n > 0 ? n : 1));
     if (!keep) return gk_err_set(err, GK_ERR_ALLOC, "out of memory");
@@ -1139,8 +1170,8 @@ GKDEF gk_result gk_hybrid_enrich(gk_mpm_points *pts, gk_hybrid_cont *c, gk_scene
 }
 
 /* ---------------------------------------------------------- coupling */
-GKDEF gk_result gk_hybrid_coupling_init(gk_hybrid_coupling *out, const gk_mpm_grid *g, const gk_allocator *alloc,
-                                        gk_err *err) {
+GKDEF gk_result gk_hybrid_coupling_init(gk_hybrid_coupling *out, const gk_mpm_grid *g,
+                                        const gk_allocator *alloc, gk_err *err) {
     gk_hybrid_coupling c;
     int k, bad = 0;
     size_t nn = g->nnode;
@@ -1156,7 +1187,8 @@ GKDEF gk_result gk_hybrid_coupling_init(gk_hybrid_coupling *out, const gk_mpm_gr
     }
     if (bad || !c.md) {
         gk_hybrid_coupling_free(&c);
-        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the coupling of %lu nodes", (unsigned long)nn);
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the coupling of %lu nodes",
+                          (unsigned long)nn);
     }
     *out = c;
     return GK_OK;
@@ -1270,8 +1302,9 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
 }
 
 /* ---------------------------------------------------------- Cundall strain */
-GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double *const x[2], const double period[2],
-                                  double cutoff, double *eps, const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double *const x[2],
+                                  const double period[2], double cutoff, double *eps,
+                                  const gk_allocator *alloc, gk_err *err) {
     double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL}, c2 = cutoff * cutoff;
     int nb[2], k, p, nbin;
     int32_t *head, *next;
@@ -1279,7 +1312,8 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
     memset(&al, 0, sizeof al);
     if (alloc) al = *alloc;
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "%d grains", n);
-    if (!(cutoff > 0.0) || !isfinite(cutoff)) return gk_err_set(err, GK_ERR_ARG, "neighbour cutoff %g (must be > 0)", cutoff);
+    if (!(cutoff > 0.0) || !isfinite(cutoff))
+        return gk_err_set(err, GK_ERR_ARG, "neighbour cutoff %g (must be > 0)", cutoff);
     for (p = 0; p < n; ++p)
         for (k = 0; k < 2; ++k) {
             if (!isfinite(X[k][p]) || !isfinite(x[k][p]))
@@ -1291,7 +1325,8 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
         double span = hi[k] - lo[k];
         if (period && period[k] > 0.0) {
             if (period[k] < 3.0 * cutoff)
-                return gk_err_set(err, GK_ERR_ARG, "period %g below three cutoffs %g", period[k], 3.0 * cutoff);
+                return gk_err_set(err, GK_ERR_ARG, "period %g below three cutoffs %g", period[k],
+                                  3.0 * cutoff);
             span = period[k];
         }
         nb[k] = (int)(span / cutoff);
@@ -1307,10 +1342,11 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d grains", n);
     }
     for (k = 0; k < nbin; ++k) head[k] = -1;
-#define GK__HY_BIN(k, v)                                                                                              \
-    ((period && period[k] > 0.0)                                                                                      \
-         ? ((int)floor(((v)-lo[k]) / period[k] * nb[k]) % nb[k] + nb[k]) % nb[k]                                    \
-         : (int)gk_clamp(floor(((v)-lo[k]) / (hi[k] - lo[k] > 0.0 ? hi[k] - lo[k] : 1.0) * nb[k]), 0.0, nb[k] - 1.0))
+#define GK__HY_BIN(k, v)                                                                                \
+    ((period && period[k] > 0.0)                                                                        \
+         ? ((int)floor(((v)-lo[k]) / period[k] * nb[k]) % nb[k] + nb[k]) % nb[k]                        \
+         : (int)gk_clamp(floor(((v)-lo[k]) / (hi[k] - lo[k] > 0.0 ? hi[k] - lo[k] : 1.0) * nb[k]), 0.0, \
+                         nb[k] - 1.0))
     /* insert in descending order so each bin lists ascending indices */
     for (p = n - 1; p >= 0; --p) {
         int b = GK__HY_BIN(0, X[0][p]) + nb[0] * GK__HY_BIN(1, X[1][p]);
@@ -1391,17 +1427,20 @@ static int gk__hy_cmp_xy(const void *a, const void *b) {
     return p[1] < q[1] ? -1 : (p[1] > q[1] ? 1 : 0);
 }
 
-GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value, double percentile,
-                               double nsd, gk_hybrid_band_result *out, const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value,
+                               double percentile, double nsd, gk_hybrid_band_result *out,
+                               const gk_allocator *alloc, gk_err *err) {
     gk_hybrid_band_result res;
     gk_allocator al;
-    double *v, *pt, *hull, thr, c[2] = {0.0, 0.0}, sxx = 0.0, sxy = 0.0, syy = 0.0, dir[2], mean = 0.0, sd = 0.0;
+    double *v, *pt, *hull, thr, c[2] = {0.0, 0.0}, sxx = 0.0, sxy = 0.0, syy = 0.0, dir[2], mean = 0.0,
+                                sd = 0.0;
     int p, nv = 0, ns = 0, nk = 0, nh = 0, i, kk;
     memset(&al, 0, sizeof al);
     if (alloc) al = *alloc;
     if (!(percentile >= 0.0 && percentile < 100.0) || !(nsd > 0.0))
-        return gk_err_set(err, GK_ERR_ARG, "percentile %g (must be in [0, 100)), outlier cut %g sd (must be > 0)",
-                          percentile, nsd);
+        return gk_err_set(err, GK_ERR_ARG,
+                          "percentile %g (must be in [0, 100)), outlier cut %g sd (must be > 0)", percentile,
+                          nsd);
     memset(&res, 0, sizeof res);
     v = (double *)gk_alloc(&al, (size_t)(n > 0 ? n : 1) * sizeof(double));
     pt = (double *)gk_alloc(&al, 2 * (size_t)(n > 0 ? n : 1) * sizeof(double));
@@ -1442,10 +1481,12 @@ GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const do
         }
         c[0] /= ns;
         c[1] /= ns;
-        for (i = 0; i < ns; ++i) r2 += (pt[2 * i] - c[0]) * (pt[2 * i] - c[0]) + (pt[2 * i + 1] - c[1]) * (pt[2 * i + 1] - c[1]);
+        for (i = 0; i < ns; ++i)
+            r2 += (pt[2 * i] - c[0]) * (pt[2 * i] - c[0]) + (pt[2 * i + 1] - c[1]) * (pt[2 * i + 1] - c[1]);
         lim = nsd * nsd * r2 / ns;
         for (i = 0; i < ns; ++i) {
-            double d2 = (pt[2 * i] - c[0]) * (pt[2 * i] - c[0]) + (pt[2 * i + 1] - c[1]) * (pt[2 * i + 1] - c[1]);
+            double d2 =
+                (pt[2 * i] - c[0]) * (pt[2 * i] - c[0]) + (pt[2 * i + 1] - c[1]) * (pt[2 * i + 1] - c[1]);
             if (d2 <= lim) {
                 pt[2 * m] = pt[2 * i];
                 pt[2 * m + 1] = pt[2 * i + 1];
@@ -1504,8 +1545,8 @@ GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const do
         res.thickness = 0.0;
         for (i = 0; i < nh; ++i) {
             const double *a = hull + 2 * i, *b = hull + 2 * ((i + 1) % nh);
-            double ex = b[0] - a[0], ey = b[1] - a[1], L = sqrt(ex * ex + ey * ey), umin = HUGE_VAL, umax = -HUGE_VAL,
-                   wmin = HUGE_VAL, wmax = -HUGE_VAL;
+            double ex = b[0] - a[0], ey = b[1] - a[1], L = sqrt(ex * ex + ey * ey), umin = HUGE_VAL,
+                   umax = -HUGE_VAL, wmin = HUGE_VAL, wmax = -HUGE_VAL;
             int j;
             if (!(L > 0.0)) continue;
             ex /= L;

@@ -72,9 +72,9 @@ typedef struct gk_field_def {
     int fixed_range;             /* 1: colours span [vmin, vmax] (the same scale for every
                                     snapshot of a run); values beyond take the end colours */
     double vmin, vmax;
-    int nlines;                  /* outline polylines drawn on top (platens, walls, ...) */
-    const int *line_len;         /* points in each polyline                            */
-    const double *line_xy;       /* their points, (x, y) pairs, polyline after polyline */
+    int nlines;            /* outline polylines drawn on top (platens, walls, ...) */
+    const int *line_len;   /* points in each polyline                            */
+    const double *line_xy; /* their points, (x, y) pairs, polyline after polyline */
 } gk_field_def;
 
 typedef struct gk_vtk {
@@ -302,7 +302,8 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
         cx[6] = 0.5 * (L + R), cy[6] = T, cx[7] = 0.5 * (L + R), cy[7] = B;
         for (k = 0; k < 8 && !placed; ++k) {
             box[0] = cx[k], box[1] = cx[k] + lw + 10, box[2] = cy[k], box[3] = cy[k] + lh;
-            if (box[0] >= L && box[1] <= f.W - f.mr - 8 && box[3] <= f.H - f.mb - 8 && !gk__plot_hits(p, &f, box))
+            if (box[0] >= L && box[1] <= f.W - f.mr - 8 && box[3] <= f.H - f.mb - 8 &&
+                !gk__plot_hits(p, &f, box))
                 placed = 1;
         }
         if (!placed) { /* outside: the axes make room on the right */
@@ -316,32 +317,38 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
     if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot write plot '%s'", path);
 #define GK__X(x) (f.ml + ((x)-f.x0) * f.sx)
 #define GK__Y(y) (f.H - f.mb - ((y)-f.y0) * f.sy)
-    fprintf(fp,
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
-            "font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n",
-            f.W, f.H, f.W, f.H);
+    fprintf(
+        fp,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
+        "font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n",
+        f.W, f.H, f.W, f.H);
     fprintf(fp, "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n");
     st = gk__nice_step(f.x1 - f.x0, 6);
     for (t = ceil(f.x0 / st) * st; t <= f.x1 + 1e-9 * st; t += st) {
         double tt = fabs(t) < 1e-12 * st ? 0.0 : t;
-        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e5e5e5\"/>\n", GK__X(tt), f.mt,
-                GK__X(tt), f.H - f.mb);
-        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%g</text>\n", GK__X(tt), f.H - f.mb + 16, tt);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e5e5e5\"/>\n", GK__X(tt),
+                f.mt, GK__X(tt), f.H - f.mb);
+        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%g</text>\n", GK__X(tt),
+                f.H - f.mb + 16, tt);
     }
     st = gk__nice_step(f.y1 - f.y0, 6);
     for (t = ceil(f.y0 / st) * st; t <= f.y1 + 1e-9 * st; t += st) {
         double tt = fabs(t) < 1e-12 * st ? 0.0 : t;
-        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e5e5e5\"/>\n", f.ml, GK__Y(tt),
-                f.W - f.mr, GK__Y(tt));
-        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%g</text>\n", f.ml - 6, GK__Y(tt) + 4, tt);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e5e5e5\"/>\n", f.ml,
+                GK__Y(tt), f.W - f.mr, GK__Y(tt));
+        fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%g</text>\n", f.ml - 6, GK__Y(tt) + 4,
+                tt);
     }
-    fprintf(fp, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n", f.ml,
-            f.mt, f.W - f.ml - f.mr, f.H - f.mt - f.mb);
-    if (f.y0 < 0 && f.y1 > 0)
-        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#999\"/>\n", f.ml, GK__Y(0.0),
-                f.W - f.mr, GK__Y(0.0));
-    fprintf(fp, "<clipPath id=\"gkclip\"><rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/></clipPath>\n",
+    fprintf(fp,
+            "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n",
             f.ml, f.mt, f.W - f.ml - f.mr, f.H - f.mt - f.mb);
+    if (f.y0 < 0 && f.y1 > 0)
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#999\"/>\n", f.ml,
+                GK__Y(0.0), f.W - f.mr, GK__Y(0.0));
+    fprintf(
+        fp,
+        "<clipPath id=\"gkclip\"><rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\"/></clipPath>\n",
+        f.ml, f.mt, f.W - f.ml - f.mr, f.H - f.mt - f.mb);
     for (k = 0; k < p->ns; ++k) {
         const char *col = p->s[k].color ? p->s[k].color : gk__cycle[k % GK_PLOT_MAX];
         int started = 0;
@@ -370,7 +377,9 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
         const char *col = p->s[k].color ? p->s[k].color : gk__cycle[k % GK_PLOT_MAX];
         if (p->s[k].label) {
             double lx = box[0] + 6, ly = box[2] + 14 + 16 * nleg++;
-            fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" stroke-width=\"2\"%s/>\n",
+            fprintf(fp,
+                    "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" "
+                    "stroke-width=\"2\"%s/>\n",
                     lx, ly - 4, lx + 24, ly - 4, col, p->s[k].dashed ? " stroke-dasharray=\"6,4\"" : "");
             fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\">", lx + 30, ly);
             gk__xml_text(fp, p->s[k].label);
@@ -383,7 +392,8 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
         fprintf(fp, "</text>\n");
     }
     if (p->xlabel) {
-        fprintf(fp, "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">", f.ml + 0.5 * (f.W - f.ml - f.mr), f.H - 12);
+        fprintf(fp, "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">", f.ml + 0.5 * (f.W - f.ml - f.mr),
+                f.H - 12);
         gk__xml_text(fp, p->xlabel);
         fprintf(fp, "</text>\n");
     }
@@ -401,8 +411,9 @@ GKDEF gk_result gk_plot_svg(const gk_plot *p, const char *path, gk_err *err) {
 
 /* viridis, 9 control points, linear in between */
 static void gk__colormap(double t, int *r, int *g, int *b) {
-    static const double c[9][3] = {{68, 1, 84},    {71, 44, 122},  {59, 81, 139},   {44, 113, 142}, {33, 144, 141},
-                                   {39, 173, 129}, {92, 200, 99},  {170, 220, 50},  {253, 231, 37}};
+    static const double c[9][3] = {{68, 1, 84},    {71, 44, 122},  {59, 81, 139},
+                                   {44, 113, 142}, {33, 144, 141}, {39, 173, 129},
+                                   {92, 200, 99},  {170, 220, 50}, {253, 231, 37}};
     double u;
     int k;
     if (!(t >= 0.0)) t = 0.0;
@@ -416,8 +427,8 @@ static void gk__colormap(double t, int *r, int *g, int *b) {
     *b = (int)(c[k][2] + u * (c[k + 1][2] - c[k][2]) + 0.5);
 }
 
-GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def_in, int npoly, int nv, const double *xy,
-                             const double *value, gk_err *err) {
+GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def_in, int npoly, int nv,
+                             const double *xy, const double *value, gk_err *err) {
     gk_field_def d;
     FILE *fp;
     double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300, v0 = 1e300, v1 = -1e300, sc, cs, dot, st, t;
@@ -433,7 +444,8 @@ GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def_in, int n
     if (d.nlines < 0 || (d.nlines > 0 && (!d.line_len || !d.line_xy)))
         return gk_err_set(err, GK_ERR_ARG, "outline: %d polylines without their points", d.nlines);
     for (k = 0; k < d.nlines; ++k)
-        if (d.line_len[k] < 0) return gk_err_set(err, GK_ERR_ARG, "outline polyline %d has %d points", k, d.line_len[k]);
+        if (d.line_len[k] < 0)
+            return gk_err_set(err, GK_ERR_ARG, "outline polyline %d has %d points", k, d.line_len[k]);
     cs = d.coord_scale > 0 ? d.coord_scale : 1.0;
     for (k = 0; k < npoly * nv; ++k) {
         double x = xy[2 * k], y = xy[2 * k + 1];
@@ -484,11 +496,13 @@ GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def_in, int n
     if (!fp) return gk_err_set(err, GK_ERR_IO, "cannot write field plot '%s'", path);
 #define GK__FX(x) (ml + ((x)-x0) * sc)
 #define GK__FY(y) (mt + (y1 - (y)) * sc)
-    fprintf(fp,
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
-            "font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n<rect width=\"100%%\" height=\"100%%\" "
-            "fill=\"white\"/>\n",
-            W, H, W, H);
+    fprintf(
+        fp,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" viewBox=\"0 0 %.0f %.0f\" "
+        "font-family=\"Helvetica, Arial, sans-serif\" font-size=\"12\">\n<rect width=\"100%%\" "
+        "height=\"100%%\" "
+        "fill=\"white\"/>\n",
+        W, H, W, H);
     for (k = 0; k < npoly; ++k) {
         char col[32];
         if (isfinite(value[k])) {
@@ -504,7 +518,8 @@ GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def_in, int n
         } else {
             fprintf(fp, "<polygon fill=\"%s\" stroke=\"%s\" stroke-width=\"0.5\" points=\"", col, col);
             for (v = 0; v < nv; ++v)
-                fprintf(fp, "%s%.2f,%.2f", v ? " " : "", GK__FX(xy[2 * (nv * k + v)]), GK__FY(xy[2 * (nv * k + v) + 1]));
+                fprintf(fp, "%s%.2f,%.2f", v ? " " : "", GK__FX(xy[2 * (nv * k + v)]),
+                        GK__FY(xy[2 * (nv * k + v) + 1]));
             fprintf(fp, "\"/>\n");
         }
     }
@@ -513,25 +528,30 @@ GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def_in, int n
         const double *q = d.line_xy;
         int L;
         for (L = 0; L < d.nlines; ++L) {
-            fprintf(fp, "<polyline class=\"outline\" fill=\"none\" stroke=\"black\" stroke-width=\"2\" points=\"");
-            for (v = 0; v < d.line_len[L]; ++v, q += 2) fprintf(fp, "%s%.2f,%.2f", v ? " " : "", GK__FX(q[0]), GK__FY(q[1]));
+            fprintf(
+                fp,
+                "<polyline class=\"outline\" fill=\"none\" stroke=\"black\" stroke-width=\"2\" points=\"");
+            for (v = 0; v < d.line_len[L]; ++v, q += 2)
+                fprintf(fp, "%s%.2f,%.2f", v ? " " : "", GK__FX(q[0]), GK__FY(q[1]));
             fprintf(fp, "\"/>\n");
         }
     }
     /* axes: a frame, ticks and labels in scaled coordinates */
-    fprintf(fp, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n", ml, mt,
-            plotw, ploth);
+    fprintf(fp,
+            "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n",
+            ml, mt, plotw, ploth);
     st = gk__nice_step((x1 - x0) * cs, 5);
     for (t = ceil(x0 * cs / st) * st; t <= x1 * cs + 1e-9 * st; t += st) {
         double tt = fabs(t) < 1e-12 * st ? 0.0 : t, X = GK__FX(tt / cs);
-        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#333\"/>\n", X, mt + ploth, X,
-                mt + ploth + 5);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#333\"/>\n", X,
+                mt + ploth, X, mt + ploth + 5);
         fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%g</text>\n", X, mt + ploth + 18, tt);
     }
     st = gk__nice_step((y1 - y0) * cs, 5);
     for (t = ceil(y0 * cs / st) * st; t <= y1 * cs + 1e-9 * st; t += st) {
         double tt = fabs(t) < 1e-12 * st ? 0.0 : t, Y = GK__FY(tt / cs);
-        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#333\"/>\n", ml - 5, Y, ml, Y);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#333\"/>\n", ml - 5, Y,
+                ml, Y);
         fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%g</text>\n", ml - 8, Y + 4, tt);
     }
     fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", ml + 0.5 * plotw, mt + ploth + 38);
@@ -549,16 +569,16 @@ GKDEF gk_result gk_field_svg(const char *path, const gk_field_def *def_in, int n
         int r, g, b;
         double h = (bary1 - bary0) / 64.0;
         gk__colormap(k / 63.0, &r, &g, &b);
-        fprintf(fp, "<rect x=\"%.1f\" y=\"%.2f\" width=\"16\" height=\"%.2f\" fill=\"rgb(%d,%d,%d)\"/>\n", barx,
-                bary1 - (k + 1) * h, h + 0.5, r, g, b);
+        fprintf(fp, "<rect x=\"%.1f\" y=\"%.2f\" width=\"16\" height=\"%.2f\" fill=\"rgb(%d,%d,%d)\"/>\n",
+                barx, bary1 - (k + 1) * h, h + 0.5, r, g, b);
     }
-    fprintf(fp, "<rect x=\"%.1f\" y=\"%.1f\" width=\"16\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n", barx, bary0,
-            bary1 - bary0);
+    fprintf(fp, "<rect x=\"%.1f\" y=\"%.1f\" width=\"16\" height=\"%.1f\" fill=\"none\" stroke=\"#333\"/>\n",
+            barx, bary0, bary1 - bary0);
     st = gk__nice_step(v1 - v0, 5);
     for (t = ceil(v0 / st) * st; t <= v1 + 1e-9 * st; t += st) {
         double tt = fabs(t) < 1e-12 * st ? 0.0 : t, Y = bary1 - (tt - v0) / (v1 - v0) * (bary1 - bary0);
-        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#333\"/>\n", barx + 16, Y, barx + 20,
-                Y);
+        fprintf(fp, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#333\"/>\n", barx + 16, Y,
+                barx + 20, Y);
         fprintf(fp, "<text x=\"%.1f\" y=\"%.1f\">%g</text>\n", barx + 23, Y + 4, tt);
     }
     if (d.label) {
@@ -595,7 +615,8 @@ GKDEF gk_result gk_vtk_open(gk_vtk *v, const char *path, const char *title) {
     memset(v, 0, sizeof *v);
     v->fp = fopen(path, "w");
     if (!v->fp) return gk_err_set(&v->err, GK_ERR_IO, "cannot write VTK file '%s'", path);
-    fprintf(v->fp, "# vtk DataFile Version 3.0\n%s\nASCII\nDATASET UNSTRUCTURED_GRID\n", title ? title : "grainkit");
+    fprintf(v->fp, "# vtk DataFile Version 3.0\n%s\nASCII\nDATASET UNSTRUCTURED_GRID\n",
+            title ? title : "grainkit");
     return GK_OK;
 }
 
@@ -655,7 +676,8 @@ static gk_result gk__vtk_tensor(gk_vtk *v, int cell, const char *name, const dou
     fprintf(v->fp, "TENSORS %s double\n", name);
     for (k = 0; k < n; ++k)
         for (j = 0; j < 3; ++j)
-            fprintf(v->fp, "%.9g %.9g %.9g\n", val9[9 * k + 3 * j], val9[9 * k + 3 * j + 1], val9[9 * k + 3 * j + 2]);
+            fprintf(v->fp, "%.9g %.9g %.9g\n", val9[9 * k + 3 * j], val9[9 * k + 3 * j + 1],
+                    val9[9 * k + 3 * j + 2]);
     return gk__vtk_status(v);
 }
 
@@ -676,7 +698,8 @@ GKDEF gk_result gk_vtk_point_vector(gk_vtk *v, const char *name, const double *v
     gk_result r = gk__vtk_section(v, 0);
     if (r) return r;
     fprintf(v->fp, "VECTORS %s double\n", name);
-    for (k = 0; k < v->npoints; ++k) fprintf(v->fp, "%.9g %.9g %.9g\n", val3[3 * k], val3[3 * k + 1], val3[3 * k + 2]);
+    for (k = 0; k < v->npoints; ++k)
+        fprintf(v->fp, "%.9g %.9g %.9g\n", val3[3 * k], val3[3 * k + 1], val3[3 * k + 2]);
     return gk__vtk_status(v);
 }
 
@@ -689,8 +712,8 @@ GKDEF gk_result gk_vtk_close(gk_vtk *v) {
 
 GKDEF void gk_progress(FILE *fp, long step, long nsteps, double t_start, const char *what) {
     double el = gk_wtime() - t_start, eta = step > 0 ? el / step * (nsteps - step) : 0.0;
-    fprintf(fp ? fp : stderr, "step %ld/%ld  %s | %.1f s elapsed, ETA %.1f s\n", step, nsteps, what ? what : "", el,
-            eta);
+    fprintf(fp ? fp : stderr, "step %ld/%ld  %s | %.1f s elapsed, ETA %.1f s\n", step, nsteps,
+            what ? what : "", el, eta);
     fflush(fp ? fp : stderr);
 }
 

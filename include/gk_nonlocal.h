@@ -43,11 +43,11 @@
  * The paper averages the whole strain-increment tensor (eq 58): apply with
  * ncomp = 6 (Voigt) or 9 (3x3) values per point. */
 typedef struct gk_nonlocal {
-    int n;        /* points                                                    */
-    int *start;   /* n + 1: point I's neighbours are nbr[start[I] .. start[I+1]) */
-    int *nbr;     /* neighbour ids, ascending, I itself included              */
-    double *w;    /* a*(x_I, x_J) of eq A.4, summing to 1 per point           */
-    double R;     /* radius [m]; 0: local                                     */
+    int n;      /* points                                                    */
+    int *start; /* n + 1: point I's neighbours are nbr[start[I] .. start[I+1]) */
+    int *nbr;   /* neighbour ids, ascending, I itself included              */
+    double *w;  /* a*(x_I, x_J) of eq A.4, summing to 1 per point           */
+    double R;   /* radius [m]; 0: local                                     */
     gk_allocator alloc;
 } gk_nonlocal;
 
@@ -65,8 +65,8 @@ extern "C" {
 /* x: n points of dim coordinates; period: NULL or 3 values (> 0: periodic
  * along that axis with this period). Any previous content of nl is ignored
  * (free it first). */
-GKDEF gk_result gk_nonlocal_build(gk_nonlocal *nl, int dim, int n, const double *x, double R, const double *period,
-                                  const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_nonlocal_build(gk_nonlocal *nl, int dim, int n, const double *x, double R,
+                                  const double *period, const gk_allocator *alloc, gk_err *err);
 /* out[ncomp I + c] = sum_J w_IJ in[ncomp J + c]; out must not alias in */
 GKDEF void gk_nonlocal_apply(const gk_nonlocal *nl, int ncomp, const double *in, double *out);
 GKDEF void gk_nonlocal_free(gk_nonlocal *nl);
@@ -117,8 +117,8 @@ static double gk__nl_weight(int dim, const double *xa, const double *xb, const d
     return w;
 }
 
-GKDEF gk_result gk_nonlocal_build(gk_nonlocal *nl, int dim, int n, const double *x, double R, const double *period,
-                                  const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_nonlocal_build(gk_nonlocal *nl, int dim, int n, const double *x, double R,
+                                  const double *period, const gk_allocator *alloc, gk_err *err) {
     gk_nonlocal z;
     size_t cnt = 0, cap;
     int I, J, k;
@@ -126,18 +126,23 @@ GKDEF gk_result gk_nonlocal_build(gk_nonlocal *nl, int dim, int n, const double 
     if (alloc) z.alloc = *alloc;
     if (dim < 1 || dim > 3 || n < 1 || !x)
         return gk_err_set(err, GK_ERR_ARG, "nonlocal: dimension %d, %d points", dim, n);
-    if (!(R >= 0.0) || !isfinite(R)) return gk_err_set(err, GK_ERR_ARG, "nonlocal: radius %g must be >= 0", R);
+    if (!(R >= 0.0) || !isfinite(R))
+        return gk_err_set(err, GK_ERR_ARG, "nonlocal: radius %g must be >= 0", R);
     for (k = 0; k < n * dim; ++k)
-        if (!isfinite(x[k])) return gk_err_set(err, GK_ERR_NAN, "nonlocal: coordinate %d of point %d is %g", k % dim, k / dim, x[k]);
+        if (!isfinite(x[k]))
+            return gk_err_set(err, GK_ERR_NAN, "nonlocal: coordinate %d of point %d is %g", k % dim, k / dim,
+                              x[k]);
     if (period)
         for (k = 0; k < dim; ++k) {
             if (!(period[k] >= 0.0) || !isfinite(period[k]) || (period[k] > 0.0 && !(R / period[k] < 1000.0)))
-                return gk_err_set(err, GK_ERR_ARG, "nonlocal: period %g along axis %d (radius %g)", period[k], k, R);
+                return gk_err_set(err, GK_ERR_ARG, "nonlocal: period %g along axis %d (radius %g)", period[k],
+                                  k, R);
         }
     /* count, then fill: neighbours in ascending order */
     for (I = 0; I < n; ++I)
         for (J = 0; J < n; ++J)
-            if (J == I || gk__nl_weight(dim, x + (size_t)dim * I, x + (size_t)dim * J, period, R) > 0.0) ++cnt;
+            if (J == I || gk__nl_weight(dim, x + (size_t)dim * I, x + (size_t)dim * J, period, R) > 0.0)
+                ++cnt;
     cap = cnt;
     z.start = (int *)gk_alloc(&z.alloc, ((size_t)n + 1) * sizeof(int));
     z.nbr = (int *)gk_alloc(&z.alloc, cap * sizeof(int));

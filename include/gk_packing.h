@@ -46,7 +46,7 @@
  * positive number is refused, the message naming the line. */
 typedef struct gk_packing {
     int dim, n;
-    double h[9];     /* cell matrix (a box is diag(Lx, Ly, Lz)); 2D: h22 = 1 */
+    double h[9]; /* cell matrix (a box is diag(Lx, Ly, Lz)); 2D: h22 = 1 */
     double *x, *y, *z, *r;
     gk_allocator alloc;
 } gk_packing;
@@ -57,12 +57,12 @@ typedef enum gk_psd_kind { GK_PSD_UNIFORM = 0, GK_PSD_TABLE_NUMBER = 1, GK_PSD_T
 typedef struct gk_gen_def {
     int dim, n;
     gk_psd_kind psd;
-    double r_min, r_max;      /* GK_PSD_UNIFORM: radii uniform in [r_min, r_max]     */
-    int ntable;               /* table kinds: ntable points (radius, cumulative     */
-    const double *table_r;    /*   fraction passing, by number or by mass), radii   */
-    const double *table_cum;  /*   increasing, cum from 0 to 1                       */
-    double packing_fraction;  /* of the initial cloud; 0 -> 0.5 (2D), 0.3 (3D)      */
-    double aspect[3];         /* cell edge ratios; 0 -> cube/square                  */
+    double r_min, r_max;     /* GK_PSD_UNIFORM: radii uniform in [r_min, r_max]     */
+    int ntable;              /* table kinds: ntable points (radius, cumulative     */
+    const double *table_r;   /*   fraction passing, by number or by mass), radii   */
+    const double *table_cum; /*   increasing, cum from 0 to 1                       */
+    double packing_fraction; /* of the initial cloud; 0 -> 0.5 (2D), 0.3 (3D)      */
+    double aspect[3];        /* cell edge ratios; 0 -> cube/square                  */
     uint64_t seed;
 } gk_gen_def;
 
@@ -81,7 +81,8 @@ GKDEF gk_result gk_packing_read(const char *path, gk_packing *pk, const gk_alloc
 GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *pk, const gk_allocator *alloc,
                                  gk_err *err);
 GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const char *comment, gk_err *err);
-GKDEF gk_result gk_packing_generate(gk_packing *pk, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_packing_generate(gk_packing *pk, const gk_gen_def *def, const gk_allocator *alloc,
+                                    gk_err *err);
 /* A periodic packing repeated nx x ny (x nz in 3D; nz ignored in 2D) times:
  * cell h diag(nx, ny, nz), copy (a, b, c) at a e1 + b e2 + c e3 (e_k the cell
  * edges, positions wrapped into the cell first); copies follow each other,
@@ -230,13 +231,14 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
         if ((r = gk__line_ok(&L, 3, err)) != GK_OK) return r;
     } while (gk__blank(L.line));
     nh = gk__parse_doubles(L.line, hd, 5, &bad);
-    if (bad || nh < 4) return gk_err_set(err, GK_ERR_FORMAT, "line %ld: header must be 'dim N Lx Ly [Lz]'", L.lineno);
+    if (bad || nh < 4)
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: header must be 'dim N Lx Ly [Lz]'", L.lineno);
     if (hd[0] != 2.0 && hd[0] != 3.0)
         return gk_err_set(err, GK_ERR_FORMAT, "line %ld: dimension %g (must be 2 or 3)", L.lineno, hd[0]);
     dim = (int)hd[0];
     if (nh != dim + 2)
-        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: a %dD header has %d numbers, found %d", L.lineno, dim,
-                          dim + 2, nh);
+        return gk_err_set(err, GK_ERR_FORMAT, "line %ld: a %dD header has %d numbers, found %d", L.lineno,
+                          dim, dim + 2, nh);
     if (!(hd[1] >= 1 && hd[1] <= 2e9) || (double)(int)hd[1] != hd[1])
         return gk_err_set(err, GK_ERR_FORMAT, "line %ld: particle count %g invalid", L.lineno, hd[1]);
     n = (int)hd[1];
@@ -289,17 +291,20 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
         nv = gk__parse_doubles(s, vals, 8, &bad);
         if (bad || nv != dim + 1) {
             gk_packing_free(&pk);
-            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: expected %d numbers (%s r), found %s", L.lineno, dim + 1,
-                              dim == 2 ? "x y" : "x y z", bad ? "a non-number" : "a different count");
+            return gk_err_set(err, GK_ERR_FORMAT, "line %ld: expected %d numbers (%s r), found %s", L.lineno,
+                              dim + 1, dim == 2 ? "x y" : "x y z",
+                              bad ? "a non-number" : "a different count");
         }
         for (nv = 0; nv <= dim; ++nv)
             if (!isfinite(vals[nv])) {
                 gk_packing_free(&pk);
-                return gk_err_set(err, GK_ERR_NAN, "line %ld: particle %d has a non-finite value", L.lineno, k);
+                return gk_err_set(err, GK_ERR_NAN, "line %ld: particle %d has a non-finite value", L.lineno,
+                                  k);
             }
         if (!(vals[dim] > 0.0)) {
             gk_packing_free(&pk);
-            return gk_err_set(err, GK_ERR_RADIUS, "line %ld: particle %d has radius %g <= 0", L.lineno, k, vals[dim]);
+            return gk_err_set(err, GK_ERR_RADIUS, "line %ld: particle %d has radius %g <= 0", L.lineno, k,
+                              vals[dim]);
         }
         pk.x[k] = vals[0];
         pk.y[k] = vals[1];
@@ -371,7 +376,8 @@ GKDEF gk_result gk_packing_write(const char *path, const gk_packing *pk, const c
     return gk_file_close(fp, path, err);
 }
 
-GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, const gk_allocator *alloc,
+                                    gk_err *err) {
     gk_packing pk;
     gk_rng rng;
     double vs = 0.0, phi, side, asp[3], V, *rr;
@@ -394,8 +400,8 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
                                   def->table_r[k]);
             if (!(def->table_cum[k] >= 0.0 && def->table_cum[k] <= 1.0) ||
                 (k && def->table_cum[k] < def->table_cum[k - 1]))
-                return gk_err_set(err, GK_ERR_ARG, "table cumulative fraction %d (%g) must rise from 0 to 1", k,
-                                  def->table_cum[k]);
+                return gk_err_set(err, GK_ERR_ARG, "table cumulative fraction %d (%g) must rise from 0 to 1",
+                                  k, def->table_cum[k]);
         }
         if (def->table_cum[0] != 0.0 || def->table_cum[def->ntable - 1] != 1.0)
             return gk_err_set(err, GK_ERR_ARG, "table cumulative fractions must start at 0 and end at 1");
@@ -484,7 +490,8 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
                         for (o0 = -1; o0 <= 1 && !clash; ++o0) {
                             int cx = (bi[0] + o0 + nbin[0]) % nbin[0], cy = (bi[1] + o1 + nbin[1]) % nbin[1];
                             int cz = (bi[2] + o2 + nbin[2]) % nbin[2], q;
-                            for (q = head[cx + nbin[0] * (cy + nbin[1] * cz)]; q >= 0 && !clash; q = next[q]) {
+                            for (q = head[cx + nbin[0] * (cy + nbin[1] * cz)]; q >= 0 && !clash;
+                                 q = next[q]) {
                                 double ds[3], d[3], R = rr[q] + rr[placed];
                                 ds[0] = sx[q] - s[0];
                                 ds[1] = sy[q] - s[1];
@@ -506,9 +513,10 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
                 }
             }
             if (!ok) {
-                res = gk_err_set(err, GK_ERR_ARG,
-                                 "could not place particle %d of %d without overlap: lower packing_fraction (%g)",
-                                 placed, n, phi);
+                res = gk_err_set(
+                    err, GK_ERR_ARG,
+                    "could not place particle %d of %d without overlap: lower packing_fraction (%g)", placed,
+                    n, phi);
                 break;
             }
             ++placed;
@@ -545,13 +553,15 @@ GKDEF gk_result gk_packing_tile(const gk_packing *pk, int nx, int ny, int nz, gk
     int dim, rep[3], a, b, c, p, k, q = 0;
     long total;
     gk_result res;
-    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1) return gk_err_set(err, GK_ERR_ARG, "tile: empty packing");
+    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1)
+        return gk_err_set(err, GK_ERR_ARG, "tile: empty packing");
     dim = pk->dim;
     rep[0] = nx;
     rep[1] = ny;
     rep[2] = dim == 3 ? nz : 1;
     if (rep[0] < 1 || rep[1] < 1 || rep[2] < 1)
-        return gk_err_set(err, GK_ERR_ARG, "tile: copies %d x %d x %d must be >= 1", nx, ny, dim == 3 ? nz : 1);
+        return gk_err_set(err, GK_ERR_ARG, "tile: copies %d x %d x %d must be >= 1", nx, ny,
+                          dim == 3 ? nz : 1);
     total = (long)pk->n * rep[0] * rep[1] * rep[2];
     if (total > 2000000000L) return gk_err_set(err, GK_ERR_ARG, "tile: %ld particles are too many", total);
     if (!(gk_m3_inverse(pk->h, hi) > 0.0)) return gk_err_set(err, GK_ERR_CELL, "tile: singular cell");
@@ -589,12 +599,14 @@ GKDEF gk_result gk_packing_subset(const gk_packing *pk, const double lo[3], cons
     gk_packing t;
     int dim, p, k, cnt = 0, q = 0;
     gk_result res;
-    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1) return gk_err_set(err, GK_ERR_ARG, "subset: empty packing");
+    if (!pk || !pk->x || !pk->y || !pk->r || pk->n < 1)
+        return gk_err_set(err, GK_ERR_ARG, "subset: empty packing");
     if (!lo || !hi) return gk_err_set(err, GK_ERR_ARG, "subset: no box given");
     dim = pk->dim;
     for (k = 0; k < dim; ++k)
         if (!isfinite(lo[k]) || !isfinite(hi[k]) || !(hi[k] > lo[k]))
-            return gk_err_set(err, GK_ERR_ARG, "subset: box axis %d [%g, %g] is not an interval", k, lo[k], hi[k]);
+            return gk_err_set(err, GK_ERR_ARG, "subset: box axis %d [%g, %g] is not an interval", k, lo[k],
+                              hi[k]);
     for (q = 0; q < 2; ++q) { /* count, then copy */
         for (p = 0; p < pk->n; ++p) {
             double x[3], m = whole ? pk->r[p] : 0.0;

@@ -53,12 +53,12 @@
 #include "gk_base.h"
 
 typedef struct gk_pcell {
-    int dim;      /* 2 or 3                                                     */
-    double h[9];  /* cell matrix, columns are the edge vectors: x = h s        */
+    int dim;     /* 2 or 3                                                     */
+    double h[9]; /* cell matrix, columns are the edge vectors: x = h s        */
     double hinv[9];
-    double F[9];  /* accumulated map since init: product of every E (remaps
+    double F[9]; /* accumulated map since init: product of every E (remaps
                      change h, never F); F - I is the total applied H         */
-    long flips;   /* number of lattice reductions applied                      */
+    long flips;  /* number of lattice reductions applied                      */
 } gk_pcell;
 
 typedef enum gk_path_kind {
@@ -84,11 +84,11 @@ typedef enum gk_servo_mode { GK_SERVO_STRAIN = 0, GK_SERVO_STRESS = 1 } gk_servo
  * Off-diagonal terms of L are left to the caller (prescribed). */
 typedef struct gk_servo {
     gk_servo_mode mode[3];
-    double target[3];  /* stress targets sigma_kk [Pa], tension-positive        */
-    double rate[3];    /* prescribed L_kk for strain-controlled axes [1/s]       */
-    double max_rate;   /* cap on |L_kk| for stress-controlled axes [1/s] (> 0)   */
-    double gain;       /* fraction of the stress error corrected per step; 0 -> 0.02 */
-    int shear;         /* 1: also drive the shear stresses sigma_kl (k < l) to    */
+    double target[3];       /* stress targets sigma_kk [Pa], tension-positive        */
+    double rate[3];         /* prescribed L_kk for strain-controlled axes [1/s]       */
+    double max_rate;        /* cap on |L_kk| for stress-controlled axes [1/s] (> 0)   */
+    double gain;            /* fraction of the stress error corrected per step; 0 -> 0.02 */
+    int shear;              /* 1: also drive the shear stresses sigma_kl (k < l) to    */
     double shear_target[3]; /* these targets (xy, xz, yz) with a symmetric L_kl = L_lk */
 } gk_servo;
 
@@ -172,7 +172,8 @@ static gk_result gk__pcell_check(int dim, const double h[9], gk_err *err) {
     if (dim == 2 && (h[2] != 0.0 || h[5] != 0.0 || h[6] != 0.0 || h[7] != 0.0 || h[8] != 1.0))
         return gk_err_set(err, GK_ERR_CELL, "2D cell matrix must have third row and column (0,0,1)");
     if (!(gk_m3_det(h) > 0.0))
-        return gk_err_set(err, GK_ERR_CELL, "cell matrix has det %g <= 0 (degenerate or inverted)", gk_m3_det(h));
+        return gk_err_set(err, GK_ERR_CELL, "cell matrix has det %g <= 0 (degenerate or inverted)",
+                          gk_m3_det(h));
     if (!isfinite(gk_m3_det(h)))
         return gk_err_set(err, GK_ERR_CELL, "cell matrix has a volume beyond the range of double (det %g)",
                           gk_m3_det(h));
@@ -228,7 +229,8 @@ GKDEF void gk_pcell_widths(const gk_pcell *c, double w[3]) {
     int k;
     for (k = 0; k < 3; ++k) {
         const double *row = c->hinv + 3 * k;
-        double n2 = k < c->dim ? row[0] * row[0] + row[1] * row[1] + (c->dim == 3 ? row[2] * row[2] : 0.0) : 0.0;
+        double n2 =
+            k < c->dim ? row[0] * row[0] + row[1] * row[1] + (c->dim == 3 ? row[2] * row[2] : 0.0) : 0.0;
         w[k] = (k < c->dim && n2 > 0.0) ? 1.0 / sqrt(n2) : 0.0;
     }
 }
@@ -291,7 +293,8 @@ GKDEF void gk_pcell_apply_basis(gk_pcell *c, const double M[9]) {
 }
 
 /* ---- deformation paths */
-GKDEF gk_result gk_path_init(gk_path *p, int dim, gk_path_kind kind, const double dH[9], int nsteps, gk_err *err) {
+GKDEF gk_result gk_path_init(gk_path *p, int dim, gk_path_kind kind, const double dH[9], int nsteps,
+                             gk_err *err) {
     double F[9], R[9], U[9];
     int k;
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);

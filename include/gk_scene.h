@@ -656,7 +656,8 @@ GKDEF gk_result gk_scene_wrap(gk_scene *out, gk_rve *rve) {
     S.mass = (double *)gk_alloc(&rve->def.alloc, (size_t)rve->n * sizeof(double));
     S.flags = (unsigned char *)gk_alloc(&rve->def.alloc, (size_t)rve->n);
     S.cap = rve->n;
-    if (!S.mass || !S.flags) res = gk_err_set(&S.err, GK_ERR_ALLOC, "wrap: out of memory for %d particles", rve->n);
+    if (!S.mass || !S.flags)
+        res = gk_err_set(&S.err, GK_ERR_ALLOC, "wrap: out of memory for %d particles", rve->n);
     for (p = 0; !res && p < rve->n; ++p) {
         S.mass[p] = 1.0 / (double)rve->minv[p];
         S.flags[p] = 0;

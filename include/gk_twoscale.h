@@ -233,18 +233,18 @@ typedef struct gk_twoscale_def {
     int npoints;                     /* N >= 1                                             */
     const gk_twoscale_proto *protos; /* nprotos prototypes (copied)                        */
     int nprotos;
-    const int *pick;      /* N prototype indices; NULL: 0 everywhere, or drawn (several) */
-    uint64_t seed;        /* of that draw (gk_twoscale_draw)                              */
-    gk_rve_def rve;       /* the RVEs' definition; zero (cookie 0) -> gk_rve_def_default() */
+    const int *pick; /* N prototype indices; NULL: 0 everywhere, or drawn (several) */
+    uint64_t seed;   /* of that draw (gk_twoscale_draw)                              */
+    gk_rve_def rve;  /* the RVEs' definition; zero (cookie 0) -> gk_rve_def_default() */
     gk_twoscale_rule rule;
     gk_twoscale_tangent_kind tangent;
-    unsigned tangent_opts; /* GK_TANGENT_* of gk_homog_tangent (also eq 8's start tangent)  */
+    unsigned tangent_opts;    /* GK_TANGENT_* of gk_homog_tangent (also eq 8's start tangent)  */
     gk_twoscale_proc_fn proc; /* the caller's procedure instead of the rule (above); NULL: none */
     void *proc_user;          /* its first argument                                          */
-    double xi;             /* eq 8 perturbation of dH; 0 -> 5e-5 (Guo & Zhao 2014 Fig 6)          */
-    double reuse;          /* tangent reuse bound, 0 <= X < 1; 0: off                      */
-    int threads;           /* OpenMP threads over a rank's points; 0 -> 1                  */
-    double balance_tol;    /* MPI: accepted load imbalance; 0 -> 0.05                      */
+    double xi;                /* eq 8 perturbation of dH; 0 -> 5e-5 (Guo & Zhao 2014 Fig 6)          */
+    double reuse;             /* tangent reuse bound, 0 <= X < 1; 0: off                      */
+    int threads;              /* OpenMP threads over a rank's points; 0 -> 1                  */
+    double balance_tol;       /* MPI: accepted load imbalance; 0 -> 0.05                      */
     gk_twoscale_balance_kind balance; /* MPI: when to rebalance; 0: at every accept (above)  */
     gk_allocator alloc;
 } gk_twoscale_def;
@@ -283,16 +283,16 @@ typedef struct gk_twoscale_field {
 
 /* traffic of this rank (MPI; zero otherwise) since creation */
 typedef struct gk_twoscale_stats {
-    long long runs;          /* gk_twoscale_run calls                                    */
-    long long run_bytes_out; /* ... bytes this rank sent in them (its part of the results; rank 0:
+    long long runs;           /* gk_twoscale_run calls                                    */
+    long long run_bytes_out;  /* ... bytes this rank sent in them (its part of the results; rank 0:
                                 the dH broadcast too)                                    */
-    long long run_bytes_in;  /* ... bytes it received in them (dH, the other ranks' results) */
-    long long bytes_out;     /* bytes sent in all calls (fields, checkpoints, migrations too) */
-    long long bytes_in;      /* bytes received in all calls                              */
-    long long collectives;   /* collective calls                                         */
-    long long migrated;      /* points that moved to another rank (all ranks counted)    */
+    long long run_bytes_in;   /* ... bytes it received in them (dH, the other ranks' results) */
+    long long bytes_out;      /* bytes sent in all calls (fields, checkpoints, migrations too) */
+    long long bytes_in;       /* bytes received in all calls                              */
+    long long collectives;    /* collective calls                                         */
+    long long migrated;       /* points that moved to another rank (all ranks counted)    */
     long long migrated_bytes; /* ... the bytes of their records (all ranks counted)       */
-    long long balances;      /* rebalances that moved points                             */
+    long long balances;       /* rebalances that moved points                             */
 } gk_twoscale_stats;
 
 struct gk__tspt; /* one local point (implementation) */
@@ -303,19 +303,19 @@ typedef struct gk_twoscale {
     int nlocal;          /* points stored on this rank                                    */
     gk_twoscale_def def; /* the definition, defaults filled (protos and pick: NULL)       */
     int nproto;
-    gk_packing *pk;      /* copies of the prototypes' packings                            */
-    int *pick;           /* N: prototype of each point                                    */
-    int *owner;          /* N: rank of each point                                         */
-    int *slot;           /* N: index in pt[] on this rank, or -1                          */
+    gk_packing *pk;               /* copies of the prototypes' packings                            */
+    int *pick;                    /* N: prototype of each point                                    */
+    int *owner;                   /* N: rank of each point                                         */
+    int *slot;                    /* N: index in pt[] on this rank, or -1                          */
     int *order, *counts, *displs; /* points by (owner, id); per rank: count, first        */
-    struct gk__tspt **pt; /* nlocal, ascending point index                                */
-    gk_twoscale_point *last; /* N: the last run (every rank)                              */
-    int nfail, *fail_id; /* failed points of the last run, ascending, and their messages  */
+    struct gk__tspt **pt;         /* nlocal, ascending point index                                */
+    gk_twoscale_point *last;      /* N: the last run (every rank)                              */
+    int nfail, *fail_id;          /* failed points of the last run, ascending, and their messages  */
     char *fail_msg;
     double *buf, *buf2; /* scratch: packed results (local; all, in rank order)            */
     size_t bufcap, buf2cap;
-    double *hbuf;       /* MPI: rank 0's dH, broadcast                                    */
-    int pending;        /* a run not yet accepted or rejected                             */
+    double *hbuf; /* MPI: rank 0's dH, broadcast                                    */
+    int pending;  /* a run not yet accepted or rejected                             */
     gk_twoscale_stats stats;
     gk_err err;
 #ifdef GK_TWOSCALE_MPI
@@ -338,8 +338,8 @@ GKDEF const char *gk_twoscale_error(const gk_twoscale *ts);
  * argument (nothing ran), or GK_ERR_STATE when one or more points failed (the message names how many
  * and the first; every point's report in gk_twoscale_points; a failed point's stress is its accepted
  * one and its tangent 0) */
-GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twoscale_run_def *rd, double *stress,
-                                double *D);
+GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twoscale_run_def *rd,
+                                double *stress, double *D);
 /* the trial states of the points whose last run succeeded become their accepted states (the
  * others keep theirs); under MPI then rebalances (def.balance 0). GK_ERR_STATE if there is no run to
  * accept */
@@ -372,8 +372,8 @@ GKDEF void gk_twoscale_draw(int npoints, int nprotos, uint64_t seed, int *pick);
 #include <stdlib.h>
 #include <string.h>
 
-#define GK__TS_MAGIC "GKTWOSC"  /* 8 bytes with its terminating zero */
-#define GK__TS_NREP 7           /* ints of a gk_twoscale_point      */
+#define GK__TS_MAGIC "GKTWOSC" /* 8 bytes with its terminating zero */
+#define GK__TS_NREP 7          /* ints of a gk_twoscale_point      */
 #define GK__TS_NFIELD ((int)(sizeof(gk_twoscale_field) / sizeof(double)))
 #define GK__TS_MAXKEYS (1 << 28) /* contacts of one RVE, for range checks */
 GK_STATIC_ASSERT(sizeof(gk_twoscale_point) == GK__TS_NREP * sizeof(int), ts_point_ints);
@@ -382,18 +382,18 @@ GK_STATIC_ASSERT(sizeof(gk_twoscale_field) % sizeof(double) == 0, ts_field_doubl
 typedef struct gk__tspt {
     int id;
     gk_rve rve;
-    gk_rve_state acc;     /* the accepted state                                     */
-    int live;             /* 1: rve holds the accepted state                         */
-    int trial_ok;         /* the last run succeeded and was not accepted yet          */
-    double H[9], dH[9];   /* accumulated dH of accepted runs; dH of the last run      */
-    double sacc[9];       /* stress of the accepted state                             */
-    double strial[9];     /* the procedure's stress of the last run (def.proc)        */
+    gk_rve_state acc;   /* the accepted state                                     */
+    int live;           /* 1: rve holds the accepted state                         */
+    int trial_ok;       /* the last run succeeded and was not accepted yet          */
+    double H[9], dH[9]; /* accumulated dH of accepted runs; dH of the last run      */
+    double sacc[9];     /* stress of the accepted state                             */
+    double strial[9];   /* the procedure's stress of the last run (def.proc)        */
     int steps_acc, steps_trial;
     /* tangent reuse: reference tangent, its network (sorted keys), the current network */
     double *Dref;
     unsigned long long *key, *cur;
     int nkey, ncur, cap, valid;
-    gk_err err;           /* the first failure of the last run                        */
+    gk_err err; /* the first failure of the last run                        */
 } gk__tspt;
 
 GKDEF const char *gk_twoscale_error(const gk_twoscale *ts) { return ts->err.msg; }
@@ -514,7 +514,8 @@ static void gk__ts_pt_free(gk_twoscale *ts, gk__tspt *pt) {
 }
 
 /* a point of prototype k: the RVE created from its packing and set to `state` (size bytes) */
-static gk_result gk__ts_pt_new(gk_twoscale *ts, int id, int k, const void *state, size_t size, gk__tspt **out) {
+static gk_result gk__ts_pt_new(gk_twoscale *ts, int id, int k, const void *state, size_t size,
+                               gk__tspt **out) {
     gk__tspt *pt = (gk__tspt *)gk_alloc(&ts->def.alloc, sizeof *pt);
     gk_result res;
     *out = NULL;
@@ -619,7 +620,8 @@ static int gk__ts_cmp_u64(const void *a, const void *b) {
 static int gk__ts_reserve_keys(const gk_allocator *a, gk__tspt *pt, int cap) {
     if (cap <= pt->cap) return 0;
     if (gk_realloc(a, (void **)&pt->key, (size_t)pt->cap, (size_t)cap, sizeof *pt->key) ||
-        gk_realloc(a, (void **)&pt->cur, (size_t)pt->cap, (size_t)cap, sizeof *pt->cur)) /* cur may be filling */
+        gk_realloc(a, (void **)&pt->cur, (size_t)pt->cap, (size_t)cap,
+                   sizeof *pt->cur)) /* cur may be filling */
         return -1;
     pt->cap = cap;
     return 0;
@@ -639,7 +641,8 @@ static int gk__ts_keys(const gk_allocator *a, gk__tspt *pt) {
 static double gk__ts_change(const gk__tspt *pt) {
     int i = 0, j = 0, ch = 0;
     while (i < pt->nkey || j < pt->ncur) {
-        unsigned long long a = i < pt->nkey ? pt->key[i] >> 1 : ~0ull, b = j < pt->ncur ? pt->cur[j] >> 1 : ~0ull;
+        unsigned long long a = i < pt->nkey ? pt->key[i] >> 1 : ~0ull,
+                           b = j < pt->ncur ? pt->cur[j] >> 1 : ~0ull;
         if (i < pt->nkey && j < pt->ncur && a == b) {
             ch += (pt->key[i] & 1u) != (pt->cur[j] & 1u);
             ++i, ++j;
@@ -848,12 +851,14 @@ static gk_result gk__ts_check(gk_twoscale *ts, const gk_twoscale_def *def, gk_tw
     }
     if (r->kind != GK_TWOSCALE_ADAPTIVE && r->kind != GK_TWOSCALE_STRAIN)
         return gk_err_set(e, GK_ERR_ARG, "unknown DEM step rule %d", (int)r->kind);
-    if (!(r->inertial_max >= 0 && isfinite(r->inertial_max)) || !(r->unbalanced_max >= 0 && isfinite(r->unbalanced_max)) ||
+    if (!(r->inertial_max >= 0 && isfinite(r->inertial_max)) ||
+        !(r->unbalanced_max >= 0 && isfinite(r->unbalanced_max)) ||
         !(r->strain >= 0 && isfinite(r->strain)) || r->n_min < 0 || r->n_max < 0 || r->every < 0)
-        return gk_err_set(e, GK_ERR_ARG,
-                          "DEM step rule: inertial_max %g, unbalanced_max %g, strain %g must be finite and >= 0; "
-                          "n_min %d, n_max %d, every %d >= 0",
-                          r->inertial_max, r->unbalanced_max, r->strain, r->n_min, r->n_max, r->every);
+        return gk_err_set(
+            e, GK_ERR_ARG,
+            "DEM step rule: inertial_max %g, unbalanced_max %g, strain %g must be finite and >= 0; "
+            "n_min %d, n_max %d, every %d >= 0",
+            r->inertial_max, r->unbalanced_max, r->strain, r->n_min, r->n_max, r->every);
     if (r->inertial_max == 0) r->inertial_max = 5e-4;
     if (r->unbalanced_max == 0) r->unbalanced_max = 5e-3;
     if (r->strain == 0) r->strain = 1e-5;
@@ -927,8 +932,10 @@ static gk_result gk__ts_create(gk_twoscale *ts, const gk_twoscale_def *def) {
         if (d.protos[k].state) {
             const gk_rve_state *st = d.protos[k].state;
             ps[k].buf = (unsigned char *)gk_alloc(a, st->size);
-            if (!ps[k].buf) res = gk_err_set(&ts->err, GK_ERR_ALLOC, "out of memory for prototype %d", k);
-            else memcpy(ps[k].buf, st->buf, st->size), ps[k].size = ps[k].cap = st->size;
+            if (!ps[k].buf)
+                res = gk_err_set(&ts->err, GK_ERR_ALLOC, "out of memory for prototype %d", k);
+            else
+                memcpy(ps[k].buf, st->buf, st->size), ps[k].size = ps[k].cap = st->size;
         } else {
             gk_rve rve;
             res = gk_rve_create(&rve, &ts->def.rve, dst);
@@ -1077,11 +1084,12 @@ static gk_result gk__ts_check_dH(gk_twoscale *ts, const double *dH) {
         for (k = 0; k < 9; ++k) {
             double v = dH[9 * (size_t)p + k];
             if (!isfinite(v))
-                return gk_err_set(&ts->err, GK_ERR_NAN, "dH of point %d has %g at (%d, %d)", p, v, k / 3, k % 3);
+                return gk_err_set(&ts->err, GK_ERR_NAN, "dH of point %d has %g at (%d, %d)", p, v, k / 3,
+                                  k % 3);
             if (ts->dim == 2 && v != 0.0 && (k == 2 || k >= 5))
                 return gk_err_set(&ts->err, GK_ERR_ARG,
-                                  "dH of point %d has %g at (%d, %d): a 2D set takes the in-plane block only", p, v,
-                                  k / 3, k % 3);
+                                  "dH of point %d has %g at (%d, %d): a 2D set takes the in-plane block only",
+                                  p, v, k / 3, k % 3);
         }
     return GK_OK;
 }
@@ -1090,8 +1098,8 @@ static gk_result gk__ts_check_dH(gk_twoscale *ts, const double *dH) {
 static gk_result gk__ts_balance(gk_twoscale *ts);
 #endif
 
-GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twoscale_run_def *rd, double *stress,
-                                double *D) {
+GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twoscale_run_def *rd,
+                                double *stress, double *D) {
     double scale = rd && rd->scale != 0.0 ? rd->scale : 1.0;
     const double *H = dH, *all;
     int want_D = D != NULL, nrec, j, nf;
@@ -1104,20 +1112,25 @@ GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twos
         double *hb = ts->hbuf;
         hb[0] = want_D, hb[1] = scale;
         if (ts->rank == 0) {
-            if (dH) memcpy(hb + 2, dH, (size_t)ts->n * 9 * sizeof(double));
-            else hb[0] = -1.0;
+            if (dH)
+                memcpy(hb + 2, dH, (size_t)ts->n * 9 * sizeof(double));
+            else
+                hb[0] = -1.0;
         }
         MPI_Bcast(hb, ts->n * 9 + 2, MPI_DOUBLE, 0, ts->comm);
         ++ts->stats.collectives;
-        if (ts->rank == 0) ts->stats.bytes_out += ((long long)ts->n * 9 + 2) * 8;
-        else ts->stats.bytes_in += ((long long)ts->n * 9 + 2) * 8;
+        if (ts->rank == 0)
+            ts->stats.bytes_out += ((long long)ts->n * 9 + 2) * 8;
+        else
+            ts->stats.bytes_in += ((long long)ts->n * 9 + 2) * 8;
         want_D = hb[0] > 0, scale = hb[1], H = hb[0] < 0 ? NULL : hb + 2;
     }
 #endif
     if (!(scale > 0.0 && scale <= 1.0))
         return gk_err_set(&ts->err, GK_ERR_ARG, "run scale %g outside (0, 1]", scale);
     if (want_D && ts->def.proc)
-        return gk_err_set(&ts->err, GK_ERR_ARG, "a set run by the caller's procedure has no tangent: D must be NULL");
+        return gk_err_set(&ts->err, GK_ERR_ARG,
+                          "a set run by the caller's procedure has no tangent: D must be NULL");
     if ((res = gk__ts_check_dH(ts, H)) != GK_OK) return res;
     nrec = 9 + (want_D ? ts->nd4 : 0) + GK__TS_NREP;
     if (gk__ts_agree(ts, gk__ts_bufs(ts, nrec))) return ts->err.code;
@@ -1126,14 +1139,16 @@ GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twos
      * states of a pending run are dropped: this run recomputes every point from its accepted state).
      * Here, after every check, so that a run that moves points always runs. A failed move changes
      * nothing: this run on the old assignment. */
-    if (ts->nranks > 1 && ts->def.balance == GK_TWOSCALE_BALANCE_RUN && ts->stats.runs > 0 && gk__ts_balance(ts))
+    if (ts->nranks > 1 && ts->def.balance == GK_TWOSCALE_BALANCE_RUN && ts->stats.runs > 0 &&
+        gk__ts_balance(ts))
         gk_err_clear(&ts->err);
 #endif
     {
         int nth = ts->def.threads;
         GK_OMP(parallel for num_threads(nth) schedule(dynamic, 1))
         for (j = 0; j < ts->nlocal; ++j)
-            gk__ts_point(ts, ts->pt[j], H + 9 * (size_t)ts->pt[j]->id, scale, want_D, ts->buf + (size_t)nrec * j);
+            gk__ts_point(ts, ts->pt[j], H + 9 * (size_t)ts->pt[j]->id, scale, want_D,
+                         ts->buf + (size_t)nrec * j);
         (void)nth;
     }
     all = gk__ts_gather(ts, nrec);
@@ -1154,18 +1169,21 @@ GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twos
         int first = -1, k, len;
         for (j = 0; j < ts->n && first < 0; ++j)
             if (ts->last[j].code) first = j;
-        len = snprintf(ts->err.msg, sizeof ts->err.msg, "%d of %d points failed; point %d: %s", nf, ts->n, first,
-                       res ? gk_result_string((gk_result)ts->last[first].code) : gk_twoscale_point_error(ts, first));
+        len = snprintf(
+            ts->err.msg, sizeof ts->err.msg, "%d of %d points failed; point %d: %s", nf, ts->n, first,
+            res ? gk_result_string((gk_result)ts->last[first].code) : gk_twoscale_point_error(ts, first));
         for (k = 0, j = first + 1; j < ts->n && len > 0 && len < (int)sizeof ts->err.msg - 16; ++j)
             if (ts->last[j].code) {
                 if (k == 8) {
                     len += snprintf(ts->err.msg + len, sizeof ts->err.msg - len, ", ...");
                     break;
                 }
-                len += snprintf(ts->err.msg + len, sizeof ts->err.msg - len, "%s%d", k ? ", " : " (also points ", j);
+                len += snprintf(ts->err.msg + len, sizeof ts->err.msg - len, "%s%d",
+                                k ? ", " : " (also points ", j);
                 ++k;
             }
-        if (k > 0 && len > 0 && len < (int)sizeof ts->err.msg - 2) snprintf(ts->err.msg + len, sizeof ts->err.msg - len, ")");
+        if (k > 0 && len > 0 && len < (int)sizeof ts->err.msg - 2)
+            snprintf(ts->err.msg + len, sizeof ts->err.msg - len, ")");
         ts->err.code = GK_ERR_STATE;
     }
     return GK_ERR_STATE;
@@ -1218,46 +1236,52 @@ static gk_result gk__ts_rec_parse(gk_twoscale *ts, int id, const unsigned char *
     int k;
     *out = NULL;
     if (!b || n < GK__TS_REC_MIN)
-        return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d is %lu bytes", id, (unsigned long)n);
+        return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d is %lu bytes", id,
+                          (unsigned long)n);
     memcpy(v, b, sizeof v);
     memcpy(H, b + 16, sizeof H);
     memcpy(S, b + 16 + sizeof H, sizeof S);
     if (v[0] != id || v[1] != ts->pick[id] || v[2] < 0 || v[3] < -1 || v[3] > GK__TS_MAXKEYS)
-        return gk_err_set(&ts->err, GK_ERR_FORMAT,
-                          "the record of point %d names point %d, prototype %d (expected %d), %d DEM steps, %d "
-                          "contact keys",
-                          id, (int)v[0], (int)v[1], ts->pick[id], (int)v[2], (int)v[3]);
+        return gk_err_set(
+            &ts->err, GK_ERR_FORMAT,
+            "the record of point %d names point %d, prototype %d (expected %d), %d DEM steps, %d "
+            "contact keys",
+            id, (int)v[0], (int)v[1], ts->pick[id], (int)v[2], (int)v[3]);
     for (k = 0; k < 9; ++k) /* finite, and small enough for the fields' squares (eps_q, q) to stay finite */
         if (!(fabs(H[k]) <= 1e6) || !(fabs(S[k]) <= 1e100))
-            return gk_err_set(&ts->err, GK_ERR_FORMAT,
-                              "the record of point %d has a NaN or impossible accumulated dH (|H| > 1e6) or stress "
-                              "(|sigma| > 1e100 Pa)",
-                              id);
+            return gk_err_set(
+                &ts->err, GK_ERR_FORMAT,
+                "the record of point %d has a NaN or impossible accumulated dH (|H| > 1e6) or stress "
+                "(|sigma| > 1e100 Pa)",
+                id);
     ref = v[3] >= 0 ? (size_t)ts->nd4 * 8 + (size_t)v[3] * 8 : 0;
     if (ref > n - GK__TS_REC_MIN)
-        return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d is shorter than its %d contact keys", id,
-                          (int)v[3]);
-    if (v[3] >= 0) { /* the reference: a finite tangent, keys as gk__ts_keys makes them (sorted, ids i <= j) */
+        return gk_err_set(&ts->err, GK_ERR_FORMAT,
+                          "the record of point %d is shorter than its %d contact keys", id, (int)v[3]);
+    if (v[3] >=
+        0) { /* the reference: a finite tangent, keys as gk__ts_keys makes them (sorted, ids i <= j) */
         unsigned long long key, prev = 0, lo, hi;
         double d;
         for (k = 0; k < ts->nd4; ++k) {
             memcpy(&d, b + off + (size_t)k * 8, 8);
             if (!isfinite(d))
-                return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d has a NaN reference tangent", id);
+                return gk_err_set(&ts->err, GK_ERR_FORMAT,
+                                  "the record of point %d has a NaN reference tangent", id);
         }
         for (k = 0; k < v[3]; ++k, prev = key) {
             memcpy(&key, b + off + (size_t)ts->nd4 * 8 + (size_t)k * 8, 8);
             lo = key >> 33, hi = (key >> 1) & 0xffffffffu;
             if (key < prev || lo > hi || hi > 0x7fffffffu)
-                return gk_err_set(&ts->err, GK_ERR_FORMAT,
-                                  "the record of point %d: contact key %d is out of order or not a particle pair", id,
-                                  k);
+                return gk_err_set(
+                    &ts->err, GK_ERR_FORMAT,
+                    "the record of point %d: contact key %d is out of order or not a particle pair", id, k);
         }
     }
     memcpy(&ss, b + off + ref, sizeof ss);
     if (ss != n - GK__TS_REC_MIN - ref)
-        return gk_err_set(&ts->err, GK_ERR_FORMAT, "the record of point %d holds a state of %llu bytes in %lu",
-                          id, (unsigned long long)ss, (unsigned long)(n - GK__TS_REC_MIN - ref));
+        return gk_err_set(&ts->err, GK_ERR_FORMAT,
+                          "the record of point %d holds a state of %llu bytes in %lu", id,
+                          (unsigned long long)ss, (unsigned long)(n - GK__TS_REC_MIN - ref));
     res = gk__ts_pt_new(ts, id, v[1], b + off + ref + 8, (size_t)ss, &pt);
     if (res) return res;
     memcpy(pt->H, H, sizeof H);
@@ -1454,7 +1478,8 @@ GKDEF gk_result gk_twoscale_accept(gk_twoscale *ts) {
             pt->acc.buf = b, pt->acc.cap = need + need / 4;
         }
     }
-    if (!gk__ts_allok(ts, ok)) return gk_err_set(&ts->err, GK_ERR_ALLOC, "out of memory accepting the trial states");
+    if (!gk__ts_allok(ts, ok))
+        return gk_err_set(&ts->err, GK_ERR_ALLOC, "out of memory accepting the trial states");
     for (j = 0; j < ts->nlocal; ++j) {
         gk__tspt *pt = ts->pt[j];
         int k;
@@ -1486,7 +1511,8 @@ static const double *gk__ts_collect(gk_twoscale *ts, int nrec, int want_D, gk__t
     gk_err_clear(&ts->err);
     if (ts->n < 1) return gk_err_set(&ts->err, GK_ERR_STATE, "the set was not created"), (const double *)NULL;
     if (ts->pending)
-        return gk_err_set(&ts->err, GK_ERR_STATE, "a run is pending: accept or reject it first"), (const double *)NULL;
+        return gk_err_set(&ts->err, GK_ERR_STATE, "a run is pending: accept or reject it first"),
+               (const double *)NULL;
     if (gk__ts_agree(ts, gk__ts_bufs(ts, nrec))) return NULL;
     GK_OMP(parallel for num_threads(nth) schedule(dynamic, 1))
     for (j = 0; j < ts->nlocal; ++j) {
@@ -1500,8 +1526,8 @@ static const double *gk__ts_collect(gk_twoscale *ts, int nrec, int want_D, gk__t
     all = gk__ts_gather(ts, nrec);
     for (j = 0; j < ts->n; ++j)
         if (all[(size_t)nrec * j + nrec - 1] != 0.0) {
-            gk_err_set(&ts->err, (gk_result)(int)all[(size_t)nrec * j + nrec - 1], "point %d: %s", ts->order[j],
-                       gk_result_string((gk_result)(int)all[(size_t)nrec * j + nrec - 1]));
+            gk_err_set(&ts->err, (gk_result)(int)all[(size_t)nrec * j + nrec - 1], "point %d: %s",
+                       ts->order[j], gk_result_string((gk_result)(int)all[(size_t)nrec * j + nrec - 1]));
             return NULL;
         }
     return all;
@@ -1526,13 +1552,15 @@ GKDEF gk_result gk_twoscale_accepted(gk_twoscale *ts, double *stress, double *D)
     }
 #endif
     if (want_D && ts->def.proc)
-        return gk_err_set(&ts->err, GK_ERR_ARG, "a set run by the caller's procedure has no tangent: D must be NULL");
+        return gk_err_set(&ts->err, GK_ERR_ARG,
+                          "a set run by the caller's procedure has no tangent: D must be NULL");
     nrec = 9 + (want_D ? ts->nd4 : 0) + 1;
     if (!(all = gk__ts_collect(ts, nrec, want_D, gk__ts_fill_acc))) return ts->err.code;
     for (j = 0; j < ts->n; ++j) {
         int p = ts->order[j];
         if (stress) memcpy(stress + 9 * (size_t)p, all + (size_t)nrec * j, 9 * sizeof(double));
-        if (want_D && D) memcpy(D + (size_t)ts->nd4 * p, all + (size_t)nrec * j + 9, (size_t)ts->nd4 * sizeof(double));
+        if (want_D && D)
+            memcpy(D + (size_t)ts->nd4 * p, all + (size_t)nrec * j + 9, (size_t)ts->nd4 * sizeof(double));
     }
     return GK_OK;
 }
@@ -1618,7 +1646,8 @@ static int gk__ck_get(gk__ckf *c, void *p, unsigned long long n) {
 
 static void gk__ts_header(const gk_twoscale *ts, uint32_t hd[8]) {
     hd[0] = GK_TWOSCALE_CHECKPOINT_VERSION, hd[1] = 0x01020304u, hd[2] = (uint32_t)sizeof(gk_real);
-    hd[3] = (uint32_t)ts->dim, hd[4] = (uint32_t)ts->n, hd[5] = (uint32_t)ts->nproto, hd[6] = (uint32_t)ts->nd4;
+    hd[3] = (uint32_t)ts->dim, hd[4] = (uint32_t)ts->n, hd[5] = (uint32_t)ts->nproto,
+    hd[6] = (uint32_t)ts->nd4;
     hd[7] = 0;
 }
 
@@ -1726,33 +1755,39 @@ static gk_result gk__ts_check_file(gk_twoscale *ts, const char *path, gk__ckf *c
     if (hd[1] != want[1])
         return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s was written with the other byte order", path);
     if (hd[0] != want[0])
-        return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s has checkpoint format version %u; this build reads %u", path,
-                          (unsigned)hd[0], (unsigned)want[0]);
+        return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s has checkpoint format version %u; this build reads %u",
+                          path, (unsigned)hd[0], (unsigned)want[0]);
     if (hd[2] != want[2] || hd[3] != want[3] || hd[4] != want[4] || hd[5] != want[5] || hd[6] != want[6])
-        return gk_err_set(&ts->err, GK_ERR_FORMAT,
-                          "%s holds %u points of dimension %u, %u prototypes, %u-byte reals; this set has %d, %d, %d, "
-                          "%d",
-                          path, (unsigned)hd[4], (unsigned)hd[3], (unsigned)hd[5], (unsigned)hd[2], ts->n, ts->dim,
-                          ts->nproto, (int)sizeof(gk_real));
+        return gk_err_set(
+            &ts->err, GK_ERR_FORMAT,
+            "%s holds %u points of dimension %u, %u prototypes, %u-byte reals; this set has %d, %d, %d, "
+            "%d",
+            path, (unsigned)hd[4], (unsigned)hd[3], (unsigned)hd[5], (unsigned)hd[2], ts->n, ts->dim,
+            ts->nproto, (int)sizeof(gk_real));
     for (k = 0; k < ts->nproto; ++k)
         if (gk__ck_get(c, &u, 4) || u != (uint32_t)ts->pk[k].n)
-            return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s: prototype %d has another particle count (or truncated)",
-                              path, k);
+            return gk_err_set(&ts->err, GK_ERR_FORMAT,
+                              "%s: prototype %d has another particle count (or truncated)", path, k);
     for (p = 0; p < ts->n; ++p)
         if (gk__ck_get(c, &u, 4) || u != (uint32_t)ts->pick[p])
-            return gk_err_set(&ts->err, GK_ERR_FORMAT,
-                              "%s: point %d has another prototype (another packing draw?) or the file is truncated",
-                              path, p);
+            return gk_err_set(
+                &ts->err, GK_ERR_FORMAT,
+                "%s: point %d has another prototype (another packing draw?) or the file is truncated", path,
+                p);
     for (p = 0; p < ts->n; ++p) {
         if (gk__ck_get(c, &n, 8))
             return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s is truncated at point %d", path, p);
-        if (n < GK__TS_REC_MIN || n > c->size - c->pos || c->size - c->pos - n < tail || n >= ((uint64_t)1 << 31))
-            return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s: the record of point %d has an impossible size %llu",
-                              path, p, (unsigned long long)n);
-        if (gk__ck_get(c, NULL, n)) return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s is truncated at point %d", path, p);
+        if (n < GK__TS_REC_MIN || n > c->size - c->pos || c->size - c->pos - n < tail ||
+            n >= ((uint64_t)1 << 31))
+            return gk_err_set(&ts->err, GK_ERR_FORMAT,
+                              "%s: the record of point %d has an impossible size %llu", path, p,
+                              (unsigned long long)n);
+        if (gk__ck_get(c, NULL, n))
+            return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s is truncated at point %d", path, p);
     }
     if (gk__ck_get(c, &n, 8) || n > c->size - c->pos || c->size - c->pos - n != 8 || n >= ((uint64_t)1 << 31))
-        return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s: the driver block is truncated or has an impossible size", path);
+        return gk_err_set(&ts->err, GK_ERR_FORMAT,
+                          "%s: the driver block is truncated or has an impossible size", path);
     if (gk__ck_get(c, NULL, n)) return gk_err_set(&ts->err, GK_ERR_FORMAT, "%s is truncated", path);
     {
         uint64_t h = c->h;
@@ -1782,7 +1817,8 @@ GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block
     memset(&c, 0, sizeof c);
     gk_err_clear(&ts->err);
     if (ts->n < 1) return gk_err_set(&ts->err, GK_ERR_STATE, "the set was not created");
-    if (!path || !block || !nblock) return gk_err_set(&ts->err, GK_ERR_ARG, "checkpoint: no path or block pointer");
+    if (!path || !block || !nblock)
+        return gk_err_set(&ts->err, GK_ERR_ARG, "checkpoint: no path or block pointer");
     if (ts->rank == 0) gk__ts_check_file(ts, path, &c);
     if (gk__ts_share_err(ts)) {
         if (c.fp) fclose(c.fp);
@@ -1803,7 +1839,8 @@ GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block
             if (!got && ok) ok = 0, gk_err_set(&ts->err, GK_ERR_IO, "%s changed while it was read", path);
             if (ts->owner[p] == 0) {
                 stage[k] = NULL;
-                if (ok && gk__ts_rec_parse(ts, p, rb, (size_t)n, &stage[k])) ok = gk__ts_rec_refused(ts, path);
+                if (ok && gk__ts_rec_parse(ts, p, rb, (size_t)n, &stage[k]))
+                    ok = gk__ts_rec_refused(ts, path);
                 ++k;
             }
 #ifdef GK_TWOSCALE_MPI
@@ -1827,7 +1864,8 @@ GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block
             unsigned long long n;
             stage[k] = NULL;
             if (gk__ts_xrecv(ts, 0, &rb, &rcap, &n, stage != NULL) && ok) {
-                if (gk__ts_rec_parse(ts, ts->pt[j]->id, rb, (size_t)n, &stage[k])) ok = gk__ts_rec_refused(ts, path);
+                if (gk__ts_rec_parse(ts, ts->pt[j]->id, rb, (size_t)n, &stage[k]))
+                    ok = gk__ts_rec_refused(ts, path);
             } else
                 ok = 0;
             ++k;

@@ -32,46 +32,45 @@ static int gk__t_passed, gk__t_failed;
 static const char *gk__t_filter;
 static const char *gk__t_prog = "test";
 
-#define CHECK(c)                                                                  \
-    do {                                                                          \
-        if (!(c)) {                                                               \
-            ++gk__t_checks_failed;                                                \
-            printf("    %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #c);      \
-        }                                                                         \
+#define CHECK(c)                                                             \
+    do {                                                                     \
+        if (!(c)) {                                                          \
+            ++gk__t_checks_failed;                                           \
+            printf("    %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #c); \
+        }                                                                    \
     } while (0)
 
 /* |a - b| <= tol */
-#define CHECK_NEAR(a, b, tol)                                                     \
-    do {                                                                          \
-        double gk__a = (double)(a), gk__b = (double)(b), gk__tol = (double)(tol); \
-        if (!(fabs(gk__a - gk__b) <= gk__tol)) {                                  \
-            ++gk__t_checks_failed;                                                \
-            printf("    %s:%d: CHECK_NEAR(%s, %s, %s): %.17g vs %.17g (diff %.3g)\n", \
-                   __FILE__, __LINE__, #a, #b, #tol, gk__a, gk__b, fabs(gk__a - gk__b)); \
-        }                                                                         \
+#define CHECK_NEAR(a, b, tol)                                                                             \
+    do {                                                                                                  \
+        double gk__a = (double)(a), gk__b = (double)(b), gk__tol = (double)(tol);                         \
+        if (!(fabs(gk__a - gk__b) <= gk__tol)) {                                                          \
+            ++gk__t_checks_failed;                                                                        \
+            printf("    %s:%d: CHECK_NEAR(%s, %s, %s): %.17g vs %.17g (diff %.3g)\n", __FILE__, __LINE__, \
+                   #a, #b, #tol, gk__a, gk__b, fabs(gk__a - gk__b));                                      \
+        }                                                                                                 \
     } while (0)
 
 /* |a - b| <= rtol * max(|a|, |b|) */
-#define CHECK_REL(a, b, rtol)                                                     \
-    do {                                                                          \
-        double gk__a = (double)(a), gk__b = (double)(b), gk__r = (double)(rtol);  \
-        double gk__m = fabs(gk__a) > fabs(gk__b) ? fabs(gk__a) : fabs(gk__b);     \
-        if (!(fabs(gk__a - gk__b) <= gk__r * gk__m)) {                            \
-            ++gk__t_checks_failed;                                                \
-            printf("    %s:%d: CHECK_REL(%s, %s, %s): %.17g vs %.17g (rel %.3g)\n", \
-                   __FILE__, __LINE__, #a, #b, #rtol, gk__a, gk__b,               \
-                   gk__m > 0 ? fabs(gk__a - gk__b) / gk__m : 0.0);                \
-        }                                                                         \
+#define CHECK_REL(a, b, rtol)                                                                               \
+    do {                                                                                                    \
+        double gk__a = (double)(a), gk__b = (double)(b), gk__r = (double)(rtol);                            \
+        double gk__m = fabs(gk__a) > fabs(gk__b) ? fabs(gk__a) : fabs(gk__b);                               \
+        if (!(fabs(gk__a - gk__b) <= gk__r * gk__m)) {                                                      \
+            ++gk__t_checks_failed;                                                                          \
+            printf("    %s:%d: CHECK_REL(%s, %s, %s): %.17g vs %.17g (rel %.3g)\n", __FILE__, __LINE__, #a, \
+                   #b, #rtol, gk__a, gk__b, gk__m > 0 ? fabs(gk__a - gk__b) / gk__m : 0.0);                 \
+        }                                                                                                   \
     } while (0)
 
-#define CHECK_EQ_INT(a, b)                                                        \
-    do {                                                                          \
-        long gk__a = (long)(a), gk__b = (long)(b);                                \
-        if (gk__a != gk__b) {                                                     \
-            ++gk__t_checks_failed;                                                \
-            printf("    %s:%d: CHECK_EQ_INT(%s, %s): %ld vs %ld\n", __FILE__,     \
-                   __LINE__, #a, #b, gk__a, gk__b);                               \
-        }                                                                         \
+#define CHECK_EQ_INT(a, b)                                                                             \
+    do {                                                                                               \
+        long gk__a = (long)(a), gk__b = (long)(b);                                                     \
+        if (gk__a != gk__b) {                                                                          \
+            ++gk__t_checks_failed;                                                                     \
+            printf("    %s:%d: CHECK_EQ_INT(%s, %s): %ld vs %ld\n", __FILE__, __LINE__, #a, #b, gk__a, \
+                   gk__b);                                                                             \
+        }                                                                                              \
     } while (0)
 
 #define TEST(name) static void name(void)

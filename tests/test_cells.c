@@ -36,7 +36,8 @@ static void make_set(pset *ps, int dim, int n, double ratio, uint64_t seed) {
 }
 
 /* brute force: nearest image over explicit lattice vectors h k, |k_a| <= K[a] */
-static int brute_pairs(const pset *ps, const double h[9], const int K[3], double skin, int *bi, int *bj, int cap) {
+static int brute_pairs(const pset *ps, const double h[9], const int K[3], double skin, int *bi, int *bj,
+                       int cap) {
     int i, j, m = 0, a0, a1, a2;
     for (i = 0; i < ps->n; ++i)
         for (j = i + 1; j < ps->n; ++j) {
@@ -136,7 +137,7 @@ TEST(cells_match_brute_force_3d_sheared_and_rotated) {
         make_set(&ps, 3, 250, 10.0, 100 + g);
         gk_m3_copy(ps.h, h);
         h[1] = gammas[g] * h[4];
-        h[5] = 0.4 * h[8]; /* also shear yz */
+        h[5] = 0.4 * h[8];    /* also shear yz */
         gk_m3_rotation(w, R); /* and rotate the whole lattice */
         gk_m3_mul(R, h, hr);
         K[0] = (int)gammas[g] + 2;
@@ -269,8 +270,8 @@ TEST(verlet_skin_criterion_is_safe) {
                 }
         }
     }
-    CHECK(accepted > 10);   /* the criterion is not trivially false */
-    CHECK(accepted < 400);  /* and it does trigger */
+    CHECK(accepted > 10);  /* the criterion is not trivially false */
+    CHECK(accepted < 400); /* and it does trigger */
     CHECK_EQ_INT(missing, 0);
     gk_cells_free(&cl);
     gk_pairlist_free(&pl);

@@ -84,7 +84,8 @@ TEST(impact_restitution_matches_analytic) {
         gk_rve_destroy(&rve);
     }
     CHECK_NEAR(gk_restitution_to_zeta(1.0), 0.0, 0);
-    CHECK_NEAR(exp(-GK_PI * gk_restitution_to_zeta(0.3) / sqrt(1 - pow(gk_restitution_to_zeta(0.3), 2))), 0.3, 1e-14);
+    CHECK_NEAR(exp(-GK_PI * gk_restitution_to_zeta(0.3) / sqrt(1 - pow(gk_restitution_to_zeta(0.3), 2))), 0.3,
+               1e-14);
 }
 
 /* Coulomb stick and slip (Guo & Zhao 2014 eq 17, incremental form): F_t grows by
@@ -105,8 +106,8 @@ TEST(coulomb_stick_and_slip_2d) {
     cap = 0.5 * (double)fn;
     /* particle j at +x, moving +y relative to i: t = (0, 1), v_t = vt */
     for (k = 1; k <= 2000; ++k) {
-        gk_contact_2d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT, (gk_real)(2 * r - delta), 0, (gk_real)r, (gk_real)r, 1, 1, 0,
-                      (gk_real)vt, 0, 0, (gk_real)dt, &ft, &mr, &st, &o);
+        gk_contact_2d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT, (gk_real)(2 * r - delta), 0, (gk_real)r, (gk_real)r,
+                      1, 1, 0, (gk_real)vt, 0, 0, (gk_real)dt, &ft, &mr, &st, &o);
         if (!(st & GK_CS_SLIDING)) {
             CHECK_REL(ft, -(double)kt * vt * dt * k, 1e-12); /* stick: exact linear growth */
         } else if (slid_at < 0) {
@@ -119,8 +120,8 @@ TEST(coulomb_stick_and_slip_2d) {
     CHECK_REL(o.f[1], -cap, 1e-12);
     CHECK_REL(o.f[0], fn, 1e-12);
     /* reverse: elastic unloading by k_t v dt per step, no longer sliding */
-    gk_contact_2d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT, (gk_real)(2 * r - delta), 0, (gk_real)r, (gk_real)r, 1, 1, 0,
-                  (gk_real)-vt, 0, 0, (gk_real)dt, &ft, &mr, &st, &o);
+    gk_contact_2d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT, (gk_real)(2 * r - delta), 0, (gk_real)r, (gk_real)r, 1,
+                  1, 0, (gk_real)-vt, 0, 0, (gk_real)dt, &ft, &mr, &st, &o);
     CHECK(!(st & GK_CS_SLIDING));
     CHECK_REL(ft, -cap + (double)kt * vt * dt, 1e-10);
     /* torques: t_i = t_j = -l F_t with l = r - delta/2 (equal radii) */
@@ -147,15 +148,15 @@ TEST(coulomb_stick_and_slip_3d) {
     gk_contact_stiffness(&K, GK_LAW_LINEAR, (gk_real)r, (gk_real)r, (gk_real)delta, &kn, &fn, &kt);
     cap = 0.3 * (double)fn;
     for (k = 1; k <= 10; ++k) {
-        gk_contact_3d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT, d, (gk_real)r, (gk_real)r, 1, 1, v, w0, w0, (gk_real)dt, ft,
-                      mr, &st, &o);
+        gk_contact_3d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT, d, (gk_real)r, (gk_real)r, 1, 1, v, w0, w0,
+                      (gk_real)dt, ft, mr, &st, &o);
         CHECK_REL(ft[1], -(double)kt * 0.006 * dt * k, 1e-12);
         CHECK_REL(ft[2], (double)kt * 0.008 * dt * k, 1e-12);
         CHECK(ft[0] == 0);
     }
     for (k = 0; k < 3000; ++k)
-        gk_contact_3d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT, d, (gk_real)r, (gk_real)r, 1, 1, v, w0, w0, (gk_real)dt, ft,
-                      mr, &st, &o);
+        gk_contact_3d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT, d, (gk_real)r, (gk_real)r, 1, 1, v, w0, w0,
+                      (gk_real)dt, ft, mr, &st, &o);
     mag = sqrt((double)ft[1] * ft[1] + (double)ft[2] * ft[2]);
     CHECK(st & GK_CS_SLIDING);
     CHECK_REL(mag, cap, 1e-12);
@@ -182,8 +183,8 @@ TEST(rolling_moment_cap) {
     cap = 0.05 * ri * (double)fn;
     for (k = 1; k <= 5000; ++k) {
         /* pure relative rolling: w_j = +wrel, w_i = 0; no translation */
-        gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)(ri + rj - delta), 0, (gk_real)ri, (gk_real)rj, 1, 1, 0, 0, 0,
-                      (gk_real)wrel, (gk_real)dt, &ft, &mr, &st, &o);
+        gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)(ri + rj - delta), 0, (gk_real)ri, (gk_real)rj, 1, 1, 0,
+                      0, 0, (gk_real)wrel, (gk_real)dt, &ft, &mr, &st, &o);
         if (!capped && fabs((double)mr) < cap * (1 - 1e-12)) CHECK_REL(mr, -kr * wrel * dt * k, 1e-10);
         if (fabs((double)mr) >= cap * (1 - 1e-12)) capped = 1;
     }
@@ -231,25 +232,25 @@ TEST(cohesion_tension_limit) {
     K = consts_of(&m);
     kn = m.young * r; /* r* = r for equal radii */
     /* touch */
-    CHECK(gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)(2 * r - 1e-6), 0, (gk_real)r, (gk_real)r, 1, 1, 0, 0, 0, 0,
-                        (gk_real)1e-5, &ft, &mr, &st, &o) == 1);
+    CHECK(gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)(2 * r - 1e-6), 0, (gk_real)r, (gk_real)r, 1, 1, 0, 0,
+                        0, 0, (gk_real)1e-5, &ft, &mr, &st, &o) == 1);
     CHECK(st & GK_CS_BONDED);
     /* pulled apart to a tension below the limit: attractive normal force */
     d = 2 * r + 0.5 * m.coh_n / kn;
-    CHECK(gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)d, 0, (gk_real)r, (gk_real)r, 1, 1, 0, 0, 0, 0, (gk_real)1e-5,
-                        &ft, &mr, &st, &o) == 1);
+    CHECK(gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)d, 0, (gk_real)r, (gk_real)r, 1, 1, 0, 0, 0, 0,
+                        (gk_real)1e-5, &ft, &mr, &st, &o) == 1);
     CHECK_REL(o.fn, -0.5 * m.coh_n, 1e-9);
     CHECK(o.f[0] < 0); /* force on j points back to i */
     /* beyond the limit: the bond breaks, no force */
     d = 2 * r + 1.5 * m.coh_n / kn;
-    CHECK(gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)d, 0, (gk_real)r, (gk_real)r, 1, 1, 0, 0, 0, 0, (gk_real)1e-5,
-                        &ft, &mr, &st, &o) == 0);
+    CHECK(gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)d, 0, (gk_real)r, (gk_real)r, 1, 1, 0, 0, 0, 0,
+                        (gk_real)1e-5, &ft, &mr, &st, &o) == 0);
     CHECK(o.f[0] == 0 && st == 0);
     /* shear strength adds coh_t to the Coulomb cap while bonded */
     st = 0;
     ft = 0;
-    CHECK(gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)(2 * r - 1e-6), 0, (gk_real)r, (gk_real)r, 1, 1, 0, 10.0, 0, 0,
-                        (gk_real)1e-3, &ft, &mr, &st, &o) == 1);
+    CHECK(gk_contact_2d(&K, GK_LAW_LINEAR, fl, (gk_real)(2 * r - 1e-6), 0, (gk_real)r, (gk_real)r, 1, 1, 0,
+                        10.0, 0, 0, (gk_real)1e-3, &ft, &mr, &st, &o) == 1);
     /* 10 m/s for 1 ms is a huge shear: the bond fails in shear, leaving mu F_n */
     CHECK(!(st & GK_CS_BONDED) && (st & GK_CS_BROKEN));
     CHECK_REL(fabs((double)ft), m.friction * kn * 1e-6, 1e-9);
@@ -278,8 +279,8 @@ TEST(history_rotates_with_rigid_spin_3d) {
         v[2] = 0;
         w[0] = w[1] = 0;
         w[2] = (gk_real)omega;
-        gk_contact_3d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION, d, (gk_real)r, (gk_real)r, 1, 1, v, w, w,
-                      (gk_real)dt, ft, mr, &st, &o);
+        gk_contact_3d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION, d, (gk_real)r, (gk_real)r, 1, 1,
+                      v, w, w, (gk_real)dt, ft, mr, &st, &o);
         last = ang;
         ang += omega * dt;
     }
@@ -300,8 +301,8 @@ TEST(history_rotates_with_rigid_spin_3d) {
     w[0] = (gk_real)omega;
     w[1] = w[2] = 0;
     for (k = 0; k < 20000; ++k)
-        gk_contact_3d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION, d, (gk_real)r, (gk_real)r, 1, 1, v, w, w,
-                      (gk_real)dt, ft, mr, &st, &o);
+        gk_contact_3d(&K, GK_LAW_LINEAR, GK_PHYS_TANGENT | GK_PHYS_ROTATION, d, (gk_real)r, (gk_real)r, 1, 1,
+                      v, w, w, (gk_real)dt, ft, mr, &st, &o);
     CHECK(ft[0] == 0);
     CHECK_NEAR(ft[1], 2.0 * cos(20000 * omega * dt), 1e-9);
     CHECK_NEAR(ft[2], 2.0 * sin(20000 * omega * dt), 1e-9);
@@ -358,9 +359,7 @@ static gk_material law_material(gk_law law) {
  * GK_LAW_TABLE and the flag sets the kernels instantiate, on random pairs
  * that are apart, touching, sticking and sliding. */
 TEST(wide_twins_equal_scalar_reference_bitwise) {
-    static const unsigned FL[] = {0u,
-                                  GK_PHYS_TANGENT,
-                                  GK_PHYS_TANGENT | GK_PHYS_ROTATION,
+    static const unsigned FL[] = {0u, GK_PHYS_TANGENT, GK_PHYS_TANGENT | GK_PHYS_ROTATION,
                                   GK_PHYS_TANGENT | GK_PHYS_VISCOUS,
                                   GK_PHYS_TANGENT | GK_PHYS_ROTATION | GK_PHYS_ROLLING | GK_PHYS_VISCOUS};
     gk_rng rng;
@@ -408,11 +407,11 @@ TEST(wide_twins_equal_scalar_reference_bitwise) {
                 }
                 if (dim == 2)
                     in = gk_contact_2d_w(&K, (gk_law)law, fl, D[0], D[1], gk_vr_loadu(ri), gk_vr_loadu(rj),
-                                         gk_vr_loadu(mi), gk_vr_loadu(mj), V[0], V[1], WI[2], WJ[2], dt, &FT[0],
-                                         &MR[2], &slide, &o);
+                                         gk_vr_loadu(mi), gk_vr_loadu(mj), V[0], V[1], WI[2], WJ[2], dt,
+                                         &FT[0], &MR[2], &slide, &o);
                 else
-                    in = gk_contact_3d_w(&K, (gk_law)law, fl, D, gk_vr_loadu(ri), gk_vr_loadu(rj), gk_vr_loadu(mi),
-                                         gk_vr_loadu(mj), V, WI, WJ, dt, FT, MR, &slide, &o);
+                    in = gk_contact_3d_w(&K, (gk_law)law, fl, D, gk_vr_loadu(ri), gk_vr_loadu(rj),
+                                         gk_vr_loadu(mi), gk_vr_loadu(mj), V, WI, WJ, dt, FT, MR, &slide, &o);
                 for (k = 0; k < 3; ++k) {
                     gk_vr_storeu(out[k], o.f[k]);
                     gk_vr_storeu(out[3 + k], o.ti[k]);
@@ -430,8 +429,9 @@ TEST(wide_twins_equal_scalar_reference_bitwise) {
                         hm[k] = mr[k][l];
                     }
                     if (dim == 2) {
-                        gk_contact_2d(&K, (gk_law)law, fl, d[0][l], d[1][l], ri[l], rj[l], mi[l], mj[l], v[0][l],
-                                      v[1][l], wi[2][l], wj[2][l], (gk_real)2e-5, &hf[0], &hm[2], &st, &so);
+                        gk_contact_2d(&K, (gk_law)law, fl, d[0][l], d[1][l], ri[l], rj[l], mi[l], mj[l],
+                                      v[0][l], v[1][l], wi[2][l], wj[2][l], (gk_real)2e-5, &hf[0], &hm[2],
+                                      &st, &so);
                         so.f[2] = so.ti[0] = so.ti[1] = so.tj[0] = so.tj[1] = 0; /* the twin's zero lanes */
                     } else {
                         gk_real dl[3], vl[3], wil[3], wjl[3];
@@ -484,17 +484,19 @@ TEST(law_kn_max_bounds_the_stiffness) {
         double rmax = 2e-3, dmax = 4e-5, bound = gk_law_kn_max(&m, rmax, dmax), worst = 0.0;
         gk_real kn0, kn1, fn, kt;
         for (it = 0; it < 1000; ++it) {
-            double ri = rmax * (0.1 + 0.9 * gk_rng_uniform(&rng)), rj = rmax * (0.1 + 0.9 * gk_rng_uniform(&rng));
-            gk_contact_stiffness(&K, (gk_law)law, (gk_real)ri, (gk_real)rj, (gk_real)(dmax * gk_rng_uniform(&rng)),
-                                 &kn0, &fn, &kt);
+            double ri = rmax * (0.1 + 0.9 * gk_rng_uniform(&rng)),
+                   rj = rmax * (0.1 + 0.9 * gk_rng_uniform(&rng));
+            gk_contact_stiffness(&K, (gk_law)law, (gk_real)ri, (gk_real)rj,
+                                 (gk_real)(dmax * gk_rng_uniform(&rng)), &kn0, &fn, &kt);
             if ((double)kn0 > worst) worst = (double)kn0;
         }
         gk_contact_stiffness(&K, (gk_law)law, (gk_real)rmax, (gk_real)rmax, (gk_real)dmax, &kn1, &fn, &kt);
-        printf("    %s: largest k_n %.6g, bound %.6g, at r_max and d_max %.6g\n", gk_law_name((gk_law)law), worst,
-               bound, (double)kn1);
+        printf("    %s: largest k_n %.6g, bound %.6g, at r_max and d_max %.6g\n", gk_law_name((gk_law)law),
+               worst, bound, (double)kn1);
         CHECK(worst <= bound * (1.0 + 1e-6));
         CHECK_REL((double)kn1, bound, 1e-6); /* the bound is reached */
-        gk_contact_stiffness(&K, (gk_law)law, (gk_real)rmax, (gk_real)rmax, (gk_real)(0.5 * dmax), &kn0, &fn, &kt);
+        gk_contact_stiffness(&K, (gk_law)law, (gk_real)rmax, (gk_real)rmax, (gk_real)(0.5 * dmax), &kn0, &fn,
+                             &kt);
         CHECK(gk_law_stiffens((gk_law)law) == ((double)kn0 < (double)kn1));
     }
 }

@@ -63,7 +63,8 @@ TEST(quickstart_runs_and_restores_bit_for_bit) {
 
 /* every include/gk_*.h named in README.md's module table, every example
  * driver named in README.md */
-static int listed_in(const char *dir, const char *prefix, const char *suffix, const char *readme, const char *fmt) {
+static int listed_in(const char *dir, const char *prefix, const char *suffix, const char *readme,
+                     const char *fmt) {
     DIR *d = opendir(dir);
     struct dirent *e;
     int missing = 0, seen = 0;
@@ -72,7 +73,8 @@ static int listed_in(const char *dir, const char *prefix, const char *suffix, co
         const char *nm = e->d_name;
         size_t n = strlen(nm), ns = strlen(suffix);
         char want[256], stem[200];
-        if (strncmp(nm, prefix, strlen(prefix)) || n <= ns || strcmp(nm + n - ns, suffix) || n - ns >= sizeof stem)
+        if (strncmp(nm, prefix, strlen(prefix)) || n <= ns || strcmp(nm + n - ns, suffix) ||
+            n - ns >= sizeof stem)
             continue;
         memcpy(stem, nm, n - ns);
         stem[n - ns] = 0;
@@ -102,8 +104,20 @@ TEST(readme_names_every_header_and_driver) {
  * design brief, issue numbers (the first two split in the source so that
  * this file does not name them either) */
 static int clean(const char *path) {
-    static const char *bad[] = {"../sha" "red", "DESI" "GN.md", "issue 1", "issue 2", "issue 3", "issue 4",
-                                "issue 5",   "issue 6",   "issue 7", "issue 8", "issue 9", "the issue's",
+    static const char *bad[] = {"../sha"
+                                "red",
+                                "DESI"
+                                "GN.md",
+                                "issue 1",
+                                "issue 2",
+                                "issue 3",
+                                "issue 4",
+                                "issue 5",
+                                "issue 6",
+                                "issue 7",
+                                "issue 8",
+                                "issue 9",
+                                "the issue's",
                                 "seed 00"};
     char *t = gk_test_slurp(path);
     int k, found = 0;

@@ -22,9 +22,9 @@ static int count_lines(const char *path) {
 TEST(rve_path_writes_csv_and_svg) {
     const char *cmd =
         BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 5 "
-        "--steps-per-increment 50 --E 6e8 --kt-ratio 0.8 --friction-angle 0.5 --density 2650 "
-        "--thickness 0.1 --damping 0.1 --damping-form component --out " BUILD "/tests/t_rve_path.csv "
-        "> " BUILD "/tests/t_rve_path.out 2>&1";
+              "--steps-per-increment 50 --E 6e8 --kt-ratio 0.8 --friction-angle 0.5 --density 2650 "
+              "--thickness 0.1 --damping 0.1 --damping-form component --out " BUILD "/tests/t_rve_path.csv "
+              "> " BUILD "/tests/t_rve_path.out 2>&1";
     FILE *fp;
     char line[1024];
     double p0 = 0;
@@ -49,22 +49,21 @@ TEST(rve_path_writes_csv_and_svg) {
     CHECK(gk_test_file_has(BUILD "/tests/t_rve_path.svg", "<svg"));
     CHECK(gk_test_file_has(BUILD "/tests/t_rve_path.out", "RESULT p="));
     /* bad arguments: a message and a non-zero status */
-    CHECK(
-        system(
-            BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 1\" > " BUILD "/tests/t_bad.out 2>&1") !=
-        0);
+    CHECK(system(BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 1\" > " BUILD
+                       "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "needs 4 numbers"));
-    CHECK(system(BUILD "/rve_path --packing no_such_file --dH \"0 0 0 0\" > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/rve_path --packing no_such_file --dH \"0 0 0 0\" > " BUILD
+                       "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "no_such_file"));
     /* numbers are parsed strictly (atof took '6e8x' as 6e8) */
     CHECK(system(BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --E 6e8x "
-                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+                       "> " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--E '6e8x' is not a finite number"));
     CHECK(system(BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" --increments 5.5 "
-                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+                       "> " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--increments '5.5' is not a whole number"));
     CHECK(system(BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 nan 0 0\" "
-                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+                       "> " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "is not a list of finite numbers"));
     CHECK(system(BUILD "/rve_path --help > " BUILD "/tests/t_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--steps-per-increment"));
@@ -75,8 +74,8 @@ TEST(gk_pack_makes_a_consolidated_packing) {
     gk_packing pk;
     gk_err e;
     FILE *fp;
-    CHECK(system(BUILD "/gk_pack --dim 2 --n 120 --pressure 1e5 --out " BUILD "/tests/t_pack.txt > "
-                 BUILD "/tests/t_pack.out 2>&1") == 0);
+    CHECK(system(BUILD "/gk_pack --dim 2 --n 120 --pressure 1e5 --out " BUILD "/tests/t_pack.txt > " BUILD
+                       "/tests/t_pack.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_pack.out", "RESULT void_ratio="));
     CHECK(gk_packing_read(BUILD "/tests/t_pack.txt", &pk, NULL, &e) == GK_OK);
     CHECK(pk.n == 120 && pk.dim == 2);
@@ -84,16 +83,15 @@ TEST(gk_pack_makes_a_consolidated_packing) {
     gk_packing_free(&pk);
     /* numbers are parsed strictly, and nothing is written for a refused one */
     remove(BUILD "/tests/t_pack_bad.txt");
-    CHECK(
-        system(
-            BUILD "/gk_pack --dim 2 --n 120x --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out 2>&1") !=
-        0);
+    CHECK(system(BUILD "/gk_pack --dim 2 --n 120x --out " BUILD "/tests/t_pack_bad.txt > " BUILD
+                       "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--n '120x' is not a whole number"));
     CHECK(system(BUILD "/gk_pack --dim 2 --pressure 1e5Pa --out " BUILD "/tests/t_pack_bad.txt "
-                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+                       "> " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--pressure '1e5Pa' is not a finite number"));
-    CHECK(system(BUILD "/gk_pack --dim 2 --seed -1 --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out "
-                 "2>&1") != 0);
+    CHECK(system(BUILD "/gk_pack --dim 2 --seed -1 --out " BUILD "/tests/t_pack_bad.txt > " BUILD
+                       "/tests/t_bad.out "
+                       "2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--seed '-1' is not a non-negative whole number"));
     fp = fopen(BUILD "/tests/t_pack_bad.txt", "r");
     CHECK(!fp);
@@ -107,10 +105,10 @@ TEST(gk_pack_makes_a_framed_packing) {
     gk_packing pk;
     gk_err e;
     int p, nx = 0, ny = 0, corner = 0;
-    CHECK(
-        system(BUILD "/gk_pack --dim 2 --n 60 --rmin 3e-4 --rmax 4.5e-4 --pressure 1500 --kn 1.5e8 --frame 3 "
-               "--stress-ratio 1.3 --out " BUILD "/tests/t_pack_frame.txt > " BUILD "/tests/t_pack_frame.out 2>&1") ==
-        0);
+    CHECK(system(BUILD
+                 "/gk_pack --dim 2 --n 60 --rmin 3e-4 --rmax 4.5e-4 --pressure 1500 --kn 1.5e8 --frame 3 "
+                 "--stress-ratio 1.3 --out " BUILD "/tests/t_pack_frame.txt > " BUILD
+                 "/tests/t_pack_frame.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_pack_frame.out", "RESULT void_ratio="));
     CHECK(gk_test_file_has(BUILD "/tests/t_pack_frame.out", "anisotropy="));
     CHECK(gk_test_file_has(BUILD "/tests/t_pack_frame.txt", "sigma_yy to 1.3 sigma_xx and back"));
@@ -127,8 +125,9 @@ TEST(gk_pack_makes_a_framed_packing) {
     CHECK_EQ_INT(ny, 3);
     CHECK_EQ_INT(corner, 1);
     gk_packing_free(&pk);
-    CHECK(system(BUILD "/gk_pack --dim 3 --frame 3 --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out "
-                 "2>&1") != 0);
+    CHECK(system(BUILD "/gk_pack --dim 3 --frame 3 --out " BUILD "/tests/t_pack_bad.txt > " BUILD
+                       "/tests/t_bad.out "
+                       "2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "2D only"));
 }
 
@@ -138,17 +137,18 @@ TEST(gk_pack_makes_a_framed_packing) {
 static int run_threads_and_restart(const char *base, const char *full, const char *part, const char *tag) {
     char cmd[1024];
     int ok = 1;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out " BUILD "/tests/%sA > " BUILD "/tests/%sA.out 2>&1", base,
-             full, tag, tag);
+    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out " BUILD "/tests/%sA > " BUILD "/tests/%sA.out 2>&1",
+             base, full, tag, tag);
     ok &= system(cmd) == 0;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 1 --out " BUILD "/tests/%s1 > " BUILD "/tests/%s1.out 2>&1", base,
-             full, tag, tag);
+    snprintf(cmd, sizeof cmd, "%s %s --threads 1 --out " BUILD "/tests/%s1 > " BUILD "/tests/%s1.out 2>&1",
+             base, full, tag, tag);
     ok &= system(cmd) == 0;
-    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out " BUILD "/tests/%sB > " BUILD "/tests/%sB.out 2>&1", base,
-             part, tag, tag);
+    snprintf(cmd, sizeof cmd, "%s %s --threads 2 --out " BUILD "/tests/%sB > " BUILD "/tests/%sB.out 2>&1",
+             base, part, tag, tag);
     ok &= system(cmd) == 0;
     snprintf(cmd, sizeof cmd,
-             "%s %s --threads 2 --out " BUILD "/tests/%sB --restart " BUILD "/tests/%sB > " BUILD "/tests/%sB2.out 2>&1",
+             "%s %s --threads 2 --out " BUILD "/tests/%sB --restart " BUILD "/tests/%sB > " BUILD
+             "/tests/%sB2.out 2>&1",
              base, full, tag, tag, tag);
     ok &= system(cmd) == 0;
     return ok;
@@ -179,7 +179,7 @@ TEST(femdem_biaxial_local_histories) {
     double v[3][2][13], eq_last[3] = {0, 0, 0}, e_last[3] = {0, 0, 0};
     int rows = 0, gp, step, i;
     CHECK(system(BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --steps 4 --threads 2 --vtk-every 0 "
-                 "--fields-at 0.2 --out " BUILD "/tests/t_fdl > " BUILD "/tests/t_fdl.out 2>&1") == 0);
+                       "--fields-at 0.2 --out " BUILD "/tests/t_fdl > " BUILD "/tests/t_fdl.out 2>&1") == 0);
     fp = fopen(BUILD "/tests/t_fdl/gp_history.csv", "r");
     CHECK(fp != NULL);
     if (!fp) return;
@@ -232,13 +232,14 @@ TEST(hexagonal_rve_is_isotropic_at_100_kPa) {
     double v[12];
     int ok = 0;
     CHECK(system(BUILD "/rve_path --packing examples/data/rve400_hex.txt --dH \"0 0 0 0\" --increments 1 "
-                 "--steps-per-increment 10 --out " BUILD "/tests/t_hex.csv > " BUILD "/tests/t_hex.out 2>&1") == 0);
+                       "--steps-per-increment 10 --out " BUILD "/tests/t_hex.csv > " BUILD
+                       "/tests/t_hex.out 2>&1") == 0);
     fp = fopen(BUILD "/tests/t_hex.csv", "r");
     CHECK(fp != NULL);
     if (!fp) return;
     while (fgets(line, sizeof line, fp))
-        ok = sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4],
-                    &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) == 12;
+        ok = sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3],
+                    &v[4], &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) == 12;
     fclose(fp);
     CHECK(ok);
     CHECK_NEAR(v[5], 1e5, 1e-3); /* sxx after 10 DEM steps: the lattice is in equilibrium */
@@ -279,7 +280,7 @@ TEST(femdem_biaxial_runs_restarts_and_is_thread_independent) {
     CHECK(gk_test_file_has(BUILD "/tests/t_fdA/mesh_0004.vtk", "displacement"));
     CHECK(gk_test_file_has(BUILD "/tests/t_fdA/biaxial_stress.svg", "<svg"));
     CHECK(gk_test_file_has(BUILD "/tests/t_fdA/eps_q_field.svg", "<svg"));
-    check_threads_and_restart("t_fd", "biaxial.csv", 6); /* columns step..iterations */
+    check_threads_and_restart("t_fd", "biaxial.csv", 6);     /* columns step..iterations */
     check_threads_and_restart("t_fd", "gp_history.csv", 15); /* the histories survive the checkpoint */
     /* bad input: a message and status 2 */
     CHECK(system(BUILD "/femdem_biaxial --element q9 > " BUILD "/tests/t_bad.out 2>&1") != 0);
@@ -294,10 +295,9 @@ TEST(femdem_single_element_matches_rve_alone) {
     double d = 1.0;
     FILE *fp;
     char line[1024];
-    CHECK(
-        system(
-            BUILD "/femdem_biaxial --test single --steps 6 --threads 2 --vtk-every 0 --out " BUILD "/tests/t_fds "
-            "> " BUILD "/tests/t_fds.out 2>&1") == 0);
+    CHECK(system(BUILD "/femdem_biaxial --test single --steps 6 --threads 2 --vtk-every 0 --out " BUILD
+                       "/tests/t_fds "
+                       "> " BUILD "/tests/t_fds.out 2>&1") == 0);
     fp = fopen(BUILD "/tests/t_fds.out", "r");
     while (fp && fgets(line, sizeof line, fp))
         if (!strncmp(line, "SINGLE max_rel_diff_to_peak=", 28)) d = atof(line + 28);
@@ -337,9 +337,9 @@ TEST(femdem_single_reference_holds_the_lateral_stress) {
     double v[31 * 8];
     char header[512];
     int n, k, runs = 0;
-    CHECK(system(BUILD "/femdem_biaxial --test single --steps 30 --threads 2 --vtk-every 0 --out "
-                 BUILD "/tests/t_fds30 "
-                 "> " BUILD "/tests/t_fds30.out 2>&1") == 0);
+    CHECK(system(BUILD "/femdem_biaxial --test single --steps 30 --threads 2 --vtk-every 0 --out " BUILD
+                       "/tests/t_fds30 "
+                       "> " BUILD "/tests/t_fds30.out 2>&1") == 0);
     n = read_csv(BUILD "/tests/t_fds30/single_element.csv", 8, v, 31, header, sizeof header);
     CHECK(n == 31);
     CHECK(strstr(header, "eps_v_rve,rve_runs") != NULL);
@@ -361,8 +361,9 @@ TEST(femdem_single_reference_through_a_slip) {
     char header[512];
     int n, k, held = 1, two_legs = 0;
     CHECK(system(BUILD "/femdem_biaxial --test single --steps 100 --dem-rule adaptive --packing "
-                 "bench/data/tradeoff/rve400.txt --threads 2 --vtk-every 0 --out " BUILD "/tests/t_fdslip "
-                 "> " BUILD "/tests/t_fdslip.out 2>&1") == 0);
+                       "bench/data/tradeoff/rve400.txt --threads 2 --vtk-every 0 --out " BUILD
+                       "/tests/t_fdslip "
+                       "> " BUILD "/tests/t_fdslip.out 2>&1") == 0);
     n = read_csv(BUILD "/tests/t_fdslip/single_element.csv", 8, v, 101, header, sizeof header);
     CHECK_EQ_INT(n, 101);
     for (k = 1; k < n; ++k) {
@@ -371,7 +372,8 @@ TEST(femdem_single_reference_through_a_slip) {
     }
     CHECK(held);
     CHECK(two_legs >= 1);
-    printf("    RVE alone to 10 %%: sigma_xx held to 1e-3 p in every row, %d increment(s) in two legs\n", two_legs);
+    printf("    RVE alone to 10 %%: sigma_xx held to 1e-3 p in every row, %d increment(s) in two legs\n",
+           two_legs);
 }
 
 #define CYC_HEADER                                                                                      \
@@ -389,7 +391,7 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
     double v[64 * C_NCOL], evmax = 0, uymax = 0, tau_pos = 0, tau_neg = 0;
     int n, k, turns = 0;
     CHECK(run_threads_and_restart(BUILD "/femdem_cyclic --test cyclic-strain --nx 2 --ny 1 --element q4 "
-                                  "--increment 0.002",
+                                        "--increment 0.002",
                                   "--cycles 1", "--cycles 0.5", "t_fc"));
     n = read_csv(BUILD "/tests/t_fcA/cyclic.csv", C_NCOL, v, 64, header, sizeof header);
     CHECK(strcmp(header, CYC_HEADER) == 0);
@@ -426,12 +428,12 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
     /* bad input: a message and status 2; a checkpoint of the other control mode is refused */
     CHECK(system(BUILD "/femdem_cyclic --test cyclic-foo > " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "cyclic-strain or cyclic-stress"));
-    CHECK(system(BUILD "/femdem_cyclic --test cyclic-strain --amplitude 0 > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/femdem_cyclic --test cyclic-strain --amplitude 0 > " BUILD
+                       "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "out of range"));
-    CHECK(
-        system(
-            BUILD "/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --restart " BUILD "/tests/t_fcA "
-            "--out " BUILD "/tests/t_fcC > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --restart " BUILD
+                       "/tests/t_fcA "
+                       "--out " BUILD "/tests/t_fcC > " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "not a checkpoint"));
     CHECK(system(BUILD "/femdem_cyclic --help > " BUILD "/tests/t_bad.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--tau-amplitude"));
@@ -447,11 +449,12 @@ TEST(femdem_cyclic_strain_constant_volume_and_contractive) {
 TEST(femdem_cyclic_stress_turns_at_the_amplitude) {
     const char *base =
         BUILD "/femdem_cyclic --test cyclic-stress --nx 2 --ny 1 --element q4 --tau-amplitude 1.5e4 "
-        "--stress-steps 2 --threads 2";
+              "--stress-steps 2 --threads 2";
     char cmd[1024], header[512];
     double v[128 * C_NCOL], tmax = 0, amp = 1.5e4, g_lim = 0.002;
     int n, k, turns = 0;
-    snprintf(cmd, sizeof cmd, "%s --cycles 1.5 --out " BUILD "/tests/t_fcS > " BUILD "/tests/t_fcS.out 2>&1", base);
+    snprintf(cmd, sizeof cmd, "%s --cycles 1.5 --out " BUILD "/tests/t_fcS > " BUILD "/tests/t_fcS.out 2>&1",
+             base);
     CHECK(system(cmd) == 0);
     n = read_csv(BUILD "/tests/t_fcS/cyclic.csv", C_NCOL, v, 128, header, sizeof header);
     CHECK(strcmp(header, CYC_HEADER) == 0);
@@ -469,8 +472,8 @@ TEST(femdem_cyclic_stress_turns_at_the_amplitude) {
     CHECK_EQ_INT(turns, 3);
     CHECK(tmax <= 1.02 * amp);
     CHECK(gk_test_file_has(BUILD "/tests/t_fcS.out", "RESULT test=cyclic-stress"));
-    snprintf(cmd, sizeof cmd, "%s --gamma-limit %g --out " BUILD "/tests/t_fcG > " BUILD "/tests/t_fcG.out 2>&1",
-             base, g_lim);
+    snprintf(cmd, sizeof cmd,
+             "%s --gamma-limit %g --out " BUILD "/tests/t_fcG > " BUILD "/tests/t_fcG.out 2>&1", base, g_lim);
     CHECK(system(cmd) == 0);
     n = read_csv(BUILD "/tests/t_fcG/cyclic.csv", C_NCOL, v, 128, header, sizeof header);
     CHECK(n > 2);
@@ -506,8 +509,8 @@ static int refused(const char *bin, const char *flags, const char *msg) {
     FILE *fp;
     int ok;
     system("rm -rf " BUILD "/tests/t_fdbad");
-    snprintf(cmd, sizeof cmd, BUILD "/%s %s --out " BUILD "/tests/t_fdbad > " BUILD "/tests/t_bad.out 2>&1", bin,
-             flags);
+    snprintf(cmd, sizeof cmd, BUILD "/%s %s --out " BUILD "/tests/t_fdbad > " BUILD "/tests/t_bad.out 2>&1",
+             bin, flags);
     ok = system(cmd) != 0 && gk_test_file_has(BUILD "/tests/t_bad.out", msg);
     fp = fopen(BUILD "/tests/t_fdbad", "r");
     if (fp) fclose(fp), ok = 0;
@@ -527,7 +530,8 @@ TEST(femdem_refuses_malformed_numbers) {
     CHECK(fd_refused("--tol abc", "--tol 'abc' is not a finite number"));
     CHECK(fd_refused("--pressure 1e5Pa", "--pressure '1e5Pa' is not a finite number"));
     CHECK(fd_refused("--increment 1e999", "is not a finite number"));
-    CHECK(refused("femdem_cyclic", "--test cyclic-strain --amplitude nan", "--amplitude 'nan' is not a finite number"));
+    CHECK(refused("femdem_cyclic", "--test cyclic-strain --amplitude nan",
+                  "--amplitude 'nan' is not a finite number"));
     CHECK(fd_refused("--nx 0", "out of range")); /* well-formed but out of range: the range check */
     /* ... named, whatever the value; an option written with '=' is refused with a hint; a step count
      * at the end of int's range cannot overflow a row count */
@@ -548,8 +552,8 @@ TEST(femdem_noise_probe_leaves_the_run_unchanged) {
     char cmd[512];
     snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fnp0 > " BUILD "/tests/t_fnp0.out 2>&1", base);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --noise-probe 2 --out " BUILD "/tests/t_fnp1 > " BUILD "/tests/t_fnp1.out 2>&1",
-             probe);
+    snprintf(cmd, sizeof cmd,
+             "%s --noise-probe 2 --out " BUILD "/tests/t_fnp1 > " BUILD "/tests/t_fnp1.out 2>&1", probe);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_fnp1.out", "noise probe at iteration 2 (E_f "));
     CHECK(gk_test_file_has(BUILD "/tests/t_fnp1.out", " 1e-06: "));
@@ -577,7 +581,8 @@ TEST(femdem_krylov_probe_leaves_the_run_unchanged) {
     snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fkp0 > " BUILD "/tests/t_fkp0.out 2>&1", base);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s --krylov-probe 2 --krylov-scale 0.02 --out " BUILD "/tests/t_fkp1 > " BUILD "/tests/t_fkp1.out 2>&1",
+             "%s --krylov-probe 2 --krylov-scale 0.02 --out " BUILD "/tests/t_fkp1 > " BUILD
+             "/tests/t_fkp1.out 2>&1",
              probe);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_fkp1.out", "krylov probe at iteration 2 (E_f "));
@@ -618,13 +623,15 @@ TEST(femdem_extrapolated_predictor) {
     char header[512];
     double a[5 * F_NCOL], b[5 * F_NCOL];
     int na, nb, r, differs = 0;
-    CHECK(run_threads_and_restart(BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --predictor "
+    CHECK(run_threads_and_restart(BUILD
+                                  "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --predictor "
                                   "extrapolate",
                                   "--steps 4", "--steps 2", "t_fx"));
     check_threads_and_restart("t_fx", "biaxial.csv", 6);
     CHECK(gk_test_file_has(BUILD "/tests/t_fxA.out", "predictor: the last converged increment"));
-    CHECK(system(BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --steps 4 --threads 2 --out "
-                 BUILD "/tests/t_fxT > " BUILD "/tests/t_fxT.out 2>&1") == 0);
+    CHECK(system(BUILD
+                 "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --steps 4 --threads 2 --out " BUILD
+                 "/tests/t_fxT > " BUILD "/tests/t_fxT.out 2>&1") == 0);
     na = read_csv(BUILD "/tests/t_fxA/biaxial.csv", F_NCOL, a, 5, header, sizeof header);
     nb = read_csv(BUILD "/tests/t_fxT/biaxial.csv", F_NCOL, b, 5, header, sizeof header);
     CHECK_EQ_INT(na, 5);
@@ -644,10 +651,9 @@ TEST(femdem_ed_newton_accepts_by_the_criterion) {
     char header[512];
     double a[4 * F_NCOL];
     int n, r;
-    CHECK(
-        system(
-            BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3 --ed newton "
-            "--out " BUILD "/tests/t_fed > " BUILD "/tests/t_fed.out 2>&1") == 0);
+    CHECK(system(BUILD
+                 "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2 --steps 3 --ed newton "
+                 "--out " BUILD "/tests/t_fed > " BUILD "/tests/t_fed.out 2>&1") == 0);
     n = read_csv(BUILD "/tests/t_fed/biaxial.csv", F_NCOL, a, 4, header, sizeof header);
     CHECK_EQ_INT(n, 4);
     for (r = 1; r < n; ++r) CHECK(a[r * F_NCOL + 7] < 0.01 || a[r * F_NCOL + 8] < 0.003);
@@ -709,7 +715,9 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
     CHECK_NEAR(gk_test_result(BUILD "/tests/t_fdr.out", "dem_steps_total"), dmax, 0.5);
     /* a 4x larger inertial-number bound: about 4x fewer deformation steps */
     snprintf(cmd, sizeof cmd,
-             "%s --steps 4 --dem-inertial 2e-3 --out " BUILD "/tests/t_fdr2 > " BUILD "/tests/t_fdr2.out 2>&1", base);
+             "%s --steps 4 --dem-inertial 2e-3 --out " BUILD "/tests/t_fdr2 > " BUILD
+             "/tests/t_fdr2.out 2>&1",
+             base);
     CHECK(system(cmd) == 0);
     CHECK_EQ_INT(read_csv(BUILD "/tests/t_fdr2/biaxial.csv", F_NCOL, b, 8, header, sizeof header), 5);
     printf(
@@ -721,8 +729,8 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
           0.5 * gk_test_result(BUILD "/tests/t_fdr.out", "dem_steps_total"));
     /* the strain rule with --dem-min N --dem-max N: exactly N steps per RVE run, every run */
     snprintf(cmd, sizeof cmd,
-             "%s --steps 3 --dem-rule strain --dem-min %d --dem-max %d --out " BUILD "/tests/t_fdn > "
-             BUILD "/tests/t_fdn.out 2>&1",
+             "%s --steps 3 --dem-rule strain --dem-min %d --dem-max %d --out " BUILD "/tests/t_fdn > " BUILD
+             "/tests/t_fdn.out 2>&1",
              base, nfix, nfix);
     CHECK(system(cmd) == 0);
     n = read_csv(BUILD "/tests/t_fdn/biaxial.csv", F_NCOL, c, 8, header, sizeof header);
@@ -737,7 +745,8 @@ TEST(femdem_dem_rule_and_tangent_reuse) {
      * --ftol = 0.3 % of the internal force, so two converged states may differ by a few tenths of a
      * percent in the reactions; 1 % allows that and no more - and it does reuse */
     snprintf(cmd, sizeof cmd,
-             "%s --steps 4 --tangent-reuse 0.3 --out " BUILD "/tests/t_fdt > " BUILD "/tests/t_fdt.out 2>&1", base);
+             "%s --steps 4 --tangent-reuse 0.3 --out " BUILD "/tests/t_fdt > " BUILD "/tests/t_fdt.out 2>&1",
+             base);
     CHECK(system(cmd) == 0);
     n = read_csv(BUILD "/tests/t_fdt/biaxial.csv", F_NCOL, b, 8, header, sizeof header);
     CHECK_EQ_INT(n, 5);
@@ -813,7 +822,7 @@ TEST(femdem_heterogeneous_packings) {
     FILE *fp;
     char line[512];
     const char *base = BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 1 "
-                       "--packing examples/data/rve400.txt,bench/data/tradeoff/rve400.txt";
+                             "--packing examples/data/rve400.txt,bench/data/tradeoff/rve400.txt";
     CHECK(run_threads_and_restart(base, "--steps 3", "--steps 1", "t_fh"));
     check_threads_and_restart("t_fh", "biaxial.csv", 6);
     n = vtk_scalars(BUILD "/tests/t_fhA/gp_0001.vtk", "void_ratio", v, 64);
@@ -838,8 +847,9 @@ TEST(femdem_heterogeneous_packings) {
     CHECK(a > 0 && b > 0 && a + b == 16);
     CHECK((a == nhi && b == nlo) || (a == nlo && b == nhi)); /* the draw is what the RVEs got */
     CHECK(system(BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --steps 1 --vtk-every 1 --packing-seed 7 "
-                 "--packing examples/data/rve400.txt,bench/data/tradeoff/rve400.txt --out " BUILD "/tests/t_fh7 "
-                 "> " BUILD "/tests/t_fh7.out 2>&1") == 0);
+                       "--packing examples/data/rve400.txt,bench/data/tradeoff/rve400.txt --out " BUILD
+                       "/tests/t_fh7 "
+                       "> " BUILD "/tests/t_fh7.out 2>&1") == 0);
     {
         double w[64];
         int m = vtk_scalars(BUILD "/tests/t_fh7/gp_0001.vtk", "void_ratio", w, 64), diff = 0;
@@ -847,12 +857,12 @@ TEST(femdem_heterogeneous_packings) {
         for (k = 0; k < m && k < n; ++k) diff += w[k] != v[k];
         CHECK(diff > 0);
     }
-    CHECK(
-        system(
-            BUILD "/femdem_biaxial --test single --packing examples/data/rve400.txt,examples/data/rve400.txt "
-            "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(BUILD
+                 "/femdem_biaxial --test single --packing examples/data/rve400.txt,examples/data/rve400.txt "
+                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "give one --packing"));
-    CHECK(system(BUILD "/femdem_biaxial --nx 1 --ny 1 --steps 1 --packing examples/data/rve400.txt,nosuch.txt "
+    CHECK(system(BUILD
+                 "/femdem_biaxial --nx 1 --ny 1 --steps 1 --packing examples/data/rve400.txt,nosuch.txt "
                  "--out " BUILD "/tests/t_fhx > " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "nosuch.txt"));
     CHECK(system(BUILD "/femdem_biaxial --packing-seed -3 > " BUILD "/tests/t_bad.out 2>&1") != 0);
@@ -881,7 +891,8 @@ TEST(femdem_failed_writes_are_errors) {
                                      {"checkpoint.bin", "--vtk-every 0"}};
     for (k = 0; k < 3; ++k) {
         char want[128];
-        snprintf(cmd, sizeof cmd, "rm -rf " BUILD "/tests/t_fw && mkdir -p " BUILD "/tests/t_fw/%s", what[k][0]);
+        snprintf(cmd, sizeof cmd, "rm -rf " BUILD "/tests/t_fw && mkdir -p " BUILD "/tests/t_fw/%s",
+                 what[k][0]);
         CHECK(system(cmd) == 0);
         snprintf(cmd, sizeof cmd, "%s %s --out " BUILD "/tests/t_fw > " BUILD "/tests/t_fw.out 2>&1", base,
                  what[k][1]);
@@ -893,8 +904,8 @@ TEST(femdem_failed_writes_are_errors) {
     CHECK(system("rm -rf " BUILD "/tests/t_fw && touch " BUILD "/tests/t_fw") == 0);
     snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fw > " BUILD "/tests/t_fw.out 2>&1", base);
     CHECK(system(cmd) != 0);
-    CHECK_EQ_INT(count_has(BUILD "/tests/t_fw.out", "--out " BUILD "/tests/t_fw: cannot create that directory"),
-                 1);
+    CHECK_EQ_INT(
+        count_has(BUILD "/tests/t_fw.out", "--out " BUILD "/tests/t_fw: cannot create that directory"), 1);
     remove(BUILD "/tests/t_fw");
 }
 
@@ -906,14 +917,17 @@ TEST(femdem_cost_log_has_every_run) {
     char cmd[512], line[1024];
     FILE *fp;
     int lines = 0, good = 0, iters = 0, row = 0;
-    snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fcl --cost-log " BUILD "/tests/t_fcl.log > " BUILD "/tests/t_fcl.out 2>&1", base);
+    snprintf(cmd, sizeof cmd,
+             "%s --out " BUILD "/tests/t_fcl --cost-log " BUILD "/tests/t_fcl.log > " BUILD
+             "/tests/t_fcl.out 2>&1",
+             base);
     CHECK(system(cmd) == 0);
     fp = fopen(BUILD "/tests/t_fcl.log", "r");
     while (fp && fgets(line, sizeof line, fp)) {
         int step, w[9], n;
         double scale;
-        n = sscanf(line, "%d %lf %d %d %d %d %d %d %d %d %d", &step, &scale, w, w + 1, w + 2, w + 3, w + 4, w + 5,
-                   w + 6, w + 7, w + 8);
+        n = sscanf(line, "%d %lf %d %d %d %d %d %d %d %d %d", &step, &scale, w, w + 1, w + 2, w + 3, w + 4,
+                   w + 5, w + 6, w + 7, w + 8);
         ++lines;
         good += n == 10 && step >= 1 && step <= 2 && (lines > 1 || step == 1) && scale == 1.0 && w[0] > 0;
     }
@@ -928,7 +942,8 @@ TEST(femdem_cost_log_has_every_run) {
     if (fp) fclose(fp);
     CHECK(lines > 2 && good == lines);
     CHECK_EQ_INT(lines, iters);
-    snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fcl --cost-log /dev/full > " BUILD "/tests/t_fcl.out 2>&1", base);
+    snprintf(cmd, sizeof cmd,
+             "%s --out " BUILD "/tests/t_fcl --cost-log /dev/full > " BUILD "/tests/t_fcl.out 2>&1", base);
     CHECK(system(cmd) != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_fcl.out", "cannot write /dev/full"));
 }

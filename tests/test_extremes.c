@@ -958,13 +958,12 @@ TEST(strain_increments_1e_8_to_1e_1_per_step) {
     }
     /* refused */
     {
-        double bad[9][9] = {{0, 0, 0, 0, 0, 0, 0, 0, 0},   {0, 0, 0, 0, 0, 0, 0, 0, 0},
-                            {0, 0, 0, 0, 0, 0, 0, 0, 0.1}, {1e-3, 0, 0, 0, 0, 0, 0, 0, 0},
-                            {-2, 0, 0, 0, 0, 0, 0, 0, 0},  {0, 0.1, 0, 0, 0, 0, 0, 0, 0},
-                            {-0.1, 0, 0, 0, -0.1, 0, 0, 0, 0}, {0, 1.0, 0, 0, 0, 0, 0, 0, 0},
-                            {-1, 0, 0, 0, 0, 0, 0, 0, 0}};
-        gk_result want[9] = {GK_ERR_NAN, GK_ERR_NAN,      GK_ERR_ARG, GK_ERR_ARG,     GK_ERR_SINGULAR,
-                             GK_ERR_ARG, GK_ERR_ARG,      GK_ERR_ARG, GK_ERR_SINGULAR};
+        double bad[9][9] = {
+            {0, 0, 0, 0, 0, 0, 0, 0, 0},       {0, 0, 0, 0, 0, 0, 0, 0, 0},   {0, 0, 0, 0, 0, 0, 0, 0, 0.1},
+            {1e-3, 0, 0, 0, 0, 0, 0, 0, 0},    {-2, 0, 0, 0, 0, 0, 0, 0, 0},  {0, 0.1, 0, 0, 0, 0, 0, 0, 0},
+            {-0.1, 0, 0, 0, -0.1, 0, 0, 0, 0}, {0, 1.0, 0, 0, 0, 0, 0, 0, 0}, {-1, 0, 0, 0, 0, 0, 0, 0, 0}};
+        gk_result want[9] = {GK_ERR_NAN, GK_ERR_NAN, GK_ERR_ARG, GK_ERR_ARG,     GK_ERR_SINGULAR,
+                             GK_ERR_ARG, GK_ERR_ARG, GK_ERR_ARG, GK_ERR_SINGULAR};
         int nst[9] = {1, 1, 1, 0, 1, 1, 1, 10, 100}, c;
         unsigned char *snap;
         size_t ns;
@@ -1313,8 +1312,8 @@ TEST(newton_divergence_is_cut_back) {
     fclose(fp);
     /* (a) cut back, then converge */
     snprintf(cmd, sizeof cmd,
-             "%s %s --increment 0.099 --max-iter 6 --dem-max 50 --out " BUILD "/tests/t_ext_cutA > "
-             BUILD "/tests/t_ext_cutA.out 2>&1",
+             "%s %s --increment 0.099 --max-iter 6 --dem-max 50 --out " BUILD "/tests/t_ext_cutA > " BUILD
+             "/tests/t_ext_cutA.out 2>&1",
              exe, base);
     st = system(cmd);
     CHECK(st != -1 && WIFEXITED(st) && WEXITSTATUS(st) == 0);
@@ -1327,8 +1326,8 @@ TEST(newton_divergence_is_cut_back) {
     CHECK(minc < 0.099 && rows > 2);
     /* (b) cut back to 1/16, then stop cleanly */
     snprintf(cmd, sizeof cmd,
-             "%s %s --increment 0.09 --max-iter 2 --dem-max 500 --out " BUILD "/tests/t_ext_cutB > "
-             BUILD "/tests/t_ext_cutB.out 2>&1",
+             "%s %s --increment 0.09 --max-iter 2 --dem-max 500 --out " BUILD "/tests/t_ext_cutB > " BUILD
+             "/tests/t_ext_cutB.out 2>&1",
              exe, base);
     st = system(cmd);
     CHECK(st != -1 && WIFEXITED(st) && WEXITSTATUS(st) == 3);

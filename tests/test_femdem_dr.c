@@ -20,15 +20,16 @@ static int rows(const char *path, double r[][12]) {
     int n = 0, k;
     if (!fp) return -1;
     if (!fgets(line, sizeof line, fp) ||
-        strcmp(line, "step,stage,eps_axial,sigma_bar,sigma_11,sigma_22,J,coordination,anisotropy,dr_iterations,"
-                     "dem_steps,seconds\n")) {
+        strcmp(line,
+               "step,stage,eps_axial,sigma_bar,sigma_11,sigma_22,J,coordination,anisotropy,dr_iterations,"
+               "dem_steps,seconds\n")) {
         fclose(fp);
         return -1;
     }
     while (n < MAXR && fgets(line, sizeof line, fp)) {
         double *v = r[n];
-        if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
-                   &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) != 12)
+        if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4],
+                   &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) != 12)
             break;
         for (k = 0; k < 12; ++k)
             if (!isfinite(v[k])) {
@@ -59,8 +60,8 @@ TEST(isotropic_stage_and_one_element_against_the_rve) {
     static double a[MAXR][12], b[MAXR][12];
     int na, nb, i;
     double peak = 0.0, dmax = 0.0;
-    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.02 --out " BUILD "/tests/t_fdr_rve > "
-                     BUILD "/tests/t_fdr_rve.out "
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.02 --out " BUILD
+                     "/tests/t_fdr_rve > " BUILD "/tests/t_fdr_rve.out "
                      "2>&1") == 0);
     CHECK(system(FDR "--nx 1 --ny 1 --frame periodic --steps 4 --strain 0.02 --out " BUILD "/tests/t_fdr_11 "
                      "> " BUILD "/tests/t_fdr_11.out 2>&1") == 0);
@@ -80,8 +81,8 @@ TEST(isotropic_stage_and_one_element_against_the_rve) {
     }
     for (i = 11; i < 15; ++i)
         if (fabs(a[i][3] - b[i][3]) > dmax) dmax = fabs(a[i][3] - b[i][3]);
-    printf("    sigma_bar at 2 %%: RVE alone %.4f, 1 x 1 mesh %.4f; largest difference %.2f %% of the peak\n", a[14][3],
-           b[14][3], 100.0 * dmax / peak);
+    printf("    sigma_bar at 2 %%: RVE alone %.4f, 1 x 1 mesh %.4f; largest difference %.2f %% of the peak\n",
+           a[14][3], b[14][3], 100.0 * dmax / peak);
     CHECK(peak > 0.2);
     CHECK(dmax <= 0.02 * peak);
     CHECK_NEAR(gk_test_result(BUILD "/tests/t_fdr_11.out", "peak_sigma_bar"), peak, 0.02 * peak); /* RESULT */
@@ -97,14 +98,12 @@ TEST(isotropic_stage_and_one_element_against_the_rve) {
 TEST(locked_rotation_is_stronger) {
     static double f[MAXR][12], l[MAXR][12];
     int nf, nl;
-    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --out " BUILD "/tests/t_fdr_free > "
-                     BUILD "/tests/t_fdr_free.out "
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --out " BUILD
+                     "/tests/t_fdr_free > " BUILD "/tests/t_fdr_free.out "
                      "2>&1") == 0);
-    CHECK(
-        system(
-            FDR
-            "--test rve --frame periodic --steps 4 --strain 0.04 --no-rotation --out " BUILD "/tests/t_fdr_lock "
-            "> " BUILD "/tests/t_fdr_lock.out 2>&1") == 0);
+    CHECK(system(FDR "--test rve --frame periodic --steps 4 --strain 0.04 --no-rotation --out " BUILD
+                     "/tests/t_fdr_lock "
+                     "> " BUILD "/tests/t_fdr_lock.out 2>&1") == 0);
     nf = rows(BUILD "/tests/t_fdr_free/dr.csv", f);
     nl = rows(BUILD "/tests/t_fdr_lock/dr.csv", l);
     CHECK(nf == 15 && nl == 15);
@@ -117,7 +116,8 @@ TEST(locked_rotation_is_stronger) {
 /* the servo frame (the paper's RVE) on a 1 x 2 mesh: 2 threads and 1 thread give the same rows bit for
  * bit, and so does a run stopped after 2 steps and restarted from its checkpoint */
 TEST(threads_and_restart_give_the_same_rows) {
-    const char *base = FDR "--nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 ";
+    const char *base =
+        FDR "--nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 ";
     char cmd[1024];
     snprintf(cmd, sizeof cmd,
              "%s --steps 2 --threads 2 --out " BUILD "/tests/t_fdrA > " BUILD "/tests/t_fdrA.out 2>&1", base);
@@ -126,7 +126,8 @@ TEST(threads_and_restart_give_the_same_rows) {
              "%s --steps 2 --threads 1 --out " BUILD "/tests/t_fdr1 > " BUILD "/tests/t_fdr1.out 2>&1", base);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             "%s --steps 2 --threads 2 --stop-after 2 --out " BUILD "/tests/t_fdrB > " BUILD "/tests/t_fdrB.out 2>&1",
+             "%s --steps 2 --threads 2 --stop-after 2 --out " BUILD "/tests/t_fdrB > " BUILD
+             "/tests/t_fdrB.out 2>&1",
              base);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
@@ -145,8 +146,8 @@ TEST(threads_and_restart_give_the_same_rows) {
 TEST(dns_runs) {
     static double r[MAXR][12];
     int n;
-    CHECK(system(FDR "--test dns --iso-steps 2 --steps 1 --strain 0.01 --out " BUILD "/tests/t_fdr_dns > "
-                     BUILD "/tests/t_fdr_dns.out "
+    CHECK(system(FDR "--test dns --iso-steps 2 --steps 1 --strain 0.01 --out " BUILD
+                     "/tests/t_fdr_dns > " BUILD "/tests/t_fdr_dns.out "
                      "2>&1") == 0);
     n = rows(BUILD "/tests/t_fdr_dns/dr.csv", r);
     CHECK_EQ_INT(n, 4);
@@ -163,11 +164,13 @@ TEST(dns_runs) {
 TEST(default_and_paper_sizes) {
     const char *cut = "--frame periodic --iso-steps 1 --steps 1 --strain 0.001 --stop-after 1 --vtk-every 0";
     char cmd[512];
-    snprintf(cmd, sizeof cmd, FDR "%s --out " BUILD "/tests/t_fdr_def > " BUILD "/tests/t_fdr_def.out 2>&1", cut);
+    snprintf(cmd, sizeof cmd, FDR "%s --out " BUILD "/tests/t_fdr_def > " BUILD "/tests/t_fdr_def.out 2>&1",
+             cut);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_fdr_def.out", " 8 Gauss points"));
     snprintf(cmd, sizeof cmd,
-             FDR "--ny 2 --paper %s --out " BUILD "/tests/t_fdr_pap > " BUILD "/tests/t_fdr_pap.out 2>&1", cut);
+             FDR "--ny 2 --paper %s --out " BUILD "/tests/t_fdr_pap > " BUILD "/tests/t_fdr_pap.out 2>&1",
+             cut);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_fdr_pap.out", " 16 Gauss points"));
     CHECK(gk_test_file_has(BUILD "/tests/t_fdr_pap.out", "stopped after step 1"));
@@ -177,32 +180,36 @@ TEST(default_and_paper_sizes) {
 TEST(bad_input_and_failed_writes) {
     CHECK(system(FDR "--nx 2x --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--nx '2x' is not a whole number"));
-    CHECK(system(FDR "--frame square --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--frame 'square' must be servo or periodic"));
-    CHECK(system(FDR "--pressure -1 --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--pressure -1 must be > 0"));
-    CHECK(system(FDR "--strain nan --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--strain 'nan' is not a finite number"));
-    CHECK(system(FDR "--material clay --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--material 'clay' must be paper or guo-zhao"));
-    CHECK(system(FDR "--material guo-zhao --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
+    CHECK(system(FDR "--frame square --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
           2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--frame 'square' must be servo or periodic"));
+    CHECK(system(FDR "--pressure -1 --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
+          2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--pressure -1 must be > 0"));
+    CHECK(system(FDR "--strain nan --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
+          2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--strain 'nan' is not a finite number"));
+    CHECK(system(FDR "--material clay --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
+          2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--material 'clay' must be paper or guo-zhao"));
+    CHECK(system(FDR "--material guo-zhao --out " BUILD "/tests/t_fdr_bad > " BUILD
+                     "/tests/t_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out",
                            "needs --frame periodic")); /* the servo's gains are per k_n */
     CHECK(system(FDR "--bogus 1 > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "unknown option --bogus"));
     CHECK(system(FDR "--test rve > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--out DIR is required"));
-    CHECK(system(FDR "--test rve --packing examples/data/rve400.txt --out " BUILD "/tests/t_fdr_bad > "
-                     BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(FDR "--test rve --packing examples/data/rve400.txt --out " BUILD "/tests/t_fdr_bad > " BUILD
+                     "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "corner"));
-    CHECK(system(FDR "--test rve --restart " BUILD "/tests/no_such_dir --out " BUILD "/tests/t_fdr_bad > "
-                     BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(FDR "--test rve --restart " BUILD "/tests/no_such_dir --out " BUILD
+                     "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "no_such_dir"));
     /* --out names a file: the directory exists as a file, nothing can be written in it */
     CHECK(system("touch " BUILD "/tests/t_fdr_file") == 0);
-    CHECK(system(FDR "--test rve --frame periodic --iso-steps 1 --steps 1 --out " BUILD "/tests/t_fdr_file > "
-                     BUILD "/tests/t_bad.out "
+    CHECK(system(FDR "--test rve --frame periodic --iso-steps 1 --steps 1 --out " BUILD
+                     "/tests/t_fdr_file > " BUILD "/tests/t_bad.out "
                      "2>&1") == 1 * 256);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "cannot write"));
     CHECK(system(FDR "--help > " BUILD "/tests/t_bad.out 2>&1") == 0);

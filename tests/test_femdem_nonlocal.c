@@ -99,21 +99,21 @@ TEST(adaptive_rule_on_eq57) {
 static void threads_and_restart(const char *args, const char *tag, const char *csv, int stop) {
     char cmd[2048], a[256], b[256];
     snprintf(cmd, sizeof cmd,
-             BUILD "/femdem_nonlocal %s --threads 2 --out " BUILD "/tests/%sA > " BUILD "/tests/%sA.out 2>&1", args,
-             tag, tag);
+             BUILD "/femdem_nonlocal %s --threads 2 --out " BUILD "/tests/%sA > " BUILD "/tests/%sA.out 2>&1",
+             args, tag, tag);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             BUILD "/femdem_nonlocal %s --threads 1 --out " BUILD "/tests/%s1 > " BUILD "/tests/%s1.out 2>&1", args,
-             tag, tag);
+             BUILD "/femdem_nonlocal %s --threads 1 --out " BUILD "/tests/%s1 > " BUILD "/tests/%s1.out 2>&1",
+             args, tag, tag);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             BUILD "/femdem_nonlocal %s --threads 2 --stop-after %d --out " BUILD "/tests/%sB > "
-             BUILD "/tests/%sB.out 2>&1",
+             BUILD "/femdem_nonlocal %s --threads 2 --stop-after %d --out " BUILD "/tests/%sB > " BUILD
+                   "/tests/%sB.out 2>&1",
              args, stop, tag, tag);
     CHECK(system(cmd) == 0);
     snprintf(cmd, sizeof cmd,
-             BUILD "/femdem_nonlocal %s --threads 2 --restart " BUILD "/tests/%sB --out " BUILD "/tests/%sB > "
-             BUILD "/tests/%sB2.out 2>&1",
+             BUILD "/femdem_nonlocal %s --threads 2 --restart " BUILD "/tests/%sB --out " BUILD
+                   "/tests/%sB > " BUILD "/tests/%sB2.out 2>&1",
              args, tag, tag, tag);
     CHECK(system(cmd) == 0);
     snprintf(a, sizeof a, BUILD "/tests/%sA/%s", tag, csv);
@@ -174,8 +174,8 @@ TEST(rve_table2_moduli) {
     FILE *fp;
     char line[1024];
     int rows = 0;
-    CHECK(system(BUILD "/femdem_nonlocal --test rve --packing " PK160
-                 " --out " BUILD "/tests/t_fnlr > " BUILD "/tests/t_fnlr.out 2>&1") == 0);
+    CHECK(system(BUILD "/femdem_nonlocal --test rve --packing " PK160 " --out " BUILD "/tests/t_fnlr > " BUILD
+                       "/tests/t_fnlr.out 2>&1") == 0);
     CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlr.out", "K_MPa"), 335.0, 33.5);
     CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlr.out", "porosity0"), 0.3496,
                1e-4); /* the packing's comment */
@@ -202,8 +202,8 @@ TEST(rve_table2_moduli) {
  * 625.6 m/s, 2.6 %), and reaches each element in order */
 TEST(wave_front_matches_elastic_column) {
     double c, ce;
-    CHECK(system(BUILD "/femdem_nonlocal --test wave --packing " PK160
-                 " --duration 1e-4 --out " BUILD "/tests/t_fnlw2 > " BUILD "/tests/t_fnlw2.out 2>&1") == 0);
+    CHECK(system(BUILD "/femdem_nonlocal --test wave --packing " PK160 " --duration 1e-4 --out " BUILD
+                       "/tests/t_fnlw2 > " BUILD "/tests/t_fnlw2.out 2>&1") == 0);
     c = gk_test_result(BUILD "/tests/t_fnlw2.out", "wave_speed_ms");
     ce = gk_test_result(BUILD "/tests/t_fnlw2.out", "wave_speed_elastic_ms");
     CHECK(fabs(c - ce) < 0.05 * ce);
@@ -220,11 +220,11 @@ TEST(biaxial_local_and_nonlocal_prepeak) {
     const char *a =
         BUILD "/femdem_nonlocal --test biaxial --packing " PK160 " --mesh 2x4x1 --steps 60 --strain 0.003";
     char cmd[512];
-    snprintf(cmd, sizeof cmd, "%s --nonlocal off --out " BUILD "/tests/t_fnlbl > " BUILD "/tests/t_fnlbl.out 2>&1",
-             a);
+    snprintf(cmd, sizeof cmd,
+             "%s --nonlocal off --out " BUILD "/tests/t_fnlbl > " BUILD "/tests/t_fnlbl.out 2>&1", a);
     CHECK(system(cmd) == 0);
-    snprintf(cmd, sizeof cmd, "%s --nonlocal 0.025 --out " BUILD "/tests/t_fnlbn > " BUILD "/tests/t_fnlbn.out 2>&1",
-             a);
+    snprintf(cmd, sizeof cmd,
+             "%s --nonlocal 0.025 --out " BUILD "/tests/t_fnlbn > " BUILD "/tests/t_fnlbn.out 2>&1", a);
     CHECK(system(cmd) == 0);
     sl = gk_test_result(BUILD "/tests/t_fnlbl.out", "peak_stress");
     sn = gk_test_result(BUILD "/tests/t_fnlbn.out", "peak_stress");
@@ -233,11 +233,12 @@ TEST(biaxial_local_and_nonlocal_prepeak) {
     CHECK(fabs(sl - sn) < 0.02 * sl && sl != sn);
     CHECK(gk_test_file_has(BUILD "/tests/t_fnlbn.out", "nonlocal on (R 0.025 m, 28 neighbour pairs)"));
     CHECK(gk_test_file_has(BUILD "/tests/t_fnlbl.out", "within 10-20 steps"));
-    snprintf(cmd, sizeof cmd, "%s --steps 2 --paper --out " BUILD "/tests/t_fnlbp > " BUILD "/tests/t_fnlbp.out 2>&1",
-             a);
+    snprintf(cmd, sizeof cmd,
+             "%s --steps 2 --paper --out " BUILD "/tests/t_fnlbp > " BUILD "/tests/t_fnlbp.out 2>&1", a);
     CHECK(system(cmd) == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_fnlbp.out", "within 10-4000 steps"));
-    CHECK(gk_test_file_has(BUILD "/tests/t_fnlbp.out", "RVE (160 spheres)")); /* --packing overrides --paper */
+    CHECK(
+        gk_test_file_has(BUILD "/tests/t_fnlbp.out", "RVE (160 spheres)")); /* --packing overrides --paper */
 }
 
 /* every flag is parsed strictly and named when refused; a restart from
@@ -261,7 +262,8 @@ TEST(bad_input_is_refused) {
     size_t k;
     for (k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
         snprintf(cmd, sizeof cmd,
-                 BUILD "/femdem_nonlocal %s%s --out " BUILD "/tests/t_fnlbad > " BUILD "/tests/t_bad.out 2>&1",
+                 BUILD "/femdem_nonlocal %s%s --out " BUILD "/tests/t_fnlbad > " BUILD
+                       "/tests/t_bad.out 2>&1",
                  bad[k][0], strstr(bad[k][0], "--packing") ? "" : " --packing " PK160);
         CHECK(system(cmd) != 0);
         if (!gk_test_file_has(BUILD "/tests/t_bad.out", bad[k][1]))
@@ -272,23 +274,26 @@ TEST(bad_input_is_refused) {
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--nonlocal"));
     /* a checkpoint of another run (other strain) is refused by name */
     CHECK(system(BUILD "/femdem_nonlocal --test element-shear --packing " PK160
-                 " --steps 40 --strain 0.005 --restart " BUILD "/tests/t_fnleB --out " BUILD "/tests/t_fnlbad > "
-                 BUILD "/tests/t_bad.out "
-                 "2>&1") != 0);
+                       " --steps 40 --strain 0.005 --restart " BUILD "/tests/t_fnleB --out " BUILD
+                       "/tests/t_fnlbad > " BUILD "/tests/t_bad.out "
+                       "2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "was written by another run"));
     /* a result that cannot be written: its path is taken by a directory */
     CHECK(system("mkdir -p " BUILD "/tests/t_fnlw/element-shear.csv") == 0);
     CHECK(system(BUILD "/femdem_nonlocal --test element-shear --packing " PK160
-                 " --steps 4 --strain 0.001 --out " BUILD "/tests/t_fnlw > " BUILD "/tests/t_bad.out 2>&1") != 0);
+                       " --steps 4 --strain 0.001 --out " BUILD "/tests/t_fnlw > " BUILD
+                       "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "element-shear.csv"));
-    CHECK(system(BUILD "/femdem_nonlocal --test rve --packing " PK160
-                 " --out /dev/null/x > " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/femdem_nonlocal --test rve --packing " PK160 " --out /dev/null/x > " BUILD
+                       "/tests/t_bad.out 2>&1") != 0);
     /* gk_pack's Hertz options */
-    CHECK(system(BUILD "/gk_pack --dim 3 --law foo --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out "
-                 "2>&1") != 0);
+    CHECK(system(BUILD "/gk_pack --dim 3 --law foo --out " BUILD "/tests/t_pack_bad.txt > " BUILD
+                       "/tests/t_bad.out "
+                       "2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--law 'foo' is neither linear nor hertz"));
-    CHECK(system(BUILD "/gk_pack --dim 3 --law hertz --out " BUILD "/tests/t_pack_bad.txt > " BUILD "/tests/t_bad.out "
-                 "2>&1") != 0);
+    CHECK(system(BUILD "/gk_pack --dim 3 --law hertz --out " BUILD "/tests/t_pack_bad.txt > " BUILD
+                       "/tests/t_bad.out "
+                       "2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--law hertz needs --G"));
 }
 

@@ -145,9 +145,10 @@ TEST(servo_frame_and_periodic_cell_under_compression) {
     CHECK(gk_rve_create(&b, &d, &fr.framed) == GK_OK && gk_rve_refresh(&b) == GK_OK);
     CHECK(gk_frame_run(&set, 0, 0, &b, H, dH, 1.0, Pb, &steps) == GK_OK);
     gk_frame_cauchy(Pb, F, sb);
-    printf("    servo frame: P11 %.0f P22 %.0f Pa, %ld DEM steps, %d corrections, r_a %.2g (relative %.2g)%s\n",
-           Pb[0], Pb[4], st[0].steps, st[0].servo, st[0].residual, st[0].residual_rel,
-           st[0].capped ? ", capped" : "");
+    printf(
+        "    servo frame: P11 %.0f P22 %.0f Pa, %ld DEM steps, %d corrections, r_a %.2g (relative %.2g)%s\n",
+        Pb[0], Pb[4], st[0].steps, st[0].servo, st[0].residual, st[0].residual_rel,
+        st[0].capped ? ", capped" : "");
     CHECK(st[0].energy_ratio <= 1e-3);
     CHECK(st[0].servo > 0);
     { /* the corrections (eqs 33-36) reduce the imbalance: 20 of them against 1 */

@@ -156,7 +156,8 @@ TEST(zones_and_distance) {
     x[1] = 0.05 + 0.04;
     CHECK_NEAR(gk_hybrid_distance(&g, NULL, flag, x), 0.05, 1e-15);
     CHECK_EQ_INT(gk_hybrid_zone(0.010, phi0, h), GK_ZONE_DISCRETE);
-    CHECK_EQ_INT(gk_hybrid_zone(0.015, phi0, h), GK_ZONE_DISCRETE); /* phi0 - th/2 belongs to the discrete zone */
+    CHECK_EQ_INT(gk_hybrid_zone(0.015, phi0, h),
+                 GK_ZONE_DISCRETE); /* phi0 - th/2 belongs to the discrete zone */
     CHECK_EQ_INT(gk_hybrid_zone(0.020, phi0, h), GK_ZONE_OVERLAP);
     CHECK_EQ_INT(gk_hybrid_zone(0.025, phi0, h), GK_ZONE_OVERLAP);
     CHECK_EQ_INT(gk_hybrid_zone(0.026, phi0, h), GK_ZONE_CONTINUUM);
@@ -398,8 +399,8 @@ TEST(coupling_equalises_and_conserves) {
         for (k = 0; k < 2; ++k) pc0[k] += g.m[I] * g.vn[k][I];
     for (p = 0; p < ng; ++p)
         for (k = 0; k < 2; ++k) pd0[k] += sc.mass[p] / t * (double)sc.rve.v[k][p];
-    CHECK(gk_hybrid_couple(&c, &g, NULL, d.basis, lp, &sc, (const double *const *)xp, coupled, NULL, t, dt, &rep,
-                           &e) == GK_OK);
+    CHECK(gk_hybrid_couple(&c, &g, NULL, d.basis, lp, &sc, (const double *const *)xp, coupled, NULL, t, dt,
+                           &rep, &e) == GK_OK);
     CHECK(rep.grains == ng && rep.nodes > 4);
     CHECK_NEAR(rep.dv_max, sqrt(0.5 * 0.5 + 0.5 * 0.5), 1e-12); /* |V - U| */
     for (I = 0; I < g.nnode; ++I) {
@@ -508,8 +509,8 @@ TEST(enrichment_conserves_mass_and_momentum) {
         vg[1][p] = 0.0;
         gz[p] = fabs(x[1] - yc) <= a ? GK_ZONE_DISCRETE : GK_ZONE_OVERLAP;
     }
-    CHECK(gk_hybrid_enrich(&P, &cont, &sc, gz, (const double *const *)vg, 0.5, 0.01, 1, extra, stride, &rep, &e) ==
-          GK_OK);
+    CHECK(gk_hybrid_enrich(&P, &cont, &sc, gz, (const double *const *)vg, 0.5, 0.01, 1, extra, stride, &rep,
+                           &e) == GK_OK);
     CHECK_REL(rep.mass_after, rep.mass_before, 1e-13);
     CHECK_NEAR(rep.mom_after[0], rep.mom_before[0], 1e-13 * fabs(rep.mom_before[0]));
     CHECK_NEAR(rep.mom_after[1], rep.mom_before[1], 1e-13 * fabs(rep.mom_before[1]));
@@ -546,7 +547,8 @@ TEST(enrichment_conserves_mass_and_momentum) {
  * periodic seam. */
 TEST(cundall_exact_for_affine_motion) {
     int n = 400, p, k, nan = 0;
-    double *X[2], *x[2], *eps, A[4] = {1.02, 0.15, -0.01, 0.97}, b[2] = {0.003, -0.001}, period[2] = {0.02, 0.0};
+    double *X[2], *x[2], *eps, A[4] = {1.02, 0.15, -0.01, 0.97}, b[2] = {0.003, -0.001},
+                               period[2] = {0.02, 0.0};
     gk_rng rng;
     gk_err e;
     gk_rng_seed(&rng, 11);
@@ -561,8 +563,8 @@ TEST(cundall_exact_for_affine_motion) {
         x[0][p] = A[0] * X[0][p] + A[1] * X[1][p] + b[0];
         x[1][p] = A[2] * X[0][p] + A[3] * X[1][p] + b[1];
     }
-    CHECK(gk_hybrid_cundall(n, (const double *const *)X, (const double *const *)x, NULL, 2.5e-3, eps, NULL, &e) ==
-          GK_OK);
+    CHECK(gk_hybrid_cundall(n, (const double *const *)X, (const double *const *)x, NULL, 2.5e-3, eps, NULL,
+                            &e) == GK_OK);
     for (p = 0; p < n; ++p) {
         if (isnan(eps[4 * p])) {
             ++nan;
@@ -572,7 +574,8 @@ TEST(cundall_exact_for_affine_motion) {
         CHECK_NEAR(eps[4 * p + 1], A[3] - 1.0, 1e-12);
         CHECK_NEAR(eps[4 * p + 2], 0.5 * (A[1] + A[2]), 1e-12);
         {
-            double m = 0.5 * (A[0] + A[3]) - 1.0, d0 = A[0] - 1.0 - m, d1 = A[3] - 1.0 - m, s = 0.5 * (A[1] + A[2]);
+            double m = 0.5 * (A[0] + A[3]) - 1.0, d0 = A[0] - 1.0 - m, d1 = A[3] - 1.0 - m,
+                   s = 0.5 * (A[1] + A[2]);
             CHECK_NEAR(eps[4 * p + 3], sqrt(2.0 * (d0 * d0 + d1 * d1 + 2.0 * s * s)), 1e-12);
         }
     }
@@ -583,15 +586,15 @@ TEST(cundall_exact_for_affine_motion) {
         x[0][p] -= period[0] * floor(x[0][p] / period[0]);
         x[1][p] = X[1][p];
     }
-    CHECK(gk_hybrid_cundall(n, (const double *const *)X, (const double *const *)x, period, 2.5e-3, eps, NULL, &e) ==
-          GK_OK);
+    CHECK(gk_hybrid_cundall(n, (const double *const *)X, (const double *const *)x, period, 2.5e-3, eps, NULL,
+                            &e) == GK_OK);
     for (p = 0; p < n; ++p) {
         if (isnan(eps[4 * p])) continue;
         CHECK_NEAR(eps[4 * p + 2], 0.15, 1e-12);
         CHECK_NEAR(eps[4 * p + 3], 0.3, 1e-12); /* simple shear: gamma */
     }
-    CHECK(gk_hybrid_cundall(n, (const double *const *)X, (const double *const *)x, NULL, -1.0, eps, NULL, &e) ==
-          GK_ERR_ARG);
+    CHECK(gk_hybrid_cundall(n, (const double *const *)X, (const double *const *)x, NULL, -1.0, eps, NULL,
+                            &e) == GK_ERR_ARG);
     for (k = 0; k < 2; ++k) {
         free(X[k]);
         free(x[k]);
@@ -665,7 +668,8 @@ TEST(training_raises_packing_stress) {
         for (p = 0; p < n; ++p)
             if (bnd[p]) gk_scene_release(&sc, p);
     }
-    CHECK(gk_hybrid_train(&sc, bnd, (const double *const *)u, QUICK(20000, 8000), QUICK(2000, 1000), &e) == GK_OK);
+    CHECK(gk_hybrid_train(&sc, bnd, (const double *const *)u, QUICK(20000, 8000), QUICK(2000, 1000), &e) ==
+          GK_OK);
     CHECK_EQ_INT(sc.nprescribed, 0);
     {
         double z[3] = {0.0, 0.0, 0.0};
@@ -674,9 +678,9 @@ TEST(training_raises_packing_stress) {
         CHECK(gk_scene_step(&sc, 1) == GK_OK);
     }
     gk_scene_stress(&sc, W * H, s1);
-    printf("    sigma_xy untrained %.3g kPa, trained %.3g kPa (sigma_yy %.3g kPa)\n", 1e-3 * s0[1], 1e-3 * s1[1],
-           1e-3 * s1[4]);
-    CHECK(s1[1] > 0.1 * P);          /* simple shear gamma > 0: sigma_xy > 0 (tension-positive) */
+    printf("    sigma_xy untrained %.3g kPa, trained %.3g kPa (sigma_yy %.3g kPa)\n", 1e-3 * s0[1],
+           1e-3 * s1[1], 1e-3 * s1[4]);
+    CHECK(s1[1] > 0.1 * P);           /* simple shear gamma > 0: sigma_xy > 0 (tension-positive) */
     CHECK(s1[1] > 5.0 * fabs(s0[1])); /* training raised the shear stress */
     /* bad input is refused */
     CHECK(gk_hybrid_train(&sc, bnd, (const double *const *)u, 0, 0, &e) == GK_ERR_ARG);
@@ -746,19 +750,21 @@ TEST(continuum_rotation_flow_and_softening) {
     {
         /* the return map of a step uses the Phi it starts with (eq 8 then updates Phi) */
         double Phi = c.Phi[0], tphi = tan(0.27) + (Phi_prev - Phi_cs) * chi, eta = sin(atan(tphi));
-        double p = 0.5 * (P.sigma[0] + P.sigma[4]), q = sqrt(0.25 * (P.sigma[0] - P.sigma[4]) * (P.sigma[0] - P.sigma[4]) + P.sigma[1] * P.sigma[1]);
+        double p = 0.5 * (P.sigma[0] + P.sigma[4]),
+               q = sqrt(0.25 * (P.sigma[0] - P.sigma[4]) * (P.sigma[0] - P.sigma[4]) +
+                        P.sigma[1] * P.sigma[1]);
         double de[3], tr, dev, spsi = sin(atan((Phi_prev - Phi_cs) * chi));
         double inv = 1.0 / Phi_cs + (1.0 / Phi0 - 1.0 / Phi_cs) * exp(-dp.xi * Phi_cs * s);
         CHECK_NEAR(q + eta * p, 0.0, 1e-6 * fabs(p)); /* on the yield surface [eq 5] */
         for (k = 0; k < 3; ++k) de[k] = c.ep[k] - ep_prev[k];
         tr = de[0] + de[1];
         dev = sqrt(0.5 * (de[0] - de[1]) * (de[0] - de[1]) + 2.0 * de[2] * de[2]);
-        CHECK(tr > 0.0); /* dilation while Phi > Phi_cs */
+        CHECK(tr > 0.0);                             /* dilation while Phi > Phi_cs */
         CHECK_REL(tr / dev, sqrt(2.0) * spsi, 1e-3); /* eq 6 flow direction */
         CHECK(Phi < Phi0 && Phi > Phi_cs);
         CHECK_REL(Phi - Phi_cs, 1.0 / inv - Phi_cs, 1e-3); /* eq 8, integrated */
-        printf("    s = %.4f, Phi %.5f (eq 8: %.5f), q/|p| = %.4f, tr/dev = %.4f (sqrt2 sin psi = %.4f)\n", s, Phi,
-               1.0 / inv, q / fabs(p), tr / dev, sqrt(2.0) * spsi);
+        printf("    s = %.4f, Phi %.5f (eq 8: %.5f), q/|p| = %.4f, tr/dev = %.4f (sqrt2 sin psi = %.4f)\n", s,
+               Phi, 1.0 / inv, q / fabs(p), tr / dev, sqrt(2.0) * spsi);
     }
     gk_hybrid_cont_free(&c);
     gk_mpm_points_destroy(&P);

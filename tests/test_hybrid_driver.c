@@ -23,8 +23,8 @@ static int read_rows(const char *path, double rows[][NCOL], int max) {
     if (!fgets(line, sizeof line, fp) || strcmp(line, HEADER) != 0) n = -1;
     while (n >= 0 && n < max && fgets(line, sizeof line, fp)) {
         double *r = rows[n];
-        if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &r[0], &r[1], &r[2], &r[3], &r[4], &r[5],
-                   &r[6], &r[7], &r[8], &r[9], &r[10]) != NCOL)
+        if (sscanf(line, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &r[0], &r[1], &r[2], &r[3], &r[4],
+                   &r[5], &r[6], &r[7], &r[8], &r[9], &r[10]) != NCOL)
             break;
         ++n;
     }
@@ -68,8 +68,8 @@ TEST(hybrid_planar_enriches_and_is_thread_independent) {
     n = read_rows(BUILD "/tests/t_hyA/hybrid.csv", r, 8);
     CHECK_EQ_INT(n, 3);
     if (n != 3) return;
-    CHECK_NEAR(r[0][3], 4e5, 1e-6); /* sigma_n [Pa], consolidated state */
-    CHECK_NEAR(r[0][2], 0.0, 1e-6); /* tau */
+    CHECK_NEAR(r[0][3], 4e5, 1e-6);                           /* sigma_n [Pa], consolidated state */
+    CHECK_NEAR(r[0][2], 0.0, 1e-6);                           /* tau */
     CHECK(r[0][6] == 0.0 && r[0][7] > 0.0 && r[0][8] == 0.0); /* no grains, points, not enriched */
     CHECK(r[2][8] == 1.0);                                    /* enriched */
     CHECK(r[2][6] > 50.0);                                    /* grains */
@@ -98,12 +98,9 @@ TEST(hybrid_planar_enriches_and_is_thread_independent) {
     CHECK(gk_test_file_has(BUILD "/tests/t_hyA/stress_strain.svg", "<svg"));
     CHECK(gk_test_file_has(BUILD "/tests/t_hyA/volume.svg", "<svg"));
     CHECK(gk_test_file_has(BUILD "/tests/t_hyA/band.svg", "<svg"));
-    CHECK(
-        system(
-            PLANAR
-            "--mode hybrid --strain 0.005 --out-every 0.0025 --window 0.001 0.005 --threads 1 "
-            "--packing " BUILD "/tests/t_hyA/packing.txt --out " BUILD "/tests/t_hy1 > " BUILD "/tests/t_hy1.out 2>&1") ==
-        0);
+    CHECK(system(PLANAR "--mode hybrid --strain 0.005 --out-every 0.0025 --window 0.001 0.005 --threads 1 "
+                        "--packing " BUILD "/tests/t_hyA/packing.txt --out " BUILD "/tests/t_hy1 > " BUILD
+                        "/tests/t_hy1.out 2>&1") == 0);
     CHECK(same_but_seconds(BUILD "/tests/t_hyA/hybrid.csv", BUILD "/tests/t_hy1/hybrid.csv"));
 }
 
@@ -150,8 +147,8 @@ static int refused(const char *flags, const char *msg) {
     FILE *fp;
     int ok;
     system("rm -rf " BUILD "/tests/t_hybad");
-    snprintf(cmd, sizeof cmd, BUILD "/hybrid %s --out " BUILD "/tests/t_hybad > " BUILD "/tests/t_bad.out 2>&1",
-             flags);
+    snprintf(cmd, sizeof cmd,
+             BUILD "/hybrid %s --out " BUILD "/tests/t_hybad > " BUILD "/tests/t_bad.out 2>&1", flags);
     ok = system(cmd) != 0 && gk_test_file_has(BUILD "/tests/t_bad.out", msg);
     fp = fopen(BUILD "/tests/t_hybad", "r");
     if (fp) fclose(fp), ok = 0;
@@ -175,14 +172,15 @@ TEST(hybrid_refuses_bad_arguments) {
     CHECK(refused("--test planar --mode dem --window 0.1 0.2 --ppd 5", "--ppd 5 is out of range"));
     CHECK(refused("--test planar --mode dem --window 0.1", "--window needs two strains"));
     /* an unreadable packing: an error, not a crash (the directory may exist) */
-    CHECK(system(BUILD "/hybrid --test planar --mode dem --packing " BUILD "/tests/no_such_packing.txt --out "
-                 BUILD "/tests/t_hybad "
-                 "> " BUILD "/tests/t_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/hybrid --test planar --mode dem --packing " BUILD
+                       "/tests/no_such_packing.txt --out " BUILD "/tests/t_hybad "
+                       "> " BUILD "/tests/t_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "no_such_packing"));
     /* --out naming an existing file */
     CHECK(system("rm -rf " BUILD "/tests/t_hyfile && touch " BUILD "/tests/t_hyfile") == 0);
-    CHECK(system(BUILD "/hybrid --test planar --mode dem --out " BUILD "/tests/t_hyfile > " BUILD "/tests/t_bad.out "
-                 "2>&1") != 0);
+    CHECK(system(BUILD "/hybrid --test planar --mode dem --out " BUILD "/tests/t_hyfile > " BUILD
+                       "/tests/t_bad.out "
+                       "2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "t_hyfile"));
     remove(BUILD "/tests/t_hyfile");
     /* --help alone (no --test) prints the usage and exits 0 */

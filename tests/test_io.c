@@ -61,8 +61,8 @@ TEST(legend_never_covers_data) {
     int i, k;
     for (i = 0; i < 200; ++i) {
         x[i] = i / 199.0;
-        up[i] = x[i];                                     /* fills the diagonal */
-        cap[i] = 1.0 - 4.0 * (x[i] - 0.5) * (x[i] - 0.5); /* top middle, low ends */
+        up[i] = x[i];                                                        /* fills the diagonal */
+        cap[i] = 1.0 - 4.0 * (x[i] - 0.5) * (x[i] - 0.5);                    /* top middle, low ends */
         for (k = 0; k < 8; ++k) wave[k][i] = sin(6.0 * x[i] + k) + 0.25 * k; /* everywhere */
     }
     /* rising curve: the top-right corner holds data, the top left does not */
@@ -122,10 +122,9 @@ TEST(equal_aspect_draws_a_round_circle) {
 
 TEST(field_plot_axes_outline_colorbar_and_fixed_range) {
     /* four unit squares of a 2 x 2 mesh of a 50 x 50 mm block */
-    static const double xy[4 * 8] = {0,     0,     0.025, 0,     0.025, 0.025, 0,     0.025,
-                                     0.025, 0,     0.05,  0,     0.05,  0.025, 0.025, 0.025,
-                                     0,     0.025, 0.025, 0.025, 0.025, 0.05,  0,     0.05,
-                                     0.025, 0.025, 0.05,  0.025, 0.05,  0.05,  0.025, 0.05};
+    static const double xy[4 * 8] = {0, 0,    0.025, 0,     0.025, 0.025, 0,     0.025, 0.025, 0,     0.05,
+                                     0, 0.05, 0.025, 0.025, 0.025, 0,     0.025, 0.025, 0.025, 0.025, 0.05,
+                                     0, 0.05, 0.025, 0.025, 0.05,  0.025, 0.05,  0.05,  0.025, 0.05};
     double val[4] = {0.0, 10.0, 20.0, NAN}; /* below, at the top of, beyond the range; none */
     static const int len[1] = {2};
     static const double platen[4] = {-0.005, 0.05, 0.055, 0.05};

@@ -63,7 +63,8 @@ TEST(biaxial_runs_and_loads) {
 /* RVEs run in parallel: one thread gives the same curve to the last digit */
 TEST(biaxial_thread_independent) {
     CHECK(system(BX "--threads 1 --out " BUILD "/tests/t_mpmbx1 > " BUILD "/tests/t_mpmbx1.out 2>&1") == 0);
-    CHECK(system("cmp -s " BUILD "/tests/t_mpmbx1/points_000000.vtk " BUILD "/tests/t_mpmbx/points_000000.vtk") == 0);
+    CHECK(system("cmp -s " BUILD "/tests/t_mpmbx1/points_000000.vtk " BUILD
+                 "/tests/t_mpmbx/points_000000.vtk") == 0);
     CHECK(gk_test_result(BUILD "/tests/t_mpmbx1.out", "peak_sigma_yy") ==
           gk_test_result(BUILD "/tests/t_mpmbx.out", "peak_sigma_yy"));
     CHECK(system("cut -d, -f1-7 " BUILD "/tests/t_mpmbx1/biaxial.csv > " BUILD "/tests/t_mpmbx1.c && "
@@ -74,11 +75,11 @@ TEST(biaxial_thread_independent) {
 /* a checkpoint half-way, then --restart: the same final state (every point
  * array and RVE state is in the checkpoint) */
 TEST(biaxial_restart_identical) {
-    int rc = system(
-        BUILD "/mpmdem_biaxial --nx 2 --ny 4 --strain 0.001 --every 0.0005 --quiet --out "
-        BUILD "/tests/t_mpmbx_a "
-        "> " BUILD "/tests/t_mpmbx_a.out 2>&1 && " BX
-        "--restart " BUILD "/tests/t_mpmbx_a --out " BUILD "/tests/t_mpmbx_b > " BUILD "/tests/t_mpmbx_b.out 2>&1");
+    int rc =
+        system(BUILD "/mpmdem_biaxial --nx 2 --ny 4 --strain 0.001 --every 0.0005 --quiet --out " BUILD
+                     "/tests/t_mpmbx_a "
+                     "> " BUILD "/tests/t_mpmbx_a.out 2>&1 && " BX "--restart " BUILD
+                     "/tests/t_mpmbx_a --out " BUILD "/tests/t_mpmbx_b > " BUILD "/tests/t_mpmbx_b.out 2>&1");
     CHECK(rc == 0);
     CHECK(gk_test_result(BUILD "/tests/t_mpmbx_b.out", "peak_sigma_yy") ==
           gk_test_result(BUILD "/tests/t_mpmbx.out", "peak_sigma_yy"));
@@ -96,11 +97,12 @@ TEST(biaxial_bad_arguments) {
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "--alpha"));
     /* bad input changes nothing: no output folder is made before the inputs are read */
     CHECK(system("rm -rf " BUILD "/tests/t_mpmbx_bad") == 0);
-    CHECK(system(BUILD "/mpmdem_biaxial --out " BUILD "/tests/t_mpmbx_bad --packing /nonexistent > "
-                 BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/mpmdem_biaxial --out " BUILD "/tests/t_mpmbx_bad --packing /nonexistent > " BUILD
+                       "/tests/t_mpmbx_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "nonexistent"));
-    CHECK(system(BUILD "/mpmdem_biaxial --out " BUILD "/tests/t_mpmbx_bad --restart /nonexistent --nx 2 --ny 4 > "
-                 BUILD "/tests/t_mpmbx_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/mpmdem_biaxial --out " BUILD
+                       "/tests/t_mpmbx_bad --restart /nonexistent --nx 2 --ny 4 > " BUILD
+                       "/tests/t_mpmbx_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_bad.out", "cannot open"));
     CHECK(system("test -e " BUILD "/tests/t_mpmbx_bad") != 0);
     CHECK(system(BUILD "/mpmdem_biaxial --help > " BUILD "/tests/t_mpmbx_bad.out 2>&1") == 0);
@@ -126,9 +128,9 @@ TEST(biaxial_bad_arguments) {
                     "> " BUILD "/tests/t_mpmbx_rule.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_rule.out",
                            "DEM steps per MPM step: <= 2e-05 strain per DEM step"));
-    CHECK(system(BX
-                 "--strain 0.0005 --dem-inertial 1e-3 --dem-unbalanced 1e-2 --out " BUILD "/tests/t_mpmbx_rule "
-                 "> " BUILD "/tests/t_mpmbx_rule.out 2>&1") == 0);
+    CHECK(system(BX "--strain 0.0005 --dem-inertial 1e-3 --dem-unbalanced 1e-2 --out " BUILD
+                    "/tests/t_mpmbx_rule "
+                    "> " BUILD "/tests/t_mpmbx_rule.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_rule.out",
                            "adaptive, I <= 0.001 then relaxation to an unbalanced force "
                            "ratio < 0.01"));
@@ -165,29 +167,29 @@ TEST(biaxial_bad_checkpoint_refused) {
     CHECK(fp != NULL);
     if (!fp) return;
     fseek(fp, 0, SEEK_END), size = ftell(fp), fclose(fp);
-    CHECK(system(
-              "rm -rf " BUILD "/tests/t_mpmbx_ck " BUILD "/tests/t_mpmbx_ckout && mkdir -p " BUILD "/tests/t_mpmbx_ck") ==
-          0);
+    CHECK(system("rm -rf " BUILD "/tests/t_mpmbx_ck " BUILD "/tests/t_mpmbx_ckout && mkdir -p " BUILD
+                 "/tests/t_mpmbx_ck") == 0);
     CHECK(copy_damaged(BUILD "/tests/t_mpmbx_a/checkpoint.bin", BUILD "/tests/t_mpmbx_ck/checkpoint.bin", -1,
                        size / 2));
-    CHECK(system(BX "--restart " BUILD "/tests/t_mpmbx_ck --out " BUILD "/tests/t_mpmbx_ckout > "
-                    BUILD "/tests/t_mpmbx_ck.out 2>&1; "
+    CHECK(system(BX "--restart " BUILD "/tests/t_mpmbx_ck --out " BUILD "/tests/t_mpmbx_ckout > " BUILD
+                    "/tests/t_mpmbx_ck.out 2>&1; "
                     "test $? -eq 1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_ck.out",
                            "checkpoint.bin: checksum mismatch (the file is corrupt)"));
     CHECK(!gk_test_file_has(BUILD "/tests/t_mpmbx_ckout/biaxial.csv", "time")); /* nothing ran */
     CHECK(copy_damaged(BUILD "/tests/t_mpmbx_a/checkpoint.bin", BUILD "/tests/t_mpmbx_ck/checkpoint.bin",
                        size - 100, -1));
-    CHECK(system(BX "--restart " BUILD "/tests/t_mpmbx_ck --out " BUILD "/tests/t_mpmbx_ckout > "
-                    BUILD "/tests/t_mpmbx_ck.out 2>&1; "
+    CHECK(system(BX "--restart " BUILD "/tests/t_mpmbx_ck --out " BUILD "/tests/t_mpmbx_ckout > " BUILD
+                    "/tests/t_mpmbx_ck.out 2>&1; "
                     "test $? -eq 1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_ck.out", "truncated"));
     CHECK(system(BUILD "/mpmdem_biaxial --nx 2 --ny 2 --height 1 --quiet --restart " BUILD "/tests/t_mpmbx_a "
-                 "--out " BUILD "/tests/t_mpmbx_ckout > " BUILD "/tests/t_mpmbx_ck.out 2>&1; test $? -eq 1") == 0);
+                       "--out " BUILD "/tests/t_mpmbx_ckout > " BUILD
+                       "/tests/t_mpmbx_ck.out 2>&1; test $? -eq 1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_ck.out", "holds 8 points"));
     CHECK(system("printf 'GKMPMDEM1biaxial' > " BUILD "/tests/t_mpmbx_ck/checkpoint.bin && " BX
-                 "--restart " BUILD "/tests/t_mpmbx_ck --out " BUILD "/tests/t_mpmbx_ckout > "
-                 BUILD "/tests/t_mpmbx_ck.out 2>&1; test $? "
+                 "--restart " BUILD "/tests/t_mpmbx_ck --out " BUILD "/tests/t_mpmbx_ckout > " BUILD
+                 "/tests/t_mpmbx_ck.out 2>&1; test $? "
                  "-eq 1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_ck.out", "is not a grainkit two-scale checkpoint"));
 }
@@ -207,8 +209,8 @@ TEST(biaxial_failed_write_exits) {
     int k;
     for (k = 0; k < (int)(sizeof cases / sizeof *cases); ++k) {
         snprintf(cmd, sizeof cmd,
-                 "rm -rf " BUILD "/tests/t_mpmbx_w && %s && " BX
-                 "--strain 0.0005 --out " BUILD "/tests/t_mpmbx_w > " BUILD "/tests/t_mpmbx_w.out "
+                 "rm -rf " BUILD "/tests/t_mpmbx_w && %s && " BX "--strain 0.0005 --out " BUILD
+                 "/tests/t_mpmbx_w > " BUILD "/tests/t_mpmbx_w.out "
                  "2>&1; test $? -eq 1",
                  cases[k][0]);
         CHECK(system(cmd) == 0);
@@ -225,21 +227,23 @@ TEST(biaxial_failed_write_exits) {
  * build/tests/t_mpmbx_cwd, so that the test writes only under build/tests) */
 TEST(biaxial_out_folder) {
     CHECK(system("rm -rf " BUILD "/tests/t_mpmbx_f && echo x > " BUILD "/tests/t_mpmbx_file && " BX
-                 "--out " BUILD "/tests/t_mpmbx_file > " BUILD "/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
-    CHECK(
-        gk_test_file_has(BUILD "/tests/t_mpmbx_f.out",
-                         "--out " BUILD "/tests/t_mpmbx_file: " BUILD "/tests/t_mpmbx_file is a file, not a folder"));
+                 "--out " BUILD "/tests/t_mpmbx_file > " BUILD
+                 "/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_f.out", "--out " BUILD "/tests/t_mpmbx_file: " BUILD
+                                                         "/tests/t_mpmbx_file is a file, not a folder"));
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_file", "x")); /* untouched */
-    CHECK(system(BX "--out " BUILD "/tests/t_mpmbx_file/sub > " BUILD "/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") ==
-          0);
+    CHECK(system(BX "--out " BUILD "/tests/t_mpmbx_file/sub > " BUILD
+                    "/tests/t_mpmbx_f.out 2>&1; test $? -eq 1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_f.out", "is a file, not a folder"));
     CHECK(system(
-              "rm -rf " BUILD "/tests/t_mpmbx_cwd && mkdir " BUILD "/tests/t_mpmbx_cwd && cd " BUILD "/tests/t_mpmbx_cwd "
+              "rm -rf " BUILD "/tests/t_mpmbx_cwd && mkdir " BUILD "/tests/t_mpmbx_cwd && cd " BUILD
+              "/tests/t_mpmbx_cwd "
               "&& "
               "../../mpmdem_biaxial --packing ../../../examples/data/rve400.txt --nx 2 --ny 4 --every 0.0005 "
               "--quiet --strain 0.0005 > ../t_mpmbx_f.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_cwd/" BUILD "/mpm_biaxial/biaxial.csv", "time,eps_axial"));
-    CHECK(system(BX "--strain 0.0005 --out " BUILD "/tests/t_mpmbx_f/a/b > " BUILD "/tests/t_mpmbx_f.out 2>&1") == 0);
+    CHECK(system(BX "--strain 0.0005 --out " BUILD "/tests/t_mpmbx_f/a/b > " BUILD
+                    "/tests/t_mpmbx_f.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx_f/a/b/biaxial.csv", "time,eps_axial"));
 }
 
@@ -267,8 +271,8 @@ TEST(single_element_follows_the_rve_alone) {
     int n = 0, k;
     FILE *fp;
     char line[1024];
-    CHECK(system(BUILD "/gk_pack --dim 2 --n 60 --pressure 1e5 --out " BUILD "/tests/t_sg_pack.txt > "
-                 BUILD "/tests/t_sg_pack.out 2>&1") == 0);
+    CHECK(system(BUILD "/gk_pack --dim 2 --n 60 --pressure 1e5 --out " BUILD "/tests/t_sg_pack.txt > " BUILD
+                       "/tests/t_sg_pack.out 2>&1") == 0);
     CHECK(system(SG "--threads 2 --out " BUILD "/tests/t_sg > " BUILD "/tests/t_sg.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_sg/single.csv",
                            "time,plate_displacement,eps_axial,sigma_yy,sigma_yy_points,point_spread,eps_v,"
@@ -309,12 +313,11 @@ TEST(single_element_follows_the_rve_alone) {
                  "cut -d, -f1-12 " BUILD "/tests/t_sg1/single.csv > " BUILD "/tests/t_sg1.c && "
                  "cmp -s " BUILD "/tests/t_sg.c " BUILD "/tests/t_sg1.c") == 0);
     /* bad input: refused with a message, no output folder */
-    CHECK(
-        system("rm -rf " BUILD "/tests/t_sg_bad && " BUILD "/mpmdem_single --margin -1 --out " BUILD "/tests/t_sg_bad > "
-               BUILD "/tests/t_sg_bad.out 2>&1") == 2 * 256);
+    CHECK(system("rm -rf " BUILD "/tests/t_sg_bad && " BUILD "/mpmdem_single --margin -1 --out " BUILD
+                 "/tests/t_sg_bad > " BUILD "/tests/t_sg_bad.out 2>&1") == 2 * 256);
     CHECK(gk_test_file_has(BUILD "/tests/t_sg_bad.out", "--margin -1 is out of range"));
-    CHECK(system(BUILD "/mpmdem_single --packing /nonexistent --out " BUILD "/tests/t_sg_bad > "
-                 BUILD "/tests/t_sg_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/mpmdem_single --packing /nonexistent --out " BUILD "/tests/t_sg_bad > " BUILD
+                       "/tests/t_sg_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_sg_bad.out", "nonexistent"));
     CHECK(system("test -e " BUILD "/tests/t_sg_bad") != 0);
 }

@@ -56,8 +56,8 @@ static int read_rows(const char *path, double rows[][NCOL], int max) {
 TEST(collapse_runs_and_conserves) {
     double r[32][NCOL];
     int n, k;
-    CHECK(system(CL "--t-end " CL_T_END
-                    " --threads 2 --out " BUILD "/tests/t_mpmcl > " BUILD "/tests/t_mpmcl.out 2>&1") == 0);
+    CHECK(system(CL "--t-end " CL_T_END " --threads 2 --out " BUILD "/tests/t_mpmcl > " BUILD
+                    "/tests/t_mpmcl.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl/collapse.csv",
                            "time,front,dstar,front_box,front_raw,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0,"
                            "mass,mass_grid,loose_rves,frozen_rves,dem_steps_per_point,seconds"));
@@ -108,7 +108,8 @@ TEST(collapse_runs_and_conserves) {
 TEST(collapse_thread_independent) {
     CHECK(system(CL "--t-end " CL_T_END " --threads 1 --thin-cell stop --out " BUILD "/tests/t_mpmcl1 "
                     "> " BUILD "/tests/t_mpmcl1.out 2>&1") == 0);
-    CHECK(system("cmp -s " BUILD "/tests/t_mpmcl1/points_000000.vtk " BUILD "/tests/t_mpmcl/points_000000.vtk") == 0);
+    CHECK(system("cmp -s " BUILD "/tests/t_mpmcl1/points_000000.vtk " BUILD
+                 "/tests/t_mpmcl/points_000000.vtk") == 0);
     CHECK(gk_test_result(BUILD "/tests/t_mpmcl1.out", "dstar") ==
           gk_test_result(BUILD "/tests/t_mpmcl.out", "dstar"));
     CHECK(system("cut -d, -f1-14 " BUILD "/tests/t_mpmcl1/collapse.csv > " BUILD "/tests/t_mpmcl1.c && "
@@ -119,10 +120,10 @@ TEST(collapse_thread_independent) {
 /* half-way, then --restart: the same history and final state (every point
  * array, RVE state and row is in the checkpoint) */
 TEST(collapse_restart_identical) {
-    int rc =
-        system(CL "--t-end " CL_T_HALF " --out " BUILD "/tests/t_mpmcl_a > " BUILD "/tests/t_mpmcl_a.out 2>&1 && " CL
-                  "--t-end " CL_T_END " --restart " BUILD "/tests/t_mpmcl_a --out " BUILD "/tests/t_mpmcl_b "
-                  "> " BUILD "/tests/t_mpmcl_b.out 2>&1");
+    int rc = system(CL "--t-end " CL_T_HALF " --out " BUILD "/tests/t_mpmcl_a > " BUILD
+                       "/tests/t_mpmcl_a.out 2>&1 && " CL "--t-end " CL_T_END " --restart " BUILD
+                       "/tests/t_mpmcl_a --out " BUILD "/tests/t_mpmcl_b "
+                       "> " BUILD "/tests/t_mpmcl_b.out 2>&1");
     CHECK(rc == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_b.out", "restarted from"));
     CHECK(gk_test_result(BUILD "/tests/t_mpmcl_b.out", "dstar") ==
@@ -155,11 +156,12 @@ TEST(collapse_bad_arguments) {
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "needs a value"));
     /* bad input changes nothing: no output folder is made before the inputs are read */
     CHECK(system("rm -rf " BUILD "/tests/t_mpmcl_bad") == 0);
-    CHECK(system(BUILD "/mpmdem_collapse --out " BUILD "/tests/t_mpmcl_bad --packing /nonexistent > "
-                 BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/mpmdem_collapse --out " BUILD "/tests/t_mpmcl_bad --packing /nonexistent > " BUILD
+                       "/tests/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "nonexistent"));
-    CHECK(system(BUILD "/mpmdem_collapse --out " BUILD "/tests/t_mpmcl_bad --nx 4 --restart /nonexistent > "
-                 BUILD "/tests/t_mpmcl_bad.out 2>&1") != 0);
+    CHECK(system(BUILD "/mpmdem_collapse --out " BUILD
+                       "/tests/t_mpmcl_bad --nx 4 --restart /nonexistent > " BUILD
+                       "/tests/t_mpmcl_bad.out 2>&1") != 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "cannot open"));
     CHECK(system("test -e " BUILD "/tests/t_mpmcl_bad") != 0);
     CHECK(system(BUILD "/mpmdem_collapse --help > " BUILD "/tests/t_mpmcl_bad.out 2>&1") == 0);
@@ -171,24 +173,22 @@ TEST(collapse_bad_arguments) {
 /* a corrupted checkpoint is refused by name (status 1); a result that cannot be written (the CSV's
  * path taken by a folder) ends the run with status 1, said once; --out onto a file is refused */
 TEST(collapse_bad_files) {
-    CHECK(
-        system(
-            "rm -rf " BUILD "/tests/t_mpmcl_k && mkdir -p " BUILD "/tests/t_mpmcl_k && "
-            "cp " BUILD "/tests/t_mpmcl_a/checkpoint.bin " BUILD "/tests/t_mpmcl_k/ && "
-            "printf 'X' | dd of=" BUILD "/tests/t_mpmcl_k/checkpoint.bin bs=1 seek=5000 conv=notrunc 2>/dev/null "
-            "&& " CL "--t-end " CL_T_END
-            " --restart " BUILD "/tests/t_mpmcl_k --out " BUILD "/tests/t_mpmcl_k2 > " BUILD "/tests/t_mpmcl_k.out 2>&1; "
-            "test $? -eq 1") == 0);
+    CHECK(system("rm -rf " BUILD "/tests/t_mpmcl_k && mkdir -p " BUILD "/tests/t_mpmcl_k && "
+                 "cp " BUILD "/tests/t_mpmcl_a/checkpoint.bin " BUILD "/tests/t_mpmcl_k/ && "
+                 "printf 'X' | dd of=" BUILD
+                 "/tests/t_mpmcl_k/checkpoint.bin bs=1 seek=5000 conv=notrunc 2>/dev/null "
+                 "&& " CL "--t-end " CL_T_END " --restart " BUILD "/tests/t_mpmcl_k --out " BUILD
+                 "/tests/t_mpmcl_k2 > " BUILD "/tests/t_mpmcl_k.out 2>&1; "
+                 "test $? -eq 1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_k.out", "checksum mismatch"));
-    CHECK(
-        system("rm -rf " BUILD "/tests/t_mpmcl_w && mkdir -p " BUILD "/tests/t_mpmcl_w/collapse.csv && " CL
-               "--t-end 0.03 --out " BUILD "/tests/t_mpmcl_w > " BUILD "/tests/t_mpmcl_w.out 2>&1; test $? -eq 1") ==
-        0);
+    CHECK(system("rm -rf " BUILD "/tests/t_mpmcl_w && mkdir -p " BUILD "/tests/t_mpmcl_w/collapse.csv && " CL
+                 "--t-end 0.03 --out " BUILD "/tests/t_mpmcl_w > " BUILD
+                 "/tests/t_mpmcl_w.out 2>&1; test $? -eq 1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_w.out",
                            "mpmdem_collapse: cannot write " BUILD "/tests/t_mpmcl_w/collapse.csv"));
     CHECK(system("grep -c 'cannot write' " BUILD "/tests/t_mpmcl_w.out | grep -qx 1") == 0);
-    CHECK(system("echo x > " BUILD "/tests/t_mpmcl_file && " CL
-                 "--out " BUILD "/tests/t_mpmcl_file > " BUILD "/tests/t_mpmcl_f.out 2>&1; "
+    CHECK(system("echo x > " BUILD "/tests/t_mpmcl_file && " CL "--out " BUILD "/tests/t_mpmcl_file > " BUILD
+                 "/tests/t_mpmcl_f.out 2>&1; "
                  "test $? -eq 1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_f.out", "is a file, not a folder"));
 }

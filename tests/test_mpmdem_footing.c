@@ -12,9 +12,9 @@
 
 #include "../examples/footing_mech.h"
 
-#define FT                                                                                                  \
+#define FT                                                                                                   \
     BUILD "/mpmdem_footing --width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 --every " \
-    "0.005 --smooth 0.01 --quiet "
+          "0.005 --smooth 0.01 --quiet "
 
 #define NCOL 9
 static int read_rows(const char *path, double rows[][NCOL], int max) {
@@ -42,9 +42,9 @@ static int read_rows(const char *path, double rows[][NCOL], int max) {
 TEST(footing_runs_and_loads) {
     double r[16][NCOL], phi, nq, nqa, pi = 3.14159265358979323846, t;
     int n, k;
-    CHECK(system(FT
-                 "--final 0.02 --phi-pressures 20 --phi-strain 0.025 --threads 1 --out " BUILD "/tests/t_mpmft "
-                 "> " BUILD "/tests/t_mpmft.out 2>&1") == 0);
+    CHECK(system(FT "--final 0.02 --phi-pressures 20 --phi-strain 0.025 --threads 1 --out " BUILD
+                    "/tests/t_mpmft "
+                    "> " BUILD "/tests/t_mpmft.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmft/footing.csv",
                            "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds,"
                            "wedge_deg,heave_x_over_B,heave_over_B"));
@@ -89,8 +89,10 @@ TEST(footing_runs_and_loads) {
  * exit before the footing (no footing.csv) */
 TEST(footing_phi_only) {
     double phi, e0;
-    CHECK(system("rm -rf " BUILD "/tests/t_mpmft_phi && " BUILD "/mpmdem_footing --phi-only --phi-pressures 20 "
-                 "--phi-strain 0.025 --threads 1 --out " BUILD "/tests/t_mpmft_phi > " BUILD "/tests/t_mpmft_phi.out "
+    CHECK(system("rm -rf " BUILD "/tests/t_mpmft_phi && " BUILD
+                 "/mpmdem_footing --phi-only --phi-pressures 20 "
+                 "--phi-strain 0.025 --threads 1 --out " BUILD "/tests/t_mpmft_phi > " BUILD
+                 "/tests/t_mpmft_phi.out "
                  "2>&1") == 0);
     phi = gk_test_result(BUILD "/tests/t_mpmft_phi.out", "phi_deg");
     CHECK(phi == gk_test_result(BUILD "/tests/t_mpmft.out", "phi_deg"));
@@ -164,11 +166,11 @@ TEST(footing_ultimate_found) {
 /* RVEs and the MPM run in parallel: one and two threads give the same curve */
 TEST(footing_thread_independent) {
     /* passive waiting: spinning OpenMP threads crawl on a machine busy with other jobs */
-    CHECK(system("OMP_WAIT_POLICY=passive " FT
-                 "--final 0.02 --phi-deg 30 --threads 2 --out " BUILD "/tests/t_mpmft2 "
+    CHECK(system("OMP_WAIT_POLICY=passive " FT "--final 0.02 --phi-deg 30 --threads 2 --out " BUILD
+                 "/tests/t_mpmft2 "
                  "> " BUILD "/tests/t_mpmft2.out 2>&1") == 0);
-    CHECK(system(FT "--final 0.02 --phi-deg 30 --threads 1 --out " BUILD "/tests/t_mpmft1 > "
-                    BUILD "/tests/t_mpmft1.out 2>&1") == 0);
+    CHECK(system(FT "--final 0.02 --phi-deg 30 --threads 1 --out " BUILD "/tests/t_mpmft1 > " BUILD
+                    "/tests/t_mpmft1.out 2>&1") == 0);
     CHECK(gk_test_result(BUILD "/tests/t_mpmft1.out", "Nq") ==
           gk_test_result(BUILD "/tests/t_mpmft2.out", "Nq"));
     CHECK(system("cut -d, -f1-8,10- " BUILD "/tests/t_mpmft1/footing.csv > " BUILD "/tests/t_mpmft1.c && "
@@ -178,12 +180,11 @@ TEST(footing_thread_independent) {
 
 /* a checkpoint half-way, then --restart: the same curve to the last digit */
 TEST(footing_restart_identical) {
-    int rc = system(
-        FT
-        "--final 0.01 --phi-deg 30 --threads 1 --out " BUILD "/tests/t_mpmft_a > " BUILD "/tests/t_mpmft_a.out 2>&1 "
-        "&& " FT
-        "--final 0.02 --phi-deg 30 --threads 1 --restart " BUILD "/tests/t_mpmft_a --out " BUILD "/tests/t_mpmft_b "
-        "> " BUILD "/tests/t_mpmft_b.out 2>&1");
+    int rc = system(FT "--final 0.01 --phi-deg 30 --threads 1 --out " BUILD "/tests/t_mpmft_a > " BUILD
+                       "/tests/t_mpmft_a.out 2>&1 "
+                       "&& " FT "--final 0.02 --phi-deg 30 --threads 1 --restart " BUILD
+                       "/tests/t_mpmft_a --out " BUILD "/tests/t_mpmft_b "
+                       "> " BUILD "/tests/t_mpmft_b.out 2>&1");
     CHECK(rc == 0);
     CHECK(gk_test_result(BUILD "/tests/t_mpmft_b.out", "Nq") ==
           gk_test_result(BUILD "/tests/t_mpmft1.out", "Nq"));
@@ -195,9 +196,9 @@ TEST(footing_restart_identical) {
 TEST(footing_bad_arguments) {
     const char *o = " > " BUILD "/tests/t_mpmft_bad.out 2>&1";
     char cmd[512];
-#define BAD(args, msg)                                                                             \
+#define BAD(args, msg)                                                                                  \
     snprintf(cmd, sizeof cmd, BUILD "/mpmdem_footing --out " BUILD "/tests/t_mpmft_bad %s%s", args, o); \
-    CHECK(system(cmd) != 0);                                                                       \
+    CHECK(system(cmd) != 0);                                                                            \
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmft_bad.out", msg))
     BAD("--nx 0", "out of range");
     BAD("--nx 31 --ny 15", "square");

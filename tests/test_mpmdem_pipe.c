@@ -11,9 +11,9 @@
 #include "gk_test.h"
 #include <stdlib.h>
 
-#define PT                                                                                                  \
+#define PT                                                                                                   \
     BUILD "/mpmdem_pipe --width 3 --nx 12 --ny 5 --penetration 0.1 --lateral 0.05 --v-down 1 --v-lateral 1 " \
-    "--ramp 0.02 --every 0.02 --quiet "
+          "--ramp 0.02 --every 0.02 --quiet "
 
 #define NCOL 10
 static int read_rows(const char *path, double rows[][NCOL], int max) {
@@ -89,11 +89,11 @@ TEST(pipe_runs_both_stages) {
  * rows of the uninterrupted 1-thread run to the last digit (restart and
  * thread count change nothing) */
 TEST(pipe_restart_and_threads_identical) {
-    int rc =
-        system("rm -rf " BUILD "/tests/t_pipe_a " BUILD "/tests/t_pipe_b && OMP_WAIT_POLICY=passive " PT
-               "--threads 2 --max-steps 100 --out " BUILD "/tests/t_pipe_a > " BUILD "/tests/t_pipe_a.out 2>&1 && "
-               "OMP_WAIT_POLICY=passive " PT "--threads 2 --restart " BUILD "/tests/t_pipe_a "
-               "--out " BUILD "/tests/t_pipe_b > " BUILD "/tests/t_pipe_b.out 2>&1");
+    int rc = system("rm -rf " BUILD "/tests/t_pipe_a " BUILD "/tests/t_pipe_b && OMP_WAIT_POLICY=passive " PT
+                    "--threads 2 --max-steps 100 --out " BUILD "/tests/t_pipe_a > " BUILD
+                    "/tests/t_pipe_a.out 2>&1 && "
+                    "OMP_WAIT_POLICY=passive " PT "--threads 2 --restart " BUILD "/tests/t_pipe_a "
+                    "--out " BUILD "/tests/t_pipe_b > " BUILD "/tests/t_pipe_b.out 2>&1");
     CHECK(rc == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_pipe_a.out", "stopped before the end of the path"));
     CHECK(gk_test_result(BUILD "/tests/t_pipe_b.out", "V_peak_kN") ==
@@ -108,9 +108,9 @@ TEST(pipe_bad_arguments) {
     const char *o = " > " BUILD "/tests/t_pipe_bad.out 2>&1";
     char cmd[512];
     CHECK(system("rm -rf " BUILD "/tests/t_pipe_bad") == 0);
-#define BAD(args, msg)                                                                         \
+#define BAD(args, msg)                                                                              \
     snprintf(cmd, sizeof cmd, BUILD "/mpmdem_pipe --out " BUILD "/tests/t_pipe_bad %s%s", args, o); \
-    CHECK(system(cmd) != 0);                                                                   \
+    CHECK(system(cmd) != 0);                                                                        \
     CHECK(gk_test_file_has(BUILD "/tests/t_pipe_bad.out", msg))
     BAD("--nx 0", "out of range");
     BAD("--diameter 0.3", "less than 2 cells");

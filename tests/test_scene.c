@@ -1654,7 +1654,7 @@ TEST(dem_biaxial_smoke) {
     double ratio, n;
     int rc;
     rc = system(BUILD "/dem_biaxial --tiles 1x1 --strain 0.01 --every 0.002 --pictures 0.004 --quiet "
-                "--out " BUILD "/tests/t_dembx > " BUILD "/tests/t_dembx.out 2>&1");
+                      "--out " BUILD "/tests/t_dembx > " BUILD "/tests/t_dembx.out 2>&1");
     CHECK(rc == 0);
     CHECK(gk_test_file_has(
         BUILD "/tests/t_dembx/biaxial.csv",
@@ -1679,14 +1679,15 @@ TEST(dem_biaxial_smoke) {
     }
     CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --strain abc > " BUILD "/tests/t_dembx.err 2>&1")) == 2);
     CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "--strain 'abc' is not a finite number"));
-    CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --strain 0.01 --every 0.02 > " BUILD "/tests/t_dembx.err 2>&1")) == 2);
+    CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --strain 0.01 --every 0.02 > " BUILD
+                                   "/tests/t_dembx.err 2>&1")) == 2);
     CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "--every 0.02: need a strain in (0, --strain]"));
     CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --tiles 0x2 > " BUILD "/tests/t_dembx.err 2>&1")) == 2);
     CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "--tiles"));
     CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --bogus 1 > " BUILD "/tests/t_dembx.err 2>&1")) == 2);
     CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "unknown option --bogus"));
     CHECK(WEXITSTATUS(system(BUILD "/dem_biaxial --tiles 1x1 --strain 0.002 --every 0.001 --quiet "
-                             "--out /proc/no_such_dir > " BUILD "/tests/t_dembx.err 2>&1")) == 1);
+                                   "--out /proc/no_such_dir > " BUILD "/tests/t_dembx.err 2>&1")) == 1);
     CHECK(system(BUILD "/dem_biaxial --help > " BUILD "/tests/t_dembx.err 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_dembx.err", "RESULT"));
 }
@@ -1698,7 +1699,8 @@ TEST(dem_biaxial_smoke) {
  * the run completes with all its disks and the lid carries the confining
  * pressure at consolidation (2 %). */
 TEST(dem_biaxial_generate) {
-    CHECK(system(BUILD "/dem_biaxial --generate 228 --tiles 1x1 --strain 0.002 --every 0.001 --pictures 0.001 "
+    CHECK(system(BUILD
+                 "/dem_biaxial --generate 228 --tiles 1x1 --strain 0.002 --every 0.001 --pictures 0.001 "
                  "--quiet --out " BUILD "/tests/t_dembx_gen > " BUILD "/tests/t_dembx_gen.out 2>&1") == 0);
     CHECK(gk_test_result(BUILD "/tests/t_dembx_gen.out", "n") == 228);
     {
@@ -1715,7 +1717,7 @@ TEST(dem_biaxial_generate) {
 TEST(dem_collapse_smoke) {
     double ds, ed, bal, h;
     CHECK(system(BUILD "/dem_collapse --diameters 8 --t-end 0.6 --every 0.02 --snapshots 0.3 --quiet "
-                 "--out " BUILD "/tests/t_demcl > " BUILD "/tests/t_demcl.out 2>&1") == 0);
+                       "--out " BUILD "/tests/t_demcl > " BUILD "/tests/t_demcl.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_demcl/collapse.csv",
                            "time,front,dstar,height,Ek_over_Ep0,Ep_over_Ep0,Ed_over_Ep0"));
     CHECK(gk_test_file_has(BUILD "/tests/t_demcl/particles_001.vtk", "POINT_DATA"));
@@ -1732,11 +1734,13 @@ TEST(dem_collapse_smoke) {
     CHECK(h < 1.0);
     CHECK(fabs(bal) < 1e-3);
     CHECK(WEXITSTATUS(system(BUILD "/dem_collapse --a 20 > " BUILD "/tests/t_demcl.err 2>&1")) == 2);
-    CHECK(gk_test_file_has(BUILD "/tests/t_demcl.err", "--a 20 is out of range: needs an aspect ratio in [0.2, 10]"));
-    CHECK(WEXITSTATUS(system(BUILD "/dem_collapse --snapshots 1,0.5 > " BUILD "/tests/t_demcl.err 2>&1")) == 2);
+    CHECK(gk_test_file_has(BUILD "/tests/t_demcl.err",
+                           "--a 20 is out of range: needs an aspect ratio in [0.2, 10]"));
+    CHECK(WEXITSTATUS(system(BUILD "/dem_collapse --snapshots 1,0.5 > " BUILD "/tests/t_demcl.err 2>&1")) ==
+          2);
     CHECK(gk_test_file_has(BUILD "/tests/t_demcl.err", "--snapshots"));
     CHECK(WEXITSTATUS(system(BUILD "/dem_collapse --diameters 8 --t-end 0.02 --quiet --out /proc/no_such_dir "
-                             "> " BUILD "/tests/t_demcl.err 2>&1")) == 1);
+                                   "> " BUILD "/tests/t_demcl.err 2>&1")) == 1);
 }
 
 int main(int argc, char **argv) {

@@ -23,7 +23,8 @@ static int have_packings;
 static int load_packings(void) {
     gk_err e;
     if (!have_packings)
-        have_packings = gk_packing_read(P100, &pk100, NULL, &e) == GK_OK && gk_packing_read(P200, &pk200, NULL, &e) == GK_OK;
+        have_packings = gk_packing_read(P100, &pk100, NULL, &e) == GK_OK &&
+                        gk_packing_read(P200, &pk200, NULL, &e) == GK_OK;
     return have_packings;
 }
 
@@ -223,7 +224,8 @@ TEST(perturbation_tangent_is_eq8) {
                 gk_rve_state_restore(&st, &r);
                 CHECK(gk_rve_deform(&r, Hp, nd) == GK_OK);
                 gk_rve_set_velocity_gradient(&r, L0);
-                for (; done < nr; done += 20) CHECK(gk_rve_step(&r, nr - done < 20 ? nr - done : 20) == GK_OK);
+                for (; done < nr; done += 20)
+                    CHECK(gk_rve_step(&r, nr - done < 20 ? nr - done : 20) == GK_OK);
                 gk_rve_stress(&r, sp);
                 for (i = 0; i < 2; ++i)
                     for (j = 0; j < 2; ++j) Dh[(i * 2 + j) * 4 + k] = (sp[3 * i + j] - s0[3 * i + j]) / xi;
@@ -264,7 +266,8 @@ TEST(thread_count_does_not_change_a_bit) {
         CHECK(make_set(&b, 6, 2, GK_TWOSCALE_ADAPTIVE, t, mode ? 0.5 : 0) == GK_OK);
         for (k = 0; k < 3; ++k) {
             step_dH(6, k, 5e-4, dH);
-            ok &= gk_twoscale_run(&a, dH, NULL, sa, Da) == GK_OK && gk_twoscale_run(&b, dH, NULL, sb, Db) == GK_OK;
+            ok &= gk_twoscale_run(&a, dH, NULL, sa, Da) == GK_OK &&
+                  gk_twoscale_run(&b, dH, NULL, sb, Db) == GK_OK;
             ok &= same(sa, sb, 54) && same(Da, Db, 96);
             ok &= !memcmp(gk_twoscale_points(&a), gk_twoscale_points(&b), 6 * sizeof(gk_twoscale_point));
             reused += gk_twoscale_points(&a)[0].tangent == 2;
@@ -351,7 +354,8 @@ TEST(checkpoint_round_trip_is_bit_identical) {
     gk_twoscale_free(&b, got);
     for (k = 2; k < 5; ++k) { /* large steps: the networks outgrow the loaded key arrays */
         step_dH(8, k, 2e-3, dH);
-        ok &= gk_twoscale_run(&a, dH, NULL, sa, Da) == GK_OK && gk_twoscale_run(&b, dH, NULL, sb, Db) == GK_OK;
+        ok &=
+            gk_twoscale_run(&a, dH, NULL, sa, Da) == GK_OK && gk_twoscale_run(&b, dH, NULL, sb, Db) == GK_OK;
         ok &= same(sa, sb, 72) && same(Da, Db, 128);
         ok &= !memcmp(gk_twoscale_points(&a), gk_twoscale_points(&b), 8 * sizeof(gk_twoscale_point));
         for (j = 0; j < 8; ++j) reused += gk_twoscale_points(&a)[j].tangent == 2;
@@ -391,7 +395,8 @@ static void reseal(unsigned char *b, long n) {
 }
 
 /* a load that must be refused by name and change nothing: the fields and the next run are as before */
-static int refused(gk_twoscale *ts, const char *path, const char *msg, const double *dH, const double *s_before) {
+static int refused(gk_twoscale *ts, const char *path, const char *msg, const double *dH,
+                   const double *s_before) {
     void *blk = NULL;
     size_t nb = 7;
     double s[9 * 4];
@@ -487,14 +492,15 @@ typedef struct proc_log {
     int point[8], proto[8], fail_at;
     double H4[8];
 } proc_log;
-static gk_result double_love(void *user, int point, int proto, gk_rve *rve, const double H[9], const double dH[9],
-                             double scale, double stress[9], int *steps) {
+static gk_result double_love(void *user, int point, int proto, gk_rve *rve, const double H[9],
+                             const double dH[9], double scale, double stress[9], int *steps) {
     proc_log *lg = (proc_log *)user;
     gk_result r;
     int k;
     (void)scale;
     lg->point[point] = point, lg->proto[point] = proto, lg->H4[point] = H[4]; /* its own slot only */
-    if (point == lg->fail_at) return gk_err_set(&rve->err, GK_ERR_NOCONVERGE, "stand-in failure at %d", point);
+    if (point == lg->fail_at)
+        return gk_err_set(&rve->err, GK_ERR_NOCONVERGE, "stand-in failure at %d", point);
     if ((r = gk_rve_deform(rve, dH, 40)) != GK_OK) return r;
     gk_rve_stress(rve, stress);
     for (k = 0; k < 9; ++k) stress[k] *= 2.0;
@@ -554,7 +560,8 @@ TEST(caller_procedure_runs_every_point) {
     CHECK(gk_twoscale_accept(&a) == GK_OK);
     CHECK(gk_twoscale_accepted(&a, acc, NULL) == GK_OK && same(acc, s, 36));
     CHECK(gk_twoscale_accepted(&a, acc, D) == GK_ERR_ARG);
-    CHECK(gk_twoscale_fields(&a, f) == GK_OK && same(f[2].stress, s + 18, 9) && f[2].p == gk_stress_p(s + 18, 2));
+    CHECK(gk_twoscale_fields(&a, f) == GK_OK && same(f[2].stress, s + 18, 9) &&
+          f[2].p == gk_stress_p(s + 18, 2));
     CHECK(gk_twoscale_save(&a, BUILD "/tests/t_ts_proc.bin", "x", 1) == GK_OK);
     CHECK(gk_twoscale_run(&a, dH2, NULL, s2, NULL) == GK_OK);
     for (k = 0; k < 4; ++k) CHECK(lg.H4[k] == dH[9 * k + 4]); /* the accepted H */
@@ -615,13 +622,14 @@ TEST(bad_arguments_are_refused) {
     x = dH[9 * 2 + 1], dH[9 * 2 + 1] = NAN;
     CHECK(gk_twoscale_run(&ts, dH, NULL, s, NULL) == GK_ERR_NAN && strstr(gk_twoscale_error(&ts), "point 2"));
     dH[9 * 2 + 1] = x, dH[9 * 1 + 8] = 1e-3; /* out of plane in 2D */
-    CHECK(gk_twoscale_run(&ts, dH, NULL, s, NULL) == GK_ERR_ARG && strstr(gk_twoscale_error(&ts), "in-plane"));
+    CHECK(gk_twoscale_run(&ts, dH, NULL, s, NULL) == GK_ERR_ARG &&
+          strstr(gk_twoscale_error(&ts), "in-plane"));
     dH[9 * 1 + 8] = 0;
     rd.scale = 2.0;
     CHECK(gk_twoscale_run(&ts, dH, &rd, s, NULL) == GK_ERR_ARG && strstr(gk_twoscale_error(&ts), "scale 2"));
     CHECK(gk_twoscale_run(&ts, NULL, NULL, s, NULL) == GK_ERR_ARG);
-    CHECK(same(s, keep, 27));                                   /* outputs untouched */
-    CHECK(gk_twoscale_accept(&ts) == GK_ERR_STATE);             /* refused runs leave nothing to accept */
+    CHECK(same(s, keep, 27));                       /* outputs untouched */
+    CHECK(gk_twoscale_accept(&ts) == GK_ERR_STATE); /* refused runs leave nothing to accept */
     CHECK(gk_twoscale_save(&ts, NULL, NULL, 0) == GK_ERR_ARG);
     CHECK(gk_twoscale_save(&ts, BUILD "/tests/no_such_dir/ck.bin", NULL, 0) == GK_ERR_IO);
     CHECK(gk_twoscale_run(&ts, dH, NULL, s, NULL) == GK_OK && same(s, s0, 27)); /* still the same set */

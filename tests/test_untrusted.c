@@ -855,12 +855,12 @@ static size_t find_tag(const unsigned char *b, size_t n, const char *tag) {
  * position and one of negative mass and ran on them. Refused now, by name, before the run starts
  * (the seeds of fuzz_femdem_ckpt and fuzz_mpmdem_ckpt found the FEMxDEM ones). */
 TEST(driver_checkpoint_blocks_are_checked) {
-#define FD_CK                                                                                     \
+#define FD_CK                                                                                      \
     BUILD "/femdem_biaxial --test single --steps 1 --increment 1e-4 --checkpoint 1 --vtk-every 0 " \
-    "--threads 1 --packing " OUT("ck_pk.txt") " "
-#define MP_CK                                                                                      \
+          "--threads 1 --packing " OUT("ck_pk.txt") " "
+#define MP_CK                                                                                       \
     BUILD "/mpmdem_biaxial --nx 1 --ny 2 --width 1 --height 2 --velocity 1 --ramp 0 --every 0.008 " \
-    "--threads 1 --dem-max 50 --quiet --packing " OUT("ck_pk.txt") " "
+          "--threads 1 --dem-max 50 --quiet --packing " OUT("ck_pk.txt") " "
     unsigned char *b;
     size_t n, at;
     int32_t step = -5;
@@ -924,12 +924,12 @@ TEST(driver_checkpoint_blocks_are_checked) {
  * block on trust: a NaN written under a valid checksum was restarted from.
  * Refused now by name, with exit 1 and no new rows. */
 TEST(dr_and_nonlocal_checkpoints_refuse_non_finite_values) {
-#define DR_CK                                                                                              \
+#define DR_CK                                                                                               \
     BUILD "/femdem_dr --nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 " \
-    "--steps 2 --threads 1 "
-#define NL_CK                                                                                     \
+          "--steps 2 --threads 1 "
+#define NL_CK                                                                                      \
     BUILD "/femdem_nonlocal --test element-shear --packing examples/data/rve160_hm.txt --steps 4 " \
-    "--strain 0.0004 --lone-increments 2 --threads 1 "
+          "--strain 0.0004 --lone-increments 2 --threads 1 "
     unsigned char *b;
     size_t n, at;
     double v = NAN;

@@ -62,7 +62,8 @@ static void usage(FILE *fp) {
             "                             (28.65 = 0.5 rad, Guo & Zhao 2014)\n"
             "  --E, --kt-ratio, --density, --thickness, --damping   material (Guo & Zhao 2014 defaults)\n"
             "  --law linear|hertz         contact law (linear); hertz: Hertz-Mindlin from --G and --poisson\n"
-            "  --G, --poisson             Hertz-Mindlin grain shear modulus [Pa] and Poisson ratio (sets E = 2G(1+nu))\n"
+            "  --G, --poisson             Hertz-Mindlin grain shear modulus [Pa] and Poisson ratio (sets E = "
+            "2G(1+nu))\n"
             "  --contact-damping Z        tangential viscous damping, fraction of critical (0)\n"
             "  --max-strain-rate R        consolidation strain-rate cap [1/s] (0: inertial number 1e-2)\n"
             "  --dt-factor F              DEM step as a fraction of the critical step (0.5; Hertz: use 0.2)\n"
@@ -78,8 +79,8 @@ static void usage(FILE *fp) {
 
 typedef struct opts {
     int dim, n, frame;
-    double rmin, rmax, pressure, mu_cons, target_e, phi, phi_deg, E, ktr, rho, thick, damp, tol, G, nu, zeta_t, dtf,
-        rate;
+    double rmin, rmax, pressure, mu_cons, target_e, phi, phi_deg, E, ktr, rho, thick, damp, tol, G, nu,
+        zeta_t, dtf, rate;
     double kn, ratio, target_a;
     int hertz;
     unsigned long seed;
@@ -113,8 +114,8 @@ static double anisotropy(const gk_rve *rve) {
     return gk_fabric_ratio(phi, rve->dim);
 }
 
-static gk_result consolidate_once(const opts *o, const gk_packing *cloud, double mu_cons, double ratio, gk_rve *rve,
-                                  gk_consolidate_report *rep) {
+static gk_result consolidate_once(const opts *o, const gk_packing *cloud, double mu_cons, double ratio,
+                                  gk_rve *rve, gk_consolidate_report *rep) {
     gk_rve_def def = gk_rve_def_default();
     gk_consolidate_def cd;
     gk_result r;
@@ -174,8 +175,7 @@ static int make_frame(const opts *o, gk_packing *pk) {
     if (!frame_role) return 1;
     gk_rng_seed(&rng, (uint64_t)o->seed * 7919u + 17u);
     for (k = 0; k < nf; ++k) {
-        do
-            p = (int)(gk_rng_u64(&rng) % (uint64_t)n);
+        do p = (int)(gk_rng_u64(&rng) % (uint64_t)n);
         while (frame_role[p]);
         if (k == 0) { /* the corner */
             frame_role[p] = 3, pk->x[p] = 0.0, pk->y[p] = 0.0;
@@ -196,7 +196,8 @@ static int make_frame(const opts *o, gk_packing *pk) {
             }
             if (!clash) break;
             if (frame_role[p] || tries == 1000000) {
-                fprintf(stderr, "gk_pack: no room for particle %d next to the frame (fewer frame particles?)\n", p);
+                fprintf(stderr,
+                        "gk_pack: no room for particle %d next to the frame (fewer frame particles?)\n", p);
                 return 1;
             }
             pk->x[p] = L[0] * gk_rng_uniform(&rng), pk->y[p] = L[1] * gk_rng_uniform(&rng);
@@ -271,38 +272,57 @@ int main(int argc, char **argv) {
             fprintf(stderr, "gk_pack: %s needs a value\n", a);
             return 2;
         }
-        if (!strcmp(a, "--dim")) bad = int_opt(a, v, &o.dim);
-        else if (!strcmp(a, "--n")) bad = int_opt(a, v, &o.n);
-        else if (!strcmp(a, "--rmin")) bad = real_opt(a, v, &o.rmin);
-        else if (!strcmp(a, "--rmax")) bad = real_opt(a, v, &o.rmax);
-        else if (!strcmp(a, "--psd")) o.psd = v;
-        else if (!strcmp(a, "--psd-by")) o.psd_by = v;
-        else if (!strcmp(a, "--pressure")) bad = real_opt(a, v, &o.pressure);
-        else if (!strcmp(a, "--consolidation-friction")) bad = real_opt(a, v, &o.mu_cons);
-        else if (!strcmp(a, "--target-void-ratio")) bad = real_opt(a, v, &o.target_e);
-        else if (!strcmp(a, "--friction-deg")) bad = real_opt(a, v, &o.phi_deg);
+        if (!strcmp(a, "--dim"))
+            bad = int_opt(a, v, &o.dim);
+        else if (!strcmp(a, "--n"))
+            bad = int_opt(a, v, &o.n);
+        else if (!strcmp(a, "--rmin"))
+            bad = real_opt(a, v, &o.rmin);
+        else if (!strcmp(a, "--rmax"))
+            bad = real_opt(a, v, &o.rmax);
+        else if (!strcmp(a, "--psd"))
+            o.psd = v;
+        else if (!strcmp(a, "--psd-by"))
+            o.psd_by = v;
+        else if (!strcmp(a, "--pressure"))
+            bad = real_opt(a, v, &o.pressure);
+        else if (!strcmp(a, "--consolidation-friction"))
+            bad = real_opt(a, v, &o.mu_cons);
+        else if (!strcmp(a, "--target-void-ratio"))
+            bad = real_opt(a, v, &o.target_e);
+        else if (!strcmp(a, "--friction-deg"))
+            bad = real_opt(a, v, &o.phi_deg);
         else if (!strcmp(a, "--friction-angle")) { /* the old radian option, kept for old scripts */
             fprintf(stderr, "gk_pack: --friction-angle (radians) is deprecated: use --friction-deg\n");
             bad = real_opt(a, v, &o.phi);
-        }
-        else if (!strcmp(a, "--E")) bad = real_opt(a, v, &o.E);
-        else if (!strcmp(a, "--kt-ratio")) bad = real_opt(a, v, &o.ktr);
-        else if (!strcmp(a, "--density")) bad = real_opt(a, v, &o.rho);
-        else if (!strcmp(a, "--thickness")) bad = real_opt(a, v, &o.thick);
-        else if (!strcmp(a, "--damping")) bad = real_opt(a, v, &o.damp);
-        else if (!strcmp(a, "--G")) bad = real_opt(a, v, &o.G);
-        else if (!strcmp(a, "--poisson")) bad = real_opt(a, v, &o.nu);
-        else if (!strcmp(a, "--contact-damping")) bad = real_opt(a, v, &o.zeta_t);
-        else if (!strcmp(a, "--dt-factor")) bad = real_opt(a, v, &o.dtf);
-        else if (!strcmp(a, "--max-strain-rate")) bad = real_opt(a, v, &o.rate);
+        } else if (!strcmp(a, "--E"))
+            bad = real_opt(a, v, &o.E);
+        else if (!strcmp(a, "--kt-ratio"))
+            bad = real_opt(a, v, &o.ktr);
+        else if (!strcmp(a, "--density"))
+            bad = real_opt(a, v, &o.rho);
+        else if (!strcmp(a, "--thickness"))
+            bad = real_opt(a, v, &o.thick);
+        else if (!strcmp(a, "--damping"))
+            bad = real_opt(a, v, &o.damp);
+        else if (!strcmp(a, "--G"))
+            bad = real_opt(a, v, &o.G);
+        else if (!strcmp(a, "--poisson"))
+            bad = real_opt(a, v, &o.nu);
+        else if (!strcmp(a, "--contact-damping"))
+            bad = real_opt(a, v, &o.zeta_t);
+        else if (!strcmp(a, "--dt-factor"))
+            bad = real_opt(a, v, &o.dtf);
+        else if (!strcmp(a, "--max-strain-rate"))
+            bad = real_opt(a, v, &o.rate);
         else if (!strcmp(a, "--law")) {
-            if (!strcmp(v, "hertz")) o.hertz = 1;
+            if (!strcmp(v, "hertz"))
+                o.hertz = 1;
             else if (strcmp(v, "linear")) {
                 fprintf(stderr, "gk_pack: --law '%s' is neither linear nor hertz\n", v);
                 bad = 1;
             }
-        }
-        else if (!strcmp(a, "--seed")) {
+        } else if (!strcmp(a, "--seed")) {
             char *e;
             errno = 0;
             o.seed = strtoul(v, &e, 10);
@@ -310,13 +330,18 @@ int main(int argc, char **argv) {
                 fprintf(stderr, "gk_pack: --seed '%s' is not a non-negative whole number\n", v);
                 bad = 1;
             }
-        }
-        else if (!strcmp(a, "--tol")) bad = real_opt(a, v, &o.tol);
-        else if (!strcmp(a, "--kn")) bad = real_opt(a, v, &o.kn);
-        else if (!strcmp(a, "--stress-ratio")) bad = real_opt(a, v, &o.ratio);
-        else if (!strcmp(a, "--target-anisotropy")) bad = real_opt(a, v, &o.target_a);
-        else if (!strcmp(a, "--frame")) bad = int_opt(a, v, &o.frame);
-        else if (!strcmp(a, "--out")) o.out = v;
+        } else if (!strcmp(a, "--tol"))
+            bad = real_opt(a, v, &o.tol);
+        else if (!strcmp(a, "--kn"))
+            bad = real_opt(a, v, &o.kn);
+        else if (!strcmp(a, "--stress-ratio"))
+            bad = real_opt(a, v, &o.ratio);
+        else if (!strcmp(a, "--target-anisotropy"))
+            bad = real_opt(a, v, &o.target_a);
+        else if (!strcmp(a, "--frame"))
+            bad = int_opt(a, v, &o.frame);
+        else if (!strcmp(a, "--out"))
+            o.out = v;
         else {
             fprintf(stderr, "gk_pack: unknown option %s (see --help)\n", a);
             return 2;
@@ -428,7 +453,8 @@ int main(int argc, char **argv) {
         }
         if (fabs(best - o.target_e) > 2e-3) {
             fprintf(stderr,
-                    "gk_pack: void ratio %g not reached: consolidation friction 0 to 1 gave %.4f to %.4f (closest "
+                    "gk_pack: void ratio %g not reached: consolidation friction 0 to 1 gave %.4f to %.4f "
+                    "(closest "
                     "%.4f at %.4f); no packing written\n",
                     o.target_e, emin, emax, best, mu);
             gk_packing_free(&cloud);
@@ -453,8 +479,10 @@ int main(int argc, char **argv) {
             gk_rve_destroy(&rve);
             if (fabs(A - o.target_a) < fabs(best - o.target_a)) best = A, o.ratio = R;
             if (fabs(A - o.target_a) < 2e-3) break;
-            if (A < o.target_a) lo = R;
-            else hi = R;
+            if (A < o.target_a)
+                lo = R;
+            else
+                hi = R;
         }
         if (fabs(best - o.target_a) > 5e-3)
             fprintf(stderr, "gk_pack: warning: closest anisotropy %.4f is %.4f from the target %.4f\n", best,
@@ -473,16 +501,17 @@ int main(int argc, char **argv) {
         size_t len = 0;
         int a;
         if (o.ratio != 1.0)
-            snprintf(ratio_txt, sizeof ratio_txt, ", then sigma_yy to %.6g sigma_xx and back with friction %.6g",
-                     o.ratio, tan(o.phi));
+            snprintf(ratio_txt, sizeof ratio_txt,
+                     ", then sigma_yy to %.6g sigma_xx and back with friction %.6g", o.ratio, tan(o.phi));
         if (o.frame)
             snprintf(frame_txt, sizeof frame_txt,
                      "\nframe: %d particles at the corner and on the lines x = 0, y = 0 (held there while "
                      "consolidating): x = 0 or y = 0 exactly",
                      2 * o.frame + 1);
         if (o.hertz)
-            snprintf(law, sizeof law, "Hertz-Mindlin G=%g Pa, nu=%g (E=%g Pa), tangential damping %g of critical",
-                     o.G, o.nu, 2.0 * o.G * (1.0 + o.nu), o.zeta_t);
+            snprintf(law, sizeof law,
+                     "Hertz-Mindlin G=%g Pa, nu=%g (E=%g Pa), tangential damping %g of critical", o.G, o.nu,
+                     2.0 * o.G * (1.0 + o.nu), o.zeta_t);
         else if (o.kn > 0)
             snprintf(law, sizeof law, "linear kn = %g N/m, kt/kn=%g", o.kn, o.ktr);
         else
@@ -493,19 +522,21 @@ int main(int argc, char **argv) {
             if (w < 0) break;
             len += (size_t)w;
         }
-        snprintf(comment, sizeof comment,
-                 "consolidated by gk_pack: %dD, %d particles, radii %g-%g m, seed %lu\n"
-                 "command: %s\n"
-                 "material: %s, friction angle %.17g deg (mu %.6g); density %g; "
-                 "2D thickness %g; local damping %g\n"
-                 "consolidation friction %.6g; target %g Pa isotropic%s; %ld steps\n"
-                 "fabric anisotropy A = Pi_1/Pi_2 - 1 = %.4f (Liu, Bosco & Suiker 2018 eq 38)%s\n"
-                 "RVE state: stress (Pa, tension +) sxx=%.6f syy=%.6f%s%.6f sxy=%.6f ; void ratio %.6f "
-                 "(porosity %.6f) ; Z=%.4f (YADE skipFree %.6f, mechanical %.4f) ; contacts=%d ; unbalanced=%.3e",
-                 o.dim, o.n, o.rmin, o.rmax, o.seed, cmd, law, o.phi * 180.0 / GK_PI, tan(o.phi), o.rho, o.thick, o.damp, mu,
-                 o.pressure, ratio_txt, rep.steps, anisotropy(&rve), frame_txt, rep.stress[0], rep.stress[4], o.dim == 3 ? " szz=" : " (2D) ",
-                 o.dim == 3 ? rep.stress[8] : 0.0, rep.stress[1], rep.void_ratio,
-                 rep.void_ratio / (1.0 + rep.void_ratio), z.z, z.z_nofree, z.z_mech, z.contacts, rep.unbalanced);
+        snprintf(
+            comment, sizeof comment,
+            "consolidated by gk_pack: %dD, %d particles, radii %g-%g m, seed %lu\n"
+            "command: %s\n"
+            "material: %s, friction angle %.17g deg (mu %.6g); density %g; "
+            "2D thickness %g; local damping %g\n"
+            "consolidation friction %.6g; target %g Pa isotropic%s; %ld steps\n"
+            "fabric anisotropy A = Pi_1/Pi_2 - 1 = %.4f (Liu, Bosco & Suiker 2018 eq 38)%s\n"
+            "RVE state: stress (Pa, tension +) sxx=%.6f syy=%.6f%s%.6f sxy=%.6f ; void ratio %.6f "
+            "(porosity %.6f) ; Z=%.4f (YADE skipFree %.6f, mechanical %.4f) ; contacts=%d ; unbalanced=%.3e",
+            o.dim, o.n, o.rmin, o.rmax, o.seed, cmd, law, o.phi * 180.0 / GK_PI, tan(o.phi), o.rho, o.thick,
+            o.damp, mu, o.pressure, ratio_txt, rep.steps, anisotropy(&rve), frame_txt, rep.stress[0],
+            rep.stress[4], o.dim == 3 ? " szz=" : " (2D) ", o.dim == 3 ? rep.stress[8] : 0.0, rep.stress[1],
+            rep.void_ratio, rep.void_ratio / (1.0 + rep.void_ratio), z.z, z.z_nofree, z.z_mech, z.contacts,
+            rep.unbalanced);
         if (gk_rve_to_packing(&rve, &pk, NULL, &err)) {
             fprintf(stderr, "gk_pack: %s\n", err.msg);
             gk_rve_destroy(&rve);
