@@ -410,6 +410,42 @@ static gk_result mpd_prepare_rve(mpd_proto *P, double p, gk_rve_state *st, gk_er
     return GK_OK;
 }
 
+/* Geostatic RVE levels (mpmdem_collapse, mpmdem_pipe): the packing prepared
+ * as it is first (st[0]; its bulk density *rho_ref), then `levels` equal
+ * layers over `depth`, each level's RVE consolidated (in parallel) to the
+ * weight of the material above its layer's middle, at least half a cell h
+ * deep: p[k] = rho_ref g z. Per level the density, void ratio, P-wave modulus
+ * and pressure reached; *Mmax the largest modulus (and its value on entry).
+ * 0, or 1 with the first failing level's message in *err. */
+GK_INLINE int mpd_prepare_levels(mpd_proto *P, const mpd_opts *o, int levels, double depth, double g,
+                                 double h, gk_rve_state *st, double *p, double *rho, double *e0, double *M,
+                                 double *pa, double *rho_ref, double *Mmax, gk_err *err) {
+    char msg[GK_ERR_MSG_LEN] = "";
+    int k, bad = 0;
+    if (mpd_proto_open(P, o, err) || mpd_prepare_rve(P, 0.0, &st[0], err)) return 1;
+    *rho_ref = P->rho;
+    for (k = 0; k < levels; ++k) {
+        double z = depth * (k + 0.5) / levels;
+        p[k] = *rho_ref * g * (z > 0.5 * h ? z : 0.5 * h);
+    }
+    GK_OMP(parallel for num_threads(o->threads) schedule(dynamic, 1))
+    for (k = 0; k < levels; ++k) {
+        mpd_proto Pk = *P;
+        gk_err e;
+        if (mpd_prepare_rve(&Pk, p[k], &st[k], &e)) {
+            GK_OMP(critical) {
+                bad = 1;
+                snprintf(msg, sizeof msg, "%s", e.msg);
+            }
+            continue;
+        }
+        rho[k] = Pk.rho, e0[k] = Pk.e0, M[k] = Pk.M, pa[k] = Pk.p0;
+    }
+    if (bad) return gk_err_set(err, GK_ERR_STATE, "%s", msg), 1;
+    for (k = 0; k < levels; ++k) *Mmax = fmax(*Mmax, M[k]);
+    return 0;
+}
+
 /* A drained biaxial test of ONE RVE (the "pure DEM" of the MPMxDEM drivers:
  * mpmdem_footing's friction angle, mpmdem_single's reference): *r created
  * from the prepared state st, driven by gk_rve_set_servo with axis 0

@@ -266,33 +266,13 @@ static int level_of(const pp *X, double y) {
     return k < 0 ? 0 : k >= X->b.levels ? X->b.levels - 1 : k;
 }
 
-/* one RVE state per pressure level (in parallel), the bulk density of the packing as shipped first */
+/* one RVE state per pressure level (mpd_prepare_levels) */
 static int prepare_levels(pp *X, gk_err *err) {
     const pp_opts *b = &X->b;
-    char msg[GK_ERR_MSG_LEN] = "";
-    int k, bad = 0;
     double t0 = gk_wtime();
-    if (mpd_proto_open(&X->P, &X->o, err) || mpd_prepare_rve(&X->P, 0.0, &X->st[0], err)) return 1;
-    X->rho_ref = X->P.rho;
-    for (k = 0; k < b->levels; ++k) {
-        double z = X->depth * (k + 0.5) / b->levels;
-        X->lev_p[k] = X->rho_ref * b->gravity * (z > 0.5 * X->h ? z : 0.5 * X->h);
-    }
-    GK_OMP(parallel for num_threads(X->o.threads) schedule(dynamic, 1))
-    for (k = 0; k < b->levels; ++k) {
-        mpd_proto Pk = X->P;
-        gk_err e;
-        if (mpd_prepare_rve(&Pk, X->lev_p[k], &X->st[k], &e)) {
-            GK_OMP(critical) {
-                bad = 1;
-                snprintf(msg, sizeof msg, "%s", e.msg);
-            }
-            continue;
-        }
-        X->lev_rho[k] = Pk.rho, X->lev_e[k] = Pk.e0, X->lev_M[k] = Pk.M, X->lev_pa[k] = Pk.p0;
-    }
-    if (bad) return gk_err_set(err, GK_ERR_STATE, "%s", msg), 1;
-    for (k = 0; k < b->levels; ++k) X->Mmax = fmax(X->Mmax, X->lev_M[k]);
+    if (mpd_prepare_levels(&X->P, &X->o, b->levels, X->depth, b->gravity, X->h, X->st, X->lev_p, X->lev_rho,
+                           X->lev_e, X->lev_M, X->lev_pa, &X->rho_ref, &X->Mmax, err))
+        return 1;
     X->prep_secs = gk_wtime() - t0;
     return 0;
 }
