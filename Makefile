@@ -62,7 +62,7 @@ help:
 	@echo "make run        the main job: FEMxDEM biaxial test (see README.md)"
 	@echo "make run-rve    one RVE along a shear path"
 	@echo "make run-mpm | run-footing | run-collapse   MPMxDEM biaxial, footing, column collapse (Liang & Zhao 2019)"
-	@echo "make run-pipe   MPMxDEM pipe-soil interaction (Liang & Zhao 2019; a few minutes)"
+	@echo "make run-pipe   MPMxDEM pipe-soil interaction (Liang & Zhao 2019; about 7 minutes on 2 idle cores)"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
 	@echo "make mpi        the MPI programs (mpicc; gk_twoscale.h with GK_TWOSCALE_MPI) into $(BUILD)/mpi/"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability, tool smoke runs"
