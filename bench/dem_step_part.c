@@ -42,7 +42,7 @@ int BENCH_PATH(int nincr, double *p, double *q) {
 /* tile a periodic packing nx x ny x nz times (still periodic and dense) */
 static int tile(const gk_packing *in, int nx, int ny, int nz, gk_packing *out, gk_err *e) {
     int a, b, c, p, q = 0, n = in->n * nx * ny * nz;
-    if (gk_packing_alloc(out, in->dim, n, NULL, e)) return 1;
+    if (gk_packing_init(out, in->dim, n, NULL, e)) return 1;
     gk_m3_identity(out->h);
     out->h[0] = in->h[0] * nx;
     out->h[4] = in->h[4] * ny;

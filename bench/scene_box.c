@@ -90,7 +90,7 @@ static int read_data(const char *path, gk_packing *pk) {
     while (fgets(line, sizeof line, fp) && !(sscanf(line, "%15s", word) == 1 && !strcmp(word, "Atoms")))
         if (sscanf(line, "%ld %15s", &q, word) == 2 && !strcmp(word, "atoms"))
             n = q >= 1 && q <= 10000000 ? (int)q : -1;
-    if (n < 1 || gk_packing_alloc(pk, 3, n, NULL, &err)) {
+    if (n < 1 || gk_packing_init(pk, 3, n, NULL, &err)) {
         fclose(fp);
         return fprintf(stderr, "bench_scene_box: %s: no \"N atoms\" line (1 <= N <= 1e7) before Atoms\n",
                        path),
@@ -161,7 +161,7 @@ static int pour_bed(gk_packing *pk, int nx, int nz, long steps, int threads, con
     gk_material wm;
     gk_err err;
     gk_rng rng;
-    if (gk_packing_alloc(pk, 3, nx * nx * nz, NULL, &err)) return fprintf(stderr, "%s\n", err.msg), 1;
+    if (gk_packing_init(pk, 3, nx * nx * nz, NULL, &err)) return fprintf(stderr, "%s\n", err.msg), 1;
     gk_rng_seed(&rng, 42);
     for (c = 0; c < nz; ++c)
         for (b = 0; b < nx; ++b)
@@ -213,7 +213,7 @@ static int impact(int threads, const char *data) {
     gk_material wm;
     gk_err err;
     int p;
-    if (gk_packing_alloc(&pk, 3, 3, NULL, &err)) return fprintf(stderr, "%s\n", err.msg), 1;
+    if (gk_packing_init(&pk, 3, 3, NULL, &err)) return fprintf(stderr, "%s\n", err.msg), 1;
     for (p = 0; p < 3; ++p) {
         pk.x[p] = X[p][0];
         pk.y[p] = X[p][1];

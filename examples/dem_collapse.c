@@ -241,7 +241,7 @@ static int dc_setup(dc_run *R) {
         d->rve.dt_factor = 0.2;
         d->rve.damping = 0.3; /* preparation only */
         d->rve.threads = o->threads;
-        if (gk_packing_alloc(&pk, 2, nx * ny + nf, NULL, &err))
+        if (gk_packing_init(&pk, 2, nx * ny + nf, NULL, &err))
             return fprintf(stderr, "dem_collapse: %s\n", err.msg), 1;
         gk_rng_seed(&rng, (uint64_t)o->seed);
         for (a = 0; a < nf; ++a, ++q) { /* floor first: ids 0 .. nf-1 */

@@ -50,7 +50,7 @@ static int dns_build(model *m, dns *D) {
         if (pk->r[p] > rmax) rmax = pk->r[p];
     }
     n = t.n + extra;
-    if (gk_packing_alloc(&sp, 2, n, NULL, &err)) {
+    if (gk_packing_init(&sp, 2, n, NULL, &err)) {
         fprintf(stderr, PROG ": %s\n", err.msg);
         return 1;
     }

@@ -322,7 +322,7 @@ static int load_checkpoint(model *m) {
                     PROG ": %s was written with other options (strain, pressure, friction, steps, stiffness "
                          "or mesh)\n",
                     path);
-            gk_twoscale_free(&m->ts, blk);
+            gk_twoscale_free_block(&m->ts, blk);
             return 1;
         }
     need += 8 * (3 * (size_t)m->ndof + 18 * (size_t)m->ngp + (size_t)NCOL * iv[6]);
@@ -355,18 +355,18 @@ static int load_checkpoint(model *m) {
     m->dem_total = (long long)dv[4], m->runs_total = (long long)dv[5], m->capped_total = (long long)dv[6];
     m->unconverged = (long long)dv[7];
     if (m->have_f0) gk_dr_reference(&m->dr, NULL, m->f0);
-    gk_twoscale_free(&m->ts, blk);
+    gk_twoscale_free_block(&m->ts, blk);
     printf("restarted from %s at step %d\n", path, m->step_done);
     return 0;
 bad:
     fprintf(stderr, PROG ": %s is not a checkpoint of this run (another test, mesh, frame or rotation)\n",
             path);
-    gk_twoscale_free(&m->ts, blk);
+    gk_twoscale_free_block(&m->ts, blk);
     return 1;
 bad_value:
     fprintf(stderr, PROG ": %s: the run's block holds a non-finite or out-of-range value; not restarted\n",
             path);
-    gk_twoscale_free(&m->ts, blk);
+    gk_twoscale_free_block(&m->ts, blk);
     return 1;
 }
 

@@ -312,9 +312,9 @@ static int fd_ck_read(fd_model *M, const char *dir, const char *tag, fd_buf *B, 
     if (gk_twoscale_load(&M->ts, path, &blk, &nb))
         return gk_err_set(err, GK_ERR_FORMAT, "%s", gk_twoscale_error(&M->ts)), 1;
     B->b = (unsigned char *)malloc(nb + 1), B->n = B->cap = nb;
-    if (!B->b) return gk_twoscale_free(&M->ts, blk), gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+    if (!B->b) return gk_twoscale_free_block(&M->ts, blk), gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
     memcpy(B->b, blk, nb);
-    gk_twoscale_free(&M->ts, blk);
+    gk_twoscale_free_block(&M->ts, blk);
     ok = !fd_get(B, tg, 16) && !memcmp(tg, tag, strlen(tag) + 1);
     ok = ok && !fd_get(B, &nx, sizeof nx) && !fd_get(B, &ny, sizeof ny) && !fd_get(B, &el, sizeof el) &&
          !fd_get(B, &quad, sizeof quad);

@@ -114,7 +114,7 @@ static int enrich(run *R) {
         for (I = 0; I < nn; ++I)
             num[(size_t)k * nn + I] = R->nden[I] > 0.0 ? num[(size_t)k * nn + I] / R->nden[I] : 0.0;
     /* the reference packing's grains that go to the discrete zone */
-    if (gk_packing_alloc(&sub, 2, R->pk.n, NULL, &e)) {
+    if (gk_packing_init(&sub, 2, R->pk.n, NULL, &e)) {
         fprintf(stderr, "error: %s\n", e.msg);
         goto done;
     }

@@ -430,13 +430,13 @@ GK_INLINE gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, 
     R2.r = NULL, R2.n = R2.cap = 0, Rk.r = NULL, Rk.n = Rk.cap = 0;
     mpd_block(&K, tag, m, pts, S, nS, &Rk, &snk, 1);
     if (K.bad) {
-        free(K.b), gk_twoscale_free(&m->ts, blk);
+        free(K.b), gk_twoscale_free_block(&m->ts, blk);
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory");
     }
     memset(&B, 0, sizeof B);
     B.b = (unsigned char *)blk, B.cap = nblk;
     mpd_block(&B, tag, m, pts, S, nS, &R2, &sn2, 0);
-    gk_twoscale_free(&m->ts, blk);
+    gk_twoscale_free_block(&m->ts, blk);
     if (B.bad)
         snprintf(why, sizeof why,
                  "its driver block is not that of an mpmdem_%s run of %d points with these flags", tag,

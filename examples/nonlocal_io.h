@@ -249,7 +249,7 @@ static int load_checkpoint(model *md, uint64_t fp) {
     GET(md->prof12, sizeof(double) * 2 * ny);
     GET(md->arrival, sizeof(double) * md->ne);
 #undef GET
-    gk_twoscale_free(&md->ts, blk);
+    gk_twoscale_free_block(&md->ts, blk);
     md->step = hd.step, md->time = hd.time, md->peak = hd.peak, md->have12 = hd.have12,
     md->dem_total = hd.dem_total;
     gk_dofmap_expand(&md->dm, md->ur, 0, md->u);
@@ -263,7 +263,7 @@ static int load_checkpoint(model *md, uint64_t fp) {
     printf("restarted from %s at step %ld\n", path, md->step);
     return 0;
 bad:
-    gk_twoscale_free(&md->ts, blk);
+    gk_twoscale_free_block(&md->ts, blk);
     return fprintf(stderr,
                    "femdem_nonlocal: restart: %s was written by another run (test, mesh, options or packing "
                    "differ) "
@@ -271,7 +271,7 @@ bad:
                    path),
            1;
 bad_value:
-    gk_twoscale_free(&md->ts, blk);
+    gk_twoscale_free_block(&md->ts, blk);
     return fprintf(stderr,
                    "femdem_nonlocal: restart: %s: the run's block holds a non-finite or out-of-range value; "
                    "not restarted\n",

@@ -170,7 +170,7 @@ static int rve_imperfect(const opts *o, micro *m) {
         int r = k + (int)(gk_rng_uniform(&rng) * (n - k)), t = idx[k];
         idx[k] = idx[r], idx[r] = t;
     }
-    if (gk_packing_alloc(&m->pk_imp, 3, n - o->imperfection, NULL, &e))
+    if (gk_packing_init(&m->pk_imp, 3, n - o->imperfection, NULL, &e))
         return fprintf(stderr, "%s\n", e.msg), 1;
     gk_m3_copy(m->pk.h, m->pk_imp.h);
     for (k = o->imperfection, j = 0; k < n; ++k, ++j) {

@@ -2496,7 +2496,7 @@ GKDEF gk_result gk_rve_to_packing(const gk_rve *rve, gk_packing *out, const gk_a
                                   gk_err *err) {
     gk_packing pk;
     int p, k;
-    gk_result res = gk_packing_alloc(&pk, rve->dim, rve->n, alloc, err);
+    gk_result res = gk_packing_init(&pk, rve->dim, rve->n, alloc, err);
     if (res) return res;
     gk_m3_copy(rve->cell.h, pk.h);
     for (p = 0; p < rve->n; ++p) {

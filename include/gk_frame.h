@@ -308,7 +308,7 @@ GKDEF gk_result gk_frame_build(gk_frame *out, const gk_packing *pk, const gk_all
         if (e[i].corner >= 0) e[i].s = -2.0 * (L0 > L1 ? L0 : L1);
     qsort(e, (size_t)ncopy, sizeof *e, gk__fq_cmp);
     /* the framed packing: inner particles first (wrapped into the cell), then the boundary copies */
-    res = gk_packing_alloc(&F.framed, 2, F.n, &F.alloc, err);
+    res = gk_packing_init(&F.framed, 2, F.n, &F.alloc, err);
     if (res) goto done;
     gk_m3_identity(F.framed.h);
     F.framed.h[0] = 2.0 * L0, F.framed.h[4] = 2.0 * L1;

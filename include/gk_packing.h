@@ -13,7 +13,7 @@
  *   gk_packing_free(&pk);
  *
  * WHAT IS HERE
- *   gk_packing_alloc / gk_packing_free   arrays for n particles (allocator hooks)
+ *   gk_packing_init / gk_packing_free   arrays for n particles (allocator hooks)
  *   gk_packing_read / gk_packing_parse   the text format, from a file or memory
  *   gk_packing_write                     the same format (round-trips exactly)
  *   gk_packing_generate                  a random loose (non-overlapping) cloud
@@ -75,7 +75,7 @@ static inline double gk_particle_volume(int dim, double r) {
 extern "C" {
 #endif
 
-GKDEF gk_result gk_packing_alloc(gk_packing *pk, int dim, int n, const gk_allocator *alloc, gk_err *err);
+GKDEF gk_result gk_packing_init(gk_packing *pk, int dim, int n, const gk_allocator *alloc, gk_err *err);
 GKDEF void gk_packing_free(gk_packing *pk);
 GKDEF gk_result gk_packing_read(const char *path, gk_packing *pk, const gk_allocator *alloc, gk_err *err);
 GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *pk, const gk_allocator *alloc,
@@ -112,7 +112,7 @@ GKDEF gk_result gk_packing_subset(const gk_packing *pk, const double lo[3], cons
 #include <string.h>
 
 /* ================================================================ packing */
-GKDEF gk_result gk_packing_alloc(gk_packing *pk, int dim, int n, const gk_allocator *alloc, gk_err *err) {
+GKDEF gk_result gk_packing_init(gk_packing *pk, int dim, int n, const gk_allocator *alloc, gk_err *err) {
     gk_packing p;
     if (dim != 2 && dim != 3) return gk_err_set(err, GK_ERR_ARG, "dimension %d (must be 2 or 3)", dim);
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "particle count %d (must be >= 1)", n);
@@ -261,7 +261,7 @@ GKDEF gk_result gk_packing_parse(const char *text, size_t len, gk_packing *out, 
     }
     if (lines != n)
         return gk_err_set(err, GK_ERR_FORMAT, "packing announces %d particles but lists %ld", n, lines);
-    r = gk_packing_alloc(&pk, dim, n, alloc, err);
+    r = gk_packing_init(&pk, dim, n, alloc, err);
     if (r) return r;
     L.p = first;
     L.lineno = body;
@@ -408,7 +408,7 @@ GKDEF gk_result gk_packing_generate(gk_packing *out, const gk_gen_def *def, cons
     } else {
         return gk_err_set(err, GK_ERR_ARG, "unknown size-distribution kind %d", (int)def->psd);
     }
-    res = gk_packing_alloc(&pk, dim, n, alloc, err);
+    res = gk_packing_init(&pk, dim, n, alloc, err);
     if (res) return res;
     gk_rng_seed(&rng, def->seed);
     rr = pk.r;
@@ -565,7 +565,7 @@ GKDEF gk_result gk_packing_tile(const gk_packing *pk, int nx, int ny, int nz, gk
     total = (long)pk->n * rep[0] * rep[1] * rep[2];
     if (total > 2000000000L) return gk_err_set(err, GK_ERR_ARG, "tile: %ld particles are too many", total);
     if (!(gk_m3_inverse(pk->h, hi) > 0.0)) return gk_err_set(err, GK_ERR_CELL, "tile: singular cell");
-    if ((res = gk_packing_alloc(&t, dim, (int)total, alloc, err)) != GK_OK) return res;
+    if ((res = gk_packing_init(&t, dim, (int)total, alloc, err)) != GK_OK) return res;
     gk_m3_copy(pk->h, t.h);
     for (k = 0; k < 3; ++k) /* column k of h scaled by rep[k] */
         for (a = 0; a < 3; ++a) t.h[3 * a + k] *= rep[k];
@@ -627,7 +627,7 @@ GKDEF gk_result gk_packing_subset(const gk_packing *pk, const double lo[3], cons
         }
         if (q == 0) {
             if (cnt < 1) return gk_err_set(err, GK_ERR_ARG, "subset: no particle inside the box");
-            if ((res = gk_packing_alloc(&t, dim, cnt, alloc, err)) != GK_OK) return res;
+            if ((res = gk_packing_init(&t, dim, cnt, alloc, err)) != GK_OK) return res;
             gk_m3_identity(t.h);
             for (k = 0; k < dim; ++k) t.h[4 * k] = hi[k] - lo[k];
             cnt = 0;

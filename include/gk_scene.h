@@ -724,7 +724,7 @@ GKDEF gk_result gk_scene_create(gk_scene *out, const gk_scene_def *def, const gk
     S.dim = dim;
     S.open = ~def->periodic & ((1u << dim) - 1u);
     /* the packing in cell coordinates */
-    if ((res = gk_packing_alloc(&fr, dim, pk->n, &def->rve.alloc, err)) != GK_OK) return res;
+    if ((res = gk_packing_init(&fr, dim, pk->n, &def->rve.alloc, err)) != GK_OK) return res;
     gk_m3_identity(fr.h);
     for (k = 0; k < dim; ++k) fr.h[4 * k] = L[k];
     for (p = 0; p < pk->n && !res; ++p) {

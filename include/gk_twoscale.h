@@ -353,9 +353,9 @@ GKDEF gk_result gk_twoscale_accepted(gk_twoscale *ts, double *stress, double *D)
 GKDEF gk_result gk_twoscale_fields(gk_twoscale *ts, gk_twoscale_field *f);
 /* the whole set and the driver's block (nblock bytes, rank 0's) into one file */
 GKDEF gk_result gk_twoscale_save(gk_twoscale *ts, const char *path, const void *block, size_t nblock);
-/* ... and back; *block (allocated with def.alloc, free with gk_twoscale_free) on every rank */
+/* ... and back; *block (allocated with def.alloc, free with gk_twoscale_free_block) on every rank */
 GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block, size_t *nblock);
-GKDEF void gk_twoscale_free(const gk_twoscale *ts, void *block);
+GKDEF void gk_twoscale_free_block(const gk_twoscale *ts, void *block);
 /* the uniform draw of prototypes per point used when def.pick is NULL and nprotos > 1 */
 GKDEF void gk_twoscale_draw(int npoints, int nprotos, uint64_t seed, int *pick);
 
@@ -922,7 +922,7 @@ static gk_result gk__ts_create(gk_twoscale *ts, const gk_twoscale_def *def) {
     for (k = 0; k < d.nprotos && !res; ++k) {
         const gk_packing *src = d.protos[k].packing;
         gk_packing *dst = &ts->pk[k];
-        res = gk_packing_alloc(dst, src->dim, src->n, a, &ts->err);
+        res = gk_packing_init(dst, src->dim, src->n, a, &ts->err);
         if (res) break;
         gk_m3_copy(src->h, dst->h);
         memcpy(dst->x, src->x, (size_t)src->n * sizeof(double));
@@ -1901,6 +1901,6 @@ GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block
     return GK_OK;
 }
 
-GKDEF void gk_twoscale_free(const gk_twoscale *ts, void *block) { gk_free(&ts->def.alloc, block); }
+GKDEF void gk_twoscale_free_block(const gk_twoscale *ts, void *block) { gk_free(&ts->def.alloc, block); }
 
 #endif /* GK_TWOSCALE implementation */

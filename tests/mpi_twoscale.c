@@ -63,7 +63,8 @@ static int run_both(gk_twoscale *w, gk_twoscale *s, const double *dH, gk_result 
 
 static int fields_same(gk_twoscale *w, gk_twoscale *s) {
     gk_twoscale_field fw[NP], fs[NP];
-    return gk_twoscale_fields(w, fw) == GK_OK && gk_twoscale_fields(s, fs) == GK_OK && !memcmp(fw, fs, sizeof fw);
+    return gk_twoscale_fields(w, fw) == GK_OK && gk_twoscale_fields(s, fs) == GK_OK &&
+           !memcmp(fw, fs, sizeof fw);
 }
 
 /* 2 ranks = 1 rank, bit for bit, over steps with migrations; eq 9 and eq 8 with reuse */
@@ -140,10 +141,10 @@ TEST(checkpoints_move_between_rank_counts) {
     CHECK(make_set(&s2, MPI_COMM_SELF, GK_TWOSCALE_TANGENT_HOMOG, 0.3) == GK_OK);
     CHECK(gk_twoscale_load(&w2, BUILD "/tests/t_tsm_s.bin", &b, &nb) == GK_OK && nb == 1 &&
           ((char *)b)[0] == 's');
-    gk_twoscale_free(&w2, b);
+    gk_twoscale_free_block(&w2, b);
     CHECK(gk_twoscale_load(&s2, BUILD "/tests/t_tsm_w.bin", &b, &nb) == GK_OK && nb == 1 &&
           ((char *)b)[0] == 'w');
-    gk_twoscale_free(&s2, b);
+    gk_twoscale_free_block(&s2, b);
     if (rank == 0) { /* a truncated copy */
         FILE *in = fopen(BUILD "/tests/t_tsm_w.bin", "rb"), *out = fopen(BUILD "/tests/t_tsm_bad.bin", "wb");
         char buf[1000];
@@ -162,9 +163,11 @@ TEST(checkpoints_move_between_rank_counts) {
         all4[0] = &w, all4[1] = &s, all4[2] = &w2, all4[3] = &s2;
         step_dH(k, 5e-4, dH);
         for (m = 0; m < 4; ++m) {
-            ok &= gk_twoscale_run(all4[m], rank == 0 || all4[m]->nranks == 1 ? dH : NULL, NULL, sg[m], Dg[m]) == GK_OK;
+            ok &= gk_twoscale_run(all4[m], rank == 0 || all4[m]->nranks == 1 ? dH : NULL, NULL, sg[m],
+                                  Dg[m]) == GK_OK;
             ok &= same(sg[m], sg[0], 9 * NP) && same(Dg[m], Dg[0], 16 * NP);
-            ok &= !memcmp(gk_twoscale_points(all4[m]), gk_twoscale_points(&w), NP * sizeof(gk_twoscale_point));
+            ok &=
+                !memcmp(gk_twoscale_points(all4[m]), gk_twoscale_points(&w), NP * sizeof(gk_twoscale_point));
         }
         for (m = 0; m < 4; ++m) ok &= gk_twoscale_accept(all4[m]) == GK_OK;
     }
@@ -233,7 +236,10 @@ static void run_all(const char *name, void (*fn)(void)) {
     fn();
     mine = gk__t_checks_failed;
     MPI_Allreduce(&mine, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-    if (all) ++gk__t_failed; else ++gk__t_passed;
+    if (all)
+        ++gk__t_failed;
+    else
+        ++gk__t_passed;
     if (rank == 0) printf("%s %s\n", all ? "FAIL" : "ok  ", name), fflush(stdout);
 }
 
@@ -249,12 +255,15 @@ int main(int argc, char **argv) {
            gk_packing_read("bench/data/tradeoff/rve200.txt", &pk200, NULL, &e) == GK_OK;
     MPI_Allreduce(&have, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     if (size != 2 || !all) {
-        if (rank == 0) printf("FAIL mpi_twoscale needs 2 ranks (mpirun -np 2) and the packings\n# mpi_twoscale: 0 passed, 1 failed\n");
+        if (rank == 0)
+            printf("FAIL mpi_twoscale needs 2 ranks (mpirun -np 2) and the packings\n# mpi_twoscale: 0 "
+                   "passed, 1 failed\n");
         MPI_Finalize();
         return 1;
     }
     run_all("two_ranks_equal_one_rank", two_ranks_equal_one_rank);
-    run_all("a_failed_point_on_another_rank_is_reported_everywhere", a_failed_point_on_another_rank_is_reported_everywhere);
+    run_all("a_failed_point_on_another_rank_is_reported_everywhere",
+            a_failed_point_on_another_rank_is_reported_everywhere);
     run_all("checkpoints_move_between_rank_counts", checkpoints_move_between_rank_counts);
     run_all("balance_before_every_run", balance_before_every_run);
     gk_packing_free(&pk100), gk_packing_free(&pk200);

@@ -15,7 +15,7 @@ static gk_result two_body(gk_rve *rve, gk_rve_def *def, int dim, double r, doubl
     gk_err e;
     gk_result res;
     int p;
-    res = gk_packing_alloc(&pk, dim, 2, NULL, &e);
+    res = gk_packing_init(&pk, dim, 2, NULL, &e);
     if (res) return res;
     gk_m3_identity(pk.h);
     pk.h[0] = pk.h[4] = 1.0;

@@ -84,7 +84,7 @@ static gk_result hex_lattice(gk_rve *rve, gk_rve_def *def, int nx, int ny, doubl
     gk_result res;
     double a = 2 * r - delta;
     int ix, iy, p = 0;
-    res = gk_packing_alloc(&pk, 2, nx * ny, NULL, &e);
+    res = gk_packing_init(&pk, 2, nx * ny, NULL, &e);
     if (res) return res;
     gk_m3_identity(pk.h);
     pk.h[0] = nx * a;
@@ -136,7 +136,7 @@ TEST(love_stress_cubic_lattice_3d) {
     double r = 0.005, delta = 3e-6, a = 2 * r - delta, s[9];
     int n = 6, i, j, k, p = 0;
     def.mat.kn = 3e5;
-    CHECK(gk_packing_alloc(&pk, 3, n * n * n, NULL, &e) == GK_OK);
+    CHECK(gk_packing_init(&pk, 3, n * n * n, NULL, &e) == GK_OK);
     gk_m3_identity(pk.h);
     pk.h[0] = pk.h[4] = pk.h[8] = n * a;
     for (i = 0; i < n; ++i)
@@ -339,7 +339,7 @@ TEST(relaxed_tangent_of_a_chain_is_springs_in_series) {
     int p;
     def.mat.friction = 0.5;
     for (p = 0; p < 12; ++p) rad[p] = p % 3 == 2 ? rb : ra;
-    CHECK(gk_packing_alloc(&pk, 2, 12, NULL, &e) == GK_OK);
+    CHECK(gk_packing_init(&pk, 2, 12, NULL, &e) == GK_OK);
     for (p = 0; p < 12; ++p) {
         len[p] = rad[p] + rad[(p + 1) % 12] - ov; /* contact p -> p + 1 */
         pk.x[p] = x, pk.y[p] = 0.025, pk.r[p] = rad[p];
@@ -859,7 +859,7 @@ TEST(particles_leaving_the_cell) {
     int p, q = -1;
     def.mat.friction = 0;
     def.damping = 0;
-    CHECK(gk_packing_alloc(&pk, 2, 2, NULL, &e) == GK_OK);
+    CHECK(gk_packing_init(&pk, 2, 2, NULL, &e) == GK_OK);
     pk.h[0] = pk.h[4] = L;
     pk.x[0] = 0.2;
     pk.y[0] = 0.25;

@@ -42,7 +42,7 @@ static gk_result hex_lattice(gk_rve *rve, const gk_rve_def *def, int nx, int ny,
     gk_result res;
     double a = 2 * r - delta;
     int ix, iy, p = 0;
-    res = gk_packing_alloc(&pk, 2, nx * ny, NULL, &e);
+    res = gk_packing_init(&pk, 2, nx * ny, NULL, &e);
     if (res) return res;
     pk.h[0] = nx * a;
     pk.h[4] = ny * a * sqrt(3.0) / 2;
@@ -257,7 +257,7 @@ static gk_result fcc_lattice(gk_rve *rve, const gk_rve_def *def, int n, double r
     gk_err e;
     gk_result res;
     int i, j, k, b, p = 0;
-    res = gk_packing_alloc(&pk, 3, 4 * n * n * n, NULL, &e);
+    res = gk_packing_init(&pk, 3, 4 * n * n * n, NULL, &e);
     if (res) return res;
     pk.h[0] = pk.h[4] = pk.h[8] = n * a;
     for (i = 0; i < n; ++i)

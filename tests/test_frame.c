@@ -87,7 +87,7 @@ TEST(energy_of_one_contact_is_eq32) {
     gk_rve r;
     gk_rve_def d = law(0u);
     double ek, ep, delta = 1e-6, rr = 1e-3;
-    CHECK(gk_packing_alloc(&two, 2, 2, NULL, NULL) == GK_OK);
+    CHECK(gk_packing_init(&two, 2, 2, NULL, NULL) == GK_OK);
     gk_m3_identity(two.h);
     two.h[0] = two.h[4] = 0.02;
     two.x[0] = 0.005, two.y[0] = 0.01, two.r[0] = rr;
@@ -208,7 +208,7 @@ TEST(bad_input_is_refused) {
     int steps, p;
     CHECK(load());
     if (!have) return;
-    CHECK(gk_packing_alloc(&q, 2, pk.n, NULL, NULL) == GK_OK);
+    CHECK(gk_packing_init(&q, 2, pk.n, NULL, NULL) == GK_OK);
     gk_m3_copy(pk.h, q.h);
     for (p = 0; p < pk.n; ++p) q.x[p] = pk.x[p] + 1e-6, q.y[p] = pk.y[p] + 1e-6, q.r[p] = pk.r[p];
     CHECK(gk_frame_build(&fr, &q, NULL, &e) == GK_ERR_ARG && strstr(e.msg, "corner"));

@@ -92,7 +92,7 @@ static int impact_scene(gk_scene *sc, int n, double (*x)[3], const double *r, co
     }
     d.rve.mat = *m;
     d.rve.dt = dt;
-    if (gk_packing_alloc(&pk, 3, n, NULL, &e)) return 1;
+    if (gk_packing_init(&pk, 3, n, NULL, &e)) return 1;
     for (p = 0; p < n; ++p) {
         pk.x[p] = x[p][0];
         pk.y[p] = x[p][1];
@@ -647,7 +647,7 @@ static int lattice(gk_packing *pk, int dim, int nx, int ny, int nz, double r, do
     gk_rng rng;
     gk_err e;
     int a, b, c, q = 0, n = nx * ny * (dim == 3 ? nz : 1);
-    if (gk_packing_alloc(pk, dim, n, NULL, &e)) return 1;
+    if (gk_packing_init(pk, dim, n, NULL, &e)) return 1;
     gk_rng_seed(&rng, seed);
     for (c = 0; c < (dim == 3 ? nz : 1); ++c)
         for (b = 0; b < ny; ++b)
@@ -1498,7 +1498,7 @@ TEST(bodies_pipe_drum_rectangle_cylinder) {
         d.rve.mat.zeta_n = 0.5;
         d.rve.damping = 0.3;
         d.rve.dt_factor = 0.2;
-        CHECK(gk_packing_alloc(&pk, 3, 1, NULL, &e) == GK_OK);
+        CHECK(gk_packing_init(&pk, 3, 1, NULL, &e) == GK_OK);
         pk.r[0] = 0.01;
         pk.x[0] = k == 1 ? 0.06 : 0.0; /* k = 1: beyond the rectangle's edge */
         pk.y[0] = k == 2 ? -0.05 : 0.012;

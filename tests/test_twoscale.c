@@ -351,7 +351,7 @@ TEST(checkpoint_round_trip_is_bit_identical) {
     CHECK(make_set(&b, 8, 1, GK_TWOSCALE_ADAPTIVE, GK_TWOSCALE_TANGENT_HOMOG, 0.3) == GK_OK);
     CHECK(gk_twoscale_load(&b, BUILD "/tests/t_ts_ck.bin", &got, &ng) == GK_OK);
     CHECK(ng == sizeof blk && got && memcmp(got, blk, ng) == 0);
-    gk_twoscale_free(&b, got);
+    gk_twoscale_free_block(&b, got);
     for (k = 2; k < 5; ++k) { /* large steps: the networks outgrow the loaded key arrays */
         step_dH(8, k, 2e-3, dH);
         ok &=
@@ -479,7 +479,7 @@ TEST(corrupt_checkpoints_are_refused_and_change_nothing) {
         void *blk = NULL;
         size_t nb = 0;
         CHECK(gk_twoscale_load(&b, BUILD "/tests/t_ts_ck2.bin", &blk, &nb) == GK_OK && nb == 3);
-        gk_twoscale_free(&b, blk);
+        gk_twoscale_free_block(&b, blk);
     }
     free(img), free(x);
     gk_twoscale_destroy(&a), gk_twoscale_destroy(&b);
@@ -568,7 +568,7 @@ TEST(caller_procedure_runs_every_point) {
     /* a fresh set from the checkpoint (one thread): the accepted stress and the next run, bit for bit */
     CHECK(make_proc_set(&b, 1, &lgb) == GK_OK);
     CHECK(gk_twoscale_load(&b, BUILD "/tests/t_ts_proc.bin", &blk, &nb) == GK_OK && nb == 1);
-    gk_twoscale_free(&b, blk);
+    gk_twoscale_free_block(&b, blk);
     CHECK(gk_twoscale_accepted(&b, acc, NULL) == GK_OK && same(acc, s, 36));
     CHECK(gk_twoscale_run(&b, dH2, NULL, sb, NULL) == GK_OK && same(sb, s2, 36));
     gk_twoscale_reject(&b);

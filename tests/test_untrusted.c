@@ -833,7 +833,7 @@ TEST(twoscale_checkpoint_reference_is_checked) {
         key = ((uint64_t)5 << 32 | 7) << 1, memcpy(x + keys + 8, &key, 8); /* in order: accepted */
         spill_resealed(bad, x, nx);
         CHECK_EQ_INT(gk_twoscale_load(&ts, bad, &blk, &nb), GK_OK);
-        gk_twoscale_free(&ts, blk);
+        gk_twoscale_free_block(&ts, blk);
     }
     free(x), free(img);
     gk_twoscale_destroy(&ts);
@@ -1035,6 +1035,23 @@ TEST(bench_tradeoff_fails_when_a_run_fails) {
     CHECK(gk_test_file_has(OUT("tradeoff/tradeoff.csv"), "group,sweep"));
 }
 
+/* README: "every other call writes it to the gk_err * you pass (NULL: no message)" - bad input
+ * with a NULL gk_err is still refused, without a crash */
+TEST(a_null_gk_err_is_allowed) {
+    gk_packing pk;
+    gk_mesh m;
+    gk_mpm_grid g;
+    gk_pcell c;
+    const int n0[3] = {0, 0, 0}, n2[3] = {2, 2, 1};
+    const double o[3] = {0.0, 0.0, 0.0}, len[3] = {1.0, 1.0, 1.0}, hbad[9] = {0};
+    CHECK(gk_packing_read(BUILD "/tests/no_such_packing.txt", &pk, NULL, NULL) != GK_OK);
+    CHECK(gk_packing_init(&pk, 5, 10, NULL, NULL) != GK_OK);
+    CHECK(gk_mesh_read_gmsh(BUILD "/tests/no_such_mesh.msh", &m, NULL, NULL) != GK_OK);
+    CHECK(gk_mesh_structured(&m, GK_Q4, n0, o, len, NULL, NULL) != GK_OK);
+    CHECK(gk_mpm_grid_create(&g, 2, o, -1.0, n2, NULL, NULL) != GK_OK);
+    CHECK(gk_pcell_init(&c, 2, hbad, NULL) != GK_OK);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     mkdir(BUILD "/tests", 0755);
@@ -1066,5 +1083,6 @@ int main(int argc, char **argv) {
     RUN(friction_angle_in_degrees_with_a_plausible_range);
     RUN(rve_path_exits_nonzero_when_its_result_is_lost);
     RUN(bench_tradeoff_fails_when_a_run_fails);
+    RUN(a_null_gk_err_is_allowed);
     return gk_test_done();
 }

@@ -43,9 +43,7 @@ static char in_path[512], out_path[512], ref_path[512];
 static int ready;
 static const double dH0[9] = {0, 1e-5, 0, -0.5e-5, 0, 0, 0, 0, 0};
 
-static void cleanup(void) {
-    remove(in_path), remove(out_path), remove(ref_path);
-}
+static void cleanup(void) { remove(in_path), remove(out_path), remove(ref_path); }
 
 /* the set's whole state as its checkpoint (with an empty driver block) equals the pristine one */
 static int same_as_pristine(void) {
@@ -131,10 +129,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     memcpy(fv, f, sizeof fv);
     fuzz_all_finite(fv, sizeof fv / sizeof fv[0]);
     FUZZ_CHECK(gk_twoscale_save(&ts, out_path, blk, nb) == GK_OK);
-    gk_twoscale_free(&ts, blk);
+    gk_twoscale_free_block(&ts, blk);
     blk = NULL;
     FUZZ_CHECK(gk_twoscale_load(&ts, out_path, &blk, &nb) == GK_OK);
-    gk_twoscale_free(&ts, blk);
+    gk_twoscale_free_block(&ts, blk);
     /* one increment from them */
     for (k = 0; k < 9 * NPT; ++k) dH[k] = dH0[k % 9];
     r = gk_twoscale_run(&ts, dH, NULL, S, D);
@@ -143,14 +141,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     } else {
         const gk_twoscale_point *pts = gk_twoscale_points(&ts);
         FUZZ_CHECK(r == GK_ERR_STATE && gk_twoscale_error(&ts)[0] != '\0');
-        for (k = 0; k < NPT; ++k) FUZZ_CHECK(pts[k].code == GK_OK || gk_twoscale_point_error(&ts, k)[0] != '\0');
+        for (k = 0; k < NPT; ++k)
+            FUZZ_CHECK(pts[k].code == GK_OK || gk_twoscale_point_error(&ts, k)[0] != '\0');
     }
     FUZZ_CHECK(gk_twoscale_accept(&ts) == GK_OK);
     FUZZ_CHECK(gk_twoscale_accepted(&ts, S, D) == GK_OK);
     fuzz_all_finite(S, 9 * NPT), fuzz_all_finite(D, 16 * NPT);
     /* back to the pristine set for the next input */
     FUZZ_CHECK(gk_twoscale_load(&ts, ref_path, &blk, &nb) == GK_OK);
-    gk_twoscale_free(&ts, blk);
+    gk_twoscale_free_block(&ts, blk);
     FUZZ_CHECK(same_as_pristine());
     return 0;
 }
