@@ -264,7 +264,7 @@ static int fdb_fields_now(fd_model *M) {
             snprintf(file, sizeof file, "fabric_field_%04d.svg", M->step);
             snprintf(title, sizeof title, "fabric anisotropy F_a (eq 25) at axial strain %.2f %% (range 0-1)",
                      100 * e1);
-            return fd_write_field_svg(M, 7, file, title, FDB_FABRIC_LABEL, 0.0, 1.0);
+            return fd_write_field_svg(M, 7, 1.0, file, title, FDB_FABRIC_LABEL, 0.0, 1.0);
         }
     return 0;
 }
@@ -411,7 +411,7 @@ static int fdb_local(fd_model *M, int mid) {
     free(x);
     snprintf(title, sizeof title, "fabric anisotropy F_a (eq 25) at axial strain %.2f %% (range 0-1)",
              100 * M->eps_done);
-    bad = bad || fd_write_field_svg(M, 7, "fabric_field.svg", title, FDB_FABRIC_LABEL, 0.0, 1.0);
+    bad = bad || fd_write_field_svg(M, 7, 1.0, "fabric_field.svg", title, FDB_FABRIC_LABEL, 0.0, 1.0);
     if (bad || !M->root) return bad;
     printf("LOCAL inside_gp=%d inside_eps_q=%.4g edge_gp=%d edge_void_ratio=%.4g outside_gp=%d "
            "outside_eps_q=%.4g "
@@ -452,7 +452,7 @@ static int fdb_finish(fd_model *M, int status) {
     }
     free(x), free(y1), free(y2);
     snprintf(title, sizeof title, "eps_q at axial strain %.2f %%", 100 * M->eps_done);
-    bad = bad || fd_write_field_svg(M, 0, "eps_q_field.svg", title, "eps_q [-]", 0, 0);
+    bad = bad || fd_write_field_svg(M, 0, 100.0, "eps_q_field.svg", title, "eps_q [%]", 0, 0);
     fdb_band(M, &ang, &wid, &mid);
     bad = bad || fdb_local(M, mid);
     bad = bad || (status != 3 && fdb_checkpoint(M));

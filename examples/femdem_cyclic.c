@@ -409,7 +409,7 @@ static int cyclic_summary(cyc_model *C, int status) {
         free(v);
     }
     snprintf(title, sizeof title, "void ratio after %.2f cycles, gamma = %.2f %%", xl->cycle, 100 * c->gamma);
-    bad = bad || fd_write_field_svg(M, 2, "void_ratio_field.svg", title, "void ratio e [-]", 0, 0);
+    bad = bad || fd_write_field_svg(M, 2, 1.0, "void_ratio_field.svg", title, "void ratio e [-]", 0, 0);
     bad = bad || ((!o->vtk_every || M->step % o->vtk_every) && fd_write_vtk(M, M->step));
     bad = bad || (status != 3 && checkpoint(M));
     if (bad) return 1;

@@ -79,12 +79,12 @@ static int fd_write_vtk(fd_model *M, int step) {
     return fd_agree(M, bad);
 }
 
-/* a Gauss-point field (fd_gp_fields index) as a map in mm: each Gauss point owns the sub-quad of its
- * element around it; the platens (the bottom and top node rows) drawn on top; label: the colour bar's
- * quantity with its unit; range [vmin, vmax] fixed when vmax > vmin (values beyond take the end
- * colours), else the field's own */
-static int fd_write_field_svg(fd_model *M, int field, const char *file, const char *title, const char *label,
-                              double vmin, double vmax) {
+/* a Gauss-point field (fd_gp_fields index) times `scale` (100: a strain in %) as a map in mm: each
+ * Gauss point owns the sub-quad of its element around it; the platens (the bottom and top node rows)
+ * drawn on top; label: the colour bar's quantity with its unit; range [vmin, vmax] fixed when
+ * vmax > vmin (values beyond take the end colours), else the field's own */
+static int fd_write_field_svg(fd_model *M, int field, double scale, const char *file, const char *title,
+                              const char *label, double vmin, double vmax) {
     int per = M->o.quad, e, i, j, c, a, g = 0, bad = 0, len[2] = {2, 2};
     double *all = fd_gp_fields(M), *xy = (double *)malloc((size_t)M->ngp * 8 * sizeof(double)),
            *val = (double *)malloc((size_t)M->ngp * sizeof(double)), line[8], lo = HUGE_VAL, hi = -HUGE_VAL,
@@ -105,7 +105,7 @@ static int fd_write_field_svg(fd_model *M, int field, const char *file, const ch
                         gk_mesh_point(&M->mesh, e, xi, x);
                         xy[8 * g + 2 * c] = x[0], xy[8 * g + 2 * c + 1] = x[1];
                     }
-                    val[g] = all[FD_NFIELD * g + field];
+                    val[g] = scale * all[FD_NFIELD * g + field];
                 }
         for (a = 0; a < M->mesh.nnode; ++a) { /* the platens span the specimen's extent in x */
             if (M->mesh.x[2 * a] < lo) lo = M->mesh.x[2 * a];

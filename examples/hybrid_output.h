@@ -242,7 +242,7 @@ static int band_measure(run *R, double *thick_D50) {
         snprintf(title, sizeof title, "%s %s: incremental shear strain, strain %.3g to %.3g",
                  test_name[R->o.test], mode_name[R->o.mode], R->o.win0, R->strain);
         fd.title = title;
-        fd.label = "gamma (incremental) [-]";
+        fd.label = "gamma (incremental) [%]";
         fd.xlabel = "x [mm]";
         fd.ylabel = "y [mm]";
         fd.coord_scale = 1e3;
@@ -250,6 +250,7 @@ static int band_measure(run *R, double *thick_D50) {
         fd.line_len = len;
         fd.line_xy = lines;
         snprintf(path, sizeof path, "%s/band.svg", R->o.out);
+        for (p = 0; p < n; ++p) val[p] *= 100.0; /* strain in % as in every plot (the band was measured) */
         if (gk_field_svg(path, &fd, n, 4, xy, val, &e))
             bad = fprintf(stderr, "error: cannot write %s\n", path);
     }
