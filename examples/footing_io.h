@@ -116,7 +116,7 @@ static double proc_kb(const char *key) {
     return v;
 }
 
-/* the footing (its base and edge, a stub of its height), the smooth wall and the base */
+/* the footing (its base and edges, drawn at most 3 cells tall), the smooth wall and the base */
 static void outline(const ft *X, mpd_outline *ol) {
     double W = X->f.width, D = X->f.depth, yb = D - X->S.disp, hs = fmin(X->f.foot_height, 3 * X->h);
     double foot[8], box[6];

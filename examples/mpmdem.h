@@ -410,6 +410,13 @@ static gk_result mpd_prepare_rve(mpd_proto *P, double p, gk_rve_state *st, gk_er
     return GK_OK;
 }
 
+/* the level (0 at the top) of a point at height y in `levels` equal layers over `depth` (the
+ * geostatic levels of mpd_prepare_levels; points outside take the nearest level) */
+GK_INLINE int mpd_level_of(double depth, int levels, double y) {
+    int k = (int)floor((depth - y) / (depth / levels));
+    return k < 0 ? 0 : k >= levels ? levels - 1 : k;
+}
+
 /* Geostatic RVE levels (mpmdem_collapse, mpmdem_pipe): the packing prepared
  * as it is first (st[0]; its bulk density *rho_ref), then `levels` equal
  * layers over `depth`, each level's RVE consolidated (in parallel) to the

@@ -246,11 +246,6 @@ static int parse(cl *X, int argc, char **argv) {
 }
 
 /* ---------------------------------------------------- initial state */
-static int level_of(const cl *X, double y) {
-    int k = (int)floor((X->b.height - y) / (X->b.height / X->b.levels));
-    return k < 0 ? 0 : k >= X->b.levels ? X->b.levels - 1 : k;
-}
-
 /* one RVE state per pressure level (mpd_prepare_levels) */
 static int prepare_levels(cl *X, gk_err *err) {
     const cl_opts *b = &X->b;
@@ -287,7 +282,7 @@ static int setup(cl *X, gk_err *err) {
     X->pick = (int *)malloc((size_t)X->pts.n * sizeof *X->pick);
     X->work = (int *)malloc((size_t)X->pts.n * sizeof *X->work);
     if (!X->pick || !X->work) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
-    for (i = 0; i < X->pts.n; ++i) X->pick[i] = level_of(X, X->pts.x[1][i]);
+    for (i = 0; i < X->pts.n; ++i) X->pick[i] = mpd_level_of(X->b.height, X->b.levels, X->pts.x[1][i]);
     if (mpd_micro_create(&X->M, &X->pts, &X->P, X->st, b->levels, X->pick, &X->o, err)) return 1;
     X->M.freeze = b->thin_freeze;
     for (i = 0; i < X->pts.n; ++i) {

@@ -261,11 +261,6 @@ static int parse(pp *X, int argc, char **argv) {
 }
 
 /* ---------------------------------------------------- initial state */
-static int level_of(const pp *X, double y) {
-    int k = (int)floor((X->depth - y) / (X->depth / X->b.levels));
-    return k < 0 ? 0 : k >= X->b.levels ? X->b.levels - 1 : k;
-}
-
 /* one RVE state per pressure level (mpd_prepare_levels) */
 static int prepare_levels(pp *X, gk_err *err) {
     const pp_opts *b = &X->b;
@@ -317,7 +312,7 @@ static int setup(pp *X, gk_err *err) {
     if (mpd_check_opts(&X->run, &X->o)) return 2;
     X->pick = (int *)malloc((size_t)X->pts.n * sizeof *X->pick);
     if (!X->pick) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
-    for (i = 0; i < X->pts.n; ++i) X->pick[i] = level_of(X, X->pts.x[1][i]);
+    for (i = 0; i < X->pts.n; ++i) X->pick[i] = mpd_level_of(X->depth, X->b.levels, X->pts.x[1][i]);
     if (mpd_micro_create(&X->M, &X->pts, &X->P, X->st, b->levels, X->pick, &X->o, err)) return 1;
     for (i = 0; i < X->pts.n; ++i) X->pts.m[i] = X->lev_rho[X->pick[i]] * X->pts.vol0[i];
     X->def = mpd_mpm_def(&X->o);
