@@ -1,7 +1,9 @@
 # grainkit - the only build. `make help` lists the targets.
 #
-# Every program under tests/, examples/, bench/ and tools/ is one C file that
-# defines GK_IMPLEMENTATION itself, so each builds with a single compiler call.
+# Every program under examples/, bench/ and tools/ is one C file that defines
+# GK_IMPLEMENTATION itself, so each builds with a single compiler call. The
+# tests, and the sanitizer builds of the drivers, link one implementation object
+# per build instead (tests/gk_impl.c), as a project of several files does.
 # Variables you may override: CC, CXX, OPT, ARCH, OMP, PREFIX, BUILD.
 
 CC      ?= cc
@@ -79,8 +81,15 @@ $(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests $(BUILD)/fuzz
 
 # the tests launch the programs of $(BUILD) and write under $(BUILD)/tests
 TESTDEF := -DBUILD='"$(BUILD)"'
-$(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)
-	$(CC) $(CFLAGS) $(TESTDEF) -o $@ $< $(LDLIBS)
+# The implementation is compiled once per build (tests/gk_impl.c: normal, ASan+UBSan,
+# no-SIMD) and linked into every test, as a project of several files does; a test
+# that defines GK_IMPLEMENTATION itself (float reals, GK_DEM_PAR_MIN) compiles its own.
+OWN_IMPL := $(patsubst tests/test_%.c,%,$(shell grep -l '^\#define GK_IMPLEMENTATION' $(TEST_SRC)))
+impl_for = $(if $(filter $(1),$(OWN_IMPL)),,$(2))
+$(BUILD)/gk_impl.o: tests/gk_impl.c $(HEADERS) | $(BUILD)
+	$(CC) $(CFLAGS) -c -o $@ $<
+$(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(BUILD)/gk_impl.o | $(BUILD)
+	$(CC) $(CFLAGS) $(TESTDEF) -o $@ $< $(call impl_for,$*,$(BUILD)/gk_impl.o) $(LDLIBS)
 
 # test_mpmdem_footing also tests the footing driver's examples/footing_mech.h directly
 $(BUILD)/test_mpmdem_footing $(BUILD)/asan/test_mpmdem_footing $(BUILD)/nosimd/test_mpmdem_footing: examples/footing_mech.h
@@ -149,40 +158,55 @@ test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) $(BUILD)/bench_tradeoff $(if 
 	@$(if $(HAVE_MPI),,echo "make test: $(MPICC) not found, the MPI tests are skipped (apt-get install openmpi-bin libopenmpi-dev)";) \
 	  tests/run_tests.sh $(TESTS) $(FUZZ_REPLAY) $(MPI_RUN)
 
-# the fuzz corpora and every crasher replayed by a plain program (tests/fuzz/replay.c)
-$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)
-	$(CC) $(CFLAGS) -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(LDLIBS)
+# the fuzz corpora and every crasher replayed by a plain program (tests/fuzz/replay.c);
+# the harness's own GK_IMPLEMENTATION (libFuzzer builds it alone) gives way to the
+# build's implementation object (GK_IMPLEMENTATION_ELSEWHERE, gk_base.h)
+ELSEWHERE := -DGK_IMPLEMENTATION_ELSEWHERE
+$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(BUILD)/gk_impl.o | $(BUILD)
+	$(CC) $(CFLAGS) $(ELSEWHERE) -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(BUILD)/gk_impl.o $(LDLIBS)
 
 # ---------------------------------------------------------------- check
 SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 # -g1 (line tables): sanitizer reports still name file:line and inlined frames,
 # at half the compile time of -g; rebuild one program with -g to debug it
 SANFLAGS := $(WARN) -O1 -g1 $(ARCH) $(FPFLAGS) $(SAN)
-ASAN_TESTS   := $(patsubst tests/%.c,$(BUILD)/asan/%,$(TEST_SRC)) $(patsubst %,$(BUILD)/asan/fuzz_replay_%,$(FUZZ_NAMES))
-NOSIMD_TESTS := $(patsubst tests/%.c,$(BUILD)/nosimd/%,$(TEST_SRC))
+# tests that only run the example programs are left out of the ASan and no-SIMD
+# builds: they would run the same -O2 programs again (tests/smoke_asan.sh runs the
+# drivers built with ASan+UBSan)
+DRIVER_TESTS := examples femdem_dr hybrid_driver mpmdem_biaxial mpmdem_collapse mpmdem_footing mpmdem_pipe
+LIB_TESTS    := $(filter-out $(DRIVER_TESTS),$(patsubst tests/test_%.c,%,$(TEST_SRC)))
+ASAN_TESTS   := $(patsubst %,$(BUILD)/asan/test_%,$(LIB_TESTS)) $(patsubst %,$(BUILD)/asan/fuzz_replay_%,$(FUZZ_NAMES))
+NOSIMD_TESTS := $(patsubst %,$(BUILD)/nosimd/test_%,$(LIB_TESTS))
 
-$(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/asan
-	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK $(TESTDEF) -o $@ $< $(LDLIBS)
+$(BUILD)/asan/gk_impl.o: tests/gk_impl.c $(HEADERS) | $(BUILD)/asan
+	$(CC) $(SANFLAGS) -Iinclude -c -o $@ $<
+$(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(BUILD)/asan/gk_impl.o | $(BUILD)/asan
+	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK $(TESTDEF) -o $@ $< $(call impl_for,$*,$(BUILD)/asan/gk_impl.o) $(LDLIBS)
 
-$(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)/asan
-	$(CC) $(SANFLAGS) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(LDLIBS)
+ASAN_IMPL := $(BUILD)/asan/gk_impl.o
+$(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(ASAN_IMPL) | $(BUILD)/asan
+	$(CC) $(SANFLAGS) $(ELSEWHERE) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(ASAN_IMPL) $(LDLIBS)
 
 # tools and drivers under ASan + UBSan for tests/smoke_asan.sh (a driver joins
-# by its name in SMOKE and its runs in the script)
+# by its name in SMOKE and its runs in the script), linked with the ASan
+# implementation object
 SMOKE := rve_path gk_pack mpmdem_biaxial mpmdem_single mpmdem_footing mpmdem_collapse mpmdem_pipe bench_scene_box femdem_nonlocal femdem_dr hybrid
-$(BUILD)/asan/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)/asan
-	$(CC) $(SANFLAGS) -Iinclude -o $@ $< $(LDLIBS)
-$(BUILD)/asan/%: tools/%.c $(HEADERS) | $(BUILD)/asan
-	$(CC) $(SANFLAGS) -Iinclude -o $@ $< $(LDLIBS)
-$(BUILD)/asan/bench_%: bench/%.c $(HEADERS) | $(BUILD)/asan
-	$(CC) $(SANFLAGS) -Iinclude -o $@ $< $(LDLIBS)
+$(BUILD)/asan/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) $(ASAN_IMPL) | $(BUILD)/asan
+	$(CC) $(SANFLAGS) $(ELSEWHERE) -Iinclude -o $@ $< $(ASAN_IMPL) $(LDLIBS)
+$(BUILD)/asan/%: tools/%.c $(HEADERS) $(ASAN_IMPL) | $(BUILD)/asan
+	$(CC) $(SANFLAGS) $(ELSEWHERE) -Iinclude -o $@ $< $(ASAN_IMPL) $(LDLIBS)
+$(BUILD)/asan/bench_%: bench/%.c $(HEADERS) $(ASAN_IMPL) | $(BUILD)/asan
+	$(CC) $(SANFLAGS) $(ELSEWHERE) -Iinclude -o $@ $< $(ASAN_IMPL) $(LDLIBS)
 
 check-smoke: $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) | $(BUILD)/tests
 	@echo "== tool and driver smoke runs under AddressSanitizer + UndefinedBehaviorSanitizer, leaks included"
 	@B=$(BUILD)/asan T=$(BUILD)/tests/smoke tests/run_tests.sh tests/smoke_asan.sh
 
-$(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/nosimd
-	$(CC) $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude -Itests $(TESTDEF) -o $@ $< $(LDLIBS)
+NOSIMDFLAGS := $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude
+$(BUILD)/nosimd/gk_impl.o: tests/gk_impl.c $(HEADERS) | $(BUILD)/nosimd
+	$(CC) $(NOSIMDFLAGS) -c -o $@ $<
+$(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(BUILD)/nosimd/gk_impl.o | $(BUILD)/nosimd
+	$(CC) $(NOSIMDFLAGS) -Itests $(TESTDEF) -o $@ $< $(call impl_for,$*,$(BUILD)/nosimd/gk_impl.o) $(LDLIBS)
 
 check-asan: $(ASAN_TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 	@echo "== tests under AddressSanitizer + UndefinedBehaviorSanitizer"

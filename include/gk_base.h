@@ -31,6 +31,12 @@
  *   GK_MALLOC/GK_FREE malloc/free  default allocator behind gk_allocator
  *   GK_FILE_MAX       INT_MAX      largest file gk_file_read accepts [bytes]
  *                                  (a reader given /dev/zero stops there)
+ *   GK_IMPLEMENTATION_ELSEWHERE    (on the command line) a GK_IMPLEMENTATION
+ *                    undefined     in the file is ignored: the program links
+ *                                  the implementation from an object compiled
+ *                                  once (many single-file programs, one
+ *                                  implementation; per-module
+ *                                  GK_<MODULE>_IMPLEMENTATION still apply)
  *
  * CONVENTIONS (all headers)
  *   - SI units throughout: m, kg, s, N, Pa.
@@ -54,6 +60,10 @@
  */
 #ifndef GK_BASE_H
 #define GK_BASE_H
+
+#ifdef GK_IMPLEMENTATION_ELSEWHERE
+#undef GK_IMPLEMENTATION
+#endif
 
 #include <stddef.h>
 #include <stdint.h>

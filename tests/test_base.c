@@ -1,6 +1,5 @@
 /* test_base.c - gk_base.h: tensors, polar decomposition, exponential, eigen,
  * allocator, random numbers, SIMD twin. */
-#define GK_IMPLEMENTATION
 #include "gk_base.h"
 #include "gk_test.h"
 #include <stdlib.h>

@@ -1,7 +1,6 @@
 /* test_cells.c - gk_cells.h and gk_pcell.h: candidate pairs against an O(N^2)
  * search over explicit periodic images, lattice re-mapping, Verlet criterion,
  * deformation paths and the servo. */
-#define GK_IMPLEMENTATION
 #include "gk_cells.h"
 #include "gk_pcell.h"
 #include "gk_test.h"

@@ -1,5 +1,4 @@
 /* test_contact.c - gk_contact.h laws, alone and through a two-particle RVE. */
-#define GK_IMPLEMENTATION
 #include "gk_homog.h"
 #include "gk_test.h"
 

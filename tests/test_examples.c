@@ -1,7 +1,6 @@
 /* test_examples.c - smoke tests of the example drivers and tools: they run,
  * exit 0, and write the documented outputs with sane values. Needs the
  * binaries in build/ (`make test` builds them first). */
-#define GK_IMPLEMENTATION
 #define GK_TEST_DRIVERS
 #include "gk_dem.h"
 #include "gk_test.h"

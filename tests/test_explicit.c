@@ -2,7 +2,6 @@
  * relaxation, corotational update) and the nonlocal averaging of gk_nonlocal.h,
  * on elastic meshes. */
 #define _POSIX_C_SOURCE 200809L
-#define GK_IMPLEMENTATION
 #include "gk_explicit.h"
 #include "gk_fem.h"
 #include "gk_nonlocal.h"

@@ -5,7 +5,6 @@
  * GK_TEST_QUICK (the sanitizer build).
  */
 #define _POSIX_C_SOURCE 200809L /* WIFEXITED for the driver run (test 11) */
-#define GK_IMPLEMENTATION
 #include "gk_homog.h"
 #include "gk_test.h"
 #include <float.h>

@@ -2,7 +2,6 @@
  * tests, convergence, assembly, boundary conditions, tied dofs, solvers, Gmsh
  * reading and bad meshes. */
 #define _POSIX_C_SOURCE 200809L
-#define GK_IMPLEMENTATION
 #include "gk_dofmap.h"
 #include "gk_fem.h"
 #include "gk_mesh.h"

@@ -3,7 +3,6 @@
  * particle-rotation field and the eq 57 relaxation criterion. Needs the
  * binaries in build/ (`make test` builds them first). Small RVEs (160
  * spheres) and a few steps: seconds. */
-#define GK_IMPLEMENTATION
 #define GK_TEST_DRIVERS
 #include "gk_homog.h"
 #include "gk_test.h"

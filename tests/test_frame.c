@@ -3,7 +3,6 @@
  * cell, both relaxed to E_kin / E_pot <= tol (eqs 30-32), first
  * Piola-Kirchhoff stress out. On the shipped framed packing
  * (examples/data/frame228_a002.txt, 205 disks, 228 in the framed RVE). */
-#define GK_IMPLEMENTATION
 #include "gk_frame.h"
 #include "gk_test.h"
 

@@ -5,7 +5,6 @@
  * coupling (eq 9), the enrichment's mass and momentum, Cundall's best-fit
  * strain (App. A), the band thickness and kinematic training (Sec 4.1.1).
  * The driver (1 vs 2 threads) is in test_hybrid_driver.c. */
-#define GK_IMPLEMENTATION
 #include "gk_hybrid.h"
 #include "gk_test.h"
 #include <stdlib.h>

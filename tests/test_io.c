@@ -5,7 +5,6 @@
  * as wide as it is tall, field plots have axes in the requested unit, the
  * outline on top, a colour bar with its label, and a fixed colour range that
  * maps the same value to the same colour in every snapshot. */
-#define GK_IMPLEMENTATION
 #include "gk_io.h"
 #include "gk_test.h"
 

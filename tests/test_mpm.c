@@ -2,7 +2,6 @@
  * elastic wave, geostatic column, Coulomb boundary, rigid plate reaction,
  * circle (pipe) bodies,
  * Drucker-Prager return map, thread determinism, bad input. */
-#define GK_IMPLEMENTATION
 #include "gk_mpm.h"
 #include "gk_test.h"
 #include <stdlib.h>

@@ -1,9 +1,6 @@
 /* test_simd.c - the SIMD force kernels equal the scalar reference bit for bit
  * (the scalar law is the reference; SIMD is a faster way to the same bits), for every law and physics switch, 2D and 3D.
  * tests/test_simd_float.c compiles this file again with GK_REAL_FLOAT. */
-#ifndef GK_TEST_SIMD_NO_IMPL
-#define GK_IMPLEMENTATION
-#endif
 #include "gk_homog.h"
 #include "gk_test.h"
 #include <stdlib.h>

@@ -9,7 +9,6 @@
  * (another micro model on the same RVEs). Small packings (100 and 200
  * disks) keep it to seconds. The MPI build has its own program
  * (tests/mpi_twoscale.c, run by `make test` with mpirun -np 2). */
-#define GK_IMPLEMENTATION
 #include "gk_twoscale.h"
 #include "gk_test.h"
 
