@@ -508,13 +508,13 @@ static int write_plot(const pp *X) {
 }
 
 /* the histories of D, E, F: eps_q and rotation against the pipe's travel (the paper's values as dashed
- * lines where it gives them: at the onset of the lateral stage and at its end), and the p-q paths;
- * 0 or 1 (said) */
+ * lines where it gives them: at the onset of the lateral stage and at its end), and the p-q paths
+ * (F's end marked; E's ~700 kPa only in the title: a line there would squeeze the paths); 0 or 1 (said) */
 static int write_def_plots(const pp *X) {
     int n = X->rows.n + 1, k, i, bad;
     double *a = (double *)malloc((1 + 4 * PP_NPT) * (size_t)n * sizeof *a + 1), *tr = a, rx[4][2], ry[4][2];
     double *eq = a + n, *rot = eq + PP_NPT * n, *pp_ = rot + PP_NPT * n, *qq = pp_ + PP_NPT * n;
-    double s0 = X->b.pen, s1 = X->b.pen + X->b.lat, qmax = 0;
+    double s0 = X->b.pen, s1 = X->b.pen + X->b.lat;
     char lab[PP_NPT][16];
     gk_plot pl;
     if (!a) return fprintf(stderr, "mpmdem_pipe: out of memory\n"), 1;
@@ -524,7 +524,6 @@ static int write_def_plots(const pp *X) {
         for (i = 0; i < PP_NPT; ++i) {
             const double *v = r ? r->pt[i] : X->S.pt0[i];
             eq[i * n + k] = v[4], rot[i * n + k] = v[6], pp_[i * n + k] = v[2], qq[i * n + k] = v[3];
-            if (v[3] > qmax) qmax = v[3];
         }
     }
     for (i = 0; i < PP_NPT; ++i) snprintf(lab[i], sizeof lab[i], "point %s", pp_pt_name[i]);
@@ -544,11 +543,9 @@ static int write_def_plots(const pp *X) {
     if (X->b.lat > 0)
         ref_line(&pl, rx[2], ry[2], s1 - 0.25 * X->b.lat, s1, 58, "Liang & Zhao: D +58 at the end");
     if (!bad) bad = mpd_plot(&X->run, &pl, "points_DEF_rotation.svg");
-    gk_plot_init(&pl, "MPMxDEM pipe: stress paths of points D, E, F (Liang & Zhao Fig 24)", "p [kPa]",
-                 "q [kPa]");
+    gk_plot_init(&pl, "MPMxDEM pipe: stress paths of points D, E, F (Liang & Zhao Fig 24: E up to ~700 kPa)",
+                 "p [kPa]", "q [kPa]");
     for (i = 0; i < PP_NPT; ++i) gk_plot_add(&pl, pp_ + i * n, qq + i * n, n, lab[i]);
-    rx[0][0] = rx[0][1] = 700, ry[0][0] = 0, ry[0][1] = qmax > 0 ? qmax : 1;
-    if ((k = gk_plot_add(&pl, rx[0], ry[0], 2, "Liang & Zhao: E p up to ~700")) >= 0) pl.s[k].dashed = 1;
     ref_line(&pl, rx[1], ry[1], 5, 25, 4, "Liang & Zhao: F ends near p 15, q 4");
     if (!bad) bad = mpd_plot(&X->run, &pl, "points_DEF_pq.svg");
     free(a);
