@@ -56,10 +56,11 @@
  * default is reduced to finish in minutes on 2 cores: a 6 m wide domain (3
  * m either side of the pipe's start; at the end of the default run points
  * with eps_q > 10 % reach from x = 0.11 m to 4.65 m, i.e. the left wall:
- * narrower than the mechanism, the smooth walls are part of the result),
- * h = 0.25 m (D = 4 cells: coarse, the
- * reactions are noisy as points cross cells) and the pipe at 0.4 m/s down,
- * 0.2 m/s left with 0.2 s ramps (the paper does not give its speeds; see
+ * narrower than the mechanism, the smooth walls are part of the result;
+ * --width 9 --nx 36 is the paper's width at this h, 360 RVEs, where they
+ * span x = 1.35-6.16 m, clear of both walls), h = 0.25 m (D = 4 cells:
+ * coarse, the reactions are noisy as points cross cells) and the pipe at
+ * 0.4 m/s down, 0.2 m/s left with 0.2 s ramps (the paper does not give its speeds; see
  * RATE). Each run prints its cost per RVE per MPM step and projects the
  * --paper run from it (--max-steps N stops after N steps).
  *
