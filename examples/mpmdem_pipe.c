@@ -56,10 +56,11 @@
  * default is reduced to finish in minutes on 2 cores: a 6 m wide domain (3
  * m either side of the pipe's start; at the end of the default run points
  * with eps_q > 10 % reach from x = 0.11 m to 4.65 m, i.e. the left wall:
- * narrower than the mechanism, the smooth walls are part of the result),
- * h = 0.25 m (D = 4 cells: coarse, the
- * reactions are noisy as points cross cells) and the pipe at 0.4 m/s down,
- * 0.2 m/s left with 0.2 s ramps (the paper does not give its speeds; see
+ * narrower than the mechanism, the smooth walls are part of the result;
+ * --width 9 --nx 36 is the paper's width at this h, 360 RVEs, where they
+ * span x = 1.35-6.16 m, clear of both walls), h = 0.25 m (D = 4 cells:
+ * coarse, the reactions are noisy as points cross cells) and the pipe at
+ * 0.4 m/s down, 0.2 m/s left with 0.2 s ramps (the paper does not give its speeds; see
  * RATE). Each run prints its cost per RVE per MPM step and projects the
  * --paper run from it (--max-steps N stops after N steps).
  *
@@ -76,8 +77,33 @@
  * penetration, not next to the ~50 kPa of the lateral stage at 0.2 m/s.
  * --v-down, --v-lateral and --alpha change it.
  *
+ * POINTS D, E, F (the paper's Figs 22E-24): D and F inside the left and
+ * right dominant shear bands, E under the pipe. The paper marks them only
+ * in its figures and gives no coordinates; its text says D and F are pushed
+ * laterally upward by ~0.08 sqrt 2 m in the penetration and E is pushed
+ * down slightly to the right of the pipe's axis. Here they are the material
+ * points nearest, at the start, to these positions relative to the pipe's
+ * start (x0 its centre, depth below the ground): D (x0 - 1.1 m, 0.6 m),
+ * E (x0 + 0.1 m, 1.05 m), F (x0 + 1.1 m, 0.6 m) - chosen from that text
+ * (beside the pipe's final depth, where the bands from its bottom rise to
+ * the ground; just under its final bottom), not read off the paper's figure.
+ * The run prints the points chosen and, at the end, the paper's numbers
+ * against its own: the lifts of D and F in the penetration; eps_q and the
+ * rotation of D and F at the lateral onset (paper: D 0.5, 10 deg
+ * anticlockwise; F 1.2, 30 deg clockwise); E's largest p (paper ~700 kPa);
+ * D's eps_q and rotation at the end (paper 2.6, 58 deg); F's p and q at
+ * the end (paper: toward the origin, then p ~15, q ~4 kPa). eps_q and
+ * eps_v are those of the point's small strain (sum of sym dH, mpmdem.h),
+ * the rotation that of F = R U, counter-clockwise positive.
+ *
  * Outputs in --out DIR (default build/mpm_pipe): pipe.csv, pipe_force.svg
- * (H and V against the pipe's travel), eps_q_pen.svg, rotation_pen.svg (end
+ * (H and V against the pipe's travel), points_DEF.csv (a row at t = 0,
+ * then the state of D, E, F at the end of every pipe.csv row: time, stage,
+ * pipe x and bottom y, travel, and per point x, y, p, q [kPa], eps_q,
+ * eps_v, rotation [deg], void ratio, coordination, DEM steps of the last
+ * MPM step), points_DEF.svg (eps_q against the pipe's travel),
+ * points_DEF_rotation.svg (rotation), points_DEF_pq.svg (the p-q paths),
+ * each with the paper's values dashed, eps_q_pen.svg, rotation_pen.svg (end
  * of penetration), eps_q_end.svg, rotation_end.svg, points_NNNNNN.vtk
  * (first, last, every --vtk-every steps), checkpoint.bin; a RESULT line.
  */
@@ -92,8 +118,20 @@ typedef struct pp_opts {
     double width, D, mu, gravity, pen, lat, v_down, v_lat, ramp, every, room;
 } pp_opts;
 
-typedef struct pp_row { /* one CSV row: means over its interval; the pipe at its end */
+/* the paper's points D, E, F (Figs 22E-24): where they start, relative to the pipe's start (its centre
+ * at mid-width, its bottom on the ground): dx right of the centre, depth below the ground [m]. The paper
+ * shows them only in its figures (D/F in the left/right dominant shear band, E under the pipe, pushed
+ * down slightly to the right); these are positions chosen from that text, see the header. */
+#define PP_NPT 3
+#define PP_NQ 10 /* per point: x, y, p, q, eps_q, eps_v, rotation, void ratio, coordination, DEM steps */
+static const char *const pp_pt_name[PP_NPT] = {"D", "E", "F"};
+static const double pp_pt_at[PP_NPT][2] = {{-1.1, 0.6}, {0.1, 1.05}, {1.1, 0.6}};
+static const char *const pp_q_name[PP_NQ] = {
+    "x", "y", "p_kPa", "q_kPa", "eps_q", "eps_v", "rotation_deg", "void_ratio", "coordination", "dem_steps"};
+
+typedef struct pp_row { /* one CSV row: means over its interval; the pipe and the points at its end */
     double t, x, y, pen, lat, H, V, dem_mean, secs;
+    double pt[PP_NPT][PP_NQ];
     int stage;
 } pp_row;
 
@@ -108,8 +146,10 @@ typedef struct pp_state {
     double acc_H, acc_V, acc_dt, acc_dem;
     long nacc;
     double next_out;
-    int pen_row; /* the row that ends the penetration (-1: not yet) */
-    double wall; /* wall seconds of the runs before this one */
+    int pen_row;               /* the row that ends the penetration (-1: not yet) */
+    double wall;               /* wall seconds of the runs before this one */
+    int pt[PP_NPT];            /* the material points D, E, F (nearest to pp_pt_at at the start) */
+    double pt0[PP_NPT][PP_NQ]; /* their state at the start */
 } pp_state;
 
 typedef struct pp { /* the whole model */
@@ -128,6 +168,7 @@ typedef struct pp { /* the whole model */
     mpd_rows rows;
     mpd_snaps snaps;
     int *pick, dem_max_given;
+    double *fld; /* MPD_NFIELD x points: the fields when a row is taken */
     double h, depth, dot, c, rho_ref, Mmax, prep_secs, x0;
 } pp;
 
@@ -186,14 +227,22 @@ static void usage(FILE *fp) {
             X.b.nx, X.b.ny, X.b.width, X.b.D, X.b.mu, X.b.pen, X.b.lat, X.b.v_down, X.b.v_lat, X.b.ramp,
             X.b.gravity, PP_MAX_LEVELS, X.b.room, X.b.every);
     mpd_usage_common(fp, &X.o);
-    fprintf(fp,
-            "\nends with: RESULT V_peak_kN=... V_peak_paper_kN=250 V_end_penetration_kN=... H_end_kN=... "
-            "H_end_paper_kN=50\n"
-            "           V_lateral_kN=... V_lateral_paper_kN=25 H_lateral_kN=... penetration=... lateral=... "
-            "n_rves=...\n"
-            "           mpm_steps=... dt=... seconds_per_step=... seconds_per_step_per_1000_rves=... "
-            "total_seconds=...\n"
-            "           paper_projection_hours=...\n");
+    fprintf(
+        fp,
+        "\nends with: RESULT V_peak_kN=... V_peak_paper_kN=250 V_end_penetration_kN=... H_end_kN=... "
+        "H_end_paper_kN=50\n"
+        "           V_lateral_kN=... V_lateral_paper_kN=25 H_lateral_kN=... penetration=... lateral=... "
+        "n_rves=...\n"
+        "           mpm_steps=... dt=... seconds_per_step=... seconds_per_step_per_1000_rves=... "
+        "total_seconds=...\n"
+        "           paper_projection_hours=... D_lift_m=... F_lift_m=... D_eps_q_onset=...\n"
+        "           D_rotation_onset=... F_eps_q_onset=... F_rotation_onset=... E_p_max_kPa=...\n"
+        "           D_eps_q_end=... D_rotation_end=... F_eps_q_end=... F_p_min_lateral_kPa=...\n"
+        "           F_p_end_kPa=... F_q_end_kPa=...\n"
+        "writes pipe.csv, pipe_force.svg, points_DEF.csv (the paper's points D, E, F: the material points\n"
+        "nearest to x0 - 1.1, x0 + 0.1, x0 + 1.1 m at 0.6, 1.05, 0.6 m depth, x0 the pipe's start),\n"
+        "points_DEF.svg, points_DEF_rotation.svg, points_DEF_pq.svg, eps_q_*.svg, rotation_*.svg,\n"
+        "points_*.vtk and checkpoint.bin into --out.\n");
 }
 
 /* the flags, twice: the preset (--paper) first, then every flag given over it */
@@ -289,6 +338,34 @@ static int check_state(const void *vS, const mpd_rows *R, char *why, size_t nwhy
     return 0;
 }
 
+/* the state of the points D, E, F now (collective: every point's fields) */
+static gk_result sample_points(pp *X, double out[PP_NPT][PP_NQ], gk_err *err) {
+    static const int f[PP_NQ - 2] = {MPD_P,        MPD_Q,    MPD_EPS_Q, MPD_EPS_V,
+                                     MPD_ROTATION, MPD_VOID, MPD_COORD, MPD_DEM};
+    int n = X->pts.n, k, j;
+    gk_result r = mpd_fields(&X->M, &X->pts, X->fld, err);
+    if (r) return r;
+    for (k = 0; k < PP_NPT; ++k) {
+        int i = X->S.pt[k];
+        out[k][0] = X->pts.x[0][i], out[k][1] = X->pts.x[1][i];
+        for (j = 0; j < PP_NQ - 2; ++j) out[k][2 + j] = X->fld[(size_t)f[j] * n + i] + 0.0; /* no -0 */
+        out[k][2] /= 1e3, out[k][3] /= 1e3;                                                 /* p, q in kPa */
+    }
+    return GK_OK;
+}
+
+/* the material point nearest to each of pp_pt_at (the first of equals) */
+static void pick_points(pp *X) {
+    int k, i;
+    for (k = 0; k < PP_NPT; ++k) {
+        double tx = X->x0 + pp_pt_at[k][0], ty = X->depth - pp_pt_at[k][1], best = HUGE_VAL;
+        for (i = 0; i < X->pts.n; ++i) {
+            double dx = X->pts.x[0][i] - tx, dy = X->pts.x[1][i] - ty, d2 = dx * dx + dy * dy;
+            if (d2 < best) best = d2, X->S.pt[k] = i;
+        }
+    }
+}
+
 /* the levels' RVEs, the grid (rollers, fixed base), the points with their levels' masses, dt, the pipe */
 static int setup(pp *X, gk_err *err) {
     const pp_opts *b = &X->b;
@@ -311,7 +388,8 @@ static int setup(pp *X, gk_err *err) {
     if (!X->dem_max_given) X->o.dem_max = (int)ceil(S->dt / X->P.dt * (1 - 1e-12));
     if (mpd_check_opts(&X->run, &X->o)) return 2;
     X->pick = (int *)malloc((size_t)X->pts.n * sizeof *X->pick);
-    if (!X->pick) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+    X->fld = (double *)malloc((size_t)MPD_NFIELD * X->pts.n * sizeof *X->fld);
+    if (!X->pick || !X->fld) return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
     for (i = 0; i < X->pts.n; ++i) X->pick[i] = mpd_level_of(X->depth, X->b.levels, X->pts.x[1][i]);
     if (mpd_micro_create(&X->M, &X->pts, &X->P, X->st, b->levels, X->pick, &X->o, err)) return 1;
     for (i = 0; i < X->pts.n; ++i) X->pts.m[i] = X->lev_rho[X->pick[i]] * X->pts.vol0[i];
@@ -325,13 +403,20 @@ static int setup(pp *X, gk_err *err) {
     S->next_out = b->every;
     S->pen_row = -1;
     X->rows.size = sizeof(pp_row);
+    pick_points(X);
     if (X->o.restart) {
         if (mpd_load(X->o.restart, &X->M, &X->pts, "pipe", S, sizeof *S, &X->rows, &X->snaps, check_state,
                      err))
             return 1;
+        for (i = 0; i < PP_NPT; ++i)
+            if (S->pt[i] < 0 || S->pt[i] >= X->pts.n)
+                return gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: point %s out of range",
+                                  X->o.restart, pp_pt_name[i]),
+                       1;
         printf("restarted from %s/checkpoint.bin at t = %.4f s (step %ld, stage %d)\n", X->o.restart, S->t,
                S->step, S->stage + 1);
-    }
+    } else if (sample_points(X, S->pt0, err))
+        return 1;
     X->g.body = &S->body, X->g.nbody = 1;
     return 0;
 }
@@ -372,6 +457,26 @@ static void put_csv(FILE *fp, const void *user) {
     }
 }
 
+/* points_DEF.csv: the start (t = 0), then a line per row of pipe.csv: the points' state at its end */
+static void put_def_csv(FILE *fp, const void *user) {
+    const pp *X = (const pp *)user;
+    int k, i, j;
+    fprintf(fp, "time,stage,pipe_x,pipe_bottom_y,travel");
+    for (i = 0; i < PP_NPT; ++i)
+        for (j = 0; j < PP_NQ; ++j) fprintf(fp, ",%s_%s", pp_pt_name[i], pp_q_name[j]);
+    fprintf(fp, "\n0,1,%.6g,%.6g,0", X->x0, X->depth);
+    for (i = 0; i < PP_NPT; ++i)
+        for (j = 0; j < PP_NQ; ++j) fprintf(fp, ",%.6g", X->S.pt0[i][j]);
+    fprintf(fp, "\n");
+    for (k = 0; k < X->rows.n; ++k) {
+        const pp_row *r = (const pp_row *)mpd_row(&X->rows, k);
+        fprintf(fp, "%.6g,%d,%.6g,%.6g,%.6g", r->t, r->stage + 1, r->x, r->y, r->pen + r->lat);
+        for (i = 0; i < PP_NPT; ++i)
+            for (j = 0; j < PP_NQ; ++j) fprintf(fp, ",%.6g", r->pt[i][j]);
+        fprintf(fp, "\n");
+    }
+}
+
 /* a dashed horizontal reference line from x0 to x1 */
 static void ref_line(gk_plot *pl, double *tx, double *ty, double x0, double x1, double v, const char *label) {
     int s;
@@ -400,6 +505,51 @@ static int write_plot(const pp *X) {
     }
     bad = mpd_plot(&X->run, &pl, "pipe_force.svg");
     free(x);
+    return bad;
+}
+
+/* the histories of D, E, F: eps_q and rotation against the pipe's travel (the paper's values as dashed
+ * lines where it gives them: at the onset of the lateral stage and at its end), and the p-q paths
+ * (F's end marked; E's ~700 kPa only in the title: a line there would squeeze the paths); 0 or 1 (said) */
+static int write_def_plots(const pp *X) {
+    int n = X->rows.n + 1, k, i, bad;
+    double *a = (double *)malloc((1 + 4 * PP_NPT) * (size_t)n * sizeof *a + 1), *tr = a, rx[4][2], ry[4][2];
+    double *eq = a + n, *rot = eq + PP_NPT * n, *pp_ = rot + PP_NPT * n, *qq = pp_ + PP_NPT * n;
+    double s0 = X->b.pen, s1 = X->b.pen + X->b.lat;
+    char lab[PP_NPT][16];
+    gk_plot pl;
+    if (!a) return fprintf(stderr, "mpmdem_pipe: out of memory\n"), 1;
+    for (k = 0; k < n; ++k) {
+        const pp_row *r = k ? (const pp_row *)mpd_row(&X->rows, k - 1) : NULL;
+        tr[k] = r ? r->pen + r->lat : 0.0;
+        for (i = 0; i < PP_NPT; ++i) {
+            const double *v = r ? r->pt[i] : X->S.pt0[i];
+            eq[i * n + k] = v[4], rot[i * n + k] = v[6], pp_[i * n + k] = v[2], qq[i * n + k] = v[3];
+        }
+    }
+    for (i = 0; i < PP_NPT; ++i) snprintf(lab[i], sizeof lab[i], "point %s", pp_pt_name[i]);
+    gk_plot_init(&pl, "MPMxDEM pipe: eps_q of points D, E, F (Liang & Zhao Fig 24); lateral stage from 0.8 m",
+                 "pipe travel: penetration + lateral [m]", "deviatoric strain eps_q");
+    for (i = 0; i < PP_NPT; ++i) gk_plot_add(&pl, tr, eq + i * n, n, lab[i]);
+    ref_line(&pl, rx[0], ry[0], 0.75 * s0, s0, 0.5, "Liang & Zhao: D 0.5 at the lateral onset");
+    ref_line(&pl, rx[1], ry[1], 0.75 * s0, s0, 1.2, "Liang & Zhao: F 1.2 at the lateral onset");
+    if (X->b.lat > 0)
+        ref_line(&pl, rx[2], ry[2], s1 - 0.25 * X->b.lat, s1, 2.6, "Liang & Zhao: D 2.6 at the end");
+    bad = mpd_plot(&X->run, &pl, "points_DEF.svg");
+    gk_plot_init(&pl, "MPMxDEM pipe: rotation of points D, E, F (counter-clockwise > 0; Liang & Zhao Fig 24)",
+                 "pipe travel: penetration + lateral [m]", "rotation of F = R U [deg]");
+    for (i = 0; i < PP_NPT; ++i) gk_plot_add(&pl, tr, rot + i * n, n, lab[i]);
+    ref_line(&pl, rx[0], ry[0], 0.75 * s0, s0, 10, "Liang & Zhao: D +10 (anticlockwise) at the onset");
+    ref_line(&pl, rx[1], ry[1], 0.75 * s0, s0, -30, "Liang & Zhao: F -30 (clockwise) at the onset");
+    if (X->b.lat > 0)
+        ref_line(&pl, rx[2], ry[2], s1 - 0.25 * X->b.lat, s1, 58, "Liang & Zhao: D +58 at the end");
+    if (!bad) bad = mpd_plot(&X->run, &pl, "points_DEF_rotation.svg");
+    gk_plot_init(&pl, "MPMxDEM pipe: stress paths of points D, E, F (Liang & Zhao Fig 24: E up to ~700 kPa)",
+                 "p [kPa]", "q [kPa]");
+    for (i = 0; i < PP_NPT; ++i) gk_plot_add(&pl, pp_ + i * n, qq + i * n, n, lab[i]);
+    ref_line(&pl, rx[1], ry[1], 5, 25, 4, "Liang & Zhao: F ends near p 15, q 4");
+    if (!bad) bad = mpd_plot(&X->run, &pl, "points_DEF_pq.svg");
+    free(a);
     return bad;
 }
 
@@ -435,6 +585,7 @@ static int snapshot(pp *X, const char *tag, const char *when) {
 static int add_row(pp *X, double t_start) {
     pp_state *S = &X->S;
     pp_row r;
+    gk_err err;
     memset(&r, 0, sizeof r);
     r.t = S->t, r.x = S->body.centre[0], r.y = S->body.centre[1] - S->body.radius, r.pen = S->pen,
     r.lat = S->lat;
@@ -443,6 +594,8 @@ static int add_row(pp *X, double t_start) {
     r.dem_mean = S->nacc ? S->acc_dem / S->nacc : 0;
     r.secs = S->wall + gk_wtime() - t_start;
     S->acc_H = S->acc_V = S->acc_dt = S->acc_dem = 0, S->nacc = 0;
+    if (sample_points(X, r.pt, &err))
+        return fprintf(stderr, "mpmdem_pipe: the points D, E, F at t = %.4f s: %s\n", S->t, err.msg), 1;
     return mpd_rows_push(&X->run, &X->rows, &r);
 }
 
@@ -474,7 +627,9 @@ static int after_step(pp *X, double ds, double t_start, long step0, long nsteps_
         S->stage += S->stage == 0 && X->b.lat > 0 ? 1 : 2 - S->stage;
         S->done = 0, S->t_stage = 0;
     }
-    if (!bad) bad = mpd_write(&X->run, "pipe.csv", put_csv, X);
+    if (!bad)
+        bad = mpd_write(&X->run, "pipe.csv", put_csv, X) ||
+              mpd_write(&X->run, "points_DEF.csv", put_def_csv, X);
     if (!X->o.quiet) {
         const pp_row *r = (const pp_row *)mpd_row(&X->rows, X->rows.n - 1);
         char buf[64], buf2[64];
@@ -504,6 +659,50 @@ static double path_steps(const pp_opts *b, double dt) {
     return (b->pen / b->v_down + b->ramp + (b->lat > 0 ? b->lat / b->v_lat + b->ramp : 0.0)) / dt;
 }
 
+/* the paper's numbers for D, E, F (Liang & Zhao Sec 3.4) against this run's, printed; into v: the lifts of
+ * D and F in the penetration, D's and F's eps_q and rotation at the lateral onset, E's largest p, D's
+ * eps_q and rotation at the end, F's eps_q at the end, F's smallest p in the lateral stage, F's p and q
+ * at the end (NAN where the run did not get there) */
+#define PP_NDV 13
+static void def_summary(const pp *X, double v[PP_NDV]) {
+    const pp_state *S = &X->S;
+    const pp_row *on = S->pen_row >= 0 ? (const pp_row *)mpd_row(&X->rows, S->pen_row) : NULL;
+    const pp_row *end =
+        S->stage == 2 && X->rows.n > 0 ? (const pp_row *)mpd_row(&X->rows, X->rows.n - 1) : NULL;
+    double lift[2] = {NAN, NAN}, pmax = X->S.pt0[1][2], pmin = NAN;
+    int k, i;
+    for (k = 0; k < X->rows.n; ++k) {
+        const pp_row *r = (const pp_row *)mpd_row(&X->rows, k);
+        if (r->pt[1][2] > pmax) pmax = r->pt[1][2];
+        if (r->stage == 1 && !(r->pt[2][2] >= pmin)) pmin = r->pt[2][2];
+    }
+    for (i = 0; on && i < 2; ++i) {
+        const double *a = S->pt0[2 * i], *b = on->pt[2 * i];
+        lift[i] = sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]));
+    }
+    v[0] = lift[0], v[1] = lift[1];
+    v[2] = on ? on->pt[0][4] : NAN, v[3] = on ? on->pt[0][6] : NAN;
+    v[4] = on ? on->pt[2][4] : NAN, v[5] = on ? on->pt[2][6] : NAN;
+    v[6] = pmax;
+    v[7] = end ? end->pt[0][4] : NAN, v[8] = end ? end->pt[0][6] : NAN, v[9] = end ? end->pt[2][4] : NAN;
+    v[10] = end ? pmin : NAN, v[11] = end ? end->pt[2][2] : NAN, v[12] = end ? end->pt[2][3] : NAN;
+    for (i = 0; i < PP_NPT; ++i)
+        printf("point %s: material point %d, at (%.4g, %.4g) m at the start (%.3g m %s of the pipe's start, "
+               "%.3g m deep; asked for %g m, %g m deep)\n",
+               pp_pt_name[i], S->pt[i], S->pt0[i][0], S->pt0[i][1], fabs(S->pt0[i][0] - X->x0),
+               S->pt0[i][0] < X->x0 ? "left" : "right", X->depth - S->pt0[i][1], pp_pt_at[i][0],
+               pp_pt_at[i][1]);
+    printf("penetration: D lifted %.3g m, F %.3g m (Liang & Zhao: both ~0.08 sqrt 2 = 0.113 m, laterally "
+           "upward); at the lateral onset D eps_q %.3g rotation %.3g deg, F eps_q %.3g rotation %.3g deg "
+           "(Liang & Zhao: D 0.5, |10| anticlockwise; F 1.2, |30| clockwise); E p up to %.4g kPa (Liang & "
+           "Zhao ~700 kPa)\n",
+           v[0], v[1], v[2], v[3], v[4], v[5], v[6]);
+    printf("lateral stage: D eps_q -> %.3g, rotation -> %.3g deg (Liang & Zhao 0.5 -> 2.6, 15 -> 58 deg); F "
+           "eps_q -> %.3g (Liang & Zhao 1.3 -> 1.4), p down to %.3g kPa, at the end p %.3g kPa q %.3g kPa "
+           "(Liang & Zhao: toward the origin, then p ~15 kPa, q ~4 kPa)\n",
+           v[7], v[8], v[9], v[10], v[11], v[12]);
+}
+
 /* the end: a last row, CSV, plot, fields, the summary and RESULT; 0 or 1 */
 static int finish(pp *X, double t_start, long steps_run, int bad) {
     const pp_opts *b = &X->b;
@@ -512,10 +711,13 @@ static int finish(pp *X, double t_start, long steps_run, int bad) {
            hp, dtp, stepsp, sv = 0, sh = 0, sw = 0;
     int k, n, np = X->pts.n;
     char buf[64];
+    double dv[PP_NDV];
     if (S->acc_dt > 0 && add_row(X, t_start)) return 1;
     n = X->rows.n;
     if (!bad)
-        bad = mpd_write(&X->run, "pipe.csv", put_csv, X) || (n > 0 && write_plot(X)) ||
+        bad = mpd_write(&X->run, "pipe.csv", put_csv, X) ||
+              mpd_write(&X->run, "points_DEF.csv", put_def_csv, X) ||
+              (n > 0 && (write_plot(X) || write_def_plots(X))) ||
               snapshot(X, "end", S->stage == 2 ? "end" : "last step") ||
               mpd_write_vtk(&X->run, S->step, &X->M, &X->pts);
 
@@ -532,8 +734,8 @@ static int finish(pp *X, double t_start, long steps_run, int bad) {
     if (S->stage != 2) hend = NAN;
     if (sw > 0 && S->stage == 2) vlat = sv / sw, hlat = sh / sw;
     if (!bad)
-        printf("wrote %s/pipe.csv, pipe_force.svg, eps_q_*.svg, rotation_*.svg, points_*.vtk (ParaView), "
-               "checkpoint.bin\n",
+        printf("wrote %s/pipe.csv, pipe_force.svg, points_DEF.csv, points_DEF.svg, points_DEF_rotation.svg, "
+               "points_DEF_pq.svg, eps_q_*.svg, rotation_*.svg, points_*.vtk (ParaView), checkpoint.bin\n",
                X->run.out);
     printf("pipe at the end: down %.4g m, left %.4g m (%s)\n", S->pen, S->lat,
            S->stage == 2 ? "the whole path" : "stopped before the end of the path");
@@ -544,6 +746,7 @@ static int finish(pp *X, double t_start, long steps_run, int bad) {
         "lateral stage, second half: V %.4g kN/m (Liang & Zhao ~25, steady), H %.4g kN/m; H at the end (the "
         "last row before the speed ramps down) %.4g kN/m (Liang & Zhao ~50, rising slightly)\n",
         vlat / 1e3, hlat / 1e3, hend / 1e3);
+    def_summary(X, dv);
     per_rve = steps_run ? secs / steps_run / np : 0.0;
     printf(
         "cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.2f per point per MPM step); %.4g s per "
@@ -561,9 +764,12 @@ static int finish(pp *X, double t_start, long steps_run, int bad) {
         "RESULT V_peak_kN=%.5g V_peak_paper_kN=250 V_end_penetration_kN=%.5g H_end_kN=%.5g H_end_paper_kN=50 "
         "V_lateral_kN=%.5g V_lateral_paper_kN=25 H_lateral_kN=%.5g penetration=%.5g lateral=%.5g n_rves=%d "
         "mpm_steps=%ld dt=%.4g seconds_per_step=%.4g seconds_per_step_per_1000_rves=%.4g "
-        "total_seconds=%.2f paper_projection_hours=%.4g\n",
+        "total_seconds=%.2f paper_projection_hours=%.4g D_lift_m=%.4g F_lift_m=%.4g D_eps_q_onset=%.4g "
+        "D_rotation_onset=%.4g F_eps_q_onset=%.4g F_rotation_onset=%.4g E_p_max_kPa=%.5g D_eps_q_end=%.4g "
+        "D_rotation_end=%.4g F_eps_q_end=%.4g F_p_min_lateral_kPa=%.4g F_p_end_kPa=%.4g F_q_end_kPa=%.4g\n",
         vpk / 1e3, vpen / 1e3, hend / 1e3, vlat / 1e3, hlat / 1e3, S->pen, S->lat, np, steps_run, S->dt,
-        steps_run ? secs / steps_run : 0.0, 1000.0 * per_rve, secs, per_rve * 9776.0 * stepsp / 3600.0);
+        steps_run ? secs / steps_run : 0.0, 1000.0 * per_rve, secs, per_rve * 9776.0 * stepsp / 3600.0, dv[0],
+        dv[1], dv[2], dv[3], dv[4], dv[5], dv[6], dv[7], dv[8], dv[9], dv[10], dv[11], dv[12]);
     return bad;
 }
 
@@ -646,7 +852,7 @@ int main(int argc, char **argv) {
     for (k = 0; k < PP_MAX_LEVELS; ++k) gk_rve_state_init(&X.st[k], NULL);
     mpd_begin(&X.run, "mpmdem_pipe", &argc, &argv);
     status = run(&X, argc, argv);
-    free(X.pick);
+    free(X.pick), free(X.fld);
     mpd_free_all(&X.M, &X.P, &X.pts, &X.g, &X.rows, &X.snaps);
     for (k = 0; k < PP_MAX_LEVELS; ++k) gk_rve_state_free(&X.st[k]);
     return mpd_end(status);
