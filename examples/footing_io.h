@@ -32,7 +32,8 @@
  *
  * Outputs in --out DIR (default build/mpm_footing): footing.csv
  * (load-settlement), footing_load.svg, rve_biaxial.svg and rve_mohr.svg (phi
- * measurement), eps_q_dB*.svg (stages, one colour scale) and eps_q_end.svg,
+ * measurement), eps_q_dB*.svg (stages, one colour scale; the fitted log
+ * spiral drawn on them when found) and eps_q_end.svg (the same),
  * rotation_end.svg, void_ratio_end.svg, displacement_end.svg (failure mode;
  * the footing, the wall and the base drawn on the points), points_NNNNNN.vtk,
  * checkpoint.bin; a RESULT line.
@@ -134,9 +135,27 @@ static void outline(const ft *X, mpd_outline *ol) {
     mpd_outline_add(ol, 3, box);
 }
 
-static int snap_field(ft *X, int k, const char *file, const char *title) {
+/* the fitted log spiral r = r0 exp(psi tan phi_fit) about the footing's corner over Prandtl's fan at the
+ * RVE's angle (fm_spiral's), as two polylines of 6 points (11 chords of the 90 deg fan); nothing if NAN */
+static void outline_spiral(const ft *X, double phi_fit, double r0, mpd_outline *ol) {
+    double d2r = FM_PI / 180.0, a = fm_prandtl_wedge(X->phi), th0 = 180.0 + a, fan = 135.0 + 0.5 * X->phi - a;
+    double yb = X->f.depth - X->S.disp, xy[12];
+    int half, k;
+    if (!(isfinite(phi_fit) && isfinite(r0))) return;
+    for (half = 0; half < 2; ++half) {
+        for (k = 0; k < 6; ++k) {
+            double psi = fan * (5 * half + k) / 10.0, r = r0 * exp(psi * d2r * tan(phi_fit * d2r));
+            xy[2 * k] = X->b + r * cos((th0 + psi) * d2r), xy[2 * k + 1] = yb + r * sin((th0 + psi) * d2r);
+        }
+        mpd_outline_add(ol, 6, xy);
+    }
+}
+
+/* a field picture of the points with the outline, and the fitted log spiral (phi_fit, r0) if not NAN */
+static int snap_field(ft *X, int k, const char *file, const char *title, double phi_fit, double r0) {
     mpd_outline ol;
     outline(X, &ol);
+    outline_spiral(X, phi_fit, r0, &ol);
     return mpd_snap_field(&X->run, &X->snaps, &X->M, &X->pts, k, file, title, X->dot, &ol);
 }
 
@@ -297,10 +316,13 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
     }
     if (!bad)
         bad = snap_field(X, MPD_EPS_Q, "eps_q_end",
-                         "deviatoric strain eps_q at the end (failure mode, Liang & Zhao Fig 14)") ||
+                         "deviatoric strain eps_q at the end (failure mode, Liang & Zhao Fig 14)",
+                         n > 0 ? ((const ft_row *)mpd_row(&X->rows, n - 1))->sp_phi : NAN,
+                         n > 0 ? ((const ft_row *)mpd_row(&X->rows, n - 1))->sp_r0 : NAN) ||
               snap_field(X, MPD_ROTATION, "rotation_end",
-                         "rotation of F = RU at the end (Liang & Zhao Fig 15)") ||
-              snap_field(X, MPD_VOID, "void_ratio_end", "void ratio at the end (Liang & Zhao Fig 15)") ||
+                         "rotation of F = RU at the end (Liang & Zhao Fig 15)", NAN, NAN) ||
+              snap_field(X, MPD_VOID, "void_ratio_end", "void ratio at the end (Liang & Zhao Fig 15)", NAN,
+                         NAN) ||
               displacement_field(X) || mpd_write_vtk(&X->run, X->S.step, &X->M, &X->pts);
     if (!mpd_path(&X->run, path, "checkpoint.bin") && stat(path, &st) == 0) ck_mb = st.st_size / 1048576.0;
     if (!bad)

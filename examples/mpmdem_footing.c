@@ -383,7 +383,7 @@ static int after_step(ft *X, double vf, double t_start, long step0, long nsteps_
         char file[48], title[120];
         snprintf(file, sizeof file, "eps_q_dB%.2f", ft_stages[S->nstage]);
         snprintf(title, sizeof title, "deviatoric strain eps_q at d/B = %.2f", ft_stages[S->nstage]);
-        bad = snap_field(X, MPD_EPS_Q, file, title);
+        bad = snap_field(X, MPD_EPS_Q, file, title, r.sp_phi, r.sp_r0);
         ++S->nstage;
     }
     if (!X->o.quiet) {
