@@ -272,7 +272,7 @@ static int load_plot(const ft *X, const double *qsm, int ku, double nq46, double
 static int mechanism(const ft *X, double *wedge, double *hx, double *hu, fm_spiral_fit *sp) {
     int n = X->pts.n, p, ns = 0;
     double *eq = (double *)malloc(3 * (size_t)n * sizeof *eq + 1), *xs = eq + n, *uy = xs + n;
-    double h = X->h, top = X->f.depth - 0.5 * h;
+    double h = X->h, top = X->f.depth - h / X->o.ppc; /* between the top row of points and the next */
     *wedge = *hx = *hu = NAN;
     if (!eq) return fprintf(stderr, "mpmdem_footing: out of memory\n"), 1;
     for (p = 0; p < n; ++p) {

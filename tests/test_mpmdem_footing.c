@@ -84,6 +84,11 @@ TEST(footing_runs_and_loads) {
     CHECK(t > 30.0 && t < 80.0);
     CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "wedge_prandtl_deg"), 45.0 + 0.5 * phi,
                0.01); /* both printed to 4 digits */
+    /* the heave: the surface row of points (at depth - h/2, exactly the old threshold: missed) rises
+     * beyond the footing edge x = b = 0.5 B */
+    t = gk_test_result(BUILD "/tests/t_mpmft.out", "heave_x_end_over_B");
+    CHECK(t > 0.5 && t <= 2.0 / 1.5);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmft.out", "heave_over_B") > 0);
     /* the log spiral: this footing (b = 1.5 cells, 0.02 B) has no ridge to fit; said in words, and
      * RESULT says not found, the numbers nan (never a number made of a NaN) */
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmft.out", "log spiral (eq 44) at the last row: not found"));
