@@ -55,10 +55,11 @@
  *                    stands FM_SP_DROP (10 %) above the lowest value on
  *                    either side of it along the ray (a shoulder or the
  *                    pole's decay is no ridge), its radius refined by the
- *                    parabola through the three samples; (4) at least
- *                    FM_SP_MINRAYS rays with a ridge, spanning at least
- *                    half of the searched fan, else NOT FOUND (found = 0,
- *                    every number NAN); (5) the fit is least squares of
+ *                    parabola through the three samples; (4) a ridge on
+ *                    at least half of the rays searched (and on at least
+ *                    FM_SP_MINRAYS), spanning at least half of the
+ *                    searched fan, else NOT FOUND (found = 0, every number
+ *                    NAN: a bump on a few rays is no spiral); (5) the fit is least squares of
  *                    ln r = ln r0 + psi tan(phi_fit) (psi in radians):
  *                    phi_fit, r0 (on the wedge side, psi = 0); the misfit
  *                    against eq 44 at the caller's phi is the RMS of r -
@@ -212,7 +213,7 @@ static int fm_spiral(const double *x, const double *y, const double *eq, int n, 
     }
     free(ct);
     F->nrays = nr;
-    if (nr < FM_SP_MINRAYS || psi_max - psi_min < 0.5 * (hi - lo)) return 0;
+    if (nr < FM_SP_MINRAYS || 2 * nr < nray || psi_max - psi_min < 0.5 * (hi - lo)) return 0;
     for (k = 0; k < nr; ++k) {
         double ly = log(F->r[k]);
         sx += F->psi[k], sy += ly, sxx += F->psi[k] * F->psi[k], sxy += F->psi[k] * ly;

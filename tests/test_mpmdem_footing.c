@@ -216,6 +216,18 @@ TEST(footing_spiral_synthetic) {
     CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, 66.0, 28.1, &F), 1);
     CHECK_NEAR(F.phi, 28.1, 1.0);
     CHECK_NEAR(F.fan, 135.0 + 14.05 - 66.0, 1e-12);
+    /* a ridge on two short stretches of the fan only (psi 13-17 and 71-75 deg of 90; with the kernel's
+     * reach, ridges on fewer than half of the 36 rays, spanning more than half of the fan): bumps, no
+     * spiral */
+    n = spiral_field(x, y, eq, NX, NY, s, b, yb, 59.05, 28.1, 0.0, 1);
+    for (k = 0; k < n; ++k) {
+        double psi = atan2(y[k] - yb, x[k] - b) * 180.0 / 3.14159265358979323846 - 239.05;
+        while (psi < -90.0) psi += 360.0;
+        while (psi > 270.0) psi -= 360.0;
+        if (!((psi > 13.0 && psi < 17.0) || (psi > 71.0 && psi < 75.0))) eq[k] = 0.01;
+    }
+    CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, 59.05, 28.1, &F), 0);
+    CHECK(F.nrays >= 10 && F.nrays < 18 && isnan(F.phi));
     /* no ridge: uniform, the pole's decay alone, no points */
     n = spiral_field(x, y, eq, NX, NY, s, b, yb, 59.05, 28.1, 0.0, 0);
     CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, 59.05, 28.1, &F), 0);
