@@ -22,13 +22,18 @@
  * angle (in each column of cells under the footing, the depth of the largest
  * eps_q; the line through the footing's corner fitted to them), and the
  * heave (the surface row's largest uplift beyond the footing, and the
- * outermost x where it is still 10 % of that); printed and in RESULT at the
- * ultimate load's row and at the end, next to Prandtl's pi/4 + phi/2 and
- * the x where his passive zone meets the ground.
+ * outermost x where it is still 10 % of that), the log spiral (the eps_q
+ * ridge along rays from the footing's corner over Prandtl's fan at the RVE's
+ * friction angle phi, i.e. from his wedge side at pi/4 + phi/2 to the
+ * passive zone at pi/4 - phi/2; ln r fitted linearly in psi: phi_fit, r0,
+ * and the RMS misfit to eq 44 at phi; "not found" when no ridge stands out);
+ * printed and in RESULT at the ultimate load's row and at the end, next to
+ * Prandtl's pi/4 + phi/2 and the x where his passive zone meets the ground.
  *
  * Outputs in --out DIR (default build/mpm_footing): footing.csv
  * (load-settlement), footing_load.svg, rve_biaxial.svg and rve_mohr.svg (phi
- * measurement), eps_q_dB*.svg (stages, one colour scale) and eps_q_end.svg,
+ * measurement), eps_q_dB*.svg (stages, one colour scale; the fitted log
+ * spiral drawn on them when found) and eps_q_end.svg (the same),
  * rotation_end.svg, void_ratio_end.svg, displacement_end.svg (failure mode;
  * the footing, the wall and the base drawn on the points), points_NNNNNN.vtk,
  * checkpoint.bin; a RESULT line.
@@ -59,6 +64,8 @@ typedef struct ft_opts {
 typedef struct ft_row { /* one CSV row: means over an output interval; the mechanism at its end */
     double t, d, q, load, ek, dem_mean, secs;
     double wedge, heave_x, heave_u; /* footing_mech.h: wedge angle [deg], heave's outer x and top [m] */
+    double sp_phi, sp_r0, sp_rms;   /* fm_spiral: fitted angle [deg], r0 and eq 44 misfit [m]; NAN if none */
+    int sp_rays;                    /* rays with an eps_q ridge (0: none) */
 } ft_row;
 
 /* what a checkpoint carries besides points and RVEs */
@@ -128,9 +135,27 @@ static void outline(const ft *X, mpd_outline *ol) {
     mpd_outline_add(ol, 3, box);
 }
 
-static int snap_field(ft *X, int k, const char *file, const char *title) {
+/* the fitted log spiral r = r0 exp(psi tan phi_fit) about the footing's corner over Prandtl's fan at the
+ * RVE's angle (fm_spiral's), as two polylines of 6 points (11 chords of the 90 deg fan); nothing if NAN */
+static void outline_spiral(const ft *X, double phi_fit, double r0, mpd_outline *ol) {
+    double d2r = FM_PI / 180.0, a = fm_prandtl_wedge(X->phi), th0 = 180.0 + a, fan = 135.0 + 0.5 * X->phi - a;
+    double yb = X->f.depth - X->S.disp, xy[12];
+    int half, k;
+    if (!(isfinite(phi_fit) && isfinite(r0))) return;
+    for (half = 0; half < 2; ++half) {
+        for (k = 0; k < 6; ++k) {
+            double psi = fan * (5 * half + k) / 10.0, r = r0 * exp(psi * d2r * tan(phi_fit * d2r));
+            xy[2 * k] = X->b + r * cos((th0 + psi) * d2r), xy[2 * k + 1] = yb + r * sin((th0 + psi) * d2r);
+        }
+        mpd_outline_add(ol, 6, xy);
+    }
+}
+
+/* a field picture of the points with the outline, and the fitted log spiral (phi_fit, r0) if not NAN */
+static int snap_field(ft *X, int k, const char *file, const char *title, double phi_fit, double r0) {
     mpd_outline ol;
     outline(X, &ol);
+    outline_spiral(X, phi_fit, r0, &ol);
     return mpd_snap_field(&X->run, &X->snaps, &X->M, &X->pts, k, file, title, X->dot, &ol);
 }
 
@@ -156,12 +181,14 @@ static void put_csv(FILE *fp, const void *user) {
     const ft *X = (const ft *)user;
     int k;
     fprintf(fp, "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds,"
-                "wedge_deg,heave_x_over_B,heave_over_B\n");
+                "wedge_deg,heave_x_over_B,heave_over_B,spiral_phi_deg,spiral_r0_over_B,spiral_rms_over_B,"
+                "spiral_rays\n");
     for (k = 0; k < X->rows.n; ++k) {
         const ft_row *r = (const ft_row *)mpd_row(&X->rows, k);
-        fprintf(fp, "%.6g,%.6g,%.6g,%.9g,%.6g,%.9g,%.6g,%.4g,%.3f,%.5g,%.5g,%.5g\n", r->t, r->d,
-                r->d / X->f.B, r->q, r->q / X->f.surcharge, r->load, r->ek, r->dem_mean, r->secs, r->wedge,
-                r->heave_x / X->f.B, r->heave_u / X->f.B);
+        fprintf(fp, "%.6g,%.6g,%.6g,%.9g,%.6g,%.9g,%.6g,%.4g,%.3f,%.5g,%.5g,%.5g,%.4g,%.4g,%.3g,%d\n", r->t,
+                r->d, r->d / X->f.B, r->q, r->q / X->f.surcharge, r->load, r->ek, r->dem_mean, r->secs,
+                r->wedge, r->heave_x / X->f.B, r->heave_u / X->f.B, r->sp_phi, r->sp_r0 / X->f.B,
+                r->sp_rms / X->f.B, r->sp_rays);
     }
 }
 
@@ -240,11 +267,12 @@ static int load_plot(const ft *X, const double *qsm, int ku, double nq46, double
     return bad;
 }
 
-/* the failure mechanism of the points now (footing_mech.h): wedge angle, heave; 0 or 1 (out of memory) */
-static int mechanism(const ft *X, double *wedge, double *hx, double *hu) {
+/* the failure mechanism of the points now (footing_mech.h): wedge angle, heave, log spiral (*sp: over
+ * Prandtl's fan at the RVE's angle); 0 or 1 (out of memory) */
+static int mechanism(const ft *X, double *wedge, double *hx, double *hu, fm_spiral_fit *sp) {
     int n = X->pts.n, p, ns = 0;
     double *eq = (double *)malloc(3 * (size_t)n * sizeof *eq + 1), *xs = eq + n, *uy = xs + n;
-    double h = X->h, top = X->f.depth - 0.5 * h;
+    double h = X->h, top = X->f.depth - h / X->o.ppc; /* between the top row of points and the next */
     *wedge = *hx = *hu = NAN;
     if (!eq) return fprintf(stderr, "mpmdem_footing: out of memory\n"), 1;
     for (p = 0; p < n; ++p) {
@@ -254,6 +282,8 @@ static int mechanism(const ft *X, double *wedge, double *hx, double *hu) {
     }
     *wedge = fm_wedge_angle(X->pts.x[0], X->pts.x[1], eq, n, h, X->b, X->f.depth - X->S.disp, NULL);
     *hx = fm_heave(xs, uy, ns, X->b, hu);
+    fm_spiral(X->pts.x[0], X->pts.x[1], eq, n, h / X->o.ppc, X->b, X->f.depth - X->S.disp,
+              fm_prandtl_wedge(X->phi), X->phi, sp);
     free(eq);
     return 0;
 }
@@ -264,7 +294,8 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
     int n = X->rows.n, ku = -1, reached = 0, k, excl = X->S.step == steps_run && steps_run > 1, np = X->pts.n;
     double *x = (double *)malloc(3 * (size_t)n * sizeof *x + 1), *q = x + n, *qsm = q + n, nq = NAN, qu = NAN,
            du = NAN;
-    double wu = NAN, hxu = NAN, huu = NAN, we = NAN, hxe = NAN;
+    double wu = NAN, hxu = NAN, huu = NAN, we = NAN, hxe = NAN, spu = NAN, spr0 = NAN, sprms = NAN, spe = NAN;
+    int sprays = 0;
     double nq46 = nq_prandtl(X->phi), nq47 = nq_prandtl(phi_reduced(X->phi)), hwm, per_rve, ck_mb = 0;
     /* cost per RVE per step without the first step's one-off relaxation of every RVE */
     double per_step_rve = steps_run ? (secs - (excl ? X->t_first : 0)) / (steps_run - excl) / np : 0.0;
@@ -285,10 +316,13 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
     }
     if (!bad)
         bad = snap_field(X, MPD_EPS_Q, "eps_q_end",
-                         "deviatoric strain eps_q at the end (failure mode, Liang & Zhao Fig 14)") ||
+                         "deviatoric strain eps_q at the end (failure mode, Liang & Zhao Fig 14)",
+                         n > 0 ? ((const ft_row *)mpd_row(&X->rows, n - 1))->sp_phi : NAN,
+                         n > 0 ? ((const ft_row *)mpd_row(&X->rows, n - 1))->sp_r0 : NAN) ||
               snap_field(X, MPD_ROTATION, "rotation_end",
-                         "rotation of F = RU at the end (Liang & Zhao Fig 15)") ||
-              snap_field(X, MPD_VOID, "void_ratio_end", "void ratio at the end (Liang & Zhao Fig 15)") ||
+                         "rotation of F = RU at the end (Liang & Zhao Fig 15)", NAN, NAN) ||
+              snap_field(X, MPD_VOID, "void_ratio_end", "void ratio at the end (Liang & Zhao Fig 15)", NAN,
+                         NAN) ||
               displacement_field(X) || mpd_write_vtk(&X->run, X->S.step, &X->M, &X->pts);
     if (!mpd_path(&X->run, path, "checkpoint.bin") && stat(path, &st) == 0) ck_mb = st.st_size / 1048576.0;
     if (!bad)
@@ -343,6 +377,22 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
             (hxu - X->b) / f->B, fm_prandtl_reach(X->b, X->phi) / f->B);
         printf("mechanism at the end (d/B = %.4f): wedge angle %.1f deg; heave reaching x = %.2f B\n",
                rl->d / f->B, we, hxe / f->B);
+        spu = ru->sp_phi, spr0 = ru->sp_r0, sprms = ru->sp_rms, sprays = ru->sp_rays, spe = rl->sp_phi;
+        if (sprays > 0)
+            printf("log spiral (eq 44) at the %s: the eps_q ridge on %d rays from the footing's corner fits "
+                   "ln r = ln r0 + psi tan(phi) with phi = %.1f deg (the RVE's %.2f; Liang & Zhao: eq 44 at "
+                   "28.1 \"agrees perfectly\"), r0 = %.2f B (Prandtl's wedge side: %.2f B); RMS distance "
+                   "to eq 44 at the RVE's angle %.3f B (h = %.3f B)\n",
+                   reached ? "ultimate load" : "last row", sprays, spu, X->phi, spr0 / f->B,
+                   X->b / cos(fm_prandtl_wedge(X->phi) * FM_PI / 180.0) / f->B, sprms / f->B, X->h / f->B);
+        else
+            printf("log spiral (eq 44) at the %s: not found (no eps_q ridge standing out along the rays "
+                   "from the footing's corner; RESULT spiral_found=0)\n",
+                   reached ? "ultimate load" : "last row");
+        if (rl->sp_rays > 0)
+            printf("log spiral at the end: phi = %.1f deg on %d rays\n", spe, rl->sp_rays);
+        else
+            printf("log spiral at the end: not found\n");
     }
     hwm = proc_kb("VmHWM");
     per_rve = X->rss_after > 0 && X->rss_before > 0 ? (X->rss_after - X->rss_before) / np : NAN;
@@ -377,12 +427,14 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
            "seconds_per_step_per_1000_rves_after_first=%.4g "
            "mem_per_rve_kb=%.4g vmhwm_mb=%.5g total_seconds=%.2f wedge_deg=%.4g wedge_prandtl_deg=%.4g "
            "heave_x_over_B=%.4g heave_width_over_B=%.4g heave_over_B=%.4g prandtl_reach_over_B=%.4g "
-           "wedge_end_deg=%.4g heave_x_end_over_B=%.4g\n",
+           "wedge_end_deg=%.4g heave_x_end_over_B=%.4g spiral_found=%d spiral_phi_deg=%.4g "
+           "spiral_r0_over_B=%.4g spiral_rms_over_B=%.4g spiral_rays=%d spiral_phi_end_deg=%.4g\n",
            nq, nq46, nq47, X->phi, X->phi_res, X->measured ? nq_prandtl(X->phi_res) : NAN, phi_of_nq(nq), qu,
            du, reached, np, steps_run, X->dt, steps_run ? secs / steps_run : 0.0,
            steps_run ? secs / steps_run * 1000.0 / np : 0.0, 1000.0 * per_step_rve, per_rve, hwm / 1024, secs,
            wu, fm_prandtl_wedge(X->phi), hxu / f->B, (hxu - X->b) / f->B, huu / f->B,
-           fm_prandtl_reach(X->b, X->phi) / f->B, we, hxe / f->B);
+           fm_prandtl_reach(X->b, X->phi) / f->B, we, hxe / f->B, sprays > 0, spu, spr0 / f->B, sprms / f->B,
+           sprays, spe);
     free(x);
     return bad;
 }

@@ -174,8 +174,10 @@ static void usage(FILE *fp) {
         "  (footing: --dem-dt defaults to 3.16e-5 s x sqrt(6e8 / E), Guo & Zhao's fraction of the critical "
         "step)\n"
         "\noutputs in --out: footing.csv (time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,\n"
-        "  dem_steps_per_point,seconds,wedge_deg,heave_x_over_B,heave_over_B), footing_load.svg, "
-        "rve_biaxial.svg, rve_mohr.svg, eps_q_dB*.svg,\n"
+        "  dem_steps_per_point,seconds,wedge_deg,heave_x_over_B,heave_over_B,spiral_phi_deg,\n"
+        "  spiral_r0_over_B,spiral_rms_over_B,spiral_rays; spiral_*: nan and 0 rays when no ridge is "
+        "found),\n"
+        "  footing_load.svg, rve_biaxial.svg, rve_mohr.svg, eps_q_dB*.svg,\n"
         "  eps_q_end.svg, rotation_end.svg, void_ratio_end.svg, displacement_end.svg, points_*.vtk,\n"
         "  checkpoint.bin\n"
         "ends with: RESULT Nq=... Nq_analytic=... Nq_analytic_local=... phi_deg=... phi_res_deg=...\n"
@@ -186,7 +188,10 @@ static void usage(FILE *fp) {
         "total_seconds=...\n"
         "           wedge_deg=... wedge_prandtl_deg=... heave_x_over_B=... heave_width_over_B=... "
         "heave_over_B=...\n"
-        "           prandtl_reach_over_B=... wedge_end_deg=... heave_x_end_over_B=...\n");
+        "           prandtl_reach_over_B=... wedge_end_deg=... heave_x_end_over_B=...\n"
+        "           spiral_found=... spiral_phi_deg=... spiral_r0_over_B=... spiral_rms_over_B=... "
+        "spiral_rays=...\n"
+        "           spiral_phi_end_deg=...\n");
 }
 
 /* the flags, twice: the presets (--material, --paper) first, then every flag given over them */
@@ -354,6 +359,7 @@ static int after_step(ft *X, double vf, double t_start, long step0, long nsteps_
     long long sum = 0;
     int i, bad;
     ft_row r;
+    fm_spiral_fit sp;
     S->t += X->dt, S->disp += vf * X->dt, ++S->step;
     if (S->step == 1) X->t_first = gk_wtime() - t_start, X->dem_first = X->M.dem_steps; /* fresh runs only */
     S->acc_load += -S->body.force[1] * X->dt, S->acc_dt += X->dt;
@@ -367,7 +373,8 @@ static int after_step(ft *X, double vf, double t_start, long step0, long nsteps_
     r.t = S->t, r.d = S->disp, r.load = S->acc_load / S->acc_dt, r.q = r.load / X->b;
     r.ek = S->acc_ek / S->nacc, r.dem_mean = S->acc_dem / S->nacc;
     r.secs = S->wall + gk_wtime() - t_start;
-    if (mechanism(X, &r.wedge, &r.heave_x, &r.heave_u)) return 1;
+    if (mechanism(X, &r.wedge, &r.heave_x, &r.heave_u, &sp)) return 1;
+    r.sp_phi = sp.phi, r.sp_r0 = sp.r0, r.sp_rms = sp.rms, r.sp_rays = sp.found ? sp.nrays : 0;
     S->acc_load = S->acc_dt = 0, S->acc_ek = S->acc_dem = 0, S->nacc = 0;
     while (S->next_out * f->B <= S->disp * (1 + 1e-9)) S->next_out += f->every;
     bad = mpd_rows_push(&X->run, &X->rows, &r) || mpd_write(&X->run, "footing.csv", put_csv, X);
@@ -376,7 +383,7 @@ static int after_step(ft *X, double vf, double t_start, long step0, long nsteps_
         char file[48], title[120];
         snprintf(file, sizeof file, "eps_q_dB%.2f", ft_stages[S->nstage]);
         snprintf(title, sizeof title, "deviatoric strain eps_q at d/B = %.2f", ft_stages[S->nstage]);
-        bad = snap_field(X, MPD_EPS_Q, file, title);
+        bad = snap_field(X, MPD_EPS_Q, file, title, r.sp_phi, r.sp_r0);
         ++S->nstage;
     }
     if (!X->o.quiet) {

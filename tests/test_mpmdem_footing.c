@@ -47,7 +47,8 @@ TEST(footing_runs_and_loads) {
                     "> " BUILD "/tests/t_mpmft.out 2>&1") == 0);
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmft/footing.csv",
                            "time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,dem_steps_per_point,seconds,"
-                           "wedge_deg,heave_x_over_B,heave_over_B"));
+                           "wedge_deg,heave_x_over_B,heave_over_B,spiral_phi_deg,spiral_r0_over_B,"
+                           "spiral_rms_over_B,spiral_rays"));
     n = read_rows(BUILD "/tests/t_mpmft/footing.csv", r, 16);
     CHECK_EQ_INT(n, 5);
     if (n != 5) return;
@@ -83,6 +84,17 @@ TEST(footing_runs_and_loads) {
     CHECK(t > 30.0 && t < 80.0);
     CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "wedge_prandtl_deg"), 45.0 + 0.5 * phi,
                0.01); /* both printed to 4 digits */
+    /* the heave: the surface row of points (at depth - h/2, exactly the old threshold: missed) rises
+     * beyond the footing edge x = b = 0.5 B */
+    t = gk_test_result(BUILD "/tests/t_mpmft.out", "heave_x_end_over_B");
+    CHECK(t > 0.5 && t <= 2.0 / 1.5);
+    CHECK(gk_test_result(BUILD "/tests/t_mpmft.out", "heave_over_B") > 0);
+    /* the log spiral: this footing (b = 1.5 cells, 0.02 B) has no ridge to fit; said in words, and
+     * RESULT says not found, the numbers nan (never a number made of a NaN) */
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft.out", "log spiral (eq 44) at the last row: not found"));
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "spiral_found"), 0, 0);
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "spiral_rays"), 0, 0);
+    CHECK(isnan(gk_test_result(BUILD "/tests/t_mpmft.out", "spiral_phi_deg")));
 }
 
 /* --phi-only: the same measurement as the full run above (same options), then the RVE at q_s, and
@@ -146,6 +158,85 @@ TEST(footing_mechanism_synthetic) {
     CHECK_NEAR(fm_prandtl_wedge(0.0), 45.0, 1e-12);
     CHECK_NEAR(fm_prandtl_reach(0.5, 0.0), 1.5, 1e-12);
     CHECK_NEAR(fm_prandtl_wedge(28.1), 59.05, 1e-12); /* Liang & Zhao's 59.05 deg */
+}
+
+/* a synthetic eps_q field on points of spacing s: a ridge of half-width 0.08 m along the log spiral
+ * r = r0 exp(psi tan phi) (eq 44) about the footing's corner (b, yb), r0 = b / cos(alpha) (the wedge
+ * side of angle alpha), over the whole half space below yb; plus, if pole > 0, a 1/r concentration at
+ * the corner (the fan's radial shear) */
+static int spiral_field(double *x, double *y, double *eq, int nx, int ny, double s, double b, double yb,
+                        double alpha, double phi, double pole, int ridge) {
+    double d2r = 3.14159265358979323846 / 180.0, r0 = b / cos(alpha * d2r), th0 = 180.0 + alpha;
+    int i, j, n = 0;
+    for (j = 0; j < ny; ++j)
+        for (i = 0; i < nx; ++i) {
+            double px = (i + 0.5) * s, py = yb - (j + 0.5) * s, dx = px - b, dy = py - yb;
+            double r = sqrt(dx * dx + dy * dy), th = atan2(dy, dx) / d2r, psi, dn;
+            psi = th - th0;
+            while (psi < -90.0) psi += 360.0; /* the fan and 90 deg either side of it */
+            while (psi > 270.0) psi -= 360.0;
+            dn = (r - r0 * exp(psi * d2r * tan(phi * d2r))) * cos(phi * d2r); /* normal distance */
+            x[n] = px, y[n] = py;
+            eq[n] =
+                0.01 + (ridge ? 0.3 * exp(-dn * dn / (2 * 0.08 * 0.08)) : 0.0) + pole * b / fmax(r, 0.5 * s);
+            ++n;
+        }
+    return n;
+}
+
+/* fm_spiral: a ridge drawn along an exact log spiral gives its angle back within 1 deg (with and
+ * without the pole's concentration, at the wedge of Prandtl's mechanism and at a steeper one); no ridge
+ * (uniform, or only the pole's 1/r decay, or no points) is NOT FOUND, every number NAN */
+TEST(footing_spiral_synthetic) {
+    enum { NX = 70, NY = 40 };
+    static double x[NX * NY], y[NX * NY], eq[NX * NY];
+    const double phis[3] = {20.0, 28.1, 35.0};
+    double s = 0.1, b = 0.5, yb = 4.0, a;
+    int k, n;
+    fm_spiral_fit F;
+    for (k = 0; k < 3; ++k) {
+        a = 45.0 + 0.5 * phis[k];
+        n = spiral_field(x, y, eq, NX, NY, s, b, yb, a, phis[k], 0.0, 1);
+        CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, a, phis[k], &F), 1);
+        CHECK_NEAR(F.phi, phis[k], 1.0);
+        CHECK_REL(F.r0, b / cos(a * 3.14159265358979323846 / 180.0), 0.05);
+        CHECK(F.rms < 0.02);  /* the spiral of eq 44 at the same angle: within a fifth of a point spacing */
+        CHECK(F.nrays >= 30); /* the fan of 90 deg less 2 x 10, every 2 deg: 36 rays */
+        /* the pole's 1/r concentration on top: the ridge is still the spiral */
+        n = spiral_field(x, y, eq, NX, NY, s, b, yb, a, phis[k], 0.2, 1);
+        CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, a, phis[k], &F), 1);
+        CHECK_NEAR(F.phi, phis[k], 1.0);
+        /* the misfit grows when eq 44 is asked at another angle */
+        CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, a, phis[k] + 8.0, &F), 1);
+        CHECK_NEAR(F.phi, phis[k], 1.0);
+        CHECK(F.rms > 0.05);
+    }
+    /* a steeper wedge (rough base): the spiral from its tip, fan 135 + phi/2 - alpha */
+    n = spiral_field(x, y, eq, NX, NY, s, b, yb, 66.0, 28.1, 0.1, 1);
+    CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, 66.0, 28.1, &F), 1);
+    CHECK_NEAR(F.phi, 28.1, 1.0);
+    CHECK_NEAR(F.fan, 135.0 + 14.05 - 66.0, 1e-12);
+    /* a ridge on two short stretches of the fan only (psi 13-17 and 71-75 deg of 90; with the kernel's
+     * reach, ridges on fewer than half of the 36 rays, spanning more than half of the fan): bumps, no
+     * spiral */
+    n = spiral_field(x, y, eq, NX, NY, s, b, yb, 59.05, 28.1, 0.0, 1);
+    for (k = 0; k < n; ++k) {
+        double psi = atan2(y[k] - yb, x[k] - b) * 180.0 / 3.14159265358979323846 - 239.05;
+        while (psi < -90.0) psi += 360.0;
+        while (psi > 270.0) psi -= 360.0;
+        if (!((psi > 13.0 && psi < 17.0) || (psi > 71.0 && psi < 75.0))) eq[k] = 0.01;
+    }
+    CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, 59.05, 28.1, &F), 0);
+    CHECK(F.nrays >= 10 && F.nrays < 18 && isnan(F.phi));
+    /* no ridge: uniform, the pole's decay alone, no points */
+    n = spiral_field(x, y, eq, NX, NY, s, b, yb, 59.05, 28.1, 0.0, 0);
+    CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, 59.05, 28.1, &F), 0);
+    CHECK(!F.found && isnan(F.phi) && isnan(F.r0) && isnan(F.rms));
+    n = spiral_field(x, y, eq, NX, NY, s, b, yb, 59.05, 28.1, 0.2, 0);
+    CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, 59.05, 28.1, &F), 0);
+    CHECK(!F.found && isnan(F.phi) && F.nrays < FM_SP_MINRAYS);
+    CHECK_EQ_INT(fm_spiral(x, y, eq, 0, s, b, yb, 59.05, 28.1, &F), 0);
+    CHECK(isnan(F.phi));
 }
 
 /* the ultimate-load rule on a curve that peaks: a longer run of the same
@@ -233,6 +324,7 @@ int main(int argc, char **argv) {
     RUN(footing_runs_and_loads);
     RUN(footing_phi_only);
     RUN(footing_mechanism_synthetic);
+    RUN(footing_spiral_synthetic);
     RUN(footing_ultimate_found);
     RUN(footing_thread_independent);
     RUN(footing_restart_identical);
