@@ -754,7 +754,7 @@ static double gk__mpm_margin(gk_mpm_basis b, double l) {
 }
 
 /* 0 if the point's support is inside the grid */
-static int gk__mpm_inside(const gk_mpm_grid *g, gk_mpm_basis b, const double x[3], double l) {
+GK_FORCE_INLINE int gk__mpm_inside(const gk_mpm_grid *g, gk_mpm_basis b, const double x[3], double l) {
     double a = gk__mpm_margin(b, l);
     int k;
     for (k = 0; k < g->dim; ++k) {
@@ -1074,19 +1074,27 @@ static void gk__mpm_p2g_point(gk_mpm_grid *g, const gk_mpm_points *P, const gk_m
         vp[k] = P->v[k][p];
         fp[k] = mp * d->gravity[k] + P->fext[k][p];
     }
-    for (k = 0; k < 9; ++k) {
-        Cm[k] = apic ? mp * P->C[9 * p + k] : 0.0;
-        S[k] = (what & GK_MPM_P2G_FORCE) ? Vp * P->sigma[9 * p + k] : 0.0;
-    }
+    if (apic)
+        for (k = 0; k < 9; ++k) Cm[k] = mp * P->C[9 * p + k];
+    else
+        for (k = 0; k < 9; ++k) Cm[k] = 0.0;
+    if (what & GK_MPM_P2G_FORCE)
+        for (k = 0; k < 9; ++k) S[k] = Vp * P->sigma[9 * p + k];
+    else
+        for (k = 0; k < 9; ++k) S[k] = 0.0;
     W = gk__mpm_wget(g, g->wc != NULL, d->basis, x, l, p, 1, &Wt);
     s = W->s;
-    if (dim == 2) {
-        if (s == 3)
-            gk__mpm_p2g_2d(g, W, 3, what, apic, mp, vp, fp, Cm, S);
-        else if (s == 2)
-            gk__mpm_p2g_2d(g, W, 2, what, apic, mp, vp, fp, Cm, S);
+    if (dim == 2 && s == 3) { /* uGIMP and quadratic: the flags as constants */
+        if (what == GK_MPM_P2G_MOMENTUM)
+            gk__mpm_p2g_2d(g, W, 3, GK_MPM_P2G_MOMENTUM, apic, mp, vp, fp, Cm, S);
+        else if (what == GK_MPM_P2G_FORCE)
+            gk__mpm_p2g_2d(g, W, 3, GK_MPM_P2G_FORCE, apic, mp, vp, fp, Cm, S);
         else
-            gk__mpm_p2g_2d(g, W, 4, what, apic, mp, vp, fp, Cm, S);
+            gk__mpm_p2g_2d(g, W, 3, what, apic, mp, vp, fp, Cm, S);
+        return;
+    }
+    if (dim == 2) {
+        gk__mpm_p2g_2d(g, W, s == 2 ? 2 : 4, what, apic, mp, vp, fp, Cm, S);
         return;
     }
     sz = dim == 3 ? s : 1;
@@ -1392,13 +1400,17 @@ GK_FORCE_INLINE void gk__mpm_gather_2d(const gk_mpm_grid *g, const gk__mpm_w *W,
 static void gk__mpm_gather(const gk_mpm_grid *g, const gk__mpm_w *W, int vel, int grad, double *const *vg,
                            int apic_b, int apic_g, gk__mpm_gath *o) {
     int a, b, c, k, q, s = W->s, sz, dim = g->dim;
-    if (dim == 2) {
-        if (s == 3)
-            gk__mpm_gather_2d(g, W, 3, vel, grad, vg, apic_b, apic_g, o);
-        else if (s == 2)
-            gk__mpm_gather_2d(g, W, 2, vel, grad, vg, apic_b, apic_g, o);
+    if (dim == 2 && s == 3 && !apic_b && !apic_g) { /* uGIMP and quadratic, PIC/FLIP: constant flags */
+        if (vel && !grad)
+            gk__mpm_gather_2d(g, W, 3, 1, 0, vg, 0, 0, o);
+        else if (grad && !vel)
+            gk__mpm_gather_2d(g, W, 3, 0, 1, vg, 0, 0, o);
         else
-            gk__mpm_gather_2d(g, W, 4, vel, grad, vg, apic_b, apic_g, o);
+            gk__mpm_gather_2d(g, W, 3, vel, grad, vg, 0, 0, o);
+        return;
+    }
+    if (dim == 2) {
+        gk__mpm_gather_2d(g, W, s, vel, grad, vg, apic_b, apic_g, o);
         return;
     }
     sz = dim == 3 ? s : 1;
@@ -1435,8 +1447,10 @@ static void gk__mpm_gather(const gk_mpm_grid *g, const gk__mpm_w *W, int vel, in
 static double gk__mpm_f_update(int dim, double dt, const double Lg[9], const double F[9], double Fn[9]) {
     double E[9];
     int k;
-    for (k = 0; k < 9; ++k) E[k] = dt * Lg[k] + (k % 4 == 0 ? 1.0 : 0.0);
-    if (dim == 2) E[8] = 1.0;
+    for (k = 0; k < 9; ++k) E[k] = dt * Lg[k] + 0.0;
+    E[0] = dt * Lg[0] + 1.0;
+    E[4] = dt * Lg[4] + 1.0;
+    E[8] = dim == 2 ? 1.0 : dt * Lg[8] + 1.0;
     gk_m3_mul(E, F, Fn);
     if (dim == 2) {
         Fn[2] = Fn[5] = Fn[6] = Fn[7] = 0.0;
@@ -1466,7 +1480,10 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
     int gather_grad = grad && (dry || !scr), gather_vel = !dry && (want_v || want_x);
     double *const *vg = (what & GK_MPM_G2P_GRADIENT_OLD) ? g->v : g->vn;
     double *sp = scr ? scr + (size_t)GK__MPM_SCR * (size_t)p : NULL;
-    memset(&o, 0, sizeof o);
+    for (k = 0; k < 3; ++k) o.vpic[k] = o.dv[k] = 0.0;
+    if (apic)
+        for (k = 0; k < 9; ++k) o.Bm[k] = 0.0;
+    for (k = 0; k < 9; ++k) o.Lg[k] = 0.0;
     if (gather_grad || gather_vel) {
         for (k = 0; k < dim; ++k) x[k] = P->x[k][p];
         W = gk__mpm_wget(g, fresh, d->basis, x, l, p, 0, &Wt);
