@@ -154,7 +154,11 @@
  * works: linear, pure FLIP, USF). Point tensors are stored 9 per point
  * (array of 3x3 blocks inside the struct of arrays) rather than 9 arrays:
  * they go whole to gk_m3_* and to an RVE, and G2P writes them together.
- * The caller owns the rigid-body array (g->body, g->nbody).
+ * The caller owns the rigid-body array (g->body, g->nbody). P2G keeps each
+ * point's per-axis weights in the grid (about 270 bytes a point), and the
+ * transfers after it reuse them while the point's position, lp and the basis
+ * are bit-for-bit the same: the weights are computed once per step, and the
+ * results are those of weights computed afresh.
  *
  * CONVENTIONS: SI units (2D: per unit thickness, volumes are areas, forces
  * N/m); stress tension-positive; L_ij = dv_i/dx_j, H_ij = du_i/dx_j;
