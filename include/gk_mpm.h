@@ -154,7 +154,11 @@
  * works: linear, pure FLIP, USF). Point tensors are stored 9 per point
  * (array of 3x3 blocks inside the struct of arrays) rather than 9 arrays:
  * they go whole to gk_m3_* and to an RVE, and G2P writes them together.
- * The caller owns the rigid-body array (g->body, g->nbody).
+ * The caller owns the rigid-body array (g->body, g->nbody). P2G keeps each
+ * point's per-axis weights in the grid (about 270 bytes a point), and the
+ * transfers after it reuse them while the point's position, lp and the basis
+ * are bit-for-bit the same: the weights are computed once per step, and the
+ * results are those of weights computed afresh.
  *
  * CONVENTIONS: SI units (2D: per unit thickness, volumes are areas, forces
  * N/m); stress tension-positive; L_ij = dv_i/dx_j, H_ij = du_i/dx_j;
@@ -258,6 +262,11 @@ typedef struct gk_mpm_grid {
     int32_t *bstart; /* nblock + 1 */
     int32_t *order, *bid;
     int cap; /* capacity of order and bid */
+    /* private: each point's per-axis weights from the last P2G, reused by the
+     * transfers that follow while its position, lp and the basis are the same */
+    struct gk__mpm_wc *wc;
+    int wc_cap;
+    double wc_stamp[4]; /* origin and 1/h the cached weights were made with */
     gk_allocator alloc;
 } gk_mpm_grid;
 
@@ -490,6 +499,7 @@ static void gk__mpm_grid_free_arrays(gk_mpm_grid *g) {
     gk_free(&g->alloc, g->bstart);
     gk_free(&g->alloc, g->order);
     gk_free(&g->alloc, g->bid);
+    gk_free(&g->alloc, g->wc);
 }
 
 GKDEF gk_result gk_mpm_grid_create(gk_mpm_grid *g_out, int dim, const double origin[3], double h,
@@ -748,7 +758,7 @@ static double gk__mpm_margin(gk_mpm_basis b, double l) {
 }
 
 /* 0 if the point's support is inside the grid */
-static int gk__mpm_inside(const gk_mpm_grid *g, gk_mpm_basis b, const double x[3], double l) {
+GK_FORCE_INLINE int gk__mpm_inside(const gk_mpm_grid *g, gk_mpm_basis b, const double x[3], double l) {
     double a = gk__mpm_margin(b, l);
     int k;
     for (k = 0; k < g->dim; ++k) {
@@ -789,6 +799,63 @@ GK_FORCE_INLINE void gk__mpm_weights(const gk_mpm_grid *g, gk_mpm_basis basis, c
             W->dw[k][j] = dN * g->inv_h;
         }
     }
+}
+
+/* one point's cached weights: valid for the bits of x and l and the basis they were made with */
+struct gk__mpm_wc {
+    uint64_t key[4]; /* bits of x[0], x[1], x[2], l */
+    int basis;       /* -1: empty */
+    gk__mpm_w W;
+};
+
+/* whether the cached weights of the grid were made with its present origin and spacing */
+static int gk__mpm_wc_fresh(const gk_mpm_grid *g) {
+    int k;
+    if (!g->wc) return 0;
+    for (k = 0; k < 3; ++k)
+        if (memcmp(&g->wc_stamp[k], &g->origin[k], sizeof(double))) return 0;
+    return !memcmp(&g->wc_stamp[3], &g->inv_h, sizeof(double));
+}
+
+/* room for n points' weights, stamped with the grid's origin and spacing; on
+ * failure to allocate there is simply no cache (the weights are computed) */
+static void gk__mpm_wc_prepare(gk_mpm_grid *g, int n) {
+    int p, k, fresh = gk__mpm_wc_fresh(g);
+    if (n > g->wc_cap) {
+        struct gk__mpm_wc *w = (struct gk__mpm_wc *)gk_alloc(&g->alloc, (size_t)n * sizeof *w);
+        gk_free(&g->alloc, g->wc);
+        g->wc = w;
+        g->wc_cap = w ? n : 0;
+        fresh = 0;
+    }
+    if (!g->wc || fresh) return;
+    for (p = 0; p < g->wc_cap; ++p) g->wc[p].basis = -1;
+    for (k = 0; k < 3; ++k) g->wc_stamp[k] = g->origin[k];
+    g->wc_stamp[3] = g->inv_h;
+}
+
+/* the weights of point p at x (l = lp/h): the cached ones when they were made
+ * for the same bits of x and l and the same basis; else computed, and stored
+ * when `store` (P2G: one writer per point) */
+GK_FORCE_INLINE const gk__mpm_w *gk__mpm_wget(const gk_mpm_grid *g, int fresh, gk_mpm_basis basis,
+                                              const double x[3], double l, int p, int store, gk__mpm_w *tmp) {
+    if (fresh && p < g->wc_cap) {
+        struct gk__mpm_wc *e = g->wc + p;
+        uint64_t key[4];
+        memcpy(key, x, 3 * sizeof(double));
+        memcpy(key + 3, &l, sizeof(double));
+        if (e->basis == (int)basis && e->key[0] == key[0] && e->key[1] == key[1] && e->key[2] == key[2] &&
+            e->key[3] == key[3])
+            return &e->W;
+        if (store) {
+            gk__mpm_weights(g, basis, x, l, &e->W);
+            memcpy(e->key, key, sizeof key);
+            e->basis = (int)basis;
+            return &e->W;
+        }
+    }
+    gk__mpm_weights(g, basis, x, l, tmp);
+    return tmp;
 }
 
 GKDEF gk_result gk_mpm_shape(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double lp,
@@ -954,12 +1021,55 @@ static gk_result gk__mpm_bin(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mp
     for (s = g->nblock; s > 0; --s) g->bstart[s] = g->bstart[s - 1];
     g->bstart[0] = 0;
     *mmin = d->mass_min > 0.0 ? d->mass_min : (n > 0 ? 1e-14 * mlow : 0.0);
+    gk__mpm_wc_prepare(g, n);
     return GK_OK;
+}
+
+/* scatter one point of a 2D grid, s nodes per axis (a constant after inlining): the
+ * operations of the general loop below with the z factors (weight 1, slope 0) taken
+ * out where that is exact (x * 1 = x; the z slope term S_k2 (w 0) is the same
+ * signed zero for every node, since w >= +0) */
+GK_FORCE_INLINE void gk__mpm_p2g_2d(gk_mpm_grid *g, const gk__mpm_w *W, int s, int what, int apic, double mp,
+                                    const double vp[3], const double fp[3], const double Cm[9],
+                                    const double S[9]) {
+    const double *w0 = W->w[0], *w1 = W->w[1], *dw0 = W->dw[0], *dw1 = W->dw[1];
+    double *gm = g->m, *p0 = g->p[0], *p1 = g->p[1];
+    double *fi0 = g->fint[0], *fi1 = g->fint[1], *fe0 = g->fext[0], *fe1 = g->fext[1];
+    double mom0 = mp * vp[0], mom1 = mp * vp[1], h = g->h, dz = W->dw[2][0];
+    double z0 = S[2] * (0.0 * dz), z1 = S[5] * (0.0 * dz);
+    int a, b, n0 = g->n[0];
+    for (b = 0; b < s; ++b) {
+        size_t row = (size_t)W->base[0] + (size_t)n0 * (size_t)(W->base[1] + b);
+        for (a = 0; a < s; ++a) {
+            size_t I = row + (size_t)a;
+            double w = w0[a] * w1[b];
+            if (what & GK_MPM_P2G_MOMENTUM) {
+                double m0 = mom0, m1 = mom1;
+                if (apic) {
+                    double dx0 = h * ((double)(W->base[0] + a) - W->xi[0]);
+                    double dx1 = h * ((double)(W->base[1] + b) - W->xi[1]);
+                    m0 += Cm[0] * dx0 + Cm[1] * dx1 + Cm[2] * 0.0;
+                    m1 += Cm[3] * dx0 + Cm[4] * dx1 + Cm[5] * 0.0;
+                }
+                gm[I] += w * mp;
+                p0[I] += w * m0;
+                p1[I] += w * m1;
+            }
+            if (what & GK_MPM_P2G_FORCE) {
+                double gr0 = dw0[a] * w1[b], gr1 = w0[a] * dw1[b];
+                fi0[I] -= S[0] * gr0 + S[1] * gr1 + z0;
+                fi1[I] -= S[3] * gr0 + S[4] * gr1 + z1;
+                fe0[I] += w * fp[0];
+                fe1[I] += w * fp[1];
+            }
+        }
+    }
 }
 
 /* scatter one point */
 static void gk__mpm_p2g_point(gk_mpm_grid *g, const gk_mpm_points *P, const gk_mpm_def *d, int p, int what) {
-    gk__mpm_w W;
+    gk__mpm_w Wt;
+    const gk__mpm_w *W;
     double x[3] = {0.0, 0.0, 0.0}, vp[3] = {0.0, 0.0, 0.0}, fp[3] = {0.0, 0.0, 0.0}, Cm[9], S[9];
     double mp = P->m[p], Vp = P->vol[p], l = d->basis == GK_MPM_UGIMP ? P->lp[p] * g->inv_h : 0.0;
     int a, b, c, k, s, sz, dim = g->dim, apic = d->transfer == GK_MPM_APIC;
@@ -968,25 +1078,42 @@ static void gk__mpm_p2g_point(gk_mpm_grid *g, const gk_mpm_points *P, const gk_m
         vp[k] = P->v[k][p];
         fp[k] = mp * d->gravity[k] + P->fext[k][p];
     }
-    for (k = 0; k < 9; ++k) {
-        Cm[k] = apic ? mp * P->C[9 * p + k] : 0.0;
-        S[k] = (what & GK_MPM_P2G_FORCE) ? Vp * P->sigma[9 * p + k] : 0.0;
+    if (apic)
+        for (k = 0; k < 9; ++k) Cm[k] = mp * P->C[9 * p + k];
+    else
+        for (k = 0; k < 9; ++k) Cm[k] = 0.0;
+    if (what & GK_MPM_P2G_FORCE)
+        for (k = 0; k < 9; ++k) S[k] = Vp * P->sigma[9 * p + k];
+    else
+        for (k = 0; k < 9; ++k) S[k] = 0.0;
+    W = gk__mpm_wget(g, g->wc != NULL, d->basis, x, l, p, 1, &Wt);
+    s = W->s;
+    if (dim == 2 && s == 3) { /* uGIMP and quadratic: the flags as constants */
+        if (what == GK_MPM_P2G_MOMENTUM)
+            gk__mpm_p2g_2d(g, W, 3, GK_MPM_P2G_MOMENTUM, apic, mp, vp, fp, Cm, S);
+        else if (what == GK_MPM_P2G_FORCE)
+            gk__mpm_p2g_2d(g, W, 3, GK_MPM_P2G_FORCE, apic, mp, vp, fp, Cm, S);
+        else
+            gk__mpm_p2g_2d(g, W, 3, what, apic, mp, vp, fp, Cm, S);
+        return;
     }
-    gk__mpm_weights(g, d->basis, x, l, &W);
-    s = W.s;
+    if (dim == 2) {
+        gk__mpm_p2g_2d(g, W, s == 2 ? 2 : 4, what, apic, mp, vp, fp, Cm, S);
+        return;
+    }
     sz = dim == 3 ? s : 1;
     for (c = 0; c < sz; ++c)
         for (b = 0; b < s; ++b)
             for (a = 0; a < s; ++a) {
                 size_t I =
-                    (size_t)(W.base[0] + a) +
-                    (size_t)g->n[0] * ((size_t)(W.base[1] + b) + (size_t)g->n[1] * (size_t)(W.base[2] + c));
-                double wyz = W.w[1][b] * W.w[2][c], w = W.w[0][a] * wyz, gr[3];
+                    (size_t)(W->base[0] + a) +
+                    (size_t)g->n[0] * ((size_t)(W->base[1] + b) + (size_t)g->n[1] * (size_t)(W->base[2] + c));
+                double wyz = W->w[1][b] * W->w[2][c], w = W->w[0][a] * wyz, gr[3];
                 if (what & GK_MPM_P2G_MOMENTUM) {
                     double dx[3];
-                    dx[0] = g->h * ((double)(W.base[0] + a) - W.xi[0]);
-                    dx[1] = g->h * ((double)(W.base[1] + b) - W.xi[1]);
-                    dx[2] = dim == 3 ? g->h * ((double)(W.base[2] + c) - W.xi[2]) : 0.0;
+                    dx[0] = g->h * ((double)(W->base[0] + a) - W->xi[0]);
+                    dx[1] = g->h * ((double)(W->base[1] + b) - W->xi[1]);
+                    dx[2] = dim == 3 ? g->h * ((double)(W->base[2] + c) - W->xi[2]) : 0.0;
                     g->m[I] += w * mp;
                     for (k = 0; k < dim; ++k) {
                         double mom = mp * vp[k];
@@ -995,9 +1122,9 @@ static void gk__mpm_p2g_point(gk_mpm_grid *g, const gk_mpm_points *P, const gk_m
                     }
                 }
                 if (what & GK_MPM_P2G_FORCE) {
-                    gr[0] = W.dw[0][a] * wyz;
-                    gr[1] = W.w[0][a] * W.dw[1][b] * W.w[2][c];
-                    gr[2] = W.w[0][a] * W.w[1][b] * W.dw[2][c];
+                    gr[0] = W->dw[0][a] * wyz;
+                    gr[1] = W->w[0][a] * W->dw[1][b] * W->w[2][c];
+                    gr[2] = W->w[0][a] * W->w[1][b] * W->dw[2][c];
                     for (k = 0; k < dim; ++k) {
                         g->fint[k][I] -= S[3 * k] * gr[0] + S[3 * k + 1] * gr[1] + S[3 * k + 2] * gr[2];
                         g->fext[k][I] += w * fp[k];
@@ -1221,85 +1348,184 @@ GKDEF gk_result gk_mpm_grid_update(gk_mpm_grid *g, const gk_mpm_def *d, double d
     return GK_OK;
 }
 
-/* gather one point; returns 1 if det F <= 0 afterwards. dry: write
- * nothing, only tell whether the gradient update would invert F */
-static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_def *d, double dt, int what,
-                             int p, int dry) {
-    gk__mpm_w W;
-    double x[3] = {0.0, 0.0, 0.0}, vpic[3] = {0.0, 0.0, 0.0}, dv[3] = {0.0, 0.0, 0.0}, Lg[9], Bm[9];
-    double l = d->basis == GK_MPM_UGIMP ? P->lp[p] * g->inv_h : 0.0;
-    int a, b, c, k, q, s, sz, dim = g->dim, apic = d->transfer == GK_MPM_APIC;
-    int grad = what & (GK_MPM_G2P_GRADIENT_NEW | GK_MPM_G2P_GRADIENT_OLD);
-    int want_v = what & GK_MPM_G2P_VELOCITY, want_x = what & GK_MPM_G2P_POSITION;
-    int apic_b = apic && want_v && (d->basis == GK_MPM_QUADRATIC || d->basis == GK_MPM_CUBIC);
-    int apic_g = apic && want_v && !apic_b;
-    double *const *vg = (what & GK_MPM_G2P_GRADIENT_OLD) ? g->v : g->vn;
-    for (k = 0; k < 9; ++k) Lg[k] = Bm[k] = 0.0;
-    for (k = 0; k < dim; ++k) x[k] = P->x[k][p];
-    gk__mpm_weights(g, d->basis, x, l, &W);
-    s = W.s;
+/* what one point gathers from the grid */
+typedef struct gk__mpm_gath {
+    double vpic[3], dv[3]; /* sum N vn, sum N (vn - v) */
+    double Bm[9];          /* APIC: sum N vn (x) dx (B-splines) or sum vn (x) grad N */
+    double Lg[9];          /* sum vg (x) grad N */
+} gk__mpm_gath;
+
+/* 2D gather, s nodes per axis (a constant after inlining): the operations of the
+ * general loop with the z factors (weight 1) taken out, exact (x * 1 = x) */
+GK_FORCE_INLINE void gk__mpm_gather_2d(const gk_mpm_grid *g, const gk__mpm_w *W, int s, int vel, int grad,
+                                       double *const *vg, int apic_b, int apic_g, gk__mpm_gath *o) {
+    const double *w0 = W->w[0], *w1 = W->w[1], *dw0 = W->dw[0], *dw1 = W->dw[1];
+    const double *vn0 = g->vn[0], *vn1 = g->vn[1], *v0 = g->v[0], *v1 = g->v[1], *g0 = vg[0], *g1 = vg[1];
+    double h = g->h;
+    int a, b, n0 = g->n[0];
+    for (b = 0; b < s; ++b) {
+        size_t row = (size_t)W->base[0] + (size_t)n0 * (size_t)(W->base[1] + b);
+        for (a = 0; a < s; ++a) {
+            size_t I = row + (size_t)a;
+            double gr0 = dw0[a] * w1[b], gr1 = w0[a] * dw1[b];
+            if (vel) {
+                double w = w0[a] * w1[b], un0 = vn0[I], un1 = vn1[I];
+                o->vpic[0] += w * un0;
+                o->vpic[1] += w * un1;
+                o->dv[0] += w * (un0 - v0[I]);
+                o->dv[1] += w * (un1 - v1[I]);
+                if (apic_b) {
+                    double dx0 = h * ((double)(W->base[0] + a) - W->xi[0]);
+                    double dx1 = h * ((double)(W->base[1] + b) - W->xi[1]);
+                    o->Bm[0] += w * un0 * dx0;
+                    o->Bm[1] += w * un0 * dx1;
+                    o->Bm[3] += w * un1 * dx0;
+                    o->Bm[4] += w * un1 * dx1;
+                }
+                if (apic_g) {
+                    o->Bm[0] += un0 * gr0;
+                    o->Bm[1] += un0 * gr1;
+                    o->Bm[3] += un1 * gr0;
+                    o->Bm[4] += un1 * gr1;
+                }
+            }
+            if (grad) {
+                double u0 = g0[I], u1 = g1[I];
+                o->Lg[0] += u0 * gr0;
+                o->Lg[1] += u0 * gr1;
+                o->Lg[3] += u1 * gr0;
+                o->Lg[4] += u1 * gr1;
+            }
+        }
+    }
+}
+
+/* the velocity (vel) and/or gradient (grad) sums of one point, o zeroed by the caller */
+static void gk__mpm_gather(const gk_mpm_grid *g, const gk__mpm_w *W, int vel, int grad, double *const *vg,
+                           int apic_b, int apic_g, gk__mpm_gath *o) {
+    int a, b, c, k, q, s = W->s, sz, dim = g->dim;
+    if (dim == 2 && s == 3 && !apic_b && !apic_g) { /* uGIMP and quadratic, PIC/FLIP: constant flags */
+        if (vel && !grad)
+            gk__mpm_gather_2d(g, W, 3, 1, 0, vg, 0, 0, o);
+        else if (grad && !vel)
+            gk__mpm_gather_2d(g, W, 3, 0, 1, vg, 0, 0, o);
+        else
+            gk__mpm_gather_2d(g, W, 3, vel, grad, vg, 0, 0, o);
+        return;
+    }
+    if (dim == 2) {
+        gk__mpm_gather_2d(g, W, s, vel, grad, vg, apic_b, apic_g, o);
+        return;
+    }
     sz = dim == 3 ? s : 1;
     for (c = 0; c < sz; ++c)
         for (b = 0; b < s; ++b)
             for (a = 0; a < s; ++a) {
                 size_t I =
-                    (size_t)(W.base[0] + a) +
-                    (size_t)g->n[0] * ((size_t)(W.base[1] + b) + (size_t)g->n[1] * (size_t)(W.base[2] + c));
-                double wyz = W.w[1][b] * W.w[2][c], w = W.w[0][a] * wyz, gr[3], dx[3];
-                gr[0] = W.dw[0][a] * wyz;
-                gr[1] = W.w[0][a] * W.dw[1][b] * W.w[2][c];
-                gr[2] = W.w[0][a] * W.w[1][b] * W.dw[2][c];
-                dx[0] = g->h * ((double)(W.base[0] + a) - W.xi[0]);
-                dx[1] = g->h * ((double)(W.base[1] + b) - W.xi[1]);
-                dx[2] = dim == 3 ? g->h * ((double)(W.base[2] + c) - W.xi[2]) : 0.0;
+                    (size_t)(W->base[0] + a) +
+                    (size_t)g->n[0] * ((size_t)(W->base[1] + b) + (size_t)g->n[1] * (size_t)(W->base[2] + c));
+                double wyz = W->w[1][b] * W->w[2][c], w = W->w[0][a] * wyz, gr[3], dx[3];
+                gr[0] = W->dw[0][a] * wyz;
+                gr[1] = W->w[0][a] * W->dw[1][b] * W->w[2][c];
+                gr[2] = W->w[0][a] * W->w[1][b] * W->dw[2][c];
+                dx[0] = g->h * ((double)(W->base[0] + a) - W->xi[0]);
+                dx[1] = g->h * ((double)(W->base[1] + b) - W->xi[1]);
+                dx[2] = dim == 3 ? g->h * ((double)(W->base[2] + c) - W->xi[2]) : 0.0;
                 for (k = 0; k < dim; ++k) {
                     double un = g->vn[k][I];
-                    vpic[k] += w * un;
-                    dv[k] += w * (un - g->v[k][I]);
+                    if (vel) {
+                        o->vpic[k] += w * un;
+                        o->dv[k] += w * (un - g->v[k][I]);
+                        if (apic_b)
+                            for (q = 0; q < dim; ++q) o->Bm[3 * k + q] += w * un * dx[q];
+                        if (apic_g)
+                            for (q = 0; q < dim; ++q) o->Bm[3 * k + q] += un * gr[q];
+                    }
                     if (grad)
-                        for (q = 0; q < dim; ++q) Lg[3 * k + q] += vg[k][I] * gr[q];
-                    if (apic_b)
-                        for (q = 0; q < dim; ++q) Bm[3 * k + q] += w * un * dx[q];
-                    if (apic_g)
-                        for (q = 0; q < dim; ++q) Bm[3 * k + q] += un * gr[q];
+                        for (q = 0; q < dim; ++q) o->Lg[3 * k + q] += vg[k][I] * gr[q];
                 }
             }
+}
+
+/* F_new = (I + dt L) F (2D: the plane block), returns det F_new */
+static double gk__mpm_f_update(int dim, double dt, const double Lg[9], const double F[9], double Fn[9]) {
+    double E[9];
+    int k;
+    for (k = 0; k < 9; ++k) E[k] = dt * Lg[k] + 0.0;
+    E[0] = dt * Lg[0] + 1.0;
+    E[4] = dt * Lg[4] + 1.0;
+    E[8] = dim == 2 ? 1.0 : dt * Lg[8] + 1.0;
+    gk_m3_mul(E, F, Fn);
+    if (dim == 2) {
+        Fn[2] = Fn[5] = Fn[6] = Fn[7] = 0.0;
+        Fn[8] = 1.0;
+    }
+    return gk_m3_det(Fn);
+}
+
+#define GK__MPM_SCR 19 /* scratch per point between the G2P passes: L, F_new, det F_new */
+
+/* gather one point. dry: write nothing, return 1 if the gradient update would
+ * invert F (and keep L, F_new, det F_new in scr when scr is not NULL). Else
+ * update the point (the gradient from scr when it is not NULL) and return 1 if
+ * det F <= 0 afterwards. */
+static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_def *d, double dt, int what,
+                             int p, int dry, int fresh, double *scr) {
+    gk__mpm_w Wt;
+    const gk__mpm_w *W = NULL;
+    gk__mpm_gath o;
+    double x[3] = {0.0, 0.0, 0.0};
+    double l = d->basis == GK_MPM_UGIMP ? P->lp[p] * g->inv_h : 0.0;
+    int k, dim = g->dim, apic = d->transfer == GK_MPM_APIC;
+    int grad = what & (GK_MPM_G2P_GRADIENT_NEW | GK_MPM_G2P_GRADIENT_OLD);
+    int want_v = what & GK_MPM_G2P_VELOCITY, want_x = what & GK_MPM_G2P_POSITION;
+    int apic_b = apic && want_v && (d->basis == GK_MPM_QUADRATIC || d->basis == GK_MPM_CUBIC);
+    int apic_g = apic && want_v && !apic_b;
+    int gather_grad = grad && (dry || !scr), gather_vel = !dry && (want_v || want_x);
+    double *const *vg = (what & GK_MPM_G2P_GRADIENT_OLD) ? g->v : g->vn;
+    double *sp = scr ? scr + (size_t)GK__MPM_SCR * (size_t)p : NULL;
+    for (k = 0; k < 3; ++k) o.vpic[k] = o.dv[k] = 0.0;
+    if (apic)
+        for (k = 0; k < 9; ++k) o.Bm[k] = 0.0;
+    for (k = 0; k < 9; ++k) o.Lg[k] = 0.0;
+    if (gather_grad || gather_vel) {
+        for (k = 0; k < dim; ++k) x[k] = P->x[k][p];
+        W = gk__mpm_wget(g, fresh, d->basis, x, l, p, 0, &Wt);
+        gk__mpm_gather(g, W, gather_vel, gather_grad, vg, apic_b, apic_g, &o);
+    }
     if (dry) {
-        double E[9], Fn[9];
-        for (k = 0; k < 9; ++k) E[k] = dt * Lg[k] + (k % 4 == 0 ? 1.0 : 0.0);
-        if (dim == 2) E[8] = 1.0;
-        gk_m3_mul(E, P->F + 9 * p, Fn);
-        if (dim == 2) Fn[2] = Fn[5] = Fn[6] = Fn[7] = 0.0, Fn[8] = 1.0;
-        return !(gk_m3_det(Fn) > 0.0);
+        double Fn[9], J = gk__mpm_f_update(dim, dt, o.Lg, P->F + 9 * p, Fn);
+        if (sp) {
+            memcpy(sp, o.Lg, 9 * sizeof(double));
+            memcpy(sp + 9, Fn, 9 * sizeof(double));
+            sp[18] = J;
+        }
+        return !(J > 0.0);
     }
     if (want_v) {
         if (apic) {
             double Dinv =
                 d->basis == GK_MPM_QUADRATIC ? 4.0 * g->inv_h * g->inv_h : 3.0 * g->inv_h * g->inv_h;
-            for (k = 0; k < dim; ++k) P->v[k][p] = vpic[k];
-            for (k = 0; k < 9; ++k) P->C[9 * p + k] = apic_b ? Bm[k] * Dinv : Bm[k];
+            for (k = 0; k < dim; ++k) P->v[k][p] = o.vpic[k];
+            for (k = 0; k < 9; ++k) P->C[9 * p + k] = apic_b ? o.Bm[k] * Dinv : o.Bm[k];
         } else {
             for (k = 0; k < dim; ++k)
-                P->v[k][p] = d->alpha * vpic[k] + (1.0 - d->alpha) * (P->v[k][p] + dv[k]);
+                P->v[k][p] = d->alpha * o.vpic[k] + (1.0 - d->alpha) * (P->v[k][p] + o.dv[k]);
         }
     }
     if (want_x)
-        for (k = 0; k < dim; ++k) P->x[k][p] += dt * vpic[k];
+        for (k = 0; k < dim; ++k) P->x[k][p] += dt * o.vpic[k];
     if (grad) {
-        double E[9], Fn[9], J;
-        double *F = P->F + 9 * p;
-        for (k = 0; k < 9; ++k) {
-            P->L[9 * p + k] = Lg[k];
-            E[k] = dt * Lg[k] + (k % 4 == 0 ? 1.0 : 0.0);
+        double Fn[9], J;
+        if (sp) {
+            memcpy(P->L + 9 * p, sp, 9 * sizeof(double));
+            memcpy(P->F + 9 * p, sp + 9, 9 * sizeof(double));
+            J = sp[18];
+        } else {
+            J = gk__mpm_f_update(dim, dt, o.Lg, P->F + 9 * p, Fn);
+            memcpy(P->L + 9 * p, o.Lg, 9 * sizeof(double));
+            gk_m3_copy(Fn, P->F + 9 * p);
         }
-        if (dim == 2) E[8] = 1.0;
-        gk_m3_mul(E, F, Fn);
-        if (dim == 2) {
-            Fn[2] = Fn[5] = Fn[6] = Fn[7] = 0.0;
-            Fn[8] = 1.0;
-        }
-        gk_m3_copy(Fn, F);
-        J = gk_m3_det(Fn);
         P->vol[p] = J * P->vol0[p];
         return !(J > 0.0);
     }
@@ -1309,7 +1535,8 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
 GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_def *d, double dt, int what,
                            gk_err *err) {
     gk_result r = gk__mpm_check_def(d, err);
-    int n, p, k, nth, bad = 0;
+    int n, p, k, nth, bad = 0, fresh;
+    double *scr = NULL;
     if (r) return r;
     if (!P) return gk_err_set(err, GK_ERR_ARG, "NULL points");
     if (P->dim != g->dim) return gk_err_set(err, GK_ERR_ARG, "points are %dD, grid is %dD", P->dim, g->dim);
@@ -1334,20 +1561,25 @@ GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_
     }
     nth = gk__mpm_nthreads(d);
     (void)nth; /* unused without OpenMP */
+    fresh = gk__mpm_wc_fresh(g);
     if (what & (GK_MPM_G2P_GRADIENT_NEW | GK_MPM_G2P_GRADIENT_OLD)) {
-        /* a dry pass first: an update that inverts some F changes no point */
+        /* a dry pass first: an update that inverts some F changes no point; it keeps
+         * each point's L and new F for the second pass (recomputed if no memory) */
+        if (n > 0) scr = (double *)gk_alloc(&P->alloc, (size_t)GK__MPM_SCR * (size_t)n * sizeof(double));
         GK_OMP(parallel for num_threads(nth) schedule(static) reduction(+ : bad) if (nth > 1))
-        for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p, 1);
+        for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p, 1, fresh, scr);
         if (bad) {
             for (p = 0; p < n; ++p)
-                if (gk__mpm_g2p_point(g, P, d, dt, what, p, 1)) break;
+                if (gk__mpm_g2p_point(g, P, d, dt, what, p, 1, fresh, NULL)) break;
+            gk_free(&P->alloc, scr);
             return gk_err_set(err, GK_ERR_DIVERGED,
                               "%d points would invert (det F <= 0), first point %d: nothing was changed", bad,
                               p);
         }
     }
     GK_OMP(parallel for num_threads(nth) schedule(static) reduction(+ : bad) if (nth > 1))
-    for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p, 0);
+    for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p, 0, fresh, scr);
+    gk_free(&P->alloc, scr);
     if (bad) return gk_err_set(err, GK_ERR_DIVERGED, "%d points inverted (det F <= 0)", bad);
     return GK_OK;
 }
