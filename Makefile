@@ -86,10 +86,11 @@ TESTDEF := -DBUILD='"$(BUILD)"'
 # that defines GK_IMPLEMENTATION itself (float reals, GK_DEM_PAR_MIN) compiles its own.
 OWN_IMPL := $(patsubst tests/test_%.c,%,$(shell grep -l '^\#define GK_IMPLEMENTATION' $(TEST_SRC)))
 impl_for = $(if $(filter $(1),$(OWN_IMPL)),,$(2))
-$(BUILD)/gk_impl.o: tests/gk_impl.c $(HEADERS) | $(BUILD)
+IMPL := $(BUILD)/gk_impl.o
+$(IMPL): tests/gk_impl.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -c -o $@ $<
-$(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(BUILD)/gk_impl.o | $(BUILD)
-	$(CC) $(CFLAGS) $(TESTDEF) -o $@ $< $(call impl_for,$*,$(BUILD)/gk_impl.o) $(LDLIBS)
+$(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(IMPL) | $(BUILD)
+	$(CC) $(CFLAGS) $(TESTDEF) -o $@ $< $(call impl_for,$*,$(IMPL)) $(LDLIBS)
 
 # test_mpmdem_footing also tests the footing driver's examples/footing_mech.h directly
 $(BUILD)/test_mpmdem_footing $(BUILD)/asan/test_mpmdem_footing $(BUILD)/nosimd/test_mpmdem_footing: examples/footing_mech.h
@@ -162,8 +163,8 @@ test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) $(BUILD)/bench_tradeoff $(if 
 # the harness's own GK_IMPLEMENTATION (libFuzzer builds it alone) gives way to the
 # build's implementation object (GK_IMPLEMENTATION_ELSEWHERE, gk_base.h)
 ELSEWHERE := -DGK_IMPLEMENTATION_ELSEWHERE
-$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(BUILD)/gk_impl.o | $(BUILD)
-	$(CC) $(CFLAGS) $(ELSEWHERE) -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(BUILD)/gk_impl.o $(LDLIBS)
+$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(IMPL) | $(BUILD)
+	$(CC) $(CFLAGS) $(ELSEWHERE) -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(IMPL) $(LDLIBS)
 
 # ---------------------------------------------------------------- check
 SAN := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
@@ -178,12 +179,12 @@ LIB_TESTS    := $(filter-out $(DRIVER_TESTS),$(patsubst tests/test_%.c,%,$(TEST_
 ASAN_TESTS   := $(patsubst %,$(BUILD)/asan/test_%,$(LIB_TESTS)) $(patsubst %,$(BUILD)/asan/fuzz_replay_%,$(FUZZ_NAMES))
 NOSIMD_TESTS := $(patsubst %,$(BUILD)/nosimd/test_%,$(LIB_TESTS))
 
-$(BUILD)/asan/gk_impl.o: tests/gk_impl.c $(HEADERS) | $(BUILD)/asan
-	$(CC) $(SANFLAGS) -Iinclude -c -o $@ $<
-$(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(BUILD)/asan/gk_impl.o | $(BUILD)/asan
-	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK $(TESTDEF) -o $@ $< $(call impl_for,$*,$(BUILD)/asan/gk_impl.o) $(LDLIBS)
-
 ASAN_IMPL := $(BUILD)/asan/gk_impl.o
+$(ASAN_IMPL): tests/gk_impl.c $(HEADERS) | $(BUILD)/asan
+	$(CC) $(SANFLAGS) -Iinclude -c -o $@ $<
+$(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(ASAN_IMPL) | $(BUILD)/asan
+	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK $(TESTDEF) -o $@ $< $(call impl_for,$*,$(ASAN_IMPL)) $(LDLIBS)
+
 $(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(ASAN_IMPL) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) $(ELSEWHERE) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(ASAN_IMPL) $(LDLIBS)
 
@@ -203,10 +204,11 @@ check-smoke: $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) | $(BUILD)/tests
 	@B=$(BUILD)/asan T=$(BUILD)/tests/smoke tests/run_tests.sh tests/smoke_asan.sh
 
 NOSIMDFLAGS := $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude
-$(BUILD)/nosimd/gk_impl.o: tests/gk_impl.c $(HEADERS) | $(BUILD)/nosimd
+NOSIMD_IMPL := $(BUILD)/nosimd/gk_impl.o
+$(NOSIMD_IMPL): tests/gk_impl.c $(HEADERS) | $(BUILD)/nosimd
 	$(CC) $(NOSIMDFLAGS) -c -o $@ $<
-$(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(BUILD)/nosimd/gk_impl.o | $(BUILD)/nosimd
-	$(CC) $(NOSIMDFLAGS) -Itests $(TESTDEF) -o $@ $< $(call impl_for,$*,$(BUILD)/nosimd/gk_impl.o) $(LDLIBS)
+$(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(NOSIMD_IMPL) | $(BUILD)/nosimd
+	$(CC) $(NOSIMDFLAGS) -Itests $(TESTDEF) -o $@ $< $(call impl_for,$*,$(NOSIMD_IMPL)) $(LDLIBS)
 
 check-asan: $(ASAN_TESTS) $(EXAMPLES) $(TOOLS) | $(BUILD)/tests
 	@echo "== tests under AddressSanitizer + UndefinedBehaviorSanitizer"
