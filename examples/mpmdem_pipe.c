@@ -281,28 +281,18 @@ static int check_state(const void *vS, const mpd_rows *R, char *why, size_t nwhy
 static gk_result sample_points(pp *X, double out[PP_NPT][PP_NQ], gk_err *err) {
     static const int f[PP_NQ - 2] = {MPD_P,        MPD_Q,    MPD_EPS_Q, MPD_EPS_V,
                                      MPD_ROTATION, MPD_VOID, MPD_COORD, MPD_DEM};
-    int n = X->pts.n, k, j;
+    int k;
     gk_result r = mpd_fields(&X->M, &X->pts, X->fld, err);
     if (r) return r;
-    for (k = 0; k < PP_NPT; ++k) {
-        int i = X->S.pt[k];
-        out[k][0] = X->pts.x[0][i], out[k][1] = X->pts.x[1][i];
-        for (j = 0; j < PP_NQ - 2; ++j) out[k][2 + j] = X->fld[(size_t)f[j] * n + i] + 0.0; /* no -0 */
-        out[k][2] /= 1e3, out[k][3] /= 1e3;                                                 /* p, q in kPa */
-    }
+    for (k = 0; k < PP_NPT; ++k) mpd_point_state(&X->pts, X->fld, X->S.pt[k], f, PP_NQ - 2, out[k]);
     return GK_OK;
 }
 
-/* the material point nearest to each of pp_pt_at (the first of equals) */
+/* the material point nearest to each of pp_pt_at */
 static void pick_points(pp *X) {
-    int k, i;
-    for (k = 0; k < PP_NPT; ++k) {
-        double tx = X->x0 + pp_pt_at[k][0], ty = X->depth - pp_pt_at[k][1], best = HUGE_VAL;
-        for (i = 0; i < X->pts.n; ++i) {
-            double dx = X->pts.x[0][i] - tx, dy = X->pts.x[1][i] - ty, d2 = dx * dx + dy * dy;
-            if (d2 < best) best = d2, X->S.pt[k] = i;
-        }
-    }
+    int k;
+    for (k = 0; k < PP_NPT; ++k)
+        X->S.pt[k] = mpd_nearest(&X->pts, X->x0 + pp_pt_at[k][0], X->depth - pp_pt_at[k][1]);
 }
 
 /* the levels' RVEs, the grid (rollers, fixed base), the points with their levels' masses, dt, the pipe */

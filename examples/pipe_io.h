@@ -5,7 +5,7 @@
 #ifndef PIPE_IO_H
 #define PIPE_IO_H
 
-#include "mpmdem.h"
+#include "mpmdem_watch.h"
 
 #define PP_MAX_LEVELS 64
 #define PP_DEM_DT_REF 3.16e-5 /* Guo & Zhao's DEM step at E = 600 MPa */
