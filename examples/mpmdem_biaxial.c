@@ -27,18 +27,46 @@
  * Outputs in --out DIR (default build/mpm_biaxial): biaxial.csv,
  * biaxial_stress.svg, biaxial_volume.svg, rotation_*.svg and eps_q_*.svg
  * (fields at 1.5 %, 2 %, 3 % and the end, the paper's stages; one colour
- * scale per quantity), points_NNNNNN.vtk, checkpoint.bin; a RESULT line.
+ * scale per quantity), points_ABC.csv and points_ABC_*.svg (the paper's
+ * points A, B, C: their state at the start and at every biaxial.csv row),
+ * points_NNNNNN.vtk, checkpoint.bin; a RESULT line.
  */
 #define GK_IMPLEMENTATION
-#include "mpmdem.h"
+#include "mpmdem_watch.h"
 
 typedef struct bx_opts {
     int nx, ny;
     double width, height, pressure, velocity, ramp, strain, every;
 } bx_opts;
 
-typedef struct bx_row { /* one CSV row: means over an output interval */
+/* the paper's points A, B, C (Sec 3.2, Figs 5 and 9-11): A in the bottom part, far from the shear
+ * bands; B at the centre, where the two bands cross ("the lower center of the cross-shape shear
+ * bands"); C in the upper right part, inside the rightward-tilting band. The paper marks them only in
+ * its figures: these are positions chosen from that text, as fractions of the width and the height (a
+ * band at 60 deg through the centre passes x = 0.85 W at y = 0.8 H); each is the material point nearest
+ * to its position at the start. */
+#define BX_NPT 3
+#define BX_NQ 11 /* x, y, then the fields of bx_q_field */
+static const char *const bx_pt_name[BX_NPT] = {"A", "B", "C"};
+static const double bx_pt_at[BX_NPT][2] = {{0.5, 0.1}, {0.5, 0.45}, {0.85, 0.8}};
+static const char *const bx_q_name[BX_NQ] = {"x",
+                                             "y",
+                                             "p_kPa",
+                                             "q_kPa",
+                                             "eps_q",
+                                             "eps_v",
+                                             "rotation_deg",
+                                             "void_ratio",
+                                             "fabric_anisotropy",
+                                             "coordination",
+                                             "dem_steps"};
+static const int bx_q_field[BX_NQ - 2] = {MPD_P,    MPD_Q,      MPD_EPS_Q, MPD_EPS_V, MPD_ROTATION,
+                                          MPD_VOID, MPD_FABRIC, MPD_COORD, MPD_DEM};
+enum { BX_X, BX_Y, BX_P, BX_Q, BX_EQ, BX_EV, BX_ROT, BX_E, BX_FA, BX_Z, BX_DEM };
+
+typedef struct bx_row { /* one CSV row: means over an output interval; the points A, B, C at its end */
     double t, eps, syy_top, syy_base, ev, ek, dem_mean, secs;
+    double pt[BX_NPT][BX_NQ];
 } bx_row;
 
 /* the state a checkpoint carries besides points and RVEs */
@@ -51,6 +79,8 @@ typedef struct bx_state {
     long nacc;                        /*   over the MPM steps since the last row    */
     double next_out;                  /* axial strain of the next CSV row */
     int nstage;
+    int pt[BX_NPT];            /* the material points A, B, C */
+    double pt0[BX_NPT][BX_NQ]; /* their state at the start */
 } bx_state;
 
 typedef struct bx { /* the whole model */
@@ -68,6 +98,7 @@ typedef struct bx { /* the whole model */
     bx_state S;
     mpd_rows rows;
     mpd_snaps snaps;
+    double *fld; /* MPD_NFIELD x points: the fields when a row is taken */
     double h, dt, c, vol0, dot;
 } bx;
 
@@ -154,8 +185,25 @@ static int bx_check(const void *state, const mpd_rows *R, char *why, size_t nwhy
         w[6] = r->dem_mean, w[7] = r->secs;
         for (j = 0; j < 8; ++j)
             if (!isfinite(w[j])) return snprintf(why, nwhy, "row %d: a non-finite value", k), 1;
+        for (j = 0; j < BX_NPT * BX_NQ; ++j)
+            if (!isfinite(r->pt[j / BX_NQ][j % BX_NQ]))
+                return snprintf(why, nwhy, "row %d: a non-finite value of point %s", k,
+                                bx_pt_name[j / BX_NQ]),
+                       1;
     }
+    for (j = 0; j < BX_NPT * BX_NQ; ++j)
+        if (!isfinite(S->pt0[j / BX_NQ][j % BX_NQ]))
+            return snprintf(why, nwhy, "a non-finite start of point %s", bx_pt_name[j / BX_NQ]), 1;
     return 0;
+}
+
+/* the state of the points A, B, C now (collective: every point's fields) */
+static gk_result sample_points(bx *X, double out[BX_NPT][BX_NQ], gk_err *err) {
+    int k;
+    gk_result r = mpd_fields(&X->M, &X->pts, X->fld, err);
+    if (r) return r;
+    for (k = 0; k < BX_NPT; ++k) mpd_point_state(&X->pts, X->fld, X->S.pt[k], bx_q_field, BX_NQ - 2, out[k]);
+    return GK_OK;
 }
 
 /* the prepared RVE at every point, the grid with its two plates, the points and their edge loads */
@@ -198,8 +246,20 @@ static int setup(bx *X, gk_err *err) {
     S->body[0].contact = S->body[1].contact = GK_MPM_CONTACT_STICK;
     S->next_out = b->every;
     X->rows.size = sizeof(bx_row);
-    if (X->o.restart &&
-        mpd_load(X->o.restart, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps, bx_check, err))
+    if (!(X->fld = (double *)malloc((size_t)MPD_NFIELD * X->pts.n * sizeof *X->fld)))
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
+    for (i = 0; i < BX_NPT; ++i)
+        S->pt[i] = mpd_nearest(&X->pts, bx_pt_at[i][0] * b->width, bx_pt_at[i][1] * b->height);
+    if (X->o.restart) {
+        if (mpd_load(X->o.restart, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps, bx_check,
+                     err))
+            return 1;
+        for (i = 0; i < BX_NPT; ++i)
+            if (S->pt[i] < 0 || S->pt[i] >= X->pts.n)
+                return gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: point %s out of range",
+                                  X->o.restart, bx_pt_name[i]),
+                       1;
+    } else if (sample_points(X, S->pt0, err))
         return 1;
     X->g.body = S->body, X->g.nbody = 2;
     return 0;
@@ -267,6 +327,103 @@ static int write_plots(const bx *X) {
     return bad;
 }
 
+/* points_ABC.csv: the start, then a line per row of biaxial.csv: the points' state at its end */
+static void put_abc_csv(FILE *fp, const void *user) {
+    const bx *X = (const bx *)user;
+    int k, i, j;
+    fprintf(fp, "time,eps_axial");
+    for (i = 0; i < BX_NPT; ++i)
+        for (j = 0; j < BX_NQ; ++j) fprintf(fp, ",%s_%s", bx_pt_name[i], bx_q_name[j]);
+    fprintf(fp, "\n0,0");
+    for (i = 0; i < BX_NPT; ++i)
+        for (j = 0; j < BX_NQ; ++j) fprintf(fp, ",%.6g", X->S.pt0[i][j]);
+    fprintf(fp, "\n");
+    for (k = 0; k < X->rows.n; ++k) {
+        const bx_row *r = (const bx_row *)mpd_row(&X->rows, k);
+        fprintf(fp, "%.6g,%.6g", r->t, r->eps);
+        for (i = 0; i < BX_NPT; ++i)
+            for (j = 0; j < BX_NQ; ++j) fprintf(fp, ",%.6g", r->pt[i][j]);
+        fprintf(fp, "\n");
+    }
+}
+
+/* the histories of A, B, C (the paper's Fig 10): q against the point's own eps_q, the p-q paths, the
+ * rotation and the fabric anisotropy against the axial strain; the paper's values in the titles (its
+ * sense of rotation is not stated for C); 0 or 1 (said) */
+static int write_abc_plots(const bx *X) {
+    static const struct {
+        int x, y; /* BX_* on the axes; x < 0: the axial strain */
+        const char *file, *title, *xl, *yl;
+    } fig[4] = {
+        {BX_EQ, BX_Q, "points_ABC.svg",
+         "MPMxDEM biaxial: q of points A, B, C (Liang & Zhao Fig 10: A peaks at eps_q ~1 %, B ~150 kPa)",
+         "deviatoric strain eps_q of the point", "q [kPa]"},
+        {BX_P, BX_Q, "points_ABC_pq.svg",
+         "MPMxDEM biaxial: stress paths of A, B, C (Liang & Zhao: B up to p ~420, q ~150 kPa)", "p [kPa]",
+         "q [kPa]"},
+        {-1, BX_ROT, "points_ABC_rotation.svg",
+         "rotation of A, B, C (Liang & Zhao at 15 %: A -0.1, B 10 clockwise, C 38 deg)", "axial strain [%]",
+         "rotation of F = R U, counter-clockwise [deg]"},
+        {-1, BX_FA, "points_ABC_fabric.svg",
+         "fabric anisotropy of A, B, C (Liang & Zhao: A ~0.075, B 0.2-0.3 with fluctuations)",
+         "axial strain [%]", "F_a"}};
+    int n = X->rows.n + 1, k, i, f, bad = 0;
+    double *a = (double *)malloc((size_t)n * (1 + 2 * BX_NPT) * sizeof *a);
+    char lab[BX_NPT][16];
+    gk_plot pl;
+    if (!a) return fprintf(stderr, "mpmdem_biaxial: out of memory for the plots\n"), 1;
+    for (i = 0; i < BX_NPT; ++i) snprintf(lab[i], sizeof lab[i], "point %s", bx_pt_name[i]);
+    for (f = 0; f < 4 && !bad; ++f) {
+        double *ax = a + n, *ay = ax + BX_NPT * n;
+        for (k = 0; k < n; ++k) {
+            const bx_row *r = k ? (const bx_row *)mpd_row(&X->rows, k - 1) : NULL;
+            a[k] = r ? 100 * r->eps : 0.0;
+            for (i = 0; i < BX_NPT; ++i) {
+                const double *v = r ? r->pt[i] : X->S.pt0[i];
+                ax[i * n + k] = fig[f].x < 0 ? a[k] : v[fig[f].x], ay[i * n + k] = v[fig[f].y];
+            }
+        }
+        gk_plot_init(&pl, fig[f].title, fig[f].xl, fig[f].yl);
+        for (i = 0; i < BX_NPT; ++i) gk_plot_add(&pl, ax + i * n, ay + i * n, n, lab[i]);
+        bad = mpd_plot(&X->run, &pl, fig[f].file);
+    }
+    free(a);
+    return bad;
+}
+
+/* the paper's numbers for A, B, C (Liang & Zhao Sec 3.2, Fig 10) against this run's, printed; into v:
+ * A's largest q and its eps_q there, A's fabric anisotropy and rotation at the end, B's largest p and q,
+ * B's rotation and fabric anisotropy at the end, C's rotation and eps_q at the end */
+#define BX_NDV 10
+static void abc_summary(const bx *X, double v[BX_NDV]) {
+    const double *e[BX_NPT];
+    int k, i;
+    for (i = 0; i < BX_NPT; ++i)
+        e[i] = X->rows.n ? ((const bx_row *)mpd_row(&X->rows, X->rows.n - 1))->pt[i] : X->S.pt0[i];
+    v[0] = X->S.pt0[0][BX_Q], v[1] = X->S.pt0[0][BX_EQ], v[4] = X->S.pt0[1][BX_P], v[5] = X->S.pt0[1][BX_Q];
+    for (k = 0; k < X->rows.n; ++k) {
+        const bx_row *r = (const bx_row *)mpd_row(&X->rows, k);
+        if (r->pt[0][BX_Q] > v[0]) v[0] = r->pt[0][BX_Q], v[1] = r->pt[0][BX_EQ];
+        if (r->pt[1][BX_P] > v[4]) v[4] = r->pt[1][BX_P];
+        if (r->pt[1][BX_Q] > v[5]) v[5] = r->pt[1][BX_Q];
+    }
+    v[2] = e[0][BX_FA], v[3] = e[0][BX_ROT], v[6] = e[1][BX_ROT], v[7] = e[1][BX_FA], v[8] = e[2][BX_ROT];
+    v[9] = e[2][BX_EQ];
+    for (i = 0; i < BX_NPT; ++i)
+        printf("point %s: material point %d at (%.4g, %.4g) m at the start (asked for %.3g W, %.3g H)\n",
+               bx_pt_name[i], X->S.pt[i], X->S.pt0[i][BX_X], X->S.pt0[i][BX_Y], bx_pt_at[i][0],
+               bx_pt_at[i][1]);
+    printf(
+        "point A: q peaks at %.4g kPa at eps_q %.3g %% (Liang & Zhao: a small peak at ~1 %%); at the end F_a "
+        "%.3g, rotation %.3g deg (0.075, -0.1)\n",
+        v[0], 100 * v[1], v[2], v[3]);
+    printf("point B: p up to %.4g kPa, q up to %.4g kPa (Liang & Zhao ~420, ~150); at the end rotation %.3g "
+           "deg, "
+           "F_a %.3g (10 deg clockwise, 0.2-0.3)\n",
+           v[4], v[5], v[6], v[7]);
+    printf("point C: at the end rotation %.3g deg, eps_q %.3g (Liang & Zhao: 38 deg)\n", v[8], v[9]);
+}
+
 static int cmp_double(const void *a, const void *b) {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
@@ -308,6 +465,7 @@ static int after_step(bx *X, double vplate, double t0, double t_start, long nste
     long long sum = 0;
     int i, bad;
     bx_row r;
+    gk_err err;
     S->t += X->dt, S->disp += vplate * X->dt, ++S->step;
     S->acc_top += -S->body[1].force[1] * X->dt, S->acc_base += S->body[0].force[1] * X->dt,
         S->acc_dt += X->dt;
@@ -324,7 +482,11 @@ static int after_step(bx *X, double vplate, double t0, double t_start, long nste
     r.secs = gk_wtime() - t0;
     S->acc_top = S->acc_base = S->acc_dt = 0, S->acc_ek = S->acc_dem = 0, S->nacc = 0;
     S->next_out += b->every;
-    bad = mpd_rows_push(&X->run, &X->rows, &r) || mpd_write(&X->run, "biaxial.csv", put_csv, &X->rows);
+    if (sample_points(X, r.pt, &err))
+        return fprintf(stderr, "mpmdem_biaxial: the points A, B, C at %.3f %%: %s\n", 100 * r.eps, err.msg),
+               1;
+    bad = mpd_rows_push(&X->run, &X->rows, &r) || mpd_write(&X->run, "biaxial.csv", put_csv, &X->rows) ||
+          mpd_write(&X->run, "points_ABC.csv", put_abc_csv, X);
     while (!bad && S->nstage < 3 && r.eps >= bx_stages[S->nstage] * (1 - 1e-9)) {
         char tag[32];
         snprintf(tag, sizeof tag, "%.1f%%", 100 * bx_stages[S->nstage]);
@@ -342,7 +504,7 @@ static int after_step(bx *X, double vplate, double t0, double t_start, long nste
 
 /* the summary and the RESULT line */
 static void report(bx *X, double secs, long steps_run, long long dems, int wrote) {
-    double peak = 0, epk = 0, rmax = 0, ang = band_angle(&X->M, &X->pts), last = 0, eps_end = 0;
+    double peak = 0, epk = 0, rmax = 0, ang = band_angle(&X->M, &X->pts), last = 0, eps_end = 0, v[BX_NDV];
     char buf[64];
     int k, n = X->pts.n;
     for (k = 0; k < X->rows.n; ++k) {
@@ -354,7 +516,7 @@ static void report(bx *X, double secs, long steps_run, long long dems, int wrote
         rmax = fmax(rmax, fabs(gk_rotation_angle(X->pts.F + 9 * (size_t)k, 2) * 180.0 / MPD_PI));
     if (wrote)
         printf("wrote %s/biaxial.csv, biaxial_stress.svg, biaxial_volume.svg, rotation_*.svg, eps_q_*.svg, "
-               "points_*.vtk (ParaView), checkpoint.bin\n",
+               "points_ABC.csv, points_ABC*.svg, points_*.vtk (ParaView), checkpoint.bin\n",
                X->run.out);
     printf("Liang & Zhao (mesh M4, their RVE): peak sigma_yy ~ 280 kPa at 1.6 %%; here %.1f kPa at %.2f %% "
            "(sigma_1/sigma_3 = %.2f; paper ~2.8)\n",
@@ -366,15 +528,20 @@ static void report(bx *X, double secs, long steps_run, long long dems, int wrote
             ang);
     else
         printf("shear band: none yet (no point with eps_q > 2 x median)\n");
+    abc_summary(X, v);
     printf("cost: %s for %ld MPM steps, %lld DEM steps over all RVEs (%.1f per point per MPM step)\n",
            mpd_duration(secs, buf, sizeof buf), steps_run, dems,
            steps_run ? (double)dems / steps_run / n : 0.0);
     mpd_print_traffic(&X->run, &X->M, steps_run, X->o.threads);
     printf("RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g sigma_yy_end=%.6g eps_end=%.5g max_rotation_deg=%.3g "
            "band_angle_deg=%.3g n_rves=%d mpm_steps=%ld dt=%.4g seconds_per_step=%.4g "
-           "seconds_per_step_per_1000_rves=%.4g total_seconds=%.2f\n",
+           "seconds_per_step_per_1000_rves=%.4g total_seconds=%.2f A_q_peak_kPa=%.4g A_eps_q_at_q_peak=%.4g "
+           "A_fabric_end=%.4g A_rotation_end_deg=%.4g B_p_peak_kPa=%.4g B_q_peak_kPa=%.4g "
+           "B_rotation_end_deg=%.4g "
+           "B_fabric_end=%.4g C_rotation_end_deg=%.4g C_eps_q_end=%.4g\n",
            peak, epk, last, eps_end, rmax, ang, n, steps_run, X->dt, steps_run ? secs / steps_run : 0.0,
-           steps_run ? secs / steps_run * 1000.0 / n : 0.0, secs);
+           steps_run ? secs / steps_run * 1000.0 / n : 0.0, secs, v[0], v[1], v[2], v[3], v[4], v[5], v[6],
+           v[7], v[8], v[9]);
 }
 
 static int run(bx *X, int argc, char **argv) {
@@ -420,8 +587,9 @@ static int run(bx *X, int argc, char **argv) {
     if (!bad && status == 0)
         bad = mpd_save(&X->run, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps);
     if (!bad)
-        bad =
-            mpd_write(&X->run, "biaxial.csv", put_csv, &X->rows) || write_plots(X) || stage_fields(X, "end");
+        bad = mpd_write(&X->run, "biaxial.csv", put_csv, &X->rows) ||
+              mpd_write(&X->run, "points_ABC.csv", put_abc_csv, X) || write_plots(X) || write_abc_plots(X) ||
+              stage_fields(X, "end");
     if (!bad) bad = mpd_write_vtk(&X->run, S->step, &X->M, &X->pts);
     report(X, gk_wtime() - t_start, S->step - step0, X->M.dem_steps - dem0, !bad);
     return status ? status : bad;
@@ -435,6 +603,7 @@ int main(int argc, char **argv) {
     mpd_begin(&X.run, "mpmdem_biaxial", &argc, &argv);
     status = run(&X, argc, argv);
     free(X.edge);
+    free(X.fld);
     mpd_free_all(&X.M, &X.P, &X.pts, &X.g, &X.rows, &X.snaps);
     gk_rve_state_free(&X.st0);
     return mpd_end(status);

@@ -64,6 +64,7 @@ TEST(biaxial_two_ranks_equal_two_threads) {
     if (!m) return;
     CHECK(both(m, "mpmdem_biaxial", "bx", BX "--strain 0.002"));
     CHECK(same_csv("bx", "biaxial.csv", 7));
+    CHECK(same_csv("bx", "points_ABC.csv", 35));
     CHECK(system("cmp -s " BUILD "/tests/t_mpiT_bx/points_000000.vtk " BUILD "/tests/t_mpiM_bx/points_000000.vtk && "
                  "cmp -s " BUILD "/tests/t_mpiT_bx/points_000278.vtk " BUILD "/tests/t_mpiM_bx/points_000278.vtk") ==
           0);

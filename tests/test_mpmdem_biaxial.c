@@ -1,6 +1,6 @@
 /* test_mpmdem_biaxial.c - smoke tests of examples/mpmdem_biaxial.c (the
  * MPMxDEM biaxial test of Liang & Zhao 2019): it runs, writes its documented
- * outputs, starts in equilibrium, loads the specimen, does not depend on the
+ * outputs (with the points A, B, C), starts in equilibrium, loads the specimen, does not depend on the
  * thread count, restarts to the identical result,
  * refuses a corrupted or foreign checkpoint, bad arguments and an --out that
  * is a file, and ends with status 1 when a result cannot be written. Needs
@@ -9,6 +9,7 @@
 #define GK_TEST_DRIVERS
 #include "gk_test.h"
 #include <stdlib.h>
+#include <string.h>
 
 /* a 2 x 4 cell specimen (8 RVEs): tiny but the whole path */
 #define BX BUILD "/mpmdem_biaxial --nx 2 --ny 4 --strain 0.002 --every 0.0005 --quiet "
@@ -60,6 +61,57 @@ TEST(biaxial_runs_and_loads) {
               1e-5); /* printed with 6 digits */
 }
 
+/* the points A, B, C: points_ABC.csv has the start and one line per biaxial.csv row (same times and
+ * strains); each point is the material point nearest to its asked position (0.5, 0.1), (0.5, 0.45),
+ * (0.85, 0.8) of the 1 x 2 m specimen: on this 2 x 4 grid (one point per 0.5 m cell) the centres
+ * (0.25, 0.25), (0.25, 0.75), (0.75, 1.75), the first of equals on a tie; the start is the consolidated
+ * RVE (p = 100 kPa, eps_q = 0); B's p and q then rise with the load, and the RESULT's B_p_peak_kPa is
+ * the largest p of the file */
+TEST(biaxial_points_abc) {
+    static const double at[3][2] = {{0.25, 0.25}, {0.25, 0.75}, {0.75, 1.75}};
+    double a[8][35], r[16][8], pmax = 0;
+    char line[4096];
+    int n = 0, k, i;
+    FILE *fp = fopen(BUILD "/tests/t_mpmbx/points_ABC.csv", "r");
+    CHECK(fp != NULL);
+    if (!fp) return;
+    CHECK(fgets(line, sizeof line, fp) != NULL);
+    CHECK(strncmp(line,
+                  "time,eps_axial,A_x,A_y,A_p_kPa,A_q_kPa,A_eps_q,A_eps_v,A_rotation_deg,A_void_ratio,"
+                  "A_fabric_anisotropy,A_coordination,A_dem_steps,B_x",
+                  124) == 0);
+    while (n < 8 && fgets(line, sizeof line, fp)) {
+        char *s = line, *e;
+        for (k = 0; k < 35; ++k, s = e + (*e == ',')) {
+            a[n][k] = strtod(s, &e);
+            if (e == s) break;
+        }
+        CHECK_EQ_INT(k, 35);
+        ++n;
+    }
+    fclose(fp);
+    CHECK_EQ_INT(n, 5);
+    CHECK_EQ_INT(read_rows(BUILD "/tests/t_mpmbx/biaxial.csv", r, 16), 4);
+    if (n != 5) return;
+    CHECK(a[0][0] == 0 && a[0][1] == 0);
+    for (k = 1; k < n; ++k) CHECK_REL(a[k][1], r[k - 1][1], 1e-5);
+    for (i = 0; i < 3; ++i) {
+        const double *v = a[0] + 2 + 11 * i;
+        CHECK_NEAR(v[0], at[i][0], 1e-12);
+        CHECK_NEAR(v[1], at[i][1], 1e-12);
+        CHECK_REL(v[2], 100.0, 0.05); /* p [kPa] */
+        CHECK(v[4] == 0.0);           /* eps_q */
+    }
+    for (k = 1; k < n; ++k) {
+        CHECK(a[k][2 + 11 + 2] > a[k - 1][2 + 11 + 2]); /* B: p */
+        CHECK(a[k][2 + 11 + 3] > a[k - 1][2 + 11 + 3]); /* B: q */
+        pmax = a[k][2 + 11 + 2] > pmax ? a[k][2 + 11 + 2] : pmax;
+    }
+    CHECK_REL(gk_test_result(BUILD "/tests/t_mpmbx.out", "B_p_peak_kPa"), pmax, 1e-3);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx/points_ABC_pq.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmbx/points_ABC_fabric.svg", "<svg"));
+}
+
 /* RVEs run in parallel: one thread gives the same curve to the last digit */
 TEST(biaxial_thread_independent) {
     CHECK(system(BX "--threads 1 --out " BUILD "/tests/t_mpmbx1 > " BUILD "/tests/t_mpmbx1.out 2>&1") == 0);
@@ -67,6 +119,8 @@ TEST(biaxial_thread_independent) {
                  "/tests/t_mpmbx/points_000000.vtk") == 0);
     CHECK(gk_test_result(BUILD "/tests/t_mpmbx1.out", "peak_sigma_yy") ==
           gk_test_result(BUILD "/tests/t_mpmbx.out", "peak_sigma_yy"));
+    CHECK(system("cmp -s " BUILD "/tests/t_mpmbx1/points_ABC.csv " BUILD "/tests/t_mpmbx/points_ABC.csv") ==
+          0);
     CHECK(system("cut -d, -f1-7 " BUILD "/tests/t_mpmbx1/biaxial.csv > " BUILD "/tests/t_mpmbx1.c && "
                  "cut -d, -f1-7 " BUILD "/tests/t_mpmbx/biaxial.csv > " BUILD "/tests/t_mpmbx2.c && "
                  "cmp -s " BUILD "/tests/t_mpmbx1.c " BUILD "/tests/t_mpmbx2.c") == 0);
@@ -83,6 +137,8 @@ TEST(biaxial_restart_identical) {
     CHECK(rc == 0);
     CHECK(gk_test_result(BUILD "/tests/t_mpmbx_b.out", "peak_sigma_yy") ==
           gk_test_result(BUILD "/tests/t_mpmbx.out", "peak_sigma_yy"));
+    CHECK(system("cmp -s " BUILD "/tests/t_mpmbx_b/points_ABC.csv " BUILD "/tests/t_mpmbx/points_ABC.csv") ==
+          0);
     CHECK(system("cut -d, -f1-7 " BUILD "/tests/t_mpmbx_b/biaxial.csv > " BUILD "/tests/t_mpmbx_b.c && "
                  "cmp -s " BUILD "/tests/t_mpmbx_b.c " BUILD "/tests/t_mpmbx2.c") == 0);
 }
@@ -325,6 +381,7 @@ TEST(single_element_follows_the_rve_alone) {
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(biaxial_runs_and_loads);
+    RUN(biaxial_points_abc);
     RUN(biaxial_thread_independent);
     RUN(biaxial_restart_identical);
     RUN(biaxial_bad_arguments);
