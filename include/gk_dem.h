@@ -2827,20 +2827,33 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
     return GK_OK;
 }
 
-/* count values of elem (4 or 8) bytes at b, all finite */
+/* the largest magnitude a real of a saved state may have: finite values beyond it (a stress of
+ * 1e248 Pa, a deformation gradient entry of 1e259) are no physical state, and they overflow in what
+ * is computed from them (q from the squares of the stress) */
+#define GK__STATE_MAX 1e100
+
+/* count values of elem (4 or 8) bytes at b, all finite and at most GK__STATE_MAX in magnitude */
 static int gk__finite_bytes(const unsigned char *b, size_t count, size_t elem) {
     size_t k;
     for (k = 0; k < count; ++k) {
         if (elem == 8) {
             double v;
             memcpy(&v, b + 8 * k, 8);
-            if (!isfinite(v)) return 0;
+            if (!(fabs(v) <= GK__STATE_MAX)) return 0;
         } else {
             float v;
             memcpy(&v, b + 4 * k, 4);
             if (!isfinite(v)) return 0;
         }
     }
+    return 1;
+}
+
+/* a 3x3 matrix of a saved state: every entry finite and at most GK__STATE_MAX in magnitude */
+static int gk__state_m3(const double a[9]) {
+    int k;
+    for (k = 0; k < 9; ++k)
+        if (!(fabs(a[k]) <= GK__STATE_MAX)) return 0;
     return 1;
 }
 
@@ -2861,12 +2874,13 @@ static int gk__pairs_valid(const unsigned char *ib, const unsigned char *jb, int
 /* a 3x3 map of the cell kind: finite, det > 0 and finite, 2D block structure */
 static int gk__map_valid(int dim, const double a[9]) {
     double d = gk_m3_det(a);
-    if (!gk_m3_isfinite(a) || !(d > 0.0) || !isfinite(d)) return 0;
+    if (!gk__state_m3(a) || !(d > 0.0) || !isfinite(d)) return 0;
     return dim == 3 || (a[2] == 0.0 && a[5] == 0.0 && a[6] == 0.0 && a[7] == 0.0 && a[8] == 1.0);
 }
 
 /* Every field of a state is checked before anything is changed: header
- * scalars in their ranges, every real finite, the maps invertible, both pair
+ * scalars in their ranges, every real finite and at most 1e100 in magnitude
+ * (GK__STATE_MAX), the maps invertible, both pair
  * lists sorted and in range, the contact bits known, and the time step at or
  * below the critical one of this RVE at the state's own geometry (the check
  * every list rebuild makes). */
@@ -2921,11 +2935,12 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
                                   "RVE state cell is %g wide, below twice the interaction distance %g", w[k],
                                   2.0 * rve->rmax + hd.skin);
     }
-    if (!gk_m3_isfinite(hd.L) || !gk_m3_isfinite(hd.G) || !gk_m3_isfinite(hd.stress) ||
-        !isfinite(hd.stiff[0]) || !isfinite(hd.stiff[1]) || !isfinite(hd.stiff[2]) || !(hd.fc_mean >= 0.0) ||
-        !isfinite(hd.fc_mean))
+    if (!gk__state_m3(hd.L) || !gk__state_m3(hd.G) || !gk__state_m3(hd.stress) ||
+        !(fabs(hd.stiff[0]) <= GK__STATE_MAX) || !(fabs(hd.stiff[1]) <= GK__STATE_MAX) ||
+        !(fabs(hd.stiff[2]) <= GK__STATE_MAX) || !(hd.fc_mean >= 0.0) || !(hd.fc_mean <= GK__STATE_MAX))
         return gk_err_set(err, GK_ERR_NAN,
-                          "RVE state has a non-finite velocity gradient, stress or stiffness");
+                          "RVE state has a non-finite or impossible (above 1e100) velocity gradient, stress "
+                          "or stiffness");
     if (dim == 2 && (hd.L[2] != 0 || hd.L[5] != 0 || hd.L[6] != 0 || hd.L[7] != 0 || hd.L[8] != 0))
         return gk_err_set(err, GK_ERR_FORMAT, "RVE state: 2D velocity gradient with a third row or column");
     if (hd.ncontacts < 0 || hd.ncontacts > hd.npairs || (hd.need_rebuild != 0 && hd.need_rebuild != 1) ||
@@ -2974,7 +2989,8 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
                                           "RVE state pair %d has unknown contact bits 0x%x", c, b[c]);
             } else if (!gk__finite_bytes(b, cnt * (f->size % 8 ? 1 : f->size / 8),
                                          f->size % 8 ? f->size : 8)) {
-                return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite %s", f->what);
+                return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite or impossible (above 1e100) %s",
+                                  f->what);
             }
         }
         dtc = gk__dt_critical_at(rve, hd.h, sb, pib, pjb, hd.npairs);

@@ -331,7 +331,7 @@ TEST(rve_restore_refuses_invalid_states_and_changes_nothing) {
     gk_rve_state st;
     unsigned char *good, *bad, *snap;
     size_t n, ns;
-    int c, ncase = 16;
+    int c, ncase = 19;
     if (seed_rve(&rve)) {
         CHECK(0);
         return;
@@ -382,8 +382,15 @@ TEST(rve_restore_refuses_invalid_states_and_changes_nothing) {
             i32 = rve.n, memcpy(bad + off_pairs(&rve) + 4 * (size_t)hd.npairs, &i32, 4), what = "j = n";
             break;
         case 15: bad[off_pairs(&rve) + 8 * (size_t)hd.npairs] = 0x80, what = "unknown contact bits"; break;
+        /* finite but impossible (found by fuzz_mpmdem_ckpt: a saved stress of 1e248 Pa gave an infinite q) */
+        case 16: hd.stress[0] = 1.15e248, what = "stress 1e248 Pa"; break;
+        case 17: hd.F[1] = 5.76e259, what = "deformation gradient entry 1e259"; break;
+        case 18:
+            xr = (gk_real)1e30, xr = xr * xr * xr * xr; /* 1e120, or Inf in float */
+            memcpy(bad + off_v(&rve) + 5 * sizeof xr, &xr, sizeof xr), what = "velocity 1e120";
+            break;
         }
-        if (c < 12) memcpy(bad, &hd, sizeof hd);
+        if (c < 12 || c == 16 || c == 17) memcpy(bad, &hd, sizeof hd);
         rve.err.msg[0] = '\0';
         r = gk_rve_restore(&rve, bad, n);
         CHECK(r != GK_OK);
