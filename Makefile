@@ -53,6 +53,8 @@ TOOLS    := $(patsubst tools/%.c,$(BUILD)/%,$(TOOL_SRC))
 FUZZ_SRC   := $(wildcard tests/fuzz/fuzz_*.c)
 FUZZ_NAMES := $(patsubst tests/fuzz/fuzz_%.c,%,$(FUZZ_SRC))
 FUZZ_REPLAY := $(patsubst %,$(BUILD)/fuzz_replay_%,$(FUZZ_NAMES))
+# the harnesses of a driver's or a tool's reader compile that program's source in
+FUZZ_DEPS   := $(wildcard examples/*.c examples/*.h tools/*.c)
 
 .PHONY: all mpi test check bench bench-peers run run-rve run-mpm run-footing run-collapse run-pipe install uninstall format format-check clean help \
         check-headers check-asan check-nosimd check-smoke check-build tradeoff fuzz
@@ -163,7 +165,7 @@ test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) $(BUILD)/bench_tradeoff $(if 
 # the harness's own GK_IMPLEMENTATION (libFuzzer builds it alone) gives way to the
 # build's implementation object (GK_IMPLEMENTATION_ELSEWHERE, gk_base.h)
 ELSEWHERE := -DGK_IMPLEMENTATION_ELSEWHERE
-$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(IMPL) | $(BUILD)
+$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(FUZZ_DEPS) $(IMPL) | $(BUILD)
 	$(CC) $(CFLAGS) $(ELSEWHERE) -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(IMPL) $(LDLIBS)
 
 # ---------------------------------------------------------------- check
@@ -185,13 +187,13 @@ $(ASAN_IMPL): tests/gk_impl.c $(HEADERS) | $(BUILD)/asan
 $(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(ASAN_IMPL) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK $(TESTDEF) -o $@ $< $(call impl_for,$*,$(ASAN_IMPL)) $(LDLIBS)
 
-$(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(ASAN_IMPL) | $(BUILD)/asan
+$(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(FUZZ_DEPS) $(ASAN_IMPL) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) $(ELSEWHERE) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(ASAN_IMPL) $(LDLIBS)
 
 # tools and drivers under ASan + UBSan for tests/smoke_asan.sh (a driver joins
 # by its name in SMOKE and its runs in the script), linked with the ASan
 # implementation object
-SMOKE := rve_path gk_pack mpmdem_biaxial mpmdem_single mpmdem_footing mpmdem_collapse mpmdem_pipe bench_scene_box femdem_nonlocal femdem_dr hybrid
+SMOKE := rve_path gk_pack csv_plot mpmdem_biaxial mpmdem_single mpmdem_footing mpmdem_collapse mpmdem_pipe bench_scene_box femdem_nonlocal femdem_dr hybrid
 $(BUILD)/asan/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) $(ASAN_IMPL) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) $(ELSEWHERE) -Iinclude -o $@ $< $(ASAN_IMPL) $(LDLIBS)
 $(BUILD)/asan/%: tools/%.c $(HEADERS) $(ASAN_IMPL) | $(BUILD)/asan
@@ -305,7 +307,7 @@ tradeoff: $(BUILD)/bench_tradeoff
 # new inputs in build/fuzz/NAME/, findings in build/fuzz/NAME-crash-*
 FUZZ_SECONDS ?= 60
 FUZZ_CC ?= clang
-$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_check.h $(HEADERS) | $(BUILD)/fuzz
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_check.h $(HEADERS) $(FUZZ_DEPS) | $(BUILD)/fuzz
 	$(FUZZ_CC) -std=c99 -g -O1 $(FPFLAGS) -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
 	  -Iinclude -Itests/fuzz -o $@ $< -lm
 

@@ -156,7 +156,7 @@ static int parse(bx *X, int argc, char **argv) {
 }
 
 /* a checkpoint's state and rows in range (mpd_load): counters >= 0 (the stage an index of bx_stages),
- * times, plates and sums finite, each plate a box with a known contact law and face */
+ * times, plates, sums and rows finite and within MPD_MAX_VALUE, each plate a box with a known contact law and face */
 static int bx_check(const void *state, const mpd_rows *R, char *why, size_t nwhy) {
     const bx_state *S = (const bx_state *)state;
     double v[7];
@@ -164,14 +164,14 @@ static int bx_check(const void *state, const mpd_rows *R, char *why, size_t nwhy
     v[0] = S->t, v[1] = S->disp, v[2] = S->acc_top, v[3] = S->acc_base, v[4] = S->acc_dt, v[5] = S->acc_ek;
     v[6] = S->acc_dem;
     for (k = 0; k < 7; ++k)
-        if (!isfinite(v[k])) return snprintf(why, nwhy, "a non-finite time, displacement or sum"), 1;
+        if (!mpd_sane(v[k])) return snprintf(why, nwhy, "a non-finite time, displacement or sum"), 1;
     if (S->step < 0 || S->step > 1000000000000L || S->nacc < 0 || S->nacc > S->step || S->nstage < 0 ||
         S->nstage > 3 || !(S->next_out > 0 && S->next_out < 1e6) || !(S->t >= 0))
         return snprintf(why, nwhy, "a step, stage or output counter out of range"), 1;
     for (k = 0; k < 2; ++k) {
         const gk_mpm_body *b = &S->body[k];
         for (j = 0; j < 3; ++j)
-            if (!isfinite(b->lo[j]) || !isfinite(b->hi[j]) || !isfinite(b->v[j]) || !isfinite(b->force[j]) ||
+            if (!mpd_sane(b->lo[j]) || !mpd_sane(b->hi[j]) || !mpd_sane(b->v[j]) || !mpd_sane(b->force[j]) ||
                 !(b->lo[j] <= b->hi[j]))
                 return snprintf(why, nwhy, "plate %d is not a finite box", k), 1;
         if ((int)b->contact < 0 || (int)b->contact > (int)GK_MPM_CONTACT_SMOOTH ||
@@ -184,15 +184,15 @@ static int bx_check(const void *state, const mpd_rows *R, char *why, size_t nwhy
         w[0] = r->t, w[1] = r->eps, w[2] = r->syy_top, w[3] = r->syy_base, w[4] = r->ev, w[5] = r->ek;
         w[6] = r->dem_mean, w[7] = r->secs;
         for (j = 0; j < 8; ++j)
-            if (!isfinite(w[j])) return snprintf(why, nwhy, "row %d: a non-finite value", k), 1;
+            if (!mpd_sane(w[j])) return snprintf(why, nwhy, "row %d: a non-finite value", k), 1;
         for (j = 0; j < BX_NPT * BX_NQ; ++j)
-            if (!isfinite(r->pt[j / BX_NQ][j % BX_NQ]))
+            if (!mpd_sane(r->pt[j / BX_NQ][j % BX_NQ]))
                 return snprintf(why, nwhy, "row %d: a non-finite value of point %s", k,
                                 bx_pt_name[j / BX_NQ]),
                        1;
     }
     for (j = 0; j < BX_NPT * BX_NQ; ++j)
-        if (!isfinite(S->pt0[j / BX_NQ][j % BX_NQ]))
+        if (!mpd_sane(S->pt0[j / BX_NQ][j % BX_NQ]))
             return snprintf(why, nwhy, "a non-finite start of point %s", bx_pt_name[j / BX_NQ]), 1;
     return 0;
 }

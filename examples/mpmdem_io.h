@@ -362,10 +362,15 @@ static int mpd_checkpoint_path(const char *dir, char *path) {
     return snprintf(path, MPD_PATH, "%s/checkpoint.bin", dir) >= MPD_PATH;
 }
 
+/* the largest magnitude a value read from a checkpoint may have: a finite strain of 1e178 is no state,
+ * and its squares overflow (eps_q came out Inf); so values beyond it are refused as non-finite ones */
+#define MPD_MAX_VALUE 1e100
+static int mpd_sane(double v) { return fabs(v) <= MPD_MAX_VALUE; }
+
 /* the driver's own check of its state and rows as read (0 in range, or 1 with the reason in why) */
 typedef int (*mpd_check_fn)(const void *S, const mpd_rows *R, char *why, size_t nwhy);
 
-/* the block as read, checked: every point value finite, mass, volumes, half-size >= 0 (mass and volume
+/* the block as read, checked: every point value finite and within MPD_MAX_VALUE, mass, volumes, half-size >= 0 (mass and volume
  * > 0), det F > 0 and vol = det(F) vol0 (to 1e-9 relative: gk_mpm keeps them so), refusal counts and
  * DEM steps >= 0; every snapshot's points finite, its dot > 0 and its outline's polylines within
  * MPD_MAXLPT points. 0, or 1 with the reason in why. */
@@ -379,12 +384,13 @@ static int mpd_block_check(const mpd_micro *m, const gk_mpm_points *pts, const m
         v[4] = pts->fext[0][p], v[5] = pts->fext[1][p], v[6] = pts->m[p], v[7] = pts->vol0[p];
         v[8] = pts->vol[p], v[9] = pts->lp[p];
         for (k = 0; k < 10; ++k)
-            if (!isfinite(v[k])) return snprintf(why, nwhy, "point %d: a non-finite value", p), 1;
+            if (!mpd_sane(v[k]))
+                return snprintf(why, nwhy, "point %d: a non-finite value (or one above 1e100)", p), 1;
         for (k = 0; k < 9; ++k)
-            if (!isfinite(F[k]) || !isfinite(pts->L[9 * (size_t)p + k]) ||
-                !isfinite(pts->sigma[9 * (size_t)p + k]) || !isfinite(pts->C[9 * (size_t)p + k]) ||
-                !isfinite(m->eps[9 * (size_t)p + k]))
-                return snprintf(why, nwhy, "point %d: a non-finite tensor", p), 1;
+            if (!mpd_sane(F[k]) || !mpd_sane(pts->L[9 * (size_t)p + k]) ||
+                !mpd_sane(pts->sigma[9 * (size_t)p + k]) || !mpd_sane(pts->C[9 * (size_t)p + k]) ||
+                !mpd_sane(m->eps[9 * (size_t)p + k]))
+                return snprintf(why, nwhy, "point %d: a non-finite tensor (or an entry above 1e100)", p), 1;
         det = F[0] * F[4] - F[1] * F[3];
         if (!(v[6] > 0) || !(v[7] > 0) || !(v[8] > 0) || v[9] < 0 || !(det > 0) ||
             !(fabs(v[8] - det * v[7]) <= 1e-9 * v[8]) || m->thin[p] < 0)
@@ -394,16 +400,16 @@ static int mpd_block_check(const mpd_micro *m, const gk_mpm_points *pts, const m
     for (k = 0; k < sn->n; ++k) {
         const mpd_snap *s = &sn->s[k];
         int used = 0;
-        if (!(s->dot > 0) || !isfinite(s->dot)) return snprintf(why, nwhy, "snapshot %d: dot size", k), 1;
+        if (!(s->dot > 0) || !mpd_sane(s->dot)) return snprintf(why, nwhy, "snapshot %d: dot size", k), 1;
         for (j = 0; j < s->ol.nlines; ++j) {
             if (s->ol.len[j] < 0 || s->ol.len[j] > MPD_MAXLPT)
                 return snprintf(why, nwhy, "snapshot %d: outline", k), 1;
             used += s->ol.len[j];
         }
         for (j = 0; j < 2 * used; ++j)
-            if (!isfinite(s->ol.xy[j])) return snprintf(why, nwhy, "snapshot %d: outline", k), 1;
+            if (!mpd_sane(s->ol.xy[j])) return snprintf(why, nwhy, "snapshot %d: outline", k), 1;
         for (j = 0; j < 2 * s->n; ++j)
-            if (!isfinite(s->xy[j])) return snprintf(why, nwhy, "snapshot %d: a non-finite point", k), 1;
+            if (!mpd_sane(s->xy[j])) return snprintf(why, nwhy, "snapshot %d: a non-finite point", k), 1;
     }
     return 0;
 }

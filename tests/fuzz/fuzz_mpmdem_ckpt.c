@@ -56,7 +56,7 @@ static void remove_dir(const char *dir) {
 
 static void cleanup(void) {
     remove_dir(in_dir), remove_dir(ref_dir), remove(pk_path);
-    if (ready) mpd_free_all(&X.M, &X.P, &X.pts, &X.g, &X.rows, &X.snaps), free(X.edge), free(snap0);
+    if (ready) mpd_free_all(&X.M, &X.P, &X.pts, &X.g, &X.rows, &X.snaps), free(X.edge), free(X.fld), free(snap0);
 }
 
 /* the run's state a checkpoint carries, as the driver writes it (malloc'ed) */
