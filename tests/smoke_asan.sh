@@ -42,6 +42,12 @@ run 0 "$B/gk_pack" --n 60 --out "$T/pack.txt"
 run 1 "$B/gk_pack" --n 60 --target-void-ratio 2.5 --out "$T/pack2.txt"
 run 1 "$B/gk_pack" --n 60 --out /dev/full
 run 2 "$B/gk_pack" --n 60 --friction-deg 95 --out "$T/pack3.txt"
+# csv_plot: a good run, an SVG that cannot be written, a bad field, a refused option
+printf 'a,b\n0,1\n1,2\n' > "$T/cp.csv" && printf 'a,b\n0,1\n1,x\n' > "$T/cp_bad.csv"
+run 0 "$B/csv_plot" --x a --y b --out "$T/cp.svg" "$T/cp.csv=one" "$T/cp.csv"
+run 1 "$B/csv_plot" --x a --y b --out /dev/full "$T/cp.csv"
+run 1 "$B/csv_plot" --x a --y b --out "$T/cp2.svg" "$T/cp_bad.csv"
+run 2 "$B/csv_plot" --x a --y b --xlim 1 --out "$T/cp2.svg" "$T/cp.csv"
 # the MPMxDEM drivers at their tests' sizes: a run, its restart, a corrupt checkpoint, a result that
 # cannot be written, a refused option
 BX="--nx 2 --ny 4 --every 0.0005 --quiet --threads 2"

@@ -97,6 +97,62 @@ TEST(gk_pack_makes_a_consolidated_packing) {
     if (fp) fclose(fp);
 }
 
+/* csv_plot: the curves of several CSV files on one SVG (the polyline of each, its legend label, the
+ * scaled values on the axes); every bad input is refused with a message naming the file and line, and
+ * no SVG is written */
+static void write_text(const char *path, const char *text) {
+    FILE *fp = fopen(path, "w");
+    if (fp) fputs(text, fp), fclose(fp);
+}
+TEST(csv_plot_draws_and_refuses) {
+    static const char *const bad[][2] = {
+        {"--x a --y nope --out " BUILD "/tests/t_cp_bad.svg " BUILD "/tests/t_cp1.csv",
+         "has no column 'nope'"},
+        {"--x a --y b --out " BUILD "/tests/t_cp_bad.svg " BUILD "/tests/t_cp_nan.csv",
+         "line 3: column 'b' is 'nan'"},
+        {"--x a --y b --out " BUILD "/tests/t_cp_bad.svg " BUILD "/tests/t_cp_short.csv",
+         "line 2: no column 'b'"},
+        {"--x a --y b --out " BUILD "/tests/t_cp_bad.svg " BUILD "/tests/t_cp_head.csv", "has no data lines"},
+        {"--x a --y b --out " BUILD "/tests/t_cp_bad.svg " BUILD "/tests/t_cp_none.csv", "cannot open"},
+        {"--x a --y b --x-scale 0 --out " BUILD "/tests/t_cp_bad.svg " BUILD "/tests/t_cp1.csv",
+         "--x-scale '0' is not a finite non-zero number"},
+        {"--x a --y b --xlim 2,1 --out " BUILD "/tests/t_cp_bad.svg " BUILD "/tests/t_cp1.csv",
+         "--xlim '2,1' is not A,B with A < B"},
+        {"--x a --y b --dashed 3 --out " BUILD "/tests/t_cp_bad.svg " BUILD "/tests/t_cp1.csv",
+         "--dashed 3 but 1 curve(s)"},
+        {"--x a --y b --out " BUILD "/tests/t_cp_bad.svg " BUILD "/tests/t_cp1.csv --bogus 1",
+         "unknown option"},
+        {"--x a --y b --out " BUILD "/tests/t_cp_bad.svg", "needs --x, --y, --out and at least one FILE"},
+        {"--x a --y b --out " BUILD "/tests/t_cp_bad.svg 1 2 3 4 5 6 7 8 9", "more than 8 curves"},
+        {"--x a --y b --out /nonexistent/dir/t.svg " BUILD "/tests/t_cp1.csv", "nonexistent"}};
+    char cmd[1024];
+    FILE *fp;
+    int k;
+    write_text(BUILD "/tests/t_cp1.csv", "a,b,c\n0,1,9\n0.5,2,9\n1,4,9\n");
+    write_text(BUILD "/tests/t_cp2.csv", "c,b,a\n9,3,0\n9,5,1\n");
+    write_text(BUILD "/tests/t_cp_nan.csv", "a,b\n0,1\n1,nan\n");
+    write_text(BUILD "/tests/t_cp_short.csv", "a,c,b\n0,1\n");
+    write_text(BUILD "/tests/t_cp_head.csv", "a,b\n");
+    remove(BUILD "/tests/t_cp_none.csv");
+    CHECK(system(BUILD "/csv_plot --x a --y b --x-scale 100 --y-scale 1e-3 --title T --dashed 2 --out " BUILD
+                       "/tests/t_cp.svg " BUILD "/tests/t_cp1.csv=first " BUILD
+                       "/tests/t_cp2.csv=second > " BUILD "/tests/t_cp.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_cp.out", "wrote " BUILD "/tests/t_cp.svg (2 curves)"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_cp.svg", ">first<"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_cp.svg", ">second<"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_cp.svg", "stroke-dasharray"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_cp.svg", ">100<")); /* x: 1 x 100 on the axis */
+    for (k = 0; k < (int)(sizeof bad / sizeof bad[0]); ++k) {
+        remove(BUILD "/tests/t_cp_bad.svg");
+        snprintf(cmd, sizeof cmd, BUILD "/csv_plot %s > " BUILD "/tests/t_cp_bad.out 2>&1", bad[k][0]);
+        CHECK(system(cmd) != 0);
+        CHECK(gk_test_file_has(BUILD "/tests/t_cp_bad.out", bad[k][1]));
+        fp = fopen(BUILD "/tests/t_cp_bad.svg", "r");
+        CHECK(!fp);
+        if (fp) fclose(fp);
+    }
+}
+
 /* gk_pack --frame: one particle at the corner and K on each of the lines x = 0, y = 0, exactly (the
  * frame of Liu, Bosco & Suiker 2018 Fig 2), the cell a box; --stress-ratio records its cycle and the
  * anisotropy of eq 38 */
@@ -951,6 +1007,7 @@ int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(rve_path_writes_csv_and_svg);
     RUN(gk_pack_makes_a_consolidated_packing);
+    RUN(csv_plot_draws_and_refuses);
     RUN(gk_pack_makes_a_framed_packing);
     RUN(femdem_biaxial_runs_restarts_and_is_thread_independent);
     RUN(femdem_biaxial_local_histories);
