@@ -156,7 +156,8 @@ static int parse(bx *X, int argc, char **argv) {
 }
 
 /* a checkpoint's state and rows in range (mpd_load): counters >= 0 (the stage an index of bx_stages),
- * times, plates, sums and rows finite and within MPD_MAX_VALUE, each plate a box with a known contact law and face */
+ * times, plates, sums and rows finite and within MPD_MAX_VALUE, each plate a box with a known contact
+ * law and face */
 static int bx_check(const void *state, const mpd_rows *R, char *why, size_t nwhy) {
     const bx_state *S = (const bx_state *)state;
     double v[7];

@@ -370,10 +370,10 @@ static int mpd_sane(double v) { return fabs(v) <= MPD_MAX_VALUE; }
 /* the driver's own check of its state and rows as read (0 in range, or 1 with the reason in why) */
 typedef int (*mpd_check_fn)(const void *S, const mpd_rows *R, char *why, size_t nwhy);
 
-/* the block as read, checked: every point value finite and within MPD_MAX_VALUE, mass, volumes, half-size >= 0 (mass and volume
- * > 0), det F > 0 and vol = det(F) vol0 (to 1e-9 relative: gk_mpm keeps them so), refusal counts and
- * DEM steps >= 0; every snapshot's points finite, its dot > 0 and its outline's polylines within
- * MPD_MAXLPT points. 0, or 1 with the reason in why. */
+/* the block as read, checked: every point value finite and within MPD_MAX_VALUE, mass, volumes,
+ * half-size >= 0 (mass and volume > 0), det F > 0 and vol = det(F) vol0 (to 1e-9 relative: gk_mpm
+ * keeps them so), refusal counts and DEM steps >= 0; every snapshot's points finite, its dot > 0 and
+ * its outline's polylines within MPD_MAXLPT points. 0, or 1 with the reason in why. */
 static int mpd_block_check(const mpd_micro *m, const gk_mpm_points *pts, const mpd_snaps *sn, char *why,
                            size_t nwhy) {
     int n = pts->n, p, k, j;

@@ -2989,8 +2989,8 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
                                           "RVE state pair %d has unknown contact bits 0x%x", c, b[c]);
             } else if (!gk__finite_bytes(b, cnt * (f->size % 8 ? 1 : f->size / 8),
                                          f->size % 8 ? f->size : 8)) {
-                return gk_err_set(err, GK_ERR_NAN, "RVE state has a non-finite or impossible (above 1e100) %s",
-                                  f->what);
+                return gk_err_set(err, GK_ERR_NAN,
+                                  "RVE state has a non-finite or impossible (above 1e100) %s", f->what);
             }
         }
         dtc = gk__dt_critical_at(rve, hd.h, sb, pib, pjb, hd.npairs);

@@ -95,16 +95,13 @@ static int field(const char *line, int k, double *v, const char *path, long lno,
     size_t len;
     int i;
     for (i = 0; i < k && s; ++i) s = strchr(s, ','), s = s ? s + 1 : NULL;
-    if (!s)
-        return cp_say("%s line %ld: no column '%s' (the row is short)", path, lno, col),
-               1;
+    if (!s) return cp_say("%s line %ld: no column '%s' (the row is short)", path, lno, col), 1;
     len = strcspn(s, ",\r\n");
-    if (len >= sizeof buf) return cp_say("%s line %ld: column '%s' is longer than a number", path, lno, col), 1;
+    if (len >= sizeof buf)
+        return cp_say("%s line %ld: column '%s' is longer than a number", path, lno, col), 1;
     memcpy(buf, s, len), buf[len] = '\0';
     if (number(buf, v))
-        return cp_say("%s line %ld: column '%s' is '%s', not a finite number", path, lno,
-                       col, buf),
-               1;
+        return cp_say("%s line %ld: column '%s' is '%s', not a finite number", path, lno, col, buf), 1;
     return 0;
 }
 
