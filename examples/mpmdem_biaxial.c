@@ -255,11 +255,7 @@ static int setup(bx *X, gk_err *err) {
         if (mpd_load(X->o.restart, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps, bx_check,
                      err))
             return 1;
-        for (i = 0; i < BX_NPT; ++i)
-            if (S->pt[i] < 0 || S->pt[i] >= X->pts.n)
-                return gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: point %s out of range",
-                                  X->o.restart, bx_pt_name[i]),
-                       1;
+        if (mpd_watch_check(S->pt, bx_pt_name, BX_NPT, X->pts.n, X->o.restart, err)) return 1;
     } else if (sample_points(X, S->pt0, err))
         return 1;
     X->g.body = S->body, X->g.nbody = 2;
@@ -331,19 +327,16 @@ static int write_plots(const bx *X) {
 /* points_ABC.csv: the start, then a line per row of biaxial.csv: the points' state at its end */
 static void put_abc_csv(FILE *fp, const void *user) {
     const bx *X = (const bx *)user;
-    int k, i, j;
+    int k;
     fprintf(fp, "time,eps_axial");
-    for (i = 0; i < BX_NPT; ++i)
-        for (j = 0; j < BX_NQ; ++j) fprintf(fp, ",%s_%s", bx_pt_name[i], bx_q_name[j]);
+    mpd_watch_csv_head(fp, bx_pt_name, BX_NPT, bx_q_name, BX_NQ);
     fprintf(fp, "\n0,0");
-    for (i = 0; i < BX_NPT; ++i)
-        for (j = 0; j < BX_NQ; ++j) fprintf(fp, ",%.6g", X->S.pt0[i][j]);
+    mpd_watch_csv_row(fp, X->S.pt0[0], BX_NPT, BX_NQ);
     fprintf(fp, "\n");
     for (k = 0; k < X->rows.n; ++k) {
         const bx_row *r = (const bx_row *)mpd_row(&X->rows, k);
         fprintf(fp, "%.6g,%.6g", r->t, r->eps);
-        for (i = 0; i < BX_NPT; ++i)
-            for (j = 0; j < BX_NQ; ++j) fprintf(fp, ",%.6g", r->pt[i][j]);
+        mpd_watch_csv_row(fp, r->pt[0], BX_NPT, BX_NQ);
         fprintf(fp, "\n");
     }
 }

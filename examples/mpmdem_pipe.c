@@ -337,11 +337,7 @@ static int setup(pp *X, gk_err *err) {
         if (mpd_load(X->o.restart, &X->M, &X->pts, "pipe", S, sizeof *S, &X->rows, &X->snaps, check_state,
                      err))
             return 1;
-        for (i = 0; i < PP_NPT; ++i)
-            if (S->pt[i] < 0 || S->pt[i] >= X->pts.n)
-                return gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: point %s out of range",
-                                  X->o.restart, pp_pt_name[i]),
-                       1;
+        if (mpd_watch_check(S->pt, pp_pt_name, PP_NPT, X->pts.n, X->o.restart, err)) return 1;
         printf("restarted from %s/checkpoint.bin at t = %.4f s (step %ld, stage %d)\n", X->o.restart, S->t,
                S->step, S->stage + 1);
     } else if (sample_points(X, S->pt0, err))

@@ -29,4 +29,29 @@ static void mpd_point_state(const gk_mpm_points *pts, const double *fld, int i, 
     }
 }
 
+/* the watched points' indices as a checkpoint restored them: each a point of the run, or an error naming
+ * the point and the checkpoint (1) */
+static int mpd_watch_check(const int *pt, const char *const *name, int npt, int n, const char *dir,
+                           gk_err *err) {
+    int k;
+    for (k = 0; k < npt; ++k)
+        if (pt[k] < 0 || pt[k] >= n)
+            return gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: point %s out of range", dir, name[k]),
+                   1;
+    return 0;
+}
+
+/* the CSV header cells of the watched points: ",NAME_QUANTITY" for each point and quantity */
+static void mpd_watch_csv_head(FILE *fp, const char *const *name, int npt, const char *const *q, int nq) {
+    int i, j;
+    for (i = 0; i < npt; ++i)
+        for (j = 0; j < nq; ++j) fprintf(fp, ",%s_%s", name[i], q[j]);
+}
+
+/* the CSV cells of npt watched points' states, nq values each (v: npt x nq) */
+static void mpd_watch_csv_row(FILE *fp, const double *v, int npt, int nq) {
+    int k;
+    for (k = 0; k < npt * nq; ++k) fprintf(fp, ",%.6g", v[k]);
+}
+
 #endif /* MPMDEM_WATCH_H */

@@ -89,19 +89,16 @@ static void put_csv(FILE *fp, const void *user) {
 /* points_DEF.csv: the start (t = 0), then a line per row of pipe.csv: the points' state at its end */
 static void put_def_csv(FILE *fp, const void *user) {
     const pp *X = (const pp *)user;
-    int k, i, j;
+    int k;
     fprintf(fp, "time,stage,pipe_x,pipe_bottom_y,travel");
-    for (i = 0; i < PP_NPT; ++i)
-        for (j = 0; j < PP_NQ; ++j) fprintf(fp, ",%s_%s", pp_pt_name[i], pp_q_name[j]);
+    mpd_watch_csv_head(fp, pp_pt_name, PP_NPT, pp_q_name, PP_NQ);
     fprintf(fp, "\n0,1,%.6g,%.6g,0", X->x0, X->depth);
-    for (i = 0; i < PP_NPT; ++i)
-        for (j = 0; j < PP_NQ; ++j) fprintf(fp, ",%.6g", X->S.pt0[i][j]);
+    mpd_watch_csv_row(fp, X->S.pt0[0], PP_NPT, PP_NQ);
     fprintf(fp, "\n");
     for (k = 0; k < X->rows.n; ++k) {
         const pp_row *r = (const pp_row *)mpd_row(&X->rows, k);
         fprintf(fp, "%.6g,%d,%.6g,%.6g,%.6g", r->t, r->stage + 1, r->x, r->y, r->pen + r->lat);
-        for (i = 0; i < PP_NPT; ++i)
-            for (j = 0; j < PP_NQ; ++j) fprintf(fp, ",%.6g", r->pt[i][j]);
+        mpd_watch_csv_row(fp, r->pt[0], PP_NPT, PP_NQ);
         fprintf(fp, "\n");
     }
 }

@@ -2831,6 +2831,7 @@ GKDEF gk_result gk_rve_save(const gk_rve *rve, void *buf, size_t cap, size_t *wr
  * 1e248 Pa, a deformation gradient entry of 1e259) are no physical state, and they overflow in what
  * is computed from them (q from the squares of the stress) */
 #define GK__STATE_MAX 1e100
+static int gk__state_real(double v) { return fabs(v) <= GK__STATE_MAX; }
 
 /* count values of elem (4 or 8) bytes at b, all finite and at most GK__STATE_MAX in magnitude */
 static int gk__finite_bytes(const unsigned char *b, size_t count, size_t elem) {
@@ -2839,7 +2840,7 @@ static int gk__finite_bytes(const unsigned char *b, size_t count, size_t elem) {
         if (elem == 8) {
             double v;
             memcpy(&v, b + 8 * k, 8);
-            if (!(fabs(v) <= GK__STATE_MAX)) return 0;
+            if (!gk__state_real(v)) return 0;
         } else {
             float v;
             memcpy(&v, b + 4 * k, 4);
@@ -2853,7 +2854,7 @@ static int gk__finite_bytes(const unsigned char *b, size_t count, size_t elem) {
 static int gk__state_m3(const double a[9]) {
     int k;
     for (k = 0; k < 9; ++k)
-        if (!(fabs(a[k]) <= GK__STATE_MAX)) return 0;
+        if (!gk__state_real(a[k])) return 0;
     return 1;
 }
 
@@ -2936,8 +2937,8 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
                                   2.0 * rve->rmax + hd.skin);
     }
     if (!gk__state_m3(hd.L) || !gk__state_m3(hd.G) || !gk__state_m3(hd.stress) ||
-        !(fabs(hd.stiff[0]) <= GK__STATE_MAX) || !(fabs(hd.stiff[1]) <= GK__STATE_MAX) ||
-        !(fabs(hd.stiff[2]) <= GK__STATE_MAX) || !(hd.fc_mean >= 0.0) || !(hd.fc_mean <= GK__STATE_MAX))
+        !gk__state_real(hd.stiff[0]) || !gk__state_real(hd.stiff[1]) || !gk__state_real(hd.stiff[2]) ||
+        !(hd.fc_mean >= 0.0) || !gk__state_real(hd.fc_mean))
         return gk_err_set(err, GK_ERR_NAN,
                           "RVE state has a non-finite or impossible (above 1e100) velocity gradient, stress "
                           "or stiffness");
