@@ -10,7 +10,7 @@
  * ~1.6 s.
  *
  *   build/mpmdem_collapse                         # 8 x 8 cells, 1 point each
- *   build/mpmdem_collapse --nx 16 --ppc 2         # the paper's size, 1024 RVEs
+ *   build/mpmdem_collapse --paper                 # the paper's size: 16 x 16 x 4, 1000 disks
  *   mpirun -np 2 build/mpmdem_collapse_mpi --threads 1   # the RVEs on 2 ranks
  *
  * Model. Square cells h = width / nx; the column holds nx x ny cells (ny =
@@ -101,7 +101,7 @@
 #define CL_MAX_SNAP 16
 
 typedef struct cl_opts {
-    int nx, levels, no_stop, thin_freeze;
+    int nx, levels, no_stop, thin_freeze, paper;
     double width, height, mu, gravity, t_end, every, domain, front_tol, rest_frac, rest_hold;
     const char *snap_list;
     int nsnap;
@@ -149,7 +149,8 @@ typedef struct cl { /* the whole model */
     double h, l0, c, rho_ref, Mmax, prep_secs;
 } cl;
 
-static void defaults(cl *X) {
+/* paper: the preset of --paper (Liang & Zhao's 16 x 16 cells, 4 points each, 1000-disk RVEs) */
+static void defaults(cl *X, int paper) {
     cl_opts *b = &X->b;
     mpd_opts_default(&X->o, "build/mpm_collapse");
     X->o.alpha = 5e-4;
@@ -159,11 +160,12 @@ static void defaults(cl *X) {
     b->every = 0.01;
     b->domain = 5.0, b->front_tol = 0.5, b->rest_frac = 5e-3, b->rest_hold = 0.05;
     b->snap_list = "0.2,0.4,0.7,1,1.3", b->thin_freeze = 1;
+    if (paper) b->paper = 1, b->nx = 16, X->o.ppc = 2, X->o.packing = "examples/data/rve1000.txt";
 }
 
 static void usage(FILE *fp) {
     cl X;
-    defaults(&X);
+    defaults(&X, 0);
     X.o.dem_max = 1000;
     fprintf(
         fp,
@@ -172,6 +174,8 @@ static void usage(FILE *fp) {
         "symmetry\n"
         "plane on the left, rigid base with Coulomb friction, the gate on the right removed at t = 0.\n\n"
         "usage: mpmdem_collapse [options]\n"
+        "  --paper                the paper's size: --nx 16 --ppc 2 --packing examples/data/rve1000.txt\n"
+        "                         (1024 RVEs of 1000 disks; other flags given override it)\n"
         "  --nx N                 cells across the column width (default 8; the paper: 16 with --ppc 2)\n"
         "  --width D0 --height H0 column [m] (default 1 x 1, aspect a = 1); H0 / (D0/nx) must be whole\n"
         "  --mu M                 Coulomb friction of the base (default 0.4)\n"
@@ -208,6 +212,7 @@ static void usage(FILE *fp) {
 static int parse(cl *X, int argc, char **argv) {
     cl_opts *b = &X->b;
     const cli_opt mine[] = {
+        {"--paper", CLI_FLAG, &b->paper, 0, 0, NULL, NULL, 0},
         {"--nx", CLI_INT, &b->nx, 1, 1000, NULL, NULL, 0},
         {"--levels", CLI_INT, &b->levels, 1, CL_MAX_LEVELS, NULL, NULL, 0},
         {"--width", CLI_REAL, &b->width, 0, 1e4, "a positive length", NULL, CLI_LO_OPEN},
@@ -225,8 +230,12 @@ static int parse(cl *X, int argc, char **argv) {
         {"--thin-cell", CLI_CHOICE, &b->thin_freeze, 0, 0, NULL, "stop|freeze", 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     int r, rows_pts;
-    defaults(X);
+    /* the flags, twice: the preset (--paper) first, then every flag given over it */
+    defaults(X, 0);
     if ((r = mpd_parse(&X->run, argc, argv, &X->o, mine, usage)) != 0) return r;
+    r = b->paper;
+    defaults(X, r);
+    mpd_parse(&X->run, argc, argv, &X->o, mine, usage);
     X->run.out = X->o.out;
     X->dem_max_given = X->o.dem_max > 0;
     if (!X->dem_max_given) X->o.dem_max = 1000000; /* placeholder until dt is known */

@@ -2,9 +2,9 @@
  * MPMxDEM column collapse of Liang & Zhao 2019 Sec 3.5): it runs, writes its
  * documented outputs, keeps the energy balance and the mass, spreads the
  * column outward, does not depend on the thread count, restarts to the
- * identical result, refuses bad arguments and a corrupted checkpoint, and
- * ends with status 1 when a result cannot be written. Needs build/mpmdem_collapse
- * (`make test` builds examples first). */
+ * identical result, takes the paper's size as a preset, refuses bad arguments and a
+ * corrupted checkpoint, and ends with status 1 when a result cannot be written. Needs
+ * build/mpmdem_collapse (`make test` builds examples first). */
 #define GK_TEST_DRIVERS
 #include "gk_test.h"
 #include <stdlib.h>
@@ -170,6 +170,22 @@ TEST(collapse_bad_arguments) {
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_bad.out", "--dem-max"));
 }
 
+/* --paper is the paper's 1000-disk RVEs on 16 x 16 cells with 4 points each; a flag given with it
+ * overrides the preset (here the grid, so that the run stays short) */
+TEST(collapse_paper_preset) {
+    CHECK(system(BUILD "/mpmdem_collapse --paper --nx 4 --ppc 1 --levels 1 --t-end 0.01 --every 0.005 "
+                       "--snapshots 0.005 --threads 1 --quiet --out " BUILD "/tests/t_mpmcl_paper > " BUILD
+                       "/tests/t_mpmcl_paper.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_paper.out", "4 x 4 cells"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_paper.out", "16 points (= RVEs of 1000 disks)"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_paper.out", "RESULT dstar="));
+    CHECK(system(BUILD "/mpmdem_collapse --paper --ppc 1 --packing /nonexistent > " BUILD
+                       "/tests/t_mpmcl_paper.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_paper.out", "nonexistent"));
+    CHECK(system(BUILD "/mpmdem_collapse --help > " BUILD "/tests/t_mpmcl_paper.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmcl_paper.out", "--paper"));
+}
+
 /* a corrupted checkpoint is refused by name (status 1); a result that cannot be written (the CSV's
  * path taken by a folder) ends the run with status 1, said once; --out onto a file is refused */
 TEST(collapse_bad_files) {
@@ -200,5 +216,6 @@ int main(int argc, char **argv) {
     RUN(collapse_restart_identical);
     RUN(collapse_bad_arguments);
     RUN(collapse_bad_files);
+    RUN(collapse_paper_preset);
     return gk_test_done();
 }
