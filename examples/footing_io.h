@@ -65,7 +65,7 @@ typedef struct ft_row { /* one CSV row: means over an output interval; the mecha
     double t, d, q, load, ek, dem_mean, secs;
     double wedge, heave_x, heave_u; /* footing_mech.h: wedge angle [deg], heave's outer x and top [m] */
     double sp_phi, sp_r0, sp_rms;   /* fm_spiral: fitted angle [deg], r0 and eq 44 misfit [m]; NAN if none */
-    int sp_rays;                    /* rays with an eps_q ridge (0: none) */
+    int sp_rays;                    /* rays with an eps_q ridge, found or not (found: sp_phi not NAN) */
 } ft_row;
 
 /* what a checkpoint carries besides points and RVEs */
@@ -295,7 +295,7 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
     double *x = (double *)malloc(3 * (size_t)n * sizeof *x + 1), *q = x + n, *qsm = q + n, nq = NAN, qu = NAN,
            du = NAN;
     double wu = NAN, hxu = NAN, huu = NAN, we = NAN, hxe = NAN, spu = NAN, spr0 = NAN, sprms = NAN, spe = NAN;
-    int sprays = 0;
+    int sprays = 0, sprays_end = 0, nsearch = fm_spiral_nsearch(fm_prandtl_wedge(X->phi), X->phi);
     double nq46 = nq_prandtl(X->phi), nq47 = nq_prandtl(phi_reduced(X->phi)), hwm, per_rve, ck_mb = 0;
     /* cost per RVE per step without the first step's one-off relaxation of every RVE */
     double per_step_rve = steps_run ? (secs - (excl ? X->t_first : 0)) / (steps_run - excl) / np : 0.0;
@@ -378,7 +378,8 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
         printf("mechanism at the end (d/B = %.4f): wedge angle %.1f deg; heave reaching x = %.2f B\n",
                rl->d / f->B, we, hxe / f->B);
         spu = ru->sp_phi, spr0 = ru->sp_r0, sprms = ru->sp_rms, sprays = ru->sp_rays, spe = rl->sp_phi;
-        if (sprays > 0)
+        sprays_end = rl->sp_rays;
+        if (!isnan(spu))
             printf("log spiral (eq 44) at the %s: the eps_q ridge on %d rays from the footing's corner fits "
                    "ln r = ln r0 + psi tan(phi) with phi = %.1f deg (the RVE's %.2f; Liang & Zhao: eq 44 at "
                    "28.1 \"agrees perfectly\"), r0 = %.2f B (Prandtl's wedge side: %.2f B); RMS distance "
@@ -386,13 +387,13 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
                    reached ? "ultimate load" : "last row", sprays, spu, X->phi, spr0 / f->B,
                    X->b / cos(fm_prandtl_wedge(X->phi) * FM_PI / 180.0) / f->B, sprms / f->B, X->h / f->B);
         else
-            printf("log spiral (eq 44) at the %s: not found (no eps_q ridge standing out along the rays "
-                   "from the footing's corner; RESULT spiral_found=0)\n",
-                   reached ? "ultimate load" : "last row");
-        if (rl->sp_rays > 0)
-            printf("log spiral at the end: phi = %.1f deg on %d rays\n", spe, rl->sp_rays);
+            printf("log spiral (eq 44) at the %s: not found (an eps_q ridge stands out on %d of the %d rays "
+                   "from the footing's corner; a spiral needs half of them; RESULT spiral_found=0)\n",
+                   reached ? "ultimate load" : "last row", sprays, nsearch);
+        if (!isnan(spe))
+            printf("log spiral at the end: phi = %.1f deg on %d rays\n", spe, sprays_end);
         else
-            printf("log spiral at the end: not found\n");
+            printf("log spiral at the end: not found (a ridge on %d of the %d rays)\n", sprays_end, nsearch);
     }
     hwm = proc_kb("VmHWM");
     per_rve = X->rss_after > 0 && X->rss_before > 0 ? (X->rss_after - X->rss_before) / np : NAN;
@@ -428,13 +429,14 @@ static int finish(ft *X, double secs, long steps_run, long long dems, int bad) {
            "mem_per_rve_kb=%.4g vmhwm_mb=%.5g total_seconds=%.2f wedge_deg=%.4g wedge_prandtl_deg=%.4g "
            "heave_x_over_B=%.4g heave_width_over_B=%.4g heave_over_B=%.4g prandtl_reach_over_B=%.4g "
            "wedge_end_deg=%.4g heave_x_end_over_B=%.4g spiral_found=%d spiral_phi_deg=%.4g "
-           "spiral_r0_over_B=%.4g spiral_rms_over_B=%.4g spiral_rays=%d spiral_phi_end_deg=%.4g\n",
+           "spiral_r0_over_B=%.4g spiral_rms_over_B=%.4g spiral_rays=%d spiral_rays_searched=%d "
+           "spiral_phi_end_deg=%.4g spiral_rays_end=%d\n",
            nq, nq46, nq47, X->phi, X->phi_res, X->measured ? nq_prandtl(X->phi_res) : NAN, phi_of_nq(nq), qu,
            du, reached, np, steps_run, X->dt, steps_run ? secs / steps_run : 0.0,
            steps_run ? secs / steps_run * 1000.0 / np : 0.0, 1000.0 * per_step_rve, per_rve, hwm / 1024, secs,
            wu, fm_prandtl_wedge(X->phi), hxu / f->B, (hxu - X->b) / f->B, huu / f->B,
-           fm_prandtl_reach(X->b, X->phi) / f->B, we, hxe / f->B, sprays > 0, spu, spr0 / f->B, sprms / f->B,
-           sprays, spe);
+           fm_prandtl_reach(X->b, X->phi) / f->B, we, hxe / f->B, !isnan(spu), spu, spr0 / f->B, sprms / f->B,
+           sprays, nsearch, spe, sprays_end);
     free(x);
     return bad;
 }

@@ -65,7 +65,10 @@
  *                    against eq 44 at the caller's phi is the RMS of r -
  *                    r0' exp(psi tan phi) over the ridge points, r0' fitted
  *                    (least squares in ln r) with that slope: the shape,
- *                    not where the spiral starts.
+ *                    not where the spiral starts. nrays counts the
+ *                    rays with a ridge whether found or not.
+ *   fm_spiral_nsearch  the number of rays fm_spiral searches (36 over
+ *                    Prandtl's 90 deg fan).
  */
 #ifndef FOOTING_MECH_H
 #define FOOTING_MECH_H
@@ -154,6 +157,16 @@ static double fm_ray_value(const double *ct, const double *cd2, const double *cv
     return sw > 0 ? swv / sw : 0.0;
 }
 
+/* the number of rays fm_spiral searches for a wedge angle alpha_deg and a friction angle phi_deg (0: the fan
+ * is too narrow or an angle is not finite); a spiral is found only with a ridge on half of them */
+static int fm_spiral_nsearch(double alpha_deg, double phi_deg) {
+    double hi = 135.0 + 0.5 * phi_deg - alpha_deg - FM_SP_MARGIN, lo = FM_SP_MARGIN;
+    int nray;
+    if (!(isfinite(alpha_deg) && isfinite(phi_deg) && hi >= lo)) return 0;
+    nray = (int)floor((hi - lo) / FM_SP_DPSI + 1e-9) + 1;
+    return nray > FM_SP_MAXRAY ? FM_SP_MAXRAY : nray;
+}
+
 /* x, y, eq: the n points (current positions, eps_q); s: their spacing; (b, yb): the pole (the footing's
  * corner); alpha_deg: the wedge angle (the fan's first side); phi_deg: the friction angle (the fan's last
  * side, and eq 44's). Fills *F; returns F->found (1) or 0 (not found: no ridge, or out of memory). */
@@ -166,9 +179,7 @@ static int fm_spiral(const double *x, const double *y, const double *eq, int n, 
     F->alpha = alpha_deg, F->th0 = 180.0 + alpha_deg, F->fan = 135.0 + 0.5 * phi_deg - alpha_deg;
     if (!(n > 0 && s > 0 && b > 0 && isfinite(alpha_deg) && isfinite(phi_deg))) return 0;
     lo = FM_SP_MARGIN, hi = F->fan - FM_SP_MARGIN;
-    if (!(hi >= lo)) return 0;
-    nray = (int)floor((hi - lo) / FM_SP_DPSI + 1e-9) + 1;
-    if (nray > FM_SP_MAXRAY) nray = FM_SP_MAXRAY;
+    if ((nray = fm_spiral_nsearch(alpha_deg, phi_deg)) == 0) return 0;
     for (p = 0; p < n; ++p) { /* the farthest point (or its mirror image) from the pole */
         double dx = fabs(x[p]) + b, dy = y[p] - yb, d = sqrt(dx * dx + dy * dy);
         if (d > rmax) rmax = d;

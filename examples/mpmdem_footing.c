@@ -175,8 +175,8 @@ static void usage(FILE *fp) {
         "step)\n"
         "\noutputs in --out: footing.csv (time,d,d_over_B,q,q_over_qs,load_half,kinetic_energy,\n"
         "  dem_steps_per_point,seconds,wedge_deg,heave_x_over_B,heave_over_B,spiral_phi_deg,\n"
-        "  spiral_r0_over_B,spiral_rms_over_B,spiral_rays; spiral_*: nan and 0 rays when no ridge is "
-        "found),\n"
+        "  spiral_r0_over_B,spiral_rms_over_B,spiral_rays; spiral_rays: the rays with an eps_q ridge,\n"
+        "  a spiral needs half of those searched; the other spiral_* nan when none is found),\n"
         "  footing_load.svg, rve_biaxial.svg, rve_mohr.svg, eps_q_dB*.svg,\n"
         "  eps_q_end.svg, rotation_end.svg, void_ratio_end.svg, displacement_end.svg, points_*.vtk,\n"
         "  checkpoint.bin\n"
@@ -191,7 +191,7 @@ static void usage(FILE *fp) {
         "           prandtl_reach_over_B=... wedge_end_deg=... heave_x_end_over_B=...\n"
         "           spiral_found=... spiral_phi_deg=... spiral_r0_over_B=... spiral_rms_over_B=... "
         "spiral_rays=...\n"
-        "           spiral_phi_end_deg=...\n");
+        "           spiral_rays_searched=... spiral_phi_end_deg=... spiral_rays_end=...\n");
 }
 
 /* the flags, twice: the presets (--material, --paper) first, then every flag given over them */
@@ -374,7 +374,7 @@ static int after_step(ft *X, double vf, double t_start, long step0, long nsteps_
     r.ek = S->acc_ek / S->nacc, r.dem_mean = S->acc_dem / S->nacc;
     r.secs = S->wall + gk_wtime() - t_start;
     if (mechanism(X, &r.wedge, &r.heave_x, &r.heave_u, &sp)) return 1;
-    r.sp_phi = sp.phi, r.sp_r0 = sp.r0, r.sp_rms = sp.rms, r.sp_rays = sp.found ? sp.nrays : 0;
+    r.sp_phi = sp.phi, r.sp_r0 = sp.r0, r.sp_rms = sp.rms, r.sp_rays = sp.nrays;
     S->acc_load = S->acc_dt = 0, S->acc_ek = S->acc_dem = 0, S->nacc = 0;
     while (S->next_out * f->B <= S->disp * (1 + 1e-9)) S->next_out += f->every;
     bad = mpd_rows_push(&X->run, &X->rows, &r) || mpd_write(&X->run, "footing.csv", put_csv, X);

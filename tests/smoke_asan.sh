@@ -65,6 +65,7 @@ rm -rf "$T/sgw" && mkdir -p "$T/sgw" && ln -s /dev/full "$T/sgw/single.csv"
 run 1 "$B/mpmdem_single" --strain 0.003 --packing "$T/pack.txt" --quiet --threads 2 --out "$T/sgw"
 run 2 "$B/mpmdem_single" --margin -1
 run 0 "$B/mpmdem_collapse" --nx 4 --every 0.025 --snapshots 0.05 --t-end 0.05 --quiet --threads 2 --out "$T/cl"
+run 0 "$B/mpmdem_collapse" --paper --nx 4 --ppc 1 --levels 1 --t-end 0.01 --every 0.005 --snapshots 0.005 --quiet --threads 1 --out "$T/clp"
 PP="--width 3 --nx 12 --ny 5 --penetration 0.02 --lateral 0.01 --v-down 1 --v-lateral 1 --ramp 0.005 --every 0.01 --quiet --threads 2"
 run 0 "$B/mpmdem_pipe" $PP --max-steps 10 --out "$T/pp"
 run 0 "$B/mpmdem_pipe" $PP --restart "$T/pp" --out "$T/pp2"

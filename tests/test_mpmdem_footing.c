@@ -93,7 +93,14 @@ TEST(footing_runs_and_loads) {
      * RESULT says not found, the numbers nan (never a number made of a NaN) */
     CHECK(gk_test_file_has(BUILD "/tests/t_mpmft.out", "log spiral (eq 44) at the last row: not found"));
     CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "spiral_found"), 0, 0);
-    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "spiral_rays"), 0, 0);
+    /* Prandtl's fan of 90 deg less 10 deg at each end, a ray every 2 deg: 36 searched; the rays with a
+     * ridge are counted found or not (here fewer than half, or no spiral would be "not found") */
+    CHECK_NEAR(gk_test_result(BUILD "/tests/t_mpmft.out", "spiral_rays_searched"), 36, 0);
+    t = gk_test_result(BUILD "/tests/t_mpmft.out", "spiral_rays");
+    CHECK(t >= 0 && t <= 36);
+    t = gk_test_result(BUILD "/tests/t_mpmft.out", "spiral_rays_end");
+    CHECK(t >= 0 && t <= 36);
+    CHECK(gk_test_file_has(BUILD "/tests/t_mpmft.out", "of the 36 rays"));
     CHECK(isnan(gk_test_result(BUILD "/tests/t_mpmft.out", "spiral_phi_deg")));
 }
 
@@ -216,6 +223,12 @@ TEST(footing_spiral_synthetic) {
     CHECK_EQ_INT(fm_spiral(x, y, eq, n, s, b, yb, 66.0, 28.1, &F), 1);
     CHECK_NEAR(F.phi, 28.1, 1.0);
     CHECK_NEAR(F.fan, 135.0 + 14.05 - 66.0, 1e-12);
+    /* the rays searched: every 2 deg over the fan less 10 deg at each end (36 over Prandtl's 90 deg, 32
+     * over 83.05); none when the fan is narrower than the two margins or an angle is not finite */
+    CHECK_EQ_INT(fm_spiral_nsearch(59.05, 28.1), 36);
+    CHECK_EQ_INT(fm_spiral_nsearch(66.0, 28.1), 32);
+    CHECK_EQ_INT(fm_spiral_nsearch(140.0, 28.1), 0);
+    CHECK_EQ_INT(fm_spiral_nsearch(NAN, 28.1), 0);
     /* a ridge on two short stretches of the fan only (psi 13-17 and 71-75 deg of 90; with the kernel's
      * reach, ridges on fewer than half of the 36 rays, spanning more than half of the fan): bumps, no
      * spiral */
