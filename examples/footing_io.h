@@ -138,7 +138,7 @@ static void outline(const ft *X, mpd_outline *ol) {
 /* the fitted log spiral r = r0 exp(psi tan phi_fit) about the footing's corner over Prandtl's fan at the
  * RVE's angle (fm_spiral's), as two polylines of 6 points (11 chords of the 90 deg fan); nothing if NAN */
 static void outline_spiral(const ft *X, double phi_fit, double r0, mpd_outline *ol) {
-    double d2r = FM_PI / 180.0, a = fm_prandtl_wedge(X->phi), th0 = 180.0 + a, fan = 135.0 + 0.5 * X->phi - a;
+    double d2r = FM_PI / 180.0, a = fm_prandtl_wedge(X->phi), th0 = 180.0 + a, fan = fm_spiral_fan(a, X->phi);
     double yb = X->f.depth - X->S.disp, xy[12];
     int half, k;
     if (!(isfinite(phi_fit) && isfinite(r0))) return;

@@ -157,10 +157,14 @@ static double fm_ray_value(const double *ct, const double *cd2, const double *cv
     return sw > 0 ? swv / sw : 0.0;
 }
 
+/* the fan fm_spiral searches [deg]: from the wedge side (alpha_deg) to the passive zone's boundary 45 -
+ * phi_deg/2 below the horizontal */
+static double fm_spiral_fan(double alpha_deg, double phi_deg) { return 135.0 + 0.5 * phi_deg - alpha_deg; }
+
 /* the number of rays fm_spiral searches for a wedge angle alpha_deg and a friction angle phi_deg (0: the fan
  * is too narrow or an angle is not finite); a spiral is found only with a ridge on half of them */
 static int fm_spiral_nsearch(double alpha_deg, double phi_deg) {
-    double hi = 135.0 + 0.5 * phi_deg - alpha_deg - FM_SP_MARGIN, lo = FM_SP_MARGIN;
+    double hi = fm_spiral_fan(alpha_deg, phi_deg) - FM_SP_MARGIN, lo = FM_SP_MARGIN;
     int nray;
     if (!(isfinite(alpha_deg) && isfinite(phi_deg) && hi >= lo)) return 0;
     nray = (int)floor((hi - lo) / FM_SP_DPSI + 1e-9) + 1;
@@ -176,7 +180,7 @@ static int fm_spiral(const double *x, const double *y, const double *eq, int n, 
     double d2r = FM_PI / 180.0, psi_min = HUGE_VAL, psi_max = -HUGE_VAL;
     int p, k, j, nray, nsmax, nr = 0;
     F->found = 0, F->nrays = 0, F->phi = F->r0 = F->rms = F->r0_44 = NAN;
-    F->alpha = alpha_deg, F->th0 = 180.0 + alpha_deg, F->fan = 135.0 + 0.5 * phi_deg - alpha_deg;
+    F->alpha = alpha_deg, F->th0 = 180.0 + alpha_deg, F->fan = fm_spiral_fan(alpha_deg, phi_deg);
     if (!(n > 0 && s > 0 && b > 0 && isfinite(alpha_deg) && isfinite(phi_deg))) return 0;
     lo = FM_SP_MARGIN, hi = F->fan - FM_SP_MARGIN;
     if ((nray = fm_spiral_nsearch(alpha_deg, phi_deg)) == 0) return 0;
