@@ -162,6 +162,8 @@ static uint64_t fingerprint(const opts *o, const gk_packing *pk) {
              o->imperfection, o->iuf, o->dem_min, o->dem_max, o->dem_damping, o->contact_damping, o->density,
              o->xi, o->mass_scale, o->kappa, o->dt, o->dt_safety, o->amplitude, o->frequency, o->duration,
              o->every, pk->n, 3, sx, o->dem_inertial);
+    if (o->mix != 1.0) /* appended only when used: the fingerprints of earlier runs stay valid */
+        snprintf(buf + strlen(buf), sizeof buf - strlen(buf), " mix %.17g", o->mix);
     for (k = 0; buf[k]; ++k) h = (h ^ (unsigned char)buf[k]) * 1099511628211ull;
     return h;
 }

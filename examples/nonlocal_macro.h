@@ -21,6 +21,12 @@
  *   free boundaries. All local increments of a step are known before any
  *   DEM run, so the average uses current increments only (the paper's
  *   staggered form takes a neighbour's previous one when it must).
+ *   Stability (not in the paper): averaging the strain scales a strain wave's
+ *   stiffness by the operator's symbol S(k) (gk_nonlocal.h), which is
+ *   negative for some waves once the mesh spacing falls below R / sqrt 2;
+ *   the driver prints min S for its mesh and warns when it is negative.
+ *   --nonlocal-mix M averages M <eps> + (1 - M) eps instead (symbol
+ *   1 - M + M S), which is positive for M < 1 / (1 - min S).
  *   One step: forces -> velocities and displacements (eqs 22-23) ->
  *   corotational increments -> nonlocal average -> rotate in (eq 60) -> all
  *   RVEs (threads) -> rotate out (eq 62) -> internal forces.
@@ -95,6 +101,9 @@ typedef struct model {
     double *Hn, *H, *deps, *depsnl, *dH, *Rh, *R1, *sigR, *sig; /* 9 per point              */
     gk_twoscale_field *fld;
     gk_nonlocal nl;
+    double sym_raw, sym_min, sym_k[3]; /* min of the averaging's symbol on this grid (gk_nonlocal.h):
+                                          as built, and after --nonlocal-mix; k h where reached */
+    int sym_dim;
     gk_twoscale ts;
     int *top, ntop, *bot, nbot, *right, nright; /* node lists                                */
     pface *pf;
@@ -329,7 +338,22 @@ static int macro_setup(model *md) {
             if (axes & (1u << k)) per[k] = md->L[k];
         r = gk_nonlocal_build(&md->nl, 3, md->ne, xg, o->R, per, NULL, &err);
         free(xg);
+        if (!r) r = gk_nonlocal_mix(&md->nl, o->mix, &err);
         if (r) return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
+        /* stability: the symbol of the (mixed) average on the mesh's regular grid, over the
+         * axes that have neighbours (more than one element, or periodic) */
+        {
+            double h[3], s = 1.0, kk[3] = {0, 0, 0};
+            int dim = 0;
+            for (k = 0; k < 3; ++k)
+                if (o->mesh[k] > 1 || per[k] > 0.0) h[dim++] = md->L[k] / o->mesh[k];
+            if (dim && o->R > 0.0 && gk_nonlocal_grid_symbol(dim, h, o->R, &s, kk, &err))
+                return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
+            md->sym_raw = s;
+            md->sym_min = 1.0 - o->mix + o->mix * s;
+            md->sym_dim = dim;
+            for (k = 0; k < 3; ++k) md->sym_k[k] = kk[k] * (k < dim ? h[k] : 0.0);
+        }
     }
     md->probe = t == T_WAVE ? (md->ne >= 9 ? 8 : md->ne - 1) : 0;
     for (e = 0; e < md->ne; ++e) md->arrival[e] = -1.0;
@@ -714,13 +738,22 @@ static int macro_time_steps(model *md) {
         md->omega1 = 0.5 * GK_PI * c / md->L[1];
         md->alpha = 2.0 * o->xi * md->omega1;
     }
-    printf("mesh %dx%dx%d (%d Gauss points), nonlocal %s (R %g m, %d neighbour pairs), dt %.4g s (eq 65: "
-           "omega_max "
+    printf("mesh %dx%dx%d (%d Gauss points), nonlocal %s (R %g m, mix %g, %d neighbour pairs, symbol min "
+           "%.4f), dt %.4g s (eq 65: omega_max "
            "%.4g rad/s), eq 66: %.1f DEM critical steps per coarse step (omega_f %.4g rad/s, DEM dt %.3g s), "
            "damping alpha %.4g 1/s\nDEM runs: I_uf < %g (eq 57) within %d-%d steps, %ld coarse steps\n",
-           o->mesh[0], o->mesh[1], o->mesh[2], md->ne, o->R > 0 ? "on" : "off", o->R, md->nl.start[md->ne],
-           md->dt, md->omega_c, gk_explicit_substeps(md->omega_c, 0.0, mi->omega_f, 0.0), mi->omega_f,
-           mi->dt_f, md->alpha, o->iuf, o->dem_min, o->dem_max, md->nsteps);
+           o->mesh[0], o->mesh[1], o->mesh[2], md->ne, o->R > 0 ? "on" : "off", o->R, o->mix,
+           md->nl.start[md->ne], md->sym_min, md->dt, md->omega_c,
+           gk_explicit_substeps(md->omega_c, 0.0, mi->omega_f, 0.0), mi->omega_f, mi->dt_f, md->alpha, o->iuf,
+           o->dem_min, o->dem_max, md->nsteps);
+    fflush(stdout);
+    if (md->sym_min < 0.0)
+        fprintf(stderr,
+                "femdem_nonlocal: warning: on this mesh the averaged strain has modes of negative stiffness "
+                "(symbol min %.4f at k h = %.2f %.2f %.2f over the %d axes with neighbours; gk_nonlocal.h): "
+                "they grow whatever the material; --nonlocal-mix below %.3f keeps every mode stiff\n",
+                md->sym_min, md->sym_k[0], md->sym_k[1], md->sym_k[2], md->sym_dim,
+                1.0 / (1.0 - md->sym_raw));
     return 0;
 }
 

@@ -71,7 +71,7 @@ static const char *test_name[T_COUNT] = {"rve",  "element-biaxial", "element-she
 typedef struct opts {
     int test, mesh[3], threads, steps, stop_after, checkpoint, vtk_every, every, imperfection, dem_min,
         dem_max, lone, paper;
-    double R, pressure, strain, iuf, dem_inertial, dem_damping, contact_damping, density, xi, mass_scale,
+    double R, mix, pressure, strain, iuf, dem_inertial, dem_damping, contact_damping, density, xi, mass_scale,
         kappa, dt, dt_safety;
     double amplitude, frequency, duration;
     const char *packing, *out, *restart;
@@ -92,12 +92,12 @@ static void usage(FILE *fp) {
     fprintf(fp,
             "usage: femdem_nonlocal --test rve|element-biaxial|element-shear|wave|simple-shear|biaxial --out "
             "DIR\n"
-            "  [--mesh NXxNYxNZ] [--nonlocal R|off] [--pressure P] [--strain S] [--steps N] [--packing F]\n"
-            "  [--threads T] [--restart DIR] [--stop-after N] [--checkpoint K] [--vtk-every K] [--every K]\n"
-            "  [--imperfection N] [--iuf X] [--dem-inertial I] [--dem-min N] [--dem-max N]\n"
-            "  [--dem-damping A] [--contact-damping Z] [--density RHO] [--xi X] [--mass-scale S]\n"
-            "  [--hourglass K] [--dt DT] [--dt-safety F] [--amplitude A] [--frequency F] [--duration T]\n"
-            "  [--lone-increments N] [--paper]\n");
+            "  [--mesh NXxNYxNZ] [--nonlocal R|off] [--nonlocal-mix M] [--pressure P] [--strain S]\n"
+            "  [--steps N] [--packing F] [--threads T] [--restart DIR] [--stop-after N] [--checkpoint K]\n"
+            "  [--vtk-every K] [--every K] [--imperfection N] [--iuf X] [--dem-inertial I] [--dem-min N]\n"
+            "  [--dem-max N] [--dem-damping A] [--contact-damping Z] [--density RHO] [--xi X]\n"
+            "  [--mass-scale S] [--hourglass K] [--dt DT] [--dt-safety F] [--amplitude A] [--frequency F]\n"
+            "  [--duration T] [--lone-increments N] [--paper]\n");
     fprintf(fp,
             "defaults: --pressure 4.16e5 --packing examples/data/rve512_hm.txt --threads 1 --nonlocal off\n"
             "  --iuf 0.01 --dem-inertial 2e-3 --dem-min 10 --dem-max 4000 (simple-shear, biaxial: 20)\n"
@@ -109,7 +109,8 @@ static void usage(FILE *fp) {
             "  --steps 4000 --imperfection 25 x N/4096; biaxial: --mesh 4x8x1 --strain 0.08 --steps 3000.\n"
             "  --paper: the paper's size, the 4096-sphere RVE (--packing examples/data/rve4096_hm.txt) and\n"
             "  its I_uf rule in the mesh tests too (--dem-max 4000); flags given override it. The paper's\n"
-            "  nonlocal radius: --nonlocal 6.75e-3.\n"
+            "  nonlocal radius: --nonlocal 6.75e-3. --nonlocal-mix M (default 1, the paper): average\n"
+            "  M <eps> + (1 - M) eps, part of the strain kept local (see gk_nonlocal.h, stability).\n"
             "See the top of examples/femdem_nonlocal.c for the model, the outputs and the RESULT line.\n");
 }
 
@@ -177,6 +178,7 @@ static int parse(int argc, char **argv, opts *o) {
         {"--test", CLI_FUNC, &test_f, 0, 0, NULL, NULL, 0},
         {"--mesh", CLI_FUNC, &mesh_f, 0, 0, NULL, NULL, 0},
         {"--nonlocal", CLI_FUNC, &nonlocal_f, 0, 0, NULL, NULL, 0},
+        {"--nonlocal-mix", CLI_REAL, &o->mix, R0, R1, "a number in [0, 1]", NULL, 0},
         {"--pressure", CLI_REAL, &o->pressure, R0, R1, "a number > 0", NULL, 0},
         {"--strain", CLI_REAL, &o->strain, R0, R1, "a number in (0, 0.5)", NULL, 0},
         {"--steps", CLI_INT, &o->steps, I0, I1, NULL, NULL, 0},
@@ -212,6 +214,7 @@ static int parse(int argc, char **argv, opts *o) {
     memset(o, 0, sizeof *o);
     o->test = -1;
     o->R = 0.0;
+    o->mix = 1.0;
     o->pressure = 4.16e5;
     o->strain = -1;
     o->steps = -1;
@@ -315,6 +318,8 @@ static int parse(int argc, char **argv, opts *o) {
     REQ(o->amplitude > 0 && o->frequency > 0 && o->duration > 0,
         "--amplitude, --frequency, --duration must be > 0");
     REQ(o->test != T_RVE || o->R == 0.0, "--nonlocal is for mesh tests, not --test rve");
+    REQ(o->mix >= 0 && o->mix <= 1, "--nonlocal-mix %g must be in [0, 1]", o->mix);
+    REQ(o->mix == 1.0 || o->R > 0.0, "--nonlocal-mix %g needs --nonlocal R", o->mix);
 #undef REQ
     return 0;
 }

@@ -7,6 +7,9 @@
  *   gk_nonlocal_apply   the averaged field: ncomp values per point
  *   gk_nonlocal_free
  *   gk_nonlocal_bell    the kernel a(r) of eq A.3
+ *   gk_nonlocal_grid_symbol  how the average scales a wave on a regular grid:
+ *                       its minimum says whether averaging the strain is stable
+ *   gk_nonlocal_mix     keep part of the field local: m w_IJ + (1 - m) delta_IJ
  *
  * LICENCE: MIT (see gk_base.h).
  */
@@ -41,7 +44,26 @@
  *   - Q_I is built once (reference configuration, as the paper precomputes
  *     it) by a direct O(n^2) search: ~0.1 s at 10 000 points.
  * The paper averages the whole strain-increment tensor (eq 58): apply with
- * ncomp = 6 (Voigt) or 9 (3x3) values per point. */
+ * ncomp = 6 (Voigt) or 9 (3x3) values per point.
+ *
+ * STABILITY OF AVERAGING THE STRAIN (not in the paper). On a regular grid the
+ * operator turns a wave phi = cos(k . x) into S(k) cos(k . x), with the symbol
+ *     S(k) = sum_m a(|m h|) cos(k . m h) / sum_m a(|m h|)
+ * (m over the integer lattice, h the spacings, every grid point alike). When the
+ * average of the strain enters the stress, a strain wave of wave vector k has its
+ * stiffness scaled by S(k): where S < 0 the model has modes of NEGATIVE stiffness,
+ * which can grow in an explicit run whatever the material (an element's hourglass
+ * control stiffens only the modes it cannot see). The bell's Fourier
+ * transform has negative lobes (fine grids tend to S(k) = 48 J_3(kR) / (kR)^3 in 2D, whose minimum is
+ * -0.029; about -0.021 in 3D),
+ * so every grid fine enough to carry waves of length ~R has such modes. On a
+ * square grid of spacing h (2D), S >= 0 everywhere while R <= sqrt(2) h (only the
+ * four edge neighbours count, each with a(h) <= 1/4); at R = 2h the chequerboard
+ * k = (pi/h, pi/h) has S = (1 - 4 a(h) + 4 a(sqrt 2 h)) / (1 + 4 a(h) + 4 a(sqrt 2
+ * h)) = -1/17 (a(h) = 9/16, a(sqrt 2 h) = 1/4; a(2h) = 0). gk_nonlocal_grid_symbol
+ * gives min S for any spacings and R; gk_nonlocal_mix(nl, m) with
+ * m < 1 / (1 - min S) keeps every symbol 1 - m + m S positive (part of the strain
+ * stays local, an option beyond the paper). */
 typedef struct gk_nonlocal {
     int n;      /* points                                                    */
     int *start; /* n + 1: point I's neighbours are nbr[start[I] .. start[I+1]) */
@@ -70,6 +92,18 @@ GKDEF gk_result gk_nonlocal_build(gk_nonlocal *nl, int dim, int n, const double 
 /* out[ncomp I + c] = sum_J w_IJ in[ncomp J + c]; out must not alias in */
 GKDEF void gk_nonlocal_apply(const gk_nonlocal *nl, int ncomp, const double *in, double *out);
 GKDEF void gk_nonlocal_free(gk_nonlocal *nl);
+/* min over the Brillouin zone of S(k) (above) for an infinite regular grid of
+ * dim axes with spacings h[0..dim) and radius R: written to *s_min, and the wave
+ * vector where it is reached to k_min (dim values, rad/m; NULL: not wanted).
+ * S is sampled on GK_NONLOCAL_SYMBOL_SAMPLES (32) intervals of [0, pi/h_k] per
+ * axis, the zone's corners included (S is even in every k_k). R <= min h: 1
+ * (local). Refused (GK_ERR_ARG) where the sampled sums would exceed 1e9 terms
+ * (3D beyond R ~ 15 h). */
+GKDEF gk_result gk_nonlocal_grid_symbol(int dim, const double *h, double R, double *s_min, double *k_min,
+                                        gk_err *err);
+/* w_IJ -> m w_IJ + (1 - m) delta_IJ, 0 <= m <= 1 (m = 1 leaves nl as built,
+ * m = 0 makes it local); the weights still sum to one */
+GKDEF gk_result gk_nonlocal_mix(gk_nonlocal *nl, double m, gk_err *err);
 #ifdef __cplusplus
 }
 #endif
@@ -184,6 +218,82 @@ GKDEF void gk_nonlocal_apply(const gk_nonlocal *nl, int ncomp, const double *in,
             for (c = 0; c < ncomp; ++c) o[c] += w * v[c];
         }
     }
+}
+
+#ifndef GK_NONLOCAL_SYMBOL_SAMPLES
+#define GK_NONLOCAL_SYMBOL_SAMPLES 32
+#endif
+
+GKDEF gk_result gk_nonlocal_grid_symbol(int dim, const double *h, double R, double *s_min, double *k_min,
+                                        gk_err *err) {
+    int k, m[3] = {0, 0, 0}, M[3] = {0, 0, 0}, q[3] = {0, 0, 0}, nq = GK_NONLOCAL_SYMBOL_SAMPLES;
+    double best = 2.0, kbest[3] = {0, 0, 0}, sum = 0.0;
+    double terms = 1.0;
+    if (dim < 1 || dim > 3 || !h || !s_min)
+        return gk_err_set(err, GK_ERR_ARG, "nonlocal symbol: dimension %d (1-3) and outputs needed", dim);
+    if (!(R >= 0.0) || !isfinite(R))
+        return gk_err_set(err, GK_ERR_ARG, "nonlocal symbol: radius %g must be >= 0", R);
+    for (k = 0; k < dim; ++k) {
+        if (!(h[k] > 0.0) || !isfinite(h[k]))
+            return gk_err_set(err, GK_ERR_ARG, "nonlocal symbol: spacing %g along axis %d must be > 0", h[k],
+                              k);
+        if (!(R / h[k] <= 100.0))
+            return gk_err_set(err, GK_ERR_ARG, "nonlocal symbol: radius %g is over 100 spacings %g (axis %d)",
+                              R, h[k], k);
+        M[k] = (int)floor(R / h[k]);
+        terms *= (2.0 * M[k] + 1.0) * (nq + 1.0);
+    }
+    if (terms > 1e9)
+        return gk_err_set(err, GK_ERR_ARG,
+                          "nonlocal symbol: %.3g terms to sum (limit 1e9): radius %g too large "
+                          "against the spacings",
+                          terms, R);
+    /* the denominator: sum of a over the lattice points within R */
+    for (m[0] = -M[0]; m[0] <= M[0]; ++m[0])
+        for (m[1] = -M[1]; m[1] <= M[1]; ++m[1])
+            for (m[2] = -M[2]; m[2] <= M[2]; ++m[2]) {
+                double r2 = 0.0;
+                for (k = 0; k < dim; ++k) r2 += (m[k] * h[k]) * (m[k] * h[k]);
+                sum += gk_nonlocal_bell(sqrt(r2), R);
+            }
+    if (!(sum > 0.0)) sum = 1.0; /* R = 0: the point alone */
+    for (q[0] = 0; q[0] <= (dim > 0 ? nq : 0); ++q[0])
+        for (q[1] = 0; q[1] <= (dim > 1 ? nq : 0); ++q[1])
+            for (q[2] = 0; q[2] <= (dim > 2 ? nq : 0); ++q[2]) {
+                double kv[3] = {0, 0, 0}, s = 0.0;
+                for (k = 0; k < dim; ++k) kv[k] = GK_PI * q[k] / (nq * h[k]);
+                for (m[0] = -M[0]; m[0] <= M[0]; ++m[0])
+                    for (m[1] = -M[1]; m[1] <= M[1]; ++m[1])
+                        for (m[2] = -M[2]; m[2] <= M[2]; ++m[2]) {
+                            double r2 = 0.0, ph = 0.0, a;
+                            for (k = 0; k < dim; ++k) {
+                                r2 += (m[k] * h[k]) * (m[k] * h[k]);
+                                ph += kv[k] * m[k] * h[k];
+                            }
+                            a = m[0] == 0 && m[1] == 0 && m[2] == 0 ? 1.0 : gk_nonlocal_bell(sqrt(r2), R);
+                            if (a > 0.0) s += a * cos(ph);
+                        }
+                s /= sum;
+                if (s < best) {
+                    best = s;
+                    for (k = 0; k < 3; ++k) kbest[k] = kv[k];
+                }
+            }
+    *s_min = best;
+    if (k_min)
+        for (k = 0; k < dim; ++k) k_min[k] = kbest[k];
+    return GK_OK;
+}
+
+GKDEF gk_result gk_nonlocal_mix(gk_nonlocal *nl, double m, gk_err *err) {
+    int I, p;
+    if (!nl || !nl->start) return gk_err_set(err, GK_ERR_STATE, "nonlocal mix: the operator is not built");
+    if (!(m >= 0.0 && m <= 1.0))
+        return gk_err_set(err, GK_ERR_ARG, "nonlocal mix: m = %g must be in [0, 1]", m);
+    for (I = 0; I < nl->n; ++I)
+        for (p = nl->start[I]; p < nl->start[I + 1]; ++p)
+            nl->w[p] = m * nl->w[p] + (nl->nbr[p] == I ? 1.0 - m : 0.0);
+    return GK_OK;
 }
 
 #endif /* GK_NONLOCAL implementation */

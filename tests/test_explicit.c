@@ -661,6 +661,89 @@ TEST(nonlocal_weights_and_linear_field) {
     free(x), free(phi), free(out);
 }
 
+/* J_3(x) by its power series sum_m (-1)^m (x/2)^(2m+3) / (m! (m+3)!) (x < 12) */
+static double bessel_j3(double x) {
+    double t = (x / 2) * (x / 2) * (x / 2) / 6.0, s = 0.0;
+    int m;
+    for (m = 0; m < 60; ++m) {
+        s += t;
+        t *= -(x / 2) * (x / 2) / ((m + 1.0) * (m + 4.0));
+    }
+    return s;
+}
+
+/* Stability of averaging the strain (gk_nonlocal.h): the symbol S(k) on a
+ * square grid. R <= sqrt(2) h: only the four edge neighbours, min at the
+ * chequerboard S = (1 - 4 a(h)) / (1 + 4 a(h)); R = 2h: (1 - 9/4 + 1) / (1 + 9/4
+ * + 1) = -1/17; the built operator on a periodic grid scales the chequerboard by
+ * exactly that; fine grids tend to the continuous symbol 48 J_3(kR) / (kR)^3,
+ * whose minimum is negative; the mix m w + (1 - m) I with m < 1 / (1 - S_min)
+ * makes the chequerboard's factor positive and keeps the weights' sum at one */
+TEST(nonlocal_symbol_and_mix) {
+    double h[3] = {2e-3, 2e-3, 2e-3}, s = 0.0, kv[3] = {0, 0, 0}, a, cmin = 1.0, x;
+    gk_err err;
+    gk_nonlocal nl;
+    int n = 8, I, i, j, p;
+    double xs[8 * 8 * 3], f[64], g[64];
+    double per[3] = {8 * 2e-3, 8 * 2e-3, 0.0};
+    CHECK(gk_nonlocal_grid_symbol(2, h, 2 * h[0], &s, kv, &err) == GK_OK);
+    CHECK_NEAR(s, -1.0 / 17.0, 1e-14);
+    CHECK_NEAR(kv[0] * h[0], GK_PI, 1e-14);
+    CHECK_NEAR(kv[1] * h[1], GK_PI, 1e-14);
+    a = gk_nonlocal_bell(h[0], 1.2 * h[0]);
+    CHECK(gk_nonlocal_grid_symbol(2, h, 1.2 * h[0], &s, kv, &err) == GK_OK);
+    CHECK_NEAR(s, (1 - 4 * a) / (1 + 4 * a), 1e-14);
+    CHECK(s > 0.0);
+    CHECK(gk_nonlocal_grid_symbol(2, h, 1.5 * h[0], &s, NULL, &err) == GK_OK);
+    CHECK(s < 0.0); /* just past sqrt 2: negative already */
+    CHECK(gk_nonlocal_grid_symbol(3, h, 0.9 * h[0], &s, NULL, &err) == GK_OK);
+    CHECK(s == 1.0); /* no neighbour: local */
+    /* the fine-grid limit: the continuous symbol's minimum */
+    for (x = 0.5; x < 12.0; x += 1e-3) {
+        double v = 48.0 * bessel_j3(x) / (x * x * x);
+        if (v < cmin) cmin = v;
+    }
+    CHECK(cmin < -0.02);
+    CHECK(gk_nonlocal_grid_symbol(2, h, 12 * h[0], &s, NULL, &err) == GK_OK);
+    CHECK_NEAR(s, cmin, 1e-3);
+    /* the built operator, periodic 8 x 8 grid, R = 2h: chequerboard -> -1/17 of itself */
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j) {
+            I = i * n + j;
+            xs[3 * I] = (i + 0.5) * h[0], xs[3 * I + 1] = (j + 0.5) * h[1], xs[3 * I + 2] = 0.0;
+            f[I] = (i + j) % 2 ? -1.0 : 1.0;
+        }
+    CHECK(gk_nonlocal_build(&nl, 3, n * n, xs, 2 * h[0], per, NULL, &err) == GK_OK);
+    gk_nonlocal_apply(&nl, 1, f, g);
+    for (I = 0; I < n * n; ++I) CHECK_NEAR(g[I], -f[I] / 17.0, 1e-14);
+    /* mixed: factor 1 - m + m S > 0 for m < 1 / (1 - S) = 17/18 */
+    CHECK(gk_nonlocal_mix(&nl, 0.9, &err) == GK_OK);
+    gk_nonlocal_apply(&nl, 1, f, g);
+    for (I = 0; I < n * n; ++I) {
+        double sum = 0.0;
+        CHECK_NEAR(g[I], (0.1 - 0.9 / 17.0) * f[I], 1e-14);
+        CHECK(g[I] * f[I] > 0.0);
+        for (p = nl.start[I]; p < nl.start[I + 1]; ++p) sum += nl.w[p];
+        CHECK_NEAR(sum, 1.0, 1e-14);
+    }
+    /* refused, unchanged */
+    g[0] = nl.w[0];
+    CHECK(gk_nonlocal_mix(&nl, 1.5, &err) == GK_ERR_ARG);
+    CHECK(gk_nonlocal_mix(&nl, NAN, &err) == GK_ERR_ARG);
+    CHECK(nl.w[0] == g[0]);
+    gk_nonlocal_free(&nl);
+    CHECK(gk_nonlocal_mix(&nl, 0.5, &err) == GK_ERR_STATE);
+    s = 7.0;
+    CHECK(gk_nonlocal_grid_symbol(0, h, 1e-3, &s, NULL, &err) == GK_ERR_ARG);
+    h[1] = -1.0;
+    CHECK(gk_nonlocal_grid_symbol(2, h, 1e-3, &s, NULL, &err) == GK_ERR_ARG);
+    CHECK(strstr(err.msg, "axis 1") != NULL);
+    h[1] = 2e-3;
+    CHECK(gk_nonlocal_grid_symbol(2, h, NAN, &s, NULL, &err) == GK_ERR_ARG);
+    CHECK(gk_nonlocal_grid_symbol(3, h, 40 * h[0], &s, NULL, &err) == GK_ERR_ARG);
+    CHECK(s == 7.0);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(dr_converges_to_direct_static_solution);
@@ -673,5 +756,6 @@ int main(int argc, char **argv) {
     RUN(corotational_rigid_rotation_zero_stress_change);
     RUN(corotational_stretch_then_rotation);
     RUN(nonlocal_weights_and_linear_field);
+    RUN(nonlocal_symbol_and_mix);
     return gk_test_done();
 }

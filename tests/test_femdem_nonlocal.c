@@ -230,7 +230,7 @@ TEST(biaxial_local_and_nonlocal_prepeak) {
     printf("    axial stress at 0.3 %%: local %.6g, nonlocal %.6g Pa\n", sl, sn);
     CHECK(sl > 1e6 && sn > 1e6);
     CHECK(fabs(sl - sn) < 0.02 * sl && sl != sn);
-    CHECK(gk_test_file_has(BUILD "/tests/t_fnlbn.out", "nonlocal on (R 0.025 m, 28 neighbour pairs)"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlbn.out", "nonlocal on (R 0.025 m, mix 1, 28 neighbour pairs"));
     CHECK(gk_test_file_has(BUILD "/tests/t_fnlbl.out", "within 10-20 steps"));
     snprintf(cmd, sizeof cmd,
              "%s --steps 2 --paper --out " BUILD "/tests/t_fnlbp > " BUILD "/tests/t_fnlbp.out 2>&1", a);
@@ -238,6 +238,39 @@ TEST(biaxial_local_and_nonlocal_prepeak) {
     CHECK(gk_test_file_has(BUILD "/tests/t_fnlbp.out", "within 10-4000 steps"));
     CHECK(
         gk_test_file_has(BUILD "/tests/t_fnlbp.out", "RVE (160 spheres)")); /* --packing overrides --paper */
+}
+
+/* the stability of averaging the strain (gk_nonlocal.h): on the 4 x 8 mesh
+ * (10 mm elements) R = 20 mm is twice the spacing, where the symbol's minimum
+ * is -1/17 (the chequerboard): the driver says so and warns, naming the mix
+ * below which every mode is stiff (1 / (1 + 1/17) = 0.944); --nonlocal-mix 0.9
+ * gives 0.1 - 0.9 / 17 = 0.0471 and no warning; --nonlocal-mix 1 is the
+ * paper's operator, bit for bit the run without the flag */
+TEST(nonlocal_mix_and_stability_warning) {
+    const char *a =
+        BUILD "/femdem_nonlocal --test biaxial --packing " PK160 " --mesh 4x8x1 --steps 2 --nonlocal 0.02";
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "%s --out " BUILD "/tests/t_fnlmw > " BUILD "/tests/t_fnlmw.out 2>&1", a);
+    CHECK(system(cmd) == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlmw.out", "symbol min -0.0588"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlmw.out",
+                           "warning: on this mesh the averaged strain has modes of "
+                           "negative stiffness"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlmw.out", "--nonlocal-mix below 0.944"));
+    snprintf(cmd, sizeof cmd,
+             "%s --nonlocal-mix 0.9 --out " BUILD "/tests/t_fnlmm > " BUILD "/tests/t_fnlmm.out 2>&1", a);
+    CHECK(system(cmd) == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlmm.out", "mix 0.9, 244 neighbour pairs, symbol min 0.0471"));
+    CHECK(!gk_test_file_has(BUILD "/tests/t_fnlmm.out", "warning"));
+    CHECK(gk_test_result(BUILD "/tests/t_fnlmm.out", "peak_stress") !=
+          gk_test_result(BUILD "/tests/t_fnlmw.out", "peak_stress"));
+    snprintf(cmd, sizeof cmd,
+             "%s --nonlocal-mix 1 --out " BUILD "/tests/t_fnlm1 > " BUILD "/tests/t_fnlm1.out 2>&1", a);
+    CHECK(system(cmd) == 0);
+    CHECK(gk_test_result(BUILD "/tests/t_fnlm1.out", "peak_stress") ==
+          gk_test_result(BUILD "/tests/t_fnlmw.out", "peak_stress"));
+    CHECK(system("cmp -s " BUILD "/tests/t_fnlm1/mesh_000002.vtk " BUILD "/tests/t_fnlmw/mesh_000002.vtk") ==
+          0);
 }
 
 /* every flag is parsed strictly and named when refused; a restart from
@@ -250,6 +283,8 @@ TEST(bad_input_is_refused) {
         {"--test element-shear --mesh 0x1x1", "--mesh '0x1x1'"},
         {"--test element-shear --mesh 2x2", "--mesh '2x2'"},
         {"--test element-shear --nonlocal -1", "--nonlocal '-1'"},
+        {"--test element-shear --nonlocal 0.01 --nonlocal-mix 1.5", "--nonlocal-mix 1.5 must be in [0, 1]"},
+        {"--test element-shear --nonlocal-mix 0.5", "--nonlocal-mix 0.5 needs --nonlocal R"},
         {"--test element-shear --pressure nan", "--pressure 'nan' is not a finite number"},
         {"--test element-shear --iuf 2", "--iuf 2"},
         {"--test element-shear --bogus 1", "unknown option --bogus"},
@@ -305,6 +340,7 @@ int main(int argc, char **argv) {
     RUN(rve_table2_moduli);
     RUN(wave_front_matches_elastic_column);
     RUN(biaxial_local_and_nonlocal_prepeak);
+    RUN(nonlocal_mix_and_stability_warning);
     RUN(bad_input_is_refused);
     return gk_test_done();
 }
