@@ -70,19 +70,35 @@
  *     382 m/s); over the first 0.1 ms the front is within 2.6 % of the
  *     elastic column (tested). The paper gives Fig 8 without numbers; the
  *     loops of element 9 and its porosity and Z are in wave.csv.
- *   biaxial (Figs 15-19): the mesh study (4x8x1, 6x12x1, 8x16x1, local and
- *     nonlocal, to 6 %) is NOT reproduced here: it was not run to the end
- *     with this version. Measured: on 2x4x1 with 160-sphere RVEs local and
- *     nonlocal (R 25 mm) give the same pre-peak stress within 0.3 % (tested);
- *     on 6x12x1 (160 spheres, 3375 steps to 6 %) the paper's R = 6.75 mm
- *     runs stably through 0.53 %, but R = 13.5 mm (2R = 27 mm, two thirds of
- *     the width) blows up: the kinetic energy grows from 1e-3 to 1.8 J and
- *     the axial stress jumps from 1.7 to 3.9 MPa at 0.28 % strain (at 0.53 %
- *     with half the coarse step, so not the step bound of eq 65), and the
- *     first RVEs to fail are the left column's at mid-height (their
- *     critical DEM step falls below the step as overlaps grow). Averaging the
- *     total strain increment (eq 58) leaves short modes of wavelength below
- *     R with little stiffness, the likely cause; not investigated further.
+ *   biaxial (Figs 15-19), the mesh study (tools/nonlocal_mesh_study.sh:
+ *     512 spheres, the 20-step cap, the same coarse step 1.826e-6 s and 5000
+ *     steps to 8 % on every mesh; about 60 min on 2 cores). Meshes 4x8x1,
+ *     8x16x1, 12x24x1 (elements 10, 5, 3.3 mm; the paper does not give its
+ *     element counts). Local: the same pre-peak and peak (1504 / 1496 / 1493
+ *     kPa at 0.5 %), then the finer meshes localize more, as in the paper's
+ *     Fig 17, but mildly: at 6 % the largest eps_q is 0.168 / 0.175 / 0.200
+ *     and the share of the specimen above half of it 0.75 / 0.73 / 0.56 (on
+ *     12x24x1 two crossing bands); the stress spreads
+ *     over the meshes by 3.0-5.8 % from 3 to 6 %, 2.3 % at 7-8 %.
+ *     Nonlocal as the paper (R 6.75 mm): on 4x8x1 no point has a neighbour
+ *     within R (the local model); on 8x16x1 (symbol min 0.102) it stays
+ *     within 2.5 % of the 4x8x1 curve from 3 to 8 % (local: 0.5-2.9 %); on
+ *     12x24x1 it fails at 0.19 % (step 120): there the averaging's symbol
+ *     is negative (-0.054 at the chequerboard; gk_nonlocal.h, stability),
+ *     the kinetic energy grows five-fold between steps 75 and 100 and an
+ *     RVE's overlaps outgrow its DEM step. The same happened with R = 13.5
+ *     mm on 6x12x1 (R/h = 2.0, symbol -0.054). On square elements the
+ *     paper's average stays positive only on meshes coarser than R / sqrt 2
+ *     = 4.8 mm (the paper gives no element sizes). With --nonlocal-mix 0.9
+ *     (0.9 <eps> + 0.1 eps, symbol min 0.051 on 12x24x1) every mesh runs to
+ *     8 %, with the same peak (1492-1504 kPa) and a spread of 1.8-4.5 % from
+ *     3 to 8 % (local 2.3-5.8 %); on 12x24x1 its field is the local one's
+ *     (largest eps_q 0.204 against 0.200 at 6 %, share 0.55 against 0.56).
+ *     NOT reproduced: the paper's nonlocal curves much closer together than
+ *     the local ones. Here the local curves are already within 6 %, and R =
+ *     6.75 mm is below the width of the bands that form (about 5 elements,
+ *     15-20 mm, on 12x24x1, read from the eps_q field), so the average
+ *     changes little.
  *
  * LICENCE: MIT (see gk_base.h).
  */
