@@ -751,7 +751,7 @@ static int macro_time_steps(model *md) {
         fprintf(stderr,
                 "femdem_nonlocal: warning: on this mesh the averaged strain has modes of negative stiffness "
                 "(symbol min %.4f at k h = %.2f %.2f %.2f over the %d axes with neighbours; gk_nonlocal.h): "
-                "they grow whatever the material; --nonlocal-mix below %.3f keeps every mode stiff\n",
+                "they can grow whatever the material; --nonlocal-mix below %.3f keeps every mode stiff\n",
                 md->sym_min, md->sym_k[0], md->sym_k[1], md->sym_k[2], md->sym_dim,
                 1.0 / (1.0 - md->sym_raw));
     return 0;

@@ -49,21 +49,22 @@
  * STABILITY OF AVERAGING THE STRAIN (not in the paper). On a regular grid the
  * operator turns a wave phi = cos(k . x) into S(k) cos(k . x), with the symbol
  *     S(k) = sum_m a(|m h|) cos(k . m h) / sum_m a(|m h|)
- * (m over the integer lattice, h the spacings, every grid point alike). When the
- * average of the strain enters the stress, a strain wave of wave vector k has its
- * stiffness scaled by S(k): where S < 0 the model has modes of NEGATIVE stiffness,
- * which can grow in an explicit run whatever the material (an element's hourglass
- * control stiffens only the modes it cannot see). The bell's Fourier
- * transform has negative lobes (fine grids tend to S(k) = 48 J_3(kR) / (kR)^3 in 2D, whose minimum is
- * -0.029; about -0.021 in 3D),
- * so every grid fine enough to carry waves of length ~R has such modes. On a
- * square grid of spacing h (2D), S >= 0 everywhere while R <= sqrt(2) h (only the
- * four edge neighbours count, each with a(h) <= 1/4); at R = 2h the chequerboard
- * k = (pi/h, pi/h) has S = (1 - 4 a(h) + 4 a(sqrt 2 h)) / (1 + 4 a(h) + 4 a(sqrt 2
- * h)) = -1/17 (a(h) = 9/16, a(sqrt 2 h) = 1/4; a(2h) = 0). gk_nonlocal_grid_symbol
- * gives min S for any spacings and R; gk_nonlocal_mix(nl, m) with
- * m < 1 / (1 - min S) keeps every symbol 1 - m + m S positive (part of the strain
- * stays local, an option beyond the paper). */
+ * (m over the integer lattice, h the spacings, every grid point alike). When
+ * the average of the strain enters the stress, a strain wave of wave vector k
+ * has its stiffness scaled by S(k): where S < 0 the model has modes of NEGATIVE
+ * stiffness, which can grow in an explicit run whatever the material (an
+ * element's hourglass control stiffens only the modes it cannot see). The
+ * bell's Fourier transform has negative lobes: fine grids tend to S(k) = 48
+ * J_3(kR) / (kR)^3 in 2D, whose minimum is -0.029 (about -0.021 in 3D), so
+ * every grid fine enough to carry waves of length ~R has such modes. On a
+ * square grid of spacing h (2D), S >= 0 everywhere while R <= sqrt(2) h (only
+ * the four edge neighbours count, each with a(h) <= 1/4); at R = 2h the
+ * chequerboard k = (pi/h, pi/h) has S = (1 - 4 a(h) + 4 a(sqrt 2 h)) / (1 +
+ * 4 a(h) + 4 a(sqrt 2 h)) = -1/17 (a(h) = 9/16, a(sqrt 2 h) = 1/4, a(2h) = 0).
+ * gk_nonlocal_grid_symbol gives min S for any spacings and R;
+ * gk_nonlocal_mix(nl, m) with m < 1 / (1 - min S) keeps every symbol
+ * 1 - m + m S positive (part of the strain stays local, an option beyond the
+ * paper). */
 typedef struct gk_nonlocal {
     int n;      /* points                                                    */
     int *start; /* n + 1: point I's neighbours are nbr[start[I] .. start[I+1]) */
@@ -102,7 +103,8 @@ GKDEF void gk_nonlocal_free(gk_nonlocal *nl);
 GKDEF gk_result gk_nonlocal_grid_symbol(int dim, const double *h, double R, double *s_min, double *k_min,
                                         gk_err *err);
 /* w_IJ -> m w_IJ + (1 - m) delta_IJ, 0 <= m <= 1 (m = 1 leaves nl as built,
- * m = 0 makes it local); the weights still sum to one */
+ * m = 0 makes it local; a second call mixes again: m1 m2 in all); the weights
+ * still sum to one */
 GKDEF gk_result gk_nonlocal_mix(gk_nonlocal *nl, double m, gk_err *err);
 #ifdef __cplusplus
 }
