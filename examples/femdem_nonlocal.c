@@ -50,15 +50,14 @@
  *     the response), and the macro damping (--xi 0.3) holds the element's
  *     lateral stress in the biaxial test at 428-430 kPa, 3 % above
  *     --pressure. With --lone-increments 8000 (post-peak increments about
- *     the element's) and --xi 0.05: shear 4.5 % (peaks 0.9995), biaxial 5.0
- *     % (peaks 0.983), the lateral stress 418 kPa; through the peak (to 3 %
- *     in shear, 1 % in biaxial) 1 %-wide windows agree within 0.4 % and
- *     0.7 %. What remains
- *     after the peak is the size of the RVE's own noise at critical state:
- *     the RVE alone with 4000 and with 8000 increments differs by up to 9 %
- *     in one window (biaxial), so one 512-sphere RVE cannot meet 2 % there.
- *     (--lone-increments 4000: biaxial 8.2 %, peaks 1.000; with --xi 0.05
- *     too: 5.0 %.)
+ *     the element's) and --xi 0.05: shear 4.5 % (peaks 0.9995), biaxial
+ *     5.0 % (peaks 0.983), the lateral stress 418 kPa; through the peak (to
+ *     3 % in shear, 1 % in biaxial) 1 %-wide windows agree within 0.4 % and
+ *     0.7 %. What remains after the peak is the size of the RVE's own noise
+ *     at critical state: the RVE alone with 4000 and with 8000 increments
+ *     differs by up to 9 % in one window (biaxial), so one 512-sphere RVE
+ *     cannot meet 2 % there. (--lone-increments 4000: biaxial 8.2 %, peaks
+ *     1.000; with --xi 0.05 too: 5.0 %.)
  *   simple-shear (Figs 9-14, default: 512 spheres, 5x12x1, local, 4000
  *     steps to 20 %, 241 s CPU): shear stress, mean over 2 % windows, 261
  *     kPa at 1-3 %, 252 at 4-6 %, 248 at 6-8 %, 238 at 8-10 %, 229 at 10-12 %,
