@@ -4,6 +4,9 @@
 #
 #   tools/nonlocal_mesh_study.sh [--report] WORK [THREADS]
 #
+# Run from the project's root (the driver's default packing is examples/data/rve512_hm.txt);
+# BUILD=DIR takes the programs from DIR instead of build/.
+#
 # Runs (into WORK/NAME; a run whose WORK/NAME/biaxial.csv exists is reused) the 40 x 80 x 5 mm
 # specimen to 8 % axial strain with the 512-sphere RVEs, every mesh with the same coarse step
 # (1.826e-6 s, the finest mesh's stable step) and the same 5000 steps, so that every RVE sees
@@ -56,7 +59,7 @@ band() {
     f="$W/$1/mesh_003750.vtk"
     [ -f "$f" ] || { printf "nan nan"; return; }
     awk '/^SCALARS eps_q/ { on = 1; getline; next } on && /^[A-Z]/ { on = 0 }
-        on { for (i = 1; i <= NF; ++i) { v[n++] = $i; s += $i; if ($i > m) m = $i } }
+        on { for (i = 1; i <= NF; ++i) { v[n++] = $i; if ($i > m) m = $i } }
         END { for (i = 0; i < n; ++i) if (v[i] > 0.5 * m) k++; printf "%.3f %.3f", m, k / n }' "$f"
 }
 printf "%-4s %-8s %-6s %-4s %-8s %-15s %-9s %-9s %-7s %-6s %-6s %-6s %-6s %-6s %-6s %-6s %-9s %-6s\n" run mesh R_mm mix symbol \
