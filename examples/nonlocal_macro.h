@@ -101,8 +101,8 @@ typedef struct model {
     double *Hn, *H, *deps, *depsnl, *dH, *Rh, *R1, *sigR, *sig; /* 9 per point              */
     gk_twoscale_field *fld;
     gk_nonlocal nl;
-    double sym_raw, sym_min, sym_k[3]; /* min of the averaging's symbol on this grid (gk_nonlocal.h):
-                                          as built, and after --nonlocal-mix; k h where reached */
+    double sym_raw, sym_k[3]; /* min of the averaging's symbol on this grid as built (gk_nonlocal.h; after
+                                 --nonlocal-mix M: 1 - M + M sym_raw) and k h where reached */
     int sym_dim;
     gk_twoscale ts;
     int *top, ntop, *bot, nbot, *right, nright; /* node lists                                */
@@ -350,7 +350,6 @@ static int macro_setup(model *md) {
             if (dim && o->R > 0.0 && gk_nonlocal_grid_symbol(dim, h, o->R, &s, kk, &err))
                 return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
             md->sym_raw = s;
-            md->sym_min = 1.0 - o->mix + o->mix * s;
             md->sym_dim = dim;
             for (k = 0; k < 3; ++k) md->sym_k[k] = kk[k] * (k < dim ? h[k] : 0.0);
         }
@@ -718,6 +717,7 @@ static void model_free(model *md) {
 static int macro_time_steps(model *md) {
     const opts *o = md->o;
     const micro *mi = md->mi;
+    double smix;
     md->omega_c = macro_omega(md);
     if (!(md->omega_c > 0))
         return fprintf(stderr, "femdem_nonlocal: no stable step (element frequency %g)\n", md->omega_c), 1;
@@ -738,22 +738,22 @@ static int macro_time_steps(model *md) {
         md->omega1 = 0.5 * GK_PI * c / md->L[1];
         md->alpha = 2.0 * o->xi * md->omega1;
     }
+    smix = 1.0 - o->mix + o->mix * md->sym_raw; /* the symbol after --nonlocal-mix */
     printf("mesh %dx%dx%d (%d Gauss points), nonlocal %s (R %g m, mix %g, %d neighbour pairs, symbol min "
            "%.4f), dt %.4g s (eq 65: omega_max "
            "%.4g rad/s), eq 66: %.1f DEM critical steps per coarse step (omega_f %.4g rad/s, DEM dt %.3g s), "
            "damping alpha %.4g 1/s\nDEM runs: I_uf < %g (eq 57) within %d-%d steps, %ld coarse steps\n",
            o->mesh[0], o->mesh[1], o->mesh[2], md->ne, o->R > 0 ? "on" : "off", o->R, o->mix,
-           md->nl.start[md->ne], md->sym_min, md->dt, md->omega_c,
+           md->nl.start[md->ne], smix, md->dt, md->omega_c,
            gk_explicit_substeps(md->omega_c, 0.0, mi->omega_f, 0.0), mi->omega_f, mi->dt_f, md->alpha, o->iuf,
            o->dem_min, o->dem_max, md->nsteps);
     fflush(stdout);
-    if (md->sym_min < 0.0)
+    if (smix < 0.0)
         fprintf(stderr,
                 "femdem_nonlocal: warning: on this mesh the averaged strain has modes of negative stiffness "
                 "(symbol min %.4f at k h = %.2f %.2f %.2f over the %d axes with neighbours; gk_nonlocal.h): "
                 "they can grow whatever the material; --nonlocal-mix below %.3f keeps every mode stiff\n",
-                md->sym_min, md->sym_k[0], md->sym_k[1], md->sym_k[2], md->sym_dim,
-                1.0 / (1.0 - md->sym_raw));
+                smix, md->sym_k[0], md->sym_k[1], md->sym_k[2], md->sym_dim, 1.0 / (1.0 - md->sym_raw));
     return 0;
 }
 

@@ -250,15 +250,7 @@ GKDEF gk_result gk_nonlocal_grid_symbol(int dim, const double *h, double R, doub
                           "nonlocal symbol: %.3g terms to sum (limit 1e9): radius %g too large "
                           "against the spacings",
                           terms, R);
-    /* the denominator: sum of a over the lattice points within R */
-    for (m[0] = -M[0]; m[0] <= M[0]; ++m[0])
-        for (m[1] = -M[1]; m[1] <= M[1]; ++m[1])
-            for (m[2] = -M[2]; m[2] <= M[2]; ++m[2]) {
-                double r2 = 0.0;
-                for (k = 0; k < dim; ++k) r2 += (m[k] * h[k]) * (m[k] * h[k]);
-                sum += gk_nonlocal_bell(sqrt(r2), R);
-            }
-    if (!(sum > 0.0)) sum = 1.0; /* R = 0: the point alone */
+    /* the first wave vector is k = 0, whose sum is the denominator (the point itself counts 1) */
     for (q[0] = 0; q[0] <= (dim > 0 ? nq : 0); ++q[0])
         for (q[1] = 0; q[1] <= (dim > 1 ? nq : 0); ++q[1])
             for (q[2] = 0; q[2] <= (dim > 2 ? nq : 0); ++q[2]) {
@@ -275,6 +267,7 @@ GKDEF gk_result gk_nonlocal_grid_symbol(int dim, const double *h, double R, doub
                             a = m[0] == 0 && m[1] == 0 && m[2] == 0 ? 1.0 : gk_nonlocal_bell(sqrt(r2), R);
                             if (a > 0.0) s += a * cos(ph);
                         }
+                if (q[0] == 0 && q[1] == 0 && q[2] == 0) sum = s;
                 s /= sum;
                 if (s < best) {
                     best = s;
