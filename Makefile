@@ -1,9 +1,11 @@
 # grainkit - the only build. `make help` lists the targets.
 #
 # Every program under examples/, bench/ and tools/ is one C file that defines
-# GK_IMPLEMENTATION itself, so each builds with a single compiler call. The
-# tests, and the sanitizer builds of the drivers, link one implementation object
-# per build instead (tests/gk_impl.c), as a project of several files does.
+# GK_IMPLEMENTATION itself, so each builds with a single compiler call (README's
+# quickstart is built that way). This build compiles the implementation once per
+# flavour instead (tests/gk_impl.c: normal, MPI, ASan+UBSan, no-SIMD) and links it
+# into the tests, drivers and tools (GK_IMPLEMENTATION_ELSEWHERE), as a project of
+# several files does; the benchmarks and the float driver keep their own copy.
 # Variables you may override: CC, CXX, OPT, ARCH, OMP, PREFIX, BUILD.
 
 CC      ?= cc
@@ -97,7 +99,11 @@ $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(IMPL) | $(BUILD)
 # test_mpmdem_footing also tests the footing driver's examples/footing_mech.h directly
 $(BUILD)/test_mpmdem_footing $(BUILD)/asan/test_mpmdem_footing $(BUILD)/nosimd/test_mpmdem_footing: examples/footing_mech.h
 
-$(BUILD)/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
+# the drivers and tools link the implementation object (ELSEWHERE below); the
+# quickstart (README's snippet) is built in one compiler call, as a user builds it
+$(BUILD)/%: examples/%.c $(HEADERS) $(wildcard examples/*.h) $(IMPL) | $(BUILD)
+	$(CC) $(CFLAGS) $(ELSEWHERE) -o $@ $< $(IMPL) $(LDLIBS)
+$(BUILD)/quickstart: examples/quickstart.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
 
 $(BUILD)/bench_%: bench/%.c $(HEADERS) $(wildcard bench/*_part.c bench/*.h) | $(BUILD)
@@ -116,12 +122,16 @@ $(BUILD)/femdem_biaxial_float: examples/femdem_biaxial.c $(HEADERS) $(wildcard e
 # bench_tradeoff runs these drivers as child processes
 $(BUILD)/bench_tradeoff: | $(BUILD)/femdem_biaxial $(BUILD)/femdem_biaxial_float $(BUILD)/mpmdem_biaxial
 
-$(BUILD)/%: tools/%.c $(HEADERS) | $(BUILD)
-	$(CC) $(CFLAGS) -o $@ $< $(LDLIBS)
+$(BUILD)/%: tools/%.c $(HEADERS) $(IMPL) | $(BUILD)
+	$(CC) $(CFLAGS) $(ELSEWHERE) -o $@ $< $(IMPL) $(LDLIBS)
 
 # ---------------------------------------------------------------- MPI
-$(BUILD)/mpi/mpi_%: tests/mpi_%.c $(HEADERS) tests/gk_test.h | $(BUILD)/mpi
-	$(MPICC) $(CFLAGS) $(TESTDEF) -o $@ $< $(LDLIBS)
+# the implementation with the MPI backend of gk_twoscale.h, once, for every MPI program but the benchmark
+MPI_IMPL := $(BUILD)/mpi/gk_impl.o
+$(MPI_IMPL): tests/gk_impl.c $(HEADERS) | $(BUILD)/mpi
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -c -o $@ $<
+$(BUILD)/mpi/mpi_%: tests/mpi_%.c $(HEADERS) tests/gk_test.h $(MPI_IMPL) | $(BUILD)/mpi
+	$(MPICC) $(CFLAGS) $(ELSEWHERE) $(TESTDEF) -o $@ $< $(MPI_IMPL) $(LDLIBS)
 
 .PRECIOUS: $(BUILD)/mpi/mpi_% $(BUILD)/mpi/mpirun_%
 $(BUILD)/mpi/mpirun_%: tests/mpirun_%.c tests/gk_test.h | $(BUILD)/mpi
@@ -138,14 +148,14 @@ $(BUILD)/mpi/bench_twoscale_mpi: bench/twoscale.c $(HEADERS) examples/cli.h | $(
 	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
 
 # the FEMxDEM driver with its RVEs over MPI ranks (the same results: tests/mpirun_femdem.c)
-$(BUILD)/femdem_biaxial_mpi: examples/femdem_biaxial.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
-	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
+$(BUILD)/femdem_biaxial_mpi: examples/femdem_biaxial.c $(HEADERS) $(wildcard examples/*.h) $(MPI_IMPL) | $(BUILD)
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI $(ELSEWHERE) -o $@ $< $(MPI_IMPL) $(LDLIBS)
 
 # the MPMxDEM drivers with their RVEs over MPI ranks (the same results: tests/mpirun_mpmdem.c)
 MPI_EXAMPLES := $(patsubst %,$(BUILD)/mpmdem_%_mpi,biaxial footing collapse pipe)
 MPI_PROGS    += $(MPI_EXAMPLES)
-$(MPI_EXAMPLES): $(BUILD)/%_mpi: examples/%.c $(HEADERS) $(wildcard examples/*.h) | $(BUILD)
-	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI -o $@ $< $(LDLIBS)
+$(MPI_EXAMPLES): $(BUILD)/%_mpi: examples/%.c $(HEADERS) $(wildcard examples/*.h) $(MPI_IMPL) | $(BUILD)
+	$(MPICC) $(CFLAGS) -DGK_TWOSCALE_MPI $(ELSEWHERE) -o $@ $< $(MPI_IMPL) $(LDLIBS)
 
 ifeq ($(HAVE_MPI),yes)
 mpi: $(MPI_PROGS)
@@ -267,10 +277,17 @@ $(BUILD)/hdr/%.clang: %.c $(HEADERS) $(wildcard examples/*.h bench/*.h bench/*_p
 check-headers: $(HDR_OK)
 	@echo "== header portability: every header alone, $(words $(HEADERS)) headers, and $(words $(STANDALONE)) of them with only their own implementation; every program with clang: ok"
 
-check: check-headers check-nosimd check-asan check-smoke
+# the four checks one after the other, even under -jN (the no-SIMD and the ASan tests
+# write the same files); inside each, -jN builds N at a time and runs N test programs
+# at a time (tests/run_tests.sh)
+check:
+	@$(MAKE) --no-print-directory check-headers
+	@$(MAKE) --no-print-directory check-nosimd
+	@$(MAKE) --no-print-directory check-asan
+	@$(MAKE) --no-print-directory check-smoke
 
-# every program make check runs, built and not run: `make -j2 check-build && make check`
-# compiles two at a time, then runs the checks one after the other
+# every program make check runs, built and not run: `make -j2 check-build && make -j2 check`
+# compiles two at a time, then runs the checks
 check-build: $(HDR_OK) $(ASAN_TESTS) $(NOSIMD_TESTS) $(patsubst %,$(BUILD)/asan/%,$(SMOKE)) $(EXAMPLES) $(TOOLS)
 
 # ---------------------------------------------------------------- run / bench

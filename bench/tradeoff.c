@@ -1,7 +1,7 @@
 /* bench_tradeoff - accuracy against cost of the two-scale drivers (issue 6).
  *
  *   build/bench_tradeoff            short version (make bench): about a minute on 2 cores
- *   build/bench_tradeoff --full     the whole sweep of the issue (make tradeoff)
+ *   build/bench_tradeoff --full     the whole sweep (make tradeoff)
  *   build/bench_tradeoff [--threads T] [--bin DIR] [--data DIR] [--out DIR]
  *                        [--sweep NAME,NAME,...] [--steps N] [--dry-run]
  *

@@ -28,7 +28,7 @@ static int same_but_seconds(const char *a, const char *b, int rows) {
     return same && n == rows + 1;
 }
 
-/* the issue's command: 4 x 8 Q8, 128 RVEs, 10 steps, on 2 ranks x 1 thread and on 1 process x 2 threads;
+/* make run's mesh, 4 x 8 Q8, 128 RVEs, 10 steps, on 2 ranks x 1 thread and on 1 process x 2 threads;
  * then each run's checkpoint continued one step by the other build (the MPI one rebalancing before
  * every Newton iteration, --balance run): the same rows again */
 TEST(femdem_biaxial_two_ranks_equal_two_threads) {

@@ -3,7 +3,8 @@
  * README.md's usage snippet is examples/quickstart.c line for line, and that
  * program runs and restores bit for bit; every header and every example
  * driver appears in README.md; no user-facing file points at material users
- * do not have (files outside the project, issue numbers). */
+ * do not have (files outside the project, issue numbers); no two test
+ * programs write the same file (tests/run_tests.sh runs them side by side). */
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -138,11 +139,66 @@ TEST(user_documents_point_at_nothing_users_lack) {
     CHECK(clean("Makefile"));
 }
 
+/* Every name written as a literal BUILD "/tests/NAME..." in a test program
+ * belongs to that program alone: `make -j2 test` runs two at a time
+ * (tests/run_tests.sh), and two programs writing one file would race. Names
+ * of files that must not exist (no_such_...) may be shared. Names made at run
+ * time ("/tests/%sA") are not seen here: give them a prefix of the program. */
+#define NAMES_MAX 4096
+TEST(test_programs_write_files_of_their_own) {
+    static char name[NAMES_MAX][64], owner[NAMES_MAX][64];
+    int n = 0, files = 0, clashes = 0, i;
+    DIR *d = opendir("tests");
+    struct dirent *e;
+    CHECK(d != NULL);
+    while (d && (e = readdir(d)) != NULL) {
+        size_t l = strlen(e->d_name);
+        char path[300], *text;
+        const char *p;
+        if (l < 3 || strcmp(e->d_name + l - 2, ".c") != 0 || l >= 64) continue;
+        snprintf(path, sizeof path, "tests/%s", e->d_name);
+        text = gk_test_slurp(path);
+        CHECK(text != NULL);
+        if (!text) continue;
+        ++files;
+        for (p = strstr(text, "\"/tests/"); p; p = strstr(p + 1, "\"/tests/")) {
+            const char *a = p + 8, *b = a;
+            char nm[64];
+            int seen = 0, other = -1;
+            while ((*b >= 'a' && *b <= 'z') || (*b >= 'A' && *b <= 'Z') || (*b >= '0' && *b <= '9') ||
+                   *b == '_' || *b == '.' || *b == '-')
+                ++b;
+            if (b == a || b - a >= 64 || strncmp(a, "no_such", 7) == 0) continue;
+            memcpy(nm, a, (size_t)(b - a)), nm[b - a] = 0;
+            for (i = 0; i < n; ++i)
+                if (strcmp(name[i], nm) == 0) {
+                    if (strcmp(owner[i], e->d_name) == 0)
+                        seen = 1;
+                    else
+                        other = i;
+                }
+            if (seen) continue;
+            if (other >= 0) {
+                printf("    %s writes BUILD/tests/%s, as %s does\n", e->d_name, nm, owner[other]);
+                ++clashes;
+            }
+            if (n < NAMES_MAX) strcpy(name[n], nm), strcpy(owner[n], e->d_name), ++n;
+        }
+        free(text);
+    }
+    if (d) closedir(d);
+    CHECK(files >= 10);   /* the scan found the test programs */
+    CHECK(n >= 100);      /* and their names */
+    CHECK(n < NAMES_MAX); /* all of them */
+    CHECK_EQ_INT(clashes, 0);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(readme_snippet_is_the_quickstart_program);
     RUN(quickstart_runs_and_restores_bit_for_bit);
     RUN(readme_names_every_header_and_driver);
     RUN(user_documents_point_at_nothing_users_lack);
+    RUN(test_programs_write_files_of_their_own);
     return gk_test_done();
 }

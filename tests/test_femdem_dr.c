@@ -178,42 +178,42 @@ TEST(default_and_paper_sizes) {
 
 /* bad input: a message naming the option and status 2; an output that cannot be written: status 1 */
 TEST(bad_input_and_failed_writes) {
-    CHECK(system(FDR "--nx 2x --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--nx '2x' is not a whole number"));
-    CHECK(system(FDR "--frame square --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
+    CHECK(system(FDR "--nx 2x --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_dr_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "--nx '2x' is not a whole number"));
+    CHECK(system(FDR "--frame square --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_dr_bad.out 2>&1") ==
           2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--frame 'square' must be servo or periodic"));
-    CHECK(system(FDR "--pressure -1 --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "--frame 'square' must be servo or periodic"));
+    CHECK(system(FDR "--pressure -1 --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_dr_bad.out 2>&1") ==
           2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--pressure -1 must be > 0"));
-    CHECK(system(FDR "--strain nan --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "--pressure -1 must be > 0"));
+    CHECK(system(FDR "--strain nan --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_dr_bad.out 2>&1") ==
           2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--strain 'nan' is not a finite number"));
-    CHECK(system(FDR "--material clay --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") ==
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "--strain 'nan' is not a finite number"));
+    CHECK(system(FDR "--material clay --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_dr_bad.out 2>&1") ==
           2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--material 'clay' must be paper or guo-zhao"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "--material 'clay' must be paper or guo-zhao"));
     CHECK(system(FDR "--material guo-zhao --out " BUILD "/tests/t_fdr_bad > " BUILD
-                     "/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out",
+                     "/tests/t_dr_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out",
                            "needs --frame periodic")); /* the servo's gains are per k_n */
-    CHECK(system(FDR "--bogus 1 > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "unknown option --bogus"));
-    CHECK(system(FDR "--test rve > " BUILD "/tests/t_bad.out 2>&1") == 2 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--out DIR is required"));
+    CHECK(system(FDR "--bogus 1 > " BUILD "/tests/t_dr_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "unknown option --bogus"));
+    CHECK(system(FDR "--test rve > " BUILD "/tests/t_dr_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "--out DIR is required"));
     CHECK(system(FDR "--test rve --packing examples/data/rve400.txt --out " BUILD "/tests/t_fdr_bad > " BUILD
-                     "/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "corner"));
+                     "/tests/t_dr_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "corner"));
     CHECK(system(FDR "--test rve --restart " BUILD "/tests/no_such_dir --out " BUILD
-                     "/tests/t_fdr_bad > " BUILD "/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "no_such_dir"));
+                     "/tests/t_fdr_bad > " BUILD "/tests/t_dr_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "no_such_dir"));
     /* --out names a file: the directory exists as a file, nothing can be written in it */
     CHECK(system("touch " BUILD "/tests/t_fdr_file") == 0);
     CHECK(system(FDR "--test rve --frame periodic --iso-steps 1 --steps 1 --out " BUILD
-                     "/tests/t_fdr_file > " BUILD "/tests/t_bad.out "
+                     "/tests/t_fdr_file > " BUILD "/tests/t_dr_bad.out "
                      "2>&1") == 1 * 256);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "cannot write"));
-    CHECK(system(FDR "--help > " BUILD "/tests/t_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--frame servo|periodic"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "cannot write"));
+    CHECK(system(FDR "--help > " BUILD "/tests/t_dr_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "--frame servo|periodic"));
 }
 
 int main(int argc, char **argv) {

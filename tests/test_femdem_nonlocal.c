@@ -297,38 +297,38 @@ TEST(bad_input_is_refused) {
     for (k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
         snprintf(cmd, sizeof cmd,
                  BUILD "/femdem_nonlocal %s%s --out " BUILD "/tests/t_fnlbad > " BUILD
-                       "/tests/t_bad.out 2>&1",
+                       "/tests/t_nl_bad.out 2>&1",
                  bad[k][0], strstr(bad[k][0], "--packing") ? "" : " --packing " PK160);
         CHECK(system(cmd) != 0);
-        if (!gk_test_file_has(BUILD "/tests/t_bad.out", bad[k][1]))
+        if (!gk_test_file_has(BUILD "/tests/t_nl_bad.out", bad[k][1]))
             printf("    missing message: %s\n", bad[k][1]);
-        CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", bad[k][1]));
+        CHECK(gk_test_file_has(BUILD "/tests/t_nl_bad.out", bad[k][1]));
     }
-    CHECK(system(BUILD "/femdem_nonlocal --help > " BUILD "/tests/t_bad.out 2>&1") == 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--nonlocal"));
+    CHECK(system(BUILD "/femdem_nonlocal --help > " BUILD "/tests/t_nl_bad.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_nl_bad.out", "--nonlocal"));
     /* a checkpoint of another run (other strain) is refused by name */
     CHECK(system(BUILD "/femdem_nonlocal --test element-shear --packing " PK160
                        " --steps 40 --strain 0.005 --restart " BUILD "/tests/t_fnleB --out " BUILD
-                       "/tests/t_fnlbad > " BUILD "/tests/t_bad.out "
+                       "/tests/t_fnlbad > " BUILD "/tests/t_nl_bad.out "
                        "2>&1") != 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "was written by another run"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_nl_bad.out", "was written by another run"));
     /* a result that cannot be written: its path is taken by a directory */
     CHECK(system("mkdir -p " BUILD "/tests/t_fnlw/element-shear.csv") == 0);
     CHECK(system(BUILD "/femdem_nonlocal --test element-shear --packing " PK160
                        " --steps 4 --strain 0.001 --out " BUILD "/tests/t_fnlw > " BUILD
-                       "/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "element-shear.csv"));
+                       "/tests/t_nl_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_nl_bad.out", "element-shear.csv"));
     CHECK(system(BUILD "/femdem_nonlocal --test rve --packing " PK160 " --out /dev/null/x > " BUILD
-                       "/tests/t_bad.out 2>&1") != 0);
+                       "/tests/t_nl_bad.out 2>&1") != 0);
     /* gk_pack's Hertz options */
-    CHECK(system(BUILD "/gk_pack --dim 3 --law foo --out " BUILD "/tests/t_pack_bad.txt > " BUILD
-                       "/tests/t_bad.out "
+    CHECK(system(BUILD "/gk_pack --dim 3 --law foo --out " BUILD "/tests/t_nl_pack_bad.txt > " BUILD
+                       "/tests/t_nl_bad.out "
                        "2>&1") != 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--law 'foo' is neither linear nor hertz"));
-    CHECK(system(BUILD "/gk_pack --dim 3 --law hertz --out " BUILD "/tests/t_pack_bad.txt > " BUILD
-                       "/tests/t_bad.out "
+    CHECK(gk_test_file_has(BUILD "/tests/t_nl_bad.out", "--law 'foo' is neither linear nor hertz"));
+    CHECK(system(BUILD "/gk_pack --dim 3 --law hertz --out " BUILD "/tests/t_nl_pack_bad.txt > " BUILD
+                       "/tests/t_nl_bad.out "
                        "2>&1") != 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "--law hertz needs --G"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_nl_bad.out", "--law hertz needs --G"));
 }
 
 int main(int argc, char **argv) {

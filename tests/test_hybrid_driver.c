@@ -148,8 +148,8 @@ static int refused(const char *flags, const char *msg) {
     int ok;
     system("rm -rf " BUILD "/tests/t_hybad");
     snprintf(cmd, sizeof cmd,
-             BUILD "/hybrid %s --out " BUILD "/tests/t_hybad > " BUILD "/tests/t_bad.out 2>&1", flags);
-    ok = system(cmd) != 0 && gk_test_file_has(BUILD "/tests/t_bad.out", msg);
+             BUILD "/hybrid %s --out " BUILD "/tests/t_hybad > " BUILD "/tests/t_hy_bad.out 2>&1", flags);
+    ok = system(cmd) != 0 && gk_test_file_has(BUILD "/tests/t_hy_bad.out", msg);
     fp = fopen(BUILD "/tests/t_hybad", "r");
     if (fp) fclose(fp), ok = 0;
     if (!ok) printf("    not refused as expected: hybrid %s\n", flags);
@@ -174,14 +174,14 @@ TEST(hybrid_refuses_bad_arguments) {
     /* an unreadable packing: an error, not a crash (the directory may exist) */
     CHECK(system(BUILD "/hybrid --test planar --mode dem --packing " BUILD
                        "/tests/no_such_packing.txt --out " BUILD "/tests/t_hybad "
-                       "> " BUILD "/tests/t_bad.out 2>&1") != 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "no_such_packing"));
+                       "> " BUILD "/tests/t_hy_bad.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_hy_bad.out", "no_such_packing"));
     /* --out naming an existing file */
     CHECK(system("rm -rf " BUILD "/tests/t_hyfile && touch " BUILD "/tests/t_hyfile") == 0);
     CHECK(system(BUILD "/hybrid --test planar --mode dem --out " BUILD "/tests/t_hyfile > " BUILD
-                       "/tests/t_bad.out "
+                       "/tests/t_hy_bad.out "
                        "2>&1") != 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_bad.out", "t_hyfile"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hy_bad.out", "t_hyfile"));
     remove(BUILD "/tests/t_hyfile");
     /* --help alone (no --test) prints the usage and exits 0 */
     CHECK(system(BUILD "/hybrid --help > " BUILD "/tests/t_hyhelp.out 2>&1") == 0);
