@@ -40,13 +40,23 @@
  * (A ratio free / locked 0.81 here, 0.82 there) but far stronger here (stress ratio 0.56,
  * there 0.81); the peak comes earlier (4-5 %, there near 7 %); higher friction gives a higher
  * stress and a lower coordination as there, but not their larger compaction; the initial
- * anisotropy changes nothing here (there: a lower, earlier peak). The meshes agree within
+ * anisotropy changes nothing here (there: a lower, earlier peak), because the isotropic
+ * stage erases it (below). The meshes agree within
  * 10 % to 5 % strain (the paper: "very close"; the largest spread at 1 %); the servo frame
  * and the periodic cell within 10 % (RVE alone) to 15 % (2 x 4); the 444-disk DNS within
  * 11 % of the 2 x 4 meshes to 3 %, then it slips (0.30 to 0.18 at 3.5 %, back to 0.31 at
  * 7.5 %: a specimen a few grains wide). The packings are looser than the paper's (solid
  * fraction 0.82 against 0.846) and the DEM is stiffer relative to the confinement than
  * Table 3's raw numbers allow (see THE RVE).
+ * WHY THE INITIAL ANISOTROPY DOES NOT MATTER (the RVE alone, `--test rve --packing
+ * examples/data/frame228_a00N.txt`, the anisotropy column of dr.csv): the packings hold
+ * A0 = 0.016, 0.049, 0.084 at their 1500 Pa; the first isotropic step (sigma0 / 10, ten
+ * times that) leaves A = 0.029 in all three (servo frame), the end of the stage 0.027,
+ * 0.023, 0.031 (periodic cell: 0.012, 0.017, 0.012): contacts close all round as the
+ * overlaps grow. Peaks 0.377 at 5.5 %, 0.379 at 5.5 %, 0.374 at 4.5 % (servo). The same
+ * packings made at the working stress (gk_pack --pressure 1.5e5 --kn 1.5e7, A 0.021 /
+ * 0.052 / 0.056) lose it too: stage 1 first unloads them to sigma0 / 10 (A jumps to 0.2-0.26,
+ * contacts open), then reloads them (A 0.046-0.051 at sigma0); peaks 0.405 / 0.403 / 0.397.
  * WHY THE MESHES DIFFER (--frame periodic, 2 x 4, to 1 %; `--nx 2 --ny 4 --frame periodic
  * --stop-after 12 --vtk-every 1`, gp_NNNN.vtk): every Gauss point starts from the same
  * packing, but their deformation gradients differ in round-off and each RVE's DEM amplifies
