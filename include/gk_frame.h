@@ -517,7 +517,7 @@ static gk_result gk__frame_servo(const gk_frame_set *set, const gk_frame *fr, gk
                                  const double dH[9], double P[9], gk_frame_stats *st) {
     gk__fw w;
     const gk_allocator *al = &rve->def.alloc;
-    double Fa[4], Fn[4], res = 0.0, rel = 0.0;
+    double Fa[4], Fn[4], res = 0.0, rel = 0.0, zero[3] = {0.0, 0.0, 0.0};
     int i, it = 0, nq = fr->nq;
     gk_result r;
     memset(&w, 0, sizeof w);
@@ -559,7 +559,10 @@ static gk_result gk__frame_servo(const gk_frame_set *set, const gk_frame *fr, gk
         w.dx[2 * i + 1] = Fn[2] * X + Fn[3] * Y + wy - x[1];
         w.dth[i] = 0.0;
     }
-    r = gk__fw_move(&w);
+    /* the frame is held (prescribed, at rest) from the start, so that a run with nothing to move
+     * (dH = 0) relaxes the inside against it and records its loads (eq 9) like any other */
+    for (i = 0, r = GK_OK; i < nq && r == GK_OK; ++i) r = gk_scene_prescribe(&w.sc, w.idx[i], zero, zero);
+    if (!r) r = gk__fw_move(&w);
     while (!r) {
         if ((r = gk__fw_relax(&w)) != GK_OK) break;
         res = gk__fw_residual(&w, &rel);

@@ -178,7 +178,8 @@ TEST(default_and_paper_sizes) {
 
 /* bad input: a message naming the option and status 2; an output that cannot be written: status 1 */
 TEST(bad_input_and_failed_writes) {
-    CHECK(system(FDR "--nx 2x --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_dr_bad.out 2>&1") == 2 * 256);
+    CHECK(system(FDR "--nx 2x --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_dr_bad.out 2>&1") ==
+          2 * 256);
     CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "--nx '2x' is not a whole number"));
     CHECK(system(FDR "--frame square --out " BUILD "/tests/t_fdr_bad > " BUILD "/tests/t_dr_bad.out 2>&1") ==
           2 * 256);
@@ -216,6 +217,22 @@ TEST(bad_input_and_failed_writes) {
     CHECK(gk_test_file_has(BUILD "/tests/t_dr_bad.out", "--frame servo|periodic"));
 }
 
+/* A load step that starts in equilibrium: a framed packing made at the working stress (gk_pack at
+ * sigma0 with the driver's k_n) and a one-step isotropic stage ask the servo frame for a run with
+ * nothing to move (dH = 0, every boundary particle exactly where F puts it): the frame is held, the
+ * inside relaxes against it, and the run ends with its RESULT line. */
+TEST(a_step_that_starts_in_equilibrium) {
+    CHECK(system(BUILD
+                 "/gk_pack --dim 2 --n 205 --rmin 3e-4 --rmax 4.5e-4 --pressure 1.5e5 --kn 1.5e7 "
+                 "--kt-ratio 0.2 --friction-angle 0.380506377112365 --density 2000 --thickness 1 --frame 10 "
+                 "--seed 4 --target-anisotropy 0.08 --out " BUILD "/tests/t_fdr_w08.txt > " BUILD
+                 "/tests/t_fdr_w08.out 2>&1") == 0);
+    CHECK(system(FDR "--test rve --iso-steps 1 --steps 1 --strain 0.005 --vtk-every 0 --packing " BUILD
+                     "/tests/t_fdr_w08.txt --out " BUILD "/tests/t_fdr_eq > " BUILD
+                     "/tests/t_fdr_eq.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_eq.out", "RESULT peak_sigma_bar=0.1"));
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(isotropic_stage_and_one_element_against_the_rve);
@@ -224,5 +241,6 @@ int main(int argc, char **argv) {
     RUN(dns_runs);
     RUN(default_and_paper_sizes);
     RUN(bad_input_and_failed_writes);
+    RUN(a_step_that_starts_in_equilibrium);
     return gk_test_done();
 }

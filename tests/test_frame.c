@@ -195,6 +195,52 @@ TEST(locked_rotation_stays_locked) {
     gk_frame_free(&fr);
 }
 
+/* no deformation at all (dH = 0: the first run of a load step that starts in equilibrium): the frame
+ * is held where it is while the inside relaxes (eq 30 with the boundary particles prescribed), and the
+ * run returns the packing's own stress (eq 14). tests/test_femdem_dr.c runs the driver on a packing
+ * whose frame has exactly nothing to move. */
+TEST(servo_frame_without_deformation_holds_the_frame) {
+    gk_frame fr;
+    gk_err e;
+    gk_rve r;
+    gk_rve_def d = law(0u);
+    gk_frame_set set;
+    gk_frame_stats st[1];
+    double H[9] = {0}, dH[9] = {0}, P[9], moved = 0.0;
+    double *x0;
+    int steps = 0, i, p, k, found = 0;
+    CHECK(load());
+    if (!have) return;
+    CHECK(gk_frame_build(&fr, &pk, NULL, &e) == GK_OK);
+    memset(&set, 0, sizeof set);
+    set.kind = GK_FRAME_SERVO, set.frames = &fr, set.stats = st;
+    CHECK(gk_rve_create(&r, &d, &fr.framed) == GK_OK && gk_rve_refresh(&r) == GK_OK);
+    x0 = (double *)calloc(3 * (size_t)fr.nq, sizeof(double));
+    CHECK(x0 != NULL);
+    if (!x0) return;
+    for (i = 0; i < fr.nq; ++i)
+        for (p = 0; p < r.n; ++p)
+            if (r.id[p] == fr.q[i]) gk_rve_position(&r, p, x0 + 3 * i), ++found;
+    CHECK_EQ_INT(found, fr.nq);
+    CHECK(gk_frame_run(&set, 0, 0, &r, H, dH, 1.0, P, &steps) == GK_OK);
+    for (i = 0; i < fr.nq; ++i)
+        for (p = 0; p < r.n; ++p)
+            if (r.id[p] == fr.q[i]) {
+                double x[3];
+                gk_rve_position(&r, p, x);
+                for (k = 0; k < 2; ++k)
+                    if (fabs(x[k] - x0[3 * i + k]) > moved) moved = fabs(x[k] - x0[3 * i + k]);
+            }
+    printf("    dH = 0: P11 %.0f P22 %.0f Pa, %ld DEM steps, %d corrections, frame moved %.3g m\n", P[0],
+           P[4], st[0].steps, st[0].servo, moved);
+    CHECK(moved <= 1e-6 * r.rmin); /* held, up to the servo's corrections */
+    for (k = 0; k < 9; ++k) CHECK(isfinite(P[k]));
+    CHECK(P[0] < 0.0 && P[4] < 0.0); /* the packing's compression */
+    free(x0);
+    gk_rve_destroy(&r);
+    gk_frame_free(&fr);
+}
+
 /* bad input: no corner particle, a skewed cell, an RVE of another frame, an inverted F, bad settings */
 TEST(bad_input_is_refused) {
     gk_frame fr;
@@ -237,6 +283,7 @@ int main(int argc, char **argv) {
     RUN(energy_of_one_contact_is_eq32);
     RUN(servo_frame_and_periodic_cell_under_compression);
     RUN(locked_rotation_stays_locked);
+    RUN(servo_frame_without_deformation_holds_the_frame);
     RUN(bad_input_is_refused);
     if (have) gk_packing_free(&pk);
     return gk_test_done();
