@@ -52,11 +52,13 @@
  * examples/data/frame228_a00N.txt`, the anisotropy column of dr.csv): the packings hold
  * A0 = 0.016, 0.049, 0.084 at their 1500 Pa; the first isotropic step (sigma0 / 10, ten
  * times that) leaves A = 0.029 in all three (servo frame), the end of the stage 0.027,
- * 0.023, 0.031 (periodic cell: 0.012, 0.017, 0.012): contacts close all round as the
- * overlaps grow. Peaks 0.377 at 5.5 %, 0.379 at 5.5 %, 0.374 at 4.5 % (servo). The same
- * packings made at the working stress (gk_pack --pressure 1.5e5 --kn 1.5e7, A 0.021 /
- * 0.052 / 0.056) lose it too: stage 1 first unloads them to sigma0 / 10 (A jumps to 0.2-0.26,
- * contacts open), then reloads them (A 0.046-0.051 at sigma0); peaks 0.405 / 0.403 / 0.397.
+ * 0.023, 0.031 (periodic cell: 0.012, 0.017, 0.012). Peaks 0.377 at 5.5 %, 0.379 at 5.5 %,
+ * 0.374 at 4.5 % (servo). Packings made at the working stress (gk_pack --pressure 1.5e5
+ * --kn 1.5e7, A 0.021 / 0.052 / 0.056) lose it too, whether stage 1 first unloads them (10
+ * steps: A 0.20-0.26 at sigma0 / 10, 0.046-0.051 back at sigma0; periodic peaks 0.405 /
+ * 0.403 / 0.397) or not (--iso-steps 1: after that one step A 0.015 in the periodic cell,
+ * 0.024-0.038 with the servo frame; servo peaks 0.345 / 0.349 / 0.348, all at 3 %). How the
+ * fabric goes at constant stress was not found.
  * WHY THE MESHES DIFFER (--frame periodic, 2 x 4, to 1 %; `--nx 2 --ny 4 --frame periodic
  * --stop-after 12 --vtk-every 1`, gp_NNNN.vtk): every Gauss point starts from the same
  * packing, but their deformation gradients differ in round-off and each RVE's DEM amplifies
