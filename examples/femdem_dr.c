@@ -57,8 +57,11 @@
  * --kn 1.5e7, A 0.021 / 0.052 / 0.056) lose it too, whether stage 1 first unloads them (10
  * steps: A 0.20-0.26 at sigma0 / 10, 0.046-0.051 back at sigma0; periodic peaks 0.405 /
  * 0.403 / 0.397) or not (--iso-steps 1: after that one step A 0.015 in the periodic cell,
- * 0.024-0.038 with the servo frame; servo peaks 0.345 / 0.349 / 0.348, all at 3 %). How the
- * fabric goes at constant stress was not found.
+ * 0.024-0.038 with the servo frame; servo peaks 0.345 / 0.349 / 0.348, all at 3 %). A clue,
+ * not an explanation: a packing file keeps positions only, and without the tangential forces
+ * of its loading history the normal forces alone carry sigma_yy / sigma_xx = 1.09 where the
+ * packing held 1.00 (A 0.056); the first relaxation rearranges it (Z 3.94 to 4.10, A 0.015),
+ * at any friction (mu 0.4, 1, 10: A 0.015, 0.010, 0.013).
  * WHY THE MESHES DIFFER (--frame periodic, 2 x 4, to 1 %; `--nx 2 --ny 4 --frame periodic
  * --stop-after 12 --vtk-every 1`, gp_NNNN.vtk): every Gauss point starts from the same
  * packing, but their deformation gradients differ in round-off and each RVE's DEM amplifies
