@@ -86,13 +86,29 @@ $(BUILD) $(BUILD)/asan $(BUILD)/nosimd $(BUILD)/hdr $(BUILD)/tests $(BUILD)/fuzz
 # the tests launch the programs of $(BUILD) and write under $(BUILD)/tests
 TESTDEF := -DBUILD='"$(BUILD)"'
 # The implementation is compiled once per build (tests/gk_impl.c: normal, ASan+UBSan,
-# no-SIMD) and linked into every test, as a project of several files does; a test
-# that defines GK_IMPLEMENTATION itself (float reals, GK_DEM_PAR_MIN) compiles its own.
+# no-SIMD) and linked into every test, as a project of several files does. A test that
+# defines GK_IMPLEMENTATION itself configures it: those of IMPL_VARIANT link an object
+# compiled once with that configuration (par64: GK_DEM_PAR_MIN 64, threads on small
+# systems, also given to the test so that a different value in it fails to compile;
+# float: GK_REAL_FLOAT); the others (test_untrusted reaches into internals) compile their own.
 OWN_IMPL := $(patsubst tests/test_%.c,%,$(shell grep -l '^\#define GK_IMPLEMENTATION' $(TEST_SRC)))
-impl_for = $(if $(filter $(1),$(OWN_IMPL)),,$(2))
+IMPL_VARIANT_dem            := par64
+IMPL_VARIANT_scene          := par64
+IMPL_VARIANT_extremes_float := float
+IMPL_VARIANT_simd_float     := float
+IMPLDEF_par64 := -DGK_DEM_PAR_MIN=64
+IMPLDEF_float := -DGK_REAL_FLOAT
+TESTDEF_par64 := -DGK_DEM_PAR_MIN=64
+# what a test links, $(call impl_for,STEM,THE BUILD'S IMPLEMENTATION OBJECT)
+impl_for = $(if $(IMPL_VARIANT_$(1)),$(ELSEWHERE) $(TESTDEF_$(IMPL_VARIANT_$(1))) \
+             $(dir $(2))gk_impl_$(IMPL_VARIANT_$(1)).o,$(if $(filter $(1),$(OWN_IMPL)),,$(2)))
 IMPL := $(BUILD)/gk_impl.o
 $(IMPL): tests/gk_impl.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -c -o $@ $<
+$(BUILD)/gk_impl_%.o: tests/gk_impl.c $(HEADERS) | $(BUILD)
+	$(CC) $(CFLAGS) $(IMPLDEF_$*) -c -o $@ $<
+$(foreach t,dem scene extremes_float simd_float,$(foreach d,$(BUILD) $(BUILD)/asan $(BUILD)/nosimd,\
+  $(eval $(d)/test_$(t): $(d)/gk_impl_$(IMPL_VARIANT_$(t)).o)))
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(IMPL) | $(BUILD)
 	$(CC) $(CFLAGS) $(TESTDEF) -o $@ $< $(call impl_for,$*,$(IMPL)) $(LDLIBS)
 
@@ -194,6 +210,8 @@ NOSIMD_TESTS := $(patsubst %,$(BUILD)/nosimd/test_%,$(LIB_TESTS))
 ASAN_IMPL := $(BUILD)/asan/gk_impl.o
 $(ASAN_IMPL): tests/gk_impl.c $(HEADERS) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) -Iinclude -c -o $@ $<
+$(BUILD)/asan/gk_impl_%.o: tests/gk_impl.c $(HEADERS) | $(BUILD)/asan
+	$(CC) $(SANFLAGS) -Iinclude $(IMPLDEF_$*) -c -o $@ $<
 $(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(ASAN_IMPL) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK $(TESTDEF) -o $@ $< $(call impl_for,$*,$(ASAN_IMPL)) $(LDLIBS)
 
@@ -219,6 +237,8 @@ NOSIMDFLAGS := $(WARN) $(OPT) $(FPFLAGS) -DGK_NO_SIMD -Iinclude
 NOSIMD_IMPL := $(BUILD)/nosimd/gk_impl.o
 $(NOSIMD_IMPL): tests/gk_impl.c $(HEADERS) | $(BUILD)/nosimd
 	$(CC) $(NOSIMDFLAGS) -c -o $@ $<
+$(BUILD)/nosimd/gk_impl_%.o: tests/gk_impl.c $(HEADERS) | $(BUILD)/nosimd
+	$(CC) $(NOSIMDFLAGS) $(IMPLDEF_$*) -c -o $@ $<
 $(BUILD)/nosimd/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(NOSIMD_IMPL) | $(BUILD)/nosimd
 	$(CC) $(NOSIMDFLAGS) -Itests $(TESTDEF) -o $@ $< $(call impl_for,$*,$(NOSIMD_IMPL)) $(LDLIBS)
 
