@@ -217,7 +217,10 @@ TEST(servo_frame_without_deformation_holds_the_frame) {
     CHECK(gk_rve_create(&r, &d, &fr.framed) == GK_OK && gk_rve_refresh(&r) == GK_OK);
     x0 = (double *)calloc(3 * (size_t)fr.nq, sizeof(double));
     CHECK(x0 != NULL);
-    if (!x0) return;
+    if (!x0) {
+        gk_rve_destroy(&r), gk_frame_free(&fr);
+        return;
+    }
     for (i = 0; i < fr.nq; ++i)
         for (p = 0; p < r.n; ++p)
             if (r.id[p] == fr.q[i]) gk_rve_position(&r, p, x0 + 3 * i), ++found;
