@@ -103,10 +103,8 @@ static int run_fem(model *m) {
         int stage = step <= o->iso_steps ? 1 : 2, iters = 0, g;
         double ps = o->pressure * (stage == 1 ? (double)step / o->iso_steps : 1.0),
                pt = stage == 1 ? ps : 0.0;
-        double Hs[9 * 1];
         double *Hstart = (double *)xcalloc(9 * (size_t)m->ngp, sizeof(double));
         memcpy(Hstart, m->Hacc, 9 * (size_t)m->ngp * sizeof(double));
-        (void)Hs;
         if (stage == 2) { /* the platen: every top node down to d below its height after stage 1 */
             double d = o->strain * m->h_ic * (step - o->iso_steps) / o->steps;
             if (m->single) {
