@@ -98,7 +98,7 @@ IMPL_VARIANT_extremes_float := float
 IMPL_VARIANT_simd_float     := float
 IMPLDEF_par64 := -DGK_DEM_PAR_MIN=64
 IMPLDEF_float := -DGK_REAL_FLOAT
-TESTDEF_par64 := -DGK_DEM_PAR_MIN=64
+TESTDEF_par64 := $(IMPLDEF_par64)
 # what a test links, $(call impl_for,STEM,THE BUILD'S IMPLEMENTATION OBJECT)
 impl_for = $(if $(IMPL_VARIANT_$(1)),$(ELSEWHERE) $(TESTDEF_$(IMPL_VARIANT_$(1))) \
              $(dir $(2))gk_impl_$(IMPL_VARIANT_$(1)).o,$(if $(filter $(1),$(OWN_IMPL)),,$(2)))
@@ -107,7 +107,7 @@ $(IMPL): tests/gk_impl.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) -c -o $@ $<
 $(BUILD)/gk_impl_%.o: tests/gk_impl.c $(HEADERS) | $(BUILD)
 	$(CC) $(CFLAGS) $(IMPLDEF_$*) -c -o $@ $<
-$(foreach t,dem scene extremes_float simd_float,$(foreach d,$(BUILD) $(BUILD)/asan $(BUILD)/nosimd,\
+$(foreach t,$(patsubst IMPL_VARIANT_%,%,$(filter IMPL_VARIANT_%,$(.VARIABLES))),$(foreach d,$(BUILD) $(BUILD)/asan $(BUILD)/nosimd,\
   $(eval $(d)/test_$(t): $(d)/gk_impl_$(IMPL_VARIANT_$(t)).o)))
 $(BUILD)/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(IMPL) | $(BUILD)
 	$(CC) $(CFLAGS) $(TESTDEF) -o $@ $< $(call impl_for,$*,$(IMPL)) $(LDLIBS)

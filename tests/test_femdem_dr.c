@@ -3,7 +3,8 @@
  * isotropic stage ends at sigma0, the 1 x 1 mesh follows the RVE alone, a
  * locked-rotation RVE is stronger, no NaN anywhere from U = 0 on, 1 and 2
  * threads and a restart give the same rows, the DNS runs, bad input is
- * refused by name and a failed write is an error. Short runs (reduced load
+ * refused by name and a failed write is an error, a load path that starts
+ * in equilibrium runs. Short runs (reduced load
  * paths; the periodic cell where the frame is not what is tested). Needs
  * build/femdem_dr (`make test` builds the examples first). */
 #define GK_TEST_DRIVERS

@@ -195,6 +195,15 @@ TEST(locked_rotation_stays_locked) {
     gk_frame_free(&fr);
 }
 
+/* the positions of the frame's boundary particles (by their ids) into x (nq x 3); the number found */
+static int frame_positions(const gk_rve *r, const gk_frame *fr, double *x) {
+    int i, p, found = 0;
+    for (i = 0; i < fr->nq; ++i)
+        for (p = 0; p < r->n; ++p)
+            if (r->id[p] == fr->q[i]) gk_rve_position(r, p, x + 3 * i), ++found;
+    return found;
+}
+
 /* no deformation at all (dH = 0: the first run of a load step that starts in equilibrium): the frame
  * is held where it is while the inside relaxes (eq 30 with the boundary particles prescribed), and the
  * run returns the packing's own stress (eq 14). tests/test_femdem_dr.c runs the driver on a packing
@@ -207,33 +216,27 @@ TEST(servo_frame_without_deformation_holds_the_frame) {
     gk_frame_set set;
     gk_frame_stats st[1];
     double H[9] = {0}, dH[9] = {0}, P[9], moved = 0.0;
-    double *x0;
-    int steps = 0, i, p, k, found = 0;
+    double *x0, *x1;
+    int steps = 0, i, k;
     CHECK(load());
     if (!have) return;
     CHECK(gk_frame_build(&fr, &pk, NULL, &e) == GK_OK);
     memset(&set, 0, sizeof set);
     set.kind = GK_FRAME_SERVO, set.frames = &fr, set.stats = st;
     CHECK(gk_rve_create(&r, &d, &fr.framed) == GK_OK && gk_rve_refresh(&r) == GK_OK);
-    x0 = (double *)calloc(3 * (size_t)fr.nq, sizeof(double));
+    x0 = (double *)calloc(6 * (size_t)fr.nq, sizeof(double));
     CHECK(x0 != NULL);
     if (!x0) {
         gk_rve_destroy(&r), gk_frame_free(&fr);
         return;
     }
-    for (i = 0; i < fr.nq; ++i)
-        for (p = 0; p < r.n; ++p)
-            if (r.id[p] == fr.q[i]) gk_rve_position(&r, p, x0 + 3 * i), ++found;
-    CHECK_EQ_INT(found, fr.nq);
+    x1 = x0 + 3 * fr.nq;
+    CHECK_EQ_INT(frame_positions(&r, &fr, x0), fr.nq);
     CHECK(gk_frame_run(&set, 0, 0, &r, H, dH, 1.0, P, &steps) == GK_OK);
+    CHECK_EQ_INT(frame_positions(&r, &fr, x1), fr.nq);
     for (i = 0; i < fr.nq; ++i)
-        for (p = 0; p < r.n; ++p)
-            if (r.id[p] == fr.q[i]) {
-                double x[3];
-                gk_rve_position(&r, p, x);
-                for (k = 0; k < 2; ++k)
-                    if (fabs(x[k] - x0[3 * i + k]) > moved) moved = fabs(x[k] - x0[3 * i + k]);
-            }
+        for (k = 0; k < 2; ++k)
+            if (fabs(x1[3 * i + k] - x0[3 * i + k]) > moved) moved = fabs(x1[3 * i + k] - x0[3 * i + k]);
     printf("    dH = 0: P11 %.0f P22 %.0f Pa, %ld DEM steps, %d corrections, frame moved %.3g m\n", P[0],
            P[4], st[0].steps, st[0].servo, moved);
     CHECK(moved <= 1e-6 * r.rmin); /* held, up to the servo's corrections */
