@@ -40,7 +40,7 @@
  *   hybrid_output.h  VTK, hybrid.csv, the band measurement, the plots; its
  *                    manual lists every output file and the RESULT line
  *   RESULT mode=M peak_tau=Pa band_thickness_D50=X strain_at_enrichment=S
- *          seconds=T speedup_vs_dem=R
+ *          seconds=T speedup_vs_dem=R packing_tau=Pa
  *
  * COST. The defaults are reduced (3 x 6 cm planar, 1778 grains; 3 x 4.71
  * cm biaxial, 1435 grains; 5x the paper's platen speed): one thread, about
@@ -73,6 +73,7 @@ int main(int argc, char **argv) {
     memset(&h, 0, sizeof h);
     R->top_wall = -1;
     R->dt = DT;
+    R->packing_tau = NAN;
     if (make_dir(o->out)) return 1;
     R->t_start = wtime();
     if (make_packing(o, &R->pk, &R->phi_pack)) return 1;
@@ -141,6 +142,16 @@ int main(int argc, char **argv) {
                 status = 1;
                 break;
             }
+            if (o->probe_on && isnan(R->packing_tau) && R->strain >= o->probe[0]) {
+                double sn;
+                if (strip_stress(R, o->probe[1], o->probe[2], &R->packing_tau, &sn)) {
+                    status = 1;
+                    break;
+                }
+                if (!o->quiet)
+                    printf("probe at strain %.6g: grains in y %.4g-%.4g m: tau %.4g kPa, sigma_n %.4g kPa\n",
+                           R->strain, o->probe[1], o->probe[2], 1e-3 * R->packing_tau, 1e-3 * sn);
+            }
         } else if (continuum_step(R)) {
             status = 1;
             break;
@@ -172,11 +183,11 @@ int main(int argc, char **argv) {
                (double)R->point_steps, R->point_steps ? 1e6 * R->sec_mpm / (double)R->point_steps : 0.0,
                R->sec_cpl);
     printf("RESULT mode=%s peak_tau=%.6g band_thickness_D50=%.4g strain_at_enrichment=%.4g seconds=%.2f "
-           "speedup_vs_dem=%.3g\n",
+           "speedup_vs_dem=%.3g packing_tau=%.6g\n",
            mode_name[o->mode], R->peak_tau, thick,
            o->mode == M_HYBRID ? (R->enriched ? R->strain_enrich : NAN)
                                : (R->triggered ? R->strain_trigger : NAN),
-           secs, o->dem_seconds > 0.0 ? o->dem_seconds / secs : NAN);
+           secs, o->dem_seconds > 0.0 ? o->dem_seconds / secs : NAN, R->packing_tau);
     free(h.s);
     free(h.tau);
     free(h.sn);

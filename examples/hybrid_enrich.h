@@ -21,6 +21,21 @@
 #include "hybrid_model.h"
 
 /* ------------------------------------------------------------------ enrichment */
+/* the grains' mean stress in the strip y0 <= y < y1 across the (periodic)
+ * width, compression-positive: tau = sigma_xy as the platen's (positive when
+ * the top drags the grains along +x), sigma_n = -sigma_yy (gk_scene_stress_box) */
+static int strip_stress(run *R, double y0, double y1, double *tau, double *sig_n) {
+    double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.0, 0.0, 0.0}, s[9];
+    lo[1] = y0;
+    hi[0] = R->W;
+    hi[1] = y1;
+    if (gk_scene_stress_box(&R->sc, lo, hi, s))
+        return fprintf(stderr, "error: strip stress: %s\n", gk_scene_error(&R->sc)), 1;
+    *tau = s[1];
+    *sig_n = -s[4];
+    return 0;
+}
+
 /* grain p of the hybrid scene: in the overlap and free (coupled this step)? */
 static void coupling_mask(run *R) {
     gk_scene *sc = &R->sc;
@@ -64,7 +79,7 @@ static int enrich(run *R) {
     gk_scene_def sd = scene_def(R);
     gk_hybrid_enrich_report rep;
     long ntrain, nrelax;
-    double t0 = wtime();
+    double t0 = wtime(), ylo = HUGE_VAL, yhi = -HUGE_VAL;
     memset(&sub, 0, sizeof sub);
     /* the distance to the flagged nodes on every node, zones of the points */
     R->dist = (double *)malloc(nn * sizeof(double));
@@ -78,7 +93,6 @@ static int enrich(run *R) {
         goto done;
     }
     {
-        double ylo = HUGE_VAL, yhi = -HUGE_VAL;
         for (I = 0; I < nn; ++I) {
             double x[3];
             gk_mpm_grid_node_position(g, I, x);
@@ -193,6 +207,22 @@ static int enrich(run *R) {
             goto done;
         }
         R->grain_steps += (long)ng * (ntrain + nrelax);
+    }
+    /* Chen et al. Fig 13: the trained (--train 0: untrained) packing's mean shear stress in the
+     * discrete zone of a planar band (the strip within phi_0 - h/2 of the flagged rows) */
+    if (o->test == T_PLANAR) {
+        double y0 = ylo - (o->phi0 - 0.5 * R->h), y1 = yhi + (o->phi0 - 0.5 * R->h), sn;
+        if (y0 < 0.0) y0 = 0.0;
+        if (y1 > R->H) y1 = R->H;
+        if (y1 <= y0 || strip_stress(R, y0, y1, &R->packing_tau, &sn)) {
+            if (y1 <= y0) fprintf(stderr, "error: enrichment: an empty discrete zone\n");
+            goto done;
+        }
+        if (!o->quiet)
+            printf("packing (%s) in the discrete zone y %.4g-%.4g m: tau %.4g kPa, sigma_n %.4g kPa; the dem "
+                   "run's: --mode dem --probe %.6g %.6g %.6g\n",
+                   o->train > 0.0 ? "trained" : "untrained", y0, y1, 1e-3 * R->packing_tau, 1e-3 * sn,
+                   R->strain, y0, y1);
     }
     /* the grains that ended in the continuum zone leave */
     drop = (int32_t *)malloc((size_t)ng * sizeof(int32_t));

@@ -11,9 +11,15 @@
  * --window S0 S1 (strain), grains by Cundall's best fit, points by F),
  * packing.txt, and on stdout a line
  *   RESULT mode=M peak_tau=Pa band_thickness_D50=X strain_at_enrichment=S
- *          seconds=T speedup_vs_dem=R
+ *          seconds=T speedup_vs_dem=R packing_tau=Pa
  * (band thickness by App. A: top --percentile, outliers beyond 2 sd out,
- * minimum-area box; speedup_vs_dem = --dem-seconds / seconds, nan without).
+ * minimum-area box; speedup_vs_dem = --dem-seconds / seconds, nan without;
+ * packing_tau, planar only: hybrid, the mean shear stress of the trained
+ * packing in the discrete zone before it is inserted (Fig 13; with --train
+ * 0 the untrained one), dem, that of the grains in the --probe strip at the
+ * probe's strain (the contacts with their midpoint in the strip,
+ * gk_scene_stress_box), nan otherwise; the hybrid run prints the --probe
+ * that measures its own zone at its enrichment strain).
  * On stdout, "cost:" counts the grain-steps and point-steps of the run (the
  * N_D and element terms of the cost model of Sec 6.4.1) with the wall time
  * spent in each.

@@ -64,6 +64,8 @@ typedef struct opts {
     double width, height, pressure, speed, strain_end, out_every;
     double cell, alpha, train, train_speed, phi0, c0, c1, cl, cg, phi_init, weak_dphi, xi;
     double win0, win1, band_window, percentile, dem_seconds, platen_zeta, ramp;
+    double probe[3]; /* --probe S Y0 Y1 (dem): strain, strip */
+    int probe_on;
     int ppd, threads, oracle_every, quiet;
     long grains;
     unsigned long seed;
@@ -155,6 +157,10 @@ static void usage(FILE *fp) {
         "  --platen-damping Z   planar top platen: damping ratio of its dashpot (default %g)\n"
         "  --ramp K             the platen speed rises linearly over K wave transits H / c (default %g)\n"
         "  --dem-seconds S      wall seconds of the dem run of the same test (for speedup_vs_dem)\n"
+        "  --probe S Y0 Y1      dem, planar: the grains' mean stress in the strip Y0 <= y < Y1 [m] at strain "
+        "S\n"
+        "                       (the hybrid run prints this option for its discrete zone and enrichment "
+        "strain)\n"
         "  --paper              the paper's specimen and speed (Tables 3, 5): 6 x 12 cm (planar, phi_0 2.2 "
         "cm) or\n"
         "                       6 x 9.42 cm (biaxial), 0.02 m/s; the other flags override it\n"
@@ -249,26 +255,40 @@ static int parse(int argc, char **argv, opts *o) {
             {"--seed", CLI_ULONG, &o->seed, 0, 0, NULL, NULL, 0}, /* at most 4294967295: checked below */
             {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
         const cli_opt *const tables[] = {table, NULL};
-        /* --window S0 S1 takes two values, which cli.h does not: the arguments are handed to
-         * cli_parse a stretch at a time, each --window read between two stretches, so that every
-         * refusal (and --help) still comes in the order of the command line */
+        /* --window S0 S1 and --probe S Y0 Y1 take several values, which cli.h does not: the
+         * arguments are handed to cli_parse a stretch at a time, each --window or --probe read
+         * between two stretches, so that every refusal (and --help) still comes in the order of
+         * the command line */
         char **seg = (char **)malloc((size_t)(argc + 1) * sizeof *seg);
         if (!seg) return fprintf(stderr, "error: out of memory\n"), 1;
         seg[0] = argv[0];
         for (i = 1; i <= argc && !r && !help; ++i) {
             const cli_opt *k = NULL;
             int t;
-            if (i < argc && strcmp(argv[i], "--window")) {
+            if (i < argc && strcmp(argv[i], "--window") && strcmp(argv[i], "--probe")) {
                 for (t = 0; table[t].name && !k; ++t)
                     if (!strcmp(argv[i], table[t].name)) k = &table[t];
                 seg[n++] = argv[i];
                 if (k && k->kind != CLI_FLAG && i + 1 < argc) seg[n++] = argv[++i];
                 continue;
             }
-            /* the end, or a --window: the stretch before it */
+            /* the end, or a --window or --probe: the stretch before it */
             if (cli_parse("hybrid", n, seg, tables, &help)) r = 1;
             n = 1;
             if (r || help || i == argc) break;
+            if (!strcmp(argv[i], "--probe")) {
+                double v0, v1, v2;
+                if (i + 3 >= argc || !num(argv[i + 1], &v0) || !num(argv[i + 2], &v1) ||
+                    !num(argv[i + 3], &v2) || !(v0 > 0.0 && v0 <= 2.0) ||
+                    !(v1 >= 0.0 && v2 > v1 && v2 <= 10.0))
+                    r = (fprintf(
+                             stderr,
+                             "error: --probe needs a strain S in (0, 2] and a strip 0 <= Y0 < Y1 <= 10 m\n"),
+                         1);
+                else
+                    o->probe[0] = v0, o->probe[1] = v1, o->probe[2] = v2, o->probe_on = 1, i += 3;
+                continue;
+            }
             {
                 double v0, v1;
                 if (i + 2 >= argc || !num(argv[i + 1], &v0) || !num(argv[i + 2], &v1) ||
@@ -292,6 +312,14 @@ static int parse(int argc, char **argv, opts *o) {
     if (mode < 0) return fprintf(stderr, "error: --mode dem|continuum|hybrid is required\n"), 1;
     o->mode = mode;
     if (o->train_speed <= 0.0) o->train_speed = o->speed;
+    if (o->probe_on && (o->mode != M_DEM || o->test != T_PLANAR))
+        return fprintf(stderr,
+                       "error: --probe is a measurement of the planar dem run (a hybrid run reports its "
+                       "trained packing's stress itself)\n"),
+               1;
+    if (o->probe_on && o->probe[0] > o->strain_end)
+        return fprintf(stderr, "error: --probe strain %g beyond --strain %g\n", o->probe[0], o->strain_end),
+               1;
     if (o->win1 > o->strain_end + 1e-12)
         return fprintf(stderr, "error: --window end %g beyond --strain %g\n", o->win1, o->strain_end), 1;
     if (o->test == T_BIAXIAL && o->train < 1.0)
@@ -484,6 +512,7 @@ typedef struct run {
     gk_hybrid_coupling cpl;
     /* measurements */
     double phi0_band, A0, peak_tau, win_c[2], win_e[2], win_a;
+    double packing_tau; /* hybrid: the trained packing's mean shear stress; dem: --probe's [Pa] */
     int window_taken, nw, band_on_grains;
     double *Xw[2];
     int32_t *idw;

@@ -104,6 +104,52 @@ TEST(hybrid_planar_enriches_and_is_thread_independent) {
     CHECK(same_but_seconds(BUILD "/tests/t_hyA/hybrid.csv", BUILD "/tests/t_hy1/hybrid.csv"));
 }
 
+/* Chen et al. Sec 4.1.1 and Fig 13 (their planar shear: untrained 6 kPa,
+ * trained 125 kPa, the all-DEM run's same region 121 kPa): the packing that
+ * enters the band carries the continuum's shear only when trained. Hybrid
+ * runs with --train 1 and --train 0 report their packing's mean shear stress
+ * in the discrete zone (packing_tau) and the --probe that measures the same
+ * strip at the same strain in a dem run; that dem run's value is the
+ * reference. The trained packing must be far closer to it than the untrained
+ * one (less than half the distance), and the untrained one must carry less
+ * than a quarter of it (the packing was consolidated isotropically). */
+TEST(hybrid_training_matches_the_dem_packing_stress) {
+    double trained, untrained, dem, S = 0.0, y0 = 0.0, y1 = 0.0;
+    char cmd[1024], line[1024];
+    FILE *fp;
+    int got = 0;
+    system("rm -rf " BUILD "/tests/t_hyT1 " BUILD "/tests/t_hyT0 " BUILD "/tests/t_hyTd");
+    CHECK(system(PLANAR "--mode hybrid --train 1 --strain 0.002 --window 0.001 0.002 --out " BUILD
+                        "/tests/t_hyT1 > " BUILD "/tests/t_hyT1.out 2>&1") == 0);
+    CHECK(system(PLANAR "--mode hybrid --train 0 --strain 0.002 --window 0.001 0.002 --out " BUILD
+                        "/tests/t_hyT0 > " BUILD "/tests/t_hyT0.out 2>&1") == 0);
+    fp = fopen(BUILD "/tests/t_hyT1.out", "r");
+    while (fp && fgets(line, sizeof line, fp)) {
+        const char *q = strstr(line, "--probe ");
+        if (!strncmp(line, "packing (trained)", 17) && q)
+            got = sscanf(q, "--probe %lf %lf %lf", &S, &y0, &y1);
+    }
+    if (fp) fclose(fp);
+    CHECK_EQ_INT(got, 3);
+    if (got != 3) return;
+    CHECK(S > 0.0 && S < 0.002 && y1 > y0);
+    snprintf(cmd, sizeof cmd,
+             PLANAR "--mode dem --probe %.9g %.9g %.9g --strain %.9g --window %.9g %.9g --out " BUILD
+                    "/tests/t_hyTd > " BUILD "/tests/t_hyTd.out 2>&1",
+             S, y0, y1, 1.5 * S, 0.5 * S, 1.5 * S);
+    CHECK(system(cmd) == 0);
+    trained = gk_test_result(BUILD "/tests/t_hyT1.out", "packing_tau");
+    untrained = gk_test_result(BUILD "/tests/t_hyT0.out", "packing_tau");
+    dem = gk_test_result(BUILD "/tests/t_hyTd.out", "packing_tau");
+    printf(
+        "    packing tau at strain %.3g, y %.3g-%.3g m: untrained %.4g kPa, trained %.4g kPa, dem %.4g kPa\n",
+        S, y0, y1, 1e-3 * untrained, 1e-3 * trained, 1e-3 * dem);
+    CHECK(dem > 0.0);
+    CHECK(fabs(untrained) < 0.25 * dem);
+    CHECK(fabs(trained - dem) < 0.5 * fabs(untrained - dem));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyTd.out", "probe at strain"));
+}
+
 /* dem mode, biaxial: the specimen starts at the confining pressure
  * (sigma_n = 100 kPa, tau = 0), axial compression raises the deviator
  * (tau > 0, sigma_n > 100 kPa), App. A's band measurement runs on the grains */
@@ -171,6 +217,11 @@ TEST(hybrid_refuses_bad_arguments) {
     CHECK(refused("--test planar --mode dem --seed 4294967296", "--seed 4294967296 is out of range"));
     CHECK(refused("--test planar --mode dem --window 0.1 0.2 --ppd 5", "--ppd 5 is out of range"));
     CHECK(refused("--test planar --mode dem --window 0.1", "--window needs two strains"));
+    CHECK(refused("--test planar --mode dem --probe 0.001 0.02", "--probe needs a strain"));
+    CHECK(refused("--test planar --mode dem --probe 0.001 0.03 0.02", "--probe needs a strain"));
+    CHECK(refused("--test planar --mode dem --probe 0.9 0.01 0.02", "--probe strain 0.9 beyond --strain"));
+    CHECK(refused("--test planar --mode hybrid --probe 0.001 0.01 0.02", "--probe is a measurement"));
+    CHECK(refused("--test biaxial --mode dem --probe 0.001 0.01 0.02", "--probe is a measurement"));
     /* an unreadable packing: an error, not a crash (the directory may exist) */
     CHECK(system(BUILD "/hybrid --test planar --mode dem --packing " BUILD
                        "/tests/no_such_packing.txt --out " BUILD "/tests/t_hybad "
@@ -192,6 +243,7 @@ int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(hybrid_refuses_bad_arguments);
     RUN(hybrid_planar_enriches_and_is_thread_independent);
+    RUN(hybrid_training_matches_the_dem_packing_stress);
     RUN(hybrid_biaxial_dem_loads);
     RUN(hybrid_biaxial_continuum_runs);
     return gk_test_done();

@@ -1292,12 +1292,25 @@ TEST(save_restore_and_threads_are_bitwise) {
  * servo holds the normal force (2 %), the shear resistance is
  * frictional (between 0.05 and the contact friction 0.5 times the normal
  * force). */
+/* mean height of row b of a lattice() packing of nx per row (ids b nx .. b nx + nx - 1) */
+static double row_height(const gk_scene *sc, int nx, int b) {
+    double x[3], y = 0.0;
+    int a;
+    for (a = 0; a < nx; ++a) {
+        gk_scene_position(sc, gk_scene_index(sc, b * nx + a), x);
+        y += x[1];
+    }
+    return y / nx;
+}
+
 TEST(periodic_shear_between_walls) {
     gk_scene_def d = gk_scene_def_default();
     gk_scene sc;
     gk_packing pk;
     gk_wall_def lid = gk_wall_def_default(), flo = gk_wall_def_default();
-    double r = 0.0025, W = 20 * 2.2 * r, N = 200.0, ratio, shear, floor_shear, normal;
+    double r = 0.0025, W = 20 * 2.2 * r, N = 200.0, ratio, shear, floor_shear, normal, s[9], strip_xy = 0.0;
+    double shear_stress;
+    double mid_lo[3] = {0.0, 0.0, 0.0}, mid_hi[3] = {0.0, 0.0, 0.0};
     int p, bad = 0;
     d.dim = 2;
     d.hi[0] = W;
@@ -1324,6 +1337,9 @@ TEST(periodic_shear_between_walls) {
     CHECK(gk_scene_step(&sc, 10000) == GK_OK); /* consolidate */
     sc.walls[1].def.velocity[0] = 0.05;        /* servo in y, sliding at 5 cm/s in x */
     CHECK(gk_scene_step(&sc, 15000) == GK_OK);
+    mid_hi[0] = W; /* from the centre line of row 3 to that of row 8 (below) */
+    mid_lo[1] = row_height(&sc, 20, 3);
+    mid_hi[1] = row_height(&sc, 20, 8);
     { /* averages over the next 20000 steps (the forces fluctuate) */
         int k;
         double sl = 0.0, sf = 0.0, sn = 0.0;
@@ -1332,15 +1348,56 @@ TEST(periodic_shear_between_walls) {
             sl -= sc.walls[1].force[0]; /* the particles resist the lid's motion */
             sf += sc.walls[0].force[0];
             sn += sc.walls[1].resistance;
+            gk_scene_stress_box(&sc, mid_lo, mid_hi, s);
+            strip_xy += s[1];
         }
         shear = sl / 100;
         floor_shear = sf / 100;
         normal = sn / 100;
+        strip_xy /= 100;
     }
     ratio = shear / normal;
     printf("    lid normal %.4g N (target %g), shear %.4g N, floor shear %.4g N, ratio %.3f (means)\n",
            normal, N, shear, floor_shear, ratio);
     CHECK_NEAR(floor_shear, shear, 0.05 * fabs(shear));
+    /* gk_scene_stress_box. (a) The box holding every contact is the pair
+     * part of gk_scene_stress (its wall part left out) over the box's area,
+     * but for the branch vectors: the step sums its stress with those at
+     * force time, the box with those after the step's move, which changes a
+     * branch by the relative motion of one step, at most the lid's speed x
+     * dt (4e-5 of a diameter here): 10 x that share of |sigma_yy|. */
+    {
+        double all_lo[3] = {0.0, -0.1, 0.0}, all_hi[3] = {W, 0.2, 0.0}, A = W * 0.3, pair[9];
+        double tol = 10.0 * 0.05 * sc.rve.dt / (1.6 * r);
+        int k;
+        CHECK(gk_scene_stress_box(&sc, all_lo, all_hi, s) == GK_OK);
+        for (k = 0; k < 9; ++k)
+            pair[k] = sc.rve.stress[k] * gk_rve_volume(&sc.rve) / (A * sc.rve.volume_factor);
+        printf(
+            "    box of everything: sigma_xy %.6g, sigma_yy %.6g Pa; the pair part of gk_scene_stress %.6g, "
+            "%.6g Pa\n",
+            s[1], s[4], pair[1], pair[4]);
+        for (k = 0; k < 9; ++k) CHECK_NEAR(s[k], pair[k], tol * fabs(pair[4]));
+    }
+    /* (b) Equilibrium of the layer above any horizontal section: the mean
+     * sigma_xy (tension-positive; the lid drags the top along +x) of the
+     * strip between the centre lines of rows 3 and 8 (its five layers of
+     * row-to-row contacts whole) is the lid's shear force over W t (Cauchy,
+     * t_x = sigma_xy n_y on the lid), within the 10 % that a contact-midpoint
+     * average over five rows of 20 disks leaves. */
+    shear_stress = shear / (W * sc.rve.volume_factor);
+    printf("    strip y %.4g-%.4g m: sigma_xy %.4g Pa (mean of 100), lid shear / W t %.4g Pa\n", mid_lo[1],
+           mid_hi[1], strip_xy, shear_stress);
+    CHECK_NEAR(strip_xy, shear_stress, 0.10 * shear_stress);
+    { /* (c) a box that is empty or not finite is refused, sigma untouched */
+        double bad_hi[3] = {W, 0.0, 0.0}, nan_lo[3] = {0.0, 0.0, 0.0};
+        bad_hi[1] = mid_lo[1];
+        s[0] = 42.0;
+        CHECK(gk_scene_stress_box(&sc, mid_lo, bad_hi, s) == GK_ERR_ARG);
+        nan_lo[1] = NAN;
+        CHECK(gk_scene_stress_box(&sc, nan_lo, mid_hi, s) == GK_ERR_ARG);
+        CHECK(s[0] == 42.0);
+    }
     CHECK_REL(normal, N, 0.02);
     CHECK(ratio > 0.05 && ratio < 0.5);
     for (p = 0; p < sc.rve.n; ++p) {
