@@ -62,6 +62,17 @@
  * of its loading history the normal forces alone carry sigma_yy / sigma_xx = 1.09 where the
  * packing held 1.00 (A 0.056); the first relaxation rearranges it (Z 3.94 to 4.10, A 0.015),
  * at any friction (mu 0.4, 1, 10: A 0.015, 0.010, 0.013).
+ * What keeps it is the stiffness: at the packing files' own k_n / p (`--kn-ratio 1e5`, servo,
+ * the RVE alone) the isotropic stage ends at A = 0.014, 0.063, 0.128 (A0 0.016, 0.049,
+ * 0.084), at 1e4 and 1e3 it is lost again (0.013 / 0.015 for A0 0.016 / 0.084 at 1e4): the
+ * contacts the loading history opened stay open only while the overlaps are small against
+ * the gaps. sigma_bar at 7.3 % then falls with A0 as in the paper (0.384, 0.346, 0.327;
+ * peaks 0.443 at 8 %, 0.405 at 5 %, 0.451 at 8 %), but two packings made alike (the files'
+ * gk_pack command with --target-anisotropy 0.02 and seeds 5, 6, which end isotropic, at
+ * stress ratio 1: A0 0.045, 0.054) give 0.315 and 0.436 at 7.3 %: one 228-disk RVE cannot resolve the effect, and at this stiffness its
+ * curve jumps (those two peak at 0.635 and 0.856, at 9.5 and 10 %). (gk_pack's anisotropic
+ * packings have their excess contact normals vertical, along the loading; the paper does not
+ * say which way its packings lean.)
  * WHY THE MESHES DIFFER (--frame periodic, 2 x 4, to 1 %; `--nx 2 --ny 4 --frame periodic
  * --stop-after 12 --vtk-every 1`, gp_NNNN.vtk): every Gauss point starts from the same
  * packing, but their deformation gradients differ in round-off and each RVE's DEM amplifies
