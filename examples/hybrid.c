@@ -50,12 +50,10 @@
  * the planar dem run to 57 % took 30 min of wall time on one core (2.7e10
  * grain-steps, 0.059 us each).
  *
- * KNOWN LIMITS. The planar continuum and hybrid runs at the default size
- * stop at 43 % (continuum) and 49 % (hybrid) strain: a point of the top
- * layer leaves the grid ("its support leaves the grid"); run them to
- * --strain 0.3 --window 0.2 0.3. The continuum's cost per MPM point-step is far above
- * the paper's relative to a grain-step, so the hybrid is slower than dem at
- * these sizes (see the cost: line).
+ * KNOWN LIMITS. The continuum's cost per MPM point-step is far above the
+ * paper's relative to a grain-step, so the hybrid is slower than dem at
+ * these sizes (see the cost: line). Plate indentation (Sec 6.3) is not
+ * implemented.
  */
 #define GK_IMPLEMENTATION
 #define _POSIX_C_SOURCE 200809L

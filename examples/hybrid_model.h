@@ -205,9 +205,11 @@ static int setup_mpm(run *R) {
                        : (x > R->W - 2.0 * R->h && x < R->W - R->h && y > R->h && y < 2.0 * R->h);
         if (weak) R->C.Phi[p] = Phi0 - o->weak_dphi;
     }
-    /* the top platen: rough and servo-controlled (planar) or frictionless (biaxial) */
+    /* the top platen: rough and servo-controlled (planar) or frictionless (biaxial). The body
+     * moves with its velocity (gk_mpm_bodies_advance): planar, it starts as far to the left
+     * as it will travel, so that it covers the whole top row to the end of the run */
     memset(&R->body, 0, sizeof R->body);
-    R->body.lo[0] = org[0] - R->h;
+    R->body.lo[0] = org[0] - R->h - (o->test == T_PLANAR ? o->strain_end * R->W : 0.0);
     R->body.hi[0] = org[0] + (n[0] + 1) * R->h;
     R->body.lo[1] = R->H - 1e-9; /* the nodes at and above the material's top surface */
     R->body.hi[1] = org[1] + (n[1] + 1) * R->h;

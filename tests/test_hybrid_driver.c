@@ -104,6 +104,29 @@ TEST(hybrid_planar_enriches_and_is_thread_independent) {
     CHECK(same_but_seconds(BUILD "/tests/t_hyA/hybrid.csv", BUILD "/tests/t_hy1/hybrid.csv"));
 }
 
+/* continuum mode, planar, to 60 % strain at 0.5 m/s: the platen (a rigid body
+ * that travels with its velocity) holds the whole top row to the end, so its
+ * servo keeps the normal stress (every row's sigma_n within 2 % of 400 kPa)
+ * and the shear stress stays below the normal one. A platen that had left the
+ * top-left nodes behind lost them after 2 cells of travel, 50 % here: sigma_n
+ * 2.5 MPa at 60 % (and on the 3 cm specimen a point thrown out of the grid
+ * at 43 %). */
+TEST(hybrid_planar_platen_holds_to_large_strain) {
+    double r[16][NCOL];
+    int n, k;
+    system("rm -rf " BUILD "/tests/t_hyL");
+    CHECK(system(PLANAR "--mode continuum --speed 0.5 --strain 0.6 --window 0.5 0.6 --out-every 0.05 --quiet "
+                        "--out " BUILD "/tests/t_hyL > " BUILD "/tests/t_hyL.out 2>&1") == 0);
+    n = read_rows(BUILD "/tests/t_hyL/hybrid.csv", r, 16);
+    CHECK_EQ_INT(n, 13);
+    if (n != 13) return;
+    CHECK_NEAR(r[12][1], 0.6, 1e-3);
+    for (k = 1; k < n; ++k) {
+        CHECK_NEAR(r[k][3], 4e5, 0.02 * 4e5);
+        CHECK(r[k][2] > 0.0 && r[k][2] < r[k][3]);
+    }
+}
+
 /* Chen et al. Sec 4.1.1 and Fig 13 (their planar shear: untrained 6 kPa,
  * trained 125 kPa, the all-DEM run's same region 121 kPa): the packing that
  * enters the band carries the continuum's shear only when trained. Hybrid
@@ -244,6 +267,7 @@ int main(int argc, char **argv) {
     RUN(hybrid_refuses_bad_arguments);
     RUN(hybrid_planar_enriches_and_is_thread_independent);
     RUN(hybrid_training_matches_the_dem_packing_stress);
+    RUN(hybrid_planar_platen_holds_to_large_strain);
     RUN(hybrid_biaxial_dem_loads);
     RUN(hybrid_biaxial_continuum_runs);
     return gk_test_done();
