@@ -214,10 +214,11 @@ static int enrich(run *R) {
         double y0 = ylo - (o->phi0 - 0.5 * R->h), y1 = yhi + (o->phi0 - 0.5 * R->h), sn;
         if (y0 < 0.0) y0 = 0.0;
         if (y1 > R->H) y1 = R->H;
-        if (y1 <= y0 || strip_stress(R, y0, y1, &R->packing_tau, &sn)) {
-            if (y1 <= y0) fprintf(stderr, "error: enrichment: an empty discrete zone\n");
+        if (y1 <= y0) {
+            fprintf(stderr, "error: enrichment: an empty discrete zone\n");
             goto done;
         }
+        if (strip_stress(R, y0, y1, &R->packing_tau, &sn)) goto done;
         if (!o->quiet)
             printf("packing (%s) in the discrete zone y %.4g-%.4g m: tau %.4g kPa, sigma_n %.4g kPa; the dem "
                    "run's: --mode dem --probe %.6g %.6g %.6g\n",

@@ -700,6 +700,11 @@ static gk_result gk__scene_hook(gk_rve *rve, int stage, void *user);
 /* interaction range of the cell lists: 2 r_max + skin */
 static double gk__scene_cutoff(const gk_scene *sc) { return 2.0 * sc->rve.rmax + sc->rve.skin; }
 
+/* u brought into [lo, hi) along a periodic axis */
+static double gk__sc_wrap(double lo, double hi, double u) {
+    return lo + (u - lo) - (hi - lo) * floor((u - lo) / (hi - lo));
+}
+
 GKDEF gk_result gk_scene_create(gk_scene *out, const gk_scene_def *def, const gk_packing *pk) {
     gk_scene S;
     gk_packing fr;
@@ -745,13 +750,13 @@ GKDEF gk_result gk_scene_create(gk_scene *out, const gk_scene_def *def, const gk
         x[1] = pk->y[p];
         x[2] = dim == 3 ? (pk->z ? pk->z[p] : 0.0) : 0.0;
         for (k = 0; k < dim; ++k) {
-            double D = def->hi[k] - def->lo[k], u = x[k];
+            double u = x[k];
             if (!isfinite(u)) {
                 res = gk_err_set(err, GK_ERR_NAN, "particle %d has a non-finite position", p);
                 break;
             }
             if (def->periodic & (1u << k)) {
-                u = def->lo[k] + (u - def->lo[k]) - D * floor((u - def->lo[k]) / D);
+                u = gk__sc_wrap(def->lo[k], def->hi[k], u);
             } else if (u < def->lo[k] || u > def->hi[k]) {
                 res = gk_err_set(err, GK_ERR_OUTSIDE,
                                  "particle %d at %g on axis %d is outside the domain [%g, %g]", p, u, k,
@@ -1010,10 +1015,7 @@ GKDEF gk_result gk_scene_stress_box(gk_scene *sc, const double lo[3], const doub
         gk_scene_position(sc, p, x);
         for (k = 0; k < dim; ++k) {
             double m = x[k] + 0.5 * ct.d[k];
-            if (sc->def.periodic & (1u << k)) {
-                double L = sc->def.hi[k] - sc->def.lo[k];
-                m -= L * floor((m - sc->def.lo[k]) / L);
-            }
+            if (sc->def.periodic & (1u << k)) m = gk__sc_wrap(sc->def.lo[k], sc->def.hi[k], m);
             if (!(m >= lo[k] && m < hi[k])) inside = 0;
         }
         if (!inside) continue;
@@ -2028,13 +2030,13 @@ GKDEF gk_result gk_scene_insert(gk_scene *sc, int k, const double *const x[3], c
     }
     for (q = 0; q < k && !res; ++q) {
         for (a = 0; a < dim; ++a) {
-            double u = x[a][q], D = sc->def.hi[a] - sc->def.lo[a];
+            double u = x[a][q];
             if (!isfinite(u) || (v && v[a] && !isfinite(v[a][q]))) {
                 res = gk_err_set(&sc->err, GK_ERR_NAN, "insert: particle %d has a non-finite value", q);
                 break;
             }
             if (!(sc->open & (1u << a))) {
-                u = sc->def.lo[a] + (u - sc->def.lo[a]) - D * floor((u - sc->def.lo[a]) / D);
+                u = gk__sc_wrap(sc->def.lo[a], sc->def.hi[a], u);
             } else if (u < sc->def.lo[a] || u > sc->def.hi[a]) {
                 res = gk_err_set(&sc->err, GK_ERR_OUTSIDE,
                                  "insert: particle %d at %g on axis %d is outside [%g, %g]", q, u, a,

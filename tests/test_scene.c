@@ -1285,13 +1285,6 @@ TEST(save_restore_and_threads_are_bitwise) {
     gk_scene_destroy(&B);
 }
 
-/* Periodic in x, walls in y: a layer sheared between a fixed rough floor
- * and a rough lid moving along x (servo in y to a normal force): particles
- * wrap in x and stay in the period; in steady shear the floor and the lid
- * hold equal and opposite shear forces (means over 20 000 steps, 5 %), the
- * servo holds the normal force (2 %), the shear resistance is
- * frictional (between 0.05 and the contact friction 0.5 times the normal
- * force). */
 /* mean height of row b of a lattice() packing of nx per row (ids b nx .. b nx + nx - 1) */
 static double row_height(const gk_scene *sc, int nx, int b) {
     double x[3], y = 0.0;
@@ -1303,6 +1296,13 @@ static double row_height(const gk_scene *sc, int nx, int b) {
     return y / nx;
 }
 
+/* Periodic in x, walls in y: a layer sheared between a fixed rough floor
+ * and a rough lid moving along x (servo in y to a normal force): particles
+ * wrap in x and stay in the period; in steady shear the floor and the lid
+ * hold equal and opposite shear forces (means over 20 000 steps, 5 %), the
+ * servo holds the normal force (2 %), the shear resistance is
+ * frictional (between 0.05 and the contact friction 0.5 times the normal
+ * force); gk_scene_stress_box against gk_scene_stress and the lid (below). */
 TEST(periodic_shear_between_walls) {
     gk_scene_def d = gk_scene_def_default();
     gk_scene sc;
