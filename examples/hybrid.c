@@ -80,11 +80,23 @@ int main(int argc, char **argv) {
      * MPM cells of height (the continuum's top surface on a node row, where its
      * platen acts): the packing is cut there, for every mode alike */
     hg = R->W / floor(R->W / o->cell + 0.5);
+    if (o->test == T_INDENT) { /* the intruder centred, its edges on node lines (as the bin's walls) */
+        double B = R->W - 2.0 * floor(0.5 * (R->W - o->intruder) / hg + 0.5) * hg;
+        if (B < 1.5 * hg)
+            return fprintf(stderr, "error: --intruder %g: narrower than two MPM cells (%g m)\n", o->intruder,
+                           hg),
+                   1;
+        if (fabs(B - o->intruder) > 1e-9 && !o->quiet)
+            printf("intruder: %.4g m wide (--intruder %g to the cells' node lines)\n", B, o->intruder);
+        o->intruder = B;
+    }
     R->H = floor(R->pk.h[4] / hg + 1e-9) * hg;
     {
         int k, q = 0;
         for (k = 0; k < R->pk.n; ++k)
-            if (R->pk.y[k] < R->H) {
+            if (R->pk.y[k] < R->H &&
+                (o->test != T_INDENT || (R->pk.x[k] - R->pk.r[k] >= 0.0 && R->pk.x[k] + R->pk.r[k] <= R->W &&
+                                         R->pk.y[k] - R->pk.r[k] >= 0.0))) {
                 R->pk.x[q] = R->pk.x[k];
                 R->pk.y[q] = R->pk.y[k];
                 R->pk.r[q] = R->pk.r[k];
@@ -93,6 +105,8 @@ int main(int argc, char **argv) {
         R->pk.n = q;
         R->pk.h[4] = R->H;
     }
+    /* indent: the bin holds the grains inside 0 <= x <= W, y >= 0 (those that crossed its walls are
+     * gone) */
     R->rho = R->phi_pack * RHO_S;
     R->M = K_C + G_C;
     R->c = sqrt(R->M / R->rho);
@@ -103,6 +117,7 @@ int main(int argc, char **argv) {
                "m/s, dt %g s\n",
                test_name[o->test], mode_name[o->mode], R->W, R->H, R->pk.n, R->phi_pack, o->pressure,
                o->speed, R->dt);
+    if (o->test == T_INDENT && indent_settle(R)) return 1;
     if (o->mode == M_DEM) {
         if (setup_dem(R)) return 1;
     } else {
@@ -123,9 +138,9 @@ int main(int argc, char **argv) {
         R->win_a = 0.3 * (fabs(R->W / R->win_e[0]) < fabs(R->H / R->win_e[1]) ? fabs(R->W / R->win_e[0])
                                                                               : fabs(R->H / R->win_e[1]));
     }
-    R->A0 = specimen_area(R);
-    R->phi0_band = band_solid_fraction(R);
-    R->sig_n = o->pressure; /* the consolidated state, before the first step */
+    R->A0 = o->test == T_INDENT ? NAN : specimen_area(R);
+    R->phi0_band = o->test == T_INDENT ? NAN : band_solid_fraction(R);
+    R->sig_n = o->test == T_INDENT ? 0.0 : o->pressure; /* the consolidated state, before the first step */
     snprintf(path, sizeof path, "%s/hybrid.csv", o->out);
     R->csv = fopen(path, "w");
     if (!R->csv) return fprintf(stderr, "error: cannot write %s\n", path), 1;

@@ -63,6 +63,25 @@ static int grow_grain_arrays(run *R, int n) {
     return 0;
 }
 
+/* indent: the training of Sec 4.1.1 with the bin's walls and the intruder in the scene: the intruder
+ * starts on the settled reference bed (as in the dem run) and travels the continuum's depth with the
+ * boundary grains, then both are held for the relaxation */
+static int indent_train(run *R, const unsigned char *bnd, double *const u[2], long ntrain, long nrelax,
+                        gk_err *e) {
+    gk_scene *sc = &R->sc;
+    double z[3] = {0.0, 0.0, 0.0};
+    int p, bad = 0;
+    if (add_bin_walls(R) || add_intruder(R, R->y_intr0, R->depth / ((double)ntrain * R->dt)))
+        return gk_err_set(e, GK_ERR_STATE, "indent: the bin or the intruder could not be added"), 1;
+    if (gk_hybrid_train(sc, bnd, (const double *const *)u, ntrain, 0, e)) return 1;
+    intruder_velocity(R, 0.0);
+    for (p = 0; p < sc->rve.n && !bad; ++p) bad = bnd[p] && gk_scene_prescribe(sc, p, z, z);
+    bad = bad || gk_scene_step(sc, nrelax);
+    for (p = 0; p < sc->rve.n && !bad; ++p) bad = bnd[p] && gk_scene_release(sc, p);
+    if (bad) return gk_err_set(e, GK_ERR_STATE, "training relaxation: %s", gk_scene_error(sc)), 1;
+    return 0;
+}
+
 /* Sec 4: zones from the flagged nodes, the reference packing's grains of the
  * discrete zone trained (Sec 4.1.1), the swap (gk_hybrid_enrich) */
 static int enrich(run *R) {
@@ -190,6 +209,7 @@ static int enrich(run *R) {
             ua[1][p] = u[1][q];
             R->role[q] = (unsigned char)role_of(R, sub.y[q]);
         }
+        if (o->test == T_INDENT && R->depth > umax) umax = R->depth;
         ntrain = (long)ceil(umax / (o->train_speed * R->dt));
         if (ntrain < 1000) ntrain = 1000;
         nrelax = ntrain / 10 > 500 ? ntrain / 10 : 500;
@@ -198,7 +218,10 @@ static int enrich(run *R) {
                    "training "
                    "%ld + %ld steps (largest boundary displacement %.3g mm)\n",
                    R->strain, R->orc.nflag, ng, nb, ntrain, nrelax, 1e3 * umax);
-        bad = gk_hybrid_train(&R->sc, bm, (const double *const *)ua, ntrain, nrelax, &e) != GK_OK;
+        if (o->test == T_INDENT)
+            bad = indent_train(R, bm, ua, ntrain, nrelax, &e);
+        else
+            bad = gk_hybrid_train(&R->sc, bm, (const double *const *)ua, ntrain, nrelax, &e) != GK_OK;
         free(bm);
         free(ua[0]);
         free(ua[1]);

@@ -10,6 +10,54 @@
 #include "hybrid_setup.h"
 
 /* ------------------------------------------------------------------ grains */
+/* indent, every mode: the bed in its bin settles under gravity (the cut
+ * periodic packing, consolidated to --pressure, relaxes to its own weight
+ * and its loose top grains drop) until its kinetic energy is below 1e-6 of
+ * N m g D50; the settled positions become the reference packing (the
+ * hybrid's grains come from it) and the intruder's start is the highest
+ * grain under it (each model's intruder starts on its own surface: the
+ * grains' here, the continuum's at y = H). The dem mode keeps the scene. */
+static int indent_settle(run *R) {
+    gk_scene_def d = scene_def(R);
+    gk_scene *sc = &R->sc;
+    double m = RHO_S * THICK * GK_PI * 0.25 * DIAM * DIAM, x0 = 0.5 * (R->W - R->o.intruder), ytop = 0.0,
+           ke = 0.0, lim;
+    long st;
+    int p;
+    if (gk_scene_create(sc, &d, &R->pk)) return fprintf(stderr, "error: scene: %s\n", gk_scene_error(sc)), 1;
+    R->have_sc = 1;
+    lim = 1e-6 * sc->rve.n * m * GRAV * DIAM;
+    if (add_bin_walls(R)) return 1;
+    for (st = 0; st < 2000000; st += 2000) {
+        if (gk_scene_step(sc, 2000)) return fprintf(stderr, "error: settling: %s\n", gk_scene_error(sc)), 1;
+        ke = gk_rve_kinetic_energy(&sc->rve);
+        if (st >= 10000 && ke < lim) break;
+    }
+    if (!(ke < lim)) return fprintf(stderr, "error: the bed did not settle (kinetic energy %g J)\n", ke), 1;
+    for (p = 0; p < sc->rve.n; ++p) {
+        double x[3], r = (double)sc->rve.r[p];
+        int k = sc->rve.id[p]; /* the scene's ids are the packing's indices */
+        gk_scene_position(sc, p, x);
+        R->pk.x[k] = x[0];
+        R->pk.y[k] = x[1];
+        if (x[0] + r > x0 && x[0] - r < x0 + R->o.intruder && x[1] + r > ytop) ytop = x[1] + r;
+    }
+    if (!R->o.quiet) {
+        double wt = 0.0; /* at rest between smooth sides the bottom carries the whole weight */
+        for (p = 0; p < sc->rve.n; ++p) wt += sc->mass[p] * GRAV;
+        printf("bed settled under gravity in %ld steps: the bottom carries %.6g N of the grains' weight %.6g "
+               "N; the grains' intruder starts at y = %.5g m\n",
+               st + 2000, -sc->walls[R->bin_bottom].force[1], wt, ytop);
+    }
+    R->y_intr0 = ytop;
+    sc->rve.time = 0.0;
+    if (R->o.mode != M_DEM) {
+        gk_scene_destroy(sc);
+        R->have_sc = 0;
+    }
+    return 0;
+}
+
 /* the all-grain specimen: the packing with its top and bottom layers as
  * platens (planar: rough, prescribed grains) or bottom layer and a
  * frictionless wall (biaxial), membranes on the sides (biaxial) */
@@ -18,6 +66,7 @@ static int setup_dem(run *R) {
     gk_scene *sc = &R->sc;
     int p, n;
     double z[3] = {0.0, 0.0, 0.0};
+    if (R->o.test == T_INDENT) return add_intruder(R, R->y_intr0, platen_speed(R, 0.0)); /* indent_settle */
     if (gk_scene_create(sc, &d, &R->pk)) return fprintf(stderr, "error: scene: %s\n", gk_scene_error(sc)), 1;
     R->have_sc = 1;
     n = sc->rve.n;
@@ -84,7 +133,12 @@ static int setup_dem(run *R) {
 /* the platen loads of the grains (compression-positive, per the specimen width) */
 static void dem_measure(run *R) {
     gk_scene *sc = &R->sc;
-    if (R->o.test == T_PLANAR) {
+    if (R->o.test == T_INDENT) {
+        double f[2];
+        intruder_force(R, f);
+        R->tau = f[1] / (R->o.intruder * THICK);
+        R->sig_n = f[0] / (R->o.intruder * THICK);
+    } else if (R->o.test == T_PLANAR) {
         double fx = 0.0, fy = 0.0;
         int p;
         for (p = 0; p < sc->rve.n; ++p)
@@ -109,6 +163,8 @@ static int dem_steps(run *R, long K) {
         v[2] = 0.0;
         for (p = 0; p < sc->rve.n; ++p)
             if (R->role[sc->rve.id[p]] == 2) gk_scene_prescribe(sc, p, v, z);
+    } else if (R->o.test == T_INDENT) {
+        intruder_velocity(R, V);
     } else {
         sc->walls[R->top_wall].def.velocity[1] = -V;
     }
@@ -123,6 +179,13 @@ static int dem_steps(run *R, long K) {
         dem_measure(R);
         platen_velocity(R, R->sig_n * R->W * THICK, K * R->dt);
         R->strain = R->plate_x / R->W;
+    } else if (R->o.test == T_INDENT) {
+        R->depth = R->y_intr0 - R->sc.walls[R->intr[0]].pos[1];
+        dem_measure(R);
+        R->qsum[0] += R->tau;
+        R->qsum[1] += R->sig_n;
+        ++R->qn;
+        R->strain = R->depth / R->o.intruder;
     } else {
         double A = specimen_area(R);
         R->plate_y = sc->walls[R->top_wall].pos[1] - R->y_plate0;
@@ -138,7 +201,7 @@ static int setup_mpm(run *R) {
     const opts *o = &R->o;
     gk_mpm_dp dp;
     gk_err e;
-    double org[3] = {0.0, 0.0, 0.0}, Phi0;
+    double org[3] = {0.0, 0.0, 0.0}, Phi0, K0 = 1.0;
     int n[3] = {1, 1, 1}, ncx = (int)floor(R->W / o->cell + 0.5), nxp, nyp, i, j, p, margin;
     if (ncx < 3)
         return fprintf(stderr, "error: --cell %g: fewer than 3 cells across %g m\n", o->cell, R->W), 1;
@@ -166,6 +229,11 @@ static int setup_mpm(run *R) {
     if (gk_hybrid_periodic_check(&R->g, &R->per, R->md.basis, &e))
         return fprintf(stderr, "error: %s\n", e.msg), 1;
     gk_mpm_grid_set_bc(&R->g, 2, GK_MPM_BC_FIXED, 0.0, 2, &e); /* bottom: no slip */
+    if (o->test == T_INDENT) {                                 /* the bin's sides: rollers */
+        gk_mpm_grid_set_bc(&R->g, 0, GK_MPM_BC_ROLLER, 0.0, 2, &e);
+        gk_mpm_grid_set_bc(&R->g, 1, GK_MPM_BC_ROLLER, 0.0, 2, &e);
+        R->md.gravity[1] = -GRAV;
+    }
     /* points: ppd per cell edge on the cells' lattice (a point row that straddled
      * a cell boundary would tie a band to its neighbours); the continuum's
      * height is the whole number of cells nearest the packing's (its top
@@ -174,6 +242,11 @@ static int setup_mpm(run *R) {
     nyp = (int)floor(R->H / R->h + 0.5) * o->ppd;
     R->dxp = R->dyp = R->h / o->ppd;
     if (gk_mpm_points_create(&R->P, 2, nxp * nyp, NULL, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
+    Phi0 = o->phi_init > 0.0 ? o->phi_init : R->phi_pack;
+    if (o->test == T_INDENT) { /* Jaky's K0 = 1 - sin(phi) with the friction angle of eq 7 at Phi0 */
+        double tphi = tan(0.27) + (Phi0 - PHI_CS) * 7.0;
+        K0 = 1.0 - tphi / sqrt(1.0 + tphi * tphi);
+    }
     R->side = (double *)calloc((size_t)nxp * nyp, sizeof(double));
     R->Fw = (double *)calloc(9 * (size_t)nxp * nyp, sizeof(double));
     if (!R->side || !R->Fw) return fprintf(stderr, "error: out of memory\n"), 1;
@@ -184,7 +257,12 @@ static int setup_mpm(run *R) {
             R->P.vol0[p] = R->P.vol[p] = R->dxp * R->dyp;
             R->P.m[p] = R->rho * R->dxp * R->dyp;
             R->P.lp[p] = 0.5 * (R->dxp < R->dyp ? R->dxp : R->dyp);
-            R->P.sigma[9 * p] = R->P.sigma[9 * p + 4] = -o->pressure;
+            if (o->test == T_INDENT) { /* geostatic: sigma_yy = -rho g depth, sigma_xx = K0 sigma_yy */
+                R->P.sigma[9 * p + 4] = -R->rho * GRAV * (nyp * R->dyp - R->P.x[1][p]);
+                R->P.sigma[9 * p] = K0 * R->P.sigma[9 * p + 4];
+            } else {
+                R->P.sigma[9 * p] = R->P.sigma[9 * p + 4] = -o->pressure;
+            }
             if (o->test == T_BIAXIAL) R->side[p] = i == 0 ? -1.0 : (i == nxp - 1 ? 1.0 : 0.0);
         }
     if (gk_mpm_dp_init(&dp, 2, K_C, G_C, 0.27, 0.0, 0.0, &e)) return fprintf(stderr, "error: %s\n", e.msg), 1;
@@ -192,7 +270,6 @@ static int setup_mpm(run *R) {
     dp.Phi_cs = PHI_CS;
     dp.chi = 7.0;
     dp.xi = o->xi;
-    Phi0 = o->phi_init > 0.0 ? o->phi_init : R->phi_pack;
     if (gk_hybrid_cont_init(&R->C, &R->P, &dp, Phi0, NULL, &e))
         return fprintf(stderr, "error: %s\n", e.msg), 1;
     /* the weak points that seed the band */
@@ -202,24 +279,37 @@ static int setup_mpm(run *R) {
          * shares its cells with strong ones could not slip alone */
         int weak = o->test == T_PLANAR
                        ? (int)floor(y / R->h) == (int)floor(0.5 * R->H / R->h)
-                       : (x > R->W - 2.0 * R->h && x < R->W - R->h && y > R->h && y < 2.0 * R->h);
+                       : (o->test == T_BIAXIAL && x > R->W - 2.0 * R->h && x < R->W - R->h && y > R->h &&
+                          y < 2.0 * R->h); /* indent: none (the intruder's corners seed the bands) */
         if (weak) R->C.Phi[p] = Phi0 - o->weak_dphi;
     }
     /* the top platen: rough and servo-controlled (planar) or frictionless (biaxial). The body
      * moves with its velocity (gk_mpm_bodies_advance): planar, it starts as far to the left
      * as it will travel, so that it covers the whole top row to the end of the run */
     memset(&R->body, 0, sizeof R->body);
-    R->body.lo[0] = org[0] - R->h - (o->test == T_PLANAR ? o->strain_end * R->W : 0.0);
-    R->body.hi[0] = org[0] + (n[0] + 1) * R->h;
-    R->body.lo[1] = R->H - 1e-9; /* the nodes at and above the material's top surface */
-    R->body.hi[1] = org[1] + (n[1] + 1) * R->h;
-    if (o->test == T_PLANAR) {
-        R->body.contact = GK_MPM_CONTACT_STICK;
-        R->body.v[0] = o->speed;
+    if (o->test == T_INDENT) { /* the intruder: rough (Coulomb, the grains' mu) on the nearest face; its
+                                * x- and x+ faces 2e-9 m out, so the bottom corners belong to its bottom */
+        double x0 = 0.5 * (R->W - o->intruder);
+        R->body.lo[0] = x0 - 2e-9;
+        R->body.hi[0] = x0 + o->intruder + 2e-9;
+        R->body.lo[1] = R->H - 1e-9;
+        R->body.hi[1] = R->H + 0.4 * o->intruder + 1e-9;
+        R->body.contact = GK_MPM_CONTACT_FRICTION;
+        R->body.mu = 0.5;
+        R->body.v[1] = -platen_speed(R, 0.0);
     } else {
-        R->body.contact = GK_MPM_CONTACT_SMOOTH;
-        R->body.face = 3; /* its y- face: normal -y into the material */
-        R->body.v[1] = -o->speed;
+        R->body.lo[0] = org[0] - R->h - (o->test == T_PLANAR ? o->strain_end * R->W : 0.0);
+        R->body.hi[0] = org[0] + (n[0] + 1) * R->h;
+        R->body.lo[1] = R->H - 1e-9; /* the nodes at and above the material's top surface */
+        R->body.hi[1] = org[1] + (n[1] + 1) * R->h;
+        if (o->test == T_PLANAR) {
+            R->body.contact = GK_MPM_CONTACT_STICK;
+            R->body.v[0] = o->speed;
+        } else {
+            R->body.contact = GK_MPM_CONTACT_SMOOTH;
+            R->body.face = 3; /* its y- face: normal -y into the material */
+            R->body.v[1] = -o->speed;
+        }
     }
     R->g.body = &R->body;
     R->g.nbody = 1;
@@ -252,6 +342,7 @@ static int mpm_predict(run *R) {
         R->body.v[1] = -platen_speed(R, R->t);
     }
     if (R->have_sc && R->top_wall >= 0) R->sc.walls[R->top_wall].def.velocity[1] = R->body.v[1];
+    if (R->have_sc && R->nintr) intruder_velocity(R, -R->body.v[1]);
     mpm_traction(R);
     if (gk_hybrid_mpm_predict(&R->g, &R->per, &R->P, &R->md, R->dt, gk_hybrid_dp_stress, &R->C, &e))
         return fprintf(stderr, "error: MPM at t = %g s: %s\n", R->t, e.msg), 1;
@@ -279,6 +370,16 @@ static void mpm_measure(run *R) {
         R->sig_n = -R->body.force[1] / W;
         platen_velocity(R, R->sig_n * R->W * THICK, R->dt);
         R->strain = R->plate_x / R->W;
+    } else if (R->o.test == T_INDENT) { /* the continuum's and the grains' push on the intruder */
+        double f[2] = {0.0, 0.0};
+        if (R->have_sc && R->nintr) intruder_force(R, f);
+        R->depth -= R->body.v[1] * R->dt;
+        R->tau = (-R->body.force[1] + f[1] / THICK) / R->o.intruder;
+        R->sig_n = (-R->body.force[0] + f[0] / THICK) / R->o.intruder;
+        R->strain = R->depth / R->o.intruder;
+        R->qsum[0] += R->tau;
+        R->qsum[1] += R->sig_n;
+        ++R->qn;
     } else {
         double F = -R->body.force[1];
         R->plate_y += R->body.v[1] * R->dt;

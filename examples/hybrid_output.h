@@ -78,16 +78,24 @@ typedef struct hist_t {
 
 static int csv_row(run *R, hist_t *h) {
     int grains = R->have_sc ? R->sc.rve.n : 0, points = R->have_mpm ? R->P.n : 0;
-    double ev, evb = R->phi0_band / band_solid_fraction(R) - 1.0;
+    double ev, evb = R->o.test == T_INDENT ? NAN : R->phi0_band / band_solid_fraction(R) - 1.0, tau = R->tau,
+               sn = R->sig_n;
+    if (R->o.test == T_INDENT && R->qn > 0) { /* the intruder's load averaged since the last row */
+        tau = R->qsum[0] / (double)R->qn;
+        sn = R->qsum[1] / (double)R->qn;
+        R->qsum[0] = R->qsum[1] = 0.0;
+        R->qn = 0;
+    }
     if (R->o.test == T_PLANAR)
         ev = R->plate_y / R->H;
+    else if (R->o.test == T_INDENT)
+        ev = NAN; /* an open bed: no specimen volume */
     else
         ev = specimen_area(R) / R->A0 - 1.0;
-    if (fprintf(R->csv, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%.3f\n", R->t, R->strain, R->tau, R->sig_n,
-                ev, evb, grains, points, R->enriched, R->enriched ? 0 : R->orc.nflag,
-                wtime() - R->t_start) < 0)
+    if (fprintf(R->csv, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%d,%d,%.3f\n", R->t, R->strain, tau, sn, ev, evb,
+                grains, points, R->enriched, R->enriched ? 0 : R->orc.nflag, wtime() - R->t_start) < 0)
         return fprintf(stderr, "error: cannot write %s/hybrid.csv\n", R->o.out), 1;
-    if (R->tau > R->peak_tau) R->peak_tau = R->tau;
+    if (tau > R->peak_tau) R->peak_tau = tau;
     if (h->n == h->cap) {
         int c = h->cap ? 2 * h->cap : 256;
         double **a[5];
@@ -105,15 +113,15 @@ static int csv_row(run *R, hist_t *h) {
         h->cap = c;
     }
     h->s[h->n] = 100.0 * R->strain;
-    h->tau[h->n] = 1e-3 * R->tau;
-    h->sn[h->n] = 1e-3 * R->sig_n;
+    h->tau[h->n] = 1e-3 * tau;
+    h->sn[h->n] = 1e-3 * sn;
     h->ev[h->n] = 100.0 * ev;
     h->evb[h->n] = 100.0 * evb;
     ++h->n;
     if (!R->o.quiet)
         printf("t %.4f s  strain %6.3f %%  tau %8.2f kPa  sigma_n %8.2f kPa  eps_v %7.3f %%  band %7.3f %%  "
                "%s%s\n",
-               R->t, 100.0 * R->strain, 1e-3 * R->tau, 1e-3 * R->sig_n, 100.0 * ev, 100.0 * evb,
+               R->t, 100.0 * R->strain, 1e-3 * tau, 1e-3 * sn, 100.0 * ev, 100.0 * evb,
                R->enriched ? "enriched" : "", R->triggered && !R->enriched ? "flagged" : "");
     return 0;
 }
@@ -226,7 +234,9 @@ static int band_measure(run *R, double *thick_D50) {
                        xy[8 * p + 7] = py[p] + a;
         }
     }
-    if (gk_hybrid_band(n, px, py, val, R->o.percentile, 2.0, &b, NULL, &e) == GK_OK) {
+    if (R->o.test == T_INDENT) { /* two curved bands: App. A's one straight box does not apply */
+        if (!R->o.quiet) printf("band: not measured (indent: curved bands; see band.svg)\n");
+    } else if (gk_hybrid_band(n, px, py, val, R->o.percentile, 2.0, &b, NULL, &e) == GK_OK) {
         /* points: the box of their centres plus the spacing of one point (the material it carries) */
         if (!R->band_on_grains) b.thickness += R->dyp;
         *thick_D50 = b.thickness / DIAM;
@@ -271,16 +281,20 @@ static int write_plots(const run *R, const hist_t *h) {
     gk_plot pl;
     gk_err e;
     char path[1200], title[200];
-    int bad = 0;
-    snprintf(title, sizeof title, "%s shear, %s", test_name[R->o.test], mode_name[R->o.mode]);
-    gk_plot_init(&pl, title,
-                 R->o.test == T_PLANAR ? "strain = platen displacement / W [%]" : "axial strain [%]",
-                 "stress [kPa]");
-    gk_plot_add(&pl, h->s, h->tau, h->n, R->o.test == T_PLANAR ? "tau" : "tau = (sigma_1 - sigma_3)/2");
-    gk_plot_add(&pl, h->s, h->sn, h->n, R->o.test == T_PLANAR ? "sigma_n" : "sigma_1 (axial)");
+    int bad = 0, t = R->o.test;
+    const char *xl[3] = {"strain = platen displacement / W [%]", "axial strain [%]",
+                         "intruder depth / width [%]"};
+    const char *l1[3] = {"tau", "tau = (sigma_1 - sigma_3)/2", "q = vertical force / B"};
+    const char *l2[3] = {"sigma_n", "sigma_1 (axial)", "horizontal force / B"};
+    snprintf(title, sizeof title, t == T_INDENT ? "plate indentation, %s" : "%s shear, %s",
+             t == T_INDENT ? mode_name[R->o.mode] : test_name[t], mode_name[R->o.mode]);
+    gk_plot_init(&pl, title, xl[t], "stress [kPa]");
+    gk_plot_add(&pl, h->s, h->tau, h->n, l1[t]);
+    gk_plot_add(&pl, h->s, h->sn, h->n, l2[t]);
     snprintf(path, sizeof path, "%s/stress_strain.svg", R->o.out);
     if (gk_plot_svg(&pl, path, &e)) bad = fprintf(stderr, "error: cannot write %s\n", path);
-    gk_plot_init(&pl, title, R->o.test == T_PLANAR ? "strain [%]" : "axial strain [%]",
+    if (t == T_INDENT) return bad != 0; /* an open bed: no volume */
+    gk_plot_init(&pl, title, t == T_PLANAR ? "strain [%]" : "axial strain [%]",
                  "volumetric strain [%] (dilation +)");
     gk_plot_add(&pl, h->s, h->ev, h->n, "specimen");
     gk_plot_add(&pl, h->s, h->evb, h->n, "band window");

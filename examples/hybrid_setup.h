@@ -41,11 +41,12 @@
 
 #define T_PLANAR 0
 #define T_BIAXIAL 1
+#define T_INDENT 2
 #define M_DEM 0
 #define M_CONT 1
 #define M_HYBRID 2
 
-static const char *test_name[] = {"planar", "biaxial"};
+static const char *test_name[] = {"planar", "biaxial", "indent"};
 static const char *mode_name[] = {"dem", "continuum", "hybrid"};
 
 /* ------------------------------------------------------------------ material */
@@ -57,6 +58,7 @@ static const char *mode_name[] = {"dem", "continuum", "hybrid"};
 #define PHI_CS 0.815 /* Table 2 */
 #define K_C 6.3e8
 #define G_C 4.6e8
+#define GRAV 9.81 /* Table 7 */
 
 typedef struct opts {
     int test, mode;
@@ -64,6 +66,7 @@ typedef struct opts {
     double width, height, pressure, speed, strain_end, out_every;
     double cell, alpha, train, train_speed, phi0, c0, c1, cl, cg, phi_init, weak_dphi, xi;
     double win0, win1, band_window, percentile, dem_seconds, platen_zeta, ramp;
+    double intruder; /* indent: the intruder's width B [m] (its height 0.4 B, Table 8) */
     double probe[3]; /* --probe S Y0 Y1 (dem): strain, strip */
     int probe_on;
     int ppd, threads, oracle_every, quiet;
@@ -105,6 +108,23 @@ static void defaults(opts *o, int test) {
         o->win0 = 0.37;
         o->win1 = 0.57;
         o->band_window = 0.011;
+    } else if (test == T_INDENT) { /* Tables 7-9 at a fifth of the size */
+        o->width = 0.12;
+        o->height = 0.04;
+        o->intruder = 0.01;
+        o->speed = 0.1;
+        o->cell = 0.0025;
+        o->pressure = 1e5; /* the packing's consolidation (it then relaxes to its weight in the bin) */
+        o->strain_end = 0.4;
+        o->out_every = 0.01;
+        o->phi0 = 0.01; /* the paper: 0.025 = 5 of its cells for its 5 cm intruder */
+        o->c0 = 1e-6;
+        o->c1 = 8e-3;
+        o->cl = 2e-2;
+        o->cg = 9.6e-3;
+        o->win0 = 0.2;
+        o->win1 = 0.4;
+        o->band_window = 0.005;
     } else { /* Tables 5-6 */
         o->height = 0.0471;
         o->pressure = 1e5;
@@ -122,28 +142,32 @@ static void defaults(opts *o, int test) {
 }
 
 static void usage(FILE *fp) {
-    opts p, b;
+    opts p, b, d;
     defaults(&p, T_PLANAR);
     defaults(&b, T_BIAXIAL);
+    defaults(&d, T_INDENT);
     fprintf(
         fp,
-        "usage: hybrid --test planar|biaxial --mode dem|continuum|hybrid [options]\n"
+        "usage: hybrid --test planar|biaxial|indent --mode dem|continuum|hybrid [options]\n"
+        "  (defaults given as planar, biaxial[, indent])\n"
         "  --out DIR            output directory (default %s)\n"
         "  --threads T          OpenMP threads (default 1; results do not depend on it)\n"
-        "  --width W --height H specimen [m] (planar %g x %g, biaxial %g x %g; paper 0.06 x 0.12, 0.06 x "
-        "0.0942)\n"
+        "  --width W --height H specimen or bin [m] (%g x %g, %g x %g, %g x %g; paper 0.06 x 0.12, 0.06 x "
+        "0.0942, 0.6 x 0.2)\n"
+        "  --intruder B         indent: the intruder's width [m], its height 0.4 B (default %g; paper 0.05)\n"
         "  --grains N           grains of the generated packing (0: from the size, packing fraction 0.85)\n"
         "  --packing FILE       read the packing (a periodic cell) instead of generating it\n"
         "  --seed S             packing generator seed (default %lu)\n"
-        "  --pressure P         normal (planar) / confining (biaxial) stress [Pa] (default %g, %g)\n"
-        "  --speed V            platen speed [m/s] (default %g; paper 0.02)\n"
-        "  --strain S           run to this strain (default %g, %g)\n"
-        "  --out-every S        CSV row every S of strain (default %g, %g)\n"
-        "  --cell H             MPM cell [m] (default %g)\n"
+        "  --pressure P         normal (planar) / confining (biaxial) stress, indent: the packing's\n"
+        "                       consolidation before it settles in the bin [Pa] (default %g, %g, %g)\n"
+        "  --speed V            platen / intruder speed [m/s] (default %g, %g, %g; paper 0.02, 0.02, 0.05)\n"
+        "  --strain S           run to this strain (default %g, %g, %g; indent: depth / B)\n"
+        "  --out-every S        CSV row every S of strain (default %g, %g, %g)\n"
+        "  --cell H             MPM cell [m] (default %g, %g, %g)\n"
         "  --ppd K              MPM points per cell edge (default %d)\n"
         "  --alpha A            MPM PIC fraction (default %g)\n"
-        "  --phi0 D             enrichment margin phi_0 [m] (default %g, %g)\n"
-        "  --c0 C --c1 C --cl C --cg C   oracle constants (defaults Tables 4 and 6)\n"
+        "  --phi0 D             enrichment margin phi_0 [m] (default %g, %g, %g)\n"
+        "  --c0 C --c1 C --cl C --cg C   oracle constants (defaults Tables 4, 6 and 9)\n"
         "  --oracle-every N     oracle evaluated every N steps (default %d)\n"
         "  --train F            kinematic training fraction in [0, 1] (default %g; below 1: planar only)\n"
         "  --train-speed V      speed of the trained boundary [m/s] (default: --speed)\n"
@@ -151,7 +175,7 @@ static void usage(FILE *fp) {
         "                       Phi_cs = 0.815 the continuum is under-consolidated)\n"
         "  --weak-dphi D        the weak points' packing fraction is the others' minus D (default %g)\n"
         "  --xi X               rate of eq 8's relaxation of Phi to Phi_cs (default %g, Table 2)\n"
-        "  --window S0 S1       strain window of the band measurement (default %g %g, %g %g)\n"
+        "  --window S0 S1       strain window of the band measurement (default %g %g, %g %g, %g %g)\n"
         "  --band-window B      half-width of the eps_v_band window [m] (default %g, %g)\n"
         "  --percentile Q       band grains: value above the Q-th percentile (default %g)\n"
         "  --platen-damping Z   planar top platen: damping ratio of its dashpot (default %g)\n"
@@ -161,14 +185,18 @@ static void usage(FILE *fp) {
         "S\n"
         "                       (the hybrid run prints this option for its discrete zone and enrichment "
         "strain)\n"
-        "  --paper              the paper's specimen and speed (Tables 3, 5): 6 x 12 cm (planar, phi_0 2.2 "
-        "cm) or\n"
-        "                       6 x 9.42 cm (biaxial), 0.02 m/s; the other flags override it\n"
+        "  --paper              the paper's sizes and speeds (Tables 3, 5, 7-8): 6 x 12 cm (planar, phi_0 "
+        "2.2 "
+        "cm),\n"
+        "                       6 x 9.42 cm (biaxial), 0.02 m/s; indent: a 60 x 20 cm bin, a 5 cm intruder "
+        "at\n"
+        "                       0.05 m/s, cells of 0.5 cm, phi_0 2.5 cm; the other flags override it\n"
         "  --quiet              no progress lines\n",
-        p.out, p.width, p.height, b.width, b.height, p.seed, p.pressure, b.pressure, p.speed, p.strain_end,
-        b.strain_end, p.out_every, b.out_every, p.cell, p.ppd, p.alpha, p.phi0, b.phi0, p.oracle_every,
-        p.train, p.weak_dphi, p.xi, p.win0, p.win1, b.win0, b.win1, p.band_window, b.band_window,
-        p.percentile, p.platen_zeta, p.ramp);
+        p.out, p.width, p.height, b.width, b.height, d.width, d.height, d.intruder, p.seed, p.pressure,
+        b.pressure, d.pressure, p.speed, b.speed, d.speed, p.strain_end, b.strain_end, d.strain_end,
+        p.out_every, b.out_every, d.out_every, p.cell, b.cell, d.cell, p.ppd, p.alpha, p.phi0, b.phi0, d.phi0,
+        p.oracle_every, p.train, p.weak_dphi, p.xi, p.win0, p.win1, b.win0, b.win1, d.win0, d.win1,
+        p.band_window, b.band_window, p.percentile, p.platen_zeta, p.ramp);
 }
 
 static int num(const char *s, double *v) {
@@ -191,21 +219,23 @@ static int parse(int argc, char **argv, opts *o) {
             else if (!strcmp(argv[i + 1], "biaxial"))
                 test = T_BIAXIAL;
             else if (!strcmp(argv[i + 1], "indent"))
-                return fprintf(stderr,
-                               "error: --test indent: the plate indentation (Sec 6.3) is not implemented "
-                               "(planar or biaxial)\n"),
-                       1;
+                test = T_INDENT;
             else
-                return fprintf(stderr, "error: --test %s: use planar or biaxial\n", argv[i + 1]), 1;
+                return fprintf(stderr, "error: --test %s: use planar, biaxial or indent\n", argv[i + 1]), 1;
         }
     }
-    if (test < 0) return fprintf(stderr, "error: --test planar|biaxial is required\n"), 1;
+    if (test < 0) return fprintf(stderr, "error: --test planar|biaxial|indent is required\n"), 1;
     defaults(o, test);
     for (i = 1; i < argc; ++i)
         if (!strcmp(argv[i], "--paper")) { /* Tables 3-6; the other flags override it */
-            o->width = 0.06;
-            o->height = test == T_PLANAR ? 0.12 : 0.0942;
-            o->speed = 0.02;
+            o->width = test == T_INDENT ? 0.6 : 0.06;
+            o->height = test == T_PLANAR ? 0.12 : (test == T_INDENT ? 0.2 : 0.0942);
+            o->speed = test == T_INDENT ? 0.05 : 0.02;
+            if (test == T_INDENT) {
+                o->intruder = 0.05;
+                o->cell = 0.005;
+                o->phi0 = 0.025;
+            }
             if (test == T_PLANAR) {
                 o->phi0 = 0.022;
                 o->band_window = 0.022;
@@ -223,6 +253,7 @@ static int parse(int argc, char **argv, opts *o) {
             {"--paper", CLI_FLAG, &paper, 0, 0, NULL, NULL, 0}, /* applied above */
             {"--width", CLI_REAL, &o->width, 0.005, 10.0, "a width in [0.005, 10] m", NULL, 0},
             {"--height", CLI_REAL, &o->height, 0.005, 10.0, "a height in [0.005, 10] m", NULL, 0},
+            {"--intruder", CLI_REAL, &o->intruder, 0.002, 10.0, "a width in [0.002, 10] m", NULL, 0},
             {"--pressure", CLI_REAL, &o->pressure, 0.0, 1e8, "a stress in (0, 1e8] Pa", NULL, CLI_LO_OPEN},
             {"--speed", CLI_REAL, &o->speed, 0.0, 10.0, "a speed in (0, 10] m/s", NULL, CLI_LO_OPEN},
             {"--strain", CLI_REAL, &o->strain_end, 0.0, 2.0, "a strain in (0, 2]", NULL, CLI_LO_OPEN},
@@ -322,7 +353,15 @@ static int parse(int argc, char **argv, opts *o) {
                1;
     if (o->win1 > o->strain_end + 1e-12)
         return fprintf(stderr, "error: --window end %g beyond --strain %g\n", o->win1, o->strain_end), 1;
-    if (o->test == T_BIAXIAL && o->train < 1.0)
+    if (o->test == T_INDENT) {
+        if (o->intruder > 0.5 * o->width || 0.4 * o->intruder > 0.5 * o->height)
+            return fprintf(stderr,
+                           "error: --intruder %g: wider than half the bin (%g m) or taller than half its "
+                           "depth (%g m)\n",
+                           o->intruder, o->width, o->height),
+                   1;
+    }
+    if (o->test != T_PLANAR && o->train < 1.0)
         return fprintf(stderr,
                        "error: --train %g: below 1 only for the planar test (the band region moves)\n",
                        o->train),
@@ -484,6 +523,11 @@ typedef struct run {
     /* platen: top displacement and velocity */
     double plate_x, plate_y, plate_vy, y_plate0;
     double tau, sig_n; /* last measured, compression-positive [Pa] */
+    /* indent: the intruder's depth [m], the grains' intruder (4 segment walls) and its start */
+    double depth, y_intr0;
+    int intr[4], nintr, bin_bottom;
+    double qsum[2]; /* indent: sums of tau and sigma_n since the last CSV row (its mean is written) */
+    long qn;
     /* continuum */
     int have_mpm;
     gk_mpm_grid g;
@@ -538,6 +582,7 @@ static gk_scene_def scene_def(const run *R) {
     }
     d.lo[1] = -0.5 * R->H;
     d.hi[1] = 1.5 * R->H;
+    if (R->o.test == T_INDENT) d.gravity[1] = -GRAV;
     d.rve.mat = grain_material(zeta_paper(), 0.4);
     d.rve.thickness = THICK;
     d.rve.dt = DT;
@@ -548,6 +593,7 @@ static gk_scene_def scene_def(const run *R) {
 
 /* the grains' role by stable id, from their reference positions */
 static int role_of(const run *R, double y) {
+    if (R->o.test == T_INDENT) return 0; /* the bin's walls hold the bed */
     if (y < 1.5 * DIAM) return 1;
     if (y > R->H - 1.5 * DIAM) return 2;
     return 0;
@@ -571,6 +617,68 @@ static double platen_velocity(run *R, double F, double dt) {
 static double platen_speed(const run *R, double t) {
     double tr = R->o.ramp * R->H / R->c;
     return t >= tr ? R->o.speed : R->o.speed * t / tr;
+}
+
+/* ---- indent: the bin and the intruder of the grains */
+/* the bin: a rough bottom (the grains' friction) and smooth sides, planes at
+ * y = 0, x = 0 and x = W (the continuum's: no-slip bottom, roller sides) */
+static int add_bin_walls(run *R) {
+    int k;
+    for (k = 0; k < 3; ++k) {
+        gk_wall_def w = gk_wall_def_default();
+        w.kind = GK_WALL_PLANE;
+        w.mat = grain_material(zeta_paper(), 0.4);
+        if (k == 0)
+            w.normal[1] = 1.0;
+        else {
+            w.point[0] = k == 1 ? 0.0 : R->W;
+            w.normal[0] = k == 1 ? 1.0 : -1.0;
+            w.mat.friction = 0.0;
+        }
+        if (gk_scene_add_wall(&R->sc, &w, k == 0 ? &R->bin_bottom : NULL))
+            return fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc)), 1;
+    }
+    return 0;
+}
+
+/* the intruder: a rigid B x 0.4 B rectangle of four segments (rough: the
+ * grains' friction) centred on the bin, its bottom at y, moving at (0, -v) */
+static int add_intruder(run *R, double y, double v) {
+    double B = R->o.intruder, Hi = 0.4 * B, x0 = 0.5 * (R->W - B);
+    double a[4][2] = {{x0, y}, {x0, y}, {x0 + B, y}, {x0, y + Hi}},
+           e[4][2] = {{B, 0}, {0, Hi}, {0, Hi}, {B, 0}};
+    int k;
+    for (k = 0; k < 4; ++k) {
+        gk_wall_def w = gk_wall_def_default();
+        w.kind = GK_WALL_SEGMENT;
+        w.point[0] = a[k][0];
+        w.point[1] = a[k][1];
+        w.e1[0] = e[k][0];
+        w.e1[1] = e[k][1];
+        w.normal[1] = -1.0;
+        w.mat = grain_material(zeta_paper(), 0.4);
+        w.drive = GK_DRIVE_VELOCITY;
+        w.velocity[1] = -v;
+        if (gk_scene_add_wall(&R->sc, &w, &R->intr[k]))
+            return fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc)), 1;
+    }
+    R->nintr = 4;
+    return 0;
+}
+
+static void intruder_velocity(run *R, double v) {
+    int k;
+    for (k = 0; k < R->nintr; ++k) R->sc.walls[R->intr[k]].def.velocity[1] = -v;
+}
+
+/* the grains' push on the intruder [N] (x, y): the sum over its four walls */
+static void intruder_force(const run *R, double f[2]) {
+    int k;
+    f[0] = f[1] = 0.0;
+    for (k = 0; k < R->nintr; ++k) {
+        f[0] += R->sc.walls[R->intr[k]].force[0];
+        f[1] += R->sc.walls[R->intr[k]].force[1];
+    }
 }
 
 /* ---- membranes on the grains at the specimen's sides (biaxial) */

@@ -11,6 +11,10 @@
 /* a 1.2 x 2.4 cm planar specimen (about 250 grains, 4 x 8 cells): tiny but the whole path */
 #define PLANAR BUILD "/hybrid --test planar --width 0.012 --height 0.024 --cell 0.003 --phi0 0.005 "
 #define BIAXIAL BUILD "/hybrid --test biaxial --width 0.012 --height 0.018 --cell 0.003 --quiet "
+/* a 6 x 2 cm bin (about 1100 grains), a 1 cm intruder, 2.5 mm cells: the oracle flags at 1 % depth */
+#define INDENT                                                                                             \
+    BUILD "/hybrid --test indent --width 0.06 --height 0.02 --strain 0.06 --out-every 0.01 --window 0.05 " \
+          "0.06 "
 #define HEADER "time,strain,tau,sigma_n,eps_v,eps_v_band,grains,points,enriched,flagged_nodes,seconds\n"
 #define NCOL 11
 
@@ -210,6 +214,71 @@ TEST(hybrid_biaxial_continuum_runs) {
     CHECK(gk_test_file_has(BUILD "/tests/t_hyC/points_end.vtk", "POINTS"));
 }
 
+/* plate indentation (Chen et al. Sec 6.3) on a small bin. dem: the settled
+ * bed is in equilibrium (between smooth sides the bottom carries the grains'
+ * whole weight, within 0.5 %), the intruder starts unloaded and then carries
+ * the load (q > 0 on average), the horizontal load stays small beside it
+ * (symmetry). hybrid, on the same packing: the oracle flags, the swap keeps
+ * the mass, the grains and points share the load afterwards with a mean q
+ * within a factor 2 of the dem run's over the same depths (the paper's Fig
+ * 23: the hybrid follows the discrete curve), and 1 and 2 threads give the
+ * same CSV. */
+TEST(hybrid_indent_dem_and_hybrid_agree) {
+    double d[10][NCOL], h[10][NCOL], qd = 0.0, qh = 0.0, hx = 0.0;
+    int nd, nh, k;
+    system("rm -rf " BUILD "/tests/t_hyI " BUILD "/tests/t_hyIh " BUILD "/tests/t_hyIh2");
+    CHECK(system(INDENT "--mode dem --out " BUILD "/tests/t_hyI > " BUILD "/tests/t_hyI.out 2>&1") == 0);
+    {
+        FILE *fp = fopen(BUILD "/tests/t_hyI.out", "r");
+        char line[1024];
+        double fb = -1.0, wt = -2.0;
+        while (fp && fgets(line, sizeof line, fp)) {
+            const char *q = strstr(line, "the bottom carries ");
+            if (q) sscanf(q, "the bottom carries %lf N of the grains' weight %lf", &fb, &wt);
+        }
+        if (fp) fclose(fp);
+        CHECK(wt > 0.0);
+        CHECK_NEAR(fb, wt, 5e-3 * wt);
+    }
+    nd = read_rows(BUILD "/tests/t_hyI/hybrid.csv", d, 10);
+    CHECK_EQ_INT(nd, 7);
+    if (nd != 7) return;
+    CHECK_NEAR(d[0][2], 0.0, 1e-9); /* unloaded at depth 0 */
+    for (k = 2; k < nd; ++k) {
+        qd += d[k][2] / (nd - 2);
+        hx += d[k][3] / (nd - 2);
+        CHECK(isnan(d[k][4]) && isnan(d[k][5])); /* no specimen volume in an open bed */
+    }
+    CHECK(qd > 1e3);
+    CHECK(fabs(hx) < 0.2 * qd);
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyI/stress_strain.svg", "<svg"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyI/band.svg", "<svg"));
+    CHECK(system(INDENT "--mode hybrid --threads 1 --packing " BUILD "/tests/t_hyI/packing.txt --out " BUILD
+                        "/tests/t_hyIh > " BUILD "/tests/t_hyIh.out 2>&1") == 0);
+    nh = read_rows(BUILD "/tests/t_hyIh/hybrid.csv", h, 10);
+    CHECK_EQ_INT(nh, 7);
+    if (nh != 7) return;
+    CHECK(h[nh - 1][8] == 1.0 && h[nh - 1][6] > 100.0 && h[nh - 1][7] < h[0][7]);
+    for (k = 2; k < nh; ++k) qh += h[k][2] / (nh - 2);
+    CHECK(qh > 0.5 * qd && qh < 2.0 * qd);
+    {
+        FILE *fp = fopen(BUILD "/tests/t_hyIh.out", "r");
+        char line[1024];
+        double m0 = -1, m1 = -2;
+        while (fp && fgets(line, sizeof line, fp)) {
+            const char *q = strstr(line, "mass ");
+            if (!strncmp(line, "swap:", 5) && q) sscanf(q, "mass %lf -> %lf", &m0, &m1);
+        }
+        if (fp) fclose(fp);
+        CHECK(m0 > 0.0);
+        CHECK_NEAR(m1, m0, 1e-4 * m0);
+    }
+    CHECK(system(INDENT "--mode hybrid --threads 2 --quiet --packing " BUILD
+                        "/tests/t_hyI/packing.txt --out " BUILD "/tests/t_hyIh2 > " BUILD
+                        "/tests/t_hyIh2.out 2>&1") == 0);
+    CHECK(same_but_seconds(BUILD "/tests/t_hyIh/hybrid.csv", BUILD "/tests/t_hyIh2/hybrid.csv"));
+}
+
 /* a bad argument: status != 0, the message, and no output directory */
 static int refused(const char *flags, const char *msg) {
     char cmd[512];
@@ -226,8 +295,10 @@ static int refused(const char *flags, const char *msg) {
 }
 
 TEST(hybrid_refuses_bad_arguments) {
-    CHECK(refused("--mode dem", "--test planar|biaxial is required"));
-    CHECK(refused("--test indent --mode dem", "is not implemented"));
+    CHECK(refused("--mode dem", "--test planar|biaxial|indent is required"));
+    CHECK(refused("--test indent --mode dem --intruder 0.07", "--intruder 0.07: wider than half the bin"));
+    CHECK(refused("--test indent --mode hybrid --train 0.5", "below 1 only for the planar test"));
+    CHECK(refused("--test shear --mode dem", "use planar, biaxial or indent"));
     CHECK(refused("--test planar --mode foo", "--mode 'foo' must be dem, continuum or hybrid"));
     CHECK(refused("--test planar --mode hybrid --train 2", "--train 2"));
     CHECK(refused("--test planar --mode dem --width 0.03x", "--width '0.03x' is not a finite number"));
@@ -259,7 +330,7 @@ TEST(hybrid_refuses_bad_arguments) {
     remove(BUILD "/tests/t_hyfile");
     /* --help alone (no --test) prints the usage and exits 0 */
     CHECK(system(BUILD "/hybrid --help > " BUILD "/tests/t_hyhelp.out 2>&1") == 0);
-    CHECK(gk_test_file_has(BUILD "/tests/t_hyhelp.out", "usage: hybrid --test planar|biaxial"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyhelp.out", "usage: hybrid --test planar|biaxial|indent"));
 }
 
 int main(int argc, char **argv) {
@@ -270,5 +341,6 @@ int main(int argc, char **argv) {
     RUN(hybrid_planar_platen_holds_to_large_strain);
     RUN(hybrid_biaxial_dem_loads);
     RUN(hybrid_biaxial_continuum_runs);
+    RUN(hybrid_indent_dem_and_hybrid_agree);
     return gk_test_done();
 }
