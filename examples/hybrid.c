@@ -2,7 +2,7 @@
  * continuum everywhere until an oracle finds the band, then grains in the
  * band (Chen, Chantharayukhonthorn, Yue, Grinspun & Kamrin 2021).
  *
- *   build/hybrid --test planar|biaxial --mode dem|continuum|hybrid [options]
+ *   build/hybrid --test planar|biaxial|indent --mode dem|continuum|hybrid [options]
  *
  * TESTS (2D; compression-positive stresses in every output)
  *   planar   planar shear (Sec 6.1, Table 3): a W x H specimen, periodic
@@ -19,6 +19,21 @@
  *            frictionless moving down at --speed. strain = axial strain,
  *            sigma_n = axial stress, tau = (sigma_n - pressure) / 2,
  *            eps_v = area / area0 - 1 (from the material's extent per row).
+ *   indent   plate indentation (Sec 6.3, Tables 7-9): a W x H bed under
+ *            gravity (9.81 m/s^2) in a bin (rough bottom, smooth sides),
+ *            settled from the consolidated packing; a rough rigid
+ *            intruder B x 0.4 B (--intruder B) centred on it, driven down
+ *            at --speed from where it touches the bed. strain = depth / B,
+ *            tau = q = the intruder's vertical load / B, sigma_n = its
+ *            horizontal load / B (zero but for noise), both the mean
+ *            since the previous CSV row (the grains' load is
+ *            intermittent; the paper smooths its Fig 23 too); eps_v and
+ *            eps_v_band nan (an open bed), no band thickness (two curved
+ *            bands: band.svg shows them). Continuum: geostatic stress
+ *            (sigma_yy = -rho g depth, sigma_xx = K0 sigma_yy, Jaky's
+ *            K0 = 1 - sin phi with eq 7's phi), rollers at the sides, the
+ *            intruder in contact with the points (not the grid nodes);
+ *            the grains' intruder: four segment walls.
  * MODES
  *   dem        grains everywhere (the ground truth)
  *   continuum  MPM everywhere: Hencky-like hypoelastic Drucker-Prager with
@@ -43,8 +58,11 @@
  *          seconds=T speedup_vs_dem=R packing_tau=Pa
  *
  * COST. The defaults are reduced (3 x 6 cm planar, 1778 grains; 3 x 4.71
- * cm biaxial, 1435 grains; 5x the paper's platen speed): one thread, about
- * 25 CPU s for dem and 35-75 CPU s for continuum or hybrid. --paper runs
+ * cm biaxial, 1435 grains; 5x the paper's platen speed; indent: a 12 x 4
+ * cm bed of about 5000 grains, a 1 cm intruder at 2x the paper's speed):
+ * one thread, about 25 CPU s for dem and 35-75 CPU s for continuum or
+ * hybrid (indent: 5 minutes for dem, most of it the consolidation of the
+ * packing, which --packing skips). --paper runs
  * the paper's sizes (Tables 3, 5: 7640 and 5910 grains at 0.02 m/s): about
  * 40x the grain-steps of the reduced runs (4 x the grains, 10 x the steps):
  * the planar dem run to 57 % took 30 min of wall time on one core (2.7e10
@@ -52,8 +70,9 @@
  *
  * KNOWN LIMITS. The continuum's cost per MPM point-step is far above the
  * paper's relative to a grain-step, so the hybrid is slower than dem at
- * these sizes (see the cost: line). Plate indentation (Sec 6.3) is not
- * implemented.
+ * these sizes (see the cost: line). Indent: the discrete zone is made once
+ * (as in the paper); the far-field variant (Fig 25, a moving side wall) is
+ * not implemented.
  */
 #define GK_IMPLEMENTATION
 #define _POSIX_C_SOURCE 200809L

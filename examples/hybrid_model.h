@@ -287,15 +287,7 @@ static int setup_mpm(run *R) {
      * moves with its velocity (gk_mpm_bodies_advance): planar, it starts as far to the left
      * as it will travel, so that it covers the whole top row to the end of the run */
     memset(&R->body, 0, sizeof R->body);
-    if (o->test == T_INDENT) { /* the intruder: rough (Coulomb, the grains' mu) on the nearest face; its
-                                * x- and x+ faces 2e-9 m out, so the bottom corners belong to its bottom */
-        double x0 = 0.5 * (R->W - o->intruder);
-        R->body.lo[0] = x0 - 2e-9;
-        R->body.hi[0] = x0 + o->intruder + 2e-9;
-        R->body.lo[1] = R->H - 1e-9;
-        R->body.hi[1] = R->H + 0.4 * o->intruder + 1e-9;
-        R->body.contact = GK_MPM_CONTACT_FRICTION;
-        R->body.mu = 0.5;
+    if (o->test == T_INDENT) { /* the intruder acts on the points (indent_contact), not on the grid */
         R->body.v[1] = -platen_speed(R, 0.0);
     } else {
         R->body.lo[0] = org[0] - R->h - (o->test == T_PLANAR ? o->strain_end * R->W : 0.0);
@@ -312,7 +304,7 @@ static int setup_mpm(run *R) {
         }
     }
     R->g.body = &R->body;
-    R->g.nbody = 1;
+    R->g.nbody = o->test == T_INDENT ? 0 : 1;
     R->have_mpm = 1;
     R->bcmask = (unsigned char *)malloc(R->g.nnode);
     if (!R->bcmask) return fprintf(stderr, "error: out of memory\n"), 1;
@@ -321,9 +313,52 @@ static int setup_mpm(run *R) {
 
 /* biaxial: the confining pressure as a follower traction on the outer columns
  * of continuum points (overlap and discrete points: the grains' membrane) */
+/* indent: the intruder on the continuum, a rough rigid rectangle [x0, x0 + B] x [yb, yb + 0.4 B]
+ * (yb = H - depth) in contact with the points as squares of their current size: a point that
+ * overlaps it is pushed out across the face of least overlap by k pen + c v_n (k = K + G per unit
+ * thickness, c at half the critical damping of the point's mass), with Coulomb friction (mu 0.5,
+ * viscously regularised) against the intruder's motion. A grid node that a box body covers would
+ * take the material's velocity only at whole rows of nodes: the load would vanish while the
+ * intruder lies between two rows and jump when it reaches the next. body.force holds the sum (the
+ * force on the material, per unit thickness). */
+static void indent_contact(run *R) {
+    double B = R->o.intruder, x0 = 0.5 * (R->W - B), yb = R->H - R->depth, k = R->M, vy = R->body.v[1];
+    int p;
+    R->body.force[0] = R->body.force[1] = 0.0;
+    for (p = 0; p < R->P.n; ++p) {
+        double a = 0.5 * R->dxp * sqrt(R->P.vol[p] / R->P.vol0[p]), x = R->P.x[0][p], y = R->P.x[1][p];
+        double pen[4], n[4][2] = {{-1.0, 0.0}, {1.0, 0.0}, {0.0, -1.0}, {0.0, 1.0}}, m = R->P.m[p];
+        double c = sqrt(k * m), vn, vt, fn, ft, t[2], rv[2];
+        int f, q;
+        if (R->C.zone[p] == GK_ZONE_DISCRETE) continue;
+        pen[0] = x + a - x0;
+        pen[1] = x0 + B - (x - a);
+        pen[2] = y + a - yb;
+        pen[3] = yb + 0.4 * B - (y - a);
+        if (pen[0] <= 0.0 || pen[1] <= 0.0 || pen[2] <= 0.0 || pen[3] <= 0.0) continue;
+        for (f = 0, q = 1; q < 4; ++q)
+            if (pen[q] < pen[f]) f = q;
+        rv[0] = R->P.v[0][p];
+        rv[1] = R->P.v[1][p] - vy; /* the point's velocity relative to the intruder */
+        vn = rv[0] * n[f][0] + rv[1] * n[f][1];
+        fn = k * pen[f] - c * vn; /* along n (out of the intruder), compressive only */
+        if (fn <= 0.0) continue;
+        t[0] = -n[f][1];
+        t[1] = n[f][0];
+        vt = rv[0] * t[0] + rv[1] * t[1];
+        ft = -vt * m / R->dt; /* what would stop the slip in one step, capped by Coulomb */
+        if (fabs(ft) > 0.5 * fn) ft = ft > 0.0 ? 0.5 * fn : -0.5 * fn;
+        R->P.fext[0][p] += fn * n[f][0] + ft * t[0];
+        R->P.fext[1][p] += fn * n[f][1] + ft * t[1];
+        R->body.force[0] += fn * n[f][0] + ft * t[0];
+        R->body.force[1] += fn * n[f][1] + ft * t[1];
+    }
+}
+
 static void mpm_traction(run *R) {
     int p, k;
     for (k = 0; k < 2; ++k) memset(R->P.fext[k], 0, (size_t)R->P.n * sizeof(double));
+    if (R->o.test == T_INDENT) indent_contact(R);
     if (R->o.test != T_BIAXIAL) return;
     for (p = 0; p < R->P.n; ++p)
         if (R->side[p] != 0.0 && R->C.zone[p] == GK_ZONE_CONTINUUM) {

@@ -5,15 +5,17 @@
  * eps_v_band, grains, points, enriched, flagged_nodes, seconds; stresses
  * in Pa compression-positive, eps_v positive in dilation, eps_v_band the
  * same inside the band window: a rectangle around the expected band, of
- * half-width --band-window, measured by mass), points_*.vtk and
+ * half-width --band-window, measured by mass; indent: tau and sigma_n the
+ * intruder's vertical and horizontal load / B averaged since the previous
+ * row, eps_v and eps_v_band nan), points_*.vtk and
  * grains_*.vtk (start, enrichment, window start, end), stress_strain.svg,
- * volume.svg, band.svg (the incremental shear strain over the band window
+ * volume.svg (not for indent), band.svg (the incremental shear strain over the band window
  * --window S0 S1 (strain), grains by Cundall's best fit, points by F),
  * packing.txt, and on stdout a line
  *   RESULT mode=M peak_tau=Pa band_thickness_D50=X strain_at_enrichment=S
  *          seconds=T speedup_vs_dem=R packing_tau=Pa
  * (band thickness by App. A: top --percentile, outliers beyond 2 sd out,
- * minimum-area box; speedup_vs_dem = --dem-seconds / seconds, nan without;
+ * minimum-area box, nan for indent; peak_tau for indent the peak of q; speedup_vs_dem = --dem-seconds / seconds, nan without;
  * packing_tau, planar only: hybrid, the mean shear stress of the trained
  * packing in the discrete zone before it is inserted (Fig 13; with --train
  * 0 the untrained one), dem, that of the grains in the --probe strip at the
@@ -286,8 +288,10 @@ static int write_plots(const run *R, const hist_t *h) {
                          "intruder depth / width [%]"};
     const char *l1[3] = {"tau", "tau = (sigma_1 - sigma_3)/2", "q = vertical force / B"};
     const char *l2[3] = {"sigma_n", "sigma_1 (axial)", "horizontal force / B"};
-    snprintf(title, sizeof title, t == T_INDENT ? "plate indentation, %s" : "%s shear, %s",
-             t == T_INDENT ? mode_name[R->o.mode] : test_name[t], mode_name[R->o.mode]);
+    if (t == T_INDENT)
+        snprintf(title, sizeof title, "plate indentation, %s", mode_name[R->o.mode]);
+    else
+        snprintf(title, sizeof title, "%s shear, %s", test_name[t], mode_name[R->o.mode]);
     gk_plot_init(&pl, title, xl[t], "stress [kPa]");
     gk_plot_add(&pl, h->s, h->tau, h->n, l1[t]);
     gk_plot_add(&pl, h->s, h->sn, h->n, l2[t]);

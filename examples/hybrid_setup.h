@@ -115,15 +115,15 @@ static void defaults(opts *o, int test) {
         o->speed = 0.1;
         o->cell = 0.0025;
         o->pressure = 1e5; /* the packing's consolidation (it then relaxes to its weight in the bin) */
-        o->strain_end = 0.4;
+        o->strain_end = 0.3; /* the intruder's top (0.4 B) stays above the bed */
         o->out_every = 0.01;
         o->phi0 = 0.01; /* the paper: 0.025 = 5 of its cells for its 5 cm intruder */
         o->c0 = 1e-6;
         o->c1 = 8e-3;
         o->cl = 2e-2;
         o->cg = 9.6e-3;
-        o->win0 = 0.2;
-        o->win1 = 0.4;
+        o->win0 = 0.1;
+        o->win1 = 0.3;
         o->band_window = 0.005;
     } else { /* Tables 5-6 */
         o->height = 0.0471;
