@@ -114,7 +114,7 @@ static void defaults(opts *o, int test) {
         o->intruder = 0.01;
         o->speed = 0.1;
         o->cell = 0.0025;
-        o->pressure = 1e5; /* the packing's consolidation (it then relaxes to its weight in the bin) */
+        o->pressure = 1e5;   /* the packing's consolidation (it then relaxes to its weight in the bin) */
         o->strain_end = 0.3; /* the intruder's top (0.4 B) stays above the bed */
         o->out_every = 0.01;
         o->phi0 = 0.01; /* the paper: 0.025 = 5 of its cells for its 5 cm intruder */
@@ -185,12 +185,10 @@ static void usage(FILE *fp) {
         "S\n"
         "                       (the hybrid run prints this option for its discrete zone and enrichment "
         "strain)\n"
-        "  --paper              the paper's sizes and speeds (Tables 3, 5, 7-8): 6 x 12 cm (planar, phi_0 "
-        "2.2 "
-        "cm),\n"
-        "                       6 x 9.42 cm (biaxial), 0.02 m/s; indent: a 60 x 20 cm bin, a 5 cm intruder "
-        "at\n"
-        "                       0.05 m/s, cells of 0.5 cm, phi_0 2.5 cm; the other flags override it\n"
+        "  --paper              the paper's sizes and speeds (Tables 3, 5, 7-8): 6 x 12 cm\n"
+        "                       (planar, phi_0 2.2 cm), 6 x 9.42 cm (biaxial), 0.02 m/s; indent: a\n"
+        "                       60 x 20 cm bin, a 5 cm intruder at 0.05 m/s, cells of 0.5 cm, phi_0\n"
+        "                       2.5 cm; the other flags override it\n"
         "  --quiet              no progress lines\n",
         p.out, p.width, p.height, b.width, b.height, d.width, d.height, d.intruder, p.seed, p.pressure,
         b.pressure, d.pressure, p.speed, b.speed, d.speed, p.strain_end, b.strain_end, d.strain_end,
