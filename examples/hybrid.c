@@ -28,8 +28,9 @@
  *            horizontal load / B (zero but for noise), both the mean
  *            since the previous CSV row (the grains' load is
  *            intermittent; the paper smooths its Fig 23 too); eps_v and
- *            eps_v_band nan (an open bed), no band thickness (two curved
- *            bands: band.svg shows them). Continuum: geostatic stress
+ *            eps_v_band nan (an open bed), no band thickness (the bands
+ *            are curved; band.svg maps the incremental shear strain).
+ *            Continuum: geostatic stress
  *            (sigma_yy = -rho g depth, sigma_xx = K0 sigma_yy, Jaky's
  *            K0 = 1 - sin phi with eq 7's phi), rollers at the sides, the
  *            intruder in contact with the points (not the grid nodes);
@@ -97,7 +98,8 @@ int main(int argc, char **argv) {
     R->W = R->pk.h[0];
     /* the specimen: the packing's width (periodic, planar) and a whole number of
      * MPM cells of height (the continuum's top surface on a node row, where its
-     * platen acts): the packing is cut there, for every mode alike */
+     * platen acts): the packing is cut there, for every mode alike; indent: the
+     * grains that cross the bin's walls (x = 0, x = W, y = 0) are left out */
     hg = R->W / floor(R->W / o->cell + 0.5);
     if (o->test == T_INDENT) { /* the intruder centred, its edges on node lines (as the bin's walls) */
         double B = R->W - 2.0 * floor(0.5 * (R->W - o->intruder) / hg + 0.5) * hg;
@@ -124,8 +126,6 @@ int main(int argc, char **argv) {
         R->pk.n = q;
         R->pk.h[4] = R->H;
     }
-    /* indent: the bin holds the grains inside 0 <= x <= W, y >= 0 (those that crossed its walls are
-     * gone) */
     R->rho = R->phi_pack * RHO_S;
     R->M = K_C + G_C;
     R->c = sqrt(R->M / R->rho);

@@ -36,17 +36,23 @@ static int strip_stress(run *R, double y0, double y1, double *tau, double *sig_n
     return 0;
 }
 
-/* grain p of the hybrid scene: in the overlap and free (coupled this step)? */
+/* grain p of the hybrid scene: free and in the overlap (coupled this step)? Under gravity (indent) a
+ * grain that has left the overlap for the continuum zone stays coupled too: the continuum's points
+ * do not touch grains, so it would fall through the material (in the indentation 27 of 397 grains
+ * did, one by 2 cm, and the intruder's mean load over depth 5-30 % was 8.4 kPa instead of 11.2).
+ * Without gravity such grains stay free: coupled, they stiffen the planar band (mean shear stress
+ * 183 kPa instead of 127, the all-grain DEM's 146) */
 static void coupling_mask(run *R) {
     gk_scene *sc = &R->sc;
-    int p;
+    int p, z;
     for (p = 0; p < sc->rve.n; ++p) {
         double x[3], d;
         R->coupled[p] = 0;
         if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) continue;
         gk_scene_position(sc, p, x);
         if (!gk_hybrid_interp(&R->g, &R->per, R->dist, 1, R->nden, x, &d)) continue;
-        R->coupled[p] = gk_hybrid_zone(d, R->o.phi0, R->h) == GK_ZONE_OVERLAP;
+        z = gk_hybrid_zone(d, R->o.phi0, R->h);
+        R->coupled[p] = z == GK_ZONE_OVERLAP || (z == GK_ZONE_CONTINUUM && R->md.gravity[1] != 0.0);
     }
 }
 

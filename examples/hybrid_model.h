@@ -311,8 +311,6 @@ static int setup_mpm(run *R) {
     return 0;
 }
 
-/* biaxial: the confining pressure as a follower traction on the outer columns
- * of continuum points (overlap and discrete points: the grains' membrane) */
 /* indent: the intruder on the continuum, a rough rigid rectangle [x0, x0 + B] x [yb, yb + 0.4 B]
  * (yb = H - depth) in contact with the points as squares of their current size: a point that
  * overlaps it is pushed out across the face of least overlap by k pen + c v_n (k = K + G per unit
@@ -355,6 +353,9 @@ static void indent_contact(run *R) {
     }
 }
 
+/* biaxial: the confining pressure as a follower traction on the outer columns
+ * of continuum points (overlap and discrete points: the grains' membrane);
+ * indent: the intruder's push */
 static void mpm_traction(run *R) {
     int p, k;
     for (k = 0; k < 2; ++k) memset(R->P.fext[k], 0, (size_t)R->P.n * sizeof(double));
