@@ -225,7 +225,7 @@ static int parse(int argc, char **argv, opts *o) {
     if (test < 0) return fprintf(stderr, "error: --test planar|biaxial|indent is required\n"), 1;
     defaults(o, test);
     for (i = 1; i < argc; ++i)
-        if (!strcmp(argv[i], "--paper")) { /* Tables 3-6; the other flags override it */
+        if (!strcmp(argv[i], "--paper")) { /* Tables 3-8; the other flags override it */
             o->width = test == T_INDENT ? 0.6 : 0.06;
             o->height = test == T_PLANAR ? 0.12 : (test == T_INDENT ? 0.2 : 0.0942);
             o->speed = test == T_INDENT ? 0.05 : 0.02;
@@ -664,6 +664,7 @@ static int add_intruder(run *R, double y, double v) {
     return 0;
 }
 
+/* the grains' intruder moves down at v [m/s] from the next step on */
 static void intruder_velocity(run *R, double v) {
     int k;
     for (k = 0; k < R->nintr; ++k) R->sc.walls[R->intr[k]].def.velocity[1] = -v;
