@@ -188,6 +188,11 @@ int main(int argc, char **argv) {
             status = 1;
             break;
         }
+        if (o->test == T_INDENT) { /* the intruder's load, averaged into the next CSV row */
+            R->qsum[0] += R->tau;
+            R->qsum[1] += R->sig_n;
+            ++R->qn;
+        }
         if (R->enriched && !was && write_vtk(R, "enrichment")) status = 1;
         if (!R->window_taken && R->strain >= o->win0 && take_window(R)) status = 1;
         if (R->strain >= R->next_out - 1e-12) {

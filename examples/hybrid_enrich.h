@@ -71,21 +71,26 @@ static int grow_grain_arrays(run *R, int n) {
 
 /* indent: the training of Sec 4.1.1 with the bin's walls and the intruder in the scene: the intruder
  * starts on the settled reference bed (as in the dem run) and travels the continuum's depth with the
- * boundary grains, then both are held for the relaxation */
+ * boundary grains, then both are held for the relaxation (gk_hybrid_train's own relaxation would
+ * keep the intruder moving: here a second training of zero displacement, after the intruder stops) */
 static int indent_train(run *R, const unsigned char *bnd, double *const u[2], long ntrain, long nrelax,
                         gk_err *e) {
     gk_scene *sc = &R->sc;
-    double z[3] = {0.0, 0.0, 0.0};
-    int p, bad = 0;
-    if (add_bin_walls(R) || add_intruder(R, R->y_intr0, R->depth / ((double)ntrain * R->dt)))
-        return gk_err_set(e, GK_ERR_STATE, "indent: the bin or the intruder could not be added"), 1;
-    if (gk_hybrid_train(sc, bnd, (const double *const *)u, ntrain, 0, e)) return 1;
-    intruder_velocity(R, 0.0);
-    for (p = 0; p < sc->rve.n && !bad; ++p) bad = bnd[p] && gk_scene_prescribe(sc, p, z, z);
-    bad = bad || gk_scene_step(sc, nrelax);
-    for (p = 0; p < sc->rve.n && !bad; ++p) bad = bnd[p] && gk_scene_release(sc, p);
-    if (bad) return gk_err_set(e, GK_ERR_STATE, "training relaxation: %s", gk_scene_error(sc)), 1;
-    return 0;
+    double *zero = (double *)calloc((size_t)sc->rve.n + 1, sizeof(double));
+    const double *const u0[2] = {zero, zero};
+    int bad;
+    if (!zero) return gk_err_set(e, GK_ERR_ALLOC, "out of memory"), 1;
+    bad = add_bin_walls(R) || add_intruder(R, R->y_intr0, R->depth / ((double)ntrain * R->dt));
+    if (bad)
+        gk_err_set(e, GK_ERR_STATE, "indent: the bin or the intruder could not be added");
+    else if (gk_hybrid_train(sc, bnd, (const double *const *)u, ntrain, 0, e))
+        bad = 1;
+    else {
+        intruder_velocity(R, 0.0);
+        bad = gk_hybrid_train(sc, bnd, u0, nrelax, 0, e) != GK_OK;
+    }
+    free(zero);
+    return bad;
 }
 
 /* Sec 4: zones from the flagged nodes, the reference packing's grains of the

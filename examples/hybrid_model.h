@@ -182,9 +182,6 @@ static int dem_steps(run *R, long K) {
     } else if (R->o.test == T_INDENT) {
         R->depth = R->y_intr0 - R->sc.walls[R->intr[0]].pos[1];
         dem_measure(R);
-        R->qsum[0] += R->tau;
-        R->qsum[1] += R->sig_n;
-        ++R->qn;
         R->strain = R->depth / R->o.intruder;
     } else {
         double A = specimen_area(R);
@@ -413,9 +410,6 @@ static void mpm_measure(run *R) {
         R->tau = (-R->body.force[1] + f[1] / THICK) / R->o.intruder;
         R->sig_n = (-R->body.force[0] + f[0] / THICK) / R->o.intruder;
         R->strain = R->depth / R->o.intruder;
-        R->qsum[0] += R->tau;
-        R->qsum[1] += R->sig_n;
-        ++R->qn;
     } else {
         double F = -R->body.force[1];
         R->plate_y += R->body.v[1] * R->dt;

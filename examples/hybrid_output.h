@@ -9,13 +9,15 @@
  * intruder's vertical and horizontal load / B averaged since the previous
  * row, eps_v and eps_v_band nan), points_*.vtk and
  * grains_*.vtk (start, enrichment, window start, end), stress_strain.svg,
- * volume.svg (not for indent), band.svg (the incremental shear strain over the band window
- * --window S0 S1 (strain), grains by Cundall's best fit, points by F),
+ * volume.svg (not for indent), band.svg (the incremental shear strain
+ * over the band window --window S0 S1 (strain), grains by Cundall's best
+ * fit, points by F),
  * packing.txt, and on stdout a line
  *   RESULT mode=M peak_tau=Pa band_thickness_D50=X strain_at_enrichment=S
  *          seconds=T speedup_vs_dem=R packing_tau=Pa
  * (band thickness by App. A: top --percentile, outliers beyond 2 sd out,
- * minimum-area box, nan for indent; peak_tau for indent the peak of q; speedup_vs_dem = --dem-seconds / seconds, nan without;
+ * minimum-area box, nan for indent; peak_tau for indent the peak of the
+ * rows' q; speedup_vs_dem = --dem-seconds / seconds, nan without;
  * packing_tau, planar only: hybrid, the mean shear stress of the trained
  * packing in the discrete zone before it is inserted (Fig 13; with --train
  * 0 the untrained one), dem, that of the grains in the --probe strip at the
