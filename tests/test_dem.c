@@ -548,7 +548,8 @@ TEST(threads_do_not_change_results_3d) {
         }
         d2 = d1;
         d2.threads = 2;
-        if (load_rve(&a, &d1, "bench/data/bench3d_1k.txt") || load_rve(&b, &d2, "bench/data/bench3d_1k.txt")) {
+        if (load_rve(&a, &d1, "bench/data/bench3d_1k.txt") ||
+            load_rve(&b, &d2, "bench/data/bench3d_1k.txt")) {
             CHECK(0);
             return;
         }
