@@ -170,6 +170,12 @@
  *       the run recomputes every point from its accepted state anyway, and
  *       an accept takes the trials of the ranks that ran them. A refused
  *       run (bad argument) moves nothing.
+ *   No balance beats the spread of the costs it is given: with the adaptive
+ *   rule a few points relax far longer than the rest, and at about 8
+ *   points per rank the most loaded rank waits on them (about 70 % of the
+ *   ideal at 1000 ranks in the scaling model). A fixed step count per run
+ *   (rule.n_min = rule.n_max) makes every point cost the same (92 %), at
+ *   the price of no relaxation (less softening after a peak).
  *   gk_twoscale_stats counts the moves and their bytes (migrated,
  *   migrated_bytes; under BALANCE_RUN they are also part of run_bytes_*).
  *   The checkpoint is written and read by rank 0. Without GK_TWOSCALE_MPI
