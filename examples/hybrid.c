@@ -47,10 +47,11 @@
  *              the method.
  *
  * THE CODE. This file holds the manual and main (set-up, the loop of
- * steps, the outputs). The rest is in four headers, each including the one
+ * steps, the outputs). The rest is in five headers, each including the one
  * before:
- *   hybrid_setup.h   tests, modes, material (Chen et al. Tables 1-2), the
- *                    options, the packing, the run's state and geometry
+ *   hybrid_opts.h    tests, modes, material (Chen et al. Tables 1-2), the
+ *                    options
+ *   hybrid_setup.h   the packing, the run's state and geometry
  *   hybrid_model.h   the grains (DEM), the continuum (MPM) and the oracle
  *   hybrid_enrich.h  the enrichment (on the oracle's trigger), the coupled steps
  *   hybrid_output.h  VTK, hybrid.csv, the band measurement, the plots; its
