@@ -401,6 +401,15 @@ GKDEF void gk_hybrid_traction(gk_mpm_points *pts, int p, const double N0[2], dou
 #include <stdlib.h>
 #include <string.h>
 
+/* err's message prefixed with "what index: " (copied first: vsnprintf must not read the buffer it
+ * writes); nothing when err is NULL */
+static gk_result gk__hybrid_prefix(gk_err *err, gk_result r, const char *what, int index) {
+    char msg[GK_ERR_MSG_LEN];
+    if (!err) return r;
+    memcpy(msg, err->msg, sizeof msg);
+    return gk_err_set(err, r, "%s %d: %s", what, index, msg);
+}
+
 /* ---------------------------------------------------------- periodic axes */
 static int gk__hy_wrap_index(int i, int ghost, int period) {
     int r = (i - ghost) % period;
@@ -670,7 +679,7 @@ GKDEF gk_result gk_hybrid_dp_stress(gk_mpm_points *pts, double dt, void *user, g
             }
         if (sqrt(2.0 * dd) > gmax) gmax = sqrt(2.0 * dd);
         r = gk_mpm_dp_update(&c->dp, 2, dH, pts->sigma + 9 * p, &c->Phi[p], &info, err);
-        if (r) return gk_err_set(err, r, "point %d: %s", p, err ? err->msg : "Drucker-Prager update failed");
+        if (r) return gk__hybrid_prefix(err, r, "point", p);
         c->ep[3 * p] += info.deps_p[0];
         c->ep[3 * p + 1] += info.deps_p[4];
         c->ep[3 * p + 2] += info.deps_p[1];
@@ -747,8 +756,7 @@ GKDEF gk_result gk_hybrid_rasterize(const gk_mpm_grid *g, const gk_hybrid_period
         xx[2] = g->dim == 3 ? x[2][p] : 0.0;
         if (!(m[p] >= 0.0) || !isfinite(m[p]))
             return gk_err_set(err, GK_ERR_MASS, "entry %d: mass %g", p, m[p]);
-        if ((r = gk_mpm_shape(g, basis, xx, lp, &st, err)))
-            return gk_err_set(err, r, "entry %d: %s", p, err ? err->msg : "");
+        if ((r = gk_mpm_shape(g, basis, xx, lp, &st, err))) return gk__hybrid_prefix(err, r, "entry", p);
     }
     memset(den, 0, nn * sizeof(double));
     if (val) memset(num, 0, (size_t)ncomp * nn * sizeof(double));
@@ -1238,7 +1246,7 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
         x[1] = xpre[1][p];
         x[2] = 0.0;
         if ((r = gk_mpm_shape(g, basis, x, lp, &c->st[i++], err)))
-            return gk_err_set(err, r, "coupled grain %d: %s", p, err ? err->msg : "");
+            return gk__hybrid_prefix(err, r, "coupled grain", p);
     }
     memset(c->md, 0, nn * sizeof(double));
     for (k = 0; k < 2; ++k) {

@@ -436,6 +436,19 @@ TEST(coupling_equalises_and_conserves) {
         CHECK_NEAR(sc.rve.v[1][p], v[1], 1e-12);
     }
     CHECK(checked > 5);
+    /* a coupled grain off the grid: refused before anything is written, the message names the grain
+     * and keeps the shape function's reason whole (it is copied before the prefix is written) */
+    {
+        gk_real v0 = sc.rve.v[0][1];
+        double xs0 = xp[0][0];
+        xp[0][0] = 1.0;
+        CHECK(gk_hybrid_couple(&c, &g, NULL, d.basis, lp, &sc, (const double *const *)xp, coupled, NULL, t,
+                               dt, &rep, &e) == GK_ERR_OUTSIDE);
+        CHECK(!strncmp(e.msg, "coupled grain 0: point (1, ", 27));
+        CHECK(strstr(e.msg, "its support leaves the grid") != NULL);
+        CHECK(sc.rve.v[0][1] == v0);
+        xp[0][0] = xs0;
+    }
     gk_hybrid_coupling_free(&c);
     gk_scene_destroy(&sc);
     gk_packing_free(&pk);
