@@ -44,7 +44,14 @@
  *              within --phi0 of the flagged nodes becomes grains from the
  *              same packing as dem mode, kinematically trained (Sec 4.1.1),
  *              coupled through a one-cell overlap (eq 9); gk_hybrid.h has
- *              the method.
+ *              the method. Biaxial: the held boundary grains' training
+ *              targets are corrected so that no two overlap more than in
+ *              the packing (the continuum's affine compression would press
+ *              them together, and released they flung grains out); a zone
+ *              that reaches the top platen gets the grains' frictionless
+ *              top wall, seated by a servo on the trained grains at the
+ *              continuum's axial stress; grains that leave the overlap for
+ *              the continuum zone stay coupled (as under gravity).
  *
  * THE CODE. This file holds the manual and main (set-up, the loop of
  * steps, the outputs). The rest is in five headers, each including the one
@@ -74,7 +81,9 @@
  * paper's relative to a grain-step, so the hybrid is slower than dem at
  * these sizes (see the cost: line). Indent: the discrete zone is made once
  * (as in the paper); the far-field variant (Fig 25, a moving side wall) is
- * not implemented.
+ * not implemented. Biaxial at the paper's size: the run stops at 3.4 %
+ * axial strain, when a grain squeezed out at a corner of the discrete zone
+ * leaves the grid (examples/README.md).
  */
 #define GK_IMPLEMENTATION
 #define _POSIX_C_SOURCE 200809L

@@ -218,6 +218,52 @@ TEST(hybrid_biaxial_continuum_runs) {
     CHECK(gk_test_file_has(BUILD "/tests/t_hyC/points_end.vtk", "POINTS"));
 }
 
+/* the driver's "top wall seated on the trained grains at A kPa (the continuum's axial stress B
+ * kPa)" line: A and B, 0 when absent */
+static int seated(const char *path, double *a, double *b) {
+    FILE *fp = fopen(path, "r");
+    char line[1024];
+    int ok = 0;
+    while (fp && fgets(line, sizeof line, fp))
+        if (sscanf(line, "top wall seated on the trained grains at %lf kPa (the continuum's axial stress %lf",
+                   a, b) == 2)
+            ok = 1;
+    if (fp) fclose(fp);
+    return ok;
+}
+
+/* hybrid mode, biaxial, a 2.4 x 3.6 cm specimen whose discrete zone reaches the top platen (the
+ * oracle flags at 0.72 %): the grains' top wall is seated on the trained packing at the
+ * continuum's axial stress (the servo's 1 %), and the held boundary grains were trained without
+ * being pressed into each other, so the grains carry the axial load from the swap on: 1 ms after
+ * it sigma_n is 94 % of the continuum's last value (58 % with the held grains pressed together,
+ * 7 % without the seating; bound 80 %); the swap keeps the mass; 1 and 2 threads write the same
+ * CSV */
+TEST(hybrid_biaxial_top_zone_is_seated) {
+    double r[16][NCOL], a = 0.0, b = 0.0;
+    int n, k, last = -1;
+    system("rm -rf " BUILD "/tests/t_hyS " BUILD "/tests/t_hyS2");
+    CHECK(system(BUILD "/hybrid --test biaxial --width 0.024 --height 0.036 --cell 0.003 --phi0 0.006 --mode "
+                       "hybrid --strain 0.011 --out-every 0.001 --window 0.009 0.011 --threads 1 --out " BUILD
+                       "/tests/t_hyS > " BUILD "/tests/t_hyS.out 2>&1") == 0);
+    n = read_rows(BUILD "/tests/t_hyS/hybrid.csv", r, 16);
+    CHECK_EQ_INT(n, 12);
+    if (n != 12) return;
+    for (k = 0; k < n && r[k][8] == 0.0; ++k) last = k;
+    CHECK(last >= 3 && last < n - 1); /* enriched within the run */
+    if (!(last >= 3 && last < n - 1)) return;
+    CHECK(seated(BUILD "/tests/t_hyS.out", &a, &b));
+    CHECK(b > 150.0 && fabs(a - b) <= 0.01 * b);
+    CHECK(fabs(1e-3 * r[last][3] - b) < 0.02 * b); /* the stress it was seated at: the continuum's */
+    CHECK(r[last + 1][3] > 0.8 * r[last][3]);
+    CHECK(swap_keeps_mass(BUILD "/tests/t_hyS.out"));
+    CHECK(system(BUILD "/hybrid --test biaxial --width 0.024 --height 0.036 --cell 0.003 --phi0 0.006 --mode "
+                       "hybrid --strain 0.011 --out-every 0.001 --window 0.009 0.011 --threads 2 --quiet "
+                       "--packing " BUILD "/tests/t_hyS/packing.txt --out " BUILD
+                       "/tests/t_hyS2 > /dev/null 2>&1") == 0);
+    CHECK(same_but_seconds(BUILD "/tests/t_hyS/hybrid.csv", BUILD "/tests/t_hyS2/hybrid.csv"));
+}
+
 /* plate indentation (Chen et al. Sec 6.3) on a small bin. dem: the settled
  * bed is in equilibrium (between smooth sides the bottom carries the grains'
  * whole weight, within 0.5 %), the intruder starts unloaded and then carries
@@ -337,6 +383,7 @@ int main(int argc, char **argv) {
     RUN(hybrid_planar_platen_holds_to_large_strain);
     RUN(hybrid_biaxial_dem_loads);
     RUN(hybrid_biaxial_continuum_runs);
+    RUN(hybrid_biaxial_top_zone_is_seated);
     RUN(hybrid_indent_dem_and_hybrid_agree);
     return gk_test_done();
 }
