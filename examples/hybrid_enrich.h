@@ -111,9 +111,9 @@ static int indent_train(run *R, const unsigned char *bnd, double *const u[2], lo
 static int biaxial_train(run *R, const unsigned char *bnd, double *const u[2], long ntrain, long nrelax,
                          gk_err *e) {
     gk_scene *sc = &R->sc;
-    int p, k, n = sc->rve.n, top = 0;
-    double z[3] = {0.0, 0.0, 0.0}, gmax = -HUGE_VAL, xlo = HUGE_VAL, xhi = -HUGE_VAL, s = 0.0;
-    gk_wall_def w = gk_wall_def_default();
+    int p, n = sc->rve.n, top = 0;
+    long steps = 0;
+    double z[3] = {0.0, 0.0, 0.0}, gmax = -HUGE_VAL, xlo = HUGE_VAL, xhi = -HUGE_VAL, s = 0.0, area;
     for (p = 0; p < n; ++p) top += bnd[p] == 2;
     if (!top) return gk_hybrid_train(sc, bnd, (const double *const *)u, ntrain, nrelax, e) != GK_OK;
     if (gk_hybrid_train(sc, bnd, (const double *const *)u, ntrain, 0, e)) return 1;
@@ -127,30 +127,13 @@ static int biaxial_train(run *R, const unsigned char *bnd, double *const u[2], l
         if (x[0] - r < xlo) xlo = x[0] - r;
         if (x[0] + r > xhi) xhi = x[0] + r;
     }
-    w.kind = GK_WALL_PLANE;
-    w.point[1] = gmax;
-    w.normal[1] = -1.0;
-    w.mat = grain_material(zeta_paper(), 0.4);
-    w.mat.friction = 0.0;
-    w.drive = GK_DRIVE_STRESS;
-    w.target = R->sig_n;
-    w.area = (xhi - xlo) * THICK;
-    w.gain = 0.05;
-    w.max_speed = R->o.speed;
-    if (gk_scene_add_wall(sc, &w, &R->top_wall))
+    area = (xhi - xlo) * THICK;
+    if (add_top_wall(R, gmax) || (steps = seat_top_wall(R, R->sig_n, area, &s)) < 0)
         return gk_err_set(e, GK_ERR_STATE, "top wall: %s", gk_scene_error(sc)), 1;
-    for (k = 0; k < 200; ++k) {
-        if (gk_scene_step(sc, 500)) return gk_err_set(e, GK_ERR_STATE, "seating: %s", gk_scene_error(sc)), 1;
-        s = sc->walls[R->top_wall].force[1] / w.area;
-        if (k >= 10 && fabs(s - w.target) < 0.01 * w.target) break;
-    }
     if (!R->o.quiet)
-        printf(
-            "top wall seated on the trained grains at %.4g kPa (the continuum's axial stress %.4g kPa) in %d "
-            "steps\n",
-            1e-3 * s, 1e-3 * w.target, 500 * (k < 200 ? k + 1 : k));
-    sc->walls[R->top_wall].def.drive = GK_DRIVE_VELOCITY;
-    sc->walls[R->top_wall].def.velocity[1] = 0.0;
+        printf("top wall seated on the trained grains at %.4g kPa (the continuum's axial stress %.4g kPa) "
+               "in %ld steps\n",
+               1e-3 * s, 1e-3 * R->sig_n, steps);
     if (nrelax > 0 && gk_scene_step(sc, nrelax))
         return gk_err_set(e, GK_ERR_STATE, "training relaxation: %s", gk_scene_error(sc)), 1;
     for (p = 0; p < n; ++p)
@@ -509,15 +492,7 @@ static int enrich(run *R) {
         }
         if (R->top_wall < 0 && ytop - gmax < 2.0 * DIAM) { /* grains near the platen (not its layer): the
                                                               frictionless wall, moving with it */
-            gk_wall_def w = gk_wall_def_default();
-            w.kind = GK_WALL_PLANE;
-            w.point[1] = gmax > ytop ? gmax : ytop;
-            w.normal[1] = -1.0;
-            w.mat = grain_material(zeta_paper(), 0.4);
-            w.mat.friction = 0.0;
-            w.drive = GK_DRIVE_VELOCITY;
-            w.velocity[1] = R->body.v[1];
-            if (gk_scene_add_wall(&R->sc, &w, &R->top_wall)) {
+            if (add_top_wall(R, gmax > ytop ? gmax : ytop)) {
                 fprintf(stderr, "error: %s\n", gk_scene_error(&R->sc));
                 goto done;
             }

@@ -83,8 +83,7 @@ static int setup_dem(run *R) {
         }
     }
     if (R->o.test == T_BIAXIAL) {
-        gk_wall_def w = gk_wall_def_default();
-        double ytop = -HUGE_VAL;
+        double ytop = -HUGE_VAL, s;
         int nrow = (int)floor(R->H / (2.0 * DIAM)), k;
         double *l = (double *)malloc((size_t)nrow * sizeof(double)),
                *r = (double *)malloc((size_t)nrow * sizeof(double));
@@ -93,14 +92,7 @@ static int setup_dem(run *R) {
             gk_scene_position(sc, p, x);
             if (x[1] + (double)sc->rve.r[p] > ytop) ytop = x[1] + (double)sc->rve.r[p];
         }
-        w.kind = GK_WALL_PLANE;
-        w.point[1] = ytop;
-        w.normal[1] = -1.0;
-        w.mat = grain_material(zeta_paper(), 0.4);
-        w.mat.friction = 0.0;
-        w.drive = GK_DRIVE_VELOCITY;
-        if (gk_scene_add_wall(sc, &w, &R->top_wall))
-            return fprintf(stderr, "error: %s\n", gk_scene_error(sc)), 1;
+        if (add_top_wall(R, ytop)) return fprintf(stderr, "error: %s\n", gk_scene_error(sc)), 1;
         R->y_plate0 = ytop;
         if (!l || !r) return fprintf(stderr, "error: out of memory\n"), 1;
         for (k = 0; k < nrow; ++k) { /* the packing's sides */
@@ -111,18 +103,8 @@ static int setup_dem(run *R) {
         free(l);
         free(r);
         /* preload: the cut-open top reloaded to the confining pressure by the wall's servo */
-        sc->walls[R->top_wall].def.drive = GK_DRIVE_STRESS;
-        sc->walls[R->top_wall].def.target = R->o.pressure;
-        sc->walls[R->top_wall].def.area = R->W * THICK;
-        sc->walls[R->top_wall].def.gain = 0.05;
-        sc->walls[R->top_wall].def.max_speed = R->o.speed;
-        for (k = 0; k < 200; ++k) {
-            double s;
-            if (gk_scene_step(sc, 500)) return fprintf(stderr, "error: preload: %s\n", gk_scene_error(sc)), 1;
-            s = sc->walls[R->top_wall].force[1] / (R->W * THICK);
-            if (k >= 10 && fabs(s - R->o.pressure) < 0.01 * R->o.pressure) break;
-        }
-        sc->walls[R->top_wall].def.drive = GK_DRIVE_VELOCITY;
+        if (seat_top_wall(R, R->o.pressure, R->W * THICK, &s) < 0)
+            return fprintf(stderr, "error: preload: %s\n", gk_scene_error(sc)), 1;
         sc->walls[R->top_wall].def.velocity[1] = -platen_speed(R, 0.0);
         R->y_plate0 = sc->walls[R->top_wall].pos[1];
         sc->rve.time = 0.0;

@@ -373,6 +373,40 @@ static int add_membranes(run *R, const double *left, const double *right, int nr
     return 0;
 }
 
+/* ---- biaxial: the grains' top wall */
+/* a frictionless plane facing down at height y (R->top_wall), velocity-driven, at rest */
+static int add_top_wall(run *R, double y) {
+    gk_wall_def w = gk_wall_def_default();
+    w.kind = GK_WALL_PLANE;
+    w.point[1] = y;
+    w.normal[1] = -1.0;
+    w.mat = grain_material(zeta_paper(), 0.4);
+    w.mat.friction = 0.0;
+    w.drive = GK_DRIVE_VELOCITY;
+    return gk_scene_add_wall(&R->sc, &w, &R->top_wall) != GK_OK;
+}
+
+/* the top wall's servo presses it on the grains until the stress over area is within 1 % of target
+ * (after at least 10 x 500 steps, at most 200 x 500), then it stops (velocity drive, at rest); the
+ * steps taken, -1 on a scene error (gk_scene_error); the stress reached in *s */
+static long seat_top_wall(run *R, double target, double area, double *s) {
+    gk_wall_def *d = &R->sc.walls[R->top_wall].def;
+    int k;
+    d->drive = GK_DRIVE_STRESS;
+    d->target = target;
+    d->area = area;
+    d->gain = 0.05;
+    d->max_speed = R->o.speed;
+    for (k = 0; k < 200; ++k) {
+        if (gk_scene_step(&R->sc, 500)) return -1;
+        *s = R->sc.walls[R->top_wall].force[1] / area;
+        if (k >= 10 && fabs(*s - target) < 0.01 * target) break;
+    }
+    d->drive = GK_DRIVE_VELOCITY;
+    d->velocity[1] = 0.0;
+    return 500L * (k < 200 ? k + 1 : k);
+}
+
 /* the material's extent per row (grains: x -+ r; points: x -+ half their size) */
 static void extent_rows(const run *R, int nrow, double row_h, double *left, double *right) {
     int k, p;
