@@ -168,7 +168,7 @@ static double limit_boundary_overlaps(const gk_packing *sub, const unsigned char
             int i = ib[a], j = ib[b];
             double dx = sub->x[j] + u[0][j] - sub->x[i] - u[0][i],
                    dy = sub->y[j] + u[1][j] - sub->y[i] - u[1][i];
-            double rs = sub->r[i] + sub->r[j], ex, ey;
+            double rs = sub->r[i] + sub->r[j], ex, ey, ov;
             if (dx * dx + dy * dy >= rs * rs) continue;
             if (np == cap) {
                 int *p2;
@@ -185,7 +185,8 @@ static double limit_boundary_overlaps(const gk_packing *sub, const unsigned char
             ey = sub->y[j] - sub->y[i];
             pa[2 * np] = i;
             pa[2 * np + 1] = j;
-            d0[np++] = rs - sqrt(ex * ex + ey * ey) > 0.0 ? rs - sqrt(ex * ex + ey * ey) : 0.0;
+            ov = rs - sqrt(ex * ex + ey * ey); /* in the reference packing */
+            d0[np++] = ov > 0.0 ? ov : 0.0;
         }
     for (sweep = 0; sweep < 100; ++sweep) {
         double worst = 0.0;

@@ -239,13 +239,14 @@ static int seated(const char *path, double *a, double *b) {
  * it sigma_n is 94 % of the continuum's last value (58 % with the held grains pressed together,
  * 7 % without the seating; bound 80 %); the swap keeps the mass; 1 and 2 threads write the same
  * CSV */
+#define TOPZONE                                                                                          \
+    BUILD "/hybrid --test biaxial --width 0.024 --height 0.036 --cell 0.003 --phi0 0.006 --mode hybrid " \
+          "--strain 0.011 --out-every 0.001 --window 0.009 0.011 "
 TEST(hybrid_biaxial_top_zone_is_seated) {
     double r[16][NCOL], a = 0.0, b = 0.0;
     int n, k, last = -1;
     system("rm -rf " BUILD "/tests/t_hyS " BUILD "/tests/t_hyS2");
-    CHECK(system(BUILD "/hybrid --test biaxial --width 0.024 --height 0.036 --cell 0.003 --phi0 0.006 --mode "
-                       "hybrid --strain 0.011 --out-every 0.001 --window 0.009 0.011 --threads 1 --out " BUILD
-                       "/tests/t_hyS > " BUILD "/tests/t_hyS.out 2>&1") == 0);
+    CHECK(system(TOPZONE "--threads 1 --out " BUILD "/tests/t_hyS > " BUILD "/tests/t_hyS.out 2>&1") == 0);
     n = read_rows(BUILD "/tests/t_hyS/hybrid.csv", r, 16);
     CHECK_EQ_INT(n, 12);
     if (n != 12) return;
@@ -257,10 +258,8 @@ TEST(hybrid_biaxial_top_zone_is_seated) {
     CHECK(fabs(1e-3 * r[last][3] - b) < 0.02 * b); /* the stress it was seated at: the continuum's */
     CHECK(r[last + 1][3] > 0.8 * r[last][3]);
     CHECK(swap_keeps_mass(BUILD "/tests/t_hyS.out"));
-    CHECK(system(BUILD "/hybrid --test biaxial --width 0.024 --height 0.036 --cell 0.003 --phi0 0.006 --mode "
-                       "hybrid --strain 0.011 --out-every 0.001 --window 0.009 0.011 --threads 2 --quiet "
-                       "--packing " BUILD "/tests/t_hyS/packing.txt --out " BUILD
-                       "/tests/t_hyS2 > /dev/null 2>&1") == 0);
+    CHECK(system(TOPZONE "--threads 2 --quiet --packing " BUILD "/tests/t_hyS/packing.txt --out " BUILD
+                         "/tests/t_hyS2 > /dev/null 2>&1") == 0);
     CHECK(same_but_seconds(BUILD "/tests/t_hyS/hybrid.csv", BUILD "/tests/t_hyS2/hybrid.csv"));
 }
 
