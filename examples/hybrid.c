@@ -81,9 +81,10 @@
  * paper's relative to a grain-step, so the hybrid is slower than dem at
  * these sizes (see the cost: line). Indent: the discrete zone is made once
  * (as in the paper); the far-field variant (Fig 25, a moving side wall) is
- * not implemented. Biaxial at the paper's size: the run stops at 3.4 %
- * axial strain, when a grain squeezed out at a corner of the discrete zone
- * leaves the grid (examples/README.md).
+ * not implemented. Biaxial at the paper's size: the run stops at 3.9 %
+ * axial strain, when a grain squeezed out of the discrete zone's side
+ * leaves the grid (examples/README.md); a failed step leaves the state it
+ * stopped in as points_stopped.vtk and grains_stopped.vtk.
  */
 #define GK_IMPLEMENTATION
 #define _POSIX_C_SOURCE 200809L
@@ -96,7 +97,7 @@ int main(int argc, char **argv) {
     hist_t h;
     char path[1200];
     double thick = NAN, secs, hg;
-    int rc = parse(argc, argv, o), status = 0;
+    int rc = parse(argc, argv, o), status = 0, step_failed = 0;
     if (rc) return rc == 2 ? 0 : 2;
     memset(&h, 0, sizeof h);
     R->top_wall = -1;
@@ -181,7 +182,7 @@ int main(int argc, char **argv) {
         int was = R->enriched;
         if (o->mode == M_DEM) {
             if (dem_steps(R, 10)) {
-                status = 1;
+                status = step_failed = 1;
                 break;
             }
             if (o->probe_on && isnan(R->packing_tau) && R->strain >= o->probe[0]) {
@@ -195,7 +196,7 @@ int main(int argc, char **argv) {
                            R->strain, o->probe[1], o->probe[2], 1e-3 * R->packing_tau, 1e-3 * sn);
             }
         } else if (continuum_step(R)) {
-            status = 1;
+            status = step_failed = 1;
             break;
         }
         if (o->test == T_INDENT) { /* the intruder's load, averaged into the next CSV row */
@@ -215,6 +216,7 @@ int main(int argc, char **argv) {
         if (status) break;
     }
     secs = wtime() - R->t_start;
+    if (step_failed) write_vtk(R, "stopped"); /* the state a failed step left, to see why */
     if (!status) {
         if (band_measure(R, &thick) || write_vtk(R, "end") || write_plots(R, &h)) status = 1;
     }

@@ -8,7 +8,8 @@
  * half-width --band-window, measured by mass; indent: tau and sigma_n the
  * intruder's vertical and horizontal load / B averaged since the previous
  * row, eps_v and eps_v_band nan), points_*.vtk and
- * grains_*.vtk (start, enrichment, window start, end), stress_strain.svg,
+ * grains_*.vtk (start, enrichment, window start, end; "stopped" when a step
+ * fails, e.g. a grain leaves the grid), stress_strain.svg,
  * volume.svg (not for indent), band.svg (the incremental shear strain
  * over the band window --window S0 S1 (strain), grains by Cundall's best
  * fit, points by F),

@@ -309,9 +309,13 @@ static void intruder_force(const run *R, double f[2]) {
 /* ---- membranes on the grains at the specimen's sides (biaxial) */
 /* On each side, the outermost free grain of every band of D50 along y whose
  * outer edge lies within 1.5 D50 of the side (left[row], right[row]
- * for rows of row_h), chained in height order (the material on the chain's
- * left: down the left side, up the right side), split where a gap of 3 D50
- * opens; a chain end within 2 D50 of the top wall is tied to it. */
+ * for rows of row_h; within 3 D50 in the 3 D50 below the top wall, so that
+ * the chain reaches the wall where a discrete zone's top corner is set
+ * back from the side: a chain ending below the wall let the grains between
+ * its end and the wall be squeezed out along it), chained in height order
+ * (the material on the chain's left: down the left side, up the right
+ * side), split where a gap of 3 D50 opens; a chain end within 2 D50 of the
+ * top wall is tied to it. */
 static int add_membranes(run *R, const double *left, const double *right, int nrow, double row_h) {
     gk_scene *sc = &R->sc;
     int n = sc->rve.n, s, p, k, nb = (int)ceil(2.0 * R->H / DIAM) + 1, nsel;
@@ -324,7 +328,7 @@ static int add_membranes(run *R, const double *left, const double *right, int nr
     for (s = -1; s <= 1; s += 2) {
         for (k = 0; k < nb; ++k) best[k] = -1;
         for (p = 0; p < n; ++p) {
-            double x[3], r = (double)sc->rve.r[p], edge;
+            double x[3], r = (double)sc->rve.r[p], edge, tol;
             int row, band;
             if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) continue;
             gk_scene_position(sc, p, x);
@@ -333,7 +337,8 @@ static int add_membranes(run *R, const double *left, const double *right, int nr
             if (row < 0 || row >= nrow || band < 0 || band >= nb) continue;
             edge = s < 0 ? left[row] : right[row];
             if (!isfinite(edge)) continue;
-            if (s < 0 ? x[0] - r < edge + 1.5 * DIAM : x[0] + r > edge - 1.5 * DIAM) {
+            tol = ytop - x[1] < 3.0 * DIAM ? 3.0 * DIAM : 1.5 * DIAM;
+            if (s < 0 ? x[0] - r < edge + tol : x[0] + r > edge - tol) {
                 double out = s < 0 ? -(x[0] - r) : x[0] + r;
                 if (best[band] < 0 || out > bx[band]) {
                     best[band] = p;
