@@ -99,7 +99,7 @@ static int setup_dem(run *R) {
             l[k] = 0.0;
             r[k] = R->W;
         }
-        if (add_membranes(R, l, r, nrow, R->H / nrow)) return 1;
+        if (add_membranes(R, l, r, nrow, R->H / nrow, 0)) return 1;
         free(l);
         free(r);
         /* preload: the cut-open top reloaded to the confining pressure by the wall's servo */

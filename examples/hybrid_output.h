@@ -27,7 +27,10 @@
  * that measures its own zone at its enrichment strain).
  * On stdout, "cost:" counts the grain-steps and point-steps of the run (the
  * N_D and element terms of the cost model of Sec 6.4.1) with the wall time
- * spent in each.
+ * spent in each. Biaxial hybrid: a grain squeezed out of the discrete zone
+ * that comes within two cells of the grid's edge is removed (see
+ * remove_escaped), with a line on stdout, and at the end a warning on
+ * stderr gives the count and the share of the grains' mass removed.
  */
 #ifndef HYBRID_OUTPUT_H
 #define HYBRID_OUTPUT_H
@@ -337,6 +340,7 @@ static void run_free(run *R) {
     free(R->xpre[0]);
     free(R->xpre[1]);
     free(R->coupled);
+    free(R->drop_ids);
     free(R->Xw[0]);
     free(R->Xw[1]);
     free(R->idw);

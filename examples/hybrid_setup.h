@@ -175,8 +175,10 @@ typedef struct run {
     int enriched;
     double strain_enrich, *dist, *xpre[2];
     unsigned char *coupled;
-    int cap_g, mask_n;
-    double grain_scale; /* the enrichment's grain mass factor */
+    int32_t *drop_ids;       /* scratch of remove_escaped */
+    int cap_g, mask_n, lost; /* lost: grains removed after leaving the specimen (remove_escaped) */
+    double lost_mass;        /* their share of the grains' mass when removed, summed */
+    double grain_scale;      /* the enrichment's grain mass factor */
     gk_hybrid_coupling cpl;
     /* measurements */
     double phi0_band, A0, peak_tau, win_c[2], win_e[2], win_a;
@@ -315,17 +317,29 @@ static void intruder_force(const run *R, double f[2]) {
  * its end and the wall be squeezed out along it), chained in height order
  * (the material on the chain's left: down the left side, up the right
  * side), split where a gap of 3 D50 opens; a chain end within 2 D50 of the
- * top wall is tied to it. */
-static int add_membranes(run *R, const double *left, const double *right, int nrow, double row_h) {
+ * top wall is tied to it. With close_top (the hybrid's enrichment), where
+ * the top member leaves more than 0.5 D50 between itself and the wall
+ * (another grain of its band sits higher), the candidate nearest the wall
+ * ends the chain too: a tied end slides along the wall, and on the
+ * paper-size biaxial hybrid grains passed through such gaps and out. (The
+ * all-grain run keeps its chains: no grain left its specimen, paper size
+ * included.) */
+static int add_membranes(run *R, const double *left, const double *right, int nrow, double row_h,
+                         int close_top) {
     gk_scene *sc = &R->sc;
     int n = sc->rve.n, s, p, k, nb = (int)ceil(2.0 * R->H / DIAM) + 1, nsel;
     int32_t *ids = (int32_t *)malloc((size_t)n * sizeof(int32_t));
-    int *best = (int *)malloc((size_t)nb * sizeof(int)), *ord = (int *)malloc((size_t)nb * sizeof(int));
+    int *best = (int *)malloc((size_t)nb * sizeof(int)), *ord = (int *)malloc((size_t)(nb + 1) * sizeof(int));
     double *bx = (double *)malloc((size_t)nb * sizeof(double)),
-           *yy = (double *)malloc((size_t)nb * sizeof(double));
+           *yy = (double *)malloc((size_t)(nb + 1) * sizeof(double));
     double ytop = R->top_wall >= 0 ? sc->walls[R->top_wall].pos[1] : HUGE_VAL;
-    if (!ids || !best || !ord || !bx || !yy) return fprintf(stderr, "error: out of memory\n"), 1;
+    if (!ids || !best || !ord || !bx || !yy) {
+        free(ids), free(best), free(ord), free(bx), free(yy);
+        return fprintf(stderr, "error: out of memory\n"), 1;
+    }
     for (s = -1; s <= 1; s += 2) {
+        int hi = -1; /* the candidate nearest the top wall */
+        double hiy = -HUGE_VAL;
         for (k = 0; k < nb; ++k) best[k] = -1;
         for (p = 0; p < n; ++p) {
             double x[3], r = (double)sc->rve.r[p], edge, tol;
@@ -340,6 +354,10 @@ static int add_membranes(run *R, const double *left, const double *right, int nr
             tol = ytop - x[1] < 3.0 * DIAM ? 3.0 * DIAM : 1.5 * DIAM;
             if (s < 0 ? x[0] - r < edge + tol : x[0] + r > edge - tol) {
                 double out = s < 0 ? -(x[0] - r) : x[0] + r;
+                if (x[1] + r > hiy) {
+                    hi = p;
+                    hiy = x[1] + r;
+                }
                 if (best[band] < 0 || out > bx[band]) {
                     best[band] = p;
                     bx[band] = out;
@@ -356,6 +374,22 @@ static int add_membranes(run *R, const double *left, const double *right, int nr
                 yy[nsel++] = x[1];
             }
         }
+        if (close_top && nsel > 0 && hi >= 0 && isfinite(ytop)) { /* a gap a grain could pass */
+            int t = s < 0 ? 0 : nsel - 1, in = 0;
+            double top = yy[t] + (double)sc->rve.r[ord[t]];
+            for (k = 0; k < nsel; ++k) in |= ord[k] == hi;
+            if (!in && hiy > top && ytop - top > 0.5 * DIAM) { /* closed by the nearest grain */
+                double x[3];
+                gk_scene_position(sc, hi, x);
+                if (s < 0) {
+                    memmove(ord + 1, ord, (size_t)nsel * sizeof(int));
+                    memmove(yy + 1, yy, (size_t)nsel * sizeof(double));
+                }
+                ord[s < 0 ? 0 : nsel] = hi;
+                yy[s < 0 ? 0 : nsel] = x[1];
+                ++nsel;
+            }
+        }
         for (p = 0; p < nsel;) {
             int q = p + 1, m, a0 = -1, a1 = -1;
             while (q < nsel && fabs(yy[q] - yy[q - 1]) < 3.0 * DIAM) ++q;
@@ -364,8 +398,11 @@ static int add_membranes(run *R, const double *left, const double *right, int nr
                 for (k = 0; k < m; ++k) ids[k] = sc->rve.id[ord[p + k]];
                 if (s < 0 && ytop - yy[p] < 2.0 * DIAM) a0 = R->top_wall;
                 if (s > 0 && ytop - yy[q - 1] < 2.0 * DIAM) a1 = R->top_wall;
-                if (gk_scene_add_membrane(sc, m, ids, R->o.pressure, 1e4, a0, a1, NULL))
-                    return fprintf(stderr, "error: membrane: %s\n", gk_scene_error(sc)), 1;
+                if (gk_scene_add_membrane(sc, m, ids, R->o.pressure, 1e4, a0, a1, NULL)) {
+                    fprintf(stderr, "error: membrane: %s\n", gk_scene_error(sc));
+                    free(ids), free(best), free(ord), free(bx), free(yy);
+                    return 1;
+                }
             }
             p = q;
         }

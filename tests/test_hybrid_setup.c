@@ -1,5 +1,5 @@
-/* test_hybrid_setup.c - the hybrid driver's specimen set-up (examples/hybrid_setup.h), tested
- * directly: the membranes on the grains' sides of a biaxial specimen. */
+/* test_hybrid_setup.c - parts of the hybrid driver (examples/hybrid_*.h) tested directly: the
+ * membranes on the grains' sides of a biaxial specimen, the removal of grains that left it. */
 #include "gk_test.h"
 #include <stdlib.h>
 
@@ -7,7 +7,7 @@
 #pragma GCC diagnostic ignored "-Wunused-function" /* the header's other helpers and tables */
 #pragma GCC diagnostic ignored "-Wunused-variable"
 #endif
-#include "../examples/hybrid_setup.h"
+#include "../examples/hybrid_enrich.h"
 
 /* A 12 x 12 mm block of 1 mm disks on a square lattice whose top two rows
  * stop 2 mm short of both sides, as the corners of a discrete zone that
@@ -51,7 +51,7 @@ TEST(membranes_reach_a_set_back_top_corner) {
         l[k] = 0.0;
         r[k] = R.W;
     }
-    CHECK(add_membranes(&R, l, r, 6, R.H / 6) == 0);
+    CHECK(add_membranes(&R, l, r, 6, R.H / 6, 1) == 0);
     CHECK_EQ_INT(R.sc.nmem, 2);
     for (m = 0; m < R.sc.nmem; ++m) {
         const gk_membrane *M = &R.sc.mem[m];
@@ -68,8 +68,112 @@ TEST(membranes_reach_a_set_back_top_corner) {
     gk_packing_free(&pk);
 }
 
+/* A column of 1 mm disks on the left side whose top band holds two grains: the outermost (A,
+ * x 0.5 mm, top edge 9.55 mm) and one further in but higher (B, top edge 10.45 mm, where the wall
+ * is): chained by the outermost grain alone, the chain would end 0.9 mm below the wall, a gap a grain
+ * passes through (on the paper-size biaxial hybrid two did); B must end the chain, tied to the wall. */
+TEST(membrane_chain_ends_at_the_wall) {
+    run R;
+    gk_packing pk;
+    gk_err e;
+    gk_scene_def d;
+    double l[6], r[6];
+    int k, n = 0;
+    const gk_membrane *M;
+    memset(&R, 0, sizeof R);
+    defaults(&R.o, T_BIAXIAL);
+    R.o.threads = 1;
+    R.W = 0.012;
+    R.H = 0.012;
+    R.top_wall = -1;
+    CHECK(gk_packing_init(&pk, 2, 10, NULL, &e) == GK_OK);
+    pk.h[0] = pk.h[4] = 0.012;
+    for (k = 1; k <= 8; ++k, ++n) { /* the column, y 1.05 ... 8.05 mm */
+        pk.x[n] = 0.5 * DIAM;
+        pk.y[n] = (k + 0.05) * DIAM;
+        pk.r[n] = 0.5 * DIAM;
+    }
+    pk.x[n] = 0.5 * DIAM, pk.y[n] = 9.05 * DIAM, pk.r[n++] = 0.5 * DIAM; /* A: id 8 */
+    pk.x[n] = 1.5 * DIAM, pk.y[n] = 9.95 * DIAM, pk.r[n++] = 0.5 * DIAM; /* B: id 9 */
+    pk.n = n;
+    d = scene_def(&R);
+    CHECK(gk_scene_create(&R.sc, &d, &pk) == GK_OK);
+    CHECK(add_top_wall(&R, 10.45 * DIAM) == 0);
+    for (k = 0; k < 6; ++k) {
+        l[k] = 0.0;
+        r[k] = R.W;
+    }
+    CHECK(add_membranes(&R, l, r, 6, R.H / 6, 1) == 0);
+    CHECK_EQ_INT(R.sc.nmem, 1); /* the left side only */
+    if (R.sc.nmem != 1) return;
+    M = &R.sc.mem[0];
+    CHECK_EQ_INT(M->n, 10);
+    CHECK_EQ_INT(M->ids[0], 9);
+    CHECK_EQ_INT(M->ids[1], 8);
+    CHECK_EQ_INT(M->anchor[0], R.top_wall);
+    gk_scene_destroy(&R.sc);
+    gk_packing_free(&pk);
+}
+
+/* remove_escaped: on a grid of 10 x 10 cells of 1 mm from (-3, -3) mm with points' half-size lp
+ * 0.25 mm, grains are kept whose centres lie within [-1.5, 5.5] mm (a quarter cell inside where the
+ * coupling stencil, h + lp around a grain, leaves the grid): grains 0 and 1. Outside it, grain
+ * 2 touches nothing (squeezed out of the specimen, on its way off the grid): removed and counted
+ * with its share of the grains' mass; grains 4 and 5 touch each other (the specimen's material
+ * spreading that far): kept; grain 3 is prescribed (the driver's platen layers): kept. */
+TEST(escaped_grains_are_removed_and_counted) {
+    run R;
+    gk_packing pk;
+    gk_err e;
+    gk_scene_def d;
+    double org[3] = {-0.003, -0.003, 0.0}, z[3] = {0.0, 0.0, 0.0}, lp = 0.00025;
+    int n[3] = {11, 11, 1}, k;
+    const double xy[6][2] = {{0.001, 0.001},  {0.0035, 0.002},   {-0.0019, 0.002},
+                             {0.002, 0.0058}, {-0.0022, 0.0035}, {-0.0022, 0.00405}};
+    memset(&R, 0, sizeof R);
+    defaults(&R.o, T_BIAXIAL);
+    R.o.threads = 1;
+    R.o.quiet = 1;
+    R.W = R.H = 0.006; /* the scene's domain: -3 to 9 mm */
+    R.top_wall = -1;
+    R.P.lp = &lp;
+    CHECK(gk_mpm_grid_create(&R.g, 2, org, 0.001, n, NULL, &e) == GK_OK); /* nodes -3 .. 7 mm */
+    CHECK(gk_packing_init(&pk, 2, 6, NULL, &e) == GK_OK);
+    pk.h[0] = pk.h[4] = 0.01;
+    for (k = 0; k < 6; ++k) {
+        pk.x[k] = xy[k][0];
+        pk.y[k] = xy[k][1];
+        pk.r[k] = k == 1 ? 0.0006 : 0.0003;
+    }
+    pk.n = 6;
+    d = scene_def(&R);
+    CHECK(gk_scene_create(&R.sc, &d, &pk) == GK_OK);
+    CHECK(grow_grain_arrays(&R, 6) == 0);
+    CHECK(gk_scene_prescribe(&R.sc, gk_scene_index(&R.sc, 3), z, z) == GK_OK);
+    CHECK(gk_scene_step(&R.sc, 1) == GK_OK); /* the contacts: 4 with 5 */
+    CHECK(remove_escaped(&R) == 0);
+    CHECK_EQ_INT(R.sc.rve.n, 5);
+    CHECK_EQ_INT(R.lost, 1);
+    CHECK(gk_scene_index(&R.sc, 2) < 0);
+    for (k = 0; k < 6; ++k)
+        if (k != 2) CHECK(gk_scene_index(&R.sc, k) >= 0);
+    /* mass share: disk areas 0.09 x 5 and 0.36 (x pi mm^2): 0.09 / 0.81 */
+    CHECK_NEAR(R.lost_mass, 0.09 / 0.81, 1e-12);
+    CHECK(remove_escaped(&R) == 0); /* nothing more to remove */
+    CHECK_EQ_INT(R.lost, 1);
+    gk_scene_destroy(&R.sc);
+    gk_mpm_grid_destroy(&R.g);
+    gk_packing_free(&pk);
+    free(R.xpre[0]);
+    free(R.xpre[1]);
+    free(R.coupled);
+    free(R.drop_ids);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(membranes_reach_a_set_back_top_corner);
+    RUN(membrane_chain_ends_at_the_wall);
+    RUN(escaped_grains_are_removed_and_counted);
     return gk_test_done();
 }
