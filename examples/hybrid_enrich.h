@@ -546,7 +546,8 @@ done: /* every exit: the scratch freed */
 
 /* Grains squeezed out of the discrete zone's side (at the paper's size of the biaxial test, a few
  * of 1900, where a membrane chain ends or at the swap) fly off; one that comes within a quarter
- * cell of where its coupling stencil would leave the grid and stop the run, touching no other
+ * cell of where its coupling stencil would leave the grid's side and stop the run (the platens
+ * hold the grains above and below), touching no other
  * grain and not on a membrane, has left the specimen: it is removed, and said so, with the running
  * count and the share of the grains' mass lost (R->lost, R->lost_mass). A grain there that touches
  * others or is a membrane's member (one may part from the grains for a moment) is the specimen's
@@ -556,17 +557,16 @@ static int remove_escaped(run *R) {
     gk_scene *sc = &R->sc;
     const gk_mpm_grid *g = &R->g;
     int p, k = 0, q, c = 0;
-    double lo[2], hi[2], m = 0.0, mall = 0.0;
+    /* the stencil reaches h + lp beyond a grain: a quarter cell to spare */
+    double lo = g->origin[0] + 1.25 * g->h + R->P.lp[0],
+           hi = g->origin[0] + (g->n[0] - 2.25) * g->h - R->P.lp[0];
+    double m = 0.0, mall = 0.0;
     gk_rve_contact ct;
-    for (p = 0; p < 2; ++p) { /* the stencil reaches h + lp beyond a grain: a quarter cell to spare */
-        lo[p] = g->origin[p] + 1.25 * g->h + R->P.lp[0];
-        hi[p] = g->origin[p] + (g->n[p] - 2.25) * g->h - R->P.lp[0];
-    }
-    for (p = 0; p < sc->rve.n; ++p) { /* the candidates: free grains near the grid's edge */
+    for (p = 0; p < sc->rve.n; ++p) { /* the candidates: free grains near the grid's sides */
         double x[3];
         if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) continue;
         gk_scene_position(sc, p, x);
-        if (x[0] < lo[0] || x[0] > hi[0] || x[1] < lo[1] || x[1] > hi[1]) R->drop_ids[k++] = sc->rve.id[p];
+        if (x[0] < lo || x[0] > hi) R->drop_ids[k++] = sc->rve.id[p];
     }
     if (!k) return 0;
     while (gk_rve_contact_next(&sc->rve, &c, &ct)) /* those that touch a grain stay */

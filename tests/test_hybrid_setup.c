@@ -9,6 +9,27 @@
 #endif
 #include "../examples/hybrid_enrich.h"
 
+/* a biaxial run's state for the tests: options at their defaults, one thread, a W x H specimen */
+static void biaxial_state(run *R, double W, double H) {
+    memset(R, 0, sizeof *R);
+    defaults(&R->o, T_BIAXIAL);
+    R->o.threads = 1;
+    R->W = W;
+    R->H = H;
+    R->top_wall = -1;
+}
+
+/* membranes on both sides of the specimen, its sides at x = 0 and W in 6 rows */
+static int membranes_on_sides(run *R) {
+    double l[6], r[6];
+    int k;
+    for (k = 0; k < 6; ++k) {
+        l[k] = 0.0;
+        r[k] = R->W;
+    }
+    return add_membranes(R, l, r, 6, R->H / 6, 1);
+}
+
 /* A 12 x 12 mm block of 1 mm disks on a square lattice whose top two rows
  * stop 2 mm short of both sides, as the corners of a discrete zone that
  * reaches the top platen while the continuum keeps the specimen's corners:
@@ -23,14 +44,9 @@ TEST(membranes_reach_a_set_back_top_corner) {
     gk_packing pk;
     gk_err e;
     gk_scene_def d;
-    double l[6], r[6], ytop = -HUGE_VAL;
+    double ytop = -HUGE_VAL;
     int i, j, n = 0, k, m, top_members = 0;
-    memset(&R, 0, sizeof R);
-    defaults(&R.o, T_BIAXIAL);
-    R.o.threads = 1;
-    R.W = 0.012;
-    R.H = 0.012;
-    R.top_wall = -1;
+    biaxial_state(&R, 0.012, 0.012);
     CHECK(gk_packing_init(&pk, 2, 144, NULL, &e) == GK_OK);
     pk.h[0] = pk.h[4] = 0.012;
     for (j = 0; j < 12; ++j)
@@ -47,11 +63,7 @@ TEST(membranes_reach_a_set_back_top_corner) {
     for (k = 0; k < pk.n; ++k)
         if (pk.y[k] + pk.r[k] > ytop) ytop = pk.y[k] + pk.r[k];
     CHECK(add_top_wall(&R, ytop) == 0);
-    for (k = 0; k < 6; ++k) {
-        l[k] = 0.0;
-        r[k] = R.W;
-    }
-    CHECK(add_membranes(&R, l, r, 6, R.H / 6, 1) == 0);
+    CHECK(membranes_on_sides(&R) == 0);
     CHECK_EQ_INT(R.sc.nmem, 2);
     for (m = 0; m < R.sc.nmem; ++m) {
         const gk_membrane *M = &R.sc.mem[m];
@@ -77,15 +89,9 @@ TEST(membrane_chain_ends_at_the_wall) {
     gk_packing pk;
     gk_err e;
     gk_scene_def d;
-    double l[6], r[6];
     int k, n = 0;
     const gk_membrane *M;
-    memset(&R, 0, sizeof R);
-    defaults(&R.o, T_BIAXIAL);
-    R.o.threads = 1;
-    R.W = 0.012;
-    R.H = 0.012;
-    R.top_wall = -1;
+    biaxial_state(&R, 0.012, 0.012);
     CHECK(gk_packing_init(&pk, 2, 10, NULL, &e) == GK_OK);
     pk.h[0] = pk.h[4] = 0.012;
     for (k = 1; k <= 8; ++k, ++n) { /* the column, y 1.05 ... 8.05 mm */
@@ -99,11 +105,7 @@ TEST(membrane_chain_ends_at_the_wall) {
     d = scene_def(&R);
     CHECK(gk_scene_create(&R.sc, &d, &pk) == GK_OK);
     CHECK(add_top_wall(&R, 10.45 * DIAM) == 0);
-    for (k = 0; k < 6; ++k) {
-        l[k] = 0.0;
-        r[k] = R.W;
-    }
-    CHECK(add_membranes(&R, l, r, 6, R.H / 6, 1) == 0);
+    CHECK(membranes_on_sides(&R) == 0);
     CHECK_EQ_INT(R.sc.nmem, 1); /* the left side only */
     if (R.sc.nmem != 1) return;
     M = &R.sc.mem[0];
@@ -116,11 +118,11 @@ TEST(membrane_chain_ends_at_the_wall) {
 }
 
 /* remove_escaped: on a grid of 10 x 10 cells of 1 mm from (-3, -3) mm with points' half-size lp
- * 0.25 mm, grains are kept whose centres lie within [-1.5, 5.5] mm (a quarter cell inside where the
- * coupling stencil, h + lp around a grain, leaves the grid): grains 0 and 1. Outside it, grain
+ * 0.25 mm, grains are kept whose centres lie within x = -1.5 ... 5.5 mm (a quarter cell inside where
+ * the coupling stencil, h + lp around a grain, leaves the grid): grains 0 and 1. Outside it, grain
  * 2 touches nothing (squeezed out of the specimen, on its way off the grid): removed and counted
  * with its share of the grains' mass; grains 4 and 5 touch each other (the specimen's material
- * spreading that far): kept; grain 3 is prescribed (the driver's platen layers): kept. */
+ * spreading that far): kept; grain 3 (x 5.8 mm) is prescribed (as the driver's platen layers): kept. */
 TEST(escaped_grains_are_removed_and_counted) {
     run R;
     gk_packing pk;
@@ -129,13 +131,9 @@ TEST(escaped_grains_are_removed_and_counted) {
     double org[3] = {-0.003, -0.003, 0.0}, z[3] = {0.0, 0.0, 0.0}, lp = 0.00025;
     int n[3] = {11, 11, 1}, k;
     const double xy[6][2] = {{0.001, 0.001},  {0.0035, 0.002},   {-0.0019, 0.002},
-                             {0.002, 0.0058}, {-0.0022, 0.0035}, {-0.0022, 0.00405}};
-    memset(&R, 0, sizeof R);
-    defaults(&R.o, T_BIAXIAL);
-    R.o.threads = 1;
+                             {0.0058, 0.002}, {-0.0022, 0.0035}, {-0.0022, 0.00405}};
+    biaxial_state(&R, 0.006, 0.006); /* the scene's domain: -3 to 9 mm */
     R.o.quiet = 1;
-    R.W = R.H = 0.006; /* the scene's domain: -3 to 9 mm */
-    R.top_wall = -1;
     R.P.lp = &lp;
     CHECK(gk_mpm_grid_create(&R.g, 2, org, 0.001, n, NULL, &e) == GK_OK); /* nodes -3 .. 7 mm */
     CHECK(gk_packing_init(&pk, 2, 6, NULL, &e) == GK_OK);
