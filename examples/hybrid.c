@@ -54,8 +54,8 @@
  *              the continuum zone stay coupled (as under gravity); the
  *              membrane chains on the grains' sides reach the top wall; a
  *              grain squeezed out that flies off, touching no grain and on
- *              no membrane, is removed two cells from the grid's edge
- *              (printed, and counted in a warning at the end).
+ *              no membrane, is removed before its coupling would leave the
+ *              grid (printed, and counted in a warning at the end).
  *
  * THE CODE. This file holds the manual and main (set-up, the loop of
  * steps, the outputs). The rest is in five headers, each including the one

@@ -28,9 +28,10 @@
  * On stdout, "cost:" counts the grain-steps and point-steps of the run (the
  * N_D and element terms of the cost model of Sec 6.4.1) with the wall time
  * spent in each. Biaxial hybrid: a grain squeezed out of the discrete zone
- * that comes within two cells of the grid's edge is removed (see
- * remove_escaped), with a line on stdout, and at the end a warning on
- * stderr gives the count and the share of the grains' mass removed.
+ * that flies off towards the grid's side is removed before its coupling
+ * would leave the grid (remove_escaped), with a line on stdout, and at the
+ * end a warning on stderr gives the count and the share of the grains'
+ * mass removed.
  */
 #ifndef HYBRID_OUTPUT_H
 #define HYBRID_OUTPUT_H
