@@ -545,19 +545,19 @@ done: /* every exit: the scratch freed */
 }
 
 /* Grains squeezed out of the discrete zone's side (at the paper's size of the biaxial test, a few
- * of 1900, where a membrane chain ends or at the swap) fly off; one that comes within a quarter
- * cell of where its coupling stencil would leave the grid's side and stop the run (the platens
- * hold the grains above and below), touching no other
- * grain and not on a membrane, has left the specimen: it is removed, and said so, with the running
- * count and the share of the grains' mass lost (R->lost, R->lost_mass). A grain there that touches
- * others or is a membrane's member (one may part from the grains for a moment) is the specimen's
- * own material spreading that far: it stays (and the run stops when it leaves the grid). Returns 1
- * on error. */
+ * of 1900, where a membrane chain ends or at the swap) fly off; one that comes within 1.25 h + lp of
+ * the grid's side (1.25 cells before its coupling support would leave the grid, gk_mpm_shape's
+ * test, and stop the run; the platens hold the grains above and below), touching no other grain
+ * and not on a membrane, has left the specimen: it is removed, and said so, with the running count
+ * and the share of the grains' mass lost (R->lost, R->lost_mass). A grain there that touches others
+ * or is a membrane's member (one may part from the grains for a moment) is the specimen's own
+ * material spreading that far: it stays (and the run stops when it leaves the grid). Returns 1 on
+ * error. */
 static int remove_escaped(run *R) {
     gk_scene *sc = &R->sc;
     const gk_mpm_grid *g = &R->g;
     int p, k = 0, q, c = 0;
-    /* the stencil reaches h + lp beyond a grain: a quarter cell to spare */
+    /* 1.25 h + lp inside the grid's sides */
     double lo = g->origin[0] + 1.25 * g->h + R->P.lp[0],
            hi = g->origin[0] + (g->n[0] - 2.25) * g->h - R->P.lp[0];
     double m = 0.0, mall = 0.0;
