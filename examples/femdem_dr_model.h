@@ -93,7 +93,15 @@ typedef struct model {
     row *rows;
     int nrows, caprows, step_done, have_f0;
     long long dem_total, runs_total, capped_total, unconverged;
+    /* the relative force residual a load step ended with (gk_dr.resid): the
+     * largest, its step, and how many steps ended above RESID_WARN */
+    double resid_last, resid_max;
+    long long resid_step, resid_over;
 } model;
+
+/* a load step that ends with |f_ext - f_int| above this share of the largest
+ * force was stopped by eq 28's energy ratio before equilibrium: warned */
+#define RESID_WARN 0.05
 
 static void die_alloc(void) {
     fprintf(stderr, PROG ": out of memory\n");
@@ -416,6 +424,7 @@ static int dr_step(model *m, double p_side, double p_top, int *iters) {
         }
     }
     *iters = (int)m->dr.iter;
+    m->resid_last = m->dr.resid;
     return 0;
 }
 

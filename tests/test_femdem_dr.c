@@ -4,7 +4,8 @@
  * locked-rotation RVE is stronger, no NaN anywhere from U = 0 on, 1 and 2
  * threads and a restart give the same rows, the DNS runs, bad input is
  * refused by name and a failed write is an error, a load path that starts
- * in equilibrium runs. Short runs (reduced load
+ * in equilibrium runs, a step eq 28 stopped short of equilibrium is
+ * reported. Short runs (reduced load
  * paths; the periodic cell where the frame is not what is tested). Needs
  * build/femdem_dr (`make test` builds the examples first). */
 #define GK_TEST_DRIVERS
@@ -142,6 +143,32 @@ TEST(threads_and_restart_give_the_same_rows) {
     CHECK(same_rows(BUILD "/tests/t_fdrA/dr.csv", BUILD "/tests/t_fdrC/dr.csv"));
 }
 
+/* a stiff RVE (k_n 1e5 sigma0) under eq 28 alone: the kinetic-energy ratio ends the first biaxial steps
+ * with the side force far from the load (sigma_11 about 3 sigma0): the run says so (the residual of
+ * gk_dr, a warning, dr_residual_max); with --dr-force-tol 1e-2 every step ends within 1 % of the
+ * largest force and the sides carry sigma0 (the load's equilibrium, eq 20 with M a = 0) */
+TEST(a_step_stopped_before_equilibrium_is_reported) {
+    static double r[MAXR][12];
+    int n;
+#define FDR_STIFF                                                                                      \
+    FDR "--test rve --packing examples/data/frame228_a005.txt --kn-ratio 1e5 --iso-steps 2 --steps 2 " \
+        "--strain 0.01 --vtk-every 0 "
+    CHECK(system(FDR_STIFF "--out " BUILD "/tests/t_fdr_stiff > " BUILD "/tests/t_fdr_stiff.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_stiff.out", "ended with a force residual above 5 %"));
+    CHECK(gk_test_result(BUILD "/tests/t_fdr_stiff.out", "dr_residual_max") > 0.05);
+    CHECK(system(FDR_STIFF "--dr-force-tol 1e-2 --out " BUILD "/tests/t_fdr_stiff2 > " BUILD
+                           "/tests/t_fdr_stiff2.out 2>&1") == 0);
+    CHECK(!gk_test_file_has(BUILD "/tests/t_fdr_stiff2.out", "force residual above"));
+    CHECK(gk_test_result(BUILD "/tests/t_fdr_stiff2.out", "dr_residual_max") <= 0.01);
+    n = rows(BUILD "/tests/t_fdr_stiff2/dr.csv", r);
+    CHECK_EQ_INT(n, 5);
+    if (n == 5) {
+        CHECK_REL(r[3][4], 1.5e5, 0.02);
+        CHECK_REL(r[4][4], 1.5e5, 0.02);
+    }
+#undef FDR_STIFF
+}
+
 /* the DNS: the packing tiled 1 x 2 (444 disks) between platens and membranes; the isotropic stage
  * reaches sigma0 on the platen within 2 %, compression raises the stress ratio */
 TEST(dns_runs) {
@@ -239,6 +266,7 @@ int main(int argc, char **argv) {
     RUN(isotropic_stage_and_one_element_against_the_rve);
     RUN(locked_rotation_is_stronger);
     RUN(threads_and_restart_give_the_same_rows);
+    RUN(a_step_stopped_before_equilibrium_is_reported);
     RUN(dns_runs);
     RUN(default_and_paper_sizes);
     RUN(bad_input_and_failed_writes);

@@ -941,10 +941,10 @@ TEST(dr_and_nonlocal_checkpoints_refuse_non_finite_values) {
     size_t n, at;
     double v = NAN;
     remove(OUT("dr_b/dr.csv")), remove(OUT("nl_b/element-shear.csv")); /* of an earlier run */
-    /* femdem_dr: tag "FDR1", 8 ints, then h_ic, the first of its reals */
+    /* femdem_dr: tag "FDR2", 8 ints, then h_ic, the first of its reals */
     CHECK_EQ_INT(run_status(DR_CK "--stop-after 1 --out " OUT("dr_a") LOG("dr_a")), 0);
     b = file_image(OUT("dr_a/checkpoint.bin"), &n);
-    CHECK(b != NULL && (at = find_tag(b, n, "FDR1")) < n);
+    CHECK(b != NULL && (at = find_tag(b, n, "FDR2")) < n);
     if (!b || at == n) return;
     CHECK_EQ_INT(run_status(DR_CK "--restart " OUT("dr_a") " --out " OUT("dr_ok") LOG("dr_ok")), 0);
     mkdir(OUT("dr_bad"), 0755);
