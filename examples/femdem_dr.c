@@ -39,16 +39,16 @@
  * 0.39, locked 0.48; A 0.27 and 0.33): the locked rotation is stronger and more anisotropic
  * (A ratio free / locked 0.81 here, 0.82 there) but far stronger here (stress ratio 0.56,
  * there 0.81); the peak comes earlier (4-5 %, there near 7 %); higher friction gives a higher
- * stress and a lower coordination as there, but not their larger compaction; the initial
- * anisotropy changes nothing here (there: a lower, earlier peak), because the isotropic
- * stage erases it (below). The meshes agree within
+ * stress and a lower coordination as there, but not their larger compaction; an ensemble of
+ * 22 RVEs resolves no effect of the initial anisotropy (there: a lower, earlier peak; below).
+ * The meshes agree within
  * 10 % to 5 % strain (the paper: "very close"; the largest spread at 1 %); the servo frame
  * and the periodic cell within 10 % (RVE alone) to 15 % (2 x 4); the 444-disk DNS within
  * 11 % of the 2 x 4 meshes to 3 %, then it slips (0.30 to 0.18 at 3.5 %, back to 0.31 at
  * 7.5 %: a specimen a few grains wide). The packings are looser than the paper's (solid
  * fraction 0.82 against 0.846) and the DEM is stiffer relative to the confinement than
  * Table 3's raw numbers allow (see THE RVE).
- * WHY THE INITIAL ANISOTROPY DOES NOT MATTER (the RVE alone, `--test rve --packing
+ * THE INITIAL ANISOTROPY (Figs 12-14; the RVE alone, `--test rve --packing
  * examples/data/frame228_a00N.txt`, the anisotropy column of dr.csv): the packings hold
  * A0 = 0.016, 0.049, 0.084 at their 1500 Pa; the first isotropic step (sigma0 / 10, ten
  * times that) leaves A = 0.029 in all three (servo frame), the end of the stage 0.027,
@@ -57,22 +57,29 @@
  * --kn 1.5e7, A 0.021 / 0.052 / 0.056) lose it too, whether stage 1 first unloads them (10
  * steps: A 0.20-0.26 at sigma0 / 10, 0.046-0.051 back at sigma0; periodic peaks 0.405 /
  * 0.403 / 0.397) or not (--iso-steps 1: after that one step A 0.015 in the periodic cell,
- * 0.024-0.038 with the servo frame; servo peaks 0.345 / 0.349 / 0.348, all at 3 %). A clue,
- * not an explanation: a packing file keeps positions only, and without the tangential forces
- * of its loading history the normal forces alone carry sigma_yy / sigma_xx = 1.09 where the
- * packing held 1.00 (A 0.056); the first relaxation rearranges it (Z 3.94 to 4.10, A 0.015),
- * at any friction (mu 0.4, 1, 10: A 0.015, 0.010, 0.013).
- * What keeps it is the stiffness: at the packing files' own k_n / p (`--kn-ratio 1e5`, servo,
- * the RVE alone) the isotropic stage ends at A = 0.014, 0.063, 0.128 (A0 0.016, 0.049,
- * 0.084), at 1e4 and 1e3 it is lost again (0.013 / 0.015 for A0 0.016 / 0.084 at 1e4): the
- * contacts the loading history opened stay open only while the overlaps are small against
- * the gaps. sigma_bar at 7.3 % then falls with A0 as in the paper (0.384, 0.346, 0.327;
- * peaks 0.443 at 8 %, 0.405 at 5 %, 0.451 at 8 %), but two packings made alike (the files'
- * gk_pack command with --target-anisotropy 0.02 and seeds 5, 6, which end isotropic, at
- * stress ratio 1: A0 0.045, 0.054) give 0.315 and 0.436 at 7.3 %: one 228-disk RVE cannot resolve the effect, and at this stiffness its
- * curve jumps (those two peak at 0.635 and 0.856, at 9.5 and 10 %). (gk_pack's anisotropic
- * packings have their excess contact normals vertical, along the loading; the paper does not
- * say which way its packings lean.)
+ * 0.024-0.038 with the servo frame; servo peaks 0.345 / 0.349 / 0.348, all at 3 %). A clue:
+ * a packing file keeps positions only, and without the tangential forces of its loading
+ * history the normal forces alone carry sigma_yy / sigma_xx = 1.09 where the packing held
+ * 1.00 (A 0.056); the first relaxation rearranges it (Z 3.94 to 4.10, A 0.015), at any
+ * friction (mu 0.4, 1, 10: A 0.015, 0.010, 0.013). At the packing files' own k_n / p
+ * (`--kn-ratio 1e5 --dr-force-tol 1e-2`) the isotropic stage ends near the packing's A
+ * (0.014, 0.051, 0.119); without --dr-force-tol, eq 28 alone ends most biaxial steps of
+ * these stiff RVEs far from equilibrium (sigma_11 about 430 kPa on the 150 kPa sides; the
+ * run warns).
+ * Three packings cannot answer the question (two made alike differ by more than the paper's
+ * effect), so `tools/dr_anisotropy_study.sh` runs an ensemble: 22 distinct packings (the
+ * files' gk_pack command, targets 0.02 / 0.05 / 0.08, seeds 1-10: A0 0.019-0.105), each RVE
+ * alone relaxed to a force residual of 1 % in every step, at k_n / sigma0 = 100 and 1e5, and
+ * fits the peak, its strain and the mean sigma_bar over 2-10 % against A0, against A at the
+ * end of the isotropic stage (0.012-0.090 at 100: not erased in general) and against a_y =
+ * phi_yy / phi_xx - 1 of the packing's contacts (-0.051 to 0.081: which way the excess points
+ * is not controlled, and A0 says nothing of it). At k_n / sigma0 = 100 no slope is beyond two
+ * standard errors (the peak against A0: -0.49 +- 0.30 per unit A0, the paper's sign; the
+ * peaks span 0.288-0.389); at 1e5 the peak and the 2-10 % mean rise with a_y (+0.52 +- 0.25,
+ * +0.46 +- 0.22: contact normals along the loading make the RVE stronger), at the margin of
+ * chance among the 18 slopes fitted. With 11 packings (seeds 1-5) the peak at 100 fell with
+ * a_y at 2.4 standard errors; the next 11 took it away. The paper does not say which way its
+ * packings lean.
  * WHY THE MESHES DIFFER (--frame periodic, 2 x 4, to 1 %; `--nx 2 --ny 4 --frame periodic
  * --stop-after 12 --vtk-every 1`, gp_NNNN.vtk): every Gauss point starts from the same
  * packing, but their deformation gradients differ in round-off and each RVE's DEM amplifies

@@ -22,8 +22,11 @@
  * consolidated, the packing is loaded with its final friction to
  * sigma_yy = R p (sigma_xx = p) and back to p isotropic: contacts open
  * across the minor stress and friction keeps the network that the deviator
- * made, vertical contact normals in excess (a frictionless unloading would
- * give the deviator's fabric back). --target-anisotropy searches R
+ * made (a frictionless unloading would give the deviator's fabric back).
+ * Which way the excess of contact normals points is not controlled: in the
+ * framed packings of examples/data (A = 0.016, 0.049, 0.084) the major axis
+ * of the fabric lies 8, 128 and 125 degrees from x (phi_yy / phi_xx - 1 =
+ * -0.015, 0.011, 0.028). --target-anisotropy searches R
  * (bisection in [1, 2.1], below failure at mu 0.4) for the fabric anisotropy A = Pi_1 / Pi_2 - 1 (Liu,
  * Bosco & Suiker 2018 eq 38) of the final state; with --target-void-ratio
  * the consolidation friction is searched first, then R.
