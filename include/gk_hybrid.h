@@ -611,6 +611,11 @@ GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *out, const gk_mpm_points *pt
             "critical-state parameters chi = %g, xi = %g, Phi_cs = %g, tan phi_cs = %g (need chi > 0, "
             "xi >= 0, 0 < Phi_cs < 1)",
             dp->chi, dp->xi, dp->Phi_cs, dp->tan_phi_cs);
+    if (dp->tan_phi_cs + (Phi0 - dp->Phi_cs) * dp->chi < 0.0) /* eq 7, as gk_mpm_dp_update */
+        return gk_err_set(err, GK_ERR_ARG,
+                          "packing fraction %g: eq 7 gives a negative friction angle below Phi_cs - tan "
+                          "phi_cs / chi = %g",
+                          Phi0, dp->Phi_cs - dp->tan_phi_cs / dp->chi);
     memset(&c, 0, sizeof c);
     if (alloc) c.alloc = *alloc;
     nn = (size_t)(n > 0 ? n : 1);

@@ -146,7 +146,8 @@
  *   eta = 6 sin phi / (sqrt3 (3 - sin phi)), zeta = 6 cos phi / (...).
  *   Critical state (chi > 0): tan phi = tan phi_cs + (Phi - Phi_cs) chi,
  *   tan psi = (Phi - Phi_cs) chi [eq 7], Phi += -(Phi - Phi_cs) Phi xi
- *   |de_p| [eq 8], |.| Frobenius.
+ *   |de_p| [eq 8], |.| Frobenius. A Phi below Phi_cs - tan phi_cs / chi
+ *   (negative friction) is refused (GK_ERR_ARG, nothing written).
  *   K and G are the moduli of the dimension: 2D plane K (p = K tr eps),
  *   P-wave modulus M = K + G (2D), K + 4G/3 (3D).
  *
@@ -400,7 +401,8 @@ GKDEF double gk_mpm_dp_yield(const gk_mpm_dp *dp, int dim, const double sigma[9]
 GKDEF gk_result gk_mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_trial[9], double sig[9],
                                  gk_mpm_dp_info *info, gk_err *err);
 /* rotate, elastic trial from dH, return map; Phi (packing fraction) updated
- * by eq 8 and used by eq 7 when dp->chi > 0 (Phi may be NULL otherwise) */
+ * by eq 8 and used by eq 7 when dp->chi > 0 (Phi may be NULL otherwise; a Phi
+ * whose eq 7 friction is negative is refused) */
 GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9],
                                  double *Phi, gk_mpm_dp_info *info, gk_err *err);
 
@@ -1853,13 +1855,19 @@ GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp_in, int dim, const double d
                               "critical-state Drucker-Prager needs a finite packing fraction");
         tpsi = (*Phi - dp.Phi_cs) * dp.chi; /* eq 7 */
         tphi = dp.tan_phi_cs + tpsi;
-        if (tphi < 0.0) tphi = 0.0;
+        if (tphi < 0.0)
+            return gk_err_set(
+                err, GK_ERR_ARG,
+                "critical-state Drucker-Prager: packing fraction %g gives tan phi = %g < 0 (eq 7 "
+                "needs Phi >= Phi_cs - tan phi_cs / chi = %g)",
+                *Phi, tphi, dp.Phi_cs - dp.tan_phi_cs / dp.chi);
         gk__mpm_dp_coeffs(dim, atan(tphi), atan(tpsi), &dp.eta, &dp.etabar, &dp.zeta);
     }
     gk_m3_copy(sigma, trial);
     gk__mpm_rotate(dim, dH, trial);
     gk__mpm_elastic_add(dp.K, dp.G, dim, dH, trial);
-    gk_mpm_dp_return(&dp, dim, trial, sigma, &info, NULL);
+    r = gk_mpm_dp_return(&dp, dim, trial, sigma, &info, err);
+    if (r) return r;
     if (dp.chi > 0.0 && info.status) {
         double n = gk_m3_norm(info.deps_p);
         *Phi -= (*Phi - dp.Phi_cs) * (*Phi) * dp.xi * n; /* eq 8 */

@@ -494,6 +494,9 @@ TEST(enrichment_conserves_mass_and_momentum) {
     dp.xi = 0.01;
     dp.Phi_cs = 0.815;
     dp.tan_phi_cs = tan(0.27);
+    /* below Phi_cs - tan phi_cs / chi = 0.7755 eq 7's friction is negative: refused at the start */
+    CHECK(gk_hybrid_cont_init(&cont, &P, &dp, 0.77, NULL, &e) == GK_ERR_ARG);
+    CHECK(strstr(e.msg, "negative friction") != NULL);
     CHECK(gk_hybrid_cont_init(&cont, &P, &dp, 0.84, NULL, &e) == GK_OK);
     n0 = P.n;
     CHECK(n0 <= 2000);

@@ -733,6 +733,38 @@ TEST(drucker_prager_update_spin_and_critical_state) {
     CHECK(Phi > dp.Phi_cs);
 }
 
+/* eq 7 below Phi_cs - tan phi_cs / chi gives tan phi < 0: refused with nothing written (the update
+ * once clamped phi to 0, kept psi < 0, failed its own parameter check inside and returned GK_OK with
+ * the stress unchanged and the info uninitialised); just above the bound it updates */
+TEST(drucker_prager_update_refuses_a_negative_friction) {
+    gk_mpm_dp dp;
+    gk_mpm_dp_info info;
+    gk_err e;
+    double sig[9] = {-1e5, 0, 0, 0, -1e5, 0, 0, 0, 0}, dH[9], keep[9], bound, Phi;
+    int k;
+    CHECK_EQ_INT(gk_mpm_dp_init(&dp, 2, 630e6, 460e6, 0.27, 0.0, 0.0, &e), GK_OK);
+    dp.tan_phi_cs = tan(0.27);
+    dp.Phi_cs = 0.815;
+    dp.chi = 7;
+    dp.xi = 0.01;
+    bound = dp.Phi_cs - dp.tan_phi_cs / dp.chi; /* 0.7755 */
+    gk_m3_zero(dH);
+    dH[0] = -1e-3;
+    dH[4] = 1e-3;
+    memcpy(keep, sig, sizeof sig);
+    Phi = bound - 1e-3;
+    info.status = -7;
+    CHECK_EQ_INT(gk_mpm_dp_update(&dp, 2, dH, sig, &Phi, &info, &e), GK_ERR_ARG);
+    CHECK(strstr(e.msg, "tan phi") != NULL);
+    CHECK(Phi == bound - 1e-3);
+    CHECK_EQ_INT(info.status, -7);
+    for (k = 0; k < 9; ++k) CHECK(sig[k] == keep[k]);
+    Phi = bound + 1e-3;
+    CHECK_EQ_INT(gk_mpm_dp_update(&dp, 2, dH, sig, &Phi, &info, &e), GK_OK);
+    CHECK(info.status > 0); /* this shear yields the nearly frictionless, cohesionless material */
+    CHECK(sig[0] != keep[0]);
+}
+
 /* Bitwise determinism: the coloured P2G gives every node its sum in one
  * fixed order, so 1 and 2 threads produce identical bits (whole steps,
  * 2D quadratic PIC/FLIP and 3D cubic APIC). */
@@ -936,6 +968,7 @@ int main(int argc, char **argv) {
     RUN(circle_body_bad_input_refused);
     RUN(drucker_prager_return_map);
     RUN(drucker_prager_update_spin_and_critical_state);
+    RUN(drucker_prager_update_refuses_a_negative_friction);
     RUN(threads_give_identical_bits);
     RUN(bad_input_is_refused_and_changes_nothing);
     return gk_test_done();
