@@ -275,15 +275,19 @@ static int rve_alone(const opts *o, micro *mi, int nstep, double *rows) {
         if (ok && fabs(rs[1]) >
                       fabs(rbest)) { /* end on the best run (the next run starts from the accepted state) */
             double deps[9], Rh[9], R1[9], dH[9], sR[9];
+            gk_err ce;
             gk_m3_copy(H0, H1);
             if (shear)
                 H1[1] = lone_strain(o->strain, i, nstep), H1[4] += xbest;
             else
                 H1[4] = -lone_strain(o->strain, i, nstep), H1[0] += xbest;
-            gk_corot_increment(3, H0, H1, deps, Rh, R1, NULL);
-            gk_corot_rotate_in(Rh, deps, dH);
-            ok = !gk_twoscale_run(&ts, dH, NULL, sR, NULL);
-            gk_corot_rotate_out(R1, sR, sig);
+            ok = !gk_corot_increment(3, H0, H1, deps, Rh, R1, &ce); /* fails only for det F <= 0 */
+            if (!ok) fprintf(stderr, "femdem_nonlocal: %s\n", ce.msg);
+            if (ok) {
+                gk_corot_rotate_in(Rh, deps, dH);
+                ok = !gk_twoscale_run(&ts, dH, NULL, sR, NULL);
+                gk_corot_rotate_out(R1, sR, sig);
+            }
             ++it;
         }
         if (ok) x_prev = xbest;
