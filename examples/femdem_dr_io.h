@@ -31,7 +31,7 @@
  *          tolerance, dr_unconverged_steps: load steps stopped by --max-dr,
  *          dr_residual_max: the largest relative force residual |f_ext - f_int|_inf /
  *          max(|f_ext|_inf, |f_int|_inf) a load step ended with, nan for the dns)
- *          A load step whose residual stays above 5 % was ended by eq 28 (the kinetic energy
+ *          A load step that ends above 5 % was ended by eq 28 (the kinetic energy
  *          ratio) before equilibrium: stiff or jumpy RVEs (a large --kn-ratio) do that; the run
  *          then warns on stderr with the count and the largest residual, and --dr-force-tol
  *          1e-2 makes every step relax to 1 %.
