@@ -649,6 +649,7 @@ static void track(model *md) {
 static void wave_elastic(model *md, double *arr) {
     int e, a, k, i, j;
     long n;
+    gk_err err;
     double lam = md->mi->K - 2.0 / 3.0 * md->mi->G, mu = md->mi->G;
     double thr = 1e-3 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
     double *u = (double *)xcalloc((size_t)md->nd, sizeof(double)),
@@ -681,7 +682,12 @@ static void wave_elastic(model *md, double *arr) {
         gk_dofmap_restrict(&md->dm, NULL, f, fr, NULL);
         for (a = 0; a < md->nd; ++a)
             if (md->fix[a]) vr[md->dm.red[a]] = md->vpre[a];
-        gk_explicit_step(md->nr, md->mr, md->fixr, fr, 0.0, md->dt, vr, ur, NULL);
+        if (gk_explicit_step(md->nr, md->mr, md->fixr, fr, 0.0, md->dt, vr, ur, &err)) {
+            /* a force that became NaN or infinite: no arrival is trusted (the speed is nan) */
+            fprintf(stderr, "femdem_nonlocal: warning: the elastic column at step %ld: %s\n", n, err.msg);
+            for (e = 0; e < md->ne; ++e) arr[e] = -1.0;
+            break;
+        }
         gk_dofmap_expand(&md->dm, ur, 0, u);
     }
     free(u), free(f), free(ur), free(vr), free(fr);
