@@ -75,8 +75,8 @@
  * phi_yy / phi_xx - 1 of the packing's contacts (-0.051 to 0.081: which way the excess points
  * is not controlled, and A0 says nothing of it). At k_n / sigma0 = 100 no slope is beyond two
  * standard errors (the peak against A0: -0.49 +- 0.30 per unit A0, the paper's sign; the
- * peaks span 0.288-0.389); at 1e5 the peak and the 2-10 % mean rise with a_y (+0.52 +- 0.25,
- * +0.46 +- 0.22: contact normals along the loading make the RVE stronger), at the margin of
+ * peaks span 0.288-0.389); at 1e5 the peak and the 2-10 % mean rise with a_y (+0.52 +- 0.26,
+ * +0.46 +- 0.23: contact normals along the loading make the RVE stronger), at the margin of
  * chance among the 18 slopes fitted. With 11 packings (seeds 1-5) the peak at 100 fell with
  * a_y at 2.4 standard errors; the next 11 took it away. The paper does not say which way its
  * packings lean.
