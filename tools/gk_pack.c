@@ -241,7 +241,7 @@ int main(int argc, char **argv) {
     gk_consolidate_report rep;
     double tab_r[256], tab_c[256], t0 = gk_wtime(), mu = 0.0;
     int i, ntab = 0;
-    char comment[2048];
+    char comment[4096];
     memset(&o, 0, sizeof o);
     memset(&rve, 0, sizeof rve); /* gk_rve_destroy is safe on it before a create and after a failed one */
     o.dim = 2;
@@ -500,11 +500,13 @@ int main(int argc, char **argv) {
     {
         gk_coordination z;
         gk_homog_coordination(&rve, &z);
-        char law[256], cmd[768], ratio_txt[128] = "", frame_txt[256] = "";
+        char law[256], cmd[768], ratio_txt[128] = "", frame_txt[256] = "", fabric_txt[192];
         double phi[9], Fa[9];
         size_t len = 0;
         int a;
         gk_homog_fabric(&rve, phi, Fa); /* the contact-normal fabric, written with its A (eq 38) */
+        snprintf(fabric_txt, sizeof fabric_txt, "xx %.6f yy %.6f zz %.6f xy %.6f yz %.6f xz %.6f", phi[0],
+                 phi[4], phi[8], phi[1], phi[5], phi[2]);
         if (o.ratio != 1.0)
             snprintf(ratio_txt, sizeof ratio_txt,
                      ", then sigma_yy to %.6g sigma_xx and back with friction %.6g", o.ratio, tan(o.phi));
@@ -535,14 +537,14 @@ int main(int argc, char **argv) {
             "2D thickness %g; local damping %g\n"
             "consolidation friction %.6g; target %g Pa isotropic%s; %ld steps\n"
             "fabric anisotropy A = Pi_1/Pi_2 - 1 = %.4f (Liu, Bosco & Suiker 2018 eq 38)\n"
-            "fabric tensor phi = sum n n / N_c: xx %.6f yy %.6f zz %.6f xy %.6f yz %.6f xz %.6f%s\n"
+            "fabric tensor phi = sum n n / N_c: %s%s\n"
             "RVE state: stress (Pa, tension +) sxx=%.6f syy=%.6f%s%.6f sxy=%.6f ; void ratio %.6f "
             "(porosity %.6f) ; Z=%.4f (YADE skipFree %.6f, mechanical %.4f) ; contacts=%d ; unbalanced=%.3e",
             o.dim, o.n, o.rmin, o.rmax, o.seed, cmd, law, o.phi * 180.0 / GK_PI, tan(o.phi), o.rho, o.thick,
-            o.damp, mu, o.pressure, ratio_txt, rep.steps, gk_fabric_ratio(phi, o.dim), phi[0], phi[4], phi[8],
-            phi[1], phi[5], phi[2], frame_txt, rep.stress[0], rep.stress[4], o.dim == 3 ? " szz=" : " (2D) ",
-            o.dim == 3 ? rep.stress[8] : 0.0, rep.stress[1], rep.void_ratio,
-            rep.void_ratio / (1.0 + rep.void_ratio), z.z, z.z_nofree, z.z_mech, z.contacts, rep.unbalanced);
+            o.damp, mu, o.pressure, ratio_txt, rep.steps, gk_fabric_ratio(phi, o.dim), fabric_txt, frame_txt,
+            rep.stress[0], rep.stress[4], o.dim == 3 ? " szz=" : " (2D) ", o.dim == 3 ? rep.stress[8] : 0.0,
+            rep.stress[1], rep.void_ratio, rep.void_ratio / (1.0 + rep.void_ratio), z.z, z.z_nofree, z.z_mech,
+            z.contacts, rep.unbalanced);
         if (gk_rve_to_packing(&rve, &pk, NULL, &err)) {
             fprintf(stderr, "gk_pack: %s\n", err.msg);
             gk_rve_destroy(&rve);
