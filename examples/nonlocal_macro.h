@@ -565,19 +565,25 @@ static void row_profile(model *md, double *prof) {
     }
 }
 
-/* band centre and width from the shear strain gained since the peak */
-static void band(const model *md, const double *prof, double *centre, double *width) {
-    int ny = md->o->mesh[1], j;
-    double h = md->L[1] / ny, gmin = HUGE_VAL, wmax = 0.0, sw = 0.0, sy = 0.0;
-    for (j = 0; j < ny; ++j)
-        if (prof[j] - md->gam_peak[j] < gmin) gmin = prof[j] - md->gam_peak[j];
+/* band centre and width from the rows' shear strain above the least row's (nonlocal_io.h) */
+static void band(const model *md, const double *prof, double *centre, double *width, double *share) {
+    int ny = md->o->mesh[1], j, jm = 0, j0, j1;
+    double h = md->L[1] / ny, gmin = HUGE_VAL, sw = 0.0, sy = 0.0, sg = 0.0, sa = 0.0;
     for (j = 0; j < ny; ++j) {
-        double w = prof[j] - md->gam_peak[j] - gmin;
-        sw += w, sy += w * (j + 0.5) * h;
-        if (w > wmax) wmax = w;
+        if (prof[j] < gmin) gmin = prof[j];
+        if (prof[j] > prof[jm]) jm = j;
+        sa += prof[j];
     }
-    *centre = sw > 0 ? 1e3 * sy / sw : NAN;
-    *width = wmax > 0 ? 1e3 * sw * h / wmax : NAN;
+    if (!(prof[jm] > gmin)) {
+        *centre = *width = *share = NAN;
+        return;
+    }
+    for (j0 = jm; j0 > 0 && prof[j0 - 1] - gmin >= 0.1 * (prof[jm] - gmin);) --j0;
+    for (j1 = jm; j1 < ny - 1 && prof[j1 + 1] - gmin >= 0.1 * (prof[jm] - gmin);) ++j1;
+    for (j = j0; j <= j1; ++j) sw += prof[j] - gmin, sy += (prof[j] - gmin) * (j + 0.5) * h, sg += prof[j];
+    *centre = 1e3 * sy / sw;
+    *width = 1e3 * sw * h / (prof[jm] - gmin);
+    *share = sa > 0.0 ? sg / sa : NAN;
 }
 
 static int record(model *md, double seconds) {
