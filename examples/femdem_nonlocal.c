@@ -17,21 +17,23 @@
  * macro scale is serial; tested).
  *
  * SIZES AND COST. By default the RVEs are the 512-sphere packing
- *   (examples/data/rve512_hm.txt, 6.4 mm cell) and the two mesh tests cap the
- *   DEM runs at 20 steps; --paper takes the paper's 4096-sphere packing
- *   (12.8 mm cell) and its I_uf rule everywhere (--dem-max 4000). The cost of
- *   a coarse step is about (Gauss points) x (DEM steps per run) x (spheres)
- *   particle-steps at ~150 ns each (one core, measured as CPU time on the
- *   simple shear: 0.090 s per coarse step at the default size, 4.2 s with
- *   --paper where the runs take 97-138 DEM steps to reach I_uf < 0.01; these
- *   CPU times were taken on a loaded shared machine and are indicative).
- *   Projections (CPU time, one thread; the RVEs run in parallel with
- *   --threads): default simple shear to 20 % (4000 steps) ~6 min (the
- *   whole run measured 241 s, the DEM runs being shorter later); --paper
- *   ~4.7 h if the runs stay at ~120 DEM steps (the paper reports 22 h CPU for
- *   its run). The measurement: --stop-after 4 and --stop-after 24
- *   (or 84) of the same test, the difference of their CPU times over the
- *   steps between; dem_steps_mean in the CSV gives the DEM steps per run.
+ *   (examples/data/rve512_hm.txt, 6.4 mm cell); every DEM run relaxes to
+ *   eq 57's I_uf < 0.01 except in the biaxial test, which caps the runs at
+ *   20 steps (--dem-max); --paper takes the paper's 4096-sphere packing
+ *   (12.8 mm cell) and the I_uf rule everywhere (--dem-max 4000). The cost
+ *   of a coarse step is about (Gauss points) x (DEM steps per run) x
+ *   (spheres) particle-steps at ~150 ns each (one core, measured as CPU
+ *   time on the simple shear: 0.090 s per coarse step with the 20-step cap,
+ *   4.2 s with --paper where the runs take 97-138 DEM steps to reach I_uf <
+ *   0.01; these CPU times were taken on a loaded shared machine and are
+ *   indicative). Measured: the default simple shear to 20 % (4000 steps)
+ *   1804 s on 2 threads, the 20-step cap to 10 % 188 s on one thread.
+ *   Projection for --paper (CPU time, one thread; the RVEs run in parallel
+ *   with --threads): ~4.7 h if the runs stay at ~120 DEM steps (the paper
+ *   reports 22 h CPU for its run). The measurement: --stop-after 4 and
+ *   --stop-after 24 (or 84) of the same test, the difference of their CPU
+ *   times over the steps between; dem_steps_mean in the CSV gives the DEM
+ *   steps per run.
  *
  * RESULTS AGAINST THE PAPER (default sizes unless stated; what is not
  *   reproduced is said so)
@@ -59,19 +61,36 @@
  *     cannot meet 2 % there. (--lone-increments 4000: biaxial 8.2 %, peaks
  *     1.000; with --xi 0.05 too: 5.0 %.)
  *   simple-shear (Figs 9-14, default: 512 spheres, 5x12x1, local, 4000
- *     steps to 20 %, 241 s CPU): shear stress, mean over 2 % windows, 261
- *     kPa at 1-3 %, 252 at 4-6 %, 248 at 6-8 %, 238 at 8-10 %, 229 at 10-12 %,
- *     207 at 16-18 %, normal stress 413-421 kPa: an early peak and gradual
- *     softening, NOT the paper's plateau to 6 % and abrupt drop between 6
- *     and 8 %. Porosity rises monotonically (0.3457 to 0.371) and Z falls
- *     fast (5.69 to 3.6 by 4 %) then stays nearly constant, as in Figs 12
- *     and 13. No band of 13-16 mm: at 12 % the shear strain is spread over
- *     five of the twelve rows (0.14-0.32); the imperfect row (93 mm) leads
- *     at the end (0.88 against 0.03-0.37). The start of the platen gives a
- *     transient (272 kPa at 0.2 %) that the RESULT line takes as the peak
- *     (peak_stress 300 kPa at 0.3 %), so band_center_mm 58.6 and
- *     band_width_mm 38 there measure the whole shear profile, not a band.
- *     20-60 of the 60 points stop at the 20-step cap (dem_capped).
+ *     steps to 20 %, eq 57's rule in every DEM run; 1804 s on 2 threads,
+ *     90-500 DEM steps per run): shear stress, means over 2 % windows, 260
+ *     kPa at 1-3 %, 238 at 4-6 %, 214 at 6-8 %, 192 at 8-10 %, 177 at 10-12
+ *     % and 174-182 from 12 to 20 % (the peak, RESULT's smoothed one, 267 kPa
+ *     at 1.4 %), normal stress 411-429 kPa: a level stretch to about 4 %,
+ *     softening between 4 and 10 %, then critical state; the paper: level to
+ *     6 %, an abrupt drop between 6 and 8 %, critical state from 8 %.
+ *     Porosity rises (0.3458 to 0.3575 at 8 %) then stays (0.3590 at 20 %)
+ *     and Z falls fast (5.69 to 3.71 by 4 %) then stays near 3.65, as in
+ *     Figs 12 and 13. The band forms in the imperfect row (93 mm, 0.79 of
+ *     the height; the paper: about 3/4): at 12 % its shear strain is 0.75
+ *     against 0.01-0.05 in eight rows, with a second, weaker band at 25 mm
+ *     (0.37) and 0.11 at 64 mm; RESULT's band (one row wide, nonlocal_io.h)
+ *     is centred at 93.4 mm, 9.8 mm wide (the paper: 13-16 mm, with element
+ *     rows as high as these) and carries 52 % of the shear displacement. At
+ *     20 % the band's particles have turned 2.1 rad on average, those of the
+ *     rows outside the two bands 0.11-0.43 (Fig 14b); its porosity 0.391, Z
+ *     3.38. With relaxed RVEs the column's first shear mode (4 H /
+ *     sqrt(G/rho), 1.05 ms, about 1 % of strain) rings: one step's base
+ *     stress swings by 100 kPa early and between 0 and 440 kPa near 20 %,
+ *     which is why RESULT's peak is a mean over one period.
+ *     The biaxial test's 20-step cap (--dem-max 20: most runs end above the
+ *     I_uf bound) forms no band: to 10 % (--strain 0.1 --steps 2000, the
+ *     same rate; 188 s against 1338 s with the rule, one thread each, side
+ *     by side) the strain spreads over the rows (0.03 to 0.22,
+ *     five rows above 0.1), the stress softens gradually (263 kPa at 1-2 %,
+ *     235 at 9-10 %; eq 57's rule: 263 and 190) and RESULT's band carries
+ *     31 % (eq 57's rule: 50 %). 1000-sphere RVEs with the cap do the same
+ *     (267 and 245 kPa, 30 %). An RVE stopped while its particles still move
+ *     resists in proportion to its rate, and that spreads the strain.
  *   wave (Fig 8, 1 ms): the shear front runs at 566 m/s, the elastic
  *     column of the same mesh (the RVE's K and G) at 607 m/s and
  *     sqrt(G / rho) is 451 m/s (with the paper's G = 241 MPa and 1650 kg/m^3:

@@ -101,7 +101,7 @@ static void usage(FILE *fp) {
     fprintf(fp,
             "defaults: --pressure 4.16e5 --packing examples/data/rve512_hm.txt --threads 1 --nonlocal off\n"
             "  --iuf 0.01 --dem-inertial 2e-3 --dem-min 10 --dem-max 4000 (biaxial: 20; simple-shear with\n"
-            "  --dem-max 20: 4x faster, but the capped RVEs spread the strain and no band forms)\n"
+            "  --dem-max 20: 7x faster, but the capped RVEs spread the strain and no band forms)\n"
             "  --dem-damping 0.2 --contact-damping 0.12 (biaxial 0) --density 2492 --xi 0.3 (wave 0)\n"
             "  --mass-scale 1 --hourglass 0.1 --dt-safety 0.5 --lone-increments 400\n"
             "  rve: --strain 2e-3 --steps 20; element-biaxial: --mesh 1x1x1 --strain 0.05 --steps 4000;\n"
