@@ -377,12 +377,16 @@ static void smoothed_peak(const model *md, double period, double *pk, double *ep
     long r, q, n = md->nrow, lo = 0, hi = 0;
     double t0 = n ? md->rows[1] : 0.0, t1 = n ? md->rows[NCOL * (n - 1) + 1] : 0.0;
     *pk = -HUGE_VAL, *epk = NAN;
+    if (t1 - t0 < period) { /* a run shorter than one period: its largest row */
+        for (r = 0; r < n; ++r)
+            if (md->rows[NCOL * r + 3] > *pk) *pk = md->rows[NCOL * r + 3], *epk = md->rows[NCOL * r + 2];
+        return;
+    }
     for (r = 0; r < n; ++r) { /* the rows within period / 2 of row r: [lo, hi), lo <= r < hi */
         double t = md->rows[NCOL * r + 1], sum = 0.0;
         while (hi < n && md->rows[NCOL * hi + 1] <= t + 0.5 * period) ++hi;
         while (md->rows[NCOL * lo + 1] < t - 0.5 * period) ++lo;
-        if (t1 - t0 >= period && (t - 0.5 * period < t0 || t + 0.5 * period > t1)) continue; /* not whole */
-        if (t1 - t0 < period) lo = r, hi = r + 1; /* a run shorter than one period: its largest row */
+        if (t - 0.5 * period < t0 || t + 0.5 * period > t1) continue; /* the window is not whole */
         for (q = lo; q < hi; ++q) sum += md->rows[NCOL * q + 3];
         if (sum / (double)(hi - lo) > *pk) *pk = sum / (double)(hi - lo), *epk = md->rows[NCOL * r + 2];
     }
