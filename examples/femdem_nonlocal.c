@@ -68,7 +68,7 @@
  *     core.
  *   simple-shear (Figs 9-14, default: 512 spheres, 5x12x1, local, 4000
  *     steps to 20 %, eq 57's rule in every DEM run; 1804 s on 2 threads,
- *     90-500 DEM steps per run): shear stress, means over 2 % windows, 260
+ *     the runs' mean 90-500 DEM steps): shear stress, means over 2 % windows, 260
  *     kPa at 1-3 %, 238 at 4-6 %, 214 at 6-8 %, 192 at 8-10 %, 177 at 10-12
  *     % and 174-182 from 12 to 20 % (the peak, RESULT's smoothed one, 267 kPa
  *     at 1.4 %), normal stress 411-429 kPa: a level stretch to about 4 %,
