@@ -501,10 +501,11 @@ int main(int argc, char **argv) {
         gk_coordination z;
         gk_homog_coordination(&rve, &z);
         char law[256], cmd[768], ratio_txt[128] = "", frame_txt[256] = "", fabric_txt[192];
-        double phi[9], Fa[9];
+        double phi[9], Fa[9], A;
         size_t len = 0;
         int a;
         gk_homog_fabric(&rve, phi, Fa); /* the contact-normal fabric, written with its A (eq 38) */
+        A = gk_fabric_ratio(phi, o.dim);
         snprintf(fabric_txt, sizeof fabric_txt, "xx %.6f yy %.6f zz %.6f xy %.6f yz %.6f xz %.6f", phi[0],
                  phi[4], phi[8], phi[1], phi[5], phi[2]);
         if (o.ratio != 1.0)
@@ -541,10 +542,10 @@ int main(int argc, char **argv) {
             "RVE state: stress (Pa, tension +) sxx=%.6f syy=%.6f%s%.6f sxy=%.6f ; void ratio %.6f "
             "(porosity %.6f) ; Z=%.4f (YADE skipFree %.6f, mechanical %.4f) ; contacts=%d ; unbalanced=%.3e",
             o.dim, o.n, o.rmin, o.rmax, o.seed, cmd, law, o.phi * 180.0 / GK_PI, tan(o.phi), o.rho, o.thick,
-            o.damp, mu, o.pressure, ratio_txt, rep.steps, gk_fabric_ratio(phi, o.dim), fabric_txt, frame_txt,
-            rep.stress[0], rep.stress[4], o.dim == 3 ? " szz=" : " (2D) ", o.dim == 3 ? rep.stress[8] : 0.0,
-            rep.stress[1], rep.void_ratio, rep.void_ratio / (1.0 + rep.void_ratio), z.z, z.z_nofree, z.z_mech,
-            z.contacts, rep.unbalanced);
+            o.damp, mu, o.pressure, ratio_txt, rep.steps, A, fabric_txt, frame_txt, rep.stress[0],
+            rep.stress[4], o.dim == 3 ? " szz=" : " (2D) ", o.dim == 3 ? rep.stress[8] : 0.0, rep.stress[1],
+            rep.void_ratio, rep.void_ratio / (1.0 + rep.void_ratio), z.z, z.z_nofree, z.z_mech, z.contacts,
+            rep.unbalanced);
         if (gk_rve_to_packing(&rve, &pk, NULL, &err)) {
             fprintf(stderr, "gk_pack: %s\n", err.msg);
             gk_rve_destroy(&rve);
@@ -561,7 +562,7 @@ int main(int argc, char **argv) {
         printf("RESULT void_ratio=%.6f porosity=%.6f Z=%.4f Z_mech=%.4f consolidation_friction=%.6g p=%.6g "
                "anisotropy=%.4f stress_ratio=%.6g steps=%ld seconds=%.2f\n",
                rep.void_ratio, rep.void_ratio / (1.0 + rep.void_ratio), z.z, z.z_mech, mu,
-               gk_stress_p(rep.stress, o.dim), anisotropy(&rve), o.ratio, rep.steps, gk_wtime() - t0);
+               gk_stress_p(rep.stress, o.dim), A, o.ratio, rep.steps, gk_wtime() - t0);
     }
     gk_packing_free(&pk);
     gk_packing_free(&cloud);
