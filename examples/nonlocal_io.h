@@ -368,8 +368,8 @@ static double curve_deviation(const double *rows, long nrow, const double *lone,
 }
 
 /* The simple shear's peak: the base reaction carries the column's inertia, whose first shear mode
- * rings at a period of 4 H / sqrt(G / rho) (1.05 ms, about 1 % of shear strain at the default
- * rate; with eq 57's rule the RVEs damp it little and the stress of one step swings by a hundred
+ * (md->omega1, the frequency the macro damping is set from) rings at a period of 4 H / sqrt(G /
+ * rho) (1.05 ms, about 1 % of shear strain at the default rate; with eq 57's rule the RVEs damp it little and the stress of one step swings by a hundred
  * kPa or more), so the peak is the largest mean of the CSV rows' stress over one such period
  * centred on a row (windows that fit in the run), and eps_at_peak that row's strain; a run shorter
  * than one period takes its largest row. */
@@ -483,7 +483,7 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
             int ny = o->mesh[1], j, bad;
             FILE *fp;
             double *pe = (double *)xcalloc((size_t)2 * ny, sizeof(double)), share;
-            smoothed_peak(md, 4.0 * md->L[1] / sqrt(mi->G / (mi->rho * o->mass_scale)), &pk, &epk);
+            smoothed_peak(md, 2.0 * GK_PI / md->omega1, &pk, &epk);
             gk_twoscale_fields(&md->ts, md->fld);
             row_profile(md, pe);
             band(md, md->have12 ? md->prof12 : pe, &bc, &bw, &share);
