@@ -15,11 +15,12 @@
 #    packing files' own k_n / p, where the isotropic stage mostly keeps the packing's anisotropy).
 # 3. Prints per run: the packing's A0 (eq 38: Pi_1 / Pi_2 - 1, whatever the axis of Pi_1), a_y
 #    (phi_yy / phi_xx - 1 of the fabric tensor gk_pack writes: signed, > 0 when the contact
-#    normals are in excess along the loading axis), A at the end of the isotropic stage (A_iso, unsigned), the peak
-#    stress ratio and its strain, sigma_bar at 7.3 %, the mean sigma_bar over 2-10 %, and the
-#    largest force residual; then for each stiffness the least-squares slope of the peak, of its
-#    strain and of the 2-10 % mean against each of A0, a_y and A_iso, with its standard error
-#    and the correlation r (a slope within two standard errors of 0: no resolved effect).
+#    normals are in excess along the loading axis), A at the end of the isotropic stage (A_iso,
+#    unsigned), the peak stress ratio and its strain, sigma_bar at 7.3 %, the mean sigma_bar
+#    over 2-10 %, and the largest force residual; then for each stiffness the least-squares
+#    slope of the peak, of its strain and of the 2-10 % mean against each of A0, a_y and A_iso,
+#    with its standard error and the correlation r (a slope within two standard errors of 0: no
+#    resolved effect).
 # Writes WORK/anisotropy.csv (one row per run). Exit status 1 if a run could not be started or a
 # result not written. The default seeds give 22 distinct packings, about 20 minutes on 2 cores
 # (a packing 20 s, a run 3 s at k_n = 100 sigma0 and about a minute at 1e5); JOBS runs at a
