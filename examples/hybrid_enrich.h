@@ -545,28 +545,30 @@ done: /* every exit: the scratch freed */
 }
 
 /* Grains squeezed out of the discrete zone's side (at the paper's size of the biaxial test, a few
- * of 1900, where a membrane chain ends or at the swap) fly off; one that comes within 1.25 h + lp of
- * the grid's side (1.25 cells before its coupling support would leave the grid, gk_mpm_shape's
- * test, and stop the run; the platens hold the grains above and below), touching no other grain
- * and not on a membrane, has left the specimen: it is removed, and said so, with the running count
- * and the share of the grains' mass lost (R->lost, R->lost_mass). A grain there that touches others
- * or is a membrane's member (one may part from the grains for a moment) is the specimen's own
- * material spreading that far: it stays (and the run stops when it leaves the grid). Returns 1 on
- * error. */
+ * of 1900, where a membrane chain ends or at the swap) fly off; one whose coupling support would
+ * leave the grid (gk_mpm_support_inside, the test that stops the run) if it moved ESCAPE_SPARE
+ * further out sideways (the platens hold the grains above and below), touching no other grain and
+ * not on a membrane, has left the specimen: it is removed, and said so, with the running count and
+ * the share of the grains' mass lost (R->lost, R->lost_mass). A grain there that touches others or
+ * is a membrane's member (one may part from the grains for a moment) is the specimen's own material
+ * spreading that far: it stays (and the run stops when it leaves the grid). Returns 1 on error. */
 static int remove_escaped(run *R) {
     gk_scene *sc = &R->sc;
     const gk_mpm_grid *g = &R->g;
     int p, k = 0, q, c = 0;
-    /* 1.25 h + lp inside the grid's sides */
-    double lo = g->origin[0] + 1.25 * g->h + R->P.lp[0],
-           hi = g->origin[0] + (g->n[0] - 2.25) * g->h - R->P.lp[0];
     double m = 0.0, mall = 0.0;
     gk_rve_contact ct;
     for (p = 0; p < sc->rve.n; ++p) { /* the candidates: free grains near the grid's sides */
-        double x[3];
+        double x[3], xl[3], xr[3];
         if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) continue;
         gk_scene_position(sc, p, x);
-        if (x[0] < lo || x[0] > hi) R->drop_ids[k++] = sc->rve.id[p];
+        memcpy(xl, x, sizeof x);
+        memcpy(xr, x, sizeof x);
+        xl[0] -= ESCAPE_SPARE * g->h;
+        xr[0] += ESCAPE_SPARE * g->h;
+        if (!gk_mpm_support_inside(g, R->md.basis, xl, R->P.lp[0]) ||
+            !gk_mpm_support_inside(g, R->md.basis, xr, R->P.lp[0]))
+            R->drop_ids[k++] = sc->rve.id[p];
     }
     if (!k) return 0;
     while (gk_rve_contact_next(&sc->rve, &c, &ct)) /* those that touch a grain stay */
@@ -603,7 +605,7 @@ static int hybrid_step(run *R) {
     gk_hybrid_couple_report rep;
     int p, ng = sc->rve.n;
     double t0;
-    if (R->o.test == T_BIAXIAL && R->step % 20 == 0) { /* free sides; as the coupling mask below */
+    if (R->o.test == T_BIAXIAL && R->step % REFRESH_EVERY == 0) { /* free sides */
         if (remove_escaped(R)) return 1;
         ng = sc->rve.n;
     }
@@ -614,8 +616,8 @@ static int hybrid_step(run *R) {
         R->xpre[0][p] = x[0];
         R->xpre[1][p] = x[1];
     }
-    /* which grains lie in the overlap: every 20 steps (a grain moves < 1e-3 D50 per step) */
-    if (R->step % 20 == 0 || R->mask_n != ng) {
+    /* which grains lie in the overlap */
+    if (R->step % REFRESH_EVERY == 0 || R->mask_n != ng) {
         coupling_mask(R);
         R->mask_n = ng;
     }

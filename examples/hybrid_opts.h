@@ -58,6 +58,15 @@ static const char *mode_name[] = {"dem", "continuum", "hybrid"};
 #define G_C 4.6e8
 #define GRAV 9.81 /* Table 7 */
 
+/* ------------------------------------------------------------------ coupling bookkeeping */
+/* steps between updates of the coupling mask and removals of escaped grains (a grain moves under
+ * 1e-3 D50 per step) */
+#define REFRESH_EVERY 20
+/* cells: a free grain is removed once this much further out sideways its coupling support would
+ * leave the grid (a generous spare: at 2 m/s a grain moves 0.02 mm, under 0.01 cell, between two
+ * checks) */
+#define ESCAPE_SPARE 1.25
+
 typedef struct opts {
     int test, mode;
     const char *out, *packing;

@@ -24,6 +24,7 @@
  *   gk_mpm_grid_node_position     position of a node
  *   gk_mpm_kernel_1d              1D weight and derivative of each basis
  *   gk_mpm_shape                  nodes, weights, gradients of one point
+ *   gk_mpm_support_inside         whether gk_mpm_shape (and P2G, G2P) take a point
  *   gk_mpm_p2g                    mass, momentum (PIC/FLIP or APIC), v = p/m,
  *                                 internal force -sum V sigma.grad N, external
  *                                 force sum N (m g + f_p)   [Liang & Zhao 2019 eqs 10-13]
@@ -366,6 +367,11 @@ GKDEF void gk_mpm_points_totals(const gk_mpm_points *pts, double *mass, double m
 /* nodes, weights and gradients of a point at x (half-size lp, uGIMP only) */
 GKDEF gk_result gk_mpm_shape(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double lp,
                              gk_mpm_stencil *st, gk_err *err);
+/* 1 if gk_mpm_shape takes a point at x (finite, basis known, uGIMP lp in
+ * (0, h/2], its support inside the grid: GRID above), else 0; no error is
+ * set. A caller that must act before a moving point leaves (remove it, stop
+ * a run) asks it at x pushed outward by its own spare */
+GKDEF int gk_mpm_support_inside(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double lp);
 
 GKDEF gk_mpm_def gk_mpm_def_default(void); /* linear, PIC/FLIP alpha 0.1, USF, 1 thread */
 
@@ -860,21 +866,36 @@ GK_FORCE_INLINE const gk__mpm_w *gk__mpm_wget(const gk_mpm_grid *g, int fresh, g
     return tmp;
 }
 
-GKDEF gk_result gk_mpm_shape(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double lp,
-                             gk_mpm_stencil *st, gk_err *err) {
-    gk__mpm_w W;
-    double xx[3], l = lp * g->inv_h;
-    int a, b, c, s, sz, k, q = 0;
+/* what gk_mpm_shape takes: xx = x with the unused axes 0, *l = lp / h (err may be NULL) */
+static gk_result gk__mpm_point_check(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double lp,
+                                     double xx[3], double *l, gk_err *err) {
+    int k;
+    *l = lp * g->inv_h;
     if ((int)basis < 0 || (int)basis > (int)GK_MPM_CUBIC)
         return gk_err_set(err, GK_ERR_ARG, "unknown basis %d", (int)basis);
     for (k = 0; k < 3; ++k) xx[k] = k < g->dim ? x[k] : 0.0;
     for (k = 0; k < g->dim; ++k)
         if (!isfinite(xx[k])) return gk_err_set(err, GK_ERR_NAN, "point position is NaN or infinite");
-    if (basis == GK_MPM_UGIMP && !(l > 0.0 && l <= 0.5))
+    if (basis == GK_MPM_UGIMP && !(*l > 0.0 && *l <= 0.5))
         return gk_err_set(err, GK_ERR_ARG, "uGIMP half-size lp = %g (must be in (0, h/2], h = %g)", lp, g->h);
-    if (!gk__mpm_inside(g, basis, xx, l))
+    if (!gk__mpm_inside(g, basis, xx, *l))
         return gk_err_set(err, GK_ERR_OUTSIDE, "point (%g, %g, %g): its support leaves the grid", xx[0],
                           xx[1], xx[2]);
+    return GK_OK;
+}
+
+GKDEF int gk_mpm_support_inside(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double lp) {
+    double xx[3], l;
+    return gk__mpm_point_check(g, basis, x, lp, xx, &l, NULL) == GK_OK;
+}
+
+GKDEF gk_result gk_mpm_shape(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double lp,
+                             gk_mpm_stencil *st, gk_err *err) {
+    gk__mpm_w W;
+    double xx[3], l;
+    int a, b, c, s, sz, q = 0;
+    gk_result r = gk__mpm_point_check(g, basis, x, lp, xx, &l, err);
+    if (r) return r;
     gk__mpm_weights(g, basis, xx, l, &W);
     s = W.s;
     sz = g->dim == 3 ? s : 1;

@@ -118,11 +118,12 @@ TEST(membrane_chain_ends_at_the_wall) {
 }
 
 /* remove_escaped: on a grid of 10 x 10 cells of 1 mm from (-3, -3) mm with points' half-size lp
- * 0.25 mm, grains are kept whose centres lie within x = -1.5 ... 5.5 mm (a quarter cell inside where
- * the coupling stencil, h + lp around a grain, leaves the grid): grains 0 and 1. Outside it, grain
- * 2 touches nothing (squeezed out of the specimen, on its way off the grid): removed and counted
- * with its share of the grains' mass; grains 4 and 5 touch each other (the specimen's material
- * spreading that far): kept; grain 3 (x 5.8 mm) is prescribed (as the driver's platen layers): kept. */
+ * 0.25 mm, grains are kept whose centres lie within x = -1.5 ... 5.5 mm (ESCAPE_SPARE, 1.25 cells,
+ * inside where the uGIMP support, lp around a grain, leaves the grid: -2.75 ... 6.75 mm): grains 0
+ * and 1. Outside it, grain 2 touches nothing (squeezed out of the specimen, on its way off the
+ * grid): removed and counted with its share of the grains' mass; grains 4 and 5 touch each other
+ * (the specimen's material spreading that far): kept; grain 3 (x 5.8 mm) is prescribed (as the
+ * driver's platen layers): kept. */
 TEST(escaped_grains_are_removed_and_counted) {
     run R;
     gk_packing pk;

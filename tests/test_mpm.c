@@ -132,6 +132,58 @@ TEST(shape_partition_of_unity) {
     }
 }
 
+/* gk_mpm_support_inside: true exactly where gk_mpm_shape takes the point, which (GRID in gk_mpm.h) is
+ * xi = (x - origin) / h in [a, n - 1 - a] per axis, a = 0 / lp/h / 1/2 / 1 for linear / uGIMP /
+ * quadratic / cubic; checked on both sides of each bound of a 2D and a 3D grid, on random points
+ * in and around the grid, and false for NaN, an unknown basis and a uGIMP lp outside (0, h/2]. */
+TEST(support_inside_agrees_with_shape) {
+    int dim, bi, t, k, side;
+    gk_rng rng;
+    gk_mpm_stencil st;
+    gk_err e;
+    gk_rng_seed(&rng, 11);
+    for (dim = 2; dim <= 3; ++dim) {
+        gk_mpm_grid g = make_grid(dim, -1.0, 0.5, 2.0, 0.37, 9, 8, 7);
+        const double lp = 0.3 * g.h;
+        for (bi = 0; bi < 4; ++bi) {
+            /* the support margin a of each basis, in cells; lp = 0.3 h */
+            const double margin[4] = {0.0, 0.3, 0.5, 1.0}, a = margin[bi];
+            for (k = 0; k < dim; ++k)
+                for (side = 0; side < 2; ++side) {
+                    /* just inside and just outside the bound of axis k, the other axes mid-grid */
+                    double x[3] = {0, 0, 0}, bound;
+                    int j;
+                    for (j = 0; j < dim; ++j) x[j] = g.origin[j] + 0.5 * (g.n[j] - 1) * g.h;
+                    bound = g.origin[k] + (side ? (g.n[k] - 1 - a) : a) * g.h;
+                    x[k] = bound + (side ? -1e-9 : 1e-9);
+                    CHECK(gk_mpm_support_inside(&g, all_bases[bi], x, lp));
+                    x[k] = bound + (side ? 1e-9 : -1e-9);
+                    CHECK(!gk_mpm_support_inside(&g, all_bases[bi], x, lp));
+                    CHECK_EQ_INT(gk_mpm_shape(&g, all_bases[bi], x, lp, &st, &e), GK_ERR_OUTSIDE);
+                }
+            for (t = 0; t < 400; ++t) {
+                double x[3] = {0, 0, 0};
+                int in;
+                for (k = 0; k < dim; ++k)
+                    x[k] = g.origin[k] + g.h * (-1.0 + (g.n[k] + 1.0) * gk_rng_uniform(&rng));
+                in = gk_mpm_support_inside(&g, all_bases[bi], x, lp);
+                CHECK_EQ_INT(in, gk_mpm_shape(&g, all_bases[bi], x, lp, &st, &e) == GK_OK);
+            }
+        }
+        {
+            double x[3];
+            for (k = 0; k < 3; ++k) x[k] = g.origin[k] + 3.0 * g.h;
+            CHECK(gk_mpm_support_inside(&g, GK_MPM_UGIMP, x, lp));
+            CHECK(!gk_mpm_support_inside(&g, GK_MPM_UGIMP, x, 0.0));
+            CHECK(!gk_mpm_support_inside(&g, GK_MPM_UGIMP, x, 0.51 * g.h));
+            CHECK(!gk_mpm_support_inside(&g, (gk_mpm_basis)7, x, lp));
+            x[1] = NAN;
+            CHECK(!gk_mpm_support_inside(&g, GK_MPM_LINEAR, x, lp));
+        }
+        gk_mpm_grid_destroy(&g);
+    }
+}
+
 /* dN/dr of every 1D kernel equals the central difference of N */
 TEST(kernel_derivative_matches_finite_difference) {
     int bi, t;
@@ -955,6 +1007,7 @@ TEST(bad_input_is_refused_and_changes_nothing) {
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(shape_partition_of_unity);
+    RUN(support_inside_agrees_with_shape);
     RUN(kernel_derivative_matches_finite_difference);
     RUN(p2g_g2p_conserve_mass_and_momentum);
     RUN(apic_preserves_rigid_rotation);
