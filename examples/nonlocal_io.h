@@ -397,22 +397,20 @@ static void smoothed_peak(const model *md, double period, double *pk, double *ep
 static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
     char path[1024];
     int e, k;
-    long r, n = md->nrow, ipk = 0;
+    long r, n = md->nrow;
     double *x = (double *)xcalloc((size_t)n, sizeof(double)),
            *y = (double *)xcalloc((size_t)n, sizeof(double));
     double *y2 = (double *)xcalloc((size_t)n, sizeof(double)),
            *val = (double *)xcalloc((size_t)md->ne, sizeof(double));
     double pk = -HUGE_VAL, epk = NAN, bc = NAN, bw = NAN;
     char extra[1024], svg[1024];
-    const char *xl = "strain", *yl = "stress [kPa]";
     extra[0] = 0;
     for (r = 0; r < n; ++r) {
         const double *row = md->rows + NCOL * r;
         x[r] = o->test == T_WAVE ? row[1] * 1e3 : row[2];
         y[r] = row[3] / 1e3;
-        if (row[3] > pk) pk = row[3], epk = row[2], ipk = r;
+        if (row[3] > pk) pk = row[3], epk = row[2];
     }
-    (void)ipk;
     snprintf(path, sizeof path, "%s/mesh_%06ld.vtk", o->out, md->step);
     if (write_vtk(md, path)) return 1;
     if (o->test == T_EBIAX || o->test == T_ESHEAR) {
@@ -510,7 +508,6 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
                   "FEM x DEM", NULL, NULL, 0, NULL))
             return 1;
     }
-    (void)xl, (void)yl;
     /* state curves: porosity and Z */
     for (r = 0; r < n; ++r) y[r] = md->rows[NCOL * r + 7], y2[r] = md->rows[NCOL * r + 8] / 10.0;
     snprintf(svg, sizeof svg, "%s/%s_state.svg", o->out, test_name[o->test]);
