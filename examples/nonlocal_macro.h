@@ -327,7 +327,8 @@ static int macro_setup(model *md) {
     md->nr = md->dm.nred;
     ALLOC(md->ur, md->nr), ALLOC(md->vr, md->nr), ALLOC(md->fr, md->nr), ALLOC(md->mr, md->nr),
         ALLOC(md->fixr, md->nr);
-    gk_dofmap_restrict(&md->dm, NULL, md->mass, md->mr, NULL);
+    if (gk_dofmap_restrict(&md->dm, NULL, md->mass, md->mr, &err))
+        return fprintf(stderr, "femdem_nonlocal: the tied mass: %s\n", err.msg), 1;
     for (a = 0; a < md->nd; ++a)
         if (md->fix[a]) md->fixr[md->dm.red[a]] = 1;
     /* nonlocal neighbourhoods of the Gauss points (reference configuration) */
@@ -466,7 +467,8 @@ static int macro_step(model *md) {
     for (a = 0; a < md->nd; ++a) /* alpha M (v - v_hom): the v_hom part enters as a force */
         md->f[a] =
             md->fext[a] - md->fint[a] + (md->alpha > 0.0 ? md->alpha * md->mass[a] * md->vhom[a] : 0.0);
-    gk_dofmap_restrict(&md->dm, NULL, md->f, md->fr, NULL);
+    if (gk_dofmap_restrict(&md->dm, NULL, md->f, md->fr, &err))
+        return fprintf(stderr, "femdem_nonlocal: step %ld: %s\n", md->step, err.msg), 1;
     for (a = 0; a < md->nd; ++a)
         if (md->fix[a]) md->vr[md->dm.red[a]] = md->vpre[a];
     r = gk_explicit_step(md->nr, md->mr, md->fixr, md->fr, md->alpha, md->dt, md->vr, md->ur,
@@ -685,7 +687,11 @@ static void wave_elastic(model *md, double *arr) {
             if (arr[e] < 0 && fabs(H[1] + H[3]) > thr) arr[e] = n * md->dt;
         }
         loading(md, n);
-        gk_dofmap_restrict(&md->dm, NULL, f, fr, NULL);
+        if (gk_dofmap_restrict(&md->dm, NULL, f, fr, &err)) {
+            fprintf(stderr, "femdem_nonlocal: warning: the elastic column at step %ld: %s\n", n, err.msg);
+            for (e = 0; e < md->ne; ++e) arr[e] = -1.0;
+            break;
+        }
         for (a = 0; a < md->nd; ++a)
             if (md->fix[a]) vr[md->dm.red[a]] = md->vpre[a];
         if (gk_explicit_step(md->nr, md->mr, md->fixr, fr, 0.0, md->dt, vr, ur, &err)) {
