@@ -28,7 +28,7 @@
 set -u
 report=0
 [ "${1:-}" = --report ] && { report=1; shift; }
-[ $# -ge 1 ] || { sed -n '2,/^$/p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+[ $# -ge 1 ] || { sed -n '2,/^[^#]/ s/^# \{0,1\}//p' "$0"; exit 2; }
 W=$1 J=${2:-2} SEEDS=${3:-"1 2 3 4 5 6 7 8 9 10"}
 B=${BUILD:-build}
 mkdir -p "$W" || exit 1

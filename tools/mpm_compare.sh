@@ -30,7 +30,7 @@
 #   ft_test_u       mpmdem_footing 4 x 3 cells to d/B 0.08  (ft_test_restart: 0.01, then to 0.02)
 #   cl_test         mpmdem_collapse 4 x 4 cells to t = 0.15 s (cl_test_restart: 0.075 s, then on)
 set -u
-[ $# -ge 3 ] || { sed -n '2,/^$/p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+[ $# -ge 3 ] || { sed -n '2,/^[^#]/ s/^# \{0,1\}//p' "$0"; exit 2; }
 REF=$1 NEW=$2 W=$3
 shift 3
 mkdir -p "$W" || exit 1
