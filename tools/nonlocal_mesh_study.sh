@@ -72,7 +72,7 @@ run N8 8x16x1 6.75e-3 1 || fail=1
 [ $relaxed = 1 ] || run N12 12x24x1 6.75e-3 1 1250 || fail=1 # to 2 %: the paper's average is unstable there
 # the stress [kPa] of NAME's CSV at strain S: linear interpolation (20-step runs, smooth curves) or,
 # relaxed, the mean of the rows over the 1 % of strain before S (the relaxed specimen rings, a row
-# swings by 30-100 kPa); nan beyond the run
+# lies up to 30-220 kPa off its window's mean); nan beyond the run
 at() {
     [ -f "$W/$1/biaxial.csv" ] || { printf nan; return; }
     awk -F, -v s="$2" -v win="$win" 'NR == 1 { for (c = 1; c <= NF; ++c) { if ($c == "strain") xs = c; if ($c == "stress") ys = c } next }
