@@ -19,7 +19,7 @@
 # then prints per run: the symbol min of the averaging on its mesh (< 0: unstable), how the run
 # ended, the largest kinetic energy to 2 % strain, the peak, the stress [kPa] at 2-8 %, and at 6 %
 # (the paper's Figs 17 and 19) the largest Gauss-point eps_q and the share of the specimen where
-# eps_q exceeds half of that; then the spread of the stress over the meshes, (max - min) / mean,
+# eps_q exceeds half of that, and the mean DEM steps per RVE run; then the spread of the stress over the meshes, (max - min) / mean,
 # for each family. Writes WORK/mesh_study.svg (every curve). Exit status 1 if a run could not be
 # started or a result not written. About 60 minutes on 2 cores. --report runs nothing: the
 # table and the figure of the runs WORK holds.
@@ -29,7 +29,8 @@
 # while its particles still move resists in proportion to its rate, which can spread the strain
 # over the elements: examples/femdem_nonlocal.c, simple shear). The relaxed specimen rings, so the
 # stress at S is the mean over the 1 % of strain before S and the peak the largest mean of five
-# rows (0.2 %). About 10 minutes (4x8x1), 40 (8x16x1) and 90 (12x24x1) per run on 2 cores.
+# rows (0.2 %). About 10 (4x8x1), 75 (8x16x1) and 180 (12x24x1, projected) minutes per run on
+# one core.
 # RUNS="L4 L8 N8" runs (and reports) only those, in either mode.
 set -u
 report=0 relaxed=0
@@ -98,8 +99,8 @@ band() {
         on { for (i = 1; i <= NF; ++i) { v[n++] = $i; if ($i > m) m = $i } }
         END { for (i = 0; i < n; ++i) if (v[i] > 0.5 * m) k++; printf "%.3f %.3f", m, k / n }' "$f"
 }
-printf "%-4s %-8s %-6s %-4s %-8s %-15s %-9s %-9s %-7s %-6s %-6s %-6s %-6s %-6s %-6s %-6s %-9s %-6s\n" run mesh R_mm mix symbol \
-    ended Ek_max_J peak_kPa at_% 2% 3% 4% 5% 6% 7% 8% eps_q_max share
+printf "%-4s %-8s %-6s %-4s %-8s %-15s %-9s %-9s %-7s %-6s %-6s %-6s %-6s %-6s %-6s %-6s %-9s %-6s %s\n" run mesh R_mm mix symbol \
+    ended Ek_max_J peak_kPa at_% 2% 3% 4% 5% 6% 7% 8% eps_q_max share dem_steps
 for r in $RUNS; do
     [ -f "$W/$r/biaxial.csv" ] || { printf "%-4s (no output)\n" "$r"; continue; }
     mesh=$(sed -n 's/^mesh \([0-9x]*\) .*/\1/p' "$W/$r.log")
@@ -120,7 +121,9 @@ for r in $RUNS; do
     printf "%-4s %-8s %-6s %-4s %-8s %-15s %-9s %-9s %-7s" "$r" "$mesh" $(echo "$R" | awk '{ printf "%g %g %.4f", $1 * 1e3, $2, $3 }') \
         "$ended" "$ek" $pk
     for s in 0.02 0.03 0.04 0.05 0.06 0.07 0.08; do printf " %-6s" "$(at "$r" $s)"; done
-    printf " %-9s %-6s\n" $(band "$r")
+    printf " %-9s %-6s" $(band "$r")
+    awk -F, 'NR == 1 { for (c = 1; c <= NF; ++c) if ($c == "dem_steps_mean") k = c; next }
+        { t += $k; n++ } END { printf " %.0f\n", n ? t / n : 0 }' "$W/$r/biaxial.csv"
 done
 # the spread over the meshes of each family, at every strain (the paper's average on the two
 # meshes where it is stable, and local on the same two for comparison)
