@@ -126,11 +126,12 @@
  *     stress as 1 % window means, the relaxed specimen rings): local 1392 /
  *     1363 / 1324 / 1257 kPa over 2-3 ... 5-6 % against 4x8x1's 1416 / 1374
  *     / 1329 / 1322, largest eps_q 0.167, share 0.75, no band; the paper's
- *     average 1401 / 1365 / 1315 / 1240 kPa, 0.154, 0.78. What holds the
- *     band back on 8x16x1 is the hourglass control: a tenth of its
- *     stiffness (--hourglass 0.01, capped) gives an inclined band about two
- *     elements wide (largest eps_q 0.287, share 0.23; 1224 kPa at 6 %
- *     against 1267); hourglass modes are not checked there.
+ *     average 1401 / 1365 / 1315 / 1240 kPa, 0.154, 0.78. The hourglass
+ *     control holds the band back on 8x16x1: a tenth of its stiffness
+ *     (--hourglass 0.01, capped) gives an inclined band about two elements
+ *     wide (largest eps_q 0.287, share 0.23; 1224 kPa at 6 % against 1267),
+ *     but its nodes also deviate more from each element's affine fit, so
+ *     part of that band may be hourglass deformation (examples/README).
  *     Nonlocal as the paper (R 6.75 mm): on 4x8x1 no point has a neighbour
  *     within R (the local model); on 8x16x1 (symbol min 0.102) it stays
  *     within 2.5 % of the 4x8x1 curve from 3 to 8 % (local: 0.5-2.9 %); on
