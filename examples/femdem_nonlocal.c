@@ -68,12 +68,13 @@
  *     core.
  *   simple-shear (Figs 9-14, default: 512 spheres, 5x12x1, local, 4000
  *     steps to 20 %, eq 57's rule in every DEM run; 1804 s on 2 threads,
- *     the runs' mean 90-500 DEM steps): shear stress, means over 2 % windows, 260
- *     kPa at 1-3 %, 238 at 4-6 %, 214 at 6-8 %, 192 at 8-10 %, 177 at 10-12
- *     % and 174-182 from 12 to 20 % (the peak, RESULT's smoothed one, 267 kPa
- *     at 1.4 %), normal stress 411-429 kPa: a level stretch to about 4 %,
- *     softening between 4 and 10 %, then critical state; the paper: level to
- *     6 %, an abrupt drop between 6 and 8 %, critical state from 8 %.
+ *     the runs' mean 90-500 DEM steps): shear stress, means over 2 %
+ *     windows, 260 kPa at 1-3 %, 238 at 4-6 %, 214 at 6-8 %, 192 at 8-10
+ *     %, 177 at 10-12 % and 174-182 from 12 to 20 % (the peak, RESULT's
+ *     smoothed one, 267 kPa at 1.4 %), normal stress 411-429 kPa: a level
+ *     stretch to about 4 %, softening between 4 and 10 %, then critical
+ *     state; the paper: level to 6 %, an abrupt drop between 6 and 8 %,
+ *     critical state from 8 %.
  *     Porosity rises (0.3458 to 0.3575 at 8 %) then stays (0.3590 at 20 %)
  *     and Z falls fast (5.69 to 3.71 by 4 %) then stays near 3.65, as in
  *     Figs 12 and 13. The band forms in the imperfect row (93 mm, 0.79 of

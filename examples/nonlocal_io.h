@@ -369,10 +369,10 @@ static double curve_deviation(const double *rows, long nrow, const double *lone,
 
 /* The simple shear's peak: the base reaction carries the column's inertia, whose first shear mode
  * (md->omega1, the frequency the macro damping is set from) rings at a period of 4 H / sqrt(G /
- * rho) (1.05 ms, about 1 % of shear strain at the default rate; with eq 57's rule the RVEs damp it little and the stress of one step swings by a hundred
- * kPa or more), so the peak is the largest mean of the CSV rows' stress over one such period
- * centred on a row (windows that fit in the run), and eps_at_peak that row's strain; a run shorter
- * than one period takes its largest row. */
+ * rho) (1.05 ms, about 1 % of shear strain at the default rate; with eq 57's rule the RVEs damp it
+ * little and the stress of one step swings by a hundred kPa or more), so the peak is the largest
+ * mean of the CSV rows' stress over one such period centred on a row (windows that fit in the
+ * run), and eps_at_peak that row's strain; a run shorter than one period takes its largest row. */
 static void smoothed_peak(const model *md, double period, double *pk, double *epk) {
     long r, q, n = md->nrow, lo = 0, hi = 0;
     double t0 = n ? md->rows[1] : 0.0, t1 = n ? md->rows[NCOL * (n - 1) + 1] : 0.0;
