@@ -658,6 +658,7 @@ static void wave_elastic(model *md, double *arr) {
     int e, a, k, i, j;
     long n;
     gk_err err;
+    gk_result r;
     double lam = md->mi->K - 2.0 / 3.0 * md->mi->G, mu = md->mi->G;
     double thr = 1e-3 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
     double *u = (double *)xcalloc((size_t)md->nd, sizeof(double)),
@@ -687,14 +688,13 @@ static void wave_elastic(model *md, double *arr) {
             if (arr[e] < 0 && fabs(H[1] + H[3]) > thr) arr[e] = n * md->dt;
         }
         loading(md, n);
-        if (gk_dofmap_restrict(&md->dm, NULL, f, fr, &err)) {
-            fprintf(stderr, "femdem_nonlocal: warning: the elastic column at step %ld: %s\n", n, err.msg);
-            for (e = 0; e < md->ne; ++e) arr[e] = -1.0;
-            break;
+        r = gk_dofmap_restrict(&md->dm, NULL, f, fr, &err);
+        if (!r) {
+            for (a = 0; a < md->nd; ++a)
+                if (md->fix[a]) vr[md->dm.red[a]] = md->vpre[a];
+            r = gk_explicit_step(md->nr, md->mr, md->fixr, fr, 0.0, md->dt, vr, ur, &err);
         }
-        for (a = 0; a < md->nd; ++a)
-            if (md->fix[a]) vr[md->dm.red[a]] = md->vpre[a];
-        if (gk_explicit_step(md->nr, md->mr, md->fixr, fr, 0.0, md->dt, vr, ur, &err)) {
+        if (r) {
             /* a force that became NaN or infinite: no arrival is trusted (the speed is nan) */
             fprintf(stderr, "femdem_nonlocal: warning: the elastic column at step %ld: %s\n", n, err.msg);
             for (e = 0; e < md->ne; ++e) arr[e] = -1.0;
