@@ -15,7 +15,12 @@
  *                    9); u_probe: right face u_x (biaxial), platen u_y
  *                    (shear), driven end u_y (wave); dem_steps of the last
  *                    run per point, dem_capped = points that stopped at
- *                    --dem-max above --iuf; kinetic = macro kinetic energy [J]
+ *                    --dem-max above --iuf; kinetic = macro kinetic energy [J];
+ *                    work_int = the stress work sum_e int sigma : d eps V
+ *                    since step 0 [J] (trapezoidal in time, the prestress's
+ *                    included), hourglass = the hourglass control's stored
+ *                    energy [J]: its share of the work says how much of the
+ *                    deformation the one-point elements did not see
  *   rve_alone.csv    (element tests) strain,stress,stress_2,p,q,porosity,Z,runs
  *   rve.csv          (rve test) eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,
  *                    Z_iso,porosity_shear,Z_shear,dem_steps
@@ -28,7 +33,9 @@
  *   mesh_NNNNNN.vtk  the deformed mesh, displacement, and per Gauss point
  *                    stress, p, q, porosity, coordination, particle_rotation
  *                    (mean |accumulated rotation vector| of its particles),
- *                    dem_steps, shear_strain, eps_v, eps_q; every
+ *                    dem_steps, shear_strain, eps_v, eps_q, work_int,
+ *                    hourglass_energy and hourglass_share = hourglass /
+ *                    (hourglass + |work_int|) per element; every
  *                    --vtk-every steps and at the end
  *   <test>_curve.svg (stress-strain, with the RVE alone for element tests),
  *   <test>_state.svg (porosity, Z / 10), <test>_field.svg (the deformed x-y
@@ -42,7 +49,10 @@
  *                    another run's file; --stop-after N ends early with one
  *   stdout: RESULT K_MPa= G_MPa= porosity0= Z0= peak_stress= eps_at_peak=
  *           band_center_mm= band_width_mm= seconds= (then test-specific
- *           keys; nan where a key does not apply)
+ *           keys; nan where a key does not apply); the mesh tests end with
+ *           dem_steps_total= dt= hourglass_pct= (the hourglass energy in %
+ *           of the stress work, the CSV's last row; nan while the work is
+ *           not positive)
  *   Peak (simple-shear): the largest mean of the rows' stress over one period
  *   of the column's first shear mode (smoothed_peak below).
  *   Band (simple-shear): over the rows of elements, the shear strain's excess
@@ -111,6 +121,9 @@ static int write_vtk(model *md, const char *path) {
         }
         ok &= ok && !gk_vtk_cell_scalar(&vk, "eps_q", val);
     }
+    FIELD("work_int", md->wint[e])
+    FIELD("hourglass_energy", md->ehg[e])
+    FIELD("hourglass_share", md->ehg[e] > 0.0 ? md->ehg[e] / (md->ehg[e] + fabs(md->wint[e])) : 0.0)
 #undef FIELD
     if (vk.fp) ok &= !gk_vtk_close(&vk);
     free(val);
@@ -180,12 +193,12 @@ static int save_checkpoint(model *md, uint64_t fp) {
     ckhead hd;
     size_t ny = (size_t)md->o->mesh[1],
            nb = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->ne +
-                                              NCOL * (size_t)md->nrow + 3 * ny + md->ne);
+                                              NCOL * (size_t)md->nrow + 3 * ny + 2 * (size_t)md->ne);
     unsigned char *b = (unsigned char *)xcalloc(nb, 1), *q = b;
     char path[1024];
     int k;
     memset(&hd, 0, sizeof hd);
-    memcpy(hd.magic, "GKFNL01", 8);
+    memcpy(hd.magic, "GKFNL02", 8);
     hd.test = md->test;
     for (k = 0; k < 3; ++k) hd.mesh[k] = md->o->mesh[k];
     hd.nd = md->nd, hd.nr = md->nr, hd.ne = md->ne, hd.ny = (int32_t)ny, hd.have12 = md->have12,
@@ -205,6 +218,7 @@ static int save_checkpoint(model *md, uint64_t fp) {
     PUT(md->gam_peak, sizeof(double) * ny);
     PUT(md->prof12, sizeof(double) * 2 * ny);
     PUT(md->arrival, sizeof(double) * md->ne);
+    PUT(md->wint, sizeof(double) * md->ne);
 #undef PUT
     snprintf(path, sizeof path, "%s/checkpoint.bin", md->o->out);
     k = gk_twoscale_save(&md->ts, path, b, nb) != GK_OK;
@@ -225,12 +239,12 @@ static int load_checkpoint(model *md, uint64_t fp) {
         return fprintf(stderr, "femdem_nonlocal: restart: %s\n", gk_twoscale_error(&md->ts)), 1;
     if (nb < sizeof hd) goto bad;
     memcpy(&hd, blk, sizeof hd);
-    if (memcmp(hd.magic, "GKFNL01", 8) || hd.test != md->test || hd.nd != md->nd || hd.nr != md->nr ||
+    if (memcmp(hd.magic, "GKFNL02", 8) || hd.test != md->test || hd.nd != md->nd || hd.nr != md->nr ||
         hd.ne != md->ne || hd.ny != (int32_t)ny || hd.ncol != NCOL || hd.fingerprint != fp || hd.nrow < 1 ||
         hd.step < 0 || hd.step > md->o->steps)
         goto bad;
     need = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->ne + NCOL * (size_t)hd.nrow +
-                                         3 * ny + md->ne);
+                                         3 * ny + 2 * (size_t)md->ne);
     if (nb != need) goto bad;
     /* a checksum only proves the file is what some writer wrote: check what
      * this run will trust (every real finite, counters in range) */
@@ -258,6 +272,7 @@ static int load_checkpoint(model *md, uint64_t fp) {
     GET(md->gam_peak, sizeof(double) * ny);
     GET(md->prof12, sizeof(double) * 2 * ny);
     GET(md->arrival, sizeof(double) * md->ne);
+    GET(md->wint, sizeof(double) * md->ne);
 #undef GET
     gk_twoscale_free_block(&md->ts, blk);
     md->step = hd.step, md->time = hd.time, md->peak = hd.peak, md->have12 = hd.have12,
@@ -276,8 +291,7 @@ bad:
     gk_twoscale_free_block(&md->ts, blk);
     return fprintf(stderr,
                    "femdem_nonlocal: restart: %s was written by another run (test, mesh, options or packing "
-                   "differ) "
-                   "or is damaged\n",
+                   "differ), by an earlier version of this program, or is damaged\n",
                    path),
            1;
 bad_value:
@@ -527,8 +541,10 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
         return 1;
     {
         char ex2[1200];
-        snprintf(ex2, sizeof ex2, "%s%sdem_steps_total=%ld dt=%.4g", extra, extra[0] ? " " : "",
-                 md->dem_total, md->dt);
+        double w = 0.0, h = 0.0;
+        for (e = 0; e < md->ne; ++e) w += md->wint[e], h += md->ehg[e];
+        snprintf(ex2, sizeof ex2, "%s%sdem_steps_total=%ld dt=%.4g hourglass_pct=%.3g", extra,
+                 extra[0] ? " " : "", md->dem_total, md->dt, w > 0.0 ? 100.0 * h / w : NAN);
         result_line(mi, ex2, pk, epk, bc, bw, gk_wtime() - t0);
     }
     free(x), free(y), free(y2), free(val);

@@ -75,10 +75,10 @@
 #include "nonlocal_micro.h"
 
 /* ------------------------------------------------------------ the macro side */
-#define NCOL 15 /* columns of the CSV rows kept in memory (and in the checkpoint) */
+#define NCOL 17 /* columns of the CSV rows kept in memory (and in the checkpoint) */
 static const char *csv_head =
     "step,time,strain,stress,stress_2,p,q,porosity,Z,u_probe,dem_steps_mean,dem_steps_max,"
-    "dem_capped,kinetic,seconds";
+    "dem_capped,kinetic,work_int,hourglass,seconds";
 
 typedef struct pface {
     int n[4];
@@ -98,6 +98,8 @@ typedef struct model {
     unsigned char *fix, *fixr; /* prescribed velocity                                    */
     double *vpre;              /* nd: the prescribed velocity of this step               */
     double *dNdX, *V0, *hg;    /* reference gradients (24), volumes, hourglass stiffness  */
+    double *fe;                /* 24 per element: B^T sigma V of the last internal_force  */
+    double *wint, *ehg;        /* per element: the stress work since step 0 and the hourglass energy [J] */
     double *Hn, *H, *deps, *depsnl, *dH, *Rh, *R1, *sigR, *sig; /* 9 per point              */
     gk_twoscale_field *fld;
     gk_nonlocal nl;
@@ -258,6 +260,7 @@ static int macro_setup(model *md) {
     ALLOC(md->sig, 9 * md->ne), ALLOC(md->fld, md->ne), ALLOC(md->top, md->nn), ALLOC(md->bot, md->nn);
     ALLOC(md->right, md->nn), ALLOC(md->pf, 2 * (nx * nz + ny * nz + nx * ny)), ALLOC(md->arrival, md->ne);
     ALLOC(md->gam_peak, ny), ALLOC(md->prof12, 2 * ny), ALLOC(md->prof_end, 2 * ny);
+    ALLOC(md->fe, 24 * md->ne), ALLOC(md->wint, md->ne), ALLOC(md->ehg, md->ne);
     if (macro_geometry(md)) return 1;
     /* lumped masses: rho V / 8 per node (HRZ of the 1-point hexahedron) */
     ALLOC(mn, md->nn);
@@ -399,13 +402,15 @@ static void external_force(model *md) {
 
 /* f_int = sum_e B^T sigma V on the current configuration + hourglass forces
  * (stiffness form on the reference geometry and the total displacement:
- * zero for every rigid motion and homogeneous deformation) */
+ * zero for every rigid motion and homogeneous deformation). Keeps each
+ * element's B^T sigma V for the work (work_step) and its hourglass energy,
+ * the stiffness form's 1/2 k sum (gamma . u)^2 = -1/2 u . f_hg */
 static int internal_force(model *md) {
     int e, a, k;
     gk_err err;
     for (a = 0; a < md->nd; ++a) md->fint[a] = 0.0;
     for (e = 0; e < md->ne; ++e) {
-        double fe[24], fh[24], xe[24], ue[24];
+        double *fe = md->fe + 24 * e, fh[24], xe[24], ue[24], uf = 0.0;
         const int *c = md->ref.conn + 8 * e;
         if (gk_fem_elem_force(&md->cur, e, &md->q1, md->sig + 9 * e, fe, &err))
             return fprintf(stderr, "femdem_nonlocal: step %ld: %s\n", md->step, err.msg), 1;
@@ -413,10 +418,29 @@ static int internal_force(model *md) {
             for (k = 0; k < 3; ++k)
                 xe[3 * a + k] = md->ref.x[3 * c[a] + k], ue[3 * a + k] = md->u[3 * c[a] + k];
         gk_fem_hex8_hourglass(xe, ue, md->hg[e], fh);
+        for (a = 0; a < 24; ++a) uf += ue[a] * fh[a];
+        md->ehg[e] = -0.5 * uf;
         for (a = 0; a < 8; ++a)
             for (k = 0; k < 3; ++k) md->fint[3 * c[a] + k] += fe[3 * a + k] - fh[3 * a + k];
     }
     return 0;
+}
+
+/* half of the step's stress work per element, B^T sigma V . v dt / 2 with
+ * the step's (mid-step) velocity: called with the forces before and after
+ * the step it is the trapezoidal rule for int sigma : d eps V, which is
+ * what the RVEs were made to do (against it the hourglass energy says how
+ * much of the deformation the 1-point element did not see) */
+static void work_half_step(model *md) {
+    int e, a, k;
+    for (e = 0; e < md->ne; ++e) {
+        const int *c = md->ref.conn + 8 * e;
+        const double *fe = md->fe + 24 * e;
+        double w = 0.0;
+        for (a = 0; a < 8; ++a)
+            for (k = 0; k < 3; ++k) w += fe[3 * a + k] * md->v[3 * c[a] + k];
+        md->wint[e] += 0.5 * md->dt * w;
+    }
 }
 
 /* the homogeneous part of the velocity field: mean velocity plus the volume
@@ -477,6 +501,7 @@ static int macro_step(model *md) {
     gk_dofmap_expand(&md->dm, md->ur, 0, md->u);
     gk_dofmap_expand(&md->dm, md->vr, 0, md->v);
     for (a = 0; a < md->nd; ++a) md->cur.x[a] = md->ref.x[a] + md->u[a];
+    work_half_step(md); /* with the forces of the start of the step */
     /* corotational increments (eqs 60-61) */
     for (e = 0; e < md->ne; ++e) {
         elem_grad(md, md->u, e, md->H + 9 * e);
@@ -507,6 +532,7 @@ static int macro_step(model *md) {
     md->time += md->dt;
     external_force(md);
     if (internal_force(md)) return 1;
+    work_half_step(md); /* and of its end */
     md->kin = gk_explicit_kinetic_energy(md->nd, md->mass, NULL, md->v);
     (void)k;
     return 0;
@@ -608,7 +634,8 @@ static int record(model *md, double seconds) {
     row[0] = (double)md->step, row[1] = md->time, row[2] = strain, row[3] = stress, row[4] = s2;
     row[5] = p / n, row[6] = q / n, row[7] = por / n, row[8] = Z / n, row[9] = up, row[10] = dm / n,
     row[11] = dx;
-    row[12] = capped, row[13] = md->kin, row[14] = seconds;
+    row[12] = capped, row[13] = md->kin, row[14] = 0.0, row[15] = 0.0, row[16] = seconds;
+    for (e = 0; e < n; ++e) row[14] += md->wint[e], row[15] += md->ehg[e];
     if (md->nrow == md->caprow) {
         double *nr;
         md->caprow = md->caprow ? 2 * md->caprow : 256;
@@ -724,7 +751,7 @@ static void model_free(model *md) {
     free(md->dNdX), free(md->V0), free(md->hg), free(md->Hn), free(md->H), free(md->deps), free(md->depsnl);
     free(md->dH), free(md->Rh), free(md->R1), free(md->sigR), free(md->sig), free(md->fld), free(md->top);
     free(md->bot), free(md->right), free(md->pf), free(md->rows), free(md->gam_peak), free(md->prof12);
-    free(md->prof_end), free(md->arrival);
+    free(md->prof_end), free(md->arrival), free(md->fe), free(md->wint), free(md->ehg);
     gk_mesh_free(&md->ref), gk_mesh_free(&md->cur), gk_dofmap_free(&md->dm), gk_nonlocal_free(&md->nl);
     gk_twoscale_destroy(&md->ts);
 }

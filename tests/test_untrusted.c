@@ -954,10 +954,10 @@ TEST(dr_and_nonlocal_checkpoints_refuse_non_finite_values) {
     CHECK(gk_test_file_has(OUT("dr_b.out"), "non-finite or out-of-range value"));
     CHECK(!exists(OUT("dr_b/dr.csv")));
     free(b);
-    /* femdem_nonlocal: tag "GKFNL01" (8 bytes), 10 ints, 3 int64, the fingerprint, then the time */
+    /* femdem_nonlocal: tag "GKFNL02" (8 bytes), 10 ints, 3 int64, the fingerprint, then the time */
     CHECK_EQ_INT(run_status(NL_CK "--stop-after 2 --out " OUT("nl_a") LOG("nl_a")), 0);
     b = file_image(OUT("nl_a/checkpoint.bin"), &n);
-    CHECK(b != NULL && (at = find_tag(b, n, "GKFNL01")) < n);
+    CHECK(b != NULL && (at = find_tag(b, n, "GKFNL02")) < n);
     if (!b || at == n) return;
     CHECK_EQ_INT(run_status(NL_CK "--restart " OUT("nl_a") " --out " OUT("nl_ok") LOG("nl_ok")), 0);
     mkdir(OUT("nl_bad"), 0755);
