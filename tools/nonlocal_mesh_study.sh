@@ -31,7 +31,10 @@
 # stress at S is the mean over the 1 % of strain before S and the peak the largest mean of five
 # rows (0.2 %). About 10 (4x8x1), 75 (8x16x1) and 180 (12x24x1, projected) minutes per run on
 # one core.
-# RUNS="L4 L8 N8" runs (and reports) only those, in either mode.
+# RUNS="L4 L8 N8" runs (and reports) only those, in either mode. HOURGLASS=K runs with --hourglass
+# K instead of the driver's 0.1; WORK/hourglass records it and a WORK made with another K is refused.
+# The column hg_% is the hourglass energy in % of the stress work at 6 % (nan for a CSV without
+# those columns).
 set -u
 report=0 relaxed=0
 while [ $# -ge 1 ]; do
@@ -54,11 +57,19 @@ else
     RUNS=${RUNS:-L4 L8 L12 N8 N12 M8 M12}
     dem="--dem-max 20" stop=0 win=0
 fi
+K=${HOURGLASS:-0.1}
+if [ -f "$W/hourglass" ]; then
+    k0=$(cat "$W/hourglass")
+    [ "$k0" = "$K" ] || { echo "nonlocal_mesh_study: $W was run with --hourglass $k0, not $K" >&2; exit 1; }
+elif [ $report = 0 ]; then
+    echo "$K" > "$W/hourglass" || exit 1
+fi
 run() { # NAME MESH R MIX [STOP]
     case " $RUNS " in *" $1 "*) ;; *) return 0 ;; esac
     [ -f "$W/$1/biaxial.csv" ] || [ $report = 1 ] && return 0
     "$B/femdem_nonlocal" --test biaxial --mesh "$2" --nonlocal "$3" --nonlocal-mix "$4" --dt 1.826e-6 \
-        --steps 5000 --stop-after "${5:-$stop}" $dem --vtk-every 750 --threads "$T" --out "$W/$1" \
+        --steps 5000 --stop-after "${5:-$stop}" $dem --hourglass "$K" --vtk-every 750 \
+        --threads "$T" --out "$W/$1" \
         > "$W/$1.log" 2>&1
     echo "$1: exit $?" >> "$W/status.txt"
     [ -f "$W/$1/biaxial.csv" ]
@@ -99,8 +110,14 @@ band() {
         on { for (i = 1; i <= NF; ++i) { v[n++] = $i; if ($i > m) m = $i } }
         END { for (i = 0; i < n; ++i) if (v[i] > 0.5 * m) k++; printf "%.3f %.3f", m, k / n }' "$f"
 }
-printf "%-4s %-8s %-6s %-4s %-8s %-15s %-9s %-9s %-7s %-6s %-6s %-6s %-6s %-6s %-6s %-6s %-9s %-6s %s\n" run mesh R_mm mix symbol \
-    ended Ek_max_J peak_kPa at_% 2% 3% 4% 5% 6% 7% 8% eps_q_max share dem_steps
+# the hourglass energy in % of the stress work at step 3750 (6 %)
+hg_pct() {
+    awk -F, 'NR == 1 { for (c = 1; c <= NF; ++c) { if ($c == "work_int") w = c; if ($c == "hourglass") h = c } next }
+        w && $1 == 3750 && $w > 0 { v = 100 * $h / $w }
+        END { if (v == "") printf "nan"; else printf "%.2f", v }' "$W/$1/biaxial.csv"
+}
+printf "%-4s %-8s %-6s %-4s %-8s %-15s %-9s %-9s %-7s %-6s %-6s %-6s %-6s %-6s %-6s %-6s %-9s %-6s %-9s %s\n" run mesh R_mm mix \
+    symbol ended Ek_max_J peak_kPa at_% 2% 3% 4% 5% 6% 7% 8% eps_q_max share dem_steps hg_%
 for r in $RUNS; do
     [ -f "$W/$r/biaxial.csv" ] || { printf "%-4s (no output)\n" "$r"; continue; }
     mesh=$(sed -n 's/^mesh \([0-9x]*\) .*/\1/p' "$W/$r.log")
@@ -123,7 +140,8 @@ for r in $RUNS; do
     for s in 0.02 0.03 0.04 0.05 0.06 0.07 0.08; do printf " %-6s" "$(at "$r" $s)"; done
     printf " %-9s %-6s" $(band "$r")
     awk -F, 'NR == 1 { for (c = 1; c <= NF; ++c) if ($c == "dem_steps_mean") k = c; next }
-        { t += $k; n++ } END { printf " %.0f\n", n ? t / n : 0 }' "$W/$r/biaxial.csv"
+        { t += $k; n++ } END { printf " %-9.0f", n ? t / n : 0 }' "$W/$r/biaxial.csv"
+    printf " %s\n" "$(hg_pct "$r")"
 done
 # the spread over the meshes of each family, at every strain (the paper's average on the two
 # meshes where it is stable, and local on the same two for comparison)
