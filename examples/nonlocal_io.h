@@ -35,7 +35,9 @@
  *                    (mean |accumulated rotation vector| of its particles),
  *                    dem_steps, shear_strain, eps_v, eps_q, work_int,
  *                    hourglass_energy and hourglass_share = hourglass /
- *                    (hourglass + |work_int|) per element; every
+ *                    (hourglass + |work_int|) per element, hourglass_strain
+ *                    (the amplitude of its hourglass modes over half its
+ *                    size: nonlocal_macro.h); every
  *                    --vtk-every steps and at the end
  *   <test>_curve.svg (stress-strain, with the RVE alone for element tests),
  *   <test>_state.svg (porosity, Z / 10), <test>_field.svg (the deformed x-y
@@ -124,6 +126,7 @@ static int write_vtk(model *md, const char *path) {
     FIELD("work_int", md->wint[e])
     FIELD("hourglass_energy", md->ehg[e])
     FIELD("hourglass_share", md->ehg[e] > 0.0 ? md->ehg[e] / (md->ehg[e] + fabs(md->wint[e])) : 0.0)
+    FIELD("hourglass_strain", hourglass_strain(md, e))
 #undef FIELD
     if (vk.fp) ok &= !gk_vtk_close(&vk);
     free(val);

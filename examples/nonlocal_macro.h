@@ -6,7 +6,9 @@
  * THE MODEL (eqs 44-66 and Appendix A of the paper)
  *   Macro: 8-node hexahedra with one Gauss point and Flanagan-Belytschko
  *   stiffness hourglass control (k = kappa (lambda + 2 mu) V sum|grad N|^2 /
- *   192, kappa = --hourglass 0.1, lambda and mu of the RVE), lumped mass
+ *   192, kappa = --hourglass 0.1, lambda and mu of the RVE; its stored
+ *   energy 1/2 k sum (gamma . u)^2 per element is an output, against the
+ *   stress work int sigma : d eps V, trapezoidal in time), lumped mass
  *   (rho V / 8 per node, rho = RVE mass / RVE volume of eq 26, times
  *   --mass-scale), explicit central differences (eqs 51-52; gk_explicit.h),
  *   updated Lagrangian with the corotational update of eqs 60-62
@@ -424,6 +426,22 @@ static int internal_force(model *md) {
             for (k = 0; k < 3; ++k) md->fint[3 * c[a] + k] += fe[3 * a + k] - fh[3 * a + k];
     }
     return 0;
+}
+
+/* the element's hourglass deformation as a strain: sqrt(sum_alpha,i (gamma^alpha .
+ * u_i)^2), what the control penalises (gamma: gk_fem_hex8_hourglass's vectors, the
+ * eight nodal values +-1 of each mode on a box), over 8 (the modes' rms nodal
+ * amplitude) over half the element's size V0^(1/3) / 2. Independent of kappa,
+ * unlike the energy; compare it with eps_q. */
+static double hourglass_strain(const model *md, int e) {
+    double xe[24], ue[24], fh[24], s = 0.0;
+    const int *c = md->ref.conn + 8 * e;
+    int a, k;
+    for (a = 0; a < 8; ++a)
+        for (k = 0; k < 3; ++k) xe[3 * a + k] = md->ref.x[3 * c[a] + k], ue[3 * a + k] = md->u[3 * c[a] + k];
+    gk_fem_hex8_hourglass(xe, ue, 1.0, fh);
+    for (a = 0; a < 24; ++a) s -= ue[a] * fh[a];
+    return sqrt(s > 0.0 ? s : 0.0) / 8.0 / (0.5 * cbrt(md->V0[e]));
 }
 
 /* half of the step's stress work per element, B^T sigma V . v dt / 2 with

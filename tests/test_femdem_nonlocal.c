@@ -337,6 +337,22 @@ static double right_face_ux(const char *dir, int step) {
     return k == 8 ? sum / 4 : NAN;
 }
 
+/* the first value of SCALARS name in a VTK file, nan if absent */
+static double vtk_first_scalar(const char *path, const char *name) {
+    char line[256];
+    double v = NAN;
+    size_t n = strlen(name);
+    FILE *fp = fopen(path, "r");
+    if (!fp) return NAN;
+    while (fgets(line, sizeof line, fp))
+        if (!strncmp(line, "SCALARS ", 8) && !strncmp(line + 8, name, n) && line[8 + n] == ' ') {
+            if (fgets(line, sizeof line, fp) && fgets(line, sizeof line, fp)) v = strtod(line, NULL);
+            break;
+        }
+    fclose(fp);
+    return v;
+}
+
 /* the energy columns: work_int, the stress work sum_e int sigma : d eps V,
  * equals on one element the work its boundary tractions do on it, int
  * sigma_yy A_xz d(shortening) - int sigma_xx A_yz d(u_x right), from the
@@ -381,6 +397,45 @@ TEST(element_biaxial_work_and_hourglass_energy) {
     CHECK(fabs(gk_test_result(BUILD "/tests/t_fnlw.out", "hourglass_pct") - 100 * hg / wint) <
           0.01 * 100 * hg / wint);
     CHECK(gk_test_file_has(BUILD "/tests/t_fnlw/mesh_000200.vtk", "SCALARS hourglass_share"));
+    { /* hourglass_strain from the eight nodal displacements: on the 10 mm cube the modes are
+       * h1 = eta zeta, h2 = xi zeta, h3 = xi eta, h4 = xi eta zeta at the corners (xi, eta, zeta
+       * = +-1; node (i, j, k) is number 4 k + 2 j + i), q = sum_a h_a u_a, strain = |q| / 8 / 5 mm */
+        double u[8][3], q2 = 0.0, hs;
+        char line[256];
+        int a = -1, al, i;
+        fp = fopen(BUILD "/tests/t_fnlw/mesh_000200.vtk", "r");
+        CHECK(fp != NULL);
+        if (!fp) return;
+        while (a < 8 && fgets(line, sizeof line, fp)) {
+            if (a < 0) {
+                if (!strncmp(line, "VECTORS displacement", 20)) a = 0;
+            } else if (sscanf(line, "%lf %lf %lf", u[a], u[a] + 1, u[a] + 2) == 3) {
+                ++a;
+            } else {
+                break;
+            }
+        }
+        fclose(fp);
+        CHECK(a == 8);
+        for (al = 0; al < 4; ++al)
+            for (i = 0; i < 3; ++i) {
+                double q = 0.0;
+                for (a = 0; a < 8; ++a) {
+                    double xi = a & 1 ? 1 : -1, eta = a & 2 ? 1 : -1, zeta = a & 4 ? 1 : -1;
+                    double h = al == 0   ? eta * zeta
+                               : al == 1 ? xi * zeta
+                               : al == 2 ? xi * eta
+                                         : xi * eta * zeta;
+                    q += h * u[a][i];
+                }
+                q2 += q * q;
+            }
+        hs = vtk_first_scalar(BUILD "/tests/t_fnlw/mesh_000200.vtk", "hourglass_strain");
+        printf("    hourglass strain %.6g (from the nodes %.6g), eps_q %.4g\n", hs, sqrt(q2) / 8 / 0.005,
+               vtk_first_scalar(BUILD "/tests/t_fnlw/mesh_000200.vtk", "eps_q"));
+        CHECK(hs > 0.0);
+        CHECK(fabs(hs - sqrt(q2) / 8 / 0.005) < 1e-6 * hs);
+    }
 }
 
 /* the stability of averaging the strain (gk_nonlocal.h): on the 4 x 8 mesh
