@@ -19,8 +19,9 @@
  *                    work_int = the stress work sum_e int sigma : d eps V
  *                    since step 0 [J] (trapezoidal in time, the prestress's
  *                    included), hourglass = the hourglass control's stored
- *                    energy [J]: its share of the work says how much of the
- *                    deformation the one-point elements did not see
+ *                    energy [J] (small against the work even where the
+ *                    elements deform much in their hourglass modes: see
+ *                    the VTK's hourglass_strain)
  *   rve_alone.csv    (element tests) strain,stress,stress_2,p,q,porosity,Z,runs
  *   rve.csv          (rve test) eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,
  *                    Z_iso,porosity_shear,Z_shear,dem_steps

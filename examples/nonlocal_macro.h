@@ -405,7 +405,7 @@ static void external_force(model *md) {
 /* f_int = sum_e B^T sigma V on the current configuration + hourglass forces
  * (stiffness form on the reference geometry and the total displacement:
  * zero for every rigid motion and homogeneous deformation). Keeps each
- * element's B^T sigma V for the work (work_step) and its hourglass energy,
+ * element's B^T sigma V for the work (work_half_step) and its hourglass energy,
  * the stiffness form's 1/2 k sum (gamma . u)^2 = -1/2 u . f_hg */
 static int internal_force(model *md) {
     int e, a, k;
@@ -446,9 +446,10 @@ static double hourglass_strain(const model *md, int e) {
 
 /* half of the step's stress work per element, B^T sigma V . v dt / 2 with
  * the step's (mid-step) velocity: called with the forces before and after
- * the step it is the trapezoidal rule for int sigma : d eps V, which is
- * what the RVEs were made to do (against it the hourglass energy says how
- * much of the deformation the 1-point element did not see) */
+ * the step it is the trapezoidal rule for int sigma : d eps V, the work
+ * the RVEs were made to do (against it the hourglass energy is what the
+ * control stores; how much the element deforms in its hourglass modes is
+ * hourglass_strain) */
 static void work_half_step(model *md) {
     int e, a, k;
     for (e = 0; e < md->ne; ++e) {
