@@ -120,8 +120,8 @@ printf "%-4s %-8s %-6s %-4s %-8s %-15s %-9s %-9s %-7s %-6s %-6s %-6s %-6s %-6s %
     symbol ended Ek_max_J peak_kPa at_% 2% 3% 4% 5% 6% 7% 8% eps_q_max share dem_steps hg_%
 for r in $RUNS; do
     [ -f "$W/$r/biaxial.csv" ] || { printf "%-4s (no output)\n" "$r"; continue; }
-    mesh=$(sed -n 's/^mesh \([0-9x]*\) .*/\1/p' "$W/$r.log")
-    R=$(sed -n 's/.*nonlocal [a-z]* (R \([^ ]*\) m, mix \([^,]*\),.*symbol min \([^)]*\)).*/\1 \2 \3/p' "$W/$r.log")
+    mesh=$(sed -n 's/^mesh \([0-9x]*\) .*/\1/p' "$W/$r.log" | head -n 1)
+    R=$(sed -n 's/.*nonlocal [a-z]* (R \([^ ]*\) m, mix \([^,]*\),.*symbol min \([^)]*\)).*/\1 \2 \3/p' "$W/$r.log" | head -n 1)
     if grep -q '^RESULT' "$W/$r.log"; then
         ended=8%
         pk=$(sed -n 's/^RESULT.* peak_stress=\([^ ]*\) eps_at_peak=\([^ ]*\) .*/\1 \2/p' "$W/$r.log" |
