@@ -360,7 +360,9 @@ static double vtk_first_scalar(const char *path, const char *name) {
  * measured 3.1605 mJ against 3.1613, 0.03 %; the right face's corner alone,
  * the CSV's u_probe, is 9 % short of the face's mean: the RVE's shear
  * stresses tilt the face). That tilt is bilinear, invisible to the one
- * point: the hourglass energy is positive and small (0.1 % of the work). */
+ * point: the hourglass energy is positive and small (0.1 % of the work),
+ * and the VTK's hourglass_strain is the amplitude of the hourglass modes
+ * computed here from the eight nodal displacements. */
 TEST(element_biaxial_work_and_hourglass_energy) {
     FILE *fp;
     char line[1024];
@@ -401,7 +403,6 @@ TEST(element_biaxial_work_and_hourglass_energy) {
        * h1 = eta zeta, h2 = xi zeta, h3 = xi eta, h4 = xi eta zeta at the corners (xi, eta, zeta
        * = +-1; node (i, j, k) is number 4 k + 2 j + i), q = sum_a h_a u_a, strain = |q| / 8 / 5 mm */
         double u[8][3], q2 = 0.0, hs;
-        char line[256];
         int a = -1, al, i;
         fp = fopen(BUILD "/tests/t_fnlw/mesh_000200.vtk", "r");
         CHECK(fp != NULL);
