@@ -141,7 +141,9 @@
  *     band, narrowing with the mesh, as the paper's Fig 17), the stress
  *     spread 0.9-5.7 % over 3-8 %; mix 0.9 spreads 1.1-3.5 % and keeps the
  *     local field (0.394, 0.16 on 12x24x1); the paper's average on 8x16x1
- *     0.253, 0.27 (examples/README).
+ *     0.253, 0.27. Twice the paper's R (13.5 mm, mix 0.9) keeps 8x16x1 and
+ *     12x24x1 within 0.9 % to 6 % (local 5.7 %) and widens the band (share
+ *     0.53 and 0.22), which still narrows with the mesh (examples/README).
  *     Nonlocal as the paper (R 6.75 mm): on 4x8x1 no point has a neighbour
  *     within R (the local model); on 8x16x1 (symbol min 0.102) it stays
  *     within 2.5 % of the 4x8x1 curve from 3 to 8 % (local: 0.5-2.9 %); on
