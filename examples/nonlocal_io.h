@@ -545,8 +545,7 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
         return 1;
     {
         char ex2[1200];
-        double w = 0.0, h = 0.0;
-        for (e = 0; e < md->ne; ++e) w += md->wint[e], h += md->ehg[e];
+        const double *last = md->rows + NCOL * (n - 1), w = last[14], h = last[15]; /* this step's row */
         snprintf(ex2, sizeof ex2, "%s%sdem_steps_total=%ld dt=%.4g hourglass_pct=%.3g", extra,
                  extra[0] ? " " : "", md->dem_total, md->dt, w > 0.0 ? 100.0 * h / w : NAN);
         result_line(mi, ex2, pk, epk, bc, bw, gk_wtime() - t0);

@@ -402,6 +402,20 @@ static void external_force(model *md) {
     }
 }
 
+/* element e's hourglass forces f (24) from the displacement field u with
+ * stiffness k (gk_fem_hex8_hourglass on the reference geometry); returns
+ * u_e . f = -k sum (gamma . u)^2 */
+static double elem_hourglass(const model *md, const double *u, int e, double k, double *f) {
+    double xe[24], ue[24], uf = 0.0;
+    const int *c = md->ref.conn + 8 * e;
+    int a, i;
+    for (a = 0; a < 8; ++a)
+        for (i = 0; i < 3; ++i) xe[3 * a + i] = md->ref.x[3 * c[a] + i], ue[3 * a + i] = u[3 * c[a] + i];
+    gk_fem_hex8_hourglass(xe, ue, k, f);
+    for (a = 0; a < 24; ++a) uf += ue[a] * f[a];
+    return uf;
+}
+
 /* f_int = sum_e B^T sigma V on the current configuration + hourglass forces
  * (stiffness form on the reference geometry and the total displacement:
  * zero for every rigid motion and homogeneous deformation). Keeps each
@@ -412,16 +426,11 @@ static int internal_force(model *md) {
     gk_err err;
     for (a = 0; a < md->nd; ++a) md->fint[a] = 0.0;
     for (e = 0; e < md->ne; ++e) {
-        double *fe = md->fe + 24 * e, fh[24], xe[24], ue[24], uf = 0.0;
+        double *fe = md->fe + 24 * e, fh[24];
         const int *c = md->ref.conn + 8 * e;
         if (gk_fem_elem_force(&md->cur, e, &md->q1, md->sig + 9 * e, fe, &err))
             return fprintf(stderr, "femdem_nonlocal: step %ld: %s\n", md->step, err.msg), 1;
-        for (a = 0; a < 8; ++a)
-            for (k = 0; k < 3; ++k)
-                xe[3 * a + k] = md->ref.x[3 * c[a] + k], ue[3 * a + k] = md->u[3 * c[a] + k];
-        gk_fem_hex8_hourglass(xe, ue, md->hg[e], fh);
-        for (a = 0; a < 24; ++a) uf += ue[a] * fh[a];
-        md->ehg[e] = -0.5 * uf;
+        md->ehg[e] = -0.5 * elem_hourglass(md, md->u, e, md->hg[e], fh);
         for (a = 0; a < 8; ++a)
             for (k = 0; k < 3; ++k) md->fint[3 * c[a] + k] += fe[3 * a + k] - fh[3 * a + k];
     }
@@ -434,13 +443,7 @@ static int internal_force(model *md) {
  * amplitude) over half the element's size V0^(1/3) / 2. Independent of kappa,
  * unlike the energy; compare it with eps_q. */
 static double hourglass_strain(const model *md, int e) {
-    double xe[24], ue[24], fh[24], s = 0.0;
-    const int *c = md->ref.conn + 8 * e;
-    int a, k;
-    for (a = 0; a < 8; ++a)
-        for (k = 0; k < 3; ++k) xe[3 * a + k] = md->ref.x[3 * c[a] + k], ue[3 * a + k] = md->u[3 * c[a] + k];
-    gk_fem_hex8_hourglass(xe, ue, 1.0, fh);
-    for (a = 0; a < 24; ++a) s -= ue[a] * fh[a];
+    double fh[24], s = -elem_hourglass(md, md->u, e, 1.0, fh);
     return sqrt(s > 0.0 ? s : 0.0) / 8.0 / (0.5 * cbrt(md->V0[e]));
 }
 
@@ -716,7 +719,7 @@ static void wave_elastic(model *md, double *arr) {
     for (n = 0; n < md->o->steps; ++n) {
         for (a = 0; a < md->nd; ++a) f[a] = 0.0;
         for (e = 0; e < md->ne; ++e) {
-            double H[9], s[9], fe[24], fh[24], xe[24], ue[24], tr;
+            double H[9], s[9], fe[24], fh[24], tr;
             const int *c = md->ref.conn + 8 * e;
             elem_grad(md, u, e, H);
             tr = H[0] + H[4] + H[8];
@@ -725,10 +728,7 @@ static void wave_elastic(model *md, double *arr) {
                     s[3 * i + j] =
                         mu * (H[3 * i + j] + H[3 * j + i]) + (i == j ? lam * tr - md->o->pressure : 0.0);
             gk_fem_elem_force(&md->ref, e, &md->q1, s, fe, NULL);
-            for (a = 0; a < 8; ++a)
-                for (k = 0; k < 3; ++k)
-                    xe[3 * a + k] = md->ref.x[3 * c[a] + k], ue[3 * a + k] = u[3 * c[a] + k];
-            gk_fem_hex8_hourglass(xe, ue, md->hg[e], fh);
+            elem_hourglass(md, u, e, md->hg[e], fh);
             for (a = 0; a < 8; ++a)
                 for (k = 0; k < 3; ++k) f[3 * c[a] + k] -= fe[3 * a + k] - fh[3 * a + k];
             if (arr[e] < 0 && fabs(H[1] + H[3]) > thr) arr[e] = n * md->dt;
