@@ -239,17 +239,19 @@ static int run(opts *o, micro *mi, model *md, int **pickp, double t0) {
         int row = (int)(0.75 * o->mesh[1]), col = o->mesh[0] / 2;
         if (rve_imperfect(o, mi)) return 1;
         pr[1].packing = &mi->pk_imp, pr[1].state = &mi->st_imp;
-        pick = *pickp = (int *)xcalloc((size_t)md->ne, sizeof(int));
+        pick = *pickp = (int *)xcalloc((size_t)md->np, sizeof(int));
         if (row > o->mesh[1] - 1) row = o->mesh[1] - 1;
-        pick[row * o->mesh[0] + col] = 1; /* front layer (k = 0) */
+        for (k = 0; k < md->ngp; ++k)
+            pick[md->ngp * (row * o->mesh[0] + col) + k] = 1; /* front layer (z 0) */
     }
-    ts_def_make(o, mi, pr, o->imperfection > 0 ? 2 : 1, pick, md->ne, &d);
+    ts_def_make(o, mi, pr, o->imperfection > 0 ? 2 : 1, pick, md->np, &d);
     if (gk_twoscale_create(&md->ts, &d))
         return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&md->ts)), 1;
     if ((rc = macro_time_steps(md)) != 0) return rc;
     fpr = fingerprint(o, &mi->pk);
     /* initial state: the RVEs' stresses, R = I */
     gk_twoscale_accepted(&md->ts, md->sig, NULL);
+    elem_means(md);
     md->peak = -HUGE_VAL;
     if (o->restart) {
         if (load_checkpoint(md, fpr)) return 1;

@@ -95,16 +95,16 @@ static int write_vtk(model *md, const char *path) {
     gk_vtk vk;
     int e, n = md->ne, ok = 1;
     double *val = (double *)xcalloc((size_t)n, sizeof(double));
-    gk_twoscale_fields(&md->ts, md->fld);
+    elem_fields(md); /* cell fields: the means of an element's points (the point's own with one) */
     ok &= !gk_vtk_open(&vk, path, "femdem_nonlocal: mesh and Gauss-point fields (stress tension-positive)");
     ok &= ok && !gk_vtk_points(&vk, md->nn, md->cur.x);
     ok &= ok && !gk_vtk_cells(&vk, n, 8, md->ref.conn, GK_VTK_HEX);
     ok &= ok && !gk_vtk_point_vector(&vk, "displacement", md->u);
-    ok &= ok && !gk_vtk_cell_tensor(&vk, "stress", md->sig);
+    ok &= ok && !gk_vtk_cell_tensor(&vk, "stress", md->sige);
 #define FIELD(name, expr)                         \
     for (e = 0; e < n; ++e) {                     \
-        const gk_twoscale_field *f = md->fld + e; \
-        const double *H = md->H + 9 * e;          \
+        const gk_twoscale_field *f = md->fle + e; \
+        const double *H = md->He + 9 * e;         \
         (void)f, (void)H;                         \
         val[e] = (expr);                          \
     }                                             \
@@ -119,7 +119,7 @@ static int write_vtk(model *md, const char *path) {
     FIELD("eps_v", H[0] + H[4] + H[8]) {
         double eps[9];
         for (e = 0; e < n; ++e) {
-            gk_m3_sym(md->H + 9 * e, eps);
+            gk_m3_sym(md->He + 9 * e, eps);
             val[e] = gk_strain_q(eps, 3);
         }
         ok &= ok && !gk_vtk_cell_scalar(&vk, "eps_q", val);
@@ -189,6 +189,7 @@ static uint64_t fingerprint(const opts *o, const gk_packing *pk) {
              o->every, pk->n, 3, sx, o->dem_inertial);
     if (o->mix != 1.0) /* appended only when used: the fingerprints of earlier runs stay valid */
         snprintf(buf + strlen(buf), sizeof buf - strlen(buf), " mix %.17g", o->mix);
+    if (o->gauss != 1) snprintf(buf + strlen(buf), sizeof buf - strlen(buf), " gauss %d", o->gauss);
     for (k = 0; buf[k]; ++k) h = (h ^ (unsigned char)buf[k]) * 1099511628211ull;
     return h;
 }
@@ -196,7 +197,7 @@ static uint64_t fingerprint(const opts *o, const gk_packing *pk) {
 static int save_checkpoint(model *md, uint64_t fp) {
     ckhead hd;
     size_t ny = (size_t)md->o->mesh[1],
-           nb = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->ne +
+           nb = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->np +
                                               NCOL * (size_t)md->nrow + 3 * ny + 2 * (size_t)md->ne);
     unsigned char *b = (unsigned char *)xcalloc(nb, 1), *q = b;
     char path[1024];
@@ -217,7 +218,7 @@ static int save_checkpoint(model *md, uint64_t fp) {
     PUT(&hd, sizeof hd);
     PUT(md->ur, sizeof(double) * md->nr);
     PUT(md->vr, sizeof(double) * md->nr);
-    PUT(md->sig, sizeof(double) * 9 * md->ne);
+    PUT(md->sig, sizeof(double) * 9 * md->np);
     PUT(md->rows, sizeof(double) * NCOL * md->nrow);
     PUT(md->gam_peak, sizeof(double) * ny);
     PUT(md->prof12, sizeof(double) * 2 * ny);
@@ -247,7 +248,7 @@ static int load_checkpoint(model *md, uint64_t fp) {
         hd.ne != md->ne || hd.ny != (int32_t)ny || hd.ncol != NCOL || hd.fingerprint != fp || hd.nrow < 1 ||
         hd.step < 0 || hd.step > md->o->steps)
         goto bad;
-    need = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->ne + NCOL * (size_t)hd.nrow +
+    need = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->np + NCOL * (size_t)hd.nrow +
                                          3 * ny + 2 * (size_t)md->ne);
     if (nb != need) goto bad;
     /* a checksum only proves the file is what some writer wrote: check what
@@ -269,7 +270,7 @@ static int load_checkpoint(model *md, uint64_t fp) {
     } while (0)
     GET(md->ur, sizeof(double) * md->nr);
     GET(md->vr, sizeof(double) * md->nr);
-    GET(md->sig, sizeof(double) * 9 * md->ne);
+    GET(md->sig, sizeof(double) * 9 * md->np);
     md->rows = (double *)xcalloc((size_t)hd.nrow * NCOL, sizeof(double));
     md->caprow = md->nrow = hd.nrow;
     GET(md->rows, sizeof(double) * NCOL * hd.nrow);
@@ -284,8 +285,9 @@ static int load_checkpoint(model *md, uint64_t fp) {
     gk_dofmap_expand(&md->dm, md->ur, 0, md->u);
     gk_dofmap_expand(&md->dm, md->vr, 0, md->v);
     for (e = 0; e < md->nd; ++e) md->cur.x[e] = md->ref.x[e] + md->u[e];
-    for (e = 0; e < md->ne; ++e) elem_grad(md, md->u, e, md->Hn + 9 * e);
-    memcpy(md->H, md->Hn, sizeof(double) * 9 * md->ne);
+    for (e = 0; e < md->np; ++e) point_grad(md, md->u, e, md->Hn + 9 * e);
+    memcpy(md->H, md->Hn, sizeof(double) * 9 * md->np);
+    elem_means(md);
     external_force(md);
     if (internal_force(md)) return 1;
     md->kin = gk_explicit_kinetic_energy(md->nd, md->mass, NULL, md->v);
@@ -500,7 +502,7 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
             FILE *fp;
             double *pe = (double *)xcalloc((size_t)2 * ny, sizeof(double)), share;
             smoothed_peak(md, 2.0 * GK_PI / md->omega1, &pk, &epk);
-            gk_twoscale_fields(&md->ts, md->fld);
+            elem_fields(md);
             row_profile(md, pe);
             band(md, md->have12 ? md->prof12 : pe, &bc, &bw, &share);
             snprintf(extra, sizeof extra, "band_share=%.3f", share);
@@ -532,11 +534,11 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
     if (plot2(svg, "porosity and coordination (Figs 8b, 12, 13)", o->test == T_WAVE ? "time [ms]" : "strain",
               "porosity, Z / 10", x, y, (int)n, "porosity", x, y2, (int)n, "Z / 10"))
         return 1;
-    for (e = 0; e < md->ne; ++e) val[e] = md->H[9 * e + 1] + md->H[9 * e + 3];
+    for (e = 0; e < md->ne; ++e) val[e] = md->He[9 * e + 1] + md->He[9 * e + 3];
     if (o->test == T_BIAX || o->test == T_EBIAX)
         for (e = 0; e < md->ne; ++e) {
             double eps[9];
-            gk_m3_sym(md->H + 9 * e, eps);
+            gk_m3_sym(md->He + 9 * e, eps);
             val[e] = gk_strain_q(eps, 3);
         }
     snprintf(svg, sizeof svg, "%s/%s_field.svg", o->out, test_name[o->test]);

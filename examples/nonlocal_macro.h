@@ -8,8 +8,14 @@
  *   stiffness hourglass control (k = kappa (lambda + 2 mu) V sum|grad N|^2 /
  *   192, kappa = --hourglass 0.1, lambda and mu of the RVE; its stored
  *   energy 1/2 k sum (gamma . u)^2 per element is an output, against the
- *   stress work int sigma : d eps V, trapezoidal in time), lumped mass
- *   (rho V / 8 per node, rho = RVE mass / RVE volume of eq 26, times
+ *   stress work int sigma : d eps V, trapezoidal in time). --gauss 8 is the
+ *   fully integrated element instead: 2 x 2 x 2 Gauss points, an RVE at each
+ *   (eight times the DEM), no hourglass modes and no control; the outputs
+ *   per element are the means of its points. It is the local reference for
+ *   the choice of kappa; its element bound on the frequency (eq 65) is 2.4
+ *   (2x4x1) to 3.9 (one cube) times the 1-point one, so it needs a smaller
+ *   step or more mass. Lumped mass (rho V / 8 per node, rho = RVE mass /
+ *   RVE volume of eq 26, times
  *   --mass-scale), explicit central differences (eqs 51-52; gk_explicit.h),
  *   updated Lagrangian with the corotational update of eqs 60-62
  *   (gk_explicit.h: F at mid-step, polar decomposition, the strain increment
@@ -91,19 +97,25 @@ typedef struct model {
     const opts *o;
     micro *mi;
     int test, nn, nd, ne, nr;
+    int ngp, np;      /* Gauss points (and RVEs) per element (--gauss 1|8) and in all: point p is element
+                         p / ngp's Gauss point p % ngp                                                   */
     double L[3];      /* specimen size [m]                                      */
     gk_mesh ref, cur; /* reference and current configurations                   */
-    gk_quad q1;       /* one Gauss point                                         */
+    gk_quad q1;       /* one Gauss point (the masses, and the rule when ngp = 1)  */
+    gk_quad q;        /* the rule of the points: 1 or 2 x 2 x 2                  */
     gk_dofmap dm;     /* periodic ties (identity without)                       */
     double *u, *v, *fint, *fext, *f, *mass, *vhom; /* nd                                   */
     double *ur, *vr, *fr, *mr; /* nr: the independent dofs                               */
     unsigned char *fix, *fixr; /* prescribed velocity                                    */
     double *vpre;              /* nd: the prescribed velocity of this step               */
-    double *dNdX, *V0, *hg;    /* reference gradients (24), volumes, hourglass stiffness  */
+    double *dNdX, *Vp;         /* per point: reference gradients (24), volume w det J      */
+    double *V0, *hg;           /* per element: volume, hourglass stiffness (0 for ngp 8)    */
     double *fe;                /* 24 per element: B^T sigma V of the last internal_force  */
     double *wint, *ehg;        /* per element: the stress work since step 0 and the hourglass energy [J] */
     double *Hn, *H, *deps, *depsnl, *dH, *Rh, *R1, *sigR, *sig; /* 9 per point              */
-    gk_twoscale_field *fld;
+    gk_twoscale_field *fld;                                     /* per point                */
+    double *He, *sige;      /* 9 per element: the means of its points' H and sigma (elem_means) */
+    gk_twoscale_field *fle; /* per element: the means of its points' fields (elem_fields)    */
     gk_nonlocal nl;
     double sym_raw, sym_k[3]; /* min of the averaging's symbol on this grid as built (gk_nonlocal.h; after
                                  --nonlocal-mix M: 1 - M + M sym_raw) and k h where reached */
@@ -132,34 +144,81 @@ static int node_id(const model *md, int i, int j, int k) {
     return (k * (md->o->mesh[1] + 1) + j) * (md->o->mesh[0] + 1) + i;
 }
 
-/* 1-point reference gradients and volumes; Flanagan-Belytschko hourglass
- * stiffness k = kappa (lambda + 2 mu) V sum_a |grad N_a|^2 / 192 (their
- * stiffness form with gk_fem_hex8_hourglass's unscaled gamma vectors) */
+/* the points' reference gradients and volumes (w det J), the elements'
+ * volumes; with one point, the Flanagan-Belytschko hourglass stiffness
+ * k = kappa (lambda + 2 mu) V sum_a |grad N_a|^2 / 192 (their stiffness form
+ * with gk_fem_hex8_hourglass's unscaled gamma vectors); the fully integrated
+ * element (8 points) has no hourglass modes and k = 0 */
 static int macro_geometry(model *md) {
-    int e, a, k;
+    int e, a, g;
     double lam2mu = md->mi->K + 4.0 / 3.0 * md->mi->G;
     gk_err err;
     for (e = 0; e < md->ne; ++e) {
-        double det, s = 0.0;
-        if (gk_fem_jacobian(&md->ref, e, md->q1.xi[0], NULL, md->dNdX + 24 * e, &det, &err))
-            return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
-        md->V0[e] = 8.0 * det;
-        for (a = 0; a < 24; ++a) s += md->dNdX[24 * e + a] * md->dNdX[24 * e + a];
-        md->hg[e] = md->o->kappa * lam2mu * md->V0[e] * s / 192.0;
+        double s = 0.0;
+        md->V0[e] = 0.0;
+        for (g = 0; g < md->ngp; ++g) {
+            int p = md->ngp * e + g;
+            double det;
+            if (gk_fem_jacobian(&md->ref, e, md->q.xi[g], NULL, md->dNdX + 24 * p, &det, &err))
+                return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
+            md->Vp[p] = md->q.w[g] * det;
+            md->V0[e] += md->Vp[p];
+        }
+        if (md->ngp == 1) {
+            for (a = 0; a < 24; ++a) s += md->dNdX[24 * e + a] * md->dNdX[24 * e + a];
+            md->hg[e] = md->o->kappa * lam2mu * md->V0[e] * s / 192.0;
+        }
     }
-    (void)k;
     return 0;
 }
 
-/* H = du/dX at the centre of element e (reference gradients) */
-static void elem_grad(const model *md, const double *u, int e, double H[9]) {
-    const int *c = md->ref.conn + 8 * e;
-    const double *g = md->dNdX + 24 * e;
+/* H = du/dX at point p (reference gradients) */
+static void point_grad(const model *md, const double *u, int p, double H[9]) {
+    const int *c = md->ref.conn + 8 * (p / md->ngp);
+    const double *g = md->dNdX + 24 * p;
     int a, i, j;
     gk_m3_zero(H);
     for (a = 0; a < 8; ++a)
         for (i = 0; i < 3; ++i)
             for (j = 0; j < 3; ++j) H[3 * i + j] += u[3 * c[a] + i] * g[3 * a + j];
+}
+
+/* He and sige: each element's mean of its points' H and sigma (the points'
+ * own values with one point; equal weights, the points' volumes on the
+ * meshes of the tests being equal) */
+static void elem_means(model *md) {
+    int e, g, i, n = md->ngp;
+    if (n == 1) {
+        memcpy(md->He, md->H, sizeof(double) * 9 * md->ne),
+            memcpy(md->sige, md->sig, sizeof(double) * 9 * md->ne);
+        return;
+    }
+    for (e = 0; e < md->ne; ++e)
+        for (i = 0; i < 9; ++i) {
+            double h = 0.0, sg = 0.0;
+            for (g = 0; g < n; ++g) h += md->H[9 * (n * e + g) + i], sg += md->sig[9 * (n * e + g) + i];
+            md->He[9 * e + i] = h / n, md->sige[9 * e + i] = sg / n;
+        }
+}
+
+/* fld (per point) from the RVEs, and fle: each element's mean of the fields the outputs use */
+static void elem_fields(model *md) {
+    int e, g, n = md->ngp;
+    gk_twoscale_fields(&md->ts, md->fld);
+    if (n == 1) {
+        memcpy(md->fle, md->fld, sizeof(gk_twoscale_field) * md->ne);
+        return;
+    }
+    memset(md->fle, 0, sizeof(gk_twoscale_field) * md->ne);
+    for (e = 0; e < md->ne; ++e) {
+        gk_twoscale_field *m = md->fle + e;
+        for (g = 0; g < n; ++g) {
+            const gk_twoscale_field *f = md->fld + n * e + g;
+            m->p += f->p / n, m->q += f->q / n, m->void_ratio += f->void_ratio / n;
+            m->coordination += f->coordination / n, m->rotation += f->rotation / n;
+            m->dem_steps += f->dem_steps / n;
+        }
+    }
 }
 
 /* the highest frequency of the mesh (element bound, the RVE's elastic K and G) */
@@ -173,7 +232,7 @@ static double macro_omega(model *md) {
     for (e = 0; e < md->ne; ++e) {
         double xe[24], ue[24], fh[24];
         const int *c = md->ref.conn + 8 * e;
-        if (gk_fem_elem_stiffness(&md->ref, e, &md->q1, D, Ke, &err)) return -1.0;
+        if (gk_fem_elem_stiffness(&md->ref, e, &md->q, D, Ke, &err)) return -1.0;
         for (a = 0; a < 8; ++a)
             for (b = 0; b < 3; ++b) xe[3 * a + b] = md->ref.x[3 * c[a] + b];
         for (b = 0; b < 24; ++b) { /* hourglass columns by unit displacements */
@@ -249,17 +308,21 @@ static int macro_setup(model *md) {
     r = gk_mesh_structured(&md->ref, GK_HEX8, o->mesh, orig, md->L, NULL, &err);
     if (!r) r = gk_mesh_structured(&md->cur, GK_HEX8, o->mesh, orig, md->L, NULL, &err);
     if (!r) r = gk_quad_rule(&md->q1, GK_HEX8, 1, &err);
+    if (!r) r = gk_quad_rule(&md->q, GK_HEX8, o->gauss == 8 ? 2 : 1, &err);
     if (r) return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
     md->nn = md->ref.nnode, md->nd = 3 * md->nn, md->ne = md->ref.nelem;
+    md->ngp = md->q.n, md->np = md->ne * md->ngp;
 #define ALLOC(p, n) p = xcalloc((size_t)(n), sizeof *(p))
     ALLOC(md->u, md->nd), ALLOC(md->v, md->nd), ALLOC(md->fint, md->nd), ALLOC(md->fext, md->nd);
     ALLOC(md->f, md->nd), ALLOC(md->mass, md->nd), ALLOC(md->vhom, md->nd), ALLOC(md->fix, md->nd);
-    ALLOC(md->vpre, md->nd), ALLOC(md->dNdX, 24 * md->ne), ALLOC(md->V0, md->ne), ALLOC(md->hg, md->ne);
-    ALLOC(md->Hn, 9 * md->ne), ALLOC(md->H, 9 * md->ne), ALLOC(md->deps, 9 * md->ne),
-        ALLOC(md->depsnl, 9 * md->ne);
-    ALLOC(md->dH, 9 * md->ne), ALLOC(md->Rh, 9 * md->ne), ALLOC(md->R1, 9 * md->ne),
-        ALLOC(md->sigR, 9 * md->ne);
-    ALLOC(md->sig, 9 * md->ne), ALLOC(md->fld, md->ne), ALLOC(md->top, md->nn), ALLOC(md->bot, md->nn);
+    ALLOC(md->vpre, md->nd), ALLOC(md->dNdX, 24 * md->np), ALLOC(md->Vp, md->np), ALLOC(md->V0, md->ne);
+    ALLOC(md->hg, md->ne), ALLOC(md->Hn, 9 * md->np), ALLOC(md->H, 9 * md->np), ALLOC(md->deps, 9 * md->np),
+        ALLOC(md->depsnl, 9 * md->np);
+    ALLOC(md->dH, 9 * md->np), ALLOC(md->Rh, 9 * md->np), ALLOC(md->R1, 9 * md->np),
+        ALLOC(md->sigR, 9 * md->np);
+    ALLOC(md->sig, 9 * md->np), ALLOC(md->fld, md->np), ALLOC(md->He, 9 * md->ne),
+        ALLOC(md->sige, 9 * md->ne);
+    ALLOC(md->fle, md->ne), ALLOC(md->top, md->nn), ALLOC(md->bot, md->nn);
     ALLOC(md->right, md->nn), ALLOC(md->pf, 2 * (nx * nz + ny * nz + nx * ny)), ALLOC(md->arrival, md->ne);
     ALLOC(md->gam_peak, ny), ALLOC(md->prof12, 2 * ny), ALLOC(md->prof_end, 2 * ny);
     ALLOC(md->fe, 24 * md->ne), ALLOC(md->wint, md->ne), ALLOC(md->ehg, md->ne);
@@ -338,11 +401,11 @@ static int macro_setup(model *md) {
         if (md->fix[a]) md->fixr[md->dm.red[a]] = 1;
     /* nonlocal neighbourhoods of the Gauss points (reference configuration) */
     {
-        double *xg = (double *)xcalloc((size_t)md->ne * 3, sizeof(double)), per[3] = {0, 0, 0};
-        for (e = 0; e < md->ne; ++e) gk_mesh_point(&md->ref, e, md->q1.xi[0], xg + 3 * e);
+        double *xg = (double *)xcalloc((size_t)md->np * 3, sizeof(double)), per[3] = {0, 0, 0};
+        for (e = 0; e < md->np; ++e) gk_mesh_point(&md->ref, e / md->ngp, md->q.xi[e % md->ngp], xg + 3 * e);
         for (k = 0; k < 3; ++k)
             if (axes & (1u << k)) per[k] = md->L[k];
-        r = gk_nonlocal_build(&md->nl, 3, md->ne, xg, o->R, per, NULL, &err);
+        r = gk_nonlocal_build(&md->nl, 3, md->np, xg, o->R, per, NULL, &err);
         free(xg);
         if (!r) r = gk_nonlocal_mix(&md->nl, o->mix, &err);
         if (r) return fprintf(stderr, "femdem_nonlocal: %s\n", err.msg), 1;
@@ -428,7 +491,7 @@ static int internal_force(model *md) {
     for (e = 0; e < md->ne; ++e) {
         double *fe = md->fe + 24 * e, fh[24];
         const int *c = md->ref.conn + 8 * e;
-        if (gk_fem_elem_force(&md->cur, e, &md->q1, md->sig + 9 * e, fe, &err))
+        if (gk_fem_elem_force(&md->cur, e, &md->q, md->sig + 9 * md->ngp * e, fe, &err))
             return fprintf(stderr, "femdem_nonlocal: step %ld: %s\n", md->step, err.msg), 1;
         md->ehg[e] = -0.5 * elem_hourglass(md, md->u, e, md->hg[e], fh);
         for (a = 0; a < 8; ++a)
@@ -482,11 +545,11 @@ static void velocity_hom(model *md) {
         for (i = 0; i < 3; ++i) vb[i] += m * md->v[3 * a + i], xb[i] += m * md->cur.x[3 * a + i];
     }
     for (i = 0; i < 3; ++i) vb[i] /= M, xb[i] /= M;
-    for (e = 0; e < md->ne; ++e) {
+    for (e = 0; e < md->np; ++e) {
         double G[9];
-        elem_grad(md, md->v, e, G);
-        for (i = 0; i < 9; ++i) Lb[i] += md->V0[e] * G[i];
-        Vt += md->V0[e];
+        point_grad(md, md->v, e, G);
+        for (i = 0; i < 9; ++i) Lb[i] += md->Vp[e] * G[i];
+        Vt += md->Vp[e];
     }
     for (i = 0; i < 9; ++i) Lb[i] /= Vt;
     if (md->ne == 1) { /* the loading's gradient only (see above) */
@@ -524,32 +587,41 @@ static int macro_step(model *md) {
     gk_dofmap_expand(&md->dm, md->vr, 0, md->v);
     for (a = 0; a < md->nd; ++a) md->cur.x[a] = md->ref.x[a] + md->u[a];
     work_half_step(md); /* with the forces of the start of the step */
-    /* corotational increments (eqs 60-61) */
-    for (e = 0; e < md->ne; ++e) {
-        elem_grad(md, md->u, e, md->H + 9 * e);
+    /* corotational increments (eqs 60-61) at every point */
+    for (e = 0; e < md->np; ++e) {
+        point_grad(md, md->u, e, md->H + 9 * e);
         if (gk_corot_increment(3, md->Hn + 9 * e, md->H + 9 * e, md->deps + 9 * e, md->Rh + 9 * e,
                                md->R1 + 9 * e, &err))
-            return fprintf(stderr, "femdem_nonlocal: step %ld, element %d: %s\n", md->step, e, err.msg), 1;
+            return fprintf(stderr, "femdem_nonlocal: step %ld, element %d: %s\n", md->step, e / md->ngp,
+                           err.msg),
+                   1;
     }
     gk_nonlocal_apply(&md->nl, 9, md->deps, md->depsnl); /* eq 58 (R = 0: each point alone) */
-    for (e = 0; e < md->ne; ++e) gk_corot_rotate_in(md->Rh + 9 * e, md->depsnl + 9 * e, md->dH + 9 * e);
+    for (e = 0; e < md->np; ++e) gk_corot_rotate_in(md->Rh + 9 * e, md->depsnl + 9 * e, md->dH + 9 * e);
     r = gk_twoscale_run(&md->ts, md->dH, NULL, md->sigR, NULL);
     if (r) {
         const gk_twoscale_point *pt = gk_twoscale_points(&md->ts);
         fprintf(stderr, "femdem_nonlocal: step %ld: %s\n", md->step, gk_twoscale_error(&md->ts));
-        for (e = 0; e < md->ne; ++e)
-            if (pt[e].code) fprintf(stderr, "  Gauss point %d: %s\n", e, gk_twoscale_point_error(&md->ts, e));
+        for (e = 0; e < md->np; ++e)
+            if (pt[e].code) {
+                if (md->ngp == 1)
+                    fprintf(stderr, "  Gauss point %d: %s\n", e, gk_twoscale_point_error(&md->ts, e));
+                else
+                    fprintf(stderr, "  Gauss point %d (element %d): %s\n", e, e / md->ngp,
+                            gk_twoscale_point_error(&md->ts, e));
+            }
         return 3;
     }
     if (gk_twoscale_accept(&md->ts))
         return fprintf(stderr, "femdem_nonlocal: %s\n", gk_twoscale_error(&md->ts)), 1;
     {
         const gk_twoscale_point *pt = gk_twoscale_points(&md->ts);
-        for (e = 0; e < md->ne; ++e) md->dem_total += pt[e].work;
+        for (e = 0; e < md->np; ++e) md->dem_total += pt[e].work;
     }
-    for (e = 0; e < md->ne; ++e)
+    for (e = 0; e < md->np; ++e)
         gk_corot_rotate_out(md->R1 + 9 * e, md->sigR + 9 * e, md->sig + 9 * e); /* eq 62 */
-    memcpy(md->Hn, md->H, sizeof(double) * 9 * md->ne);
+    memcpy(md->Hn, md->H, sizeof(double) * 9 * md->np);
+    elem_means(md);
     ++md->step;
     md->time += md->dt;
     external_force(md);
@@ -567,8 +639,8 @@ static void measure(model *md, double *strain, double *stress, double *stress2, 
     int t = md->test, a, e;
     double s = 0.0, area = 0.0, lat = 0.0;
     *uprobe = 0.0;
-    for (e = 0; e < md->ne; ++e) lat += md->sig[9 * e + (t == T_ESHEAR || t == T_SSHEAR ? 4 : 0)];
-    lat /= md->ne;
+    for (e = 0; e < md->np; ++e) lat += md->sig[9 * e + (t == T_ESHEAR || t == T_SSHEAR ? 4 : 0)];
+    lat /= md->np;
     if (t == T_EBIAX || t == T_BIAX) {
         for (a = 0; a < md->ntop; ++a) s += md->fint[3 * md->top[a] + 1];
         for (e = 0; e < md->ne; ++e) /* the current area of the top face: nodes 3, 2, 6, 7 of the top row */
@@ -598,7 +670,7 @@ static void measure(model *md, double *strain, double *stress, double *stress2, 
 }
 
 /* per-row means (simple shear): engineering shear strain of the macro
- * displacement gradient, porosity */
+ * displacement gradient, porosity (of the element means: He, fle) */
 static void row_profile(model *md, double *prof) {
     int nx = md->o->mesh[0], ny = md->o->mesh[1], nz = md->o->mesh[2], i, j, k;
     for (j = 0; j < ny; ++j) {
@@ -606,9 +678,9 @@ static void row_profile(model *md, double *prof) {
         for (k = 0; k < nz; ++k)
             for (i = 0; i < nx; ++i) {
                 int e = (k * ny + j) * nx + i;
-                const double *H = md->H + 9 * e;
+                const double *H = md->He + 9 * e;
                 g += H[1] + H[3];
-                n += md->fld[e].void_ratio / (1.0 + md->fld[e].void_ratio);
+                n += md->fle[e].void_ratio / (1.0 + md->fle[e].void_ratio);
             }
         prof[j] = g / (nx * nz);
         prof[ny + j] = n / (nx * nz);
@@ -639,7 +711,7 @@ static void band(const model *md, const double *prof, double *centre, double *wi
 static int record(model *md, double seconds) {
     double row[NCOL], strain, stress, s2, up, p = 0, q = 0, por = 0, Z = 0, dm = 0, dx = 0, capped = 0;
     const gk_twoscale_point *pt = gk_twoscale_points(&md->ts);
-    int e, n = md->ne;
+    int e, n = md->np;
     gk_twoscale_fields(&md->ts, md->fld);
     measure(md, &strain, &stress, &s2, &up);
     for (e = 0; e < n; ++e) {
@@ -657,7 +729,7 @@ static int record(model *md, double seconds) {
     row[5] = p / n, row[6] = q / n, row[7] = por / n, row[8] = Z / n, row[9] = up, row[10] = dm / n,
     row[11] = dx;
     row[12] = capped, row[13] = md->kin, row[14] = 0.0, row[15] = 0.0, row[16] = seconds;
-    for (e = 0; e < n; ++e) row[14] += md->wint[e], row[15] += md->ehg[e];
+    for (e = 0; e < md->ne; ++e) row[14] += md->wint[e], row[15] += md->ehg[e]; /* per element */
     if (md->nrow == md->caprow) {
         double *nr;
         md->caprow = md->caprow ? 2 * md->caprow : 256;
@@ -676,7 +748,7 @@ static void track(model *md) {
     int e, ny = md->o->mesh[1];
     if (md->test == T_SSHEAR) {
         double *prof = (double *)xcalloc((size_t)2 * ny, sizeof(double));
-        gk_twoscale_fields(&md->ts, md->fld);
+        elem_fields(md);
         measure(md, &strain, &stress, &s2, &up);
         row_profile(md, prof);
         if (stress > md->peak) {
@@ -692,7 +764,7 @@ static void track(model *md) {
     if (md->test == T_WAVE) { /* first time the element's shear strain passes 1e-3 a / (element length) */
         double thr = 1e-3 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
         for (e = 0; e < md->ne; ++e) {
-            const double *H = md->H + 9 * e;
+            const double *H = md->He + 9 * e;
             if (md->arrival[e] < 0 && fabs(H[1] + H[3]) > thr) md->arrival[e] = md->time;
         }
     }
@@ -721,7 +793,7 @@ static void wave_elastic(model *md, double *arr) {
         for (e = 0; e < md->ne; ++e) {
             double H[9], s[9], fe[24], fh[24], tr;
             const int *c = md->ref.conn + 8 * e;
-            elem_grad(md, u, e, H);
+            point_grad(md, u, e, H); /* (one point per element) */
             tr = H[0] + H[4] + H[8];
             for (i = 0; i < 3; ++i)
                 for (j = 0; j < 3; ++j)
@@ -767,7 +839,8 @@ static double front_speed(const model *md, const double *arr) {
 static void model_free(model *md) {
     free(md->u), free(md->v), free(md->fint), free(md->fext), free(md->f), free(md->mass), free(md->vhom);
     free(md->ur), free(md->vr), free(md->fr), free(md->mr), free(md->fix), free(md->fixr), free(md->vpre);
-    free(md->dNdX), free(md->V0), free(md->hg), free(md->Hn), free(md->H), free(md->deps), free(md->depsnl);
+    free(md->dNdX), free(md->Vp), free(md->He), free(md->sige), free(md->fle), free(md->V0), free(md->hg),
+        free(md->Hn), free(md->H), free(md->deps), free(md->depsnl);
     free(md->dH), free(md->Rh), free(md->R1), free(md->sigR), free(md->sig), free(md->fld), free(md->top);
     free(md->bot), free(md->right), free(md->pf), free(md->rows), free(md->gam_peak), free(md->prof12);
     free(md->prof_end), free(md->arrival), free(md->fe), free(md->wint), free(md->ehg);
@@ -807,8 +880,8 @@ static int macro_time_steps(model *md) {
            "%.4f), dt %.4g s (eq 65: omega_max "
            "%.4g rad/s), eq 66: %.1f DEM critical steps per coarse step (omega_f %.4g rad/s, DEM dt %.3g s), "
            "damping alpha %.4g 1/s\nDEM runs: I_uf < %g (eq 57) within %d-%d steps, %ld coarse steps\n",
-           o->mesh[0], o->mesh[1], o->mesh[2], md->ne, o->R > 0 ? "on" : "off", o->R, o->mix,
-           md->nl.start[md->ne], smix, md->dt, md->omega_c,
+           o->mesh[0], o->mesh[1], o->mesh[2], md->np, o->R > 0 ? "on" : "off", o->R, o->mix,
+           md->nl.start[md->np], smix, md->dt, md->omega_c,
            gk_explicit_substeps(md->omega_c, 0.0, mi->omega_f, 0.0), mi->omega_f, mi->dt_f, md->alpha, o->iuf,
            o->dem_min, o->dem_max, md->nsteps);
     fflush(stdout);

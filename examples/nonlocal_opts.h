@@ -70,7 +70,7 @@ static const char *test_name[T_COUNT] = {"rve",  "element-biaxial", "element-she
 
 typedef struct opts {
     int test, mesh[3], threads, steps, stop_after, checkpoint, vtk_every, every, imperfection, dem_min,
-        dem_max, lone, paper;
+        dem_max, lone, paper, gauss;
     double R, mix, pressure, strain, iuf, dem_inertial, dem_damping, contact_damping, density, xi, mass_scale,
         kappa, dt, dt_safety;
     double amplitude, frequency, duration;
@@ -97,13 +97,15 @@ static void usage(FILE *fp) {
             "  [--vtk-every K] [--every K] [--imperfection N] [--iuf X] [--dem-inertial I] [--dem-min N]\n"
             "  [--dem-max N] [--dem-damping A] [--contact-damping Z] [--density RHO] [--xi X]\n"
             "  [--mass-scale S] [--hourglass K] [--dt DT] [--dt-safety F] [--amplitude A] [--frequency F]\n"
-            "  [--duration T] [--lone-increments N] [--paper]\n");
+            "  [--duration T] [--lone-increments N] [--gauss 1|8] [--paper]\n");
     fprintf(fp,
             "defaults: --pressure 4.16e5 --packing examples/data/rve512_hm.txt --threads 1 --nonlocal off\n"
             "  --iuf 0.01 --dem-inertial 2e-3 --dem-min 10 --dem-max 4000 (biaxial: 20; simple-shear with\n"
             "  --dem-max 20: 7x faster, but the capped RVEs spread the strain and no band forms)\n"
             "  --dem-damping 0.2 --contact-damping 0.12 (biaxial 0) --density 2492 --xi 0.3 (wave 0)\n"
-            "  --mass-scale 1 --hourglass 0.1 --dt-safety 0.5 --lone-increments 400\n"
+            "  --mass-scale 1 --hourglass 0.1 (0 with --gauss 8) --dt-safety 0.5 --lone-increments 400\n"
+            "  --gauss 1 (one Gauss point and RVE per element; 8: fully integrated, 8 RVEs per element,\n"
+            "  no hourglass control, the local reference of the element and biaxial tests)\n"
             "  rve: --strain 2e-3 --steps 20; element-biaxial: --mesh 1x1x1 --strain 0.05 --steps 4000;\n"
             "  element-shear: --mesh 1x1x1 --strain 0.1 --steps 4000; wave: --mesh 10x1x1 --dt 1e-6\n"
             "  --duration 1e-3 --amplitude 1e-4 --frequency 1e4; simple-shear: --mesh 5x12x1 --strain 0.2\n"
@@ -194,6 +196,7 @@ static int parse(int argc, char **argv, opts *o) {
         {"--dem-min", CLI_INT, &o->dem_min, I0, I1, NULL, NULL, 0},
         {"--dem-max", CLI_INT, &o->dem_max, I0, I1, NULL, NULL, 0},
         {"--lone-increments", CLI_INT, &o->lone, I0, I1, NULL, NULL, 0},
+        {"--gauss", CLI_INT, &o->gauss, I0, I1, NULL, NULL, 0},
         {"--dem-damping", CLI_REAL, &o->dem_damping, R0, R1, "a number in [0, 1)", NULL, 0},
         {"--contact-damping", CLI_REAL, &o->contact_damping, R0, R1, "a number in [0, 1)", NULL, 0},
         {"--density", CLI_REAL, &o->density, R0, R1, "a number > 0", NULL, 0},
@@ -234,7 +237,8 @@ static int parse(int argc, char **argv, opts *o) {
     o->density = 2492.0;
     o->xi = -1;
     o->mass_scale = 1.0;
-    o->kappa = 0.1;
+    o->kappa = NAN; /* 0.1, or 0 with --gauss 8 (a given value is finite) */
+    o->gauss = 1;
     o->dt = 0.0;
     o->dt_safety = 0.5;
     o->amplitude = 1e-4;
@@ -313,7 +317,18 @@ static int parse(int argc, char **argv, opts *o) {
     REQ(o->density > 0, "--density %g must be > 0", o->density);
     REQ(o->xi >= 0 && o->xi <= 10, "--xi %g must be in [0, 10]", o->xi);
     REQ(o->mass_scale > 0, "--mass-scale %g must be > 0", o->mass_scale);
-    REQ(o->kappa >= 0 && o->kappa <= 1, "--hourglass %g must be in [0, 1]", o->kappa);
+    REQ(o->gauss == 1 || o->gauss == 8, "--gauss %d must be 1 or 8 (Gauss points per element)", o->gauss);
+    REQ(isnan(o->kappa) || (o->kappa >= 0 && o->kappa <= 1), "--hourglass %g must be in [0, 1]", o->kappa);
+    REQ(o->gauss == 1 || isnan(o->kappa) || o->kappa == 0.0,
+        "--hourglass %g is for one Gauss point per element: --gauss 8 has no hourglass modes to control",
+        o->kappa);
+    REQ(o->gauss == 1 || o->test == T_EBIAX || o->test == T_ESHEAR || o->test == T_SSHEAR ||
+            o->test == T_BIAX,
+        "--gauss 8 is for the element, simple-shear and biaxial tests (not --test %s)", test_name[o->test]);
+    REQ(o->gauss == 1 || o->R == 0.0,
+        "--gauss 8 is the local reference: --nonlocal needs one Gauss point per element (its stability bound "
+        "is computed for a regular grid of points)");
+    if (isnan(o->kappa)) o->kappa = o->gauss == 1 ? 0.1 : 0.0;
     REQ(o->dt >= 0, "--dt %g must be >= 0 (0: from eq 65)", o->dt);
     REQ(o->dt_safety > 0 && o->dt_safety <= 1, "--dt-safety %g must be in (0, 1]", o->dt_safety);
     REQ(o->amplitude > 0 && o->frequency > 0 && o->duration > 0,

@@ -363,35 +363,49 @@ static double vtk_first_scalar(const char *path, const char *name) {
  * point: the hourglass energy is positive and small (0.1 % of the work),
  * and the VTK's hourglass_strain is the amplitude of the hourglass modes
  * computed here from the eight nodal displacements. */
-TEST(element_biaxial_work_and_hourglass_energy) {
+/* runs the one-element biaxial (200 steps to 0.4 %, a VTK every 20) into
+ * BUILD/tests/<tag> with the extra flags; the last row's work_int and
+ * hourglass and the boundary tractions' work w (the comment above); 0 when
+ * all of it was read */
+static int element_biaxial_work(const char *tag, const char *extra, double *wint, double *w, double *hg) {
     FILE *fp;
-    char line[1024];
-    const char *dir = BUILD "/tests/t_fnlw";
-    double st[11][3], w = 0.0, L = 0.01, wint = NAN, hg = NAN;
+    char line[1024], cmd[1024], dir[256];
+    double st[11][3], L = 0.01;
     int n = 0, k;
-    CHECK(system(BUILD "/femdem_nonlocal --test element-biaxial --packing " PK160
-                       " --steps 200 --strain 0.004 "
-                       "--lone-increments 10 --vtk-every 20 --out " BUILD "/tests/t_fnlw > " BUILD
-                       "/tests/t_fnlw.out 2>&1") == 0);
-    fp = fopen(BUILD "/tests/t_fnlw/element-biaxial.csv", "r");
-    CHECK(fp != NULL);
-    if (!fp) return;
-    CHECK(fgets(line, sizeof line, fp) != NULL); /* step,time,strain,stress,stress_2,...,work_int,hourglass */
+    *wint = *w = *hg = NAN;
+    snprintf(dir, sizeof dir, BUILD "/tests/%s", tag);
+    snprintf(cmd, sizeof cmd,
+             BUILD "/femdem_nonlocal --test element-biaxial --packing " PK160 " --steps 200 --strain 0.004 "
+                   "--lone-increments 10 --vtk-every 20 %s --out %s > %s.out 2>&1",
+             extra, dir, dir);
+    if (system(cmd) != 0) return 1;
+    snprintf(cmd, sizeof cmd, "%s/element-biaxial.csv", dir);
+    if (!(fp = fopen(cmd, "r"))) return 1;
+    if (!fgets(line, sizeof line, fp)) n = -100; /* step,time,strain,stress,stress_2,...,work_int,hourglass */
     while (fgets(line, sizeof line, fp)) {
         double c[17];
         char *q = line;
         int j;
         for (j = 0; j < 17; ++j) c[j] = strtod(q, &q), q += *q == ',';
-        if ((long)c[0] % 20 == 0 && n < 11) st[n][0] = c[2], st[n][1] = c[3], st[n][2] = c[4], ++n;
-        wint = c[14], hg = c[15];
+        if ((long)c[0] % 20 == 0 && n >= 0 && n < 11) st[n][0] = c[2], st[n][1] = c[3], st[n][2] = c[4], ++n;
+        *wint = c[14], *hg = c[15];
     }
     fclose(fp);
-    CHECK(n == 11);
+    if (n != 11) return 1;
+    *w = 0.0;
     for (k = 0; k + 1 < n; ++k) {
         double ua = right_face_ux(dir, 20 * k), ub = right_face_ux(dir, 20 * (k + 1));
-        w += 0.5 * (st[k][1] * (L + ua) + st[k + 1][1] * (L + ub)) * L * (st[k + 1][0] - st[k][0]) * L;
-        w -= 0.5 * (st[k][2] * (L - st[k][0] * L) + st[k + 1][2] * (L - st[k + 1][0] * L)) * L * (ub - ua);
+        *w += 0.5 * (st[k][1] * (L + ua) + st[k + 1][1] * (L + ub)) * L * (st[k + 1][0] - st[k][0]) * L;
+        *w -= 0.5 * (st[k][2] * (L - st[k][0] * L) + st[k + 1][2] * (L - st[k + 1][0] * L)) * L * (ub - ua);
     }
+    return 0;
+}
+
+TEST(element_biaxial_work_and_hourglass_energy) {
+    FILE *fp;
+    char line[1024];
+    double w, wint, hg;
+    CHECK(element_biaxial_work("t_fnlw", "", &wint, &w, &hg) == 0);
     printf("    work: stress work %.6g J, boundary %.6g J; hourglass energy %.3g J\n", wint, w, hg);
     CHECK(w > 1e-3);
     CHECK(fabs(wint - w) < 0.005 * w);
@@ -437,6 +451,33 @@ TEST(element_biaxial_work_and_hourglass_energy) {
         CHECK(hs > 0.0);
         CHECK(fabs(hs - sqrt(q2) / 8 / 0.005) < 1e-6 * hs);
     }
+}
+
+/* the fully integrated element (--gauss 8: eight RVEs, 2 x 2 x 2 Gauss
+ * points, no hourglass control): the stress work, now sum over the points of
+ * int sigma : d eps w det J, still equals the boundary tractions' work (the
+ * test above; measured 3.6335 against 3.6280 mJ), and the hourglass energy is
+ * exactly zero */
+TEST(element_biaxial_fully_integrated) {
+    double w, wint, hg;
+    CHECK(element_biaxial_work("t_fnlg8", "--gauss 8", &wint, &w, &hg) == 0);
+    printf("    work: stress work %.6g J, boundary %.6g J; hourglass energy %.3g J\n", wint, w, hg);
+    CHECK(w > 1e-3);
+    CHECK(fabs(wint - w) < 0.005 * w);
+    CHECK(hg == 0.0);
+    CHECK(gk_test_result(BUILD "/tests/t_fnlg8.out", "hourglass_pct") == 0.0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlg8.out", "mesh 1x1x1 (8 Gauss points)"));
+}
+
+/* --gauss 8 on a periodic simple shear with the imperfect RVE (all eight
+ * points of its element): 1 vs 2 threads and a restart identical */
+TEST(fully_integrated_threads_restart) {
+    const char *args =
+        "--test simple-shear --gauss 8 --packing " PK160 " --mesh 1x2x1 --steps 16 --strain 0.002";
+    threads_and_restart(args, "t_fnlg", "simple-shear.csv", 7);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlgA.out", "mesh 1x2x1 (16 Gauss points)"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlgA.out", "imperfect RVE: 1 particles removed"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlgA/mesh_000016.vtk", "SCALARS porosity"));
 }
 
 /* the stability of averaging the strain (gk_nonlocal.h): on the 4 x 8 mesh
@@ -490,6 +531,11 @@ TEST(bad_input_is_refused) {
         {"--test element-shear --dt 1", "--dt 1 is above the stable step"},
         {"--test element-shear --packing no_such_file", "no_such_file"},
         {"--test element-shear --packing examples/data/rve400.txt", "2D packing"},
+        {"--test biaxial --gauss 4", "--gauss 4 must be 1 or 8"},
+        {"--test wave --gauss 8", "--gauss 8 is for the element, simple-shear and biaxial tests"},
+        {"--test biaxial --gauss 8 --hourglass 0.1", "--hourglass 0.1 is for one Gauss point per element"},
+        {"--test biaxial --gauss 8 --nonlocal 0.01", "--gauss 8 is the local reference"},
+        {"--test biaxial --hourglass -1", "--hourglass -1 must be in [0, 1]"},
     };
     char cmd[1024];
     size_t k;
@@ -542,6 +588,8 @@ int main(int argc, char **argv) {
     RUN(biaxial_local_and_nonlocal_prepeak);
     RUN(nonlocal_mix_and_stability_warning);
     RUN(element_biaxial_work_and_hourglass_energy);
+    RUN(element_biaxial_fully_integrated);
+    RUN(fully_integrated_threads_restart);
     RUN(bad_input_is_refused);
     return gk_test_done();
 }
