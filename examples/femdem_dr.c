@@ -113,7 +113,7 @@
 /* ------------------------------------------------------------------ the load path */
 static int run_fem(model *m) {
     const opts *o = &m->o;
-    int nsteps = o->iso_steps + o->steps, step, rc, k;
+    int nsteps = o->iso_steps + o->steps, step, step0, rc, k;
     row r;
     long long dem0;
     if (o->restart) {
@@ -123,6 +123,7 @@ static int run_fem(model *m) {
                  &r); /* the unloaded state (no RVE has run: P = 0, as Table 1's first increment) */
         add_row(m, &r);
     }
+    step0 = m->step_done;
     for (step = m->step_done + 1; step <= nsteps; ++step) {
         int stage = step <= o->iso_steps ? 1 : 2, iters = 0, g;
         double ps = o->pressure * (stage == 1 ? (double)step / o->iso_steps : 1.0),
@@ -180,7 +181,7 @@ static int run_fem(model *m) {
                      "DEM/run %.0f",
                      stage, 100.0 * r.v[2], r.v[3], r.v[4], r.v[5], iters, m->resid_last,
                      (double)(m->dem_total - dem0) / (iters > 0 ? (double)iters * m->ngp : 1.0));
-            gk_progress(stderr, step, nsteps, m->t0, what);
+            gk_progress_since(stderr, step, step0, nsteps, m->t0, what);
         }
         if (write_csv(m, "dr.csv")) return 1;
         if ((o->vtk_every > 0 && step % o->vtk_every == 0) || step == nsteps)

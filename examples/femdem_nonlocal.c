@@ -255,6 +255,8 @@ static int run(opts *o, micro *mi, model *md, int **pickp, double t0) {
     md->peak = -HUGE_VAL;
     if (o->restart) {
         if (load_checkpoint(md, fpr)) return 1;
+        /* the seconds column and RESULT's seconds go on from the last row before the checkpoint */
+        t0 -= md->rows[NCOL * (md->nrow - 1) + NCOL - 1];
     } else {
         /* the loading's own homogeneous velocity field from the start: a steady
          * homogeneous deformation needs no acceleration, so no start-up wave */
@@ -272,7 +274,8 @@ static int run(opts *o, micro *mi, model *md, int **pickp, double t0) {
     /* the loop */
     {
         long stop = o->stop_after > 0 ? o->stop_after : md->nsteps,
-             every_print = md->nsteps / 20 > 0 ? md->nsteps / 20 : 1;
+             every_print = md->nsteps / 20 > 0 ? md->nsteps / 20 : 1, step0 = md->step;
+        double t_proc = gk_wtime(); /* the progress line: this process's time and steps */
         char csv[1024];
         snprintf(csv, sizeof csv, "%s/%s.csv", o->out, test_name[o->test]);
         while (md->step < stop) {
@@ -298,7 +301,7 @@ static int run(opts *o, micro *mi, model *md, int **pickp, double t0) {
                 char what[256];
                 snprintf(what, sizeof what, "strain %.4g stress %.4g Pa, DEM steps %.0f", row[2], row[3],
                          row[10]);
-                gk_progress(stdout, md->step, md->nsteps, t0, what);
+                gk_progress_since(stdout, md->step, step0, md->nsteps, t_proc, what);
             }
         }
         if (write_rows(csv, csv_head, md->rows, md->nrow, NCOL, 0) || save_checkpoint(md, fpr)) return 1;

@@ -452,7 +452,7 @@ static double band_angle(const mpd_micro *M, const gk_mpm_points *pts) {
 }
 
 /* after a step: the interval sums, and a CSV row (with the stage fields) when due; 0 or 1 (said) */
-static int after_step(bx *X, double vplate, double t0, double t_start, long nsteps_total) {
+static int after_step(bx *X, double vplate, double t0, double t_start, long step0, long nsteps_total) {
     bx_state *S = &X->S;
     const bx_opts *b = &X->b;
     double ek, m, mom[3];
@@ -491,7 +491,7 @@ static int after_step(bx *X, double vplate, double t0, double t_start, long nste
         char what[300];
         snprintf(what, sizeof what, "eps %.2f %%  sigma_yy %.1f kPa (base %.1f)  eps_v %.3f %%  DEM %.1f/pt",
                  100 * r.eps, r.syy_top / 1e3, r.syy_base / 1e3, 100 * r.ev, r.dem_mean);
-        gk_progress(stderr, S->step, nsteps_total, t_start, what);
+        gk_progress_since(stderr, S->step, step0, nsteps_total, t_start, what);
     }
     return bad;
 }
@@ -572,7 +572,7 @@ static int run(bx *X, int argc, char **argv) {
             status = 3;
             break;
         }
-        bad = after_step(X, vplate, t0, t_start, nsteps_total);
+        bad = after_step(X, vplate, t0, t_start, step0, nsteps_total);
         if (!bad && X->o.vtk_every && S->step % X->o.vtk_every == 0)
             bad = mpd_write_vtk(&X->run, S->step, &X->M, &X->pts);
         if (!bad && X->o.checkpoint_every && S->step % X->o.checkpoint_every == 0)

@@ -390,7 +390,7 @@ static int after_step(ft *X, double vf, double t_start, long step0, long nsteps_
         char what[300];
         snprintf(what, sizeof what, "d/B %.4f  q %.1f kPa (q/q_s %.2f)  DEM %.1f/pt", r.d / f->B, r.q / 1e3,
                  r.q / f->surcharge, r.dem_mean);
-        gk_progress(stderr, S->step - step0, nsteps_total - step0, t_start, what);
+        gk_progress_since(stderr, S->step, step0, nsteps_total, t_start, what);
     }
     return bad;
 }

@@ -7,8 +7,9 @@
  *   <test>.csv       one row per --every steps (steps / 200; element tests
  *                    steps / 1000): step,time,strain,stress,stress_2,p,q,
  *                    porosity,Z,u_probe,dem_steps_mean,dem_steps_max,dem_capped,
- *                    kinetic,seconds. strain, stress: axial (biaxial tests),
- *                    u_top / h and base shear stress (shear tests), element
+ *                    kinetic,work_int,hourglass,seconds. strain, stress:
+ *                    axial (biaxial tests), u_top / h and base shear
+ *                    stress (shear tests), element
  *                    9's shear strain and stress (wave); stress_2: lateral
  *                    (biaxial), normal (shear), axial (wave) stress; p, q,
  *                    porosity, Z: means over the Gauss points (wave: element
@@ -21,7 +22,9 @@
  *                    included), hourglass = the hourglass control's stored
  *                    energy [J] (small against the work even where the
  *                    elements deform much in their hourglass modes: see
- *                    the VTK's hourglass_strain)
+ *                    the VTK's hourglass_strain); seconds = wall time
+ *                    since the run's start, a restart going on from the
+ *                    last row before its checkpoint
  *   rve_alone.csv    (element tests) strain,stress,stress_2,p,q,porosity,Z,runs
  *   rve.csv          (rve test) eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,
  *                    Z_iso,porosity_shear,Z_shear,dem_steps
@@ -31,8 +34,8 @@
  *                    and porosity at 12 % and at the end
  *   wave_arrival.csv (wave) per element: distance from the driven end,
  *                    arrival multiscale / elastic / distance over sqrt(G/rho)
- *   mesh_NNNNNN.vtk  the deformed mesh, displacement, and per Gauss point
- *                    stress, p, q, porosity, coordination, particle_rotation
+ *   mesh_NNNNNN.vtk  the deformed mesh, displacement, and per element (with
+ *                    --gauss 8 the means of its eight points) stress, p, q, porosity, coordination, particle_rotation
  *                    (mean |accumulated rotation vector| of its particles),
  *                    dem_steps, shear_strain, eps_v, eps_q, work_int,
  *                    hourglass_energy and hourglass_share = hourglass /

@@ -23,6 +23,8 @@
  *                              point and cell data (scalars, vectors, 3x3
  *                              tensors) for ParaView
  *   gk_progress                one line per step with elapsed time and ETA
+ *   gk_progress_since          the same for a run resumed at step0 (a restart):
+ *                              the ETA from the steps done since then
  *   gk_file_close (gk_base.h)  closes a file you wrote (a CSV) the way every
  *                              writer here does: fflush + ferror + fclose,
  *                              GK_ERR_IO naming the path and the reason when
@@ -123,6 +125,10 @@ GKDEF gk_result gk_vtk_close(gk_vtk *v);
 /* "step 12/100  eps 1.20 %  ... | 3.4 s elapsed, ETA 25.1 s" on stderr
  * (or fp); `what` is any extra text. */
 GKDEF void gk_progress(FILE *fp, long step, long nsteps, double t_start, const char *what);
+/* the same for a run that started (or restarted) at step0 at time t_start:
+ * elapsed is since t_start, the ETA elapsed / (step - step0) x (nsteps -
+ * step); gk_progress is step0 = 0 */
+GKDEF void gk_progress_since(FILE *fp, long step, long step0, long nsteps, double t_start, const char *what);
 
 #ifdef __cplusplus
 }
@@ -710,11 +716,16 @@ GKDEF gk_result gk_vtk_close(gk_vtk *v) {
     return gk_file_close(fp, "VTK file", &v->err);
 }
 
-GKDEF void gk_progress(FILE *fp, long step, long nsteps, double t_start, const char *what) {
-    double el = gk_wtime() - t_start, eta = step > 0 ? el / step * (nsteps - step) : 0.0;
+GKDEF void gk_progress_since(FILE *fp, long step, long step0, long nsteps, double t_start, const char *what) {
+    double el = gk_wtime() - t_start,
+           eta = step > step0 ? el / (double)(step - step0) * (nsteps - step) : 0.0;
     fprintf(fp ? fp : stderr, "step %ld/%ld  %s | %.1f s elapsed, ETA %.1f s\n", step, nsteps,
             what ? what : "", el, eta);
     fflush(fp ? fp : stderr);
+}
+
+GKDEF void gk_progress(FILE *fp, long step, long nsteps, double t_start, const char *what) {
+    gk_progress_since(fp, step, 0, nsteps, t_start, what);
 }
 
 #endif /* GK_IO implementation */

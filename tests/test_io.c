@@ -161,10 +161,32 @@ TEST(field_plot_axes_outline_colorbar_and_fixed_range) {
     free(svg);
 }
 
+/* the progress line's ETA: elapsed / steps done x steps left; a run resumed
+ * at step 50 that did 10 steps in 10 s has 40 s left at step 60 of 100
+ * (gk_progress, counting from step 0, would say 6.7 s) */
+TEST(progress_eta_counts_the_steps_since_a_restart) {
+    char line[256];
+    double el = NAN, eta = NAN;
+    FILE *fp = fopen(OUT "io_progress.txt", "w+");
+    CHECK(fp != NULL);
+    if (!fp) return;
+    gk_progress_since(fp, 60, 50, 100, gk_wtime() - 10.0, "eps 1 %");
+    gk_progress(fp, 60, 100, gk_wtime() - 10.0, NULL);
+    rewind(fp);
+    CHECK(fgets(line, sizeof line, fp) != NULL);
+    CHECK(sscanf(line, "step 60/100  eps 1 %% | %lf s elapsed, ETA %lf s", &el, &eta) == 2);
+    CHECK(fabs(el - 10.0) < 0.5 && fabs(eta - 40.0) < 2.0);
+    CHECK(fgets(line, sizeof line, fp) != NULL);
+    CHECK(sscanf(line, "step 60/100   | %lf s elapsed, ETA %lf s", &el, &eta) == 2);
+    CHECK(fabs(eta - 10.0 / 60.0 * 40.0) < 0.5);
+    fclose(fp);
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(legend_never_covers_data);
     RUN(equal_aspect_draws_a_round_circle);
     RUN(field_plot_axes_outline_colorbar_and_fixed_range);
+    RUN(progress_eta_counts_the_steps_since_a_restart);
     return gk_test_done();
 }
