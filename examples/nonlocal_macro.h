@@ -6,22 +6,21 @@
  * THE MODEL (eqs 44-66 and Appendix A of the paper)
  *   Macro: 8-node hexahedra with one Gauss point and Flanagan-Belytschko
  *   stiffness hourglass control (k = kappa (lambda + 2 mu) V sum|grad N|^2 /
- *   192, kappa = --hourglass 0.1, lambda and mu of the RVE; its stored
- *   energy 1/2 k sum (gamma . u)^2 per element is an output, against the
- *   stress work int sigma : d eps V, trapezoidal in time). --gauss 8 is the
- *   fully integrated element instead: 2 x 2 x 2 Gauss points, an RVE at each
- *   (eight times the DEM), no hourglass modes and no control; the outputs
- *   per element are the means of its points. It is the local reference for
- *   the choice of kappa; its element bound on the frequency (eq 65) is 2.4
- *   (2x4x1) to 3.9 (one cube) times the 1-point one, so it needs a smaller
- *   step or more mass. Lumped mass (rho V / 8 per node, rho = RVE mass /
- *   RVE volume of eq 26, times
- *   --mass-scale), explicit central differences (eqs 51-52; gk_explicit.h),
- *   updated Lagrangian with the corotational update of eqs 60-62
- *   (gk_explicit.h: F at mid-step, polar decomposition, the strain increment
- *   rotated in and the stress out; what the missing Appendix B leaves open
- *   is written there). Stress tension-positive inside, compression-positive
- *   in every output.
+ *   192, kappa = --hourglass 0.1, lambda and mu of the RVE; its stored energy
+ *   1/2 k sum (gamma . u)^2 per element is an output, against the stress work
+ *   int sigma : d eps V, trapezoidal in time). --gauss 8 is the fully
+ *   integrated element instead: 2 x 2 x 2 Gauss points, an RVE at each (eight
+ *   times the DEM), no hourglass modes and no control; the outputs per element
+ *   are the means of its points. It is the local reference for the choice of
+ *   kappa; its element bound on the frequency (eq 65) is 2.4 (2x4x1) to 3.9
+ *   (one cube) times the 1-point one, so it needs a smaller step or more mass.
+ *   Lumped mass (rho V / 8 per node, rho = RVE mass / RVE volume of eq 26,
+ *   times --mass-scale), explicit central differences (eqs 51-52;
+ *   gk_explicit.h), updated Lagrangian with the corotational update of eqs
+ *   60-62 (gk_explicit.h: F at mid-step, polar decomposition, the strain
+ *   increment rotated in and the stress out; what the missing Appendix B
+ *   leaves open is written there). Stress tension-positive inside,
+ *   compression-positive in every output.
  *   Nonlocal (eq 58, Appendix A; gk_nonlocal.h): the whole strain increment at
  *   every Gauss point is replaced by its bell-weighted average over the
  *   points within R (--nonlocal R, or off), normalised per point without
