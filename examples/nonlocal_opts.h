@@ -105,7 +105,7 @@ static void usage(FILE *fp) {
             "  --dem-damping 0.2 --contact-damping 0.12 (biaxial 0) --density 2492 --xi 0.3 (wave 0)\n"
             "  --mass-scale 1 --hourglass 0.1 (0 with --gauss 8) --dt-safety 0.5 --lone-increments 400\n"
             "  --gauss 1 (one Gauss point and RVE per element; 8: fully integrated, 8 RVEs per element,\n"
-            "  no hourglass control, the local reference of the element and biaxial tests)\n"
+            "  no hourglass control: the local reference; element, simple-shear and biaxial tests)\n"
             "  rve: --strain 2e-3 --steps 20; element-biaxial: --mesh 1x1x1 --strain 0.05 --steps 4000;\n"
             "  element-shear: --mesh 1x1x1 --strain 0.1 --steps 4000; wave: --mesh 10x1x1 --dt 1e-6\n"
             "  --duration 1e-3 --amplitude 1e-4 --frequency 1e4; simple-shear: --mesh 5x12x1 --strain 0.2\n"
