@@ -145,12 +145,13 @@
  *     meshes within 2.1 / 0.6 / 0.7 / 1.3 % at 3-6 % (local 1.7 / 1.2 / 5.7
  *     / 2.8 %) and widens the band (share 0.88 / 0.53 / 0.22), which still
  *     narrows with the mesh (examples/README). The fully integrated element
- *     (--gauss 8, 8 RVEs per element, no hourglass control; --mass-scale 2
- *     for the same step) forms no band on 8x16x1 either: largest eps_q
- *     0.162 and share 0.82 at 6 %, its field correlated 0.83 with the
- *     default's and 0.20 with --hourglass 0.01's, its stress 0-7 % above
- *     the default's. So the default stays: the bands of a softer control
- *     live in the hourglass modes, which a standard element lacks too.
+ *     (--gauss 8, 8 RVEs per element, no hourglass control; with
+ *     --mass-scale 2, as its one-point companions) forms no band on 8x16x1
+ *     either: largest eps_q 0.162 and share 0.82 at 6 %, its field
+ *     correlated 0.83 with the default's and 0.20 with --hourglass 0.01's,
+ *     its stress 0-7 % above the default's. So the default stays: the bands
+ *     of a softer control live in the hourglass modes, which a standard
+ *     element lacks too.
  *     Nonlocal as the paper (R 6.75 mm): on 4x8x1 no point has a neighbour
  *     within R (the local model); on 8x16x1 (symbol min 0.102) it stays
  *     within 2.5 % of the 4x8x1 curve from 3 to 8 % (local: 0.5-2.9 %); on
