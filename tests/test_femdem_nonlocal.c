@@ -95,8 +95,6 @@ TEST(adaptive_rule_on_eq57) {
     gk_packing_free(&pk);
 }
 
-/* a run with 2 and 1 threads, and a run stopped half way and restarted from
- * its checkpoint: the same CSV in every column but the seconds */
 /* 1 when the CSV's last column (seconds) never decreases down the rows */
 static int seconds_never_decrease(const char *path) {
     char line[2048];
@@ -116,6 +114,8 @@ static int seconds_never_decrease(const char *path) {
     return ok && n > 2;
 }
 
+/* a run with 2 and 1 threads, and a run stopped half way and restarted from
+ * its checkpoint: the same CSV in every column but the seconds */
 static void threads_and_restart(const char *args, const char *tag, const char *csv, int stop) {
     char cmd[2048], a[256], b[256];
     snprintf(cmd, sizeof cmd,
@@ -373,19 +373,9 @@ static double vtk_first_scalar(const char *path, const char *name) {
     return v;
 }
 
-/* the energy columns: work_int, the stress work sum_e int sigma : d eps V,
- * equals on one element the work its boundary tractions do on it, int
- * sigma_yy A_xz d(shortening) - int sigma_xx A_yz d(u_x right), from the
- * CSV's stresses and the VTK's right face every 20 steps (trapezoids;
- * measured 3.1605 mJ against 3.1613, 0.03 %; the right face's corner alone,
- * the CSV's u_probe, is 9 % short of the face's mean: the RVE's shear
- * stresses tilt the face). That tilt is bilinear, invisible to the one
- * point: the hourglass energy is positive and small (0.1 % of the work),
- * and the VTK's hourglass_strain is the amplitude of the hourglass modes
- * computed here from the eight nodal displacements. */
 /* runs the one-element biaxial (200 steps to 0.4 %, a VTK every 20) into
  * BUILD/tests/<tag> with the extra flags; the last row's work_int and
- * hourglass and the boundary tractions' work w (the comment above); 0 when
+ * hourglass and the boundary tractions' work w (the comment below); 0 when
  * all of it was read */
 static int element_biaxial_work(const char *tag, const char *extra, double *wint, double *w, double *hg) {
     FILE *fp;
@@ -421,6 +411,16 @@ static int element_biaxial_work(const char *tag, const char *extra, double *wint
     return 0;
 }
 
+/* the energy columns: work_int, the stress work sum_e int sigma : d eps V,
+ * equals on one element the work its boundary tractions do on it, int
+ * sigma_yy A_xz d(shortening) - int sigma_xx A_yz d(u_x right), from the
+ * CSV's stresses and the VTK's right face every 20 steps (trapezoids;
+ * measured 3.1605 mJ against 3.1613, 0.03 %; the right face's corner alone,
+ * the CSV's u_probe, is 9 % short of the face's mean: the RVE's shear
+ * stresses tilt the face). That tilt is bilinear, invisible to the one
+ * point: the hourglass energy is positive and small (0.1 % of the work),
+ * and the VTK's hourglass_strain is the amplitude of the hourglass modes
+ * computed here from the eight nodal displacements. */
 TEST(element_biaxial_work_and_hourglass_energy) {
     FILE *fp;
     char line[1024];
