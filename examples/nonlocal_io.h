@@ -35,7 +35,8 @@
  *   wave_arrival.csv (wave) per element: distance from the driven end,
  *                    arrival multiscale / elastic / distance over sqrt(G/rho)
  *   mesh_NNNNNN.vtk  the deformed mesh, displacement, and per element (with
- *                    --gauss 8 the means of its eight points) stress, p, q, porosity, coordination, particle_rotation
+ *                    --gauss 8 the means of its eight points) stress, p, q,
+ *                    porosity, coordination, particle_rotation
  *                    (mean |accumulated rotation vector| of its particles),
  *                    dem_steps, shear_strain, eps_v, eps_q, work_int,
  *                    hourglass_energy and hourglass_share = hourglass /

@@ -182,16 +182,11 @@ static void point_grad(const model *md, const double *u, int p, double H[9]) {
             for (j = 0; j < 3; ++j) H[3 * i + j] += u[3 * c[a] + i] * g[3 * a + j];
 }
 
-/* He and sige: each element's mean of its points' H and sigma (the points'
- * own values with one point; equal weights, the points' volumes on the
- * meshes of the tests being equal) */
+/* He and sige: each element's mean of its points' H and sigma (exactly the
+ * point's own values with one point; equal weights, the points' volumes on
+ * the meshes of the tests being equal) */
 static void elem_means(model *md) {
     int e, g, i, n = md->ngp;
-    if (n == 1) {
-        memcpy(md->He, md->H, sizeof(double) * 9 * md->ne),
-            memcpy(md->sige, md->sig, sizeof(double) * 9 * md->ne);
-        return;
-    }
     for (e = 0; e < md->ne; ++e)
         for (i = 0; i < 9; ++i) {
             double h = 0.0, sg = 0.0;
@@ -200,14 +195,11 @@ static void elem_means(model *md) {
         }
 }
 
-/* fld (per point) from the RVEs, and fle: each element's mean of the fields the outputs use */
+/* fld (per point) from the RVEs, and fle: each element's mean of the fields
+ * the outputs use (the others left 0) */
 static void elem_fields(model *md) {
     int e, g, n = md->ngp;
     gk_twoscale_fields(&md->ts, md->fld);
-    if (n == 1) {
-        memcpy(md->fle, md->fld, sizeof(gk_twoscale_field) * md->ne);
-        return;
-    }
     memset(md->fle, 0, sizeof(gk_twoscale_field) * md->ne);
     for (e = 0; e < md->ne; ++e) {
         gk_twoscale_field *m = md->fle + e;
