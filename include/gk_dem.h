@@ -1253,10 +1253,14 @@ GK_FORCE_INLINE void gk__simd_state(unsigned char *cs, gk_vrm in, gk_vrm slide, 
     for (l = 0; l < GK_VR_W; l += 8) {
         uint64_t v = lut[(bi >> l) & 0xffu] * GK_CS_CONTACT | lut[(bs >> l) & 0xffu] * GK_CS_SLIDING;
         int m, nb = GK_VR_W - l < 8 ? GK_VR_W - l : 8;
-        if (nb == 8)
+        if (nb == 8) {
             memcpy(cs + l, &v, 8);
-        else
+        } else if (nb == 4) { /* AVX2 doubles: one 4-byte store, not four */
+            uint32_t v4 = (uint32_t)v;
+            memcpy(cs + l, &v4, 4);
+        } else {
             for (m = 0; m < nb; ++m) cs[l + m] = (unsigned char)(v >> (8 * m));
+        }
     }
 }
 
