@@ -172,6 +172,51 @@ TEST(element_shear_runs_threads_restart) {
     CHECK(gk_test_file_has(BUILD "/tests/t_fnleA/rve_alone.csv", "strain,stress,stress_2"));
 }
 
+/* the "largest" figure tools/curve_gap.sh prints (NAN if none) */
+static double curve_gap_largest(const char *out) {
+    char *t = gk_test_slurp(out), *q = t ? strstr(t, "largest ") : NULL;
+    double v = q ? atof(q + 8) : NAN;
+    free(t);
+    return v;
+}
+
+/* tools/curve_gap.sh: on two straight lines 10 apart (B peaks at 200) every
+ * window mean is 10 / 200 = 5 %, the peaks' ratio 210 / 200; on an element
+ * test it gives the driver's own rve_alone_dev_pct (curve_deviation in
+ * examples/nonlocal_io.h, printed to 3 decimals); a missing column or a bad
+ * S is refused with status 2 */
+TEST(curve_gap_tool_is_the_drivers_measure) {
+    FILE *a = fopen(BUILD "/tests/t_cgA.csv", "w"), *b = fopen(BUILD "/tests/t_cgB.csv", "w");
+    double drv;
+    CHECK(a && b);
+    if (!a || !b) {
+        if (a) fclose(a);
+        if (b) fclose(b);
+        return;
+    }
+    fprintf(a, "strain,stress\n0,110\n1,210\n");
+    fprintf(b, "strain,stress\n0,100\n0.5,150\n1,200\n");
+    CHECK(fclose(a) == 0 && fclose(b) == 0);
+    CHECK(system("sh tools/curve_gap.sh " BUILD "/tests/t_cgA.csv " BUILD "/tests/t_cgB.csv 1 > " BUILD
+                 "/tests/t_cg.out 2>&1") == 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_cg.out", "5.00 5.00 5.00 5.00 5.00 5.00 5.00 5.00 5.00 5.00"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_cg.out", "largest 5.000 %, peaks A/B 1.0500"));
+    CHECK(system(BUILD "/femdem_nonlocal --test element-shear --packing " PK160
+                       " --steps 40 --strain 0.004 --lone-increments 10 --out " BUILD "/tests/t_cgE > " BUILD
+                       "/tests/t_cgE.out 2>&1") == 0);
+    CHECK(system("sh tools/curve_gap.sh " BUILD "/tests/t_cgE/element-shear.csv " BUILD
+                 "/tests/t_cgE/rve_alone.csv 0.004 > " BUILD "/tests/t_cg2.out 2>&1") == 0);
+    drv = gk_test_result(BUILD "/tests/t_cgE.out", "rve_alone_dev_pct");
+    CHECK(drv > 0);
+    CHECK_NEAR(curve_gap_largest(BUILD "/tests/t_cg2.out"), drv, 1.5e-3);
+    CHECK(system("sh tools/curve_gap.sh " BUILD "/tests/t_cgA.csv " BUILD
+                 "/tests/t_cgB.csv 1 strain q > " BUILD "/tests/t_cg3.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_cg3.out", "no column strain or q"));
+    CHECK(system("sh tools/curve_gap.sh " BUILD "/tests/t_cgA.csv " BUILD "/tests/t_cgB.csv 0 > " BUILD
+                 "/tests/t_cg4.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_cg4.out", "S must be > 0"));
+}
+
 /* a small periodic simple shear with the nonlocal operator on (every
  * point sees its neighbours), an imperfect RVE: threads and restart */
 TEST(simple_shear_nonlocal_threads_restart) {
@@ -601,6 +646,7 @@ int main(int argc, char **argv) {
     RUN(rotation_tracking_3d);
     RUN(adaptive_rule_on_eq57);
     RUN(element_shear_runs_threads_restart);
+    RUN(curve_gap_tool_is_the_drivers_measure);
     RUN(simple_shear_nonlocal_threads_restart);
     RUN(simple_shear_peak_and_band_as_documented);
     RUN(rve_table2_moduli);
