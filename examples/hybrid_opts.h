@@ -66,6 +66,9 @@ static const char *mode_name[] = {"dem", "continuum", "hybrid"};
  * leave the grid (a generous spare: at 2 m/s a grain moves 0.02 mm, under 0.01 cell, between two
  * checks) */
 #define ESCAPE_SPARE 1.25
+/* cells: planar, a free grain touching none this far beyond the overlap's outer edge (phi0 + h / 2
+ * from the flagged nodes) is a stray and is removed (coupling_mask) */
+#define STRAY_CELLS 1.0
 
 typedef struct opts {
     int test, mode;
@@ -76,7 +79,7 @@ typedef struct opts {
     double intruder; /* indent: the intruder's width B [m] (its height 0.4 B, Table 8) */
     double probe[3]; /* --probe S Y0 Y1 (dem): strain, strip */
     int probe_on;
-    int ppd, threads, oracle_every, quiet;
+    int ppd, threads, oracle_every, quiet, keep_strays;
     long grains;
     unsigned long seed;
 } opts;
@@ -197,6 +200,8 @@ static void usage(FILE *fp) {
         "                       (planar, phi_0 2.2 cm), 6 x 9.42 cm (biaxial), 0.02 m/s; indent: a\n"
         "                       60 x 20 cm bin, a 5 cm intruder at 0.05 m/s, cells of 0.5 cm, phi_0\n"
         "                       2.5 cm; the other flags override it\n"
+        "  --keep-strays        planar hybrid: keep the free grains that stray more than a cell beyond\n"
+        "                       the overlap touching none (by default removed, and counted)\n"
         "  --quiet              no progress lines\n",
         p.out, p.width, p.height, b.width, b.height, d.width, d.height, d.intruder, p.seed, p.pressure,
         b.pressure, d.pressure, p.speed, b.speed, d.speed, p.strain_end, b.strain_end, d.strain_end,
@@ -256,6 +261,7 @@ static int parse(int argc, char **argv, opts *o) {
             {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
             {"--packing", CLI_STR, &o->packing, 0, 0, NULL, NULL, 0},
             {"--quiet", CLI_FLAG, &o->quiet, 0, 0, NULL, NULL, 0},
+            {"--keep-strays", CLI_FLAG, &o->keep_strays, 0, 0, NULL, NULL, 0},
             {"--paper", CLI_FLAG, &paper, 0, 0, NULL, NULL, 0}, /* applied above */
             {"--width", CLI_REAL, &o->width, 0.005, 10.0, "a width in [0.005, 10] m", NULL, 0},
             {"--height", CLI_REAL, &o->height, 0.005, 10.0, "a height in [0.005, 10] m", NULL, 0},
@@ -367,6 +373,8 @@ static int parse(int argc, char **argv, opts *o) {
                            o->intruder, o->width, o->height),
                    1;
     }
+    if (o->keep_strays && (o->test != T_PLANAR || o->mode != M_HYBRID))
+        return fprintf(stderr, "error: --keep-strays is an option of the planar hybrid run\n"), 1;
     if (o->test != T_PLANAR && o->train < 1.0)
         return fprintf(stderr,
                        "error: --train %g: below 1 only for the planar test (the band region moves)\n",

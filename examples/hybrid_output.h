@@ -29,7 +29,9 @@
  * N_D and element terms of the cost model of Sec 6.4.1) with the wall time
  * spent in each. Biaxial hybrid: a grain squeezed out of the discrete zone
  * that flies off towards the grid's side is removed before its coupling
- * would leave the grid (remove_escaped), with a line on stdout, and at the
+ * would leave the grid (remove_escaped); planar hybrid: one that strays
+ * more than a cell beyond the overlap into the continuum zone (coupling_mask).
+ * Either only when it touches no grain, with a line on stdout, and at the
  * end a warning on stderr gives the count and the share of the grains'
  * mass removed.
  */

@@ -176,7 +176,7 @@ typedef struct run {
     double strain_enrich, *dist, *xpre[2];
     unsigned char *coupled;
     int32_t *drop_ids;       /* scratch of remove_escaped */
-    int cap_g, mask_n, lost; /* lost: grains removed after leaving the specimen (remove_escaped) */
+    int cap_g, mask_n, lost; /* lost: loose grains removed (drop_loose) */
     double lost_mass;        /* their share of the grains' mass when removed, summed */
     double grain_scale;      /* the enrichment's grain mass factor */
     gk_hybrid_coupling cpl;

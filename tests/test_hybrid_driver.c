@@ -339,6 +339,8 @@ TEST(hybrid_refuses_bad_arguments) {
     CHECK(refused("--mode dem", "--test planar|biaxial|indent is required"));
     CHECK(refused("--test indent --mode dem --intruder 0.07", "--intruder 0.07: wider than half the bin"));
     CHECK(refused("--test indent --mode hybrid --train 0.5", "below 1 only for the planar test"));
+    CHECK(refused("--test biaxial --mode hybrid --keep-strays", "an option of the planar hybrid run"));
+    CHECK(refused("--test planar --mode dem --keep-strays", "an option of the planar hybrid run"));
     CHECK(refused("--test shear --mode dem", "use planar, biaxial or indent"));
     CHECK(refused("--test planar --mode foo", "--mode 'foo' must be dem, continuum or hybrid"));
     CHECK(refused("--test planar --mode hybrid --train 2", "--train 2"));

@@ -1,5 +1,6 @@
 /* test_hybrid_setup.c - parts of the hybrid driver (examples/hybrid_*.h) tested directly: the
- * membranes on the grains' sides of a biaxial specimen, the removal of grains that left it. */
+ * membranes on the grains' sides of a biaxial specimen, the removal of grains that left it, the
+ * planar test's coupling mask and its removal of stray grains. */
 #include "gk_test.h"
 #include <stdlib.h>
 
@@ -117,6 +118,19 @@ TEST(membrane_chain_ends_at_the_wall) {
     gk_packing_free(&pk);
 }
 
+/* frees what the grid tests below made (free(NULL) where a test made less) */
+static void free_grid_state(run *R, gk_packing *pk) {
+    gk_scene_destroy(&R->sc);
+    gk_mpm_grid_destroy(&R->g);
+    gk_packing_free(pk);
+    free(R->dist);
+    free(R->nden);
+    free(R->xpre[0]);
+    free(R->xpre[1]);
+    free(R->coupled);
+    free(R->drop_ids);
+}
+
 /* remove_escaped: on a grid of 10 x 10 cells of 1 mm from (-3, -3) mm with points' half-size lp
  * 0.25 mm, grains are kept whose centres lie within x = -1.5 ... 5.5 mm (ESCAPE_SPARE, 1.25 cells,
  * inside where the uGIMP support, lp around a grain, leaves the grid: -2.75 ... 6.75 mm): grains 0
@@ -160,13 +174,78 @@ TEST(escaped_grains_are_removed_and_counted) {
     CHECK_NEAR(R.lost_mass, 0.09 / 0.81, 1e-12);
     CHECK(remove_escaped(&R) == 0); /* nothing more to remove */
     CHECK_EQ_INT(R.lost, 1);
-    gk_scene_destroy(&R.sc);
-    gk_mpm_grid_destroy(&R.g);
-    gk_packing_free(&pk);
-    free(R.xpre[0]);
-    free(R.xpre[1]);
-    free(R.coupled);
-    free(R.drop_ids);
+    free_grid_state(&R, &pk);
+}
+
+/* coupling_mask and drop_loose, planar: flagged nodes along y = 0 (the distance field |y| on a
+ * grid of 10 x 10 cells of 1 mm from (-3, -3) mm, every node holding material), phi0 2 mm: the
+ * discrete zone y < 1.5 mm, the overlap to 2.5 mm, strays beyond 2.5 + STRAY_CELLS = 3.5 mm or off
+ * the grid (above 8 mm the interpolation finds no node). Grain 0 (y 1 mm, discrete) and grain 1
+ * (3 mm, continuum, within a cell of the overlap) are neither coupled nor strays; grain 7 (2 mm) is
+ * coupled; strays: 2 (4.5 mm, touching nothing: removed), 3 and 4 (5 and 5.55 mm, touching each
+ * other: kept), 6 (8.2 mm, off the grid, touching nothing: removed); 5 (5.8 mm) is prescribed (a
+ * platen grain): kept and no stray. Removed: 2 of 8 equal disks, a quarter of the mass. With
+ * --keep-strays none is a stray. */
+TEST(planar_strays_are_removed_and_counted) {
+    run R;
+    gk_packing pk;
+    gk_err e;
+    gk_scene_def d;
+    double org[3] = {-0.003, -0.003, 0.0}, z[3] = {0.0, 0.0, 0.0}, lp = 0.00025;
+    int n[3] = {11, 11, 1}, k;
+    size_t I;
+    const double xy[8][2] = {{0.001, 0.001},   {0.002, 0.003},  {0.003, 0.0045}, {0.004, 0.005},
+                             {0.004, 0.00555}, {0.005, 0.0058}, {0.001, 0.0082}, {0.005, 0.002}};
+    memset(&R, 0, sizeof R);
+    defaults(&R.o, T_PLANAR);
+    R.o.threads = 1;
+    R.o.quiet = 1;
+    R.o.phi0 = 0.002;
+    R.W = R.H = 0.006; /* the scene's domain: x periodic over 0 .. 6 mm, y -3 .. 9 mm */
+    R.h = 0.001;
+    R.P.lp = &lp;
+    CHECK(gk_mpm_grid_create(&R.g, 2, org, 0.001, n, NULL, &e) == GK_OK); /* nodes -3 .. 7 mm */
+    R.dist = (double *)malloc(R.g.nnode * sizeof(double));
+    R.nden = (double *)malloc(R.g.nnode * sizeof(double));
+    CHECK(R.dist && R.nden);
+    for (I = 0; I < R.g.nnode; ++I) {
+        R.dist[I] = fabs(org[1] + R.h * (double)(I / (size_t)n[0]));
+        R.nden[I] = 1.0;
+    }
+    CHECK(gk_packing_init(&pk, 2, 8, NULL, &e) == GK_OK);
+    pk.h[0] = pk.h[4] = 0.006;
+    for (k = 0; k < 8; ++k) {
+        pk.x[k] = xy[k][0];
+        pk.y[k] = xy[k][1];
+        pk.r[k] = 0.0003;
+    }
+    pk.n = 8;
+    d = scene_def(&R);
+    CHECK(gk_scene_create(&R.sc, &d, &pk) == GK_OK);
+    CHECK(grow_grain_arrays(&R, 8) == 0);
+    CHECK(gk_scene_prescribe(&R.sc, gk_scene_index(&R.sc, 5), z, z) == GK_OK);
+    CHECK(gk_scene_step(&R.sc, 1) == GK_OK); /* the contacts: 3 with 4 */
+    k = coupling_mask(&R);
+    CHECK_EQ_INT(k, 4);
+    CHECK(R.coupled[gk_scene_index(&R.sc, 7)]);
+    CHECK(!R.coupled[gk_scene_index(&R.sc, 0)] && !R.coupled[gk_scene_index(&R.sc, 1)]);
+    CHECK(drop_loose(&R, k, "strayed") == 0);
+    CHECK_EQ_INT(R.sc.rve.n, 6);
+    CHECK_EQ_INT(R.lost, 2);
+    CHECK(gk_scene_index(&R.sc, 2) < 0 && gk_scene_index(&R.sc, 6) < 0);
+    for (k = 0; k < 8; ++k)
+        if (k != 2 && k != 6) CHECK(gk_scene_index(&R.sc, k) >= 0);
+    CHECK_NEAR(R.lost_mass, 0.25, 1e-12);
+    k = coupling_mask(&R); /* 3 and 4 again, still touching */
+    CHECK_EQ_INT(k, 2);
+    CHECK(R.coupled[gk_scene_index(&R.sc, 7)]);
+    CHECK(drop_loose(&R, k, "strayed") == 0);
+    CHECK_EQ_INT(R.lost, 2);
+    CHECK_EQ_INT(R.sc.rve.n, 6);
+    R.o.keep_strays = 1; /* --keep-strays: none, the mask the same */
+    CHECK_EQ_INT(coupling_mask(&R), 0);
+    CHECK(R.coupled[gk_scene_index(&R.sc, 7)] && !R.coupled[gk_scene_index(&R.sc, 1)]);
+    free_grid_state(&R, &pk);
 }
 
 int main(int argc, char **argv) {
@@ -174,5 +253,6 @@ int main(int argc, char **argv) {
     RUN(membranes_reach_a_set_back_top_corner);
     RUN(membrane_chain_ends_at_the_wall);
     RUN(escaped_grains_are_removed_and_counted);
+    RUN(planar_strays_are_removed_and_counted);
     return gk_test_done();
 }
