@@ -175,7 +175,7 @@ typedef struct run {
     int enriched;
     double strain_enrich, *dist, *xpre[2];
     unsigned char *coupled;
-    int32_t *drop_ids;       /* scratch of remove_escaped */
+    int32_t *drop_ids;       /* scratch: grains to remove (coupling_mask, remove_escaped) */
     int cap_g, mask_n, lost; /* lost: loose grains removed (drop_loose) */
     double lost_mass;        /* their share of the grains' mass when removed, summed */
     double grain_scale;      /* the enrichment's grain mass factor */
