@@ -632,8 +632,7 @@ static int hybrid_step(run *R) {
     if (grow_grain_arrays(R, ng)) return 1;
     /* which grains lie in the overlap; planar: strays removed */
     if (R->step % REFRESH_EVERY == 0 || R->mask_n != ng) {
-        int k = coupling_mask(R);
-        if (k && drop_loose(R, k, "strayed into the continuum zone")) return 1;
+        if (drop_loose(R, coupling_mask(R), "strayed into the continuum zone")) return 1;
         if (sc->rve.n != ng) {
             ng = sc->rve.n;
             coupling_mask(R); /* the indices have moved */

@@ -118,7 +118,35 @@ TEST(membrane_chain_ends_at_the_wall) {
     gk_packing_free(&pk);
 }
 
-/* frees what the grid tests below made (free(NULL) where a test made less) */
+/* the grid tests' set-up, R's test, size and options set before: a grid of 10 x 10 cells of 1 mm
+ * from (-3, -3) mm (points' half-size lp 0.25 mm), n grains of radii r at xy in a packing cell of
+ * width `cell`, grain `fixed` prescribed at rest (as the driver's platen layers), one step for the
+ * contacts */
+static void grains_on_grid(run *R, gk_packing *pk, int n, const double (*xy)[2], const double *r, double cell,
+                           int fixed) {
+    static double lp = 0.00025;
+    double org[3] = {-0.003, -0.003, 0.0}, z[3] = {0.0, 0.0, 0.0};
+    int nn[3] = {11, 11, 1}, k;
+    gk_err e;
+    gk_scene_def d;
+    R->P.lp = &lp;
+    CHECK(gk_mpm_grid_create(&R->g, 2, org, 0.001, nn, NULL, &e) == GK_OK); /* nodes -3 .. 7 mm */
+    CHECK(gk_packing_init(pk, 2, n, NULL, &e) == GK_OK);
+    pk->h[0] = pk->h[4] = cell;
+    for (k = 0; k < n; ++k) {
+        pk->x[k] = xy[k][0];
+        pk->y[k] = xy[k][1];
+        pk->r[k] = r[k];
+    }
+    pk->n = n;
+    d = scene_def(R);
+    CHECK(gk_scene_create(&R->sc, &d, pk) == GK_OK);
+    CHECK(grow_grain_arrays(R, n) == 0);
+    CHECK(gk_scene_prescribe(&R->sc, gk_scene_index(&R->sc, fixed), z, z) == GK_OK);
+    CHECK(gk_scene_step(&R->sc, 1) == GK_OK);
+}
+
+/* frees what grains_on_grid and the tests made (free(NULL) where a test made less) */
 static void free_grid_state(run *R, gk_packing *pk) {
     gk_scene_destroy(&R->sc);
     gk_mpm_grid_destroy(&R->g);
@@ -141,29 +169,13 @@ static void free_grid_state(run *R, gk_packing *pk) {
 TEST(escaped_grains_are_removed_and_counted) {
     run R;
     gk_packing pk;
-    gk_err e;
-    gk_scene_def d;
-    double org[3] = {-0.003, -0.003, 0.0}, z[3] = {0.0, 0.0, 0.0}, lp = 0.00025;
-    int n[3] = {11, 11, 1}, k;
+    int k;
     const double xy[6][2] = {{0.001, 0.001},  {0.0035, 0.002},   {-0.0019, 0.002},
                              {0.0058, 0.002}, {-0.0022, 0.0035}, {-0.0022, 0.00405}};
+    const double r[6] = {0.0003, 0.0006, 0.0003, 0.0003, 0.0003, 0.0003};
     biaxial_state(&R, 0.006, 0.006); /* the scene's domain: -3 to 9 mm */
     R.o.quiet = 1;
-    R.P.lp = &lp;
-    CHECK(gk_mpm_grid_create(&R.g, 2, org, 0.001, n, NULL, &e) == GK_OK); /* nodes -3 .. 7 mm */
-    CHECK(gk_packing_init(&pk, 2, 6, NULL, &e) == GK_OK);
-    pk.h[0] = pk.h[4] = 0.01;
-    for (k = 0; k < 6; ++k) {
-        pk.x[k] = xy[k][0];
-        pk.y[k] = xy[k][1];
-        pk.r[k] = k == 1 ? 0.0006 : 0.0003;
-    }
-    pk.n = 6;
-    d = scene_def(&R);
-    CHECK(gk_scene_create(&R.sc, &d, &pk) == GK_OK);
-    CHECK(grow_grain_arrays(&R, 6) == 0);
-    CHECK(gk_scene_prescribe(&R.sc, gk_scene_index(&R.sc, 3), z, z) == GK_OK);
-    CHECK(gk_scene_step(&R.sc, 1) == GK_OK); /* the contacts: 4 with 5 */
+    grains_on_grid(&R, &pk, 6, xy, r, 0.01, 3); /* the contacts: 4 with 5 */
     CHECK(remove_escaped(&R) == 0);
     CHECK_EQ_INT(R.sc.rve.n, 5);
     CHECK_EQ_INT(R.lost, 1);
@@ -189,13 +201,11 @@ TEST(escaped_grains_are_removed_and_counted) {
 TEST(planar_strays_are_removed_and_counted) {
     run R;
     gk_packing pk;
-    gk_err e;
-    gk_scene_def d;
-    double org[3] = {-0.003, -0.003, 0.0}, z[3] = {0.0, 0.0, 0.0}, lp = 0.00025;
-    int n[3] = {11, 11, 1}, k;
+    int k;
     size_t I;
     const double xy[8][2] = {{0.001, 0.001},   {0.002, 0.003},  {0.003, 0.0045}, {0.004, 0.005},
                              {0.004, 0.00555}, {0.005, 0.0058}, {0.001, 0.0082}, {0.005, 0.002}};
+    const double r[8] = {0.0003, 0.0003, 0.0003, 0.0003, 0.0003, 0.0003, 0.0003, 0.0003};
     memset(&R, 0, sizeof R);
     defaults(&R.o, T_PLANAR);
     R.o.threads = 1;
@@ -203,28 +213,14 @@ TEST(planar_strays_are_removed_and_counted) {
     R.o.phi0 = 0.002;
     R.W = R.H = 0.006; /* the scene's domain: x periodic over 0 .. 6 mm, y -3 .. 9 mm */
     R.h = 0.001;
-    R.P.lp = &lp;
-    CHECK(gk_mpm_grid_create(&R.g, 2, org, 0.001, n, NULL, &e) == GK_OK); /* nodes -3 .. 7 mm */
+    grains_on_grid(&R, &pk, 8, xy, r, 0.006, 5); /* the contacts: 3 with 4 */
     R.dist = (double *)malloc(R.g.nnode * sizeof(double));
     R.nden = (double *)malloc(R.g.nnode * sizeof(double));
     CHECK(R.dist && R.nden);
     for (I = 0; I < R.g.nnode; ++I) {
-        R.dist[I] = fabs(org[1] + R.h * (double)(I / (size_t)n[0]));
+        R.dist[I] = fabs(R.g.origin[1] + R.h * (double)(I / (size_t)R.g.n[0]));
         R.nden[I] = 1.0;
     }
-    CHECK(gk_packing_init(&pk, 2, 8, NULL, &e) == GK_OK);
-    pk.h[0] = pk.h[4] = 0.006;
-    for (k = 0; k < 8; ++k) {
-        pk.x[k] = xy[k][0];
-        pk.y[k] = xy[k][1];
-        pk.r[k] = 0.0003;
-    }
-    pk.n = 8;
-    d = scene_def(&R);
-    CHECK(gk_scene_create(&R.sc, &d, &pk) == GK_OK);
-    CHECK(grow_grain_arrays(&R, 8) == 0);
-    CHECK(gk_scene_prescribe(&R.sc, gk_scene_index(&R.sc, 5), z, z) == GK_OK);
-    CHECK(gk_scene_step(&R.sc, 1) == GK_OK); /* the contacts: 3 with 4 */
     k = coupling_mask(&R);
     CHECK_EQ_INT(k, 4);
     CHECK(R.coupled[gk_scene_index(&R.sc, 7)]);
