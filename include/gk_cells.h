@@ -18,6 +18,12 @@
  * fixed-order force reduction and to carry contact history across rebuilds
  * by a linear merge.
  *
+ * HOW. The particles are copied in bin order once per call; the bins of a
+ * stencil row along axis 0 are then one or two runs of that copy, which each
+ * particle scans a SIMD block at a time with no branch per candidate. The
+ * pairs found bin by bin are put in (i, j) order by a counting sort on i and
+ * a short sort of each row.
+ *
  * POLYDISPERSITY. The bin size is set by the largest pair cutoff
  * (2 r_max + skin); per-pair cutoffs r_i + r_j + skin are tested exactly, so a
  * size ratio of 10 is correct (small particles share bins; it costs time,
@@ -55,8 +61,9 @@ typedef struct gk_cells {
     int32_t *bin_start;   /* nbins + 1: particles of bin b are order[bin_start[b] .. bin_start[b+1]) */
     int32_t *order;       /* particle indices sorted by bin, ascending inside a bin */
     int32_t *bin_of;      /* bin of each particle */
-    int32_t *buf;         /* scratch for one particle's candidates */
-    size_t cap_bins, cap_n, cap_buf;
+    int32_t *buf;         /* scratch: the pairs of gk_cells_pairs, bin by bin */
+    double *sorted;       /* scratch: coordinates, radius, index in bin order */
+    size_t cap_bins, cap_n, cap_buf, cap_sorted;
     gk_allocator alloc;
 } gk_cells;
 
@@ -126,7 +133,8 @@ GKDEF void gk_cells_init(gk_cells *c, const gk_allocator *alloc) {
     c->nbin[0] = c->nbin[1] = c->nbin[2] = 0;
     c->open = 0;
     c->bin_start = c->order = c->bin_of = c->buf = NULL;
-    c->cap_bins = c->cap_n = c->cap_buf = 0;
+    c->sorted = NULL;
+    c->cap_bins = c->cap_n = c->cap_buf = c->cap_sorted = 0;
     if (alloc)
         c->alloc = *alloc;
     else {
@@ -141,6 +149,7 @@ GKDEF void gk_cells_free(gk_cells *c) {
     gk_free(&c->alloc, c->order);
     gk_free(&c->alloc, c->bin_of);
     gk_free(&c->alloc, c->buf);
+    gk_free(&c->alloc, c->sorted);
     gk_cells_init(c, &c->alloc);
 }
 
@@ -300,11 +309,77 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
     return GK_OK;
 }
 
+/* the particles in bin order, as doubles (coordinates, radius, index), with
+ * GK_VD_W entries of padding: room for n */
+static gk_result gk__cells_sorted_grow(gk_cells *c, size_t n) {
+    size_t cap = c->cap_sorted ? c->cap_sorted : 64;
+    while (cap < n + GK_VD_W) cap *= 2;
+    if (cap == c->cap_sorted) return GK_OK;
+    gk_free(&c->alloc, c->sorted);
+    c->sorted = NULL;
+    c->cap_sorted = 0;
+    if (gk_realloc(&c->alloc, (void **)&c->sorted, 0, 5 * cap, sizeof(double))) return GK_ERR_ALLOC;
+    c->cap_sorted = cap;
+    return GK_OK;
+}
+
+/* particle p (P: its coordinates, radius, the skin and p, broadcast)
+ * against the sorted entries [f0, f1): the pairs (p, q) with q > p within
+ * r_p + r_q + skin go to buf (which has room for f1 - f0 + GK_VD_W more),
+ * GK_VD_W entries at a time. The arithmetic of gk_pcell_image, lane by lane:
+ * every SIMD width keeps the same pairs. */
+GK_FORCE_INLINE int gk__cells_scan(const gk_cells *c, const gk_vd P[6], const gk_vd H[9], int p, int f0,
+                                   int f1, int np, const int dim) {
+    const size_t cap = c->cap_sorted;
+    const double *cx = c->sorted, *cy = cx + cap, *cz = cx + 2 * cap, *cr = cx + 3 * cap, *cq = cx + 4 * cap;
+    const gk_vd end = gk_vd_set1((double)f1);
+    int32_t *buf = c->buf;
+    gk_vd lane;
+    int f, l;
+    {
+        double io[GK_VD_W];
+        for (l = 0; l < GK_VD_W; ++l) io[l] = (double)(f0 + l);
+        lane = gk_vd_loadu(io);
+    }
+    for (f = f0; f < f1; f += GK_VD_W, lane = gk_vd_add(lane, gk_vd_set1((double)GK_VD_W))) {
+        gk_vd a = gk_vd_sub(gk_vd_loadu(cx + f), P[0]), b = gk_vd_sub(gk_vd_loadu(cy + f), P[1]), d2, q;
+        const gk_vd cut = gk_vd_add(gk_vd_add(P[3], gk_vd_loadu(cr + f)), P[4]);
+        unsigned bits;
+        a = gk_vd_sub(a, gk_vd_round(a));
+        b = gk_vd_sub(b, gk_vd_round(b));
+        if (dim == 2) {
+            gk_vd dx = gk_vd_add(gk_vd_mul(H[0], a), gk_vd_mul(H[1], b));
+            gk_vd dy = gk_vd_add(gk_vd_mul(H[3], a), gk_vd_mul(H[4], b));
+            d2 = gk_vd_add(gk_vd_mul(dx, dx), gk_vd_mul(dy, dy));
+        } else {
+            gk_vd e = gk_vd_sub(gk_vd_loadu(cz + f), P[2]), dx, dy, dz;
+            e = gk_vd_sub(e, gk_vd_round(e));
+            dx = gk_vd_add(gk_vd_add(gk_vd_mul(H[0], a), gk_vd_mul(H[1], b)), gk_vd_mul(H[2], e));
+            dy = gk_vd_add(gk_vd_add(gk_vd_mul(H[3], a), gk_vd_mul(H[4], b)), gk_vd_mul(H[5], e));
+            dz = gk_vd_add(gk_vd_add(gk_vd_mul(H[6], a), gk_vd_mul(H[7], b)), gk_vd_mul(H[8], e));
+            d2 = gk_vd_add(gk_vd_add(gk_vd_mul(dx, dx), gk_vd_mul(dy, dy)), gk_vd_mul(dz, dz));
+        }
+        q = gk_vd_loadu(cq + f);
+        bits = gk_vdm_bits(gk_vdm_and(gk_vdm_and(gk_vd_lt(d2, gk_vd_mul(cut, cut)), gk_vd_gt(q, P[5])),
+                                      gk_vd_lt(lane, end)));
+        if (!bits) continue;
+        for (l = 0; l < GK_VD_W; ++l) { /* written always, kept where the bit is set */
+            buf[2 * np] = p;
+            buf[2 * np + 1] = (int32_t)cq[f + l];
+            np += (int)(bits >> l & 1u);
+        }
+    }
+    return np;
+}
+
 GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *const s[3], const gk_real *r,
                                double skin, gk_pairlist *out, gk_err *err) {
-    int off[3][3], noff[3], k, p, dim = c->dim, n = c->n;
+    int off[3][3], noff[3], k, p, q, e, dim = c->dim, n = c->n, bx, by, bz, np = 0;
+    gk_vd H[9];
     if (gk_pairlist_reserve(out, out->cap ? out->cap : (size_t)4 * n + 16, (size_t)n))
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the pair list");
+    out->n = 0;
+    out->np = n;
     for (k = 0; k < 3; ++k) {
         int nb = c->nbin[k];
         if (k >= dim || nb == 1) {
@@ -321,69 +396,115 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
             off[k][2] = 1;
         }
     }
-    if (gk__cells_grow(c, &c->buf, &c->cap_buf, 256))
+    if (gk__cells_grow(c, &c->buf, &c->cap_buf, 2 * out->cap) || gk__cells_sorted_grow(c, (size_t)n))
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the pair buffer");
-    out->n = 0;
-    out->np = n;
-    for (p = 0; p < n; ++p) {
-        int b = c->bin_of[p];
-        int bx = b % c->nbin[0], by = (b / c->nbin[0]) % c->nbin[1], bz = b / (c->nbin[0] * c->nbin[1]);
-        int a0, a1, a2, cnt = 0, q;
-        double spx = s[0][p], spy = s[1][p], spz = dim == 3 ? s[2][p] : 0.0;
-        double rp = (double)r[p];
-        out->start[p] = out->n;
-        for (a2 = 0; a2 < noff[2]; ++a2)
-            for (a1 = 0; a1 < noff[1]; ++a1)
-                for (a0 = 0; a0 < noff[0]; ++a0) {
-                    int cx = (bx + off[0][a0] + c->nbin[0]) % c->nbin[0];
-                    int cy = (by + off[1][a1] + c->nbin[1]) % c->nbin[1];
-                    int cz = (bz + off[2][a2] + c->nbin[2]) % c->nbin[2];
-                    int nb = cx + c->nbin[0] * (cy + c->nbin[1] * cz), e;
-                    if (c->open && (((c->open & 1u) && cx != bx + off[0][a0]) ||
-                                    ((c->open & 2u) && cy != by + off[1][a1]) ||
-                                    ((c->open & 4u) && cz != bz + off[2][a2])))
-                        continue; /* no wrap across an open axis */
-                    for (e = c->bin_start[nb]; e < c->bin_start[nb + 1]; ++e) {
-                        int q2 = c->order[e];
-                        double ds[3], d[3], cut;
-                        if (q2 <= p) continue;
-                        ds[0] = s[0][q2] - spx;
-                        ds[1] = s[1][q2] - spy;
-                        ds[2] = dim == 3 ? s[2][q2] - spz : 0.0;
-                        gk_pcell_image(h, dim, ds, d);
-                        cut = rp + (double)r[q2] + skin;
-                        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut) {
-                            if ((size_t)cnt >= c->cap_buf &&
-                                gk__cells_grow(c, &c->buf, &c->cap_buf, c->cap_buf * 2))
-                                return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the pair buffer");
-                            c->buf[cnt++] = q2;
-                        }
-                    }
-                }
-        /* insertion sort: lists are short (a few to a few tens) */
-        for (q = 1; q < cnt; ++q) {
-            int32_t v = c->buf[q];
-            int t = q - 1;
-            while (t >= 0 && c->buf[t] > v) {
-                c->buf[t + 1] = c->buf[t];
-                --t;
-            }
-            c->buf[t + 1] = v;
+    { /* the particles in bin order; the padding is never kept (index -1) */
+        const size_t cap = c->cap_sorted;
+        double *x = c->sorted;
+        for (e = 0; e < n; ++e) {
+            int o = c->order[e];
+            x[e] = s[0][o];
+            x[cap + e] = s[1][o];
+            x[2 * cap + e] = dim == 3 ? s[2][o] : 0.0;
+            x[3 * cap + e] = (double)r[o];
+            x[4 * cap + e] = (double)o;
         }
-        if (cnt > INT32_MAX - out->n)
-            return gk_err_set(err, GK_ERR_ALLOC, "more than %ld candidate pairs", (long)INT32_MAX);
-        if ((size_t)(out->n + cnt) > out->cap) {
-            size_t want = out->cap * 2 > (size_t)(out->n + cnt) ? out->cap * 2 : (size_t)(out->n + cnt);
-            if (gk_pairlist_reserve(out, want, (size_t)n))
-                return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d pairs", out->n + cnt);
-        }
-        for (q = 0; q < cnt; ++q) {
-            out->i[out->n] = p;
-            out->j[out->n] = c->buf[q];
-            ++out->n;
+        for (e = n; e < n + GK_VD_W; ++e) {
+            for (k = 0; k < 4; ++k) x[k * cap + e] = 0.0;
+            x[4 * cap + e] = -1.0;
         }
     }
-    out->start[n] = out->n;
+    for (k = 0; k < 9; ++k) H[k] = gk_vd_set1(h[k]);
+    /* pass 1, bin by bin. The neighbour bins of a row along axis 0 are
+     * consecutive in bin order, so their particles are one or two runs of the
+     * sorted entries (two where the row wraps): each particle of the bin is
+     * tested against those runs without a branch; the pairs (p, q), q > p,
+     * into buf (two ints each) */
+    for (bx = 0; bx < c->nbin[0]; ++bx) {
+        int xs[3][2], nxs = 0, a0, a1, a2;
+        for (a0 = 0; a0 < noff[0]; ++a0) { /* the x bins of the stencil as runs [lo, hi] */
+            int u = bx + off[0][a0], w = u < 0 ? u + c->nbin[0] : (u >= c->nbin[0] ? u - c->nbin[0] : u);
+            if ((c->open & 1u) && w != u) continue; /* no wrap across an open axis */
+            if (nxs > 0 && xs[nxs - 1][1] + 1 == w)
+                xs[nxs - 1][1] = w;
+            else {
+                xs[nxs][0] = xs[nxs][1] = w;
+                ++nxs;
+            }
+        }
+        for (bz = 0; bz < c->nbin[2]; ++bz)
+            for (by = 0; by < c->nbin[1]; ++by) {
+                int run[18][2], nrun = 0, t, b = bx + c->nbin[0] * (by + c->nbin[1] * bz);
+                size_t total = 0;
+                if (c->bin_start[b] == c->bin_start[b + 1]) continue;
+                for (a2 = 0; a2 < noff[2]; ++a2)
+                    for (a1 = 0; a1 < noff[1]; ++a1) {
+                        int u1 = by + off[1][a1], u2 = bz + off[2][a2], w1, w2, row;
+                        w1 = u1 < 0 ? u1 + c->nbin[1] : (u1 >= c->nbin[1] ? u1 - c->nbin[1] : u1);
+                        w2 = u2 < 0 ? u2 + c->nbin[2] : (u2 >= c->nbin[2] ? u2 - c->nbin[2] : u2);
+                        if (((c->open & 2u) && w1 != u1) || ((c->open & 4u) && w2 != u2)) continue;
+                        row = c->nbin[0] * (w1 + c->nbin[1] * w2);
+                        for (t = 0; t < nxs; ++t) {
+                            int f0 = c->bin_start[row + xs[t][0]], f1 = c->bin_start[row + xs[t][1] + 1];
+                            if (f0 == f1) continue;
+                            run[nrun][0] = f0;
+                            run[nrun][1] = f1;
+                            total += (size_t)(f1 - f0);
+                            ++nrun;
+                        }
+                    }
+                for (e = c->bin_start[b]; e < c->bin_start[b + 1]; ++e) {
+                    const size_t cap = c->cap_sorted;
+                    gk_vd P[6];
+                    int pp = c->order[e];
+                    /* room for every write of this particle: its candidates plus a block per run */
+                    size_t room = total + (size_t)nrun * GK_VD_W;
+                    if ((size_t)np + room > c->cap_buf / 2) {
+                        size_t want = 4 * ((size_t)np + room); /* ints: twice the pairs needed */
+                        if (room > (size_t)(INT32_MAX / 2 - np))
+                            return gk_err_set(err, GK_ERR_ALLOC, "more than %ld candidate pairs",
+                                              (long)(INT32_MAX / 2));
+                        if (gk_realloc(&c->alloc, (void **)&c->buf, 2 * (size_t)np, want, sizeof(int32_t)))
+                            return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the pair buffer");
+                        c->cap_buf = want;
+                    }
+                    for (k = 0; k < 4; ++k) P[k] = gk_vd_set1(c->sorted[k * cap + (size_t)e]);
+                    P[4] = gk_vd_set1(skin);
+                    P[5] = gk_vd_set1((double)pp);
+                    for (t = 0; t < nrun; ++t)
+                        np = dim == 2 ? gk__cells_scan(c, P, H, pp, run[t][0], run[t][1], np, 2)
+                                      : gk__cells_scan(c, P, H, pp, run[t][0], run[t][1], np, 3);
+                }
+            }
+    }
+    /* pass 2: by a counting sort on p into rows, each row then sorted by q
+     * (rows are short: a few to a few tens) */
+    if ((size_t)np > out->cap && gk_pairlist_reserve(out, (size_t)np, (size_t)n))
+        return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d pairs", np);
+    for (p = 0; p <= n; ++p) out->start[p] = 0;
+    for (q = 0; q < np; ++q) ++out->start[c->buf[2 * q] + 1];
+    for (p = 0; p < n; ++p) out->start[p + 1] += out->start[p];
+    for (q = 0; q < np; ++q) {
+        int32_t pp = c->buf[2 * q], at = out->start[pp]++;
+        out->i[at] = pp;
+        out->j[at] = c->buf[2 * q + 1];
+    }
+    for (p = n; p > 0; --p) out->start[p] = out->start[p - 1];
+    out->start[0] = 0;
+    for (p = 0; p < n; ++p) {
+        int32_t *row = out->j + out->start[p];
+        int cnt = out->start[p + 1] - out->start[p];
+        for (q = 1; q < cnt; ++q) {
+            int32_t v = row[q];
+            int t = q - 1;
+            while (t >= 0 && row[t] > v) {
+                row[t + 1] = row[t];
+                --t;
+            }
+            row[t + 1] = v;
+        }
+    }
+    out->n = np;
     return GK_OK;
 }
 

@@ -154,6 +154,58 @@ TEST(cells_monodisperse_dense) {
     compare_with_brute(&ps, ps.h, K, 0.02);
 }
 
+/* Open axes (no wrap; particles kept within half the cell along them, see
+ * OPEN AXES in gk_cells.h) and coarse grids (1 to 3 bins along an axis, where
+ * the stencil's bins coincide or wrap onto each other; the bin-count cap for
+ * few particles in 3D): the pairs equal an O(N^2) search over the periodic
+ * axes' images only, in (i, j) order. */
+TEST(cells_open_axes_and_coarse_grids_match_brute_force) {
+    static pset ps;
+    static int bi[MAXN * MAXN / 2], bj[MAXN * MAXN / 2];
+    const double skins[5] = {0.01, 0.06, 0.1, 0.15, 0.3};
+    const int counts[2] = {30, 300};
+    int dim, mask, si, ni, two_open = 0;
+    for (dim = 2; dim <= 3; ++dim)
+        for (mask = 0; mask < (1 << dim); ++mask)
+            for (si = 0; si < 5; ++si)
+                for (ni = 0; ni < 2; ++ni) {
+                    gk_cells cl;
+                    gk_pairlist pl;
+                    gk_err e;
+                    const double *sp[3];
+                    double rmax = 0.0;
+                    int K[3], k, p, c, nb;
+                    make_set(&ps, dim, counts[ni], 4.0,
+                             (uint64_t)(1000 + 100 * dim + 10 * mask + 3 * si + ni));
+                    for (k = 0; k < 3; ++k) {
+                        K[k] = k < dim && !(mask & (1 << k)) ? 2 : 0;
+                        if (mask & (1 << k))
+                            for (p = 0; p < ps.n; ++p) ps.s[k][p] = 0.05 + 0.4 * ps.s[k][p];
+                        sp[k] = ps.s[k];
+                    }
+                    for (p = 0; p < ps.n; ++p)
+                        if (ps.r[p] > rmax) rmax = ps.r[p];
+                    gk_cells_init(&cl, NULL);
+                    gk_pairlist_init(&pl, NULL);
+                    cl.open = (unsigned)mask;
+                    CHECK(gk_cells_bin(&cl, dim, ps.h, ps.n, sp, 2 * rmax + skins[si], &e) == GK_OK);
+                    for (k = 0; k < dim; ++k) two_open |= (mask & (1 << k)) && cl.nbin[k] == 2;
+                    CHECK(gk_cells_pairs(&cl, ps.h, sp, ps.r, skins[si], &pl, &e) == GK_OK);
+                    nb = brute_pairs(&ps, ps.h, K, skins[si], bi, bj, MAXN * MAXN / 2);
+                    CHECK_EQ_INT(pl.n, nb);
+                    for (c = 0; c < pl.n && c < nb; ++c)
+                        if (pl.i[c] != bi[c] || pl.j[c] != bj[c]) {
+                            CHECK(pl.i[c] == bi[c] && pl.j[c] == bj[c]);
+                            break;
+                        }
+                    for (p = 0; p < ps.n; ++p)
+                        for (c = pl.start[p]; c < pl.start[p + 1]; ++c) CHECK_EQ_INT(pl.i[c], p);
+                    gk_cells_free(&cl);
+                    gk_pairlist_free(&pl);
+                }
+    CHECK(two_open); /* the coarsest open grid was reached (its -1 and +1 bins must not wrap) */
+}
+
 /* a cell thinner than twice the interaction distance is refused, not miscounted */
 TEST(cells_refuse_ambiguous_nearest_image) {
     gk_cells cl;
@@ -376,6 +428,7 @@ int main(int argc, char **argv) {
     RUN(cells_match_brute_force_2d_sheared);
     RUN(cells_match_brute_force_3d_sheared_and_rotated);
     RUN(cells_monodisperse_dense);
+    RUN(cells_open_axes_and_coarse_grids_match_brute_force);
     RUN(cells_refuse_ambiguous_nearest_image);
     RUN(remap_preserves_pair_distances);
     RUN(verlet_skin_criterion_is_safe);
