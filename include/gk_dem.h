@@ -974,18 +974,17 @@ GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const 
     const double *h = rve->cell.h, skin = rve->skin_in;
     const int32_t *oi = rve->outer.i, *oj = rve->outer.j;
     const gk_real *r = rve->r;
-    int c, k, no = rve->outer.n;
-    for (c = 0; c < no; ++c) {
+    int c, k, no = rve->outer.n, m = nl->n;
+    for (c = 0; c < no; ++c) { /* written always, kept inside the cutoff: no branch */
         int i = oi[c], j = oj[c];
         double ds[3], d[3], cut = (double)r[i] + (double)r[j] + skin;
         for (k = 0; k < dim; ++k) ds[k] = rve->s[k][j] - rve->s[k][i];
         gk_pcell_image(h, dim, ds, d);
-        if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut) {
-            nl->i[nl->n] = i;
-            nl->j[nl->n] = j;
-            ++nl->n;
-        }
+        nl->i[m] = i;
+        nl->j[m] = j;
+        m += d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut;
     }
+    nl->n = m;
 }
 
 /* rebuild the pair list at the current positions, carrying history over by merge */
@@ -1052,13 +1051,20 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
      * is the scratch, rebuilt below) */
     {
         int32_t *map = rve->jlist;
-        oc = 0;
-        for (c = 0; c < nl.n; ++c) {
-            int32_t ni = nl.i[c], nj = nl.j[c];
-            while (oc < rve->pl.n && (rve->pl.i[oc] < ni || (rve->pl.i[oc] == ni && rve->pl.j[oc] < nj)))
-                ++oc;
-            map[c] = oc < rve->pl.n && rve->pl.i[oc] == ni && rve->pl.j[oc] == nj ? oc : -1;
+        const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
+        int no = rve->pl.n;
+        /* a merge join on the key (i, j) with no data-dependent branch: each
+         * round advances the side(s) with the smaller key; map[c] is written
+         * every round, the last write for c being the one where c advanced */
+        c = oc = 0;
+        while (c < nl.n && oc < no) {
+            uint64_t kn = (uint64_t)(uint32_t)nl.i[c] << 32 | (uint32_t)nl.j[c],
+                     ko = (uint64_t)(uint32_t)pi[oc] << 32 | (uint32_t)pj[oc];
+            map[c] = kn == ko ? oc : -1;
+            c += kn <= ko;
+            oc += ko <= kn;
         }
+        for (; c < nl.n; ++c) map[c] = -1;
         gk__pairs_gather(rve, map, nl.n);
     }
     /* swap the spare set in */
