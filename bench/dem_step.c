@@ -5,6 +5,10 @@
  *   build/bench_dem_step --case NAME [--threads T] [--steps S] [--law linear|hertz]
  *                        [--real double|float] [--scalar] [--repeats R]
  *                        [--packing FILE] [--write-packing FILE]
+ *   build/bench_dem_step --case NAME --lists [--repeats R]
+ *                                             contact detection alone: one outer-list build (cell
+ *                                             binning + candidate pairs within the skin) of the
+ *                                             case's starting packing, median of R batches [us]
  *
  * Cases: rve400 (the Guo & Zhao 2014 400-disk RVE, its own material, simple shear at
  * 1e-5 per step), 2d_10k and 2d_100k (bench/data/bench2d_10k.txt, tiled 5x2),
@@ -52,11 +56,12 @@ static void usage(FILE *fp) {
     fprintf(fp, "usage: bench_dem_step [--case rve400|2d_10k|2d_100k|3d_1k|3d_10k|3d_100k] [--threads T]\n"
                 "                      [--steps S] [--law linear|hertz] [--real double|float] [--scalar]\n"
                 "                      [--repeats R] [--packing FILE] [--write-packing FILE]\n"
-                "                      [--physics norot,frictionless,rolling,viscous,cohesion]\n"
+                "                      [--physics norot,frictionless,rolling,viscous,cohesion] [--lists]\n"
                 "       bench_dem_step --float-error   q/p along the rve_path shear, float vs double\n"
                 "with no --case, runs the whole suite (1 and 2 threads, both laws, double and float,\n"
                 "SIMD and scalar) and prints a table, then the cost of each physics switch on rve400\n"
-                "and the float-error report.\n");
+                "and the float-error report. --lists times the case's cell-list build (bin and\n"
+                "candidate pairs) instead of time steps.\n");
 }
 
 static int run_one(const bench_case *c, int use_float, int quiet_header) {
@@ -66,6 +71,14 @@ static int run_one(const bench_case *c, int use_float, int quiet_header) {
     if (rc) {
         fprintf(stderr, "bench_dem_step: %s: %s\n", c->name, o.err);
         return rc;
+    }
+    if (c->lists) {
+        printf("%-8s %dD %7d  %-6s %-6s %12.1f %9d\n", c->name, o.dim, o.n, o.real, o.simd, o.list_build_us,
+               o.list_pairs);
+        printf("BENCH case=%s dim=%d n=%d real=%s simd=%s list_build_us=%.4g list_pairs=%d\n", c->name, o.dim,
+               o.n, o.real, o.simd, o.list_build_us, o.list_pairs);
+        fflush(stdout);
+        return 0;
     }
     printf("%-8s %dD %7d  %2d  %-6s %-6s %-6s %8.2f %9.2f %6.2f %6.2f %s\n", c->name, o.dim, o.n, c->threads,
            c->hertz ? "hertz" : "linear", o.real, o.simd, o.particle_steps_per_s / 1e6,
@@ -85,6 +98,10 @@ static int run_one(const bench_case *c, int use_float, int quiet_header) {
 static void header(void) {
     printf("%-8s %2s %7s  %2s  %-6s %-6s %-6s %8s %9s %6s %6s\n", "case", "", "n", "th", "law", "real",
            "simd", "Mpart/s", "Mcont/s", "Z", "pairs");
+}
+
+static void header_lists(void) {
+    printf("%-8s %2s %7s  %-6s %-6s %12s %9s\n", "case", "", "n", "real", "simd", "us/build", "pairs");
 }
 
 /* float against double along the Guo & Zhao RVE shear path: what float costs in accuracy */
@@ -125,6 +142,7 @@ int main(int argc, char **argv) {
         {"--packing", CLI_STR, &c.packing, 0, 0, NULL, NULL, 0},
         {"--write-packing", CLI_STR, &c.write_packing, 0, 0, NULL, NULL, 0},
         {"--physics", CLI_STR, &c.physics, 0, 0, NULL, NULL, 0},
+        {"--lists", CLI_FLAG, &c.lists, 0, 0, NULL, NULL, 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     const cli_opt *tables[2];
     memset(&c, 0, sizeof c);
@@ -139,7 +157,10 @@ int main(int argc, char **argv) {
     c.steps = steps, c.hertz = hertz;
     if (ci >= 0) {
         c.name = cases[ci];
-        header();
+        if (c.lists)
+            header_lists();
+        else
+            header();
         return run_one(&c, use_float, 0);
     }
     if (float_error) return float_error_report();
@@ -183,6 +204,18 @@ int main(int argc, char **argv) {
                 b.physics = phys[k].name;
                 if (run_one(&b, 0, 1)) rc = 1;
             }
+    }
+    { /* contact detection alone: one outer-list build (cell binning + candidate pairs) */
+        static const char *const lc[] = {"rve400", "2d_10k", "3d_10k"};
+        int k;
+        printf("\ncell-list build (bin + candidate pairs within the skin) of each packing, double:\n");
+        header_lists();
+        for (k = 0; k < 3; ++k) {
+            bench_case b = c;
+            b.name = lc[k];
+            b.lists = 1;
+            if (run_one(&b, 0, 1)) rc = 1;
+        }
     }
     printf("\n");
     fflush(stdout);

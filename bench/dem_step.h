@@ -11,6 +11,7 @@ typedef struct bench_case {
     int threads, hertz, scalar, repeats;
     const char *physics; /* comma list: norot, frictionless, rolling, viscous, cohesion */
     long steps;          /* timed steps per repeat; 0: case default          */
+    int lists;           /* time the cell-list build instead of steps        */
 } bench_case;
 
 typedef struct bench_out {
@@ -21,7 +22,9 @@ typedef struct bench_out {
     double contacts_per_particle;
     double pairs_per_particle;
     double seconds_min, seconds_median;
-    double sigma[9]; /* final Love stress (tension +) */
+    double list_build_us; /* lists: median time of one outer-list build [us] */
+    int list_pairs;       /* lists: candidate pairs it found                 */
+    double sigma[9];      /* final Love stress (tension +) */
     char simd[16], real[8], err[256];
 } bench_out;
 
