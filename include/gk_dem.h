@@ -667,13 +667,45 @@ static void gk__gather_by(void *dst, const void *src, const int32_t *map, int n,
 }
 
 /* every per-pair array carried by pair (GK__SPARE) into its spare twin:
- * pair c of the new list takes old pair map[c], or zero */
+ * pair c of the new list takes old pair map[c], or zero. A rebuild keeps
+ * most pairs in order, so map is mostly long runs map[c + 1] = map[c] + 1:
+ * up to GK_DEM_GATHER_RUNS of them are copied as blocks (the same bits),
+ * more go element by element (tests set it low to take both ways). */
+#ifndef GK_DEM_GATHER_RUNS
+#define GK_DEM_GATHER_RUNS 256
+#endif
 static void gk__pairs_gather(gk_rve *rve, const int32_t *map, int n) {
-    int q;
+    int32_t at[GK_DEM_GATHER_RUNS], from[GK_DEM_GATHER_RUNS], len[GK_DEM_GATHER_RUNS];
+    int q, c, nr = 0;
+    for (c = 0; c < n && nr < GK_DEM_GATHER_RUNS; ++nr) { /* runs: new [at, at + len) from old [from, ...) or zeros */
+        int e = c + 1;
+        if (map[c] < 0)
+            while (e < n && map[e] < 0) ++e;
+        else
+            while (e < n && map[e] == map[e - 1] + 1) ++e;
+        at[nr] = c;
+        from[nr] = map[c] < 0 ? -1 : map[c];
+        len[nr] = e - c;
+        c = e;
+    }
     for (q = 0; q < GK__NFIELDS; ++q) {
         const gk__field *f = &gk__fields[q];
+        unsigned char *d, *s;
+        int r;
         if (!(f->flags & GK__SPARE) || !gk__field_on(rve, f)) continue;
-        gk__gather_by(gk__fget(rve, f->spare), gk__fget(rve, f->off), map, n, f->size);
+        d = (unsigned char *)gk__fget(rve, f->spare);
+        s = (unsigned char *)gk__fget(rve, f->off);
+        if (c < n) { /* too many runs */
+            gk__gather_by(d, s, map, n, f->size);
+            continue;
+        }
+        for (r = 0; r < nr; ++r) {
+            size_t z = f->size;
+            if (from[r] < 0)
+                memset(d + z * (size_t)at[r], 0, z * (size_t)len[r]);
+            else
+                memcpy(d + z * (size_t)at[r], s + z * (size_t)from[r], z * (size_t)len[r]);
+        }
     }
 }
 
