@@ -677,7 +677,8 @@ static void gk__gather_by(void *dst, const void *src, const int32_t *map, int n,
 static void gk__pairs_gather(gk_rve *rve, const int32_t *map, int n) {
     int32_t at[GK_DEM_GATHER_RUNS], from[GK_DEM_GATHER_RUNS], len[GK_DEM_GATHER_RUNS];
     int q, c, nr = 0;
-    for (c = 0; c < n && nr < GK_DEM_GATHER_RUNS; ++nr) { /* runs: new [at, at + len) from old [from, ...) or zeros */
+    /* the runs: new pairs [at, at + len) from old [from, from + len), or zeros */
+    for (c = 0; c < n && nr < GK_DEM_GATHER_RUNS; ++nr) {
         int e = c + 1;
         if (map[c] < 0)
             while (e < n && map[e] < 0) ++e;
