@@ -65,13 +65,21 @@ static int cmp_double(const void *a, const void *b) {
     return x < y ? -1 : x > y;
 }
 
+/* median of n values (sorts them) */
+static double median(double *v, int n) {
+    qsort(v, (size_t)n, sizeof v[0], cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 int BENCH_RUN(const bench_case *bc, bench_out *o) {
     gk_packing base, pk;
     gk_err e;
     gk_rve rve;
     gk_rve_def def = gk_rve_def_default();
     const char *path = bc->packing;
-    int tx = 1, ty = 1, tz = 1, rve400 = !strcmp(bc->name, "rve400"), dim_want, r, nrep;
+    int tx = 1, ty = 1, tz = 1, rve400 = !strcmp(bc->name, "rve400"), dim_want, r;
+    /* repeats (batches of list builds with --lists) */
+    int nrep = bc->repeats > 0 ? (bc->repeats > 64 ? 64 : bc->repeats) : bc->lists ? 5 : 3;
     double L[9], secs[64], rate;
     long steps = bc->steps;
     memset(o, 0, sizeof *o);
@@ -180,12 +188,12 @@ int BENCH_RUN(const bench_case *bc, bench_out *o) {
         gk_cells cl;
         gk_pairlist pl;
         const double *sp[3];
-        int k, b, nb = bc->repeats > 0 ? (bc->repeats > 64 ? 64 : bc->repeats) : 5;
+        int k, b;
         long reps = rve.n <= 1000 ? 2000 : rve.n <= 20000 ? 20 : 4, q;
         gk_cells_init(&cl, NULL);
         gk_pairlist_init(&pl, NULL);
         for (k = 0; k < 3; ++k) sp[k] = rve.s[k < rve.dim ? k : 0];
-        for (b = 0; b <= nb; ++b) { /* batch 0 warms up */
+        for (b = 0; b <= nrep; ++b) { /* batch 0 warms up */
             double t0 = gk_wtime();
             for (q = 0; q < reps; ++q)
                 if (gk_cells_bin(&cl, rve.dim, rve.cell.h, rve.n, sp, 2.0 * rve.rmax + rve.skin, &e) ||
@@ -195,10 +203,9 @@ int BENCH_RUN(const bench_case *bc, bench_out *o) {
                 }
             if (b > 0) secs[b - 1] = (gk_wtime() - t0) / (double)reps;
         }
-        qsort(secs, (size_t)nb, sizeof secs[0], cmp_double);
         o->dim = rve.dim;
         o->n = rve.n;
-        o->list_build_us = 1e6 * (nb % 2 ? secs[nb / 2] : 0.5 * (secs[nb / 2 - 1] + secs[nb / 2]));
+        o->list_build_us = 1e6 * median(secs, nrep);
         o->list_pairs = pl.n;
         gk_cells_free(&cl);
         gk_pairlist_free(&pl);
@@ -215,7 +222,6 @@ int BENCH_RUN(const bench_case *bc, bench_out *o) {
         snprintf(o->err, sizeof o->err, "%s", gk_rve_error(&rve));
         return 1;
     }
-    nrep = bc->repeats > 0 ? (bc->repeats > 64 ? 64 : bc->repeats) : 3;
     for (r = 0; r < nrep; ++r) {
         double t0 = gk_wtime();
         if (gk_rve_step(&rve, steps)) {
@@ -224,12 +230,11 @@ int BENCH_RUN(const bench_case *bc, bench_out *o) {
         }
         secs[r] = gk_wtime() - t0;
     }
-    qsort(secs, (size_t)nrep, sizeof secs[0], cmp_double);
     o->dim = rve.dim;
     o->n = rve.n;
     o->steps = steps;
+    o->seconds_median = median(secs, nrep); /* sorts secs */
     o->seconds_min = secs[0];
-    o->seconds_median = nrep % 2 ? secs[nrep / 2] : 0.5 * (secs[nrep / 2 - 1] + secs[nrep / 2]);
     o->particle_steps_per_s = (double)rve.n * steps / o->seconds_median;
     o->contacts_per_particle = (double)rve.ncontacts / rve.n;
     o->pairs_per_particle = (double)rve.pl.n / rve.n;

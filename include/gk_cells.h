@@ -309,6 +309,9 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
     return GK_OK;
 }
 
+/* a stencil bin index u in [-1, nb] wrapped into [0, nb) */
+GK_INLINE int gk__cells_wrap(int u, int nb) { return u < 0 ? u + nb : (u >= nb ? u - nb : u); }
+
 /* the particles in bin order, as doubles (coordinates, radius, index), with
  * GK_VD_W entries of padding: room for n */
 static gk_result gk__cells_sorted_grow(gk_cells *c, size_t n) {
@@ -423,7 +426,7 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
     for (bx = 0; bx < c->nbin[0]; ++bx) {
         int xs[3][2], nxs = 0, a0, a1, a2;
         for (a0 = 0; a0 < noff[0]; ++a0) { /* the x bins of the stencil as runs [lo, hi] */
-            int u = bx + off[0][a0], w = u < 0 ? u + c->nbin[0] : (u >= c->nbin[0] ? u - c->nbin[0] : u);
+            int u = bx + off[0][a0], w = gk__cells_wrap(u, c->nbin[0]);
             if ((c->open & 1u) && w != u) continue; /* no wrap across an open axis */
             if (nxs > 0 && xs[nxs - 1][1] + 1 == w)
                 xs[nxs - 1][1] = w;
@@ -440,8 +443,8 @@ GKDEF gk_result gk_cells_pairs(gk_cells *c, const double h[9], const double *con
                 for (a2 = 0; a2 < noff[2]; ++a2)
                     for (a1 = 0; a1 < noff[1]; ++a1) {
                         int u1 = by + off[1][a1], u2 = bz + off[2][a2], w1, w2, row;
-                        w1 = u1 < 0 ? u1 + c->nbin[1] : (u1 >= c->nbin[1] ? u1 - c->nbin[1] : u1);
-                        w2 = u2 < 0 ? u2 + c->nbin[2] : (u2 >= c->nbin[2] ? u2 - c->nbin[2] : u2);
+                        w1 = gk__cells_wrap(u1, c->nbin[1]);
+                        w2 = gk__cells_wrap(u2, c->nbin[2]);
                         if (((c->open & 2u) && w1 != u1) || ((c->open & 4u) && w2 != u2)) continue;
                         row = c->nbin[0] * (w1 + c->nbin[1] * w2);
                         for (t = 0; t < nxs; ++t) {
