@@ -97,11 +97,13 @@
 #define GK_UNUSED __attribute__((unused))
 #define GK_LIKELY(x) __builtin_expect(!!(x), 1)
 #define GK_UNLIKELY(x) __builtin_expect(!!(x), 0)
+#define GK_PREFETCH(p) __builtin_prefetch(p)
 #else
 #define GK_FORCE_INLINE static inline
 #define GK_UNUSED
 #define GK_LIKELY(x) (x)
 #define GK_UNLIKELY(x) (x)
+#define GK_PREFETCH(p) ((void)(p))
 #endif
 
 #ifdef __cplusplus
