@@ -170,6 +170,10 @@ typedef struct gk_hybrid_cont {
     unsigned char *zone; /* GK_ZONE_* (after enrichment; CONTINUUM before)         */
     gk_mpm_dp dp;        /* the Drucker-Prager continuum [eqs 4-8], chi > 0        */
     double gdot_max;     /* largest sqrt(2 D':D') of the last update [1/s]         */
+    /* eq 7's eta, etabar, zeta per point, kept while its Phi (and dp) stay:
+     * 4 per point, the Phi they were made at first (not yet made: NaN) */
+    double *dpk;
+    gk_mpm_dp dpk_of; /* the dp they were made with */
     gk_allocator alloc;
 } gk_hybrid_cont;
 
@@ -591,6 +595,7 @@ static void gk__hy_cont_free_arrays(gk_hybrid_cont *c) {
     gk_free(&c->alloc, c->ep);
     gk_free(&c->alloc, c->rate);
     gk_free(&c->alloc, c->zone);
+    gk_free(&c->alloc, c->dpk);
 }
 
 GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *out, const gk_mpm_points *pts, const gk_mpm_dp *dp,
@@ -625,7 +630,8 @@ GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *out, const gk_mpm_points *pt
     c.ep = (double *)gk_alloc(&c.alloc, 3 * nn * sizeof(double));
     c.rate = (double *)gk_alloc(&c.alloc, nn * sizeof(double));
     c.zone = (unsigned char *)gk_alloc(&c.alloc, nn);
-    if (bad || !c.Phi || !c.ep || !c.rate || !c.zone) {
+    c.dpk = (double *)gk_alloc(&c.alloc, 4 * nn * sizeof(double));
+    if (bad || !c.Phi || !c.ep || !c.rate || !c.zone || !c.dpk) {
         gk__hy_cont_free_arrays(&c);
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory for the state of %d points", n);
     }
@@ -636,6 +642,7 @@ GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *out, const gk_mpm_points *pt
         c.ep[3 * p] = c.ep[3 * p + 1] = c.ep[3 * p + 2] = 0.0;
         c.rate[p] = 0.0;
         c.zone[p] = GK_ZONE_CONTINUUM;
+        c.dpk[4 * p] = NAN;
     }
     c.n = c.cap = n;
     c.dp = *dp;
@@ -656,6 +663,10 @@ GKDEF gk_result gk_hybrid_dp_stress(gk_mpm_points *pts, double dt, void *user, g
     if (!c || c->n != pts->n)
         return gk_err_set(err, GK_ERR_STATE, "continuum state has %d points, the MPM %d", c ? c->n : -1,
                           pts->n);
+    if (memcmp(&c->dpk_of, &c->dp, sizeof c->dp)) { /* the model changed: every point's eq 7 anew */
+        for (p = 0; p < pts->n; ++p) c->dpk[4 * p] = NAN;
+        c->dpk_of = c->dp;
+    }
     for (p = 0; p < pts->n; ++p) {
         double dH[9], D[9], tr, dd = 0.0;
         gk_mpm_dp_info info;
@@ -683,7 +694,22 @@ GKDEF gk_result gk_hybrid_dp_stress(gk_mpm_points *pts, double dt, void *user, g
                 dd += e * e;
             }
         if (sqrt(2.0 * dd) > gmax) gmax = sqrt(2.0 * dd);
-        r = gk_mpm_dp_update(&c->dp, 2, dH, pts->sigma + 9 * p, &c->Phi[p], &info, err);
+        {
+            double *k = c->dpk + 4 * p;
+            gk_mpm_dp at = c->dp;
+            if (memcmp(k, &c->Phi[p], sizeof(double))) { /* eq 7 anew: Phi moved (a plastic step) */
+                r = gk_mpm_dp_at(&c->dp, 2, c->Phi[p], &at, err);
+                if (r) return gk__hybrid_prefix(err, r, "point", p);
+                k[0] = c->Phi[p];
+                k[1] = at.eta;
+                k[2] = at.etabar;
+                k[3] = at.zeta;
+            }
+            at.eta = k[1];
+            at.etabar = k[2];
+            at.zeta = k[3];
+            r = gk_mpm_dp_update_at(&at, 2, dH, pts->sigma + 9 * p, &c->Phi[p], &info, err);
+        }
         if (r) return gk__hybrid_prefix(err, r, "point", p);
         c->ep[3 * p] += info.deps_p[0];
         c->ep[3 * p + 1] += info.deps_p[4];
@@ -734,6 +760,7 @@ GKDEF int gk_hybrid_points_keep(gk_mpm_points *P, gk_hybrid_cont *c, const unsig
         gk__hy_compact(c->ep, 3, n, keep);
         gk__hy_compact(c->rate, 1, n, keep);
         gk__hy_compact_u8(c->zone, n, keep);
+        gk__hy_compact(c->dpk, 4, n, keep);
     }
     for (e = 0; e < nextra; ++e) gk__hy_compact(extra[e], stride[e], n, keep);
     for (p = 0; p < n; ++p) q += keep[p] != 0;

@@ -411,6 +411,15 @@ GKDEF gk_result gk_mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_
  * whose eq 7 friction is negative is refused) */
 GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9],
                                  double *Phi, gk_mpm_dp_info *info, gk_err *err);
+/* gk_mpm_dp_update in two parts, for callers that keep each point's
+ * coefficients while its Phi does not change (elastic points: eq 8 moves
+ * Phi only on plastic steps), so that they skip eq 7's trigonometry:
+ * gk_mpm_dp_at gives dp with eta, etabar, zeta of eq 7 at Phi (a copy of
+ * dp when dp->chi <= 0); gk_mpm_dp_update_at is gk_mpm_dp_update with
+ * those made for *Phi. Both together give gk_mpm_dp_update's bits. */
+GKDEF gk_result gk_mpm_dp_at(const gk_mpm_dp *dp, int dim, double Phi, gk_mpm_dp *out, gk_err *err);
+GKDEF gk_result gk_mpm_dp_update_at(const gk_mpm_dp *dp_at, int dim, const double dH[9], double sigma[9],
+                                    double *Phi, gk_mpm_dp_info *info, gk_err *err);
 
 #ifdef __cplusplus
 }
@@ -1819,12 +1828,11 @@ GKDEF double gk_mpm_dp_yield(const gk_mpm_dp *dp, int dim, const double sigma[9]
     return q + dp->eta * p - dp->zeta * dp->c;
 }
 
-GKDEF gk_result gk_mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_trial[9], double sig[9],
-                                 gk_mpm_dp_info *info, gk_err *err) {
+/* gk_mpm_dp_return on a dp already checked */
+static gk_result gk__mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_trial[9], double sig[9],
+                                   gk_mpm_dp_info *info, gk_err *err) {
     double s[9], q, p, f, dl = 0.0, out[9];
     int i, j, status = 0;
-    gk_result r = gk__mpm_dp_check(dp, dim, err);
-    if (r) return r;
     if (!gk_m3_isfinite(sig_trial))
         return gk_err_set(err, GK_ERR_NAN, "trial stress has a NaN or infinite entry");
     p = gk__mpm_pq(dim, sig_trial, s, &q);
@@ -1859,42 +1867,73 @@ GKDEF gk_result gk_mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_
     return GK_OK;
 }
 
-GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp_in, int dim, const double dH[9], double sigma[9],
-                                 double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
-    gk_mpm_dp dp;
-    gk_mpm_dp_info info;
-    double trial[9];
-    gk_result r = gk__mpm_dp_check(dp_in, dim, err);
+GKDEF gk_result gk_mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_trial[9], double sig[9],
+                                 gk_mpm_dp_info *info, gk_err *err) {
+    gk_result r = gk__mpm_dp_check(dp, dim, err);
     if (r) return r;
-    r = gk__mpm_check_dH(dim, dH, sigma, err);
+    return gk__mpm_dp_return(dp, dim, sig_trial, sig, info, err);
+}
+
+GKDEF gk_result gk_mpm_dp_at(const gk_mpm_dp *dp, int dim, double Phi, gk_mpm_dp *out, gk_err *err) {
+    gk_mpm_dp t;
+    gk_result r = gk__mpm_dp_check(dp, dim, err);
     if (r) return r;
-    dp = *dp_in;
-    if (dp.chi > 0.0) {
+    if (!out) return gk_err_set(err, GK_ERR_ARG, "NULL Drucker-Prager result");
+    t = *dp;
+    if (t.chi > 0.0) {
         double tphi, tpsi;
-        if (!Phi || !isfinite(*Phi) || !isfinite(dp.tan_phi_cs) || !isfinite(dp.Phi_cs) || !isfinite(dp.xi))
+        if (!isfinite(Phi) || !isfinite(t.tan_phi_cs) || !isfinite(t.Phi_cs) || !isfinite(t.xi))
             return gk_err_set(err, GK_ERR_ARG,
                               "critical-state Drucker-Prager needs a finite packing fraction");
-        tpsi = (*Phi - dp.Phi_cs) * dp.chi; /* eq 7 */
-        tphi = dp.tan_phi_cs + tpsi;
+        tpsi = (Phi - t.Phi_cs) * t.chi; /* eq 7 */
+        tphi = t.tan_phi_cs + tpsi;
         if (tphi < 0.0)
             return gk_err_set(
                 err, GK_ERR_ARG,
                 "critical-state Drucker-Prager: packing fraction %g gives tan phi = %g < 0 (eq 7 "
                 "needs Phi >= Phi_cs - tan phi_cs / chi = %g)",
-                *Phi, tphi, dp.Phi_cs - dp.tan_phi_cs / dp.chi);
-        gk__mpm_dp_coeffs(dim, atan(tphi), atan(tpsi), &dp.eta, &dp.etabar, &dp.zeta);
+                Phi, tphi, t.Phi_cs - t.tan_phi_cs / t.chi);
+        gk__mpm_dp_coeffs(dim, atan(tphi), atan(tpsi), &t.eta, &t.etabar, &t.zeta);
     }
+    *out = t;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_mpm_dp_update_at(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9],
+                                    double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
+    gk_mpm_dp_info info;
+    double trial[9];
+    gk_result r = gk__mpm_dp_check(dp, dim, err);
+    if (r) return r;
+    r = gk__mpm_check_dH(dim, dH, sigma, err);
+    if (r) return r;
+    if (dp->chi > 0.0 && (!Phi || !isfinite(*Phi)))
+        return gk_err_set(err, GK_ERR_ARG, "critical-state Drucker-Prager needs a finite packing fraction");
     gk_m3_copy(sigma, trial);
     gk__mpm_rotate(dim, dH, trial);
-    gk__mpm_elastic_add(dp.K, dp.G, dim, dH, trial);
-    r = gk_mpm_dp_return(&dp, dim, trial, sigma, &info, err);
+    gk__mpm_elastic_add(dp->K, dp->G, dim, dH, trial);
+    r = gk__mpm_dp_return(dp, dim, trial, sigma, &info, err);
     if (r) return r;
-    if (dp.chi > 0.0 && info.status) {
+    if (dp->chi > 0.0 && info.status) {
         double n = gk_m3_norm(info.deps_p);
-        *Phi -= (*Phi - dp.Phi_cs) * (*Phi) * dp.xi * n; /* eq 8 */
+        *Phi -= (*Phi - dp->Phi_cs) * (*Phi) * dp->xi * n; /* eq 8 */
     }
     if (info_out) *info_out = info;
     return GK_OK;
+}
+
+GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp_in, int dim, const double dH[9], double sigma[9],
+                                 double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
+    gk_mpm_dp dp;
+    gk_result r = gk__mpm_dp_check(dp_in, dim, err);
+    if (r) return r;
+    r = gk__mpm_check_dH(dim, dH, sigma, err);
+    if (r) return r;
+    if (dp_in->chi > 0.0 && !Phi)
+        return gk_err_set(err, GK_ERR_ARG, "critical-state Drucker-Prager needs a finite packing fraction");
+    r = gk_mpm_dp_at(dp_in, dim, Phi ? *Phi : 0.0, &dp, err);
+    if (r) return r;
+    return gk_mpm_dp_update_at(&dp, dim, dH, sigma, Phi, info_out, err);
 }
 
 #endif /* GK_MPM implementation */

@@ -785,10 +785,68 @@ TEST(continuum_rotation_flow_and_softening) {
     gk_mpm_points_destroy(&P);
 }
 
+/* gk_hybrid_dp_stress keeps each point's eq 7 coefficients while its Phi and
+ * the model stay: the stresses and Phi are bit for bit those of making them
+ * anew at every step (the same run with the kept ones thrown away each
+ * step), through elastic and plastic steps, a packing fraction set from
+ * outside and a model changed between two steps. */
+TEST(dp_stress_keeps_eq7_per_point) {
+    gk_mpm_points P[2];
+    gk_hybrid_cont c[2];
+    gk_mpm_dp dp;
+    gk_err e;
+    int r, k, p, it, plastic = 0, elastic = 0;
+    CHECK(gk_mpm_dp_init(&dp, 2, 6.3e8, 4.6e8, 0.3, 0.0, 0.0, &e) == GK_OK);
+    dp.tan_phi_cs = tan(0.27);
+    dp.Phi_cs = 0.815;
+    dp.chi = 7.0;
+    dp.xi = 20.0;
+    for (r = 0; r < 2; ++r) {
+        CHECK(gk_mpm_points_create(&P[r], 2, 3, NULL, &e) == GK_OK);
+        for (p = 0; p < 3; ++p) {
+            for (k = 0; k < 9; ++k) P[r].sigma[9 * p + k] = P[r].L[9 * p + k] = 0.0;
+            P[r].sigma[9 * p] = P[r].sigma[9 * p + 4] = P[r].sigma[9 * p + 8] = -4e5;
+        }
+        CHECK(gk_hybrid_cont_init(&c[r], &P[r], &dp, 0.8425, NULL, &e) == GK_OK);
+    }
+    for (it = 0; it < 3000; ++it) {
+        double Phi0[3];
+        for (p = 0; p < 3; ++p) Phi0[p] = c[0].Phi[p];
+        for (r = 0; r < 2; ++r) {
+            /* point 0 shears on; 1 shears, unloads a little and rests; 2 is squeezed */
+            for (p = 0; p < 3; ++p) {
+                double g = p == 1 && it >= 1500 ? (it < 1520 ? -10.0 : 0.0) : 10.0;
+                P[r].L[9 * p + 1] = p == 2 ? 0.0 : g;
+                P[r].L[9 * p] = p == 2 ? -1.0 : 0.0;
+            }
+            if (it == 1000) c[r].Phi[2] = 0.83;       /* set from outside */
+            if (it == 2000) c[r].dp.tan_phi_cs = 0.1; /* the model changed: point 1 yields again */
+            if (r == 1)
+                for (p = 0; p < 3; ++p) c[1].dpk[4 * p] = NAN; /* made anew every step */
+            CHECK(gk_hybrid_dp_stress(&P[r], 1e-6, &c[r], &e) == GK_OK);
+        }
+        for (p = 0; p < 3; ++p) {
+            if (c[0].Phi[p] != Phi0[p] && !(it == 1000 && p == 2))
+                ++plastic;
+            else
+                ++elastic;
+            CHECK(memcmp(&c[0].Phi[p], &c[1].Phi[p], sizeof(double)) == 0);
+            CHECK(memcmp(P[0].sigma + 9 * p, P[1].sigma + 9 * p, 9 * sizeof(double)) == 0);
+        }
+    }
+    printf("    %d plastic and %d elastic point steps\n", plastic, elastic);
+    CHECK(plastic > 100 && elastic > 100); /* both kinds of step were taken */
+    for (r = 0; r < 2; ++r) {
+        gk_hybrid_cont_free(&c[r]);
+        gk_mpm_points_destroy(&P[r]);
+    }
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(oracle_synthetic_fields);
     RUN(continuum_rotation_flow_and_softening);
+    RUN(dp_stress_keeps_eq7_per_point);
     RUN(oracle_persistence);
     RUN(zones_and_distance);
     RUN(periodic_fold);

@@ -815,6 +815,29 @@ TEST(drucker_prager_update_refuses_a_negative_friction) {
     CHECK_EQ_INT(gk_mpm_dp_update(&dp, 2, dH, sig, &Phi, &info, &e), GK_OK);
     CHECK(info.status > 0); /* this shear yields the nearly frictionless, cohesionless material */
     CHECK(sig[0] != keep[0]);
+    { /* the two parts: gk_mpm_dp_at refuses the same packing fraction; together they give the bits */
+        gk_mpm_dp at, at0;
+        double sig2[9], Phi2, Phi3, notnum = NAN;
+        memset(&at, 0x5a, sizeof at);
+        at0 = at;
+        CHECK_EQ_INT(gk_mpm_dp_at(&dp, 2, bound - 1e-3, &at, &e), GK_ERR_ARG);
+        CHECK(strstr(e.msg, "tan phi") != NULL);
+        CHECK_EQ_INT(gk_mpm_dp_at(&dp, 2, notnum, &at, &e), GK_ERR_ARG);
+        CHECK_EQ_INT(gk_mpm_dp_at(&dp, 2, Phi, NULL, &e), GK_ERR_ARG);
+        CHECK(memcmp(&at, &at0, sizeof at) == 0);
+        memcpy(keep, sig, sizeof sig);
+        memcpy(sig2, sig, sizeof sig);
+        Phi2 = Phi3 = Phi;
+        CHECK_EQ_INT(gk_mpm_dp_at(&dp, 2, Phi, &at, &e), GK_OK);
+        CHECK(at.eta != dp.eta && at.etabar < 0.0); /* below Phi_cs: contractant, tan psi < 0 (eq 7) */
+        CHECK_EQ_INT(gk_mpm_dp_update_at(&at, 2, dH, sig2, NULL, &info, &e), GK_ERR_ARG);
+        CHECK_EQ_INT(gk_mpm_dp_update_at(&at, 2, dH, sig2, &notnum, &info, &e), GK_ERR_ARG);
+        CHECK(memcmp(sig2, keep, sizeof keep) == 0);
+        CHECK_EQ_INT(gk_mpm_dp_update_at(&at, 2, dH, sig2, &Phi2, &info, &e), GK_OK);
+        CHECK_EQ_INT(gk_mpm_dp_update(&dp, 2, dH, sig, &Phi3, &info, &e), GK_OK);
+        CHECK(memcmp(sig2, sig, sizeof sig) == 0 && memcmp(&Phi2, &Phi3, sizeof Phi2) == 0);
+        CHECK(Phi3 != Phi); /* a plastic step: eq 8 moved it */
+    }
 }
 
 /* Bitwise determinism: the coloured P2G gives every node its sum in one
