@@ -277,8 +277,9 @@ GKDEF gk_result gk_hybrid_cont_init(gk_hybrid_cont *c, const gk_mpm_points *pts,
                                     double Phi0, const gk_allocator *alloc, gk_err *err);
 GKDEF void gk_hybrid_cont_free(gk_hybrid_cont *c);
 /* gk_mpm_stress_fn (user = gk_hybrid_cont *): rotate, elastic trial, return
- * map with Phi by eqs 7-8 (gk_mpm_dp_update); accumulates ep, sets rate
- * and gdot_max */
+ * map with Phi by eqs 7-8 (gk_mpm_dp_update's bits; eq 7 made anew only for
+ * the points whose Phi or model changed); accumulates ep, sets rate and
+ * gdot_max */
 GKDEF gk_result gk_hybrid_dp_stress(gk_mpm_points *pts, double dt, void *user, gk_err *err);
 /* keep the points with keep[p] != 0 (pts and c together, order kept);
  * also compacts the caller's per-point arrays extra[e] (stride[e] doubles
