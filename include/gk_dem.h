@@ -1556,15 +1556,16 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
 }
 
 /* ---------------------------------------------------------------- sums and integration */
+/* 3D: the pairs where p is j lie far apart in the pair arrays (a plane of
+ * cells away); fetching them this many entries ahead made a 10^5-sphere
+ * step on 2 threads about 10 % faster (bench/README.md). 2D gained nothing. */
+#define GK__REDUCE_AHEAD 16
+
 /* Per-particle sums of the pair forces in the fixed order (pairs where p is j,
  * ascending; then pairs where p is i, ascending), by gathering: used with
  * threads. A single thread scatters inside the force loop instead
  * (gk__scatter_*), in pair order, which is the same order and so gives the
  * same bits. */
-/* 3D: the pairs where p is j lie far apart in the pair arrays (a z plane of
- * cells away); fetching them this many entries ahead made a 10^5-sphere
- * step on 2 threads 12-15 % faster (bench/README.md). 2D gained nothing. */
-#define GK__REDUCE_AHEAD 16
 GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int dim, const int rot) {
     const int32_t *GK_RESTRICT start = rve->pl.start, *GK_RESTRICT jst = rve->jstart,
                                *GK_RESTRICT jl = rve->jlist;

@@ -170,8 +170,8 @@ typedef struct gk_hybrid_cont {
     unsigned char *zone; /* GK_ZONE_* (after enrichment; CONTINUUM before)         */
     gk_mpm_dp dp;        /* the Drucker-Prager continuum [eqs 4-8], chi > 0        */
     double gdot_max;     /* largest sqrt(2 D':D') of the last update [1/s]         */
-    /* eq 7's eta, etabar, zeta per point, kept while its Phi (and dp) stay:
-     * 4 per point, the Phi they were made at first (not yet made: NaN) */
+    /* eq 7's coefficients per point, kept while its Phi (and dp) stay: 4 per
+     * point, the Phi they were made at (NaN: not yet made), eta, etabar, zeta */
     double *dpk;
     gk_mpm_dp dpk_of; /* the dp they were made with */
     gk_allocator alloc;
