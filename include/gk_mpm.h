@@ -1874,12 +1874,9 @@ GKDEF gk_result gk_mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_
     return gk__mpm_dp_return(dp, dim, sig_trial, sig, info, err);
 }
 
-GKDEF gk_result gk_mpm_dp_at(const gk_mpm_dp *dp, int dim, double Phi, gk_mpm_dp *out, gk_err *err) {
-    gk_mpm_dp t;
-    gk_result r = gk__mpm_dp_check(dp, dim, err);
-    if (r) return r;
-    if (!out) return gk_err_set(err, GK_ERR_ARG, "NULL Drucker-Prager result");
-    t = *dp;
+/* eq 7: dp with eta, etabar, zeta at Phi (chi > 0); dp itself not checked */
+static gk_result gk__mpm_dp_eq7(const gk_mpm_dp *dp, int dim, double Phi, gk_mpm_dp *out, gk_err *err) {
+    gk_mpm_dp t = *dp;
     if (t.chi > 0.0) {
         double tphi, tpsi;
         if (!isfinite(Phi) || !isfinite(t.tan_phi_cs) || !isfinite(t.Phi_cs) || !isfinite(t.xi))
@@ -1899,16 +1896,13 @@ GKDEF gk_result gk_mpm_dp_at(const gk_mpm_dp *dp, int dim, double Phi, gk_mpm_dp
     return GK_OK;
 }
 
-GKDEF gk_result gk_mpm_dp_update_at(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9],
-                                    double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
+/* rotate, elastic trial, return map, eq 8: dp (with eq 7 made for *Phi),
+ * dH, sigma and Phi already checked */
+static gk_result gk__mpm_dp_step(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9],
+                                 double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
     gk_mpm_dp_info info;
     double trial[9];
-    gk_result r = gk__mpm_dp_check(dp, dim, err);
-    if (r) return r;
-    r = gk__mpm_check_dH(dim, dH, sigma, err);
-    if (r) return r;
-    if (dp->chi > 0.0 && (!Phi || !isfinite(*Phi)))
-        return gk_err_set(err, GK_ERR_ARG, "critical-state Drucker-Prager needs a finite packing fraction");
+    gk_result r;
     gk_m3_copy(sigma, trial);
     gk__mpm_rotate(dim, dH, trial);
     gk__mpm_elastic_add(dp->K, dp->G, dim, dH, trial);
@@ -1922,6 +1916,24 @@ GKDEF gk_result gk_mpm_dp_update_at(const gk_mpm_dp *dp, int dim, const double d
     return GK_OK;
 }
 
+GKDEF gk_result gk_mpm_dp_at(const gk_mpm_dp *dp, int dim, double Phi, gk_mpm_dp *out, gk_err *err) {
+    gk_result r = gk__mpm_dp_check(dp, dim, err);
+    if (r) return r;
+    if (!out) return gk_err_set(err, GK_ERR_ARG, "NULL Drucker-Prager result");
+    return gk__mpm_dp_eq7(dp, dim, Phi, out, err);
+}
+
+GKDEF gk_result gk_mpm_dp_update_at(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9],
+                                    double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
+    gk_result r = gk__mpm_dp_check(dp, dim, err);
+    if (r) return r;
+    r = gk__mpm_check_dH(dim, dH, sigma, err);
+    if (r) return r;
+    if (dp->chi > 0.0 && (!Phi || !isfinite(*Phi)))
+        return gk_err_set(err, GK_ERR_ARG, "critical-state Drucker-Prager needs a finite packing fraction");
+    return gk__mpm_dp_step(dp, dim, dH, sigma, Phi, info_out, err);
+}
+
 GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp_in, int dim, const double dH[9], double sigma[9],
                                  double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
     gk_mpm_dp dp;
@@ -1931,9 +1943,11 @@ GKDEF gk_result gk_mpm_dp_update(const gk_mpm_dp *dp_in, int dim, const double d
     if (r) return r;
     if (dp_in->chi > 0.0 && !Phi)
         return gk_err_set(err, GK_ERR_ARG, "critical-state Drucker-Prager needs a finite packing fraction");
-    r = gk_mpm_dp_at(dp_in, dim, Phi ? *Phi : 0.0, &dp, err);
+    r = gk__mpm_dp_eq7(dp_in, dim, Phi ? *Phi : 0.0, &dp, err);
     if (r) return r;
-    return gk_mpm_dp_update_at(&dp, dim, dH, sigma, Phi, info_out, err);
+    r = gk__mpm_dp_check(&dp, dim, err); /* the coefficients eq 7 made (eta 0 with etabar != 0) */
+    if (r) return r;
+    return gk__mpm_dp_step(&dp, dim, dH, sigma, Phi, info_out, err);
 }
 
 #endif /* GK_MPM implementation */
