@@ -1480,7 +1480,8 @@ static void gk__mpm_gather(const gk_mpm_grid *g, const gk__mpm_w *W, int vel, in
 }
 
 /* F_new = (I + dt L) F (2D: the plane block), returns det F_new */
-static double gk__mpm_f_update(int dim, double dt, const double Lg[9], const double F[9], double Fn[9]) {
+GK_FORCE_INLINE double gk__mpm_f_update(int dim, double dt, const double Lg[9], const double F[9],
+                                        double Fn[9]) {
     double E[9];
     int k;
     for (k = 0; k < 9; ++k) E[k] = dt * Lg[k] + 0.0;
@@ -1526,7 +1527,8 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
         gk__mpm_gather(g, W, gather_vel, gather_grad, vg, apic_b, apic_g, &o);
     }
     if (dry) {
-        double Fn[9], J = gk__mpm_f_update(dim, dt, o.Lg, P->F + 9 * p, Fn);
+        double Fn[9], J = dim == 2 ? gk__mpm_f_update(2, dt, o.Lg, P->F + 9 * p, Fn)
+                                   : gk__mpm_f_update(3, dt, o.Lg, P->F + 9 * p, Fn);
         if (sp) {
             memcpy(sp, o.Lg, 9 * sizeof(double));
             memcpy(sp + 9, Fn, 9 * sizeof(double));
@@ -1554,7 +1556,8 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
             memcpy(P->F + 9 * p, sp + 9, 9 * sizeof(double));
             J = sp[18];
         } else {
-            J = gk__mpm_f_update(dim, dt, o.Lg, P->F + 9 * p, Fn);
+            J = dim == 2 ? gk__mpm_f_update(2, dt, o.Lg, P->F + 9 * p, Fn)
+                         : gk__mpm_f_update(3, dt, o.Lg, P->F + 9 * p, Fn);
             memcpy(P->L + 9 * p, o.Lg, 9 * sizeof(double));
             gk_m3_copy(Fn, P->F + 9 * p);
         }
@@ -1717,7 +1720,7 @@ GKDEF gk_result gk_mpm_point_polar(const gk_mpm_points *pts, int p, double R[9],
 
 /* ---- constitutive updates */
 /* sigma <- R sigma R^T, R = exp(skew dH) (objective rotation of the stress) */
-static void gk__mpm_rotate(int dim, const double dH[9], double sigma[9]) {
+GK_FORCE_INLINE void gk__mpm_rotate(int dim, const double dH[9], double sigma[9]) {
     double W[9], R[9], T[9], Rt[9];
     gk_m3_skew(dH, W);
     if (W[1] == 0.0 && W[2] == 0.0 && W[5] == 0.0) return;
@@ -1736,7 +1739,7 @@ static gk_result gk__mpm_check_dH(int dim, const double dH[9], const double sigm
 }
 
 /* sigma += K tr(de) I + 2 G dev(de), de = sym dH (dimension dim) */
-static void gk__mpm_elastic_add(double K, double G, int dim, const double dH[9], double sigma[9]) {
+GK_FORCE_INLINE void gk__mpm_elastic_add(double K, double G, int dim, const double dH[9], double sigma[9]) {
     double e[9], tr = 0.0;
     int i, j;
     gk_m3_sym(dH, e);
@@ -1808,7 +1811,7 @@ GKDEF gk_result gk_mpm_dp_init(gk_mpm_dp *dp, int dim, double K, double G, doubl
 }
 
 /* p = tr/dim, s = sigma - p I (dim block), q = sqrt(s:s/2) */
-static double gk__mpm_pq(int dim, const double sig[9], double s[9], double *q) {
+GK_FORCE_INLINE double gk__mpm_pq(int dim, const double sig[9], double s[9], double *q) {
     double p = 0.0, ss = 0.0;
     int i, j;
     for (i = 0; i < dim; ++i) p += sig[4 * i];
@@ -1829,8 +1832,8 @@ GKDEF double gk_mpm_dp_yield(const gk_mpm_dp *dp, int dim, const double sigma[9]
 }
 
 /* gk_mpm_dp_return on a dp already checked */
-static gk_result gk__mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_trial[9], double sig[9],
-                                   gk_mpm_dp_info *info, gk_err *err) {
+GK_FORCE_INLINE gk_result gk__mpm_dp_return(const gk_mpm_dp *dp, int dim, const double sig_trial[9],
+                                            double sig[9], gk_mpm_dp_info *info, gk_err *err) {
     double s[9], q, p, f, dl = 0.0, out[9];
     int i, j, status = 0;
     if (!gk_m3_isfinite(sig_trial))
@@ -1898,8 +1901,9 @@ static gk_result gk__mpm_dp_eq7(const gk_mpm_dp *dp, int dim, double Phi, gk_mpm
 
 /* rotate, elastic trial, return map, eq 8: dp (with eq 7 made for *Phi),
  * dH, sigma and Phi already checked */
-static gk_result gk__mpm_dp_step(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9],
-                                 double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
+GK_FORCE_INLINE gk_result gk__mpm_dp_step_dim(const gk_mpm_dp *dp, int dim, const double dH[9],
+                                              double sigma[9], double *Phi, gk_mpm_dp_info *info_out,
+                                              gk_err *err) {
     gk_mpm_dp_info info;
     double trial[9];
     gk_result r;
@@ -1914,6 +1918,13 @@ static gk_result gk__mpm_dp_step(const gk_mpm_dp *dp, int dim, const double dH[9
     }
     if (info_out) *info_out = info;
     return GK_OK;
+}
+
+/* the same with the dimension a constant (the loops unrolled; the same operations) */
+static gk_result gk__mpm_dp_step(const gk_mpm_dp *dp, int dim, const double dH[9], double sigma[9],
+                                 double *Phi, gk_mpm_dp_info *info_out, gk_err *err) {
+    if (dim == 2) return gk__mpm_dp_step_dim(dp, 2, dH, sigma, Phi, info_out, err);
+    return gk__mpm_dp_step_dim(dp, 3, dH, sigma, Phi, info_out, err);
 }
 
 GKDEF gk_result gk_mpm_dp_at(const gk_mpm_dp *dp, int dim, double Phi, gk_mpm_dp *out, gk_err *err) {
