@@ -1072,7 +1072,7 @@ GK_FORCE_INLINE void gk__mpm_p2g_2d(gk_mpm_grid *g, const gk__mpm_w *W, int s, i
     int a, b, n0 = g->n[0];
     for (b = 0; b < s; ++b) {
         size_t row = (size_t)W->base[0] + (size_t)n0 * (size_t)(W->base[1] + b);
-        for (a = 0; a < s; ++a) {
+            for (a = 0; a < s; ++a) {
             size_t I = row + (size_t)a;
             double w = w0[a] * w1[b];
             if (what & GK_MPM_P2G_MOMENTUM) {
@@ -1121,8 +1121,10 @@ static void gk__mpm_p2g_point(gk_mpm_grid *g, const gk_mpm_points *P, const gk_m
     W = gk__mpm_wget(g, g->wc != NULL, d->basis, x, l, p, 1, &Wt);
     s = W->s;
     if (dim == 2 && s == 3) { /* uGIMP and quadratic: the flags as constants */
-        if (what == GK_MPM_P2G_MOMENTUM)
-            gk__mpm_p2g_2d(g, W, 3, GK_MPM_P2G_MOMENTUM, apic, mp, vp, fp, Cm, S);
+        if (what == GK_MPM_P2G_MOMENTUM && !apic)
+            gk__mpm_p2g_2d(g, W, 3, GK_MPM_P2G_MOMENTUM, 0, mp, vp, fp, Cm, S);
+        else if (what == GK_MPM_P2G_MOMENTUM)
+            gk__mpm_p2g_2d(g, W, 3, GK_MPM_P2G_MOMENTUM, 1, mp, vp, fp, Cm, S);
         else if (what == GK_MPM_P2G_FORCE)
             gk__mpm_p2g_2d(g, W, 3, GK_MPM_P2G_FORCE, apic, mp, vp, fp, Cm, S);
         else
@@ -1397,7 +1399,7 @@ GK_FORCE_INLINE void gk__mpm_gather_2d(const gk_mpm_grid *g, const gk__mpm_w *W,
     int a, b, n0 = g->n[0];
     for (b = 0; b < s; ++b) {
         size_t row = (size_t)W->base[0] + (size_t)n0 * (size_t)(W->base[1] + b);
-        for (a = 0; a < s; ++a) {
+            for (a = 0; a < s; ++a) {
             size_t I = row + (size_t)a;
             double gr0 = dw0[a] * w1[b], gr1 = w0[a] * dw1[b];
             if (vel) {
@@ -1498,6 +1500,16 @@ GK_FORCE_INLINE double gk__mpm_f_update(int dim, double dt, const double Lg[9], 
 
 #define GK__MPM_SCR 19 /* scratch per point between the G2P passes: L, F_new, det F_new */
 
+/* the gradient update of point p kept by the dry pass (sp): L, F, volume;
+ * returns 1 if det F <= 0 */
+GK_FORCE_INLINE int gk__mpm_g2p_commit(gk_mpm_points *P, int p, const double *sp) {
+    double J = sp[18];
+    memcpy(P->L + 9 * p, sp, 9 * sizeof(double));
+    memcpy(P->F + 9 * p, sp + 9, 9 * sizeof(double));
+    P->vol[p] = J * P->vol0[p];
+    return !(J > 0.0);
+}
+
 /* gather one point. dry: write nothing, return 1 if the gradient update would
  * invert F (and keep L, F_new, det F_new in scr when scr is not NULL). Else
  * update the point (the gradient from scr when it is not NULL) and return 1 if
@@ -1551,16 +1563,11 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
         for (k = 0; k < dim; ++k) P->x[k][p] += dt * o.vpic[k];
     if (grad) {
         double Fn[9], J;
-        if (sp) {
-            memcpy(P->L + 9 * p, sp, 9 * sizeof(double));
-            memcpy(P->F + 9 * p, sp + 9, 9 * sizeof(double));
-            J = sp[18];
-        } else {
-            J = dim == 2 ? gk__mpm_f_update(2, dt, o.Lg, P->F + 9 * p, Fn)
-                         : gk__mpm_f_update(3, dt, o.Lg, P->F + 9 * p, Fn);
-            memcpy(P->L + 9 * p, o.Lg, 9 * sizeof(double));
-            gk_m3_copy(Fn, P->F + 9 * p);
-        }
+        if (sp) return gk__mpm_g2p_commit(P, p, sp);
+        J = dim == 2 ? gk__mpm_f_update(2, dt, o.Lg, P->F + 9 * p, Fn)
+                     : gk__mpm_f_update(3, dt, o.Lg, P->F + 9 * p, Fn);
+        memcpy(P->L + 9 * p, o.Lg, 9 * sizeof(double));
+        gk_m3_copy(Fn, P->F + 9 * p);
         P->vol[p] = J * P->vol0[p];
         return !(J > 0.0);
     }
@@ -1612,8 +1619,13 @@ GKDEF gk_result gk_mpm_g2p(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mpm_
                               p);
         }
     }
-    GK_OMP(parallel for num_threads(nth) schedule(static) reduction(+ : bad) if (nth > 1))
-    for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p, 0, fresh, scr);
+    if (scr && !(what & (GK_MPM_G2P_VELOCITY | GK_MPM_G2P_POSITION))) { /* the gradient alone: kept */
+        GK_OMP(parallel for num_threads(nth) schedule(static) reduction(+ : bad) if (nth > 1))
+        for (p = 0; p < n; ++p) bad += gk__mpm_g2p_commit(P, p, scr + (size_t)GK__MPM_SCR * (size_t)p);
+    } else {
+        GK_OMP(parallel for num_threads(nth) schedule(static) reduction(+ : bad) if (nth > 1))
+        for (p = 0; p < n; ++p) bad += gk__mpm_g2p_point(g, P, d, dt, what, p, 0, fresh, scr);
+    }
     gk_free(&P->alloc, scr);
     if (bad) return gk_err_set(err, GK_ERR_DIVERGED, "%d points inverted (det F <= 0)", bad);
     return GK_OK;
