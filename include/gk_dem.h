@@ -51,6 +51,15 @@
  *     dH (a shear of 1e-5 on the Guo & Zhao packing: sigma_xy 617 Pa before, 690
  *     after the deform, 782 after gk_rve_refresh). gk_rve_refresh gives the
  *     stress of the end state (one force pass, history unchanged).
+ *     gk_rve_step_flags with GK_STEP_NO_STRESS makes none, for a caller
+ *     that steps one step at a time and reads the stress seldom (a coupled
+ *     scheme): it saves the stress pass (about a third of a 2D step) and,
+ *     on one thread, the per-pair force stores. The stress, ncontacts,
+ *     fc_mean and the per-pair forces (fc, tci, tcj: what
+ *     gk_rve_contact_next, gk_rve_unbalanced, gk_scene_stress and
+ *     gk_scene_stress_box read) then stay those of the last step that made
+ *     them; the motion is the same to the bit. A servo makes the stress at
+ *     every step regardless.
  *   gk_homog_tangent (gk_homog.h): the tangent at the current contacts.
  *   gk_rve_save / gk_rve_restore  the full state (positions, velocities,
  *     spins, cell, pair list with contact history) to and from caller
@@ -68,7 +77,9 @@
  *                            constant velocity gradient or objective)
  *   gk_rve_step(n)           the velocity gradient of gk_rve_set_velocity_
  *                            gradient; with a servo (gk_rve_set_servo) its
- *                            diagonal (and shear) follow the stress each step
+ *                            diagonal (and shear) follow the stress each step;
+ *                            gk_rve_step_flags(n, GK_STEP_NO_STRESS) the same
+ *                            without the stress of the last step
  *   gk_rve_relax(uf, every, max)   L = 0 in runs of `every` steps until the
  *                            unbalanced force ratio is at most uf
  *   gk_rve_consolidate       the isotropic servo until the target pressure
@@ -198,6 +209,8 @@ typedef enum gk_mass_model { GK_MASS_CYLINDER = 0, GK_MASS_SPHERE = 1 } gk_mass_
 #define GK_RVE_SCALAR 2u         /* always use the scalar reference kernels          */
 #define GK_RVE_WRAP 4u           /* accept positions outside the cell (wrap them)    */
 #define GK_RVE_TRACK_ROTATION 8u /* 3D: accumulate each particle's rotation vector  */
+/* flags of gk_rve_step_flags (and gk_scene_step_flags) */
+#define GK_STEP_NO_STRESS 1u /* the last step makes no stress (see gk_rve_stress)  */
 #define GK_RVE_DEF_COOKIE 0x52564531
 
 typedef struct gk_rve_def {
@@ -350,6 +363,8 @@ GKDEF gk_result gk_rve_set_damping(gk_rve *rve, double alpha, gk_damp_form form)
 GKDEF gk_result gk_rve_set_velocity_gradient(gk_rve *rve, const double L[9]);
 GKDEF gk_result gk_rve_set_servo(gk_rve *rve, const gk_servo *servo); /* NULL switches it off */
 GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps);
+/* the same, with GK_STEP_* flags (0: gk_rve_step) */
+GKDEF gk_result gk_rve_step_flags(gk_rve *rve, long nsteps, unsigned flags);
 GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps);
 GKDEF gk_result gk_rve_consolidate(gk_rve *rve, const gk_consolidate_def *cd, gk_consolidate_report *rep);
 /* relaxation at a fixed cell (velocity gradient 0, no servo): runs of `every`
@@ -2207,6 +2222,7 @@ enum { GK__DRIVE_PATH, GK__DRIVE_RATE, GK__DRIVE_SERVO };
 typedef struct gk__drive {
     int kind;     /* PATH: I + dH split by a gk_path; RATE: constant L; SERVO  */
     long n;       /* steps in the run                                          */
+    int stress;   /* make the stress (and keep the pair forces) at the last step */
     gk_path path; /* PATH                                                      */
     double L[9];  /* RATE, SERVO (the servo rewrites its diagonal, shear)       */
 } gk__drive;
@@ -2229,17 +2245,21 @@ static gk_result gk__drive_run(gk_rve *rve, gk__drive *d) {
             for (i = 0; i < 9; ++i) A[i] = d->L[i] * rve->dt;
             gk_m3_exp(A, E);
         }
-        res = gk__step_once(rve, E, d->kind == GK__DRIVE_SERVO || k == d->n);
+        res = gk__step_once(rve, E, d->kind == GK__DRIVE_SERVO || (k == d->n && d->stress));
         if (res) return res;
     }
     return GK_OK;
 }
 
-GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
+GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) { return gk_rve_step_flags(rve, nsteps, 0); }
+
+GKDEF gk_result gk_rve_step_flags(gk_rve *rve, long nsteps, unsigned flags) {
     gk__drive d;
     gk_result res = gk__rve_ready(rve);
     if (res) return res;
     if (nsteps < 0) return gk_err_set(&rve->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
+    if (flags & ~GK_STEP_NO_STRESS)
+        return gk_err_set(&rve->err, GK_ERR_ARG, "unknown step flags 0x%x", flags);
     { /* the largest per-step map: the servo's rates are bounded by max_rate */
         double C[9], f = 0.0, lim = gk__step_stretch_max(rve);
         int i, j;
@@ -2264,6 +2284,7 @@ GKDEF gk_result gk_rve_step(gk_rve *rve, long nsteps) {
     }
     d.kind = rve->servo_on ? GK__DRIVE_SERVO : GK__DRIVE_RATE;
     d.n = nsteps;
+    d.stress = !(flags & GK_STEP_NO_STRESS);
     gk_m3_copy(rve->L, d.L);
     return gk__drive_run(rve, &d);
 }
@@ -2327,6 +2348,7 @@ GKDEF gk_result gk_rve_deform(gk_rve *rve, const double dH[9], int nsteps) {
                                   w[k], 2.0 * rve->rmax + rve->skin);
     }
     d.kind = GK__DRIVE_PATH;
+    d.stress = 1;
     d.n = nsteps;
     d.path = path;
     return gk__drive_run(rve, &d);
@@ -2382,6 +2404,7 @@ static gk_result gk__relax(gk_rve *rve, double uf_max, int every, long max_steps
                           max_steps);
     memset(&d, 0, sizeof d);
     d.kind = GK__DRIVE_RATE; /* L = 0: the cell stands still */
+    d.stress = 1;
     while (done < max_steps && (rms ? gk_rve_unbalanced_rms(rve) : gk_rve_unbalanced(rve)) > uf_max) {
         d.n = every < max_steps - done ? every : max_steps - done;
         res = gk__drive_run(rve, &d);

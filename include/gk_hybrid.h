@@ -363,7 +363,8 @@ GKDEF gk_result gk_hybrid_coupling_init(gk_hybrid_coupling *c, const gk_mpm_grid
 GKDEF void gk_hybrid_coupling_free(gk_hybrid_coupling *c);
 /* eq 9 after the continuum's grid update and the grains' step: xpre the
  * grains' positions before their step (world coordinates, by particle
- * index), coupled[p] != 0 for the grains to couple, skip[I] != 0 for nodes
+ * index; only the coupled grains' are read), coupled[p] != 0 for the
+ * grains to couple, skip[I] != 0 for nodes
  * left alone (constrained; may be NULL); basis and lp of the grains'
  * stencil; t the disk thickness; dt the step. Changes g->vn and the grains'
  * velocities and positions. */

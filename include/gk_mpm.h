@@ -1072,7 +1072,7 @@ GK_FORCE_INLINE void gk__mpm_p2g_2d(gk_mpm_grid *g, const gk__mpm_w *W, int s, i
     int a, b, n0 = g->n[0];
     for (b = 0; b < s; ++b) {
         size_t row = (size_t)W->base[0] + (size_t)n0 * (size_t)(W->base[1] + b);
-            for (a = 0; a < s; ++a) {
+        for (a = 0; a < s; ++a) {
             size_t I = row + (size_t)a;
             double w = w0[a] * w1[b];
             if (what & GK_MPM_P2G_MOMENTUM) {
@@ -1399,7 +1399,7 @@ GK_FORCE_INLINE void gk__mpm_gather_2d(const gk_mpm_grid *g, const gk__mpm_w *W,
     int a, b, n0 = g->n[0];
     for (b = 0; b < s; ++b) {
         size_t row = (size_t)W->base[0] + (size_t)n0 * (size_t)(W->base[1] + b);
-            for (a = 0; a < s; ++a) {
+        for (a = 0; a < s; ++a) {
             size_t I = row + (size_t)a;
             double gr0 = dw0[a] * w1[b], gr1 = w0[a] * dw1[b];
             if (vel) {

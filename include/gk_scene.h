@@ -26,7 +26,7 @@
  *   gk_scene_destroy(&sc);
  *
  * WHAT IS HERE
- *   gk_scene_def_default / gk_scene_create / gk_scene_destroy / gk_scene_step
+ *   gk_scene_def_default / gk_scene_create / gk_scene_destroy / gk_scene_step (_flags)
  *   gk_scene_add_wall, gk_scene_add_box, gk_wall_def_default, gk_scene_pair_material
  *   gk_scene_set_external, gk_scene_prescribe / gk_scene_release,
  *   gk_scene_set_velocity, gk_scene_set_mass      per particle (index p)
@@ -359,6 +359,8 @@ GKDEF gk_result gk_scene_wrap(gk_scene *sc, gk_rve *rve);
 GKDEF void gk_scene_unwrap(gk_scene *sc, gk_rve *rve);
 GKDEF const char *gk_scene_error(const gk_scene *sc);
 GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps);
+/* the same with GK_STEP_* flags (gk_dem.h: GK_STEP_NO_STRESS for one-step calls of a coupled scheme) */
+GKDEF gk_result gk_scene_step_flags(gk_scene *sc, long nsteps, unsigned flags);
 GKDEF void gk_scene_position(const gk_scene *sc, int p, double x[3]);
 GKDEF int gk_scene_index(const gk_scene *sc, int32_t id);
 GKDEF double gk_scene_dt_critical(const gk_scene *sc);
@@ -1763,11 +1765,14 @@ static gk_result gk__scene_hook(gk_rve *rve, int stage, void *user) {
 /* ------------------------------------------------------------- stepping */
 static gk_result gk__scene_delete(gk_scene *sc, const unsigned char *drop);
 
-GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps) {
+GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps) { return gk_scene_step_flags(sc, nsteps, 0); }
+
+GKDEF gk_result gk_scene_step_flags(gk_scene *sc, long nsteps, unsigned flags) {
     gk_result r;
     int w, k;
     long done0;
     if (nsteps < 0) return gk_err_set(&sc->err, GK_ERR_ARG, "step count %ld < 0", nsteps);
+    if (flags & ~GK_STEP_NO_STRESS) return gk_err_set(&sc->err, GK_ERR_ARG, "unknown step flags 0x%x", flags);
     for (k = 0; k < 9; ++k)
         if (sc->rve.L[k] != 0.0 || sc->rve.servo_on)
             return gk_err_set(&sc->err, GK_ERR_STATE,
@@ -1786,7 +1791,7 @@ GKDEF gk_result gk_scene_step(gk_scene *sc, long nsteps) {
     sc->rve.hook_user = sc; /* the scene may have moved since the last call */
     done0 = sc->rve.step;
     while (sc->rve.step - done0 < nsteps) {
-        r = gk_rve_step(&sc->rve, nsteps - (sc->rve.step - done0));
+        r = gk_rve_step_flags(&sc->rve, nsteps - (sc->rve.step - done0), flags);
         if (r == GK_ERR_OUTSIDE && sc->def.lost == GK_LOST_DELETE) {
             /* delete what left the domain and redo the step (nothing else moved) */
             unsigned char *drop = (unsigned char *)gk_alloc(gk__sc_alloc(sc), (size_t)sc->rve.n);

@@ -422,7 +422,8 @@ TEST(save_restore_is_bitwise) {
 }
 
 /* physical state (not the lists): positions, velocities, spins, forces, stress */
-static int same_physics(const gk_rve *a, const gk_rve *b) {
+/* positions, velocities, forces, spins and torques bit for bit (not the stress) */
+static int same_physics_motion(const gk_rve *a, const gk_rve *b) {
     int k, p;
     for (k = 0; k < 3; ++k)
         for (p = 0; p < a->n; ++p) {
@@ -431,6 +432,12 @@ static int same_physics(const gk_rve *a, const gk_rve *b) {
                 return 0;
             if (a->w[k] && (a->w[k][p] != b->w[k][p] || a->t[k][p] != b->t[k][p])) return 0;
         }
+    return 1;
+}
+
+static int same_physics(const gk_rve *a, const gk_rve *b) {
+    int k;
+    if (!same_physics_motion(a, b)) return 0;
     for (k = 0; k < 9; ++k)
         if (a->stress[k] != b->stress[k]) return 0;
     return 1;
@@ -521,6 +528,49 @@ TEST(threads_do_not_change_results) {
 #endif
     gk_rve_destroy(&a);
     gk_rve_destroy(&b);
+}
+
+/* gk_rve_step_flags with GK_STEP_NO_STRESS: the motion is that of gk_rve_step to
+ * the bit (positions, velocities, forces, history; on 1 and 2 threads), the
+ * stress stays that of the last step that made it, and a final plain step
+ * gives the same whole state; unknown flags are refused, nothing moving. */
+TEST(steps_without_stress_move_the_same) {
+    gk_rve a, b, c;
+    gk_rve_def d1 = gk_rve_def_default(), d2 = gk_rve_def_default();
+    double L[9] = {0, 5.0, 0, 0, 0, 0, 0, 0, 0}, s0[9], x0;
+    long st;
+    int k;
+    d2.threads = 2;
+    if (load_rve(&a, &d1, RVE400) || load_rve(&b, &d1, RVE400) || load_rve(&c, &d2, RVE400)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_rve_set_velocity_gradient(&a, L) == GK_OK);
+    CHECK(gk_rve_set_velocity_gradient(&b, L) == GK_OK);
+    CHECK(gk_rve_set_velocity_gradient(&c, L) == GK_OK);
+    CHECK(gk_rve_step(&b, 1) == GK_OK);
+    memcpy(s0, b.stress, sizeof s0);
+    x0 = b.s[0][7];
+    CHECK(gk_rve_step_flags(&b, 1, GK_STEP_NO_STRESS) == GK_OK);
+    CHECK(memcmp(s0, b.stress, sizeof s0) == 0); /* not made */
+    CHECK(b.s[0][7] != x0);                      /* but it moved */
+    CHECK(gk_rve_step(&a, 2) == GK_OK);
+    for (k = 0; k < 300; ++k) {
+        CHECK(gk_rve_step(&a, 1) == GK_OK);
+        CHECK(gk_rve_step_flags(&b, 1, GK_STEP_NO_STRESS) == GK_OK);
+    }
+    CHECK(gk_rve_step_flags(&c, 302, GK_STEP_NO_STRESS) == GK_OK);
+    CHECK(same_physics_motion(&a, &b));
+    CHECK(same_physics_motion(&a, &c));
+    CHECK(a.rebuilds > 0); /* the lists were rebuilt on the way */
+    CHECK(gk_rve_step(&a, 1) == GK_OK && gk_rve_step(&b, 1) == GK_OK && gk_rve_step(&c, 1) == GK_OK);
+    CHECK(same_state(&a, &b));
+    CHECK(same_state(&a, &c));
+    st = b.step;
+    CHECK(gk_rve_step_flags(&b, 1, 2u) == GK_ERR_ARG && b.step == st && same_state(&a, &b));
+    gk_rve_destroy(&a);
+    gk_rve_destroy(&b);
+    gk_rve_destroy(&c);
 }
 
 /* The same in 3D, for each law, with every per-pair torque on (rotation,
@@ -1257,6 +1307,7 @@ int main(int argc, char **argv) {
     RUN(restore_rejects_bad_buffers);
     RUN(skin_does_not_change_results);
     RUN(threads_do_not_change_results);
+    RUN(steps_without_stress_move_the_same);
     RUN(threads_do_not_change_results_3d);
     RUN(consolidation_reaches_target_stress);
     RUN(consolidation_to_a_stress_ratio);

@@ -1398,6 +1398,10 @@ TEST(periodic_shear_between_walls) {
         CHECK(gk_scene_stress_box(&sc, nan_lo, mid_hi, s) == GK_ERR_ARG);
         CHECK(s[0] == 42.0);
     }
+    { /* (d) unknown step flags are refused before anything moves */
+        long st = sc.rve.step;
+        CHECK(gk_scene_step_flags(&sc, 1, 4u) == GK_ERR_ARG && sc.rve.step == st);
+    }
     CHECK_REL(normal, N, 0.02);
     CHECK(ratio > 0.05 && ratio < 0.5);
     for (p = 0; p < sc.rve.n; ++p) {
