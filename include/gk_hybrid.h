@@ -439,10 +439,44 @@ static int gk__hy_has_period(const gk_hybrid_periodic *per) {
     return per && (per->period[0] > 0 || per->period[1] > 0 || per->period[2] > 0);
 }
 
+/* when only x wraps and it has at most GK__HY_MAXCOPY copy columns: those
+ * columns, ascending, and their home columns (the same in every row) */
+#define GK__HY_MAXCOPY 64
+static int gk__hy_x_copies(const gk_mpm_grid *g, const gk_hybrid_periodic *per, int *col, int *hom, int *nc) {
+    int i, a;
+    if (per->period[0] <= 0) return 0;
+    for (a = 1; a < g->dim; ++a)
+        if (per->period[a] > 0) return 0;
+    *nc = 0;
+    for (i = 0; i < g->n[0]; ++i) {
+        int w;
+        if (i >= per->ghost[0] && i - per->ghost[0] < per->period[0]) continue; /* a home column */
+        w = gk__hy_wrap_index(i, per->ghost[0], per->period[0]);
+        if (w == i) continue;
+        if (*nc == GK__HY_MAXCOPY) return 0;
+        col[*nc] = i;
+        hom[*nc] = w;
+        ++*nc;
+    }
+    return 1;
+}
+
 /* visit every copy node I with its home H, in index order */
 #define GK__HY_FOR_COPIES(g, per, BODY)                                                                     \
     do {                                                                                                    \
-        int gk__i, gk__j, gk__k;                                                                            \
+        int gk__i, gk__j, gk__k, gk__q, gk__nc = 0, gk__col[GK__HY_MAXCOPY], gk__hom[GK__HY_MAXCOPY];       \
+        if (gk__hy_x_copies(g, per, gk__col, gk__hom, &gk__nc)) {                                           \
+            for (gk__k = 0; gk__k < (g)->n[2]; ++gk__k)                                                     \
+                for (gk__j = 0; gk__j < (g)->n[1]; ++gk__j) {                                               \
+                    size_t gk__row =                                                                        \
+                        (size_t)(g)->n[0] * ((size_t)gk__j + (size_t)(g)->n[1] * (size_t)gk__k);            \
+                    for (gk__q = 0; gk__q < gk__nc; ++gk__q) {                                              \
+                        size_t I = gk__row + (size_t)gk__col[gk__q], H = gk__row + (size_t)gk__hom[gk__q];  \
+                        BODY;                                                                               \
+                    }                                                                                       \
+                }                                                                                           \
+            break;                                                                                          \
+        }                                                                                                   \
         for (gk__k = 0; gk__k < (g)->n[2]; ++gk__k)                                                         \
             for (gk__j = 0; gk__j < (g)->n[1]; ++gk__j)                                                     \
                 for (gk__i = 0; gk__i < (g)->n[0]; ++gk__i) {                                               \

@@ -217,6 +217,36 @@ TEST(periodic_fold) {
     CHECK_REL(gm, M, 1e-14);
     CHECK_REL(gp[0], mom[0], 1e-13);
     CHECK_REL(gp[1], mom[1], 1e-13);
+    { /* fold and sync are gk_hybrid_home's map visited in index order (the
+       * sums in that order, to the bit): x alone; x with a short period
+       * (several copies per home); x and y */
+        int round;
+        for (round = 0; round < 3; ++round) {
+            gk_hybrid_periodic q = per;
+            double *a = (double *)malloc(g.nnode * sizeof(double)),
+                   *r = (double *)malloc(g.nnode * sizeof(double));
+            if (round == 1) q.period[0] = 3;
+            if (round == 2) {
+                q.ghost[1] = 1;
+                q.period[1] = 4; /* y nodes: home 1..4, copies 0, 5, 6 */
+            }
+            for (I = 0; I < g.nnode; ++I) a[I] = r[I] = 0.1 * (double)(I + 1);
+            gk_hybrid_fold(&g, &q, a);
+            for (I = 0; I < g.nnode; ++I) {
+                size_t H = gk_hybrid_home(&g, &q, I);
+                if (H == I) continue;
+                r[H] += r[I];
+                r[I] = 0.0;
+            }
+            CHECK(memcmp(a, r, g.nnode * sizeof(double)) == 0);
+            for (I = 0; I < g.nnode; ++I) a[I] = r[I] = 0.1 * (double)(I + 1);
+            gk_hybrid_sync(&g, &q, a);
+            for (I = 0; I < g.nnode; ++I) r[I] = r[gk_hybrid_home(&g, &q, I)];
+            CHECK(memcmp(a, r, g.nnode * sizeof(double)) == 0);
+            free(a);
+            free(r);
+        }
+    }
     /* wrapping: a point past the seam comes back by one period, its follower too */
     {
         double X0[1] = {0.0}, *fol[3];
