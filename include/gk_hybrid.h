@@ -492,12 +492,7 @@ static int gk__hy_x_copies(const gk_mpm_grid *g, const gk_hybrid_periodic *per, 
                             gk__copy |= gk__w != gk__c[gk__a];                                              \
                             gk__c[gk__a] = gk__w;                                                           \
                         }                                                                                   \
-                    if (!gk__copy) {                                                                        \
-                        /* only x wraps: jump over the home range of the row */                             \
-                        if ((per)->period[1] <= 0 && (per)->period[2] <= 0 && gk__i == (per)->ghost[0])     \
-                            gk__i = (per)->ghost[0] + (per)->period[0] - 1;                                 \
-                        continue;                                                                           \
-                    }                                                                                       \
+                    if (!gk__copy) continue;                                                                \
                     I = (size_t)gk__i +                                                                     \
                         (size_t)(g)->n[0] * ((size_t)gk__j + (size_t)(g)->n[1] * (size_t)gk__k);            \
                     H = (size_t)gk__c[0] +                                                                  \

@@ -1482,8 +1482,8 @@ static void gk__mpm_gather(const gk_mpm_grid *g, const gk__mpm_w *W, int vel, in
 }
 
 /* F_new = (I + dt L) F (2D: the plane block), returns det F_new */
-GK_FORCE_INLINE double gk__mpm_f_update(int dim, double dt, const double Lg[9], const double F[9],
-                                        double Fn[9]) {
+GK_FORCE_INLINE double gk__mpm_f_update_dim(int dim, double dt, const double Lg[9], const double F[9],
+                                            double Fn[9]) {
     double E[9];
     int k;
     for (k = 0; k < 9; ++k) E[k] = dt * Lg[k] + 0.0;
@@ -1496,6 +1496,13 @@ GK_FORCE_INLINE double gk__mpm_f_update(int dim, double dt, const double Lg[9], 
         Fn[8] = 1.0;
     }
     return gk_m3_det(Fn);
+}
+
+/* the same with the dimension a constant (the same operations) */
+GK_FORCE_INLINE double gk__mpm_f_update(int dim, double dt, const double Lg[9], const double F[9],
+                                        double Fn[9]) {
+    if (dim == 2) return gk__mpm_f_update_dim(2, dt, Lg, F, Fn);
+    return gk__mpm_f_update_dim(3, dt, Lg, F, Fn);
 }
 
 #define GK__MPM_SCR 19 /* scratch per point between the G2P passes: L, F_new, det F_new */
@@ -1539,8 +1546,7 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
         gk__mpm_gather(g, W, gather_vel, gather_grad, vg, apic_b, apic_g, &o);
     }
     if (dry) {
-        double Fn[9], J = dim == 2 ? gk__mpm_f_update(2, dt, o.Lg, P->F + 9 * p, Fn)
-                                   : gk__mpm_f_update(3, dt, o.Lg, P->F + 9 * p, Fn);
+        double Fn[9], J = gk__mpm_f_update(dim, dt, o.Lg, P->F + 9 * p, Fn);
         if (sp) {
             memcpy(sp, o.Lg, 9 * sizeof(double));
             memcpy(sp + 9, Fn, 9 * sizeof(double));
@@ -1564,8 +1570,7 @@ static int gk__mpm_g2p_point(const gk_mpm_grid *g, gk_mpm_points *P, const gk_mp
     if (grad) {
         double Fn[9], J;
         if (sp) return gk__mpm_g2p_commit(P, p, sp);
-        J = dim == 2 ? gk__mpm_f_update(2, dt, o.Lg, P->F + 9 * p, Fn)
-                     : gk__mpm_f_update(3, dt, o.Lg, P->F + 9 * p, Fn);
+        J = gk__mpm_f_update(dim, dt, o.Lg, P->F + 9 * p, Fn);
         memcpy(P->L + 9 * p, o.Lg, 9 * sizeof(double));
         gk_m3_copy(Fn, P->F + 9 * p);
         P->vol[p] = J * P->vol0[p];

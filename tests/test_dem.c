@@ -421,7 +421,6 @@ TEST(save_restore_is_bitwise) {
     gk_rve_destroy(&b);
 }
 
-/* physical state (not the lists): positions, velocities, spins, forces, stress */
 /* positions, velocities, forces, spins and torques bit for bit (not the stress) */
 static int same_physics_motion(const gk_rve *a, const gk_rve *b) {
     int k, p;
@@ -435,6 +434,7 @@ static int same_physics_motion(const gk_rve *a, const gk_rve *b) {
     return 1;
 }
 
+/* physical state (not the lists): positions, velocities, spins, forces, stress */
 static int same_physics(const gk_rve *a, const gk_rve *b) {
     int k;
     if (!same_physics_motion(a, b)) return 0;
