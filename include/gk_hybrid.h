@@ -204,11 +204,19 @@ typedef struct gk_hybrid_oracle {
     gk_allocator alloc;
 } gk_hybrid_oracle;
 
+/* a coupled grain's nodes and weights (a 2D basis: at most 4 x 4 nodes);
+ * the coupling keeps these, not the gradients, so they stay in cache */
+typedef struct gk_hybrid_stencil {
+    int n;
+    int32_t node[16];
+    double w[16];
+} gk_hybrid_stencil;
+
 /* scratch of the coupling, nnode entries each */
 typedef struct gk_hybrid_coupling {
     size_t nnode;
     double *md, *pd[2], *dv[2];
-    gk_mpm_stencil *st; /* the stencils of the coupled grains of a step */
+    gk_hybrid_stencil *st; /* the stencils of the coupled grains of a step */
     int cap;
     gk_allocator alloc;
 } gk_hybrid_coupling;
@@ -806,8 +814,9 @@ GKDEF gk_result gk_hybrid_rasterize(const gk_mpm_grid *g, const gk_hybrid_period
                                     const double *val, int ncomp, const unsigned char *skip, double *num,
                                     double *den, gk_err *err) {
     size_t nn = g->nnode;
-    int p, q, c;
-    gk_mpm_stencil st;
+    int p, q, c, ns;
+    int32_t node[GK_MPM_MAX_STENCIL];
+    double w[GK_MPM_MAX_STENCIL];
     if (ncomp < 0 || ncomp > 9) return gk_err_set(err, GK_ERR_ARG, "%d components (0..9)", ncomp);
     /* validate every position first: nothing is written on failure */
     for (p = 0; p < n; ++p) {
@@ -819,7 +828,8 @@ GKDEF gk_result gk_hybrid_rasterize(const gk_mpm_grid *g, const gk_hybrid_period
         xx[2] = g->dim == 3 ? x[2][p] : 0.0;
         if (!(m[p] >= 0.0) || !isfinite(m[p]))
             return gk_err_set(err, GK_ERR_MASS, "entry %d: mass %g", p, m[p]);
-        if ((r = gk_mpm_shape(g, basis, xx, lp, &st, err))) return gk__hybrid_prefix(err, r, "entry", p);
+        if ((r = gk_mpm_shape_values(g, basis, xx, lp, &ns, node, w, err)))
+            return gk__hybrid_prefix(err, r, "entry", p);
     }
     memset(den, 0, nn * sizeof(double));
     if (val) memset(num, 0, (size_t)ncomp * nn * sizeof(double));
@@ -829,14 +839,14 @@ GKDEF gk_result gk_hybrid_rasterize(const gk_mpm_grid *g, const gk_hybrid_period
         xx[0] = x[0][p];
         xx[1] = x[1][p];
         xx[2] = g->dim == 3 ? x[2][p] : 0.0;
-        gk_mpm_shape(g, basis, xx, lp, &st, NULL);
-        for (q = 0; q < st.n; ++q) {
-            double wm = st.w[q] * m[p];
-            if (st.w[q] == 0.0) continue;
-            den[st.node[q]] += wm;
+        gk_mpm_shape_values(g, basis, xx, lp, &ns, node, w, NULL);
+        for (q = 0; q < ns; ++q) {
+            double wm = w[q] * m[p];
+            if (w[q] == 0.0) continue;
+            den[node[q]] += wm;
             if (val)
                 for (c = 0; c < ncomp; ++c)
-                    num[(size_t)c * nn + (size_t)st.node[q]] += wm * val[(size_t)ncomp * p + c];
+                    num[(size_t)c * nn + (size_t)node[q]] += wm * val[(size_t)ncomp * p + c];
         }
     }
     gk_hybrid_fold(g, per, den);
@@ -1294,7 +1304,8 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
     memset(&rep, 0, sizeof rep);
     for (p = 0; p < ng; ++p) nc += coupled[p] != 0;
     if (nc > c->cap) {
-        gk_mpm_stencil *s2 = (gk_mpm_stencil *)gk_alloc(&c->alloc, (size_t)nc * sizeof(gk_mpm_stencil));
+        gk_hybrid_stencil *s2 =
+            (gk_hybrid_stencil *)gk_alloc(&c->alloc, (size_t)nc * sizeof(gk_hybrid_stencil));
         if (!s2) return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d grain stencils", nc);
         gk_free(&c->alloc, c->st);
         c->st = s2;
@@ -1303,12 +1314,14 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
     /* every stencil first (nothing is written if a grain is off the grid) */
     for (p = 0, i = 0; p < ng; ++p) {
         double x[3];
+        gk_hybrid_stencil *h;
         gk_result r;
         if (!coupled[p]) continue;
         x[0] = xpre[0][p];
         x[1] = xpre[1][p];
         x[2] = 0.0;
-        if ((r = gk_mpm_shape(g, basis, x, lp, &c->st[i++], err)))
+        h = &c->st[i++]; /* 2D: at most 4 x 4 nodes */
+        if ((r = gk_mpm_shape_values(g, basis, x, lp, &h->n, h->node, h->w, err)))
             return gk__hybrid_prefix(err, r, "coupled grain", p);
     }
     memset(c->md, 0, nn * sizeof(double));
@@ -1318,17 +1331,20 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
     }
     /* grains to the nodes: mass at x^n, momentum with v^{n+1/2} */
     for (p = 0, i = 0; p < ng; ++p) {
-        const gk_mpm_stencil *st;
-        double m;
+        const gk_hybrid_stencil *st;
+        double m, v0, v1, *md = c->md, *pd0 = c->pd[0], *pd1 = c->pd[1];
         if (!coupled[p]) continue;
         st = &c->st[i++];
         m = sc->mass[p] * inv_t;
+        v0 = (double)sc->rve.v[0][p];
+        v1 = (double)sc->rve.v[1][p];
         for (q = 0; q < st->n; ++q) {
             double wm = st->w[q] * m;
+            int32_t J = st->node[q];
             if (st->w[q] == 0.0) continue;
-            c->md[st->node[q]] += wm;
-            c->pd[0][st->node[q]] += wm * (double)sc->rve.v[0][p];
-            c->pd[1][st->node[q]] += wm * (double)sc->rve.v[1][p];
+            md[J] += wm;
+            pd0[J] += wm * v0;
+            pd1[J] += wm * v1;
         }
     }
     rep.grains = nc;
@@ -1355,14 +1371,17 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
     gk_hybrid_sync_velocity(g, per);
     /* FLIP correction of the grains and of their new positions */
     for (p = 0, i = 0; p < ng; ++p) {
-        const gk_mpm_stencil *st;
-        double dv[2] = {0.0, 0.0};
+        const gk_hybrid_stencil *st;
+        const double *dv0 = c->dv[0], *dv1 = c->dv[1];
+        double dv[2], a0 = 0.0, a1 = 0.0;
         if (!coupled[p]) continue;
         st = &c->st[i++];
         for (q = 0; q < st->n; ++q) {
-            dv[0] += st->w[q] * c->dv[0][st->node[q]];
-            dv[1] += st->w[q] * c->dv[1][st->node[q]];
+            a0 += st->w[q] * dv0[st->node[q]];
+            a1 += st->w[q] * dv1[st->node[q]];
         }
+        dv[0] = a0;
+        dv[1] = a1;
         for (k = 0; k < 2; ++k) {
             sc->rve.v[k][p] = (gk_real)((double)sc->rve.v[k][p] + dv[k]);
             sc->rve.s[k][p] += dt * dv[k] * sc->rve.cell.hinv[4 * k];

@@ -5,6 +5,7 @@
 #include "gk_mpm.h"
 #include "gk_test.h"
 #include <stdlib.h>
+#include <string.h>
 
 #ifdef GK_TEST_QUICK
 #define QUICK 1
@@ -184,7 +185,62 @@ TEST(support_inside_agrees_with_shape) {
     }
 }
 
-/* dN/dr of every 1D kernel equals the central difference of N */
+/* gk_mpm_shape_values: the nodes and weights of gk_mpm_shape bit for bit, and its result code, on
+ * random points in and around a 2D and a 3D grid for every basis (and NaN, an unknown basis, a bad
+ * uGIMP lp); it writes n entries and nothing beyond them, and nothing at all when it refuses */
+TEST(shape_values_equal_shape) {
+    int dim, bi, t, k, q;
+    gk_rng rng;
+    gk_rng_seed(&rng, 13);
+    for (dim = 2; dim <= 3; ++dim) {
+        gk_mpm_grid g = make_grid(dim, -1.0, 0.5, 2.0, 0.37, 9, 8, 7);
+        for (bi = 0; bi < 6; ++bi) {
+            gk_mpm_basis b = bi < 4 ? all_bases[bi] : (gk_mpm_basis)(bi == 4 ? 7 : -1);
+            for (t = 0; t < 300; ++t) {
+                gk_mpm_stencil st;
+                gk_err e1, e2;
+                int32_t node[GK_MPM_MAX_STENCIL + 1];
+                double w[GK_MPM_MAX_STENCIL + 1], x[3] = {0, 0, 0}, lp = 0.3 * g.h;
+                int n = -7;
+                gk_result r1, r2;
+                for (k = 0; k < dim; ++k)
+                    x[k] = g.origin[k] + g.h * (-1.0 + (g.n[k] + 1.0) * gk_rng_uniform(&rng));
+                if (t % 50 == 1) x[t % dim] = NAN;
+                if (t % 50 == 2) lp = 0.6 * g.h;
+                for (q = 0; q <= GK_MPM_MAX_STENCIL; ++q) {
+                    node[q] = -99;
+                    w[q] = -99.0;
+                }
+                r1 = gk_mpm_shape(&g, b, x, lp, &st, &e1);
+                r2 = gk_mpm_shape_values(&g, b, x, lp, &n, node, w, &e2);
+                CHECK_EQ_INT(r2, r1);
+                if (r1 == GK_OK) {
+                    CHECK_EQ_INT(n, st.n);
+                    CHECK(!memcmp(node, st.node, (size_t)st.n * sizeof(int32_t)));
+                    CHECK(!memcmp(w, st.w, (size_t)st.n * sizeof(double)));
+                } else {
+                    CHECK_EQ_INT(n, -7);
+                    CHECK(!strcmp(e1.msg, e2.msg));
+                }
+                for (q = r1 == GK_OK ? st.n : 0; q <= GK_MPM_MAX_STENCIL; ++q)
+                    CHECK(node[q] == -99 && w[q] == -99.0);
+            }
+        }
+        {
+            int32_t node[GK_MPM_MAX_STENCIL];
+            double w[GK_MPM_MAX_STENCIL], x[3];
+            int n;
+            gk_err e;
+            for (k = 0; k < 3; ++k) x[k] = g.origin[k] + 3.0 * g.h;
+            CHECK_EQ_INT(gk_mpm_shape_values(&g, GK_MPM_LINEAR, x, 0.0, NULL, node, w, &e), GK_ERR_ARG);
+            CHECK_EQ_INT(gk_mpm_shape_values(&g, GK_MPM_LINEAR, x, 0.0, &n, NULL, w, &e), GK_ERR_ARG);
+            CHECK_EQ_INT(gk_mpm_shape_values(&g, GK_MPM_LINEAR, x, 0.0, &n, node, NULL, &e), GK_ERR_ARG);
+        }
+        gk_mpm_grid_destroy(&g);
+    }
+}
+
+/* dN/dr of every 1D kernel equals the central difference of N; asked for N alone (dN NULL), the same N */
 TEST(kernel_derivative_matches_finite_difference) {
     int bi, t;
     for (bi = 0; bi < 4; ++bi)
@@ -192,8 +248,9 @@ TEST(kernel_derivative_matches_finite_difference) {
             double r = -2.2 + 4.4 * (t + 0.37) / 400.0, d, dm, dp, eps = 1e-6, l = 0.3;
             double Np = gk_mpm_kernel_1d(all_bases[bi], r + eps, l, &dp);
             double Nm = gk_mpm_kernel_1d(all_bases[bi], r - eps, l, &dm);
-            gk_mpm_kernel_1d(all_bases[bi], r, l, &d);
+            double N = gk_mpm_kernel_1d(all_bases[bi], r, l, &d);
             CHECK_NEAR(d, (Np - Nm) / (2 * eps), 1e-5);
+            CHECK(gk_mpm_kernel_1d(all_bases[bi], r, l, NULL) == N); /* the weight alone: the same */
         }
 }
 
@@ -1030,6 +1087,7 @@ TEST(bad_input_is_refused_and_changes_nothing) {
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(shape_partition_of_unity);
+    RUN(shape_values_equal_shape);
     RUN(support_inside_agrees_with_shape);
     RUN(kernel_derivative_matches_finite_difference);
     RUN(p2g_g2p_conserve_mass_and_momentum);
