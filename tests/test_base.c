@@ -2,6 +2,7 @@
  * allocator, random numbers, SIMD twin. */
 #include "gk_base.h"
 #include "gk_test.h"
+#include <float.h>
 #include <stdlib.h>
 
 static double max_abs_diff(const double *a, const double *b, int n) {
@@ -25,6 +26,27 @@ TEST(singular_inverse_leaves_output_untouched) {
     double a[9] = {1, 2, 3, 2, 4, 6, 1, 1, 1}, inv[9] = {7, 7, 7, 7, 7, 7, 7, 7, 7};
     CHECK(gk_m3_inverse(a, inv) == 0.0);
     CHECK(inv[0] == 7 && inv[8] == 7);
+}
+
+/* gk_m3_isfinite: 0 when any one entry is +inf, -inf or NaN, 1 for every finite value up to
+ * +-DBL_MAX, subnormals and -0 */
+TEST(m3_isfinite_finds_each_bad_entry) {
+    const double bad[3] = {HUGE_VAL, -HUGE_VAL, NAN}, good[5] = {DBL_MAX, -DBL_MAX, 4.9e-324, -0.0, 1.0};
+    double a[9];
+    int k, v;
+    for (k = 0; k < 9; ++k) {
+        int j;
+        for (v = 0; v < 5; ++v) {
+            for (j = 0; j < 9; ++j) a[j] = 0.5 * j;
+            a[k] = good[v];
+            CHECK(gk_m3_isfinite(a) == 1);
+        }
+        for (v = 0; v < 3; ++v) {
+            for (j = 0; j < 9; ++j) a[j] = 0.5 * j;
+            a[k] = bad[v];
+            CHECK(gk_m3_isfinite(a) == 0);
+        }
+    }
 }
 
 /* F = R U with R orthogonal (det +1) and U symmetric positive definite */
@@ -166,6 +188,7 @@ int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(inverse_times_matrix_is_identity);
     RUN(singular_inverse_leaves_output_untouched);
+    RUN(m3_isfinite_finds_each_bad_entry);
     RUN(polar_decomposition_2d_and_3d);
     RUN(polar_rejects_inverted_map);
     RUN(matrix_exponential);
