@@ -832,27 +832,27 @@ GK_FORCE_INLINE void gk__mpm_weights_b(const gk_mpm_grid *g, gk_mpm_basis basis,
     }
 }
 
-/* the weights and slopes of a point at x (l = lp/h): the loops above with the
- * basis a constant (the same operations) */
+/* the loops above with the basis (and grad) constants after inlining: the same operations */
+GK_FORCE_INLINE void gk__mpm_weights_d(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double l,
+                                       int grad, gk__mpm_w *W) {
+    switch (basis) {
+    case GK_MPM_LINEAR: gk__mpm_weights_b(g, GK_MPM_LINEAR, x, l, grad, W); break;
+    case GK_MPM_UGIMP: gk__mpm_weights_b(g, GK_MPM_UGIMP, x, l, grad, W); break;
+    case GK_MPM_QUADRATIC: gk__mpm_weights_b(g, GK_MPM_QUADRATIC, x, l, grad, W); break;
+    default: gk__mpm_weights_b(g, basis, x, l, grad, W); break;
+    }
+}
+
+/* the weights and slopes of a point at x (l = lp/h) */
 static void gk__mpm_weights(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double l,
                             gk__mpm_w *W) {
-    switch (basis) {
-    case GK_MPM_LINEAR: gk__mpm_weights_b(g, GK_MPM_LINEAR, x, l, 1, W); break;
-    case GK_MPM_UGIMP: gk__mpm_weights_b(g, GK_MPM_UGIMP, x, l, 1, W); break;
-    case GK_MPM_QUADRATIC: gk__mpm_weights_b(g, GK_MPM_QUADRATIC, x, l, 1, W); break;
-    default: gk__mpm_weights_b(g, basis, x, l, 1, W); break;
-    }
+    gk__mpm_weights_d(g, basis, x, l, 1, W);
 }
 
 /* the same weights without the slopes (W->dw is not written) */
 static void gk__mpm_weights_only(const gk_mpm_grid *g, gk_mpm_basis basis, const double x[3], double l,
                                  gk__mpm_w *W) {
-    switch (basis) {
-    case GK_MPM_LINEAR: gk__mpm_weights_b(g, GK_MPM_LINEAR, x, l, 0, W); break;
-    case GK_MPM_UGIMP: gk__mpm_weights_b(g, GK_MPM_UGIMP, x, l, 0, W); break;
-    case GK_MPM_QUADRATIC: gk__mpm_weights_b(g, GK_MPM_QUADRATIC, x, l, 0, W); break;
-    default: gk__mpm_weights_b(g, basis, x, l, 0, W); break;
-    }
+    gk__mpm_weights_d(g, basis, x, l, 0, W);
 }
 
 /* one point's cached weights: valid for the bits of x and l and the basis they were made with */
