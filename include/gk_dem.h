@@ -1265,16 +1265,21 @@ GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const 
     gk_vd dd[2][3];
     int hf, k;
     for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
-        gk_vd ds[3];
-        for (k = 0; k < dim; ++k) {
-            ds[k] = gk_vd_sub(gk_vd_gather(rve->s[k], jj + hf * GK_VD_W),
-                              gk_vd_gather(rve->s[k], ii + hf * GK_VD_W));
-            ds[k] = gk_vd_sub(ds[k], gk_vd_round(ds[k]));
-        }
-        for (k = 0; k < dim; ++k) {
-            gk_vd a = gk_vd_add(gk_vd_mul(H[3 * k], ds[0]), gk_vd_mul(H[3 * k + 1], ds[1]));
-            if (dim == 3) a = gk_vd_add(a, gk_vd_mul(H[3 * k + 2], ds[2]));
-            dd[hf][k] = a;
+        /* written out per axis: as a loop over k, gcc kept the loop and sent ds through the stack */
+        const int32_t *i4 = ii + hf * GK_VD_W, *j4 = jj + hf * GK_VD_W;
+        gk_vd ds0 = gk_vd_sub(gk_vd_gather(rve->s[0], j4), gk_vd_gather(rve->s[0], i4)),
+              ds1 = gk_vd_sub(gk_vd_gather(rve->s[1], j4), gk_vd_gather(rve->s[1], i4));
+        ds0 = gk_vd_sub(ds0, gk_vd_round(ds0));
+        ds1 = gk_vd_sub(ds1, gk_vd_round(ds1));
+        if (dim == 3) {
+            gk_vd ds2 = gk_vd_sub(gk_vd_gather(rve->s[2], j4), gk_vd_gather(rve->s[2], i4));
+            ds2 = gk_vd_sub(ds2, gk_vd_round(ds2));
+            for (k = 0; k < 3; ++k)
+                dd[hf][k] = gk_vd_add(gk_vd_add(gk_vd_mul(H[3 * k], ds0), gk_vd_mul(H[3 * k + 1], ds1)),
+                                      gk_vd_mul(H[3 * k + 2], ds2));
+        } else {
+            dd[hf][0] = gk_vd_add(gk_vd_mul(H[0], ds0), gk_vd_mul(H[1], ds1));
+            dd[hf][1] = gk_vd_add(gk_vd_mul(H[3], ds0), gk_vd_mul(H[4], ds1));
         }
     }
     for (k = 0; k < dim; ++k) {
@@ -1318,37 +1323,47 @@ GK_FORCE_INLINE void gk__simd_state(unsigned char *cs, gk_vrm in, gk_vrm slide, 
     }
 }
 
-GK_FORCE_INLINE void gk__scatter_buf_2d(gk_rve *rve, const int32_t *ii, const int32_t *jj, const gk_real *bx,
-                                        const gk_real *by, const gk_real *bi, const gk_real *bj,
-                                        unsigned rot) {
+/* b[0], b[1]: force on j (x, y); b[2], b[3]: torque on i, on j. One array
+ * on the stack, so the scatter needs no pointer of its own for each buffer
+ * (with four, gcc kept their addresses in spilled registers) */
+GK_FORCE_INLINE void gk__scatter_buf_2d(gk_rve *rve, const int32_t *ii, const int32_t *jj,
+                                        gk_real b[4][GK_VR_W], unsigned rot) {
     gk_real *f0 = rve->f[0], *f1 = rve->f[1], *t2 = rve->t[2];
     int l;
     for (l = 0; l < GK_VR_W; ++l) {
         int i = ii[l], j = jj[l];
-        f0[j] += bx[l];
-        f1[j] += by[l];
-        f0[i] -= bx[l];
-        f1[i] -= by[l];
+        f0[j] += b[0][l];
+        f1[j] += b[1][l];
+        f0[i] -= b[0][l];
+        f1[i] -= b[1][l];
         if (rot) {
-            t2[j] += bj[l];
-            t2[i] += bi[l];
+            t2[j] += b[3][l];
+            t2[i] += b[2][l];
         }
     }
 }
 
+/* b[k]: force on j along k; b[3 + k], b[6 + k]: torque on i, on j (one array, as in 2D) */
 GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const int32_t *jj,
-                                        gk_real bF[3][GK_VR_W], gk_real bI[3][GK_VR_W],
-                                        gk_real bJ[3][GK_VR_W], unsigned rot) {
-    int l, k;
+                                        gk_real b[9][GK_VR_W], unsigned rot) {
+    gk_real *f0 = rve->f[0], *f1 = rve->f[1], *f2 = rve->f[2];
+    int l;
     for (l = 0; l < GK_VR_W; ++l) {
         int i = ii[l], j = jj[l];
-        for (k = 0; k < 3; ++k) {
-            rve->f[k][j] += bF[k][l];
-            rve->f[k][i] -= bF[k][l];
-            if (rot) {
-                rve->t[k][j] += bJ[k][l];
-                rve->t[k][i] += bI[k][l];
-            }
+        f0[j] += b[0][l];
+        f0[i] -= b[0][l];
+        f1[j] += b[1][l];
+        f1[i] -= b[1][l];
+        f2[j] += b[2][l];
+        f2[i] -= b[2][l];
+        if (rot) {
+            gk_real *t0 = rve->t[0], *t1 = rve->t[1], *t2 = rve->t[2];
+            t0[j] += b[6][l];
+            t0[i] += b[3][l];
+            t1[j] += b[7][l];
+            t1[i] += b[4][l];
+            t2[j] += b[8][l];
+            t2[i] += b[5][l];
         }
     }
 }
@@ -1361,7 +1376,7 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
     const gk_vr G0 = gk_vr_set1(x->G[0]), G1 = gk_vr_set1(x->G[1]), G3 = gk_vr_set1(x->G[3]),
                 G4 = gk_vr_set1(x->G[4]);
     const gk_vr wa = gk_vr_set1(x->wa[2]);
-    gk_real bx[GK_VR_W], by[GK_VR_W], bi[GK_VR_W], bj[GK_VR_W];
+    gk_real b[4][GK_VR_W];
     gk_vd H[9];
     const uint64_t *lut = gk__bitbytes;
     int c = c0, pend = -1, k;
@@ -1405,17 +1420,17 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
             /* scatter the previous block now (its buffer stores have retired: no
              * store-forwarding stall) and buffer this one; pair order is kept */
             if (pend >= 0)
-                gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
-            gk_vr_storeu(bx, o.f[0]);
-            gk_vr_storeu(by, o.f[1]);
+                gk__scatter_buf_2d(rve, pi + pend, pj + pend, b, fl & GK_PHYS_ROTATION);
+            gk_vr_storeu(b[0], o.f[0]);
+            gk_vr_storeu(b[1], o.f[1]);
             if (fl & GK_PHYS_ROTATION) {
-                gk_vr_storeu(bi, o.ti[2]);
-                gk_vr_storeu(bj, o.tj[2]);
+                gk_vr_storeu(b[2], o.ti[2]);
+                gk_vr_storeu(b[3], o.tj[2]);
             }
             pend = c;
         }
     }
-    if (pend >= 0) gk__scatter_buf_2d(rve, pi + pend, pj + pend, bx, by, bi, bj, fl & GK_PHYS_ROTATION);
+    if (pend >= 0) gk__scatter_buf_2d(rve, pi + pend, pj + pend, b, fl & GK_PHYS_ROTATION);
     gk__forces_ref_2d(rve, x, c, c1, law, fl);
 }
 
@@ -1426,7 +1441,7 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
     const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), dt = gk_vr_set1(x->dt);
     gk_vr G[9], wa[3];
     gk_vd H[9];
-    gk_real bF[3][GK_VR_W], bI[3][GK_VR_W], bJ[3][GK_VR_W];
+    gk_real b[9][GK_VR_W];
     const uint64_t *lut = gk__bitbytes;
     int c = c0, k, pend = -1;
     for (k = 0; k < 9; ++k) {
@@ -1469,18 +1484,18 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
         }
         gk__simd_state(rve->cs + c, in, slide, lut);
         if (x->scatter) { /* pipelined as in 2D */
-            if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, bF, bI, bJ, fl & GK_PHYS_ROTATION);
+            if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, b, fl & GK_PHYS_ROTATION);
             for (k = 0; k < 3; ++k) {
-                gk_vr_storeu(bF[k], o.f[k]);
+                gk_vr_storeu(b[k], o.f[k]);
                 if (fl & GK_PHYS_ROTATION) {
-                    gk_vr_storeu(bI[k], o.ti[k]);
-                    gk_vr_storeu(bJ[k], o.tj[k]);
+                    gk_vr_storeu(b[3 + k], o.ti[k]);
+                    gk_vr_storeu(b[6 + k], o.tj[k]);
                 }
             }
             pend = c;
         }
     }
-    if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, bF, bI, bJ, fl & GK_PHYS_ROTATION);
+    if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, b, fl & GK_PHYS_ROTATION);
     gk__forces_ref_3d(rve, x, c, c1, law, fl);
 }
 #endif /* GK_VR_W > 1 */
