@@ -92,6 +92,17 @@
 /* leaf helpers: always visible, never a bare `inline` (C99 -O0 link hazard) */
 #define GK_INLINE static inline
 
+/* GK_UNROLL before a loop over the axes (2 or 3 turns, constant after
+ * inlining): gcc -O2 otherwise keeps such a loop in the SIMD kernels and
+ * passes its vectors through the stack */
+#if defined(__clang__)
+#define GK_UNROLL _Pragma("unroll")
+#elif defined(__GNUC__) && __GNUC__ >= 8
+#define GK_UNROLL _Pragma("GCC unroll 4")
+#else
+#define GK_UNROLL
+#endif
+
 #if defined(__GNUC__) || defined(__clang__)
 #define GK_FORCE_INLINE static inline __attribute__((always_inline))
 #define GK_UNUSED __attribute__((unused))

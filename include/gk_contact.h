@@ -525,11 +525,13 @@ GK_FORCE_INLINE void gk_contact_rotate_history_w(const gk_vr n[3], gk_vr a, gk_v
     p[1] = gk_vr_add(h[1], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[2], h[0]), gk_vr_mul(n[0], h[2]))));
     p[2] = gk_vr_add(h[2], gk_vr_mul(a, gk_vr_sub(gk_vr_mul(n[0], h[1]), gk_vr_mul(n[1], h[0]))));
     dn = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], n[0]), gk_vr_mul(p[1], n[1])), gk_vr_mul(p[2], n[2]));
+    GK_UNROLL
     for (k = 0; k < 3; ++k) p[k] = gk_vr_sub(p[k], gk_vr_mul(dn, n[k]));
     p2 = gk_vr_add(gk_vr_add(gk_vr_mul(p[0], p[0]), gk_vr_mul(p[1], p[1])), gk_vr_mul(p[2], p[2]));
     sc = gk_vr_sqrt(gk_vr_div(m2, p2));
     has = gk_vr_gt(m2, zero);
     pos = gk_vr_gt(p2, zero);
+    GK_UNROLL
     for (k = 0; k < 3; ++k) h[k] = gk_vr_select(has, gk_vr_select(pos, gk_vr_mul(p[k], sc), zero), h[k]);
 }
 
@@ -541,6 +543,7 @@ GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned f
     gk_real R = ri + rj, d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], dist, inv, n[3], delta, kn, fn, kt;
     unsigned char s = *st;
     int bonded = (flags & GK_PHYS_COHESION) && (s & GK_CS_BONDED), k;
+    GK_UNROLL
     for (k = 0; k < 3; ++k) o->f[k] = o->ti[k] = o->tj[k] = 0;
     o->fn = o->delta = 0;
     if (!(d2 < R * R) && !bonded) {
@@ -586,20 +589,24 @@ GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned f
         if (flags & GK_PHYS_TANGENT) {
             gk_real sw[3], vc[3], vcn, vt[3], f[3], tot[3], c[3], cap, fnp = fn > 0 ? fn : (gk_real)0, gt = 0,
                                                                        m2;
+            GK_UNROLL
             for (k = 0; k < 3; ++k) sw[k] = li * wi[k] + lj * wj[k];
             /* v_c = v - sw x n */
             vc[0] = v[0] - (sw[1] * n[2] - sw[2] * n[1]);
             vc[1] = v[1] - (sw[2] * n[0] - sw[0] * n[2]);
             vc[2] = v[2] - (sw[0] * n[1] - sw[1] * n[0]);
             vcn = vc[0] * n[0] + vc[1] * n[1] + vc[2] * n[2];
+            GK_UNROLL
             for (k = 0; k < 3; ++k) vt[k] = vc[k] - vcn * n[k];
             gk_contact_rotate_history(n[0], n[1], n[2], twist, ft);
+            GK_UNROLL
             for (k = 0; k < 3; ++k) {
                 f[k] = ft[k] - (kt * vt[k]) * dt;
                 tot[k] = f[k];
             }
             if (flags & GK_PHYS_VISCOUS) {
                 gt = K->zt2 * (gk_real)sqrt(mstar * kt);
+                GK_UNROLL
                 for (k = 0; k < 3; ++k) tot[k] = f[k] - gt * vt[k];
             }
             cap = K->mu * fnp;
@@ -614,6 +621,7 @@ GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned f
                 }
                 if (m2 > cap * cap) {
                     gk_real sc = cap / (gk_real)sqrt(m2);
+                    GK_UNROLL
                     for (k = 0; k < 3; ++k) {
                         tot[k] = tot[k] * sc;
                         f[k] = (flags & GK_PHYS_VISCOUS) ? tot[k] + gt * vt[k] : tot[k];
@@ -621,6 +629,7 @@ GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned f
                     s |= GK_CS_SLIDING;
                 }
             }
+            GK_UNROLL
             for (k = 0; k < 3; ++k) {
                 ft[k] = f[k];
                 o->f[k] = fn * n[k] + tot[k];
@@ -629,25 +638,31 @@ GK_FORCE_INLINE int gk_contact_3d(const gk_law_consts *K, gk_law law, unsigned f
             c[0] = n[1] * tot[2] - n[2] * tot[1];
             c[1] = n[2] * tot[0] - n[0] * tot[2];
             c[2] = n[0] * tot[1] - n[1] * tot[0];
+            GK_UNROLL
             for (k = 0; k < 3; ++k) {
                 o->ti[k] = -li * c[k];
                 o->tj[k] = -lj * c[k];
             }
         } else {
+            GK_UNROLL
             for (k = 0; k < 3; ++k) o->f[k] = fn * n[k];
         }
         if (flags & GK_PHYS_ROLLING) {
             gk_real wr[3], wrn, kr = (K->beta * kt) * (ri * rj), fnp = fn > 0 ? fn : (gk_real)0, capr, m2;
             capr = (K->eta * (ri < rj ? ri : rj)) * fnp;
+            GK_UNROLL
             for (k = 0; k < 3; ++k) wr[k] = wj[k] - wi[k];
             wrn = wr[0] * n[0] + wr[1] * n[1] + wr[2] * n[2];
             gk_contact_rotate_history(n[0], n[1], n[2], twist, mr);
+            GK_UNROLL
             for (k = 0; k < 3; ++k) mr[k] = mr[k] - (kr * (wr[k] - wrn * n[k])) * dt;
             m2 = mr[0] * mr[0] + mr[1] * mr[1] + mr[2] * mr[2];
             if (m2 > capr * capr) {
                 gk_real sc = capr / (gk_real)sqrt(m2);
+                GK_UNROLL
                 for (k = 0; k < 3; ++k) mr[k] = mr[k] * sc;
             }
+            GK_UNROLL
             for (k = 0; k < 3; ++k) {
                 o->ti[k] -= mr[k];
                 o->tj[k] += mr[k];
@@ -676,9 +691,11 @@ GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsig
     *slide = gk_vr_lt(one, zero);
     dist = gk_vr_sqrt(d2);
     inv = gk_vr_div(one, dist);
+    GK_UNROLL
     for (k = 0; k < 3; ++k) n[k] = gk_vr_mul(d[k], inv);
     delta = gk_vr_sub(R, dist);
     gk_contact_stiffness_w(K, law, ri, rj, delta, &kn, &fn, &kt);
+    GK_UNROLL
     for (k = 0; k < 3; ++k) o->ti[k] = o->tj[k] = zero;
     vn = gk_vr_add(gk_vr_add(gk_vr_mul(v[0], n[0]), gk_vr_mul(v[1], n[1])), gk_vr_mul(v[2], n[2]));
     if (flags & GK_PHYS_VISCOUS) {
@@ -694,19 +711,23 @@ GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsig
                                                          gk_vr_mul(gk_vr_add(wi[2], wj[2]), n[2])));
     if (flags & GK_PHYS_TANGENT) {
         gk_vr sw[3], vc[3], vcn, vt[3], f[3], tot[3], cc[3], cap, gt = zero, m2;
+        GK_UNROLL
         for (k = 0; k < 3; ++k) sw[k] = gk_vr_add(gk_vr_mul(li, wi[k]), gk_vr_mul(lj, wj[k]));
         vc[0] = gk_vr_sub(v[0], gk_vr_sub(gk_vr_mul(sw[1], n[2]), gk_vr_mul(sw[2], n[1])));
         vc[1] = gk_vr_sub(v[1], gk_vr_sub(gk_vr_mul(sw[2], n[0]), gk_vr_mul(sw[0], n[2])));
         vc[2] = gk_vr_sub(v[2], gk_vr_sub(gk_vr_mul(sw[0], n[1]), gk_vr_mul(sw[1], n[0])));
         vcn = gk_vr_add(gk_vr_add(gk_vr_mul(vc[0], n[0]), gk_vr_mul(vc[1], n[1])), gk_vr_mul(vc[2], n[2]));
+        GK_UNROLL
         for (k = 0; k < 3; ++k) vt[k] = gk_vr_sub(vc[k], gk_vr_mul(vcn, n[k]));
         gk_contact_rotate_history_w(n, twist, ft);
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             f[k] = gk_vr_sub(ft[k], gk_vr_mul(gk_vr_mul(kt, vt[k]), dt));
             tot[k] = f[k];
         }
         if (flags & GK_PHYS_VISCOUS) {
             gt = gk_vr_mul(gk_vr_set1(K->zt2), gk_vr_sqrt(gk_vr_mul(mstar, kt)));
+            GK_UNROLL
             for (k = 0; k < 3; ++k) tot[k] = gk_vr_sub(f[k], gk_vr_mul(gt, vt[k]));
         }
         cap = gk_vr_mul(gk_vr_set1(K->mu), gk_vr_max(fn, zero));
@@ -715,6 +736,7 @@ GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsig
         *slide = gk_vr_gt(m2, gk_vr_mul(cap, cap));
         if (gk_vrm_any(*slide)) {
             gk_vr sc = gk_vr_div(cap, gk_vr_sqrt(m2));
+            GK_UNROLL
             for (k = 0; k < 3; ++k) {
                 gk_vr t = gk_vr_mul(tot[k], sc);
                 tot[k] = gk_vr_select(*slide, t, tot[k]);
@@ -723,6 +745,7 @@ GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsig
                     f[k]);
             }
         }
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             ft[k] = gk_vr_select(in, f[k], zero);
             F[k] = gk_vr_add(gk_vr_mul(fn, n[k]), tot[k]);
@@ -730,34 +753,41 @@ GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsig
         cc[0] = gk_vr_sub(gk_vr_mul(n[1], tot[2]), gk_vr_mul(n[2], tot[1]));
         cc[1] = gk_vr_sub(gk_vr_mul(n[2], tot[0]), gk_vr_mul(n[0], tot[2]));
         cc[2] = gk_vr_sub(gk_vr_mul(n[0], tot[1]), gk_vr_mul(n[1], tot[0]));
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             o->ti[k] = gk_vr_mul(gk_vr_neg(li), cc[k]);
             o->tj[k] = gk_vr_mul(gk_vr_neg(lj), cc[k]);
         }
     } else {
+        GK_UNROLL
         for (k = 0; k < 3; ++k) F[k] = gk_vr_mul(fn, n[k]);
     }
     if (flags & GK_PHYS_ROLLING) {
         gk_vr wr[3], wrn, kr = gk_vr_mul(gk_vr_mul(gk_vr_set1(K->beta), kt), gk_vr_mul(ri, rj)), capr, m2;
         gk_vrm over;
         capr = gk_vr_mul(gk_vr_mul(gk_vr_set1(K->eta), gk_vr_min(ri, rj)), gk_vr_max(fn, zero));
+        GK_UNROLL
         for (k = 0; k < 3; ++k) wr[k] = gk_vr_sub(wj[k], wi[k]);
         wrn = gk_vr_add(gk_vr_add(gk_vr_mul(wr[0], n[0]), gk_vr_mul(wr[1], n[1])), gk_vr_mul(wr[2], n[2]));
         gk_contact_rotate_history_w(n, twist, mr);
+        GK_UNROLL
         for (k = 0; k < 3; ++k)
             mr[k] = gk_vr_sub(mr[k], gk_vr_mul(gk_vr_mul(kr, gk_vr_sub(wr[k], gk_vr_mul(wrn, n[k]))), dt));
         m2 = gk_vr_add(gk_vr_add(gk_vr_mul(mr[0], mr[0]), gk_vr_mul(mr[1], mr[1])), gk_vr_mul(mr[2], mr[2]));
         over = gk_vr_gt(m2, gk_vr_mul(capr, capr));
         if (gk_vrm_any(over)) {
             gk_vr sc = gk_vr_div(capr, gk_vr_sqrt(m2));
+            GK_UNROLL
             for (k = 0; k < 3; ++k) mr[k] = gk_vr_select(over, gk_vr_mul(mr[k], sc), mr[k]);
         }
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             o->ti[k] = gk_vr_sub(o->ti[k], mr[k]);
             o->tj[k] = gk_vr_add(o->tj[k], mr[k]);
             mr[k] = gk_vr_select(in, mr[k], zero);
         }
     }
+    GK_UNROLL
     for (k = 0; k < 3; ++k) {
         o->f[k] = gk_vr_select(in, F[k], zero);
         o->ti[k] = gk_vr_select(in, o->ti[k], zero);

@@ -1444,10 +1444,12 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
     gk_real b[9][GK_VR_W];
     const uint64_t *lut = gk__bitbytes;
     int c = c0, k, pend = -1;
+    GK_UNROLL
     for (k = 0; k < 9; ++k) {
         G[k] = gk_vr_set1(x->G[k]);
         H[k] = gk_vd_set1(x->hd[k]);
     }
+    GK_UNROLL
     for (k = 0; k < 3; ++k) wa[k] = gk_vr_set1(x->wa[k]);
     for (; c + GK_VR_W <= c1; c += GK_VR_W) {
         const int32_t *ii = pi + c, *jj = pj + c;
@@ -1457,6 +1459,7 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
         gk__simd_branch(rve, H, ii, jj, 3, d);
         ri = gk_vr_gather(rve->r, ii);
         rj = gk_vr_gather(rve->r, jj);
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             v[k] = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[k], jj), gk_vr_gather(rve->v[k], ii)),
                              gk_vr_add(gk_vr_add(gk_vr_mul(G[3 * k], d[0]), gk_vr_mul(G[3 * k + 1], d[1])),
@@ -1471,6 +1474,7 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
             mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
         }
         in = gk_contact_3d_w(&K, law, fl, d, ri, rj, mi, mj, v, wi, wj, dt, fh, mh, &slide, &o);
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             if (fl & GK_PHYS_TANGENT) gk_vr_store(rve->ft[k] + c, fh[k]);
             if (fl & GK_PHYS_ROLLING) gk_vr_store(rve->mr[k] + c, mh[k]);
@@ -1485,6 +1489,7 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
         gk__simd_state(rve->cs + c, in, slide, lut);
         if (x->scatter) { /* pipelined as in 2D */
             if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, b, fl & GK_PHYS_ROTATION);
+            GK_UNROLL
             for (k = 0; k < 3; ++k) {
                 gk_vr_storeu(b[k], o.f[k]);
                 if (fl & GK_PHYS_ROTATION) {
@@ -1838,16 +1843,19 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
     }
     for (; p + GK_VR_W <= p1; p += GK_VR_W) {
         gk_vr minv = gk_vr_loadu(rve->minv + p), a[3], v[3], nv[3], d[3];
+        GK_UNROLL
         for (k = 0; k < dim; ++k) {
             a[k] = gk_vr_mul(gk_vr_loadu(rve->f[k] + p), minv);
             v[k] = gk_vr_loadu(rve->v[k] + p);
         }
         if (damp == 1) {
-            for (k = 0; k < dim; ++k) a[k] = gk__damp_v(a[k], v[k], hdt, alpha);
+            GK_UNROLL
+        for (k = 0; k < dim; ++k) a[k] = gk__damp_v(a[k], v[k], hdt, alpha);
         } else if (damp == 2) {
             gk_vr w[3], vv, aa, sc;
             gk_vrm pos;
-            for (k = 0; k < dim; ++k) w[k] = gk_vr_add(v[k], gk_vr_mul(hdt, a[k]));
+            GK_UNROLL
+        for (k = 0; k < dim; ++k) w[k] = gk_vr_add(v[k], gk_vr_mul(hdt, a[k]));
             vv = gk_vr_add(gk_vr_mul(w[0], w[0]), gk_vr_mul(w[1], w[1]));
             aa = gk_vr_add(gk_vr_mul(a[0], a[0]), gk_vr_mul(a[1], a[1]));
             if (dim == 3) {
@@ -1856,8 +1864,10 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
             }
             pos = gk_vr_gt(vv, zero);
             sc = gk_vr_div(gk_vr_mul(alpha, gk_vr_sqrt(aa)), gk_vr_sqrt(vv));
-            for (k = 0; k < dim; ++k) a[k] = gk_vr_select(pos, gk_vr_sub(a[k], gk_vr_mul(sc, w[k])), a[k]);
+            GK_UNROLL
+        for (k = 0; k < dim; ++k) a[k] = gk_vr_select(pos, gk_vr_sub(a[k], gk_vr_mul(sc, w[k])), a[k]);
         }
+        GK_UNROLL
         for (k = 0; k < dim; ++k) {
             nv[k] = gk_vr_add(v[k], gk_vr_mul(dt, a[k]));
             gk_vr_storeu(rve->v[k] + p, nv[k]);
@@ -1867,8 +1877,10 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
         for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
             int q = p + hf * GK_VD_W;
             gk_vd dd[3], sp[3], e[3], u[3], u2;
-            for (k = 0; k < dim; ++k) dd[k] = gk__vr_half(d[k], hf);
-            for (k = 0; k < dim; ++k) {
+            GK_UNROLL
+        for (k = 0; k < dim; ++k) dd[k] = gk__vr_half(d[k], hf);
+            GK_UNROLL
+        for (k = 0; k < dim; ++k) {
                 gk_vd inc = gk_vd_add(gk_vd_mul(H[3 * k], dd[0]), gk_vd_mul(H[3 * k + 1], dd[1])), fl, r0;
                 if (dim == 3) inc = gk_vd_add(inc, gk_vd_mul(H[3 * k + 2], dd[2]));
                 sp[k] = gk_vd_add(gk_vd_loadu(rve->s[k] + q), inc);
@@ -1881,7 +1893,8 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
                 gk_vd_storeu(rve->s[k] + q, sp[k]);
                 e[k] = gk_vd_sub(sp[k], r0);
             }
-            for (k = 0; k < dim; ++k) {
+            GK_UNROLL
+        for (k = 0; k < dim; ++k) {
                 u[k] = gk_vd_add(gk_vd_mul(Gn[3 * k], e[0]), gk_vd_mul(Gn[3 * k + 1], e[1]));
                 if (dim == 3) u[k] = gk_vd_add(u[k], gk_vd_mul(Gn[3 * k + 2], e[2]));
             }
