@@ -1214,12 +1214,16 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
         double ds[3], dd[3];
         gk_real d[3], vr[3], wi[3], wj[3], hist[3], mh[3];
         gk_contact_out o;
+        GK_UNROLL
         for (k = 0; k < 3; ++k) ds[k] = rve->s[k][j] - rve->s[k][i];
         gk_pcell_image(x->hd, 3, ds, dd);
+        GK_UNROLL
         for (k = 0; k < 3; ++k) d[k] = (gk_real)dd[k];
+        GK_UNROLL
         for (k = 0; k < 3; ++k)
             vr[k] = (rve->v[k][j] - rve->v[k][i]) +
                     (x->G[3 * k] * d[0] + x->G[3 * k + 1] * d[1] + x->G[3 * k + 2] * d[2]);
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             wi[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][i] : x->wa[k];
             wj[k] = (fl & GK_PHYS_ROTATION) ? x->wa[k] + rve->w[k][j] : x->wa[k];
@@ -1228,6 +1232,7 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
         }
         gk_contact_3d(&rve->K, law, fl, d, r[i], r[j], (gk_real)1 / minv[i], (gk_real)1 / minv[j], vr, wi, wj,
                       x->dt, hist, mh, rve->cs + c, &o);
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             rve->ft[k][c] = hist[k];
             if (fl & GK_PHYS_ROLLING) rve->mr[k][c] = mh[k];
@@ -1240,6 +1245,7 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
             }
         }
         if (x->scatter)
+            GK_UNROLL
             for (k = 0; k < 3; ++k) {
                 rve->f[k][j] += o.f[k];
                 rve->f[k][i] -= o.f[k];
@@ -1618,6 +1624,7 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
                 GK_PREFETCH(fc1 + q);
                 GK_PREFETCH(fc2 + q);
                 if (rot)
+                    GK_UNROLL
                     for (k = 0; k < 3; ++k) GK_PREFETCH(rve->tcj[k] + q);
             }
             a0 += fc0[c];
@@ -1627,6 +1634,7 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
                 if (dim == 2)
                     t[2] += rve->tcj[2][c];
                 else
+                    GK_UNROLL
                     for (k = 0; k < 3; ++k) t[k] += rve->tcj[k][c];
             }
         }
@@ -1638,6 +1646,7 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
                 if (dim == 2)
                     t[2] += rve->tci[2][e];
                 else
+                    GK_UNROLL
                     for (k = 0; k < 3; ++k) t[k] += rve->tci[k][e];
             }
         }
@@ -1648,6 +1657,7 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
             if (dim == 2)
                 rve->t[2][p] = t[2];
             else
+                GK_UNROLL
                 for (k = 0; k < 3; ++k) rve->t[k][p] = t[k];
         }
     }
@@ -1775,11 +1785,14 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
             } else {
                 gk_real aw[3], wn;
                 int k;
+                GK_UNROLL
                 for (k = 0; k < 3; ++k) aw[k] = rve->t[k][p] * Iinv[p];
                 if (damp == 1) {
+                    GK_UNROLL
                     for (k = 0; k < 3; ++k) aw[k] = gk__damp_component(aw[k], rve->w[k][p], dt, alpha);
                 } else if (damp == 2) {
                     gk_real ve[3], vv = 0, aa = 0;
+                    GK_UNROLL
                     for (k = 0; k < 3; ++k) {
                         ve[k] = rve->w[k][p] + hdt * aw[k];
                         vv += ve[k] * ve[k];
@@ -1787,9 +1800,11 @@ GK_FORCE_INLINE double gk__integrate_kernel(gk_rve *rve, const gk__stepctx *x, c
                     }
                     if (vv > 0) {
                         gk_real sc = alpha * (gk_real)sqrt(aa) / (gk_real)sqrt(vv);
+                        GK_UNROLL
                         for (k = 0; k < 3; ++k) aw[k] = aw[k] - sc * ve[k];
                     }
                 }
+                GK_UNROLL
                 for (k = 0; k < 3; ++k) {
                     wn = rve->w[k][p] + dt * aw[k];
                     rve->w[k][p] = wn;
