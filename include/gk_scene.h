@@ -828,10 +828,12 @@ static double gk__wall_geom(const gk_wall *W, int dim, const double x[3], double
     const gk_wall_def *d = &W->def;
     double u[3], dist = 0.0, l2;
     int k;
+    GK_UNROLL
     for (k = 0; k < 3; ++k) u[k] = k < dim ? x[k] - W->pos[k] : 0.0;
     switch (d->kind) {
     case GK_WALL_PLANE:
         dist = gk__dot3(u, d->normal);
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             n[k] = d->normal[k];
             c[k] = x[k] - dist * n[k];
@@ -842,6 +844,7 @@ static double gk__wall_geom(const gk_wall *W, int dim, const double x[3], double
         double t1 = gk__dot3(u, d->e1) / gk__dot3(d->e1, d->e1), t2 = 0.0;
         t1 = gk_clamp(t1, 0.0, 1.0);
         if (d->kind == GK_WALL_RECT) t2 = gk_clamp(gk__dot3(u, d->e2) / gk__dot3(d->e2, d->e2), 0.0, 1.0);
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             c[k] = W->pos[k] + t1 * d->e1[k] + t2 * d->e2[k];
             n[k] = k < dim ? x[k] - c[k] : 0.0;
@@ -850,6 +853,7 @@ static double gk__wall_geom(const gk_wall *W, int dim, const double x[3], double
     }
     default: { /* disk, cylinder */
         double a = d->kind == GK_WALL_CYLINDER ? gk__dot3(u, d->axis) : 0.0, rho;
+        GK_UNROLL
         for (k = 0; k < 3; ++k) n[k] = u[k] - (d->kind == GK_WALL_CYLINDER ? a * d->axis[k] : 0.0);
         rho = sqrt(gk__dot3(n, n));
         if (!(rho > 0.0)) { /* on the axis: any radial direction */
@@ -861,10 +865,13 @@ static double gk__wall_geom(const gk_wall *W, int dim, const double x[3], double
             }
             rho = 0.0;
         } else {
+            GK_UNROLL
             for (k = 0; k < 3; ++k) n[k] /= rho;
         }
+        GK_UNROLL
         for (k = 0; k < 3; ++k) c[k] = x[k] - (rho - d->radius) * n[k];
         if (d->inside) {
+            GK_UNROLL
             for (k = 0; k < 3; ++k) n[k] = -n[k];
             return d->radius - rho;
         }
@@ -874,6 +881,7 @@ static double gk__wall_geom(const gk_wall *W, int dim, const double x[3], double
     l2 = gk__dot3(n, n);
     dist = sqrt(l2);
     if (dist > 0.0) {
+        GK_UNROLL
         for (k = 0; k < 3; ++k) n[k] /= dist;
     } else { /* centre on the wall: normal of the wall's plane */
         double e[3];
@@ -885,6 +893,7 @@ static double gk__wall_geom(const gk_wall *W, int dim, const double x[3], double
             e[2] = 0.0;
         }
         l2 = sqrt(gk__dot3(e, e));
+        GK_UNROLL
         for (k = 0; k < 3; ++k) n[k] = e[k] / l2;
     }
     return dist;
@@ -1400,8 +1409,10 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
         if (!(dist < r) && !(cs & GK_CS_CONTACT)) continue;
         if (r + dist < 1e-3 * r) dist = 1e-3 * r - r; /* centre through the wall: keep the branch defined */
         /* surface velocity at the contact: translation + spin x (c - centre) */
+        GK_UNROLL
         for (k = 0; k < 3; ++k) rel[k] = c[k] - W->pos[k];
         gk_v3_cross(W->def.spin, rel, vs);
+        GK_UNROLL
         for (k = 0; k < 3; ++k) {
             vs[k] += W->vel[k];
             if (k >= dim) vs[k] = 0.0;
@@ -1409,6 +1420,7 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
             v[k] = k < dim ? (gk_real)((double)rve->v[k][p] - vs[k]) : 0;
             wj[k] = (rot && rve->w[k]) ? rve->w[k][p] : 0;
         }
+        GK_UNROLL
         for (k = 0; k < nh; ++k) {
             if (W->ft[k]) ft[dim == 2 ? 0 : k] = W->ft[k][p];
             if (W->mr[k]) mr[dim == 2 ? 0 : k] = W->mr[k][p];
@@ -1416,6 +1428,7 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
         gk__wall_consts(W, r, &Kc);
         gk__contact_terms(&Kc, law, W->phys, dim, d, (gk_real)r, (gk_real)r, m, m, v, zero3, wj, dt,
                           sc->energy_on, ft, mr, &cs, &t);
+        GK_UNROLL
         for (k = 0; k < nh; ++k) {
             if (W->ft[k]) W->ft[k][p] = ft[dim == 2 ? 0 : k];
             if (W->mr[k]) W->mr[k][p] = mr[dim == 2 ? 0 : k];
@@ -1428,18 +1441,23 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
             gk_contact_stiffness(&Kc, law, (gk_real)r, (gk_real)r, t.o.delta, &kn, &fn, &kt);
             K += (double)kn;
             if ((double)t.o.delta > dmax) dmax = (double)t.o.delta;
+            GK_UNROLL
             for (k = 0; k < 3; ++k) f[k] = k < dim ? (double)t.o.f[k] : 0.0;
+            GK_UNROLL
             for (k = 0; k < dim; ++k) rve->f[k][p] += t.o.f[k];
             if (rot) {
                 if (dim == 2)
                     rve->t[2][p] += t.o.tj[2];
                 else
+                    GK_UNROLL
                     for (k = 0; k < 3; ++k) rve->t[k][p] += t.o.tj[k];
             }
             /* the wall receives -(force) and -(moment of the particle's load about pos) */
+            GK_UNROLL
             for (k = 0; k < 3; ++k) arm[k] = x[k] - W->pos[k];
             if (dim == 2) arm[2] = 0.0;
             gk_v3_cross(arm, f, mp);
+            GK_UNROLL
             for (k = 0; k < 3; ++k) {
                 F[k] -= f[k];
                 M[k] -= mp[k] + (dim == 3 || k == 2 ? (double)t.o.tj[k] : 0.0);
@@ -1455,6 +1473,7 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
             ++nc;
         }
     }
+    GK_UNROLL
     for (k = 0; k < 3; ++k) {
         W->force[k] = F[k];
         W->moment[k] = M[k];
