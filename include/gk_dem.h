@@ -1280,6 +1280,7 @@ GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const 
         if (dim == 3) {
             gk_vd ds2 = gk_vd_sub(gk_vd_gather(rve->s[2], j4), gk_vd_gather(rve->s[2], i4));
             ds2 = gk_vd_sub(ds2, gk_vd_round(ds2));
+            GK_UNROLL
             for (k = 0; k < 3; ++k)
                 dd[hf][k] = gk_vd_add(gk_vd_add(gk_vd_mul(H[3 * k], ds0), gk_vd_mul(H[3 * k + 1], ds1)),
                                       gk_vd_mul(H[3 * k + 2], ds2));
