@@ -1244,7 +1244,7 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
                 }
             }
         }
-        if (x->scatter)
+        if (x->scatter) {
             GK_UNROLL
             for (k = 0; k < 3; ++k) {
                 rve->f[k][j] += o.f[k];
@@ -1254,6 +1254,7 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
                     rve->t[k][i] += o.ti[k];
                 }
             }
+        }
     }
 }
 
@@ -1353,7 +1354,8 @@ GK_FORCE_INLINE void gk__scatter_buf_2d(gk_rve *rve, const int32_t *ii, const in
 /* b[k]: force on j along k; b[3 + k], b[6 + k]: torque on i, on j (one array, as in 2D) */
 GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const int32_t *jj,
                                         gk_real b[9][GK_VR_W], unsigned rot) {
-    gk_real *f0 = rve->f[0], *f1 = rve->f[1], *f2 = rve->f[2];
+    gk_real *f0 = rve->f[0], *f1 = rve->f[1], *f2 = rve->f[2], *t0 = rve->t[0], *t1 = rve->t[1],
+            *t2 = rve->t[2];
     int l;
     for (l = 0; l < GK_VR_W; ++l) {
         int i = ii[l], j = jj[l];
@@ -1364,7 +1366,6 @@ GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const in
         f2[j] += b[2][l];
         f2[i] -= b[2][l];
         if (rot) {
-            gk_real *t0 = rve->t[0], *t1 = rve->t[1], *t2 = rve->t[2];
             t0[j] += b[6][l];
             t0[i] += b[3][l];
             t1[j] += b[7][l];
@@ -1426,8 +1427,7 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
         if (x->scatter) {
             /* scatter the previous block now (its buffer stores have retired: no
              * store-forwarding stall) and buffer this one; pair order is kept */
-            if (pend >= 0)
-                gk__scatter_buf_2d(rve, pi + pend, pj + pend, b, fl & GK_PHYS_ROTATION);
+            if (pend >= 0) gk__scatter_buf_2d(rve, pi + pend, pj + pend, b, fl & GK_PHYS_ROTATION);
             gk_vr_storeu(b[0], o.f[0]);
             gk_vr_storeu(b[1], o.f[1]);
             if (fl & GK_PHYS_ROTATION) {
@@ -1624,9 +1624,10 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
                 GK_PREFETCH(fc0 + q);
                 GK_PREFETCH(fc1 + q);
                 GK_PREFETCH(fc2 + q);
-                if (rot)
+                if (rot) {
                     GK_UNROLL
                     for (k = 0; k < 3; ++k) GK_PREFETCH(rve->tcj[k] + q);
+                }
             }
             a0 += fc0[c];
             a1 += fc1[c];
@@ -1634,9 +1635,10 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
             if (rot) {
                 if (dim == 2)
                     t[2] += rve->tcj[2][c];
-                else
+                else {
                     GK_UNROLL
                     for (k = 0; k < 3; ++k) t[k] += rve->tcj[k][c];
+                }
             }
         }
         for (e = start[p]; e < start[p + 1]; ++e) {
@@ -1646,9 +1648,10 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
             if (rot) {
                 if (dim == 2)
                     t[2] += rve->tci[2][e];
-                else
+                else {
                     GK_UNROLL
                     for (k = 0; k < 3; ++k) t[k] += rve->tci[k][e];
+                }
             }
         }
         f0[p] = a0;
@@ -1657,9 +1660,10 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
         if (rot) {
             if (dim == 2)
                 rve->t[2][p] = t[2];
-            else
+            else {
                 GK_UNROLL
                 for (k = 0; k < 3; ++k) rve->t[k][p] = t[k];
+            }
         }
     }
 }
@@ -1866,12 +1870,12 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
         }
         if (damp == 1) {
             GK_UNROLL
-        for (k = 0; k < dim; ++k) a[k] = gk__damp_v(a[k], v[k], hdt, alpha);
+            for (k = 0; k < dim; ++k) a[k] = gk__damp_v(a[k], v[k], hdt, alpha);
         } else if (damp == 2) {
             gk_vr w[3], vv, aa, sc;
             gk_vrm pos;
             GK_UNROLL
-        for (k = 0; k < dim; ++k) w[k] = gk_vr_add(v[k], gk_vr_mul(hdt, a[k]));
+            for (k = 0; k < dim; ++k) w[k] = gk_vr_add(v[k], gk_vr_mul(hdt, a[k]));
             vv = gk_vr_add(gk_vr_mul(w[0], w[0]), gk_vr_mul(w[1], w[1]));
             aa = gk_vr_add(gk_vr_mul(a[0], a[0]), gk_vr_mul(a[1], a[1]));
             if (dim == 3) {
@@ -1881,7 +1885,7 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
             pos = gk_vr_gt(vv, zero);
             sc = gk_vr_div(gk_vr_mul(alpha, gk_vr_sqrt(aa)), gk_vr_sqrt(vv));
             GK_UNROLL
-        for (k = 0; k < dim; ++k) a[k] = gk_vr_select(pos, gk_vr_sub(a[k], gk_vr_mul(sc, w[k])), a[k]);
+            for (k = 0; k < dim; ++k) a[k] = gk_vr_select(pos, gk_vr_sub(a[k], gk_vr_mul(sc, w[k])), a[k]);
         }
         GK_UNROLL
         for (k = 0; k < dim; ++k) {
@@ -1894,9 +1898,9 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
             int q = p + hf * GK_VD_W;
             gk_vd dd[3], sp[3], e[3], u[3], u2;
             GK_UNROLL
-        for (k = 0; k < dim; ++k) dd[k] = gk__vr_half(d[k], hf);
+            for (k = 0; k < dim; ++k) dd[k] = gk__vr_half(d[k], hf);
             GK_UNROLL
-        for (k = 0; k < dim; ++k) {
+            for (k = 0; k < dim; ++k) {
                 gk_vd inc = gk_vd_add(gk_vd_mul(H[3 * k], dd[0]), gk_vd_mul(H[3 * k + 1], dd[1])), fl, r0;
                 if (dim == 3) inc = gk_vd_add(inc, gk_vd_mul(H[3 * k + 2], dd[2]));
                 sp[k] = gk_vd_add(gk_vd_loadu(rve->s[k] + q), inc);
@@ -1910,7 +1914,7 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
                 e[k] = gk_vd_sub(sp[k], r0);
             }
             GK_UNROLL
-        for (k = 0; k < dim; ++k) {
+            for (k = 0; k < dim; ++k) {
                 u[k] = gk_vd_add(gk_vd_mul(Gn[3 * k], e[0]), gk_vd_mul(Gn[3 * k + 1], e[1]));
                 if (dim == 3) u[k] = gk_vd_add(u[k], gk_vd_mul(Gn[3 * k + 2], e[2]));
             }

@@ -1448,9 +1448,10 @@ static void gk__wall_contacts(gk_scene *sc, gk_wall *W) {
             if (rot) {
                 if (dim == 2)
                     rve->t[2][p] += t.o.tj[2];
-                else
+                else {
                     GK_UNROLL
                     for (k = 0; k < 3; ++k) rve->t[k][p] += t.o.tj[k];
+                }
             }
             /* the wall receives -(force) and -(moment of the particle's load about pos) */
             GK_UNROLL
