@@ -29,6 +29,11 @@
 #   PEERS_WORK     scratch directory (build/peers)
 #   PEERS_MPIRUN   MPI launcher for the 2-rank LAMMPS run (mpirun)
 #
+# LAMMPS also runs once more on one rank in an orthogonal box under pure shear
+# at the same rate from rest (peer lammps_pure, its faster box): a speed
+# reference only, since its stress is not that of the simple shear; packings
+# whose cell is skewed skip it.
+#
 # Output: one "PEER peer=... case=... ranks=... n=... steps=...
 # particle_steps_per_s=... contact_steps_per_s=... pair_fraction=...
 # contacts_per_particle=... sxx=... syy=... sxy=..." line per run (stress
@@ -167,6 +172,17 @@ for cs in $CASES; do
                 fi
                 parse_lmp lammps "$cs" "$np" "$S" "$log" "$note"
             done
+            # LAMMPS's faster orthogonal box: pure shear at the same rate from rest, one
+            # rank, a speed reference only (its stress is not the simple shear's)
+            if python3 $PEERDIR/pack2lammps.py "$pk" "$WORK/${cs}_pure.data" --orthogonal --shear-rate 0 \
+                2>"$WORK/${cs}_pure.conv"; then
+                log=$WORK/lammps_pure_${cs}_np1.log
+                OMP_NUM_THREADS=1 lmp -log none -echo none -in $PEERDIR/lammps.in -var data "$WORK/${cs}_pure.data" \
+                    -var dim "$dim" -var warm "$W" -var steps "$S" -var reps "$REPS" -var mode pure >"$log" 2>&1
+                parse_lmp lammps_pure "$cs" 1 "$S" "$log" "pure_shear"
+            else
+                skip "peer=lammps_pure case=$cs: the starting cell is skewed (pure shear runs in an orthogonal box)"
+            fi
         else
             skip "peer=lammps case=$cs: conversion failed: $(cat "$WORK/$cs.conv")"
         fi
@@ -226,11 +242,11 @@ awk '/^PEER/ {
   function rd(a,b) { return b==0 ? 0 : (a-b)/(b<0?-b:b) }
   function ab(x) { return x<0?-x:x }
   END {
-    printf "%-8s %-9s %5s %8s %12s %12s %12s %7s %8s %12s  %s\n", "case", "peer", "ranks", "cont/p", "sxx", "syy", "sxy", "dev", "cont/p@0", "sxx@0", "note"
+    printf "%-8s %-11s %5s %8s %12s %12s %12s %7s %8s %12s  %s\n", "case", "peer", "ranks", "cont/p", "sxx", "syy", "sxy", "dev", "cont/p@0", "sxx@0", "note"
     for (i=1;i<=k;i++) {
         split(L[i], f, SUBSEP); c=f[1]
         d=ab(rd(f[4],gc[c])); e=ab(rd(f[5],gx[c])); if(e>d)d=e; e=ab(rd(f[6],gy[c])); if(e>d)d=e; e=ab(rd(f[7],gs[c])); if(e>d)d=e
-        printf "%-8s %-9s %5s %8s %12.6g %12.6g %12.6g %6.2f%% %8s %12s  %s\n", c, f[2], f[3], f[4], f[5], f[6], f[7], 100*d, f[9], f[10], f[8]
+        printf "%-8s %-11s %5s %8s %12.6g %12.6g %12.6g %6.2f%% %8s %12s  %s\n", c, f[2], f[3], f[4], f[5], f[6], f[7], 100*d, f[9], f[10], f[8]
     }
   }' "$RES"
 
@@ -246,11 +262,13 @@ awk '/^PEER/ {
   function cell(c,p,t) { return ((c,p,t) in r) ? sprintf("%8.2f", r[c,p,t]) : sprintf("%8s", "-") }
   function ratio(c,p,t) { return ((c,p,t) in r && (c,"grainkit",t) in r && r[c,p,t]>0) ? sprintf("%8.1fx", r[c,"grainkit",t]/r[c,p,t]) : sprintf("%9s", "-") }
   END {
-    printf "%-8s %3s %8s %8s %9s %8s %9s %8s %9s\n", "case", "thr", "grainkit", "lammps", "gk/lmp", "liggghts", "gk/lig", "yade", "gk/yade"
+    printf "%-8s %3s %8s %8s %9s %8s %9s %8s %9s %8s %9s\n", "case", "thr", "grainkit", "lammps", "gk/lmp", "lmp_pure", "gk/lmp_p",
+        "liggghts", "gk/lig", "yade", "gk/yade"
     for (i=1;i<=nc;i++) for (t=1;t<=2;t++) {
         c=order[i]
-        printf "%-8s %3d %s %s %s %s %s %s %s\n", c, t, cell(c,"grainkit",t), cell(c,"lammps",t), ratio(c,"lammps",t),
-            cell(c,"liggghts",t), ratio(c,"liggghts",t), cell(c,"yade",t), ratio(c,"yade",t)
+        printf "%-8s %3d %s %s %s %s %s %s %s %s %s\n", c, t, cell(c,"grainkit",t), cell(c,"lammps",t), ratio(c,"lammps",t),
+            cell(c,"lammps_pure",t), ratio(c,"lammps_pure",t), cell(c,"liggghts",t), ratio(c,"liggghts",t),
+            cell(c,"yade",t), ratio(c,"yade",t)
     }
   }' "$RES"
 echo
