@@ -32,10 +32,14 @@ TOOL_SRC := $(wildcard tools/*.c)
 TESTS    := $(patsubst tests/%.c,$(BUILD)/%,$(TEST_SRC))
 
 # the optional MPI build (gk_twoscale.h with GK_TWOSCALE_MPI): `make mpi`; `make test` runs its tests
-# with 2 ranks when mpicc is installed (Open MPI: openmpi-bin libopenmpi-dev) and says so when not
+# with 2 ranks when mpicc builds an MPI program (Open MPI: openmpi-bin libopenmpi-dev) and says so when
+# not. The probe compiles and links one: mpicc alone is not enough (openmpi-bin, which other packages
+# pull in, has mpicc without mpi.h). \043 is the '#' of #include (a bare one starts a comment in make)
 MPICC   ?= mpicc
 MPIRUN  ?= mpirun
-HAVE_MPI := $(shell command -v $(MPICC) >/dev/null 2>&1 && command -v $(MPIRUN) >/dev/null 2>&1 && echo yes)
+HAVE_MPI := $(shell command -v $(MPIRUN) >/dev/null 2>&1 && \
+              printf '\043include <mpi.h>\nint main(int c, char **v) { MPI_Init(&c, &v); return MPI_Finalize(); }\n' | \
+              $(MPICC) -x c -o /dev/null - >/dev/null 2>&1 && echo yes)
 # Open MPI refuses root without --allow-run-as-root, and more ranks than it counts cores without
 # --oversubscribe (other MPIs do not know these flags)
 MPIRUN_FLAGS ?= $(shell $(MPIRUN) --version 2>/dev/null | grep -q 'Open MPI' && \
@@ -181,13 +185,13 @@ mpi: $(MPI_PROGS)
 MPI_RUN := $(MPI_RUNNERS)
 else
 mpi:
-	@echo "make mpi: $(MPICC) or $(MPIRUN) not found, the MPI programs are skipped (Debian: apt-get install openmpi-bin libopenmpi-dev)"
+	@echo "make mpi: $(MPICC) cannot build an MPI program or $(MPIRUN) is missing, the MPI programs are skipped (Debian: apt-get install openmpi-bin libopenmpi-dev)"
 MPI_RUN :=
 endif
 
 # bench_tradeoff too: test_untrusted checks that a failed run fails it
 test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) $(BUILD)/bench_tradeoff $(if $(HAVE_MPI),$(MPI_PROGS)) | $(BUILD)/tests
-	@$(if $(HAVE_MPI),,echo "make test: $(MPICC) not found, the MPI tests are skipped (apt-get install openmpi-bin libopenmpi-dev)";) \
+	@$(if $(HAVE_MPI),,echo "make test: $(MPICC) cannot build an MPI program or $(MPIRUN) is missing, the MPI tests are skipped (apt-get install openmpi-bin libopenmpi-dev)";) \
 	  tests/run_tests.sh $(TESTS) $(FUZZ_REPLAY) $(MPI_RUN)
 
 # the fuzz corpora and every crasher replayed by a plain program (tests/fuzz/replay.c);
