@@ -1487,8 +1487,8 @@ GKDEF gk_result gk_twoscale_accept(gk_twoscale *ts) {
     if (!gk__ts_allok(ts, ok))
         return gk_err_set(&ts->err, GK_ERR_ALLOC, "out of memory accepting the trial states");
     {
-        /* the copies on the run's threads: each point writes its own buffer (on one thread
-         * this was an eighth of an MPM x DEM step on two, the other thread waiting) */
+        /* on the run's threads: each point copies its state into its own buffer (on one
+         * thread, these copies left the others waiting for a large part of a short run) */
         int nth = ts->def.threads;
         GK_OMP(parallel for num_threads(nth) schedule(dynamic, 4))
         for (j = 0; j < ts->nlocal; ++j) {
