@@ -1487,8 +1487,8 @@ GKDEF gk_result gk_twoscale_accept(gk_twoscale *ts) {
     if (!gk__ts_allok(ts, ok))
         return gk_err_set(&ts->err, GK_ERR_ALLOC, "out of memory accepting the trial states");
     {
-        /* on the run's threads: each point copies its state into its own buffer (on one
-         * thread, these copies left the others waiting for a large part of a short run) */
+        /* on the run's threads: each point copies its state into its own buffer (a copy can
+         * cost as much as a short run of its point) */
         int nth = ts->def.threads;
         GK_OMP(parallel for num_threads(nth) schedule(dynamic, 4))
         for (j = 0; j < ts->nlocal; ++j) {
