@@ -110,6 +110,17 @@ parse_lmp() {
         tee -a "$RES"
 }
 
+# LAMMPS on the peer input: lmp_run DATA LOG [-var NAME VALUE ...] after LMP_LAUNCH="" (one
+# process) or LMP_LAUNCH="mpirun flags -np N"; dim, W, S, REPS are the case's
+lmp_run() {
+    lr_data=$1 lr_log=$2
+    shift 2
+    # shellcheck disable=SC2086
+    OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 $LMP_LAUNCH \
+        lmp -log none -echo none -in $PEERDIR/lammps.in -var data "$lr_data" -var dim "$dim" -var warm "$W" \
+        -var steps "$S" -var reps "$REPS" "$@" >"$lr_log" 2>&1
+}
+
 loadavg() { cut -d' ' -f1-3 /proc/loadavg 2>/dev/null || echo '?'; }
 echo "run_peers: $(date -u '+%Y-%m-%d %H:%M UTC'), $(uname -m), $(nproc 2>/dev/null || echo '?') cores, load average $(loadavg); cases: $CASES; repeats $REPS"
 have python3 || echo "run_peers: python3 not found: LAMMPS and LIGGGHTS (need the data-file converter) will be skipped"
@@ -159,13 +170,9 @@ for cs in $CASES; do
             for np in 1 2; do
                 log=$WORK/lammps_${cs}_np$np.log
                 if [ "$np" = 1 ]; then
-                    OMP_NUM_THREADS=1 lmp -log none -echo none -in $PEERDIR/lammps.in -var data "$WORK/$cs.data" -var dim "$dim" \
-                        -var warm "$W" -var steps "$S" -var reps "$REPS" >"$log" 2>&1
+                    LMP_LAUNCH="" lmp_run "$WORK/$cs.data" "$log"
                 elif have "$MPIRUN"; then
-                    # shellcheck disable=SC2086
-                    OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
-                        "$MPIRUN" $MPI_FLAGS -np 2 lmp -log none -echo none -in $PEERDIR/lammps.in -var data "$WORK/$cs.data" \
-                        -var dim "$dim" -var warm "$W" -var steps "$S" -var reps "$REPS" >"$log" 2>&1
+                    LMP_LAUNCH="$MPIRUN $MPI_FLAGS -np 2" lmp_run "$WORK/$cs.data" "$log"
                 else
                     skip "peer=lammps case=$cs ranks=2: $MPIRUN not found"
                     continue
@@ -177,8 +184,7 @@ for cs in $CASES; do
             if python3 $PEERDIR/pack2lammps.py "$pk" "$WORK/${cs}_pure.data" --orthogonal --shear-rate 0 \
                 2>"$WORK/${cs}_pure.conv"; then
                 log=$WORK/lammps_pure_${cs}_np1.log
-                OMP_NUM_THREADS=1 lmp -log none -echo none -in $PEERDIR/lammps.in -var data "$WORK/${cs}_pure.data" \
-                    -var dim "$dim" -var warm "$W" -var steps "$S" -var reps "$REPS" -var mode pure >"$log" 2>&1
+                LMP_LAUNCH="" lmp_run "$WORK/${cs}_pure.data" "$log" -var mode pure
                 parse_lmp lammps_pure "$cs" 1 "$S" "$log" "pure_shear"
             else
                 skip "peer=lammps_pure case=$cs: the starting cell is skewed (pure shear runs in an orthogonal box)"
