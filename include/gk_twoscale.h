@@ -348,7 +348,9 @@ GKDEF gk_result gk_twoscale_run(gk_twoscale *ts, const double *dH, const gk_twos
                                 double *stress, double *D);
 /* the trial states of the points whose last run succeeded become their accepted states (the
  * others keep theirs); under MPI then rebalances (def.balance 0). GK_ERR_STATE if there is no run to
- * accept */
+ * accept. Copies nothing: a point's accepted state is copied out of its RVE when the next run starts
+ * to change it (a run's point that cannot get the memory for that copy fails with GK_ERR_ALLOC and
+ * keeps its state), or by a checkpoint or a migration */
 GKDEF gk_result gk_twoscale_accept(gk_twoscale *ts);
 GKDEF void gk_twoscale_reject(gk_twoscale *ts);
 /* the reports of the last run (N), and a failed point's message ("" if it did not fail) */
@@ -388,8 +390,9 @@ GK_STATIC_ASSERT(sizeof(gk_twoscale_field) % sizeof(double) == 0, ts_field_doubl
 typedef struct gk__tspt {
     int id;
     gk_rve rve;
-    gk_rve_state acc;   /* the accepted state                                     */
+    gk_rve_state acc;   /* the accepted state, unless stale                        */
     int live;           /* 1: rve holds the accepted state                         */
+    int stale;          /* 1: only rve holds it (accepted since the last copy)      */
     int trial_ok;       /* the last run succeeded and was not accepted yet          */
     double H[9], dH[9]; /* accumulated dH of accepted runs; dH of the last run      */
     double sacc[9];     /* stress of the accepted state                             */
@@ -555,13 +558,23 @@ static gk_result gk__ts_pt_new(gk_twoscale *ts, int id, int k, const void *state
     return GK_OK;
 }
 
-/* the RVE back to the accepted state when it holds another */
-static gk_result gk__ts_reset(gk__tspt *pt) {
+/* the RVE back to the accepted state when it holds another; and before a run changes it (change =
+ * 1), its accepted state copied out when only the RVE holds it. The copy is taken here rather than
+ * at accept: the run that follows finds the RVE in cache, and a point that does not run again is
+ * never copied. A point whose copy fails is left as it was. */
+static gk_result gk__ts_reset(gk__tspt *pt, int change) {
     gk_result res;
-    if (pt->live) return GK_OK;
-    res = gk_rve_state_restore(&pt->acc, &pt->rve);
-    if (!res) pt->live = 1;
-    return res;
+    if (!pt->live) { /* (stale implies live) */
+        res = gk_rve_state_restore(&pt->acc, &pt->rve);
+        if (res) return res;
+        pt->live = 1;
+    }
+    if (change && pt->stale) {
+        if (gk_rve_state_save(&pt->acc, &pt->rve))
+            return gk_err_set(&pt->rve.err, GK_ERR_ALLOC, "out of memory for the copy of its accepted state");
+        pt->stale = 0;
+    }
+    return GK_OK;
 }
 
 /* the strain rule's step count for H at rate scale `scale` */
@@ -695,7 +708,7 @@ static void gk__ts_point(const gk_twoscale *ts, gk__tspt *pt, const double H[9],
     pt->trial_ok = 0;
     rp.particles = pt->rve.n;
     if (d->proc) {
-        res = gk__ts_reset(pt);
+        res = gk__ts_reset(pt, 1);
         if (!res) {
             pt->live = 0;
             res = d->proc(d->proc_user, pt->id, ts->pick[pt->id], &pt->rve, pt->H, H, scale, s0, &nd);
@@ -720,14 +733,14 @@ static void gk__ts_point(const gk_twoscale *ts, gk__tspt *pt, const double H[9],
             double Hp[9];
             memcpy(Hp, H, sizeof Hp);
             Hp[3 * (k / dim) + k % dim] += d->xi;
-            res = gk__ts_reset(pt);
+            res = gk__ts_reset(pt, 1);
             if (!res) pt->live = 0, res = gk_rve_deform(&pt->rve, Hp, nd);
             if (res) gk__ts_fail(pt, &rp, res);
             gk_rve_stress(&pt->rve, sp[k]);
             rp.work += nd;
         }
     }
-    res = gk__ts_reset(pt);
+    res = gk__ts_reset(pt, 1);
     if (!res) res = gk__ts_trial(ts, pt, H, scale, &nd, &nr);
     if (res) {
         gk__ts_fail(pt, &rp, res);
@@ -757,13 +770,13 @@ static void gk__ts_point(const gk_twoscale *ts, gk__tspt *pt, const double H[9],
                         double Hp[9];
                         memcpy(Hp, H, sizeof Hp);
                         Hp[3 * (k / dim) + k % dim] += d->xi;
-                        res = gk__ts_reset(pt);
+                        res = gk__ts_reset(pt, 1);
                         if (!res) res = gk__ts_replay(pt, Hp, nd, nr, d->rule.every);
                         if (res) gk__ts_fail(pt, &rp, res);
                         gk_rve_stress(&pt->rve, sp[k]);
                         rp.work += nd + nr;
                     }
-                    res = gk__ts_reset(pt); /* the trial state again (the same run: bit-identical) */
+                    res = gk__ts_reset(pt, 1); /* the trial state again (the same run: bit-identical) */
                     if (!res) res = gk__ts_replay(pt, H, nd, nr, d->rule.every);
                     if (res) {
                         gk__ts_fail(pt, &rp, res);
@@ -1210,6 +1223,15 @@ typedef void (*gk__ts_sink)(void *ctx, const void *p, size_t n);
 
 static int gk__ts_has_ref(const gk__tspt *pt) { return pt->Dref && pt->valid; }
 
+/* a record carries the accepted state: copied out of the RVE first where only the RVE holds it
+ * (GK_OK, or GK_ERR_ALLOC and the point as it was) */
+static gk_result gk__ts_sync(gk__tspt *pt) {
+    if (!pt->stale) return GK_OK;
+    if (gk_rve_state_save(&pt->acc, &pt->rve)) return GK_ERR_ALLOC;
+    pt->stale = 0;
+    return GK_OK;
+}
+
 static size_t gk__ts_rec_size(const gk_twoscale *ts, const gk__tspt *pt) {
     size_t s = GK__TS_REC_MIN + pt->acc.size;
     if (gk__ts_has_ref(pt)) s += (size_t)ts->nd4 * 8 + (size_t)pt->nkey * 8;
@@ -1382,8 +1404,9 @@ static gk_result gk__ts_migrate(gk_twoscale *ts, const int *nown) {
     for (p = 0; p < ts->n; ++p) {
         if (ts->owner[p] == nown[p]) continue;
         if (ts->owner[p] == ts->rank) {
-            size_t n;
-            unsigned char *b = gk__ts_rec_pack(ts, ts->pt[ts->slot[p]], &n);
+            size_t n = 0;
+            gk__tspt *q = ts->pt[ts->slot[p]];
+            unsigned char *b = gk__ts_sync(q) ? NULL : gk__ts_rec_pack(ts, q, &n);
             ok &= gk__ts_xsend(ts, nown[p], b, n);
             gk_free(a, b);
         } else if (nown[p] == ts->rank) {
@@ -1467,44 +1490,22 @@ static gk_result gk__ts_balance(gk_twoscale *ts) {
 #endif
 
 GKDEF gk_result gk_twoscale_accept(gk_twoscale *ts) {
-    int j, ok = 1;
+    int j;
     gk_err_clear(&ts->err);
     if (!ts->pending) return gk_err_set(&ts->err, GK_ERR_STATE, "no run to accept (gk_twoscale_run first)");
-    for (j = 0; j < ts->nlocal; ++j) { /* room first, so that accepting cannot fail half-way */
+    /* no copy of the state here: the next change of the RVE copies it (gk__ts_reset) */
+    GK_OMP(parallel for num_threads(ts->def.threads) schedule(dynamic, 16))
+    for (j = 0; j < ts->nlocal; ++j) {
         gk__tspt *pt = ts->pt[j];
-        size_t need = gk_rve_state_size(&pt->rve);
-        if (pt->trial_ok && need > pt->acc.cap) {
-            unsigned char *b = (unsigned char *)gk_alloc(&pt->acc.alloc, need + need / 4);
-            if (!b) {
-                ok = 0;
-                continue;
-            }
-            memcpy(b, pt->acc.buf, pt->acc.size);
-            gk_free(&pt->acc.alloc, pt->acc.buf);
-            pt->acc.buf = b, pt->acc.cap = need + need / 4;
-        }
-    }
-    if (!gk__ts_allok(ts, ok))
-        return gk_err_set(&ts->err, GK_ERR_ALLOC, "out of memory accepting the trial states");
-    {
-        /* on the run's threads: each point copies its state into its own buffer (a copy can
-         * cost as much as a short run of its point) */
-        int nth = ts->def.threads;
-        GK_OMP(parallel for num_threads(nth) schedule(dynamic, 4))
-        for (j = 0; j < ts->nlocal; ++j) {
-            gk__tspt *pt = ts->pt[j];
-            int k;
-            if (!pt->trial_ok) continue;
-            gk_rve_save(&pt->rve, pt->acc.buf, pt->acc.cap, &pt->acc.size);
-            for (k = 0; k < 9; ++k) pt->H[k] += pt->dH[k];
-            pt->steps_acc = pt->steps_trial;
-            if (ts->def.proc)
-                memcpy(pt->sacc, pt->strial, sizeof pt->sacc);
-            else
-                gk_rve_stress(&pt->rve, pt->sacc);
-            pt->live = 1, pt->trial_ok = 0;
-        }
-        (void)nth;
+        int k;
+        if (!pt->trial_ok) continue;
+        for (k = 0; k < 9; ++k) pt->H[k] += pt->dH[k];
+        pt->steps_acc = pt->steps_trial;
+        if (ts->def.proc)
+            memcpy(pt->sacc, pt->strial, sizeof pt->sacc);
+        else
+            gk_rve_stress(&pt->rve, pt->sacc);
+        pt->live = 1, pt->stale = 1, pt->trial_ok = 0;
     }
     ts->pending = 0;
 #ifdef GK_TWOSCALE_MPI
@@ -1531,7 +1532,7 @@ static const double *gk__ts_collect(gk_twoscale *ts, int nrec, int want_D, gk__t
     for (j = 0; j < ts->nlocal; ++j) {
         gk__tspt *pt = ts->pt[j];
         double *rec = ts->buf + (size_t)nrec * j;
-        gk_result res = gk__ts_reset(pt);
+        gk_result res = gk__ts_reset(pt, 0);
         if (!res) res = fill(ts, pt, want_D, rec);
         rec[nrec - 1] = (double)res;
     }
@@ -1673,6 +1674,9 @@ GKDEF gk_result gk_twoscale_save(gk_twoscale *ts, const char *path, const void *
     c.h = UINT64_C(0xcbf29ce484222325);
     gk_err_clear(&ts->err);
     if (ts->n < 1) return gk_err_set(&ts->err, GK_ERR_STATE, "the set was not created");
+    for (j = 0, p = 1; j < ts->nlocal; ++j) p &= gk__ts_sync(ts->pt[j]) == GK_OK;
+    if (!gk__ts_allok(ts, p))
+        return gk_err_set(&ts->err, GK_ERR_ALLOC, "checkpoint: out of memory for the accepted states");
     if (ts->rank == 0) {
         if (!path || (!block && nblock))
             gk_err_set(&ts->err, GK_ERR_ARG, "checkpoint: no path, or a driver block of %lu bytes at NULL",

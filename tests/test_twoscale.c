@@ -9,6 +9,7 @@
  * (another micro model on the same RVEs). Small packings (100 and 200
  * disks) keep it to seconds. The MPI build has its own program
  * (tests/mpi_twoscale.c, run by `make test` with mpirun -np 2). */
+#define _POSIX_C_SOURCE 200809L /* posix_memalign */
 #include "gk_twoscale.h"
 #include "gk_test.h"
 
@@ -132,6 +133,10 @@ TEST(run_is_the_rve_contract) {
     CHECK_EQ_INT(pts[2].tangent, 0); /* the last run asked for none */
     CHECK_EQ_INT(pts[2].particles, r.n);
     CHECK(gk_twoscale_accept(&ts) == GK_OK);
+    /* accept copies nothing; the trial below copies the accepted state out of the RVE before it
+     * changes it, and reject goes back to that copy: the next run is the by-hand RVE's again */
+    CHECK(gk_twoscale_run(&ts, dH, NULL, s3, NULL) == GK_OK);
+    gk_twoscale_reject(&ts);
     CHECK(gk_twoscale_run(&ts, dH2, NULL, s2, NULL) == GK_OK);
     CHECK(gk_rve_deform_adaptive(&r, dH2 + 18, &ad, &rep) == GK_OK);
     gk_rve_stress(&r, sr);
@@ -578,6 +583,88 @@ TEST(caller_procedure_runs_every_point) {
     gk_twoscale_destroy(&a), gk_twoscale_destroy(&b);
 }
 
+/* an allocator that refuses requests of 16 KiB and more while refuse is set (an RVE's state, not a
+ * message) */
+typedef struct gate {
+    int refuse;
+} gate;
+static void *gate_alloc(size_t size, size_t align, void *user) {
+    void *p = NULL;
+    if ((((gate *)user)->refuse && size >= 16384) || posix_memalign(&p, align < sizeof(void *) ? sizeof(void *) : align, size))
+        return NULL;
+    return p;
+}
+static void gate_free(void *p, void *user) {
+    (void)user;
+    free(p);
+}
+
+/* a procedure that, while *grow, first adds 256 small disks on a grid (the RVE's state then outgrows
+ * the room of the copy made at creation), then deforms by dH over 40 DEM steps */
+static gk_result grow_then_deform(void *user, int point, int proto, gk_rve *rve, const double H[9],
+                                  const double dH[9], double scale, double stress[9], int *steps) {
+    gk_result res;
+    (void)point, (void)proto, (void)H, (void)scale;
+    if (*(const int *)user) {
+        double sx[256], sy[256], r[256];
+        const double *sp[3];
+        int32_t id[256];
+        int q;
+        for (q = 0; q < 256; ++q)
+            sx[q] = (q % 16 + 0.5) / 16, sy[q] = (q / 16 + 0.5) / 16, r[q] = 0.3 * rve->rmin, id[q] = 100000 + q;
+        sp[0] = sx, sp[1] = sy, sp[2] = NULL;
+        if ((res = gk_rve_append(rve, 256, sp, r, id)) != GK_OK) return res;
+    }
+    if ((res = gk_rve_deform(rve, dH, 40)) != GK_OK) return res;
+    gk_rve_stress(rve, stress);
+    *steps = 40;
+    return GK_OK;
+}
+
+/* accept copies no state: a run copies it out of the RVE before changing it. A point whose copy
+ * finds no memory fails with GK_ERR_ALLOC and keeps its accepted state: once memory is back, the
+ * run gives the bits of a set that never ran short */
+TEST(a_copy_of_the_accepted_state_without_memory_changes_nothing) {
+    gk_twoscale a, b;
+    gk_twoscale_proto pr;
+    gk_twoscale_def d;
+    gate g = {0};
+    int grow = 1, k;
+    double dH[9 * 4], dH2[9 * 4], sa[9 * 4], sb[9 * 4];
+    gk_twoscale_field fa[4], fb[4];
+    const gk_twoscale_point *pts;
+    CHECK(load_packings());
+    if (!have_packings) return;
+    pr.packing = &pk200, pr.state = NULL;
+    memset(&d, 0, sizeof d);
+    d.npoints = 4, d.protos = &pr, d.nprotos = 1, d.threads = 2;
+    d.rve = gk_rve_def_default();
+    d.rve.dt = DT;
+    d.proc = grow_then_deform, d.proc_user = &grow;
+    CHECK(gk_twoscale_create(&b, &d) == GK_OK);
+    d.alloc.alloc = gate_alloc, d.alloc.free = gate_free, d.alloc.user = &g;
+    d.rve.alloc = d.alloc;
+    CHECK(gk_twoscale_create(&a, &d) == GK_OK);
+    step_dH(4, 0, 1e-3, dH);
+    step_dH(4, 1, 1e-3, dH2);
+    CHECK(gk_twoscale_run(&a, dH, NULL, sa, NULL) == GK_OK && gk_twoscale_accept(&a) == GK_OK);
+    CHECK(gk_twoscale_run(&b, dH, NULL, sb, NULL) == GK_OK && gk_twoscale_accept(&b) == GK_OK);
+    CHECK(same(sa, sb, 36));
+    grow = 0;
+    g.refuse = 1;
+    CHECK(gk_twoscale_run(&a, dH2, NULL, sa, NULL) == GK_ERR_STATE);
+    g.refuse = 0;
+    pts = gk_twoscale_points(&a);
+    for (k = 0; k < 4; ++k) CHECK_EQ_INT(pts[k].code, GK_ERR_ALLOC);
+    CHECK(strstr(gk_twoscale_point_error(&a, 1), "out of memory for the copy of its accepted state") != NULL);
+    CHECK(gk_twoscale_run(&a, dH2, NULL, sa, NULL) == GK_OK && gk_twoscale_accept(&a) == GK_OK);
+    CHECK(gk_twoscale_run(&b, dH2, NULL, sb, NULL) == GK_OK && gk_twoscale_accept(&b) == GK_OK);
+    CHECK(same(sa, sb, 36));
+    CHECK(gk_twoscale_fields(&a, fa) == GK_OK && gk_twoscale_fields(&b, fb) == GK_OK);
+    CHECK(memcmp(fa, fb, sizeof fa) == 0 && gk_twoscale_points(&a)[0].particles == 456);
+    gk_twoscale_destroy(&a), gk_twoscale_destroy(&b);
+}
+
 /* bad arguments: a message naming the value, and nothing changed */
 TEST(bad_arguments_are_refused) {
     gk_twoscale ts;
@@ -646,6 +733,7 @@ int main(int argc, char **argv) {
     RUN(checkpoint_round_trip_is_bit_identical);
     RUN(corrupt_checkpoints_are_refused_and_change_nothing);
     RUN(caller_procedure_runs_every_point);
+    RUN(a_copy_of_the_accepted_state_without_memory_changes_nothing);
     RUN(bad_arguments_are_refused);
     if (have_packings) gk_packing_free(&pk100), gk_packing_free(&pk200);
     return gk_test_done();
