@@ -590,7 +590,8 @@ typedef struct gate {
 } gate;
 static void *gate_alloc(size_t size, size_t align, void *user) {
     void *p = NULL;
-    if ((((gate *)user)->refuse && size >= 16384) || posix_memalign(&p, align < sizeof(void *) ? sizeof(void *) : align, size))
+    if ((((gate *)user)->refuse && size >= 16384) ||
+        posix_memalign(&p, align < sizeof(void *) ? sizeof(void *) : align, size))
         return NULL;
     return p;
 }
@@ -611,7 +612,8 @@ static gk_result grow_then_deform(void *user, int point, int proto, gk_rve *rve,
         int32_t id[256];
         int q;
         for (q = 0; q < 256; ++q)
-            sx[q] = (q % 16 + 0.5) / 16, sy[q] = (q / 16 + 0.5) / 16, r[q] = 0.3 * rve->rmin, id[q] = 100000 + q;
+            sx[q] = (q % 16 + 0.5) / 16, sy[q] = (q / 16 + 0.5) / 16, r[q] = 0.3 * rve->rmin,
+            id[q] = 100000 + q;
         sp[0] = sx, sp[1] = sy, sp[2] = NULL;
         if ((res = gk_rve_append(rve, 256, sp, r, id)) != GK_OK) return res;
     }
