@@ -2433,16 +2433,21 @@ GKDEF double gk_rve_unbalanced_rms(const gk_rve *rve) {
     return (nc && fc2 > 0.0) ? sqrt(fp2 / rve->n) / sqrt(fc2 / nc) : 0.0; /* nothing to balance: 0 */
 }
 
-static gk_result gk__relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps, int rms);
+static gk_result gk__relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps, int rms,
+                           double *uf_end);
 GKDEF gk_result gk_rve_relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps) {
-    return gk__relax(rve, uf_max, every, max_steps, steps, 0);
+    return gk__relax(rve, uf_max, every, max_steps, steps, 0, NULL);
 }
-/* gk_rve_relax on the mean (rms = 0) or the RMS (rms = 1) unbalanced ratio */
-static gk_result gk__relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps, int rms) {
+/* gk_rve_relax on the mean (rms = 0) or the RMS (rms = 1) unbalanced ratio; *uf_end (if not NULL)
+ * the ratio of the final state when the loop measured it last, else -1 */
+static gk_result gk__relax(gk_rve *rve, double uf_max, int every, long max_steps, long *steps, int rms,
+                           double *uf_end) {
     gk__drive d;
+    double uf = -1.0;
     long done = 0;
     gk_result res = gk__rve_ready(rve);
     if (steps) *steps = 0;
+    if (uf_end) *uf_end = -1.0;
     if (res) return res;
     if (rve->servo_on)
         return gk_err_set(&rve->err, GK_ERR_STATE, "a servo is active: switch it off before relax");
@@ -2453,13 +2458,15 @@ static gk_result gk__relax(gk_rve *rve, double uf_max, int every, long max_steps
     memset(&d, 0, sizeof d);
     d.kind = GK__DRIVE_RATE; /* L = 0: the cell stands still */
     d.stress = 1;
-    while (done < max_steps && (rms ? gk_rve_unbalanced_rms(rve) : gk_rve_unbalanced(rve)) > uf_max) {
+    while (done < max_steps && (uf = rms ? gk_rve_unbalanced_rms(rve) : gk_rve_unbalanced(rve)) > uf_max) {
         d.n = every < max_steps - done ? every : max_steps - done;
+        uf = -1.0;
         res = gk__drive_run(rve, &d);
         if (res) break;
         done += d.n;
     }
     if (steps) *steps = done;
+    if (uf_end && !res) *uf_end = uf;
     return res;
 }
 
@@ -2481,7 +2488,7 @@ GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk
                                        gk_adapt_report *rep) {
     gk_adapt_def ad;
     gk_adapt_report R;
-    double rate[9], p, rmean = 0.0, I1, n;
+    double rate[9], p, rmean = 0.0, I1, n, uf;
     long nr = 0;
     int k;
     gk_result res;
@@ -2511,10 +2518,11 @@ GKDEF gk_result gk_rve_deform_adaptive(gk_rve *rve, const double dH[9], const gk
     R.inertial = isfinite(I1) ? I1 / n : I1;
     res = gk_rve_deform(rve, dH, R.n_deform);
     if (res) return res;
-    res = gk__relax(rve, ad.unbalanced_max, ad.every, ad.n_max - R.n_deform, &nr, ad.rms);
+    res = gk__relax(rve, ad.unbalanced_max, ad.every, ad.n_max - R.n_deform, &nr, ad.rms, &uf);
     if (res) return res;
     R.n_relax = (int)nr;
-    R.unbalanced = ad.rms ? gk_rve_unbalanced_rms(rve) : gk_rve_unbalanced(rve);
+    /* the relaxation's last measure when it is of this state (no step since), else measured now */
+    R.unbalanced = uf >= 0.0 ? uf : ad.rms ? gk_rve_unbalanced_rms(rve) : gk_rve_unbalanced(rve);
     R.capped = R.unbalanced > ad.unbalanced_max;
     if (rep) *rep = R;
     return GK_OK;

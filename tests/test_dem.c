@@ -1258,6 +1258,7 @@ TEST(adaptive_deform_follows_the_inertial_number) {
     CHECK(gk_rve_deform_adaptive(&a, dH, &ad, &ra) == GK_OK);
     CHECK_EQ_INT(ra.n_deform, (long)ceil(I1 / 2e-4));
     CHECK_EQ_INT(ra.n_relax, 0);
+    CHECK(ra.unbalanced == gk_rve_unbalanced(&a)); /* the relaxation's own measure of this state */
     CHECK(ra.inertial <= 2e-4 && ra.inertial > 1e-4);
     dH[4] = -4e-4; /* twice the increment: twice the steps (to the rounding) */
     CHECK(gk_rve_deform_adaptive(&b, dH, &ad, &rb) == GK_OK);
