@@ -1294,6 +1294,42 @@ TEST(adaptive_deform_follows_the_inertial_number) {
     gk_rve_destroy(&b);
 }
 
+/* The Love stress of a step (Guo & Zhao 2014 eq 5), sigma = -(1/V) sum_c f_c (x) d_c, and the mean
+ * contact force are sums in pair order, bit for bit (what a faster pass must keep): rebuilt here from
+ * the public contact iterator (its d by gk_pcell_image),
+ * in 2D (400 disks) and 3D (1000 spheres), after a shear and a refresh (forces and branch vectors at
+ * the same positions). */
+TEST(stress_pass_is_the_pair_order_sum) {
+    const char *path[2] = {RVE400, "bench/data/bench3d_1k.txt"};
+    int t;
+    for (t = 0; t < 2; ++t) {
+        gk_rve r;
+        gk_rve_def def = gk_rve_def_default();
+        gk_rve_contact k;
+        double S[9] = {0}, want[9], got[9], V, fsum = 0.0, dH[9] = {2e-4, 1e-3, 0, 0, -1e-3, 0, 0, 0, 0};
+        int c = 0, n = 0, i, j;
+        if (t == 1) def.skin = 5e-4, dH[8] = 3e-4;
+        if (load_rve(&r, &def, path[t])) {
+            CHECK(0);
+            return;
+        }
+        CHECK(gk_rve_deform(&r, dH, 50) == GK_OK && gk_rve_refresh(&r) == GK_OK);
+        V = gk_rve_volume(&r);
+        while (gk_rve_contact_next(&r, &c, &k)) {
+            for (i = 0; i < r.dim; ++i)
+                for (j = 0; j < r.dim; ++j) S[3 * i + j] += k.f[i] * k.d[j];
+            fsum += sqrt(k.f[0] * k.f[0] + k.f[1] * k.f[1] + k.f[2] * k.f[2]);
+            ++n;
+        }
+        for (i = 0; i < 9; ++i) want[i] = -S[i] / V;
+        gk_rve_stress(&r, got);
+        CHECK(n == r.ncontacts && n > r.n);
+        CHECK(memcmp(got, want, sizeof got) == 0);
+        CHECK(r.fc_mean == fsum / n);
+        gk_rve_destroy(&r);
+    }
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(seed_packing_reproduces_yade);
@@ -1327,5 +1363,6 @@ int main(int argc, char **argv) {
     RUN(hertz_rolling_rve_runs);
     RUN(adaptive_deform_follows_the_inertial_number);
     RUN(relax_holds_the_cell_until_balanced);
+    RUN(stress_pass_is_the_pair_order_sum);
     return gk_test_done();
 }
