@@ -1674,9 +1674,13 @@ GKDEF gk_result gk_twoscale_save(gk_twoscale *ts, const char *path, const void *
     c.h = UINT64_C(0xcbf29ce484222325);
     gk_err_clear(&ts->err);
     if (ts->n < 1) return gk_err_set(&ts->err, GK_ERR_STATE, "the set was not created");
-    for (j = 0, p = 1; j < ts->nlocal; ++j) p &= gk__ts_sync(ts->pt[j]) == GK_OK;
-    if (!gk__ts_allok(ts, p))
-        return gk_err_set(&ts->err, GK_ERR_ALLOC, "checkpoint: out of memory for the accepted states");
+    { /* the accepted states into the records' buffers (on the set's threads, as a run copies) */
+        int ok = 1;
+        GK_OMP(parallel for num_threads(ts->def.threads) schedule(dynamic, 4) reduction(& : ok))
+        for (j = 0; j < ts->nlocal; ++j) ok &= gk__ts_sync(ts->pt[j]) == GK_OK;
+        if (!gk__ts_allok(ts, ok))
+            return gk_err_set(&ts->err, GK_ERR_ALLOC, "checkpoint: out of memory for the accepted states");
+    }
     if (ts->rank == 0) {
         if (!path || (!block && nblock))
             gk_err_set(&ts->err, GK_ERR_ARG, "checkpoint: no path, or a driver block of %lu bytes at NULL",

@@ -1296,9 +1296,8 @@ TEST(adaptive_deform_follows_the_inertial_number) {
 
 /* The Love stress of a step (Guo & Zhao 2014 eq 5), sigma = -(1/V) sum_c f_c (x) d_c, and the mean
  * contact force are sums in pair order, bit for bit (what a faster pass must keep): rebuilt here from
- * the public contact iterator (its d by gk_pcell_image),
- * in 2D (400 disks) and 3D (1000 spheres), after a shear and a refresh (forces and branch vectors at
- * the same positions). */
+ * the public contact iterator (its d by gk_pcell_image), in 2D (400 disks) and 3D (1000 spheres),
+ * after a shear and a refresh (forces and branch vectors at the same positions). */
 TEST(stress_pass_is_the_pair_order_sum) {
     const char *path[2] = {RVE400, "bench/data/bench3d_1k.txt"};
     int t;
