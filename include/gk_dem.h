@@ -176,9 +176,12 @@
  *   gk_cells.open  open (non-periodic) axes of the cell lists (gk_cells.h).
  *
  * CONFIG: GK_REAL_FLOAT (see gk_base.h), GK_DEM_PAR_MIN (pairs below which
- * one RVE never uses threads, default 20000), GK_RVE_STEP_OVERLAP_MAX (the
- * admissible overlap change per DEM step as a fraction of the smaller
- * radius, default 0.1). An RVE holds at most GK_RVE_MAX_PARTICLES (2^26):
+ * one RVE never uses threads, default 20000), GK_DEM_GATHER_MAX (pairs up to
+ * which one thread stores the pair forces and gathers each particle's sum
+ * instead of scattering them in the force loop: the same bits, and faster
+ * while the pair arrays stay in the core's cache; default 32768),
+ * GK_RVE_STEP_OVERLAP_MAX (the admissible overlap change per DEM step as a
+ * fraction of the smaller radius, default 0.1). An RVE holds at most GK_RVE_MAX_PARTICLES (2^26):
  * its pair lists are int32.
  *
  * LICENCE: MIT (see gk_base.h).
@@ -194,6 +197,9 @@
 
 #ifndef GK_DEM_PAR_MIN
 #define GK_DEM_PAR_MIN 20000
+#endif
+#ifndef GK_DEM_GATHER_MAX
+#define GK_DEM_GATHER_MAX 32768
 #endif
 /* particles of one RVE: int32 pair lists hold up to ~30 candidates each */
 #define GK_RVE_MAX_PARTICLES (1 << 26)
@@ -1565,12 +1571,20 @@ static int gk__nthreads(const gk_rve *rve);
 
 static void gk__reduce_range(gk_rve *rve, int p0, int p1);
 
-/* pair forces and their per-particle sums (f, t) for this step. A single
- * thread scatters in the force loop; threads store per-pair forces and
- * gather. want_store keeps per-pair forces and torques (stress, tangent). */
+/* pair forces and their per-particle sums (f, t) for this step. Threads, and
+ * one thread on up to GK_DEM_GATHER_MAX pairs, store per-pair forces and
+ * gather each particle's sum; one thread on more pairs scatters in the force
+ * loop (the gather's reads then miss the cache). The same sums in the same
+ * order either way. want_store keeps per-pair forces and torques (stress,
+ * tangent). */
 static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
     int nc = rve->pl.n, nth = gk__nthreads(rve), k;
-    if (nth <= 1) {
+    if (nth <= 1 && nc <= GK_DEM_GATHER_MAX) {
+        x->scatter = 0;
+        x->store = 1;
+        gk__forces_range(rve, x, 0, nc);
+        gk__reduce_range(rve, 0, rve->n);
+    } else if (nth <= 1) {
         x->scatter = 1;
         x->store = want_store;
         for (k = 0; k < 3; ++k) {
@@ -1605,9 +1619,9 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
 
 /* Per-particle sums of the pair forces in the fixed order (pairs where p is j,
  * ascending; then pairs where p is i, ascending), by gathering: used with
- * threads. A single thread scatters inside the force loop instead
- * (gk__scatter_*), in pair order, which is the same order and so gives the
- * same bits. */
+ * threads and for small lists. A single thread on a large list scatters inside
+ * the force loop instead (gk__scatter_*), in pair order, which is the same
+ * order and so gives the same bits. */
 GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int dim, const int rot) {
     const int32_t *GK_RESTRICT start = rve->pl.start, *GK_RESTRICT jst = rve->jstart,
                                *GK_RESTRICT jl = rve->jlist;
