@@ -181,8 +181,8 @@
  * instead of scattering them in the force loop: the same bits, and faster
  * while the pair arrays stay in the core's cache; default 32768),
  * GK_RVE_STEP_OVERLAP_MAX (the admissible overlap change per DEM step as a
- * fraction of the smaller radius, default 0.1). An RVE holds at most GK_RVE_MAX_PARTICLES (2^26):
- * its pair lists are int32.
+ * fraction of the smaller radius, default 0.1). An RVE holds at most
+ * GK_RVE_MAX_PARTICLES (2^26): its pair lists are int32.
  *
  * LICENCE: MIT (see gk_base.h).
  */
