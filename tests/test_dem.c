@@ -1,5 +1,5 @@
 /* test_dem.c - the RVE (gk_dem.h) and homogenisation (gk_homog.h). */
-#define GK_DEM_PAR_MIN 64 /* let the 400-disk RVE use threads, to test thread invariance */
+#define GK_DEM_PAR_MIN 64   /* let the 400-disk RVE use threads, to test thread invariance */
 #define GK_DEM_GATHER_MAX 0 /* one thread scatters: its thread tests compare that with the threads' gather */
 #define GK_IMPLEMENTATION
 #include "gk_homog.h"

@@ -4,7 +4,7 @@
  * energy balance, save/restore and thread invariance, packing tiles and
  * subsets, and smoke runs of the two scene drivers (build/dem_biaxial,
  * build/dem_collapse: `make test` builds the examples first). */
-#define GK_DEM_PAR_MIN 64 /* let small scenes use threads, to test thread invariance */
+#define GK_DEM_PAR_MIN 64   /* let small scenes use threads, to test thread invariance */
 #define GK_DEM_GATHER_MAX 0 /* one thread scatters: its thread tests compare that with the threads' gather */
 #define GK_IMPLEMENTATION
 #define GK_TEST_DRIVERS
