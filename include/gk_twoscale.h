@@ -558,6 +558,15 @@ static gk_result gk__ts_pt_new(gk_twoscale *ts, int id, int k, const void *state
     return GK_OK;
 }
 
+/* the accepted state copied out of the RVE where only the RVE holds it (before a run changes the
+ * RVE, and for a record: checkpoint, migration): GK_OK, or GK_ERR_ALLOC and the point as it was */
+static gk_result gk__ts_sync(gk__tspt *pt) {
+    if (!pt->stale) return GK_OK;
+    if (gk_rve_state_save(&pt->acc, &pt->rve)) return GK_ERR_ALLOC;
+    pt->stale = 0;
+    return GK_OK;
+}
+
 /* the RVE back to the accepted state when it holds another; and before a run changes it (change =
  * 1), its accepted state copied out when only the RVE holds it. The copy is taken here rather than
  * at accept: the run that follows finds the RVE in cache, and a point that does not run again is
@@ -569,11 +578,8 @@ static gk_result gk__ts_reset(gk__tspt *pt, int change) {
         if (res) return res;
         pt->live = 1;
     }
-    if (change && pt->stale) {
-        if (gk_rve_state_save(&pt->acc, &pt->rve))
-            return gk_err_set(&pt->rve.err, GK_ERR_ALLOC, "out of memory for the copy of its accepted state");
-        pt->stale = 0;
-    }
+    if (change && gk__ts_sync(pt))
+        return gk_err_set(&pt->rve.err, GK_ERR_ALLOC, "out of memory for the copy of its accepted state");
     return GK_OK;
 }
 
@@ -1222,15 +1228,6 @@ typedef void (*gk__ts_sink)(void *ctx, const void *p, size_t n);
 #define GK__TS_REC_MIN (4 * 4 + 18 * 8 + 8)
 
 static int gk__ts_has_ref(const gk__tspt *pt) { return pt->Dref && pt->valid; }
-
-/* a record carries the accepted state: copied out of the RVE first where only the RVE holds it
- * (GK_OK, or GK_ERR_ALLOC and the point as it was) */
-static gk_result gk__ts_sync(gk__tspt *pt) {
-    if (!pt->stale) return GK_OK;
-    if (gk_rve_state_save(&pt->acc, &pt->rve)) return GK_ERR_ALLOC;
-    pt->stale = 0;
-    return GK_OK;
-}
 
 static size_t gk__ts_rec_size(const gk_twoscale *ts, const gk__tspt *pt) {
     size_t s = GK__TS_REC_MIN + pt->acc.size;
