@@ -239,7 +239,7 @@ int main(int argc, char **argv) {
            m.single ? "the RVE alone" : "biaxial test",
            m.o.frame == GK_FRAME_SERVO ? "servo-framed" : "periodic-cell",
            m.o.frame == GK_FRAME_SERVO ? m.fr.n : m.pk.n, m.o.frame == GK_FRAME_SERVO ? m.fr.nq : 0,
-           m.o.no_rotation ? "locked" : "free", m.ngp, kn_txt, m.omega_max);
+           rotation_name(&m.o), m.ngp, kn_txt, m.omega_max);
     rc = run_fem(&m);
     gk_twoscale_destroy(&m.ts);
     gk_frame_free(&m.fr);

@@ -258,7 +258,7 @@ static int write_svgs(const model *m) {
 }
 
 /* ------------------------------------------------------------------ checkpoint */
-/* driver block: uint32 magic, int32 ngp, ndof, frame, no_rotation, test, step_done, nrows, have_f0;
+/* driver block: uint32 magic, int32 ngp, ndof, frame, rotation_lock, test, step_done, nrows, have_f0;
  * double h_ic, J_ic, omega, dr_total, dem_total, runs_total, capped_total, unconverged, resid_max,
  * resid_step, resid_over, 8 option values;
  * u, v, f0 (ndof each), Hacc (9 ngp), P (9 ngp), rows */
@@ -281,7 +281,7 @@ static int save_checkpoint(model *m) {
     uint32_t magic = CK_MAGIC;
     char path[1024];
     int i, bad;
-    iv[0] = m->ngp, iv[1] = m->ndof, iv[2] = m->o.frame, iv[3] = m->o.no_rotation, iv[4] = m->o.test;
+    iv[0] = m->ngp, iv[1] = m->ndof, iv[2] = m->o.frame, iv[3] = rotation_lock(&m->o), iv[4] = m->o.test;
     iv[5] = m->step_done, iv[6] = m->nrows, iv[7] = m->have_f0;
     dv[0] = m->h_ic, dv[1] = m->J_ic, dv[2] = m->dr.omega, dv[3] = (double)m->dr.total,
     dv[4] = (double)m->dem_total;
@@ -324,7 +324,7 @@ static int load_checkpoint(model *m) {
     memcpy(&magic, b, 4), memcpy(iv, b + 4, sizeof iv), memcpy(dv, b + 4 + sizeof iv, sizeof dv);
     ck_opts(m, want);
     if (magic != CK_MAGIC || iv[0] != m->ngp || iv[1] != m->ndof || iv[2] != m->o.frame ||
-        iv[3] != m->o.no_rotation || iv[4] != m->o.test || iv[6] < 0 || iv[5] < 0)
+        iv[3] != rotation_lock(&m->o) || iv[4] != m->o.test || iv[6] < 0 || iv[5] < 0)
         goto bad;
     for (i = CK_OPT; i < CK_ND; ++i)
         if (dv[i] != want[i]) {
@@ -409,7 +409,7 @@ static void result_line(const model *m) {
            peak, epk, interp(m, 3, 0.073), interp(m, 8, 0.073), edil, nst ? iters / nst : 0.0,
            gk_wtime() - m->t0, m->runs_total ? (double)m->dem_total / (double)m->runs_total : 0.0,
            m->capped_total, m->unconverged, m->o.test == TEST_DNS ? NAN : m->resid_max,
-           m->o.frame == GK_FRAME_SERVO ? "servo" : "periodic", m->o.no_rotation ? "locked" : "free");
+           m->o.frame == GK_FRAME_SERVO ? "servo" : "periodic", rotation_name(&m->o));
 }
 
 #endif /* FEMDEM_DR_IO_H */

@@ -117,7 +117,7 @@ static gk_rve_def rve_def(const opts *o) {
     gk_rve_def d = gk_rve_def_default();
     if (o->material == 1) { /* Guo & Zhao 2014's, as examples/femdem_biaxial.c: E r*, their YADE time step */
         d.dt = 3.1602315723728926e-05;
-        d.flags = o->no_rotation ? GK_RVE_NO_ROTATION : 0u;
+        d.flags = rotation_lock(o) == ROT_ALL ? GK_RVE_NO_ROTATION : 0u;
         return d;
     }
     d.mat.law = GK_LAW_LINEAR;
@@ -129,7 +129,7 @@ static gk_rve_def rve_def(const opts *o) {
     d.damping = o->damping;
     d.damping_form = GK_DAMP_COMPONENT;
     d.dt_factor = o->dt_factor;
-    d.flags = o->no_rotation ? GK_RVE_NO_ROTATION : 0u;
+    d.flags = rotation_lock(o) == ROT_ALL ? GK_RVE_NO_ROTATION : 0u;
     return d;
 }
 
@@ -305,6 +305,7 @@ static int setup(model *m) {
     m->fs.def.tol_servo = o->tol_servo;
     m->fs.def.max_servo = o->servo_max;
     m->fs.def.max_steps = o->rve_max;
+    m->fs.def.lock_inner = rotation_lock(o) == ROT_INNER;
     m->fs.frames = &m->fr;
     m->fs.stats = m->stats;
     pr.packing = o->frame == GK_FRAME_SERVO ? &m->fr.framed : &m->pk;

@@ -17,8 +17,8 @@
 enum { TEST_BIAXIAL = 0, TEST_RVE = 1, TEST_DNS = 2 };
 
 typedef struct opts {
-    int test, nx, ny, iso_steps, steps, threads, frame, no_rotation, vtk_every, checkpoint, max_dr, servo_max,
-        rayleigh;
+    int test, nx, ny, iso_steps, steps, threads, frame, no_rotation, lock_frame, vtk_every, checkpoint,
+        max_dr, servo_max, rayleigh;
     int rve_max, stop_after, material, paper;
     int tiles[2];
     double strain, pressure, friction, width, height, kn_ratio, dt_factor, damping, tol_energy, tol_dr,
@@ -38,7 +38,10 @@ static void usage(FILE *fp) {
             "  --strain E              final axial strain d / h_ic (0.10)\n"
             "  --pressure P            confinement sigma0 [Pa = N/m per m] (1.5e5)\n"
             "  --friction MU           contact friction (0.4)\n"
-            "  --no-rotation           particles do not rotate\n"
+            "  --no-rotation           the paper's theta_p = 0: the inner particles do not rotate, the\n"
+            "                          servo frame does (the periodic cell, the dns: no particle does)\n"
+            "  --lock-frame            with --no-rotation and the servo frame: the frame does not rotate\n"
+            "                          either (no moment is corrected)\n"
             "  --frame servo|periodic  RVE boundary: the servo frame (paper) or the periodic cell\n"
             "  --packing FILE          framed packing (examples/data/frame228_a002.txt)\n"
             "  --kn-ratio K            k_n / sigma0 (100)\n"
@@ -118,6 +121,7 @@ static int parse(int argc, char **argv, opts *o) {
         {"--frame", CLI_STR, &o->frame_s, 0, 0, NULL, NULL, 0},
         {"--dns-tiles", CLI_STR, &o->tiles_s, 0, 0, NULL, NULL, 0},
         {"--no-rotation", CLI_FLAG, &o->no_rotation, 0, 0, NULL, NULL, 0},
+        {"--lock-frame", CLI_FLAG, &o->lock_frame, 0, 0, NULL, NULL, 0},
         {"--paper", CLI_FLAG, &o->paper, 0, 0, NULL, NULL, 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     const cli_opt *const tables[] = {tab, NULL};
@@ -201,11 +205,28 @@ static int parse(int argc, char **argv, opts *o) {
         }
         o->tiles[0] = a, o->tiles[1] = b;
     }
+    if (o->lock_frame && (!o->no_rotation || o->frame != GK_FRAME_SERVO || o->test == TEST_DNS)) {
+        fprintf(stderr, PROG ": --lock-frame goes with --no-rotation and the servo frame (the periodic "
+                             "cell and the dns lock every particle already)\n");
+        return 2;
+    }
     if (!o->out) {
         fprintf(stderr, PROG ": --out DIR is required (see --help)\n");
         return 2;
     }
     return 0;
+}
+
+/* the rotation lock: ROT_FREE; ROT_ALL every particle (GK_RVE_NO_ROTATION); ROT_INNER the inner
+ * particles, the servo frame turning (gk_frame_def.lock_inner) */
+enum { ROT_FREE = 0, ROT_ALL = 1, ROT_INNER = 2 };
+static int rotation_lock(const opts *o) {
+    if (!o->no_rotation) return ROT_FREE;
+    return o->frame == GK_FRAME_SERVO && o->test != TEST_DNS && !o->lock_frame ? ROT_INNER : ROT_ALL;
+}
+static const char *rotation_name(const opts *o) {
+    static const char *const name[3] = {"free", "locked", "locked-inner"};
+    return name[rotation_lock(o)];
 }
 
 #endif /* FEMDEM_DR_OPTS_H */

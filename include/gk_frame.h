@@ -81,9 +81,13 @@
  *      g k_eff ~ 1, a Newton step with the pair's contact stiffness;
  *   5. P = (1/V) sum_q a_q (x) X_q (eq 14), tension-positive, and its
  *      Cauchy stress sigma = P F^T / det F (eq 16) by gk_frame_cauchy.
- * Without rotation (GK_RVE_NO_ROTATION in the RVE's def, the paper's
- * theta_p = 0) no particle turns, boundary ones included, and no moment is
- * corrected.
+ * The paper's locked rotation (Figs 10-11) is theta_p = 0 for the inner
+ * particles p: def.lock_inner = 1 holds their spin at zero
+ * (gk_scene_lock_rotation) while the frame turns with its moment
+ * corrections. Without rotation in the RVE's def (GK_RVE_NO_ROTATION) no
+ * particle turns, boundary ones included, and no moment is corrected. The
+ * periodic cell has no frame: every particle is inner, so it takes
+ * GK_RVE_NO_ROTATION for the paper's lock, and refuses lock_inner.
  *
  * ONE RUN OF THE PERIODIC CELL (GK_FRAME_PERIODIC): the cell is deformed by
  * dH (gk_rve_deform, the cell boundary moving at most ramp r_min per step),
@@ -129,6 +133,7 @@ typedef struct gk_frame_def {
     int every;         /* DEM steps between energy checks; 0 -> 10                          */
     int max_servo;     /* servo corrections per run; 0 -> 20                                */
     long max_steps;    /* DEM steps per run; 0 -> 200 000                                   */
+    int lock_inner;    /* 1: the inner particles do not turn, the frame does (servo only)   */
 } gk_frame_def;
 
 /* what one run did (per point; written by that point's run only) */
@@ -562,6 +567,9 @@ static gk_result gk__frame_servo(const gk_frame_set *set, const gk_frame *fr, gk
     /* the frame is held (prescribed, at rest) from the start, so that a run with nothing to move
      * (dH = 0) relaxes the inside against it and records its loads (eq 9) like any other */
     for (i = 0, r = GK_OK; i < nq && r == GK_OK; ++i) r = gk_scene_prescribe(&w.sc, w.idx[i], zero, zero);
+    if (set->def.lock_inner)
+        for (i = 0; i < w.sc.rve.n && r == GK_OK; ++i)
+            if (!w.skip[w.sc.rve.id[i]]) r = gk_scene_lock_rotation(&w.sc, i, 1);
     if (!r) r = gk__fw_move(&w);
     while (!r) {
         if ((r = gk__fw_relax(&w)) != GK_OK) break;
@@ -662,6 +670,12 @@ GKDEF gk_result gk_frame_run(void *user, int point, int proto, gk_rve *rve, cons
         !(set.def.gain_m > 0) || !(set.def.ramp > 0) || set.def.every < 1 || set.def.max_servo < 1 ||
         set.def.max_steps < 1)
         return gk_err_set(&rve->err, GK_ERR_ARG, "frame: tolerances, gains, ramp and caps must be > 0");
+    if (set.def.lock_inner != 0 && set.def.lock_inner != 1)
+        return gk_err_set(&rve->err, GK_ERR_ARG, "frame: lock_inner %d is not 0 or 1", set.def.lock_inner);
+    if (set.def.lock_inner && set.kind == GK_FRAME_PERIODIC)
+        return gk_err_set(&rve->err, GK_ERR_ARG,
+                          "frame: the periodic cell has no frame (every particle is inner): lock the "
+                          "rotation with GK_RVE_NO_ROTATION, not lock_inner");
     gk_m3_identity(F);
     for (k = 0; k < 9; ++k) F[k] += H[k] + dH[k];
     if (!(gk_m3_det(F) > 0.0)) return gk_err_set(&rve->err, GK_ERR_CELL, "frame: det F = %g", gk_m3_det(F));

@@ -29,7 +29,8 @@
  *   gk_scene_def_default / gk_scene_create / gk_scene_destroy / gk_scene_step (_flags)
  *   gk_scene_add_wall, gk_scene_add_box, gk_wall_def_default, gk_scene_pair_material
  *   gk_scene_set_external, gk_scene_prescribe / gk_scene_release,
- *   gk_scene_set_velocity, gk_scene_set_mass      per particle (index p)
+ *   gk_scene_lock_rotation, gk_scene_set_velocity, gk_scene_set_mass
+ *                                                  per particle (index p)
  *   gk_scene_add_membrane, gk_scene_side_chain      flexible 2D boundary
  *   gk_scene_insert / gk_scene_remove / gk_scene_index   stable ids
  *   gk_scene_energy_track / gk_scene_energy        the energy books
@@ -106,6 +107,11 @@
  * external) is in sc.load[k][p], sc.loadt[k][p] after each step;
  * gk_scene_release frees it. (Liu, Bosco & Suiker 2018's frame of boundary particles and
  * Chen et al. 2021's trained grains are prescribed particles.)
+ * gk_scene_lock_rotation(sc, p, 1) holds the spin of particle p at zero
+ * (its orientation stays, it translates freely; its contact moments act on
+ * nothing) until it is called with 0: one particle's share of
+ * GK_RVE_NO_ROTATION, e.g. Liu, Bosco & Suiker 2018's theta_p = 0 for the
+ * inner particles while the frame turns. A prescribed spin overrides it.
  *
  * MEMBRANE (2D). gk_scene_add_membrane(sc, k, ids, pressure, stiffness,
  * anchor_first, anchor_last): a chain of particles (stable ids, the
@@ -297,6 +303,8 @@ typedef struct gk_energy {
 
 /* particle flags */
 #define GK_PARTICLE_PRESCRIBED 1u
+#define GK_PARTICLE_LOCKED_ROTATION 2u
+#define GK__PARTICLE_FLAGS 3u
 
 /* gk_scene_add_box faces: bit 2k lower face of axis k, bit 2k+1 upper */
 #define GK_BOX_ALL 0x3fu
@@ -317,7 +325,7 @@ typedef struct gk_scene {
     double *vp[3], *wp[3];      /* prescribed velocity and spin                            */
     double *load[3], *loadt[3]; /* load on prescribed particles, last step              */
     double *fext[3], *text[3];  /* constant external force and moment                   */
-    int nprescribed;
+    int nprescribed, nlocked;   /* particles with GK_PARTICLE_PRESCRIBED, _LOCKED_ROTATION */
     int32_t next_id, *index_of; /* id -> index (-1: gone), capacity cap_ids              */
     int cap_ids;
     long lost; /* particles deleted as lost                               */
@@ -390,6 +398,8 @@ GKDEF gk_result gk_scene_add_box(gk_scene *sc, const gk_material *m, unsigned fa
 GKDEF gk_result gk_scene_set_external(gk_scene *sc, int p, const double f[3], const double t[3]);
 GKDEF gk_result gk_scene_prescribe(gk_scene *sc, int p, const double v[3], const double w[3]);
 GKDEF gk_result gk_scene_release(gk_scene *sc, int p);
+/* locked 1: the spin of particle p is held at zero from the next step on; 0: free again */
+GKDEF gk_result gk_scene_lock_rotation(gk_scene *sc, int p, int locked);
 /* mass and moment of inertia of particle p (e.g. another density) */
 GKDEF gk_result gk_scene_set_mass(gk_scene *sc, int p, double m, double I);
 /* velocity and spin of particle p (NULL: unchanged), e.g. the initial state */
@@ -1713,6 +1723,12 @@ static void gk__hook_post_forces(gk_scene *sc) {
                 }
             }
         }
+    if (sc->nlocked) /* a prescribed spin overrides the lock */
+        for (p = 0; p < n; ++p)
+            if ((sc->flags[p] & (GK_PARTICLE_LOCKED_ROTATION | GK_PARTICLE_PRESCRIBED)) ==
+                GK_PARTICLE_LOCKED_ROTATION)
+                for (k = 0; k < 3; ++k)
+                    if (rve->t[k]) rve->t[k][p] = rve->w[k][p] = 0;
 }
 
 /* kinetic energy at the current (half-step) velocities */
@@ -1890,6 +1906,20 @@ GKDEF gk_result gk_scene_release(gk_scene *sc, int p) {
     if ((r = gk__scene_p(sc, p)) != GK_OK) return r;
     if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) --sc->nprescribed;
     sc->flags[p] &= (unsigned char)~GK_PARTICLE_PRESCRIBED;
+    return GK_OK;
+}
+
+GKDEF gk_result gk_scene_lock_rotation(gk_scene *sc, int p, int locked) {
+    gk_result r;
+    if ((r = gk__scene_p(sc, p)) != GK_OK) return r;
+    if (locked != 0 && locked != 1)
+        return gk_err_set(&sc->err, GK_ERR_ARG, "lock_rotation: locked %d is not 0 or 1", locked);
+    if (locked && !(sc->flags[p] & GK_PARTICLE_LOCKED_ROTATION)) ++sc->nlocked;
+    if (!locked && (sc->flags[p] & GK_PARTICLE_LOCKED_ROTATION)) --sc->nlocked;
+    if (locked)
+        sc->flags[p] |= GK_PARTICLE_LOCKED_ROTATION;
+    else
+        sc->flags[p] &= (unsigned char)~GK_PARTICLE_LOCKED_ROTATION;
     return GK_OK;
 }
 
@@ -2195,6 +2225,7 @@ static gk_result gk__scene_delete(gk_scene *sc, const unsigned char *drop) {
     for (p = 0, q = 0; p < n; ++p) {
         if (drop[p]) {
             if (sc->flags[p] & GK_PARTICLE_PRESCRIBED) --sc->nprescribed;
+            if (sc->flags[p] & GK_PARTICLE_LOCKED_ROTATION) --sc->nlocked;
             continue;
         }
         sc->mass[q] = sc->mass[p];
@@ -2436,7 +2467,7 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
     gk__scene_hdr hd;
     const unsigned char *in = (const unsigned char *)buf;
     size_t off = 0, n, R = sizeof(gk_real);
-    int k, w, m, p, nh = sc->dim == 2 ? 1 : 3;
+    int k, w, m, p, np, nl, nh = sc->dim == 2 ? 1 : 3;
     gk_result r;
     if (!buf || size < sizeof hd) return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state buffer too small");
     memcpy(&hd, buf, sizeof hd);
@@ -2521,6 +2552,17 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
             return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state particle %d is invalid", p);
     GK__SGET(sc->mass, n * sizeof(double));
     GK__SGET(sc->flags, n);
+    for (p = 0, np = nl = 0; p < hd.n; ++p) {
+        if ((sc->flags[p] & ~GK__PARTICLE_FLAGS) ||
+            ((sc->flags[p] & GK_PARTICLE_PRESCRIBED) && !hd.have_presc))
+            return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state particle %d has invalid flags %u", p,
+                              (unsigned)sc->flags[p]);
+        np += (sc->flags[p] & GK_PARTICLE_PRESCRIBED) != 0;
+        nl += (sc->flags[p] & GK_PARTICLE_LOCKED_ROTATION) != 0;
+    }
+    if (np != hd.nprescribed)
+        return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state: %d prescribed particles, the header says %d",
+                          np, (int)hd.nprescribed);
     if (hd.have_presc)
         for (k = 0; k < 3; ++k) {
             if ((r = gk__sc_new(sc, &sc->vp[k])) || (r = gk__sc_new(sc, &sc->wp[k])) ||
@@ -2588,7 +2630,8 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
     gk_rve_update_totals(&sc->rve);
     sc->next_id = hd.next_id;
     if ((r = gk__scene_index(sc)) != GK_OK) return r;
-    sc->nprescribed = hd.nprescribed;
+    sc->nprescribed = np;
+    sc->nlocked = nl;
     sc->lost = hd.lost;
     sc->en = hd.en;
     for (k = 0; k < 9; ++k) sc->wall_love[k] = hd.wall_love[k];

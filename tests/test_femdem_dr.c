@@ -96,7 +96,8 @@ TEST(isotropic_stage_and_one_element_against_the_rve) {
 }
 
 /* Liu, Bosco & Suiker 2018 Figs 10-11: with particle rotation locked (theta_p = 0) the RVE is stronger:
- * its stress ratio at 4 % axial strain exceeds the free one (the RVE alone, periodic cell) */
+ * its stress ratio at 4 % axial strain exceeds the free one (the RVE alone, periodic cell and servo
+ * frame) */
 TEST(locked_rotation_is_stronger) {
     static double f[MAXR][12], l[MAXR][12];
     int nf, nl;
@@ -113,6 +114,25 @@ TEST(locked_rotation_is_stronger) {
     printf("    sigma_bar at 4 %%: free %.4f, locked %.4f\n", f[14][3], l[14][3]);
     CHECK(l[14][3] > f[14][3] * 1.05);
     CHECK(gk_test_file_has(BUILD "/tests/t_fdr_lock.out", "rotation=locked"));
+    /* the servo frame: the paper's lock holds the inner particles only (the frame turns) */
+    CHECK(system(FDR "--test rve --steps 4 --strain 0.04 --out " BUILD "/tests/t_fdr_sfree > " BUILD
+                     "/tests/t_fdr_sfree.out 2>&1") == 0);
+    CHECK(system(FDR "--test rve --steps 4 --strain 0.04 --no-rotation --out " BUILD
+                     "/tests/t_fdr_slock > " BUILD "/tests/t_fdr_slock.out 2>&1") == 0);
+    nf = rows(BUILD "/tests/t_fdr_sfree/dr.csv", f);
+    nl = rows(BUILD "/tests/t_fdr_slock/dr.csv", l);
+    CHECK(nf == 15 && nl == 15);
+    if (nf != 15 || nl != 15) return;
+    printf("    servo frame, sigma_bar at 4 %%: free %.4f, inner particles locked %.4f\n", f[14][3],
+           l[14][3]);
+    CHECK(l[14][3] > f[14][3] * 1.05);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_slock.out", "rotation=locked-inner"));
+    /* --lock-frame goes with --no-rotation and the servo frame only */
+    CHECK(system(FDR "--test rve --lock-frame --out " BUILD "/tests/t_fdr_bad > " BUILD
+                     "/tests/t_fdr_bad.out 2>&1") == 2 * 256);
+    CHECK(system(FDR "--test rve --no-rotation --lock-frame --frame periodic --out " BUILD
+                     "/tests/t_fdr_bad > " BUILD "/tests/t_fdr_bad.out 2>&1") == 2 * 256);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fdr_bad.out", "--lock-frame goes with"));
 }
 
 /* the servo frame (the paper's RVE) on a 1 x 2 mesh: 2 threads and 1 thread give the same rows bit for

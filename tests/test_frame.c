@@ -195,6 +195,47 @@ TEST(locked_rotation_stays_locked) {
     gk_frame_free(&fr);
 }
 
+/* the paper's own lock, theta_p = 0 for the inner particles p (def.lock_inner): under shear no inner
+ * particle turns while the frame does (the servo corrects its moments); the periodic cell, which has
+ * no frame, refuses lock_inner and changes nothing */
+TEST(inner_lock_turns_only_the_frame) {
+    gk_frame fr;
+    gk_err e;
+    gk_rve r;
+    gk_rve_def d = law(0u);
+    gk_frame_set set;
+    double H[9] = {0}, dH[9] = {0}, P[9], inner = 0.0, frame = 0.0, th0;
+    int steps, p, i;
+    CHECK(load());
+    if (!have) return;
+    CHECK(gk_frame_build(&fr, &pk, NULL, &e) == GK_OK);
+    memset(&set, 0, sizeof set);
+    set.kind = GK_FRAME_SERVO, set.frames = &fr;
+    set.def.max_servo = 3, set.def.lock_inner = 1;
+    dH[1] = 2e-3, dH[0] = dH[4] = -1e-3;
+    CHECK(gk_rve_create(&r, &d, &fr.framed) == GK_OK && gk_rve_refresh(&r) == GK_OK);
+    CHECK(gk_frame_run(&set, 0, 0, &r, H, dH, 1.0, P, &steps) == GK_OK);
+    for (p = 0; p < r.n; ++p) {
+        int on_frame = 0;
+        for (i = 0; i < fr.nq; ++i) on_frame |= r.id[p] == fr.q[i];
+        if (on_frame)
+            frame += fabs(r.theta[p]);
+        else
+            inner += fabs(r.theta[p]) + fabs((double)r.w[2][p]);
+    }
+    printf("    sum |theta|: inner %g, frame %g rad\n", inner, frame);
+    CHECK_NEAR(inner, 0.0, 0.0);
+    CHECK(frame > 0.0);
+    set.kind = GK_FRAME_PERIODIC;
+    th0 = r.theta[0];
+    CHECK(gk_frame_run(&set, 0, 0, &r, H, dH, 1.0, P, &steps) == GK_ERR_ARG);
+    CHECK(r.theta[0] == th0);
+    set.kind = GK_FRAME_SERVO, set.def.lock_inner = 2;
+    CHECK(gk_frame_run(&set, 0, 0, &r, H, dH, 1.0, P, &steps) == GK_ERR_ARG);
+    gk_rve_destroy(&r);
+    gk_frame_free(&fr);
+}
+
 /* the positions of the frame's boundary particles (by their ids) into x (nq x 3); the number found */
 static int frame_positions(const gk_rve *r, const gk_frame *fr, double *x) {
     int i, p, found = 0;
@@ -289,6 +330,7 @@ int main(int argc, char **argv) {
     RUN(energy_of_one_contact_is_eq32);
     RUN(servo_frame_and_periodic_cell_under_compression);
     RUN(locked_rotation_stays_locked);
+    RUN(inner_lock_turns_only_the_frame);
     RUN(servo_frame_without_deformation_holds_the_frame);
     RUN(bad_input_is_refused);
     if (have) gk_packing_free(&pk);

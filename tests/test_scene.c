@@ -378,6 +378,95 @@ TEST(chung_ooi_4_oblique_constant_speed) {
     }
 }
 
+/* gk_scene_lock_rotation: test 4's sphere that cannot turn. Its moment of
+ * inertia is in effect infinite, chi = 1 + m R^2 / I = 1, so it slides
+ * throughout the impact from tan(theta) >= 2 chi mu on (theta >= 10.4 deg,
+ * where the free sphere still sticks), with Chung & Ooi's gross-sliding
+ * result e_t = 1 - 2 mu / tan(theta) and no spin at all (w = 0 exactly at
+ * every step). A prescribed spin overrides the lock; the lock survives a
+ * save and restore; bad arguments and a damaged flag are refused. */
+static unsigned char *state_of(const gk_scene *sc, size_t *n);
+TEST(locked_rotation_slides_without_turning) {
+    const double ang[3] = {15, 30, 50};
+    double R = 2.5e-3, mu = 0.092, V = 3.9, m = sphere_mass(AL_OXIDE.rho, R);
+    double dt = hertz_tc(m, R, estar(&AL_OXIDE, NULL), V) / 1000.0;
+    gk_material mat = hertz_mat(&AL_OXIDE, mu);
+    int a, k;
+    for (a = 0; a < 3; ++a) {
+        double th = ang[a] * GK_PI / 180.0, vn = V * cos(th), vt = V * sin(th), v[3] = {0, 0, 0}, wmax = 0.0,
+               free_et = 0.0;
+        gk_scene sc;
+        long st;
+        int pass;
+        v[0] = vt, v[1] = -vn;
+        for (pass = 0; pass < 2; ++pass) { /* 0: free, 1: locked */
+            int started = 0;
+            if (sphere_on_plane(&sc, &mat, R, v, NULL, dt)) {
+                CHECK(0);
+                return;
+            }
+            if (pass) CHECK(gk_scene_lock_rotation(&sc, 0, 1) == GK_OK && sc.nlocked == 1);
+            for (st = 0; st < 2000000; ++st) {
+                double f;
+                CHECK(gk_scene_step(&sc, 1) == GK_OK);
+                if (pass)
+                    for (k = 0; k < 3; ++k)
+                        if (fabs((double)sc.rve.w[k][0]) > wmax) wmax = fabs((double)sc.rve.w[k][0]);
+                f = fabs((double)sc.rve.f[1][0]);
+                if (f > 0.0)
+                    started = 1;
+                else if (started)
+                    break;
+            }
+            if (!pass) {
+                free_et = (double)sc.rve.v[0][0] / vt;
+                gk_scene_destroy(&sc);
+            }
+        }
+        printf("    theta %4.1f: locked e_t %.4f (1 - 2 mu / tan theta = %.4f; free %.4f), |w| max %g\n",
+               ang[a], (double)sc.rve.v[0][0] / vt, 1.0 - 2.0 * mu / tan(th), free_et, wmax);
+        CHECK(wmax == 0.0);
+        CHECK_NEAR((double)sc.rve.v[0][0] / vt, 1.0 - 2.0 * mu / tan(th), 2e-3);
+        CHECK_NEAR((double)sc.rve.v[1][0], vn, 1e-3 * vn);
+        if (a == 0) CHECK(free_et - (1.0 - 2.0 * mu / tan(th)) > 0.05); /* the free sphere rolls part of it */
+        if (a == 0) {
+            double w5[3] = {0, 0, 5}, zero[3] = {0, 0, 0};
+            unsigned char *s0, *s1;
+            size_t n0, n1, i, at = 0, ndiff = 0;
+            gk_scene B;
+            /* the lock survives save and restore; its byte is the only difference from an unlocked state */
+            s1 = state_of(&sc, &n1);
+            CHECK(gk_scene_lock_rotation(&sc, 0, 0) == GK_OK && sc.nlocked == 0);
+            s0 = state_of(&sc, &n0);
+            CHECK(s0 && s1 && n0 == n1);
+            for (i = 0; s0 && s1 && i < n0 && n0 == n1; ++i)
+                if (s0[i] != s1[i]) at = i, ++ndiff;
+            CHECK(ndiff == 1);
+            CHECK(sphere_on_plane(&B, &mat, R, v, NULL, dt) == 0);
+            CHECK(gk_scene_restore(&B, s1, n1) == GK_OK && B.nlocked == 1 &&
+                  (B.flags[0] & GK_PARTICLE_LOCKED_ROTATION));
+            if (s1 && ndiff == 1) {
+                s1[at] = 0x80; /* no such flag */
+                CHECK(gk_scene_restore(&B, s1, n1) == GK_ERR_FORMAT);
+                printf("    %s\n", gk_scene_error(&B));
+            }
+            gk_scene_destroy(&B);
+            free(s0), free(s1);
+            /* bad arguments change nothing */
+            CHECK(gk_scene_lock_rotation(&sc, 0, 1) == GK_OK);
+            CHECK(gk_scene_lock_rotation(&sc, 1, 1) == GK_ERR_ARG);
+            CHECK(gk_scene_lock_rotation(&sc, 0, 2) == GK_ERR_ARG);
+            CHECK(sc.nlocked == 1 && sc.flags[0] == GK_PARTICLE_LOCKED_ROTATION);
+            /* a prescribed spin overrides the lock; released, the lock holds the spin at zero again */
+            CHECK(gk_scene_prescribe(&sc, 0, zero, w5) == GK_OK && gk_scene_step(&sc, 3) == GK_OK);
+            CHECK((double)sc.rve.w[2][0] == 5.0);
+            CHECK(gk_scene_release(&sc, 0) == GK_OK && gk_scene_step(&sc, 1) == GK_OK);
+            CHECK((double)sc.rve.w[2][0] == 0.0);
+        }
+        gk_scene_destroy(&sc);
+    }
+}
+
 /* Test 5: constant normal speed 5 m/s, tangential speed varied (aluminium
  * alloy and nylon, R = 0.1 m, mu = 0.4), in Maw et al.'s normalised
  * angles Psi1 = kappa v_c / (mu v_n), Psi2 = kappa v_c' / (mu v_n), kappa =
@@ -1811,6 +1900,7 @@ int main(int argc, char **argv) {
     RUN(chung_ooi_2_sphere_on_wall_normal);
     RUN(chung_ooi_3_restitution);
     RUN(chung_ooi_4_oblique_constant_speed);
+    RUN(locked_rotation_slides_without_turning);
     RUN(chung_ooi_5_oblique_constant_normal_speed);
     RUN(chung_ooi_6_spinning_sphere_on_wall);
     RUN(chung_ooi_7_two_spheres_oblique);
