@@ -19,10 +19,10 @@
  * `build/femdem_dr [--nx N --ny M] [--frame periodic] [--test rve|dns] --vtk-every 0 --out DIR`;
  * sigma_bar at axial strain 1, 2, 3, 5 %, its peak, sigma_bar and A at 7.3 %, all RVE DEM steps)
  *   run                 1 %    2 %    3 %    5 %    peak          7.3 %: s_bar  A      DEM steps
- *   servo, RVE alone    0.187  0.294  0.343  0.370  0.383 at 6.5  0.332  0.295  2.3e5
- *   servo, 1 x 1        0.187  0.296  0.341  0.372  0.378 at 5.5  0.309  0.285  2.8e6
+ *   servo, RVE alone    0.187  0.294  0.343  0.370  0.377 at 5.5  0.328  0.288  2.6e5
+ *   servo, 1 x 1        0.186  0.294  0.339  0.365  0.369 at 5.5  0.327  0.306  3.3e6
  *   servo, 1 x 2        0.174  0.279  0.335  0.365  0.365 at 5.0  0.323  0.292  5.0e6
- *   servo, 2 x 4        0.169  0.271  0.327  0.360  0.360 at 5.0  0.317  0.256  2.3e7
+ *   servo, 2 x 4        0.170  0.271  0.327  0.360  0.360 at 5.0  0.320  0.257  2.3e7
  *   periodic, RVE alone 0.207  0.314  0.345  0.358  0.370 at 4.5  0.325  0.240  2.1e4
  *   periodic, 1 x 1     0.208  0.311  0.339  0.337  0.363 at 4.5  0.331  0.249  1.7e5
  *   periodic, 1 x 2     0.204  0.308  0.338  0.349  0.356 at 4.0  0.340  0.241  4.2e5
@@ -38,7 +38,11 @@
  * Against Liu, Bosco & Suiker (2018), who give numbers only for Figs 10-11 (at 7.3 %: free
  * 0.39, locked 0.48; A 0.27 and 0.33): the locked rotation is stronger and more anisotropic
  * (A ratio free / locked 0.81 here, 0.82 there) but far stronger here (stress ratio 0.56,
- * there 0.81); the peak comes earlier (4-5 %, there near 7 %); higher friction gives a higher
+ * there 0.81; the servo frame with the paper's lock of the inner particles only, RVE alone:
+ * 0.59); the ratio depends on k_n / sigma0, which the paper leaves open: 0.81 at 30 (RVE
+ * alone; 2 x 4 servo: free 0.332, locked 0.416, A 0.12 and 0.12), 0.93 at 10, 0.54 at 1000
+ * (tools/dr_rotation_study.sh, examples/README.md); the peak comes earlier (4-5 %, there near
+ * 7 %; 7 % at k_n = 30 sigma0); higher friction gives a higher
  * stress and a lower coordination as there, but not their larger compaction; an ensemble of
  * 22 RVEs resolves no effect of the initial anisotropy (there: a lower, earlier peak; below).
  * The meshes agree within

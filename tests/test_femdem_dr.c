@@ -135,6 +135,43 @@ TEST(locked_rotation_is_stronger) {
     CHECK(gk_test_file_has(BUILD "/tests/t_fdr_bad.out", "--lock-frame goes with"));
 }
 
+/* tools/dr_rotation_study.sh at one stiffness (k_n = 1000 sigma0, the fastest): nine runs (three
+ * packings x free, inner particles locked, every particle locked), each row filled, the locked RVEs
+ * stronger at 7.3 %, the table and the figure written; without the programs it stops with status 1 */
+TEST(rotation_study_runs) {
+    FILE *fp;
+    char line[512], pk[32], rot[32];
+    double kn, v[5], free_s = 0.0, inner_s = 0.0;
+    int n = 0, filled = 0;
+    CHECK(system("rm -rf " BUILD "/tests/t_rot && BUILD=" BUILD " sh tools/dr_rotation_study.sh " BUILD
+                 "/tests/t_rot 2 1000 > " BUILD "/tests/t_rot.out 2>&1") == 0);
+    fp = fopen(BUILD "/tests/t_rot/rotation.csv", "r");
+    CHECK(fp != NULL);
+    if (!fp) return;
+    CHECK(fgets(line, sizeof line, fp) &&
+          !strcmp(line, "kn_ratio,packing,rotation,peak_sigma_bar,eps_at_peak,"
+                        "sigma_bar_0073,anisotropy_0073,dem_steps_per_run\n"));
+    while (fgets(line, sizeof line, fp)) {
+        ++n;
+        if (sscanf(line, "%lf,%31[^,],%31[^,],%lf,%lf,%lf,%lf,%lf", &kn, pk, rot, &v[0], &v[1], &v[2], &v[3],
+                   &v[4]) == 8 &&
+            kn == 1000 && v[2] > 0.0 && v[4] > 0.0) {
+            ++filled;
+            if (!strcmp(pk, "a002") && !strcmp(rot, "free")) free_s = v[2];
+            if (!strcmp(pk, "a002") && !strcmp(rot, "inner")) inner_s = v[2];
+        }
+    }
+    fclose(fp);
+    printf("    %d rows, %d filled; a002 at 7.3 %%: free %.3f, inner locked %.3f\n", n, filled, free_s,
+           inner_s);
+    CHECK(n == 9 && filled == 9);
+    CHECK(inner_s > 1.2 * free_s);
+    CHECK(gk_test_file_has(BUILD "/tests/t_rot.out", "free/inner"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_rot/ratio.svg", "Liu, Bosco"));
+    CHECK(system("BUILD=" BUILD "/no_such_dir sh tools/dr_rotation_study.sh " BUILD "/tests/t_rot2 > " BUILD
+                 "/tests/t_rot2.out 2>&1") == 256);
+}
+
 /* the servo frame (the paper's RVE) on a 1 x 2 mesh: 2 threads and 1 thread give the same rows bit for
  * bit, and so does a run stopped after 2 steps and restarted from its checkpoint */
 TEST(threads_and_restart_give_the_same_rows) {
@@ -285,6 +322,7 @@ int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(isotropic_stage_and_one_element_against_the_rve);
     RUN(locked_rotation_is_stronger);
+    RUN(rotation_study_runs);
     RUN(threads_and_restart_give_the_same_rows);
     RUN(a_step_stopped_before_equilibrium_is_reported);
     RUN(dns_runs);
