@@ -89,8 +89,8 @@ GKDEF void gk_cells_free(gk_cells *c);
  * GK_ERR_CELL if cutoff >= half the smallest cell width (minimum image would
  * be ambiguous). */
 GK_INLINE int gk__open_bin(double s, double lo, double inv, int nb) {
-    int b = (int)((s - lo) * inv);
-    return b >= nb ? nb - 1 : (b < 0 ? 0 : b);
+    double t = (s - lo) * inv; /* compared before the conversion: a NaN or a huge t is no int */
+    return t >= (double)nb ? nb - 1 : (t >= 1.0 ? (int)t : 0);
 }
 
 GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, const double *const s[3],
@@ -271,6 +271,7 @@ GKDEF gk_result gk_cells_bin(gk_cells *c, int dim, const double h[9], int n, con
             for (p = 0; p < n; ++p)
                 if (s[k][p] > smax) smax = s[k][p];
             c->inv[k] = smax > c->lo[k] ? (double)c->nbin[k] / (smax - c->lo[k]) : 0.0;
+            if (!(c->inv[k] <= 1e300)) c->inv[k] = 0.0; /* an extent of a denormal: one bin */
         }
     if ((size_t)n + 1 > c->cap_n) { /* order and bin_of share one capacity */
         size_t cap = (size_t)n + 1;

@@ -422,6 +422,9 @@ GKDEF void gk_scene_energy(const gk_scene *sc, gk_energy *e);
 
 GKDEF size_t gk_scene_state_size(const gk_scene *sc);
 GKDEF gk_result gk_scene_save(const gk_scene *sc, void *buf, size_t cap, size_t *written);
+/* a state of this scene (same dim, walls, membranes, domain; any particle count): a buffer from
+ * anywhere is untrusted, and one refused (GK_ERR_FORMAT with a message, GK_ERR_DT for a time step
+ * above its particles' critical one) leaves the scene exactly as it was */
 GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size);
 
 /* output: particles (points with radius, velocity, spin, id) and walls
@@ -590,7 +593,12 @@ static gk_result gk__scene_index(gk_scene *sc) {
         sc->cap_ids = cap;
     }
     for (p = 0; p < sc->next_id; ++p) sc->index_of[p] = -1;
-    for (p = 0; p < sc->rve.n; ++p) sc->index_of[sc->rve.id[p]] = p;
+    for (p = 0; p < sc->rve.n; ++p) {
+        if (sc->index_of[sc->rve.id[p]] >= 0)
+            return gk_err_set(&sc->err, GK_ERR_FORMAT, "particles %d and %d have the same id %d",
+                              (int)sc->index_of[sc->rve.id[p]], p, (int)sc->rve.id[p]);
+        sc->index_of[sc->rve.id[p]] = p;
+    }
     return GK_OK;
 }
 
@@ -2463,11 +2471,28 @@ GKDEF gk_result gk_scene_save(const gk_scene *sc, void *buf, size_t cap, size_t 
     return GK_OK;
 }
 
-GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
+/* every value finite and at most 1e100 in magnitude (what a state can hold) */
+static int gk__sc_sane(const double *a, size_t n) {
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (!(fabs(a[i]) <= 1e100)) return 0;
+    return 1;
+}
+static int gk__sc_sane_real(const gk_real *a, size_t n) {
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (!(fabs((double)a[i]) <= 1e100)) return 0;
+    return 1;
+}
+
+/* reads a state into sc, checking as it goes: a refused state may leave sc half-written
+ * (gk_scene_restore puts it back) */
+static gk_result gk__scene_restore_raw(gk_scene *sc, const void *buf, size_t size) {
     gk__scene_hdr hd;
     const unsigned char *in = (const unsigned char *)buf;
     size_t off = 0, n, R = sizeof(gk_real);
     int k, w, m, p, np, nl, nh = sc->dim == 2 ? 1 : 3;
+    double hkeep[9];
     gk_result r;
     if (!buf || size < sizeof hd) return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state buffer too small");
     memcpy(&hd, buf, sizeof hd);
@@ -2482,6 +2507,18 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
             "%d, %d",
             hd.dim, hd.real_size, hd.nwalls, hd.nmem, sc->dim, (int)R, sc->nwalls, sc->nmem);
     if (hd.rve_bytes > size) return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state has the wrong size");
+    {
+        const gk_energy *E = &hd.en;
+        double hv[17];
+        hv[0] = E->kinetic, hv[1] = E->elastic, hv[2] = E->gravity, hv[3] = E->walls, hv[4] = E->external;
+        hv[5] = E->pressure, hv[6] = E->prescribed, hv[7] = E->friction, hv[8] = E->viscous;
+        hv[9] = E->damping, hv[10] = E->slip, hv[11] = E->removed, hv[12] = E->inserted, hv[13] = E->initial;
+        hv[14] = E->balance, hv[15] = E->scale, hv[16] = hd.erest_prev;
+        if ((unsigned)hd.energy_on > 1u || (unsigned)hd.energy_pending > 1u || (unsigned)hd.have_presc > 1u ||
+            (unsigned)hd.have_ext > 1u || hd.lost < 0 || hd.en.steps < 0 || !gk__sc_sane(hv, 17) ||
+            !gk__sc_sane(hd.wall_love, 9))
+            return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state header holds an impossible value");
+    }
     n = (size_t)hd.n;
     { /* the whole layout before anything changes: walk it (membrane lengths are inside) */
         size_t want = sizeof hd + n * (3 * R + sizeof(int32_t) + sizeof(double) + 1);
@@ -2550,7 +2587,11 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
         if (sc->rve.id[p] < 0 || sc->rve.id[p] >= hd.next_id || !((double)sc->rve.r[p] > 0.0) ||
             !((double)sc->rve.minv[p] > 0.0) || !((double)sc->rve.Iinv[p] > 0.0))
             return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state particle %d is invalid", p);
+    gk_rve_update_totals(&sc->rve); /* gk_rve_restore checks the time step with these particles */
     GK__SGET(sc->mass, n * sizeof(double));
+    for (p = 0; p < hd.n; ++p)
+        if (!(sc->mass[p] > 0.0) || !(sc->mass[p] <= 1e100))
+            return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state particle %d has mass %g", p, sc->mass[p]);
     GK__SGET(sc->flags, n);
     for (p = 0, np = nl = 0; p < hd.n; ++p) {
         if ((sc->flags[p] & ~GK__PARTICLE_FLAGS) ||
@@ -2572,18 +2613,29 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
             GK__SGET(sc->wp[k], n * sizeof(double));
             GK__SGET(sc->load[k], n * sizeof(double));
             GK__SGET(sc->loadt[k], n * sizeof(double));
+            if (!gk__sc_sane(sc->vp[k], n) || !gk__sc_sane(sc->wp[k], n) || !gk__sc_sane(sc->load[k], n) ||
+                !gk__sc_sane(sc->loadt[k], n))
+                return gk_err_set(&sc->err, GK_ERR_FORMAT,
+                                  "scene state: a prescribed motion or load is not finite");
         }
     if (hd.have_ext)
         for (k = 0; k < 3; ++k) {
             if ((r = gk__sc_new(sc, &sc->fext[k])) || (r = gk__sc_new(sc, &sc->text[k]))) return r;
             GK__SGET(sc->fext[k], n * sizeof(double));
             GK__SGET(sc->text[k], n * sizeof(double));
+            if (!gk__sc_sane(sc->fext[k], n) || !gk__sc_sane(sc->text[k], n))
+                return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state: an external load is not finite");
         }
     for (w = 0; w < sc->nwalls; ++w) {
         gk_wall *W = &sc->walls[w];
         gk__wall_rec rec;
         GK__SGET(&rec, sizeof rec);
         if ((r = gk__wall_check(sc, &rec.def)) != GK_OK) return r;
+        if (!gk__sc_sane(rec.pos, 3) || !gk__sc_sane(rec.vel, 3) || !gk__sc_sane(rec.force, 3) ||
+            !gk__sc_sane(rec.moment, 3) || !gk__sc_sane(&rec.angle, 1) || !gk__sc_sane(&rec.stiffness, 1) ||
+            !gk__sc_sane(&rec.resistance, 1) || !gk__sc_sane(&rec.dmax, 1) || rec.ncontacts < 0 ||
+            rec.ncontacts > hd.n)
+            return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state wall %d holds an impossible value", w);
         if (gk_material_flags(&rec.def.mat) != gk_material_flags(&W->def.mat))
             return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state wall %d has other contact physics", w);
         W->def = rec.def;
@@ -2604,6 +2656,9 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
             if (W->ft[0]) GK__SGET(W->ft[k], n * R);
         for (k = 0; k < nh; ++k)
             if (W->mr[0]) GK__SGET(W->mr[k], n * R);
+        for (k = 0; k < nh; ++k)
+            if ((W->ft[0] && !gk__sc_sane_real(W->ft[k], n)) || (W->mr[0] && !gk__sc_sane_real(W->mr[k], n)))
+                return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state wall %d has a non-finite history", w);
     }
     for (m = 0; m < sc->nmem; ++m) {
         gk_membrane *M = &sc->mem[m];
@@ -2623,10 +2678,24 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
         GK__SGET(M->rest, (size_t)nm * sizeof(double));
         GK__SGET(M->fx, (size_t)nm * sizeof(double));
         GK__SGET(M->fy, (size_t)nm * sizeof(double));
+        for (p = 0; p < nm; ++p)
+            if (M->ids[p] < 0 || M->ids[p] >= hd.next_id)
+                return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state membrane %d names id %d", m,
+                                  (int)M->ids[p]);
+        if (!gk__sc_sane(&M->pressure, 1) || !gk__sc_sane(&M->stiffness, 1) || M->stiffness < 0.0 ||
+            !gk__sc_sane(M->arest, 2) || !gk__sc_sane(M->rest, (size_t)nm) ||
+            !gk__sc_sane(M->fx, (size_t)nm) || !gk__sc_sane(M->fy, (size_t)nm))
+            return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state membrane %d holds an impossible value",
+                              m);
     }
     if (off + hd.rve_bytes != size) goto bad;
+    gk_m3_copy(sc->rve.cell.h, hkeep);
     if ((r = gk_rve_restore(&sc->rve, in + off, (size_t)hd.rve_bytes)) != GK_OK)
         return gk__scene_rve_err(sc, r);
+    for (k = 0; k < 9; ++k) /* the scene's cell is its domain: fixed, never driven */
+        if (sc->rve.cell.h[k] != hkeep[k] || sc->rve.L[k] != 0.0 || sc->rve.servo_on)
+            return gk_err_set(&sc->err, GK_ERR_FORMAT,
+                              "scene state: its cell is not this scene's domain (or is driven)");
     gk_rve_update_totals(&sc->rve);
     sc->next_id = hd.next_id;
     if ((r = gk__scene_index(sc)) != GK_OK) return r;
@@ -2648,6 +2717,29 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
     return GK_OK;
 bad:
     return gk_err_set(&sc->err, GK_ERR_FORMAT, "scene state has the wrong size");
+}
+
+/* a refused state changes nothing: the scene's own state is kept aside first and put back */
+GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
+    size_t nb = gk_scene_state_size(sc);
+    void *keep = gk_alloc(gk__sc_alloc(sc), nb);
+    gk_result r, back;
+    gk_err e;
+    if (!keep) return gk_err_set(&sc->err, GK_ERR_ALLOC, "restore: out of memory for the scene's own state");
+    if (gk_scene_save(sc, keep, nb, NULL) != GK_OK) {
+        gk__sc_free(sc, keep);
+        return gk_err_set(&sc->err, GK_ERR_STATE, "restore: the scene's own state could not be kept");
+    }
+    r = gk__scene_restore_raw(sc, buf, size);
+    if (r != GK_OK) {
+        e = sc->err;
+        back = gk__scene_restore_raw(sc, keep, nb);
+        sc->err = e;
+        if (back != GK_OK) /* only running out of memory can get here */
+            gk_err_set(&sc->err, r, "%s; putting the scene back failed too, it is unusable", e.msg);
+    }
+    gk__sc_free(sc, keep);
+    return r;
 }
 
 /* ------------------------------------------------------------- output */

@@ -206,6 +206,43 @@ TEST(cells_open_axes_and_coarse_grids_match_brute_force) {
     CHECK(two_open); /* the coarsest open grid was reached (its -1 and +1 bins must not wrap) */
 }
 
+/* an open axis whose particles span a denormal extent (a monolayer on z = 0, one particle at z =
+ * 1.6e-319: the bin scale nbin / extent overflows) bins them all in one layer: no NaN reaches the
+ * conversion to a bin index (UBSan in make check stops at it), and the pairs are the brute-force
+ * ones */
+TEST(cells_open_axis_of_denormal_extent) {
+    static pset ps;
+    static int bi[MAXN * MAXN / 2], bj[MAXN * MAXN / 2];
+    gk_cells cl;
+    gk_pairlist pl;
+    gk_err e;
+    const double *sp[3];
+    double rmax = 0.0;
+    int K[3] = {2, 2, 0}, p, c, nb, ok;
+    make_set(&ps, 3, 200, 4.0, 77);
+    for (p = 0; p < ps.n; ++p) {
+        ps.s[2][p] = 0.0;
+        if (ps.r[p] > rmax) rmax = ps.r[p];
+    }
+    ps.s[2][7] = 1.61895e-319;
+    for (c = 0; c < 3; ++c) sp[c] = ps.s[c];
+    gk_cells_init(&cl, NULL);
+    gk_pairlist_init(&pl, NULL);
+    cl.open = 4u;
+    ok = gk_cells_bin(&cl, 3, ps.h, ps.n, sp, 2 * rmax + 0.05, &e) == GK_OK;
+    CHECK(ok);
+    if (ok) {
+        CHECK(isfinite(cl.inv[2]));
+        for (p = 0; p < ps.n; ++p) CHECK(cl.bin_of[p] >= 0 && cl.bin_of[p] < cl.nbins);
+        CHECK(gk_cells_pairs(&cl, ps.h, sp, ps.r, 0.05, &pl, &e) == GK_OK);
+        nb = brute_pairs(&ps, ps.h, K, 0.05, bi, bj, MAXN * MAXN / 2);
+        printf("    %d pairs (brute force %d)\n", pl.n, nb);
+        CHECK_EQ_INT(pl.n, nb);
+    }
+    gk_cells_free(&cl);
+    gk_pairlist_free(&pl);
+}
+
 /* a cell thinner than twice the interaction distance is refused, not miscounted */
 TEST(cells_refuse_ambiguous_nearest_image) {
     gk_cells cl;
@@ -429,6 +466,7 @@ int main(int argc, char **argv) {
     RUN(cells_match_brute_force_3d_sheared_and_rotated);
     RUN(cells_monodisperse_dense);
     RUN(cells_open_axes_and_coarse_grids_match_brute_force);
+    RUN(cells_open_axis_of_denormal_extent);
     RUN(cells_refuse_ambiguous_nearest_image);
     RUN(remap_preserves_pair_distances);
     RUN(verlet_skin_criterion_is_safe);

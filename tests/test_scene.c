@@ -1375,6 +1375,57 @@ TEST(save_restore_and_threads_are_bitwise) {
     gk_scene_destroy(&B);
 }
 
+/* a refused state changes nothing, even one refused after its particles were read: particle 0 with a
+ * thousandth of its mass (the time step is then above the critical one: GK_ERR_DT), and particle 1
+ * given particle 0's id (found only after gk_rve_restore accepted the RVE part: GK_ERR_FORMAT). Each
+ * time the scene's state is byte for byte what it was, and it runs on. (The time step was once
+ * checked against the masses of the state before, so the lighter state was refused only at the id,
+ * and putting the scene back then failed against the lighter masses.) The offsets are found by
+ * difference: a state with particle 0's mass changed differs first in its inverse mass, at header +
+ * n R. */
+TEST(a_refused_state_changes_nothing) {
+    gk_scene A;
+    unsigned char *s0, *s1, *bad, *now;
+    size_t n0, n1, nn, d = 0, H, R = sizeof(gk_real), n;
+    int32_t id0;
+    if (full_scene(&A, 1)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_scene_step(&A, 200) == GK_OK);
+    n = (size_t)A.rve.n;
+    s0 = state_of(&A, &n0);
+    CHECK(gk_scene_set_mass(&A, 0, 1e-3 * A.mass[0], 1e-3 / (double)A.rve.Iinv[0]) == GK_OK);
+    s1 = state_of(&A, &n1);
+    CHECK(s0 && s1 && n0 == n1);
+    if (!s0 || !s1 || n0 != n1) return;
+    while (d < n0 && s0[d] == s1[d]) ++d;
+    CHECK(d >= n * R);
+    H = (d - n * R) / 8 * 8; /* the header: minv[0] starts at H + n R */
+    bad = (unsigned char *)malloc(n1);
+    CHECK(bad != NULL);
+    if (!bad) return;
+    memcpy(bad, s1, n1);
+    memcpy(&id0, bad + H + 3 * n * R, sizeof id0);
+    memcpy(bad + H + 3 * n * R + sizeof id0, &id0, sizeof id0); /* particle 1 gets particle 0's id */
+    CHECK(gk_scene_restore(&A, s0, n0) == GK_OK);
+    CHECK(gk_scene_restore(&A, bad, n1) == GK_ERR_DT);
+    printf("    %s\n", gk_scene_error(&A));
+    now = state_of(&A, &nn);
+    CHECK(now && nn == n0 && !memcmp(now, s0, n0));
+    free(now);
+    memcpy(bad, s0, n0); /* the same with the original masses: refused once the RVE part is in */
+    memcpy(bad + H + 3 * n * R + sizeof id0, bad + H + 3 * n * R, sizeof id0);
+    CHECK(gk_scene_restore(&A, bad, n0) == GK_ERR_FORMAT);
+    printf("    %s\n", gk_scene_error(&A));
+    now = state_of(&A, &nn);
+    CHECK(now && nn == n0 && !memcmp(now, s0, n0));
+    free(now);
+    CHECK(gk_scene_restore(&A, s0, n0) == GK_OK && gk_scene_step(&A, 10) == GK_OK);
+    free(s0), free(s1), free(bad);
+    gk_scene_destroy(&A);
+}
+
 /* mean height of row b of a lattice() packing of nx per row (ids b nx .. b nx + nx - 1) */
 static double row_height(const gk_scene *sc, int nx, int b) {
     double x[3], y = 0.0;
@@ -1913,6 +1964,7 @@ int main(int argc, char **argv) {
     RUN(insert_and_remove_leave_the_others_alone);
     RUN(energy_balance_closes);
     RUN(save_restore_and_threads_are_bitwise);
+    RUN(a_refused_state_changes_nothing);
     RUN(periodic_shear_between_walls);
     RUN(packing_tile_and_subset);
     RUN(bodies_pipe_drum_rectangle_cylinder);
