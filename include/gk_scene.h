@@ -400,7 +400,9 @@ GKDEF gk_result gk_scene_prescribe(gk_scene *sc, int p, const double v[3], const
 GKDEF gk_result gk_scene_release(gk_scene *sc, int p);
 /* locked 1: the spin of particle p is held at zero from the next step on; 0: free again */
 GKDEF gk_result gk_scene_lock_rotation(gk_scene *sc, int p, int locked);
-/* mass and moment of inertia of particle p (e.g. another density) */
+/* mass and moment of inertia of particle p (e.g. another density); a lighter particle lowers an
+ * automatic time step as a new wall does, and is refused (GK_ERR_DT, nothing changed) when an
+ * explicit def.rve.dt is above the critical step it gives */
 GKDEF gk_result gk_scene_set_mass(gk_scene *sc, int p, double m, double I);
 /* velocity and spin of particle p (NULL: unchanged), e.g. the initial state */
 GKDEF gk_result gk_scene_set_velocity(gk_scene *sc, int p, const double v[3], const double w[3]);
@@ -1933,13 +1935,31 @@ GKDEF gk_result gk_scene_lock_rotation(gk_scene *sc, int p, int locked) {
 
 GKDEF gk_result gk_scene_set_mass(gk_scene *sc, int p, double m, double I) {
     gk_result r;
+    gk_real minv0, Iinv0;
+    double mass0, dtc;
     if ((r = gk__scene_p(sc, p)) != GK_OK) return r;
+    minv0 = sc->rve.minv[p], Iinv0 = sc->rve.Iinv[p], mass0 = sc->mass[p];
     if (!(m > 0.0) || !(I > 0.0) || !isfinite(m) || !isfinite(I))
         return gk_err_set(&sc->err, GK_ERR_MASS, "mass %g and inertia %g must be > 0", m, I);
     sc->rve.minv[p] = (gk_real)(1.0 / m);
     sc->rve.Iinv[p] = (gk_real)(1.0 / I);
     sc->mass[p] = 1.0 / (double)sc->rve.minv[p];
     gk_rve_update_totals(&sc->rve);
+    /* the time step must hold for the lighter particle too (as for a new wall) */
+    dtc = gk_scene_dt_critical(sc);
+    if (sc->def.rve.dt > 0.0) {
+        if (sc->rve.dt > dtc) {
+            sc->rve.minv[p] = minv0, sc->rve.Iinv[p] = Iinv0, sc->mass[p] = mass0;
+            gk_rve_update_totals(&sc->rve);
+            return gk_err_set(&sc->err, GK_ERR_DT,
+                              "mass %g: the time step %g s is above the critical %g s it gives (Guo & Zhao "
+                              "2014 eq 19)",
+                              m, sc->rve.dt, dtc);
+        }
+    } else {
+        double f = sc->def.rve.dt_factor > 0.0 ? sc->def.rve.dt_factor : 0.5;
+        if (f * dtc < sc->rve.dt) sc->rve.dt = f * dtc;
+    }
     return GK_OK;
 }
 

@@ -1376,18 +1376,21 @@ TEST(save_restore_and_threads_are_bitwise) {
 }
 
 /* a refused state changes nothing, even one refused after its particles were read: particle 0 with a
- * thousandth of its mass (the time step is then above the critical one: GK_ERR_DT), and particle 1
- * given particle 0's id (found only after gk_rve_restore accepted the RVE part: GK_ERR_FORMAT). Each
- * time the scene's state is byte for byte what it was, and it runs on. (The time step was once
- * checked against the masses of the state before, so the lighter state was refused only at the id,
- * and putting the scene back then failed against the lighter masses.) The offsets are found by
- * difference: a state with particle 0's mass changed differs first in its inverse mass, at header +
- * n R. */
+ * thousandth of its mass (the time step is then above the critical one: GK_ERR_DT), particle 1 given
+ * particle 0's id (found only after gk_rve_restore accepted the RVE part: GK_ERR_FORMAT), and both.
+ * Each time the scene's state is byte for byte what it was, and it runs on. (The time step was once
+ * checked against the masses of the state before, so the lighter state with the duplicate id was
+ * refused only at the id, and putting the scene back then failed against the lighter masses.) The
+ * offsets are found by difference: a state with particle 0 twice as heavy (gk_scene_set_mass)
+ * differs first in its inverse mass, at header + n R; ids follow at header + 3 n R, masses at header
+ * + 3 n R + 4 n. */
 TEST(a_refused_state_changes_nothing) {
     gk_scene A;
-    unsigned char *s0, *s1, *bad, *now;
+    unsigned char *s0, *s1, *bad[3], *now;
     size_t n0, n1, nn, d = 0, H, R = sizeof(gk_real), n;
     int32_t id0;
+    int b;
+    const gk_result want[3] = {GK_ERR_DT, GK_ERR_FORMAT, GK_ERR_DT};
     if (full_scene(&A, 1)) {
         CHECK(0);
         return;
@@ -1395,34 +1398,67 @@ TEST(a_refused_state_changes_nothing) {
     CHECK(gk_scene_step(&A, 200) == GK_OK);
     n = (size_t)A.rve.n;
     s0 = state_of(&A, &n0);
-    CHECK(gk_scene_set_mass(&A, 0, 1e-3 * A.mass[0], 1e-3 / (double)A.rve.Iinv[0]) == GK_OK);
+    CHECK(gk_scene_set_mass(&A, 0, 2.0 * A.mass[0], 2.0 / (double)A.rve.Iinv[0]) == GK_OK);
     s1 = state_of(&A, &n1);
     CHECK(s0 && s1 && n0 == n1);
     if (!s0 || !s1 || n0 != n1) return;
     while (d < n0 && s0[d] == s1[d]) ++d;
     CHECK(d >= n * R);
     H = (d - n * R) / 8 * 8; /* the header: minv[0] starts at H + n R */
-    bad = (unsigned char *)malloc(n1);
-    CHECK(bad != NULL);
-    if (!bad) return;
-    memcpy(bad, s1, n1);
-    memcpy(&id0, bad + H + 3 * n * R, sizeof id0);
-    memcpy(bad + H + 3 * n * R + sizeof id0, &id0, sizeof id0); /* particle 1 gets particle 0's id */
     CHECK(gk_scene_restore(&A, s0, n0) == GK_OK);
-    CHECK(gk_scene_restore(&A, bad, n1) == GK_ERR_DT);
+    for (b = 0; b < 3; ++b) {
+        bad[b] = (unsigned char *)malloc(n0);
+        CHECK(bad[b] != NULL);
+        if (!bad[b]) return;
+        memcpy(bad[b], s0, n0);
+        if (b != 1) { /* particle 0 a thousand times lighter */
+            gk_real minv;
+            double mass;
+            memcpy(&minv, bad[b] + H + n * R, R);
+            memcpy(&mass, bad[b] + H + 3 * n * R + 4 * n, sizeof mass);
+            minv = (gk_real)(1e3 * (double)minv), mass *= 1e-3;
+            memcpy(bad[b] + H + n * R, &minv, R);
+            memcpy(bad[b] + H + 3 * n * R + 4 * n, &mass, sizeof mass);
+        }
+        if (b != 0) { /* particle 1 gets particle 0's id */
+            memcpy(&id0, bad[b] + H + 3 * n * R, sizeof id0);
+            memcpy(bad[b] + H + 3 * n * R + sizeof id0, &id0, sizeof id0);
+        }
+        CHECK(gk_scene_restore(&A, bad[b], n0) == want[b]);
+        printf("    %s\n", gk_scene_error(&A));
+        now = state_of(&A, &nn);
+        CHECK(now && nn == n0 && !memcmp(now, s0, n0));
+        free(now);
+        free(bad[b]);
+    }
+    CHECK(gk_scene_restore(&A, s1, n1) == GK_OK && gk_scene_step(&A, 10) == GK_OK);
+    free(s0), free(s1);
+    gk_scene_destroy(&A);
+}
+
+/* gk_scene_set_mass: a lighter particle lowers an automatic time step (as a new wall does) and
+ * is refused with an explicit one above the critical step it gives, nothing changed (Guo & Zhao
+ * 2014 eq 19: dt_cr = sqrt(m_min / k_n)) */
+TEST(set_mass_keeps_the_time_step_stable) {
+    gk_scene A;
+    double dt0, m0, dtc;
+    gk_real minv0;
+    if (full_scene(&A, 1)) {
+        CHECK(0);
+        return;
+    }
+    dt0 = A.rve.dt, m0 = A.mass[3], minv0 = A.rve.minv[3];
+    CHECK(gk_scene_set_mass(&A, 3, 1e-4 * m0, 1e-4 / (double)A.rve.Iinv[3]) == GK_OK);
+    dtc = gk_scene_dt_critical(&A);
+    printf("    automatic dt %g s -> %g s (0.2 of the critical %g s)\n", dt0, A.rve.dt, dtc);
+    CHECK(A.rve.dt < dt0 && A.rve.dt <= 0.2 * dtc * (1.0 + 1e-12));
+    CHECK(gk_scene_step(&A, 100) == GK_OK);
+    CHECK(gk_scene_set_mass(&A, 3, m0, 1.0 / (double)minv0) == GK_OK);
+    A.def.rve.dt = A.rve.dt;                                                   /* now explicit */
+    CHECK(gk_scene_set_mass(&A, 3, 1e-4 * m0, 1e-4 / (double)minv0) == GK_OK); /* the same dt holds */
+    CHECK(gk_scene_set_mass(&A, 3, 1e-6 * m0, 1e-6 / (double)minv0) == GK_ERR_DT);
     printf("    %s\n", gk_scene_error(&A));
-    now = state_of(&A, &nn);
-    CHECK(now && nn == n0 && !memcmp(now, s0, n0));
-    free(now);
-    memcpy(bad, s0, n0); /* the same with the original masses: refused once the RVE part is in */
-    memcpy(bad + H + 3 * n * R + sizeof id0, bad + H + 3 * n * R, sizeof id0);
-    CHECK(gk_scene_restore(&A, bad, n0) == GK_ERR_FORMAT);
-    printf("    %s\n", gk_scene_error(&A));
-    now = state_of(&A, &nn);
-    CHECK(now && nn == n0 && !memcmp(now, s0, n0));
-    free(now);
-    CHECK(gk_scene_restore(&A, s0, n0) == GK_OK && gk_scene_step(&A, 10) == GK_OK);
-    free(s0), free(s1), free(bad);
+    CHECK(A.mass[3] == 1e-4 * m0 || fabs(A.mass[3] / (1e-4 * m0) - 1.0) < 1e-12);
     gk_scene_destroy(&A);
 }
 
@@ -1965,6 +2001,7 @@ int main(int argc, char **argv) {
     RUN(energy_balance_closes);
     RUN(save_restore_and_threads_are_bitwise);
     RUN(a_refused_state_changes_nothing);
+    RUN(set_mass_keeps_the_time_step_stable);
     RUN(periodic_shear_between_walls);
     RUN(packing_tile_and_subset);
     RUN(bodies_pipe_drum_rectangle_cylinder);
