@@ -1057,6 +1057,19 @@ GKDEF gk_result gk_scene_stress_box(gk_scene *sc, const double lo[3], const doub
     return GK_OK;
 }
 
+/* after a change that can lower the critical step (a stiffer wall, a lighter particle): an
+ * automatic dt (def.rve.dt = 0) follows it down to dt_factor x the critical step; 0 if an explicit
+ * dt is above it (the caller undoes its change), and *dtc that critical step */
+static int gk__scene_dt_holds(gk_scene *sc, double *dtc) {
+    *dtc = gk_scene_dt_critical(sc);
+    if (sc->def.rve.dt > 0.0) return !(sc->rve.dt > *dtc);
+    {
+        double f = sc->def.rve.dt_factor > 0.0 ? sc->def.rve.dt_factor : 0.5;
+        if (f * *dtc < sc->rve.dt) sc->rve.dt = f * *dtc;
+    }
+    return 1;
+}
+
 GKDEF double gk_scene_dt_critical(const gk_scene *sc) {
     double a = gk_rve_dt_critical(&sc->rve), b = gk__walls_dt_critical(sc);
     return a < b ? a : b;
@@ -1120,18 +1133,12 @@ GKDEF gk_result gk_scene_add_wall(gk_scene *sc, const gk_wall_def *wd, int *inde
     }
     sc->walls[sc->nwalls++] = W;
     /* the time step must hold for the wall's contacts too */
-    dtc = gk_scene_dt_critical(sc);
-    if (sc->def.rve.dt > 0.0) {
-        if (sc->rve.dt > dtc) {
-            gk__wall_free(sc, &sc->walls[--sc->nwalls]);
-            return gk_err_set(
-                &sc->err, GK_ERR_DT,
-                "time step %g s is above the critical %g s of this wall's contacts (Guo & Zhao 2014 eq 19)",
-                sc->rve.dt, dtc);
-        }
-    } else {
-        double f = sc->def.rve.dt_factor > 0.0 ? sc->def.rve.dt_factor : 0.5;
-        if (f * dtc < sc->rve.dt) sc->rve.dt = f * dtc;
+    if (!gk__scene_dt_holds(sc, &dtc)) {
+        gk__wall_free(sc, &sc->walls[--sc->nwalls]);
+        return gk_err_set(
+            &sc->err, GK_ERR_DT,
+            "time step %g s is above the critical %g s of this wall's contacts (Guo & Zhao 2014 eq 19)",
+            sc->rve.dt, dtc);
     }
     if (index) *index = sc->nwalls - 1;
     return GK_OK;
@@ -1946,19 +1953,13 @@ GKDEF gk_result gk_scene_set_mass(gk_scene *sc, int p, double m, double I) {
     sc->mass[p] = 1.0 / (double)sc->rve.minv[p];
     gk_rve_update_totals(&sc->rve);
     /* the time step must hold for the lighter particle too (as for a new wall) */
-    dtc = gk_scene_dt_critical(sc);
-    if (sc->def.rve.dt > 0.0) {
-        if (sc->rve.dt > dtc) {
-            sc->rve.minv[p] = minv0, sc->rve.Iinv[p] = Iinv0, sc->mass[p] = mass0;
-            gk_rve_update_totals(&sc->rve);
-            return gk_err_set(&sc->err, GK_ERR_DT,
-                              "mass %g: the time step %g s is above the critical %g s it gives (Guo & Zhao "
-                              "2014 eq 19)",
-                              m, sc->rve.dt, dtc);
-        }
-    } else {
-        double f = sc->def.rve.dt_factor > 0.0 ? sc->def.rve.dt_factor : 0.5;
-        if (f * dtc < sc->rve.dt) sc->rve.dt = f * dtc;
+    if (!gk__scene_dt_holds(sc, &dtc)) {
+        sc->rve.minv[p] = minv0, sc->rve.Iinv[p] = Iinv0, sc->mass[p] = mass0;
+        gk_rve_update_totals(&sc->rve);
+        return gk_err_set(&sc->err, GK_ERR_DT,
+                          "mass %g: the time step %g s is above the critical %g s it gives (Guo & Zhao "
+                          "2014 eq 19)",
+                          m, sc->rve.dt, dtc);
     }
     return GK_OK;
 }
@@ -2716,7 +2717,6 @@ static gk_result gk__scene_restore_raw(gk_scene *sc, const void *buf, size_t siz
         if (sc->rve.cell.h[k] != hkeep[k] || sc->rve.L[k] != 0.0 || sc->rve.servo_on)
             return gk_err_set(&sc->err, GK_ERR_FORMAT,
                               "scene state: its cell is not this scene's domain (or is driven)");
-    gk_rve_update_totals(&sc->rve);
     sc->next_id = hd.next_id;
     if ((r = gk__scene_index(sc)) != GK_OK) return r;
     sc->nprescribed = np;
