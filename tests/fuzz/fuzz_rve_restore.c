@@ -98,7 +98,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 /* states of both RVEs at 0, 1, 10 and 100 steps of shear, each prefixed with its selector byte */
 int main(int argc, char **argv) {
     int w, k;
-    char path[512];
+    char name[64];
     if (argc < 2) return 2;
     setup();
     for (w = 0; w < 2; ++w)
@@ -106,18 +106,13 @@ int main(int argc, char **argv) {
             static const int steps[4] = {0, 1, 10, 100};
             double dH[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
             gk_rve_state st;
-            FILE *fp;
-            unsigned char sel = (unsigned char)w;
             dH[1] = 1e-5 * steps[k];
             FUZZ_CHECK(gk_rve_state_restore(&pristine[w], &rves[w]) == GK_OK);
             if (steps[k]) FUZZ_CHECK(gk_rve_deform(&rves[w], dH, steps[k]) == GK_OK);
             gk_rve_state_init(&st, NULL);
             FUZZ_CHECK(gk_rve_state_save(&st, &rves[w]) == GK_OK);
-            snprintf(path, sizeof path, "%s/state_%s_%03d", argv[1], w ? "3d_hertz_rolling" : "2d_linear",
-                     steps[k]);
-            fp = fopen(path, "wb");
-            FUZZ_CHECK(fp && fwrite(&sel, 1, 1, fp) == 1 && fwrite(st.buf, 1, st.size, fp) == st.size);
-            FUZZ_CHECK(fclose(fp) == 0);
+            snprintf(name, sizeof name, "state_%s_%03d", w ? "3d_hertz_rolling" : "2d_linear", steps[k]);
+            fuzz_write_seed(argv[1], name, (unsigned char)w, (const unsigned char *)st.buf, st.size);
             gk_rve_state_free(&st);
         }
     return 0;

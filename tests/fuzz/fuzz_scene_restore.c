@@ -124,23 +124,19 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 /* states of both scenes at 0, 1, 20 and 200 steps, each prefixed with its selector byte */
 int main(int argc, char **argv) {
     int w, k;
-    char path[512];
+    char name[64];
     if (argc < 2) return 2;
     for (w = 0; w < 2; ++w) {
         static const int steps[4] = {0, 1, 20, 200};
         create(w);
         for (k = 0; k < 4; ++k) {
             size_t n;
-            unsigned char *b, sel = (unsigned char)w;
-            FILE *fp;
+            unsigned char *b;
             if (steps[k])
                 FUZZ_CHECK(gk_scene_step(&scenes[w], steps[k] - (k > 1 ? steps[k - 1] : 0)) == GK_OK);
             b = state_of(&scenes[w], &n);
-            snprintf(path, sizeof path, "%s/state_%s_%03d", argv[1], w ? "3d_box_rolling" : "2d_box_membrane",
-                     steps[k]);
-            fp = fopen(path, "wb");
-            FUZZ_CHECK(fp && fwrite(&sel, 1, 1, fp) == 1 && fwrite(b, 1, n, fp) == n);
-            FUZZ_CHECK(fclose(fp) == 0);
+            snprintf(name, sizeof name, "state_%s_%03d", w ? "3d_box_rolling" : "2d_box_membrane", steps[k]);
+            fuzz_write_seed(argv[1], name, (unsigned char)w, b, n);
             free(b);
         }
     }
