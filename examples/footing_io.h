@@ -98,6 +98,7 @@ typedef struct ft { /* the whole model */
     mpd_snaps snaps;
     double h, b, bnode, dt, c, dot, phi, phi_res, rss_before, rss_after, t_first;
     long long dem_first;
+    gk_mpm_body body_run; /* the footing as the run starts it (a checkpoint's is it, moved down) */
 } ft;
 
 static const char *material_names[3] = {"dense", "medium", "soft"};

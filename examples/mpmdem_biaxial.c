@@ -155,13 +155,14 @@ static int parse(bx *X, int argc, char **argv) {
     return 0;
 }
 
-/* a checkpoint's state and rows in range (mpd_load): counters >= 0 (the stage an index of bx_stages),
- * times, plates, sums and rows finite and within MPD_MAX_VALUE, each plate a box with a known contact
- * law and face */
-static int bx_check(const void *state, const mpd_rows *R, char *why, size_t nwhy) {
+/* a checkpoint's state and rows in range (mpd_load, ctx the model): counters >= 0 (the stage an index
+ * of bx_stages), times, plates, sums and rows finite and within MPD_MAX_VALUE, each plate a box with a
+ * known contact law and face, the watched points points of the run */
+static int bx_check(const void *state, const mpd_rows *R, const void *ctx, char *why, size_t nwhy) {
     const bx_state *S = (const bx_state *)state;
     double v[7];
     int k, j;
+    if (mpd_watch_check(S->pt, bx_pt_name, BX_NPT, ((const bx *)ctx)->pts.n, why, nwhy)) return 1;
     v[0] = S->t, v[1] = S->disp, v[2] = S->acc_top, v[3] = S->acc_base, v[4] = S->acc_dt, v[5] = S->acc_ek;
     v[6] = S->acc_dem;
     for (k = 0; k < 7; ++k)
@@ -252,10 +253,9 @@ static int setup(bx *X, gk_err *err) {
     for (i = 0; i < BX_NPT; ++i)
         S->pt[i] = mpd_nearest(&X->pts, bx_pt_at[i][0] * b->width, bx_pt_at[i][1] * b->height);
     if (X->o.restart) {
-        if (mpd_load(X->o.restart, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps, bx_check,
+        if (mpd_load(X->o.restart, &X->M, &X->pts, "biaxial", S, sizeof *S, &X->rows, &X->snaps, bx_check, X,
                      err))
             return 1;
-        if (mpd_watch_check(S->pt, bx_pt_name, BX_NPT, X->pts.n, X->o.restart, err)) return 1;
     } else if (sample_points(X, S->pt0, err))
         return 1;
     X->g.body = S->body, X->g.nbody = 2;

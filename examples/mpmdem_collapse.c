@@ -147,6 +147,7 @@ typedef struct cl { /* the whole model */
     mpd_snaps snaps;
     int ny, dem_max_given, *work, *pick;
     double h, l0, c, rho_ref, Mmax, prep_secs;
+    double dt_run, Ep0_run; /* the run's time step and E_p0 (a checkpoint's must be the same) */
 } cl;
 
 /* paper: the preset of --paper (Liang & Zhao's 16 x 16 cells, 4 points each, 1000-disk RVEs) */
@@ -268,6 +269,43 @@ static int prepare_levels(cl *X, gk_err *err) {
 
 /* the levels' RVEs, the grid (roller x = 0, friction base), the points with their levels' masses;
  * dt and the real-time DEM-step cap */
+/* a checkpoint's state and rows as read (mpd_load's driver check, ctx the model): every value finite
+ * and within MPD_MAX_VALUE, the time step, DEM cap and initial potential energy the run's, counters and
+ * the snapshot index in range, the next row not behind the time by more than one interval, a row at
+ * least */
+static int cl_check(const void *vS, const mpd_rows *R, const void *ctx, char *why, size_t nwhy) {
+    const cl_state *S = (const cl_state *)vS;
+    const cl *X = (const cl *)ctx;
+    double v[8];
+    int k, j;
+    v[0] = S->t, v[1] = S->dt, v[2] = S->Ep0, v[3] = S->next_out, v[4] = S->ek_peak, v[5] = S->t_ek_peak;
+    v[6] = S->t_rest, v[7] = S->acc_dem;
+    for (k = 0; k < 8; ++k)
+        if (!mpd_sane(v[k])) return snprintf(why, nwhy, "collapse state: a non-finite value"), 1;
+    if (S->dt != X->dt_run || S->Ep0 != X->Ep0_run || S->dem_max != X->o.dem_max)
+        return snprintf(
+                   why, nwhy,
+                   "written by another run (time step %g s, DEM cap %d, E_p0 %g J; this run %g s, %d, %g J)",
+                   S->dt, S->dem_max, S->Ep0, X->dt_run, X->o.dem_max, X->Ep0_run),
+               1;
+    if (S->step < 0 || S->step > 1000000000000L || S->nacc < 0 || S->nacc > S->step || S->thin_total < 0 ||
+        S->nsnap < 0 || S->nsnap > X->b.nsnap || (S->at_rest != 0 && S->at_rest != 1) || !(S->t >= 0) ||
+        S->next_out < S->t - 2 * (X->b.every + S->dt))
+        return snprintf(why, nwhy, "collapse state: a step, snapshot or output counter out of range"), 1;
+    if (R->n < 1) return snprintf(why, nwhy, "it holds no rows"), 1;
+    for (k = 0; k < R->n; ++k) {
+        const cl_row *r = (const cl_row *)mpd_row(R, k);
+        double w[12];
+        w[0] = r->t, w[1] = r->front, w[2] = r->front_box, w[3] = r->front_raw, w[4] = r->height;
+        w[5] = r->ek, w[6] = r->ep, w[7] = r->ed, w[8] = r->mass, w[9] = r->mass_grid, w[10] = r->dem_mean;
+        w[11] = r->secs;
+        for (j = 0; j < 12; ++j)
+            if (!mpd_sane(w[j])) return snprintf(why, nwhy, "row %d: a non-finite value", k), 1;
+        if (r->loose < 0 || r->frozen < 0) return snprintf(why, nwhy, "row %d: a negative count", k), 1;
+    }
+    return 0;
+}
+
 static int setup(cl *X, gk_err *err) {
     const cl_opts *b = &X->b;
     cl_state *S = &X->S;
@@ -304,10 +342,10 @@ static int setup(cl *X, gk_err *err) {
     S->t_rest = -1;
     X->rows.size = sizeof(cl_row);
     if (X->o.restart) {
-        if (mpd_load(X->o.restart, &X->M, &X->pts, "collapse", S, sizeof *S, &X->rows, &X->snaps, NULL, err))
+        X->dt_run = S->dt, X->Ep0_run = S->Ep0;
+        if (mpd_load(X->o.restart, &X->M, &X->pts, "collapse", S, sizeof *S, &X->rows, &X->snaps, cl_check, X,
+                     err))
             return 1;
-        if (X->rows.n < 1)
-            return gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin holds no rows", X->o.restart), 1;
         printf("restarted from %s/checkpoint.bin at t = %.4f s (step %ld)\n", X->o.restart, S->t, S->step);
     }
     return 0;

@@ -268,6 +268,49 @@ static int parse(ft *X, int argc, char **argv) {
 
 /* the friction angle (given or measured), the RVE at q_s at every point, the grid with its walls and
  * the footing, the points and the surcharge on the ground beyond the footing */
+/* a checkpoint's state and rows as read (mpd_load's driver check, ctx the model): every value finite
+ * and within MPD_MAX_VALUE (the spiral fit's NaN, "none found", allowed), the settlement between 0 and
+ * the soil's depth, the footing the run's box moved down by it, counters and the stage index in range,
+ * the next row not behind the settlement by more than one interval */
+static int ft_check(const void *vS, const mpd_rows *R, const void *ctx, char *why, size_t nwhy) {
+    const ft_state *S = (const ft_state *)vS;
+    const ft *X = (const ft *)ctx;
+    const gk_mpm_body *B = &S->body, *B0 = &X->body_run;
+    const ft_opts *f = &X->f;
+    double v[8];
+    int k, j;
+    v[0] = S->t, v[1] = S->disp, v[2] = S->acc_load, v[3] = S->acc_dt, v[4] = S->acc_ek, v[5] = S->acc_dem;
+    v[6] = S->next_out, v[7] = S->wall;
+    for (k = 0; k < 8; ++k)
+        if (!mpd_sane(v[k])) return snprintf(why, nwhy, "footing state: a non-finite value"), 1;
+    if (S->step < 0 || S->step > 1000000000000L || S->nacc < 0 || S->nacc > S->step || S->nstage < 0 ||
+        S->nstage > FT_NSTAGE || !(S->t >= 0) || !(S->wall >= 0) || !(S->disp >= 0 && S->disp <= f->depth) ||
+        S->next_out < S->disp / f->B - 2 * f->every)
+        return snprintf(why, nwhy, "footing state: a step, stage, settlement or output counter out of range"),
+               1;
+    for (k = 0; k < 3; ++k)
+        if (!mpd_sane(B->lo[k]) || !mpd_sane(B->hi[k]) || !mpd_sane(B->v[k]) || !mpd_sane(B->force[k]))
+            return snprintf(why, nwhy, "the footing is not a finite box"), 1;
+    if (B->shape != B0->shape || B->contact != B0->contact || B->face != B0->face || B->mu != B0->mu ||
+        B->lo[0] != B0->lo[0] || B->hi[0] != B0->hi[0] ||
+        !(fabs(B0->lo[1] - B->lo[1] - S->disp) <= 1e-6 * f->B) ||
+        !(fabs(B0->hi[1] - B->hi[1] - S->disp) <= 1e-6 * f->B))
+        return snprintf(why, nwhy, "the footing is not this run's, moved down by the settlement"), 1;
+    for (k = 0; k < R->n; ++k) {
+        const ft_row *r = (const ft_row *)mpd_row(R, k);
+        double w[13];
+        w[0] = r->t, w[1] = r->d, w[2] = r->q, w[3] = r->load, w[4] = r->ek, w[5] = r->dem_mean,
+        w[6] = r->secs;
+        w[7] = r->wedge, w[8] = r->heave_x, w[9] = r->heave_u, w[10] = r->sp_phi, w[11] = r->sp_r0;
+        w[12] = r->sp_rms;
+        for (j = 0; j < 13; ++j)
+            if (!mpd_sane(w[j]) && !(j >= 7 && isnan(w[j])))
+                return snprintf(why, nwhy, "row %d: a non-finite value", k), 1;
+        if (r->sp_rays < 0) return snprintf(why, nwhy, "row %d: a negative count", k), 1;
+    }
+    return 0;
+}
+
 static int setup(ft *X, gk_err *err) {
     const ft_opts *f = &X->f;
     ft_state *S = &X->S;
@@ -344,8 +387,9 @@ static int setup(ft *X, gk_err *err) {
     S->body.contact = GK_MPM_CONTACT_STICK;
     S->next_out = 0.0; /* a row after the first step (d ~ 0) */
     X->rows.size = sizeof(ft_row);
-    if (X->o.restart &&
-        mpd_load(X->o.restart, &X->M, &X->pts, "footing", S, sizeof *S, &X->rows, &X->snaps, NULL, err))
+    X->body_run = S->body;
+    if (X->o.restart && mpd_load(X->o.restart, &X->M, &X->pts, "footing", S, sizeof *S, &X->rows, &X->snaps,
+                                 ft_check, X, err))
         return 1;
     X->g.body = &S->body, X->g.nbody = 1;
     return 0;

@@ -367,8 +367,9 @@ static int mpd_checkpoint_path(const char *dir, char *path) {
 #define MPD_MAX_VALUE 1e100
 static int mpd_sane(double v) { return fabs(v) <= MPD_MAX_VALUE; }
 
-/* the driver's own check of its state and rows as read (0 in range, or 1 with the reason in why) */
-typedef int (*mpd_check_fn)(const void *S, const mpd_rows *R, char *why, size_t nwhy);
+/* the driver's own check of its state and rows as read, against its run (ctx: the driver's model, as
+ * given to mpd_load): 0 in range, or 1 with the reason in why */
+typedef int (*mpd_check_fn)(const void *S, const mpd_rows *R, const void *ctx, char *why, size_t nwhy);
 
 /* the block as read, checked: every point value finite and within MPD_MAX_VALUE, mass, volumes,
  * half-size >= 0 (mass and volume > 0), det F > 0 and vol = det(F) vol0 (to 1e-9 relative: gk_mpm
@@ -416,11 +417,12 @@ static int mpd_block_check(const mpd_micro *m, const gk_mpm_points *pts, const m
 
 /* DIR/checkpoint.bin into the set, the points, the driver's state S, its rows and snapshots (the
  * rows and snapshots it had are freed). The block is read and checked (mpd_block_check, then the
- * driver's check when not NULL) before it replaces anything: a refused block leaves the points, the
+ * driver's check with ctx) before it replaces anything: a refused block leaves the points, the
  * strains, S, the rows and the snapshots as they were (the set holds the file's RVE states, which
  * gk_twoscale_load accepted). */
 GK_INLINE gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, const char *tag, void *S,
-                             size_t nS, mpd_rows *R, mpd_snaps *sn, mpd_check_fn check, gk_err *err) {
+                             size_t nS, mpd_rows *R, mpd_snaps *sn, mpd_check_fn check, const void *ctx,
+                             gk_err *err) {
     char path[MPD_PATH], why[200];
     void *blk = NULL;
     size_t nblk = 0;
@@ -447,8 +449,7 @@ GK_INLINE gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, 
         snprintf(why, sizeof why,
                  "its driver block is not that of an mpmdem_%s run of %d points with these flags", tag,
                  pts->n);
-    if (B.bad || mpd_block_check(m, pts, &sn2, why, sizeof why) ||
-        (check && check(S, &R2, why, sizeof why))) {
+    if (B.bad || mpd_block_check(m, pts, &sn2, why, sizeof why) || check(S, &R2, ctx, why, sizeof why)) {
         K.cap = K.n, K.n = 0; /* read back what was there */
         mpd_block(&K, tag, m, pts, S, nS, &Rk, &snk, 0);
         free(K.b), free(R2.r), free(Rk.r), mpd_snaps_free(&sn2), mpd_snaps_free(&snk);

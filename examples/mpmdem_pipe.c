@@ -260,20 +260,51 @@ static int prepare_levels(pp *X, gk_err *err) {
     return 0;
 }
 
-/* a checkpoint's state as read: in range (mpd_load's driver check) */
-static int check_state(const void *vS, const mpd_rows *R, char *why, size_t nwhy) {
+/* a checkpoint's state and rows as read (mpd_load's driver check, ctx the model): every value finite
+ * and within MPD_MAX_VALUE, the time step the run's, the stage, rows and watched points in range, the
+ * next row not behind the time by more than one interval, the pipe the run's circle and contact law */
+static int check_state(const void *vS, const mpd_rows *R, const void *ctx, char *why, size_t nwhy) {
     const pp_state *S = (const pp_state *)vS;
+    const pp *X = (const pp *)ctx;
     const gk_mpm_body *B = &S->body;
-    double v[12];
-    int k;
+    double v[15];
+    int k, j;
     v[0] = S->t, v[1] = S->dt, v[2] = S->done, v[3] = S->t_stage, v[4] = S->pen, v[5] = S->lat;
     v[6] = S->acc_H, v[7] = S->acc_V, v[8] = S->acc_dt, v[9] = S->next_out, v[10] = B->centre[0];
-    v[11] = B->centre[1];
-    for (k = 0; k < 12; ++k)
-        if (!isfinite(v[k])) return snprintf(why, nwhy, "pipe state: a non-finite value"), 1;
-    if (S->step < 0 || S->stage < 0 || S->stage > 2 || !(S->dt > 0) || S->pen_row < -1 ||
-        S->pen_row >= R->n || B->shape != GK_MPM_CIRCLE || !(B->radius > 0) || S->nacc < 0)
+    v[11] = B->centre[1], v[12] = S->acc_dem, v[13] = S->wall, v[14] = B->mu;
+    for (k = 0; k < 15; ++k)
+        if (!mpd_sane(v[k])) return snprintf(why, nwhy, "pipe state: a non-finite value"), 1;
+    for (k = 0; k < 3; ++k)
+        if (!mpd_sane(B->v[k]) || !mpd_sane(B->force[k]))
+            return snprintf(why, nwhy, "pipe state: a non-finite value"), 1;
+    if (S->dt != X->dt_run)
+        return snprintf(why, nwhy, "written with another time step (%g s; this run %g s)", S->dt, X->dt_run),
+               1;
+    if (S->step < 0 || S->step > 1000000000000L || S->stage < 0 || S->stage > 2 || S->pen_row < -1 ||
+        S->pen_row >= R->n || S->nacc < 0 || S->nacc > S->step || !(S->t >= 0) || !(S->done >= 0) ||
+        !(S->t_stage >= 0) || !(S->wall >= 0) || S->next_out < S->t - 2 * (X->b.every + S->dt))
         return snprintf(why, nwhy, "pipe state out of range"), 1;
+    if (B->shape != GK_MPM_CIRCLE || B->radius != 0.5 * X->b.D || B->contact != pp_contacts[X->b.contact] ||
+        B->mu != (X->b.contact == 1 ? X->b.mu : 0.0))
+        return snprintf(why, nwhy, "the pipe is not this run's (diameter or contact law)"), 1;
+    if (mpd_watch_check(S->pt, pp_pt_name, PP_NPT, X->pts.n, why, nwhy)) return 1;
+    for (j = 0; j < PP_NPT * PP_NQ; ++j)
+        if (!mpd_sane(S->pt0[j / PP_NQ][j % PP_NQ]))
+            return snprintf(why, nwhy, "a non-finite start of point %s", pp_pt_name[j / PP_NQ]), 1;
+    for (k = 0; k < R->n; ++k) {
+        const pp_row *r = (const pp_row *)mpd_row(R, k);
+        double w[9];
+        w[0] = r->t, w[1] = r->x, w[2] = r->y, w[3] = r->pen, w[4] = r->lat, w[5] = r->H, w[6] = r->V;
+        w[7] = r->dem_mean, w[8] = r->secs;
+        for (j = 0; j < 9; ++j)
+            if (!mpd_sane(w[j])) return snprintf(why, nwhy, "row %d: a non-finite value", k), 1;
+        for (j = 0; j < PP_NPT * PP_NQ; ++j)
+            if (!mpd_sane(r->pt[j / PP_NQ][j % PP_NQ]))
+                return snprintf(why, nwhy, "row %d: a non-finite value of point %s", k,
+                                pp_pt_name[j / PP_NQ]),
+                       1;
+        if (r->stage < 0 || r->stage > 1) return snprintf(why, nwhy, "row %d: stage out of range", k), 1;
+    }
     return 0;
 }
 
@@ -334,10 +365,10 @@ static int setup(pp *X, gk_err *err) {
     X->rows.size = sizeof(pp_row);
     pick_points(X);
     if (X->o.restart) {
-        if (mpd_load(X->o.restart, &X->M, &X->pts, "pipe", S, sizeof *S, &X->rows, &X->snaps, check_state,
+        X->dt_run = S->dt;
+        if (mpd_load(X->o.restart, &X->M, &X->pts, "pipe", S, sizeof *S, &X->rows, &X->snaps, check_state, X,
                      err))
             return 1;
-        if (mpd_watch_check(S->pt, pp_pt_name, PP_NPT, X->pts.n, X->o.restart, err)) return 1;
         printf("restarted from %s/checkpoint.bin at t = %.4f s (step %ld, stage %d)\n", X->o.restart, S->t,
                S->step, S->stage + 1);
     } else if (sample_points(X, S->pt0, err))

@@ -29,15 +29,12 @@ static void mpd_point_state(const gk_mpm_points *pts, const double *fld, int i, 
     }
 }
 
-/* the watched points' indices as a checkpoint restored them: each a point of the run, or an error naming
- * the point and the checkpoint (1) */
-static int mpd_watch_check(const int *pt, const char *const *name, int npt, int n, const char *dir,
-                           gk_err *err) {
+/* the watched points' indices as a checkpoint holds them (a driver's mpd_load check): each a point of
+ * the run; 0, or 1 with the point named in why */
+static int mpd_watch_check(const int *pt, const char *const *name, int npt, int n, char *why, size_t nwhy) {
     int k;
     for (k = 0; k < npt; ++k)
-        if (pt[k] < 0 || pt[k] >= n)
-            return gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: point %s out of range", dir, name[k]),
-                   1;
+        if (pt[k] < 0 || pt[k] >= n) return snprintf(why, nwhy, "point %s out of range", name[k]), 1;
     return 0;
 }
 

@@ -67,6 +67,7 @@ typedef struct pp { /* the whole model */
     int *pick, dem_max_given;
     double *fld; /* MPD_NFIELD x points: the fields when a row is taken */
     double h, depth, dot, c, rho_ref, Mmax, prep_secs, x0;
+    double dt_run; /* the run's time step (a checkpoint's must be the same) */
 } pp;
 
 static const gk_mpm_contact pp_contacts[3] = {GK_MPM_CONTACT_STICK, GK_MPM_CONTACT_FRICTION,

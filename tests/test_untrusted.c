@@ -971,6 +971,82 @@ TEST(dr_and_nonlocal_checkpoints_refuse_non_finite_values) {
 #undef NL_CK
 }
 
+/* the MPMxDEM collapse and footing drivers read their own state from a checkpoint unchecked, and
+ * the pipe driver its rows and the watched points' start: a snapshot index of -1e8 (collapse) made
+ * the run read far outside its list of snapshot times (SIGSEGV), a stage index of -5 (footing)
+ * before its list of stages, and the pipe restarted with a NaN in a watched point's start. Each now
+ * refused by name, exit 1, no rows written; a time step other than the run's too. A state starts
+ * after the block's tag (32 bytes), point count (4), state size (8), the points (444 bytes each)
+ * and the DEM-step count (8). */
+static void patch_state(const char *from, const char *to, const char *tag, size_t off, const void *v,
+                        size_t nv) {
+    size_t n, at;
+    unsigned char *b = file_image(from, &n);
+    int32_t np = 0;
+    CHECK(b != NULL && (at = find_tag(b, n, tag)) < n);
+    if (!b || at == n) {
+        free(b);
+        return;
+    }
+    memcpy(&np, b + at + 32, 4);
+    at += 52 + 444 * (size_t)np + off;
+    CHECK(np > 0 && at + nv + 8 <= n);
+    if (np > 0 && at + nv + 8 <= n) memcpy(b + at, v, nv), spill_resealed(to, b, n);
+    free(b);
+}
+
+TEST(mpmdem_driver_states_are_checked) {
+#define CL_CK BUILD "/mpmdem_collapse --nx 4 --every 0.025 --snapshots 0.05 --quiet --t-end 0.1 "
+#define FT_CK                                                                                        \
+    BUILD "/mpmdem_footing --width 2 --depth 1.5 --nx 4 --ny 3 --B 1.5 --velocity 0.25 --ramp 0.01 " \
+          "--every 0.005 --smooth 0.01 --phi-deg 30 --threads 1 --quiet "
+#define PP_CK                                                                                              \
+    BUILD "/mpmdem_pipe --width 3 --nx 12 --ny 5 --penetration 0.1 --lateral 0.05 --v-down 1 --v-lateral " \
+          "1 --ramp 0.02 --every 0.02 --threads 1 --quiet "
+    int32_t i = -100000000;
+    double v;
+    size_t n;
+    unsigned char *b;
+    CHECK_EQ_INT(run_status("rm -rf " OUT("cl_b") " " OUT("ft_b") " " OUT("pp_b")), 0);
+    mkdir(OUT("cl_bad"), 0755), mkdir(OUT("ft_bad"), 0755), mkdir(OUT("pp_bad"), 0755);
+    /* collapse: cl_state's snapshot index (offset 44), then its time step (16) doubled */
+    CHECK_EQ_INT(run_status(CL_CK "--t-end 0.05 --checkpoint 10 --out " OUT("cl_a") LOG("cl_a")), 0);
+    patch_state(OUT("cl_a/checkpoint.bin"), OUT("cl_bad/checkpoint.bin"), "GKMPMDEM2 collapse", 44, &i, 4);
+    CHECK_EQ_INT(run_status(CL_CK "--restart " OUT("cl_bad") " --out " OUT("cl_b") LOG("cl_b")), 1);
+    CHECK(gk_test_file_has(OUT("cl_b.out"), "snapshot or output counter out of range"));
+    CHECK(!exists(OUT("cl_b/collapse.csv")));
+    b = file_image(OUT("cl_a/checkpoint.bin"), &n);
+    if (b) {
+        size_t at = find_tag(b, n, "GKMPMDEM2 collapse");
+        int32_t np = 0;
+        if (at < n) memcpy(&np, b + at + 32, 4), memcpy(&v, b + at + 52 + 444 * (size_t)np + 16, 8);
+        free(b);
+    }
+    v *= 2;
+    patch_state(OUT("cl_a/checkpoint.bin"), OUT("cl_bad/checkpoint.bin"), "GKMPMDEM2 collapse", 16, &v, 8);
+    CHECK_EQ_INT(run_status(CL_CK "--restart " OUT("cl_bad") " --out " OUT("cl_b") LOG("cl_b")), 1);
+    CHECK(gk_test_file_has(OUT("cl_b.out"), "written by another run"));
+    CHECK(!exists(OUT("cl_b/collapse.csv")));
+    /* footing: ft_state's stage index (offset 232) */
+    i = -5;
+    CHECK_EQ_INT(run_status(FT_CK "--final 0.01 --out " OUT("ft_a") LOG("ft_a")), 0);
+    patch_state(OUT("ft_a/checkpoint.bin"), OUT("ft_bad/checkpoint.bin"), "GKMPMDEM2 footing", 232, &i, 4);
+    CHECK_EQ_INT(run_status(FT_CK "--final 0.02 --restart " OUT("ft_bad") " --out " OUT("ft_b") LOG("ft_b")),
+                 1);
+    CHECK(gk_test_file_has(OUT("ft_b.out"), "stage, settlement or output counter out of range"));
+    CHECK(!exists(OUT("ft_b/footing.csv")));
+    /* pipe: the first watched point's start (pp_state's pt0, offset 304) */
+    v = NAN;
+    CHECK_EQ_INT(run_status(PP_CK "--max-steps 100 --out " OUT("pp_a") LOG("pp_a")), 0);
+    patch_state(OUT("pp_a/checkpoint.bin"), OUT("pp_bad/checkpoint.bin"), "GKMPMDEM2 pipe", 304, &v, 8);
+    CHECK_EQ_INT(run_status(PP_CK "--restart " OUT("pp_bad") " --out " OUT("pp_b") LOG("pp_b")), 1);
+    CHECK(gk_test_file_has(OUT("pp_b.out"), "a non-finite start of point D"));
+    CHECK(!exists(OUT("pp_b/pipe.csv")));
+#undef CL_CK
+#undef FT_CK
+#undef PP_CK
+}
+
 /* =============================================================== tools */
 #define RVE_PATH BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
 #define GK_PACK BUILD "/gk_pack --n 60 "
@@ -1086,6 +1162,7 @@ int main(int argc, char **argv) {
     RUN(twoscale_checkpoint_reference_is_checked);
     RUN(driver_checkpoint_blocks_are_checked);
     RUN(dr_and_nonlocal_checkpoints_refuse_non_finite_values);
+    RUN(mpmdem_driver_states_are_checked);
     RUN(gk_pack_fails_on_a_void_ratio_it_cannot_reach);
     RUN(friction_angle_in_degrees_with_a_plausible_range);
     RUN(rve_path_exits_nonzero_when_its_result_is_lost);

@@ -79,7 +79,7 @@ static int same_as_pristine(void) {
 
 /* the driver's call (setup) on DIR */
 static gk_result load(const char *dir, gk_err *err) {
-    return mpd_load(dir, &X.M, &X.pts, "biaxial", &X.S, sizeof X.S, &X.rows, &X.snaps, bx_check, err);
+    return mpd_load(dir, &X.M, &X.pts, "biaxial", &X.S, sizeof X.S, &X.rows, &X.snaps, bx_check, &X, err);
 }
 
 static void restore(void) {
@@ -141,7 +141,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     /* accepted: the driver's own checks hold, the points are finite, the fields too */
     n = X.pts.n;
-    FUZZ_CHECK(bx_check(&X.S, &X.rows, why, sizeof why) == 0);
+    FUZZ_CHECK(bx_check(&X.S, &X.rows, &X, why, sizeof why) == 0);
     FUZZ_CHECK(mpd_block_check(&X.M, &X.pts, &X.snaps, why, sizeof why) == 0);
     for (k = 0; k < 2; ++k) fuzz_all_finite(X.pts.x[k], (size_t)n), fuzz_all_finite(X.pts.v[k], (size_t)n);
     fuzz_all_finite(X.pts.sigma, 9 * (size_t)n), fuzz_all_finite(X.pts.F, 9 * (size_t)n),
