@@ -200,7 +200,7 @@ test: $(TESTS) $(EXAMPLES) $(TOOLS) $(FUZZ_REPLAY) $(BUILD)/bench_tradeoff $(if 
 # the harness's own GK_IMPLEMENTATION (libFuzzer builds it alone) gives way to the
 # build's implementation object (GK_IMPLEMENTATION_ELSEWHERE, gk_base.h)
 ELSEWHERE := -DGK_IMPLEMENTATION_ELSEWHERE
-$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(FUZZ_DEPS) $(IMPL) | $(BUILD)
+$(BUILD)/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(wildcard tests/fuzz/*.h) $(HEADERS) $(FUZZ_DEPS) $(IMPL) | $(BUILD)
 	$(CC) $(CFLAGS) $(ELSEWHERE) -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(IMPL) $(LDLIBS)
 
 # ---------------------------------------------------------------- check
@@ -224,7 +224,7 @@ $(BUILD)/asan/gk_impl_%.o: tests/gk_impl.c $(HEADERS) | $(BUILD)/asan
 $(BUILD)/asan/test_%: tests/test_%.c $(HEADERS) tests/gk_test.h $(ASAN_IMPL) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) -Iinclude -Itests -DGK_TEST_QUICK $(TESTDEF) -o $@ $< $(call impl_for,$*,$(ASAN_IMPL)) $(LDLIBS)
 
-$(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c tests/fuzz/fuzz_check.h $(HEADERS) $(FUZZ_DEPS) $(ASAN_IMPL) | $(BUILD)/asan
+$(BUILD)/asan/fuzz_replay_%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(wildcard tests/fuzz/*.h) $(HEADERS) $(FUZZ_DEPS) $(ASAN_IMPL) | $(BUILD)/asan
 	$(CC) $(SANFLAGS) $(ELSEWHERE) -Iinclude -Itests/fuzz -o $@ tests/fuzz/replay.c $< $(ASAN_IMPL) $(LDLIBS)
 
 # tools and drivers under ASan + UBSan for tests/smoke_asan.sh (a driver joins
@@ -353,7 +353,7 @@ tradeoff: $(BUILD)/bench_tradeoff
 # new inputs in build/fuzz/NAME/, findings in build/fuzz/NAME-crash-*
 FUZZ_SECONDS ?= 60
 FUZZ_CC ?= clang
-$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_check.h $(HEADERS) $(FUZZ_DEPS) | $(BUILD)/fuzz
+$(BUILD)/fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(HEADERS) $(FUZZ_DEPS) | $(BUILD)/fuzz
 	$(FUZZ_CC) -std=c99 -g -O1 $(FPFLAGS) -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
 	  -Iinclude -Itests/fuzz -o $@ $< -lm
 

@@ -341,8 +341,8 @@ static int setup(cl *X, gk_err *err) {
     S->next_out = b->every;
     S->t_rest = -1;
     X->rows.size = sizeof(cl_row);
+    X->dt_run = S->dt, X->Ep0_run = S->Ep0;
     if (X->o.restart) {
-        X->dt_run = S->dt, X->Ep0_run = S->Ep0;
         if (mpd_load(X->o.restart, &X->M, &X->pts, "collapse", S, sizeof *S, &X->rows, &X->snaps, cl_check, X,
                      err))
             return 1;

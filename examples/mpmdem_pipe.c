@@ -364,8 +364,8 @@ static int setup(pp *X, gk_err *err) {
     S->pen_row = -1;
     X->rows.size = sizeof(pp_row);
     pick_points(X);
+    X->dt_run = S->dt;
     if (X->o.restart) {
-        X->dt_run = S->dt;
         if (mpd_load(X->o.restart, &X->M, &X->pts, "pipe", S, sizeof *S, &X->rows, &X->snaps, check_state, X,
                      err))
             return 1;
