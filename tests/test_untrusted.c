@@ -971,6 +971,43 @@ TEST(dr_and_nonlocal_checkpoints_refuse_non_finite_values) {
 #undef NL_CK
 }
 
+/* femdem_dr took any finite value of its block (found by fuzz_dr_ckpt): a
+ * bottom node lifted off its support, a row numbered as another step, a row
+ * of negative seconds, h_ic other than the specimen's before the end of the
+ * isotropic stage, a DR iteration count of 1e300 (converted to a long: undefined
+ * behaviour). Each refused by exit 1 with the message, no new rows. */
+TEST(dr_checkpoint_values_are_checked_in_range) {
+#define DR_CK                                                                                               \
+    BUILD "/femdem_dr --nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 " \
+          "--steps 2 --threads 1 "
+    /* the block (1 x 2 mesh: 12 dofs, 8 Gauss points, stopped after step 1: 2 rows): tag "FDR2", 8
+     * ints, 19 reals (h_ic first, the DR's iteration count fourth), u, v, f0, H, P, the rows */
+    const size_t reals = 4 + 8 * 4, u = reals + 19 * 8, rows = u + 8 * (3 * 12 + 18 * 8);
+    const size_t at[5] = {u + 3 * 8, rows + 12 * 8, rows + 12 * 8 + 11 * 8, reals, reals + 3 * 8};
+    const double val[5] = {1e-3, 0.0, -1.0, 0.019, 1e300};
+    unsigned char *b;
+    size_t n, tag;
+    int k;
+    CHECK_EQ_INT(run_status(DR_CK "--stop-after 1 --out " OUT("drr_a") LOG("drr_a")), 0);
+    mkdir(OUT("drr_bad"), 0755);
+    for (k = 0; k < 5; ++k) {
+        double was;
+        b = file_image(OUT("drr_a/checkpoint.bin"), &n);
+        CHECK(b != NULL && (tag = find_tag(b, n, "FDR2")) < n && tag + rows + 2 * 12 * 8 + 8 == n);
+        if (!b || tag + rows + 2 * 12 * 8 + 8 != n) return;
+        memcpy(&was, b + tag + at[k], 8);
+        CHECK(was != val[k]);
+        memcpy(b + tag + at[k], &val[k], 8);
+        spill_resealed(OUT("drr_bad/checkpoint.bin"), b, n);
+        free(b);
+        remove(OUT("drr_b/dr.csv"));
+        CHECK_EQ_INT(run_status(DR_CK "--restart " OUT("drr_bad") " --out " OUT("drr_b") LOG("drr_b")), 1);
+        CHECK(gk_test_file_has(OUT("drr_b.out"), "non-finite or out-of-range value"));
+        CHECK(!exists(OUT("drr_b/dr.csv")));
+    }
+#undef DR_CK
+}
+
 /* =============================================================== tools */
 #define RVE_PATH BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
 #define GK_PACK BUILD "/gk_pack --n 60 "
@@ -1086,6 +1123,7 @@ int main(int argc, char **argv) {
     RUN(twoscale_checkpoint_reference_is_checked);
     RUN(driver_checkpoint_blocks_are_checked);
     RUN(dr_and_nonlocal_checkpoints_refuse_non_finite_values);
+    RUN(dr_checkpoint_values_are_checked_in_range);
     RUN(gk_pack_fails_on_a_void_ratio_it_cannot_reach);
     RUN(friction_angle_in_degrees_with_a_plausible_range);
     RUN(rve_path_exits_nonzero_when_its_result_is_lost);
