@@ -274,7 +274,8 @@ static const char *ck_check(const model *md, const ckhead *hd, const unsigned ch
     for (k = 0; k < end; ++k) {
         double x;
         memcpy(&x, q + sizeof(double) * k, sizeof x);
-        if (!(fabs(x) <= (k < nr ? 10 * L : CK_MAX))) return k < nr ? "a displacement" : "a non-finite value";
+        if (!(fabs(x) <= (k < nr ? 10 * L : CK_MAX)))
+            return k < nr ? "a displacement" : "a non-finite or huge value";
         if (k >= arr && k < arr + ne && x != -1.0 && !(x >= 0.0)) return "an arrival time";
         if (k >= rows && k < prof && (k - rows) % NCOL == 0) { /* 0 first, then ascending */
             if (x != floor(x) || (prev < 0.0 ? x != 0.0 : x <= prev) || x > (double)hd->step)
