@@ -33,9 +33,9 @@
  * environment lets it through (and skips that check) to read a sanitizer's
  * report.
  * Seeds (tests/fuzz/corpus/dr_ckpt): the pristine checkpoint, one a step
- * later, truncated copies, bit flips in the block (the step, h_ic, a
- * displacement, an accumulated H, a stress, a row) with the checksum
- * mended, and one with another driver's tag, written by this file compiled
+ * later, truncated copies, bit flips in the block (the step, h_ic, the DR's
+ * omega, a displacement, an accumulated H, a stress, a row) with the
+ * checksum mended, and one with another tag, written by this file compiled
  * with -DFUZZ_MAKE_SEEDS:
  *   cc -O2 -Iinclude -Itests/fuzz -DFUZZ_MAKE_SEEDS tests/fuzz/fuzz_dr_ckpt.c -lm -o build/seeds && build/seeds DIR
  * Its folders are in $TMPDIR (default /tmp), named by the process id,
