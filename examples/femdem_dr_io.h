@@ -41,6 +41,7 @@
 #define FEMDEM_DR_IO_H
 
 #include "femdem_dr_model.h"
+#include <limits.h>
 
 #define CK_MAGIC 0x32524446u /* "FDR2" */
 
@@ -304,6 +305,56 @@ static int save_checkpoint(model *m) {
     return bad;
 }
 
+/* the block's values (iv, dv and the arrays from a) against what the run can hold: the step within
+ * the run, one row per step with its step and stage, h_ic and J_ic > 0 (the setup's before the end of
+ * stage 1), omega within the DR's bound, counters whole and >= 0, |u| <= 10 x the specimen, |H| <=
+ * 1e6 with det(I + H) > 0, every other real within CK_MAX; 0 if all hold */
+#define CK_MAX 1e100
+static int ck_in(double x, double lo, double hi) { return x >= lo && x <= hi; }
+static int ck_check(const model *m, const int32_t *iv, const double *dv, const unsigned char *a) {
+    const opts *o = &m->o;
+    size_t nd = (size_t)m->ndof, ng = (size_t)m->ngp, k;
+    double L = o->width > o->height ? o->width : o->height, cap = m->dr.def.omega_cap, F[9];
+    int i, g, step = iv[5], nrows = iv[6];
+    if (step < 0 || step > o->iso_steps + o->steps || nrows != step + 1 || (iv[7] != 0 && iv[7] != 1))
+        return 1;
+    if (!(dv[0] > 0.0 && dv[0] <= o->height + 10 * L) || !(dv[1] > 0.0 && dv[1] <= CK_MAX) ||
+        !ck_in(dv[2], 0.0, cap > 0.0 ? cap : CK_MAX) || !ck_in(dv[8], 0.0, 2.0))
+        return 1;
+    if (step < o->iso_steps && (dv[0] != o->height || dv[1] != 1.0)) return 1; /* set at its end */
+    for (i = 3; i < CK_OPT; ++i) /* the counters: whole, >= 0, exact in a double */
+        if (i != 8 && (!ck_in(dv[i], 0.0, 9007199254740992.0) || dv[i] != floor(dv[i]))) return 1;
+    if (dv[9] > step || dv[10] > step || dv[7] > step) return 1;
+    for (k = 0; k < 3 * nd + 18 * ng + (size_t)NCOL * nrows; ++k) {
+        double x, lim = k < nd ? 10 * L : (k >= 3 * nd && k < 3 * nd + 9 * ng ? 1e6 : CK_MAX);
+        memcpy(&x, a + 8 * k, 8);
+        if (!ck_in(x, -lim, lim)) return 1;
+    }
+    if (!m->single) /* the supports of setup: the bottom's u_y and the first node's u_x are 0 */
+        for (k = 0; k < nd; ++k) {
+            double x;
+            memcpy(&x, a + 8 * k, 8);
+            if (x != 0.0 && (k == 0 || (k % 2 == 1 && m->mesh.x[k] <= 1e-12 * o->height))) return 1;
+        }
+    for (g = 0; g < (int)ng; ++g) { /* det(I + H) > 0 */
+        gk_m3_identity(F);
+        for (i = 0; i < 9; ++i) {
+            double h;
+            memcpy(&h, a + 8 * (3 * nd + 9 * (size_t)g + i), 8);
+            F[i] += h;
+        }
+        if (!(gk_m3_det(F) > 0.0)) return 1;
+    }
+    for (i = 0; i < nrows; ++i) { /* step, stage, DR iterations, DEM steps, seconds */
+        double v[NCOL];
+        memcpy(v, a + 8 * (3 * nd + 18 * ng + (size_t)NCOL * i), sizeof v);
+        if (v[0] != i || v[1] != (i > o->iso_steps ? 2 : 1) || !ck_in(v[9], 0.0, INT_MAX) || v[10] < 0.0 ||
+            v[11] < 0.0)
+            return 1;
+    }
+    return 0;
+}
+
 static int load_checkpoint(model *m) {
     char path[1024];
     void *blk = NULL;
@@ -338,16 +389,8 @@ static int load_checkpoint(model *m) {
     need += 8 * (3 * (size_t)m->ndof + 18 * (size_t)m->ngp + (size_t)NCOL * iv[6]);
     if (nb != need) goto bad;
     /* a checksum only proves the file is what some writer wrote: check what
-     * this run will trust (every real finite, counters in range) */
-    if (iv[5] > m->o.iso_steps + m->o.steps || (iv[7] != 0 && iv[7] != 1)) goto bad_value;
-    for (i = 0; i < CK_OPT; ++i)
-        if (!isfinite(dv[i]) || (i >= 3 && dv[i] < 0.0)) goto bad_value;
-    for (b += 4 + sizeof iv + sizeof dv; b < (const unsigned char *)blk + nb; b += 8) {
-        double x;
-        memcpy(&x, b, 8);
-        if (!isfinite(x)) goto bad_value;
-    }
-    b = (const unsigned char *)blk;
+     * this run will trust (every value in range), all of it before anything is written */
+    if (ck_check(m, iv, dv, b + 4 + sizeof iv + sizeof dv)) goto bad_value;
     b += 4 + sizeof iv + sizeof dv;
     memcpy(m->u, b, 8 * (size_t)m->ndof), b += 8 * (size_t)m->ndof;
     memcpy(m->v, b, 8 * (size_t)m->ndof), b += 8 * (size_t)m->ndof;

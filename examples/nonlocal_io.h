@@ -236,36 +236,90 @@ static int save_checkpoint(model *md, uint64_t fp) {
     return 0;
 }
 
+/* what the reader writes into the model (the block and what it derives from it), kept to be put
+ * back when it is refused after all: n parts, their addresses and sizes */
+#define CK_NPART 24
+static void ck_parts(model *md, void **p, size_t *n) {
+    size_t nd = sizeof(double) * md->nd, np9 = sizeof(double) * 9 * md->np, ne = sizeof(double) * md->ne,
+           ny = sizeof(double) * md->o->mesh[1];
+    void *a[CK_NPART];
+    size_t s[CK_NPART];
+    int k = 0;
+#define PART(ptr, size) a[k] = (void *)(ptr), s[k++] = (size)
+    PART(&md->step, sizeof md->step), PART(&md->time, sizeof md->time), PART(&md->peak, sizeof md->peak);
+    PART(&md->have12, sizeof md->have12), PART(&md->dem_total, sizeof md->dem_total);
+    PART(&md->kin, sizeof md->kin), PART(md->ur, sizeof(double) * md->nr),
+        PART(md->vr, sizeof(double) * md->nr);
+    PART(md->sig, np9), PART(md->gam_peak, ny), PART(md->prof12, 2 * ny), PART(md->arrival, ne);
+    PART(md->wint, ne), PART(md->u, nd), PART(md->v, nd), PART(md->cur.x, nd), PART(md->Hn, np9);
+    PART(md->H, np9), PART(md->He, 9 * ne), PART(md->sige, 9 * ne), PART(md->fext, nd), PART(md->fint, nd);
+    PART(md->fe, 24 * ne), PART(md->ehg, ne);
+#undef PART
+    memcpy(p, a, sizeof a), memcpy(n, s, sizeof s);
+}
+
+/* the block's values against what the run can hold (hd checked for its sizes, q its arrays): the
+ * time >= 0, the peak finite or -inf, whole counters, |u| <= 10 x the specimen, arrival times -1 or
+ * >= 0, rows of whole ascending steps from 0 to at most the step and seconds >= 0, every real
+ * within 1e100; 0 if all hold, else what is wrong */
+#define CK_MAX 1e100
+static const char *ck_check(const model *md, const ckhead *hd, const unsigned char *q) {
+    size_t nr = (size_t)md->nr, np = (size_t)md->np, ne = (size_t)md->ne, ny = (size_t)md->o->mesh[1], k;
+    size_t rows = 2 * nr + 9 * np, prof = rows + NCOL * (size_t)hd->nrow, arr = prof + 3 * ny,
+           end = arr + 2 * ne;
+    double L = fmax(md->L[0], fmax(md->L[1], md->L[2])), prev = -1.0;
+    if (!(hd->time >= 0.0 && hd->time <= CK_MAX) || !(fabs(hd->peak) <= CK_MAX || hd->peak == -HUGE_VAL) ||
+        hd->dem_total < 0 || hd->dem_total > LONG_MAX || (hd->have12 != 0 && hd->have12 != 1))
+        return "its time, peak, DEM step count or 12 % flag";
+    for (k = 0; k < end; ++k) {
+        double x;
+        memcpy(&x, q + sizeof(double) * k, sizeof x);
+        if (!(fabs(x) <= (k < nr ? 10 * L : CK_MAX)))
+            return k < nr ? "a displacement" : "a non-finite or huge value";
+        if (k >= arr && k < arr + ne && x != -1.0 && !(x >= 0.0)) return "an arrival time";
+        if (k >= rows && k < prof && (k - rows) % NCOL == 0) { /* 0 first, then ascending */
+            if (x != floor(x) || (prev < 0.0 ? x != 0.0 : x <= prev) || x > (double)hd->step)
+                return "a row's step";
+            prev = x;
+        }
+        if (k >= rows && k < prof && (k - rows) % NCOL == NCOL - 1 && x < 0.0) return "a row's seconds";
+    }
+    return NULL;
+}
+
 static int load_checkpoint(model *md, uint64_t fp) {
     char path[1024];
-    void *blk = NULL;
-    size_t nb = 0, ny = (size_t)md->o->mesh[1], need;
+    void *blk = NULL, *part[CK_NPART];
+    size_t nb = 0, ny = (size_t)md->o->mesh[1], need, npart[CK_NPART], nkeep = 0, k;
     ckhead hd;
     const unsigned char *q;
+    const char *why = NULL;
+    unsigned char *keep;
+    double *rows;
     int e;
     snprintf(path, sizeof path, "%s/checkpoint.bin", md->o->restart);
     if (gk_twoscale_load(&md->ts, path, &blk, &nb))
         return fprintf(stderr, "femdem_nonlocal: restart: %s\n", gk_twoscale_error(&md->ts)), 1;
     if (nb < sizeof hd) goto bad;
     memcpy(&hd, blk, sizeof hd);
+    need =
+        sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->np + 3 * ny + 2 * (size_t)md->ne);
     if (memcmp(hd.magic, "GKFNL02", 8) || hd.test != md->test || hd.nd != md->nd || hd.nr != md->nr ||
         hd.ne != md->ne || hd.ny != (int32_t)ny || hd.ncol != NCOL || hd.fingerprint != fp || hd.nrow < 1 ||
-        hd.step < 0 || hd.step > md->o->steps)
+        hd.step < 0 || hd.step > md->o->steps || need > nb ||
+        (uint64_t)hd.nrow > (nb - need) / (sizeof(double) * NCOL)) /* the row count within the file */
         goto bad;
-    need = sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->np + NCOL * (size_t)hd.nrow +
-                                         3 * ny + 2 * (size_t)md->ne);
+    need += sizeof(double) * NCOL * (size_t)hd.nrow;
     if (nb != need) goto bad;
     /* a checksum only proves the file is what some writer wrote: check what
-     * this run will trust (every real finite, counters in range) */
-    if (!isfinite(hd.time) || hd.time < 0.0 || !(isfinite(hd.peak) || hd.peak == -HUGE_VAL) ||
-        hd.dem_total < 0 || (hd.have12 != 0 && hd.have12 != 1))
-        goto bad_value;
-    for (q = (const unsigned char *)blk + sizeof hd; q < (const unsigned char *)blk + nb;
-         q += sizeof(double)) {
-        double x;
-        memcpy(&x, q, sizeof x);
-        if (!isfinite(x)) goto bad_value;
-    }
+     * this run will trust (every value in range), all of it before anything is written */
+    if ((why = ck_check(md, &hd, (const unsigned char *)blk + sizeof hd)) != NULL) goto bad_value;
+    /* what the model holds now, kept: the derived state below may still refuse it */
+    ck_parts(md, part, npart);
+    for (k = 0; k < CK_NPART; ++k) nkeep += npart[k];
+    keep = (unsigned char *)xcalloc(nkeep, 1);
+    for (nkeep = 0, k = 0; k < CK_NPART; ++k) memcpy(keep + nkeep, part[k], npart[k]), nkeep += npart[k];
+    rows = (double *)xcalloc((size_t)hd.nrow * NCOL, sizeof(double));
     q = (const unsigned char *)blk + sizeof hd;
 #define GET(p, n)            \
     do {                     \
@@ -275,9 +329,7 @@ static int load_checkpoint(model *md, uint64_t fp) {
     GET(md->ur, sizeof(double) * md->nr);
     GET(md->vr, sizeof(double) * md->nr);
     GET(md->sig, sizeof(double) * 9 * md->np);
-    md->rows = (double *)xcalloc((size_t)hd.nrow * NCOL, sizeof(double));
-    md->caprow = md->nrow = hd.nrow;
-    GET(md->rows, sizeof(double) * NCOL * hd.nrow);
+    GET(rows, sizeof(double) * NCOL * hd.nrow);
     GET(md->gam_peak, sizeof(double) * ny);
     GET(md->prof12, sizeof(double) * 2 * ny);
     GET(md->arrival, sizeof(double) * md->ne);
@@ -285,7 +337,7 @@ static int load_checkpoint(model *md, uint64_t fp) {
 #undef GET
     gk_twoscale_free_block(&md->ts, blk);
     md->step = hd.step, md->time = hd.time, md->peak = hd.peak, md->have12 = hd.have12,
-    md->dem_total = hd.dem_total;
+    md->dem_total = (long)hd.dem_total;
     gk_dofmap_expand(&md->dm, md->ur, 0, md->u);
     gk_dofmap_expand(&md->dm, md->vr, 0, md->v);
     for (e = 0; e < md->nd; ++e) md->cur.x[e] = md->ref.x[e] + md->u[e];
@@ -293,7 +345,17 @@ static int load_checkpoint(model *md, uint64_t fp) {
     memcpy(md->H, md->Hn, sizeof(double) * 9 * md->np);
     elem_means(md);
     external_force(md);
-    if (internal_force(md)) return 1;
+    if (internal_force(md)) { /* an element the displacements invert: put back what was there */
+        for (nkeep = 0, k = 0; k < CK_NPART; ++k) memcpy(part[k], keep + nkeep, npart[k]), nkeep += npart[k];
+        free(keep), free(rows);
+        return fprintf(
+                   stderr,
+                   "femdem_nonlocal: restart: %s: its displacements are not a valid mesh; not restarted\n",
+                   path),
+               1;
+    }
+    free(keep), free(md->rows);
+    md->rows = rows, md->caprow = md->nrow = hd.nrow;
     md->kin = gk_explicit_kinetic_energy(md->nd, md->mass, NULL, md->v);
     printf("restarted from %s at step %ld\n", path, md->step);
     return 0;
@@ -306,10 +368,11 @@ bad:
            1;
 bad_value:
     gk_twoscale_free_block(&md->ts, blk);
-    return fprintf(stderr,
-                   "femdem_nonlocal: restart: %s: the run's block holds a non-finite or out-of-range value; "
-                   "not restarted\n",
-                   path),
+    return fprintf(
+               stderr,
+               "femdem_nonlocal: restart: %s: the run's block holds a non-finite or out-of-range value (%s); "
+               "not restarted\n",
+               path, why),
            1;
 }
 

@@ -1047,6 +1047,91 @@ TEST(mpmdem_driver_states_are_checked) {
 #undef PP_CK
 }
 
+/* femdem_dr took any finite value of its block (found by fuzz_dr_ckpt): a
+ * bottom node lifted off its support, a row numbered as another step, a row
+ * of negative seconds, h_ic other than the specimen's before the end of the
+ * isotropic stage, a DR iteration count of 1e300 (converted to a long: undefined
+ * behaviour). Each refused by exit 1 with the message, no new rows. */
+TEST(dr_checkpoint_values_are_checked_in_range) {
+#define DR_CK                                                                                               \
+    BUILD "/femdem_dr --nx 1 --ny 2 --iso-steps 2 --strain 0.01 --dr-tol 1e-2 --servo-max 3 --vtk-every 0 " \
+          "--steps 2 --threads 1 "
+    /* the block (1 x 2 mesh: 12 dofs, 8 Gauss points, stopped after step 1: 2 rows): tag "FDR2", 8
+     * ints, 19 reals (h_ic first, the DR's iteration count fourth), u, v, f0, H, P, the rows */
+    const size_t reals = 4 + 8 * 4, u = reals + 19 * 8, rows = u + 8 * (3 * 12 + 18 * 8);
+    const size_t at[5] = {u + 3 * 8, rows + 12 * 8, rows + 12 * 8 + 11 * 8, reals, reals + 3 * 8};
+    const double val[5] = {1e-3, 0.0, -1.0, 0.019, 1e300};
+    unsigned char *b;
+    size_t n, tag;
+    int k;
+    CHECK_EQ_INT(run_status(DR_CK "--stop-after 1 --out " OUT("drr_a") LOG("drr_a")), 0);
+    mkdir(OUT("drr_bad"), 0755);
+    for (k = 0; k < 5; ++k) {
+        double was;
+        b = file_image(OUT("drr_a/checkpoint.bin"), &n);
+        CHECK(b != NULL && (tag = find_tag(b, n, "FDR2")) < n && tag + rows + 2 * 12 * 8 + 8 == n);
+        if (!b || tag + rows + 2 * 12 * 8 + 8 != n) return;
+        memcpy(&was, b + tag + at[k], 8);
+        CHECK(was != val[k]);
+        memcpy(b + tag + at[k], &val[k], 8);
+        spill_resealed(OUT("drr_bad/checkpoint.bin"), b, n);
+        free(b);
+        remove(OUT("drr_b/dr.csv"));
+        CHECK_EQ_INT(run_status(DR_CK "--restart " OUT("drr_bad") " --out " OUT("drr_b") LOG("drr_b")), 1);
+        CHECK(gk_test_file_has(OUT("drr_b.out"), "non-finite or out-of-range value"));
+        CHECK(!exists(OUT("drr_b/dr.csv")));
+    }
+#undef DR_CK
+}
+
+/* femdem_nonlocal took any finite value of its block (found by
+ * fuzz_nonlocal_ckpt): rows numbered out of order, a row of negative
+ * seconds (the restart's clock goes back by it), a time or a peak of 1e300,
+ * an arrival time of -5 (-1 means none). Each refused by exit 1 with the
+ * message, no new rows. (Its reader also wrote the block into the model
+ * before an inverted element refused it, and leaked the rows it replaced:
+ * tests/fuzz/crashers/nonlocal_ckpt, replayed by `make test` and `make check`.) */
+TEST(nonlocal_checkpoint_values_are_checked_in_range) {
+#define NL_CK                                                                                      \
+    BUILD "/femdem_nonlocal --test element-shear --packing examples/data/rve160_hm.txt --steps 4 " \
+          "--strain 0.0004 --lone-increments 2 --threads 1 "
+    /* the block: tag "GKFNL02" (8 bytes), 10 ints (the reduced dof count sixth), step, row count,
+     * DEM steps, fingerprint, time, peak; then u and v (reduced), sigma (one point), the rows (17
+     * columns; stopped after step 2: rows of steps 0, 1, 2), the band profiles (one row of elements:
+     * 3 reals), the arrival time and the work of the one element */
+    unsigned char *b;
+    size_t n, tag, at[5], rows;
+    int32_t nr = 0;
+    int64_t nrow = 0;
+    const double val[5] = {0.0, -1.0, 1e300, 1e300, -5.0};
+    int k;
+    CHECK_EQ_INT(run_status(NL_CK "--stop-after 2 --out " OUT("nlr_a") LOG("nlr_a")), 0);
+    mkdir(OUT("nlr_bad"), 0755);
+    for (k = 0; k < 5; ++k) {
+        double was;
+        b = file_image(OUT("nlr_a/checkpoint.bin"), &n);
+        CHECK(b != NULL && (tag = find_tag(b, n, "GKFNL02")) < n);
+        if (!b || tag == n) return;
+        memcpy(&nr, b + tag + 8 + 5 * 4, 4), memcpy(&nrow, b + tag + 56, 8);
+        CHECK_EQ_INT((int)nrow, 3);
+        rows = tag + 96 + 8 * (2 * (size_t)nr + 9);
+        CHECK(rows + 8 * (17 * 3 + 5) + 8 == n);
+        if (nrow != 3 || rows + 8 * (17 * 3 + 5) + 8 != n) return;
+        at[0] = rows + 17 * 8, at[1] = rows + 8 * (2 * 17 + 16), at[2] = tag + 80, at[3] = tag + 88;
+        at[4] = rows + 8 * (17 * 3 + 3);
+        memcpy(&was, b + at[k], 8);
+        CHECK(was != val[k]);
+        memcpy(b + at[k], &val[k], 8);
+        spill_resealed(OUT("nlr_bad/checkpoint.bin"), b, n);
+        free(b);
+        remove(OUT("nlr_b/element-shear.csv"));
+        CHECK_EQ_INT(run_status(NL_CK "--restart " OUT("nlr_bad") " --out " OUT("nlr_b") LOG("nlr_b")), 1);
+        CHECK(gk_test_file_has(OUT("nlr_b.out"), "non-finite or out-of-range value"));
+        CHECK(!exists(OUT("nlr_b/element-shear.csv")));
+    }
+#undef NL_CK
+}
+
 /* =============================================================== tools */
 #define RVE_PATH BUILD "/rve_path --packing examples/data/rve400.txt --dH \"0 0.001 0 0\" "
 #define GK_PACK BUILD "/gk_pack --n 60 "
@@ -1163,6 +1248,8 @@ int main(int argc, char **argv) {
     RUN(driver_checkpoint_blocks_are_checked);
     RUN(dr_and_nonlocal_checkpoints_refuse_non_finite_values);
     RUN(mpmdem_driver_states_are_checked);
+    RUN(dr_checkpoint_values_are_checked_in_range);
+    RUN(nonlocal_checkpoint_values_are_checked_in_range);
     RUN(gk_pack_fails_on_a_void_ratio_it_cannot_reach);
     RUN(friction_angle_in_degrees_with_a_plausible_range);
     RUN(rve_path_exits_nonzero_when_its_result_is_lost);
