@@ -193,7 +193,9 @@ static int checkpoint(fd_model *M) {
 }
 
 /* --restart DIR: the model's block and this driver's part (the cyclic state, a cyc_extra per row: the
- * exact length, every real finite) checked before the model changes (femdem_biaxial.h's fdb_restart) */
+ * exact length, every real finite, the direction +-1, the branch and step counters >= 0 and far from
+ * overflowing, the stress-control increment in (0, 1], the moduli >= 0) checked before the model
+ * changes (femdem_biaxial.h's fdb_restart) */
 static int restart(cyc_model *C, gk_err *err) {
     fd_model *M = &C->m;
     fd_buf B;
@@ -212,7 +214,9 @@ static int restart(cyc_model *C, gk_err *err) {
         fd_get(&B, &cs, sizeof cs), fd_get(&B, cx, (size_t)ck.nc * sizeof *cx);
         d[0] = cs.gamma, d[1] = cs.g_start, d[2] = cs.t_start, d[3] = cs.tau, d[4] = cs.h, d[5] = cs.p0;
         d[6] = cs.cyc_liq, d[7] = cs.cyc_gamma, d[8] = cs.G0, d[9] = cs.Gu;
-        bad = !fd_ck_bounded(d, 10, 1e100) || (cs.dir != 1 && cs.dir != -1);
+        bad = !fd_ck_bounded(d, 10, 1e100) || (cs.dir != 1 && cs.dir != -1) || cs.branch < 0 ||
+              cs.branch > 100000000 || cs.bsteps < 0 || cs.bsteps > 1000000000 || cs.good < 0 ||
+              cs.good > 1000000000 || !(cs.h > 0.0 && cs.h <= 1.0) || cs.G0 < 0.0 || cs.Gu < 0.0;
         for (k = 0; k < ck.nc && !bad; ++k) {
             double e[5];
             e[0] = cx[k].cycle, e[1] = cx[k].tau, e[2] = cx[k].p, e[3] = cx[k].q, e[4] = cx[k].top_uy;

@@ -1047,6 +1047,37 @@ TEST(mpmdem_driver_states_are_checked) {
 #undef PP_CK
 }
 
+/* femdem_cyclic checked its cyclic state for finite reals and a direction of +-1 only: a branch
+ * counter of INT_MAX (its next reversal would overflow) was restarted from with exit 0, the run
+ * taking its cycles as done without a step. Now refused, exit 1, no new rows. The state lies before
+ * the rows' extras (5 doubles each) and the checksum; its ints: dir, branch, good, bsteps. */
+TEST(cyclic_checkpoint_counters_are_checked) {
+#define CY_CK \
+    BUILD "/femdem_cyclic --test cyclic-strain --nx 2 --ny 1 --element q4 --increment 0.002 --threads 1 "
+    unsigned char *b;
+    size_t n, nc = 3; /* the initial row and two steps of 0.2 % (0.1 cycle of 1 %) */
+    int32_t big = INT32_MAX;
+    remove(OUT("cy_b/cyclic.csv"));
+    CHECK_EQ_INT(run_status(CY_CK "--cycles 0.1 --out " OUT("cy_a") LOG("cy_a")), 0);
+    b = file_image(OUT("cy_a/checkpoint.bin"), &n);
+    CHECK(b != NULL && n > 8 + 40 * nc + 96);
+    if (!b || n <= 8 + 40 * nc + 96) {
+        free(b);
+        return;
+    }
+    mkdir(OUT("cy_bad"), 0755);
+    memcpy(b + n - 8 - 40 * nc - 96 + 4, &big, 4);
+    spill_resealed(OUT("cy_bad/checkpoint.bin"), b, n);
+    CHECK_EQ_INT(run_status(CY_CK "--cycles 0.2 --restart " OUT("cy_bad") " --out " OUT("cy_b") LOG("cy_b")),
+                 1);
+    CHECK(gk_test_file_has(OUT("cy_b.out"), "the cyclic state is out of range"));
+    CHECK(!exists(OUT("cy_b/cyclic.csv")));
+    CHECK_EQ_INT(run_status(CY_CK "--cycles 0.2 --restart " OUT("cy_a") " --out " OUT("cy_c") LOG("cy_c")),
+                 0);
+    free(b);
+#undef CY_CK
+}
+
 /* femdem_dr took any finite value of its block (found by fuzz_dr_ckpt): a
  * bottom node lifted off its support, a row numbered as another step, a row
  * of negative seconds, h_ic other than the specimen's before the end of the
@@ -1248,6 +1279,7 @@ int main(int argc, char **argv) {
     RUN(driver_checkpoint_blocks_are_checked);
     RUN(dr_and_nonlocal_checkpoints_refuse_non_finite_values);
     RUN(mpmdem_driver_states_are_checked);
+    RUN(cyclic_checkpoint_counters_are_checked);
     RUN(dr_checkpoint_values_are_checked_in_range);
     RUN(nonlocal_checkpoint_values_are_checked_in_range);
     RUN(gk_pack_fails_on_a_void_ratio_it_cannot_reach);
