@@ -971,30 +971,33 @@ TEST(dr_and_nonlocal_checkpoints_refuse_non_finite_values) {
 #undef NL_CK
 }
 
-/* the MPMxDEM collapse and footing drivers read their own state from a checkpoint unchecked, and
- * the pipe driver its rows and the watched points' start: a snapshot index of -1e8 (collapse) made
- * the run read far outside its list of snapshot times (SIGSEGV), a stage index of -5 (footing)
- * before its list of stages, and the pipe restarted with a NaN in a watched point's start. Each now
- * refused by name, exit 1, no rows written; a time step other than the run's too. A state starts
- * after the block's tag (32 bytes), point count (4), state size (8), the points (444 bytes each)
- * and the DEM-step count (8). */
+/* where the driver state of a checkpoint image lies (after the block's tag, point count, state size,
+ * the points and the DEM-step count), or n */
+static size_t state_at(const unsigned char *b, size_t n, const char *tag) {
+    size_t at = find_tag(b, n, tag);
+    int32_t np = 0;
+    if (at >= n || n - at < 52) return n;
+    memcpy(&np, b + at + 32, 4);
+    if (np <= 0 || (n - at - 52) / 444 < (size_t)np) return n;
+    return at + 52 + 444 * (size_t)np;
+}
+
+/* the checkpoint from, with nv bytes of v written at off into its driver state, resealed into to */
 static void patch_state(const char *from, const char *to, const char *tag, size_t off, const void *v,
                         size_t nv) {
     size_t n, at;
     unsigned char *b = file_image(from, &n);
-    int32_t np = 0;
-    CHECK(b != NULL && (at = find_tag(b, n, tag)) < n);
-    if (!b || at == n) {
-        free(b);
-        return;
-    }
-    memcpy(&np, b + at + 32, 4);
-    at += 52 + 444 * (size_t)np + off;
-    CHECK(np > 0 && at + nv + 8 <= n);
-    if (np > 0 && at + nv + 8 <= n) memcpy(b + at, v, nv), spill_resealed(to, b, n);
+    CHECK(b != NULL && (at = state_at(b, n, tag)) < n && n - at >= off + nv + 8);
+    if (b && (at = state_at(b, n, tag)) < n && n - at >= off + nv + 8)
+        memcpy(b + at + off, v, nv), spill_resealed(to, b, n);
     free(b);
 }
 
+/* the MPMxDEM collapse and footing drivers read their own state from a checkpoint unchecked, and
+ * the pipe driver its rows and the watched points' start: a snapshot index of -1e8 (collapse) made
+ * the run read far outside its list of snapshot times (SIGSEGV), a stage index of -5 (footing)
+ * before its list of stages, and the pipe restarted with a NaN in a watched point's start. Each now
+ * refused by name, exit 1, no rows written; a time step other than the run's too. */
 TEST(mpmdem_driver_states_are_checked) {
 #define CL_CK BUILD "/mpmdem_collapse --nx 4 --every 0.025 --snapshots 0.05 --quiet --t-end 0.1 "
 #define FT_CK                                                                                        \
@@ -1004,8 +1007,8 @@ TEST(mpmdem_driver_states_are_checked) {
     BUILD "/mpmdem_pipe --width 3 --nx 12 --ny 5 --penetration 0.1 --lateral 0.05 --v-down 1 --v-lateral " \
           "1 --ramp 0.02 --every 0.02 --threads 1 --quiet "
     int32_t i = -100000000;
-    double v;
-    size_t n;
+    double v = NAN;
+    size_t n, at;
     unsigned char *b;
     CHECK_EQ_INT(run_status("rm -rf " OUT("cl_b") " " OUT("ft_b") " " OUT("pp_b")), 0);
     mkdir(OUT("cl_bad"), 0755), mkdir(OUT("ft_bad"), 0755), mkdir(OUT("pp_bad"), 0755);
@@ -1016,12 +1019,9 @@ TEST(mpmdem_driver_states_are_checked) {
     CHECK(gk_test_file_has(OUT("cl_b.out"), "snapshot or output counter out of range"));
     CHECK(!exists(OUT("cl_b/collapse.csv")));
     b = file_image(OUT("cl_a/checkpoint.bin"), &n);
-    if (b) {
-        size_t at = find_tag(b, n, "GKMPMDEM2 collapse");
-        int32_t np = 0;
-        if (at < n) memcpy(&np, b + at + 32, 4), memcpy(&v, b + at + 52 + 444 * (size_t)np + 16, 8);
-        free(b);
-    }
+    if (b && (at = state_at(b, n, "GKMPMDEM2 collapse")) < n && n - at >= 24) memcpy(&v, b + at + 16, 8);
+    free(b);
+    CHECK(v > 0.0);
     v *= 2;
     patch_state(OUT("cl_a/checkpoint.bin"), OUT("cl_bad/checkpoint.bin"), "GKMPMDEM2 collapse", 16, &v, 8);
     CHECK_EQ_INT(run_status(CL_CK "--restart " OUT("cl_bad") " --out " OUT("cl_b") LOG("cl_b")), 1);
