@@ -44,16 +44,13 @@
 #define main femdem_dr_main
 #include "../../examples/femdem_dr.c"
 #undef main
-#include "fuzz_check.h"
-#include <dirent.h>
-#include <fcntl.h>
-#include <unistd.h>
+#include "fuzz_driver.h"
 
 static model M;
 static char in_dir[400], ref_dir[400], out_dir[400], pk_path[400], cap_path[400];
 static unsigned char *snap0; /* the pristine model's state */
 static size_t nsnap;
-static int ready, cap_fd = -1, null_fd = -1, saved_fd[2] = {-1, -1};
+static int ready;
 
 /* the state no checkpoint carries, as setup left it */
 static struct {
@@ -63,36 +60,9 @@ static struct {
     gk_dr dr;
 } side0;
 
-/* every file of dir, then dir */
-static void remove_dir(const char *dir) {
-    DIR *d = opendir(dir);
-    struct dirent *de;
-    char p[700];
-    while (d && (de = readdir(d)) != NULL)
-        if (de->d_name[0] != '.') snprintf(p, sizeof p, "%s/%s", dir, de->d_name), remove(p);
-    if (d) closedir(d);
-    rmdir(dir);
-}
-
 static void cleanup(void) {
-    remove_dir(in_dir), remove_dir(ref_dir), remove_dir(out_dir), remove(pk_path), remove(cap_path);
-}
-
-/* the driver's output off (stdout to /dev/null, stderr to a file) around a call; the bytes it wrote to
- * stderr after. FUZZ_VERBOSE: nothing redirected, -1 */
-static void quiet_begin(void) {
-    if (getenv("FUZZ_VERBOSE")) return;
-    fflush(stdout), fflush(stderr);
-    FUZZ_CHECK(ftruncate(cap_fd, 0) == 0 && lseek(cap_fd, 0, SEEK_SET) == 0);
-    FUZZ_CHECK((saved_fd[0] = dup(1)) >= 0 && (saved_fd[1] = dup(2)) >= 0);
-    FUZZ_CHECK(dup2(null_fd, 1) >= 0 && dup2(cap_fd, 2) >= 0);
-}
-static long quiet_end(void) {
-    if (getenv("FUZZ_VERBOSE")) return -1;
-    fflush(stdout), fflush(stderr);
-    FUZZ_CHECK(dup2(saved_fd[0], 1) >= 0 && dup2(saved_fd[1], 2) >= 0);
-    close(saved_fd[0]), close(saved_fd[1]);
-    return (long)lseek(cap_fd, 0, SEEK_END);
+    fuzz_remove_dir(in_dir), fuzz_remove_dir(ref_dir), fuzz_remove_dir(out_dir), remove(pk_path),
+        remove(cap_path);
 }
 
 /* the model's state a checkpoint carries, as bytes (malloc'ed) */
@@ -160,9 +130,9 @@ static void restore(void) {
     int bad;
     side_put();
     M.o.restart = ref_dir;
-    quiet_begin();
+    fuzz_quiet_begin();
     bad = load_checkpoint(&M);
-    quiet_end();
+    fuzz_quiet_end();
     FUZZ_CHECK(bad == 0);
 }
 
@@ -187,8 +157,7 @@ static void fuzz_setup(void) {
     FUZZ_CHECK(mkdir(in_dir, 0777) == 0 || errno == EEXIST);
     FUZZ_CHECK(mkdir(out_dir, 0777) == 0 || errno == EEXIST);
     atexit(cleanup);
-    FUZZ_CHECK((cap_fd = open(cap_path, O_RDWR | O_CREAT | O_TRUNC, 0600)) >= 0);
-    FUZZ_CHECK((null_fd = open("/dev/null", O_WRONLY)) >= 0);
+    fuzz_quiet_open(cap_path);
     /* the packing: 12 disks consolidated to 100 kPa */
     memset(&g, 0, sizeof g);
     g.dim = 2, g.n = 12, g.r_min = 0.4e-3, g.r_max = 0.6e-3, g.seed = 11;
@@ -216,9 +185,9 @@ static void fuzz_setup(void) {
     FUZZ_CHECK(parse(argc, argv, &M.o) == 0);
     FUZZ_CHECK(mkdir(M.o.out, 0777) == 0 || errno == EEXIST);
     M.t0 = gk_wtime();
-    quiet_begin();
+    fuzz_quiet_begin();
     rc = setup(&M);
-    quiet_end();
+    fuzz_quiet_end();
     FUZZ_CHECK(rc == 0);
     nd = (size_t)M.ndof, g9 = 9 * (size_t)M.ngp;
     side0.fixed = (unsigned char *)dup_bytes(M.fixed, nd);
@@ -230,9 +199,9 @@ static void fuzz_setup(void) {
     side0.fext = (double *)dup_bytes(M.fext, nd * sizeof(double));
     side0.u0 = (double *)dup_bytes(M.u0, nd * sizeof(double));
     side0.resid_last = M.resid_last, side0.dr = M.dr;
-    quiet_begin();
+    fuzz_quiet_begin();
     rc = run_fem(&M);
-    quiet_end();
+    fuzz_quiet_end();
     FUZZ_CHECK(rc == 0 && M.step_done == 3 && M.nrows == 4);
     M.o.out = out_dir;
     restore();
@@ -284,9 +253,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
     fuzz_write_checkpoint(path, data, size);
     M.o.restart = in_dir;
-    quiet_begin();
+    fuzz_quiet_begin();
     bad = load_checkpoint(&M);
-    said = quiet_end();
+    said = fuzz_quiet_end();
     if (bad) {
         FUZZ_CHECK(said != 0);
         FUZZ_CHECK(same_as_pristine());
@@ -298,9 +267,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     step = M.step_done;
     side_put();
     M.o.restart = in_dir, M.o.stop_after = step + 1;
-    quiet_begin();
+    fuzz_quiet_begin();
     rc = run_fem(&M);
-    said = quiet_end();
+    said = fuzz_quiet_end();
     if (rc == 0) {
         fuzz_all_finite(M.u, (size_t)M.ndof), fuzz_all_finite(M.P, 9 * (size_t)M.ngp);
         fuzz_all_finite(M.Hacc, 9 * (size_t)M.ngp);
@@ -357,9 +326,9 @@ int main(int argc, char **argv) {
     /* a step later */
     side_put();
     M.o.restart = ref_dir, M.o.stop_after = 4, M.o.out = ref_dir;
-    quiet_begin();
+    fuzz_quiet_begin();
     FUZZ_CHECK(run_fem(&M) == 0);
-    quiet_end();
+    fuzz_quiet_end();
     b = fuzz_slurp(path, &n);
     fuzz_write_seed(argv[1], "ckpt_step4", 0, b, n);
     free(b);

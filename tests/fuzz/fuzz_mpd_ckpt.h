@@ -23,30 +23,17 @@
  * the first row, and one with another driver's tag. */
 #ifndef FUZZ_MPD_CKPT_H
 #define FUZZ_MPD_CKPT_H
-#include "fuzz_check.h"
-#include <dirent.h>
+#include "fuzz_driver.h"
 #include <stddef.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 static char in_dir[400], ref_dir[400], out_dir[400], pk_path[400];
 static unsigned char *snap0; /* the pristine run's block */
 static size_t nsnap;
 static int ready;
 
-/* every file of dir, then dir */
-static void remove_dir(const char *dir) {
-    DIR *d = opendir(dir);
-    struct dirent *de;
-    char p[700];
-    while (d && (de = readdir(d)) != NULL)
-        if (de->d_name[0] != '.') snprintf(p, sizeof p, "%s/%s", dir, de->d_name), remove(p);
-    if (d) closedir(d);
-    rmdir(dir);
-}
-
 static void cleanup(void) {
-    remove_dir(in_dir), remove_dir(ref_dir), remove_dir(out_dir), remove(pk_path);
+    fuzz_remove_dir(in_dir), fuzz_remove_dir(ref_dir), fuzz_remove_dir(out_dir), remove(pk_path);
     if (ready) fz_free(), free(snap0);
 }
 

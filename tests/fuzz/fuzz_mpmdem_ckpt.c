@@ -32,10 +32,8 @@
 #define main mpmdem_biaxial_main
 #include "../../examples/mpmdem_biaxial.c"
 #undef main
-#include "fuzz_check.h"
-#include <dirent.h>
+#include "fuzz_driver.h"
 #include <sys/stat.h>
-#include <unistd.h>
 
 static bx X;
 static char in_dir[400], ref_dir[400], pk_path[400];
@@ -43,19 +41,8 @@ static unsigned char *snap0; /* the pristine run's block */
 static size_t nsnap;
 static int ready;
 
-/* every file of dir, then dir */
-static void remove_dir(const char *dir) {
-    DIR *d = opendir(dir);
-    struct dirent *de;
-    char p[700];
-    while (d && (de = readdir(d)) != NULL)
-        if (de->d_name[0] != '.') snprintf(p, sizeof p, "%s/%s", dir, de->d_name), remove(p);
-    if (d) closedir(d);
-    rmdir(dir);
-}
-
 static void cleanup(void) {
-    remove_dir(in_dir), remove_dir(ref_dir), remove(pk_path);
+    fuzz_remove_dir(in_dir), fuzz_remove_dir(ref_dir), remove(pk_path);
     if (ready) mpd_free_all(&X.M, &X.P, &X.pts, &X.g, &X.rows, &X.snaps), free(X.edge), free(X.fld), free(snap0);
 }
 

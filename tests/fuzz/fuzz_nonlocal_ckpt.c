@@ -42,10 +42,7 @@
 #define main femdem_nonlocal_main
 #include "../../examples/femdem_nonlocal.c"
 #undef main
-#include "fuzz_check.h"
-#include <dirent.h>
-#include <fcntl.h>
-#include <unistd.h>
+#include "fuzz_driver.h"
 
 static opts O;
 static micro MI;
@@ -55,36 +52,10 @@ static uint64_t fpr;
 static char in_dir[400], ref_dir[400], pk_path[400], cap_path[400];
 static unsigned char *snap0; /* the pristine model's state */
 static size_t nsnap;
-static int ready, cap_fd = -1, null_fd = -1, saved_fd[2] = {-1, -1};
+static int ready;
 
-/* every file of dir, then dir */
-static void remove_dir(const char *dir) {
-    DIR *d = opendir(dir);
-    struct dirent *de;
-    char p[700];
-    while (d && (de = readdir(d)) != NULL)
-        if (de->d_name[0] != '.') snprintf(p, sizeof p, "%s/%s", dir, de->d_name), remove(p);
-    if (d) closedir(d);
-    rmdir(dir);
-}
-
-static void cleanup(void) { remove_dir(in_dir), remove_dir(ref_dir), remove(pk_path), remove(cap_path); }
-
-/* the driver's output off (stdout to /dev/null, stderr to a file) around a call; the bytes it wrote to
- * stderr after. FUZZ_VERBOSE: nothing redirected, -1 */
-static void quiet_begin(void) {
-    if (getenv("FUZZ_VERBOSE")) return;
-    fflush(stdout), fflush(stderr);
-    FUZZ_CHECK(ftruncate(cap_fd, 0) == 0 && lseek(cap_fd, 0, SEEK_SET) == 0);
-    FUZZ_CHECK((saved_fd[0] = dup(1)) >= 0 && (saved_fd[1] = dup(2)) >= 0);
-    FUZZ_CHECK(dup2(null_fd, 1) >= 0 && dup2(cap_fd, 2) >= 0);
-}
-static long quiet_end(void) {
-    if (getenv("FUZZ_VERBOSE")) return -1;
-    fflush(stdout), fflush(stderr);
-    FUZZ_CHECK(dup2(saved_fd[0], 1) >= 0 && dup2(saved_fd[1], 2) >= 0);
-    close(saved_fd[0]), close(saved_fd[1]);
-    return (long)lseek(cap_fd, 0, SEEK_END);
+static void cleanup(void) {
+    fuzz_remove_dir(in_dir), fuzz_remove_dir(ref_dir), remove(pk_path), remove(cap_path);
 }
 
 /* the model's state a checkpoint carries and what the reader derives from it, as bytes (malloc'ed) */
@@ -137,9 +108,9 @@ static int same_as_pristine(void) {
 static int load(const char *dir) {
     int bad;
     O.restart = dir;
-    quiet_begin();
+    fuzz_quiet_begin();
     bad = load_checkpoint(&MD, fpr);
-    quiet_end();
+    fuzz_quiet_end();
     return bad;
 }
 
@@ -165,8 +136,7 @@ static void fuzz_setup(void) {
     snprintf(cap_path, sizeof cap_path, "%s/gk_fuzz_nonlocal_%ld.stderr", tmp, (long)getpid());
     FUZZ_CHECK(mkdir(in_dir, 0777) == 0 || errno == EEXIST);
     atexit(cleanup);
-    FUZZ_CHECK((cap_fd = open(cap_path, O_RDWR | O_CREAT | O_TRUNC, 0600)) >= 0);
-    FUZZ_CHECK((null_fd = open("/dev/null", O_WRONLY)) >= 0);
+    fuzz_quiet_open(cap_path);
     {
         const char *a[] = {"femdem_nonlocal",
                            "--test",
@@ -209,9 +179,9 @@ static void fuzz_setup(void) {
     memset(&MI, 0, sizeof MI), memset(&MD, 0, sizeof MD);
     gk_rve_state_init(&MI.st_imp, NULL);
     atexit(free_all);
-    quiet_begin();
+    fuzz_quiet_begin();
     rc = run(&O, &MI, &MD, &pick, gk_wtime());
-    quiet_end();
+    fuzz_quiet_end();
     ready = 1;
     FUZZ_CHECK(rc == 0 && MD.step == 3 && MD.nrow == 4);
     fpr = fingerprint(&O, &MI.pk);
@@ -252,9 +222,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
     fuzz_write_checkpoint(path, data, size);
     O.restart = in_dir;
-    quiet_begin();
+    fuzz_quiet_begin();
     rc = load_checkpoint(&MD, fpr);
-    said = quiet_end();
+    said = fuzz_quiet_end();
     if (rc) {
         FUZZ_CHECK(said != 0);
         FUZZ_CHECK(same_as_pristine());
@@ -264,10 +234,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     check_model();
     /* the driver's next coarse step, as its loop makes it (none after the last) */
     if (MD.step < MD.nsteps) {
-        quiet_begin();
+        fuzz_quiet_begin();
         rc = macro_step(&MD);
         if (!rc) track(&MD), rc = record(&MD, 0.0);
-        said = quiet_end();
+        said = fuzz_quiet_end();
         if (rc == 0) {
             fuzz_all_finite(MD.u, (size_t)MD.nd), fuzz_all_finite(MD.v, (size_t)MD.nd);
             fuzz_all_finite(MD.sig, 9 * (size_t)MD.np), fuzz_all_finite(MD.fint, (size_t)MD.nd);
@@ -317,9 +287,9 @@ int main(int argc, char **argv) {
     /* a step later */
     O.stop_after = 4, O.restart = ref_dir, O.out = in_dir;
     FUZZ_CHECK(load(ref_dir) == 0);
-    quiet_begin();
+    fuzz_quiet_begin();
     FUZZ_CHECK(macro_step(&MD) == 0 && record(&MD, 0.0) == 0 && save_checkpoint(&MD, fpr) == 0);
-    quiet_end();
+    fuzz_quiet_end();
     snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
     b = fuzz_slurp(path, &n);
     fuzz_write_seed(argv[1], "ckpt_step4", 0, b, n);
