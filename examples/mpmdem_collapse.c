@@ -267,8 +267,6 @@ static int prepare_levels(cl *X, gk_err *err) {
     return 0;
 }
 
-/* the levels' RVEs, the grid (roller x = 0, friction base), the points with their levels' masses;
- * dt and the real-time DEM-step cap */
 /* a checkpoint's state and rows as read (mpd_load's driver check, ctx the model): every value finite
  * and within MPD_MAX_VALUE, the time step, DEM cap and initial potential energy the run's, counters and
  * the snapshot index in range, the next row not behind the time by more than one interval, a row at
@@ -306,6 +304,8 @@ static int cl_check(const void *vS, const mpd_rows *R, const void *ctx, char *wh
     return 0;
 }
 
+/* the levels' RVEs, the grid (roller x = 0, friction base), the points with their levels' masses;
+ * dt and the real-time DEM-step cap */
 static int setup(cl *X, gk_err *err) {
     const cl_opts *b = &X->b;
     cl_state *S = &X->S;

@@ -266,8 +266,6 @@ static int parse(ft *X, int argc, char **argv) {
     return 0;
 }
 
-/* the friction angle (given or measured), the RVE at q_s at every point, the grid with its walls and
- * the footing, the points and the surcharge on the ground beyond the footing */
 /* a checkpoint's state and rows as read (mpd_load's driver check, ctx the model): every value finite
  * and within MPD_MAX_VALUE (the spiral fit's NaN, "none found", allowed), the settlement between 0 and
  * the soil's depth, the footing the run's box moved down by it, counters and the stage index in range,
@@ -311,6 +309,8 @@ static int ft_check(const void *vS, const mpd_rows *R, const void *ctx, char *wh
     return 0;
 }
 
+/* the friction angle (given or measured), the RVE at q_s at every point, the grid with its walls and
+ * the footing, the points and the surcharge on the ground beyond the footing */
 static int setup(ft *X, gk_err *err) {
     const ft_opts *f = &X->f;
     ft_state *S = &X->S;
