@@ -20,7 +20,7 @@
  *     stops with a message. The run then returns to the pristine checkpoint.
  * Seeds (FUZZ_MAKE_SEEDS): the pristine checkpoint, a truncated copy, a bit flipped in a point's
  * position, in its mass, in each byte of the state named by fz_seed_at (offsets into the state), in
- * the first row, and one with another driver's tag. */
+ * the first row, and one with a tag no driver writes. */
 #ifndef FUZZ_MPD_CKPT_H
 #define FUZZ_MPD_CKPT_H
 #include "fuzz_driver.h"
@@ -173,7 +173,7 @@ int main(int argc, char **argv) {
         fuzz_write_seed(argv[1], name, 0, c, n);
     }
     memcpy(c, b, n);
-    memcpy(c + b0 + 10, "biaxial\0", 8);
+    memcpy(c + b0 + 10, "nothing\0", 8); /* a tag no driver writes */
     fuzz_write_seed(argv[1], "ckpt_other_tag", 0, c, n);
     free(b), free(c);
     return 0;
