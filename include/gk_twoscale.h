@@ -50,6 +50,7 @@
  *   gk_twoscale_fields(ts, f)            p, q, e, Z, fabric, rotations, strains, DEM steps ...
  *                                        (gk_twoscale_field) of the accepted states
  *   gk_twoscale_save(ts, path, blk, n) / gk_twoscale_load(ts, path, &blk, &n)   checkpoint
+ *   gk_twoscale_load_take(ts, path, take, user)   the same, the driver's block checked first
  *   gk_twoscale_draw(n, nprotos, seed, pick)   the per-point draw of prototypes
  *   accepted, fields: of the accepted states, so not while a run is pending (accept or
  *   reject first: GK_ERR_STATE). Under MPI every function is collective.
@@ -142,7 +143,10 @@
  *   |H| <= 1e6, |sigma| <= 1e100 Pa, a finite reference tangent, sorted
  *   contact keys), and restores all points into staging first: a truncated,
  *   corrupted, foreign or other-version file is refused by name and the set
- *   is unchanged.
+ *   is unchanged. gk_twoscale_load_take gives the driver's block to the
+ *   driver's take function before the set takes the staged states, so a
+ *   driver that checks its block there and refuses it leaves the set as it
+ *   was too (a driver replicated on MPI ranks refuses on all of them alike).
  *
  * MPI (optional, like OpenMP). Define GK_TWOSCALE_MPI (and build with mpicc)
  *   and create the set with gk_twoscale_create_mpi(&ts, &def, comm) (or
@@ -363,6 +367,14 @@ GKDEF gk_result gk_twoscale_fields(gk_twoscale *ts, gk_twoscale_field *f);
 GKDEF gk_result gk_twoscale_save(gk_twoscale *ts, const char *path, const void *block, size_t nblock);
 /* ... and back; *block (allocated with def.alloc, free with gk_twoscale_free_block) on every rank */
 GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block, size_t *nblock);
+/* the driver's part of a load: its block (nblock bytes, read and checksummed) checked and, when it is
+ * taken, applied to the driver's model (user); 0 to take it, else a reason in why (nwhy bytes) */
+typedef int (*gk_twoscale_take_fn)(const void *block, size_t nblock, void *user, char *why, size_t nwhy);
+/* gk_twoscale_load with the driver's block taken by take (on every rank) before the set takes the
+ * file's states: when take refuses it (on any rank) the set is left as it was, GK_ERR_FORMAT with
+ * take's reason; when it takes it, the set takes the states (which can no longer fail) */
+GKDEF gk_result gk_twoscale_load_take(gk_twoscale *ts, const char *path, gk_twoscale_take_fn take,
+                                      void *user);
 GKDEF void gk_twoscale_free_block(const gk_twoscale *ts, void *block);
 /* the uniform draw of prototypes per point used when def.pick is NULL and nprotos > 1 */
 GKDEF void gk_twoscale_draw(int npoints, int nprotos, uint64_t seed, int *pick);
@@ -1824,7 +1836,9 @@ static int gk__ts_rec_refused(gk_twoscale *ts, const char *path) {
     return 0;
 }
 
-GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block, size_t *nblock) {
+/* gk_twoscale_load, and gk_twoscale_load_take when take is not NULL (block and nblock unused then) */
+static gk_result gk__ts_load(gk_twoscale *ts, const char *path, gk_twoscale_take_fn take, void *user,
+                             void **block, size_t *nblock) {
     const gk_allocator *a = &ts->def.alloc;
     gk__ckf c;
     gk__tspt **stage = NULL;
@@ -1835,7 +1849,7 @@ GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block
     memset(&c, 0, sizeof c);
     gk_err_clear(&ts->err);
     if (ts->n < 1) return gk_err_set(&ts->err, GK_ERR_STATE, "the set was not created");
-    if (!path || !block || !nblock)
+    if (!path || (!take && (!block || !nblock)))
         return gk_err_set(&ts->err, GK_ERR_ARG, "checkpoint: no path or block pointer");
     if (ts->rank == 0) gk__ts_check_file(ts, path, &c);
     if (gk__ts_share_err(ts)) {
@@ -1909,14 +1923,37 @@ GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block
         }
     }
 #endif
+    if (take) { /* the driver's block first: refused on any rank, nothing changes */
+        char why[sizeof ts->err.msg];
+        why[0] = '\0';
+        ok = take(blk, (size_t)nb, user, why, sizeof why) == 0;
+        gk_free(a, blk), blk = NULL;
+        if (!ok)
+            gk_err_set(&ts->err, GK_ERR_FORMAT, "%s: %s", path, why[0] ? why : "its driver block is refused");
+        if (gk__ts_agree(ts, ok ? GK_OK : GK_ERR_FORMAT)) {
+            for (j = 0; j < k; ++j) gk__ts_pt_free(ts, stage[j]);
+            gk_free(a, stage);
+            return ts->err.code;
+        }
+    }
     for (j = 0; j < ts->nlocal; ++j) {
         gk__ts_pt_free(ts, ts->pt[j]);
         ts->pt[j] = stage[j];
     }
     gk_free(a, stage);
     ts->pending = 0;
-    *block = blk, *nblock = (size_t)nb;
+    if (!take) *block = blk, *nblock = (size_t)nb;
     return GK_OK;
+}
+
+GKDEF gk_result gk_twoscale_load(gk_twoscale *ts, const char *path, void **block, size_t *nblock) {
+    return gk__ts_load(ts, path, NULL, NULL, block, nblock);
+}
+
+GKDEF gk_result gk_twoscale_load_take(gk_twoscale *ts, const char *path, gk_twoscale_take_fn take,
+                                      void *user) {
+    if (!take) return gk_err_set(&ts->err, GK_ERR_ARG, "checkpoint: no function to take the driver block");
+    return gk__ts_load(ts, path, take, user, NULL, NULL);
 }
 
 GKDEF void gk_twoscale_free_block(const gk_twoscale *ts, void *block) { gk_free(&ts->def.alloc, block); }

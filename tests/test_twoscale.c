@@ -489,6 +489,58 @@ TEST(corrupt_checkpoints_are_refused_and_change_nothing) {
     gk_twoscale_destroy(&a), gk_twoscale_destroy(&b);
 }
 
+/* what a driver's take function saw, and whether it takes the block */
+typedef struct take_log {
+    int calls, takes;
+    size_t n;
+    char b[8];
+} take_log;
+static int take_block(const void *block, size_t nblock, void *user, char *why, size_t nwhy) {
+    take_log *t = (take_log *)user;
+    ++t->calls, t->n = nblock;
+    if (nblock <= sizeof t->b) memcpy(t->b, block, nblock);
+    if (!t->takes) return snprintf(why, nwhy, "the driver's step count is out of range"), 1;
+    return 0;
+}
+
+/* gk_twoscale_load_take: a driver block its take function refuses leaves the set as it was (the next
+ * run as before, the error naming the file and take's reason); a block it takes is given to it once,
+ * byte for byte, and the set then holds the file's states (the next run is the file's set's) */
+TEST(a_refused_driver_block_leaves_the_set_as_it_was) {
+    gk_twoscale a, b;
+    double dH[9 * 4], s[9 * 4], sa[9 * 4], sb[9 * 4];
+    take_log t;
+    const char *path = BUILD "/tests/t_ts_take.bin";
+    CHECK(load_packings());
+    if (!have_packings) return;
+    CHECK(make_set(&a, 4, 1, GK_TWOSCALE_ADAPTIVE, GK_TWOSCALE_TANGENT_HOMOG, 0) == GK_OK);
+    step_dH(4, 0, 5e-4, dH);
+    CHECK(gk_twoscale_run(&a, dH, NULL, s, NULL) == GK_OK && gk_twoscale_accept(&a) == GK_OK);
+    CHECK(gk_twoscale_save(&a, path, "xyz", 3) == GK_OK);
+    CHECK(gk_twoscale_run(&a, dH, NULL, sa, NULL) == GK_OK); /* the file's set, one run on */
+    gk_twoscale_reject(&a);
+    /* b: two steps further than the file */
+    CHECK(make_set(&b, 4, 2, GK_TWOSCALE_ADAPTIVE, GK_TWOSCALE_TANGENT_HOMOG, 0) == GK_OK);
+    CHECK(gk_twoscale_run(&b, dH, NULL, s, NULL) == GK_OK && gk_twoscale_accept(&b) == GK_OK);
+    CHECK(gk_twoscale_run(&b, dH, NULL, s, NULL) == GK_OK && gk_twoscale_accept(&b) == GK_OK);
+    CHECK(gk_twoscale_run(&b, dH, NULL, sb, NULL) == GK_OK);
+    gk_twoscale_reject(&b);
+    CHECK(!same(sa, sb, 36));
+    memset(&t, 0, sizeof t);
+    CHECK_EQ_INT(gk_twoscale_load_take(&b, path, take_block, &t), GK_ERR_FORMAT);
+    CHECK(t.calls == 1 && t.n == 3 && memcmp(t.b, "xyz", 3) == 0);
+    CHECK(strstr(gk_twoscale_error(&b), path) && strstr(gk_twoscale_error(&b), "step count is out of range"));
+    CHECK(gk_twoscale_run(&b, dH, NULL, s, NULL) == GK_OK && same(s, sb, 36)); /* unchanged */
+    gk_twoscale_reject(&b);
+    t.takes = 1, t.calls = 0;
+    CHECK_EQ_INT(gk_twoscale_load_take(&b, path, take_block, &t), GK_OK);
+    CHECK(t.calls == 1 && t.n == 3 && memcmp(t.b, "xyz", 3) == 0);
+    CHECK(gk_twoscale_run(&b, dH, NULL, s, NULL) == GK_OK && same(s, sa, 36)); /* the file's states */
+    gk_twoscale_reject(&b);
+    CHECK_EQ_INT(gk_twoscale_load_take(&b, path, NULL, &t), GK_ERR_ARG);
+    gk_twoscale_destroy(&a), gk_twoscale_destroy(&b);
+}
+
 /* the caller's procedure: a stand-in that deforms the RVE by dH over 40 DEM steps (gk_rve_deform) and
  * returns twice the Love stress (another measure than the set's own); it records what it was given,
  * and fails at a point asked to */
@@ -734,6 +786,7 @@ int main(int argc, char **argv) {
     RUN(one_failed_point_does_not_hide_the_others);
     RUN(checkpoint_round_trip_is_bit_identical);
     RUN(corrupt_checkpoints_are_refused_and_change_nothing);
+    RUN(a_refused_driver_block_leaves_the_set_as_it_was);
     RUN(caller_procedure_runs_every_point);
     RUN(a_copy_of_the_accepted_state_without_memory_changes_nothing);
     RUN(bad_arguments_are_refused);
