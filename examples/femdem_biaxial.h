@@ -109,47 +109,46 @@ static int fdb_checkpoint(fd_model *M) {
     return bad;
 }
 
-/* --restart DIR: the checkpoint into the set and the model. The model's block and the driver's part
- * (the predictor's last increment, at most 1 and zero or above 1e-12, and its displacements; the
- * fields of every row) are read and checked before anything of the model changes: a refused file
- * leaves the model as it was (the set holds the file's RVE states, which gk_twoscale_load accepted).
- * 0, or 1 with err set. */
-static int fdb_restart(fd_model *M, gk_err *err) {
-    fd_buf B;
-    fd_ck ck;
-    double inclast = 0.0, *ulast = NULL, *hist = NULL, L = 0.0;
+/* the driver's part of a checkpoint (fd_ck_load's part): the predictor's last increment (at most 1,
+ * and zero or above 1e-12), its displacements (within 10 x the specimen) and the fields of every row
+ * (within 1e100), the exact length first (no allocation from a row count the file does not hold) */
+typedef struct fdb_part {
+    double inclast, *ulast, *hist;
+} fdb_part;
+
+static int fdb_part_read(fd_model *M, fd_buf *B, const fd_ck *ck, void *user, char *why, size_t nwhy) {
+    fdb_part *p = (fdb_part *)user;
     size_t nh = (size_t)M->ngp * FD_NFIELD, n = (size_t)M->ndof, k;
-    int bad = fd_ck_read(M, M->o.restart, FDB_TAG, &B, &ck, err);
-    if (bad) return 1;
+    double L = 0.0;
     for (k = 0; k < n; ++k) L = fmax(L, fabs(M->A0x[k]));
-    /* the exact length first: no allocation from a row count the rest of the file does not hold */
-    if ((B.n - B.pos) / sizeof(double) != 1 + n + (size_t)ck.nc * nh || (B.n - B.pos) % sizeof(double))
-        bad = 1, gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the driver's block has the wrong length",
-                            M->o.restart);
-    else if (!(ulast = (double *)malloc(n * sizeof(double) + 1)) ||
-             !(hist = (double *)malloc((size_t)ck.nc * nh * sizeof(double) + 1)))
-        bad = 1, gk_err_set(err, GK_ERR_ALLOC, "out of memory");
-    else {
-        fd_get(&B, &inclast, sizeof(double)), fd_get(&B, ulast, n * sizeof(double));
-        fd_get(&B, hist, (size_t)ck.nc * nh * sizeof(double));
-        if (!(fabs(inclast) <= 1.0) || (inclast != 0.0 && !(fabs(inclast) >= 1e-12)) ||
-            !fd_ck_bounded(ulast, n, 10 * L) || !fd_ck_bounded(hist, (size_t)ck.nc * nh, 1e100))
-            bad = 1,
-            gk_err_set(err, GK_ERR_FORMAT,
-                       "%s/checkpoint.bin: the last increment, its displacements or a row's fields are out "
-                       "of range",
-                       M->o.restart);
-    }
-    free(B.b);
-    if (!bad && fd_ck_apply(M, &ck, err)) bad = 1;
-    if (bad) {
-        fd_ck_free(&ck), free(ulast), free(hist);
+    if ((B->n - B->pos) / sizeof(double) != 1 + n + (size_t)ck->nc * nh || (B->n - B->pos) % sizeof(double))
+        return snprintf(why, nwhy, "the driver's block has the wrong length"), 1;
+    if (!(p->ulast = (double *)malloc(n * sizeof(double) + 1)) ||
+        !(p->hist = (double *)malloc((size_t)ck->nc * nh * sizeof(double) + 1)))
+        return snprintf(why, nwhy, "out of memory"), 1;
+    fd_get(B, &p->inclast, sizeof(double)), fd_get(B, p->ulast, n * sizeof(double));
+    fd_get(B, p->hist, (size_t)ck->nc * nh * sizeof(double));
+    if (!(fabs(p->inclast) <= 1.0) || (p->inclast != 0.0 && !(fabs(p->inclast) >= 1e-12)) ||
+        !fd_ck_bounded(p->ulast, n, 10 * L) || !fd_ck_bounded(p->hist, (size_t)ck->nc * nh, 1e100))
+        return snprintf(why, nwhy,
+                        "the last increment, its displacements or a row's fields are out of range"),
+               1;
+    return 0;
+}
+
+/* --restart DIR: the checkpoint into the set and the model, or neither (fd_ck_load with the driver's
+ * part above). 0, or 1 with err set. */
+static int fdb_restart(fd_model *M, gk_err *err) {
+    fdb_part p;
+    memset(&p, 0, sizeof p);
+    if (fd_ck_load(M, M->o.restart, FDB_TAG, fdb_part_read, &p, err)) {
+        free(p.ulast), free(p.hist);
         return 1;
     }
-    M->inclast = inclast;
-    memcpy(M->ulast, ulast, n * sizeof(double));
-    free(ulast), free(M->hist);
-    M->hist = hist;
+    M->inclast = p.inclast;
+    memcpy(M->ulast, p.ulast, (size_t)M->ndof * sizeof(double));
+    free(p.ulast), free(M->hist);
+    M->hist = p.hist;
     fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (axial strain %.3f %%)\n", M->prog,
            M->o.restart, M->step, 100 * M->eps_done);
     return 0;

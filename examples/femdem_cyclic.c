@@ -192,49 +192,58 @@ static int checkpoint(fd_model *M) {
     return bad;
 }
 
-/* --restart DIR: the model's block and this driver's part (the cyclic state, a cyc_extra per row: the
- * exact length, every real finite, the direction +-1, the branch and step counters >= 0 and far from
- * overflowing, the stress-control increment in (0, 1], the moduli >= 0) checked before the model
- * changes (femdem_biaxial.h's fdb_restart) */
+/* this driver's part of a checkpoint (fd_ck_load's part): the cyclic state and a cyc_extra per row,
+ * the exact length, every real finite, the direction +-1, the branch and step counters >= 0 and far
+ * from overflowing, the stress-control increment in (0, 1], the moduli >= 0 */
+typedef struct cyc_part {
+    cyc_state cs;
+    cyc_extra *cx;
+    int cap;
+} cyc_part;
+
+static int cyc_part_read(fd_model *M, fd_buf *B, const fd_ck *ck, void *user, char *why, size_t nwhy) {
+    cyc_part *p = (cyc_part *)user;
+    cyc_state cs;
+    double d[10];
+    int k;
+    (void)M;
+    if (B->n - B->pos != sizeof cs + (size_t)ck->nc * sizeof(cyc_extra))
+        return snprintf(why, nwhy, "the driver's block has the wrong length"), 1;
+    p->cap = ck->nc + 16; /* the model's curve capacity after fd_ck_apply */
+    if (!(p->cx = (cyc_extra *)malloc((size_t)p->cap * sizeof *p->cx)))
+        return snprintf(why, nwhy, "out of memory"), 1;
+    fd_get(B, &cs, sizeof cs), fd_get(B, p->cx, (size_t)ck->nc * sizeof *p->cx);
+    d[0] = cs.gamma, d[1] = cs.g_start, d[2] = cs.t_start, d[3] = cs.tau, d[4] = cs.h, d[5] = cs.p0;
+    d[6] = cs.cyc_liq, d[7] = cs.cyc_gamma, d[8] = cs.G0, d[9] = cs.Gu;
+    if (!fd_ck_bounded(d, 10, 1e100) || (cs.dir != 1 && cs.dir != -1) || cs.branch < 0 ||
+        cs.branch > 100000000 || cs.bsteps < 0 || cs.bsteps > 1000000000 || cs.good < 0 ||
+        cs.good > 1000000000 || !(cs.h > 0.0 && cs.h <= 1.0) || cs.G0 < 0.0 || cs.Gu < 0.0)
+        return snprintf(why, nwhy, "the cyclic state is out of range"), 1;
+    for (k = 0; k < ck->nc; ++k) {
+        double e[5];
+        e[0] = p->cx[k].cycle, e[1] = p->cx[k].tau, e[2] = p->cx[k].p, e[3] = p->cx[k].q,
+        e[4] = p->cx[k].top_uy;
+        if (!fd_ck_bounded(e, 5, 1e100)) return snprintf(why, nwhy, "the cyclic state is out of range"), 1;
+    }
+    p->cs = cs;
+    return 0;
+}
+
+/* --restart DIR: the checkpoint into the set and the model, or neither (fd_ck_load with the driver's
+ * part above) */
 static int restart(cyc_model *C, gk_err *err) {
     fd_model *M = &C->m;
-    fd_buf B;
-    fd_ck ck;
-    cyc_state cs;
-    cyc_extra *cx = NULL;
-    double d[10];
-    int bad = fd_ck_read(M, M->o.restart, ck_tag(C), &B, &ck, err), k;
-    if (bad) return 1;
-    if (B.n - B.pos != sizeof cs + (size_t)ck.nc * sizeof(cyc_extra))
-        bad = 1, gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the driver's block has the wrong length",
-                            M->o.restart);
-    else if (!(cx = (cyc_extra *)malloc((size_t)ck.nc * sizeof *cx)))
-        bad = 1, gk_err_set(err, GK_ERR_ALLOC, "out of memory");
-    else {
-        fd_get(&B, &cs, sizeof cs), fd_get(&B, cx, (size_t)ck.nc * sizeof *cx);
-        d[0] = cs.gamma, d[1] = cs.g_start, d[2] = cs.t_start, d[3] = cs.tau, d[4] = cs.h, d[5] = cs.p0;
-        d[6] = cs.cyc_liq, d[7] = cs.cyc_gamma, d[8] = cs.G0, d[9] = cs.Gu;
-        bad = !fd_ck_bounded(d, 10, 1e100) || (cs.dir != 1 && cs.dir != -1) || cs.branch < 0 ||
-              cs.branch > 100000000 || cs.bsteps < 0 || cs.bsteps > 1000000000 || cs.good < 0 ||
-              cs.good > 1000000000 || !(cs.h > 0.0 && cs.h <= 1.0) || cs.G0 < 0.0 || cs.Gu < 0.0;
-        for (k = 0; k < ck.nc && !bad; ++k) {
-            double e[5];
-            e[0] = cx[k].cycle, e[1] = cx[k].tau, e[2] = cx[k].p, e[3] = cx[k].q, e[4] = cx[k].top_uy;
-            bad = !fd_ck_bounded(e, 5, 1e100);
-        }
-        if (bad)
-            gk_err_set(err, GK_ERR_FORMAT, "%s/checkpoint.bin: the cyclic state is out of range",
-                       M->o.restart);
+    cyc_part p;
+    memset(&p, 0, sizeof p);
+    if (fd_ck_load(M, M->o.restart, ck_tag(C), cyc_part_read, &p, err)) {
+        free(p.cx);
+        return 1;
     }
-    free(B.b);
-    if (!bad && fd_ck_apply(M, &ck, err)) bad = 1;
-    if (!bad && cx_room(C)) bad = 1, gk_err_set(err, GK_ERR_ALLOC, "out of memory");
-    if (!bad) C->cs = cs, memcpy(C->cx, cx, (size_t)ck.nc * sizeof *cx);
-    fd_ck_free(&ck), free(cx);
-    if (!bad)
-        fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (shear strain %.3f %%, %.2f cycles)\n",
-               M->prog, M->o.restart, M->step, 100 * C->cs.gamma, C->cx[M->ncurve - 1].cycle);
-    return bad;
+    C->cs = p.cs;
+    free(C->cx), C->cx = p.cx, C->cxcap = p.cap;
+    fd_say(M, "%s: restarted from %s/checkpoint.bin at step %d (shear strain %.3f %%, %.2f cycles)\n",
+           M->prog, M->o.restart, M->step, 100 * C->cs.gamma, C->cx[M->ncurve - 1].cycle);
+    return 0;
 }
 
 /* ------------------------------------------------------------ the loading loop */

@@ -355,42 +355,37 @@ static int ck_check(const model *m, const int32_t *iv, const double *dv, const u
     return 0;
 }
 
-static int load_checkpoint(model *m) {
-    char path[1024];
-    void *blk = NULL;
-    size_t nb = 0, need;
-    const unsigned char *b;
+/* load_checkpoint's take (gk_twoscale_load_take): the block checked against the run, then written
+ * into the model; refused: nothing written, the reason in why */
+static int take_checkpoint(const void *blk, size_t nb, void *user, char *why, size_t nwhy) {
+    model *m = (model *)user;
+    const unsigned char *b = (const unsigned char *)blk;
+    size_t need = 4 + (CK_NI - 1) * sizeof(int32_t) + CK_ND * sizeof(double);
     int32_t iv[CK_NI - 1];
     double dv[CK_ND], want[CK_ND];
     uint32_t magic;
     int i;
-    snprintf(path, sizeof path, "%s/checkpoint.bin", m->o.restart);
-    if (gk_twoscale_load(&m->ts, path, &blk, &nb)) {
-        fprintf(stderr, PROG ": %s\n", gk_twoscale_error(&m->ts));
-        return 1;
-    }
-    b = (const unsigned char *)blk;
-    need = 4 + sizeof iv + sizeof dv;
-    if (nb < need) goto bad;
+    if (nb < need)
+        return snprintf(why, nwhy, "not a checkpoint of this run (another test, mesh, frame or rotation)"), 1;
     memcpy(&magic, b, 4), memcpy(iv, b + 4, sizeof iv), memcpy(dv, b + 4 + sizeof iv, sizeof dv);
     ck_opts(m, want);
     if (magic != CK_MAGIC || iv[0] != m->ngp || iv[1] != m->ndof || iv[2] != m->o.frame ||
         iv[3] != rotation_lock(&m->o) || iv[4] != m->o.test || iv[6] < 0 || iv[5] < 0)
-        goto bad;
+        return snprintf(why, nwhy, "not a checkpoint of this run (another test, mesh, frame or rotation)"), 1;
     for (i = CK_OPT; i < CK_ND; ++i)
-        if (dv[i] != want[i]) {
-            fprintf(stderr,
-                    PROG ": %s was written with other options (strain, pressure, friction, steps, stiffness "
-                         "or mesh)\n",
-                    path);
-            gk_twoscale_free_block(&m->ts, blk);
-            return 1;
-        }
+        if (dv[i] != want[i])
+            return snprintf(
+                       why, nwhy,
+                       "written with other options (strain, pressure, friction, steps, stiffness or mesh)"),
+                   1;
     need += 8 * (3 * (size_t)m->ndof + 18 * (size_t)m->ngp + (size_t)NCOL * iv[6]);
-    if (nb != need) goto bad;
+    if (nb != need)
+        return snprintf(why, nwhy, "not a checkpoint of this run (another test, mesh, frame or rotation)"), 1;
     /* a checksum only proves the file is what some writer wrote: check what
      * this run will trust (every value in range), all of it before anything is written */
-    if (ck_check(m, iv, dv, b + 4 + sizeof iv + sizeof dv)) goto bad_value;
+    if (ck_check(m, iv, dv, b + 4 + sizeof iv + sizeof dv))
+        return snprintf(why, nwhy, "the run's block holds a non-finite or out-of-range value; not restarted"),
+               1;
     b += 4 + sizeof iv + sizeof dv;
     memcpy(m->u, b, 8 * (size_t)m->ndof), b += 8 * (size_t)m->ndof;
     memcpy(m->v, b, 8 * (size_t)m->ndof), b += 8 * (size_t)m->ndof;
@@ -409,19 +404,19 @@ static int load_checkpoint(model *m) {
     m->unconverged = (long long)dv[7];
     m->resid_max = dv[8], m->resid_step = (long long)dv[9], m->resid_over = (long long)dv[10];
     if (m->have_f0) gk_dr_reference(&m->dr, NULL, m->f0);
-    gk_twoscale_free_block(&m->ts, blk);
+    return 0;
+}
+
+/* DIR/checkpoint.bin (--restart): the set and the model, or neither (the reason said) */
+static int load_checkpoint(model *m) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/checkpoint.bin", m->o.restart);
+    if (gk_twoscale_load_take(&m->ts, path, take_checkpoint, m)) {
+        fprintf(stderr, PROG ": %s\n", gk_twoscale_error(&m->ts));
+        return 1;
+    }
     printf("restarted from %s at step %d\n", path, m->step_done);
     return 0;
-bad:
-    fprintf(stderr, PROG ": %s is not a checkpoint of this run (another test, mesh, frame or rotation)\n",
-            path);
-    gk_twoscale_free_block(&m->ts, blk);
-    return 1;
-bad_value:
-    fprintf(stderr, PROG ": %s: the run's block holds a non-finite or out-of-range value; not restarted\n",
-            path);
-    gk_twoscale_free_block(&m->ts, blk);
-    return 1;
 }
 
 static double interp(const model *m, int col, double eps) {

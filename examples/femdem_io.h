@@ -3,7 +3,7 @@
  * For the model of femdem.h: the Gauss-point fields (fd_gp_fields, from gk_twoscale_fields), the VTK of
  * the Gauss points and of the deformed mesh, SVG maps and plots, the CSV writer of the drivers' rows,
  * and the checkpoint: the RVE set's own file (gk_twoscale_save: versioned, checksummed) carrying this
- * model's block (fd_ck_save / fd_ck_read and fd_ck_apply; a driver appends its own bytes). Rank 0 writes (M->root);
+ * model's block (fd_ck_save / fd_ck_load; a driver appends its own bytes). Rank 0 writes (M->root);
  * every function returns non-zero after saying once that a write failed, on every rank.
  */
 #ifndef FEMDEM_IO_H
@@ -297,53 +297,6 @@ static int fd_ck_check(const fd_model *M, const fd_ck *ck, char *why, size_t nwh
     return 0;
 }
 
-/* the checkpoint of DIR into the set, and its model block read and checked into ck (the model is not
- * touched: fd_ck_apply puts it there); B keeps the block positioned at the driver's own part (free
- * B->b after reading it). 0, or 1 with err set naming the file. */
-static int fd_ck_read(fd_model *M, const char *dir, const char *tag, fd_buf *B, fd_ck *ck, gk_err *err) {
-    char path[1200], tg[16], why[200];
-    void *blk = NULL;
-    size_t nb = 0, n = (size_t)M->ndof, nv = 2 * n + 25 * (size_t)M->ngp;
-    int nx, ny, quad, ok;
-    gk_elem_type el;
-    memset(B, 0, sizeof *B);
-    memset(ck, 0, sizeof *ck);
-    snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
-    if (gk_twoscale_load(&M->ts, path, &blk, &nb))
-        return gk_err_set(err, GK_ERR_FORMAT, "%s", gk_twoscale_error(&M->ts)), 1;
-    B->b = (unsigned char *)malloc(nb + 1), B->n = B->cap = nb;
-    if (!B->b) return gk_twoscale_free_block(&M->ts, blk), gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
-    memcpy(B->b, blk, nb);
-    gk_twoscale_free_block(&M->ts, blk);
-    ok = !fd_get(B, tg, 16) && !memcmp(tg, tag, strlen(tag) + 1);
-    ok = ok && !fd_get(B, &nx, sizeof nx) && !fd_get(B, &ny, sizeof ny) && !fd_get(B, &el, sizeof el) &&
-         !fd_get(B, &quad, sizeof quad);
-    if (!ok || nx != M->o.nx || ny != M->o.ny || el != M->o.elem || quad != M->o.quad) {
-        free(B->b), memset(B, 0, sizeof *B);
-        return gk_err_set(err, GK_ERR_FORMAT,
-                          "%s: not a checkpoint of this test and mesh (%s %dx%d, element, quad must match)",
-                          path, tag, M->o.nx, M->o.ny),
-               1;
-    }
-    ok = !fd_get(B, &ck->step, sizeof(int)) && !fd_get(B, &ck->eps, sizeof(double)) &&
-         !fd_get(B, &ck->scale, sizeof(double)) && !fd_get(B, &ck->nc, sizeof(int)) && ck->nc >= 1 &&
-         (size_t)ck->nc <= (B->n - B->pos) / sizeof(fd_row) &&
-         nv <= (B->n - B->pos - (size_t)ck->nc * sizeof(fd_row)) / sizeof(double);
-    if (ok && (!(ck->rows = (fd_row *)malloc((size_t)ck->nc * sizeof(fd_row))) ||
-               !(ck->v = (double *)malloc(nv * sizeof(double))))) {
-        fd_ck_free(ck), free(B->b), memset(B, 0, sizeof *B);
-        return gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
-    }
-    ok =
-        ok && !fd_get(B, ck->rows, (size_t)ck->nc * sizeof(fd_row)) && !fd_get(B, ck->v, nv * sizeof(double));
-    if (!ok) snprintf(why, sizeof why, "the driver's block is truncated");
-    if (!ok || fd_ck_check(M, ck, why, sizeof why)) {
-        fd_ck_free(ck), free(B->b), memset(B, 0, sizeof *B);
-        return gk_err_set(err, GK_ERR_FORMAT, "%s: %s", path, why), 1;
-    }
-    return 0;
-}
-
 /* ck into the model (and freed); 0, or 1 (out of memory: the model as it was, err set) */
 static int fd_ck_apply(fd_model *M, fd_ck *ck, gk_err *err) {
     size_t n = (size_t)M->ndof, g9 = 9 * (size_t)M->ngp;
@@ -356,6 +309,80 @@ static int fd_ck_apply(fd_model *M, fd_ck *ck, gk_err *err) {
     memcpy(M->sig_n, ck->v + 2 * n, g9 * sizeof(double));
     memcpy(M->D_n, ck->v + 2 * n + g9, 16 * (size_t)M->ngp * sizeof(double));
     fd_ck_free(ck);
+    return 0;
+}
+
+/* the driver's own part of its block (after the model's), read from B, checked, and kept in user: 0,
+ * or 1 with the reason in why; nothing of the model written (fd_ck_load) */
+typedef int (*fd_part_fn)(fd_model *M, fd_buf *B, const fd_ck *ck, void *user, char *why, size_t nwhy);
+
+typedef struct fd_take {
+    fd_model *M;
+    const char *tag;
+    fd_part_fn part;
+    void *user;
+    int oom;
+} fd_take;
+
+/* fd_ck_load's take (gk_twoscale_load_take): the model's block read and checked into ck, the driver's
+ * part checked, then the model written (fd_ck_apply) */
+static int fd_take_block(const void *blk, size_t nb, void *user, char *why, size_t nwhy) {
+    fd_take *t = (fd_take *)user;
+    fd_model *M = t->M;
+    size_t n = (size_t)M->ndof, nv = 2 * n + 25 * (size_t)M->ngp;
+    fd_buf B;
+    fd_ck ck;
+    char tg[16];
+    int nx, ny, quad, ok;
+    gk_elem_type el;
+    gk_err e;
+    memset(&B, 0, sizeof B);
+    memset(&ck, 0, sizeof ck);
+    B.b = (unsigned char *)malloc(nb + 1), B.n = B.cap = nb;
+    if (!B.b) return t->oom = 1, snprintf(why, nwhy, "out of memory"), 1;
+    memcpy(B.b, blk, nb);
+    ok = !fd_get(&B, tg, 16) && !memcmp(tg, t->tag, strlen(t->tag) + 1);
+    ok = ok && !fd_get(&B, &nx, sizeof nx) && !fd_get(&B, &ny, sizeof ny) && !fd_get(&B, &el, sizeof el) &&
+         !fd_get(&B, &quad, sizeof quad);
+    if (!ok || nx != M->o.nx || ny != M->o.ny || el != M->o.elem || quad != M->o.quad) {
+        free(B.b);
+        return snprintf(why, nwhy,
+                        "not a checkpoint of this test and mesh (%s %dx%d, element, quad must match)", t->tag,
+                        M->o.nx, M->o.ny),
+               1;
+    }
+    ok = !fd_get(&B, &ck.step, sizeof(int)) && !fd_get(&B, &ck.eps, sizeof(double)) &&
+         !fd_get(&B, &ck.scale, sizeof(double)) && !fd_get(&B, &ck.nc, sizeof(int)) && ck.nc >= 1 &&
+         (size_t)ck.nc <= (B.n - B.pos) / sizeof(fd_row) &&
+         nv <= (B.n - B.pos - (size_t)ck.nc * sizeof(fd_row)) / sizeof(double);
+    if (ok && (!(ck.rows = (fd_row *)malloc((size_t)ck.nc * sizeof(fd_row))) ||
+               !(ck.v = (double *)malloc(nv * sizeof(double))))) {
+        fd_ck_free(&ck), free(B.b);
+        return t->oom = 1, snprintf(why, nwhy, "out of memory"), 1;
+    }
+    ok = ok && !fd_get(&B, ck.rows, (size_t)ck.nc * sizeof(fd_row)) && !fd_get(&B, ck.v, nv * sizeof(double));
+    if (!ok) snprintf(why, nwhy, "the driver's block is truncated");
+    if (!ok || fd_ck_check(M, &ck, why, nwhy) || t->part(M, &B, &ck, t->user, why, nwhy)) {
+        fd_ck_free(&ck), free(B.b);
+        return 1;
+    }
+    free(B.b);
+    if (fd_ck_apply(M, &ck, &e)) return t->oom = 1, snprintf(why, nwhy, "out of memory"), 1;
+    return 0;
+}
+
+/* the checkpoint of DIR into the set and the model, or neither: the model's block read and checked
+ * (fd_ck_check), the driver's part read, checked and kept in user (part), then the model written, all
+ * before the set takes the file's states (gk_twoscale_load_take). The driver then puts its part into
+ * its model. 0, or 1 with err set naming the file (what part kept in user is the caller's to free). */
+static int fd_ck_load(fd_model *M, const char *dir, const char *tag, fd_part_fn part, void *user,
+                      gk_err *err) {
+    char path[1200];
+    fd_take t;
+    snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
+    t.M = M, t.tag = tag, t.part = part, t.user = user, t.oom = 0;
+    if (gk_twoscale_load_take(&M->ts, path, fd_take_block, &t))
+        return gk_err_set(err, t.oom ? GK_ERR_ALLOC : GK_ERR_FORMAT, "%s", gk_twoscale_error(&M->ts)), 1;
     return 0;
 }
 

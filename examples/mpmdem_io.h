@@ -415,48 +415,66 @@ static int mpd_block_check(const mpd_micro *m, const gk_mpm_points *pts, const m
     return 0;
 }
 
-/* DIR/checkpoint.bin into the set, the points, the driver's state S, its rows and snapshots (the
- * rows and snapshots it had are freed). The block is read and checked (mpd_block_check, then the
- * driver's check with ctx) before it replaces anything: a refused block leaves the points, the
- * strains, S, the rows and the snapshots as they were (the set holds the file's RVE states, which
- * gk_twoscale_load accepted). */
-GK_INLINE gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, const char *tag, void *S,
-                             size_t nS, mpd_rows *R, mpd_snaps *sn, mpd_check_fn check, const void *ctx,
-                             gk_err *err) {
-    char path[MPD_PATH], why[200];
-    void *blk = NULL;
-    size_t nblk = 0;
+/* mpd_load's driver part (gk_twoscale_load_take's take): the block read into the model over a kept
+ * copy, checked, and put back when refused */
+typedef struct mpd_take {
+    mpd_micro *m;
+    gk_mpm_points *pts;
+    const char *tag;
+    void *S;
+    size_t nS;
+    mpd_rows *R;
+    mpd_snaps *sn;
+    mpd_check_fn check;
+    const void *ctx;
+    int oom;
+} mpd_take;
+
+static int mpd_take_block(const void *blk, size_t nblk, void *user, char *why, size_t nwhy) {
+    mpd_take *t = (mpd_take *)user;
     mpd_buf B, K;
-    mpd_rows R2 = *R, Rk = *R;
+    mpd_rows R2 = *t->R, Rk = *t->R;
     mpd_snaps sn2, snk;
-    if (mpd_checkpoint_path(dir, path))
-        return gk_err_set(err, GK_ERR_ARG, "--restart %s: path too long", dir);
-    if (gk_twoscale_load(&m->ts, path, &blk, &nblk))
-        return gk_err_set(err, m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
     /* what the block overwrites, kept (the same format, without rows and snapshots) */
     memset(&K, 0, sizeof K), memset(&sn2, 0, sizeof sn2), memset(&snk, 0, sizeof snk);
     R2.r = NULL, R2.n = R2.cap = 0, Rk.r = NULL, Rk.n = Rk.cap = 0;
-    mpd_block(&K, tag, m, pts, S, nS, &Rk, &snk, 1);
+    mpd_block(&K, t->tag, t->m, t->pts, t->S, t->nS, &Rk, &snk, 1);
     if (K.bad) {
-        free(K.b), gk_twoscale_free_block(&m->ts, blk);
-        return gk_err_set(err, GK_ERR_ALLOC, "out of memory");
+        free(K.b), t->oom = 1;
+        return snprintf(why, nwhy, "out of memory"), 1;
     }
     memset(&B, 0, sizeof B);
-    B.b = (unsigned char *)blk, B.cap = nblk;
-    mpd_block(&B, tag, m, pts, S, nS, &R2, &sn2, 0);
-    gk_twoscale_free_block(&m->ts, blk);
+    B.b = (unsigned char *)(uintptr_t)blk, B.cap = nblk; /* read only (wr = 0) */
+    mpd_block(&B, t->tag, t->m, t->pts, t->S, t->nS, &R2, &sn2, 0);
     if (B.bad)
-        snprintf(why, sizeof why,
-                 "its driver block is not that of an mpmdem_%s run of %d points with these flags", tag,
-                 pts->n);
-    if (B.bad || mpd_block_check(m, pts, &sn2, why, sizeof why) || check(S, &R2, ctx, why, sizeof why)) {
+        snprintf(why, nwhy, "its driver block is not that of an mpmdem_%s run of %d points with these flags",
+                 t->tag, t->pts->n);
+    if (B.bad || mpd_block_check(t->m, t->pts, &sn2, why, nwhy) || t->check(t->S, &R2, t->ctx, why, nwhy)) {
         K.cap = K.n, K.n = 0; /* read back what was there */
-        mpd_block(&K, tag, m, pts, S, nS, &Rk, &snk, 0);
+        mpd_block(&K, t->tag, t->m, t->pts, t->S, t->nS, &Rk, &snk, 0);
         free(K.b), free(R2.r), free(Rk.r), mpd_snaps_free(&sn2), mpd_snaps_free(&snk);
-        return gk_err_set(err, GK_ERR_FORMAT, "%s: %s", path, why);
+        return 1;
     }
-    free(K.b), free(R->r), mpd_snaps_free(sn);
-    *R = R2, *sn = sn2;
+    free(K.b), free(t->R->r), mpd_snaps_free(t->sn);
+    *t->R = R2, *t->sn = sn2;
+    return 0;
+}
+
+/* DIR/checkpoint.bin into the set, the points, the driver's state S, its rows and snapshots (the
+ * rows and snapshots it had are freed). The block is read and checked (mpd_block_check, then the
+ * driver's check with ctx) before it replaces anything (gk_twoscale_load_take): a refused block
+ * leaves the set, the points, the strains, S, the rows and the snapshots as they were. */
+GK_INLINE gk_result mpd_load(const char *dir, mpd_micro *m, gk_mpm_points *pts, const char *tag, void *S,
+                             size_t nS, mpd_rows *R, mpd_snaps *sn, mpd_check_fn check, const void *ctx,
+                             gk_err *err) {
+    char path[MPD_PATH];
+    mpd_take t;
+    if (mpd_checkpoint_path(dir, path))
+        return gk_err_set(err, GK_ERR_ARG, "--restart %s: path too long", dir);
+    t.m = m, t.pts = pts, t.tag = tag, t.S = S, t.nS = nS, t.R = R, t.sn = sn, t.check = check, t.ctx = ctx;
+    t.oom = 0;
+    if (gk_twoscale_load_take(&m->ts, path, mpd_take_block, &t))
+        return gk_err_set(err, t.oom ? GK_ERR_ALLOC : m->ts.err.code, "%s", gk_twoscale_error(&m->ts));
     return GK_OK;
 }
 

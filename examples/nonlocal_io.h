@@ -287,33 +287,41 @@ static const char *ck_check(const model *md, const ckhead *hd, const unsigned ch
     return NULL;
 }
 
-static int load_checkpoint(model *md, uint64_t fp) {
-    char path[1024];
-    void *blk = NULL, *part[CK_NPART];
-    size_t nb = 0, ny = (size_t)md->o->mesh[1], need, npart[CK_NPART], nkeep = 0, k;
+/* load_checkpoint's take (gk_twoscale_load_take): the block checked against the run, written into
+ * the model over a kept copy, and the copy put back when the derived state refuses it */
+typedef struct ck_take {
+    model *md;
+    uint64_t fp;
+} ck_take;
+
+static int take_checkpoint(const void *blk, size_t nb, void *user, char *why, size_t nwhy) {
+    model *md = ((ck_take *)user)->md;
+    void *part[CK_NPART];
+    size_t ny = (size_t)md->o->mesh[1], need, npart[CK_NPART], nkeep = 0, k;
     ckhead hd;
     const unsigned char *q;
-    const char *why = NULL;
+    const char *bad;
     unsigned char *keep;
     double *rows;
     int e;
-    snprintf(path, sizeof path, "%s/checkpoint.bin", md->o->restart);
-    if (gk_twoscale_load(&md->ts, path, &blk, &nb))
-        return fprintf(stderr, "femdem_nonlocal: restart: %s\n", gk_twoscale_error(&md->ts)), 1;
-    if (nb < sizeof hd) goto bad;
+    if (nb < sizeof hd) goto other;
     memcpy(&hd, blk, sizeof hd);
     need =
         sizeof hd + sizeof(double) * (2 * (size_t)md->nr + 9 * (size_t)md->np + 3 * ny + 2 * (size_t)md->ne);
     if (memcmp(hd.magic, "GKFNL02", 8) || hd.test != md->test || hd.nd != md->nd || hd.nr != md->nr ||
-        hd.ne != md->ne || hd.ny != (int32_t)ny || hd.ncol != NCOL || hd.fingerprint != fp || hd.nrow < 1 ||
-        hd.step < 0 || hd.step > md->o->steps || need > nb ||
+        hd.ne != md->ne || hd.ny != (int32_t)ny || hd.ncol != NCOL ||
+        hd.fingerprint != ((ck_take *)user)->fp || hd.nrow < 1 || hd.step < 0 || hd.step > md->o->steps ||
+        need > nb ||
         (uint64_t)hd.nrow > (nb - need) / (sizeof(double) * NCOL)) /* the row count within the file */
-        goto bad;
+        goto other;
     need += sizeof(double) * NCOL * (size_t)hd.nrow;
-    if (nb != need) goto bad;
+    if (nb != need) goto other;
     /* a checksum only proves the file is what some writer wrote: check what
      * this run will trust (every value in range), all of it before anything is written */
-    if ((why = ck_check(md, &hd, (const unsigned char *)blk + sizeof hd)) != NULL) goto bad_value;
+    if ((bad = ck_check(md, &hd, (const unsigned char *)blk + sizeof hd)) != NULL)
+        return snprintf(why, nwhy,
+                        "the run's block holds a non-finite or out-of-range value (%s); not restarted", bad),
+               1;
     /* what the model holds now, kept: the derived state below may still refuse it */
     ck_parts(md, part, npart);
     for (k = 0; k < CK_NPART; ++k) nkeep += npart[k];
@@ -335,7 +343,6 @@ static int load_checkpoint(model *md, uint64_t fp) {
     GET(md->arrival, sizeof(double) * md->ne);
     GET(md->wint, sizeof(double) * md->ne);
 #undef GET
-    gk_twoscale_free_block(&md->ts, blk);
     md->step = hd.step, md->time = hd.time, md->peak = hd.peak, md->have12 = hd.have12,
     md->dem_total = (long)hd.dem_total;
     gk_dofmap_expand(&md->dm, md->ur, 0, md->u);
@@ -348,32 +355,29 @@ static int load_checkpoint(model *md, uint64_t fp) {
     if (internal_force(md)) { /* an element the displacements invert: put back what was there */
         for (nkeep = 0, k = 0; k < CK_NPART; ++k) memcpy(part[k], keep + nkeep, npart[k]), nkeep += npart[k];
         free(keep), free(rows);
-        return fprintf(
-                   stderr,
-                   "femdem_nonlocal: restart: %s: its displacements are not a valid mesh; not restarted\n",
-                   path),
-               1;
+        return snprintf(why, nwhy, "its displacements are not a valid mesh; not restarted"), 1;
     }
     free(keep), free(md->rows);
     md->rows = rows, md->caprow = md->nrow = hd.nrow;
     md->kin = gk_explicit_kinetic_energy(md->nd, md->mass, NULL, md->v);
+    return 0;
+other:
+    return snprintf(why, nwhy,
+                    "was written by another run (test, mesh, options or packing differ), by an earlier "
+                    "version of this program, or is damaged"),
+           1;
+}
+
+/* DIR/checkpoint.bin (--restart): the set and the model, or neither (the reason said) */
+static int load_checkpoint(model *md, uint64_t fp) {
+    char path[1024];
+    ck_take t;
+    snprintf(path, sizeof path, "%s/checkpoint.bin", md->o->restart);
+    t.md = md, t.fp = fp;
+    if (gk_twoscale_load_take(&md->ts, path, take_checkpoint, &t))
+        return fprintf(stderr, "femdem_nonlocal: restart: %s\n", gk_twoscale_error(&md->ts)), 1;
     printf("restarted from %s at step %ld\n", path, md->step);
     return 0;
-bad:
-    gk_twoscale_free_block(&md->ts, blk);
-    return fprintf(stderr,
-                   "femdem_nonlocal: restart: %s was written by another run (test, mesh, options or packing "
-                   "differ), by an earlier version of this program, or is damaged\n",
-                   path),
-           1;
-bad_value:
-    gk_twoscale_free_block(&md->ts, blk);
-    return fprintf(
-               stderr,
-               "femdem_nonlocal: restart: %s: the run's block holds a non-finite or out-of-range value (%s); "
-               "not restarted\n",
-               path, why),
-           1;
 }
 
 static void result_line(const micro *mi, const char *extra, double pk, double epk, double bc, double bw,

@@ -1,6 +1,6 @@
 /* fuzz_dr_ckpt.c - libFuzzer harness: the --restart reader of the FEMxDEM
  * dynamic-relaxation driver (load_checkpoint of examples/femdem_dr_io.h:
- * gk_twoscale_load, then the driver's block) on arbitrary bytes. The driver
+ * gk_twoscale_load_take with its take_checkpoint) on arbitrary bytes. The driver
  * itself is compiled in (its main renamed), so the harness calls the very
  * functions the driver's main does: parse, setup, run_fem.
  *

@@ -1,8 +1,8 @@
 /* fuzz_femdem_ckpt.c - libFuzzer harness: the FEMxDEM biaxial driver's
- * --restart reader (fdb_restart of examples/femdem_biaxial.h: gk_twoscale_load,
- * then the model's block, fd_ck_read and fd_ck_apply of examples/femdem_io.h,
- * then the driver's own part) on arbitrary bytes, through the driver's own
- * functions.
+ * --restart reader (fdb_restart of examples/femdem_biaxial.h: fd_ck_load of
+ * examples/femdem_io.h within gk_twoscale_load_take: the model's block, then
+ * the driver's own part, then the model written) on arbitrary bytes, through
+ * the driver's own functions.
  *
  * One small model is built once, deterministically: the single-element test
  * (one Q4 element, 2 x 2 Gauss points) on a 12-disk 2D packing consolidated

@@ -14,7 +14,8 @@
  * One tiny run is made once by the driver's own run, its RVEs of a 12-disk packing; its final checkpoint is the pristine one every
  * input starts from; the outputs of the steps the harness runs go to a third folder. Input: one mode
  * byte, then the file (an even mode byte writes the right checksum, fuzz_check.h). Each input:
- *   - refused: a message, and the points, strains, state, rows and snapshots byte for byte as before;
+ *   - refused: a message, and the points, strains, state, rows and snapshots byte for byte as before,
+ *     the set's accepted stresses too (the set does not take the file's states);
  *   - accepted: the driver's check and mpd_block_check hold again, every point value and field is
  *     finite; then the driver's next step either gives finite positions, velocities and stresses, or
  *     stops with a message. The run then returns to the pristine checkpoint.
@@ -30,11 +31,12 @@
 static char in_dir[400], ref_dir[400], out_dir[400], pk_path[400];
 static unsigned char *snap0; /* the pristine run's block */
 static size_t nsnap;
+static double *acc0; /* the pristine set's accepted stresses */
 static int ready;
 
 static void cleanup(void) {
     fuzz_remove_dir(in_dir), fuzz_remove_dir(ref_dir), fuzz_remove_dir(out_dir), remove(pk_path);
-    if (ready) fz_free(), free(snap0);
+    if (ready) fz_free(), free(snap0), free(acc0);
 }
 
 /* the run's state a checkpoint carries, as the driver writes it (malloc'ed) */
@@ -47,11 +49,21 @@ static unsigned char *model_bytes(size_t *n) {
     return B.b;
 }
 
+/* the set's accepted stresses (malloc'ed) */
+static double *set_stresses(void) {
+    double *s = (double *)malloc(9 * (size_t)X.M.ts.n * sizeof *s);
+    FUZZ_CHECK(s != NULL && gk_twoscale_accepted(&X.M.ts, s, NULL) == GK_OK);
+    return s;
+}
+
+/* the model and the set as the pristine checkpoint left them */
 static int same_as_pristine(void) {
     size_t n;
     unsigned char *b = model_bytes(&n);
-    int same = n == nsnap && memcmp(b, snap0, n) == 0;
-    free(b);
+    double *s = set_stresses();
+    int same =
+        n == nsnap && memcmp(b, snap0, n) == 0 && memcmp(s, acc0, 9 * (size_t)X.M.ts.n * sizeof *s) == 0;
+    free(b), free(s);
     return same;
 }
 
@@ -98,6 +110,7 @@ static void fuzz_setup(void) {
     restore();
     X.run.out = out_dir; /* what the harness's steps write */
     snap0 = model_bytes(&nsnap);
+    acc0 = set_stresses();
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {

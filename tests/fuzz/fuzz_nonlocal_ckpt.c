@@ -1,6 +1,6 @@
 /* fuzz_nonlocal_ckpt.c - libFuzzer harness: the --restart reader of the
  * nonlocal FEMxDEM driver (load_checkpoint of examples/nonlocal_io.h:
- * gk_twoscale_load, then the driver's block) on arbitrary bytes. The driver
+ * gk_twoscale_load_take with its take_checkpoint) on arbitrary bytes. The driver
  * itself is compiled in (its main renamed): its own run() makes the run, and
  * the harness calls its reader and its step (macro_step, track, record).
  *
