@@ -50,6 +50,7 @@ static model M;
 static char in_dir[400], ref_dir[400], out_dir[400], pk_path[400], cap_path[400];
 static unsigned char *snap0; /* the pristine model's state */
 static size_t nsnap;
+static double *acc0; /* the pristine set's accepted stresses */
 static int ready;
 
 /* the state no checkpoint carries, as setup left it */
@@ -99,10 +100,11 @@ static unsigned char *model_bytes(size_t *n) {
     return b;
 }
 
+/* the model and the set as the pristine checkpoint left them */
 static int same_as_pristine(void) {
     size_t n;
     unsigned char *b = model_bytes(&n);
-    int same = n == nsnap && memcmp(b, snap0, n) == 0;
+    int same = n == nsnap && memcmp(b, snap0, n) == 0 && fuzz_same_set(&M.ts, acc0);
     free(b);
     return same;
 }
@@ -206,6 +208,7 @@ static void fuzz_setup(void) {
     M.o.out = out_dir;
     restore();
     snap0 = model_bytes(&nsnap);
+    acc0 = fuzz_set_stresses(&M.ts);
     ready = 1;
 }
 

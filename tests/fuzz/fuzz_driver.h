@@ -1,6 +1,7 @@
-/* fuzz_driver.h - what the harnesses that run a driver share: removing their temporary folders, and
- * the driver's output off around a call (stdout to /dev/null, stderr to a file whose length then says
- * whether the driver gave a message). Include after fuzz_check.h, with _POSIX_C_SOURCE defined. */
+/* fuzz_driver.h - what the harnesses that run a driver share: removing their temporary folders, the
+ * driver's output off around a call (stdout to /dev/null, stderr to a file whose length then says
+ * whether the driver gave a message), and the RVE set's accepted stresses (a refused checkpoint must
+ * leave them as they were). Include after the driver (gk_twoscale.h), with _POSIX_C_SOURCE defined. */
 #ifndef FUZZ_DRIVER_H
 #define FUZZ_DRIVER_H
 #include "fuzz_check.h"
@@ -43,5 +44,19 @@ static inline long fuzz_quiet_end(void) {
     FUZZ_CHECK(dup2(fuzz_saved_fd[0], 1) >= 0 && dup2(fuzz_saved_fd[1], 2) >= 0);
     close(fuzz_saved_fd[0]), close(fuzz_saved_fd[1]);
     return (long)lseek(fuzz_cap_fd, 0, SEEK_END);
+}
+/* the set's accepted stresses (malloc'ed, 9 per point) */
+static inline double *fuzz_set_stresses(gk_twoscale *ts) {
+    double *s = (double *)malloc(9 * (size_t)ts->n * sizeof *s);
+    FUZZ_CHECK(s != NULL && gk_twoscale_accepted(ts, s, NULL) == GK_OK);
+    return s;
+}
+
+/* whether the set's accepted stresses are still ref's */
+static inline int fuzz_same_set(gk_twoscale *ts, const double *ref) {
+    double *s = fuzz_set_stresses(ts);
+    int same = memcmp(s, ref, 9 * (size_t)ts->n * sizeof *s) == 0;
+    free(s);
+    return same;
 }
 #endif /* FUZZ_DRIVER_H */

@@ -52,6 +52,7 @@ static uint64_t fpr;
 static char in_dir[400], ref_dir[400], pk_path[400], cap_path[400];
 static unsigned char *snap0; /* the pristine model's state */
 static size_t nsnap;
+static double *acc0; /* the pristine set's accepted stresses */
 static int ready;
 
 static void cleanup(void) {
@@ -97,10 +98,11 @@ static unsigned char *model_bytes(size_t *n) {
     return b;
 }
 
+/* the model and the set as the pristine checkpoint left them */
 static int same_as_pristine(void) {
     size_t n;
     unsigned char *b = model_bytes(&n);
-    int same = n == nsnap && memcmp(b, snap0, n) == 0;
+    int same = n == nsnap && memcmp(b, snap0, n) == 0 && fuzz_same_set(&MD.ts, acc0);
     free(b);
     return same;
 }
@@ -115,7 +117,7 @@ static int load(const char *dir) {
 }
 
 static void free_all(void) {
-    if (ready) free(pick), model_free(&MD), micro_free(&MI), free(snap0);
+    if (ready) free(pick), model_free(&MD), micro_free(&MI), free(snap0), free(acc0);
 }
 
 static void fuzz_setup(void) {
@@ -187,6 +189,7 @@ static void fuzz_setup(void) {
     fpr = fingerprint(&O, &MI.pk);
     FUZZ_CHECK(load(ref_dir) == 0);
     snap0 = model_bytes(&nsnap);
+    acc0 = fuzz_set_stresses(&MD.ts);
 }
 
 /* the accepted model: every value finite and in range */
