@@ -69,9 +69,8 @@ static void cleanup(void) {
 /* the model's state a checkpoint carries, as bytes (malloc'ed) */
 static unsigned char *model_bytes(size_t *n) {
     size_t nd = (size_t)M.ndof * sizeof(double), g9 = 9 * (size_t)M.ngp * sizeof(double);
-    size_t parts[22], k, at = 0;
+    size_t parts[22];
     const void *src[22];
-    unsigned char *b;
     src[0] = &M.step_done, parts[0] = sizeof M.step_done;
     src[1] = &M.nrows, parts[1] = sizeof M.nrows;
     src[2] = M.rows, parts[2] = (size_t)M.nrows * sizeof(row);
@@ -94,10 +93,7 @@ static unsigned char *model_bytes(size_t *n) {
     src[19] = M.Hacc, parts[19] = g9;
     src[20] = M.P, parts[20] = g9;
     src[21] = &M.dr.u0, parts[21] = sizeof M.dr.u0;
-    for (*n = 0, k = 0; k < 22; ++k) *n += parts[k];
-    FUZZ_CHECK((b = (unsigned char *)malloc(*n + 1)) != NULL);
-    for (k = 0; k < 22; ++k) memcpy(b + at, src[k], parts[k]), at += parts[k];
-    return b;
+    return fuzz_concat(src, parts, 22, n);
 }
 
 /* the model and the set as the pristine checkpoint left them */
@@ -140,12 +136,7 @@ static void restore(void) {
 
 static void fuzz_setup(void) {
     const char *tmp = getenv("TMPDIR");
-    gk_packing pk, out;
-    gk_gen_def g;
-    gk_rve rve;
-    gk_consolidate_def cd;
     gk_rve_def def = gk_rve_def_default();
-    gk_err err;
     char *argv[40];
     int argc, rc;
     size_t nd, g9;
@@ -160,17 +151,7 @@ static void fuzz_setup(void) {
     FUZZ_CHECK(mkdir(out_dir, 0777) == 0 || errno == EEXIST);
     atexit(cleanup);
     fuzz_quiet_open(cap_path);
-    /* the packing: 12 disks consolidated to 100 kPa */
-    memset(&g, 0, sizeof g);
-    g.dim = 2, g.n = 12, g.r_min = 0.4e-3, g.r_max = 0.6e-3, g.seed = 11;
-    FUZZ_CHECK(gk_packing_generate(&pk, &g, NULL, &err) == GK_OK);
-    FUZZ_CHECK(gk_rve_create(&rve, &def, &pk) == GK_OK);
-    memset(&cd, 0, sizeof cd);
-    cd.pressure = 1e5, cd.max_steps = 200000;
-    FUZZ_CHECK(gk_rve_consolidate(&rve, &cd, NULL) == GK_OK);
-    FUZZ_CHECK(gk_rve_to_packing(&rve, &out, NULL, &err) == GK_OK);
-    FUZZ_CHECK(gk_packing_write(pk_path, &out, "fuzz_dr_ckpt", &err) == GK_OK);
-    gk_rve_destroy(&rve), gk_packing_free(&pk), gk_packing_free(&out);
+    fuzz_small_packing(pk_path, "fuzz_dr_ckpt", 1e5, &def); /* 12 disks consolidated to 100 kPa */
     {
         const char *a[] = {"femdem_dr", "--nx",         "1",        "--ny",
                            "1",         "--frame",      "periodic", "--packing",

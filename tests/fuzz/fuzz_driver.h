@@ -1,7 +1,7 @@
 /* fuzz_driver.h - what the harnesses that run a driver share: removing their temporary folders, the
  * driver's output off around a call (stdout to /dev/null, stderr to a file whose length then says
- * whether the driver gave a message), and the RVE set's accepted stresses (a refused checkpoint must
- * leave them as they were). Include after the driver (gk_twoscale.h), with _POSIX_C_SOURCE defined. */
+ * whether the driver gave a message), the RVE set's accepted stresses (a refused checkpoint must
+ * leave them as they were), their small packing and their model's bytes. Include after the driver (gk_twoscale.h), with _POSIX_C_SOURCE defined. */
 #ifndef FUZZ_DRIVER_H
 #define FUZZ_DRIVER_H
 #include "fuzz_check.h"
@@ -45,6 +45,41 @@ static inline long fuzz_quiet_end(void) {
     close(fuzz_saved_fd[0]), close(fuzz_saved_fd[1]);
     return (long)lseek(fuzz_cap_fd, 0, SEEK_END);
 }
+/* the parts (np of them: addresses and sizes) one after another in one buffer (malloc'ed, n bytes) */
+static inline unsigned char *fuzz_concat(const void *const *src, const size_t *parts, int np, size_t *n) {
+    unsigned char *b;
+    size_t at = 0;
+    int k;
+    for (*n = 0, k = 0; k < np; ++k) *n += parts[k];
+    FUZZ_CHECK((b = (unsigned char *)malloc(*n + 1)) != NULL);
+    for (k = 0; k < np; ++k) memcpy(b + at, src[k], parts[k]), at += parts[k];
+    return b;
+}
+
+/* the drivers' small packing, written to path with comment: 12 disks of radius 0.4-0.6 mm (seed 11),
+ * consolidated to pressure [Pa] with def's contact law first when pressure > 0 */
+static inline void fuzz_small_packing(const char *path, const char *comment, double pressure,
+                                      const gk_rve_def *def) {
+    gk_packing pk, out;
+    gk_gen_def g;
+    gk_rve rve;
+    gk_consolidate_def cd;
+    gk_err err;
+    memset(&g, 0, sizeof g);
+    g.dim = 2, g.n = 12, g.r_min = 0.4e-3, g.r_max = 0.6e-3, g.seed = 11;
+    FUZZ_CHECK(gk_packing_generate(&pk, &g, NULL, &err) == GK_OK);
+    if (pressure > 0.0) {
+        FUZZ_CHECK(gk_rve_create(&rve, def, &pk) == GK_OK);
+        memset(&cd, 0, sizeof cd);
+        cd.pressure = pressure, cd.max_steps = 200000;
+        FUZZ_CHECK(gk_rve_consolidate(&rve, &cd, NULL) == GK_OK);
+        FUZZ_CHECK(gk_rve_to_packing(&rve, &out, NULL, &err) == GK_OK);
+        gk_rve_destroy(&rve), gk_packing_free(&pk), pk = out;
+    }
+    FUZZ_CHECK(gk_packing_write(path, &pk, comment, &err) == GK_OK);
+    gk_packing_free(&pk);
+}
+
 /* the set's accepted stresses (malloc'ed, 9 per point) */
 static inline double *fuzz_set_stresses(gk_twoscale *ts) {
     double *s = (double *)malloc(9 * (size_t)ts->n * sizeof *s);

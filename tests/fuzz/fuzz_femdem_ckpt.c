@@ -64,9 +64,8 @@ static void cleanup(void) {
 /* the model's state a checkpoint carries, as bytes (malloc'ed) */
 static unsigned char *model_bytes(size_t *n) {
     size_t nd = (size_t)M.ndof * sizeof(double), ng = (size_t)M.ngp, nr = (size_t)M.ncurve;
-    size_t parts[12], k, at = 0;
+    size_t parts[12];
     const void *src[12];
-    unsigned char *b;
     src[0] = &M.step, parts[0] = sizeof M.step;
     src[1] = &M.eps_done, parts[1] = sizeof M.eps_done;
     src[2] = &M.scale, parts[2] = sizeof M.scale;
@@ -79,10 +78,7 @@ static unsigned char *model_bytes(size_t *n) {
     src[9] = &M.inclast, parts[9] = sizeof M.inclast;
     src[10] = M.ulast, parts[10] = nd;
     src[11] = M.hist, parts[11] = nr * ng * FD_NFIELD * sizeof(double);
-    for (*n = 0, k = 0; k < 12; ++k) *n += parts[k];
-    FUZZ_CHECK((b = (unsigned char *)malloc(*n)) != NULL);
-    for (k = 0; k < 12; ++k) memcpy(b + at, src[k], parts[k]), at += parts[k];
-    return b;
+    return fuzz_concat(src, parts, 12, n);
 }
 
 /* the model and the set as the pristine checkpoint left them */
@@ -109,10 +105,6 @@ static void restore(void) {
 
 static void setup(void) {
     const char *tmp = getenv("TMPDIR");
-    gk_packing pk, out;
-    gk_gen_def g;
-    gk_rve rve;
-    gk_consolidate_def cd;
     gk_rve_def def = gk_rve_def_default();
     gk_err err;
     if (ready) return;
@@ -122,17 +114,7 @@ static void setup(void) {
     make_dir(out_dir, sizeof out_dir, tmp, "out");
     snprintf(pk_path, sizeof pk_path, "%s/gk_fuzz_femdem_%ld.pk", tmp, (long)getpid());
     atexit(cleanup);
-    /* the packing: 12 disks consolidated to 100 kPa */
-    memset(&g, 0, sizeof g);
-    g.dim = 2, g.n = 12, g.r_min = 0.4e-3, g.r_max = 0.6e-3, g.seed = 11;
-    FUZZ_CHECK(gk_packing_generate(&pk, &g, NULL, &err) == GK_OK);
-    FUZZ_CHECK(gk_rve_create(&rve, &def, &pk) == GK_OK);
-    memset(&cd, 0, sizeof cd);
-    cd.pressure = 1e5, cd.max_steps = 200000;
-    FUZZ_CHECK(gk_rve_consolidate(&rve, &cd, NULL) == GK_OK);
-    FUZZ_CHECK(gk_rve_to_packing(&rve, &out, NULL, &err) == GK_OK);
-    FUZZ_CHECK(gk_packing_write(pk_path, &out, "fuzz_femdem_ckpt", &err) == GK_OK);
-    gk_rve_destroy(&rve), gk_packing_free(&pk), gk_packing_free(&out);
+    fuzz_small_packing(pk_path, "fuzz_femdem_ckpt", 1e5, &def); /* 12 disks consolidated to 100 kPa */
     /* the model: the driver's defaults, its single-element test, one load step */
     memset(&M, 0, sizeof M);
     M.prog = "fuzz_femdem_ckpt", M.root = 1;

@@ -72,9 +72,6 @@ static void fuzz_setup(void) {
     const char *tmp = getenv("TMPDIR");
     char *argv[64];
     int argc = 0;
-    gk_packing pk;
-    gk_gen_def g;
-    gk_err err;
     (void)fz_seed_at; /* the seeds' (FUZZ_MAKE_SEEDS) */
     if (ready) return;
     if (!tmp || !*tmp) tmp = "/tmp";
@@ -85,12 +82,7 @@ static void fuzz_setup(void) {
     FUZZ_CHECK(mkdir(in_dir, 0777) == 0 || errno == EEXIST);
     FUZZ_CHECK(mkdir(out_dir, 0777) == 0 || errno == EEXIST);
     atexit(cleanup);
-    /* RVEs of 12 disks: small checkpoints, fast runs */
-    memset(&g, 0, sizeof g);
-    g.dim = 2, g.n = 12, g.r_min = 0.4e-3, g.r_max = 0.6e-3, g.seed = 11;
-    FUZZ_CHECK(gk_packing_generate(&pk, &g, NULL, &err) == GK_OK);
-    FUZZ_CHECK(gk_packing_write(pk_path, &pk, "fuzz_" FZ_NAME "_ckpt", &err) == GK_OK);
-    gk_packing_free(&pk);
+    fuzz_small_packing(pk_path, "fuzz_" FZ_NAME "_ckpt", 0.0, NULL); /* RVEs of 12 disks: small, fast */
     for (argc = 0; fz_args[argc]; ++argc) argv[argc] = (char *)fz_args[argc];
     argv[argc++] = (char *)"--packing", argv[argc++] = pk_path;
     argv[argc++] = (char *)"--out", argv[argc++] = ref_dir, argv[argc] = NULL;

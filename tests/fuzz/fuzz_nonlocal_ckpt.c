@@ -63,9 +63,8 @@ static void cleanup(void) {
 static unsigned char *model_bytes(size_t *n) {
     size_t nd = (size_t)MD.nd * 8, np9 = 9 * (size_t)MD.np * 8, ne = (size_t)MD.ne * 8,
            ny = (size_t)O.mesh[1] * 8;
-    size_t parts[26], k, at = 0;
+    size_t parts[26];
     const void *src[26];
-    unsigned char *b;
     src[0] = &MD.step, parts[0] = sizeof MD.step;
     src[1] = &MD.time, parts[1] = sizeof MD.time;
     src[2] = &MD.peak, parts[2] = sizeof MD.peak;
@@ -92,10 +91,7 @@ static unsigned char *model_bytes(size_t *n) {
     src[23] = MD.fint, parts[23] = nd;
     src[24] = MD.fe, parts[24] = 24 * ne;
     src[25] = MD.ehg, parts[25] = ne;
-    for (*n = 0, k = 0; k < 26; ++k) *n += parts[k];
-    FUZZ_CHECK((b = (unsigned char *)malloc(*n + 1)) != NULL);
-    for (k = 0; k < 26; ++k) memcpy(b + at, src[k], parts[k]), at += parts[k];
-    return b;
+    return fuzz_concat(src, parts, 26, n);
 }
 
 /* the model and the set as the pristine checkpoint left them */
