@@ -365,13 +365,12 @@ static int take_checkpoint(const void *blk, size_t nb, void *user, char *why, si
     double dv[CK_ND], want[CK_ND];
     uint32_t magic;
     int i;
-    if (nb < need)
-        return snprintf(why, nwhy, "not a checkpoint of this run (another test, mesh, frame or rotation)"), 1;
+    if (nb < need) goto other;
     memcpy(&magic, b, 4), memcpy(iv, b + 4, sizeof iv), memcpy(dv, b + 4 + sizeof iv, sizeof dv);
     ck_opts(m, want);
     if (magic != CK_MAGIC || iv[0] != m->ngp || iv[1] != m->ndof || iv[2] != m->o.frame ||
         iv[3] != rotation_lock(&m->o) || iv[4] != m->o.test || iv[6] < 0 || iv[5] < 0)
-        return snprintf(why, nwhy, "not a checkpoint of this run (another test, mesh, frame or rotation)"), 1;
+        goto other;
     for (i = CK_OPT; i < CK_ND; ++i)
         if (dv[i] != want[i])
             return snprintf(
@@ -379,8 +378,7 @@ static int take_checkpoint(const void *blk, size_t nb, void *user, char *why, si
                        "written with other options (strain, pressure, friction, steps, stiffness or mesh)"),
                    1;
     need += 8 * (3 * (size_t)m->ndof + 18 * (size_t)m->ngp + (size_t)NCOL * iv[6]);
-    if (nb != need)
-        return snprintf(why, nwhy, "not a checkpoint of this run (another test, mesh, frame or rotation)"), 1;
+    if (nb != need) goto other;
     /* a checksum only proves the file is what some writer wrote: check what
      * this run will trust (every value in range), all of it before anything is written */
     if (ck_check(m, iv, dv, b + 4 + sizeof iv + sizeof dv))
@@ -405,6 +403,8 @@ static int take_checkpoint(const void *blk, size_t nb, void *user, char *why, si
     m->resid_max = dv[8], m->resid_step = (long long)dv[9], m->resid_over = (long long)dv[10];
     if (m->have_f0) gk_dr_reference(&m->dr, NULL, m->f0);
     return 0;
+other:
+    return snprintf(why, nwhy, "not a checkpoint of this run (another test, mesh, frame or rotation)"), 1;
 }
 
 /* DIR/checkpoint.bin (--restart): the set and the model, or neither (the reason said) */
