@@ -1270,22 +1270,36 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
  * remainder of a range (fewer than GK_VR_W pairs) and cohesive contacts go
  * through the scalar reference. */
 #if GK_VR_W > 1
+/* The i side of a block of pairs (pl.i ascending) mostly spans fewer
+ * particles than lanes: its gathers are then one load and a permutation each
+ * (gk_vd_win in gk_base.h), the same values. Double only: in a float build a
+ * gk_vr holds two double vectors of positions. */
+GK_FORCE_INLINE void gk__iwin_make(const int32_t *ii, int32_t n, gk_vd_win *w) {
+#ifdef GK_REAL_FLOAT
+    (void)ii;
+    (void)n;
+    w->ok = 0;
+#else
+    gk_vd_win_make(ii, n, w);
+#endif
+}
+
 /* branch vectors d = h (ds - round(ds)) of GK_VR_W pairs, from double
  * positions (the wide twin of gk_pcell_image); H = the cell matrix broadcast
- * once per call */
+ * once per call; wi the window of the i side */
 GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const int32_t *ii,
-                                     const int32_t *jj, int dim, gk_vr d[3]) {
+                                     const int32_t *jj, const gk_vd_win *wi, int dim, gk_vr d[3]) {
     gk_vd dd[2][3];
     int hf, k;
     for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
         /* written out per axis: as a loop over k, gcc kept the loop and sent ds through the stack */
         const int32_t *i4 = ii + hf * GK_VD_W, *j4 = jj + hf * GK_VD_W;
-        gk_vd ds0 = gk_vd_sub(gk_vd_gather(rve->s[0], j4), gk_vd_gather(rve->s[0], i4)),
-              ds1 = gk_vd_sub(gk_vd_gather(rve->s[1], j4), gk_vd_gather(rve->s[1], i4));
+        gk_vd ds0 = gk_vd_sub(gk_vd_gather(rve->s[0], j4), gk_vd_gather_win(rve->s[0], i4, wi)),
+              ds1 = gk_vd_sub(gk_vd_gather(rve->s[1], j4), gk_vd_gather_win(rve->s[1], i4, wi));
         ds0 = gk_vd_sub(ds0, gk_vd_round(ds0));
         ds1 = gk_vd_sub(ds1, gk_vd_round(ds1));
         if (dim == 3) {
-            gk_vd ds2 = gk_vd_sub(gk_vd_gather(rve->s[2], j4), gk_vd_gather(rve->s[2], i4));
+            gk_vd ds2 = gk_vd_sub(gk_vd_gather(rve->s[2], j4), gk_vd_gather_win(rve->s[2], i4, wi));
             ds2 = gk_vd_sub(ds2, gk_vd_round(ds2));
             GK_UNROLL
             for (k = 0; k < 3; ++k)
@@ -1385,7 +1399,7 @@ GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const in
 GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
                                         unsigned fl) {
     const gk_law_consts K = rve->K; /* a local copy: its broadcasts stay out of the loop */
-    const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
+    const int32_t *pi = rve->pl.i, *pj = rve->pl.j, n = rve->n;
     const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), dt = gk_vr_set1(x->dt);
     const gk_vr G0 = gk_vr_set1(x->G[0]), G1 = gk_vr_set1(x->G[1]), G3 = gk_vr_set1(x->G[3]),
                 G4 = gk_vr_set1(x->G[4]);
@@ -1400,19 +1414,21 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
         gk_vr d[3], ri, rj, vx, vy, mi = zero, mj = zero, wi = wa, wj = wa, fh = zero, m = zero;
         gk_vrm in, slide;
         gk_contact_out_w o;
-        gk__simd_branch(rve, H, ii, jj, 2, d);
-        ri = gk_vr_gather(rve->r, ii);
+        gk_vd_win win;
+        gk__iwin_make(ii, n, &win);
+        gk__simd_branch(rve, H, ii, jj, &win, 2, d);
+        ri = gk_vr_gather_win(rve->r, ii, &win);
         rj = gk_vr_gather(rve->r, jj);
-        vx = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[0], jj), gk_vr_gather(rve->v[0], ii)),
+        vx = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[0], jj), gk_vr_gather_win(rve->v[0], ii, &win)),
                        gk_vr_add(gk_vr_mul(G0, d[0]), gk_vr_mul(G1, d[1])));
-        vy = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[1], jj), gk_vr_gather(rve->v[1], ii)),
+        vy = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[1], jj), gk_vr_gather_win(rve->v[1], ii, &win)),
                        gk_vr_add(gk_vr_mul(G3, d[0]), gk_vr_mul(G4, d[1])));
         if (fl & GK_PHYS_VISCOUS) {
-            mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii));
+            mi = gk_vr_div(one, gk_vr_gather_win(rve->minv, ii, &win));
             mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
         }
         if (fl & GK_PHYS_ROTATION) {
-            wi = gk_vr_add(wa, gk_vr_gather(rve->w[2], ii));
+            wi = gk_vr_add(wa, gk_vr_gather_win(rve->w[2], ii, &win));
             wj = gk_vr_add(wa, gk_vr_gather(rve->w[2], jj));
         }
         if (fl & GK_PHYS_TANGENT) fh = gk_vr_load(rve->ft[0] + c);
@@ -1450,7 +1466,7 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
 GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
                                         unsigned fl) {
     const gk_law_consts K = rve->K; /* a local copy: its broadcasts stay out of the loop */
-    const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
+    const int32_t *pi = rve->pl.i, *pj = rve->pl.j, n = rve->n;
     const gk_vr zero = gk_vr_zero(), one = gk_vr_set1(1), dt = gk_vr_set1(x->dt);
     gk_vr G[9], wa[3];
     gk_vd H[9];
@@ -1469,21 +1485,23 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
         gk_vr d[3], v[3], wi[3], wj[3], fh[3], mh[3], ri, rj, mi = zero, mj = zero;
         gk_vrm in, slide;
         gk_contact_out_w o;
-        gk__simd_branch(rve, H, ii, jj, 3, d);
-        ri = gk_vr_gather(rve->r, ii);
+        gk_vd_win win;
+        gk__iwin_make(ii, n, &win);
+        gk__simd_branch(rve, H, ii, jj, &win, 3, d);
+        ri = gk_vr_gather_win(rve->r, ii, &win);
         rj = gk_vr_gather(rve->r, jj);
         GK_UNROLL
         for (k = 0; k < 3; ++k) {
-            v[k] = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[k], jj), gk_vr_gather(rve->v[k], ii)),
+            v[k] = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[k], jj), gk_vr_gather_win(rve->v[k], ii, &win)),
                              gk_vr_add(gk_vr_add(gk_vr_mul(G[3 * k], d[0]), gk_vr_mul(G[3 * k + 1], d[1])),
                                        gk_vr_mul(G[3 * k + 2], d[2])));
-            wi[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather(rve->w[k], ii)) : wa[k];
+            wi[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather_win(rve->w[k], ii, &win)) : wa[k];
             wj[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather(rve->w[k], jj)) : wa[k];
             fh[k] = (fl & GK_PHYS_TANGENT) ? gk_vr_load(rve->ft[k] + c) : zero;
             mh[k] = (fl & GK_PHYS_ROLLING) ? gk_vr_load(rve->mr[k] + c) : zero;
         }
         if (fl & GK_PHYS_VISCOUS) {
-            mi = gk_vr_div(one, gk_vr_gather(rve->minv, ii));
+            mi = gk_vr_div(one, gk_vr_gather_win(rve->minv, ii, &win));
             mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
         }
         in = gk_contact_3d_w(&K, law, fl, d, ri, rj, mi, mj, v, wi, wj, dt, fh, mh, &slide, &o);

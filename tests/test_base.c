@@ -184,6 +184,50 @@ TEST(simd_lanes_match_scalar) {
     }
 }
 
+/* the window gather returns what the gather does for every index vector:
+ * sorted ones within a window (the fast path where the width has it), ones
+ * spanning exactly the lane count, unsorted and negative offsets, and a window
+ * that would read past n; it takes its path only where that is allowed */
+TEST(window_gather_equals_gather) {
+    enum { N = 40 };
+    double a[N];
+    int32_t idx[GK_VD_W];
+    gk_rng rng;
+    int k, l, t, fast = 0;
+    for (k = 0; k < N; ++k) a[k] = 1.0 / (k + 1.5) - 0.25 * k;
+    gk_rng_seed(&rng, 17);
+    for (t = 0; t < 4000; ++t) {
+        double got[GK_VD_W];
+        int kind = t % 4, at = (int)(gk_rng_uniform(&rng) * (N - 1)), lo = N, hi = -1;
+        gk_vd_win w;
+        for (l = 0; l < GK_VD_W; ++l) {
+            int step = (int)(gk_rng_uniform(&rng) * (kind == 0 ? 1.6 : 3.0));
+            if (kind == 2) /* unsorted, anywhere */
+                idx[l] = (int32_t)(gk_rng_uniform(&rng) * N);
+            else /* non-decreasing from at (kind 1 and 3 may span the lane count or more) */
+                idx[l] = (int32_t)(l == 0 ? at : idx[l - 1] + step);
+            if (idx[l] >= N) idx[l] = N - 1;
+            if (idx[l] < lo) lo = idx[l];
+            if (idx[l] > hi) hi = idx[l];
+        }
+        if (kind == 3) idx[0] = (int32_t)(N - 1 - (t / 4) % GK_VD_W); /* near the end of the array */
+        gk_vd_win_make(idx, N, &w);
+        gk_vd_storeu(got, gk_vd_gather_win(a, idx, &w));
+        for (l = 0; l < GK_VD_W; ++l) CHECK(got[l] == a[idx[l]]);
+        if (w.ok) {
+            ++fast;
+            lo = idx[0];
+            for (l = 0; l < GK_VD_W; ++l) CHECK(idx[l] >= lo && idx[l] < lo + GK_VD_W);
+            CHECK(idx[0] + GK_VD_W <= N);
+        }
+    }
+#ifdef GK_VD_HAS_WIN
+    CHECK(fast > 500); /* the window is taken where it may be */
+#else
+    CHECK(fast == 0);
+#endif
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(inverse_times_matrix_is_identity);
@@ -198,5 +242,6 @@ int main(int argc, char **argv) {
     RUN(rng_is_deterministic_and_sane);
     RUN(error_messages);
     RUN(simd_lanes_match_scalar);
+    RUN(window_gather_equals_gather);
     return gk_test_done();
 }
