@@ -401,7 +401,8 @@ GK_FORCE_INLINE gk_vd gk_vd_gather(const double *base, const int32_t *idx) {
  * (the i side of a block of pairs sorted by i), one load of the GK_VD_W entries
  * from base + idx[0] and a permutation replace the GK_VD_W loads and inserts,
  * with the same values. gk_vd_win_make tells whether idx allows it (n: the
- * length of the arrays it will read); gk_vd_gather_win gathers either way. */
+ * length of the arrays it will read); gk_vd_gather_win gathers either way.
+ * gk_vf_win: the same for floats. */
 typedef struct gk_vd_win {
     __m512i lane; /* idx[l] - at */
     int32_t at;
@@ -410,16 +411,28 @@ typedef struct gk_vd_win {
 #define GK_VD_HAS_WIN 1
 GK_FORCE_INLINE void gk_vd_win_make(const int32_t *idx, int32_t n, gk_vd_win *w) {
     int32_t at = idx[0];
-    w->ok = 0;
-    if (at < 0 || at > n - GK_VD_W) return;
     w->lane = _mm512_sub_epi64(_mm512_cvtepi32_epi64(_mm256_loadu_si256((const __m256i *)(const void *)idx)),
                                _mm512_set1_epi64(at));
     w->at = at;
-    w->ok = _mm512_cmplt_epu64_mask(w->lane, _mm512_set1_epi64(GK_VD_W)) == 0xff;
+    w->ok =
+        at >= 0 && at <= n - GK_VD_W && _mm512_cmplt_epu64_mask(w->lane, _mm512_set1_epi64(GK_VD_W)) == 0xff;
 }
 GK_FORCE_INLINE gk_vd gk_vd_gather_win(const double *base, const int32_t *idx, const gk_vd_win *w) {
     if (w->ok) return _mm512_permutexvar_pd(w->lane, _mm512_loadu_pd(base + w->at));
     return gk_vd_gather(base, idx);
+}
+/* the same for GK_VF_W floats */
+typedef struct gk_vf_win {
+    __m512i lane; /* idx[l] - at */
+    int32_t at;
+    int ok;
+} gk_vf_win;
+GK_FORCE_INLINE void gk_vf_win_make(const int32_t *idx, int32_t n, gk_vf_win *w) {
+    int32_t at = idx[0];
+    w->lane = _mm512_sub_epi32(_mm512_loadu_si512((const void *)idx), _mm512_set1_epi32(at));
+    w->at = at;
+    w->ok = at >= 0 && at <= n - GK_VF_W &&
+            _mm512_cmplt_epu32_mask(w->lane, _mm512_set1_epi32(GK_VF_W)) == 0xffff;
 }
 GK_FORCE_INLINE unsigned gk_vdm_bits(gk_vdm m) { return (unsigned)m; }
 GK_FORCE_INLINE gk_vd gk_vd_xorsign(gk_vd a) { /* -a, exactly */
@@ -461,6 +474,10 @@ GK_FORCE_INLINE gk_vf gk_vf_gather(const float *base, const int32_t *idx) {
                          base[idx[10]], base[idx[9]], base[idx[8]], base[idx[7]], base[idx[6]], base[idx[5]],
                          base[idx[4]], base[idx[3]], base[idx[2]], base[idx[1]], base[idx[0]]);
 #endif
+}
+GK_FORCE_INLINE gk_vf gk_vf_gather_win(const float *base, const int32_t *idx, const gk_vf_win *w) {
+    if (w->ok) return _mm512_permutexvar_ps(w->lane, _mm512_loadu_ps(base + w->at));
+    return gk_vf_gather(base, idx);
 }
 /* float lanes 0..7 (half 0) or 8..15 (half 1) widened to double, exactly */
 GK_FORCE_INLINE gk_vd gk_vd_from_vf(gk_vf a, int half) {
@@ -703,7 +720,8 @@ GK_FORCE_INLINE gk_vd gk_vd_from_vf(gk_vf a, int half) {
 
 #ifndef GK_VD_HAS_WIN
 /* No window gather below 512 bits (with AVX2's 4 lanes it saved nothing,
- * measured): gk_vd_win_make always says no, gk_vd_gather_win is a gather. */
+ * measured): gk_vd_win_make and gk_vf_win_make always say no, the window
+ * gathers are gathers. */
 typedef struct gk_vd_win {
     int ok;
 } gk_vd_win;
@@ -715,6 +733,18 @@ GK_FORCE_INLINE void gk_vd_win_make(const int32_t *idx, int32_t n, gk_vd_win *w)
 GK_FORCE_INLINE gk_vd gk_vd_gather_win(const double *base, const int32_t *idx, const gk_vd_win *w) {
     (void)w;
     return gk_vd_gather(base, idx);
+}
+typedef struct gk_vf_win {
+    int ok;
+} gk_vf_win;
+GK_FORCE_INLINE void gk_vf_win_make(const int32_t *idx, int32_t n, gk_vf_win *w) {
+    (void)idx;
+    (void)n;
+    w->ok = 0;
+}
+GK_FORCE_INLINE gk_vf gk_vf_gather_win(const float *base, const int32_t *idx, const gk_vf_win *w) {
+    (void)w;
+    return gk_vf_gather(base, idx);
 }
 #endif
 
@@ -750,7 +780,9 @@ typedef gk_vfm gk_vrm;
 #define gk_vrm_bits gk_vfm_bits
 #define gk_vr_select gk_vf_select
 #define gk_vr_gather gk_vf_gather
-#define gk_vr_gather_win(base, idx, w) gk_vf_gather(base, idx) /* float: no window */
+typedef gk_vf_win gk_vr_win;
+#define gk_vr_win_make gk_vf_win_make
+#define gk_vr_gather_win gk_vf_gather_win
 #else
 typedef gk_vd gk_vr;
 typedef gk_vdm gk_vrm;
@@ -781,6 +813,8 @@ typedef gk_vdm gk_vrm;
 #define gk_vrm_bits gk_vdm_bits
 #define gk_vr_select gk_vd_select
 #define gk_vr_gather gk_vd_gather
+typedef gk_vd_win gk_vr_win;
+#define gk_vr_win_make gk_vd_win_make
 #define gk_vr_gather_win gk_vd_gather_win
 #endif
 

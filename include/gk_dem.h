@@ -1272,34 +1272,44 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
 #if GK_VR_W > 1
 /* The i side of a block of pairs (pl.i ascending) mostly spans fewer
  * particles than lanes: its gathers are then one load and a permutation each
- * (gk_vd_win in gk_base.h), the same values. Double only: in a float build a
- * gk_vr holds two double vectors of positions. */
-GK_FORCE_INLINE void gk__iwin_make(const int32_t *ii, int32_t n, gk_vd_win *w) {
+ * (gk_vd_win, gk_vf_win in gk_base.h), the same values. Positions are double:
+ * in a float build a block's positions are two double vectors, each with its
+ * own window, and the float arrays have theirs. */
+typedef struct gk__iwin {
+    gk_vd_win d[GK_VR_DHALVES]; /* positions */
 #ifdef GK_REAL_FLOAT
-    (void)ii;
-    (void)n;
-    w->ok = 0;
-#else
-    gk_vd_win_make(ii, n, w);
+    gk_vr_win r; /* the gk_real arrays */
+#endif
+} gk__iwin;
+GK_FORCE_INLINE void gk__iwin_make(const int32_t *ii, int32_t n, gk__iwin *w) {
+    int hf;
+    for (hf = 0; hf < GK_VR_DHALVES; ++hf) gk_vd_win_make(ii + hf * GK_VD_W, n, &w->d[hf]);
+#ifdef GK_REAL_FLOAT
+    gk_vr_win_make(ii, n, &w->r);
 #endif
 }
+#ifdef GK_REAL_FLOAT
+#define GK__GI(base, ii, w) gk_vr_gather_win(base, ii, &(w)->r)
+#else
+#define GK__GI(base, ii, w) gk_vr_gather_win(base, ii, &(w)->d[0])
+#endif
 
 /* branch vectors d = h (ds - round(ds)) of GK_VR_W pairs, from double
  * positions (the wide twin of gk_pcell_image); H = the cell matrix broadcast
  * once per call; wi the window of the i side */
 GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const int32_t *ii,
-                                     const int32_t *jj, const gk_vd_win *wi, int dim, gk_vr d[3]) {
+                                     const int32_t *jj, const gk__iwin *wi, int dim, gk_vr d[3]) {
     gk_vd dd[2][3];
     int hf, k;
     for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
         /* written out per axis: as a loop over k, gcc kept the loop and sent ds through the stack */
         const int32_t *i4 = ii + hf * GK_VD_W, *j4 = jj + hf * GK_VD_W;
-        gk_vd ds0 = gk_vd_sub(gk_vd_gather(rve->s[0], j4), gk_vd_gather_win(rve->s[0], i4, wi)),
-              ds1 = gk_vd_sub(gk_vd_gather(rve->s[1], j4), gk_vd_gather_win(rve->s[1], i4, wi));
+        gk_vd ds0 = gk_vd_sub(gk_vd_gather(rve->s[0], j4), gk_vd_gather_win(rve->s[0], i4, &wi->d[hf])),
+              ds1 = gk_vd_sub(gk_vd_gather(rve->s[1], j4), gk_vd_gather_win(rve->s[1], i4, &wi->d[hf]));
         ds0 = gk_vd_sub(ds0, gk_vd_round(ds0));
         ds1 = gk_vd_sub(ds1, gk_vd_round(ds1));
         if (dim == 3) {
-            gk_vd ds2 = gk_vd_sub(gk_vd_gather(rve->s[2], j4), gk_vd_gather_win(rve->s[2], i4, wi));
+            gk_vd ds2 = gk_vd_sub(gk_vd_gather(rve->s[2], j4), gk_vd_gather_win(rve->s[2], i4, &wi->d[hf]));
             ds2 = gk_vd_sub(ds2, gk_vd_round(ds2));
             GK_UNROLL
             for (k = 0; k < 3; ++k)
@@ -1414,21 +1424,21 @@ GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c
         gk_vr d[3], ri, rj, vx, vy, mi = zero, mj = zero, wi = wa, wj = wa, fh = zero, m = zero;
         gk_vrm in, slide;
         gk_contact_out_w o;
-        gk_vd_win win;
+        gk__iwin win;
         gk__iwin_make(ii, n, &win);
         gk__simd_branch(rve, H, ii, jj, &win, 2, d);
-        ri = gk_vr_gather_win(rve->r, ii, &win);
+        ri = GK__GI(rve->r, ii, &win);
         rj = gk_vr_gather(rve->r, jj);
-        vx = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[0], jj), gk_vr_gather_win(rve->v[0], ii, &win)),
+        vx = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[0], jj), GK__GI(rve->v[0], ii, &win)),
                        gk_vr_add(gk_vr_mul(G0, d[0]), gk_vr_mul(G1, d[1])));
-        vy = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[1], jj), gk_vr_gather_win(rve->v[1], ii, &win)),
+        vy = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[1], jj), GK__GI(rve->v[1], ii, &win)),
                        gk_vr_add(gk_vr_mul(G3, d[0]), gk_vr_mul(G4, d[1])));
         if (fl & GK_PHYS_VISCOUS) {
-            mi = gk_vr_div(one, gk_vr_gather_win(rve->minv, ii, &win));
+            mi = gk_vr_div(one, GK__GI(rve->minv, ii, &win));
             mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
         }
         if (fl & GK_PHYS_ROTATION) {
-            wi = gk_vr_add(wa, gk_vr_gather_win(rve->w[2], ii, &win));
+            wi = gk_vr_add(wa, GK__GI(rve->w[2], ii, &win));
             wj = gk_vr_add(wa, gk_vr_gather(rve->w[2], jj));
         }
         if (fl & GK_PHYS_TANGENT) fh = gk_vr_load(rve->ft[0] + c);
@@ -1485,23 +1495,23 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
         gk_vr d[3], v[3], wi[3], wj[3], fh[3], mh[3], ri, rj, mi = zero, mj = zero;
         gk_vrm in, slide;
         gk_contact_out_w o;
-        gk_vd_win win;
+        gk__iwin win;
         gk__iwin_make(ii, n, &win);
         gk__simd_branch(rve, H, ii, jj, &win, 3, d);
-        ri = gk_vr_gather_win(rve->r, ii, &win);
+        ri = GK__GI(rve->r, ii, &win);
         rj = gk_vr_gather(rve->r, jj);
         GK_UNROLL
         for (k = 0; k < 3; ++k) {
-            v[k] = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[k], jj), gk_vr_gather_win(rve->v[k], ii, &win)),
+            v[k] = gk_vr_add(gk_vr_sub(gk_vr_gather(rve->v[k], jj), GK__GI(rve->v[k], ii, &win)),
                              gk_vr_add(gk_vr_add(gk_vr_mul(G[3 * k], d[0]), gk_vr_mul(G[3 * k + 1], d[1])),
                                        gk_vr_mul(G[3 * k + 2], d[2])));
-            wi[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather_win(rve->w[k], ii, &win)) : wa[k];
+            wi[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], GK__GI(rve->w[k], ii, &win)) : wa[k];
             wj[k] = (fl & GK_PHYS_ROTATION) ? gk_vr_add(wa[k], gk_vr_gather(rve->w[k], jj)) : wa[k];
             fh[k] = (fl & GK_PHYS_TANGENT) ? gk_vr_load(rve->ft[k] + c) : zero;
             mh[k] = (fl & GK_PHYS_ROLLING) ? gk_vr_load(rve->mr[k] + c) : zero;
         }
         if (fl & GK_PHYS_VISCOUS) {
-            mi = gk_vr_div(one, gk_vr_gather_win(rve->minv, ii, &win));
+            mi = gk_vr_div(one, GK__GI(rve->minv, ii, &win));
             mj = gk_vr_div(one, gk_vr_gather(rve->minv, jj));
         }
         in = gk_contact_3d_w(&K, law, fl, d, ri, rj, mi, mj, v, wi, wj, dt, fh, mh, &slide, &o);
@@ -1534,6 +1544,7 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
     if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, b, fl & GK_PHYS_ROTATION);
     gk__forces_ref_3d(rve, x, c, c1, law, fl);
 }
+#undef GK__GI
 #endif /* GK_VR_W > 1 */
 
 /* instantiate a kernel with constant law and flags (pay only for what is on):

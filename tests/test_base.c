@@ -184,47 +184,61 @@ TEST(simd_lanes_match_scalar) {
     }
 }
 
-/* the window gather returns what the gather does for every index vector:
- * sorted ones within a window (the fast path where the width has it), ones
- * spanning exactly the lane count, unsorted and negative offsets, and a window
- * that would read past n; it takes its path only where that is allowed */
+/* index vectors of w lanes into an array of n for the window gathers' test:
+ * kind 0 sorted within a window, 1 sorted and spanning up to twice the lane
+ * count, 2 unsorted, 3 sorted from near the array's end */
+static void window_indices(gk_rng *rng, int kind, int t, int w, int n, int32_t *idx) {
+    int l, at = (int)(gk_rng_uniform(rng) * (n - 1));
+    for (l = 0; l < w; ++l) {
+        int step = (int)(gk_rng_uniform(rng) * (kind == 0 ? 1.6 : 3.0));
+        idx[l] = (int32_t)(kind == 2 ? gk_rng_uniform(rng) * n : (l == 0 ? at : idx[l - 1] + step));
+        if (idx[l] >= n) idx[l] = n - 1;
+    }
+    if (kind == 3) idx[0] = (int32_t)(n - 1 - (t / 4) % w);
+}
+
+/* the window gathers return what the gathers do for every index vector, and
+ * take their path only where every lane lies in [idx[0], idx[0] + lanes) and
+ * the window ends inside the array (here at N) */
 TEST(window_gather_equals_gather) {
     enum { N = 40 };
     double a[N];
-    int32_t idx[GK_VD_W];
+    float b[N];
+    int32_t idx[GK_VF_W];
     gk_rng rng;
-    int k, l, t, fast = 0;
-    for (k = 0; k < N; ++k) a[k] = 1.0 / (k + 1.5) - 0.25 * k;
+    int k, l, t, fast_d = 0, fast_f = 0;
+    for (k = 0; k < N; ++k) a[k] = 1.0 / (k + 1.5) - 0.25 * k, b[k] = (float)a[k];
     gk_rng_seed(&rng, 17);
     for (t = 0; t < 4000; ++t) {
         double got[GK_VD_W];
-        int kind = t % 4, at = (int)(gk_rng_uniform(&rng) * (N - 1)), lo = N, hi = -1;
         gk_vd_win w;
-        for (l = 0; l < GK_VD_W; ++l) {
-            int step = (int)(gk_rng_uniform(&rng) * (kind == 0 ? 1.6 : 3.0));
-            if (kind == 2) /* unsorted, anywhere */
-                idx[l] = (int32_t)(gk_rng_uniform(&rng) * N);
-            else /* non-decreasing from at (kind 1 and 3 may span the lane count or more) */
-                idx[l] = (int32_t)(l == 0 ? at : idx[l - 1] + step);
-            if (idx[l] >= N) idx[l] = N - 1;
-            if (idx[l] < lo) lo = idx[l];
-            if (idx[l] > hi) hi = idx[l];
-        }
-        if (kind == 3) idx[0] = (int32_t)(N - 1 - (t / 4) % GK_VD_W); /* near the end of the array */
+        window_indices(&rng, t % 4, t, GK_VD_W, N, idx);
         gk_vd_win_make(idx, N, &w);
         gk_vd_storeu(got, gk_vd_gather_win(a, idx, &w));
         for (l = 0; l < GK_VD_W; ++l) CHECK(got[l] == a[idx[l]]);
         if (w.ok) {
-            ++fast;
-            lo = idx[0];
-            for (l = 0; l < GK_VD_W; ++l) CHECK(idx[l] >= lo && idx[l] < lo + GK_VD_W);
+            ++fast_d;
+            for (l = 0; l < GK_VD_W; ++l) CHECK(idx[l] >= idx[0] && idx[l] < idx[0] + GK_VD_W);
             CHECK(idx[0] + GK_VD_W <= N);
         }
     }
+    for (t = 0; t < 4000; ++t) {
+        float got[GK_VF_W];
+        gk_vf_win w;
+        window_indices(&rng, t % 4, t, GK_VF_W, N, idx);
+        gk_vf_win_make(idx, N, &w);
+        gk_vf_storeu(got, gk_vf_gather_win(b, idx, &w));
+        for (l = 0; l < GK_VF_W; ++l) CHECK(got[l] == b[idx[l]]);
+        if (w.ok) {
+            ++fast_f;
+            for (l = 0; l < GK_VF_W; ++l) CHECK(idx[l] >= idx[0] && idx[l] < idx[0] + GK_VF_W);
+            CHECK(idx[0] + GK_VF_W <= N);
+        }
+    }
 #ifdef GK_VD_HAS_WIN
-    CHECK(fast > 500); /* the window is taken where it may be */
+    CHECK(fast_d > 500 && fast_f > 500); /* the windows are taken where they may be */
 #else
-    CHECK(fast == 0);
+    CHECK(fast_d == 0 && fast_f == 0);
 #endif
 }
 
