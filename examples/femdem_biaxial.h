@@ -125,7 +125,7 @@ static int fdb_part_read(fd_model *M, fd_buf *B, const fd_ck *ck, void *user, ch
         return snprintf(why, nwhy, "the driver's block has the wrong length"), 1;
     if (!(p->ulast = (double *)malloc(n * sizeof(double) + 1)) ||
         !(p->hist = (double *)malloc((size_t)ck->nc * nh * sizeof(double) + 1)))
-        return snprintf(why, nwhy, "out of memory"), 1;
+        return snprintf(why, nwhy, "out of memory"), 2;
     fd_get(B, &p->inclast, sizeof(double)), fd_get(B, p->ulast, n * sizeof(double));
     fd_get(B, p->hist, (size_t)ck->nc * nh * sizeof(double));
     if (!(fabs(p->inclast) <= 1.0) || (p->inclast != 0.0 && !(fabs(p->inclast) >= 1e-12)) ||

@@ -211,7 +211,7 @@ static int cyc_part_read(fd_model *M, fd_buf *B, const fd_ck *ck, void *user, ch
         return snprintf(why, nwhy, "the driver's block has the wrong length"), 1;
     p->cap = ck->nc + 16; /* the model's curve capacity after fd_ck_apply */
     if (!(p->cx = (cyc_extra *)malloc((size_t)p->cap * sizeof *p->cx)))
-        return snprintf(why, nwhy, "out of memory"), 1;
+        return snprintf(why, nwhy, "out of memory"), 2;
     fd_get(B, &cs, sizeof cs), fd_get(B, p->cx, (size_t)ck->nc * sizeof *p->cx);
     d[0] = cs.gamma, d[1] = cs.g_start, d[2] = cs.t_start, d[3] = cs.tau, d[4] = cs.h, d[5] = cs.p0;
     d[6] = cs.cyc_liq, d[7] = cs.cyc_gamma, d[8] = cs.G0, d[9] = cs.Gu;

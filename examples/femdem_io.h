@@ -313,7 +313,7 @@ static int fd_ck_apply(fd_model *M, fd_ck *ck, gk_err *err) {
 }
 
 /* the driver's own part of its block (after the model's), read from B, checked, and kept in user: 0,
- * or 1 with the reason in why; nothing of the model written (fd_ck_load) */
+ * or 1 (refused) or 2 (out of memory) with the reason in why; nothing of the model written (fd_ck_load) */
 typedef int (*fd_part_fn)(fd_model *M, fd_buf *B, const fd_ck *ck, void *user, char *why, size_t nwhy);
 
 typedef struct fd_take {
@@ -333,7 +333,7 @@ static int fd_take_block(const void *blk, size_t nb, void *user, char *why, size
     fd_buf B;
     fd_ck ck;
     char tg[16];
-    int nx, ny, quad, ok;
+    int nx, ny, quad, ok, pr = 0;
     gk_elem_type el;
     gk_err e;
     memset(&B, 0, sizeof B);
@@ -362,8 +362,9 @@ static int fd_take_block(const void *blk, size_t nb, void *user, char *why, size
     }
     ok = ok && !fd_get(&B, ck.rows, (size_t)ck.nc * sizeof(fd_row)) && !fd_get(&B, ck.v, nv * sizeof(double));
     if (!ok) snprintf(why, nwhy, "the driver's block is truncated");
-    if (!ok || fd_ck_check(M, &ck, why, nwhy) || t->part(M, &B, &ck, t->user, why, nwhy)) {
+    if (!ok || fd_ck_check(M, &ck, why, nwhy) || (pr = t->part(M, &B, &ck, t->user, why, nwhy)) != 0) {
         fd_ck_free(&ck), free(B.b);
+        if (pr == 2) t->oom = 1;
         return 1;
     }
     free(B.b);
