@@ -209,7 +209,7 @@ static int cyc_part_read(fd_model *M, fd_buf *B, const fd_ck *ck, void *user, ch
     (void)M;
     if (B->n - B->pos != sizeof cs + (size_t)ck->nc * sizeof(cyc_extra))
         return snprintf(why, nwhy, "the driver's block has the wrong length"), 1;
-    p->cap = ck->nc + 16; /* the model's curve capacity after fd_ck_apply */
+    p->cap = ck->nc + FD_CK_ROOM; /* the model's curve capacity after fd_ck_apply */
     if (!(p->cx = (cyc_extra *)malloc((size_t)p->cap * sizeof *p->cx)))
         return snprintf(why, nwhy, "out of memory"), 2;
     fd_get(B, &cs, sizeof cs), fd_get(B, p->cx, (size_t)ck->nc * sizeof *p->cx);

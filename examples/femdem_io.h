@@ -297,12 +297,15 @@ static int fd_ck_check(const fd_model *M, const fd_ck *ck, char *why, size_t nwh
     return 0;
 }
 
+/* rows of room in the curve after a restart (fd_ck_apply; a driver's per-row arrays take as many) */
+#define FD_CK_ROOM 16
+
 /* ck into the model (and freed); 0, or 1 (out of memory: the model as it was, err set) */
 static int fd_ck_apply(fd_model *M, fd_ck *ck, gk_err *err) {
     size_t n = (size_t)M->ndof, g9 = 9 * (size_t)M->ngp;
-    fd_row *c = (fd_row *)realloc(M->curve, ((size_t)ck->nc + 16) * sizeof *c);
+    fd_row *c = (fd_row *)realloc(M->curve, ((size_t)ck->nc + FD_CK_ROOM) * sizeof *c);
     if (!c) return fd_ck_free(ck), gk_err_set(err, GK_ERR_ALLOC, "out of memory"), 1;
-    M->curve = c, M->cap = ck->nc + 16, M->ncurve = ck->nc;
+    M->curve = c, M->cap = ck->nc + FD_CK_ROOM, M->ncurve = ck->nc;
     memcpy(M->curve, ck->rows, (size_t)ck->nc * sizeof(fd_row));
     M->step = ck->step, M->eps_done = ck->eps, M->scale = ck->scale;
     memcpy(M->mesh.x, ck->v, n * sizeof(double)), memcpy(M->utot, ck->v + n, n * sizeof(double));
