@@ -31,9 +31,6 @@
 #undef main
 #include "fuzz_check.h"
 #include "fuzz_fd.h"
-#include <errno.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 static cyc_model C;
 static char in_dir[400], ref_dir[400], out_dir[400], pk_path[400];
@@ -43,15 +40,7 @@ static double *acc0; /* the pristine set's accepted stresses */
 static int ready;
 
 static void cleanup(void) {
-    static const char *files[2] = {"checkpoint.bin", "cyclic.csv"};
-    const char *dirs[3] = {in_dir, ref_dir, out_dir};
-    char p[600];
-    int d, f;
-    for (d = 0; d < 3; ++d) {
-        for (f = 0; f < 2; ++f) snprintf(p, sizeof p, "%s/%s", dirs[d], files[f]), remove(p);
-        rmdir(dirs[d]);
-    }
-    remove(pk_path);
+    fuzz_remove_dir(in_dir), fuzz_remove_dir(ref_dir), fuzz_remove_dir(out_dir), remove(pk_path);
     if (ready) free(C.cx), fd_free(&C.m), free(snap0), free(acc0);
 }
 
@@ -76,11 +65,6 @@ static int same_as_pristine(void) {
     return same;
 }
 
-static void make_dir(char *dir, size_t cap, const char *tmp, const char *what) {
-    snprintf(dir, cap, "%s/gk_fuzz_cyclic_%ld_%s", tmp, (long)getpid(), what);
-    FUZZ_CHECK(mkdir(dir, 0777) == 0 || errno == EEXIST);
-}
-
 /* back to the pristine checkpoint */
 static void restore(void) {
     gk_err err;
@@ -96,9 +80,9 @@ static void setup(void) {
     int help = 0;
     if (ready) return;
     if (!tmp || !*tmp) tmp = "/tmp";
-    make_dir(in_dir, sizeof in_dir, tmp, "in");
-    make_dir(ref_dir, sizeof ref_dir, tmp, "ref");
-    make_dir(out_dir, sizeof out_dir, tmp, "out");
+    fuzz_temp_dir(in_dir, sizeof in_dir, "cyclic", "in");
+    fuzz_temp_dir(ref_dir, sizeof ref_dir, "cyclic", "ref");
+    fuzz_temp_dir(out_dir, sizeof out_dir, "cyclic", "out");
     snprintf(pk_path, sizeof pk_path, "%s/gk_fuzz_cyclic_%ld.pk", tmp, (long)getpid());
     atexit(cleanup);
     fuzz_small_packing(pk_path, "fuzz_cyclic_ckpt", 1e5, &def); /* 12 disks consolidated to 100 kPa */

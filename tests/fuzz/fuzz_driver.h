@@ -1,13 +1,24 @@
-/* fuzz_driver.h - what the harnesses that run a driver share: removing their temporary folders, the
- * driver's output off around a call (stdout to /dev/null, stderr to a file whose length then says
- * whether the driver gave a message), the RVE set's accepted stresses (a refused checkpoint must
- * leave them as they were), their small packing and their model's bytes. Include after the driver (gk_twoscale.h), with _POSIX_C_SOURCE defined. */
+/* fuzz_driver.h - what the harnesses that run a driver share: making and removing their temporary
+ * folders, the driver's output off around a call (stdout to /dev/null, stderr to a file whose length
+ * then says whether the driver gave a message), the RVE set's accepted stresses (a refused checkpoint
+ * must leave them as they were), their small packing and their model's bytes. Include after the
+ * driver (gk_twoscale.h), with _POSIX_C_SOURCE defined. */
 #ifndef FUZZ_DRIVER_H
 #define FUZZ_DRIVER_H
 #include "fuzz_check.h"
 #include <dirent.h>
+#include <errno.h>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+/* dir (cap bytes) = $TMPDIR (default /tmp)/gk_fuzz_NAME_PID_WHAT, made */
+static inline void fuzz_temp_dir(char *dir, size_t cap, const char *name, const char *what) {
+    const char *tmp = getenv("TMPDIR");
+    if (!tmp || !*tmp) tmp = "/tmp";
+    snprintf(dir, cap, "%s/gk_fuzz_%s_%ld_%s", tmp, name, (long)getpid(), what);
+    FUZZ_CHECK(mkdir(dir, 0777) == 0 || errno == EEXIST);
+}
 
 /* every file of dir, then dir */
 static inline void fuzz_remove_dir(const char *dir) {

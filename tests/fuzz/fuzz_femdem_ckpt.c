@@ -49,15 +49,7 @@ static double *acc0; /* the pristine set's accepted stresses */
 static int ready;
 
 static void cleanup(void) {
-    static const char *files[2] = {"checkpoint.bin", "biaxial.csv"};
-    const char *dirs[3] = {in_dir, ref_dir, out_dir};
-    char p[600];
-    int d, f;
-    for (d = 0; d < 3; ++d) {
-        for (f = 0; f < 2; ++f) snprintf(p, sizeof p, "%s/%s", dirs[d], files[f]), remove(p);
-        rmdir(dirs[d]);
-    }
-    remove(pk_path);
+    fuzz_remove_dir(in_dir), fuzz_remove_dir(ref_dir), fuzz_remove_dir(out_dir), remove(pk_path);
     if (ready) fd_free(&M), free(snap0), free(acc0);
 }
 
@@ -85,11 +77,6 @@ static int same_as_pristine(void) {
     return same;
 }
 
-static void make_dir(char *dir, size_t cap, const char *tmp, const char *what) {
-    snprintf(dir, cap, "%s/gk_fuzz_femdem_%ld_%s", tmp, (long)getpid(), what);
-    FUZZ_CHECK(mkdir(dir, 0777) == 0 || errno == EEXIST);
-}
-
 /* back to the pristine checkpoint */
 static void restore(void) {
     gk_err err;
@@ -104,9 +91,9 @@ static void setup(void) {
     gk_err err;
     if (ready) return;
     if (!tmp || !*tmp) tmp = "/tmp";
-    make_dir(in_dir, sizeof in_dir, tmp, "in");
-    make_dir(ref_dir, sizeof ref_dir, tmp, "ref");
-    make_dir(out_dir, sizeof out_dir, tmp, "out");
+    fuzz_temp_dir(in_dir, sizeof in_dir, "femdem", "in");
+    fuzz_temp_dir(ref_dir, sizeof ref_dir, "femdem", "ref");
+    fuzz_temp_dir(out_dir, sizeof out_dir, "femdem", "out");
     snprintf(pk_path, sizeof pk_path, "%s/gk_fuzz_femdem_%ld.pk", tmp, (long)getpid());
     atexit(cleanup);
     fuzz_small_packing(pk_path, "fuzz_femdem_ckpt", 1e5, &def); /* 12 disks consolidated to 100 kPa */
