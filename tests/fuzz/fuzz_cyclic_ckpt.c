@@ -74,16 +74,14 @@ static void restore(void) {
 }
 
 static void setup(void) {
-    const char *tmp = getenv("TMPDIR");
     gk_rve_def def = gk_rve_def_default();
     gk_err err;
     int help = 0;
     if (ready) return;
-    if (!tmp || !*tmp) tmp = "/tmp";
     fuzz_temp_dir(in_dir, sizeof in_dir, "cyclic", "in");
     fuzz_temp_dir(ref_dir, sizeof ref_dir, "cyclic", "ref");
     fuzz_temp_dir(out_dir, sizeof out_dir, "cyclic", "out");
-    snprintf(pk_path, sizeof pk_path, "%s/gk_fuzz_cyclic_%ld.pk", tmp, (long)getpid());
+    fuzz_temp_path(pk_path, sizeof pk_path, "cyclic", "pk");
     atexit(cleanup);
     fuzz_small_packing(pk_path, "fuzz_cyclic_ckpt", 1e5, &def); /* 12 disks consolidated to 100 kPa */
     {

@@ -135,20 +135,16 @@ static void restore(void) {
 }
 
 static void fuzz_setup(void) {
-    const char *tmp = getenv("TMPDIR");
     gk_rve_def def = gk_rve_def_default();
     char *argv[40];
     int argc, rc;
     size_t nd, g9;
     if (ready) return;
-    if (!tmp || !*tmp) tmp = "/tmp";
-    snprintf(in_dir, sizeof in_dir, "%s/gk_fuzz_dr_%ld_in", tmp, (long)getpid());
-    snprintf(ref_dir, sizeof ref_dir, "%s/gk_fuzz_dr_%ld_ref", tmp, (long)getpid());
-    snprintf(out_dir, sizeof out_dir, "%s/gk_fuzz_dr_%ld_out", tmp, (long)getpid());
-    snprintf(pk_path, sizeof pk_path, "%s/gk_fuzz_dr_%ld.pk", tmp, (long)getpid());
-    snprintf(cap_path, sizeof cap_path, "%s/gk_fuzz_dr_%ld.stderr", tmp, (long)getpid());
-    FUZZ_CHECK(mkdir(in_dir, 0777) == 0 || errno == EEXIST);
-    FUZZ_CHECK(mkdir(out_dir, 0777) == 0 || errno == EEXIST);
+    fuzz_temp_dir(in_dir, sizeof in_dir, "dr", "in");
+    fuzz_temp_dir(ref_dir, sizeof ref_dir, "dr", "ref");
+    fuzz_temp_dir(out_dir, sizeof out_dir, "dr", "out");
+    fuzz_temp_path(pk_path, sizeof pk_path, "dr", "pk");
+    fuzz_temp_path(cap_path, sizeof cap_path, "dr", "stderr");
     atexit(cleanup);
     fuzz_quiet_open(cap_path);
     fuzz_small_packing(pk_path, "fuzz_dr_ckpt", 1e5, &def); /* 12 disks consolidated to 100 kPa */
@@ -166,7 +162,6 @@ static void fuzz_setup(void) {
     memset(&M, 0, sizeof M);
     dr_opts_default(&M.o);
     FUZZ_CHECK(parse(argc, argv, &M.o) == 0);
-    FUZZ_CHECK(mkdir(M.o.out, 0777) == 0 || errno == EEXIST);
     M.t0 = gk_wtime();
     fuzz_quiet_begin();
     rc = setup(&M);

@@ -12,12 +12,21 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-/* dir (cap bytes) = $TMPDIR (default /tmp)/gk_fuzz_NAME_PID_WHAT, made */
-static inline void fuzz_temp_dir(char *dir, size_t cap, const char *name, const char *what) {
+/* $TMPDIR, default /tmp */
+static inline const char *fuzz_tmp_root(void) {
     const char *tmp = getenv("TMPDIR");
-    if (!tmp || !*tmp) tmp = "/tmp";
-    snprintf(dir, cap, "%s/gk_fuzz_%s_%ld_%s", tmp, name, (long)getpid(), what);
+    return tmp && *tmp ? tmp : "/tmp";
+}
+
+/* dir (cap bytes) = $TMPDIR/gk_fuzz_NAME_PID_WHAT, made */
+static inline void fuzz_temp_dir(char *dir, size_t cap, const char *name, const char *what) {
+    snprintf(dir, cap, "%s/gk_fuzz_%s_%ld_%s", fuzz_tmp_root(), name, (long)getpid(), what);
     FUZZ_CHECK(mkdir(dir, 0777) == 0 || errno == EEXIST);
+}
+
+/* path (cap bytes) = $TMPDIR/gk_fuzz_NAME_PID.EXT (a file; not made) */
+static inline void fuzz_temp_path(char *path, size_t cap, const char *name, const char *ext) {
+    snprintf(path, cap, "%s/gk_fuzz_%s_%ld.%s", fuzz_tmp_root(), name, (long)getpid(), ext);
 }
 
 /* every file of dir, then dir */

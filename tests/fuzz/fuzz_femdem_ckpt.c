@@ -86,15 +86,13 @@ static void restore(void) {
 }
 
 static void setup(void) {
-    const char *tmp = getenv("TMPDIR");
     gk_rve_def def = gk_rve_def_default();
     gk_err err;
     if (ready) return;
-    if (!tmp || !*tmp) tmp = "/tmp";
     fuzz_temp_dir(in_dir, sizeof in_dir, "femdem", "in");
     fuzz_temp_dir(ref_dir, sizeof ref_dir, "femdem", "ref");
     fuzz_temp_dir(out_dir, sizeof out_dir, "femdem", "out");
-    snprintf(pk_path, sizeof pk_path, "%s/gk_fuzz_femdem_%ld.pk", tmp, (long)getpid());
+    fuzz_temp_path(pk_path, sizeof pk_path, "femdem", "pk");
     atexit(cleanup);
     fuzz_small_packing(pk_path, "fuzz_femdem_ckpt", 1e5, &def); /* 12 disks consolidated to 100 kPa */
     /* the model: the driver's defaults, its single-element test, one load step */

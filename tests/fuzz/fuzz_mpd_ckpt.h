@@ -26,7 +26,6 @@
 #define FUZZ_MPD_CKPT_H
 #include "fuzz_driver.h"
 #include <stddef.h>
-#include <sys/stat.h>
 
 static char in_dir[400], ref_dir[400], out_dir[400], pk_path[400];
 static unsigned char *snap0; /* the pristine run's block */
@@ -69,18 +68,14 @@ static void restore(void) {
 }
 
 static void fuzz_setup(void) {
-    const char *tmp = getenv("TMPDIR");
     char *argv[64];
     int argc = 0;
     (void)fz_seed_at; /* the seeds' (FUZZ_MAKE_SEEDS) */
     if (ready) return;
-    if (!tmp || !*tmp) tmp = "/tmp";
-    snprintf(in_dir, sizeof in_dir, "%s/gk_fuzz_" FZ_NAME "_%ld_in", tmp, (long)getpid());
-    snprintf(ref_dir, sizeof ref_dir, "%s/gk_fuzz_" FZ_NAME "_%ld_ref", tmp, (long)getpid());
-    snprintf(out_dir, sizeof out_dir, "%s/gk_fuzz_" FZ_NAME "_%ld_out", tmp, (long)getpid());
-    snprintf(pk_path, sizeof pk_path, "%s/gk_fuzz_" FZ_NAME "_%ld.pk", tmp, (long)getpid());
-    FUZZ_CHECK(mkdir(in_dir, 0777) == 0 || errno == EEXIST);
-    FUZZ_CHECK(mkdir(out_dir, 0777) == 0 || errno == EEXIST);
+    fuzz_temp_dir(in_dir, sizeof in_dir, FZ_NAME, "in");
+    fuzz_temp_dir(ref_dir, sizeof ref_dir, FZ_NAME, "ref");
+    fuzz_temp_dir(out_dir, sizeof out_dir, FZ_NAME, "out");
+    fuzz_temp_path(pk_path, sizeof pk_path, FZ_NAME, "pk");
     atexit(cleanup);
     fuzz_small_packing(pk_path, "fuzz_" FZ_NAME "_ckpt", 0.0, NULL); /* RVEs of 12 disks: small, fast */
     for (argc = 0; fz_args[argc]; ++argc) argv[argc] = (char *)fz_args[argc];

@@ -117,7 +117,6 @@ static void free_all(void) {
 }
 
 static void fuzz_setup(void) {
-    const char *tmp = getenv("TMPDIR");
     gk_packing pk, out;
     gk_gen_def g;
     gk_rve rve;
@@ -127,12 +126,10 @@ static void fuzz_setup(void) {
     char *argv[48];
     int argc, rc;
     if (ready) return;
-    if (!tmp || !*tmp) tmp = "/tmp";
-    snprintf(in_dir, sizeof in_dir, "%s/gk_fuzz_nonlocal_%ld_in", tmp, (long)getpid());
-    snprintf(ref_dir, sizeof ref_dir, "%s/gk_fuzz_nonlocal_%ld_ref", tmp, (long)getpid());
-    snprintf(pk_path, sizeof pk_path, "%s/gk_fuzz_nonlocal_%ld.pk", tmp, (long)getpid());
-    snprintf(cap_path, sizeof cap_path, "%s/gk_fuzz_nonlocal_%ld.stderr", tmp, (long)getpid());
-    FUZZ_CHECK(mkdir(in_dir, 0777) == 0 || errno == EEXIST);
+    fuzz_temp_dir(in_dir, sizeof in_dir, "nonlocal", "in");
+    fuzz_temp_dir(ref_dir, sizeof ref_dir, "nonlocal", "ref");
+    fuzz_temp_path(pk_path, sizeof pk_path, "nonlocal", "pk");
+    fuzz_temp_path(cap_path, sizeof cap_path, "nonlocal", "stderr");
     atexit(cleanup);
     fuzz_quiet_open(cap_path);
     {
