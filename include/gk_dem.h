@@ -179,7 +179,9 @@
  * one RVE never uses threads, default 20000), GK_DEM_GATHER_MAX (pairs up to
  * which one thread stores the pair forces and gathers each particle's sum
  * instead of scattering them in the force loop: the same bits, and faster
- * while the pair arrays stay in the core's cache; default 32768),
+ * while the pair arrays stay in the core's cache; default 32768; threads
+ * gather 2D lists longer than that through a fixed number of branch-free
+ * slots per particle, the same bits again),
  * GK_RVE_STEP_OVERLAP_MAX (the admissible overlap change per DEM step as a
  * fraction of the smaller radius, default 0.1). An RVE holds at most
  * GK_RVE_MAX_PARTICLES (2^26): its pair lists are int32.
@@ -632,8 +634,12 @@ static size_t gk__grown(size_t have, size_t need) {
     return c;
 }
 
-/* per-pair arrays for cap pairs, copying the first ncopy */
+/* room kept after the last pair: the gather's padded slots (gk__reduce_kernel) */
+#define GK__PAIR_PAD 8
+
+/* per-pair arrays for cap pairs (and GK__PAIR_PAD more), copying the first ncopy */
 static gk_result gk__pairs_reserve(gk_rve *rve, size_t cap, size_t ncopy) {
+    cap += GK__PAIR_PAD;
     if (cap <= rve->pcap) return GK_OK;
     cap = gk__grown(rve->pcap, cap);
     if (gk__fields_grow(rve, GK__PAIR, 0, cap, ncopy)) return GK_ERR_ALLOC;
@@ -643,6 +649,7 @@ static gk_result gk__pairs_reserve(gk_rve *rve, size_t cap, size_t ncopy) {
 
 /* the spare per-pair arrays (same set as the current ones) for cap pairs */
 static gk_result gk__spare_reserve(gk_rve *rve, size_t cap) {
+    cap += GK__PAIR_PAD;
     if (cap <= rve->spare.cap) return GK_OK;
     cap = gk__grown(rve->spare.cap, cap);
     if (gk__fields_grow(rve, GK__PAIR, 1, cap, 0)) return GK_ERR_ALLOC;
@@ -666,6 +673,8 @@ static void gk__pair_index(gk_rve *rve) {
     for (c = 0; c < rve->pl.n; ++c) rve->jlist[rve->jstart[rve->pl.j[c]]++] = c;
     for (p = n; p > 0; --p) rve->jstart[p] = rve->jstart[p - 1];
     rve->jstart[0] = 0;
+    if (rve->pcap >= (size_t)rve->pl.n + GK__PAIR_PAD)
+        for (c = rve->pl.n; c < rve->pl.n + GK__PAIR_PAD; ++c) rve->jlist[c] = rve->pl.n;
     rve->pl.np = n;
 }
 
@@ -1598,7 +1607,8 @@ static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) 
 
 static int gk__nthreads(const gk_rve *rve);
 
-static void gk__reduce_range(gk_rve *rve, int p0, int p1);
+static void gk__reduce_range(gk_rve *rve, int p0, int p1, int pad);
+static int gk__reduce_pad(gk_rve *rve);
 
 /* pair forces and their per-particle sums (f, t) for this step. Threads, and
  * one thread on up to GK_DEM_GATHER_MAX pairs, store per-pair forces and
@@ -1612,7 +1622,7 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
         x->scatter = 0;
         x->store = 1;
         gk__forces_range(rve, x, 0, nc);
-        gk__reduce_range(rve, 0, rve->n);
+        gk__reduce_range(rve, 0, rve->n, 0);
     } else if (nth <= 1) {
         x->scatter = 1;
         x->store = want_store;
@@ -1622,7 +1632,7 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
         }
         gk__forces_range(rve, x, 0, nc);
     } else {
-        int b, n = rve->n;
+        int b, n = rve->n, pad = gk__reduce_pad(rve);
         x->scatter = 0;
         x->store = 1;
         GK_OMP(parallel for num_threads(nth) schedule(static))
@@ -1635,7 +1645,7 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
         GK_OMP(parallel for num_threads(nth) schedule(static))
         for (b = 0; b < nth * 4; ++b) {
             long p0 = (long)n * b / (nth * 4), p1 = (long)n * (b + 1) / (nth * 4);
-            gk__reduce_range(rve, (int)p0, (int)p1);
+            gk__reduce_range(rve, (int)p0, (int)p1, pad);
         }
     }
 }
@@ -1645,58 +1655,84 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
  * cells away); fetching them this many entries ahead made a 10^5-sphere
  * step on 2 threads about 10 % faster (bench/README.md). 2D gained nothing. */
 #define GK__REDUCE_AHEAD 16
+/* 2D lists above GK_DEM_GATHER_MAX pairs: the slots per side (pairs where p
+ * is j, where it is i) that a particle's gather reads without a branch on its
+ * pair count; beyond them a loop. On such lists the branch predictor cannot
+ * learn every particle's count, and a mispredicted loop exit costs more than
+ * reading the padding (bench/README.md). */
+#define GK__GATHER_SLOTS_2D 3
 
 /* Per-particle sums of the pair forces in the fixed order (pairs where p is j,
  * ascending; then pairs where p is i, ascending), by gathering: used with
  * threads and for small lists. A single thread on a large list scatters inside
  * the force loop instead (gk__scatter_*), in pair order, which is the same
- * order and so gives the same bits. */
-GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int dim, const int rot) {
+ * order and so gives the same bits. K > 0: the first K pairs of each side
+ * are read without a branch on the particle's count (gk__reduce_pad must
+ * have said yes); K = 0: plain loops. */
+GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int dim, const int rot, const int K) {
     const int32_t *GK_RESTRICT start = rve->pl.start, *GK_RESTRICT jst = rve->jstart,
                                *GK_RESTRICT jl = rve->jlist;
     const gk_real *fc0 = rve->fc[0], *fc1 = rve->fc[1], *fc2 = dim == 3 ? rve->fc[2] : NULL;
     gk_real *f0 = rve->f[0], *f1 = rve->f[1], *f2 = dim == 3 ? rve->f[2] : NULL;
-    const int32_t jend = jst[rve->n];
-    int p, e, k;
+    const int32_t jend = jst[rve->n], nc = rve->pl.n;
+    int p, e, k, q;
+#define GK__RJ(c)                                                          \
+    do {                                                                   \
+        a0 += fc0[c];                                                      \
+        a1 += fc1[c];                                                      \
+        if (dim == 3) a2 += fc2[c];                                        \
+        if (rot) {                                                         \
+            if (dim == 2)                                                  \
+                t[2] += rve->tcj[2][c];                                    \
+            else {                                                         \
+                GK_UNROLL                                                  \
+                for (k = 0; k < 3; ++k) t[k] += rve->tcj[k][c];            \
+            }                                                              \
+        }                                                                  \
+    } while (0)
+#define GK__RI(c)                                                          \
+    do {                                                                   \
+        a0 -= fc0[c];                                                      \
+        a1 -= fc1[c];                                                      \
+        if (dim == 3) a2 -= fc2[c];                                        \
+        if (rot) {                                                         \
+            if (dim == 2)                                                  \
+                t[2] += rve->tci[2][c];                                    \
+            else {                                                         \
+                GK_UNROLL                                                  \
+                for (k = 0; k < 3; ++k) t[k] += rve->tci[k][c];            \
+            }                                                              \
+        }                                                                  \
+    } while (0)
     for (p = p0; p < p1; ++p) {
         gk_real a0 = 0, a1 = 0, a2 = 0, t[3] = {0, 0, 0};
-        for (e = jst[p]; e < jst[p + 1]; ++e) {
+        const int e0 = jst[p], e1 = jst[p + 1], s0 = start[p], s1 = start[p + 1];
+        /* a slot past the particle's pairs reads pair nc, whose force and
+         * torques are +0: a sum started at +0 is never -0, so adding or
+         * subtracting +0 changes no bit */
+        for (q = 0; q < K; ++q) {
+            const int32_t cj = jl[e0 + q], c = e0 + q < e1 ? cj : nc;
+            GK__RJ(c);
+        }
+        for (e = e0 + K; e < e1; ++e) {
             int c = jl[e];
             if (dim == 3 && e + GK__REDUCE_AHEAD < jend) {
-                int q = jl[e + GK__REDUCE_AHEAD];
-                GK_PREFETCH(fc0 + q);
-                GK_PREFETCH(fc1 + q);
-                GK_PREFETCH(fc2 + q);
+                int r = jl[e + GK__REDUCE_AHEAD];
+                GK_PREFETCH(fc0 + r);
+                GK_PREFETCH(fc1 + r);
+                GK_PREFETCH(fc2 + r);
                 if (rot) {
                     GK_UNROLL
-                    for (k = 0; k < 3; ++k) GK_PREFETCH(rve->tcj[k] + q);
+                    for (k = 0; k < 3; ++k) GK_PREFETCH(rve->tcj[k] + r);
                 }
             }
-            a0 += fc0[c];
-            a1 += fc1[c];
-            if (dim == 3) a2 += fc2[c];
-            if (rot) {
-                if (dim == 2)
-                    t[2] += rve->tcj[2][c];
-                else {
-                    GK_UNROLL
-                    for (k = 0; k < 3; ++k) t[k] += rve->tcj[k][c];
-                }
-            }
+            GK__RJ(c);
         }
-        for (e = start[p]; e < start[p + 1]; ++e) {
-            a0 -= fc0[e];
-            a1 -= fc1[e];
-            if (dim == 3) a2 -= fc2[e];
-            if (rot) {
-                if (dim == 2)
-                    t[2] += rve->tci[2][e];
-                else {
-                    GK_UNROLL
-                    for (k = 0; k < 3; ++k) t[k] += rve->tci[k][e];
-                }
-            }
+        for (q = 0; q < K; ++q) {
+            const int32_t c = s0 + q < s1 ? s0 + q : nc;
+            GK__RI(c);
         }
+        for (e = s0 + K; e < s1; ++e) GK__RI(e);
         f0[p] = a0;
         f1[p] = a1;
         if (dim == 3) f2[p] = a2;
@@ -1709,20 +1745,38 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
             }
         }
     }
+#undef GK__RJ
+#undef GK__RI
 }
 
-static void gk__reduce_range(gk_rve *rve, int p0, int p1) {
+/* whether the gather reads padded slots (2D lists above GK_DEM_GATHER_MAX
+ * pairs); if so the pair nc (one past the last) is made its zero pair */
+static int gk__reduce_pad(gk_rve *rve) {
+    int nc = rve->pl.n;
+    if (rve->dim != 2 || nc <= GK_DEM_GATHER_MAX || rve->pcap < (size_t)nc + GK__PAIR_PAD) return 0;
+    rve->fc[0][nc] = rve->fc[1][nc] = 0;
+    if (GK__HAS_ROT(rve)) rve->tci[2][nc] = rve->tcj[2][nc] = 0;
+    return 1;
+}
+
+/* pad: gk__reduce_pad's answer */
+static void gk__reduce_range(gk_rve *rve, int p0, int p1, int pad) {
     int rot = GK__HAS_ROT(rve);
-    if (rve->dim == 2) {
+    if (rve->dim == 2 && pad) {
         if (rot)
-            gk__reduce_kernel(rve, p0, p1, 2, 1);
+            gk__reduce_kernel(rve, p0, p1, 2, 1, GK__GATHER_SLOTS_2D);
         else
-            gk__reduce_kernel(rve, p0, p1, 2, 0);
+            gk__reduce_kernel(rve, p0, p1, 2, 0, GK__GATHER_SLOTS_2D);
+    } else if (rve->dim == 2) {
+        if (rot)
+            gk__reduce_kernel(rve, p0, p1, 2, 1, 0);
+        else
+            gk__reduce_kernel(rve, p0, p1, 2, 0, 0);
     } else {
         if (rot)
-            gk__reduce_kernel(rve, p0, p1, 3, 1);
+            gk__reduce_kernel(rve, p0, p1, 3, 1, 0);
         else
-            gk__reduce_kernel(rve, p0, p1, 3, 0);
+            gk__reduce_kernel(rve, p0, p1, 3, 0, 0);
     }
 }
 
