@@ -1669,40 +1669,41 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
  * order and so gives the same bits. K > 0: the first K pairs of each side
  * are read without a branch on the particle's count (gk__reduce_pad must
  * have said yes); K = 0: plain loops. */
-GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int dim, const int rot, const int K) {
+GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int dim, const int rot,
+                                       const int K) {
     const int32_t *GK_RESTRICT start = rve->pl.start, *GK_RESTRICT jst = rve->jstart,
                                *GK_RESTRICT jl = rve->jlist;
     const gk_real *fc0 = rve->fc[0], *fc1 = rve->fc[1], *fc2 = dim == 3 ? rve->fc[2] : NULL;
     gk_real *f0 = rve->f[0], *f1 = rve->f[1], *f2 = dim == 3 ? rve->f[2] : NULL;
     const int32_t jend = jst[rve->n], nc = rve->pl.n;
     int p, e, k, q;
-#define GK__RJ(c)                                                          \
-    do {                                                                   \
-        a0 += fc0[c];                                                      \
-        a1 += fc1[c];                                                      \
-        if (dim == 3) a2 += fc2[c];                                        \
-        if (rot) {                                                         \
-            if (dim == 2)                                                  \
-                t[2] += rve->tcj[2][c];                                    \
-            else {                                                         \
-                GK_UNROLL                                                  \
-                for (k = 0; k < 3; ++k) t[k] += rve->tcj[k][c];            \
-            }                                                              \
-        }                                                                  \
+#define GK__RJ(c)                                               \
+    do {                                                        \
+        a0 += fc0[c];                                           \
+        a1 += fc1[c];                                           \
+        if (dim == 3) a2 += fc2[c];                             \
+        if (rot) {                                              \
+            if (dim == 2)                                       \
+                t[2] += rve->tcj[2][c];                         \
+            else {                                              \
+                GK_UNROLL                                       \
+                for (k = 0; k < 3; ++k) t[k] += rve->tcj[k][c]; \
+            }                                                   \
+        }                                                       \
     } while (0)
-#define GK__RI(c)                                                          \
-    do {                                                                   \
-        a0 -= fc0[c];                                                      \
-        a1 -= fc1[c];                                                      \
-        if (dim == 3) a2 -= fc2[c];                                        \
-        if (rot) {                                                         \
-            if (dim == 2)                                                  \
-                t[2] += rve->tci[2][c];                                    \
-            else {                                                         \
-                GK_UNROLL                                                  \
-                for (k = 0; k < 3; ++k) t[k] += rve->tci[k][c];            \
-            }                                                              \
-        }                                                                  \
+#define GK__RI(c)                                               \
+    do {                                                        \
+        a0 -= fc0[c];                                           \
+        a1 -= fc1[c];                                           \
+        if (dim == 3) a2 -= fc2[c];                             \
+        if (rot) {                                              \
+            if (dim == 2)                                       \
+                t[2] += rve->tci[2][c];                         \
+            else {                                              \
+                GK_UNROLL                                       \
+                for (k = 0; k < 3; ++k) t[k] += rve->tci[k][c]; \
+            }                                                   \
+        }                                                       \
     } while (0)
     for (p = p0; p < p1; ++p) {
         gk_real a0 = 0, a1 = 0, a2 = 0, t[3] = {0, 0, 0};
