@@ -531,6 +531,49 @@ TEST(threads_do_not_change_results) {
     gk_rve_destroy(&b);
 }
 
+/* The threads' gather of a 2D list above GK_DEM_GATHER_MAX (0 here) reads the
+ * first pairs of each side of a particle without a branch on its count,
+ * through a zero pair past the list: without rotation (no torques), and with
+ * rolling resistance and viscous damping (every per-pair term), 1 and 2
+ * threads end in the same state bit for bit, with particles that have more
+ * pairs on a side than those slots (the loop after them runs too) */
+TEST(threads_do_not_change_results_2d_without_and_with_every_torque) {
+    int v;
+    for (v = 0; v < 2; ++v) {
+        gk_rve a, b;
+        gk_rve_def d1 = gk_rve_def_default(), d2;
+        double dH[9] = {0, 2e-3, 0, 0, -1e-3, 0, 0, 0, 0};
+        int k, p, most_i = 0, most_j = 0;
+        if (v == 0)
+            d1.flags |= GK_RVE_NO_ROTATION;
+        else {
+            d1.mat.roll_beta = 1.0;
+            d1.mat.roll_eta = 0.1;
+            d1.mat.zeta_n = d1.mat.zeta_t = 0.05;
+        }
+        d2 = d1;
+        d2.threads = 2;
+        if (load_rve(&a, &d1, RVE400) || load_rve(&b, &d2, RVE400)) {
+            CHECK(0);
+            return;
+        }
+        for (k = 0; k < 3; ++k) {
+            CHECK(gk_rve_deform(&a, dH, 100) == GK_OK);
+            CHECK(gk_rve_deform(&b, dH, 100) == GK_OK);
+        }
+        CHECK(b.pl.n >= GK_DEM_PAR_MIN); /* b's pair forces run on 2 threads */
+        for (p = 0; p < b.n; ++p) {
+            if (b.pl.start[p + 1] - b.pl.start[p] > most_i) most_i = b.pl.start[p + 1] - b.pl.start[p];
+            if (b.jstart[p + 1] - b.jstart[p] > most_j) most_j = b.jstart[p + 1] - b.jstart[p];
+        }
+        CHECK(most_i > 3 && most_j > 3);
+        CHECK((a.phys & GK_PHYS_ROTATION) == (v ? GK_PHYS_ROTATION : 0u));
+        CHECK(same_state(&a, &b));
+        gk_rve_destroy(&a);
+        gk_rve_destroy(&b);
+    }
+}
+
 /* gk_rve_step_flags with GK_STEP_NO_STRESS: the motion is that of gk_rve_step to
  * the bit (positions, velocities, forces, history; on 1 and 2 threads), the
  * stress stays that of the last step that made it, and a final plain step
@@ -1344,6 +1387,7 @@ int main(int argc, char **argv) {
     RUN(restore_rejects_bad_buffers);
     RUN(skin_does_not_change_results);
     RUN(threads_do_not_change_results);
+    RUN(threads_do_not_change_results_2d_without_and_with_every_torque);
     RUN(steps_without_stress_move_the_same);
     RUN(threads_do_not_change_results_3d);
     RUN(consolidation_reaches_target_stress);
