@@ -753,8 +753,8 @@ static void track(model *md) {
         }
         free(prof);
     }
-    if (md->test == T_WAVE) { /* first time the element's shear strain passes 1e-3 a / (element length) */
-        double thr = 1e-3 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
+    if (md->test == T_WAVE) { /* first time the element's shear strain passes F a / (element length) */
+        double thr = md->o->front * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
         for (e = 0; e < md->ne; ++e) {
             const double *H = md->He + 9 * e;
             if (md->arrival[e] < 0 && fabs(H[1] + H[3]) > thr) md->arrival[e] = md->time;
@@ -773,7 +773,7 @@ static void wave_elastic(model *md, double *arr) {
     gk_err err;
     gk_result r;
     double lam = md->mi->K - 2.0 / 3.0 * md->mi->G, mu = md->mi->G;
-    double thr = 1e-3 * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
+    double thr = md->o->front * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
     double *u = (double *)xcalloc((size_t)md->nd, sizeof(double)),
            *f = (double *)xcalloc((size_t)md->nd, sizeof(double));
     double *ur = (double *)xcalloc((size_t)md->nr, sizeof(double)),
