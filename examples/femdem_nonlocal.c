@@ -115,9 +115,10 @@
  *     passes 1e-3 a / h, the columns' earliest response; a front taken at a
  *     larger strain arrives later (--front-threshold F): 490 and 536 m/s at
  *     1e-2, 431 and 502 m/s at 3e-2; at 0.1 the elastic front runs at 464
- *     m/s, while the multiscale column's strain, attenuated by its RVEs'
- *     damping, passes 0.1 a / h in the three elements nearest the driven end
- *     only. At every threshold the multiscale front is 7-14 % slower than
+ *     m/s, while the multiscale column's strain, attenuated by what its RVEs
+ *     dissipate (friction and contact damping: without the local damping,
+ *     --dem-damping 0, the same), passes 0.1 a / h in the three elements
+ *     nearest the driven end only. At every threshold the multiscale front is 7-14 % slower than
  *     the elastic one. The paper gives Fig 8 without numbers; the loops of
  *     element 9 and its porosity and Z are in wave.csv.
  *   biaxial (Figs 15-19), the mesh study (tools/nonlocal_mesh_study.sh:
