@@ -1677,33 +1677,20 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
     gk_real *f0 = rve->f[0], *f1 = rve->f[1], *f2 = dim == 3 ? rve->f[2] : NULL;
     const int32_t jend = jst[rve->n], nc = rve->pl.n;
     int p, e, k, q;
-#define GK__RJ(c)                                               \
-    do {                                                        \
-        a0 += fc0[c];                                           \
-        a1 += fc1[c];                                           \
-        if (dim == 3) a2 += fc2[c];                             \
-        if (rot) {                                              \
-            if (dim == 2)                                       \
-                t[2] += rve->tcj[2][c];                         \
-            else {                                              \
-                GK_UNROLL                                       \
-                for (k = 0; k < 3; ++k) t[k] += rve->tcj[k][c]; \
-            }                                                   \
-        }                                                       \
-    } while (0)
-#define GK__RI(c)                                               \
-    do {                                                        \
-        a0 -= fc0[c];                                           \
-        a1 -= fc1[c];                                           \
-        if (dim == 3) a2 -= fc2[c];                             \
-        if (rot) {                                              \
-            if (dim == 2)                                       \
-                t[2] += rve->tci[2][c];                         \
-            else {                                              \
-                GK_UNROLL                                       \
-                for (k = 0; k < 3; ++k) t[k] += rve->tci[k][c]; \
-            }                                                   \
-        }                                                       \
+/* pair c into the sums: the force with OP (+= where p is j, -= where it is i), the torque tc on p */
+#define GK__RSUM(c, OP, tc)                                    \
+    do {                                                       \
+        a0 OP fc0[c];                                          \
+        a1 OP fc1[c];                                          \
+        if (dim == 3) a2 OP fc2[c];                            \
+        if (rot) {                                             \
+            if (dim == 2)                                      \
+                t[2] += rve->tc[2][c];                         \
+            else {                                             \
+                GK_UNROLL                                      \
+                for (k = 0; k < 3; ++k) t[k] += rve->tc[k][c]; \
+            }                                                  \
+        }                                                      \
     } while (0)
     for (p = p0; p < p1; ++p) {
         gk_real a0 = 0, a1 = 0, a2 = 0, t[3] = {0, 0, 0};
@@ -1713,7 +1700,7 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
          * subtracting +0 changes no bit */
         for (q = 0; q < K; ++q) {
             const int32_t cj = jl[e0 + q], c = e0 + q < e1 ? cj : nc;
-            GK__RJ(c);
+            GK__RSUM(c, +=, tcj);
         }
         for (e = e0 + K; e < e1; ++e) {
             int c = jl[e];
@@ -1727,13 +1714,13 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
                     for (k = 0; k < 3; ++k) GK_PREFETCH(rve->tcj[k] + r);
                 }
             }
-            GK__RJ(c);
+            GK__RSUM(c, +=, tcj);
         }
         for (q = 0; q < K; ++q) {
             const int32_t c = s0 + q < s1 ? s0 + q : nc;
-            GK__RI(c);
+            GK__RSUM(c, -=, tci);
         }
-        for (e = s0 + K; e < s1; ++e) GK__RI(e);
+        for (e = s0 + K; e < s1; ++e) GK__RSUM(e, -=, tci);
         f0[p] = a0;
         f1[p] = a1;
         if (dim == 3) f2[p] = a2;
@@ -1746,8 +1733,7 @@ GK_FORCE_INLINE void gk__reduce_kernel(gk_rve *rve, int p0, int p1, const int di
             }
         }
     }
-#undef GK__RJ
-#undef GK__RI
+#undef GK__RSUM
 }
 
 /* whether the gather reads padded slots (2D lists above GK_DEM_GATHER_MAX
