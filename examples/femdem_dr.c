@@ -173,6 +173,15 @@ static int run_fem(model *m) {
             if (!m->single) /* a rigid platen: the top nodes level at h_ic */
                 for (k = 0; k < m->ntop; ++k) m->u[2 * m->top[k] + 1] = m->h_ic - m->h0;
         }
+        for (g = 0; g < m->ngp; ++g) /* eq 38 needs contacts along two directions */
+            if (!isfinite(m->stats[g].anisotropy)) {
+                fprintf(stderr,
+                        PROG ": step %d: the contacts of Gauss point %d's RVE no longer span the plane "
+                             "(its fabric tensor is singular, eq 38's anisotropy unbounded): the specimen "
+                             "has come apart; stopping\n",
+                        step, g);
+                return 1;
+            }
         make_row(m, step, stage, iters, m->dem_total - dem0, &r);
         add_row(m, &r);
         m->step_done = step;
