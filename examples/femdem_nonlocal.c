@@ -118,9 +118,9 @@
  *     m/s, while the multiscale column's strain, attenuated by what its RVEs
  *     dissipate (friction and contact damping: without the local damping,
  *     --dem-damping 0, the same), passes 0.1 a / h in the three elements
- *     nearest the driven end only. At every threshold the multiscale front is 7-14 % slower than
- *     the elastic one. The paper gives Fig 8 without numbers; the loops of
- *     element 9 and its porosity and Z are in wave.csv.
+ *     nearest the driven end only. At every threshold the multiscale front
+ *     is 7-14 % slower than the elastic one. The paper gives Fig 8 without
+ *     numbers; the loops of element 9 and its porosity and Z are in wave.csv.
  *   biaxial (Figs 15-19), the mesh study (tools/nonlocal_mesh_study.sh:
  *     512 spheres, the 20-step cap, the same coarse step 1.826e-6 s and 5000
  *     steps to 8 % on every mesh; about 60 min on 2 cores). Meshes 4x8x1,

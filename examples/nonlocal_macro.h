@@ -733,6 +733,12 @@ static int record(model *md, double seconds) {
     return 0;
 }
 
+/* the wave's front reaches an element when its shear strain first passes
+ * F a / (element length), F = --front-threshold (both columns) */
+static double wave_front_strain(const model *md) {
+    return md->o->front * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
+}
+
 /* per step bookkeeping that is not a CSV row: the peak profile and the 12 %
  * profile of the simple shear, the wave's arrival times */
 static void track(model *md) {
@@ -753,8 +759,8 @@ static void track(model *md) {
         }
         free(prof);
     }
-    if (md->test == T_WAVE) { /* first time the element's shear strain passes F a / (element length) */
-        double thr = md->o->front * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
+    if (md->test == T_WAVE) {
+        double thr = wave_front_strain(md);
         for (e = 0; e < md->ne; ++e) {
             const double *H = md->He + 9 * e;
             if (md->arrival[e] < 0 && fabs(H[1] + H[3]) > thr) md->arrival[e] = md->time;
@@ -773,7 +779,7 @@ static void wave_elastic(model *md, double *arr) {
     gk_err err;
     gk_result r;
     double lam = md->mi->K - 2.0 / 3.0 * md->mi->G, mu = md->mi->G;
-    double thr = md->o->front * md->o->amplitude / (md->L[0] / md->o->mesh[0]);
+    double thr = wave_front_strain(md);
     double *u = (double *)xcalloc((size_t)md->nd, sizeof(double)),
            *f = (double *)xcalloc((size_t)md->nd, sizeof(double));
     double *ur = (double *)xcalloc((size_t)md->nr, sizeof(double)),
