@@ -175,12 +175,9 @@ static int run_fem(model *m) {
         }
         for (g = 0; g < m->ngp; ++g) /* eq 38 needs contacts along two directions */
             if (!isfinite(m->stats[g].anisotropy)) {
-                fprintf(stderr,
-                        PROG ": step %d: the contacts of Gauss point %d's RVE no longer span the plane "
-                             "(its fabric tensor is singular, eq 38's anisotropy unbounded): the specimen "
-                             "has come apart; stopping\n",
-                        step, g);
-                return 1;
+                char whose[64];
+                snprintf(whose, sizeof whose, "Gauss point %d's RVE", g);
+                return came_apart(step, whose);
             }
         make_row(m, step, stage, iters, m->dem_total - dem0, &r);
         add_row(m, &r);

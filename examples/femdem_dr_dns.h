@@ -214,6 +214,7 @@ static int run_dns(model *m) {
         }
         m->dem_total += steps;
         dns_row(m, &D, step, stage, checks, steps, &r);
+        if (!isfinite(r.v[8])) return came_apart(step, "the specimen");
         add_row(m, &r);
         {
             char what[256];

@@ -47,6 +47,17 @@
 
 /* ------------------------------------------------------------------ rows, outputs */
 /* the macro state as a row of dr.csv */
+/* 1 after a message: the contacts of `whose` (a Gauss point's RVE, the DNS specimen) no longer span
+ * the plane at this step, their fabric tensor is singular and eq 38's anisotropy unbounded
+ * (gk_fabric_ratio: +inf); the run stops rather than write it */
+static int came_apart(int step, const char *whose) {
+    fprintf(stderr,
+            PROG ": step %d: the contacts of %s no longer span the plane (its fabric tensor is singular, "
+                 "eq 38's anisotropy unbounded): the specimen has come apart; stopping\n",
+            step, whose);
+    return 1;
+}
+
 static void make_row(model *m, int step, int stage, int iters, long long dem, row *r) {
     double s11 = 0.0, s22 = 0.0, sb = 0.0, J = 0.0, W = 0.0, Z = 0.0, A = 0.0, h = mean_top(m, m->u);
     int g;
