@@ -1,8 +1,9 @@
-/* fuzz_driver.h - what the harnesses that run a driver share: making and removing their temporary
- * folders, the driver's output off around a call (stdout to /dev/null, stderr to a file whose length
- * then says whether the driver gave a message), the RVE set's accepted stresses (a refused checkpoint
- * must leave them as they were), their small packing and their model's bytes. Include after the
- * driver (gk_twoscale.h), with _POSIX_C_SOURCE defined. */
+/* fuzz_driver.h - what the harnesses that run a driver share: naming, making and removing their
+ * temporary folders and files (fuzz_twoscale's files too), the driver's output off around a call
+ * (stdout to /dev/null, stderr to a file whose length then says whether the driver gave a message),
+ * the RVE set's accepted stresses (a refused checkpoint must leave them as they were), their small
+ * packing and their model's bytes. Include after the driver (gk_twoscale.h), with _POSIX_C_SOURCE
+ * defined. */
 #ifndef FUZZ_DRIVER_H
 #define FUZZ_DRIVER_H
 #include "fuzz_check.h"

@@ -32,8 +32,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define GK_IMPLEMENTATION
 #include "gk_twoscale.h"
-#include "fuzz_check.h"
-#include <unistd.h>
+#include "fuzz_driver.h"
 
 #define NPT 2
 static gk_twoscale ts;
@@ -64,13 +63,11 @@ static void setup(void) {
     gk_twoscale_def def;
     static const int pick[NPT] = {0, 1};
     double dH[9 * NPT], S[9 * NPT], D[16 * NPT];
-    const char *dir = getenv("TMPDIR");
     int k;
     if (ready) return;
-    if (!dir || !*dir) dir = "/tmp";
-    snprintf(in_path, sizeof in_path, "%s/gk_fuzz_twoscale_%ld.in", dir, (long)getpid());
-    snprintf(out_path, sizeof out_path, "%s/gk_fuzz_twoscale_%ld.out", dir, (long)getpid());
-    snprintf(ref_path, sizeof ref_path, "%s/gk_fuzz_twoscale_%ld.ref", dir, (long)getpid());
+    fuzz_temp_path(in_path, sizeof in_path, "twoscale", "in");
+    fuzz_temp_path(out_path, sizeof out_path, "twoscale", "out");
+    fuzz_temp_path(ref_path, sizeof ref_path, "twoscale", "ref");
     atexit(cleanup);
     memset(&def, 0, sizeof def);
     def.rve = gk_rve_def_default();
