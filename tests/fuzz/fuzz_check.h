@@ -62,6 +62,27 @@ static inline void fuzz_write_checkpoint(const char *path, const uint8_t *data, 
     free(file);
 }
 
+/* The driver harnesses' checkpoint: the file checkpoint.bin of a run folder,
+ * as the drivers write and read it. */
+static inline void fuzz_checkpoint_path(char *path, size_t cap, const char *dir) {
+    int len = snprintf(path, cap, "%s/checkpoint.bin", dir);
+    FUZZ_CHECK(len > 0 && (size_t)len < cap);
+}
+
+/* the input as DIR/checkpoint.bin (fuzz_write_checkpoint) */
+static inline void fuzz_write_checkpoint_in(const char *dir, const uint8_t *data, size_t size) {
+    char path[1024];
+    fuzz_checkpoint_path(path, sizeof path, dir);
+    fuzz_write_checkpoint(path, data, size);
+}
+
+/* the bytes of DIR/checkpoint.bin (fuzz_slurp) */
+static inline unsigned char *fuzz_slurp_checkpoint(const char *dir, size_t *n) {
+    char path[1024];
+    fuzz_checkpoint_path(path, sizeof path, dir);
+    return fuzz_slurp(path, n);
+}
+
 /* a seed file for a checkpoint harness: the mode byte, then the bytes */
 static inline void fuzz_write_seed(const char *dir, const char *name, unsigned char mode,
                                    const unsigned char *b, size_t n) {

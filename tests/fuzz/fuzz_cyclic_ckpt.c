@@ -151,15 +151,13 @@ static void next_step(void) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-    char path[600];
     gk_err err;
     const cyc_state *c = &C.cs;
     double d[10];
     int k;
     if (size < 1) return 0;
     setup();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
-    fuzz_write_checkpoint(path, data, size);
+    fuzz_write_checkpoint_in(in_dir, data, size);
     err.msg[0] = '\0';
     C.m.o.restart = in_dir;
     if (restart(&C, &err)) {
@@ -191,14 +189,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 /* the pristine checkpoint, a truncated copy, bit flips in the cyclic part (the direction, the branch
  * counter, the stress-control increment, a row's extra) and one a step later */
 int main(int argc, char **argv) {
-    char path[600];
     unsigned char *b, *c;
     size_t n, k, cs0, cx0;
     gk_err err;
     if (argc < 2) return 2;
     setup();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", ref_dir);
-    b = fuzz_slurp(path, &n);
+    b = fuzz_slurp_checkpoint(ref_dir, &n);
     fuzz_write_seed(argv[1], "ckpt_step1", 0, b, n);
     fuzz_write_seed(argv[1], "ckpt_truncated", 0, b, n - 60);
     /* the driver's block ends 8 bytes (the checksum) before the file's end, with the cyclic state
@@ -222,7 +218,7 @@ int main(int argc, char **argv) {
     /* a step later: the reversal */
     C.m.o.out = ref_dir, C.cycles = 0.25;
     FUZZ_CHECK(run_cyclic(&C, gk_wtime(), &err) == 0 && C.m.ncurve == 3 && C.cs.branch == 1);
-    b = fuzz_slurp(path, &n);
+    b = fuzz_slurp_checkpoint(ref_dir, &n);
     fuzz_write_seed(argv[1], "ckpt_step2", 0, b, n);
     free(b);
     return 0; /* the model is freed at exit */

@@ -224,13 +224,11 @@ static void check_model(void) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-    char path[600];
     int bad, rc, step;
     long said;
     if (size < 1) return 0;
     fuzz_setup();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
-    fuzz_write_checkpoint(path, data, size);
+    fuzz_write_checkpoint_in(in_dir, data, size);
     M.o.restart = in_dir;
     fuzz_quiet_begin();
     bad = load_checkpoint(&M);
@@ -265,14 +263,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 /* the pristine checkpoint, truncated copies, bit flips in the driver's block (checksum mended), one a
  * step later, one with another driver's tag */
 int main(int argc, char **argv) {
-    char path[600];
     unsigned char *b, *c;
     size_t n, b0, nb, k, nd, ng;
     uint32_t magic = CK_MAGIC;
     if (argc < 2) return 2;
     fuzz_setup();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", ref_dir);
-    b = fuzz_slurp(path, &n);
+    b = fuzz_slurp_checkpoint(ref_dir, &n);
     fuzz_write_seed(argv[1], "ckpt_step3", 0, b, n);
     /* the driver's block: its magic, then 8 ints and CK_ND reals, the arrays and the rows */
     nd = (size_t)M.ndof, ng = (size_t)M.ngp;
@@ -308,7 +304,7 @@ int main(int argc, char **argv) {
     fuzz_quiet_begin();
     FUZZ_CHECK(run_fem(&M) == 0);
     fuzz_quiet_end();
-    b = fuzz_slurp(path, &n);
+    b = fuzz_slurp_checkpoint(ref_dir, &n);
     fuzz_write_seed(argv[1], "ckpt_step4", 0, b, n);
     free(b);
     return 0;

@@ -116,15 +116,13 @@ static void setup(void) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-    char path[600];
     size_t n = 0, k;
     gk_err err;
     double L = 0.0, syy, sxx, ev, Ed = 0, Ef = 0;
     int r, iters = 0;
     if (size < 1) return 0;
     setup();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
-    fuzz_write_checkpoint(path, data, size);
+    fuzz_write_checkpoint_in(in_dir, data, size);
     err.msg[0] = '\0';
     M.o.restart = in_dir;
     if (fdb_restart(&M, &err)) {
@@ -165,14 +163,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
  * a node, a stress; in the driver's part: the last increment, a field), one a step later, and one
  * with the cyclic driver's tag */
 int main(int argc, char **argv) {
-    char path[600];
     unsigned char *b, *c;
     size_t n, k, blk, b0;
     gk_err err;
     if (argc < 2) return 2;
     setup();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", ref_dir);
-    b = fuzz_slurp(path, &n);
+    b = fuzz_slurp_checkpoint(ref_dir, &n);
     fuzz_write_seed(argv[1], "ckpt_step1", 0, b, n);
     /* the driver's block starts with its tag; its size: the model's block plus the driver's part */
     for (b0 = 0; b0 + 16 < n && memcmp(b + b0, FDB_TAG, sizeof FDB_TAG); ++b0) continue;
@@ -202,12 +198,12 @@ int main(int argc, char **argv) {
     /* a step later */
     M.o.steps = 2, M.o.out = ref_dir;
     FUZZ_CHECK(fdb_loop(&M, gk_wtime(), &err) == 0 && M.ncurve == 3);
-    b = fuzz_slurp(path, &n);
+    b = fuzz_slurp_checkpoint(ref_dir, &n);
     fuzz_write_seed(argv[1], "ckpt_step2", 0, b, n);
     free(b);
     /* another driver's tag */
     FUZZ_CHECK(fd_ck_save(&M, "GKFEMCYC2", NULL) == 0);
-    b = fuzz_slurp(path, &n);
+    b = fuzz_slurp_checkpoint(ref_dir, &n);
     fuzz_write_seed(argv[1], "ckpt_other_tag", 0, b, n);
     free(b);
     return 0; /* the model is freed at exit */

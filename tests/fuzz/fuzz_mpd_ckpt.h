@@ -92,15 +92,14 @@ static void fuzz_setup(void) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-    char path[600], why[200];
+    char why[200];
     size_t k;
     gk_err err;
     double *f;
     int n;
     if (size < 1) return 0;
     fuzz_setup();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
-    fuzz_write_checkpoint(path, data, size);
+    fuzz_write_checkpoint_in(in_dir, data, size);
     err.msg[0] = '\0';
     if (load(in_dir, &err) != GK_OK) {
         FUZZ_CHECK(err.msg[0] != '\0');
@@ -134,13 +133,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
 #ifdef FUZZ_MAKE_SEEDS
 int main(int argc, char **argv) {
-    char p[600], name[64];
+    char name[64];
     unsigned char *b, *c;
     size_t n, b0, k, np, pts_end;
     if (argc < 2) return 2;
     fuzz_setup();
-    snprintf(p, sizeof p, "%s/checkpoint.bin", ref_dir);
-    b = fuzz_slurp(p, &n);
+    b = fuzz_slurp_checkpoint(ref_dir, &n);
     FUZZ_CHECK((c = (unsigned char *)malloc(n)) != NULL);
     fuzz_write_seed(argv[1], "ckpt_" FZ_NAME, 0, b, n);
     fuzz_write_seed(argv[1], "ckpt_truncated", 0, b, n / 2);

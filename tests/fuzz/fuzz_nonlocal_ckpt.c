@@ -210,13 +210,11 @@ static void check_model(void) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-    char path[600];
     int rc;
     long said;
     if (size < 1) return 0;
     fuzz_setup();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
-    fuzz_write_checkpoint(path, data, size);
+    fuzz_write_checkpoint_in(in_dir, data, size);
     O.restart = in_dir;
     fuzz_quiet_begin();
     rc = load_checkpoint(&MD, fpr);
@@ -250,13 +248,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 /* the pristine checkpoint, truncated copies, bit flips in the driver's block (checksum mended), one a
  * step later, one with another version's tag */
 int main(int argc, char **argv) {
-    char path[600];
     unsigned char *b, *c;
     size_t n, b0, k;
     if (argc < 2) return 2;
     fuzz_setup();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", ref_dir);
-    b = fuzz_slurp(path, &n);
+    b = fuzz_slurp_checkpoint(ref_dir, &n);
     fuzz_write_seed(argv[1], "ckpt_step3", 0, b, n);
     for (b0 = 0; b0 + 16 < n && memcmp(b + b0, "GKFNL02", 8); ++b0) continue;
     FUZZ_CHECK(b0 + 16 < n);
@@ -286,8 +282,7 @@ int main(int argc, char **argv) {
     fuzz_quiet_begin();
     FUZZ_CHECK(macro_step(&MD) == 0 && record(&MD, 0.0) == 0 && save_checkpoint(&MD, fpr) == 0);
     fuzz_quiet_end();
-    snprintf(path, sizeof path, "%s/checkpoint.bin", in_dir);
-    b = fuzz_slurp(path, &n);
+    b = fuzz_slurp_checkpoint(in_dir, &n);
     fuzz_write_seed(argv[1], "ckpt_step4", 0, b, n);
     free(b);
     return 0;
