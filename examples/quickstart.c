@@ -23,7 +23,7 @@ int main(int argc, char **argv) {
     gk_err e;
     gk_rve_def def = gk_rve_def_default();         /* linear + Coulomb, Guo & Zhao 2014 */
     double dH[9] = {0, 1e-3, 0, 0, 0, 0, 0, 0, 0}; /* H01 = du_x/dy: simple shear */
-    double sig[9], sig2[9], D[16];
+    double sig[9], sig2[9], D[81];                 /* the tangent: dim^4 entries, 81 in 3D */
     int rc = 1;
 
     if (gk_packing_read(path, &pk, NULL, &e)) {
@@ -45,8 +45,9 @@ int main(int argc, char **argv) {
 
     if (gk_rve_deform(&rve, dH, 100)) goto done; /* 100 DEM steps */
     gk_rve_stress(&rve, sig);                    /* Love stress, tension-positive */
-    if (gk_homog_tangent(&rve, 0, D)) goto done; /* Taylor tangent, 2D: 2x2x2x2 */
-    printf("sheared  sxx %.1f  syy %.1f  sxy %.1f Pa   D_xyxy %.4g Pa\n", sig[0], sig[4], sig[1], D[5]);
+    if (gk_homog_tangent(&rve, 0, D)) goto done; /* Taylor tangent, D[((i d + j) d + k) d + l] */
+    printf("sheared  sxx %.1f  syy %.1f  sxy %.1f Pa   D_xyxy %.4g Pa\n", sig[0], sig[4], sig[1],
+           D[rve.dim * rve.dim + 1]); /* i = k = x, j = l = y */
 
     /* an implicit driver retries an increment from the last converged state */
     if (gk_rve_state_restore(&saved, &rve) || gk_rve_deform(&rve, dH, 100)) goto done;
