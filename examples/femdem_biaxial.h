@@ -470,12 +470,6 @@ static int fdb_finish(fd_model *M, int status) {
         printf("shear band: angle %.1f deg from the horizontal, width %.1f mm\n", ang, 1e3 * wid);
     else
         printf("shear band: none (max eps_q < 1.5 x median)\n");
-    printf(
-        "RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g band_angle_deg=%.3g band_width_mm=%.3g max_iterations=%d "
-        "steps=%d seconds_per_step=%.3f total_seconds=%.2f mean_iterations=%.2f",
-        peak, epk, ang, 1e3 * wid, itmax, M->ncurve - 1, M->ncurve > 1 ? tot / (M->ncurve - 1) : 0.0, tot,
-        M->ncurve > 1 ? (double)itsum / (M->ncurve - 1) : 0.0);
-    fd_print_work_totals(M);
 #ifdef GK_TWOSCALE_MPI
     printf("MPI ranks=%d rve_runs=%lld rank0_bytes_in_per_run=%.0f rank0_bytes_out_per_run=%.0f "
            "point_moves=%lld "
@@ -486,6 +480,12 @@ static int fdb_finish(fd_model *M, int status) {
            M->ts.stats.migrated, M->ts.stats.migrated_bytes, M->ts.stats.bytes_in,
            o->balance_run ? "run" : "accept");
 #endif
+    printf(
+        "RESULT peak_sigma_yy=%.6g eps_at_peak=%.5g band_angle_deg=%.3g band_width_mm=%.3g max_iterations=%d "
+        "steps=%d seconds_per_step=%.3f total_seconds=%.2f mean_iterations=%.2f",
+        peak, epk, ang, 1e3 * wid, itmax, M->ncurve - 1, M->ncurve > 1 ? tot / (M->ncurve - 1) : 0.0, tot,
+        M->ncurve > 1 ? (double)itsum / (M->ncurve - 1) : 0.0);
+    fd_print_work_totals(M);
     return status;
 }
 
