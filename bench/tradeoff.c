@@ -1,4 +1,4 @@
-/* bench_tradeoff - accuracy against cost of the two-scale drivers (issue 6).
+/* bench_tradeoff - accuracy against cost of the two-scale drivers.
  *
  *   build/bench_tradeoff            short version (make bench): about a minute on 2 cores
  *   build/bench_tradeoff --full     the whole sweep (make tradeoff)
@@ -701,7 +701,7 @@ static void usage(FILE *fp) {
         "usage: bench_tradeoff [--full] [--threads T] [--bin DIR] [--data DIR] [--out DIR]\n"
         "                      [--sweep NAME,...] [--steps N] [--dry-run]\n"
         "  (no option)     short version: the single-element group, about a minute on 2 cores (make bench)\n"
-        "  --full          the whole sweep of issue 6 (make tradeoff), about 10-15 minutes on 2 idle cores\n"
+        "  --full          the whole sweep (make tradeoff), about 10-15 minutes on 2 idle cores\n"
         "  --threads T     threads given to every driver run (2)\n"
         "  --bin DIR       where the driver binaries are (build)\n"
         "  --data DIR      packings rveN.txt of the RVE-size series (bench/data/tradeoff)\n"

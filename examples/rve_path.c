@@ -41,7 +41,7 @@ static void usage(FILE *fp) {
         "                [--dt DT] [--law linear|hertz] [--poisson 0.25] [--path constant-L|objective]\n"
         "                [--threads T] [--out FILE.csv] [--svg FILE.svg]\n"
         "\n"
-        "  --packing FILE           packing in the shared/data format (2D: 'x y r', 3D: 'x y z r')\n"
+        "  --packing FILE           packing file (gk_packing.h's format; 2D: 'x y r', 3D: 'x y z r')\n"
         "  --dH \"...\"               displacement-gradient increment, row-major, H01 = du_x/dy\n"
         "                           (4 numbers in 2D, 9 in 3D)\n"
         "  --increments N           how many times dH is applied (default 10)\n"

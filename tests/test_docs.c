@@ -107,6 +107,8 @@ TEST(readme_names_every_header_and_driver) {
 static int clean(const char *path) {
     static const char *bad[] = {"../sha"
                                 "red",
+                                "shared/da"
+                                "ta",
                                 "DESI"
                                 "GN.md",
                                 "issue 1",
@@ -132,11 +134,40 @@ static int clean(const char *path) {
     return !found;
 }
 
+/* clean() over the files of a folder whose names end in one of the suffixes; the count of unclean ones */
+static int unclean_in(const char *dir, const char *const *suffix, int nsuffix) {
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    int bad = 0, k;
+    if (!d) return 1;
+    while ((e = readdir(d)) != NULL) {
+        size_t l = strlen(e->d_name);
+        char path[600];
+        for (k = 0; k < nsuffix; ++k) {
+            size_t ls = strlen(suffix[k]);
+            if (l > ls && strcmp(e->d_name + l - ls, suffix[k]) == 0) break;
+        }
+        if (k == nsuffix || strcmp(e->d_name, "test_docs.c") == 0) continue; /* this file names them */
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        bad += !clean(path);
+    }
+    closedir(d);
+    return bad;
+}
+
 TEST(user_documents_point_at_nothing_users_lack) {
+    static const char *const code[] = {".c", ".h", ".sh", ".md", ".py", ".in"};
+    static const char *const dirs[] = {"include", "examples",   "examples/data",       "tools",
+                                       "bench",   "bench/data", "bench/data/tradeoff", "bench/peers",
+                                       "tests",   "tests/fuzz"};
+    int k;
     CHECK(clean("README.md"));
-    CHECK(clean("examples/README.md"));
-    CHECK(clean("bench/README.md"));
     CHECK(clean("Makefile"));
+    for (k = 0; k < (int)(sizeof dirs / sizeof dirs[0]); ++k) {
+        int bad = unclean_in(dirs[k], code, 6);
+        if (bad) printf("    %s: %d files\n", dirs[k], bad);
+        CHECK_EQ_INT(bad, 0);
+    }
 }
 
 /* Every name written as a literal BUILD "/tests/NAME..." in a test program

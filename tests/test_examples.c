@@ -743,7 +743,7 @@ TEST(femdem_relaxed_tangent_converges_to_the_same_curve) {
     CHECK(fd_refused("--tangent voigt", "taylor, yade, relaxed or perturbation"));
 }
 
-/* issue 6: the DEM step rule (adaptive by default) and tangent reuse in femdem_biaxial. 2 x 2 Q4, 16
+/* the DEM step rule (adaptive by default) and tangent reuse in femdem_biaxial. 2 x 2 Q4, 16
  * RVEs, a few 0.1 % steps. */
 TEST(femdem_dem_rule_and_tangent_reuse) {
     const char *base = BUILD "/femdem_biaxial --nx 2 --ny 2 --element q4 --vtk-every 0 --threads 2";
@@ -864,7 +864,7 @@ static int vtk_scalars(const char *path, const char *name, double *v, int max) {
     return n;
 }
 
-/* heterogeneity (issue 4: "optionally a different packing per point"):
+/* heterogeneity (optionally a different packing per point):
  * --packing A,B gives each Gauss point one of the two packings, drawn from
  * --packing-seed. The initial void ratios of the Gauss points are then those
  * of the two files (0.175 for the authors' RVE, 0.171 for the gk_pack one,

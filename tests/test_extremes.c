@@ -1,4 +1,4 @@
-/* test_extremes.c - stability at the extremes (issue 6).
+/* test_extremes.c - stability at the extremes.
  *
  * One named test per extreme. Each states the behaviour it expects (with the
  * analytic result where there is one) and checks it. Sizes shrink under
@@ -241,7 +241,7 @@ TEST(dt_0_1_to_0_95_critical_seed_packing) {
  *     more than 1e3 within 2000 steps (1000 for fcc). Either way the state
  *     stays finite.
  *
- *     KNOWN LIMITATION (found by this suite, issue 6): on this lattice
+ *     KNOWN LIMITATION (found by this suite): on this lattice
  *     gk_rve_dt_critical() is exactly sqrt(m/k), so the API accepts (GK_OK)
  *     a dt up to 2.2 x the
  *     rotational limit; the default dt_factor 0.5 is above it. Such a run is
@@ -580,7 +580,7 @@ TEST(friction_0_and_10) {
  * same r_max), and the default dt is 0.5 dt_cr. The shear response at the
  * default dt equals (1 %) the one at dt = 0.25 dt_cr, at the same strain
  * rate: the default step is converged -
- * KNOWN LIMITATION (issue 6, see dt_stability_limit_lattices)
+ * KNOWN LIMITATION (see dt_stability_limit_lattices)
  * except at ratio 1: equal frictional disks crystallise (Z up to 6), their
  * rotational mode is unstable at 0.5 dt_cr: the kinetic energy is 400x the
  * converged run's and sigma_xy 11 % high (measured with these 150 disks;
@@ -672,7 +672,7 @@ TEST(size_ratio_1_to_10) {
  * 100 MPa the mean overlap is a few % of the radius (< 10 %) and no overlap
  * reaches half a radius (no centre inside a neighbour).
  *
- * Two things the low end needs, both measured here (limitations, issue 6):
+ * Two things the low end needs, both measured here (limitations):
  * - velocities are zeroed before each level. Local damping acts through the
  *   contact forces, so a particle without contacts (a rattler) keeps the
  *   kinetic energy it picked up at 100 MPa for ever; at 1 Pa that energy is
