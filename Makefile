@@ -74,7 +74,7 @@ help:
 	@echo "make run-mpm | run-footing | run-collapse   MPMxDEM biaxial, footing, column collapse (Liang & Zhao 2019)"
 	@echo "make run-pipe   MPMxDEM pipe-soil interaction (Liang & Zhao 2019; about 7 minutes on 2 idle cores)"
 	@echo "make test       build and run every test; ends with 'N passed, N failed'"
-	@echo "make mpi        the MPI programs (mpicc; gk_twoscale.h with GK_TWOSCALE_MPI) into $(BUILD)/mpi/"
+	@echo "make mpi        the MPI drivers $(BUILD)/*_mpi and $(BUILD)/mpi/ (mpicc; gk_twoscale.h with GK_TWOSCALE_MPI)"
 	@echo "make check      tests under ASan+UBSan, a no-SIMD build, header portability, tool smoke runs"
 	@echo "make check-build  every program make check runs, built (make -j2 check-build: in parallel)"
 	@echo "make fuzz       each libFuzzer harness of tests/fuzz for FUZZ_SECONDS (60) s, one at a time (clang)"

@@ -49,7 +49,7 @@
  *   Taylor tangents cost a few contact loops, so the gain is in the Newton iterations if any; with
  *   --tangent perturbation a reused tangent saves the 4 perturbed runs.
  *
- * ROBUSTNESS (what the authors' script lacks; see README "Convergence")
+ * ROBUSTNESS (what the authors' script lacks; see examples/README.md, "FEMxDEM convergence study")
  *   - tangent 'taylor' (default) drops the tangential stiffness of sliding contacts (consistent with the
  *     Coulomb cap); 'yade' keeps it (the authors' Shop::getStressAndTangent); 'relaxed' = the contact
  *     network with every particle relaxed (GK_TANGENT_RELAXED: softer than eq 9 where the network is

@@ -10,7 +10,7 @@
  *                      in proportion to eps it is the RVE map's response; where it grows much more
  *                      slowly (tiny eps) it is DEM noise: a residual far above that floor is not noise
  *                      (on the 8 x 16 mesh at most 3e-4 of |f_int| at eps = 1e-3, while the iterates'
- *                      E_f is 2e-3 to 1e-2; README "Convergence").
+ *                      E_f is 2e-3 to 1e-2; examples/README.md, "FEMxDEM convergence study").
  *   --krylov-probe K   asks whether any deformation near the iterate reduces the residual at all:
  *                      GMRES on J d = -R with J the RVEs' own directional derivatives
  *                      (R(u + h z) - R(u)) / h, |h z| = X |u| (--krylov-scale X, default 0.05), right-
