@@ -7,7 +7,7 @@
  * their values). gk_test_done() prints "# <program>: P passed, F failed" and
  * returns non-zero on failure; tests/run_tests.sh sums these lines.
  * A program given a test name as argv[1] runs only the tests whose names
- * contain it.
+ * contain it (none matching: a message and a non-zero exit); --help says so.
  *
  * Tests run from the repository's root and write only under BUILD/tests/
  * (gk_test_init creates it; `make test` leaves nothing else behind). BUILD is
@@ -186,12 +186,22 @@ static void gk_test_init(int argc, char **argv) {
         p = strrchr(gk__t_prog, '/');
         if (p) gk__t_prog = p + 1;
     }
+    if (argc > 1 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
+        printf("usage: %s [PART]   run every test of this program, or those whose names contain PART\n"
+               "(from the repository's root; outputs under %s/tests/)\n",
+               gk__t_prog, BUILD);
+        exit(0);
+    }
     if (argc > 1) gk__t_filter = argv[1];
     mkdir(BUILD, 0755); /* where the outputs go (already there under make test) */
     mkdir(BUILD "/tests", 0755);
 }
 static int gk_test_done(void) {
     printf("# %s: %d passed, %d failed\n", gk__t_prog, gk__t_passed, gk__t_failed);
+    if (gk__t_filter && gk__t_passed + gk__t_failed == 0) {
+        printf("# %s: no test name contains \"%s\" (--help)\n", gk__t_prog, gk__t_filter);
+        return 1;
+    }
     return gk__t_failed ? 1 : 0;
 }
 #endif
