@@ -150,8 +150,12 @@
  * deletes by id. Survivors keep their ids, contact histories (pairs and
  * walls), prescribed motion and loads. Indices p (0..n-1, the order of the
  * arrays) change at every insertion or deletion; gk_scene_index maps an id
- * to its index (-1 if gone). gk_packing_tile / gk_packing_subset
- * (gk_packing.h) build a scene's packing from a periodic one.
+ * to its index (-1 if gone): a table lookup while the largest id is within
+ * 4 n + 1024, a binary search over the n ids beyond (ids are never reused,
+ * so a long run of insertions and deletions, or a saved state, can name
+ * ids far above n; the index stays O(n) either way). gk_packing_tile /
+ * gk_packing_subset (gk_packing.h) build a scene's packing from a periodic
+ * one.
  *
  * ENERGY (gk_scene_energy_track, gk_scene_energy). From the moment tracking
  * starts, each step books: kinetic energy (translation + rotation, at the
@@ -326,9 +330,9 @@ typedef struct gk_scene {
     double *load[3], *loadt[3]; /* load on prescribed particles, last step              */
     double *fext[3], *text[3];  /* constant external force and moment                   */
     int nprescribed, nlocked;   /* particles with GK_PARTICLE_PRESCRIBED, _LOCKED_ROTATION */
-    int32_t next_id, *index_of; /* id -> index (-1: gone), capacity cap_ids              */
-    int cap_ids;
-    long lost; /* particles deleted as lost                               */
+    int32_t next_id, *index_of; /* id -> index (-1: gone), capacity cap_ids; sparse ids:  */
+    int cap_ids, sparse_ids;    /* (id, index) pairs sorted by id, n of them (below)      */
+    long lost;                  /* particles deleted as lost                               */
     long seen_rebuilds;
     /* energy */
     int energy_on, energy_pending;
@@ -529,7 +533,21 @@ GKDEF void gk_scene_position(const gk_scene *sc, int p, double x[3]) {
 }
 
 GKDEF int gk_scene_index(const gk_scene *sc, int32_t id) {
-    if (id < 0 || id >= sc->next_id || id >= sc->cap_ids) return -1;
+    if (id < 0 || id >= sc->next_id) return -1;
+    if (sc->sparse_ids) { /* binary search of the (id, index) pairs */
+        int lo = 0, hi = sc->rve.n - 1;
+        while (lo <= hi) {
+            int mid = lo + (hi - lo) / 2;
+            int32_t m = sc->index_of[2 * mid];
+            if (m == id) return sc->index_of[2 * mid + 1];
+            if (m < id)
+                lo = mid + 1;
+            else
+                hi = mid - 1;
+        }
+        return -1;
+    }
+    if (id >= sc->cap_ids) return -1;
     return sc->index_of[id];
 }
 
@@ -585,17 +603,48 @@ static gk_result gk__sc_new(gk_scene *sc, double **p) {
 
 static void gk__sc_free(gk_scene *sc, void *p) { gk_free(gk__sc_alloc(sc), p); }
 
-/* id -> index for every particle */
+/* ids above this many per particle (plus GK__SCENE_IDS_SLACK) are looked up
+ * by binary search instead of in a table as long as the largest id: the
+ * index then stays O(n) however many particles were inserted and deleted
+ * before, or a saved state claims (a 20 kB state claiming a next id of
+ * 4.5e8 asked for a table of 2.7 GB) */
+#define GK__SCENE_IDS_PER_PARTICLE 4
+#define GK__SCENE_IDS_SLACK 1024
+
+static int gk__scene_pair_cmp(const void *a, const void *b) {
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* id -> index for every particle (ids in [0, next_id), each at most once): a
+ * table as long as the largest id + 1 when the ids are dense enough, else the
+ * (id, index) pairs sorted by id */
 static gk_result gk__scene_index(gk_scene *sc) {
-    int p;
-    if (sc->next_id > sc->cap_ids) {
-        int cap = sc->next_id + sc->next_id / 2 + 16;
-        if (gk_realloc(gk__sc_alloc(sc), (void **)&sc->index_of, 0, (size_t)cap, sizeof(int32_t)))
+    int p, n = sc->rve.n, top = 0, need;
+    for (p = 0; p < n; ++p)
+        if (sc->rve.id[p] >= top) top = sc->rve.id[p] + 1;
+    sc->sparse_ids = (double)top > (double)GK__SCENE_IDS_PER_PARTICLE * n + GK__SCENE_IDS_SLACK;
+    need = sc->sparse_ids ? 2 * n : top;
+    if (need > sc->cap_ids) {
+        int cap = need + need / 2 + 16;
+        if (gk_realloc(gk__sc_alloc(sc), (void **)&sc->index_of, 0, (size_t)cap, sizeof(int32_t))) {
+            sc->sparse_ids = 0, sc->cap_ids = 0; /* no index: gk_scene_index says -1 */
             return gk_err_set(&sc->err, GK_ERR_ALLOC, "out of memory for %d ids", cap);
+        }
         sc->cap_ids = cap;
     }
-    for (p = 0; p < sc->next_id; ++p) sc->index_of[p] = -1;
-    for (p = 0; p < sc->rve.n; ++p) {
+    if (sc->sparse_ids) {
+        for (p = 0; p < n; ++p) sc->index_of[2 * p] = sc->rve.id[p], sc->index_of[2 * p + 1] = p;
+        qsort(sc->index_of, (size_t)n, 2 * sizeof(int32_t), gk__scene_pair_cmp); /* unique ids: one order */
+        for (p = 1; p < n; ++p)
+            if (sc->index_of[2 * p] == sc->index_of[2 * p - 2])
+                return gk_err_set(&sc->err, GK_ERR_FORMAT, "particles %d and %d have the same id %d",
+                                  (int)sc->index_of[2 * p - 1], (int)sc->index_of[2 * p + 1],
+                                  (int)sc->index_of[2 * p]);
+        return GK_OK;
+    }
+    for (p = 0; p < sc->cap_ids; ++p) sc->index_of[p] = -1;
+    for (p = 0; p < n; ++p) {
         if (sc->index_of[sc->rve.id[p]] >= 0)
             return gk_err_set(&sc->err, GK_ERR_FORMAT, "particles %d and %d have the same id %d",
                               (int)sc->index_of[sc->rve.id[p]], p, (int)sc->rve.id[p]);

@@ -1168,6 +1168,53 @@ TEST(insert_and_remove_leave_the_others_alone) {
     gk_scene_destroy(&C);
 }
 
+/* Ids far apart: a pile into which one particle was inserted and removed
+ * 2000 times has ids 0-63 and, once one more is inserted, id 2064 with 65
+ * particles. Its id index stays O(n) (sorted (id, index) pairs once the
+ * largest id exceeds 4 n + 1024: a table as long as the next id is what
+ * let a 20 kB saved state ask for 2.7 GB) and finds every particle; the run
+ * is the same, bit for bit, as that of the pile with the particle inserted
+ * once (id 64). */
+TEST(ids_far_apart_keep_the_index_small) {
+    gk_scene A, B;
+    const double *xs[3];
+    double rr = 0.004, X = 0.01, Y = 0.28, Z = 0.0, xa[3], xb[3];
+    int32_t id = -1, idb = -1;
+    int k, p, diff = 0, found = 0;
+    if (box_scene(&A, 2, 8, 8, 0.1, 0.3, 0.2, 0) || box_scene(&B, 2, 8, 8, 0.1, 0.3, 0.2, 0)) {
+        CHECK(0);
+        return;
+    }
+    xs[0] = &X, xs[1] = &Y, xs[2] = &Z;
+    for (k = 0; k < 2000; ++k)
+        if (gk_scene_insert(&A, 1, xs, &rr, NULL, &id) != GK_OK || gk_scene_remove(&A, 1, &id) != GK_OK)
+            break;
+    CHECK_EQ_INT(k, 2000);
+    CHECK(A.sparse_ids == 0); /* ids 0-63 present: a table */
+    CHECK(gk_scene_insert(&A, 1, xs, &rr, NULL, &id) == GK_OK && id == 2064);
+    CHECK(gk_scene_insert(&B, 1, xs, &rr, NULL, &idb) == GK_OK && idb == 64);
+    printf("    next id %d, 65 particles: index of %d entries (%s)\n", (int)A.next_id, A.cap_ids,
+           A.sparse_ids ? "sorted pairs" : "table");
+    /* at most 1.5 (4 n + 1024) + 16 entries whatever the next id (the table grew to that while the
+     * churned ids were within 4 n + 1024); a table as long as the next id: 3113 */
+    CHECK(A.sparse_ids == 1 && A.cap_ids <= 3 * (4 * 65 + 1024) / 2 + 16);
+    for (p = 0; p < A.rve.n; ++p) found += gk_scene_index(&A, A.rve.id[p]) == p;
+    CHECK_EQ_INT(found, 65);
+    CHECK(gk_scene_index(&A, 64) == -1 && gk_scene_index(&A, 2063) == -1 && gk_scene_index(&A, 2065) == -1 &&
+          gk_scene_index(&A, -1) == -1 && gk_scene_index(&A, 2064) == gk_scene_index(&B, 64));
+    CHECK(gk_scene_step(&A, 500) == GK_OK && gk_scene_step(&B, 500) == GK_OK);
+    for (p = 0; p < 65; ++p) {
+        pos_of(&A, p < 64 ? p : 2064, xa);
+        pos_of(&B, p, xb);
+        diff += memcmp(xa, xb, sizeof xa) != 0;
+    }
+    CHECK_EQ_INT(diff, 0);
+    /* removing it again: the ids are dense enough for a table */
+    CHECK(gk_scene_remove(&A, 1, &id) == GK_OK && A.sparse_ids == 0 && gk_scene_index(&A, 2064) == -1);
+    gk_scene_destroy(&A);
+    gk_scene_destroy(&B);
+}
+
 /* the energy balance of a scene run, printed */
 static double report_energy(const gk_scene *sc, const char *what) {
     gk_energy e;
@@ -1998,6 +2045,7 @@ int main(int argc, char **argv) {
     RUN(membrane_confines_at_its_pressure);
     RUN(wrap_runs_an_rve_as_a_scene);
     RUN(insert_and_remove_leave_the_others_alone);
+    RUN(ids_far_apart_keep_the_index_small);
     RUN(energy_balance_closes);
     RUN(save_restore_and_threads_are_bitwise);
     RUN(a_refused_state_changes_nothing);

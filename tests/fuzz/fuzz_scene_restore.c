@@ -105,6 +105,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         free(now);
         return 0;
     }
+    /* every particle found by its id, by an index of O(n) entries whatever ids the state claims
+     * (a table as long as its next id let a 20 kB state ask for 2.7 GB) */
+    {
+        static int nmax;
+        if (sc->rve.n > nmax) nmax = sc->rve.n;
+        for (p = 0; p < sc->rve.n; ++p) FUZZ_CHECK(gk_scene_index(sc, sc->rve.id[p]) == p);
+        FUZZ_CHECK(sc->cap_ids <= 8 * nmax + 2048); /* gk_scene.h: at most 1.5 (4 n + 1024) + 16 */
+    }
     res = gk_scene_step(sc, 3);
     if (res != GK_OK) {
         FUZZ_CHECK(gk_scene_error(sc)[0] != '\0');
