@@ -94,17 +94,17 @@ static double run_float(void) {
 
 int main(int argc, char **argv) {
     int real, th;
-    if (argc > 1) { /* no options: what it measures */
-        int help = !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h");
-        fprintf(
-            help ? stdout : stderr,
-            "usage: bench_peak (no options)\nthe FMA throughput of one and two threads in double and float\n"
-            "(%s), GFLOP/s: the peak the DEM kernels are compared with in bench/README.md\n",
-            GK_SIMD_NAME);
-        return help ? 0 : 2;
-    }
     double lanes_d = GK_SIMD_WIDTH >= 256 ? GK_SIMD_WIDTH / 64 : 1,
            lanes_f = GK_SIMD_WIDTH >= 256 ? GK_SIMD_WIDTH / 32 : 1;
+    if (argc > 1) { /* no options: what it measures */
+        int help = !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h");
+        fprintf(help ? stdout : stderr,
+                "usage: bench_peak (no options)\n"
+                "the FMA throughput of one and two threads in double and float (%s), in GFLOP/s:\n"
+                "the peak the DEM kernels are compared with in bench/README.md\n",
+                GK_SIMD_NAME);
+        return help ? 0 : 2;
+    }
     printf("peak FMA throughput (%s, %d accumulators)\n", GK_SIMD_NAME, NACC);
     for (real = 0; real < 2; ++real)
         for (th = 1; th <= 2; ++th) {

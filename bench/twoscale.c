@@ -636,11 +636,11 @@ int main(int argc, char **argv) {
     tables[0] = opts, tables[1] = NULL;
     if (cli_parse(rank == 0 ? "bench_twoscale" : NULL, argc, argv, tables, &help) || help) {
         if (help && rank == 0)
-            printf("usage: bench_twoscale [--points 512] [--steps 3] [--iterations 3] [--threads T] [--band "
-                   "0.1]\n"
-                   "                      [--balance accept|run] [--model [--cost-log FILE | --costs FILE]]\n"
-                   "                      [--alpha 2e-6] [--bandwidth 1e10] [--rate2d R] [--rate3d 1.05e7]\n"
-                   "                      [--tol 0.05] [--steal-answer run|now] [--steal-order own|global]\n"
+            printf("usage: bench_twoscale [--points 512] [--steps 3] [--iterations 3] [--threads T]\n"
+                   "         [--band 0.1] [--balance accept|run]\n"
+                   "         [--model [--cost-log FILE | --costs FILE]] [--alpha 2e-6] [--bandwidth 1e10]\n"
+                   "         [--rate2d R] [--rate3d 1.05e7] [--tol 0.05]\n"
+                   "         [--steal-answer run|now] [--steal-order own|global]\n"
                    "       mpirun -np R build/mpi/bench_twoscale_mpi ... (the same on R ranks)\n"
                    "N RVEs of the Guo & Zhao (2014) 400-disk packing, one Newton iteration after another;\n"
                    "prints ms per iteration and a BENCH line; --model adds the scaling model of\n"
