@@ -31,7 +31,7 @@
  *   DNS 1x2 (444 disks) 0.181  0.287  0.304  0.180  0.312 at 7.5  0.308  0.165  (2.0e6 of 444)
  *   --paper --frame periodic (2 x 4, 10 + 50 steps of 0.2 %): peak 0.357 at 4.0 %, at 7.3 %
  *     0.334 and A 0.247, 4.1e6 DEM steps; --paper (servo): 2.2e7 DEM steps to 2 % (sigma_bar
- *     0.278 there, 0.271 with 0.5 % steps), 2-3e6 per step from there: >= 1.2e8 to 10 %.
+ *     0.278 there, 0.271 with 0.5 % steps), 7.9e7 to 10 %: peak 0.365 at 5.2 %, 419 s on one core.
  *   periodic 2 x 4, mu 0.2 / 0.6:  peaks 0.235 at 7.0 / 0.420 at 5.5 %; coordination at 7.3 %
  *     4.10 / 3.76 (mu 0.4: 3.89); locked rotation: 0.590 at 7.5 %, at 7.3 % sigma_bar 0.590,
  *     A 0.304; packings with A0 0.05 / 0.08: peaks 0.352 at 5.0 / 0.352 at 4.0 %.
