@@ -62,6 +62,12 @@ TEST(quickstart_runs_and_restores_bit_for_bit) {
     free(out);
 }
 
+/* whether name ends in suffix (and is longer) */
+static int ends_with(const char *name, const char *suffix) {
+    size_t n = strlen(name), ns = strlen(suffix);
+    return n > ns && strcmp(name + n - ns, suffix) == 0;
+}
+
 /* every include/gk_*.h named in README.md's module table, every example
  * driver named in README.md */
 static int listed_in(const char *dir, const char *prefix, const char *suffix, const char *readme,
@@ -74,9 +80,7 @@ static int listed_in(const char *dir, const char *prefix, const char *suffix, co
         const char *nm = e->d_name;
         size_t n = strlen(nm), ns = strlen(suffix);
         char want[256], stem[200];
-        if (strncmp(nm, prefix, strlen(prefix)) || n <= ns || strcmp(nm + n - ns, suffix) ||
-            n - ns >= sizeof stem)
-            continue;
+        if (strncmp(nm, prefix, strlen(prefix)) || !ends_with(nm, suffix) || n - ns >= sizeof stem) continue;
         memcpy(stem, nm, n - ns);
         stem[n - ns] = 0;
         snprintf(want, sizeof want, fmt, stem);
@@ -141,12 +145,8 @@ static int unclean_in(const char *dir, const char *const *suffix, int nsuffix) {
     int bad = 0, k;
     if (!d) return 1;
     while ((e = readdir(d)) != NULL) {
-        size_t l = strlen(e->d_name);
         char path[600];
-        for (k = 0; k < nsuffix; ++k) {
-            size_t ls = strlen(suffix[k]);
-            if (l > ls && strcmp(e->d_name + l - ls, suffix[k]) == 0) break;
-        }
+        for (k = 0; k < nsuffix && !ends_with(e->d_name, suffix[k]); ++k) continue;
         if (k == nsuffix || strcmp(e->d_name, "test_docs.c") == 0) continue; /* this file names them */
         snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
         bad += !clean(path);
@@ -186,7 +186,7 @@ TEST(test_programs_write_files_of_their_own) {
         size_t l = strlen(e->d_name);
         char path[300], *text;
         const char *p;
-        if (l < 3 || strcmp(e->d_name + l - 2, ".c") != 0 || l >= 64) continue;
+        if (!ends_with(e->d_name, ".c") || l >= 64) continue;
         snprintf(path, sizeof path, "tests/%s", e->d_name);
         text = gk_test_slurp(path);
         CHECK(text != NULL);
