@@ -9,6 +9,11 @@
  *                                             contact detection alone: one outer-list build (cell
  *                                             binning + candidate pairs within the skin) of the
  *                                             case's starting packing, median of R batches [us]
+ *   build/bench_dem_step --case NAME --phases [--threads T] ...
+ *                                             where the step's time goes: per phase (list rebuild,
+ *                                             pair forces, per-particle sums, particle update, the
+ *                                             rest) its wall time and each thread's time inside
+ *                                             its chunks, ms per step over the timed steps
  *
  * Cases: rve400 (the Guo & Zhao 2014 400-disk RVE, its own material, simple shear at
  * 1e-5 per step), 2d_10k and 2d_100k (bench/data/bench2d_10k.txt, tiled 5x2),
@@ -53,15 +58,69 @@ static int physics_ok(const char *list) {
 }
 
 static void usage(FILE *fp) {
-    fprintf(fp, "usage: bench_dem_step [--case rve400|2d_10k|2d_100k|3d_1k|3d_10k|3d_100k] [--threads T]\n"
-                "                      [--steps S] [--law linear|hertz] [--real double|float] [--scalar]\n"
-                "                      [--repeats R] [--packing FILE] [--write-packing FILE]\n"
-                "                      [--physics norot,frictionless,rolling,viscous,cohesion] [--lists]\n"
-                "       bench_dem_step --float-error   q/p along the rve_path shear, float vs double\n"
-                "with no --case, runs the whole suite (1 and 2 threads, both laws, double and float,\n"
-                "SIMD and scalar) and prints a table, then the cost of each physics switch on rve400\n"
-                "and the float-error report. --lists times the case's cell-list build (bin and\n"
-                "candidate pairs) instead of time steps.\n");
+    fprintf(fp,
+            "usage: bench_dem_step [--case rve400|2d_10k|2d_100k|3d_1k|3d_10k|3d_100k] [--threads T]\n"
+            "                      [--steps S] [--law linear|hertz] [--real double|float] [--scalar]\n"
+            "                      [--repeats R] [--packing FILE] [--write-packing FILE]\n"
+            "                      [--physics norot,frictionless,rolling,viscous,cohesion] [--lists]\n"
+            "                      [--phases]\n"
+            "       bench_dem_step --float-error   q/p along the rve_path shear, float vs double\n"
+            "with no --case, runs the whole suite (1 and 2 threads, both laws, double and float,\n"
+            "SIMD and scalar) and prints a table, then the cost of each physics switch on rve400\n"
+            "and the float-error report. --lists times the case's cell-list build (bin and\n"
+            "candidate pairs) instead of time steps. --phases (with --case, at most %d threads)\n"
+            "prints each phase's wall time per step and each thread's time inside its chunks\n"
+            "(the clock is read at every mark, a few tens of ns each).\n",
+            BENCH_PHASE_THREADS);
+}
+
+/* --phases: a table, then one PHASES line (ms per step); 1 if the times do not add up */
+static int print_phases(const bench_case *c, const bench_out *o) {
+    static const char *const name[BENCH_PHASES] = {"list rebuild", "pair forces", "per-particle sums",
+                                                   "particle update"};
+    static const char *const key[BENCH_PHASES] = {"rebuild", "forces", "sums", "update"};
+    double rest = o->step_ms;
+    int ph, t, nth = c->threads, ok = 1;
+    printf("phases of %s, %d thread%s, ms per step (busy: inside the chunks of a threaded loop):\n", c->name,
+           nth, nth > 1 ? "s" : "");
+    printf("  %-18s %8s  %-28s %s\n", "phase", "wall", "busy per thread", "idle in the phase");
+    for (ph = 0; ph < BENCH_PHASES; ++ph) {
+        char busy[96] = "serial";
+        double sum = 0.0;
+        rest -= o->phase_ms[ph];
+        if (o->phase_threaded[ph]) {
+            size_t l = 0;
+            busy[0] = 0;
+            for (t = 0; t < nth; ++t) {
+                sum += o->phase_busy_ms[ph][t];
+                if (l + 12 < sizeof busy)
+                    l += (size_t)snprintf(busy + l, sizeof busy - l, "%s%.4f", t ? " " : "",
+                                          o->phase_busy_ms[ph][t]);
+            }
+        }
+        if (ph == 0) snprintf(busy, sizeof busy, "serial, %ld in %ld steps", o->rebuilds, o->steps * o->nrep);
+        if (o->phase_threaded[ph] && o->phase_ms[ph] > 0.0)
+            printf("  %-18s %8.4f  %-28s %.1f %%\n", name[ph], o->phase_ms[ph], busy,
+                   100.0 * (1.0 - sum / (nth * o->phase_ms[ph])));
+        else
+            printf("  %-18s %8.4f  %s\n", name[ph], o->phase_ms[ph], busy);
+    }
+    printf("  %-18s %8.4f  serial (cell update, stress, step loop)\n", "rest", rest);
+    /* the phases do not overlap and no thread is busy longer than its phase lasts */
+    for (ph = 0; ph < BENCH_PHASES; ++ph)
+        for (t = 0; t < nth; ++t)
+            if (o->phase_busy_ms[ph][t] > 1.01 * o->phase_ms[ph] + 1e-6) ok = 0;
+    if (!(rest > -0.01 * o->step_ms)) ok = 0;
+    printf("  %-18s %8.4f\n", "step", o->step_ms);
+    printf("PHASES case=%s threads=%d step_ms=%.5g", c->name, nth, o->step_ms);
+    for (ph = 0; ph < BENCH_PHASES; ++ph) {
+        printf(" %s_ms=%.5g", key[ph], o->phase_ms[ph]);
+        if (o->phase_threaded[ph])
+            for (t = 0; t < nth; ++t) printf("%s%.5g", t ? "," : " busy_ms=", o->phase_busy_ms[ph][t]);
+    }
+    printf(" rest_ms=%.5g rebuilds=%ld steps=%ld\n", rest, o->rebuilds, o->steps * o->nrep);
+    if (!ok) fprintf(stderr, "bench_dem_step: --phases: the phases overlap or a thread outlasts its phase\n");
+    return !ok;
 }
 
 static int run_one(const bench_case *c, int use_float, int quiet_header) {
@@ -80,6 +139,7 @@ static int run_one(const bench_case *c, int use_float, int quiet_header) {
         fflush(stdout);
         return 0;
     }
+    if (c->phases && print_phases(c, &o)) return 1;
     printf("%-8s %dD %7d  %2d  %-6s %-6s %-6s %8.2f %9.2f %6.2f %6.2f %s\n", c->name, o.dim, o.n, c->threads,
            c->hertz ? "hertz" : "linear", o.real, o.simd, o.particle_steps_per_s / 1e6,
            o.contact_steps_per_s / 1e6, 2.0 * o.contacts_per_particle, o.pairs_per_particle,
@@ -143,6 +203,7 @@ int main(int argc, char **argv) {
         {"--write-packing", CLI_STR, &c.write_packing, 0, 0, NULL, NULL, 0},
         {"--physics", CLI_STR, &c.physics, 0, 0, NULL, NULL, 0},
         {"--lists", CLI_FLAG, &c.lists, 0, 0, NULL, NULL, 0},
+        {"--phases", CLI_FLAG, &c.phases, 0, 0, NULL, NULL, 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     const cli_opt *tables[2];
     memset(&c, 0, sizeof c);
@@ -154,6 +215,13 @@ int main(int argc, char **argv) {
         return 0;
     }
     if (c.physics && !physics_ok(c.physics)) return 2;
+    if (c.phases && (ci < 0 || c.lists || c.threads > BENCH_PHASE_THREADS)) {
+        fprintf(stderr,
+                "bench_dem_step: --phases times the steps of one --case on at most %d threads (not "
+                "with --lists)\n",
+                BENCH_PHASE_THREADS);
+        return 2;
+    }
     c.steps = steps, c.hertz = hertz;
     if (ci >= 0) {
         c.name = cases[ci];
@@ -216,6 +284,16 @@ int main(int argc, char **argv) {
             b.lists = 1;
             if (run_one(&b, 0, 1)) rc = 1;
         }
+    }
+    { /* where one large system's step goes on 2 threads */
+        bench_case b = c;
+        printf("\nthe step's phases, 10^5 disks on 2 threads, double (--phases --steps 600):\n");
+        header();
+        b.name = "2d_100k";
+        b.threads = 2;
+        b.steps = 600; /* a few list rebuilds in every repeat */
+        b.phases = 1;
+        if (run_one(&b, 0, 1)) rc = 1;
     }
     printf("\n");
     fflush(stdout);

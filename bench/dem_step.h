@@ -12,11 +12,16 @@ typedef struct bench_case {
     const char *physics; /* comma list: norot, frictionless, rolling, viscous, cohesion */
     long steps;          /* timed steps per repeat; 0: case default          */
     int lists;           /* time the cell-list build instead of steps        */
+    int phases;          /* time each phase of the step in each thread       */
 } bench_case;
+
+/* --phases: the step's phases (gk_dem.h's GK_DEM_PHASE hook) */
+enum { BENCH_PHASES = 4, BENCH_PHASE_THREADS = 16 };
 
 typedef struct bench_out {
     int dim, n;
     long steps;                  /* per repeat */
+    int nrep;                    /* repeats */
     double particle_steps_per_s; /* median over repeats */
     double contact_steps_per_s;  /* median */
     double contacts_per_particle;
@@ -25,6 +30,12 @@ typedef struct bench_out {
     double list_build_us; /* lists: median time of one outer-list build [us] */
     int list_pairs;       /* lists: candidate pairs it found                 */
     double sigma[9];      /* final Love stress (tension +) */
+    /* phases: mean milliseconds per step over the timed steps. wall: from the
+     * stepping thread's entry into the phase to its exit; busy: inside the
+     * chunks each thread ran (threaded loops only; 0 for a serial phase) */
+    double step_ms, phase_ms[BENCH_PHASES], phase_busy_ms[BENCH_PHASES][BENCH_PHASE_THREADS];
+    int phase_threaded[BENCH_PHASES]; /* the phase ran as chunks on threads */
+    long rebuilds;                    /* list rebuilds in the timed steps */
     char simd[16], real[8], err[256];
 } bench_out;
 

@@ -4,12 +4,37 @@
 #define _POSIX_C_SOURCE 200809L
 #define GK_STATIC
 #define GK_IMPLEMENTATION
+/* --phases: gk_dem.h's timing hook, a flag test per mark while it is off */
+static int bench_ph_on;
+static void bench_phase(int phase, int mark);
+#define GK_DEM_PHASE(phase, mark) (bench_ph_on ? bench_phase(phase, mark) : (void)0)
 #include "gk_homog.h"
 #include "gk_io.h"
 #include "dem_step.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* per thread (64 bytes): the start of its open chunk and its busy time, per phase */
+static struct { double t0[BENCH_PHASES], busy[BENCH_PHASES]; } bench_ph_thread[BENCH_PHASE_THREADS];
+static double bench_ph_enter[BENCH_PHASES], bench_ph_wall[BENCH_PHASES];
+static int bench_ph_chunks[BENCH_PHASES];
+
+static void bench_phase(int phase, int mark) {
+    double t = gk_wtime();
+    int th = 0;
+#ifdef _OPENMP
+    th = omp_get_thread_num();
+#endif
+    if (phase < 0 || phase >= BENCH_PHASES || th >= BENCH_PHASE_THREADS) return;
+    if (mark == 0) bench_ph_enter[phase] = t;
+    if (mark == 1) bench_ph_wall[phase] += t - bench_ph_enter[phase];
+    if (mark == 2) bench_ph_thread[th].t0[phase] = t;
+    if (mark == 3) {
+        bench_ph_thread[th].busy[phase] += t - bench_ph_thread[th].t0[phase];
+        if (th == 0) bench_ph_chunks[phase] = 1;
+    }
+}
 
 #ifdef GK_REAL_FLOAT
 #define BENCH_RUN bench_run_float
@@ -222,17 +247,40 @@ int BENCH_RUN(const bench_case *bc, bench_out *o) {
         snprintf(o->err, sizeof o->err, "%s", gk_rve_error(&rve));
         return 1;
     }
+    o->rebuilds = -rve.rebuilds;
+    if (bc->phases) {
+        memset(bench_ph_thread, 0, sizeof bench_ph_thread);
+        memset(bench_ph_wall, 0, sizeof bench_ph_wall);
+        memset(bench_ph_chunks, 0, sizeof bench_ph_chunks);
+        bench_ph_on = 1;
+    }
     for (r = 0; r < nrep; ++r) {
         double t0 = gk_wtime();
         if (gk_rve_step(&rve, steps)) {
+            bench_ph_on = 0;
             snprintf(o->err, sizeof o->err, "%s", gk_rve_error(&rve));
             return 1;
         }
         secs[r] = gk_wtime() - t0;
     }
+    bench_ph_on = 0;
+    o->rebuilds += rve.rebuilds;
+    if (bc->phases) {
+        double total = 0.0, per = 1e3 / ((double)steps * nrep);
+        int ph, t;
+        for (r = 0; r < nrep; ++r) total += secs[r];
+        o->step_ms = total * per;
+        for (ph = 0; ph < BENCH_PHASES; ++ph) {
+            o->phase_ms[ph] = bench_ph_wall[ph] * per;
+            o->phase_threaded[ph] = bench_ph_chunks[ph];
+            for (t = 0; t < BENCH_PHASE_THREADS; ++t)
+                o->phase_busy_ms[ph][t] = bench_ph_thread[t].busy[ph] * per;
+        }
+    }
     o->dim = rve.dim;
     o->n = rve.n;
     o->steps = steps;
+    o->nrep = nrep;
     o->seconds_median = median(secs, nrep); /* sorts secs */
     o->seconds_min = secs[0];
     o->particle_steps_per_s = (double)rve.n * steps / o->seconds_median;

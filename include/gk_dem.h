@@ -183,7 +183,12 @@
  * gather 2D lists longer than that through a fixed number of branch-free
  * slots per particle, the same bits again),
  * GK_RVE_STEP_OVERLAP_MAX (the admissible overlap change per DEM step as a
- * fraction of the smaller radius, default 0.1). An RVE holds at most
+ * fraction of the smaller radius, default 0.1), GK_DEM_PHASE(phase, mark)
+ * (a timing hook for profilers, empty by default: phase 0 the list rebuild,
+ * 1 the pair forces, 2 the per-particle sums when they are gathered, 3 the
+ * particle update; mark 0 when the stepping thread enters the phase, 1 when
+ * it leaves it, 2 and 3 around each chunk of a threaded loop, called by the
+ * thread that runs the chunk; bench_dem_step --phases). An RVE holds at most
  * GK_RVE_MAX_PARTICLES (2^26): its pair lists are int32.
  *
  * LICENCE: MIT (see gk_base.h).
@@ -207,6 +212,9 @@
 #define GK_RVE_MAX_PARTICLES (1 << 26)
 #ifndef GK_RVE_STEP_OVERLAP_MAX
 #define GK_RVE_STEP_OVERLAP_MAX 0.1
+#endif
+#ifndef GK_DEM_PHASE
+#define GK_DEM_PHASE(phase, mark) ((void)0)
 #endif
 
 /* ------------------------------------------------------------- RVE def */
@@ -1621,32 +1629,46 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
     if (nth <= 1 && nc <= GK_DEM_GATHER_MAX) {
         x->scatter = 0;
         x->store = 1;
+        GK_DEM_PHASE(1, 0);
         gk__forces_range(rve, x, 0, nc);
+        GK_DEM_PHASE(1, 1);
+        GK_DEM_PHASE(2, 0);
         gk__reduce_range(rve, 0, rve->n, 0);
+        GK_DEM_PHASE(2, 1);
     } else if (nth <= 1) {
         x->scatter = 1;
         x->store = want_store;
+        GK_DEM_PHASE(1, 0);
         for (k = 0; k < 3; ++k) {
             if (rve->f[k]) memset(rve->f[k], 0, (size_t)rve->n * sizeof(gk_real));
             if (rve->t[k]) memset(rve->t[k], 0, (size_t)rve->n * sizeof(gk_real));
         }
         gk__forces_range(rve, x, 0, nc);
+        GK_DEM_PHASE(1, 1);
     } else {
         int b, n = rve->n, pad = gk__reduce_pad(rve);
         x->scatter = 0;
         x->store = 1;
+        GK_DEM_PHASE(1, 0);
         GK_OMP(parallel for num_threads(nth) schedule(static))
         for (b = 0; b < nth * 4; ++b) {
             /* chunk starts on a multiple of 16 pairs: aligned SIMD loads, same lanes as serial */
             long c0 = ((long)nc * b / (nth * 4)) & ~15L,
                  c1 = b + 1 == nth * 4 ? nc : ((long)nc * (b + 1) / (nth * 4)) & ~15L;
+            GK_DEM_PHASE(1, 2);
             gk__forces_range(rve, x, (int)c0, (int)c1);
+            GK_DEM_PHASE(1, 3);
         }
+        GK_DEM_PHASE(1, 1);
+        GK_DEM_PHASE(2, 0);
         GK_OMP(parallel for num_threads(nth) schedule(static))
         for (b = 0; b < nth * 4; ++b) {
             long p0 = (long)n * b / (nth * 4), p1 = (long)n * (b + 1) / (nth * 4);
+            GK_DEM_PHASE(2, 2);
             gk__reduce_range(rve, (int)p0, (int)p1, pad);
+            GK_DEM_PHASE(2, 3);
         }
+        GK_DEM_PHASE(2, 1);
     }
 }
 
@@ -2104,19 +2126,25 @@ static double gk__integrate(gk_rve *rve, const gk__stepctx *x, const double hinv
                             int *bad) {
     int n = rve->n, nth = gk__nthreads(rve);
     double m2 = 0.0;
-    if (nth <= 1) return gk__integrate_range(rve, x, hinv, hnew, 0, n, bad);
-    {
+    GK_DEM_PHASE(3, 0);
+    if (nth <= 1) {
+        m2 = gk__integrate_range(rve, x, hinv, hnew, 0, n, bad);
+    } else {
         int b, badl = 0;
         GK_OMP(parallel for num_threads(nth) schedule(static) reduction(max : m2) reduction(| : badl))
         for (b = 0; b < nth * 4; ++b) {
             long p0 = (long)n * b / (nth * 4), p1 = (long)n * (b + 1) / (nth * 4);
             int bb = 0;
-            double mm = gk__integrate_range(rve, x, hinv, hnew, (int)p0, (int)p1, &bb);
+            double mm;
+            GK_DEM_PHASE(3, 2);
+            mm = gk__integrate_range(rve, x, hinv, hnew, (int)p0, (int)p1, &bb);
+            GK_DEM_PHASE(3, 3);
             if (mm > m2) m2 = mm;
             badl |= bb;
         }
         if (badl) *bad = 1;
     }
+    GK_DEM_PHASE(3, 1);
     return m2;
 }
 
@@ -2205,7 +2233,9 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
     int bad = 0, k;
     gk_result res;
     if (rve->need_rebuild) {
+        GK_DEM_PHASE(0, 0);
         res = gk__rve_rebuild(rve);
+        GK_DEM_PHASE(0, 1);
         if (res) return res;
     }
     if (rve->hook && (res = rve->hook(rve, GK_HOOK_PRE_FORCES, rve->hook_user)) != GK_OK) return res;
