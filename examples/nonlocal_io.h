@@ -532,7 +532,7 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
                   o->test == T_EBIAX ? "one element, biaxial (Fig 6a)" : "one element, simple shear (Fig 6b)",
                   o->test == T_EBIAX ? "axial strain" : "shear strain u_top / h",
                   o->test == T_EBIAX ? "axial stress [kPa]" : "shear stress [kPa]", x, y, (int)n,
-                  "FEM x DEM, 1 element", lx, ly, nl + 1, "RVE alone"))
+                  "FEMxDEM, 1 element", lx, ly, nl + 1, "RVE alone"))
             return 1;
         snprintf(extra, sizeof extra, "rve_alone_dev_pct=%.3f peak_ratio=%.4f", 100.0 * dev, pkr);
         printf("one element against the RVE alone: largest gap of the 10 strain-window means %.2f %% of the "
@@ -597,7 +597,7 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
         if (plot2(svg, o->test == T_SSHEAR ? "simple shear (Fig 10)" : "plane-strain biaxial (Figs 16, 18)",
                   o->test == T_SSHEAR ? "shear strain u_top / h" : "axial strain",
                   o->test == T_SSHEAR ? "shear stress [kPa]" : "axial stress [kPa]", x, y, (int)n,
-                  "FEM x DEM", NULL, NULL, 0, NULL))
+                  "FEMxDEM", NULL, NULL, 0, NULL))
             return 1;
     }
     /* state curves: porosity and Z */

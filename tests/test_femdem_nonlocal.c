@@ -1,4 +1,4 @@
-/* test_femdem_nonlocal.c - the 3D explicit nonlocal FEM x DEM driver
+/* test_femdem_nonlocal.c - the 3D explicit nonlocal FEMxDEM driver
  * (examples/femdem_nonlocal.c) and what it added to the library: the 3D
  * particle-rotation field and the eq 57 relaxation criterion. Needs the
  * binaries in build/ (`make test` builds them first). Small RVEs (160
