@@ -338,13 +338,11 @@ GK_FORCE_INLINE int gk__cells_scan(const gk_cells *c, const gk_vd P[6], const gk
     const double *cx = c->sorted, *cy = cx + cap, *cz = cx + 2 * cap, *cr = cx + 3 * cap, *cq = cx + 4 * cap;
     const gk_vd end = gk_vd_set1((double)f1);
     int32_t *buf = c->buf;
-    gk_vd lane;
+    /* lane l holds f0 + l (exact in double). Not from a local array filled here:
+     * its vector load right after the element stores stalls (store forwarding) */
+    static const double iota[8] = {0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0};
+    gk_vd lane = gk_vd_add(gk_vd_set1((double)f0), gk_vd_loadu(iota));
     int f, l;
-    {
-        double io[GK_VD_W];
-        for (l = 0; l < GK_VD_W; ++l) io[l] = (double)(f0 + l);
-        lane = gk_vd_loadu(io);
-    }
     for (f = f0; f < f1; f += GK_VD_W, lane = gk_vd_add(lane, gk_vd_set1((double)GK_VD_W))) {
         gk_vd a = gk_vd_sub(gk_vd_loadu(cx + f), P[0]), b = gk_vd_sub(gk_vd_loadu(cy + f), P[1]), d2, q;
         const gk_vd cut = gk_vd_add(gk_vd_add(P[3], gk_vd_loadu(cr + f)), P[4]);

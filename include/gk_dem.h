@@ -1058,6 +1058,24 @@ GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const 
     nl->n = m;
 }
 
+/* the sort key of pair x of a list (i, j): i, then j */
+#define GK__KEY(I, J, x) ((uint64_t)(uint32_t)(I)[x] << 32 | (uint32_t)(J)[x])
+/* the interleaved merges of a rebuild (the four rounds of its loop are written out) */
+#define GK__MERGE_WAYS 4
+
+/* the first of n pairs sorted by key whose key is not below key (n if none) */
+static int gk__key_lower_bound(const int32_t *pi, const int32_t *pj, int n, uint64_t key) {
+    int lo = 0, hi = n;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (GK__KEY(pi, pj, mid) < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 /* rebuild the pair list at the current positions, carrying history over by merge */
 static gk_result gk__rve_rebuild(gk_rve *rve) {
     gk_pairlist nl;
@@ -1072,7 +1090,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
                 rve->dt, dtc);
         rve->dt_crit = dtc;
     }
-    int dim = rve->dim, n = rve->n, k, c, oc;
+    int dim = rve->dim, n = rve->n, k, c;
     double w[3];
     gk_result res;
     const double *sp[3];
@@ -1122,20 +1140,41 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
      * is the scratch, rebuilt below) */
     {
         int32_t *map = rve->jlist;
-        const int32_t *pi = rve->pl.i, *pj = rve->pl.j;
-        int no = rve->pl.n;
+        const int32_t *pi = rve->pl.i, *pj = rve->pl.j, *ni = nl.i, *nj = nl.j;
+        int no = rve->pl.n, cw[GK__MERGE_WAYS], ce[GK__MERGE_WAYS], ow[GK__MERGE_WAYS], oe[GK__MERGE_WAYS], w;
         /* a merge join on the key (i, j) with no data-dependent branch: each
          * round advances the side(s) with the smaller key; map[c] is written
-         * every round, the last write for c being the one where c advanced */
-        c = oc = 0;
-        while (c < nl.n && oc < no) {
-            uint64_t kn = (uint64_t)(uint32_t)nl.i[c] << 32 | (uint32_t)nl.j[c],
-                     ko = (uint64_t)(uint32_t)pi[oc] << 32 | (uint32_t)pj[oc];
-            map[c] = kn == ko ? oc : -1;
-            c += kn <= ko;
-            oc += ko <= kn;
+         * every round, the last write for c being the one where c advanced.
+         * A round's loads wait for the last round's comparisons, so one merge
+         * runs at the latency of that chain: the lists are cut into
+         * GK__MERGE_WAYS key ranges (new pairs in equal parts, the old list at
+         * the first key of each part) whose merges run interleaved. The same
+         * map: keys are unique, so a new pair's match lies in its own range. */
+        for (w = 0; w < GK__MERGE_WAYS; ++w) {
+            cw[w] = (int)((long)nl.n * w / GK__MERGE_WAYS);
+            ce[w] = (int)((long)nl.n * (w + 1) / GK__MERGE_WAYS);
+            ow[w] = w == 0 ? 0 : cw[w] < nl.n ? gk__key_lower_bound(pi, pj, no, GK__KEY(ni, nj, cw[w])) : no;
         }
-        for (; c < nl.n; ++c) map[c] = -1;
+        for (w = 0; w < GK__MERGE_WAYS; ++w) oe[w] = w + 1 < GK__MERGE_WAYS ? ow[w + 1] : no;
+#define GK__MERGE_ROUND(w)                                                   \
+    do {                                                                     \
+        uint64_t kn_ = GK__KEY(ni, nj, cw[w]), ko_ = GK__KEY(pi, pj, ow[w]); \
+        map[cw[w]] = kn_ == ko_ ? ow[w] : -1;                                \
+        cw[w] += kn_ <= ko_;                                                 \
+        ow[w] += ko_ <= kn_;                                                 \
+    } while (0)
+        while (cw[0] < ce[0] && ow[0] < oe[0] && cw[1] < ce[1] && ow[1] < oe[1] && cw[2] < ce[2] &&
+               ow[2] < oe[2] && cw[3] < ce[3] && ow[3] < oe[3]) {
+            GK__MERGE_ROUND(0);
+            GK__MERGE_ROUND(1);
+            GK__MERGE_ROUND(2);
+            GK__MERGE_ROUND(3);
+        }
+        for (w = 0; w < GK__MERGE_WAYS; ++w) {
+            while (cw[w] < ce[w] && ow[w] < oe[w]) GK__MERGE_ROUND(w);
+            for (c = cw[w]; c < ce[w]; ++c) map[c] = -1;
+        }
+#undef GK__MERGE_ROUND
         gk__pairs_gather(rve, map, nl.n);
     }
     /* swap the spare set in */
