@@ -596,8 +596,8 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
         snprintf(svg, sizeof svg, "%s/%s_curve.svg", o->out, test_name[o->test]);
         if (plot2(svg, o->test == T_SSHEAR ? "simple shear (Fig 10)" : "plane-strain biaxial (Figs 16, 18)",
                   o->test == T_SSHEAR ? "shear strain u_top / h" : "axial strain",
-                  o->test == T_SSHEAR ? "shear stress [kPa]" : "axial stress [kPa]", x, y, (int)n,
-                  "FEMxDEM", NULL, NULL, 0, NULL))
+                  o->test == T_SSHEAR ? "shear stress [kPa]" : "axial stress [kPa]", x, y, (int)n, "FEMxDEM",
+                  NULL, NULL, 0, NULL))
             return 1;
     }
     /* state curves: porosity and Z */
