@@ -1062,6 +1062,7 @@ GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const 
 #define GK__KEY(I, J, x) ((uint64_t)(uint32_t)(I)[x] << 32 | (uint32_t)(J)[x])
 /* the interleaved merges of a rebuild (the four rounds of its loop are written out) */
 #define GK__MERGE_WAYS 4
+GK_STATIC_ASSERT(GK__MERGE_WAYS == 4, merge_rounds_written_out);
 
 /* the first of n pairs sorted by key whose key is not below key (n if none) */
 static int gk__key_lower_bound(const int32_t *pi, const int32_t *pj, int n, uint64_t key) {
