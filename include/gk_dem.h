@@ -1142,7 +1142,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
     {
         int32_t *map = rve->jlist;
         const int32_t *pi = rve->pl.i, *pj = rve->pl.j, *ni = nl.i, *nj = nl.j;
-        int no = rve->pl.n, cw[GK__MERGE_WAYS], ce[GK__MERGE_WAYS], ow[GK__MERGE_WAYS], oe[GK__MERGE_WAYS], w;
+        int no = rve->pl.n, cw[GK__MERGE_WAYS], ce[GK__MERGE_WAYS], ow[GK__MERGE_WAYS], oe[GK__MERGE_WAYS], u;
         /* a merge join on the key (i, j) with no data-dependent branch: each
          * round advances the side(s) with the smaller key; map[c] is written
          * every round, the last write for c being the one where c advanced.
@@ -1151,18 +1151,18 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
          * GK__MERGE_WAYS key ranges (new pairs in equal parts, the old list at
          * the first key of each part) whose merges run interleaved. The same
          * map: keys are unique, so a new pair's match lies in its own range. */
-        for (w = 0; w < GK__MERGE_WAYS; ++w) {
-            cw[w] = (int)((long)nl.n * w / GK__MERGE_WAYS);
-            ce[w] = (int)((long)nl.n * (w + 1) / GK__MERGE_WAYS);
-            ow[w] = w == 0 ? 0 : cw[w] < nl.n ? gk__key_lower_bound(pi, pj, no, GK__KEY(ni, nj, cw[w])) : no;
+        for (u = 0; u < GK__MERGE_WAYS; ++u) {
+            cw[u] = (int)((long)nl.n * u / GK__MERGE_WAYS);
+            ce[u] = (int)((long)nl.n * (u + 1) / GK__MERGE_WAYS);
+            ow[u] = u == 0 ? 0 : cw[u] < nl.n ? gk__key_lower_bound(pi, pj, no, GK__KEY(ni, nj, cw[u])) : no;
         }
-        for (w = 0; w < GK__MERGE_WAYS; ++w) oe[w] = w + 1 < GK__MERGE_WAYS ? ow[w + 1] : no;
-#define GK__MERGE_ROUND(w)                                                   \
+        for (u = 0; u < GK__MERGE_WAYS; ++u) oe[u] = u + 1 < GK__MERGE_WAYS ? ow[u + 1] : no;
+#define GK__MERGE_ROUND(u)                                                   \
     do {                                                                     \
-        uint64_t kn_ = GK__KEY(ni, nj, cw[w]), ko_ = GK__KEY(pi, pj, ow[w]); \
-        map[cw[w]] = kn_ == ko_ ? ow[w] : -1;                                \
-        cw[w] += kn_ <= ko_;                                                 \
-        ow[w] += ko_ <= kn_;                                                 \
+        uint64_t kn_ = GK__KEY(ni, nj, cw[u]), ko_ = GK__KEY(pi, pj, ow[u]); \
+        map[cw[u]] = kn_ == ko_ ? ow[u] : -1;                                \
+        cw[u] += kn_ <= ko_;                                                 \
+        ow[u] += ko_ <= kn_;                                                 \
     } while (0)
         while (cw[0] < ce[0] && ow[0] < oe[0] && cw[1] < ce[1] && ow[1] < oe[1] && cw[2] < ce[2] &&
                ow[2] < oe[2] && cw[3] < ce[3] && ow[3] < oe[3]) {
@@ -1171,9 +1171,9 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
             GK__MERGE_ROUND(2);
             GK__MERGE_ROUND(3);
         }
-        for (w = 0; w < GK__MERGE_WAYS; ++w) {
-            while (cw[w] < ce[w] && ow[w] < oe[w]) GK__MERGE_ROUND(w);
-            for (c = cw[w]; c < ce[w]; ++c) map[c] = -1;
+        for (u = 0; u < GK__MERGE_WAYS; ++u) {
+            while (cw[u] < ce[u] && ow[u] < oe[u]) GK__MERGE_ROUND(u);
+            for (c = cw[u]; c < ce[u]; ++c) map[c] = -1;
         }
 #undef GK__MERGE_ROUND
         gk__pairs_gather(rve, map, nl.n);
