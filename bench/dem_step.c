@@ -115,8 +115,10 @@ static int print_phases(const bench_case *c, const bench_out *o) {
     printf("PHASES case=%s threads=%d step_ms=%.5g", c->name, nth, o->step_ms);
     for (ph = 0; ph < BENCH_PHASES; ++ph) {
         printf(" %s_ms=%.5g", key[ph], o->phase_ms[ph]);
-        if (o->phase_threaded[ph])
-            for (t = 0; t < nth; ++t) printf("%s%.5g", t ? "," : " busy_ms=", o->phase_busy_ms[ph][t]);
+        if (o->phase_threaded[ph]) { /* forces_busy_ms=a,b: one key per phase */
+            printf(" %s_busy_ms=", key[ph]);
+            for (t = 0; t < nth; ++t) printf("%s%.5g", t ? "," : "", o->phase_busy_ms[ph][t]);
+        }
     }
     printf(" rest_ms=%.5g rebuilds=%ld steps=%ld\n", rest, o->rebuilds, o->steps * o->nrep);
     if (!ok) fprintf(stderr, "bench_dem_step: --phases: the phases overlap or a thread outlasts its phase\n");
