@@ -435,6 +435,32 @@ GK_FORCE_INLINE void gk_vf_win_make(const int32_t *idx, int32_t n, gk_vf_win *w)
             _mm512_cmplt_epu32_mask(w->lane, _mm512_set1_epi32(GK_VF_W)) == 0xffff;
 }
 GK_FORCE_INLINE unsigned gk_vdm_bits(gk_vdm m) { return (unsigned)m; }
+/* Compaction of a block of GK_VD_W int32 entries by a lane mask (512 bits
+ * only): gk_i32_compress writes the src[l] whose bit l of m is set to dst in
+ * lane order, and may write all GK_VD_W entries of dst; gk_i32_ranks writes
+ * dst[l] = base + the number of set bits below bit l where bit l is set, -1
+ * elsewhere, and returns the number of set bits. */
+GK_FORCE_INLINE void gk_i32_compress(unsigned m, const int32_t *src, int32_t *dst) {
+    __m512i v = _mm512_castsi256_si512(_mm256_loadu_si256((const __m256i *)(const void *)src));
+    _mm256_storeu_si256((__m256i *)(void *)dst,
+                        _mm512_castsi512_si256(_mm512_maskz_compress_epi32((__mmask16)m, v)));
+}
+GK_FORCE_INLINE int gk_i32_ranks(unsigned m, int32_t base, int32_t *dst) {
+    __m512i r = _mm512_maskz_expand_epi32(
+        (__mmask16)m, _mm512_add_epi32(_mm512_set1_epi32(base), _mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8,
+                                                                                 7, 6, 5, 4, 3, 2, 1, 0)));
+    r = _mm512_mask_blend_epi32((__mmask16)m, _mm512_set1_epi32(-1), r);
+    _mm256_storeu_si256((__m256i *)(void *)dst, _mm512_castsi512_si256(r));
+#ifdef __POPCNT__
+    return _mm_popcnt_u32(m);
+#else
+    {
+        int k = 0;
+        for (; m; m &= m - 1) ++k;
+        return k;
+    }
+#endif
+}
 GK_FORCE_INLINE gk_vd gk_vd_xorsign(gk_vd a) { /* -a, exactly */
     return _mm512_castsi512_pd(
         _mm512_xor_si512(_mm512_castpd_si512(a), _mm512_set1_epi64((long long)0x8000000000000000ull)));

@@ -292,6 +292,10 @@ typedef struct gk_rve {
     double *o0[3];     /* reduced positions at the outer build               */
     double ho0[9];     /* cell at the outer build                            */
     int outer_valid;
+    int32_t *outer_in; /* each outer pair's index in pl, or -1 (outer_in_ok)  */
+    size_t outer_in_cap;
+    int outer_in_ok; /* pl was filtered from this outer list: a rebuild that
+                        keeps it looks the old pairs up instead of merging */
     int need_rebuild, diverged;
     /* results of the last step that computed them (the last step of each call) */
     double stress[9]; /* Love stress, tension-positive [Pa]                 */
@@ -623,6 +627,10 @@ static void gk__rve_free_arrays(gk_rve *rve) {
     }
     gk_free(a, rve->jstart);
     rve->jstart = NULL;
+    gk_free(a, rve->outer_in);
+    rve->outer_in = NULL;
+    rve->outer_in_cap = 0;
+    rve->outer_in_ok = 0;
     rve->pcap = rve->spare.cap = 0;
     gk_pairlist_free(&rve->spare.pl);
     gk_pairlist_free(&rve->pl);
@@ -993,7 +1001,7 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         if (R.skin < 2.0 * def->mat.coh_n / knmin) R.skin = 2.0 * def->mat.coh_n / knmin;
         R.skin_in = R.skin;
     }
-    R.outer_valid = 0;
+    R.outer_valid = R.outer_in_ok = 0;
     gk_pcell_widths(&R.cell, w);
     cutoff = 2.0 * R.rmax + R.skin;
     for (k = 0; k < dim; ++k)
@@ -1040,23 +1048,32 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
 }
 
 /* inner list: the outer pairs closer than r_i + r_j + skin_in, in outer
- * order, into nl */
-GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const int dim) {
+ * order, into nl; outer_in[c] := the new index of outer pair c, or -1. With
+ * `lookup` (the current list was filtered from this outer list, outer_in its
+ * indices) map[m] := the current index of new pair m, or -1, on the way */
+GK_FORCE_INLINE void gk__inner_filter(const gk_rve *rve, gk_pairlist *nl, const int dim, const int lookup,
+                                      int32_t *GK_RESTRICT oin, int32_t *GK_RESTRICT map, int c0) {
     const double *h = rve->cell.h, skin = rve->skin_in;
     const int32_t *oi = rve->outer.i, *oj = rve->outer.j;
     const gk_real *r = rve->r;
     int c, k, no = rve->outer.n, m = nl->n;
-    for (c = 0; c < no; ++c) { /* written always, kept inside the cutoff: no branch */
-        int i = oi[c], j = oj[c];
+    for (c = c0; c < no; ++c) { /* written always, kept inside the cutoff: no branch */
+        int i = oi[c], j = oj[c], keep;
         double ds[3], d[3], cut = (double)r[i] + (double)r[j] + skin;
         for (k = 0; k < dim; ++k) ds[k] = rve->s[k][j] - rve->s[k][i];
         gk_pcell_image(h, dim, ds, d);
         nl->i[m] = i;
         nl->j[m] = j;
-        m += d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut;
+        if (lookup) map[m] = oin[c];
+        keep = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cut * cut;
+        oin[c] = keep ? m : -1;
+        m += keep;
     }
     nl->n = m;
 }
+
+/* the inner filter for the rve's dimension, SIMD unless GK_RVE_SCALAR (defined below) */
+static void gk__inner_filter_all(const gk_rve *rve, gk_pairlist *nl, int lookup, int32_t *map);
 
 /* the sort key of pair x of a list (i, j): i, then j */
 #define GK__KEY(I, J, x) ((uint64_t)(uint32_t)(I)[x] << 32 | (uint32_t)(J)[x])
@@ -1091,7 +1108,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
                 rve->dt, dtc);
         rve->dt_crit = dtc;
     }
-    int dim = rve->dim, n = rve->n, k, c;
+    int dim = rve->dim, n = rve->n, k, c, lookup;
     double w[3];
     gk_result res;
     const double *sp[3];
@@ -1114,12 +1131,13 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         if (res) return res;
         res = gk_cells_pairs(&rve->cells, rve->cell.h, sp, rve->r, rve->skin, &rve->outer, &rve->err);
         if (res) {
-            rve->outer_valid = 0;
+            rve->outer_valid = rve->outer_in_ok = 0;
             return res;
         }
         for (k = 0; k < dim; ++k) memcpy(rve->o0[k], rve->s[k], (size_t)n * sizeof(double));
         gk_m3_copy(rve->cell.h, rve->ho0);
         rve->outer_valid = 1;
+        rve->outer_in_ok = 0;
     }
     /* inner list: outer pairs closer than r_i + r_j + skin_in, in outer order,
      * written into the spare list and spare per-pair arrays */
@@ -1132,14 +1150,23 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
     }
     nl.np = n;
     nl.n = 0;
-    if (dim == 2)
-        gk__inner_filter(rve, &nl, 2);
-    else
-        gk__inner_filter(rve, &nl, 3);
-    /* history into the spare arrays by a merge with the current list (both
-     * sorted by (i, j)): map[c] = the old index of new pair c, or -1 (jlist
-     * is the scratch, rebuilt below) */
-    {
+    if ((size_t)rve->outer.n > rve->outer_in_cap) {
+        size_t cap = gk__grown(rve->outer_in_cap, (size_t)rve->outer.n);
+        rve->outer_in_ok = 0;
+        if (gk_realloc(&rve->def.alloc, (void **)&rve->outer_in, 0, cap, sizeof(int32_t))) {
+            rve->spare.pl = nl;
+            return gk_err_set(&rve->err, GK_ERR_ALLOC, "out of memory for %d pairs", rve->outer.n);
+        }
+        rve->outer_in_cap = cap;
+    }
+    /* history into the spare arrays: map[c] = the old index of new pair c, or
+     * -1 (jlist is the scratch, rebuilt below). When the current list was
+     * filtered from the same outer list, the filter looks each pair up;
+     * else a merge of the two lists, both sorted by (i, j) */
+    lookup = rve->outer_in_ok;
+    gk__inner_filter_all(rve, &nl, lookup, rve->jlist);
+    rve->outer_in_ok = 1;
+    if (!lookup) {
         int32_t *map = rve->jlist;
         const int32_t *pi = rve->pl.i, *pj = rve->pl.j, *ni = nl.i, *nj = nl.j;
         int no = rve->pl.n, cw[GK__MERGE_WAYS], ce[GK__MERGE_WAYS], ow[GK__MERGE_WAYS], oe[GK__MERGE_WAYS], u;
@@ -1176,8 +1203,8 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
             for (c = cw[u]; c < ce[u]; ++c) map[c] = -1;
         }
 #undef GK__MERGE_ROUND
-        gk__pairs_gather(rve, map, nl.n);
     }
+    gk__pairs_gather(rve, rve->jlist, nl.n);
     /* swap the spare set in */
     {
         gk_pairlist t = rve->pl;
@@ -1385,6 +1412,42 @@ GK_FORCE_INLINE void gk__simd_branch(const gk_rve *rve, const gk_vd H[9], const 
 #endif
     }
 }
+
+#if GK_SIMD_WIDTH == 512 && !defined(GK_REAL_FLOAT)
+#define GK__FILTER_SIMD 1
+/* gk__inner_filter GK_VR_W outer pairs at a time: the same branch vectors
+ * (gk__simd_branch, the twin of gk_pcell_image), cutoffs and comparisons, lane
+ * by lane; the kept pairs written as there. The rest of the list goes through
+ * gk__inner_filter; returns where it stopped. Only with 512-bit vectors: with
+ * AVX2's 4 lanes the rebuilds were slower than with the scalar filter
+ * (measured); a float build filters in double through gk__inner_filter. */
+GK_FORCE_INLINE int gk__inner_filter_simd(const gk_rve *rve, gk_pairlist *nl, const int dim, const int lookup,
+                                          int32_t *GK_RESTRICT oin, int32_t *GK_RESTRICT map) {
+    const int32_t *oi = rve->outer.i, *oj = rve->outer.j, n = rve->n;
+    const gk_vr skin = gk_vr_set1(rve->skin_in);
+    gk_vd H[9];
+    int c, k, no = rve->outer.n, m = nl->n;
+    for (k = 0; k < 9; ++k) H[k] = gk_vd_set1(rve->cell.h[k]);
+    for (c = 0; c + GK_VR_W <= no; c += GK_VR_W) {
+        const int32_t *ii = oi + c, *jj = oj + c;
+        gk__iwin win;
+        gk_vr d[3], cut, d2;
+        unsigned keep;
+        gk__iwin_make(ii, n, &win);
+        gk__simd_branch(rve, H, ii, jj, &win, dim, d);
+        cut = gk_vr_add(gk_vr_add(GK__GI(rve->r, ii, &win), gk_vr_gather(rve->r, jj)), skin);
+        d2 = gk_vr_add(gk_vr_mul(d[0], d[0]), gk_vr_mul(d[1], d[1]));
+        if (dim == 3) d2 = gk_vr_add(d2, gk_vr_mul(d[2], d[2]));
+        keep = gk_vrm_bits(gk_vr_lt(d2, gk_vr_mul(cut, cut)));
+        gk_i32_compress(keep, ii, nl->i + m);
+        gk_i32_compress(keep, jj, nl->j + m);
+        if (lookup) gk_i32_compress(keep, oin + c, map + m);
+        m += gk_i32_ranks(keep, m, oin + c);
+    }
+    nl->n = m;
+    return c;
+}
+#endif
 
 /* 8 mask bits -> 8 bytes of 0/1 (bit l -> byte l): a constant table */
 #define GK__E(b)                                                                                        \
@@ -1603,6 +1666,29 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
 }
 #undef GK__GI
 #endif /* GK_VR_W > 1 */
+
+static void gk__inner_filter_all(const gk_rve *rve, gk_pairlist *nl, int lookup, int32_t *map) {
+    int32_t *oin = rve->outer_in;
+    int c0 = 0;
+#ifdef GK__FILTER_SIMD
+    if (rve->def.flags & GK_RVE_SCALAR)
+        ;
+    else if (rve->dim == 2)
+        c0 = lookup ? gk__inner_filter_simd(rve, nl, 2, 1, oin, map)
+                    : gk__inner_filter_simd(rve, nl, 2, 0, oin, map);
+    else
+        c0 = lookup ? gk__inner_filter_simd(rve, nl, 3, 1, oin, map)
+                    : gk__inner_filter_simd(rve, nl, 3, 0, oin, map);
+#endif
+    if (rve->dim == 2 && lookup)
+        gk__inner_filter(rve, nl, 2, 1, oin, map, c0);
+    else if (rve->dim == 2)
+        gk__inner_filter(rve, nl, 2, 0, oin, map, c0);
+    else if (lookup)
+        gk__inner_filter(rve, nl, 3, 1, oin, map, c0);
+    else
+        gk__inner_filter(rve, nl, 3, 0, oin, map, c0);
+}
 
 /* instantiate a kernel with constant law and flags (pay only for what is on):
  * the common flag sets get their own copy, the rest share one with fl */
@@ -2312,7 +2398,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
             gk_m3_copy(h0n, rve->h0);
         }
         rve->need_rebuild = 1;
-        rve->outer_valid = 0;
+        rve->outer_valid = rve->outer_in_ok = 0;
     }
     dispmax2 = gk__integrate(rve, &x, rve->cell.hinv, rve->cell.h, &bad);
     if (rve->dim == 3 && rve->theta) { /* GK_RVE_TRACK_ROTATION: outside the kernels, paid only when asked */
@@ -2982,7 +3068,7 @@ GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], cons
     rve->n = n0 + k;
     gk_rve_update_totals(rve);
     rve->need_rebuild = 1;
-    rve->outer_valid = 0;
+    rve->outer_valid = rve->outer_in_ok = 0;
     return GK_OK;
 }
 
@@ -3020,7 +3106,7 @@ GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop) {
     gk__pair_index(rve);
     gk_rve_update_totals(rve);
     rve->need_rebuild = 1;
-    rve->outer_valid = 0;
+    rve->outer_valid = rve->outer_in_ok = 0;
     return GK_OK;
 }
 
@@ -3305,6 +3391,7 @@ GKDEF gk_result gk_rve_restore(gk_rve *rve, const void *buf, size_t size) {
     rve->outer.n = hd.nouter;
     rve->outer.np = rve->n;
     rve->outer_valid = hd.outer_valid;
+    rve->outer_in_ok = 0; /* the lists come from the state */
     gk_m3_copy(hd.ho0, rve->ho0);
     rve->skin_in = hd.skin_in;
     rve->pl.n = hd.npairs;

@@ -467,6 +467,40 @@ TEST(skin_does_not_change_results) {
     gk_rve_destroy(&b);
 }
 
+/* A rebuild carries the contact history over from the old list to the new
+ * one. When the outer list is the one the old list was filtered from, each
+ * pair's old index is looked up (outer_in); otherwise the two lists are
+ * merged on (i, j). Both give the same map: b merges at every rebuild, a looks
+ * up wherever it can, and their states stay equal bit for bit. */
+TEST(rebuild_lookup_equals_merge) {
+    gk_rve a, b;
+    gk_rve_def def = gk_rve_def_default();
+    double L[9] = {0, 40.0, 0, 20.0, -30.0, 0, 0, 0, 0};
+    int k, lookups = 0;
+    if (load_rve(&a, &def, RVE400) || load_rve(&b, &def, RVE400)) {
+        CHECK(0);
+        return;
+    }
+    CHECK(gk_rve_set_velocity_gradient(&a, L) == GK_OK);
+    CHECK(gk_rve_set_velocity_gradient(&b, L) == GK_OK);
+    for (k = 0; k < 3000; ++k) {
+        long r0 = a.rebuilds;
+        int ok = a.outer_in_ok, no = a.outer.n;
+        int32_t oi0 = no > 0 ? a.outer.i[no - 1] : -1, oj0 = no > 0 ? a.outer.j[no - 1] : -1;
+        b.outer_in_ok = 0;
+        CHECK(gk_rve_step(&a, 1) == GK_OK);
+        CHECK(gk_rve_step(&b, 1) == GK_OK);
+        /* a rebuilt its inner list from an outer list it kept: a lookup */
+        lookups += a.rebuilds > r0 && ok && a.outer.n == no && no > 0 && a.outer.i[no - 1] == oi0 &&
+                   a.outer.j[no - 1] == oj0;
+    }
+    CHECK(lookups > 50);
+    CHECK(b.rebuilds == a.rebuilds);
+    CHECK(same_state(&a, &b));
+    gk_rve_destroy(&a);
+    gk_rve_destroy(&b);
+}
+
 /* a restore from a corrupted or foreign buffer fails and changes nothing */
 TEST(restore_rejects_bad_buffers) {
     gk_rve a;
@@ -1386,6 +1420,7 @@ int main(int argc, char **argv) {
     RUN(save_restore_is_bitwise);
     RUN(restore_rejects_bad_buffers);
     RUN(skin_does_not_change_results);
+    RUN(rebuild_lookup_equals_merge);
     RUN(threads_do_not_change_results);
     RUN(threads_do_not_change_results_2d_without_and_with_every_torque);
     RUN(steps_without_stress_move_the_same);
