@@ -445,6 +445,25 @@ GK_FORCE_INLINE void gk_i32_compress(unsigned m, const int32_t *src, int32_t *ds
     _mm256_storeu_si256((__m256i *)(void *)dst,
                         _mm512_castsi512_si256(_mm512_maskz_compress_epi32((__mmask16)m, v)));
 }
+/* Candidate pairs of a block (generic version below): for each lane l whose
+ * bit of m is set, in lane order, the pair (p, (int32_t)q[l]) appended to
+ * buf as two ints; may write GK_VD_W pairs; returns the number appended. q
+ * holds GK_VD_W indices stored as doubles (exact). */
+#define GK_HAS_PAIRS_COMPRESS 1
+GK_FORCE_INLINE int gk_pairs_compress(unsigned m, int32_t p, const double *q, int32_t *buf) {
+    __m512i qi = _mm512_cvtepu32_epi64(_mm512_cvttpd_epi32(_mm512_loadu_pd(q)));
+    __m512i v = _mm512_or_si512(_mm512_slli_epi64(qi, 32), _mm512_set1_epi64((long long)(uint32_t)p));
+    _mm512_storeu_si512((void *)buf, _mm512_maskz_compress_epi64((__mmask8)m, v));
+#ifdef __POPCNT__
+    return _mm_popcnt_u32(m);
+#else
+    {
+        int k = 0;
+        for (; m; m &= m - 1) ++k;
+        return k;
+    }
+#endif
+}
 GK_FORCE_INLINE int gk_i32_ranks(unsigned m, int32_t base, int32_t *dst) {
     __m512i r = _mm512_maskz_expand_epi32(
         (__mmask16)m, _mm512_add_epi32(_mm512_set1_epi32(base), _mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8,
@@ -741,6 +760,18 @@ GK_FORCE_INLINE gk_vf gk_vf_from_vd2(gk_vd lo, gk_vd hi) {
 GK_FORCE_INLINE gk_vd gk_vd_from_vf(gk_vf a, int half) {
     (void)half;
     return (double)a;
+}
+#endif
+
+#ifndef GK_HAS_PAIRS_COMPRESS
+GK_FORCE_INLINE int gk_pairs_compress(unsigned m, int32_t p, const double *q, int32_t *buf) {
+    int l, k = 0;
+    for (l = 0; l < GK_VD_W; ++l) { /* written always, kept where the bit is set */
+        buf[2 * k] = p;
+        buf[2 * k + 1] = (int32_t)q[l];
+        k += (int)(m >> l & 1u);
+    }
+    return k;
 }
 #endif
 

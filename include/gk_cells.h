@@ -342,7 +342,7 @@ GK_FORCE_INLINE int gk__cells_scan(const gk_cells *c, const gk_vd P[6], const gk
      * its vector load right after the element stores stalls (store forwarding) */
     static const double iota[8] = {0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0};
     gk_vd lane = gk_vd_add(gk_vd_set1((double)f0), gk_vd_loadu(iota));
-    int f, l;
+    int f;
     for (f = f0; f < f1; f += GK_VD_W, lane = gk_vd_add(lane, gk_vd_set1((double)GK_VD_W))) {
         gk_vd a = gk_vd_sub(gk_vd_loadu(cx + f), P[0]), b = gk_vd_sub(gk_vd_loadu(cy + f), P[1]), d2, q;
         const gk_vd cut = gk_vd_add(gk_vd_add(P[3], gk_vd_loadu(cr + f)), P[4]);
@@ -365,11 +365,7 @@ GK_FORCE_INLINE int gk__cells_scan(const gk_cells *c, const gk_vd P[6], const gk
         bits = gk_vdm_bits(gk_vdm_and(gk_vdm_and(gk_vd_lt(d2, gk_vd_mul(cut, cut)), gk_vd_gt(q, P[5])),
                                       gk_vd_lt(lane, end)));
         if (!bits) continue;
-        for (l = 0; l < GK_VD_W; ++l) { /* written always, kept where the bit is set */
-            buf[2 * np] = p;
-            buf[2 * np + 1] = (int32_t)cq[f + l];
-            np += (int)(bits >> l & 1u);
-        }
+        np += gk_pairs_compress(bits, p, cq + f, buf + 2 * (size_t)np);
     }
     return np;
 }
