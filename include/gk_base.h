@@ -435,6 +435,16 @@ GK_FORCE_INLINE void gk_vf_win_make(const int32_t *idx, int32_t n, gk_vf_win *w)
             _mm512_cmplt_epu32_mask(w->lane, _mm512_set1_epi32(GK_VF_W)) == 0xffff;
 }
 GK_FORCE_INLINE unsigned gk_vdm_bits(gk_vdm m) { return (unsigned)m; }
+/* the number of set bits of a lane mask */
+GK_FORCE_INLINE int gk__mask_count(unsigned m) {
+#ifdef __POPCNT__
+    return _mm_popcnt_u32(m);
+#else
+    int k = 0;
+    for (; m; m &= m - 1) ++k;
+    return k;
+#endif
+}
 /* Compaction of a block of GK_VD_W int32 entries by a lane mask (512 bits
  * only): gk_i32_compress writes the src[l] whose bit l of m is set to dst in
  * lane order, and may write all GK_VD_W entries of dst; gk_i32_ranks writes
@@ -445,40 +455,24 @@ GK_FORCE_INLINE void gk_i32_compress(unsigned m, const int32_t *src, int32_t *ds
     _mm256_storeu_si256((__m256i *)(void *)dst,
                         _mm512_castsi512_si256(_mm512_maskz_compress_epi32((__mmask16)m, v)));
 }
-/* Candidate pairs of a block (generic version below): for each lane l whose
- * bit of m is set, in lane order, the pair (p, (int32_t)q[l]) appended to
- * buf as two ints; may write GK_VD_W pairs; returns the number appended. q
- * holds GK_VD_W indices stored as doubles (exact). */
-#define GK_HAS_PAIRS_COMPRESS 1
-GK_FORCE_INLINE int gk_pairs_compress(unsigned m, int32_t p, const double *q, int32_t *buf) {
-    __m512i qi = _mm512_cvtepu32_epi64(_mm512_cvttpd_epi32(_mm512_loadu_pd(q)));
-    __m512i v = _mm512_or_si512(_mm512_slli_epi64(qi, 32), _mm512_set1_epi64((long long)(uint32_t)p));
-    _mm512_storeu_si512((void *)buf, _mm512_maskz_compress_epi64((__mmask8)m, v));
-#ifdef __POPCNT__
-    return _mm_popcnt_u32(m);
-#else
-    {
-        int k = 0;
-        for (; m; m &= m - 1) ++k;
-        return k;
-    }
-#endif
-}
 GK_FORCE_INLINE int gk_i32_ranks(unsigned m, int32_t base, int32_t *dst) {
     __m512i r = _mm512_maskz_expand_epi32(
         (__mmask16)m, _mm512_add_epi32(_mm512_set1_epi32(base), _mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8,
                                                                                  7, 6, 5, 4, 3, 2, 1, 0)));
     r = _mm512_mask_blend_epi32((__mmask16)m, _mm512_set1_epi32(-1), r);
     _mm256_storeu_si256((__m256i *)(void *)dst, _mm512_castsi512_si256(r));
-#ifdef __POPCNT__
-    return _mm_popcnt_u32(m);
-#else
-    {
-        int k = 0;
-        for (; m; m &= m - 1) ++k;
-        return k;
-    }
-#endif
+    return gk__mask_count(m);
+}
+/* Candidate pairs of a block (a generic version below): for each lane l
+ * whose bit of m is set, in lane order, the pair (p, (int32_t)q[l]) appended
+ * to buf as two ints; may write GK_VD_W pairs; returns the number appended.
+ * q holds GK_VD_W indices stored as doubles (exact). */
+#define GK_HAS_PAIRS_COMPRESS 1
+GK_FORCE_INLINE int gk_pairs_compress(unsigned m, int32_t p, const double *q, int32_t *buf) {
+    __m512i qi = _mm512_cvtepu32_epi64(_mm512_cvttpd_epi32(_mm512_loadu_pd(q)));
+    __m512i v = _mm512_or_si512(_mm512_slli_epi64(qi, 32), _mm512_set1_epi64((long long)(uint32_t)p));
+    _mm512_storeu_si512((void *)buf, _mm512_maskz_compress_epi64((__mmask8)m, v));
+    return gk__mask_count(m);
 }
 GK_FORCE_INLINE gk_vd gk_vd_xorsign(gk_vd a) { /* -a, exactly */
     return _mm512_castsi512_pd(
