@@ -295,7 +295,9 @@ typedef struct gk_rve {
     int32_t *outer_in; /* each outer pair's index in pl, or -1 (outer_in_ok)  */
     size_t outer_in_cap;
     int outer_in_ok; /* pl was filtered from this outer list: a rebuild that
-                        keeps it looks the old pairs up instead of merging */
+                        keeps it looks the old pairs up instead of merging.
+                        Cleared by each outer build and by a restore (every
+                        other change of pl also clears outer_valid) */
     int need_rebuild, diverged;
     /* results of the last step that computed them (the last step of each call) */
     double stress[9]; /* Love stress, tension-positive [Pa]                 */
@@ -1001,7 +1003,7 @@ GKDEF gk_result gk_rve_create(gk_rve *rve_out, const gk_rve_def *def, const gk_p
         if (R.skin < 2.0 * def->mat.coh_n / knmin) R.skin = 2.0 * def->mat.coh_n / knmin;
         R.skin_in = R.skin;
     }
-    R.outer_valid = R.outer_in_ok = 0;
+    R.outer_valid = 0;
     gk_pcell_widths(&R.cell, w);
     cutoff = 2.0 * R.rmax + R.skin;
     for (k = 0; k < dim; ++k)
@@ -1131,7 +1133,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         if (res) return res;
         res = gk_cells_pairs(&rve->cells, rve->cell.h, sp, rve->r, rve->skin, &rve->outer, &rve->err);
         if (res) {
-            rve->outer_valid = rve->outer_in_ok = 0;
+            rve->outer_valid = 0;
             return res;
         }
         for (k = 0; k < dim; ++k) memcpy(rve->o0[k], rve->s[k], (size_t)n * sizeof(double));
@@ -1671,14 +1673,14 @@ static void gk__inner_filter_all(const gk_rve *rve, gk_pairlist *nl, int lookup,
     int32_t *oin = rve->outer_in;
     int c0 = 0;
 #ifdef GK__FILTER_SIMD
-    if (rve->def.flags & GK_RVE_SCALAR)
-        ;
-    else if (rve->dim == 2)
-        c0 = lookup ? gk__inner_filter_simd(rve, nl, 2, 1, oin, map)
-                    : gk__inner_filter_simd(rve, nl, 2, 0, oin, map);
-    else
-        c0 = lookup ? gk__inner_filter_simd(rve, nl, 3, 1, oin, map)
-                    : gk__inner_filter_simd(rve, nl, 3, 0, oin, map);
+    if (!(rve->def.flags & GK_RVE_SCALAR)) {
+        if (rve->dim == 2)
+            c0 = lookup ? gk__inner_filter_simd(rve, nl, 2, 1, oin, map)
+                        : gk__inner_filter_simd(rve, nl, 2, 0, oin, map);
+        else
+            c0 = lookup ? gk__inner_filter_simd(rve, nl, 3, 1, oin, map)
+                        : gk__inner_filter_simd(rve, nl, 3, 0, oin, map);
+    }
 #endif
     if (rve->dim == 2 && lookup)
         gk__inner_filter(rve, nl, 2, 1, oin, map, c0);
@@ -2398,7 +2400,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
             gk_m3_copy(h0n, rve->h0);
         }
         rve->need_rebuild = 1;
-        rve->outer_valid = rve->outer_in_ok = 0;
+        rve->outer_valid = 0;
     }
     dispmax2 = gk__integrate(rve, &x, rve->cell.hinv, rve->cell.h, &bad);
     if (rve->dim == 3 && rve->theta) { /* GK_RVE_TRACK_ROTATION: outside the kernels, paid only when asked */
@@ -3068,7 +3070,7 @@ GKDEF gk_result gk_rve_append(gk_rve *rve, int k, const double *const s[3], cons
     rve->n = n0 + k;
     gk_rve_update_totals(rve);
     rve->need_rebuild = 1;
-    rve->outer_valid = rve->outer_in_ok = 0;
+    rve->outer_valid = 0;
     return GK_OK;
 }
 
@@ -3106,7 +3108,7 @@ GKDEF gk_result gk_rve_remove(gk_rve *rve, const unsigned char *drop) {
     gk__pair_index(rve);
     gk_rve_update_totals(rve);
     rve->need_rebuild = 1;
-    rve->outer_valid = rve->outer_in_ok = 0;
+    rve->outer_valid = 0;
     return GK_OK;
 }
 
