@@ -28,6 +28,9 @@
 #   PEERS_LIST     codes to run ("grainkit lammps liggghts yade")
 #   PEERS_WORK     scratch directory (build/peers)
 #   PEERS_MPIRUN   MPI launcher for the 2-rank LAMMPS run (mpirun)
+#   PEERS_THREADS  thread / rank counts ("1 2"); "1" alone runs every code on
+#                  one core, e.g. under `taskset -c 1` on a machine whose cores
+#                  run at unequal speeds
 #
 # LAMMPS also runs once more on one rank in an orthogonal box under pure shear
 # at the same rate from rest (peer lammps_pure, its faster box): a speed
@@ -49,6 +52,14 @@ CASES=${PEERS_CASES:-"3d_10k 3d_1k 2d_10k rve400"}
 REPS=${PEERS_REPEATS:-3}
 LIST=${PEERS_LIST:-"grainkit lammps liggghts yade"}
 MPIRUN=${PEERS_MPIRUN:-mpirun}
+THREADS=${PEERS_THREADS:-"1 2"}
+case " $THREADS " in
+*" 1 "*) ;;
+*) echo "run_peers: PEERS_THREADS='$THREADS' must include 1 (the one-thread run writes the packing)" >&2; exit 2 ;;
+esac
+for th in $THREADS; do
+    case $th in 1 | 2) ;; *) echo "run_peers: PEERS_THREADS='$THREADS': counts are 1 and 2" >&2; exit 2 ;; esac
+done
 RES=$WORK/results.txt
 
 if [ ! -x "$BENCH" ]; then
@@ -141,7 +152,7 @@ for cs in $CASES; do
     echo
     echo "== case $cs: $S timed steps x $REPS repeats after $W warm-up steps"
     # grainkit first: it also writes the exact starting packing
-    for th in 1 2; do
+    for th in $THREADS; do
         if [ "$th" = 2 ] && ! wants grainkit; then continue; fi
         wp=""
         [ "$th" = 1 ] && wp="--write-packing $pk"
@@ -167,7 +178,7 @@ for cs in $CASES; do
         elif python3 $PEERDIR/pack2lammps.py "$pk" "$WORK/$cs.data" 2>"$WORK/$cs.conv"; then
             note=match
             if grep -q rotated "$WORK/$cs.conv"; then note="cell_rotated_$(sed -n 's/.*by ~\([^ ]*\) rad.*/\1/p' "$WORK/$cs.conv")rad"; fi
-            for np in 1 2; do
+            for np in $THREADS; do
                 log=$WORK/lammps_${cs}_np$np.log
                 if [ "$np" = 1 ]; then
                     LMP_LAUNCH="" lmp_run "$WORK/$cs.data" "$log"
@@ -218,7 +229,7 @@ for cs in $CASES; do
         if ! have yade; then
             skip "peer=yade case=$cs: yade not found (Debian: apt-get install yade)"
         else
-            for j in 1 2; do
+            for j in $THREADS; do
                 log=$WORK/yade_${cs}_j$j.log
                 yade -j"$j" -n -x $PEERDIR/yade_bench.py "$pk" "$W" "$S" "$REPS" >"$log" 2>&1
                 line=$(grep '^YADE ' "$log" | tail -n 1)
