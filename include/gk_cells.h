@@ -39,10 +39,12 @@
  *
  * VERLET SKIN. gk_cells_skin_margin bounds how much closer than when a list
  * was built (reduced positions s0 in cell h0) any pair can now be: through
- * the smallest singular value of the affine map A = h h0^-1 and twice the
- * largest non-affine displacement (gk_cells_disp2_max). While the margin is
- * positive the list still holds every touching pair; gk_dem.h tests its
- * inner and outer lists with it, gk_cells_skin_ok is the yes/no form.
+ * the smallest singular value of the affine map A = h h0^-1 and the sum of
+ * the two largest non-affine displacements of distinct particles
+ * (gk_cells_disp2_top2, gk_cells_skin_margin2; gk_cells_skin_margin takes
+ * twice the largest, a looser bound). While the margin is positive the list
+ * still holds every touching pair; gk_dem.h tests its inner and outer lists
+ * with it, gk_cells_skin_ok is the yes/no form.
  *
  * LICENCE: MIT (see gk_base.h).
  */
@@ -110,12 +112,22 @@ GKDEF gk_result gk_pairlist_reserve(gk_pairlist *p, size_t npairs, size_t np);
  * or dispmax2 is not finite: the list must be rebuilt. */
 GKDEF double gk_cells_skin_margin(int dim, const double h0[9], const double h[9], double skin, double rmax,
                                   double dispmax2);
+/* The same margin from the two largest squared non-affine displacements of
+ * distinct particles, top2[0] >= top2[1]: two particles have moved apart from
+ * the affine map by at most sqrt(top2[0]) + sqrt(top2[1]), which is tighter
+ * than gk_cells_skin_margin's 2 sqrt(dispmax2) (that is top2 = {d, d}) */
+GKDEF double gk_cells_skin_margin2(int dim, const double h0[9], const double h[9], double skin, double rmax,
+                                   const double top2[2]);
 /* largest squared non-affine displacement |h (s - s0)|^2 over n particles */
 GKDEF double gk_cells_disp2_max(int dim, const double h[9], int n, const double *const s0[3],
                                 const double *const s[3]);
+/* the two largest of them over distinct particles, top2[0] >= top2[1] (0 for a
+ * missing particle); a NaN displacement is kept in top2[0] */
+GKDEF void gk_cells_disp2_top2(int dim, const double h[9], int n, const double *const s0[3],
+                               const double *const s[3], double top2[2]);
 /* Verlet criterion: 1 if a list built at s0 in cell h0 (with this skin and
- * largest radius rmax) is still complete at s in cell h (margin > 0).
- * dispmax2 receives the largest squared non-affine displacement. */
+ * largest radius rmax) is still complete at s in cell h (gk_cells_skin_margin2
+ * > 0). dispmax2 receives the largest squared non-affine displacement. */
 GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n, const double *const s0[3],
                            const double *const s[3], double skin, double rmax, double *dispmax2);
 
@@ -520,15 +532,36 @@ static double gk__sigma_min(int dim, const double A[9]) {
     return val[0] > 0.0 ? sqrt(val[0]) : 0.0;
 }
 
-GKDEF double gk_cells_skin_margin(int dim, const double h0[9], const double h[9], double skin, double rmax,
-                                  double dispmax2) {
+/* margin with the two particles' relative non-affine displacement bounded by dsum */
+static double gk__skin_margin(int dim, const double h0[9], const double h[9], double skin, double rmax,
+                              double dsum) {
     double h0i[9], A[9], smin;
-    if (!(gk_m3_inverse(h0, h0i) > 0.0) || !isfinite(dispmax2)) return -1.0;
+    if (!(gk_m3_inverse(h0, h0i) > 0.0) || !isfinite(dsum)) return -1.0;
     gk_m3_mul(h, h0i, A);
     smin = gk__sigma_min(dim, A);
-    /* a pair listed out had |d0| >= R + skin; now |d| >= smin (R + skin) - 2 disp,
-     * and |d| - R >= smin skin - (1 - smin) R - 2 disp with R <= 2 rmax */
-    return smin * skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rmax : 0.0) - 2.0 * sqrt(dispmax2);
+    /* a pair listed out had |d0| >= R + skin; now |d| >= smin (R + skin) - dsum,
+     * and |d| - R >= smin skin - (1 - smin) R - dsum with R <= 2 rmax */
+    return smin * skin - (smin < 1.0 ? (1.0 - smin) * 2.0 * rmax : 0.0) - dsum;
+}
+
+GKDEF double gk_cells_skin_margin(int dim, const double h0[9], const double h[9], double skin, double rmax,
+                                  double dispmax2) {
+    return gk__skin_margin(dim, h0, h, skin, rmax, 2.0 * sqrt(dispmax2));
+}
+
+GKDEF double gk_cells_skin_margin2(int dim, const double h0[9], const double h[9], double skin, double rmax,
+                                   const double top2[2]) {
+    return gk__skin_margin(dim, h0, h, skin, rmax, sqrt(top2[0]) + sqrt(top2[1]));
+}
+
+/* squared non-affine displacement of particle p */
+static double gk__disp2(int dim, const double h[9], const double *const s0[3], const double *const s[3],
+                        int p) {
+    double dx = s[0][p] - s0[0][p], dy = s[1][p] - s0[1][p], dz = dim == 3 ? s[2][p] - s0[2][p] : 0.0;
+    double ex = h[0] * dx + h[1] * dy + h[2] * dz;
+    double ey = h[3] * dx + h[4] * dy + h[5] * dz;
+    double ez = dim == 3 ? h[6] * dx + h[7] * dy + h[8] * dz : 0.0;
+    return ex * ex + ey * ey + ez * ez;
 }
 
 GKDEF double gk_cells_disp2_max(int dim, const double h[9], int n, const double *const s0[3],
@@ -536,21 +569,34 @@ GKDEF double gk_cells_disp2_max(int dim, const double h[9], int n, const double 
     double m2 = 0.0;
     int p;
     for (p = 0; p < n; ++p) {
-        double dx = s[0][p] - s0[0][p], dy = s[1][p] - s0[1][p], dz = dim == 3 ? s[2][p] - s0[2][p] : 0.0;
-        double ex = h[0] * dx + h[1] * dy + h[2] * dz;
-        double ey = h[3] * dx + h[4] * dy + h[5] * dz;
-        double ez = dim == 3 ? h[6] * dx + h[7] * dy + h[8] * dz : 0.0;
-        double d2 = ex * ex + ey * ey + ez * ez;
+        double d2 = gk__disp2(dim, h, s0, s, p);
         if (d2 > m2 || d2 != d2) m2 = d2; /* a NaN is kept: the margin refuses it */
     }
     return m2;
 }
 
+GKDEF void gk_cells_disp2_top2(int dim, const double h[9], int n, const double *const s0[3],
+                               const double *const s[3], double top2[2]) {
+    double a = 0.0, b = 0.0;
+    int p;
+    for (p = 0; p < n; ++p) {
+        double d2 = gk__disp2(dim, h, s0, s, p);
+        if (d2 != d2) {
+            top2[0] = d2, top2[1] = 0.0; /* a NaN: the margin refuses it */
+            return;
+        }
+        b = d2 < a ? (d2 > b ? d2 : b) : a;
+        a = d2 > a ? d2 : a;
+    }
+    top2[0] = a, top2[1] = b;
+}
+
 GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n, const double *const s0[3],
                            const double *const s[3], double skin, double rmax, double *dispmax2) {
-    double m2 = gk_cells_disp2_max(dim, h, n, s0, s);
-    if (dispmax2) *dispmax2 = m2;
-    return gk_cells_skin_margin(dim, h0, h, skin, rmax, m2) > 0.0;
+    double t2[2];
+    gk_cells_disp2_top2(dim, h, n, s0, s, t2);
+    if (dispmax2) *dispmax2 = t2[0];
+    return gk_cells_skin_margin2(dim, h0, h, skin, rmax, t2) > 0.0;
 }
 
 #endif /* GK_CELLS implementation */

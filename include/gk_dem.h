@@ -1111,7 +1111,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         rve->dt_crit = dtc;
     }
     int dim = rve->dim, n = rve->n, k, c, lookup;
-    double w[3];
+    double w[3], o2[2] = {0.0, 0.0};
     gk_result res;
     const double *sp[3];
     /* cell too thin for the nearest image: try a lattice reduction first */
@@ -1123,10 +1123,11 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
                 "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
                 "too far for this many particles)",
                 w[k], 2.0 * rve->rmax + rve->skin);
+    if (rve->outer_valid) /* the two largest displacements: a tighter bound than twice the largest */
+        gk_cells_disp2_top2(dim, rve->cell.h, n, (const double *const *)rve->o0,
+                            (const double *const *)rve->s, o2);
     if (!rve->outer_valid ||
-        !(gk_cells_skin_margin(dim, rve->ho0, rve->cell.h, rve->skin, rve->rmax,
-                               gk_cells_disp2_max(dim, rve->cell.h, n, (const double *const *)rve->o0,
-                                                  (const double *const *)rve->s)) > rve->skin_in)) {
+        !(gk_cells_skin_margin2(dim, rve->ho0, rve->cell.h, rve->skin, rve->rmax, o2) > rve->skin_in)) {
         /* outer list from the cell grid (positions are in [0,1): gk__wrap) */
         for (k = 0; k < 3; ++k) sp[k] = rve->s[k < dim ? k : 0];
         res = gk_cells_bin(&rve->cells, dim, rve->cell.h, n, sp, 2.0 * rve->rmax + rve->skin, &rve->err);
@@ -2419,6 +2420,8 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
             "non-finite velocity or position at step %ld (time step too large or unstable input?)",
             rve->step);
     }
+    /* twice the largest displacement: the kernels keeping the two largest (the
+     * outer test's tighter bound) cost the update more than the rebuilds saved */
     if (!rve->need_rebuild &&
         !(gk_cells_skin_margin(rve->dim, rve->h0, rve->cell.h, rve->skin_in, rve->rmax, dispmax2) > 0.0))
         rve->need_rebuild = 1;

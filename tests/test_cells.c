@@ -365,6 +365,120 @@ TEST(verlet_skin_criterion_is_safe) {
     gk_pairlist_free(&pl);
 }
 
+/* nearest-image distance of particles i, j of a 2D set in cell h */
+static double dist2d(const pset *ps, const double h[9], int i, int j) {
+    double ds[3], d[3];
+    int k;
+    for (k = 0; k < 3; ++k) ds[k] = k < 2 ? ps->s[k][j] - ps->s[k][i] : 0.0;
+    for (k = 0; k < 2; ++k) ds[k] -= rint(ds[k]);
+    gk_m3_matvec(h, ds, d);
+    return sqrt(d[0] * d[0] + d[1] * d[1]);
+}
+
+/* Two particles move apart from the affine map by at most the sum of their
+ * displacements, |e_j - e_i| <= |e_i| + |e_j|, so the two largest of distinct
+ * particles bound every pair (gk_cells_skin_margin2), where twice the largest
+ * (gk_cells_skin_margin) is looser. Checked: the two largest against a full
+ * scan, the two margins equal for {d, d}, a lone particle, a NaN; and one
+ * particle moved 0.9 skin straight at its nearest unlisted neighbour: twice
+ * the largest refuses the list, the two largest keep it, and every touching
+ * pair is still listed. */
+TEST(skin_two_largest_displacements) {
+    static pset ps;
+    static double s0[3][MAXN];
+    gk_cells cl;
+    gk_pairlist pl;
+    gk_err e;
+    gk_rng rng;
+    const double *sp[3], *sp0[3];
+    double t2[2], a = 0.0, b = 0.0, skin = 0.01, rmax = 0.0, best = 1e300, dd[2];
+    int p, k, q = -1, i, j, c, missing = 0;
+    make_set(&ps, 3, 200, 2.0, 5);
+    for (k = 0; k < 3; ++k) {
+        memcpy(s0[k], ps.s[k], sizeof s0[k]);
+        sp[k] = ps.s[k];
+        sp0[k] = s0[k];
+    }
+    gk_rng_seed(&rng, 11);
+    for (p = 0; p < ps.n; ++p) {
+        double ds[3], u[3], d2;
+        for (k = 0; k < 3; ++k) ps.s[k][p] += 1e-3 * (gk_rng_uniform(&rng) - 0.5);
+        for (k = 0; k < 3; ++k) ds[k] = ps.s[k][p] - s0[k][p];
+        gk_m3_matvec(ps.h, ds, u);
+        d2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+        if (d2 > a) {
+            b = a;
+            a = d2;
+        } else if (d2 > b) {
+            b = d2;
+        }
+    }
+    gk_cells_disp2_top2(3, ps.h, ps.n, sp0, sp, t2);
+    CHECK(t2[0] == a && t2[1] == b && b > 0.0 && b < a);
+    CHECK(gk_cells_disp2_max(3, ps.h, ps.n, sp0, sp) == a);
+    dd[0] = dd[1] = a;
+    CHECK(gk_cells_skin_margin2(3, ps.h, ps.h, skin, 0.04, dd) ==
+          gk_cells_skin_margin(3, ps.h, ps.h, skin, 0.04, a));
+    CHECK(gk_cells_skin_margin2(3, ps.h, ps.h, skin, 0.04, t2) >
+          gk_cells_skin_margin(3, ps.h, ps.h, skin, 0.04, a));
+    gk_cells_disp2_top2(3, ps.h, 1, sp0, sp, t2);
+    CHECK(t2[1] == 0.0 && t2[0] > 0.0);
+    ps.s[1][7] = NAN;
+    gk_cells_disp2_top2(3, ps.h, ps.n, sp0, sp, t2);
+    CHECK(t2[0] != t2[0] && !(gk_cells_skin_margin2(3, ps.h, ps.h, skin, 0.04, t2) > 0.0));
+
+    /* 2D: the nearest unlisted pair, one of its particles moved 0.9 skin at the other */
+    make_set(&ps, 2, 300, 2.0, 9);
+    for (p = 0; p < ps.n; ++p)
+        if (ps.r[p] > rmax) rmax = ps.r[p];
+    for (k = 0; k < 3; ++k) {
+        memcpy(s0[k], ps.s[k], sizeof s0[k]);
+        sp[k] = ps.s[k];
+        sp0[k] = s0[k];
+    }
+    gk_cells_init(&cl, NULL);
+    gk_pairlist_init(&pl, NULL);
+    CHECK(gk_cells_bin(&cl, 2, ps.h, ps.n, sp0, 2 * rmax + skin, &e) == GK_OK);
+    CHECK(gk_cells_pairs(&cl, ps.h, sp0, ps.r, skin, &pl, &e) == GK_OK);
+    for (i = 0; i < ps.n; ++i)
+        for (j = i + 1; j < ps.n; ++j) {
+            double gap = dist2d(&ps, ps.h, i, j) - (double)ps.r[i] - (double)ps.r[j];
+            int listed = 0;
+            for (c = pl.start[i]; c < pl.start[i + 1]; ++c)
+                if (pl.j[c] == j) listed = 1;
+            if (!listed && gap < best) best = gap, q = i, p = j;
+        }
+    CHECK(q >= 0 && best >= skin);
+    if (q >= 0) {
+        double ds[3], dv[3], hi[9], L;
+        for (k = 0; k < 3; ++k) ds[k] = k < 2 ? ps.s[k][p] - ps.s[k][q] : 0.0;
+        for (k = 0; k < 2; ++k) ds[k] -= rint(ds[k]);
+        gk_m3_matvec(ps.h, ds, dv);
+        L = sqrt(dv[0] * dv[0] + dv[1] * dv[1]);
+        for (k = 0; k < 2; ++k) dv[k] *= 0.9 * skin / L; /* 0.9 skin along the line of centres */
+        dv[2] = 0.0;
+        CHECK(gk_m3_inverse(ps.h, hi) > 0.0);
+        gk_m3_matvec(hi, dv, ds);
+        ps.s[0][q] += ds[0];
+        ps.s[1][q] += ds[1];
+        CHECK(fabs(dist2d(&ps, ps.h, q, p) - (L - 0.9 * skin)) < 1e-12);
+        CHECK(!(gk_cells_skin_margin(2, ps.h, ps.h, skin, rmax, gk_cells_disp2_max(2, ps.h, ps.n, sp0, sp)) >
+                0.0));
+        CHECK(gk_cells_skin_ok(2, ps.h, ps.h, ps.n, sp0, sp, skin, rmax, NULL));
+        for (i = 0; i < ps.n; ++i)
+            for (j = i + 1; j < ps.n; ++j) {
+                int listed = 0;
+                if (dist2d(&ps, ps.h, i, j) >= (double)ps.r[i] + (double)ps.r[j]) continue;
+                for (c = pl.start[i]; c < pl.start[i + 1]; ++c)
+                    if (pl.j[c] == j) listed = 1;
+                if (!listed) ++missing;
+            }
+        CHECK_EQ_INT(missing, 0);
+    }
+    gk_cells_free(&cl);
+    gk_pairlist_free(&pl);
+}
+
 /* GK_PATH_OBJECTIVE ends exactly at I + dH, also for a 90 degree spin or a
  * shear of 10; GK_PATH_CONSTANT_L ends at exp(dH) (constant L, YADE). */
 TEST(deformation_paths_end_maps) {
@@ -470,6 +584,7 @@ int main(int argc, char **argv) {
     RUN(cells_refuse_ambiguous_nearest_image);
     RUN(remap_preserves_pair_distances);
     RUN(verlet_skin_criterion_is_safe);
+    RUN(skin_two_largest_displacements);
     RUN(deformation_paths_end_maps);
     RUN(path_rejects_bad_increments);
     RUN(pcell_rejects_bad_cells);
