@@ -2086,7 +2086,8 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
                                           const int rot, const int damp) {
     const gk_vr dt = gk_vr_set1(x->dt), alpha = gk_vr_set1((gk_real)rve->def.damping),
                 hdt = gk_vr_set1((gk_real)0.5 * x->dt), zero = gk_vr_zero();
-    const gk_vd dtd = gk_vd_set1((double)x->dt), wad = gk_vd_set1((double)x->wa[2]);
+    const gk_vd dtd = gk_vd_set1((double)x->dt), wad = gk_vd_set1((double)x->wa[2]), dzero = gk_vd_zero(),
+                done = gk_vd_set1(1.0);
     gk_vd H[9], Gn[9], vm2 = gk_vd_zero();
     gk_vr vchk = zero;
     double m2 = 0.0, chk = 0.0, buf[GK_VD_W];
@@ -2131,22 +2132,35 @@ GK_FORCE_INLINE double gk__integrate_simd(gk_rve *rve, const gk__stepctx *x, con
         }
         for (hf = 0; hf < GK_VR_DHALVES; ++hf) {
             int q = p + hf * GK_VD_W;
-            gk_vd dd[3], sp[3], e[3], u[3], u2;
+            gk_vd dd[3], sp[3], r0[3], e[3], u[3], u2;
             GK_UNROLL
             for (k = 0; k < dim; ++k) dd[k] = gk__vr_half(d[k], hf);
+            gk_vdm out = gk_vd_lt(dzero, dzero); /* no lane */
             GK_UNROLL
             for (k = 0; k < dim; ++k) {
-                gk_vd inc = gk_vd_add(gk_vd_mul(H[3 * k], dd[0]), gk_vd_mul(H[3 * k + 1], dd[1])), fl, r0;
+                gk_vd inc = gk_vd_add(gk_vd_mul(H[3 * k], dd[0]), gk_vd_mul(H[3 * k + 1], dd[1]));
                 if (dim == 3) inc = gk_vd_add(inc, gk_vd_mul(H[3 * k + 2], dd[2]));
                 sp[k] = gk_vd_add(gk_vd_loadu(rve->s[k] + q), inc);
-                /* gk__wrap */
-                fl = gk_vd_floor(sp[k]);
-                r0 = gk_vd_sub(gk_vd_loadu(rve->s0[k] + q), fl);
-                sp[k] = gk_vd_sub(sp[k], fl);
-                gk_vd_storeu(rve->s0[k] + q, r0);
-                gk_vd_storeu(rve->o0[k] + q, gk_vd_sub(gk_vd_loadu(rve->o0[k] + q), fl));
+                out = gk_vdm_or(out, gk_vdm_or(gk_vd_lt(sp[k], dzero), gk_vdm_not(gk_vd_lt(sp[k], done))));
+            }
+            /* gk__wrap where a lane left [0, 1) (rare); elsewhere floor is 0 and changes nothing */
+            if (gk_vdm_any(out)) {
+                GK_UNROLL
+                for (k = 0; k < dim; ++k) {
+                    gk_vd fl = gk_vd_floor(sp[k]);
+                    r0[k] = gk_vd_sub(gk_vd_loadu(rve->s0[k] + q), fl);
+                    sp[k] = gk_vd_sub(sp[k], fl);
+                    gk_vd_storeu(rve->s0[k] + q, r0[k]);
+                    gk_vd_storeu(rve->o0[k] + q, gk_vd_sub(gk_vd_loadu(rve->o0[k] + q), fl));
+                }
+            } else {
+                GK_UNROLL
+                for (k = 0; k < dim; ++k) r0[k] = gk_vd_loadu(rve->s0[k] + q);
+            }
+            GK_UNROLL
+            for (k = 0; k < dim; ++k) {
                 gk_vd_storeu(rve->s[k] + q, sp[k]);
-                e[k] = gk_vd_sub(sp[k], r0);
+                e[k] = gk_vd_sub(sp[k], r0[k]);
             }
             GK_UNROLL
             for (k = 0; k < dim; ++k) {

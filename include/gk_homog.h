@@ -451,8 +451,7 @@ GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
                             (j == k ? s[3 * i + l] : 0.0) - (k == l ? s[3 * i + j] : 0.0);
     }
     if (!(opts & GK_TANGENT_RAW)) {
-        double *T = (double *)gk_alloc(&rve->def.alloc, (size_t)n4 * sizeof(double));
-        if (!T) return GK_ERR_ALLOC;
+        double T[81]; /* n4 <= 3^4 */
         for (i = 0; i < dim; ++i)
             for (j = 0; j < dim; ++j)
                 for (k = 0; k < dim; ++k)
@@ -464,7 +463,6 @@ GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
 #undef GK__DI
                     }
         memcpy(D, T, (size_t)n4 * sizeof(double));
-        gk_free(&rve->def.alloc, T);
     }
     return GK_OK;
 }
