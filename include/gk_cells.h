@@ -43,8 +43,9 @@
  * the two largest non-affine displacements of distinct particles
  * (gk_cells_disp2_top2, gk_cells_skin_margin2; gk_cells_skin_margin takes
  * twice the largest, a looser bound). While the margin is positive the list
- * still holds every touching pair; gk_dem.h tests its inner and outer lists
- * with it, gk_cells_skin_ok is the yes/no form.
+ * still holds every touching pair; gk_dem.h tests its outer list with the
+ * two largest and its inner list, at every step, with twice the largest (the
+ * one its update tracks), gk_cells_skin_ok is the yes/no form.
  *
  * LICENCE: MIT (see gk_base.h).
  */
