@@ -307,31 +307,42 @@ TEST(remap_preserves_pair_distances) {
     CHECK(checked > 100);
 }
 
+/* the 2D set of the skin tests (300 particles, seed 9), its positions kept in
+ * s0 (sp: the moving ones, sp0: the kept), and its list with this skin built
+ * at s0 in the set's cell; returns the largest radius */
+static double skin_test_list(pset *ps, double s0[3][MAXN], const double *sp[3], const double *sp0[3],
+                             double skin, gk_cells *cl, gk_pairlist *pl) {
+    gk_err e;
+    double rmax = 0.0;
+    int p, k;
+    make_set(ps, 2, 300, 2.0, 9);
+    for (p = 0; p < ps->n; ++p)
+        if (ps->r[p] > rmax) rmax = ps->r[p];
+    for (k = 0; k < 3; ++k) {
+        memcpy(s0[k], ps->s[k], sizeof s0[k]);
+        sp[k] = ps->s[k];
+        sp0[k] = s0[k];
+    }
+    gk_cells_init(cl, NULL);
+    gk_pairlist_init(pl, NULL);
+    CHECK(gk_cells_bin(cl, 2, ps->h, ps->n, sp0, 2 * rmax + skin, &e) == GK_OK);
+    CHECK(gk_cells_pairs(cl, ps->h, sp0, ps->r, skin, pl, &e) == GK_OK);
+    return rmax;
+}
+
 /* Verlet criterion: while gk_cells_skin_ok says yes, every pair closer than
  * r_i + r_j is in the list built earlier (random walks + affine shear). */
 TEST(verlet_skin_criterion_is_safe) {
     static pset ps;
     gk_cells cl;
     gk_pairlist pl;
-    gk_err e;
     gk_rng rng;
-    double h0[9], h[9], s0[3][MAXN], skin = 0.01, rmax = 0;
+    double h0[9], h[9], s0[3][MAXN], skin = 0.01, rmax;
     const double *sp[3], *sp0[3];
     int step, p, k, accepted = 0, missing = 0;
-    make_set(&ps, 2, 300, 2.0, 9);
-    for (p = 0; p < ps.n; ++p)
-        if (ps.r[p] > rmax) rmax = ps.r[p];
+    rmax = skin_test_list(&ps, s0, sp, sp0, skin, &cl, &pl);
     gk_m3_copy(ps.h, h0);
     gk_m3_copy(h0, h);
-    for (k = 0; k < 3; ++k) {
-        memcpy(s0[k], ps.s[k], sizeof s0[k]);
-        sp[k] = ps.s[k];
-        sp0[k] = s0[k];
-    }
-    gk_cells_init(&cl, NULL);
-    gk_pairlist_init(&pl, NULL);
-    CHECK(gk_cells_bin(&cl, 2, h0, ps.n, sp0, 2 * rmax + skin, &e) == GK_OK);
-    CHECK(gk_cells_pairs(&cl, h0, sp0, ps.r, skin, &pl, &e) == GK_OK);
     gk_rng_seed(&rng, 3);
     for (step = 0; step < 400; ++step) {
         double dm2;
@@ -388,10 +399,9 @@ TEST(skin_two_largest_displacements) {
     static double s0[3][MAXN];
     gk_cells cl;
     gk_pairlist pl;
-    gk_err e;
     gk_rng rng;
     const double *sp[3], *sp0[3];
-    double t2[2], a = 0.0, b = 0.0, skin = 0.01, rmax = 0.0, best = 1e300, dd[2];
+    double t2[2], a = 0.0, b = 0.0, skin = 0.01, rmax, best = 1e300, dd[2];
     int p, k, q = -1, i, j, c, missing = 0;
     make_set(&ps, 3, 200, 2.0, 5);
     for (k = 0; k < 3; ++k) {
@@ -428,18 +438,7 @@ TEST(skin_two_largest_displacements) {
     CHECK(t2[0] != t2[0] && !(gk_cells_skin_margin2(3, ps.h, ps.h, skin, 0.04, t2) > 0.0));
 
     /* 2D: the nearest unlisted pair, one of its particles moved 0.9 skin at the other */
-    make_set(&ps, 2, 300, 2.0, 9);
-    for (p = 0; p < ps.n; ++p)
-        if (ps.r[p] > rmax) rmax = ps.r[p];
-    for (k = 0; k < 3; ++k) {
-        memcpy(s0[k], ps.s[k], sizeof s0[k]);
-        sp[k] = ps.s[k];
-        sp0[k] = s0[k];
-    }
-    gk_cells_init(&cl, NULL);
-    gk_pairlist_init(&pl, NULL);
-    CHECK(gk_cells_bin(&cl, 2, ps.h, ps.n, sp0, 2 * rmax + skin, &e) == GK_OK);
-    CHECK(gk_cells_pairs(&cl, ps.h, sp0, ps.r, skin, &pl, &e) == GK_OK);
+    rmax = skin_test_list(&ps, s0, sp, sp0, skin, &cl, &pl);
     for (i = 0; i < ps.n; ++i)
         for (j = i + 1; j < ps.n; ++j) {
             double gap = dist2d(&ps, ps.h, i, j) - (double)ps.r[i] - (double)ps.r[j];
