@@ -307,6 +307,42 @@ TEST(remap_preserves_pair_distances) {
     CHECK(checked > 100);
 }
 
+/* nearest-image branch vector d from particle i to j of a 2D set in cell h (d[2] = 0) */
+static void image2d(const pset *ps, const double h[9], int i, int j, double d[3]) {
+    double ds[3];
+    int k;
+    for (k = 0; k < 3; ++k) ds[k] = k < 2 ? ps->s[k][j] - ps->s[k][i] : 0.0;
+    for (k = 0; k < 2; ++k) ds[k] -= rint(ds[k]);
+    gk_m3_matvec(h, ds, d);
+    d[2] = 0.0;
+}
+
+static double dist2d(const pset *ps, const double h[9], int i, int j) {
+    double d[3];
+    image2d(ps, h, i, j, d);
+    return sqrt(d[0] * d[0] + d[1] * d[1]);
+}
+
+/* whether the list holds the pair (i, j), i < j */
+static int listed(const gk_pairlist *pl, int i, int j) {
+    int c;
+    for (c = pl->start[i]; c < pl->start[i + 1]; ++c)
+        if (pl->j[c] == j) return 1;
+    return 0;
+}
+
+/* the touching pairs (closer than r_i + r_j) of a 2D set in cell h that the list misses */
+static int unlisted_contacts(const pset *ps, const double h[9], const gk_pairlist *pl) {
+    int i, j, missing = 0;
+    for (i = 0; i < ps->n; ++i)
+        for (j = i + 1; j < ps->n; ++j) {
+            double d[3], R = (double)ps->r[i] + (double)ps->r[j];
+            image2d(ps, h, i, j, d);
+            if (d[0] * d[0] + d[1] * d[1] < R * R && !listed(pl, i, j)) ++missing;
+        }
+    return missing;
+}
+
 /* the 2D set of the skin tests (300 particles, seed 9), its positions kept in
  * s0 (sp: the moving ones, sp0: the kept), and its list with this skin built
  * at s0 in the set's cell; returns the largest radius */
@@ -352,38 +388,13 @@ TEST(verlet_skin_criterion_is_safe) {
         h[0] *= 1.0 - 1e-4;  /* and compression */
         if (!gk_cells_skin_ok(2, h0, h, ps.n, sp0, sp, skin, rmax, &dm2)) break;
         ++accepted;
-        /* every touching pair must be listed */
-        {
-            int i, j;
-            for (i = 0; i < ps.n; ++i)
-                for (j = i + 1; j < ps.n; ++j) {
-                    double ds[3], d[3], R = (double)ps.r[i] + (double)ps.r[j];
-                    int c, found = 0;
-                    for (k = 0; k < 3; ++k) ds[k] = k < 2 ? ps.s[k][j] - ps.s[k][i] : 0.0;
-                    for (k = 0; k < 2; ++k) ds[k] -= rint(ds[k]);
-                    gk_m3_matvec(h, ds, d);
-                    if (d[0] * d[0] + d[1] * d[1] >= R * R) continue;
-                    for (c = pl.start[i]; c < pl.start[i + 1]; ++c)
-                        if (pl.j[c] == j) found = 1;
-                    if (!found) ++missing;
-                }
-        }
+        missing += unlisted_contacts(&ps, h, &pl); /* every touching pair must be listed */
     }
     CHECK(accepted > 10);  /* the criterion is not trivially false */
     CHECK(accepted < 400); /* and it does trigger */
     CHECK_EQ_INT(missing, 0);
     gk_cells_free(&cl);
     gk_pairlist_free(&pl);
-}
-
-/* nearest-image distance of particles i, j of a 2D set in cell h */
-static double dist2d(const pset *ps, const double h[9], int i, int j) {
-    double ds[3], d[3];
-    int k;
-    for (k = 0; k < 3; ++k) ds[k] = k < 2 ? ps->s[k][j] - ps->s[k][i] : 0.0;
-    for (k = 0; k < 2; ++k) ds[k] -= rint(ds[k]);
-    gk_m3_matvec(h, ds, d);
-    return sqrt(d[0] * d[0] + d[1] * d[1]);
 }
 
 /* Two particles move apart from the affine map by at most the sum of their
@@ -402,7 +413,7 @@ TEST(skin_two_largest_displacements) {
     gk_rng rng;
     const double *sp[3], *sp0[3];
     double t2[2], a = 0.0, b = 0.0, skin = 0.01, rmax, best = 1e300, dd[2];
-    int p, k, q = -1, i, j, c, missing = 0;
+    int p, k, q = -1, i, j;
     make_set(&ps, 3, 200, 2.0, 5);
     for (k = 0; k < 3; ++k) {
         memcpy(s0[k], ps.s[k], sizeof s0[k]);
@@ -442,20 +453,14 @@ TEST(skin_two_largest_displacements) {
     for (i = 0; i < ps.n; ++i)
         for (j = i + 1; j < ps.n; ++j) {
             double gap = dist2d(&ps, ps.h, i, j) - (double)ps.r[i] - (double)ps.r[j];
-            int listed = 0;
-            for (c = pl.start[i]; c < pl.start[i + 1]; ++c)
-                if (pl.j[c] == j) listed = 1;
-            if (!listed && gap < best) best = gap, q = i, p = j;
+            if (!listed(&pl, i, j) && gap < best) best = gap, q = i, p = j;
         }
     CHECK(q >= 0 && best >= skin);
     if (q >= 0) {
         double ds[3], dv[3], hi[9], L;
-        for (k = 0; k < 3; ++k) ds[k] = k < 2 ? ps.s[k][p] - ps.s[k][q] : 0.0;
-        for (k = 0; k < 2; ++k) ds[k] -= rint(ds[k]);
-        gk_m3_matvec(ps.h, ds, dv);
+        image2d(&ps, ps.h, q, p, dv);
         L = sqrt(dv[0] * dv[0] + dv[1] * dv[1]);
         for (k = 0; k < 2; ++k) dv[k] *= 0.9 * skin / L; /* 0.9 skin along the line of centres */
-        dv[2] = 0.0;
         CHECK(gk_m3_inverse(ps.h, hi) > 0.0);
         gk_m3_matvec(hi, dv, ds);
         ps.s[0][q] += ds[0];
@@ -464,15 +469,7 @@ TEST(skin_two_largest_displacements) {
         CHECK(!(gk_cells_skin_margin(2, ps.h, ps.h, skin, rmax, gk_cells_disp2_max(2, ps.h, ps.n, sp0, sp)) >
                 0.0));
         CHECK(gk_cells_skin_ok(2, ps.h, ps.h, ps.n, sp0, sp, skin, rmax, NULL));
-        for (i = 0; i < ps.n; ++i)
-            for (j = i + 1; j < ps.n; ++j) {
-                int listed = 0;
-                if (dist2d(&ps, ps.h, i, j) >= (double)ps.r[i] + (double)ps.r[j]) continue;
-                for (c = pl.start[i]; c < pl.start[i + 1]; ++c)
-                    if (pl.j[c] == j) listed = 1;
-                if (!listed) ++missing;
-            }
-        CHECK_EQ_INT(missing, 0);
+        CHECK_EQ_INT(unlisted_contacts(&ps, ps.h, &pl), 0);
     }
     gk_cells_free(&cl);
     gk_pairlist_free(&pl);
