@@ -555,33 +555,16 @@ GKDEF double gk_cells_skin_margin2(int dim, const double h0[9], const double h[9
     return gk__skin_margin(dim, h0, h, skin, rmax, sqrt(top2[0]) + sqrt(top2[1]));
 }
 
-/* squared non-affine displacement of particle p */
-static double gk__disp2(int dim, const double h[9], const double *const s0[3], const double *const s[3],
-                        int p) {
-    double dx = s[0][p] - s0[0][p], dy = s[1][p] - s0[1][p], dz = dim == 3 ? s[2][p] - s0[2][p] : 0.0;
-    double ex = h[0] * dx + h[1] * dy + h[2] * dz;
-    double ey = h[3] * dx + h[4] * dy + h[5] * dz;
-    double ez = dim == 3 ? h[6] * dx + h[7] * dy + h[8] * dz : 0.0;
-    return ex * ex + ey * ey + ez * ez;
-}
-
-GKDEF double gk_cells_disp2_max(int dim, const double h[9], int n, const double *const s0[3],
-                                const double *const s[3]) {
-    double m2 = 0.0;
-    int p;
-    for (p = 0; p < n; ++p) {
-        double d2 = gk__disp2(dim, h, s0, s, p);
-        if (d2 > m2 || d2 != d2) m2 = d2; /* a NaN is kept: the margin refuses it */
-    }
-    return m2;
-}
-
 GKDEF void gk_cells_disp2_top2(int dim, const double h[9], int n, const double *const s0[3],
                                const double *const s[3], double top2[2]) {
     double a = 0.0, b = 0.0;
     int p;
     for (p = 0; p < n; ++p) {
-        double d2 = gk__disp2(dim, h, s0, s, p);
+        double dx = s[0][p] - s0[0][p], dy = s[1][p] - s0[1][p], dz = dim == 3 ? s[2][p] - s0[2][p] : 0.0;
+        double ex = h[0] * dx + h[1] * dy + h[2] * dz;
+        double ey = h[3] * dx + h[4] * dy + h[5] * dz;
+        double ez = dim == 3 ? h[6] * dx + h[7] * dy + h[8] * dz : 0.0;
+        double d2 = ex * ex + ey * ey + ez * ez;
         if (d2 != d2) {
             top2[0] = d2, top2[1] = 0.0; /* a NaN: the margin refuses it */
             return;
@@ -590,6 +573,13 @@ GKDEF void gk_cells_disp2_top2(int dim, const double h[9], int n, const double *
         a = d2 > a ? d2 : a;
     }
     top2[0] = a, top2[1] = b;
+}
+
+GKDEF double gk_cells_disp2_max(int dim, const double h[9], int n, const double *const s0[3],
+                                const double *const s[3]) {
+    double t2[2];
+    gk_cells_disp2_top2(dim, h, n, s0, s, t2);
+    return t2[0]; /* a NaN is kept: the margin refuses it */
 }
 
 GKDEF int gk_cells_skin_ok(int dim, const double h0[9], const double h[9], int n, const double *const s0[3],

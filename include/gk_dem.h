@@ -1096,6 +1096,16 @@ static int gk__key_lower_bound(const int32_t *pi, const int32_t *pj, int n, uint
     return lo;
 }
 
+/* whether the outer list still holds every pair within skin_in of touching, by
+ * the two largest displacements since its build (tighter than twice the largest) */
+static int gk__outer_holds(const gk_rve *rve) {
+    double t2[2];
+    if (!rve->outer_valid) return 0;
+    gk_cells_disp2_top2(rve->dim, rve->cell.h, rve->n, (const double *const *)rve->o0,
+                        (const double *const *)rve->s, t2);
+    return gk_cells_skin_margin2(rve->dim, rve->ho0, rve->cell.h, rve->skin, rve->rmax, t2) > rve->skin_in;
+}
+
 /* rebuild the pair list at the current positions, carrying history over by merge */
 static gk_result gk__rve_rebuild(gk_rve *rve) {
     gk_pairlist nl;
@@ -1111,7 +1121,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
         rve->dt_crit = dtc;
     }
     int dim = rve->dim, n = rve->n, k, c, lookup;
-    double w[3], o2[2] = {0.0, 0.0};
+    double w[3];
     gk_result res;
     const double *sp[3];
     /* cell too thin for the nearest image: try a lattice reduction first */
@@ -1123,11 +1133,7 @@ static gk_result gk__rve_rebuild(gk_rve *rve) {
                 "cell width %g fell below twice the interaction distance %g (cell compressed or sheared "
                 "too far for this many particles)",
                 w[k], 2.0 * rve->rmax + rve->skin);
-    if (rve->outer_valid) /* the two largest displacements: a tighter bound than twice the largest */
-        gk_cells_disp2_top2(dim, rve->cell.h, n, (const double *const *)rve->o0,
-                            (const double *const *)rve->s, o2);
-    if (!rve->outer_valid ||
-        !(gk_cells_skin_margin2(dim, rve->ho0, rve->cell.h, rve->skin, rve->rmax, o2) > rve->skin_in)) {
+    if (!gk__outer_holds(rve)) {
         /* outer list from the cell grid (positions are in [0,1): gk__wrap) */
         for (k = 0; k < 3; ++k) sp[k] = rve->s[k < dim ? k : 0];
         res = gk_cells_bin(&rve->cells, dim, rve->cell.h, n, sp, 2.0 * rve->rmax + rve->skin, &rve->err);
