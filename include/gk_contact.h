@@ -734,7 +734,11 @@ GK_FORCE_INLINE gk_vrm gk_contact_3d_w(const gk_law_consts *K, gk_law law, unsig
         m2 = gk_vr_add(gk_vr_add(gk_vr_mul(tot[0], tot[0]), gk_vr_mul(tot[1], tot[1])),
                        gk_vr_mul(tot[2], tot[2]));
         *slide = gk_vr_gt(m2, gk_vr_mul(cap, cap));
-        if (gk_vrm_any(*slide)) {
+        /* the Coulomb rescale for every block, not behind a test of any
+         * sliding lane: in a sheared packing that branch mispredicts, and a
+         * misprediction discards the next block's loads begun out of order
+         * (3D, 10^4 spheres: 1.04x); lanes that do not slide keep tot */
+        {
             gk_vr sc = gk_vr_div(cap, gk_vr_sqrt(m2));
             GK_UNROLL
             for (k = 0; k < 3; ++k) {
