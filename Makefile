@@ -95,7 +95,8 @@ TESTDEF := -DBUILD='"$(BUILD)"'
 # compiled once with that configuration (par64: GK_DEM_PAR_MIN 64, threads on small
 # systems, GK_DEM_GATHER_RUNS 4, the rebuild's history copy element by element past 4
 # runs, and GK_DEM_GATHER_MAX 0, one thread always scattering, so that its tests compare
-# the scatter with the threads' gather; also given to the test so that a different value
+# the scatter with the threads' gather, GK_DEM_FREC_MAX 600, 3D scatters through the force
+# records up to 600 particles only; also given to the test so that a different value
 # in it fails to compile;
 # float: GK_REAL_FLOAT); the others (test_untrusted reaches into internals) compile their own.
 OWN_IMPL := $(patsubst tests/test_%.c,%,$(shell grep -l '^\#define GK_IMPLEMENTATION' $(TEST_SRC)))
@@ -103,7 +104,7 @@ IMPL_VARIANT_dem            := par64
 IMPL_VARIANT_scene          := par64
 IMPL_VARIANT_extremes_float := float
 IMPL_VARIANT_simd_float     := float
-IMPLDEF_par64 := -DGK_DEM_PAR_MIN=64 -DGK_DEM_GATHER_RUNS=4 -DGK_DEM_GATHER_MAX=0
+IMPLDEF_par64 := -DGK_DEM_PAR_MIN=64 -DGK_DEM_GATHER_RUNS=4 -DGK_DEM_GATHER_MAX=0 -DGK_DEM_FREC_MAX=600
 IMPLDEF_float := -DGK_REAL_FLOAT
 TESTDEF_par64 := $(IMPLDEF_par64)
 # what a test links, $(call impl_for,STEM,THE BUILD'S IMPLEMENTATION OBJECT)

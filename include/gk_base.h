@@ -479,6 +479,30 @@ GK_FORCE_INLINE gk_vd gk_vd_xorsign(gk_vd a) { /* -a, exactly */
         _mm512_xor_si512(_mm512_castpd_si512(a), _mm512_set1_epi64((long long)0x8000000000000000ull)));
 }
 GK_FORCE_INLINE gk_vd gk_vd_abs(gk_vd a) { return _mm512_abs_pd(a); }
+/* r[l][k] = r[k][l]: the 8 x 8 transpose, three rounds of two-source
+ * shuffles (24); rows of lanes become per-lane records and back */
+#define GK_VD_HAS_TRANSPOSE8 1
+GK_FORCE_INLINE void gk_vd_transpose8(gk_vd r[8]) {
+    /* written out: as loops, gcc kept them and passed the vectors through the
+     * stack. t: pairs of rows interleaved (r0[0] r1[0] r0[2] r1[2] ...); u:
+     * their 128-bit lanes 0 and 2 (0x88) or 1 and 3 (0xdd) side by side */
+    gk_vd t0 = _mm512_unpacklo_pd(r[0], r[1]), t1 = _mm512_unpackhi_pd(r[0], r[1]);
+    gk_vd t2 = _mm512_unpacklo_pd(r[2], r[3]), t3 = _mm512_unpackhi_pd(r[2], r[3]);
+    gk_vd t4 = _mm512_unpacklo_pd(r[4], r[5]), t5 = _mm512_unpackhi_pd(r[4], r[5]);
+    gk_vd t6 = _mm512_unpacklo_pd(r[6], r[7]), t7 = _mm512_unpackhi_pd(r[6], r[7]);
+    gk_vd u0 = _mm512_shuffle_f64x2(t0, t2, 0x88), u1 = _mm512_shuffle_f64x2(t1, t3, 0x88);
+    gk_vd u2 = _mm512_shuffle_f64x2(t0, t2, 0xdd), u3 = _mm512_shuffle_f64x2(t1, t3, 0xdd);
+    gk_vd u4 = _mm512_shuffle_f64x2(t4, t6, 0x88), u5 = _mm512_shuffle_f64x2(t5, t7, 0x88);
+    gk_vd u6 = _mm512_shuffle_f64x2(t4, t6, 0xdd), u7 = _mm512_shuffle_f64x2(t5, t7, 0xdd);
+    r[0] = _mm512_shuffle_f64x2(u0, u4, 0x88);
+    r[1] = _mm512_shuffle_f64x2(u1, u5, 0x88);
+    r[2] = _mm512_shuffle_f64x2(u2, u6, 0x88);
+    r[3] = _mm512_shuffle_f64x2(u3, u7, 0x88);
+    r[4] = _mm512_shuffle_f64x2(u0, u4, 0xdd);
+    r[5] = _mm512_shuffle_f64x2(u1, u5, 0xdd);
+    r[6] = _mm512_shuffle_f64x2(u2, u6, 0xdd);
+    r[7] = _mm512_shuffle_f64x2(u3, u7, 0xdd);
+}
 GK_FORCE_INLINE gk_vf gk_vf_zero(void) { return _mm512_setzero_ps(); }
 GK_FORCE_INLINE gk_vf gk_vf_set1(float a) { return _mm512_set1_ps(a); }
 GK_FORCE_INLINE gk_vf gk_vf_load(const float *p) { return _mm512_load_ps(p); }

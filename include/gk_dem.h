@@ -181,7 +181,10 @@
  * instead of scattering them in the force loop: the same bits, and faster
  * while the pair arrays stay in the core's cache; default 32768; threads
  * gather 2D lists longer than that through a fixed number of branch-free
- * slots per particle, the same bits again),
+ * slots per particle, the same bits again), GK_DEM_FREC_MAX (3D particles
+ * up to which that scattering loop of an AVX-512 double build adds into one
+ * 64-byte record per particle instead of six arrays: the same bits, faster
+ * while the records stay in the cache; default 32768),
  * GK_RVE_STEP_OVERLAP_MAX (the admissible overlap change per DEM step as a
  * fraction of the smaller radius, default 0.1), GK_DEM_PHASE(phase, mark)
  * (a timing hook for profilers, empty by default: phase 0 the list rebuild,
@@ -207,6 +210,9 @@
 #endif
 #ifndef GK_DEM_GATHER_MAX
 #define GK_DEM_GATHER_MAX 32768
+#endif
+#ifndef GK_DEM_FREC_MAX
+#define GK_DEM_FREC_MAX 32768
 #endif
 /* particles of one RVE: int32 pair lists hold up to ~30 candidates each */
 #define GK_RVE_MAX_PARTICLES (1 << 26)
@@ -263,6 +269,10 @@ typedef struct gk_rve {
     gk_real *w[3]; /* fluctuating spin [rad/s] (2D: w[2] only)           */
     gk_real *f[3]; /* contact force sum of the last step [N]             */
     gk_real *t[3]; /* contact torque sum of the last step (2D: t[2])     */
+    double *frec;  /* 3D, AVX-512 double: the scattering force loop's
+                      records f0 f1 f2 t0 t1 t2 (8 doubles per particle),
+                      all zero between steps                          */
+    size_t frec_cap;
     gk_real *r, *minv, *Iinv;
     double *theta; /* 2D: accumulated rotation [rad] (incl. cell spin);
                                  3D with GK_RVE_TRACK_ROTATION: 3 n, the sum of the
@@ -608,6 +618,7 @@ static gk_result gk__fields_grow(gk_rve *rve, int set, int spare, size_t cap, si
             return GK_ERR_ALLOC;
         gk__fset(rve, off, p);
     }
+
     if (set == GK__PART &&
         gk_realloc(a, (void **)&rve->jstart, ncopy ? ncopy + 1 : 0, cap + 1, sizeof(int32_t)))
         return GK_ERR_ALLOC;
@@ -629,6 +640,9 @@ static void gk__rve_free_arrays(gk_rve *rve) {
     }
     gk_free(a, rve->jstart);
     rve->jstart = NULL;
+    gk_free(a, rve->frec);
+    rve->frec = NULL;
+    rve->frec_cap = 0;
     gk_free(a, rve->outer_in);
     rve->outer_in = NULL;
     rve->outer_in_cap = 0;
@@ -1249,7 +1263,8 @@ typedef struct gk__stepctx {
     gk_real G[9];  /* affine velocity gradient of this step                 */
     gk_real wa[3]; /* affine spin (2D: wa[2])                               */
     gk_real dt;
-    int scatter; /* add pair forces to the particles in the force loop    */
+    int scatter; /* add pair forces to the particles in the force loop:
+                    1 into f and t, 2 into the records frec (3D, GK__FREC)  */
     int store;   /* keep per-pair forces and torques (stress, threads)    */
 } gk__stepctx;
 
@@ -1535,6 +1550,91 @@ GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const in
     }
 }
 
+/* The scattering force loop (one thread, lists above GK_DEM_GATHER_MAX pairs)
+ * of a 3D AVX-512 double build, up to GK_DEM_FREC_MAX particles, adds each
+ * pair's force and torques to one 64-byte record per particle (f0 f1 f2 t0 t1
+ * t2, two pads): a block of 8 pairs is two 8 x 8 transposes and 16 vector
+ * read-modify-writes instead of 96 scalar ones; after the loop the records
+ * become f and t. The same additions in the same order (pair order), so the
+ * same bits. Above GK_DEM_FREC_MAX particles the records leave the cache and
+ * copying them costs more than they save (bench/README.md). */
+#if GK_SIMD_WIDTH == 512 && !defined(GK_REAL_FLOAT)
+#define GK__FREC 1
+#else
+#define GK__FREC 0
+#endif
+#if GK__FREC
+/* a block's forces and torques added to the particles' records (GK__FREC):
+ * lane l's record for j is (f, tj), for i (-f, ti), lane after lane, j before
+ * i, as gk__scatter_buf_3d adds them component by component */
+GK_FORCE_INLINE void gk__scatter_rec_3d(double *GK_RESTRICT frec, const int32_t *ii, const int32_t *jj,
+                                        const gk_contact_out_w *o, unsigned rot) {
+    const gk_vd zero = gk_vd_zero();
+    gk_vd rj[8], ri[8];
+    int k, l;
+    GK_UNROLL
+    for (k = 0; k < 3; ++k) {
+        rj[k] = o->f[k];
+        ri[k] = gk_vd_xorsign(o->f[k]); /* f[i] - b == f[i] + (-b), exactly */
+        rj[3 + k] = rot ? o->tj[k] : zero;
+        ri[3 + k] = rot ? o->ti[k] : zero;
+    }
+    rj[6] = rj[7] = ri[6] = ri[7] = zero;
+    gk_vd_transpose8(rj);
+    gk_vd_transpose8(ri);
+    GK_UNROLL
+    for (l = 0; l < 8; ++l) {
+        double *aj = frec + 8 * (size_t)jj[l], *ai = frec + 8 * (size_t)ii[l];
+        gk_vd_store(aj, gk_vd_add(gk_vd_load(aj), rj[l]));
+        gk_vd_store(ai, gk_vd_add(gk_vd_load(ai), ri[l]));
+    }
+}
+
+/* records for n particles, all zero; 0 if they cannot be had (the loop then
+ * scatters into f and t as without them: the same bits) */
+static int gk__frec_ready(gk_rve *rve) {
+    size_t n = (size_t)rve->n;
+    if (rve->frec_cap < n) {
+        double *p = NULL;
+        if (gk_realloc(&rve->def.alloc, (void **)&p, 0, n, 8 * sizeof(double))) return 0;
+        memset(p, 0, n * 8 * sizeof(double));
+        gk_free(&rve->def.alloc, rve->frec);
+        rve->frec = p;
+        rve->frec_cap = n;
+    }
+    return 1;
+}
+
+/* f, t of particles [0, n) from the records, zeroing them for the next step */
+static void gk__frec_unpack(gk_rve *rve, int rot) {
+    double *rec = rve->frec;
+    const gk_vd zero = gk_vd_zero();
+    int n = rve->n, p, k;
+    for (p = 0; p + 8 <= n; p += 8) {
+        gk_vd r[8];
+        GK_UNROLL
+        for (k = 0; k < 8; ++k) {
+            r[k] = gk_vd_load(rec + 8 * (size_t)(p + k));
+            gk_vd_store(rec + 8 * (size_t)(p + k), zero);
+        }
+        gk_vd_transpose8(r);
+        GK_UNROLL
+        for (k = 0; k < 3; ++k) {
+            gk_vd_store(rve->f[k] + p, r[k]);
+            if (rot) gk_vd_store(rve->t[k] + p, r[3 + k]);
+        }
+    }
+    for (; p < n; ++p) {
+        double *a = rec + 8 * (size_t)p;
+        for (k = 0; k < 3; ++k) {
+            rve->f[k][p] = a[k];
+            if (rot) rve->t[k][p] = a[3 + k];
+        }
+        memset(a, 0, 8 * sizeof *a);
+    }
+}
+#endif
+
 GK_FORCE_INLINE void gk__forces_simd_2d(gk_rve *rve, const gk__stepctx *x, int c0, int c1, gk_law law,
                                         unsigned fl) {
     const gk_law_consts K = rve->K; /* a local copy: its broadcasts stay out of the loop */
@@ -1657,6 +1757,12 @@ GK_FORCE_INLINE void gk__forces_simd_3d(gk_rve *rve, const gk__stepctx *x, int c
             }
         }
         gk__simd_state(rve->cs + c, in, slide, lut);
+#if GK__FREC
+        if (x->scatter == 2) { /* into the records (gk__forces leaves no tail) */
+            gk__scatter_rec_3d(rve->frec, ii, jj, &o, fl & GK_PHYS_ROTATION);
+            continue;
+        }
+#endif
         if (x->scatter) { /* pipelined as in 2D */
             if (pend >= 0) gk__scatter_buf_3d(rve, pi + pend, pj + pend, b, fl & GK_PHYS_ROTATION);
             GK_UNROLL
@@ -1734,10 +1840,15 @@ static void gk__inner_filter_all(const gk_rve *rve, gk_pairlist *nl, int lookup,
             GK__FLAG_SETS(gk__forces_ref_3d, rve, x, c0, c1, E, fl); \
         break;
 
-/* pair forces of [c0, c1): the wide kernels unless GK_RVE_SCALAR or cohesion */
+/* the wide kernels run unless GK_RVE_SCALAR or cohesion */
+static int gk__wide(const gk_rve *rve) {
+    return !(rve->def.flags & GK_RVE_SCALAR) && !(rve->phys & GK_PHYS_COHESION);
+}
+
+/* pair forces of [c0, c1) */
 static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
     unsigned fl = rve->phys;
-    int wide = !(rve->def.flags & GK_RVE_SCALAR) && !(fl & GK_PHYS_COHESION);
+    int wide = gk__wide(rve);
     (void)wide;
     switch (rve->def.mat.law) {
         GK_LAW_TABLE(GK__LAW_KERNELS)
@@ -1774,6 +1885,20 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
         x->scatter = 1;
         x->store = want_store;
         GK_DEM_PHASE(1, 0);
+#if GK__FREC
+        if (rve->dim == 3 && rve->n <= GK_DEM_FREC_MAX && gk__wide(rve) && gk__frec_ready(rve)) {
+            /* whole blocks into the records, which become f and t; then the
+             * last pairs (the last in pair order) added to f and t */
+            int cb = nc - nc % GK_VR_W;
+            x->scatter = 2;
+            gk__forces_range(rve, x, 0, cb);
+            gk__frec_unpack(rve, GK__HAS_ROT(rve));
+            x->scatter = 1;
+            gk__forces_range(rve, x, cb, nc);
+            GK_DEM_PHASE(1, 1);
+            return;
+        }
+#endif
         for (k = 0; k < 3; ++k) {
             if (rve->f[k]) memset(rve->f[k], 0, (size_t)rve->n * sizeof(gk_real));
             if (rve->t[k]) memset(rve->t[k], 0, (size_t)rve->n * sizeof(gk_real));

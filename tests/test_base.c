@@ -242,6 +242,24 @@ TEST(window_gather_equals_gather) {
 #endif
 }
 
+/* gk_vd_transpose8 (AVX-512 double): row k lane l becomes row l lane k, for
+ * distinct values (signed zeros and infinities among them, moved as bits) */
+TEST(transpose8_moves_every_lane) {
+#ifdef GK_VD_HAS_TRANSPOSE8
+    double a[64], got[64];
+    gk_vd r[8];
+    int k, l;
+    for (k = 0; k < 64; ++k) a[k] = k == 5 ? -0.0 : (k == 42 ? -HUGE_VAL : 0.5 * k - 7.25);
+    for (k = 0; k < 8; ++k) r[k] = gk_vd_loadu(a + 8 * k);
+    gk_vd_transpose8(r);
+    for (k = 0; k < 8; ++k) gk_vd_storeu(got + 8 * k, r[k]);
+    for (k = 0; k < 8; ++k)
+        for (l = 0; l < 8; ++l) CHECK(memcmp(&got[8 * l + k], &a[8 * k + l], sizeof(double)) == 0);
+#else
+    CHECK(GK_VD_W != 8 || GK_SIMD_WIDTH != 512); /* only the 512-bit build has it */
+#endif
+}
+
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(inverse_times_matrix_is_identity);
@@ -257,5 +275,6 @@ int main(int argc, char **argv) {
     RUN(error_messages);
     RUN(simd_lanes_match_scalar);
     RUN(window_gather_equals_gather);
+    RUN(transpose8_moves_every_lane);
     return gk_test_done();
 }

@@ -1,6 +1,7 @@
 /* test_dem.c - the RVE (gk_dem.h) and homogenisation (gk_homog.h). */
 #define GK_DEM_PAR_MIN 64   /* let the 400-disk RVE use threads, to test thread invariance */
 #define GK_DEM_GATHER_MAX 0 /* one thread scatters: its thread tests compare that with the threads' gather */
+#define GK_DEM_FREC_MAX 600 /* 3D: 512 spheres scatter through the force records, 1000 without */
 #define GK_IMPLEMENTATION
 #include "gk_homog.h"
 #include "gk_test.h"
@@ -651,22 +652,31 @@ TEST(steps_without_stress_move_the_same) {
 }
 
 /* The same in 3D, for each law, with every per-pair torque on (rotation,
- * rolling resistance, viscous damping): the 1000-sphere packing of the
- * benchmarks sheared by 1 and by 2 threads ends in the same state bit for bit */
+ * rolling resistance, viscous damping), and without rotation: the
+ * 1000-sphere packing of the benchmarks and a 512-sphere one sheared by 1 and
+ * by 2 threads end in the same state bit for bit. One thread scatters
+ * (GK_DEM_GATHER_MAX 0); with AVX-512 in double the 512 spheres through the
+ * per-particle force records (up to GK_DEM_FREC_MAX, 600 here), whole blocks
+ * of pairs first and the list's last pairs after them (lists whose length is
+ * not a multiple of a block are among those stepped), the 1000 into f and t. */
 TEST(threads_do_not_change_results_3d) {
-    int law;
-    for (law = 0; law < 2; ++law) {
+    const char *packing[2] = {"bench/data/bench3d_1k.txt", "examples/data/rve512_hm.txt"};
+    int v, tails = 0;
+    for (v = 0; v < 6; ++v) {
         gk_rve a, b;
         gk_rve_def d1 = gk_rve_def_default(), d2;
         double dH[9] = {0, 2e-3, 0, 0, 0, 0, 0, 0, -1e-3};
-        int k;
+        int k, law = v % 3 == 1, pk = v / 3;
+        if (v % 3 == 2) d1.flags |= GK_RVE_NO_ROTATION;
         d1.mat.kn = 2e5;
         d1.mat.kt_ratio = 0.5;
         d1.mat.friction = 0.5;
-        d1.mat.roll_beta = 1.0;
-        d1.mat.roll_eta = 0.1;
+        if (v % 3 < 2) { /* rolling resistance needs rotation */
+            d1.mat.roll_beta = 1.0;
+            d1.mat.roll_eta = 0.1;
+        }
         d1.mat.zeta_n = d1.mat.zeta_t = 0.05;
-        d1.skin = 5e-4;
+        if (pk == 0) d1.skin = 5e-4;
         if (law) {
             d1.mat.law = GK_LAW_HERTZ;
             d1.mat.kn = 0;
@@ -675,8 +685,7 @@ TEST(threads_do_not_change_results_3d) {
         }
         d2 = d1;
         d2.threads = 2;
-        if (load_rve(&a, &d1, "bench/data/bench3d_1k.txt") ||
-            load_rve(&b, &d2, "bench/data/bench3d_1k.txt")) {
+        if (load_rve(&a, &d1, packing[pk]) || load_rve(&b, &d2, packing[pk])) {
             CHECK(0);
             return;
         }
@@ -684,12 +693,18 @@ TEST(threads_do_not_change_results_3d) {
         for (k = 0; k < 3; ++k) {
             CHECK(gk_rve_deform(&a, dH, 100) == GK_OK);
             CHECK(gk_rve_deform(&b, dH, 100) == GK_OK);
+            tails += a.pl.n % 8 != 0;
         }
         CHECK(a.ncontacts > a.n); /* a dense packing: the sums have many terms */
+        CHECK((a.phys & GK_PHYS_ROTATION) == (v % 3 == 2 ? 0u : GK_PHYS_ROTATION));
+#if GK_SIMD_WIDTH == 512 && !defined(GK_REAL_FLOAT)
+        CHECK((a.frec != NULL) == (pk == 1)); /* records: 512 spheres, not 1000 */
+#endif
         CHECK(same_state(&a, &b));
         gk_rve_destroy(&a);
         gk_rve_destroy(&b);
     }
+    CHECK(tails > 0);
 }
 
 static gk_result gen_consolidate(gk_rve *rve, int dim, int n, double mu_cons, double damping, uint64_t seed,
