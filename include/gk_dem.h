@@ -618,7 +618,6 @@ static gk_result gk__fields_grow(gk_rve *rve, int set, int spare, size_t cap, si
             return GK_ERR_ALLOC;
         gk__fset(rve, off, p);
     }
-
     if (set == GK__PART &&
         gk_realloc(a, (void **)&rve->jstart, ncopy ? ncopy + 1 : 0, cap + 1, sizeof(int32_t)))
         return GK_ERR_ALLOC;
