@@ -184,7 +184,9 @@
  * slots per particle, the same bits again), GK_DEM_FREC_MAX (3D particles
  * up to which that scattering loop of an AVX-512 double build adds into one
  * 64-byte record per particle instead of six arrays: the same bits, faster
- * while the records stay in the cache; default 32768),
+ * while the records stay in the cache; default 32768), GK_DEM_GATHER_MAX_3D
+ * (with those records, the smaller GK_DEM_GATHER_MAX for 3D lists; default
+ * 8192 pairs: a 1000-sphere RVE still gathers, a 4096-sphere one scatters),
  * GK_RVE_STEP_OVERLAP_MAX (the admissible overlap change per DEM step as a
  * fraction of the smaller radius, default 0.1), GK_DEM_PHASE(phase, mark)
  * (a timing hook for profilers, empty by default: phase 0 the list rebuild,
@@ -213,6 +215,9 @@
 #endif
 #ifndef GK_DEM_FREC_MAX
 #define GK_DEM_FREC_MAX 32768
+#endif
+#ifndef GK_DEM_GATHER_MAX_3D
+#define GK_DEM_GATHER_MAX_3D 8192
 #endif
 /* particles of one RVE: int32 pair lists hold up to ~30 candidates each */
 #define GK_RVE_MAX_PARTICLES (1 << 26)
@@ -1868,10 +1873,14 @@ static int gk__reduce_pad(gk_rve *rve);
  * gather each particle's sum; one thread on more pairs scatters in the force
  * loop (the gather's reads then miss the cache). The same sums in the same
  * order either way. want_store keeps per-pair forces and torques (stress,
- * tangent). */
+ * tangent). In 3D with the force records (GK__FREC) scattering wins from
+ * GK_DEM_GATHER_MAX_3D pairs on. */
 static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
-    int nc = rve->pl.n, nth = gk__nthreads(rve), k;
-    if (nth <= 1 && nc <= GK_DEM_GATHER_MAX) {
+    int nc = rve->pl.n, nth = gk__nthreads(rve), k, gmax = GK_DEM_GATHER_MAX;
+#if GK__FREC
+    if (rve->dim == 3 && GK_DEM_GATHER_MAX_3D < gmax) gmax = GK_DEM_GATHER_MAX_3D;
+#endif
+    if (nth <= 1 && nc <= gmax) {
         x->scatter = 0;
         x->store = 1;
         GK_DEM_PHASE(1, 0);
