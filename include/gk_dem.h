@@ -1376,6 +1376,20 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
     }
 }
 
+/* The scattering force loop (one thread, lists above GK_DEM_GATHER_MAX pairs)
+ * of a 3D AVX-512 double build, up to GK_DEM_FREC_MAX particles, adds each
+ * pair's force and torques to one 64-byte record per particle (f0 f1 f2 t0 t1
+ * t2, two pads): a block of 8 pairs is two 8 x 8 transposes and 16 vector
+ * read-modify-writes instead of 96 scalar ones; after the loop the records
+ * become f and t. The same additions in the same order (pair order), so the
+ * same bits. Above GK_DEM_FREC_MAX particles the records leave the cache and
+ * copying them costs more than they save (bench/README.md). */
+#if GK_SIMD_WIDTH == 512 && !defined(GK_REAL_FLOAT)
+#define GK__FREC 1
+#else
+#define GK__FREC 0
+#endif
+
 /* ---------------------------------------------------------------- SIMD forces
  * GK_VR_W pairs at a time: gather, the wide twin of the law
  * (gk_contact_2d_w / _3d_w, bit-identical lanes), store and scatter. The
@@ -1554,19 +1568,6 @@ GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const in
     }
 }
 
-/* The scattering force loop (one thread, lists above GK_DEM_GATHER_MAX pairs)
- * of a 3D AVX-512 double build, up to GK_DEM_FREC_MAX particles, adds each
- * pair's force and torques to one 64-byte record per particle (f0 f1 f2 t0 t1
- * t2, two pads): a block of 8 pairs is two 8 x 8 transposes and 16 vector
- * read-modify-writes instead of 96 scalar ones; after the loop the records
- * become f and t. The same additions in the same order (pair order), so the
- * same bits. Above GK_DEM_FREC_MAX particles the records leave the cache and
- * copying them costs more than they save (bench/README.md). */
-#if GK_SIMD_WIDTH == 512 && !defined(GK_REAL_FLOAT)
-#define GK__FREC 1
-#else
-#define GK__FREC 0
-#endif
 #if GK__FREC
 /* a block's forces and torques added to the particles' records (GK__FREC):
  * lane l's record for j is (f, tj), for i (-f, ti), lane after lane, j before
@@ -1598,12 +1599,9 @@ GK_FORCE_INLINE void gk__scatter_rec_3d(double *GK_RESTRICT frec, const int32_t 
  * scatters into f and t as without them: the same bits) */
 static int gk__frec_ready(gk_rve *rve) {
     size_t n = (size_t)rve->n;
-    if (rve->frec_cap < n) {
-        double *p = NULL;
-        if (gk_realloc(&rve->def.alloc, (void **)&p, 0, n, 8 * sizeof(double))) return 0;
-        memset(p, 0, n * 8 * sizeof(double));
-        gk_free(&rve->def.alloc, rve->frec);
-        rve->frec = p;
+    if (rve->frec_cap < n) { /* nothing to keep: the old records are all zero */
+        if (gk_realloc(&rve->def.alloc, (void **)&rve->frec, 0, n, 8 * sizeof(double))) return 0;
+        memset(rve->frec, 0, n * 8 * sizeof(double));
         rve->frec_cap = n;
     }
     return 1;
@@ -1849,6 +1847,12 @@ static int gk__wide(const gk_rve *rve) {
     return !(rve->def.flags & GK_RVE_SCALAR) && !(rve->phys & GK_PHYS_COHESION);
 }
 
+/* whether the scattering loop may use the force records (GK__FREC): a 3D RVE
+ * of at most GK_DEM_FREC_MAX particles on the wide kernels */
+static int gk__frec_usable(const gk_rve *rve) {
+    return GK__FREC && rve->dim == 3 && rve->n <= GK_DEM_FREC_MAX && gk__wide(rve);
+}
+
 /* pair forces of [c0, c1) */
 static void gk__forces_range(gk_rve *rve, const gk__stepctx *x, int c0, int c1) {
     unsigned fl = rve->phys;
@@ -1873,13 +1877,11 @@ static int gk__reduce_pad(gk_rve *rve);
  * gather each particle's sum; one thread on more pairs scatters in the force
  * loop (the gather's reads then miss the cache). The same sums in the same
  * order either way. want_store keeps per-pair forces and torques (stress,
- * tangent). In 3D with the force records (GK__FREC) scattering wins from
+ * tangent). Where the force records can be used, scattering wins from
  * GK_DEM_GATHER_MAX_3D pairs on. */
 static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
-    int nc = rve->pl.n, nth = gk__nthreads(rve), k, gmax = GK_DEM_GATHER_MAX;
-#if GK__FREC
-    if (rve->dim == 3 && GK_DEM_GATHER_MAX_3D < gmax) gmax = GK_DEM_GATHER_MAX_3D;
-#endif
+    int nc = rve->pl.n, nth = gk__nthreads(rve), k, rec = gk__frec_usable(rve), gmax = GK_DEM_GATHER_MAX;
+    if (rec && GK_DEM_GATHER_MAX_3D < gmax) gmax = GK_DEM_GATHER_MAX_3D;
     if (nth <= 1 && nc <= gmax) {
         x->scatter = 0;
         x->store = 1;
@@ -1894,7 +1896,7 @@ static void gk__forces(gk_rve *rve, gk__stepctx *x, int want_store) {
         x->store = want_store;
         GK_DEM_PHASE(1, 0);
 #if GK__FREC
-        if (rve->dim == 3 && rve->n <= GK_DEM_FREC_MAX && gk__wide(rve) && gk__frec_ready(rve)) {
+        if (rec && gk__frec_ready(rve)) {
             /* whole blocks into the records, which become f and t; then the
              * last pairs (the last in pair order) added to f and t */
             int cb = nc - nc % GK_VR_W;
