@@ -169,24 +169,29 @@ GK_INLINE double gk_strain_q(const double e[9], int dim) {
 
 #include <string.h>
 
-/* geometry of pair c at the current positions: branch d, |d| */
-static double gk__pair_branch(const gk_rve *rve, int c, double d[3]) {
+/* geometry of pair c at the current positions: branch d, |d|. dim is
+ * rve->dim, a constant where the caller is inlined with one */
+GK_FORCE_INLINE double gk__pair_branch_d(const gk_rve *rve, int c, double d[3], const int dim) {
     int i = rve->pl.i[c], j = rve->pl.j[c], k;
     double ds[3];
-    for (k = 0; k < 3; ++k) ds[k] = k < rve->dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
-    gk_pcell_min_image(&rve->cell, ds, d);
-    if (rve->dim == 2) d[2] = 0.0;
+    for (k = 0; k < 3; ++k) ds[k] = k < dim ? rve->s[k][j] - rve->s[k][i] : 0.0;
+    gk_pcell_image(rve->cell.h, dim, ds, d);
+    if (dim == 2) d[2] = 0.0;
     return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 }
 
+static double gk__pair_branch(const gk_rve *rve, int c, double d[3]) {
+    return gk__pair_branch_d(rve, c, d, rve->dim);
+}
+
 /* contact springs of eq 9 for pair c: A (dim x dim, row-major in 3 x 3), branch d; 0 = no contact */
-static int gk__contact_spring(const gk_rve *rve, int c, unsigned opts, double A[9], double d[3], double n[3],
-                              double *dd_out) {
-    int dim = rve->dim, a = rve->pl.i[c], b = rve->pl.j[c], i, k;
+GK_FORCE_INLINE int gk__contact_spring_d(const gk_rve *rve, int c, unsigned opts, double A[9], double d[3],
+                                         double n[3], double *dd_out, const int dim) {
+    int a = rve->pl.i[c], b = rve->pl.j[c], i, k;
     double dd, delta;
     gk_real kn, fn, kt;
     if (!(rve->cs[c] & GK_CS_CONTACT)) return 0;
-    dd = gk__pair_branch(rve, c, d);
+    dd = gk__pair_branch_d(rve, c, d, dim);
     if (!(dd > 0.0)) return 0;
     for (k = 0; k < 3; ++k) n[k] = d[k] / dd;
     delta = (double)rve->r[a] + (double)rve->r[b] - dd;
@@ -199,6 +204,11 @@ static int gk__contact_spring(const gk_rve *rve, int c, unsigned opts, double A[
             A[3 * i + k] = (double)kn * n[i] * n[k] + (double)kt * ((i == k ? 1.0 : 0.0) - n[i] * n[k]);
     *dd_out = dd;
     return 1;
+}
+
+static int gk__contact_spring(const gk_rve *rve, int c, unsigned opts, double A[9], double d[3], double n[3],
+                              double *dd_out) {
+    return gk__contact_spring_d(rve, c, opts, A, d, n, dd_out, rve->dim);
 }
 
 /* reverse Cuthill-McKee order of the nodes with neighbours of an undirected
@@ -408,8 +418,32 @@ done:
     return res;
 }
 
+/* eq 9's sum over the contacts (and the geometric terms) into D, not yet
+ * divided by V; dim a constant after inlining: the same operations */
+GK_FORCE_INLINE void gk__taylor_sum(const gk_rve *rve, unsigned opts, double *D, const int dim) {
+    int c, i, j, k, l;
+    for (c = 0; c < rve->pl.n; ++c) {
+        double d[3], n[3], dd, A[9];
+        if (!gk__contact_spring_d(rve, c, opts, A, d, n, &dd, dim)) continue;
+        if (opts & GK_TANGENT_GEOMETRIC) { /* A_ik += -(F_n/|d|)(delta_ik - n_i n_k) + n_i F_t,k / |d| */
+            double F[3], Fn, Ft[3];
+            for (k = 0; k < 3; ++k) F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
+            Fn = F[0] * n[0] + F[1] * n[1] + F[2] * n[2];
+            for (k = 0; k < 3; ++k) Ft[k] = F[k] - Fn * n[k];
+            for (i = 0; i < dim; ++i)
+                for (k = 0; k < dim; ++k)
+                    A[3 * i + k] += -(Fn / dd) * ((i == k ? 1.0 : 0.0) - n[i] * n[k]) + n[i] * Ft[k] / dd;
+        }
+        /* A_ik = kn n_i n_k + kt (delta_ik - n_i n_k) [+ geometric]; D_ijkl += A_ik d_j d_l / V */
+        for (i = 0; i < dim; ++i)
+            for (j = 0; j < dim; ++j)
+                for (k = 0; k < dim; ++k)
+                    for (l = 0; l < dim; ++l) D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
+    }
+}
+
 GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
-    int dim = rve->dim, n4 = dim * dim * dim * dim, c, i, j, k, l;
+    int dim = rve->dim, n4 = dim * dim * dim * dim, i, j, k, l;
     double V = gk_rve_volume(rve);
     for (k = 0; k < n4; ++k) D[k] = 0.0;
     if (!(V > 0.0)) return GK_ERR_CELL;
@@ -420,25 +454,10 @@ GKDEF gk_result gk_homog_tangent(const gk_rve *rve, unsigned opts, double *D) {
             return res;
         }
     } else {
-        for (c = 0; c < rve->pl.n; ++c) {
-            double d[3], n[3], dd, A[9];
-            if (!gk__contact_spring(rve, c, opts, A, d, n, &dd)) continue;
-            if (opts & GK_TANGENT_GEOMETRIC) { /* A_ik += -(F_n/|d|)(delta_ik - n_i n_k) + n_i F_t,k / |d| */
-                double F[3], Fn, Ft[3];
-                for (k = 0; k < 3; ++k) F[k] = k < dim ? (double)rve->fc[k][c] : 0.0;
-                Fn = F[0] * n[0] + F[1] * n[1] + F[2] * n[2];
-                for (k = 0; k < 3; ++k) Ft[k] = F[k] - Fn * n[k];
-                for (i = 0; i < dim; ++i)
-                    for (k = 0; k < dim; ++k)
-                        A[3 * i + k] += -(Fn / dd) * ((i == k ? 1.0 : 0.0) - n[i] * n[k]) + n[i] * Ft[k] / dd;
-            }
-            /* A_ik = kn n_i n_k + kt (delta_ik - n_i n_k) [+ geometric]; D_ijkl += A_ik d_j d_l / V */
-            for (i = 0; i < dim; ++i)
-                for (j = 0; j < dim; ++j)
-                    for (k = 0; k < dim; ++k)
-                        for (l = 0; l < dim; ++l)
-                            D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
-        }
+        if (dim == 2)
+            gk__taylor_sum(rve, opts, D, 2);
+        else
+            gk__taylor_sum(rve, opts, D, 3);
         for (k = 0; k < n4; ++k) D[k] /= V;
     }
     if (opts & GK_TANGENT_GEOMETRIC) {
