@@ -438,7 +438,8 @@ GK_FORCE_INLINE void gk__taylor_sum(const gk_rve *rve, unsigned opts, double *D,
         for (i = 0; i < dim; ++i)
             for (j = 0; j < dim; ++j)
                 for (k = 0; k < dim; ++k)
-                    for (l = 0; l < dim; ++l) D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
+                    for (l = 0; l < dim; ++l)
+                        D[((i * dim + j) * dim + k) * dim + l] += A[3 * i + k] * d[j] * d[l];
     }
 }
 
