@@ -1379,10 +1379,10 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
 /* The scattering force loop (one thread, lists above GK_DEM_GATHER_MAX pairs)
  * of a 3D AVX-512 double build, up to GK_DEM_FREC_MAX particles, adds each
  * pair's force and torques to one 64-byte record per particle (f0 f1 f2 t0 t1
- * t2, two pads): a block of 8 pairs is two 8 x 8 transposes and 16 vector
- * read-modify-writes instead of 96 scalar ones; after the loop the records
- * become f and t. The same additions in the same order (pair order), so the
- * same bits. Above GK_DEM_FREC_MAX particles the records leave the cache and
+ * t2, two pads): a block of 8 pairs is one 8 x 8 transpose, 8 permutations
+ * and 16 vector read-modify-writes instead of 96 scalar ones; after the loop
+ * the records become f and t. The same additions in the same order (pair
+ * order), so the same bits. Above GK_DEM_FREC_MAX particles the records leave the cache and
  * copying them costs more than they save (bench/README.md). */
 #if GK_SIMD_WIDTH == 512 && !defined(GK_REAL_FLOAT)
 #define GK__FREC 1
@@ -1571,27 +1571,36 @@ GK_FORCE_INLINE void gk__scatter_buf_3d(gk_rve *rve, const int32_t *ii, const in
 #if GK__FREC
 /* a block's forces and torques added to the particles' records (GK__FREC):
  * lane l's record for j is (f, tj), for i (-f, ti), lane after lane, j before
- * i, as gk__scatter_buf_3d adds them component by component */
+ * i, as gk__scatter_buf_3d adds them component by component. One 8 x 8
+ * transpose of (f, tj, ti0, ti1) gives each lane's j record; its i record is
+ * a two-source permutation of that row and ti2 (a second transpose cost more:
+ * the shuffles were a sixth of the 3D force loop) */
 GK_FORCE_INLINE void gk__scatter_rec_3d(double *GK_RESTRICT frec, const int32_t *ii, const int32_t *jj,
                                         const gk_contact_out_w *o, unsigned rot) {
     const gk_vd zero = gk_vd_zero();
-    gk_vd rj[8], ri[8];
+    /* -0.0 in lanes 0-2: the i record's -f, exactly */
+    const __m512d neg = _mm512_castsi512_pd(_mm512_set_epi64(0, 0, 0, 0, 0, (long long)0x8000000000000000ULL,
+                                                             (long long)0x8000000000000000ULL,
+                                                             (long long)0x8000000000000000ULL));
+    gk_vd r[8], ti2 = rot ? o->ti[2] : zero;
     int k, l;
     GK_UNROLL
     for (k = 0; k < 3; ++k) {
-        rj[k] = o->f[k];
-        ri[k] = gk_vd_xorsign(o->f[k]); /* f[i] - b == f[i] + (-b), exactly */
-        rj[3 + k] = rot ? o->tj[k] : zero;
-        ri[3 + k] = rot ? o->ti[k] : zero;
+        r[k] = o->f[k];
+        r[3 + k] = rot ? o->tj[k] : zero;
     }
-    rj[6] = rj[7] = ri[6] = ri[7] = zero;
-    gk_vd_transpose8(rj);
-    gk_vd_transpose8(ri);
+    r[6] = rot ? o->ti[0] : zero;
+    r[7] = rot ? o->ti[1] : zero;
+    gk_vd_transpose8(r); /* r[l] = (f, tj, ti0, ti1) of lane l */
     GK_UNROLL
     for (l = 0; l < 8; ++l) {
         double *aj = frec + 8 * (size_t)jj[l], *ai = frec + 8 * (size_t)ii[l];
-        gk_vd_store(aj, gk_vd_add(gk_vd_load(aj), rj[l]));
-        gk_vd_store(ai, gk_vd_add(gk_vd_load(ai), ri[l]));
+        /* (f, tj, 0, 0) and (-f, ti0, ti1, ti2 of lane l, 0, 0) */
+        const __m512i idx = _mm512_set_epi64(0, 0, 8 + l, 7, 6, 2, 1, 0);
+        gk_vd rj = _mm512_maskz_mov_pd(0x3f, r[l]);
+        gk_vd ri = _mm512_xor_pd(_mm512_maskz_permutex2var_pd(0x3f, r[l], idx, ti2), neg);
+        gk_vd_store(aj, gk_vd_add(gk_vd_load(aj), rj));
+        gk_vd_store(ai, gk_vd_add(gk_vd_load(ai), ri));
     }
 }
 
