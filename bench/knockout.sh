@@ -12,14 +12,21 @@
 #   w  of that scatter, only the read-modify-writes (the records are summed into a register)
 #   q  the law's square roots become copies and its divisions products (three of each per block)
 # Run from anywhere; needs an AVX-512 CPU, cc (CC) with OpenMP and sed.
+# bench/knockout.sh --patch-only DIR: only make the patched copies (make test checks that every
+# patch still finds its line).
 set -eu
 cd "$(dirname "$0")/.."
+patch_only=0
+if [ "${1:-}" = --patch-only ]; then
+    patch_only=1
+    shift
+fi
 D=${1:-build/knockout}
 R=${2:-5}
 CORE=${KO_CORE:-1}
 CC=${CC:-cc}
 FLAGS="-std=c99 -O2 -march=native -ffp-contract=off -fno-fast-math -fopenmp"
-if ! $CC -march=native -dM -E - </dev/null | grep -q '__AVX512F__'; then
+if [ "$patch_only" = 0 ] && ! $CC -march=native -dM -E - </dev/null | grep -q '__AVX512F__'; then
     echo "knockout.sh: this CPU has no AVX-512; the loop it studies is the AVX-512 double one"
     exit 0
 fi
@@ -66,13 +73,14 @@ variant() {
         patch_ '/^GK_FORCE_INLINE void gk_contact_rotate_history_w(/,/^#endif \/\* GK_CONTACT_H/ { s/gk_vr_sqrt(/GK_KO_SQRT(/g; s/gk_vr_div(/GK_KO_DIV(/g; }' "$v/gk_contact.h"
         ;;
     esac
-    $CC $FLAGS -I"$v" -o "$v/knockout" bench/knockout.c -lm
+    [ "$patch_only" = 1 ] || $CC $FLAGS -I"$v" -o "$v/knockout" bench/knockout.c -lm
 }
 
 names="whole j s t w q js jq sq jsq"
 for n in $names; do
     if [ "$n" = whole ]; then variant whole ""; else variant "$n" "$n"; fi
 done
+[ "$patch_only" = 0 ] || exit 0
 "$D/whole/knockout" --make "$D/state.bin"
 pin=""
 command -v taskset >/dev/null 2>&1 && pin="taskset -c $CORE"

@@ -170,6 +170,13 @@ TEST(user_documents_point_at_nothing_users_lack) {
     }
 }
 
+/* bench/README.md's account of what bounds the 3D force loop comes from
+ * bench/knockout.sh, which patches copies of the headers line by line: every
+ * patch must still find its line (the script fails when one changes nothing) */
+TEST(knockout_patches_still_apply) {
+    CHECK_EQ_INT(system("sh bench/knockout.sh --patch-only " BUILD "/tests/knockout > /dev/null"), 0);
+}
+
 /* Every name written as a literal BUILD "/tests/NAME..." in a test program
  * belongs to that program alone: `make -j2 test` runs two at a time
  * (tests/run_tests.sh), and two programs writing one file would race. Names
@@ -231,5 +238,6 @@ int main(int argc, char **argv) {
     RUN(readme_names_every_header_and_driver);
     RUN(user_documents_point_at_nothing_users_lack);
     RUN(test_programs_write_files_of_their_own);
+    RUN(knockout_patches_still_apply);
     return gk_test_done();
 }
