@@ -1382,8 +1382,8 @@ GK_FORCE_INLINE void gk__forces_ref_3d(gk_rve *rve, const gk__stepctx *x, int c0
  * t2, two pads): a block of 8 pairs is one 8 x 8 transpose, 8 permutations
  * and 16 vector read-modify-writes instead of 96 scalar ones; after the loop
  * the records become f and t. The same additions in the same order (pair
- * order), so the same bits. Above GK_DEM_FREC_MAX particles the records leave the cache and
- * copying them costs more than they save (bench/README.md). */
+ * order), so the same bits. Above GK_DEM_FREC_MAX particles the records leave
+ * the cache and copying them costs more than they save (bench/README.md). */
 #if GK_SIMD_WIDTH == 512 && !defined(GK_REAL_FLOAT)
 #define GK__FREC 1
 #else
@@ -1579,9 +1579,7 @@ GK_FORCE_INLINE void gk__scatter_rec_3d(double *GK_RESTRICT frec, const int32_t 
                                         const gk_contact_out_w *o, unsigned rot) {
     const gk_vd zero = gk_vd_zero();
     /* -0.0 in lanes 0-2: the i record's -f, exactly */
-    const __m512d neg = _mm512_castsi512_pd(_mm512_set_epi64(0, 0, 0, 0, 0, (long long)0x8000000000000000ULL,
-                                                             (long long)0x8000000000000000ULL,
-                                                             (long long)0x8000000000000000ULL));
+    const __m512d neg = _mm512_set_pd(0.0, 0.0, 0.0, 0.0, 0.0, -0.0, -0.0, -0.0);
     gk_vd r[8], ti2 = rot ? o->ti[2] : zero;
     int k, l;
     GK_UNROLL
