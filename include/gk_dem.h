@@ -1579,7 +1579,7 @@ GK_FORCE_INLINE void gk__scatter_rec_3d(double *GK_RESTRICT frec, const int32_t 
                                         const gk_contact_out_w *o, unsigned rot) {
     const gk_vd zero = gk_vd_zero();
     /* -0.0 in lanes 0-2: the i record's -f, exactly */
-    const __m512d neg = _mm512_set_pd(0.0, 0.0, 0.0, 0.0, 0.0, -0.0, -0.0, -0.0);
+    const gk_vd neg = _mm512_set_pd(0.0, 0.0, 0.0, 0.0, 0.0, -0.0, -0.0, -0.0);
     gk_vd r[8], ti2 = rot ? o->ti[2] : zero;
     int k, l;
     GK_UNROLL
