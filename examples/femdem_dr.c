@@ -121,6 +121,24 @@
 #include "femdem_dr_dns.h"
 
 /* ------------------------------------------------------------------ the load path */
+/* --predictor homogeneous: where load step `step` of a mesh starts its relaxation. Stage 1: the
+ * displacements scaled by the ratio of the step's pressure to the last one's, step / (step - 1).
+ * Stage 2: every node but the supports moved down by the platen's increment in proportion to its
+ * present height (the platen's own nodes are set after this), the lateral displacements kept. Both are the homogeneous specimen's next state; without
+ * them the first iterations put the whole increment into the loaded edges' elements, whose RVEs
+ * (accepted at every iteration, so path-dependent) keep the excursion. */
+static void predict(model *m, int stage, int step) {
+    int k;
+    if (stage == 1) {
+        for (k = 0; k < m->ndof; ++k)
+            if (!m->fixed[k]) m->u[k] *= (double)step / (double)(step - 1);
+    } else {
+        double d = m->o.strain * m->h_ic / m->o.steps, ht = mean_top(m, m->u);
+        for (k = 0; k < m->nnode; ++k)
+            if (!m->fixed[2 * k + 1]) m->u[2 * k + 1] -= d * (m->mesh.x[2 * k + 1] + m->u[2 * k + 1]) / ht;
+    }
+}
+
 static int run_fem(model *m) {
     const opts *o = &m->o;
     int nsteps = o->iso_steps + o->steps, step, step0, rc, k;
@@ -140,6 +158,7 @@ static int run_fem(model *m) {
                pt = stage == 1 ? ps : 0.0;
         double *Hstart = (double *)xcalloc(9 * (size_t)m->ngp, sizeof(double));
         memcpy(Hstart, m->Hacc, 9 * (size_t)m->ngp * sizeof(double));
+        if (o->predictor && !m->single && step > 1) predict(m, stage, step);
         if (stage == 2) { /* the platen: every top node down to d below its height after stage 1 */
             double d = o->strain * m->h_ic * (step - o->iso_steps) / o->steps;
             if (m->single) {

@@ -18,13 +18,13 @@ enum { TEST_BIAXIAL = 0, TEST_RVE = 1, TEST_DNS = 2 };
 
 typedef struct opts {
     int test, nx, ny, iso_steps, steps, threads, frame, no_rotation, lock_frame, vtk_every, checkpoint,
-        max_dr, servo_max, rayleigh;
+        max_dr, servo_max, rayleigh, predictor;
     int rve_max, stop_after, material, paper;
     int tiles[2];
     double strain, pressure, friction, width, height, kn_ratio, dt_factor, damping, tol_energy, tol_dr,
         tol_servo;
     double xi, gamma, force_tol;
-    const char *out, *restart, *packing, *test_s, *frame_s, *tiles_s, *rayleigh_s, *material_s;
+    const char *out, *restart, *packing, *test_s, *frame_s, *tiles_s, *rayleigh_s, *material_s, *predictor_s;
 } opts;
 
 static void usage(FILE *fp) {
@@ -55,6 +55,10 @@ static void usage(FILE *fp) {
             "  --dr-xi X --dr-gamma G  eqs 25, 27 (1, 0.5)\n"
             "  --dr-force-tol T        also |f_ext - f_int| <= T max|f| to end a step (0: eq 28 alone)\n"
             "  --rayleigh step|total   eq 26 relative to the step's start (step) or to U = 0 (total)\n"
+            "  --predictor homogeneous|none  where a mesh's load step starts: the homogeneous\n"
+            "                          specimen's next state (the last displacements scaled by the\n"
+            "                          pressure's ratio, then the platen's increment spread over the\n"
+            "                          height), or the last state with only the platen moved\n"
             "  --material paper|guo-zhao  the contact law above, or Guo & Zhao 2014's (femdem_biaxial's:\n"
             "                          k_n = E r*, E 0.6 GPa, k_t 0.8 k_n, friction angle 0.5, 2650 kg/m^3,\n"
             "                          0.1 m disks, damping 0.1; with --frame periodic)\n"
@@ -78,7 +82,7 @@ static void dr_opts_default(opts *o) {
     o->tiles[0] = 1, o->tiles[1] = 2;
     o->strain = 0.10, o->pressure = 1.5e5, o->friction = 0.4, o->width = 0.01, o->height = 0.02;
     o->kn_ratio = 100.0, o->dt_factor = 0.4, o->damping = 0.7, o->tol_energy = 1e-3, o->tol_dr = 1e-3;
-    o->tol_servo = 1e-4, o->xi = 1.0, o->gamma = 0.5;
+    o->tol_servo = 1e-4, o->xi = 1.0, o->gamma = 0.5, o->predictor = 1;
     o->packing = "examples/data/frame228_a002.txt";
 }
 
@@ -113,6 +117,7 @@ static int parse(int argc, char **argv, opts *o) {
         {"--dr-gamma", CLI_REAL, &o->gamma, 1e-6, 1.0, NULL, NULL, 0},
         {"--dr-force-tol", CLI_REAL, &o->force_tol, 0.0, 1.0, NULL, NULL, 0},
         {"--rayleigh", CLI_STR, &o->rayleigh_s, 0, 0, NULL, NULL, 0},
+        {"--predictor", CLI_STR, &o->predictor_s, 0, 0, NULL, NULL, 0},
         {"--material", CLI_STR, &o->material_s, 0, 0, NULL, NULL, 0},
         {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
         {"--restart", CLI_STR, &o->restart, 0, 0, NULL, NULL, 0},
@@ -192,6 +197,16 @@ static int parse(int argc, char **argv, opts *o) {
             o->rayleigh = 1;
         else {
             fprintf(stderr, PROG ": --rayleigh '%s' must be step or total\n", o->rayleigh_s);
+            return 2;
+        }
+    }
+    if (o->predictor_s) {
+        if (!strcmp(o->predictor_s, "homogeneous"))
+            o->predictor = 1;
+        else if (!strcmp(o->predictor_s, "none"))
+            o->predictor = 0;
+        else {
+            fprintf(stderr, PROG ": --predictor '%s' must be homogeneous or none\n", o->predictor_s);
             return 2;
         }
     }
