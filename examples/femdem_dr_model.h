@@ -22,7 +22,10 @@
  * 0.5), bounded by the element frequencies (gk_explicit_elem_omega with
  * twice the Taylor tangent of the packing: an upper bound, since the
  * particles only soften it), converged when E_kin / E_kin,max <= --dr-tol
- * (eq 28, 1e-3). Velocities start from 0 at every load step. Every DR
+ * (eq 28, 1e-3). Velocities start from 0 at every load step, the
+ * displacements from the last step's (only the loads and the platen
+ * moved; --predictor homogeneous starts a mesh from the uniform specimen's
+ * next state instead: run_fem's predict in femdem_dr.c). Every DR
  * iteration (Table 1) computes F = I + dU/dX at each Gauss point, runs its
  * RVE from its last state by dF (gk_twoscale.h with a gk_frame.h
  * procedure), takes P back and assembles f_int = int B^T P dV0

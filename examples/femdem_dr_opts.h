@@ -55,10 +55,10 @@ static void usage(FILE *fp) {
             "  --dr-xi X --dr-gamma G  eqs 25, 27 (1, 0.5)\n"
             "  --dr-force-tol T        also |f_ext - f_int| <= T max|f| to end a step (0: eq 28 alone)\n"
             "  --rayleigh step|total   eq 26 relative to the step's start (step) or to U = 0 (total)\n"
-            "  --predictor homogeneous|none  where a mesh's load step starts: the homogeneous\n"
-            "                          specimen's next state (the last displacements scaled by the\n"
-            "                          pressure's ratio, then the platen's increment spread over the\n"
-            "                          height), or the last state with only the platen moved\n"
+            "  --predictor none|homogeneous  where a mesh's load step starts: the last state with\n"
+            "                          only the loads and the platen moved (none), or the uniform\n"
+            "                          specimen's next state (the last step's mean stretches\n"
+            "                          repeated, the platen's increment spread over the height)\n"
             "  --material paper|guo-zhao  the contact law above, or Guo & Zhao 2014's (femdem_biaxial's:\n"
             "                          k_n = E r*, E 0.6 GPa, k_t 0.8 k_n, friction angle 0.5, 2650 kg/m^3,\n"
             "                          0.1 m disks, damping 0.1; with --frame periodic)\n"
@@ -82,7 +82,7 @@ static void dr_opts_default(opts *o) {
     o->tiles[0] = 1, o->tiles[1] = 2;
     o->strain = 0.10, o->pressure = 1.5e5, o->friction = 0.4, o->width = 0.01, o->height = 0.02;
     o->kn_ratio = 100.0, o->dt_factor = 0.4, o->damping = 0.7, o->tol_energy = 1e-3, o->tol_dr = 1e-3;
-    o->tol_servo = 1e-4, o->xi = 1.0, o->gamma = 0.5, o->predictor = 1;
+    o->tol_servo = 1e-4, o->xi = 1.0, o->gamma = 0.5;
     o->packing = "examples/data/frame228_a002.txt";
 }
 
@@ -206,7 +206,7 @@ static int parse(int argc, char **argv, opts *o) {
         else if (!strcmp(o->predictor_s, "none"))
             o->predictor = 0;
         else {
-            fprintf(stderr, PROG ": --predictor '%s' must be homogeneous or none\n", o->predictor_s);
+            fprintf(stderr, PROG ": --predictor '%s' must be none or homogeneous\n", o->predictor_s);
             return 2;
         }
     }
