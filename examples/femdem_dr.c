@@ -97,7 +97,7 @@
  * alone (on 2 x 4 four times the step's strain), an isotropic step's those along the loaded
  * edges, and every iteration's RVE state is kept (the paper's scheme), so the excursion stays.
  * The finer the mesh the softer it comes out: sigma_bar at 0.5 / 1 / 1.5 % 0.104 / 0.186 /
- * 0.250 (1 x 1), 0.099 / 0.174 / 0.234 (1 x 2), 0.094 / 0.170 / 0.229 (2 x 4), 9-10 % apart
+ * 0.250 (1 x 1), 0.099 / 0.174 / 0.233 (1 x 2), 0.094 / 0.170 / 0.229 (2 x 4), 9-10 % apart
  * (servo, `--strain 0.05 --steps 10`, the default's 0.5 % steps); the 32 points of 2 x 4 end
  * the isotropic stage at sigma_22 143.6-154.1 kPa, det F spanning 1.2e-3, and their strain
  * increments over the first biaxial step span 0.0038-0.0076 (gp_NNNN.vtk, --vtk-every 1). Not
