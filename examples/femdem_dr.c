@@ -116,8 +116,8 @@
  * longer (DEM steps to 5 %: 2 x 4 4.6e7 against 1.5e7), and on 4 x 8 one step (the third,
  * the first it predicted) did not relax in 20000 iterations and the mesh came out 9 % below
  * the others at 1.5 % (within 2.7 % of them again from 4 %); the locked-rotation 2 x 4 mesh
- * did not relax its fifth isotropic step in 20000 iterations. A criterion that ends a step started near
- * equilibrium is what it needs; the paper's eq 28 is kept.
+ * did not relax its fifth isotropic step in 20000 iterations. A criterion that ends a step
+ * started near equilibrium is what it needs; the paper's eq 28 is kept.
  */
 #define _POSIX_C_SOURCE 200809L
 #define GK_IMPLEMENTATION
@@ -137,10 +137,10 @@
 
 /* ------------------------------------------------------------------ the load path */
 /* --predictor homogeneous (not the default: the manual above): where load step `step` of a mesh
- * starts its relaxation, the uniform specimen's next state. Stage 1 from its third step: every node stretched about the fixed corner
- * by the ratios of the mean stretches the last step made (the top's height and J in the rows, which
- * the checkpoint keeps; the first step may unload a packing made at a higher stress, so the second
- * starts where the first ended). Stage 2: every node moved down by the platen's increment in
+ * starts its relaxation, the uniform specimen's next state. Stage 1 from its third step: every
+ * node stretched about the fixed corner by the ratios of the mean stretches the last step made
+ * (the top's height and J in the rows, which the checkpoint keeps; the first step may unload a
+ * packing made at a higher stress, so the second starts where the first ended). Stage 2: every node moved down by the platen's increment in
  * proportion to its height (the platen's own nodes are set after this), the lateral displacements
  * kept. Supports are not moved, and ratios that are not finite or beyond 2x (a damaged restart)
  * leave the state as it is. Without it the first iterations put the whole increment into the
