@@ -24,7 +24,7 @@ typedef struct opts {
     double strain, pressure, friction, width, height, kn_ratio, dt_factor, damping, tol_energy, tol_dr,
         tol_servo;
     double xi, gamma, force_tol;
-    const char *out, *restart, *packing, *test_s, *frame_s, *tiles_s, *rayleigh_s, *material_s, *predictor_s;
+    const char *out, *restart, *packing, *tiles_s;
 } opts;
 
 static void usage(FILE *fp) {
@@ -116,14 +116,14 @@ static int parse(int argc, char **argv, opts *o) {
         {"--dr-xi", CLI_REAL, &o->xi, 1e-6, 100.0, NULL, NULL, 0},
         {"--dr-gamma", CLI_REAL, &o->gamma, 1e-6, 1.0, NULL, NULL, 0},
         {"--dr-force-tol", CLI_REAL, &o->force_tol, 0.0, 1.0, NULL, NULL, 0},
-        {"--rayleigh", CLI_STR, &o->rayleigh_s, 0, 0, NULL, NULL, 0},
-        {"--predictor", CLI_STR, &o->predictor_s, 0, 0, NULL, NULL, 0},
-        {"--material", CLI_STR, &o->material_s, 0, 0, NULL, NULL, 0},
+        {"--rayleigh", CLI_CHOICE, &o->rayleigh, 0, 0, NULL, "step|total", 0},
+        {"--predictor", CLI_CHOICE, &o->predictor, 0, 0, NULL, "none|homogeneous", 0},
+        {"--material", CLI_CHOICE, &o->material, 0, 0, NULL, "paper|guo-zhao", 0},
         {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
         {"--restart", CLI_STR, &o->restart, 0, 0, NULL, NULL, 0},
         {"--packing", CLI_STR, &o->packing, 0, 0, NULL, NULL, 0},
-        {"--test", CLI_STR, &o->test_s, 0, 0, NULL, NULL, 0},
-        {"--frame", CLI_STR, &o->frame_s, 0, 0, NULL, NULL, 0},
+        {"--test", CLI_CHOICE, &o->test, 0, 0, NULL, "biaxial|rve|dns", 0},  /* index: TEST_* */
+        {"--frame", CLI_CHOICE, &o->frame, 0, 0, NULL, "servo|periodic", 0}, /* index: gk_frame_kind */
         {"--dns-tiles", CLI_STR, &o->tiles_s, 0, 0, NULL, NULL, 0},
         {"--no-rotation", CLI_FLAG, &o->no_rotation, 0, 0, NULL, NULL, 0},
         {"--lock-frame", CLI_FLAG, &o->lock_frame, 0, 0, NULL, NULL, 0},
@@ -152,63 +152,11 @@ static int parse(int argc, char **argv, opts *o) {
             fprintf(stderr, PROG ": %s needs a non-empty value\n", tab[k].name);
             return 2;
         }
-    if (o->test_s) {
-        if (!strcmp(o->test_s, "biaxial"))
-            o->test = TEST_BIAXIAL;
-        else if (!strcmp(o->test_s, "rve"))
-            o->test = TEST_RVE;
-        else if (!strcmp(o->test_s, "dns"))
-            o->test = TEST_DNS;
-        else {
-            fprintf(stderr, PROG ": --test '%s' must be biaxial, rve or dns\n", o->test_s);
-            return 2;
-        }
-    }
-    if (o->frame_s) {
-        if (!strcmp(o->frame_s, "servo"))
-            o->frame = GK_FRAME_SERVO;
-        else if (!strcmp(o->frame_s, "periodic"))
-            o->frame = GK_FRAME_PERIODIC;
-        else {
-            fprintf(stderr, PROG ": --frame '%s' must be servo or periodic\n", o->frame_s);
-            return 2;
-        }
-    }
-    if (o->material_s) {
-        if (!strcmp(o->material_s, "paper"))
-            o->material = 0;
-        else if (!strcmp(o->material_s, "guo-zhao"))
-            o->material = 1;
-        else {
-            fprintf(stderr, PROG ": --material '%s' must be paper or guo-zhao\n", o->material_s);
-            return 2;
-        }
-        if (o->material == 1 && o->frame == GK_FRAME_SERVO) {
-            fprintf(stderr, PROG
-                    ": --material guo-zhao (k_n = E r*) needs --frame periodic: the servo's gains are per "
-                    "constant k_n\n");
-            return 2;
-        }
-    }
-    if (o->rayleigh_s) {
-        if (!strcmp(o->rayleigh_s, "step"))
-            o->rayleigh = 0;
-        else if (!strcmp(o->rayleigh_s, "total"))
-            o->rayleigh = 1;
-        else {
-            fprintf(stderr, PROG ": --rayleigh '%s' must be step or total\n", o->rayleigh_s);
-            return 2;
-        }
-    }
-    if (o->predictor_s) {
-        if (!strcmp(o->predictor_s, "homogeneous"))
-            o->predictor = 1;
-        else if (!strcmp(o->predictor_s, "none"))
-            o->predictor = 0;
-        else {
-            fprintf(stderr, PROG ": --predictor '%s' must be none or homogeneous\n", o->predictor_s);
-            return 2;
-        }
+    if (o->material == 1 && o->frame == GK_FRAME_SERVO) {
+        fprintf(stderr,
+                PROG ": --material guo-zhao (k_n = E r*) needs --frame periodic: the servo's gains are per "
+                     "constant k_n\n");
+        return 2;
     }
     if (o->tiles_s) {
         int a = 0, b = 0, n = 0;
