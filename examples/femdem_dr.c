@@ -140,12 +140,12 @@
  * starts its relaxation, the uniform specimen's next state. Stage 1 from its third step: every
  * node stretched about the fixed corner by the ratios of the mean stretches the last step made
  * (the top's height and J in the rows, which the checkpoint keeps; the first step may unload a
- * packing made at a higher stress, so the second starts where the first ended). Stage 2: every node moved down by the platen's increment in
- * proportion to its height (the platen's own nodes are set after this), the lateral displacements
- * kept. Supports are not moved, and ratios that are not finite or beyond 2x (a damaged restart)
- * leave the state as it is. Without it the first iterations put the whole increment into the
- * loaded edges' elements, whose RVEs (accepted at every iteration, so path-dependent) keep the
- * excursion. */
+ * packing made at a higher stress, so the second starts where the first ended). Stage 2: every
+ * node moved down by the platen's increment in proportion to its height (the platen's own nodes
+ * are set after this), the lateral displacements kept. Supports are not moved, and ratios that
+ * are not finite or beyond 2x (a damaged restart) leave the state as it is. Without it the first
+ * iterations put the whole increment into the loaded edges' elements, whose RVEs (accepted at
+ * every iteration, so path-dependent) keep the excursion. */
 static void predict(model *m, int stage, int step) {
     double rx, ry;
     int k;
