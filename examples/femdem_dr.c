@@ -20,44 +20,48 @@
  * sigma_bar at axial strain 1, 2, 3, 5 %, its peak, sigma_bar and A at 7.3 %, all RVE DEM steps)
  *   run                 1 %    2 %    3 %    5 %    peak          7.3 %: s_bar  A      DEM steps
  *   servo, RVE alone    0.187  0.294  0.343  0.370  0.377 at 5.5  0.328  0.288  2.6e5
- *   servo, 1 x 1        0.186  0.294  0.339  0.365  0.369 at 5.5  0.327  0.306  3.3e6
- *   servo, 1 x 2        0.174  0.279  0.335  0.365  0.365 at 5.0  0.323  0.292  5.0e6
- *   servo, 2 x 4        0.170  0.271  0.327  0.360  0.360 at 5.0  0.320  0.257  2.3e7
+ *   servo, 1 x 1        0.190  0.289  0.336  0.373  0.374 at 5.5  0.307  0.287  2.8e6
+ *   servo, 1 x 2        0.192  0.297  0.339  0.373  0.381 at 5.5  0.315  0.296  6.8e6
+ *   servo, 2 x 4        0.190  0.291  0.334  0.368  0.375 at 5.5  0.321  0.297  5.6e7
+ *     --predictor none  0.170  0.271  0.327  0.360  0.360 at 5.0  0.320  0.257  2.3e7
  *   periodic, RVE alone 0.207  0.314  0.345  0.358  0.370 at 4.5  0.325  0.240  2.1e4
- *   periodic, 1 x 1     0.208  0.311  0.339  0.337  0.363 at 4.5  0.331  0.249  1.7e5
- *   periodic, 1 x 2     0.204  0.308  0.338  0.349  0.356 at 4.0  0.340  0.241  4.2e5
- *   periodic, 2 x 4     0.199  0.300  0.329  0.350  0.351 at 4.5  0.330  0.245  3.1e6
- *   periodic, 4 x 8     0.191  0.292  0.321  0.340  0.340 at 5.0  0.292  0.197  1.3e7
+ *   periodic, 1 x 1     0.208  0.312  0.340  0.337  0.363 at 4.5  0.351  0.263  1.5e5
+ *   periodic, 1 x 2     0.209  0.312  0.339  0.337  0.361 at 4.5  0.349  0.259  3.2e5
+ *   periodic, 2 x 4     0.208  0.311  0.340  0.343  0.357 at 4.5  0.348  0.260  2.3e6
+ *   periodic, 4 x 8     0.209  0.312  0.340  0.344  0.356 at 3.5  0.343  0.255  1.0e7
+ *     --predictor none  0.191  0.292  0.321  0.340  0.340 at 5.0  0.292  0.197  1.3e7
  *   DNS 1x2 (444 disks) 0.181  0.287  0.304  0.180  0.312 at 7.5  0.308  0.165  (2.0e6 of 444)
  *   DNS 2x4 (1707)      0.175  0.298  0.308  0.345  0.368 at 8.5  0.310  0.164  28.5 s
- *   --paper --frame periodic (2 x 4, 10 + 50 steps of 0.2 %): peak 0.357 at 4.0 %, at 7.3 %
- *     0.334 and A 0.247, 4.1e6 DEM steps; --paper (servo): 2.2e7 DEM steps to 2 % (sigma_bar
- *     0.278 there, 0.271 with 0.5 % steps), 7.9e7 to 10 %: peak 0.365 at 5.2 %, 419 s on one core.
- *   periodic 2 x 4, mu 0.2 / 0.6:  peaks 0.235 at 7.0 / 0.420 at 5.5 %; coordination at 7.3 %
- *     4.10 / 3.76 (mu 0.4: 3.89); locked rotation: 0.590 at 7.5 %, at 7.3 % sigma_bar 0.590,
- *     A 0.304; packings with A0 0.05 / 0.08: peaks 0.352 at 5.0 / 0.352 at 4.0 %.
+ *   --paper --frame periodic (2 x 4, 10 + 50 steps of 0.2 %): peak 0.361 at 4.4 %, at 7.3 %
+ *     0.353 and A 0.263, 3.0e6 DEM steps; --paper (servo): 2.9e7 DEM steps to 2 % (sigma_bar
+ *     0.290 there, 0.291 with 0.5 % steps), 6.2e7 to 10 %: peak 0.374 at 5.8 %, 211 s on one core.
+ *   periodic 2 x 4, mu 0.2 / 0.6:  peaks 0.266 at 7.0 / 0.428 at 4.5 %; coordination at 7.3 %
+ *     4.11 / 3.79 (mu 0.4: 3.88); locked rotation: 0.595 at 10 %, at 7.3 % sigma_bar 0.591,
+ *     A 0.308; packings with A0 0.05 / 0.08: peaks 0.357 at 4.5 / 0.363 at 3.5 %.
  * Against Liu, Bosco & Suiker (2018), who give numbers only for Figs 10-11 (at 7.3 %: free
  * 0.39, locked 0.48; A 0.27 and 0.33): the locked rotation is stronger and more anisotropic
- * (A ratio free / locked 0.81 here, 0.82 there) but far stronger here (stress ratio 0.56,
- * there 0.81; the servo frame with the paper's lock of the inner particles only, RVE alone:
- * 0.59); the ratio depends on k_n / sigma0, which the paper leaves open: 0.81 at 30 (RVE
- * alone; 2 x 4 servo: free 0.332, locked 0.416, A 0.12 and 0.12), 0.93 at 10, 0.54 at 1000
- * (tools/dr_rotation_study.sh, examples/README.md); the peak comes earlier (4-5 %, there near
- * 7 %; 7 % at k_n = 30 sigma0); higher friction gives a higher
- * stress and a lower coordination as there, but not their larger compaction; an ensemble of
- * 22 RVEs resolves no effect of the initial anisotropy (there: a lower, earlier peak; below).
- * The meshes agree within
- * 10 % to 5 % strain (the paper: "very close"; the largest spread at 1 %); the servo frame
- * and the periodic cell within 10 % (RVE alone) to 15 % (2 x 4); the 444-disk DNS within
- * 11 % of the 2 x 4 meshes to 3 %, then it slips (0.30 to 0.18 at 3.5 %, back to 0.31 at
+ * (servo 2 x 4: locked 0.564, A 0.377; A ratio free / locked 0.79 here, 0.82 there) but far
+ * stronger here (stress ratio 0.57, there 0.81; the RVE alone: 0.59); the ratio depends on
+ * k_n / sigma0, which the paper leaves open: 0.81 at 30 (RVE alone; 2 x 4 servo: free 0.333,
+ * locked 0.417, A 0.12 and 0.12), 0.93 at 10, 0.54 at 1000 (tools/dr_rotation_study.sh,
+ * examples/README.md); the peak comes earlier (4-6 %, there near 7 %; 7 % at k_n = 30
+ * sigma0); higher friction gives a higher stress and a lower coordination as there, but not
+ * their larger compaction; an ensemble of 22 RVEs resolves no effect of the initial
+ * anisotropy (there: a lower, earlier peak; below).
+ * The meshes agree within 3.0 % to 5 % strain (servo frame, 1 x 1 to 4 x 8, `--strain 0.05
+ * --steps 10`) and the periodic cells within 2.4 % to 7.3 % (the paper: "very close"); after
+ * the peak they part (servo 1 x 1 to 2 x 4: 4 % at 7.3 %, 32 % at 10 %). The servo frame and
+ * the periodic cell differ by at most 7 % (RVE alone) and 8 % (2 x 4) of the servo peak to
+ * 5 %, 13 % and 14 % to 10 %. The 444-disk DNS lies within 8 % of the servo 2 x 4 mesh's peak
+ * to 3 % (10 % of the periodic one's), then it slips (0.30 to 0.18 at 3.5 %, back to 0.31 at
  * 7.5 %: a specimen a few grains wide). The 1707-disk DNS (`--dns-tiles 2x4`, the size of
  * the paper's DNS B) slips at the same strain (0.31 to 0.25; with --paper's 0.2 % steps 0.31
- * to 0.19 at 3.6 %): it tiles the same cell. With --paper it lies within 10.4 % of the
- * --paper mesh's peak to 3.4 %, within 12.3 % from 5 % to 10 % (28 s on one core against
- * the mesh's 300-420 s); like the paper's DNS, 3 particles escape through its membranes (removed,
- * counted in `lost`). The packings are looser than the paper's (solid
- * fraction 0.82 against 0.846) and the DEM is stiffer relative to the confinement than
- * Table 3's raw numbers allow (see THE RVE).
+ * to 0.19 at 3.6 %): it tiles the same cell. With --paper it lies within 10.8 % of the
+ * --paper mesh's peak to 3.4 %, within 10.9 % from 5 % to 10 % (peaks 0.375 at 6.0 % and
+ * 0.374 at 5.8 %; 28 s on one core against the mesh's 211 s); like the paper's DNS, 3
+ * particles escape through its membranes (removed, counted in `lost`). The packings are
+ * looser than the paper's (solid fraction 0.82 against 0.846) and the DEM is stiffer relative
+ * to the confinement than Table 3's raw numbers allow (see THE RVE).
  * THE INITIAL ANISOTROPY (Figs 12-14; the RVE alone, `--test rve --packing
  * examples/data/frame228_a00N.txt`, the anisotropy column of dr.csv): the packings hold
  * A0 = 0.016, 0.049, 0.084 at their 1500 Pa; the first isotropic step (sigma0 / 10, ten
@@ -90,34 +94,45 @@
  * chance among the 18 slopes fitted. With 11 packings (seeds 1-5) the peak at 100 fell with
  * a_y at 2.4 standard errors; the next 11 took it away. The paper does not say which way its
  * packings lean.
- * WHERE A LOAD STEP STARTS (--predictor; Fig 4: the meshes agree before the peak). The
- * specimen is uniform (smooth platens, the same packing at every Gauss point), so every mesh
- * should give one curve. By default (--predictor none) a step starts from the last state with
- * only the loads and the platen moved: its first DR iterations compress the top row of elements
- * alone (on 2 x 4 four times the step's strain), an isotropic step's those along the loaded
- * edges, and every iteration's RVE state is kept (the paper's scheme), so the excursion stays.
- * The finer the mesh the softer it comes out: sigma_bar at 0.5 / 1 / 1.5 % 0.104 / 0.186 /
- * 0.250 (1 x 1), 0.099 / 0.174 / 0.233 (1 x 2), 0.094 / 0.170 / 0.229 (2 x 4), 9-10 % apart
- * (servo, `--strain 0.05 --steps 10`, the default's 0.5 % steps); the 32 points of 2 x 4 end
- * the isotropic stage at sigma_22 143.6-154.1 kPa, det F spanning 1.2e-3, and their strain
- * increments over the first biaxial step span 0.0038-0.0076 (gp_NNNN.vtk, --vtk-every 1). Not
- * the RVE's tolerances (--tol-energy 1e-5 --servo-max 200: 141.8-154.7 kPa, the meshes as far
- * apart), nor the macro relaxation's (periodic cell, 2 x 4 at 1 %: 0.2002 with a 100x tighter
- * eq 28 and 4x the DR iterations, against 0.1992; the 1 x 1 mesh 0.2075), nor one RVE's chaos
- * (the RVE alone with sigma0 perturbed by 1e-12 to 9e-12, ten runs, spans 0.9-1.0 % of
- * sigma_bar at 1, 2 and 3 %). --predictor homogeneous starts each step of a mesh from the
- * uniform specimen's next state: from the third isotropic step the last step's mean stretches
- * repeated, in stage 2 the platen's increment spread over the height (the lateral displacements
- * kept). Then the points of 2 x 4 end the isotropic stage at 148.8-151.1 kPa, the first biaxial
- * step's increments span 0.0050-0.0057, and 1 x 1, 1 x 2 and 2 x 4 agree within 1.4 % to 3 %
- * and 2.0 % to 5 % (the test meshes_agree_with_the_homogeneous_predictor). It is not the
- * default, for what it costs and where it fails: eq 28 ends a step at 1e-3 of its largest
- * kinetic energy, which stays small in a step that starts near equilibrium, so the steps run
- * longer (DEM steps to 5 %: 2 x 4 4.6e7 against 1.5e7), and on 4 x 8 one step (the third,
- * the first it predicted) did not relax in 20000 iterations and the mesh came out 9 % below
- * the others at 1.5 % (within 2.7 % of them again from 4 %); the locked-rotation 2 x 4 mesh
- * did not relax its fifth isotropic step in 20000 iterations. A criterion that ends a step
- * started near equilibrium is what it needs; the paper's eq 28 is kept.
+ * WHERE A LOAD STEP STARTS AND ENDS (--predictor, --dr-force-stop; Fig 4: the meshes agree
+ * before the peak). The specimen is uniform (smooth platens, the same packing at every Gauss
+ * point), so every mesh should give one curve. The paper's scheme as written (--predictor
+ * none) starts a step from the last state with only the loads and the platen moved: its first
+ * DR iterations compress the top row of elements alone (on 2 x 4 four times the step's strain),
+ * an isotropic step's those along the loaded edges, and every iteration's RVE state is kept,
+ * so the excursion stays. The finer the mesh the softer it comes out: sigma_bar at 0.5 / 1 /
+ * 1.5 % 0.104 / 0.186 / 0.250 (1 x 1), 0.099 / 0.174 / 0.233 (1 x 2), 0.094 / 0.170 / 0.229
+ * (2 x 4), 9-10 % apart (servo, `--strain 0.05 --steps 10 --predictor none`); the 32 points of
+ * 2 x 4 end the isotropic stage at sigma_22 143.6-154.1 kPa, det F spanning 1.2e-3, and their
+ * strain increments over the first biaxial step span 0.0038-0.0076 (gp_NNNN.vtk, --vtk-every
+ * 1). Not the RVE's tolerances (--tol-energy 1e-5 --servo-max 200: 141.8-154.7 kPa, the meshes
+ * as far apart), nor the macro relaxation's (periodic cell, 2 x 4 at 1 %: 0.2002 with a 100x
+ * tighter eq 28 and 4x the DR iterations, against 0.1992; the 1 x 1 mesh 0.2075), nor one
+ * RVE's chaos (the RVE alone with sigma0 perturbed by 1e-12 to 9e-12, ten runs, spans 0.9-1.0 %
+ * of sigma_bar at 1, 2 and 3 %). By default (--predictor homogeneous) a step of a mesh starts
+ * from the uniform specimen's next state: from the third isotropic step the last step's mean
+ * stretches repeated, in stage 2 the platen's increment spread over the height (the lateral
+ * displacements kept). The points of 2 x 4 then end the isotropic stage at 148.8-151.1 kPa and
+ * the first biaxial step's increments span 0.0050-0.0057. Such a step starts near equilibrium,
+ * and eq 28 (E_kin at 1e-3 of the step's largest) cannot end it: the largest kinetic energy
+ * stays small (the locked-rotation 2 x 4 mesh's first predicted step: 4.5e-7, an unpredicted
+ * step's about 4e-4), the servo frames' own jitter (1e-8) holds the ratio at 1-5e-2, and the
+ * force residual sits at 1-3e-3 for 10000 iterations and more; with eq 28 alone that mesh did
+ * not relax its fifth isotropic step in 20000 iterations, nor the 4 x 8 mesh its third. So a
+ * predicted step also ends once |f_ext - f_int| <= 2e-3 max|f| (--dr-force-stop; 0 leaves eq 28
+ * alone). The stop's bias is small: sigma_bar at 0.5 % of the periodic 1 x 1 / 2 x 4 meshes
+ * 0.1173 / 0.1192 with 5e-3, 0.1157 / 0.1162 with 2e-3, 0.1152 / 0.1154 with 1e-3, 0.1145 /
+ * 0.1151 with 5e-4 (the 1 x 1 mesh without the predictor 0.1142, the RVE alone 0.1131); 5e-3
+ * put the first biaxial step 1.5-2.5 % high. Servo, `--strain 0.05 --steps 10`, sigma_bar at
+ * 0.5 / 1 / 1.5 / 2 / 3 / 5 % and the DEM steps to 5 %:
+ *   1 x 1  0.107  0.190  0.246  0.289  0.336  0.373   1.5e6    (none: 1.8e6)
+ *   1 x 2  0.106  0.192  0.253  0.297  0.339  0.373   3.6e6    (none: 2.5e6)
+ *   2 x 4  0.106  0.190  0.247  0.291  0.334  0.368   3.0e7    (none: 1.5e7)
+ *   4 x 8  0.108  0.190  0.248  0.291  0.336  0.369   1.1e8    (414 s on one core)
+ * within 1.2, 1.0, 2.7, 3.0, 1.8, 1.5 % of each other (none, 1 x 1 to 2 x 4: 9.9, 8.7, 8.8,
+ * 8.2, 3.8, 1.5 %), as the paper's Fig 4 has them. The finer meshes pay for it (2 x 4: twice
+ * the DEM steps of --predictor none), and the locked-rotation 2 x 4 mesh relaxes every step (to
+ * 10 % in 134 s).
  */
 #define _POSIX_C_SOURCE 200809L
 #define GK_IMPLEMENTATION
@@ -136,7 +151,7 @@
 #include "femdem_dr_dns.h"
 
 /* ------------------------------------------------------------------ the load path */
-/* --predictor homogeneous (not the default: the manual above): where load step `step` of a mesh
+/* --predictor homogeneous (the default; the manual above): where load step `step` of a mesh
  * starts its relaxation, the uniform specimen's next state. Stage 1 from its third step: every
  * node stretched about the fixed corner by the ratios of the mean stretches the last step made
  * (the top's height and J in the rows, which the checkpoint keeps; the first step may unload a
@@ -301,6 +316,14 @@ int main(int argc, char **argv) {
            m.o.frame == GK_FRAME_SERVO ? "servo-framed" : "periodic-cell",
            m.o.frame == GK_FRAME_SERVO ? m.fr.n : m.pk.n, m.o.frame == GK_FRAME_SERVO ? m.fr.nq : 0,
            rotation_name(&m.o), m.ngp, kn_txt, m.omega_max);
+    if (!m.single) {
+        char stop_txt[64] = "";
+        if (m.o.force_stop > 0.0)
+            snprintf(stop_txt, sizeof stop_txt, " or at a force residual %g", m.o.force_stop);
+        printf("femdem_dr: a load step starts from %s and ends at E_kin / E_kin,max %g (eq 28)%s\n",
+               m.o.predictor ? "the uniform specimen's next state" : "the last state, the platen moved",
+               m.o.tol_dr, stop_txt);
+    }
     rc = run_fem(&m);
     gk_twoscale_destroy(&m.ts);
     gk_frame_free(&m.fr);

@@ -22,10 +22,13 @@
  * 0.5), bounded by the element frequencies (gk_explicit_elem_omega with
  * twice the Taylor tangent of the packing: an upper bound, since the
  * particles only soften it), converged when E_kin / E_kin,max <= --dr-tol
- * (eq 28, 1e-3). Velocities start from 0 at every load step, the
- * displacements from the last step's (only the loads and the platen
- * moved; --predictor homogeneous starts a mesh from the uniform specimen's
- * next state instead: run_fem's predict in femdem_dr.c). Every DR
+ * (eq 28, 1e-3). Velocities start from 0 at every load step. A mesh's
+ * displacements start from the uniform specimen's next state (--predictor
+ * homogeneous, the default: run_fem's predict in femdem_dr.c), and such a
+ * step, started near equilibrium, also ends once |f_ext - f_int| <= 2e-3
+ * max|f| (--dr-force-stop: eq 28 alone does not end it); --predictor none
+ * starts from the last step's with only the loads and the platen moved,
+ * as the paper writes it, and eq 28 alone ends it. Every DR
  * iteration (Table 1) computes F = I + dU/dX at each Gauss point, runs its
  * RVE from its last state by dF (gk_twoscale.h with a gk_frame.h
  * procedure), takes P back and assembles f_int = int B^T P dV0
@@ -354,7 +357,7 @@ static int setup(model *m) {
         gk_dr_def dd;
         memset(&dd, 0, sizeof dd);
         dd.xi = o->xi, dd.gamma = o->gamma, dd.tol = o->tol_dr, dd.omega_max = m->omega_max;
-        dd.omega_cap = m->omega_max, dd.force_tol = o->force_tol;
+        dd.omega_cap = m->omega_max, dd.force_tol = o->force_tol, dd.force_stop = o->force_stop;
         dd.max_iter = o->max_dr;
         if (gk_dr_init(&m->dr, &dd, m->ndof, m->mass, m->fixed, &err)) {
             fprintf(stderr, PROG ": %s\n", err.msg);
