@@ -40,6 +40,10 @@
  *   periodic 2 x 4, mu 0.2 / 0.6:  peaks 0.266 at 7.0 / 0.428 at 4.5 %; coordination at 7.3 %
  *     4.11 / 3.79 (mu 0.4: 3.88); locked rotation: 0.595 at 10 %, at 7.3 % sigma_bar 0.591,
  *     A 0.308; packings with A0 0.05 / 0.08: peaks 0.357 at 4.5 / 0.363 at 3.5 %.
+ *   2 x 4, k_n = 30 sigma0, mu 0.2 / 0.4 / 0.6: periodic peaks 0.254 / 0.348 / 0.406 (at 9.5-10 %),
+ *     coordination at 7.3 % 4.65 / 4.60 / 4.50, J_rel down to -0.037 / -0.043 / -0.049, no
+ *     dilation to 10 %; servo peaks 0.200 at 4.5 / 0.336 at 7.0 / 0.402 at 9.0 %, coordination
+ *     4.08 / 4.10 / 4.05, J_rel down to -0.043 / -0.033 / -0.040, dilation from 10 / 8 / 9 %.
  * Against Liu, Bosco & Suiker (2018), who give numbers only for Figs 10-11 (at 7.3 %: free
  * 0.39, locked 0.48; A 0.27 and 0.33): the locked rotation is stronger and more anisotropic
  * (servo 2 x 4: locked 0.564, A 0.377; A ratio free / locked 0.79 here, 0.82 there) but far
@@ -48,8 +52,9 @@
  * locked 0.417, A 0.12 and 0.12), 0.93 at 10, 0.54 at 1000 (tools/dr_rotation_study.sh,
  * examples/README.md); the peak comes earlier (4-6 %, there near 7 %; 7 % at k_n = 30
  * sigma0); higher friction gives a higher stress and a lower coordination as there, but not
- * their larger compaction; an ensemble of 22 RVEs resolves no effect of the initial
- * anisotropy (there: a lower, earlier peak; below).
+ * their larger compaction (at k_n = 30 sigma0 the periodic cells give that too, but no
+ * dilation to 10 %; the servo frames dilate from 8-10 %, there from about 8 %); an ensemble of
+ * 22 RVEs resolves no effect of the initial anisotropy (there: a lower, earlier peak; below).
  * The meshes agree within 3.0 % to 5 % strain (servo frame, 1 x 1 to 4 x 8, `--strain 0.05
  * --steps 10`) and the periodic cells within 2.4 % to 7.3 % (the paper: "very close"); after
  * the peak they part (servo 1 x 1 to 2 x 4: 4 % at 7.3 %, 32 % at 10 %). The servo frame and
