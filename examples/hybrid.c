@@ -108,6 +108,7 @@ int main(int argc, char **argv) {
     hist_t h;
     char path[1200];
     double thick = NAN, secs, hg;
+    int band_done = 0; /* the band is measured once, when the strain reaches --window's end */
     int rc = parse(argc, argv, o), status = 0, step_failed = 0;
     if (rc) return rc == 2 ? 0 : 2;
     memset(&h, 0, sizeof h);
@@ -217,6 +218,10 @@ int main(int argc, char **argv) {
         }
         if (R->enriched && !was && write_vtk(R, "enrichment")) status = 1;
         if (!R->window_taken && R->strain >= o->win0 && take_window(R)) status = 1;
+        if (R->window_taken && !band_done && R->strain >= o->win1 - 1e-12) {
+            band_done = 1;
+            if (band_measure(R, &thick)) status = 1;
+        }
         if (R->strain >= R->next_out - 1e-12) {
             if (csv_row(R, &h)) {
                 status = 1;
@@ -229,7 +234,7 @@ int main(int argc, char **argv) {
     secs = wtime() - R->t_start;
     if (step_failed) write_vtk(R, "stopped"); /* the state a failed step left, to see why */
     if (!status) {
-        if (band_measure(R, &thick) || write_vtk(R, "end") || write_plots(R, &h)) status = 1;
+        if ((!band_done && band_measure(R, &thick)) || write_vtk(R, "end") || write_plots(R, &h)) status = 1;
     }
     if (fclose(R->csv)) {
         fprintf(stderr, "error: cannot write %s/hybrid.csv\n", o->out);

@@ -218,6 +218,30 @@ TEST(hybrid_biaxial_continuum_runs) {
     CHECK(gk_test_file_has(BUILD "/tests/t_hyC/points_end.vtk", "POINTS"));
 }
 
+/* App. A measures the band over --window S0 S1 alone: a run that goes on beyond S1 reports the
+ * thickness of a run that stops at S1 (grains by Cundall's strain in dem mode, points by F in the
+ * continuum). The tiny dem specimen gives 6.58 D50 at S1 = 0.2 % and 5.54 D50 over 0.1-0.3 %,
+ * which is what a measurement to the run's end reported */
+TEST(hybrid_band_is_measured_over_its_window) {
+    const char *mode[2] = {"dem", "continuum"};
+    char cmd[512], out[2][96];
+    int m, k;
+    for (m = 0; m < 2; ++m) {
+        for (k = 0; k < 2; ++k) {
+            snprintf(out[k], sizeof out[k], BUILD "/tests/t_hyW_%s%d", mode[m], k);
+            snprintf(cmd, sizeof cmd,
+                     BIAXIAL
+                     "--mode %s --strain %s --out-every 0.001 --window 0.001 0.002 --out %s > %s.out 2>&1",
+                     mode[m], k ? "0.003" : "0.002", out[k], out[k]);
+            CHECK(system(cmd) == 0);
+            strcat(out[k], ".out");
+        }
+        CHECK(gk_test_result(out[0], "band_thickness_D50") > 0.0);
+        CHECK_NEAR(gk_test_result(out[1], "band_thickness_D50"), gk_test_result(out[0], "band_thickness_D50"),
+                   0.0);
+    }
+}
+
 /* the driver's "top wall seated on the trained grains at A kPa (the continuum's axial stress B
  * kPa)" line: A and B, 0 when absent */
 static int seated(const char *path, double *a, double *b) {
@@ -384,6 +408,7 @@ int main(int argc, char **argv) {
     RUN(hybrid_planar_platen_holds_to_large_strain);
     RUN(hybrid_biaxial_dem_loads);
     RUN(hybrid_biaxial_continuum_runs);
+    RUN(hybrid_band_is_measured_over_its_window);
     RUN(hybrid_biaxial_top_zone_is_seated);
     RUN(hybrid_indent_dem_and_hybrid_agree);
     return gk_test_done();
