@@ -27,13 +27,12 @@
  *   4.2 s with --paper where the runs take 97-138 DEM steps to reach I_uf <
  *   0.01; these CPU times were taken on a loaded shared machine and are
  *   indicative). Measured: the default simple shear to 20 % (4000 steps)
- *   1804 s on 2 threads, the 20-step cap to 10 % 188 s on one thread.
- *   Projection for --paper (CPU time, one thread; the RVEs run in parallel
- *   with --threads): ~4.7 h if the runs stay at ~120 DEM steps (the paper
- *   reports 22 h CPU for its run). The measurement: --stop-after 4 and
- *   --stop-after 24 (or 84) of the same test, the difference of their CPU
- *   times over the steps between; dem_steps_mean in the CSV gives the DEM
- *   steps per run.
+ *   1804 s on 2 threads, the 20-step cap to 10 % 188 s on one thread;
+ *   with --paper to 20 % 5147 s on 2 threads and 8415 s of CPU, 2.1 s per
+ *   coarse step (4.4e7 DEM steps; the runs' mean per coarse step 87-640,
+ *   median 114, to 18 %, up to 1580 near 20 %, where the column rings; the
+ *   paper reports 22 h CPU for its run). dem_steps_mean in the CSV gives
+ *   the DEM steps per run.
  *
  * RESULTS AGAINST THE PAPER (default sizes unless stated; what is not
  *   reproduced is said so)
@@ -97,7 +96,15 @@
  *     (--packing examples/data/rve1000_hm.txt --imperfection 6 --strain 0.1
  *     --steps 2000, 1091 s on 2 threads) soften a little later (1 % windows
  *     at 5-6 %: 241 kPa against 231) and put the band in the same row (52 %
- *     of the displacement at 10 %).
+ *     of the displacement at 10 %). The paper's 4096-sphere RVEs (--paper)
+ *     keep the stress level from 1 to 6 % (265-270 kPa in 1 % windows,
+ *     RESULT's peak 272 kPa at 3.4 %), soften it from 6 to 12 % (257 kPa at
+ *     6-7 %, 233 at 8-9 %, 194 at 11-12 %) and hold 170-190 kPa to 20 %: the
+ *     paper's plateau, its drop spread over 6-12 %. They form two bands, one
+ *     row each: 34 mm (0.53 at 12 %, RESULT's band, 37 % of the displacement)
+ *     and 84 mm, the row below the imperfect one (0.31), which stays at 0.04;
+ *     at 20 % their particles have turned 1.9 and 1.6 rad (outside 0.14-0.52)
+ *     and their porosity is 0.390.
  *     The biaxial test's 20-step cap (--dem-max 20: most runs end above the
  *     I_uf bound) forms no band: to 10 % (--strain 0.1 --steps 2000, the
  *     same rate; 188 s against 1338 s with the rule, one thread each, side
