@@ -93,8 +93,8 @@
  * slab under the top platen, not the band; 17 grains squeezed out of its
  * sides are removed (0.5 % of the grains' mass); the hybrid's mean shear
  * stress is 24 % above the all-grain run's, and on 2.5 mm cells the run
- * stops at 3.6 % when a continuum point at the top right corner leaves
- * the grid (examples/README.md). Planar:
+ * stops at 3.6 % when an overlap point at the top right corner leaves the
+ * grid (examples/README.md). Planar:
  * the stray grains' mass leaves the model (1.6 % at the paper's size). A
  * failed step leaves the state it stopped in as points_stopped.vtk and
  * grains_stopped.vtk.
