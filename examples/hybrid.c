@@ -110,7 +110,8 @@ int main(int argc, char **argv) {
     hist_t h;
     char path[1200];
     double thick = NAN, secs, hg;
-    int band_done = 0; /* the band is measured once, when the strain reaches --window's end */
+    int band_done = 0; /* the band is measured once, when the strain reaches --window's end (at the
+                        * latest on the last step: parse() keeps it within --strain) */
     int rc = parse(argc, argv, o), status = 0, step_failed = 0;
     if (rc) return rc == 2 ? 0 : 2;
     memset(&h, 0, sizeof h);
@@ -236,7 +237,7 @@ int main(int argc, char **argv) {
     secs = wtime() - R->t_start;
     if (step_failed) write_vtk(R, "stopped"); /* the state a failed step left, to see why */
     if (!status) {
-        if ((!band_done && band_measure(R, &thick)) || write_vtk(R, "end") || write_plots(R, &h)) status = 1;
+        if (write_vtk(R, "end") || write_plots(R, &h)) status = 1;
     }
     if (fclose(R->csv)) {
         fprintf(stderr, "error: cannot write %s/hybrid.csv\n", o->out);
