@@ -50,11 +50,48 @@ static int strip_stress(run *R, double y0, double y1, double *tau, double *sig_n
  * which stopped the run): the planar test's free grains more than STRAY_CELLS beyond the overlap
  * (or off the grid) are put in R->drop_ids, to be removed if they touch no grain (drop_loose).
  * Returns their count (0 in the other tests and with --keep-strays). */
+/* 1 if one of the nodes of the stencil at x (with half-size lp) is marked in R->deep */
+static int touches_deep(const run *R, const double x[3], double lp) {
+    int32_t node[GK_MPM_MAX_STENCIL];
+    double w[GK_MPM_MAX_STENCIL];
+    int n, k;
+    if (gk_mpm_shape_values(&R->g, R->md.basis, x, lp, &n, node, w, NULL)) return 0;
+    for (k = 0; k < n; ++k)
+        if (w[k] > 0.0 && R->deep[gk_hybrid_home(&R->g, &R->per, (size_t)node[k])]) return 1;
+    return 0;
+}
+
+/* Biaxial and indent: the points carried more than DEEP_CELLS into the discrete zone; their
+ * stencils' nodes are marked in R->deep (their count in R->deep_n). The discrete zone's grains
+ * are not coupled, so nothing held such a point: on the paper-size biaxial hybrid on 2.5 mm cells
+ * one rode along the top platen over a corner's grains and out of the grid. The grains whose
+ * stencils share those nodes are coupled (coupling_mask), so the point moves with them, as a grain
+ * that leaves the overlap for the continuum zone stays coupled. */
+static void mark_deep_points(run *R) {
+    const double deep = R->o.phi0 - (0.5 + DEEP_CELLS) * R->h;
+    int p, k;
+    R->deep_n = 0;
+    if (R->md.gravity[1] == 0.0 && R->o.test != T_BIAXIAL) return;
+    memset(R->deep, 0, R->g.nnode);
+    for (p = 0; p < R->P.n; ++p) {
+        int32_t node[GK_MPM_MAX_STENCIL];
+        double x[3] = {R->P.x[0][p], R->P.x[1][p], 0.0}, w[GK_MPM_MAX_STENCIL], d;
+        int n;
+        if (!gk_hybrid_interp(&R->g, &R->per, R->dist, 1, R->nden, x, &d) || d >= deep) continue;
+        if (gk_mpm_shape_values(&R->g, R->md.basis, x, R->P.lp[p], &n, node, w, NULL)) continue;
+        for (k = 0; k < n; ++k)
+            if (w[k] > 0.0) R->deep[gk_hybrid_home(&R->g, &R->per, (size_t)node[k])] = 1;
+        ++R->deep_n;
+    }
+    if (R->deep_n > R->deep_max) R->deep_max = R->deep_n;
+}
+
 static int coupling_mask(run *R) {
     gk_scene *sc = &R->sc;
     const int stray = R->o.test == T_PLANAR && R->md.gravity[1] == 0.0 && !R->o.keep_strays;
     const double far = R->o.phi0 + (0.5 + STRAY_CELLS) * R->h;
     int p, z, k = 0;
+    mark_deep_points(R);
     for (p = 0; p < sc->rve.n; ++p) {
         double x[3], d;
         R->coupled[p] = 0;
@@ -66,7 +103,8 @@ static int coupling_mask(run *R) {
         }
         z = gk_hybrid_zone(d, R->o.phi0, R->h);
         R->coupled[p] = z == GK_ZONE_OVERLAP ||
-                        (z == GK_ZONE_CONTINUUM && (R->md.gravity[1] != 0.0 || R->o.test == T_BIAXIAL));
+                        (z == GK_ZONE_CONTINUUM && (R->md.gravity[1] != 0.0 || R->o.test == T_BIAXIAL)) ||
+                        (z == GK_ZONE_DISCRETE && R->deep_n && touches_deep(R, x, R->P.lp[0]));
         if (stray && d > far) R->drop_ids[k++] = sc->rve.id[p];
     }
     return k;
@@ -569,6 +607,11 @@ static int enrich(run *R) {
         goto done;
     }
     for (I = 0; I < nn; ++I) R->nden[I] = 1.0; /* every node carries a distance */
+    R->deep = (unsigned char *)calloc(nn, 1);
+    if (!R->deep) {
+        fprintf(stderr, "error: out of memory\n");
+        goto done;
+    }
     if (grow_grain_arrays(R, ng)) goto done;
     R->enriched = 1;
     R->strain_enrich = R->strain;

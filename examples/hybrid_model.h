@@ -336,8 +336,11 @@ static void indent_contact(run *R) {
 }
 
 /* biaxial: the confining pressure as a follower traction on the outer columns
- * of continuum points (overlap and discrete points: the grains' membrane);
- * indent: the intruder's push */
+ * of continuum points; none on overlap points: the overlap's grains carry
+ * their whole contact forces and get the membrane's whole pressure, and a
+ * confined 1 - w share of the points on top of them would make the overlap
+ * stronger than the material (tests/test_hybrid_setup.c); indent: the
+ * intruder's push */
 static void mpm_traction(run *R) {
     int p, k;
     for (k = 0; k < 2; ++k) memset(R->P.fext[k], 0, (size_t)R->P.n * sizeof(double));

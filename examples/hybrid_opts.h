@@ -69,6 +69,10 @@ static const char *mode_name[] = {"dem", "continuum", "hybrid"};
 /* cells: planar, a free grain touching none this far beyond the overlap's outer edge (phi0 + h / 2
  * from the flagged nodes) is a stray and is removed (coupling_mask) */
 #define STRAY_CELLS 1.0
+/* cells: biaxial and indent, a point this far inside the discrete zone (beyond the overlap's inner
+ * edge, phi0 - h / 2 from the flagged nodes) couples the grains whose stencils share its nodes
+ * (coupling_mask) */
+#define DEEP_CELLS 0.5
 
 typedef struct opts {
     int test, mode;

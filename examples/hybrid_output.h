@@ -343,6 +343,7 @@ static void run_free(run *R) {
     free(R->xpre[0]);
     free(R->xpre[1]);
     free(R->coupled);
+    free(R->deep);
     free(R->drop_ids);
     free(R->Xw[0]);
     free(R->Xw[1]);

@@ -175,6 +175,8 @@ typedef struct run {
     int enriched;
     double strain_enrich, *dist, *xpre[2];
     unsigned char *coupled;
+    unsigned char *deep;     /* per node: in a stencil of a point carried into the discrete zone */
+    int deep_n, deep_max;    /* those points, at the last coupling_mask and at most */
     int32_t *drop_ids;       /* scratch: grains to remove (coupling_mask, remove_escaped) */
     int cap_g, mask_n, lost; /* lost: loose grains removed (drop_loose) */
     double lost_mass;        /* their share of the grains' mass when removed, summed */
