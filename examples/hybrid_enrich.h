@@ -36,20 +36,6 @@ static int strip_stress(run *R, double y0, double y1, double *tau, double *sig_n
     return 0;
 }
 
-/* grain p of the hybrid scene: free and in the overlap (coupled this step)? Under gravity (indent) a
- * grain that has left the overlap for the continuum zone stays coupled too: the continuum's points
- * do not touch grains, so it would fall through the material (in the indentation 27 of 397 grains
- * did, one by 2 cm, and the intruder's mean load over depth 5-30 % was 8.4 kPa instead of 11.2).
- * So in the biaxial test, where a zone that reaches the sides leaves thin strips of continuum at
- * its corners: free, the grains pushed into them were squeezed out of the specimen along the top
- * wall and below the membranes' ends (on the paper-size specimen the specimen's eps_v reached 36 %
- * at 3 % strain against the band's 2 %; coupled, 2.9 % at 3.4 %).
- * In the planar test such grains stay free: coupled, they stiffen its band (mean shear stress
- * 184 kPa instead of 128, the all-grain DEM's 146). A few squeezed out of the discrete zone then
- * cross the continuum and fly on (at the paper's size one left the grains' domain at 42.5 % strain,
- * which stopped the run): the planar test's free grains more than STRAY_CELLS beyond the overlap
- * (or off the grid) are put in R->drop_ids, to be removed if they touch no grain (drop_loose).
- * Returns their count (0 in the other tests and with --keep-strays). */
 /* 1 if one of the nodes of the stencil at x (with half-size lp) is marked in R->deep */
 static int touches_deep(const run *R, const double x[3], double lp) {
     int32_t node[GK_MPM_MAX_STENCIL];
@@ -86,6 +72,22 @@ static void mark_deep_points(run *R) {
     if (R->deep_n > R->deep_max) R->deep_max = R->deep_n;
 }
 
+/* grain p of the hybrid scene: free and in the overlap (coupled this step)? Under gravity (indent) a
+ * grain that has left the overlap for the continuum zone stays coupled too: the continuum's points
+ * do not touch grains, so it would fall through the material (in the indentation 27 of 397 grains
+ * did, one by 2 cm, and the intruder's mean load over depth 5-30 % was 8.4 kPa instead of 11.2).
+ * So in the biaxial test, where a zone that reaches the sides leaves thin strips of continuum at
+ * its corners: free, the grains pushed into them were squeezed out of the specimen along the top
+ * wall and below the membranes' ends (on the paper-size specimen the specimen's eps_v reached 36 %
+ * at 3 % strain against the band's 2 %; coupled, 2.9 % at 3.4 %).
+ * In the planar test such grains stay free: coupled, they stiffen its band (mean shear stress
+ * 184 kPa instead of 128, the all-grain DEM's 146). A few squeezed out of the discrete zone then
+ * cross the continuum and fly on (at the paper's size one left the grains' domain at 42.5 % strain,
+ * which stopped the run): the planar test's free grains more than STRAY_CELLS beyond the overlap
+ * (or off the grid) are put in R->drop_ids, to be removed if they touch no grain (drop_loose).
+ * Biaxial and indent: a discrete grain beside a point carried into the discrete zone is coupled
+ * as well (mark_deep_points). Returns the count of strays (0 in the other tests and with
+ * --keep-strays). */
 static int coupling_mask(run *R) {
     gk_scene *sc = &R->sc;
     const int stray = R->o.test == T_PLANAR && R->md.gravity[1] == 0.0 && !R->o.keep_strays;
