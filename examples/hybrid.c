@@ -101,11 +101,12 @@
  * stress is 28 % above the all-grain run's, and on 2.5 mm cells the oracle
  * flags the platen's two corners, not the slab; the continuum alone stops
  * at 8.9 %, when its band, the layer under the platen, has slid out
- * along the platen past the grid's side (examples/README.md). The points carried into the discrete zone and
- * the grains they couple are material twice over there, as are the grains
- * that leave the overlap for the continuum zone. Planar: the stray grains'
- * mass leaves the model (1.6 % at the paper's size). A failed step leaves
- * the state it stopped in as points_stopped.vtk and grains_stopped.vtk.
+ * along the platen past the grid's side (examples/README.md). The points
+ * carried into the discrete zone and the grains they couple are material
+ * twice over there, as are the grains that leave the overlap for the
+ * continuum zone. Planar: the stray grains' mass leaves the model (1.6 %
+ * at the paper's size). A failed step leaves the state it stopped in as
+ * points_stopped.vtk and grains_stopped.vtk.
  */
 #define GK_IMPLEMENTATION
 #define _POSIX_C_SOURCE 200809L

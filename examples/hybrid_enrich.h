@@ -36,14 +36,24 @@ static int strip_stress(run *R, double y0, double y1, double *tau, double *sig_n
     return 0;
 }
 
+/* the nodes (periodic axes: their home) carrying a weight in the stencil at x with half-size lp, into
+ * node[] (room for GK_MPM_MAX_STENCIL); returns their count, 0 for a stencil off the grid */
+static int stencil_nodes(const run *R, const double x[3], double lp, size_t *node) {
+    int32_t nd[GK_MPM_MAX_STENCIL];
+    double w[GK_MPM_MAX_STENCIL];
+    int n, k, m = 0;
+    if (gk_mpm_shape_values(&R->g, R->md.basis, x, lp, &n, nd, w, NULL)) return 0;
+    for (k = 0; k < n; ++k)
+        if (w[k] > 0.0) node[m++] = gk_hybrid_home(&R->g, &R->per, (size_t)nd[k]);
+    return m;
+}
+
 /* 1 if one of the nodes of the stencil at x (with half-size lp) is marked in R->deep */
 static int touches_deep(const run *R, const double x[3], double lp) {
-    int32_t node[GK_MPM_MAX_STENCIL];
-    double w[GK_MPM_MAX_STENCIL];
-    int n, k;
-    if (gk_mpm_shape_values(&R->g, R->md.basis, x, lp, &n, node, w, NULL)) return 0;
+    size_t node[GK_MPM_MAX_STENCIL];
+    int k, n = stencil_nodes(R, x, lp, node);
     for (k = 0; k < n; ++k)
-        if (w[k] > 0.0 && R->deep[gk_hybrid_home(&R->g, &R->per, (size_t)node[k])]) return 1;
+        if (R->deep[node[k]]) return 1;
     return 0;
 }
 
@@ -60,13 +70,12 @@ static void mark_deep_points(run *R) {
     if (R->md.gravity[1] == 0.0 && R->o.test != T_BIAXIAL) return;
     memset(R->deep, 0, R->g.nnode);
     for (p = 0; p < R->P.n; ++p) {
-        int32_t node[GK_MPM_MAX_STENCIL];
-        double x[3] = {R->P.x[0][p], R->P.x[1][p], 0.0}, w[GK_MPM_MAX_STENCIL], d;
+        size_t node[GK_MPM_MAX_STENCIL];
+        double x[3] = {R->P.x[0][p], R->P.x[1][p], 0.0}, d;
         int n;
         if (!gk_hybrid_interp(&R->g, &R->per, R->dist, 1, R->nden, x, &d) || d >= deep) continue;
-        if (gk_mpm_shape_values(&R->g, R->md.basis, x, R->P.lp[p], &n, node, w, NULL)) continue;
-        for (k = 0; k < n; ++k)
-            if (w[k] > 0.0) R->deep[gk_hybrid_home(&R->g, &R->per, (size_t)node[k])] = 1;
+        n = stencil_nodes(R, x, R->P.lp[p], node);
+        for (k = 0; k < n; ++k) R->deep[node[k]] = 1;
         ++R->deep_n;
     }
     if (R->deep_n > R->deep_max) R->deep_max = R->deep_n;

@@ -1,7 +1,7 @@
 /* test_hybrid_setup.c - parts of the hybrid driver (examples/hybrid_*.h) tested directly: the
  * membranes on the grains' sides of a biaxial specimen, the removal of grains that left it, the
- * side traction on the continuum's points, the planar test's coupling mask and its removal of stray
- * grains. */
+ * side traction on the continuum's points, the coupling of grains beside a point carried into the
+ * discrete zone, the planar test's coupling mask and its removal of stray grains. */
 #include "gk_test.h"
 #include <stdlib.h>
 
