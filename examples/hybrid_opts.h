@@ -84,6 +84,7 @@ typedef struct opts {
     double probe[3]; /* --probe S Y0 Y1 (dem): strain, strip */
     int probe_on;
     int ppd, threads, oracle_every, quiet, keep_strays;
+    int band_grains; /* > 0: band grains are the band_grains largest values (not --percentile) */
     long grains;
     unsigned long seed;
 } opts;
@@ -193,6 +194,9 @@ static void usage(FILE *fp) {
         "  --window S0 S1       strain window of the band measurement (default %g %g, %g %g, %g %g)\n"
         "  --band-window B      half-width of the eps_v_band window [m] (default %g, %g)\n"
         "  --percentile Q       band grains: value above the Q-th percentile (default %g)\n"
+        "  --band-grains N      band grains: the N largest values instead (a hybrid measures only\n"
+        "                       its discrete zone's grains and prints its count: give it to a dem\n"
+        "                       run to compare bands measured on as many grains)\n"
         "  --platen-damping Z   planar top platen: damping ratio of its dashpot (default %g)\n"
         "  --ramp K             the platen speed rises linearly over K wave transits H / c (default %g)\n"
         "  --dem-seconds S      wall seconds of the dem run of the same test (for speedup_vs_dem)\n"
@@ -295,6 +299,7 @@ static int parse(int argc, char **argv, opts *o) {
             {"--platen-damping", CLI_REAL, &o->platen_zeta, 0.0, 10.0, "a value in [0, 10]", NULL, 0},
             {"--ramp", CLI_REAL, &o->ramp, 0.0, 1e4, "a value in [0, 1e4]", NULL, 0},
             {"--dem-seconds", CLI_REAL, &o->dem_seconds, 0.0, HUGE_VAL, "a positive time", NULL, CLI_LO_OPEN},
+            {"--band-grains", CLI_INT, &o->band_grains, 3, 5000000, NULL, NULL, 0},
             {"--threads", CLI_INT, &o->threads, 1, 256, NULL, NULL, 0},
             {"--grains", CLI_INT, &grains, 0, 5000000, NULL, NULL, 0},
             {"--ppd", CLI_INT, &o->ppd, 1, 4, NULL, NULL, 0},
@@ -377,6 +382,10 @@ static int parse(int argc, char **argv, opts *o) {
                            o->intruder, o->width, o->height),
                    1;
     }
+    if (o->band_grains > 0 && (o->test == T_INDENT || o->mode == M_CONT))
+        return fprintf(stderr, "error: --band-grains: a count of grains (planar or biaxial, dem or hybrid; "
+                               "the continuum's band is measured on its points)\n"),
+               1;
     if (o->keep_strays && (o->test != T_PLANAR || o->mode != M_HYBRID))
         return fprintf(stderr, "error: --keep-strays is an option of the planar hybrid run\n"), 1;
     if (o->test != T_PLANAR && o->train < 1.0)
@@ -385,6 +394,21 @@ static int parse(int argc, char **argv, opts *o) {
                        o->train),
                1;
     return 0;
+}
+
+/* the values gk_hybrid_band measures: finite, at finite positions */
+static int band_finite(int n, const double *x, const double *y, const double *val) {
+    int p, nv = 0;
+    for (p = 0; p < n; ++p) nv += isfinite(val[p]) && isfinite(x[p]) && isfinite(y[p]);
+    return nv;
+}
+
+/* the percentile gk_hybrid_band selects by: --percentile, or with --band-grains N the one
+ * whose threshold, the value of rank floor(Q / 100 (nv - 1)) in ascending order, is that of
+ * rank nv - N, so that the N largest of the nv values are selected (more only on ties) */
+static double band_percentile(const opts *o, int nv) {
+    if (o->band_grains <= 0) return o->percentile;
+    return 100.0 * ((double)(nv - o->band_grains) + 0.5) / (double)(nv - 1);
 }
 
 static gk_material grain_material(double zeta_n, double zeta_t) {

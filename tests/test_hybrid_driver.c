@@ -143,12 +143,14 @@ TEST(hybrid_planar_platen_holds_to_large_strain) {
  * strip at the same strain in a dem run; that dem run's value is the
  * reference. The trained packing must be far closer to it than the untrained
  * one (less than half the distance), and the untrained one must carry less
- * than a quarter of it (the packing was consolidated isotropically). */
+ * than a quarter of it (the packing was consolidated isotropically). The
+ * dem run also takes the count of band grains the trained run prints
+ * (--band-grains) and selects exactly that many. */
 TEST(hybrid_training_matches_the_dem_packing_stress) {
     double trained, untrained, dem, S = 0.0, y0 = 0.0, y1 = 0.0;
-    char cmd[1024], line[1024];
+    char cmd[1024], line[1024], want[64];
     FILE *fp;
-    int got = 0;
+    int got = 0, nband = 0;
     system("rm -rf " BUILD "/tests/t_hyT1 " BUILD "/tests/t_hyT0 " BUILD "/tests/t_hyTd");
     CHECK(system(PLANAR "--mode hybrid --train 1 --strain 0.002 --window 0.001 0.002 --out " BUILD
                         "/tests/t_hyT1 > " BUILD "/tests/t_hyT1.out 2>&1") == 0);
@@ -159,16 +161,21 @@ TEST(hybrid_training_matches_the_dem_packing_stress) {
         const char *q = strstr(line, "--probe ");
         if (!strncmp(line, "packing (trained)", 17) && q)
             got = sscanf(q, "--probe %lf %lf %lf", &S, &y0, &y1);
+        q = strstr(line, "--band-grains ");
+        if (!strncmp(line, "the same count of band grains", 29) && q) sscanf(q, "--band-grains %d", &nband);
     }
     if (fp) fclose(fp);
     CHECK_EQ_INT(got, 3);
-    if (got != 3) return;
+    CHECK(nband >= 3);
+    if (got != 3 || nband < 3) return;
     CHECK(S > 0.0 && S < 0.002 && y1 > y0);
     snprintf(cmd, sizeof cmd,
-             PLANAR "--mode dem --probe %.9g %.9g %.9g --strain %.9g --window %.9g %.9g --out " BUILD
-                    "/tests/t_hyTd > " BUILD "/tests/t_hyTd.out 2>&1",
-             S, y0, y1, 1.5 * S, 0.5 * S, 1.5 * S);
+             PLANAR "--mode dem --probe %.9g %.9g %.9g --strain %.9g --window %.9g %.9g --band-grains %d "
+                    "--out " BUILD "/tests/t_hyTd > " BUILD "/tests/t_hyTd.out 2>&1",
+             S, y0, y1, 1.5 * S, 0.5 * S, 1.5 * S, nband);
     CHECK(system(cmd) == 0);
+    snprintf(want, sizeof want, "selected (the %d largest of ", nband);
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyTd.out", want));
     trained = gk_test_result(BUILD "/tests/t_hyT1.out", "packing_tau");
     untrained = gk_test_result(BUILD "/tests/t_hyT0.out", "packing_tau");
     dem = gk_test_result(BUILD "/tests/t_hyTd.out", "packing_tau");
@@ -365,6 +372,9 @@ TEST(hybrid_refuses_bad_arguments) {
     CHECK(refused("--test indent --mode hybrid --train 0.5", "below 1 only for the planar test"));
     CHECK(refused("--test biaxial --mode hybrid --keep-strays", "an option of the planar hybrid run"));
     CHECK(refused("--test planar --mode dem --keep-strays", "an option of the planar hybrid run"));
+    CHECK(refused("--test planar --mode continuum --band-grains 20", "--band-grains: a count of grains"));
+    CHECK(refused("--test indent --mode dem --band-grains 20", "--band-grains: a count of grains"));
+    CHECK(refused("--test planar --mode dem --band-grains 2", "--band-grains 2 is out of range"));
     CHECK(refused("--test shear --mode dem", "use planar, biaxial or indent"));
     CHECK(refused("--test planar --mode foo", "--mode 'foo' must be dem, continuum or hybrid"));
     CHECK(refused("--test planar --mode hybrid --train 2", "--train 2"));
