@@ -16,9 +16,12 @@
  * packing.txt, and on stdout a line
  *   RESULT mode=M peak_tau=Pa band_thickness_D50=X strain_at_enrichment=S
  *          seconds=T speedup_vs_dem=R packing_tau=Pa
- * (band thickness by App. A: top --percentile, outliers beyond 2 sd out,
- * minimum-area box, nan for indent; peak_tau for indent the peak of the
- * rows' q; speedup_vs_dem = --dem-seconds / seconds, nan without;
+ * (band thickness by App. A: top --percentile, or the --band-grains N
+ * largest, outliers beyond 2 sd out, minimum-area box, nan for indent; a
+ * hybrid measures only its discrete zone's grains and prints their count
+ * as the --band-grains of a dem run of the same test; peak_tau for indent
+ * the peak of the rows' q; speedup_vs_dem = --dem-seconds / seconds, nan
+ * without;
  * packing_tau, planar only: hybrid, the mean shear stress of the trained
  * packing in the discrete zone before it is inserted (Fig 13; with --train
  * 0 the untrained one), dem, that of the grains in the --probe strip at the
