@@ -78,7 +78,7 @@
  *   hybrid_output.h  VTK, hybrid.csv, the band measurement, the plots; its
  *                    manual lists every output file and the RESULT line
  *   RESULT mode=M peak_tau=Pa band_thickness_D50=X strain_at_enrichment=S
- *          seconds=T speedup_vs_dem=R packing_tau=Pa
+ *          seconds=T speedup_vs_dem=R packing_tau=Pa band_count=N
  *
  * COST. The defaults are reduced (3 x 6 cm planar, 1778 grains; 3 x 4.71
  * cm biaxial, 1435 grains; 5x the paper's platen speed; indent: a 12 x 4
@@ -119,6 +119,7 @@ int main(int argc, char **argv) {
     hist_t h;
     char path[1200];
     double thick = NAN, secs, hg;
+    int band_count = 0;
     int band_done = 0; /* the band is measured once, when the strain reaches --window's end (at the
                         * latest on the last step: parse() keeps it within --strain) */
     int rc = parse(argc, argv, o), status = 0, step_failed = 0;
@@ -232,7 +233,7 @@ int main(int argc, char **argv) {
         if (!R->window_taken && R->strain >= o->win0 && take_window(R)) status = 1;
         if (R->window_taken && !band_done && R->strain >= o->win1 - 1e-12) {
             band_done = 1;
-            if (band_measure(R, &thick)) status = 1;
+            if (band_measure(R, &thick, &band_count)) status = 1;
         }
         if (R->strain >= R->next_out - 1e-12) {
             if (csv_row(R, &h)) {
@@ -268,11 +269,11 @@ int main(int argc, char **argv) {
                 R->lost, o->test == T_PLANAR ? "strayed into the continuum zone" : "left the specimen",
                 100.0 * R->lost_mass);
     printf("RESULT mode=%s peak_tau=%.6g band_thickness_D50=%.4g strain_at_enrichment=%.4g seconds=%.2f "
-           "speedup_vs_dem=%.3g packing_tau=%.6g\n",
+           "speedup_vs_dem=%.3g packing_tau=%.6g band_count=%d\n",
            mode_name[o->mode], R->peak_tau, thick,
            o->mode == M_HYBRID ? (R->enriched ? R->strain_enrich : NAN)
                                : (R->triggered ? R->strain_trigger : NAN),
-           secs, o->dem_seconds > 0.0 ? o->dem_seconds / secs : NAN, R->packing_tau);
+           secs, o->dem_seconds > 0.0 ? o->dem_seconds / secs : NAN, R->packing_tau, band_count);
     free(h.s);
     free(h.tau);
     free(h.sn);

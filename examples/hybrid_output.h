@@ -15,11 +15,13 @@
  * fit, points by F),
  * packing.txt, and on stdout a line
  *   RESULT mode=M peak_tau=Pa band_thickness_D50=X strain_at_enrichment=S
- *          seconds=T speedup_vs_dem=R packing_tau=Pa
+ *          seconds=T speedup_vs_dem=R packing_tau=Pa band_count=N
  * (band thickness by App. A: top --percentile, or the --band-grains N
- * largest, outliers beyond 2 sd out, minimum-area box, nan for indent; a
- * hybrid measures only its discrete zone's grains and prints their count
- * as the --band-grains of a dem run of the same test; peak_tau for indent
+ * largest, outliers beyond 2 sd out, minimum-area box, nan for indent;
+ * band_count the grains (continuum: points) selected for it, 0 when not
+ * measured; a hybrid measures only its discrete zone's grains, so its
+ * band_count is the --band-grains of a dem run of the same test measured
+ * on as many grains (also printed); peak_tau for indent
  * the peak of the rows' q; speedup_vs_dem = --dem-seconds / seconds, nan
  * without;
  * packing_tau, planar only: hybrid, the mean shear stress of the trained
@@ -170,13 +172,14 @@ static int take_window(run *R) {
 }
 
 /* App. A over the window: incremental shear strain, band thickness; band.svg */
-static int band_measure(run *R, double *thick_D50) {
+static int band_measure(run *R, double *thick_D50, int *count) {
     gk_err e;
     gk_hybrid_band_result b;
     int n, p, q = 0, bad = 0, nv;
     double *xy, *val, *X[2], *x[2], *eps, period[2] = {0.0, 0.0}, *px, *py;
     char path[1200];
     *thick_D50 = NAN;
+    *count = 0;
     if (!R->window_taken) return 0;
     n = R->band_on_grains ? R->nw : R->P.n;
     xy = (double *)malloc(8 * (size_t)n * sizeof(double));
@@ -258,6 +261,7 @@ static int band_measure(run *R, double *thick_D50) {
         /* points: the box of their centres plus the spacing of one point (the material it carries) */
         if (!R->band_on_grains) b.thickness += R->dyp;
         *thick_D50 = b.thickness / DIAM;
+        *count = b.selected;
         if (!R->o.quiet) {
             char sel[80];
             if (R->o.band_grains > 0)

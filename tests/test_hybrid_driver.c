@@ -145,7 +145,7 @@ TEST(hybrid_planar_platen_holds_to_large_strain) {
  * one (less than half the distance), and the untrained one must carry less
  * than a quarter of it (the packing was consolidated isotropically). The
  * dem run also takes the count of band grains the trained run prints
- * (--band-grains) and selects exactly that many. */
+ * (--band-grains, its RESULT's band_count) and selects exactly that many. */
 TEST(hybrid_training_matches_the_dem_packing_stress) {
     double trained, untrained, dem, S = 0.0, y0 = 0.0, y1 = 0.0;
     char cmd[1024], line[1024], want[64];
@@ -176,6 +176,8 @@ TEST(hybrid_training_matches_the_dem_packing_stress) {
     CHECK(system(cmd) == 0);
     snprintf(want, sizeof want, "selected (the %d largest of ", nband);
     CHECK(gk_test_file_has(BUILD "/tests/t_hyTd.out", want));
+    CHECK_EQ_INT((int)gk_test_result(BUILD "/tests/t_hyT1.out", "band_count"), nband);
+    CHECK_EQ_INT((int)gk_test_result(BUILD "/tests/t_hyTd.out", "band_count"), nband);
     trained = gk_test_result(BUILD "/tests/t_hyT1.out", "packing_tau");
     untrained = gk_test_result(BUILD "/tests/t_hyT0.out", "packing_tau");
     dem = gk_test_result(BUILD "/tests/t_hyTd.out", "packing_tau");
