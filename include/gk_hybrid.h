@@ -128,7 +128,11 @@
  * (repeated until none), then those farther than nsd standard deviations
  * from the principal line of the rest; the thickness is the width of the
  * minimum-area rectangle around what remains (one side on an edge of the
- * convex hull).
+ * convex hull). The selection is the values at or above the one of rank
+ * floor(Q / 100 (nv - 1)) of the nv finite ones in ascending order, so
+ * Q = 100 (nv - N + 1/2) / (nv - 1) selects the N largest (more on ties).
+ * Fewer values make a thinner box: compare two measures (a zone's grains
+ * against a whole specimen's) on as many values, not at one percentile.
  *
  * CONVENTIONS: SI units, 2D; stress tension-positive (gk_mpm.h); zones
  * GK_ZONE_*; continuum masses per unit thickness, grain masses for the disk
