@@ -21,9 +21,8 @@
  * band_count the grains (continuum: points) selected for it, 0 when not
  * measured; a hybrid measures only its discrete zone's grains, so its
  * band_count is the --band-grains of a dem run of the same test measured
- * on as many grains (also printed); peak_tau for indent
- * the peak of the rows' q; speedup_vs_dem = --dem-seconds / seconds, nan
- * without;
+ * on as many grains (also printed); peak_tau for indent the peak of the
+ * rows' q; speedup_vs_dem = --dem-seconds / seconds, nan without;
  * packing_tau, planar only: hybrid, the mean shear stress of the trained
  * packing in the discrete zone before it is inserted (Fig 13; with --train
  * 0 the untrained one), dem, that of the grains in the --probe strip at the
