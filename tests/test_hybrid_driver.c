@@ -190,6 +190,16 @@ TEST(hybrid_training_matches_the_dem_packing_stress) {
     CHECK(gk_test_file_has(BUILD "/tests/t_hyTd.out", "probe at strain"));
 }
 
+/* --band-grains beyond the grains the band is measured on: known only at the
+ * window's end, so the run says so and ends non-zero (its other outputs stay) */
+TEST(hybrid_band_grains_beyond_the_grains_fails) {
+    system("rm -rf " BUILD "/tests/t_hyN");
+    CHECK(system(PLANAR "--mode dem --strain 0.002 --window 0.001 0.002 --band-grains 100000 --out " BUILD
+                        "/tests/t_hyN > " BUILD "/tests/t_hyN.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyN.out", "error: --band-grains 100000: only "));
+    CHECK(gk_test_result(BUILD "/tests/t_hyN.out", "band_count") == 0.0);
+}
+
 /* dem mode, biaxial: the specimen starts at the confining pressure
  * (sigma_n = 100 kPa, tau = 0), axial compression raises the deviator
  * (tau > 0, sigma_n > 100 kPa), App. A's band measurement runs on the grains */
@@ -417,6 +427,7 @@ int main(int argc, char **argv) {
     RUN(hybrid_refuses_bad_arguments);
     RUN(hybrid_planar_enriches_and_is_thread_independent);
     RUN(hybrid_training_matches_the_dem_packing_stress);
+    RUN(hybrid_band_grains_beyond_the_grains_fails);
     RUN(hybrid_planar_platen_holds_to_large_strain);
     RUN(hybrid_biaxial_dem_loads);
     RUN(hybrid_biaxial_continuum_runs);
