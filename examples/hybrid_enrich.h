@@ -48,6 +48,11 @@ static int stencil_nodes(const run *R, const double x[3], double lp, size_t *nod
     return m;
 }
 
+/* biaxial and indent (under gravity): the zone stays where it was made on the grid while material
+ * moves through it, so grains that leave the overlap for the continuum zone stay coupled and points
+ * carried into the discrete zone couple the grains about them (coupling_mask, mark_deep_points) */
+static int zone_fixed_on_grid(const run *R) { return R->md.gravity[1] != 0.0 || R->o.test == T_BIAXIAL; }
+
 /* 1 if one of the nodes of the stencil at x (with half-size lp) is marked in R->deep */
 static int touches_deep(const run *R, const double x[3], double lp) {
     size_t node[GK_MPM_MAX_STENCIL];
@@ -67,7 +72,7 @@ static void mark_deep_points(run *R) {
     const double deep = R->o.phi0 - (0.5 + DEEP_CELLS) * R->h;
     int p, k;
     R->deep_n = 0;
-    if (R->md.gravity[1] == 0.0 && R->o.test != T_BIAXIAL) return;
+    if (!zone_fixed_on_grid(R)) return;
     memset(R->deep, 0, R->g.nnode);
     for (p = 0; p < R->P.n; ++p) {
         size_t node[GK_MPM_MAX_STENCIL];
@@ -113,8 +118,7 @@ static int coupling_mask(run *R) {
             continue;
         }
         z = gk_hybrid_zone(d, R->o.phi0, R->h);
-        R->coupled[p] = z == GK_ZONE_OVERLAP ||
-                        (z == GK_ZONE_CONTINUUM && (R->md.gravity[1] != 0.0 || R->o.test == T_BIAXIAL)) ||
+        R->coupled[p] = z == GK_ZONE_OVERLAP || (z == GK_ZONE_CONTINUUM && zone_fixed_on_grid(R)) ||
                         (z == GK_ZONE_DISCRETE && R->deep_n && touches_deep(R, x, R->P.lp[0]));
         if (stray && d > far) R->drop_ids[k++] = sc->rve.id[p];
     }
