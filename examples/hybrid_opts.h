@@ -396,21 +396,6 @@ static int parse(int argc, char **argv, opts *o) {
     return 0;
 }
 
-/* the values gk_hybrid_band measures: finite, at finite positions */
-static int band_finite(int n, const double *x, const double *y, const double *val) {
-    int p, nv = 0;
-    for (p = 0; p < n; ++p) nv += isfinite(val[p]) && isfinite(x[p]) && isfinite(y[p]);
-    return nv;
-}
-
-/* the percentile gk_hybrid_band selects by: --percentile, or with --band-grains N the one
- * whose threshold, the value of rank floor(Q / 100 (nv - 1)) in ascending order, is that of
- * rank nv - N, so that the N largest of the nv values are selected (more only on ties) */
-static double band_percentile(const opts *o, int nv) {
-    if (o->band_grains <= 0) return o->percentile;
-    return 100.0 * ((double)(nv - o->band_grains) + 0.5) / (double)(nv - 1);
-}
-
 static gk_material grain_material(double zeta_n, double zeta_t) {
     gk_material m = gk_material_default();
     m.kn = KN;

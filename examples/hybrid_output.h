@@ -174,7 +174,7 @@ static int take_window(run *R) {
 static int band_measure(run *R, double *thick_D50, int *count) {
     gk_err e;
     gk_hybrid_band_result b;
-    int n, p, q = 0, bad = 0, nv;
+    int n, p, q = 0, bad = 0;
     double *xy, *val, *X[2], *x[2], *eps, period[2] = {0.0, 0.0}, *px, *py;
     char path[1200];
     *thick_D50 = NAN;
@@ -252,11 +252,14 @@ static int band_measure(run *R, double *thick_D50, int *count) {
     }
     if (R->o.test == T_INDENT) { /* two curved bands: App. A's one straight box does not apply */
         if (!R->o.quiet) printf("band: not measured (indent: curved bands; see band.svg)\n");
-    } else if ((nv = band_finite(n, px, py, val)) < R->o.band_grains) {
-        bad =
-            fprintf(stderr, "error: --band-grains %d: only %d grains have a Cundall strain over the window\n",
-                    R->o.band_grains, nv);
-    } else if (gk_hybrid_band(n, px, py, val, band_percentile(&R->o, nv), 2.0, &b, NULL, &e) == GK_OK) {
+    } else if ((R->o.band_grains > 0
+                    ? gk_hybrid_band_top(n, px, py, val, R->o.band_grains, 2.0, &b, NULL, &e)
+                    : gk_hybrid_band(n, px, py, val, R->o.percentile, 2.0, &b, NULL, &e)) != GK_OK) {
+        /* a percentile of fewer than 3 values: no band (NaN); more grains asked for than measured: an error */
+        if (R->o.band_grains > 0)
+            bad = fprintf(stderr, "error: --band-grains %d: %s (the grains with a Cundall strain)\n",
+                          R->o.band_grains, e.msg);
+    } else {
         /* points: the box of their centres plus the spacing of one point (the material it carries) */
         if (!R->band_on_grains) b.thickness += R->dyp;
         *thick_D50 = b.thickness / DIAM;
@@ -264,9 +267,9 @@ static int band_measure(run *R, double *thick_D50, int *count) {
         if (!R->o.quiet) {
             char sel[80];
             if (R->o.band_grains > 0)
-                snprintf(sel, sizeof sel, "the %d largest of %d", R->o.band_grains, nv);
+                snprintf(sel, sizeof sel, "the %d largest of %d", R->o.band_grains, b.finite);
             else
-                snprintf(sel, sizeof sel, "above the %g-th percentile of %d", R->o.percentile, nv);
+                snprintf(sel, sizeof sel, "above the %g-th percentile of %d", R->o.percentile, b.finite);
             printf("band (App. A, %s, strain %.3g-%.3g): thickness %.2f D50, angle %.1f deg, centre (%.2f, "
                    "%.2f) cm, %d of %d selected (%s) kept\n",
                    R->band_on_grains ? "grains, Cundall" : "points", R->o.win0, R->strain, b.thickness / DIAM,

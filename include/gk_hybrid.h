@@ -58,6 +58,7 @@
  *   gk_hybrid_cundall       Cundall's best-fit strain of every grain (App. A)
  *   gk_hybrid_band          band thickness: top percentile, outliers out,
  *                           minimum-area bounding box (App. A)
+ *   gk_hybrid_band_top      the same on the count largest values
  *   gk_hybrid_bc_mask       nodes a face or body of the grid constrains
  *   gk_hybrid_traction      follower pressure on a boundary point (Nanson)
  *
@@ -129,10 +130,11 @@
  * from the principal line of the rest; the thickness is the width of the
  * minimum-area rectangle around what remains (one side on an edge of the
  * convex hull). The selection is the values at or above the one of rank
- * floor(Q / 100 (nv - 1)) of the nv finite ones in ascending order, so
- * Q = 100 (nv - N + 1/2) / (nv - 1) selects the N largest (more on ties).
- * Fewer values make a thinner box: compare two measures (a zone's grains
- * against a whole specimen's) on as many values, not at one percentile.
+ * floor(Q / 100 (nv - 1)) of the nv finite ones in ascending order;
+ * gk_hybrid_band_top selects the N largest instead (at or above the one of
+ * rank nv - N: more only on ties). Fewer values make a thinner box:
+ * compare two measures (a zone's grains against a whole specimen's) on as
+ * many values, not at one percentile.
  *
  * CONVENTIONS: SI units, 2D; stress tension-positive (gk_mpm.h); zones
  * GK_ZONE_*; continuum masses per unit thickness, grain masses for the disk
@@ -245,7 +247,8 @@ typedef struct gk_hybrid_band_result {
     double length;    /* its other side [m]                             */
     double angle;     /* direction of the long side, rad from the x axis */
     double centre[2];
-    int selected, kept; /* above the percentile; after the outlier cut  */
+    int selected, kept; /* above the percentile (or the count largest); after the outlier cut */
+    int finite;         /* the values measured: finite, at finite positions */
 } gk_hybrid_band_result;
 
 #ifdef __cplusplus
@@ -398,6 +401,11 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
 GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value,
                                double percentile, double nsd, gk_hybrid_band_result *out,
                                const gk_allocator *alloc, gk_err *err);
+/* the same on the count largest values (more only on ties): an error when
+ * count exceeds the finite values */
+GKDEF gk_result gk_hybrid_band_top(int n, const double *x, const double *y, const double *value, int count,
+                                   double nsd, gk_hybrid_band_result *out, const gk_allocator *alloc,
+                                   gk_err *err);
 
 /* ---- boundaries */
 /* mask[I] = 1 for the nodes a face (not FREE) or a rigid body of g acts on */
@@ -1521,9 +1529,10 @@ static int gk__hy_cmp_xy(const void *a, const void *b) {
     return p[1] < q[1] ? -1 : (p[1] > q[1] ? 1 : 0);
 }
 
-GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value,
-                               double percentile, double nsd, gk_hybrid_band_result *out,
-                               const gk_allocator *alloc, gk_err *err) {
+/* the band of the values at or above a percentile (count 0) or of the count largest */
+static gk_result gk__hy_band(int n, const double *x, const double *y, const double *value, double percentile,
+                             int count, double nsd, gk_hybrid_band_result *out, const gk_allocator *alloc,
+                             gk_err *err) {
     gk_hybrid_band_result res;
     gk_allocator al;
     double *v, *pt, *hull, thr, c[2] = {0.0, 0.0}, sxx = 0.0, sxy = 0.0, syy = 0.0, dir[2], mean = 0.0,
@@ -1553,9 +1562,16 @@ GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const do
         gk_free(&al, hull);
         return gk_err_set(err, GK_ERR_ARG, "%d finite values: too few for a band", nv);
     }
+    if (count > nv) {
+        gk_free(&al, v);
+        gk_free(&al, pt);
+        gk_free(&al, hull);
+        return gk_err_set(err, GK_ERR_ARG, "count %d above the %d finite values", count, nv);
+    }
     qsort(v, (size_t)nv, sizeof(double), gk__hy_cmp_double);
-    i = (int)floor(percentile / 100.0 * (nv - 1));
+    i = count > 0 ? nv - count : (int)floor(percentile / 100.0 * (nv - 1));
     thr = v[i];
+    res.finite = nv;
     for (p = 0; p < n; ++p)
         if (isfinite(value[p]) && isfinite(x[p]) && isfinite(y[p]) && value[p] >= thr) {
             pt[2 * ns] = x[p];
@@ -1671,6 +1687,19 @@ GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const do
     gk_free(&al, hull);
     if (out) *out = res;
     return GK_OK;
+}
+
+GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value,
+                               double percentile, double nsd, gk_hybrid_band_result *out,
+                               const gk_allocator *alloc, gk_err *err) {
+    return gk__hy_band(n, x, y, value, percentile, 0, nsd, out, alloc, err);
+}
+
+GKDEF gk_result gk_hybrid_band_top(int n, const double *x, const double *y, const double *value, int count,
+                                   double nsd, gk_hybrid_band_result *out, const gk_allocator *alloc,
+                                   gk_err *err) {
+    if (count < 3) return gk_err_set(err, GK_ERR_ARG, "count %d: a band needs at least 3 values", count);
+    return gk__hy_band(n, x, y, value, 0.0, count, nsd, out, alloc, err);
 }
 
 /* ---------------------------------------------------------- boundaries */

@@ -675,6 +675,50 @@ TEST(band_thickness_of_a_strip) {
     CHECK(gk_hybrid_band(n, x, y, v, 100.0, 2.0, &b, NULL, &e) == GK_ERR_ARG);
 }
 
+/* gk_hybrid_band_top selects the count largest of the finite values, and
+ * no others, for every count from 3 to all of them (values distinct, in a
+ * scrambled order, one of them NaN); gk_hybrid_band at the percentile
+ * whose floored rank (BAND THICKNESS) is nv - N, Q = 100 (nv - N + 1/2) /
+ * (nv - 1), selects the same N in the same box; a count above the finite
+ * values or below 3 is refused and writes nothing. */
+TEST(band_top_selects_that_many) {
+    gk_hybrid_band_result b, pb;
+    gk_err e;
+    double x[400], y[400], v[400];
+    int n, N, k, bad = 0, calls = 0;
+    for (n = 4; n <= 400; n += n < 60 ? 1 : 67) {
+        for (k = 0; k < n; ++k) { /* distinct values in a scrambled order, along a wavy line */
+            x[k] = 1e-3 * k;
+            y[k] = 1e-4 * (k % 7);
+            v[k] = (double)((k * 337) % 401);
+        }
+        v[n / 2] = NAN; /* not measured: the count is of the n - 1 finite ones */
+        for (N = 3; N <= n - 1; ++N) {
+            double Q = 100.0 * ((n - 1 - N) + 0.5) / (n - 2);
+            ++calls;
+            if (gk_hybrid_band_top(n, x, y, v, N, 2.0, &b, NULL, &e) != GK_OK || b.selected != N ||
+                b.finite != n - 1) {
+                ++bad;
+                continue;
+            }
+            if (gk_hybrid_band(n, x, y, v, Q, 2.0, &pb, NULL, &e) != GK_OK || pb.selected != N ||
+                pb.thickness != b.thickness)
+                ++bad;
+        }
+    }
+    CHECK(calls > 2000);
+    CHECK_EQ_INT(bad, 0);
+    n = 50; /* 48 finite of 50 */
+    v[10] = v[20] = NAN;
+    b.selected = -7;
+    CHECK(gk_hybrid_band_top(n, x, y, v, 49, 2.0, &b, NULL, &e) == GK_ERR_ARG);
+    CHECK(strstr(e.msg, "count 49 above the 48 finite values") != NULL);
+    CHECK(gk_hybrid_band_top(n, x, y, v, 48, 2.0, &pb, NULL, &e) == GK_OK && pb.selected == 48);
+    CHECK(gk_hybrid_band_top(n, x, y, v, 2, 2.0, &b, NULL, &e) == GK_ERR_ARG);
+    CHECK(gk_hybrid_band_top(n, x, y, v, 0, 2.0, &b, NULL, &e) == GK_ERR_ARG);
+    CHECK_EQ_INT(b.selected, -7);
+}
+
 /* ================================================================ training
  * Sec 4.1.1 / Fig 13: a packing whose boundary is moved by the continuum's
  * simple-shear displacement builds the shear stress the continuum carries;
@@ -885,6 +929,7 @@ int main(int argc, char **argv) {
     RUN(enrichment_conserves_mass_and_momentum);
     RUN(cundall_exact_for_affine_motion);
     RUN(band_thickness_of_a_strip);
+    RUN(band_top_selects_that_many);
     RUN(training_raises_packing_stress);
     return gk_test_done();
 }

@@ -332,41 +332,6 @@ TEST(planar_strays_are_removed_and_counted) {
     free_grid_state(&R, &pk);
 }
 
-/* --band-grains N selects the N largest values: band_percentile gives the
- * percentile whose threshold in gk_hybrid_band, the value of rank
- * floor(Q / 100 (nv - 1)), is that of rank nv - N, for every count it accepts;
- * and gk_hybrid_band then selects exactly N of nv distinct values. */
-TEST(band_grains_selects_that_many) {
-    opts o;
-    gk_hybrid_band_result b;
-    gk_err e;
-    double x[600], y[600], v[600];
-    int nv, N, k, bad = 0, counts[3] = {3, 10, 67};
-    defaults(&o, T_PLANAR);
-    CHECK(band_percentile(&o, 1000) == 98.0);
-    for (nv = 3; nv <= 20000; nv += nv < 200 ? 1 : 97)
-        for (N = 3; N <= nv; N += N < 50 || N > nv - 50 ? 1 : 53) {
-            double Q;
-            o.band_grains = N;
-            Q = band_percentile(&o, nv);
-            bad += !(Q >= 0.0 && Q < 100.0) || (int)floor(Q / 100.0 * (nv - 1)) != nv - N;
-        }
-    CHECK(bad == 0);
-    for (k = 0; k < 600; ++k) { /* distinct values in a scrambled order, along a line */
-        x[k] = 1e-3 * k;
-        y[k] = 1e-4 * (k % 7);
-        v[k] = (double)((k * 337) % 600);
-    }
-    v[5] = NAN; /* not measured: the count is of the 599 finite ones */
-    nv = band_finite(600, x, y, v);
-    CHECK(nv == 599);
-    for (k = 0; k < 3; ++k) {
-        o.band_grains = counts[k];
-        CHECK(gk_hybrid_band(600, x, y, v, band_percentile(&o, nv), 2.0, &b, NULL, &e) == GK_OK);
-        CHECK(b.selected == counts[k]);
-    }
-}
-
 int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(membranes_reach_a_set_back_top_corner);
@@ -375,6 +340,5 @@ int main(int argc, char **argv) {
     RUN(planar_strays_are_removed_and_counted);
     RUN(side_traction_acts_on_the_continuum_points);
     RUN(grains_about_a_deep_point_are_coupled);
-    RUN(band_grains_selects_that_many);
     return gk_test_done();
 }
