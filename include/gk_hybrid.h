@@ -401,8 +401,8 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
 GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value,
                                double percentile, double nsd, gk_hybrid_band_result *out,
                                const gk_allocator *alloc, gk_err *err);
-/* the same on the count largest values (more only on ties): an error when
- * count exceeds the finite values */
+/* the same on the count >= 3 largest values (more only on ties); a count
+ * above the finite values is an error */
 GKDEF gk_result gk_hybrid_band_top(int n, const double *x, const double *y, const double *value, int count,
                                    double nsd, gk_hybrid_band_result *out, const gk_allocator *alloc,
                                    gk_err *err);
