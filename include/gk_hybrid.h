@@ -1556,16 +1556,11 @@ static gk_result gk__hy_band(int n, const double *x, const double *y, const doub
     }
     for (p = 0; p < n; ++p)
         if (isfinite(value[p]) && isfinite(x[p]) && isfinite(y[p])) v[nv++] = value[p];
-    if (nv < 3) {
+    if (nv < 3 || count > nv) {
         gk_free(&al, v);
         gk_free(&al, pt);
         gk_free(&al, hull);
-        return gk_err_set(err, GK_ERR_ARG, "%d finite values: too few for a band", nv);
-    }
-    if (count > nv) {
-        gk_free(&al, v);
-        gk_free(&al, pt);
-        gk_free(&al, hull);
+        if (nv < 3) return gk_err_set(err, GK_ERR_ARG, "%d finite values: too few for a band", nv);
         return gk_err_set(err, GK_ERR_ARG, "count %d above the %d finite values", count, nv);
     }
     qsort(v, (size_t)nv, sizeof(double), gk__hy_cmp_double);
