@@ -70,6 +70,14 @@
  *   band_share = their share of the column's shear displacement (sum of
  *   their shear strain over all rows'), at 12 % strain (the paper's Fig 14)
  *   or at the end if it is never reached.
+ *   band_porosity_center_mm, band_porosity_width_mm (simple-shear): the band
+ *   as the paper reads it from its 12 row porosities (Fig 14a, "13-16 mm"):
+ *   at the same strain, the rows' porosity linear between the row centres
+ *   (flat over the half rows at the faces), its peak's width at half its
+ *   height above the rows' median and the midpoint of the two crossings. One
+ *   row above the others' level measures one row (9.8 mm on 5x12x1), its
+ *   neighbours at half its excess 1.5 rows. Stdout has the same measure of
+ *   the shear strain's profile.
  *
  */
 #ifndef NONLOCAL_IO_H
@@ -572,12 +580,18 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
         if (o->test == T_SSHEAR) {
             int ny = o->mesh[1], j, bad;
             FILE *fp;
-            double *pe = (double *)xcalloc((size_t)2 * ny, sizeof(double)), share;
+            double *pe = (double *)xcalloc((size_t)2 * ny, sizeof(double)), share, pc, pw, gc, gw;
+            const double *pr;
             smoothed_peak(md, 2.0 * GK_PI / md->omega1, &pk, &epk);
             elem_fields(md);
             row_profile(md, pe);
-            band(md, md->have12 ? md->prof12 : pe, &bc, &bw, &share);
-            snprintf(extra, sizeof extra, "band_share=%.3f", share);
+            pr = md->have12 ? md->prof12 : pe;
+            band(md, pr, &bc, &bw, &share);
+            peak_fwhm(md, pr + ny, &pc, &pw);
+            peak_fwhm(md, pr, &gc, &gw);
+            snprintf(extra, sizeof extra,
+                     "band_share=%.3f band_porosity_center_mm=%.4g band_porosity_width_mm=%.4g", share, pc,
+                     pw);
             snprintf(path, sizeof path, "%s/profile.csv", o->out);
             fp = fopen(path, "w");
             if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
@@ -591,6 +605,10 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
             printf("band (shear strain above the least row's, at %s): centre %.1f mm, width %.1f mm, %.0f %% "
                    "of the shear displacement\n",
                    md->have12 ? "12 %" : "the end", bc, bw, 100.0 * share);
+            printf(
+                "the rows' peak at half its height above their median (Fig 14a's reading): porosity centre "
+                "%.1f mm, width %.1f mm; shear strain centre %.1f mm, width %.1f mm\n",
+                pc, pw, gc, gw);
             free(pe);
         }
         snprintf(svg, sizeof svg, "%s/%s_curve.svg", o->out, test_name[o->test]);

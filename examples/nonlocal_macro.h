@@ -700,6 +700,35 @@ static void band(const model *md, const double *prof, double *centre, double *wi
     *share = sa > 0.0 ? sg / sa : NAN;
 }
 
+/* the paper's reading of its Fig 14a (nonlocal_io.h): the peak of a row
+ * profile v at half its height above the rows' median, the profile linear
+ * between the row centres and flat over the half rows at the faces; centre
+ * = the midpoint of the two crossings, width = their distance [mm]; nan if
+ * no row is above the median or a value is not finite */
+static void peak_fwhm(const model *md, const double *v, double *centre, double *width) {
+    int ny = md->o->mesh[1], i, j, jm = 0, a, b;
+    double h = md->L[1] / ny, med, half, lo, hi, *s;
+    *centre = *width = NAN;
+    for (j = 0; j < ny; ++j)
+        if (!isfinite(v[j])) return;
+    s = (double *)xcalloc((size_t)ny, sizeof(double));
+    for (j = 0; j < ny; ++j) {
+        for (i = j; i > 0 && s[i - 1] > v[j]; --i) s[i] = s[i - 1]; /* insertion sort: ny is small */
+        s[i] = v[j];
+        if (v[j] > v[jm]) jm = j;
+    }
+    med = ny % 2 ? s[ny / 2] : 0.5 * (s[ny / 2 - 1] + s[ny / 2]);
+    free(s);
+    if (!(v[jm] > med)) return;
+    half = med + 0.5 * (v[jm] - med);
+    for (a = jm; a > 0 && v[a - 1] >= half;) --a;
+    for (b = jm; b < ny - 1 && v[b + 1] >= half;) ++b;
+    lo = a == 0 ? 0.0 : (a - 0.5 + (half - v[a - 1]) / (v[a] - v[a - 1])) * h;
+    hi = b == ny - 1 ? md->L[1] : (b + 0.5 + (v[b] - half) / (v[b] - v[b + 1])) * h;
+    *centre = 0.5e3 * (lo + hi);
+    *width = 1e3 * (hi - lo);
+}
+
 static int record(model *md, double seconds) {
     double row[NCOL], strain, stress, s2, up, p = 0, q = 0, por = 0, Z = 0, dm = 0, dx = 0, capped = 0;
     const gk_twoscale_point *pt = gk_twoscale_points(&md->ts);

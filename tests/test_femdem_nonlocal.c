@@ -238,7 +238,7 @@ TEST(simple_shear_nonlocal_threads_restart) {
 TEST(simple_shear_peak_and_band_as_documented) {
     FILE *fp;
     char line[1024];
-    double t[1000], s[1000], e[1000], g[16], rho = 0, T, pk = -1e300, epk = 0, rowmax = -1e300;
+    double t[1000], s[1000], e[1000], g[16], por[16], rho = 0, T, pk = -1e300, epk = 0, rowmax = -1e300;
     double gmin = 1e300, sw = 0, sy = 0, sg = 0, sa = 0, h = 0.118 / 4;
     int n = 0, r, q, ng = 0, jm = 0, j0, j1, j;
     CHECK(system(BUILD "/femdem_nonlocal --test simple-shear --packing " PK160 " --mesh 1x4x1 --steps 400 "
@@ -277,7 +277,7 @@ TEST(simple_shear_peak_and_band_as_documented) {
     CHECK(fp != NULL);
     if (!fp) return;
     while (ng < 16 && fgets(line, sizeof line, fp)) /* row,y_mm,gamma_max_stress_step,g12,p12,gamma_end,.. */
-        if (sscanf(line, "%*d,%*f,%*f,%*f,%*f,%lf", &g[ng]) == 1) ++ng;
+        if (sscanf(line, "%*d,%*f,%*f,%*f,%*f,%lf,%lf", &g[ng], &por[ng]) == 2) ++ng;
     fclose(fp);
     CHECK(ng == 4);
     if (ng != 4) return;
@@ -296,6 +296,41 @@ TEST(simple_shear_peak_and_band_as_documented) {
     CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlpk.out", "band_width_mm"), 1e3 * sw * h / (g[jm] - gmin),
                5e-3 * 1e3 * sw * h / (g[jm] - gmin));
     CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlpk.out", "band_share"), sg / sa, 1e-3);
+    { /* Fig 14a's reading: the porosity profile (linear between the row
+       * centres, flat to the faces) sampled every micrometre; the stretch
+       * above median + (max - median) / 2 that holds the largest row */
+        double srt[4], med, half, lo = -1, hi = -1, y, yc;
+        int k, m, in = 0, top = 0;
+        memcpy(srt, por, sizeof srt);
+        for (k = 0; k < 4; ++k) {
+            if (por[k] > por[top]) top = k;
+            for (m = k + 1; m < 4; ++m)
+                if (srt[m] < srt[k]) y = srt[k], srt[k] = srt[m], srt[m] = y;
+        }
+        med = 0.5 * (srt[1] + srt[2]);
+        half = 0.5 * (med + srt[3]);
+        yc = 1e3 * (top + 0.5) * h;
+        for (k = 0; k <= 118000; ++k) { /* y = k um */
+            double f = k * 1e-6 / h - 0.5, v;
+            int r0 = f < 0 ? 0 : f >= 3 ? 2 : (int)f;
+            f = f < 0 ? 0 : f >= 3 ? 1 : f - r0;
+            v = por[r0] + f * (por[r0 + 1] - por[r0]);
+            if (v >= half) {
+                if (!in) in = 1, lo = k * 1e-3;
+                hi = k * 1e-3;
+            } else if (in) {
+                if (lo <= yc && yc <= hi) break;
+                in = 0;
+            }
+        }
+        printf("    porosity peak at half height: %.4g-%.4g mm (median %.6g, largest %.6g)\n", lo, hi, med,
+               srt[3]);
+        CHECK(lo <= yc && yc <= hi);
+        CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlpk.out", "band_porosity_width_mm"), hi - lo,
+                   1e-3 * (hi - lo));
+        CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlpk.out", "band_porosity_center_mm"), 0.5 * (lo + hi),
+                   1e-3 * 0.5 * (lo + hi));
+    }
 }
 
 /* --test rve (Table II of Liu, Sun, Yuan & Fish 2016): the 160-sphere
