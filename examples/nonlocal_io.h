@@ -32,6 +32,8 @@
  *                    at the step of the largest base stress (one step's, with
  *                    the column's ringing: not the peak below), shear strain
  *                    and porosity at 12 % and at the end
+ *   simple-shear_profile.svg  the rows' porosity over the height at 12 %
+ *                    and at the end (Fig 14a)
  *   wave_arrival.csv (wave) per element: distance from the driven end,
  *                    arrival multiscale / elastic / distance over sqrt(G/rho)
  *   mesh_NNNNNN.vtk  the deformed mesh, displacement, and per element (with
@@ -609,6 +611,17 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
                 "the rows' peak at half its height above their median (Fig 14a's reading): porosity centre "
                 "%.1f mm, width %.1f mm; shear strain centre %.1f mm, width %.1f mm\n",
                 pc, pw, gc, gw);
+            {
+                double *yv = (double *)xcalloc((size_t)ny, sizeof(double));
+                int fail;
+                for (j = 0; j < ny; ++j) yv[j] = 1e3 * (j + 0.5) * md->L[1] / ny;
+                snprintf(svg, sizeof svg, "%s/simple-shear_profile.svg", o->out);
+                fail = plot2(svg, "porosity over the height (Fig 14a)", "porosity of the row", "height [mm]",
+                             pr + ny, yv, ny, md->have12 ? "at 12 %" : "at the end",
+                             md->have12 ? pe + ny : NULL, yv, ny, "at the end");
+                free(yv);
+                if (fail) return free(pe), 1;
+            }
             free(pe);
         }
         snprintf(svg, sizeof svg, "%s/%s_curve.svg", o->out, test_name[o->test]);

@@ -326,6 +326,7 @@ TEST(simple_shear_peak_and_band_as_documented) {
         printf("    porosity peak at half height: %.4g-%.4g mm (median %.6g, largest %.6g)\n", lo, hi, med,
                srt[3]);
         CHECK(lo <= yc && yc <= hi);
+        CHECK(gk_test_file_has(BUILD "/tests/t_fnlpk/simple-shear_profile.svg", "(Fig 14a)"));
         CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlpk.out", "band_porosity_width_mm"), hi - lo,
                    1e-3 * (hi - lo));
         CHECK_NEAR(gk_test_result(BUILD "/tests/t_fnlpk.out", "band_porosity_center_mm"), 0.5 * (lo + hi),
