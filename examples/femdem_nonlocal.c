@@ -86,7 +86,10 @@
  *     against 0.01-0.05 in eight rows, with a second, weaker band at 25 mm
  *     (0.37) and 0.11 at 64 mm; RESULT's band (one row wide, nonlocal_io.h)
  *     is centred at 93.4 mm, 9.8 mm wide (the paper: 13-16 mm, with element
- *     rows as high as these) and carries 52 % of the shear displacement. At
+ *     rows as high as these) and carries 52 % of the shear displacement.
+ *     Read as the paper reads its Fig 14a, from the rows' porosity
+ *     (band_porosity_width_mm, simple-shear_profile.svg), it is 9.3 mm: 0.392
+ *     in the band's row, 0.348 in both neighbours, the rows' median 0.350. At
  *     20 % the band's particles have turned 2.1 rad on average, those of the
  *     rows outside the two bands 0.11-0.43 (Fig 14b); its porosity 0.391, Z
  *     3.38. With relaxed RVEs the column's first shear mode (4 H /
