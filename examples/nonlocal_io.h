@@ -77,9 +77,9 @@
  *   at the same strain, the rows' porosity linear between the row centres
  *   (flat over the half rows at the faces), its peak's width at half its
  *   height above the rows' median and the midpoint of the two crossings. One
- *   row above the others' level measures one row (9.8 mm on 5x12x1), its
- *   neighbours at half its excess 1.5 rows. Stdout has the same measure of
- *   the shear strain's profile.
+ *   row above the others' level measures one row (9.8 mm on 5x12x1), one
+ *   neighbour at half its excess 1.5 rows, both 2 rows. Stdout has the same
+ *   measure of the shear strain's profile.
  *
  */
 #ifndef NONLOCAL_IO_H
