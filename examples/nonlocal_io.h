@@ -582,11 +582,15 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
         if (o->test == T_SSHEAR) {
             int ny = o->mesh[1], j, bad;
             FILE *fp;
-            double *pe = (double *)xcalloc((size_t)2 * ny, sizeof(double)), share, pc, pw, gc, gw;
+            /* pe: the end's profile (shear strain, porosity), then the rows' heights [mm] */
+            double *pe = (double *)xcalloc((size_t)3 * ny, sizeof(double)), *yv = pe + 2 * ny, share, pc, pw,
+                   gc, gw;
             const double *pr;
+            int fail;
             smoothed_peak(md, 2.0 * GK_PI / md->omega1, &pk, &epk);
             elem_fields(md);
             row_profile(md, pe);
+            for (j = 0; j < ny; ++j) yv[j] = 1e3 * (j + 0.5) * md->L[1] / ny;
             pr = md->have12 ? md->prof12 : pe;
             band(md, pr, &bc, &bw, &share);
             peak_fwhm(md, pr + ny, &pc, &pw);
@@ -599,9 +603,9 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
             if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
             fprintf(fp, "row,y_mm,gamma_max_stress_step,gamma_12,porosity_12,gamma_end,porosity_end\n");
             for (j = 0; j < ny; ++j)
-                fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", j, 1e3 * (j + 0.5) * md->L[1] / ny,
-                        md->gam_peak[j], md->have12 ? md->prof12[j] : NAN,
-                        md->have12 ? md->prof12[ny + j] : NAN, pe[j], pe[ny + j]);
+                fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", j, yv[j], md->gam_peak[j],
+                        md->have12 ? md->prof12[j] : NAN, md->have12 ? md->prof12[ny + j] : NAN, pe[j],
+                        pe[ny + j]);
             bad = ferror(fp);
             if (fclose(fp) || bad) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", path), 1;
             printf("band (shear strain above the least row's, at %s): centre %.1f mm, width %.1f mm, %.0f %% "
@@ -611,18 +615,12 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
                 "the rows' peak at half its height above their median (Fig 14a's reading): porosity centre "
                 "%.1f mm, width %.1f mm; shear strain centre %.1f mm, width %.1f mm\n",
                 pc, pw, gc, gw);
-            {
-                double *yv = (double *)xcalloc((size_t)ny, sizeof(double));
-                int fail;
-                for (j = 0; j < ny; ++j) yv[j] = 1e3 * (j + 0.5) * md->L[1] / ny;
-                snprintf(svg, sizeof svg, "%s/simple-shear_profile.svg", o->out);
-                fail = plot2(svg, "porosity over the height (Fig 14a)", "porosity of the row", "height [mm]",
-                             pr + ny, yv, ny, md->have12 ? "at 12 %" : "at the end",
-                             md->have12 ? pe + ny : NULL, yv, ny, "at the end");
-                free(yv);
-                if (fail) return free(pe), 1;
-            }
+            snprintf(svg, sizeof svg, "%s/simple-shear_profile.svg", o->out);
+            fail = plot2(svg, "porosity over the height (Fig 14a)", "porosity of the row", "height [mm]",
+                         pr + ny, yv, ny, md->have12 ? "at 12 %" : "at the end", md->have12 ? pe + ny : NULL,
+                         yv, ny, "at the end");
             free(pe);
+            if (fail) return 1;
         }
         snprintf(svg, sizeof svg, "%s/%s_curve.svg", o->out, test_name[o->test]);
         if (plot2(svg, o->test == T_SSHEAR ? "simple shear (Fig 10)" : "plane-strain biaxial (Figs 16, 18)",
