@@ -205,6 +205,7 @@ static uint64_t fingerprint(const opts *o, const gk_packing *pk) {
         snprintf(buf + strlen(buf), sizeof buf - strlen(buf), " mix %.17g", o->mix);
     if (o->gauss != 1) snprintf(buf + strlen(buf), sizeof buf - strlen(buf), " gauss %d", o->gauss);
     if (o->front != 1e-3) snprintf(buf + strlen(buf), sizeof buf - strlen(buf), " front %.17g", o->front);
+    if (o->imperfect_row) snprintf(buf + strlen(buf), sizeof buf - strlen(buf), " imperfect-row");
     for (k = 0; buf[k]; ++k) h = (h ^ (unsigned char)buf[k]) * 1099511628211ull;
     return h;
 }

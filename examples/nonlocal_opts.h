@@ -47,7 +47,8 @@
  *                    default 25 x N_particles / 4096 as the paper's 25 of
  *                    4096, re-consolidated to --pressure with friction) in
  *                    the middle column of the row starting at 3/4 of the
- *                    height. Shear stress = base reaction / base area,
+ *                    height (--imperfect-row: in every element of that
+ *                    row). Shear stress = base reaction / base area,
  *                    strain = u_top / 118 mm.
  *   biaxial          Figs 15-19: 40 x 80 x 5 mm plane strain (--mesh 4x8x1),
  *                    the top a smooth platen pressed down, --pressure on both
@@ -72,7 +73,7 @@ static const char *test_name[T_COUNT] = {"rve",  "element-biaxial", "element-she
 
 typedef struct opts {
     int test, mesh[3], threads, steps, stop_after, checkpoint, vtk_every, every, imperfection, dem_min,
-        dem_max, lone, paper, gauss;
+        dem_max, lone, paper, gauss, imperfect_row;
     double R, mix, pressure, strain, iuf, dem_inertial, dem_damping, contact_damping, density, xi, mass_scale,
         kappa, dt, dt_safety;
     double amplitude, frequency, duration, front;
@@ -99,7 +100,8 @@ static void usage(FILE *fp) {
             "  [--vtk-every K] [--every K] [--imperfection N] [--iuf X] [--dem-inertial I] [--dem-min N]\n"
             "  [--dem-max N] [--dem-damping A] [--contact-damping Z] [--density RHO] [--xi X]\n"
             "  [--mass-scale S] [--hourglass K] [--dt DT] [--dt-safety F] [--amplitude A] [--frequency F]\n"
-            "  [--duration T] [--front-threshold F] [--lone-increments N] [--gauss 1|8] [--paper]\n");
+            "  [--duration T] [--front-threshold F] [--lone-increments N] [--gauss 1|8] [--paper]\n"
+            "  [--imperfect-row]\n");
     fprintf(fp,
             "defaults: --pressure 4.16e5 --packing examples/data/rve512_hm.txt --threads 1 --nonlocal off\n"
             "  --iuf 0.01 --dem-inertial 2e-3 --dem-min 10 --dem-max 4000 (biaxial: 20; simple-shear with\n"
@@ -118,6 +120,8 @@ static void usage(FILE *fp) {
             "  its I_uf rule in the biaxial test too (--dem-max 4000); flags given override it. The paper's\n"
             "  nonlocal radius: --nonlocal 6.75e-3. --nonlocal-mix M (default 1, the paper): average\n"
             "  M <eps> + (1 - M) eps, part of the strain kept local (see gk_nonlocal.h, stability).\n"
+            "  --imperfect-row: the imperfect RVE in every element of its row, not in its middle one\n"
+            "  (the paper names one imperfect cell, not which elements carry it).\n"
             "See the top of examples/femdem_nonlocal.c for the model, the outputs and the RESULT line.\n");
 }
 
@@ -217,6 +221,7 @@ static int parse(int argc, char **argv, opts *o) {
         {"--out", CLI_STR, &o->out, 0, 0, NULL, NULL, 0},
         {"--restart", CLI_STR, &o->restart, 0, 0, NULL, NULL, 0},
         {"--paper", CLI_FLAG, &o->paper, 0, 0, NULL, NULL, 0},
+        {"--imperfect-row", CLI_FLAG, &o->imperfect_row, 0, 0, NULL, NULL, 0},
         {NULL, CLI_FLAG, NULL, 0, 0, NULL, NULL, 0}};
     const cli_opt *const tables[] = {tab, NULL};
     int help;
@@ -312,6 +317,8 @@ static int parse(int argc, char **argv, opts *o) {
     REQ(o->vtk_every >= 0, "--vtk-every %d must be >= 0", o->vtk_every);
     REQ(o->every >= 1, "--every %d must be >= 1", o->every);
     REQ(o->imperfection >= -2, "--imperfection %d must be >= 0", o->imperfection);
+    REQ(!o->imperfect_row || o->imperfection != 0,
+        "--imperfect-row needs an imperfection (--imperfection N > 0)");
     REQ(o->iuf > 0 && o->iuf < 1, "--iuf %g must be in (0, 1)", o->iuf);
     REQ(o->dem_inertial > 0 && o->dem_inertial < 1, "--dem-inertial %g must be in (0, 1)", o->dem_inertial);
     REQ(o->dem_min >= 1 && o->dem_max >= o->dem_min && o->dem_max <= 1000000,

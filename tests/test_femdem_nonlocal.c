@@ -458,6 +458,59 @@ static double vtk_first_scalar(const char *path, const char *name) {
     return v;
 }
 
+/* the n values of SCALARS name in a VTK file (one per line, as gk_vtk
+ * writes them); 0 when all n were read */
+static int vtk_scalars(const char *path, const char *name, double *v, int n) {
+    char line[256];
+    int k = -1;
+    size_t len = strlen(name);
+    FILE *fp = fopen(path, "r");
+    if (!fp) return 1;
+    while (k < n && fgets(line, sizeof line, fp)) {
+        if (k < 0) {
+            if (!strncmp(line, "SCALARS ", 8) && !strncmp(line + 8, name, len) && line[8 + len] == ' ')
+                k = fgets(line, sizeof line, fp) ? 0 : n; /* skip LOOKUP_TABLE */
+            continue;
+        }
+        v[k++] = strtod(line, NULL);
+    }
+    fclose(fp);
+    return k != n;
+}
+
+/* --imperfect-row: the imperfect RVE (one particle of 160 removed,
+ * re-consolidated: porosity 0.3504 against 0.3496) in every element of the
+ * row at 3/4 of the height, row 3 of 3x4x1 (elements 9-11); without it in
+ * the middle element (10) alone. Read off each element's porosity after one
+ * step; a checkpoint of the one run does not restart the other (its point
+ * 9 holds the other RVE). */
+TEST(imperfect_row_places_the_imperfect_rve) {
+    static const char *run[2] = {"", " --imperfect-row"};
+    char cmd[1024], path[256];
+    double phi[12];
+    int r, e;
+    for (r = 0; r < 2; ++r) {
+        snprintf(cmd, sizeof cmd,
+                 BUILD "/femdem_nonlocal --test simple-shear --packing " PK160
+                       " --mesh 3x4x1 --stop-after 1 --vtk-every 1%s --out " BUILD "/tests/t_fnlir%d > " BUILD
+                       "/tests/t_fnlir%d.out 2>&1",
+                 run[r], r, r);
+        CHECK(system(cmd) == 0);
+        snprintf(path, sizeof path, BUILD "/tests/t_fnlir%d/mesh_000001.vtk", r);
+        CHECK(vtk_scalars(path, "porosity", phi, 12) == 0);
+        for (e = 0; e < 12; ++e) {
+            int imperfect = r ? e >= 9 : e == 10;
+            CHECK(fabs(phi[e] - phi[0]) > 2e-4 ? imperfect : !imperfect);
+        }
+    }
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlir0.out", "imperfect RVE in 1 element of row 3"));
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlir1.out", "imperfect RVE in 3 elements of row 3"));
+    CHECK(system(BUILD "/femdem_nonlocal --test simple-shear --packing " PK160
+                       " --mesh 3x4x1 --imperfect-row --restart " BUILD "/tests/t_fnlir0 --out " BUILD
+                       "/tests/t_fnlir0 > " BUILD "/tests/t_fnlir2.out 2>&1") != 0);
+    CHECK(gk_test_file_has(BUILD "/tests/t_fnlir2.out", "point 9 has another prototype"));
+}
+
 /* runs the one-element biaxial (200 steps to 0.4 %, a VTK every 20) into
  * BUILD/tests/<tag> with the extra flags; the last row's work_int and
  * hourglass and the boundary tractions' work w (the comment below); 0 when
@@ -643,6 +696,8 @@ TEST(bad_input_is_refused) {
         {"--test biaxial --hourglass -1", "--hourglass -1 must be in [0, 1]"},
         {"--test wave --front-threshold 0", "--front-threshold 0 must be in (0, 1]"},
         {"--test element-shear --front-threshold 0.1", "--front-threshold is for --test wave"},
+        {"--test element-shear --imperfect-row", "--imperfect-row needs an imperfection"},
+        {"--test simple-shear --imperfection 0 --imperfect-row", "--imperfect-row needs an imperfection"},
     };
     char cmd[1024];
     size_t k;
@@ -691,6 +746,7 @@ int main(int argc, char **argv) {
     RUN(curve_gap_tool_is_the_drivers_measure);
     RUN(simple_shear_nonlocal_threads_restart);
     RUN(simple_shear_peak_and_band_as_documented);
+    RUN(imperfect_row_places_the_imperfect_rve);
     RUN(rve_table2_moduli);
     RUN(wave_front_matches_elastic_column);
     RUN(biaxial_local_and_nonlocal_prepeak);
