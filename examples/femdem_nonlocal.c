@@ -281,8 +281,8 @@ static int run(opts *o, micro *mi, model *md, int **pickp, double t0) {
             for (i = o->imperfect_row ? 0 : col; i < (o->imperfect_row ? o->mesh[0] : col + 1); ++i, ++ne)
                 for (k = 0; k < md->ngp; ++k)
                     pick[md->ngp * ((l * o->mesh[1] + row) * o->mesh[0] + i) + k] = 1;
-        printf("imperfect RVE in %d element%s of row %d (y %.4g-%.4g m)\n", ne, ne > 1 ? "s" : "", row,
-               md->L[1] * row / o->mesh[1], md->L[1] * (row + 1) / o->mesh[1]);
+        printf("imperfect RVE in %d element%s of row %d (y %.1f-%.1f mm)\n", ne, ne > 1 ? "s" : "", row,
+               1e3 * md->L[1] * row / o->mesh[1], 1e3 * md->L[1] * (row + 1) / o->mesh[1]);
     }
     ts_def_make(o, mi, pr, o->imperfection > 0 ? 2 : 1, pick, md->np, &d);
     if (gk_twoscale_create(&md->ts, &d))
