@@ -110,6 +110,18 @@
  *     and their porosity is 0.390. Off the rows' porosity at 12 % (Fig 14a's
  *     reading) the band at 34 mm is 9.0 mm: 0.390 against 0.347 in both
  *     neighbours, the rows' median 0.350.
+ *     The paper names one imperfect cell, not which elements carry it. In
+ *     the one-element shear the imperfect 4096-sphere RVE is 3-6 % weaker
+ *     (260 against 271 kPa at 2-3 %, 245 against 260 at 9-10 %;
+ *     --test element-shear --paper --imperfection 25, and 0). Across its
+ *     whole row (--imperfect-row, --paper) it places the band: at 93 mm,
+ *     one row (Fig 14a's reading 8.7 mm), 73 % of the displacement at 12 %
+ *     (a weaker one at 25 mm, 0.11); the stress is level at 263-267 kPa
+ *     from 1 to 4 %, softens from 4 to 8 % (241 kPa at 5-6 %, 224 at 7-8 %)
+ *     and holds 219-227 kPa to 20 %; the band's particles turn 2.9 rad by
+ *     20 % (outside 0.09-0.38). With 512 spheres the row changes little:
+ *     the same band (68 %, 9.4 mm), 247 kPa at 3-4 %, 204 at 7-8 %, 172-181
+ *     from 15 to 20 %.
  *     The biaxial test's 20-step cap (--dem-max 20: most runs end above the
  *     I_uf bound) forms no band: to 10 % (--strain 0.1 --steps 2000, the
  *     same rate; 188 s against 1338 s with the rule, one thread each, side
