@@ -81,6 +81,9 @@ run 2 "$B/femdem_nonlocal" $NL --steps 0 --out "$T/nl3"
 # its simple shear on a 1x4x1 column to the end: the band measures, profile.csv and its plot
 run 0 "$B/femdem_nonlocal" --test simple-shear --packing examples/data/rve160_hm.txt --mesh 1x4x1 --steps 4 \
     --strain 0.001 --out "$T/nls"
+# the imperfect RVE in every element of its row, on two layers (2x4x2)
+run 0 "$B/femdem_nonlocal" --test simple-shear --packing examples/data/rve160_hm.txt --mesh 2x4x2 --steps 2 \
+    --strain 0.001 --imperfect-row --out "$T/nlr"
 # the fully integrated element (8 RVEs per element) on a 2x2 biaxial mesh, stopped and restarted
 NG="--test biaxial --gauss 8 --mesh 2x2x1 --packing examples/data/rve160_hm.txt --steps 4 --strain 0.001"
 run 0 "$B/femdem_nonlocal" $NG --stop-after 2 --out "$T/ng"

@@ -442,22 +442,6 @@ static double right_face_ux(const char *dir, int step) {
     return k == 8 ? sum / 4 : NAN;
 }
 
-/* the first value of SCALARS name in a VTK file, nan if absent */
-static double vtk_first_scalar(const char *path, const char *name) {
-    char line[256];
-    double v = NAN;
-    size_t n = strlen(name);
-    FILE *fp = fopen(path, "r");
-    if (!fp) return NAN;
-    while (fgets(line, sizeof line, fp))
-        if (!strncmp(line, "SCALARS ", 8) && !strncmp(line + 8, name, n) && line[8 + n] == ' ') {
-            if (fgets(line, sizeof line, fp) && fgets(line, sizeof line, fp)) v = strtod(line, NULL);
-            break;
-        }
-    fclose(fp);
-    return v;
-}
-
 /* the n values of SCALARS name in a VTK file (one per line, as gk_vtk
  * writes them); 0 when all n were read */
 static int vtk_scalars(const char *path, const char *name, double *v, int n) {
@@ -468,14 +452,22 @@ static int vtk_scalars(const char *path, const char *name, double *v, int n) {
     if (!fp) return 1;
     while (k < n && fgets(line, sizeof line, fp)) {
         if (k < 0) {
-            if (!strncmp(line, "SCALARS ", 8) && !strncmp(line + 8, name, len) && line[8 + len] == ' ')
-                k = fgets(line, sizeof line, fp) ? 0 : n; /* skip LOOKUP_TABLE */
+            if (!strncmp(line, "SCALARS ", 8) && !strncmp(line + 8, name, len) && line[8 + len] == ' ') {
+                if (!fgets(line, sizeof line, fp)) break; /* LOOKUP_TABLE */
+                k = 0;
+            }
             continue;
         }
         v[k++] = strtod(line, NULL);
     }
     fclose(fp);
     return k != n;
+}
+
+/* the first value of SCALARS name in a VTK file, nan if absent */
+static double vtk_first_scalar(const char *path, const char *name) {
+    double v;
+    return vtk_scalars(path, name, &v, 1) ? NAN : v;
 }
 
 /* --imperfect-row: the imperfect RVE (one particle of 160 removed,
