@@ -282,19 +282,20 @@ static int run(opts *o, micro *mi, model *md, int **pickp, double t0) {
     /* the micro side: one RVE per Gauss point, the imperfect one where asked */
     pr[0].packing = &mi->pk, pr[0].state = NULL;
     if (o->imperfection > 0) {
-        int row = (int)(0.75 * o->mesh[1]), col = o->mesh[0] / 2, i, l, ne = 0;
+        /* the middle element of the front layer (z 0), or with --imperfect-row every element of the row */
+        int row = (int)(0.75 * o->mesh[1]), i0 = o->imperfect_row ? 0 : o->mesh[0] / 2,
+            i1 = o->imperfect_row ? o->mesh[0] : i0 + 1, nl = o->imperfect_row ? o->mesh[2] : 1, i, l;
         if (rve_imperfect(o, mi)) return 1;
         pr[1].packing = &mi->pk_imp, pr[1].state = &mi->st_imp;
         pick = *pickp = (int *)xcalloc((size_t)md->np, sizeof(int));
         if (row > o->mesh[1] - 1) row = o->mesh[1] - 1;
-        /* element (i, row, l) is (l ny + row) nx + i: the middle one of the front layer (z 0), or with
-           --imperfect-row every element of the row */
-        for (l = 0; l < (o->imperfect_row ? o->mesh[2] : 1); ++l)
-            for (i = o->imperfect_row ? 0 : col; i < (o->imperfect_row ? o->mesh[0] : col + 1); ++i, ++ne)
+        for (l = 0; l < nl; ++l) /* element (i, row, l) is (l ny + row) nx + i */
+            for (i = i0; i < i1; ++i)
                 for (k = 0; k < md->ngp; ++k)
                     pick[md->ngp * ((l * o->mesh[1] + row) * o->mesh[0] + i) + k] = 1;
-        printf("imperfect RVE in %d element%s of row %d (y %.1f-%.1f mm)\n", ne, ne > 1 ? "s" : "", row,
-               1e3 * md->L[1] * row / o->mesh[1], 1e3 * md->L[1] * (row + 1) / o->mesh[1]);
+        printf("imperfect RVE in %d element%s of row %d (y %.1f-%.1f mm)\n", nl * (i1 - i0),
+               nl * (i1 - i0) > 1 ? "s" : "", row, 1e3 * md->L[1] * row / o->mesh[1],
+               1e3 * md->L[1] * (row + 1) / o->mesh[1]);
     }
     ts_def_make(o, mi, pr, o->imperfection > 0 ? 2 : 1, pick, md->np, &d);
     if (gk_twoscale_create(&md->ts, &d))
