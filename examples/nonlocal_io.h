@@ -409,18 +409,20 @@ static int run_rve_test(const opts *o, micro *mi, double t0) {
            *y1 = (double *)xcalloc((size_t)n, sizeof(double));
     double *x2 = (double *)xcalloc((size_t)n, sizeof(double)),
            *y2 = (double *)xcalloc((size_t)n, sizeof(double));
-    if (rve_moduli(o, mi, rows)) return 1;
     snprintf(path, sizeof path, "%s/rve.csv", o->out);
-    if (write_rows(path, "eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,Z_iso,porosity_shear,Z_shear,dem_steps",
-                   rows, n, RVE_NCOL, 1))
-        return 1;
-    for (k = 0; k < n; ++k) {
-        const double *rw = rows + RVE_NCOL * k;
-        x1[k] = rw[0], y1[k] = (rw[1] - mi->p0) / 1e3, x2[k] = rw[3], y2[k] = rw[4] / 1e3;
+    r = rve_moduli(o, mi, rows) ||
+        write_rows(path, "eps_v,p,K_MPa,gamma,tau,G_MPa,porosity_iso,Z_iso,porosity_shear,Z_shear,dem_steps",
+                   rows, n, RVE_NCOL, 1);
+    if (!r) {
+        for (k = 0; k < n; ++k) {
+            const double *rw = rows + RVE_NCOL * k;
+            x1[k] = rw[0], y1[k] = (rw[1] - mi->p0) / 1e3, x2[k] = rw[3], y2[k] = rw[4] / 1e3;
+        }
+        snprintf(path, sizeof path, "%s/rve_curve.svg", o->out);
+        r = plot2(path, "RVE alone: isotropic compression and simple shear", "strain (eps_v, gamma)",
+                  "stress change (p - p0, tau) [kPa]", x1, y1, n, "p - p0 vs eps_v", x2, y2, n,
+                  "tau vs gamma");
     }
-    snprintf(path, sizeof path, "%s/rve_curve.svg", o->out);
-    r = plot2(path, "RVE alone: isotropic compression and simple shear", "strain (eps_v, gamma)",
-              "stress change (p - p0, tau) [kPa]", x1, y1, n, "p - p0 vs eps_v", x2, y2, n, "tau vs gamma");
     free(rows), free(x1), free(y1), free(x2), free(y2);
     if (r) return 1;
     printf("RVE: initial p %.0f Pa, porosity %.4f, Z %.3f, density %.1f kg/m^3; K %.1f MPa, G %.1f MPa "
@@ -496,7 +498,8 @@ static void smoothed_peak(const model *md, double period, double *pk, double *ep
 }
 
 /* the outputs at the end of a mesh test: the last VTK, the test's own files and plots (the RVE
- * alone, the wave front, the shear profile), the state and field plots, the RESULT line */
+ * alone, the wave front, the shear profile), the state and field plots, the RESULT line; every
+ * failure goes to the one exit that frees the buffers */
 static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
     char path[1024];
     int e, k;
@@ -505,8 +508,10 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
            *y = (double *)xcalloc((size_t)n, sizeof(double));
     double *y2 = (double *)xcalloc((size_t)n, sizeof(double)),
            *val = (double *)xcalloc((size_t)md->ne, sizeof(double));
+    double *lone = NULL, *lx = NULL, *ly = NULL, *ae = NULL, *pe = NULL;
     double pk = -HUGE_VAL, epk = NAN, bc = NAN, bw = NAN;
     char extra[1024], svg[1024];
+    int rc = 1;
     extra[0] = 0;
     for (r = 0; r < n; ++r) {
         const double *row = md->rows + NCOL * r;
@@ -515,24 +520,31 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
         if (row[3] > pk) pk = row[3], epk = row[2];
     }
     snprintf(path, sizeof path, "%s/mesh_%06ld.vtk", o->out, md->step);
-    if (write_vtk(md, path)) return 1;
+    if (write_vtk(md, path)) goto done;
     if (o->test == T_EBIAX || o->test == T_ESHEAR) {
         int nl = o->lone;
-        double *lone = (double *)xcalloc((size_t)8 * (nl + 1), sizeof(double)), *lx, *ly, dev, pkr;
+        double dev, pkr;
+        lone = (double *)xcalloc((size_t)8 * (nl + 1), sizeof(double));
         printf("the RVE alone on the same path (%d increments)...\n", nl);
-        if (rve_alone(o, mi, nl, lone)) return 1;
+        if (rve_alone(o, mi, nl, lone)) goto done;
         snprintf(path, sizeof path, "%s/rve_alone.csv", o->out);
         {
             FILE *fp = fopen(path, "w");
             int k2, bad;
-            if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
+            if (!fp) {
+                fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path);
+                goto done;
+            }
             fprintf(fp, "strain,stress,stress_2,p,q,porosity,Z,runs\n");
             for (k2 = 0; k2 <= nl; ++k2)
                 fprintf(fp, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.0f\n", lone[8 * k2], lone[8 * k2 + 1],
                         lone[8 * k2 + 2], lone[8 * k2 + 3], lone[8 * k2 + 4], lone[8 * k2 + 5],
                         lone[8 * k2 + 6], lone[8 * k2 + 7]);
             bad = ferror(fp);
-            if (fclose(fp) || bad) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", path), 1;
+            if (fclose(fp) || bad) {
+                fprintf(stderr, "femdem_nonlocal: error writing %s\n", path);
+                goto done;
+            }
         }
         dev = curve_deviation(md->rows, md->nrow, lone, nl, o->strain, &pkr);
         lx = (double *)xcalloc((size_t)nl + 1, sizeof(double)),
@@ -544,22 +556,25 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
                   o->test == T_EBIAX ? "axial strain" : "shear strain u_top / h",
                   o->test == T_EBIAX ? "axial stress [kPa]" : "shear stress [kPa]", x, y, (int)n,
                   "FEMxDEM, 1 element", lx, ly, nl + 1, "RVE alone"))
-            return 1;
+            goto done;
         snprintf(extra, sizeof extra, "rve_alone_dev_pct=%.3f peak_ratio=%.4f", 100.0 * dev, pkr);
         printf("one element against the RVE alone: largest gap of the 10 strain-window means %.2f %% of the "
                "peak; peaks %.4f\n",
                100.0 * dev, pkr);
-        free(lone), free(lx), free(ly);
     } else if (o->test == T_WAVE) {
-        double *ae = (double *)xcalloc((size_t)md->ne, sizeof(double)), cm, ce, cs;
+        double cm, ce, cs;
         FILE *fp;
         int bad;
+        ae = (double *)xcalloc((size_t)md->ne, sizeof(double));
         wave_elastic(md, ae);
         cm = front_speed(md, md->arrival), ce = front_speed(md, ae),
         cs = sqrt(mi->G / (mi->rho * o->mass_scale));
         snprintf(path, sizeof path, "%s/wave_arrival.csv", o->out);
         fp = fopen(path, "w");
-        if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
+        if (!fp) {
+            fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path);
+            goto done;
+        }
         fprintf(fp, "element,distance_mm,arrival_us,arrival_elastic_us,arrival_sqrtGrho_us\n");
         for (e = 0; e < md->ne; ++e) {
             double dd = md->L[0] - (e + 0.5) * md->L[0] / md->ne;
@@ -567,7 +582,10 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
                     1e6 * dd / cs);
         }
         bad = ferror(fp);
-        if (fclose(fp) || bad) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", path), 1;
+        if (fclose(fp) || bad) {
+            fprintf(stderr, "femdem_nonlocal: error writing %s\n", path);
+            goto done;
+        }
         snprintf(extra, sizeof extra, "wave_speed_ms=%.2f wave_speed_elastic_ms=%.2f sqrtGrho_ms=%.2f", cm,
                  ce, cs);
         printf("shear-wave front: %.1f m/s (multiscale), %.1f m/s (elastic, same mesh), sqrt(G/rho) = "
@@ -577,17 +595,15 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
         snprintf(svg, sizeof svg, "%s/wave_curve.svg", o->out);
         if (plot2(svg, "wave column: element 9 (Fig 8a)", "shear strain", "shear stress [kPa]", x, y, (int)n,
                   "element 9", NULL, NULL, 0, NULL))
-            return 1;
-        free(ae);
+            goto done;
     } else {
         if (o->test == T_SSHEAR) {
             int ny = o->mesh[1], j, bad;
             FILE *fp;
-            /* pe: the end's profile (shear strain, porosity), then the rows' heights [mm] */
-            double *pe = (double *)xcalloc((size_t)3 * ny, sizeof(double)), *yv = pe + 2 * ny, share, pc, pw,
-                   gc, gw;
+            double *yv, share, pc, pw, gc, gw;
             const double *pr;
-            int fail;
+            /* pe: the end's profile (shear strain, porosity), then the rows' heights [mm] */
+            pe = (double *)xcalloc((size_t)3 * ny, sizeof(double)), yv = pe + 2 * ny;
             smoothed_peak(md, 2.0 * GK_PI / md->omega1, &pk, &epk);
             elem_fields(md);
             row_profile(md, pe);
@@ -601,14 +617,20 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
                      pw);
             snprintf(path, sizeof path, "%s/profile.csv", o->out);
             fp = fopen(path, "w");
-            if (!fp) return fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path), 1;
+            if (!fp) {
+                fprintf(stderr, "femdem_nonlocal: cannot write %s\n", path);
+                goto done;
+            }
             fprintf(fp, "row,y_mm,gamma_max_stress_step,gamma_12,porosity_12,gamma_end,porosity_end\n");
             for (j = 0; j < ny; ++j)
                 fprintf(fp, "%d,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", j, yv[j], md->gam_peak[j],
                         md->have12 ? md->prof12[j] : NAN, md->have12 ? md->prof12[ny + j] : NAN, pe[j],
                         pe[ny + j]);
             bad = ferror(fp);
-            if (fclose(fp) || bad) return fprintf(stderr, "femdem_nonlocal: error writing %s\n", path), 1;
+            if (fclose(fp) || bad) {
+                fprintf(stderr, "femdem_nonlocal: error writing %s\n", path);
+                goto done;
+            }
             printf("band (shear strain above the least row's, at %s): centre %.1f mm, width %.1f mm, %.0f %% "
                    "of the shear displacement\n",
                    md->have12 ? "12 %" : "the end", bc, bw, 100.0 * share);
@@ -617,25 +639,24 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
                 "%.1f mm, width %.1f mm; shear strain centre %.1f mm, width %.1f mm\n",
                 pc, pw, gc, gw);
             snprintf(svg, sizeof svg, "%s/simple-shear_profile.svg", o->out);
-            fail = plot2(svg, "porosity over the height (Fig 14a)", "porosity of the row", "height [mm]",
-                         pr + ny, yv, ny, md->have12 ? "at 12 %" : "at the end", md->have12 ? pe + ny : NULL,
-                         yv, ny, "at the end");
-            free(pe);
-            if (fail) return 1;
+            if (plot2(svg, "porosity over the height (Fig 14a)", "porosity of the row", "height [mm]",
+                      pr + ny, yv, ny, md->have12 ? "at 12 %" : "at the end", md->have12 ? pe + ny : NULL, yv,
+                      ny, "at the end"))
+                goto done;
         }
         snprintf(svg, sizeof svg, "%s/%s_curve.svg", o->out, test_name[o->test]);
         if (plot2(svg, o->test == T_SSHEAR ? "simple shear (Fig 10)" : "plane-strain biaxial (Figs 16, 18)",
                   o->test == T_SSHEAR ? "shear strain u_top / h" : "axial strain",
                   o->test == T_SSHEAR ? "shear stress [kPa]" : "axial stress [kPa]", x, y, (int)n, "FEMxDEM",
                   NULL, NULL, 0, NULL))
-            return 1;
+            goto done;
     }
     /* state curves: porosity and Z */
     for (r = 0; r < n; ++r) y[r] = md->rows[NCOL * r + 7], y2[r] = md->rows[NCOL * r + 8] / 10.0;
     snprintf(svg, sizeof svg, "%s/%s_state.svg", o->out, test_name[o->test]);
     if (plot2(svg, "porosity and coordination (Figs 8b, 12, 13)", o->test == T_WAVE ? "time [ms]" : "strain",
               "porosity, Z / 10", x, y, (int)n, "porosity", x, y2, (int)n, "Z / 10"))
-        return 1;
+        goto done;
     for (e = 0; e < md->ne; ++e) val[e] = md->He[9 * e + 1] + md->He[9 * e + 3];
     if (o->test == T_BIAX || o->test == T_EBIAX)
         for (e = 0; e < md->ne; ++e) {
@@ -646,7 +667,7 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
     snprintf(svg, sizeof svg, "%s/%s_field.svg", o->out, test_name[o->test]);
     if (write_field(md, svg, "deformed mesh",
                     o->test == T_BIAX || o->test == T_EBIAX ? "eps_q" : "shear strain", val))
-        return 1;
+        goto done;
     {
         char ex2[1200];
         const double *last = md->rows + NCOL * (n - 1), w = last[14], h = last[15]; /* this step's row */
@@ -654,8 +675,10 @@ static int final_outputs(const opts *o, micro *mi, model *md, double t0) {
                  extra[0] ? " " : "", md->dem_total, md->dt, w > 0.0 ? 100.0 * h / w : NAN);
         result_line(mi, ex2, pk, epk, bc, bw, gk_wtime() - t0);
     }
-    free(x), free(y), free(y2), free(val);
-    return 0;
+    rc = 0;
+done:
+    free(x), free(y), free(y2), free(val), free(lone), free(lx), free(ly), free(ae), free(pe);
+    return rc;
 }
 
 #endif /* NONLOCAL_IO_H */

@@ -84,6 +84,17 @@ run 0 "$B/femdem_nonlocal" --test simple-shear --packing examples/data/rve160_hm
 # the imperfect RVE in every element of its row, on two layers (2x4x2)
 run 0 "$B/femdem_nonlocal" --test simple-shear --packing examples/data/rve160_hm.txt --mesh 2x4x2 --steps 2 \
     --strain 0.001 --imperfect-row --out "$T/nlr"
+# a result that cannot be written (a full device in its place) is exit 1 with every buffer freed:
+# the RVE test's rve.csv, the simple shear's profile.csv, the one element's rve_alone.csv, the wave's
+# wave_arrival.csv
+NW="--packing examples/data/rve160_hm.txt --strain 0.001"
+for f in nlw1/rve.csv nlw2/profile.csv nlw3/rve_alone.csv nlw4/wave_arrival.csv; do
+    rm -rf "$T/${f%/*}" && mkdir -p "$T/${f%/*}" && ln -s /dev/full "$T/$f"
+done
+run 1 "$B/femdem_nonlocal" --test rve --packing examples/data/rve160_hm.txt --steps 2 --out "$T/nlw1"
+run 1 "$B/femdem_nonlocal" --test simple-shear $NW --mesh 1x4x1 --steps 2 --out "$T/nlw2"
+run 1 "$B/femdem_nonlocal" --test element-shear $NW --steps 2 --out "$T/nlw3"
+run 1 "$B/femdem_nonlocal" --test wave --packing examples/data/rve160_hm.txt --steps 4 --out "$T/nlw4"
 # the fully integrated element (8 RVEs per element) on a 2x2 biaxial mesh, stopped and restarted
 NG="--test biaxial --gauss 8 --mesh 2x2x1 --packing examples/data/rve160_hm.txt --steps 4 --strain 0.001"
 run 0 "$B/femdem_nonlocal" $NG --stop-after 2 --out "$T/ng"
