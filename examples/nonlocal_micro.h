@@ -192,8 +192,9 @@ static int rve_imperfect(const opts *o, micro *m) {
         return 1;
     }
     printf(
-        "imperfect RVE: %d particles removed, re-consolidated in %ld steps to p = %.0f Pa, porosity %.4f\n",
-        o->imperfection, rep.steps, gk_stress_p(rep.stress, 3), rep.void_ratio / (1 + rep.void_ratio));
+        "imperfect RVE: %d particle%s removed, re-consolidated in %ld steps to p = %.0f Pa, porosity %.4f\n",
+        o->imperfection, o->imperfection == 1 ? "" : "s", rep.steps, gk_stress_p(rep.stress, 3),
+        rep.void_ratio / (1 + rep.void_ratio));
     gk_rve_destroy(&rve);
     return 0;
 }
