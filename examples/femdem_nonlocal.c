@@ -27,7 +27,7 @@
  *   4.2 s with --paper where the runs take 97-138 DEM steps to reach I_uf <
  *   0.01; these CPU times were taken on a loaded shared machine and are
  *   indicative). Measured: the default simple shear to 20 % (4000 steps)
- *   1804 s on 2 threads, the 20-step cap to 10 % 188 s on one thread;
+ *   791 s on 2 threads, the 20-step cap to 10 % 188 s on one thread;
  *   with --paper to 20 % 5147 s on 2 threads and 8415 s of CPU, 2.1 s per
  *   coarse step (4.4e7 DEM steps; the runs' mean per coarse step 87-640,
  *   median 114, to 18 %, up to 1580 near 20 %, where the column rings; the
@@ -71,7 +71,7 @@
  *     --xi 0.3) the shear element is 6.4 % off (peaks 1.061). 4-6 min each
  *     on one core.
  *   simple-shear (Figs 9-14, default: 512 spheres, 5x12x1, local, 4000
- *     steps to 20 %, eq 57's rule in every DEM run; 1804 s on 2 threads,
+ *     steps to 20 %, eq 57's rule in every DEM run; 791 s on 2 threads,
  *     the runs' mean 90-500 DEM steps): shear stress, means over 2 %
  *     windows, 260 kPa at 1-3 %, 238 at 4-6 %, 214 at 6-8 %, 192 at 8-10
  *     %, 177 at 10-12 % and 174-182 from 12 to 20 % (the peak, RESULT's
