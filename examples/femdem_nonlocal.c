@@ -122,6 +122,13 @@
  *     20 % (outside 0.09-0.38). With 512 spheres the row changes little:
  *     the same band (68 %, 9.4 mm), 247 kPa at 3-4 %, 204 at 7-8 %, 172-181
  *     from 15 to 20 %.
+ *     Twice the paper's R (--nonlocal 0.0135: the four face neighbours at
+ *     10-12 % weight each) narrows the default run's band (68 % of the
+ *     displacement at 12 %, 8.5 mm off the porosity) and the rows beside it
+ *     shear backwards (-0.13, -0.14 against 0.98): as the band softens they
+ *     unload, and their averaged increments stay small only if their
+ *     elements undo the band's share, the weakness of averaging the total
+ *     strain (examples/README.md; with --nonlocal-mix 0.9 the same).
  *     The biaxial test's 20-step cap (--dem-max 20: most runs end above the
  *     I_uf bound) forms no band: to 10 % (--strain 0.1 --steps 2000, the
  *     same rate; 188 s against 1338 s with the rule, one thread each, side
