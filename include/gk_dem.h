@@ -167,6 +167,10 @@
  *                  its motion: local damping of a zero force is zero) and
  *                  GK_HOOK_POST_STEP (after the leap-frog update). A non-OK
  *                  result stops the step with that result.
+ *   gk_rve.hook_pairs  nonzero: every step keeps the per-pair forces and
+ *                  torques (fc, tci, tcj) for a hook that reads them at
+ *                  GK_HOOK_POST_FORCES; otherwise one thread on a long list
+ *                  keeps them only at a step that makes the stress.
  *   gk_rve_reserve / gk_rve_append / gk_rve_remove   change the particle
  *                  count between steps: appended particles get the next
  *                  indices, removal keeps the survivors' order (so the pair
@@ -325,7 +329,8 @@ typedef struct gk_rve {
     /* seam for scenes beyond the periodic cell (gk_scene.h); NULL/0 in an RVE */
     gk_result (*hook)(struct gk_rve *rve, int stage, void *user);
     void *hook_user;
-    int ncap; /* capacity of the per-particle arrays (0: n)         */
+    int hook_pairs; /* nonzero: every step keeps the per-pair forces (a hook reads them) */
+    int ncap;       /* capacity of the per-particle arrays (0: n)         */
 } gk_rve;
 
 /* stages at which gk_rve.hook is called in every step */
@@ -2532,7 +2537,7 @@ static gk_result gk__step_once(gk_rve *rve, const double E[9], int want_stress) 
     if (rve->hook && (res = rve->hook(rve, GK_HOOK_PRE_FORCES, rve->hook_user)) != GK_OK) return res;
     gk__ctx_make(rve, E, &x);
     for (k = 0; k < 9; ++k) rve->G[k] = (double)x.G[k];
-    gk__forces(rve, &x, want_stress);
+    gk__forces(rve, &x, want_stress || rve->hook_pairs);
     if (rve->hook && (res = rve->hook(rve, GK_HOOK_POST_FORCES, rve->hook_user)) != GK_OK) return res;
     if (want_stress) gk__stress_pass(rve);
     res = gk_pcell_advance(&rve->cell, E, &rve->err);

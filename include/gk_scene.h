@@ -157,6 +157,25 @@
  * gk_packing_subset (gk_packing.h) build a scene's packing from a periodic
  * one.
  *
+ * CONTACT WEIGHTS (gk_scene_weight_contacts). With a weight w_p in (0, 1]
+ * per particle, the force and moments of every particle-particle contact
+ * are scaled by s = (w_i + w_j) / 2 before the particles move: equal and
+ * opposite still, so momentum is kept. This is the partition of unity of
+ * a region shared with another model, Chen et al.'s eq 9 (w rho dv/dt =
+ * w f + f_coupling, after Yue et al. 2018): particles of weight w hold w
+ * of their mass (gk_scene_set_mass) and carry w of their contacts' forces.
+ * Walls, membranes, gravity and external loads act whole. The array is
+ * the caller's, read at every step and not copied or saved: it holds rve.n
+ * values in index order, checked at every gk_scene_step (a value outside
+ * (0, 1] is refused before anything moves). Whatever changes the indices
+ * forgets it (gk_scene_insert, gk_scene_remove, a lost particle's deletion,
+ * a gk_scene_restore that changes the particle count): set it again. The
+ * per-pair forces (gk_scene_stress, gk_scene_stress_box) stay the contact
+ * law's. Every step then keeps the per-pair forces (gk_rve.hook_pairs),
+ * which one thread on a long list otherwise stores only with the stress.
+ * Not with energy tracking (refused both ways: the books would not know
+ * the scaling).
+ *
  * ENERGY (gk_scene_energy_track, gk_scene_energy). From the moment tracking
  * starts, each step books: kinetic energy (translation + rotation, at the
  * half steps of the leap-frog), elastic energy (the springs of every pair
@@ -330,6 +349,7 @@ typedef struct gk_scene {
     double *load[3], *loadt[3]; /* load on prescribed particles, last step              */
     double *fext[3], *text[3];  /* constant external force and moment                   */
     int nprescribed, nlocked;   /* particles with GK_PARTICLE_PRESCRIBED, _LOCKED_ROTATION */
+    const double *cw;           /* contact weights, the caller's (NULL: none)              */
     int32_t next_id, *index_of; /* id -> index (-1: gone), capacity cap_ids; sparse ids:  */
     int cap_ids, sparse_ids;    /* (id, index) pairs sorted by id, n of them (below)      */
     long lost;                  /* particles deleted as lost                               */
@@ -424,6 +444,8 @@ GKDEF gk_result gk_scene_insert(gk_scene *sc, int k, const double *const x[3], c
 GKDEF gk_result gk_scene_remove(gk_scene *sc, int k, const int32_t *ids);
 
 GKDEF gk_result gk_scene_energy_track(gk_scene *sc, int on);
+/* contact forces scaled by the pair's mean weight; w: rve.n values in (0, 1], borrowed; NULL: none */
+GKDEF gk_result gk_scene_weight_contacts(gk_scene *sc, const double *w);
 GKDEF void gk_scene_energy(const gk_scene *sc, gk_energy *e);
 
 GKDEF size_t gk_scene_state_size(const gk_scene *sc);
@@ -762,11 +784,14 @@ GKDEF void gk_scene_unwrap(gk_scene *sc, gk_rve *rve) {
     *rve = sc->rve;
     rve->hook = NULL;
     rve->hook_user = NULL;
+    rve->hook_pairs = 0;
     memset(&sc->rve, 0, sizeof sc->rve);
 }
 
 /* ------------------------------------------------------------- create */
 static gk_result gk__scene_hook(gk_rve *rve, int stage, void *user);
+static void gk__forget_weights(gk_scene *sc);
+static gk_result gk__check_weights(gk_scene *sc, const double *w);
 
 /* interaction range of the cell lists: 2 r_max + skin */
 static double gk__scene_cutoff(const gk_scene *sc) { return 2.0 * sc->rve.rmax + sc->rve.skin; }
@@ -1731,6 +1756,30 @@ static gk_result gk__hook_pre(gk_scene *sc) {
     return GK_OK;
 }
 
+/* contact weights: take (1 - s) of each pair's force and moments back off
+ * the sums, pair by pair in list order (fixed, whatever the threads) */
+static void gk__weigh_contacts(gk_scene *sc) {
+    gk_rve *rve = &sc->rve;
+    const double *w = sc->cw;
+    int c, k, dim = sc->dim, rot = GK__HAS_ROT(rve);
+    for (c = 0; c < rve->pl.n; ++c) {
+        int i = rve->pl.i[c], j = rve->pl.j[c];
+        double d = 1.0 - 0.5 * (w[i] + w[j]);
+        if (d == 0.0) continue;
+        for (k = 0; k < dim; ++k) { /* fc is the force on j */
+            double f = d * (double)rve->fc[k][c];
+            rve->f[k][i] = (gk_real)((double)rve->f[k][i] + f);
+            rve->f[k][j] = (gk_real)((double)rve->f[k][j] - f);
+        }
+        if (rot)
+            for (k = 0; k < 3; ++k)
+                if (rve->t[k]) {
+                    rve->t[k][i] = (gk_real)((double)rve->t[k][i] - d * (double)rve->tci[k][c]);
+                    rve->t[k][j] = (gk_real)((double)rve->t[k][j] - d * (double)rve->tcj[k][c]);
+                }
+    }
+}
+
 static void gk__hook_post_forces(gk_scene *sc) {
     gk_rve *rve = &sc->rve;
     int n = rve->n, dim = sc->dim, p, k, w, rot = (rve->phys & GK_PHYS_ROTATION) != 0;
@@ -1745,6 +1794,7 @@ static void gk__hook_post_forces(gk_scene *sc) {
         sc->nrec = 0;
         gk__energy_pairs(sc);
     }
+    if (sc->cw) gk__weigh_contacts(sc);
     for (k = 0; k < 9; ++k) sc->wall_love[k] = 0.0;
     for (w = 0; w < sc->nwalls; ++w) gk__wall_contacts(sc, &sc->walls[w]);
     if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0)
@@ -1889,8 +1939,10 @@ GKDEF gk_result gk_scene_step_flags(gk_scene *sc, long nsteps, unsigned flags) {
             !isfinite(sc->mem[w].stiffness))
             return gk_err_set(&sc->err, GK_ERR_ARG, "membrane %d: pressure %g / stiffness %g invalid", w,
                               sc->mem[w].pressure, sc->mem[w].stiffness);
+    if (sc->cw && (r = gk__check_weights(sc, sc->cw)) != GK_OK) return r;
     sc->rve.hook = gk__scene_hook;
     sc->rve.hook_user = sc; /* the scene may have moved since the last call */
+    sc->rve.hook_pairs = sc->cw != NULL;
     done0 = sc->rve.step;
     while (sc->rve.step - done0 < nsteps) {
         r = gk_rve_step_flags(&sc->rve, nsteps - (sc->rve.step - done0), flags);
@@ -2195,6 +2247,7 @@ GKDEF gk_result gk_scene_insert(gk_scene *sc, int k, const double *const x[3], c
         goto out;
     }
     sc->next_id += k;
+    gk__forget_weights(sc); /* the array is n0 long */
     for (q = n0; q < rve->n; ++q) {
         int w;
         sc->mass[q] = 1.0 / (double)rve->minv[q];
@@ -2287,6 +2340,7 @@ static gk_result gk__scene_delete(gk_scene *sc, const unsigned char *drop) {
     for (p = 0, q = 0; p < n; ++p) q += !drop[p];
     if (q == n) return GK_OK;
     if (q < 1) return gk_err_set(&sc->err, GK_ERR_ARG, "cannot remove every particle");
+    gk__forget_weights(sc); /* the indices change */
     if (sc->energy_on) {
         for (p = 0; p < n; ++p)
             if (drop[p]) {
@@ -2367,6 +2421,36 @@ GKDEF gk_result gk_scene_remove(gk_scene *sc, int k, const int32_t *ids) {
     return r;
 }
 
+/* ------------------------------------------------------------- contact weights */
+static gk_result gk__check_weights(gk_scene *sc, const double *w) {
+    int p;
+    for (p = 0; p < sc->rve.n; ++p)
+        if (!(w[p] > 0.0 && w[p] <= 1.0))
+            return gk_err_set(&sc->err, GK_ERR_ARG, "contact weight %g of particle %d (must be in (0, 1])",
+                              w[p], p);
+    return GK_OK;
+}
+
+static void gk__forget_weights(gk_scene *sc) {
+    sc->cw = NULL;
+    sc->rve.hook_pairs = 0;
+}
+
+GKDEF gk_result gk_scene_weight_contacts(gk_scene *sc, const double *w) {
+    gk_result r;
+    if (!w) {
+        gk__forget_weights(sc);
+        return GK_OK;
+    }
+    if (sc->energy_on)
+        return gk_err_set(&sc->err, GK_ERR_STATE,
+                          "contact weights with energy tracking on (the books do not know the scaling)");
+    if ((r = gk__check_weights(sc, w)) != GK_OK) return r;
+    sc->cw = w;
+    sc->rve.hook_pairs = 1;
+    return GK_OK;
+}
+
 /* ------------------------------------------------------------- energy */
 GKDEF gk_result gk_scene_energy_track(gk_scene *sc, int on) {
     int k;
@@ -2375,6 +2459,9 @@ GKDEF gk_result gk_scene_energy_track(gk_scene *sc, int on) {
         sc->energy_on = 0;
         return GK_OK;
     }
+    if (sc->cw)
+        return gk_err_set(&sc->err, GK_ERR_STATE,
+                          "energy tracking with contact weights set (the books do not know the scaling)");
     for (k = 0; k < 3; ++k)
         if ((r = gk__sc_new(sc, &sc->vold[k])) != GK_OK || (r = gk__sc_new(sc, &sc->wold[k])) != GK_OK ||
             (r = gk__sc_new(sc, &sc->ftot[k])) != GK_OK || (r = gk__sc_new(sc, &sc->ttot[k])) != GK_OK)
@@ -2790,6 +2877,7 @@ bad:
 
 /* a refused state changes nothing: the scene's own state is kept aside first and put back */
 GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
+    int n0 = sc->rve.n;
     size_t nb = gk_scene_state_size(sc);
     void *keep = gk_alloc(gk__sc_alloc(sc), nb);
     gk_result r, back;
@@ -2800,6 +2888,7 @@ GKDEF gk_result gk_scene_restore(gk_scene *sc, const void *buf, size_t size) {
         return gk_err_set(&sc->err, GK_ERR_STATE, "restore: the scene's own state could not be kept");
     }
     r = gk__scene_restore_raw(sc, buf, size);
+    if (r == GK_OK && sc->cw && sc->rve.n != n0) gk__forget_weights(sc);
     if (r != GK_OK) {
         e = sc->err;
         back = gk__scene_restore_raw(sc, keep, nb);

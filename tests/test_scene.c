@@ -1483,6 +1483,142 @@ TEST(a_refused_state_changes_nothing) {
     gk_scene_destroy(&A);
 }
 
+/* Contact weights (Chen et al. eq 9: w rho dv/dt = w f + f_coupling): with
+ * no damping one leap-frog step from v0 gives m (v - v0) / dt = sum over the
+ * particle's pairs of s_c F_c, s_c = (w_i + w_j) / 2 and F_c the pair's
+ * force in the same scene unweighted (and the moments likewise), with the
+ * stress skipped (one thread scatters then and keeps no pair forces of its
+ * own); momentum is kept (the scaled pair forces are equal and opposite);
+ * weights of 1 change no bit; a weight outside (0, 1], now or changed in the
+ * caller's array later, is refused before anything moves; energy tracking
+ * and weights exclude each other; a removal forgets the weights. */
+static int weighted_scene(gk_scene *sc) {
+    gk_scene_def d = gk_scene_def_default();
+    gk_packing pk;
+    gk_rng rng;
+    int p;
+    d.dim = 2;
+    d.periodic = 3u;
+    d.hi[0] = d.hi[1] = 12 * 2.2 * 0.005;
+    d.rve.mat.young = 5e7;
+    d.rve.mat.friction = 0.4;
+    d.rve.damping = 0.0;
+    d.rve.dt_factor = 0.2;
+    if (lattice(&pk, 2, 12, 12, 1, 0.005, 0.0, 0.0, 0.0, 0.3, 5)) return 1;
+    for (p = 0; p < pk.n; ++p) pk.r[p] *= 1.3; /* overlapping neighbours */
+    if (gk_scene_create(sc, &d, &pk) != GK_OK) return gk_packing_free(&pk), 1;
+    gk_packing_free(&pk);
+    gk_rng_seed(&rng, 17);
+    for (p = 0; p < sc->rve.n; ++p) {
+        double v[3] = {0.02 * (2.0 * gk_rng_uniform(&rng) - 1.0), 0.02 * (2.0 * gk_rng_uniform(&rng) - 1.0),
+                       0},
+               w[3] = {0, 0, 5.0 * (2.0 * gk_rng_uniform(&rng) - 1.0)};
+        if (gk_scene_set_velocity(sc, p, v, w) != GK_OK) return 1;
+    }
+    return 0;
+}
+
+TEST(contact_weights_scale_pair_forces) {
+    gk_scene A, B;
+    gk_rng rng;
+    double w[144], ones[144], v0[2][144], w0[144], fx = 0.0, fy = 0.0, fmax = 0.0, tmax = 0.0, ferr = 0.0,
+                                                   terr = 0.0, px = 0.0, py = 0.0;
+    int p, c, k, n;
+    CHECK(weighted_scene(&A) == 0 && weighted_scene(&B) == 0);
+    n = A.rve.n;
+    CHECK(n == 144 && B.rve.n == n);
+    gk_rng_seed(&rng, 3);
+    for (p = 0; p < n; ++p) {
+        w[p] = p % 3 == 0 ? 1.0 : 0.3 + 0.7 * gk_rng_uniform(&rng);
+        ones[p] = 1.0;
+        for (k = 0; k < 2; ++k) v0[k][p] = (double)A.rve.v[k][p];
+        w0[p] = (double)A.rve.w[2][p];
+    }
+    CHECK(gk_scene_weight_contacts(&A, w) == GK_OK && A.cw == w);
+    CHECK(gk_scene_step_flags(&A, 1, GK_STEP_NO_STRESS) == GK_OK);
+    CHECK(gk_scene_step(&B, 1) == GK_OK); /* B keeps its pair forces F_c */
+    CHECK(A.rve.pl.n == B.rve.pl.n && B.rve.ncontacts > 100);
+    {
+        double *fe[3], *te = (double *)calloc((size_t)n, sizeof(double));
+        for (k = 0; k < 2; ++k) fe[k] = (double *)calloc((size_t)n, sizeof(double));
+        for (c = 0; c < B.rve.pl.n; ++c) {
+            int i = B.rve.pl.i[c], j = B.rve.pl.j[c];
+            double s = 0.5 * (w[i] + w[j]);
+            CHECK(A.rve.pl.i[c] == i && A.rve.pl.j[c] == j);
+            for (k = 0; k < 2; ++k) {
+                fe[k][i] -= s * (double)B.rve.fc[k][c];
+                fe[k][j] += s * (double)B.rve.fc[k][c];
+            }
+            te[i] += s * (double)B.rve.tci[2][c];
+            te[j] += s * (double)B.rve.tcj[2][c];
+        }
+        for (p = 0; p < n; ++p) {
+            double m = A.mass[p], I = 1.0 / (double)A.rve.Iinv[p], dt = A.rve.dt;
+            double ax = m * ((double)A.rve.v[0][p] - v0[0][p]) / dt,
+                   ay = m * ((double)A.rve.v[1][p] - v0[1][p]) / dt;
+            double at = I * ((double)A.rve.w[2][p] - w0[p]) / dt;
+            fmax = fmax > fabs(fe[0][p]) + fabs(fe[1][p]) ? fmax : fabs(fe[0][p]) + fabs(fe[1][p]);
+            tmax = tmax > fabs(te[p]) ? tmax : fabs(te[p]);
+            ferr = ferr > fabs(ax - fe[0][p]) + fabs(ay - fe[1][p])
+                       ? ferr
+                       : fabs(ax - fe[0][p]) + fabs(ay - fe[1][p]);
+            terr = terr > fabs(at - te[p]) ? terr : fabs(at - te[p]);
+            fx += fabs(ax), fy += fabs(ay);
+            px += m * ((double)A.rve.v[0][p] - v0[0][p]);
+            py += m * ((double)A.rve.v[1][p] - v0[1][p]);
+        }
+        free(te), free(fe[0]), free(fe[1]);
+    }
+    printf("    largest force %.4g N, error %.3g N; largest moment %.4g N m, error %.3g N m; net impulse "
+           "%.3g, %.3g\n",
+           fmax, ferr, tmax, terr, px, py);
+    CHECK(fmax > 0.0 && tmax > 0.0);
+    CHECK(ferr <= 1e-9 * fmax && terr <= 1e-9 * tmax);
+    CHECK(fabs(px) + fabs(py) <= 1e-12 * (fx + fy) * A.rve.dt);
+    gk_scene_destroy(&A);
+    gk_scene_destroy(&B);
+    /* weights of 1: the same bits as none */
+    CHECK(weighted_scene(&A) == 0 && weighted_scene(&B) == 0);
+    CHECK(gk_scene_weight_contacts(&A, ones) == GK_OK);
+    CHECK(gk_scene_step_flags(&A, 20, GK_STEP_NO_STRESS) == GK_OK &&
+          gk_scene_step_flags(&B, 20, GK_STEP_NO_STRESS) == GK_OK);
+    for (p = 0, c = 0; p < n; ++p)
+        for (k = 0; k < 2; ++k) c += A.rve.s[k][p] != B.rve.s[k][p] || A.rve.v[k][p] != B.rve.v[k][p];
+    CHECK(c == 0);
+    /* refused: nothing moves */
+    {
+        double keep = ones[7], x0[3], x1[3];
+        long step = A.rve.step;
+        const double bad[3] = {0.0, 1.5, NAN};
+        for (k = 0; k < 3; ++k) {
+            ones[7] = bad[k];
+            CHECK(gk_scene_weight_contacts(&A, w) == GK_OK);
+            CHECK(gk_scene_weight_contacts(&A, ones) == GK_ERR_ARG && A.cw == w);
+            printf("    %s\n", gk_scene_error(&A));
+        }
+        ones[7] = keep;
+        CHECK(gk_scene_weight_contacts(&A, ones) == GK_OK);
+        ones[7] = 2.0; /* the caller's array changed after it was given */
+        gk_scene_position(&A, 7, x0);
+        CHECK(gk_scene_step(&A, 5) == GK_ERR_ARG && A.rve.step == step);
+        gk_scene_position(&A, 7, x1);
+        CHECK(x0[0] == x1[0] && x0[1] == x1[1]);
+        ones[7] = keep;
+        CHECK(gk_scene_energy_track(&A, 1) == GK_ERR_STATE && !A.energy_on);
+        CHECK(gk_scene_weight_contacts(&B, ones) == GK_OK && gk_scene_weight_contacts(&B, NULL) == GK_OK &&
+              B.cw == NULL && gk_scene_energy_track(&B, 1) == GK_OK);
+        CHECK(gk_scene_weight_contacts(&B, ones) == GK_ERR_STATE && B.cw == NULL);
+        /* a removal changes the indices: the weights are forgotten */
+        {
+            int32_t id = A.rve.id[3];
+            CHECK(gk_scene_remove(&A, 1, &id) == GK_OK && A.cw == NULL && !A.rve.hook_pairs);
+            CHECK(gk_scene_step(&A, 1) == GK_OK);
+        }
+    }
+    gk_scene_destroy(&A);
+    gk_scene_destroy(&B);
+}
+
 /* gk_scene_set_mass: a lighter particle lowers an automatic time step (as a new wall does) and
  * is refused with an explicit one above the critical step it gives, nothing changed (Guo & Zhao
  * 2014 eq 19: dt_cr = sqrt(m_min / k_n)) */
@@ -2049,6 +2185,7 @@ int main(int argc, char **argv) {
     RUN(energy_balance_closes);
     RUN(save_restore_and_threads_are_bitwise);
     RUN(a_refused_state_changes_nothing);
+    RUN(contact_weights_scale_pair_forces);
     RUN(set_mass_keeps_the_time_step_stable);
     RUN(periodic_shear_between_walls);
     RUN(packing_tile_and_subset);
