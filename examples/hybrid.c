@@ -66,6 +66,12 @@
  *              they stiffen the band); one that strays more than a cell
  *              beyond the overlap touching no grain is removed (the same;
  *              --keep-strays keeps it).
+ *              Overlap grains hold w = 1/2 of their mass and carry their
+ *              whole contact forces; --weigh-overlap scales each contact
+ *              by its grains' mean w (eq 9's w f; a grain's w is its share
+ *              at the swap); on the reduced specimens that moves bands
+ *              and stresses less than another packing does, in no
+ *              consistent direction (examples/README.md).
  *
  * THE CODE. This file holds the manual and main (set-up, the loop of
  * steps, the outputs). The rest is in five headers, each including the one

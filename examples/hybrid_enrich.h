@@ -127,15 +127,18 @@ static int coupling_mask(run *R) {
 
 static int grow_grain_arrays(run *R, int n) {
     if (n <= R->cap_g) return 0;
+    gk_scene_weight_contacts(&R->sc, NULL); /* the scene reads R->cw */
     free(R->xpre[0]);
     free(R->xpre[1]);
     free(R->coupled);
+    free(R->cw);
     R->xpre[0] = (double *)malloc((size_t)n * sizeof(double));
     R->xpre[1] = (double *)malloc((size_t)n * sizeof(double));
     free(R->drop_ids);
     R->coupled = (unsigned char *)malloc((size_t)n);
+    R->cw = (double *)malloc((size_t)n * sizeof(double));
     R->drop_ids = (int32_t *)malloc((size_t)n * sizeof(int32_t));
-    if (!R->xpre[0] || !R->xpre[1] || !R->coupled || !R->drop_ids)
+    if (!R->xpre[0] || !R->xpre[1] || !R->coupled || !R->cw || !R->drop_ids)
         return fprintf(stderr, "error: out of memory\n"), 1;
     R->cap_g = n;
     return 0;
@@ -558,12 +561,23 @@ static int enrich(run *R) {
         int stride[2] = {1, 9};
         extra[0] = R->side;
         extra[1] = R->Fw;
-        if (gk_hybrid_enrich(&R->P, &R->C, &R->sc, gz, (const double *const *)vg, 0.5, THICK, 2, extra,
+        if (gk_hybrid_enrich(&R->P, &R->C, &R->sc, gz, (const double *const *)vg, PARTITION, THICK, 2, extra,
                              stride, &rep, &e)) {
             fprintf(stderr, "error: %s\n", e.msg);
             goto done;
         }
         R->grain_scale = rep.mass_scale;
+        if (o->weigh_overlap) { /* a grain's share of the contacts is its share of the mass */
+            int idmax = 0;
+            for (p = 0; p < ng; ++p)
+                if (R->sc.rve.id[p] > idmax) idmax = R->sc.rve.id[p];
+            R->wid = (double *)malloc(((size_t)idmax + 1) * sizeof(double));
+            if (!R->wid) {
+                fprintf(stderr, "error: out of memory\n");
+                goto done;
+            }
+            for (p = 0; p < ng; ++p) R->wid[R->sc.rve.id[p]] = gz[p] == GK_ZONE_OVERLAP ? PARTITION : 1.0;
+        }
     }
     if (!o->quiet)
         printf("swap: %d points deleted, %d in the overlap; %d grains (%d in the overlap, %d left the zone); "
@@ -696,6 +710,10 @@ static int hybrid_step(run *R) {
             coupling_mask(R); /* the indices have moved */
         }
         R->mask_n = ng;
+    }
+    if (R->o.weigh_overlap && !sc->cw) { /* set again after every removal (the indices moved) */
+        for (p = 0; p < ng; ++p) R->cw[p] = R->wid[sc->rve.id[p]];
+        if (gk_scene_weight_contacts(sc, R->cw)) return fprintf(stderr, "error: %s\n", gk_scene_error(sc)), 1;
     }
     for (p = 0; p < ng; ++p) { /* the coupling reads the coupled grains' only */
         double x[3];

@@ -50,6 +50,7 @@ static const char *mode_name[] = {"dem", "continuum", "hybrid"};
 /* ------------------------------------------------------------------ material */
 #define DIAM 1e-3      /* D50 [m] */
 #define THICK 1e-3     /* stress thickness: one diameter */
+#define PARTITION 0.5  /* w of eq 9: the overlap grains' share of their mass */
 #define RHO_S 25300.0  /* grain mass 1.98e-5 kg for D = 1 mm, t = 1 mm */
 #define KN 1.7720938e6 /* Table 1 */
 #define DT 5e-7
@@ -84,7 +85,8 @@ typedef struct opts {
     double probe[3]; /* --probe S Y0 Y1 (dem): strain, strip */
     int probe_on;
     int ppd, threads, oracle_every, quiet, keep_strays;
-    int band_grains; /* > 0: band grains are the band_grains largest values (not --percentile) */
+    int weigh_overlap; /* --weigh-overlap: overlap grains carry w of their contact forces */
+    int band_grains;   /* > 0: band grains are the band_grains largest values (not --percentile) */
     long grains;
     unsigned long seed;
 } opts;
@@ -210,6 +212,9 @@ static void usage(FILE *fp) {
         "                       2.5 cm; the other flags override it\n"
         "  --keep-strays        planar hybrid: keep the free grains that stray more than a cell beyond\n"
         "                       the overlap touching none (by default removed, and counted)\n"
+        "  --weigh-overlap      hybrid: a grain that holds w = 1/2 of its mass (in the overlap at the\n"
+        "                       swap) carries w of its contact forces too, each contact scaled by its\n"
+        "                       grains' mean w (eq 9 read literally; by default the forces are whole)\n"
         "  --quiet              no progress lines\n",
         p.out, p.width, p.height, b.width, b.height, d.width, d.height, d.intruder, p.seed, p.pressure,
         b.pressure, d.pressure, p.speed, b.speed, d.speed, p.strain_end, b.strain_end, d.strain_end,
@@ -270,6 +275,7 @@ static int parse(int argc, char **argv, opts *o) {
             {"--packing", CLI_STR, &o->packing, 0, 0, NULL, NULL, 0},
             {"--quiet", CLI_FLAG, &o->quiet, 0, 0, NULL, NULL, 0},
             {"--keep-strays", CLI_FLAG, &o->keep_strays, 0, 0, NULL, NULL, 0},
+            {"--weigh-overlap", CLI_FLAG, &o->weigh_overlap, 0, 0, NULL, NULL, 0},
             {"--paper", CLI_FLAG, &paper, 0, 0, NULL, NULL, 0}, /* applied above */
             {"--width", CLI_REAL, &o->width, 0.005, 10.0, "a width in [0.005, 10] m", NULL, 0},
             {"--height", CLI_REAL, &o->height, 0.005, 10.0, "a height in [0.005, 10] m", NULL, 0},
@@ -388,6 +394,8 @@ static int parse(int argc, char **argv, opts *o) {
                1;
     if (o->keep_strays && (o->test != T_PLANAR || o->mode != M_HYBRID))
         return fprintf(stderr, "error: --keep-strays is an option of the planar hybrid run\n"), 1;
+    if (o->weigh_overlap && o->mode != M_HYBRID)
+        return fprintf(stderr, "error: --weigh-overlap is an option of the hybrid run (--mode hybrid)\n"), 1;
     if (o->test != T_PLANAR && o->train < 1.0)
         return fprintf(stderr,
                        "error: --train %g: below 1 only for the planar test (the band region moves)\n",

@@ -364,6 +364,8 @@ static void run_free(run *R) {
     free(R->xpre[0]);
     free(R->xpre[1]);
     free(R->coupled);
+    free(R->wid);
+    free(R->cw);
     free(R->deep);
     free(R->drop_ids);
     free(R->Xw[0]);

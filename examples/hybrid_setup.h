@@ -175,6 +175,7 @@ typedef struct run {
     int enriched;
     double strain_enrich, *dist, *xpre[2];
     unsigned char *coupled;
+    double *wid, *cw;        /* --weigh-overlap: partition weight by stable id, by index (the scene's) */
     unsigned char *deep;     /* per node: in a stencil of a point carried into the discrete zone */
     int deep_n, deep_max;    /* those points, at the last coupling_mask and at most */
     int32_t *drop_ids;       /* scratch: grains to remove (coupling_mask, remove_escaped) */

@@ -85,8 +85,10 @@
  * ENRICHMENT. Points in the discrete zone are deleted. Overlap points keep
  * (1 - w) of their mass and volume (so of their stress's force) and overlap
  * grains w of their mass (the partition w = 1/2 of eq 9, as the public
- * Hybrid Grains code weights them; grain contact forces are not scaled, a
- * choice the paper leaves open). The grain masses are then scaled by one
+ * Hybrid Grains code weights them). Their contact forces are the caller's
+ * choice: whole, or w f as eq 9 writes it, each contact scaled by its
+ * grains' mean w (gk_scene_weight_contacts, gk_scene.h); the paper does
+ * not say how w enters. The grain masses are then scaled by one
  * factor and their velocities (the continuum's, interpolated) shifted by one
  * vector so that the total mass and momentum equal those before the swap
  * (the factor is 1 +- a few % for a packing cut from the continuum's own

@@ -102,10 +102,11 @@ run 0 "$B/femdem_nonlocal" $NG --restart "$T/ng" --out "$T/ng"
 # the dynamic-relaxation FEMxDEM driver (periodic frame RVE) and a refused option
 run 0 "$B/femdem_dr" --test rve --frame periodic --steps 4 --strain 0.02 --out "$T/dr"
 run 2 "$B/femdem_dr" --test rve --frame periodic --steps -1 --out "$T/dr2"
-# the hybrid continuum-grain driver: a small planar shear through its enrichment, and one refused at
-# the enrichment (the discrete zone reaches a platen)
+# the hybrid continuum-grain driver: a small planar shear through its enrichment (and with the overlap's
+# contacts weighted), and one refused at the enrichment (the discrete zone reaches a platen)
 HY="--test planar --mode hybrid --width 0.008 --cell 0.002 --strain 0.002 --out-every 0.001 --window 0.001 0.002"
 run 0 "$B/hybrid" $HY --height 0.016 --phi0 0.003 --threads 2 --out "$T/hy"
+run 0 "$B/hybrid" $HY --height 0.016 --phi0 0.003 --weigh-overlap --threads 1 --out "$T/hyw"
 run 1 "$B/hybrid" $HY --height 0.012 --phi0 0.004 --threads 2 --out "$T/hy2"
 # biaxial on a 1.2 x 1.8 cm specimen: the zone reaches the top platen (training targets corrected,
 # the top wall seated by its servo, the swap)

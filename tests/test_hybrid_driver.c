@@ -112,6 +112,39 @@ TEST(hybrid_planar_enriches_and_is_thread_independent) {
     CHECK(same_but_seconds(BUILD "/tests/t_hyA/hybrid.csv", BUILD "/tests/t_hy1/hybrid.csv"));
 }
 
+/* --weigh-overlap (Chen et al. eq 9's w f: the overlap grains carry w = 1/2 of their contact
+ * forces, as of their mass): the weighted hybrid swaps at the same strain with the same trained
+ * packing (the weights act only after the swap), keeps the mass, carries shear, departs from the
+ * unweighted run, and gives the same CSV with 1 and 2 threads */
+TEST(hybrid_weigh_overlap_acts_after_the_swap) {
+    double a[8][NCOL], b[8][NCOL];
+    int na, nb;
+    system("rm -rf " BUILD "/tests/t_hyW0 " BUILD "/tests/t_hyW1 " BUILD "/tests/t_hyW2");
+    CHECK(system(PLANAR "--mode hybrid --strain 0.005 --out-every 0.0025 --window 0.001 0.005 --threads 1 "
+                        "--out " BUILD "/tests/t_hyW0 > " BUILD "/tests/t_hyW0.out 2>&1") == 0);
+    CHECK(system(PLANAR "--mode hybrid --weigh-overlap --strain 0.005 --out-every 0.0025 --window 0.001 "
+                        "0.005 --threads 2 --packing " BUILD "/tests/t_hyW0/packing.txt --out " BUILD
+                        "/tests/t_hyW1 > " BUILD "/tests/t_hyW1.out 2>&1") == 0);
+    CHECK(system(PLANAR "--mode hybrid --weigh-overlap --strain 0.005 --out-every 0.0025 --window 0.001 "
+                        "0.005 --threads 1 --packing " BUILD "/tests/t_hyW0/packing.txt --out " BUILD
+                        "/tests/t_hyW2 > " BUILD "/tests/t_hyW2.out 2>&1") == 0);
+    CHECK(swap_keeps_mass(BUILD "/tests/t_hyW1.out"));
+    CHECK(same_but_seconds(BUILD "/tests/t_hyW1/hybrid.csv", BUILD "/tests/t_hyW2/hybrid.csv"));
+    CHECK(gk_test_result(BUILD "/tests/t_hyW0.out", "strain_at_enrichment") > 0.0);
+    CHECK(gk_test_result(BUILD "/tests/t_hyW0.out", "strain_at_enrichment") ==
+          gk_test_result(BUILD "/tests/t_hyW1.out", "strain_at_enrichment"));
+    CHECK(gk_test_result(BUILD "/tests/t_hyW0.out", "packing_tau") ==
+          gk_test_result(BUILD "/tests/t_hyW1.out", "packing_tau"));
+    na = read_rows(BUILD "/tests/t_hyW0/hybrid.csv", a, 8);
+    nb = read_rows(BUILD "/tests/t_hyW1/hybrid.csv", b, 8);
+    CHECK_EQ_INT(na, 3);
+    CHECK_EQ_INT(nb, 3);
+    if (na != 3 || nb != 3) return;
+    CHECK(a[1][8] == 1.0 && b[1][8] == 1.0 && a[1][6] == b[1][6]); /* enriched, as many grains */
+    CHECK(a[1][2] != b[1][2] && a[2][2] != b[2][2]);               /* the weights act */
+    CHECK(b[1][2] > 0.0 && b[2][2] > 0.0);                         /* shear carried */
+}
+
 /* continuum mode, planar, to 60 % strain at 0.5 m/s: the platen (a rigid body
  * that travels with its velocity) holds the whole top row to the end, so its
  * servo keeps the normal stress (every row's sigma_n within 2 % of 400 kPa)
@@ -384,6 +417,7 @@ TEST(hybrid_refuses_bad_arguments) {
     CHECK(refused("--test indent --mode hybrid --train 0.5", "below 1 only for the planar test"));
     CHECK(refused("--test biaxial --mode hybrid --keep-strays", "an option of the planar hybrid run"));
     CHECK(refused("--test planar --mode dem --keep-strays", "an option of the planar hybrid run"));
+    CHECK(refused("--test planar --mode continuum --weigh-overlap", "an option of the hybrid run"));
     CHECK(refused("--test planar --mode continuum --band-grains 20", "--band-grains: a count of grains"));
     CHECK(refused("--test indent --mode dem --band-grains 20", "--band-grains: a count of grains"));
     CHECK(refused("--test planar --mode dem --band-grains 2", "--band-grains 2 is out of range"));
@@ -426,6 +460,7 @@ int main(int argc, char **argv) {
     gk_test_init(argc, argv);
     RUN(hybrid_refuses_bad_arguments);
     RUN(hybrid_planar_enriches_and_is_thread_independent);
+    RUN(hybrid_weigh_overlap_acts_after_the_swap);
     RUN(hybrid_training_matches_the_dem_packing_stress);
     RUN(hybrid_band_grains_beyond_the_grains_fails);
     RUN(hybrid_planar_platen_holds_to_large_strain);
