@@ -71,7 +71,8 @@
  *              by its grains' mean w (eq 9's w f; a grain's w is its share
  *              at the swap); on the reduced specimens that moves bands
  *              and stresses less than another packing does, in no
- *              consistent direction (examples/README.md).
+ *              consistent direction, and lowers the intruder's load
+ *              (examples/README.md).
  *
  * THE CODE. This file holds the manual and main (set-up, the loop of
  * steps, the outputs). The rest is in five headers, each including the one
