@@ -1608,11 +1608,19 @@ TEST(contact_weights_scale_pair_forces) {
         CHECK(gk_scene_weight_contacts(&B, ones) == GK_OK && gk_scene_weight_contacts(&B, NULL) == GK_OK &&
               B.cw == NULL && gk_scene_energy_track(&B, 1) == GK_OK);
         CHECK(gk_scene_weight_contacts(&B, ones) == GK_ERR_STATE && B.cw == NULL);
-        /* a removal changes the indices: the weights are forgotten */
+        /* a removal changes the indices: the weights are forgotten; so does a restore to another
+         * particle count, and one to the same count keeps them */
         {
             int32_t id = A.rve.id[3];
+            size_t n0, n1;
+            unsigned char *s0 = state_of(&A, &n0), *s1;
             CHECK(gk_scene_remove(&A, 1, &id) == GK_OK && A.cw == NULL && !A.rve.hook_pairs);
             CHECK(gk_scene_step(&A, 1) == GK_OK);
+            s1 = state_of(&A, &n1);
+            CHECK(s0 && s1 && gk_scene_weight_contacts(&A, ones) == GK_OK);
+            CHECK(gk_scene_restore(&A, s1, n1) == GK_OK && A.cw == ones);
+            CHECK(gk_scene_restore(&A, s0, n0) == GK_OK && A.cw == NULL && A.rve.n == n);
+            free(s0), free(s1);
         }
     }
     gk_scene_destroy(&A);
