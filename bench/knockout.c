@@ -51,9 +51,10 @@ int main(int argc, char **argv) {
     double L[9] = {0}, E[9], best = HUGE_VAL, sink[8];
     gk__stepctx x;
     size_t need = 0;
-    void *buf;
-    FILE *fp;
-    int r, k, make = argc == 3 && !strcmp(argv[1], "--make"), reps = !make && argc > 2 ? atoi(argv[2]) : 50;
+    void *buf = NULL;
+    FILE *fp = NULL;
+    int r, k, rc = 1, have_rve = 0, make = argc == 3 && !strcmp(argv[1], "--make"),
+              reps = !make && argc > 2 ? atoi(argv[2]) : 50;
     const char *path = make ? argv[2] : argc > 1 ? argv[1] : NULL;
     if (!path || reps < 1) {
         fprintf(stderr, "usage: knockout --make STATE | knockout STATE [REPS]\n");
@@ -68,32 +69,49 @@ int main(int argc, char **argv) {
     d.damping = 0.0;
     d.dt = 2.7e-6;
     d.skin = 5e-4;
-    if (gk_rve_create(&rve, &d, &pk)) return fprintf(stderr, "knockout: %s\n", gk_rve_error(&rve)), 1;
+    if (gk_rve_create(&rve, &d, &pk)) {
+        fprintf(stderr, "knockout: %s\n", gk_rve_error(&rve));
+        goto done;
+    }
+    have_rve = 1;
     L[1] = 1.5;
-    if (gk_rve_set_velocity_gradient(&rve, L))
-        return fprintf(stderr, "knockout: %s\n", gk_rve_error(&rve)), 1;
+    if (gk_rve_set_velocity_gradient(&rve, L)) {
+        fprintf(stderr, "knockout: %s\n", gk_rve_error(&rve));
+        goto done;
+    }
     if (make) {
-        if (gk_rve_step(&rve, 30)) return fprintf(stderr, "knockout: %s\n", gk_rve_error(&rve)), 1;
+        int bad;
+        if (gk_rve_step(&rve, 30)) {
+            fprintf(stderr, "knockout: %s\n", gk_rve_error(&rve));
+            goto done;
+        }
         gk_rve_save(&rve, NULL, 0, &need);
         buf = malloc(need);
-        if (!buf || gk_rve_save(&rve, buf, need, &need)) return fprintf(stderr, "knockout: cannot save\n"), 1;
+        if (!buf || gk_rve_save(&rve, buf, need, &need)) {
+            fprintf(stderr, "knockout: cannot save\n");
+            goto done;
+        }
         fp = fopen(path, "wb");
-        if (!fp || fwrite(buf, 1, need, fp) != need || fclose(fp))
-            return fprintf(stderr, "knockout: cannot write %s\n", path), 1;
-        free(buf);
-        gk_rve_destroy(&rve);
-        gk_packing_free(&pk);
-        return 0;
+        bad = !fp || fwrite(buf, 1, need, fp) != need;
+        if (fp && fclose(fp)) bad = 1;
+        fp = NULL;
+        if (bad) {
+            fprintf(stderr, "knockout: cannot write %s\n", path);
+            goto done;
+        }
+        rc = 0;
+        goto done;
     }
     fp = fopen(path, "rb");
-    if (!fp || fseek(fp, 0, SEEK_END) || (need = (size_t)ftell(fp)) == 0 || fseek(fp, 0, SEEK_SET))
-        return fprintf(stderr, "knockout: cannot read %s\n", path), 1;
-    buf = malloc(need);
-    if (!buf || fread(buf, 1, need, fp) != need)
-        return fprintf(stderr, "knockout: cannot read %s\n", path), 1;
-    fclose(fp);
-    if (gk_rve_restore(&rve, buf, need)) return fprintf(stderr, "knockout: %s\n", gk_rve_error(&rve)), 1;
-    free(buf);
+    if (!fp || fseek(fp, 0, SEEK_END) || (need = (size_t)ftell(fp)) == 0 || fseek(fp, 0, SEEK_SET) ||
+        !(buf = malloc(need)) || fread(buf, 1, need, fp) != need) {
+        fprintf(stderr, "knockout: cannot read %s\n", path);
+        goto done;
+    }
+    if (gk_rve_restore(&rve, buf, need)) {
+        fprintf(stderr, "knockout: %s\n", gk_rve_error(&rve));
+        goto done;
+    }
     for (k = 0; k < 9; ++k) E[k] = k % 4 == 0 ? 1.0 : 0.0;
     E[1] = L[1] * rve.dt;
     gk__ctx_make(&rve, E, &x);
@@ -106,7 +124,11 @@ int main(int argc, char **argv) {
     _mm512_storeu_pd(sink, ko_sink);
     printf("%d pairs: %.2f ns per pair (the fastest of 7 x %d passes; sink %g)\n", rve.pl.n,
            1e9 * best / rve.pl.n, reps, sink[0]);
-    gk_rve_destroy(&rve);
+    rc = 0;
+done:
+    if (fp) fclose(fp);
+    free(buf);
+    if (have_rve) gk_rve_destroy(&rve);
     gk_packing_free(&pk);
-    return 0;
+    return rc;
 }
