@@ -33,6 +33,7 @@
  *                                                  per particle (index p)
  *   gk_scene_add_membrane, gk_scene_side_chain      flexible 2D boundary
  *   gk_scene_insert / gk_scene_remove / gk_scene_index   stable ids
+ *   gk_scene_weight_contacts                       contact forces weighted per particle
  *   gk_scene_energy_track / gk_scene_energy        the energy books
  *   gk_scene_stress, gk_scene_stress_box           mean stress of the particles, of a region
  *   gk_scene_save / gk_scene_restore / gk_scene_state_size   bitwise state
