@@ -158,6 +158,7 @@ static void free_grid_state(run *R, gk_packing *pk) {
     free(R->xpre[0]);
     free(R->xpre[1]);
     free(R->coupled);
+    free(R->cw);
     free(R->drop_ids);
     free(R->deep);
 }
