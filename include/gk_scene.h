@@ -2448,7 +2448,6 @@ GKDEF gk_result gk_scene_weight_contacts(gk_scene *sc, const double *w) {
                           "contact weights with energy tracking on (the books do not know the scaling)");
     if ((r = gk__check_weights(sc, w)) != GK_OK) return r;
     sc->cw = w;
-    sc->rve.hook_pairs = 1;
     return GK_OK;
 }
 
