@@ -73,6 +73,12 @@
  *              and stresses less than another packing does, in no
  *              consistent direction, and lowers the intruder's load
  *              (examples/README.md).
+ *   band       App. A on the grains over --window: Cundall's best-fit
+ *              strain over the grains within 1.6 D50 of each, or over its
+ *              Delaunay neighbours as the paper (--delaunay; the reduced
+ *              bands move by up to 6.4 D50, in no consistent direction:
+ *              examples/README.md), then the top --percentile (or the
+ *              --band-grains N largest) in a minimum-area box.
  *
  * THE CODE. This file holds the manual and main (set-up, the loop of
  * steps, the outputs). The rest is in five headers, each including the one

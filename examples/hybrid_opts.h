@@ -86,6 +86,7 @@ typedef struct opts {
     int probe_on;
     int ppd, threads, oracle_every, quiet, keep_strays;
     int weigh_overlap; /* --weigh-overlap: overlap grains carry w of their contact forces */
+    int delaunay;      /* --delaunay: Cundall strain over Delaunay neighbours (else within 1.6 D50) */
     int band_grains;   /* > 0: band grains are the band_grains largest values (not --percentile) */
     long grains;
     unsigned long seed;
@@ -196,6 +197,8 @@ static void usage(FILE *fp) {
         "  --window S0 S1       strain window of the band measurement (default %g %g, %g %g, %g %g)\n"
         "  --band-window B      half-width of the eps_v_band window [m] (default %g, %g)\n"
         "  --percentile Q       band grains: value above the Q-th percentile (default %g)\n"
+        "  --delaunay           band grains: Cundall strain over each grain's Delaunay neighbours,\n"
+        "                       as App. A (by default over the grains within 1.6 D50)\n"
         "  --band-grains N      band grains: the N largest values instead (a hybrid measures only\n"
         "                       its discrete zone's grains and prints its count: give it to a dem\n"
         "                       run to compare bands measured on as many grains)\n"
@@ -205,22 +208,23 @@ static void usage(FILE *fp) {
         "  --probe S Y0 Y1      dem, planar: the grains' mean stress in the strip Y0 <= y < Y1 [m] at strain "
         "S\n"
         "                       (the hybrid run prints this option for its discrete zone and enrichment "
-        "strain)\n"
-        "  --paper              the paper's sizes and speeds (Tables 3, 5, 7-8): 6 x 12 cm\n"
-        "                       (planar, phi_0 2.2 cm), 6 x 9.42 cm (biaxial), 0.02 m/s; indent: a\n"
-        "                       60 x 20 cm bin, a 5 cm intruder at 0.05 m/s, cells of 0.5 cm, phi_0\n"
-        "                       2.5 cm; the other flags override it\n"
-        "  --keep-strays        planar hybrid: keep the free grains that stray more than a cell beyond\n"
-        "                       the overlap touching none (by default removed, and counted)\n"
-        "  --weigh-overlap      hybrid: a grain that holds w = 1/2 of its mass (in the overlap at the\n"
-        "                       swap) carries w of its contact forces too, each contact scaled by its\n"
-        "                       grains' mean w (eq 9 read literally; by default the forces are whole)\n"
-        "  --quiet              no progress lines\n",
+        "strain)\n",
         p.out, p.width, p.height, b.width, b.height, d.width, d.height, d.intruder, p.seed, p.pressure,
         b.pressure, d.pressure, p.speed, b.speed, d.speed, p.strain_end, b.strain_end, d.strain_end,
         p.out_every, b.out_every, d.out_every, p.cell, b.cell, d.cell, p.ppd, p.alpha, p.phi0, b.phi0, d.phi0,
         p.oracle_every, p.train, p.weak_dphi, p.xi, p.win0, p.win1, b.win0, b.win1, d.win0, d.win1,
         p.band_window, b.band_window, p.percentile, p.platen_zeta, p.ramp);
+    fputs("  --paper              the paper's sizes and speeds (Tables 3, 5, 7-8): 6 x 12 cm\n"
+          "                       (planar, phi_0 2.2 cm), 6 x 9.42 cm (biaxial), 0.02 m/s; indent: a\n"
+          "                       60 x 20 cm bin, a 5 cm intruder at 0.05 m/s, cells of 0.5 cm, phi_0\n"
+          "                       2.5 cm; the other flags override it\n"
+          "  --keep-strays        planar hybrid: keep the free grains that stray more than a cell beyond\n"
+          "                       the overlap touching none (by default removed, and counted)\n"
+          "  --weigh-overlap      hybrid: a grain that holds w = 1/2 of its mass (in the overlap at the\n"
+          "                       swap) carries w of its contact forces too, each contact scaled by its\n"
+          "                       grains' mean w (eq 9 read literally; by default the forces are whole)\n"
+          "  --quiet              no progress lines\n",
+          fp);
 }
 
 static int num(const char *s, double *v) {
@@ -276,6 +280,7 @@ static int parse(int argc, char **argv, opts *o) {
             {"--quiet", CLI_FLAG, &o->quiet, 0, 0, NULL, NULL, 0},
             {"--keep-strays", CLI_FLAG, &o->keep_strays, 0, 0, NULL, NULL, 0},
             {"--weigh-overlap", CLI_FLAG, &o->weigh_overlap, 0, 0, NULL, NULL, 0},
+            {"--delaunay", CLI_FLAG, &o->delaunay, 0, 0, NULL, NULL, 0},
             {"--paper", CLI_FLAG, &paper, 0, 0, NULL, NULL, 0}, /* applied above */
             {"--width", CLI_REAL, &o->width, 0.005, 10.0, "a width in [0.005, 10] m", NULL, 0},
             {"--height", CLI_REAL, &o->height, 0.005, 10.0, "a height in [0.005, 10] m", NULL, 0},
@@ -396,6 +401,9 @@ static int parse(int argc, char **argv, opts *o) {
         return fprintf(stderr, "error: --keep-strays is an option of the planar hybrid run\n"), 1;
     if (o->weigh_overlap && o->mode != M_HYBRID)
         return fprintf(stderr, "error: --weigh-overlap is an option of the hybrid run (--mode hybrid)\n"), 1;
+    if (o->delaunay && o->mode == M_CONT)
+        return fprintf(stderr, "error: --delaunay measures grains: the continuum's band is of its points\n"),
+               1;
     if (o->test != T_PLANAR && o->train < 1.0)
         return fprintf(stderr,
                        "error: --train %g: below 1 only for the planar test (the band region moves)\n",

@@ -56,6 +56,8 @@
  *                           and momentum matched to what left the continuum
  *   gk_hybrid_couple        the overlap coupling (eq 9)
  *   gk_hybrid_cundall       Cundall's best-fit strain of every grain (App. A)
+ *                           over the grains within a cutoff
+ *   gk_hybrid_cundall_delaunay  the same over Delaunay neighbours (App. A's)
  *   gk_hybrid_band          band thickness: top percentile, outliers out,
  *                           minimum-area bounding box (App. A)
  *   gk_hybrid_band_top      the same on the count largest values
@@ -119,11 +121,15 @@
  * (the paper's "early attempts").
  *
  * CUNDALL STRAIN (App. A). grad u = (Sum du dX^T)(Sum dX dX^T)^-1 over the
- * neighbours of a grain (here every grain within a cutoff distance in the
- * reference positions instead of Delaunay neighbours), du = dx - dX; eps =
- * sym grad u and the equivalent shear strain gamma = sqrt(2 dev eps : dev
- * eps) (= the engineering shear strain of simple shear). Exact for any
- * affine motion when a grain has two non-collinear neighbours (else NaN).
+ * neighbours of a grain in the reference positions: its Delaunay
+ * neighbours as in the paper (gk_hybrid_cundall_delaunay, the edges of its
+ * Voronoi cell, each found by clipping a square around the grain with the
+ * bisectors of the grains within reach; nearest images on a periodic axis)
+ * or every grain within a cutoff distance (gk_hybrid_cundall, which takes
+ * in the second shell as the cutoff grows), du = dx - dX; eps = sym grad u
+ * and the equivalent shear strain gamma = sqrt(2 dev eps : dev eps) (= the
+ * engineering shear strain of simple shear). Exact for any affine motion
+ * when a grain has two non-collinear neighbours (else NaN).
  *
  * BAND THICKNESS (App. A): the grains (or points) whose value is at or
  * above the given percentile (98: the top 2 %); outliers dropped - first
@@ -398,6 +404,15 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
 GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double *const x[2],
                                   const double period[2], double cutoff, double *eps,
                                   const gk_allocator *alloc, gk_err *err);
+/* the same over each grain's Delaunay neighbours in X (App. A), found as
+ * the edges of its Voronoi cell among the grains within reach: exact where
+ * the cell lies within reach / 2 of the grain (inside a packing, reach 4
+ * D50 is ample); a grain on a free surface, whose cell stays open, gets
+ * the neighbours whose cell edges lie there (counted in *open_cells).
+ * neighbours[p] (optional) = grain p's count. */
+GKDEF gk_result gk_hybrid_cundall_delaunay(int n, const double *const X[2], const double *const x[2],
+                                           const double period[2], double reach, double *eps, int *neighbours,
+                                           int *open_cells, const gk_allocator *alloc, gk_err *err);
 /* band thickness of the n positions (x, y) by value (see BAND THICKNESS);
  * values that are not finite are ignored */
 GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value,
@@ -1406,18 +1421,57 @@ GKDEF gk_result gk_hybrid_couple(gk_hybrid_coupling *c, gk_mpm_grid *g, const gk
 }
 
 /* ---------------------------------------------------------- Cundall strain */
-GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double *const x[2],
-                                  const double period[2], double cutoff, double *eps,
-                                  const gk_allocator *alloc, gk_err *err) {
-    double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL}, c2 = cutoff * cutoff;
-    int nb[2], k, p, nbin;
+/* the bin of v on axis k: wrapped on a periodic axis, clamped on another */
+static int gk__hy_bin(const double *lo, const double *hi, const int *nb, const double *period, int k,
+                      double v) {
+    if (period && period[k] > 0.0)
+        return ((int)floor((v - lo[k]) / period[k] * nb[k]) % nb[k] + nb[k]) % nb[k];
+    return (int)gk_clamp(floor((v - lo[k]) / (hi[k] - lo[k] > 0.0 ? hi[k] - lo[k] : 1.0) * nb[k]), 0.0,
+                         nb[k] - 1.0);
+}
+
+/* clips the convex polygon v (m vertices; edge k, from v[k] to v[k + 1],
+ * labelled lab[k]) to the half-plane y . d <= |d|^2 / 2, the origin's side
+ * of the bisector with a grain at d; the new edge is labelled c. Returns
+ * the new vertex count, written to w and wl. */
+static int gk__hy_clip(const double *v, const int *lab, int m, const double d[2], int c, double *w, int *wl) {
+    double h = 0.5 * (d[0] * d[0] + d[1] * d[1]);
+    int k, o = 0;
+    for (k = 0; k < m; ++k) {
+        const double *a = v + 2 * k, *b = v + 2 * ((k + 1) % m);
+        double fa = a[0] * d[0] + a[1] * d[1] - h, fb = b[0] * d[0] + b[1] * d[1] - h;
+        if (fa <= 0.0) {
+            w[2 * o] = a[0], w[2 * o + 1] = a[1], wl[o++] = lab[k];
+            if (fb > 0.0) { /* leaves: the clip line runs to where the polygon comes back */
+                double t = fa / (fa - fb);
+                w[2 * o] = a[0] + t * (b[0] - a[0]), w[2 * o + 1] = a[1] + t * (b[1] - a[1]), wl[o++] = c;
+            }
+        } else if (fb <= 0.0) { /* comes back on edge k */
+            double t = fa / (fa - fb);
+            w[2 * o] = a[0] + t * (b[0] - a[0]), w[2 * o + 1] = a[1] + t * (b[1] - a[1]), wl[o++] = lab[k];
+        }
+    }
+    return o;
+}
+
+/* both Cundall strains: delaunay 0, the neighbours within radius; 1, the
+ * Delaunay neighbours among those (Voronoi cell edges) */
+static gk_result gk__hy_cundall(int n, const double *const X[2], const double *const x[2],
+                                const double period[2], double radius, int delaunay, double *eps, int *nnb,
+                                int *open_cells, const gk_allocator *alloc, gk_err *err) {
+    double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL}, c2 = radius * radius,
+           half = radius / (2.0 * sqrt(2.0)), *cand = NULL, *poly = NULL;
+    int nb[2], k, p, nbin, cap = 0, nopen = 0, *lab = NULL;
     int32_t *head, *next;
+    unsigned char *use = NULL;
     gk_allocator al;
     memset(&al, 0, sizeof al);
     if (alloc) al = *alloc;
+    if (open_cells) *open_cells = 0;
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "%d grains", n);
-    if (!(cutoff > 0.0) || !isfinite(cutoff))
-        return gk_err_set(err, GK_ERR_ARG, "neighbour cutoff %g (must be > 0)", cutoff);
+    if (!(radius > 0.0) || !isfinite(radius))
+        return gk_err_set(err, GK_ERR_ARG, "neighbour %s %g (must be > 0)", delaunay ? "reach" : "cutoff",
+                          radius);
     for (p = 0; p < n; ++p)
         for (k = 0; k < 2; ++k) {
             if (!isfinite(X[k][p]) || !isfinite(x[k][p]))
@@ -1428,38 +1482,62 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
     for (k = 0; k < 2; ++k) {
         double span = hi[k] - lo[k];
         if (period && period[k] > 0.0) {
-            if (period[k] < 3.0 * cutoff)
-                return gk_err_set(err, GK_ERR_ARG, "period %g below three cutoffs %g", period[k],
-                                  3.0 * cutoff);
+            if (period[k] < 3.0 * radius)
+                return gk_err_set(err, GK_ERR_ARG, "period %g below three times the neighbour %s %g",
+                                  period[k], delaunay ? "reach" : "cutoff", radius);
             span = period[k];
         }
-        nb[k] = (int)(span / cutoff);
+        nb[k] = (int)(span / radius);
         if (nb[k] < 1) nb[k] = 1;
         if (nb[k] > 4096) nb[k] = 4096;
     }
     nbin = nb[0] * nb[1];
     head = (int32_t *)gk_alloc(&al, (size_t)nbin * sizeof(int32_t));
     next = (int32_t *)gk_alloc(&al, (size_t)n * sizeof(int32_t));
-    if (!head || !next) {
+    if (head) {
+        for (k = 0; k < nbin; ++k) head[k] = -1;
+        if (next) {
+            int32_t *fill = (int32_t *)gk_alloc(&al, (size_t)nbin * sizeof(int32_t));
+            /* insert in descending order so each bin lists ascending indices */
+            for (p = n - 1; p >= 0; --p) {
+                int b = gk__hy_bin(lo, hi, nb, period, 0, X[0][p]) +
+                        nb[0] * gk__hy_bin(lo, hi, nb, period, 1, X[1][p]);
+                next[p] = head[b];
+                head[b] = p;
+            }
+            if (fill) { /* the largest bin bounds a grain's candidates: nine bins */
+                int most = 0;
+                for (k = 0; k < nbin; ++k) fill[k] = 0;
+                for (p = 0; p < n; ++p) {
+                    int b = gk__hy_bin(lo, hi, nb, period, 0, X[0][p]) +
+                            nb[0] * gk__hy_bin(lo, hi, nb, period, 1, X[1][p]);
+                    if (++fill[b] > most) most = fill[b];
+                }
+                gk_free(&al, fill);
+                cap = 9 * most;
+                cand = (double *)gk_alloc(&al, 4 * (size_t)cap * sizeof(double));
+                use = (unsigned char *)gk_alloc(&al, (size_t)cap);
+                if (delaunay) {
+                    poly = (double *)gk_alloc(&al, 4 * ((size_t)cap + 5) * sizeof(double));
+                    lab = (int *)gk_alloc(&al, 2 * ((size_t)cap + 5) * sizeof(int));
+                }
+            }
+        }
+    }
+    if (!head || !next || !cand || !use || (delaunay && (!poly || !lab))) {
         gk_free(&al, head);
         gk_free(&al, next);
+        gk_free(&al, cand);
+        gk_free(&al, use);
+        gk_free(&al, poly);
+        gk_free(&al, lab);
         return gk_err_set(err, GK_ERR_ALLOC, "out of memory for %d grains", n);
     }
-    for (k = 0; k < nbin; ++k) head[k] = -1;
-#define GK__HY_BIN(k, v)                                                                                \
-    ((period && period[k] > 0.0)                                                                        \
-         ? ((int)floor(((v)-lo[k]) / period[k] * nb[k]) % nb[k] + nb[k]) % nb[k]                        \
-         : (int)gk_clamp(floor(((v)-lo[k]) / (hi[k] - lo[k] > 0.0 ? hi[k] - lo[k] : 1.0) * nb[k]), 0.0, \
-                         nb[k] - 1.0))
-    /* insert in descending order so each bin lists ascending indices */
-    for (p = n - 1; p >= 0; --p) {
-        int b = GK__HY_BIN(0, X[0][p]) + nb[0] * GK__HY_BIN(1, X[1][p]);
-        next[p] = head[b];
-        head[b] = p;
-    }
     for (p = 0; p < n; ++p) {
-        int bx = GK__HY_BIN(0, X[0][p]), by = GK__HY_BIN(1, X[1][p]), dx, dy, cnt = 0;
+        int bx = gk__hy_bin(lo, hi, nb, period, 0, X[0][p]), by = gk__hy_bin(lo, hi, nb, period, 1, X[1][p]),
+            dx, dy, cnt = 0, nc = 0, c;
         double AA[3] = {0.0, 0.0, 0.0}, B[4] = {0.0, 0.0, 0.0, 0.0}, det;
+        /* the candidates within radius in the reference positions, bin by bin */
         for (dy = -1; dy <= 1; ++dy)
             for (dx = -1; dx <= 1; ++dx) {
                 int cx = bx + dx, cy = by + dy, q;
@@ -1470,7 +1548,7 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
                 if (nb[0] < 3 && dx != 0 && (period && period[0] > 0.0)) continue;
                 if (nb[1] < 3 && dy != 0 && (period && period[1] > 0.0)) continue;
                 for (q = head[cx + nb[0] * cy]; q >= 0; q = next[q]) {
-                    double dX[2], du[2];
+                    double *o = cand + 4 * nc;
                     if (q == p) continue;
                     for (k = 0; k < 2; ++k) {
                         double a = X[k][q] - X[k][p], b = x[k][q] - x[k][p];
@@ -1478,20 +1556,49 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
                             a -= period[k] * floor(a / period[k] + 0.5);
                             b -= period[k] * floor(b / period[k] + 0.5);
                         }
-                        dX[k] = a;
-                        du[k] = b - a;
+                        o[k] = a;         /* dX */
+                        o[2 + k] = b - a; /* du */
                     }
-                    if (dX[0] * dX[0] + dX[1] * dX[1] > c2) continue;
-                    AA[0] += dX[0] * dX[0];
-                    AA[1] += dX[0] * dX[1];
-                    AA[2] += dX[1] * dX[1];
-                    B[0] += du[0] * dX[0];
-                    B[1] += du[0] * dX[1];
-                    B[2] += du[1] * dX[0];
-                    B[3] += du[1] * dX[1];
-                    ++cnt;
+                    if (o[0] * o[0] + o[1] * o[1] > c2) continue;
+                    use[nc++] = (unsigned char)!delaunay;
                 }
             }
+        if (delaunay) {
+            /* the Voronoi cell in a square of half-diagonal radius / 2: no grain beyond radius cuts it,
+               so the clipped cell is exact; its edges of positive length are the Delaunay neighbours */
+            double *v = poly, *w = poly + 2 * (cap + 5), *t, tol = 1e-9 * radius;
+            int *vl = lab, *wl = lab + cap + 5, *tl, m = 4, open = 0;
+            v[0] = -half, v[1] = -half, v[2] = half, v[3] = -half, v[4] = half, v[5] = half, v[6] = -half,
+            v[7] = half;
+            vl[0] = vl[1] = vl[2] = vl[3] = -1;
+            for (c = 0; c < nc && m > 0; ++c) {
+                m = gk__hy_clip(v, vl, m, cand + 4 * c, c, w, wl);
+                t = v, v = w, w = t;
+                tl = vl, vl = wl, wl = tl;
+            }
+            for (k = 0; k < m; ++k) {
+                const double *a = v + 2 * k, *b = v + 2 * ((k + 1) % m);
+                if (hypot(b[0] - a[0], b[1] - a[1]) <= tol) continue;
+                if (vl[k] >= 0)
+                    use[vl[k]] = 1;
+                else
+                    open = 1;
+            }
+            nopen += open;
+        }
+        for (c = 0; c < nc; ++c) {
+            const double *dX = cand + 4 * c, *du = dX + 2;
+            if (!use[c]) continue;
+            AA[0] += dX[0] * dX[0];
+            AA[1] += dX[0] * dX[1];
+            AA[2] += dX[1] * dX[1];
+            B[0] += du[0] * dX[0];
+            B[1] += du[0] * dX[1];
+            B[2] += du[1] * dX[0];
+            B[3] += du[1] * dX[1];
+            ++cnt;
+        }
+        if (nnb) nnb[p] = cnt;
         det = AA[0] * AA[2] - AA[1] * AA[1];
         if (cnt < 2 || !(det > 1e-12 * (AA[0] + AA[2]) * (AA[0] + AA[2]))) {
             for (k = 0; k < 4; ++k) eps[4 * p + k] = NAN;
@@ -1502,17 +1609,33 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
             double i00 = AA[2] / det, i01 = -AA[1] / det, i11 = AA[0] / det;
             double g00 = B[0] * i00 + B[1] * i01, g01 = B[0] * i01 + B[1] * i11;
             double g10 = B[2] * i00 + B[3] * i01, g11 = B[2] * i01 + B[3] * i11;
-            double exy = 0.5 * (g01 + g10), m = 0.5 * (g00 + g11), d0 = g00 - m, d1 = g11 - m;
+            double exy = 0.5 * (g01 + g10), mm = 0.5 * (g00 + g11), d0 = g00 - mm, d1 = g11 - mm;
             eps[4 * p] = g00;
             eps[4 * p + 1] = g11;
             eps[4 * p + 2] = exy;
             eps[4 * p + 3] = sqrt(2.0 * (d0 * d0 + d1 * d1 + 2.0 * exy * exy));
         }
     }
-#undef GK__HY_BIN
+    if (open_cells) *open_cells = nopen;
     gk_free(&al, head);
     gk_free(&al, next);
+    gk_free(&al, cand);
+    gk_free(&al, use);
+    gk_free(&al, poly);
+    gk_free(&al, lab);
     return GK_OK;
+}
+
+GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double *const x[2],
+                                  const double period[2], double cutoff, double *eps,
+                                  const gk_allocator *alloc, gk_err *err) {
+    return gk__hy_cundall(n, X, x, period, cutoff, 0, eps, NULL, NULL, alloc, err);
+}
+
+GKDEF gk_result gk_hybrid_cundall_delaunay(int n, const double *const X[2], const double *const x[2],
+                                           const double period[2], double reach, double *eps, int *neighbours,
+                                           int *open_cells, const gk_allocator *alloc, gk_err *err) {
+    return gk__hy_cundall(n, X, x, period, reach, 1, eps, neighbours, open_cells, alloc, err);
 }
 
 /* ---------------------------------------------------------- band thickness */

@@ -103,15 +103,16 @@ run 0 "$B/femdem_nonlocal" $NG --restart "$T/ng" --out "$T/ng"
 run 0 "$B/femdem_dr" --test rve --frame periodic --steps 4 --strain 0.02 --out "$T/dr"
 run 2 "$B/femdem_dr" --test rve --frame periodic --steps -1 --out "$T/dr2"
 # the hybrid continuum-grain driver: a small planar shear through its enrichment (and with the overlap's
-# contacts weighted), and one refused at the enrichment (the discrete zone reaches a platen)
+# contacts weighted, the band over Delaunay neighbours across the periodic seam), and one refused at the enrichment (the discrete zone reaches a platen)
 HY="--test planar --mode hybrid --width 0.008 --cell 0.002 --strain 0.002 --out-every 0.001 --window 0.001 0.002"
 run 0 "$B/hybrid" $HY --height 0.016 --phi0 0.003 --threads 2 --out "$T/hy"
-run 0 "$B/hybrid" $HY --height 0.016 --phi0 0.003 --weigh-overlap --threads 1 --out "$T/hyw"
+run 0 "$B/hybrid" $HY --height 0.016 --phi0 0.003 --weigh-overlap --delaunay --threads 1 --out "$T/hyw"
 run 1 "$B/hybrid" $HY --height 0.012 --phi0 0.004 --threads 2 --out "$T/hy2"
 # biaxial on a 1.2 x 1.8 cm specimen: the zone reaches the top platen (training targets corrected,
-# the top wall seated by its servo, the swap)
+# the top wall seated by its servo, the swap; the band over Delaunay neighbours, open cells at the
+# zone's edges)
 run 0 "$B/hybrid" --test biaxial --mode hybrid --width 0.012 --height 0.018 --cell 0.003 --strain 0.008 \
-    --out-every 0.001 --window 0.007 0.008 --threads 2 --out "$T/hyb"
+    --out-every 0.001 --window 0.007 0.008 --delaunay --threads 2 --out "$T/hyb"
 # plate indentation on a 2 x 1 cm bin: settling, the oracle made eager (c1 0) so that the intruder's
 # training and the swap run; an intruder wider than half the bin refused
 IND="--test indent --mode hybrid --width 0.02 --height 0.01 --cell 0.0025 --strain 0.02 --out-every 0.01 --window 0.01 0.02"

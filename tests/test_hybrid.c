@@ -647,6 +647,94 @@ TEST(cundall_exact_for_affine_motion) {
     free(eps);
 }
 
+/* Delaunay neighbours by brute force (general position): i-j is an edge
+ * when some third point k gives a circle through i, j, k with no point
+ * inside */
+static int delaunay_edge(int n, const double *x, const double *y, int i, int j) {
+    int k, l;
+    for (k = 0; k < n; ++k) {
+        double ax = x[i] - x[k], ay = y[i] - y[k], bx = x[j] - x[k], by = y[j] - y[k],
+               d = 2.0 * (ax * by - ay * bx), ux, uy, r2;
+        int empty = 1;
+        if (k == i || k == j || fabs(d) < 1e-30) continue;
+        ux = (by * (ax * ax + ay * ay) - ay * (bx * bx + by * by)) / d; /* centre, relative to k */
+        uy = (ax * (bx * bx + by * by) - bx * (ax * ax + ay * ay)) / d;
+        r2 = ux * ux + uy * uy;
+        for (l = 0; l < n && empty; ++l) {
+            double ex = x[l] - x[k] - ux, ey = y[l] - y[k] - uy;
+            if (l != i && l != j && l != k && ex * ex + ey * ey < r2 * (1.0 - 1e-12)) empty = 0;
+        }
+        if (empty) return 1;
+    }
+    return 0;
+}
+
+/* App. A's neighbours: gk_hybrid_cundall_delaunay against the brute-force
+ * triangulation of a jittered grid (every grain at least two spacings
+ * inside: the same neighbour count, and the least-squares grad u of eq
+ * A.1 over exactly those neighbours), exact for affine motion, open cells
+ * only on the free surface, none across a periodic seam. */
+TEST(cundall_delaunay_neighbours) {
+    enum { NX = 16, NY = 12, N = NX * NY };
+    double X0[N], X1[N], x0[N], x1[N], eps[4 * N], s = 1e-3, period[2] = {NX * 1e-3, 0.0};
+    const double *X[2] = {X0, X1}, *x[2] = {x0, x1};
+    int nnb[N], p, q, open = -1, inner = 0;
+    gk_rng rng;
+    gk_err e;
+    gk_rng_seed(&rng, 5);
+    for (p = 0; p < N; ++p) {
+        X0[p] = s * ((p % NX) + 0.6 * (gk_rng_uniform(&rng) - 0.5));
+        X1[p] = s * ((p / NX) + 0.6 * (gk_rng_uniform(&rng) - 0.5));
+        x0[p] = X0[p] + 1e-5 * gk_rng_normal(&rng); /* a non-affine motion */
+        x1[p] = X1[p] + 1e-5 * gk_rng_normal(&rng);
+    }
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, NULL, 4.0 * s, eps, nnb, &open, NULL, &e) == GK_OK);
+    CHECK(open > 0 && open <= 2 * (NX + NY)); /* the outer ring's cells stay open, no inner one */
+    for (p = 0; p < N; ++p) {
+        int i = p % NX, j = p / NX, cnt = 0;
+        double A[3] = {0.0, 0.0, 0.0}, B[4] = {0.0, 0.0, 0.0, 0.0}, det, g[4];
+        if (i < 2 || j < 2 || i >= NX - 2 || j >= NY - 2) continue;
+        ++inner;
+        for (q = 0; q < N; ++q) {
+            double dX[2], du[2];
+            if (q == p || !delaunay_edge(N, X0, X1, p, q)) continue;
+            dX[0] = X0[q] - X0[p], dX[1] = X1[q] - X1[p];
+            du[0] = x0[q] - x0[p] - dX[0], du[1] = x1[q] - x1[p] - dX[1];
+            A[0] += dX[0] * dX[0], A[1] += dX[0] * dX[1], A[2] += dX[1] * dX[1];
+            B[0] += du[0] * dX[0], B[1] += du[0] * dX[1], B[2] += du[1] * dX[0], B[3] += du[1] * dX[1];
+            ++cnt;
+        }
+        CHECK(cnt >= 3);
+        CHECK(nnb[p] == cnt);
+        det = A[0] * A[2] - A[1] * A[1];
+        g[0] = (B[0] * A[2] - B[1] * A[1]) / det;
+        g[1] = (-B[0] * A[1] + B[1] * A[0]) / det;
+        g[2] = (B[2] * A[2] - B[3] * A[1]) / det;
+        g[3] = (-B[2] * A[1] + B[3] * A[0]) / det;
+        CHECK_NEAR(eps[4 * p], g[0], 1e-12);
+        CHECK_NEAR(eps[4 * p + 1], g[3], 1e-12);
+        CHECK_NEAR(eps[4 * p + 2], 0.5 * (g[1] + g[2]), 1e-12);
+    }
+    CHECK(inner == (NX - 4) * (NY - 4));
+    /* affine motion, periodic along x (shear and a vertical stretch, which keep the period): exact at every
+       grain; only the top and bottom rows are open */
+    for (p = 0; p < N; ++p) {
+        x0[p] = X0[p] + 0.2 * X1[p];
+        x0[p] -= period[0] * floor(x0[p] / period[0]);
+        x1[p] = X1[p] - 0.02 * X1[p];
+    }
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 4.0 * s, eps, nnb, &open, NULL, &e) == GK_OK);
+    CHECK(open > 0 && open <= 2 * NX);
+    for (p = 0; p < N; ++p) {
+        CHECK(nnb[p] >= 3);
+        CHECK_NEAR(eps[4 * p], 0.0, 1e-12);
+        CHECK_NEAR(eps[4 * p + 1], -0.02, 1e-12);
+        CHECK_NEAR(eps[4 * p + 2], 0.1, 1e-12);
+    }
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 0.0, eps, nnb, &open, NULL, &e) == GK_ERR_ARG);
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 6.0 * s, eps, nnb, &open, NULL, &e) == GK_ERR_ARG);
+}
+
 /* ================================================================ band thickness
  * App. A on a synthetic band: values high in a tilted strip (rows 1 mm
  * apart, |w| <= 2.5 mm), low elsewhere, one far outlier: the minimum-area
@@ -928,6 +1016,7 @@ int main(int argc, char **argv) {
     RUN(coupling_equalises_and_conserves);
     RUN(enrichment_conserves_mass_and_momentum);
     RUN(cundall_exact_for_affine_motion);
+    RUN(cundall_delaunay_neighbours);
     RUN(band_thickness_of_a_strip);
     RUN(band_top_selects_that_many);
     RUN(training_raises_packing_stress);

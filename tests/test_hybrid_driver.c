@@ -18,6 +18,8 @@
 #define HEADER "time,strain,tau,sigma_n,eps_v,eps_v_band,grains,points,enriched,flagged_nodes,seconds\n"
 #define NCOL 11
 
+static int refused(const char *flags, const char *msg);
+
 /* the data rows of a hybrid.csv (at most max), -1 when unreadable or the header differs */
 static int read_rows(const char *path, double rows[][NCOL], int max) {
     FILE *fp = fopen(path, "r");
@@ -253,6 +255,30 @@ TEST(hybrid_biaxial_dem_loads) {
     CHECK(gk_test_file_has(BUILD "/tests/t_hyB/grains_end.vtk", "POINTS"));
 }
 
+/* --delaunay (App. A's neighbours for Cundall's strain) changes the band measurement and nothing
+ * else: the same CSV, a band, and the grains on the specimen's free sides are counted as open
+ * cells (some, not all) */
+TEST(hybrid_delaunay_changes_only_the_band) {
+    FILE *fp;
+    char line[1024];
+    int open = -1, total = -1;
+    system("rm -rf " BUILD "/tests/t_hyD0 " BUILD "/tests/t_hyD1");
+    CHECK(system(BIAXIAL "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
+                         "--out " BUILD "/tests/t_hyD0 > " BUILD "/tests/t_hyD0.out 2>&1") == 0);
+    CHECK(system(BUILD
+                 "/hybrid --test biaxial --width 0.012 --height 0.018 --cell 0.003 --mode dem --strain 0.003 "
+                 "--out-every 0.001 --window 0.001 0.003 --threads 1 --delaunay --out " BUILD
+                 "/tests/t_hyD1 > " BUILD "/tests/t_hyD1.out 2>&1") == 0);
+    CHECK(same_but_seconds(BUILD "/tests/t_hyD0/hybrid.csv", BUILD "/tests/t_hyD1/hybrid.csv"));
+    CHECK(gk_test_result(BUILD "/tests/t_hyD1.out", "band_thickness_D50") > 0.0);
+    fp = fopen(BUILD "/tests/t_hyD1.out", "r");
+    while (fp && fgets(line, sizeof line, fp))
+        sscanf(line, "Cundall strain over Delaunay neighbours: %d of %d", &open, &total);
+    if (fp) fclose(fp);
+    CHECK(open > 0 && total > 100 && open < total / 2);
+    CHECK(refused("--test planar --mode continuum --delaunay", "--delaunay measures grains"));
+}
+
 /* continuum mode, biaxial: MPM only, never enriched, starts at the confining pressure */
 TEST(hybrid_biaxial_continuum_runs) {
     double r[8][NCOL];
@@ -466,6 +492,7 @@ int main(int argc, char **argv) {
     RUN(hybrid_planar_platen_holds_to_large_strain);
     RUN(hybrid_biaxial_dem_loads);
     RUN(hybrid_biaxial_continuum_runs);
+    RUN(hybrid_delaunay_changes_only_the_band);
     RUN(hybrid_band_is_measured_over_its_window);
     RUN(hybrid_biaxial_top_zone_is_seated);
     RUN(hybrid_indent_dem_and_hybrid_agree);
