@@ -406,10 +406,12 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
                                   const gk_allocator *alloc, gk_err *err);
 /* the same over each grain's Delaunay neighbours in X (App. A), found as
  * the edges of its Voronoi cell among the grains within reach: exact where
- * the cell lies within reach / 2 of the grain (inside a packing, reach 4
- * D50 is ample); a grain on a free surface, whose cell stays open, gets
- * the neighbours whose cell edges lie there (counted in *open_cells).
- * neighbours[p] (optional) = grain p's count. */
+ * the cell closes inside the square of half-width reach / (2 sqrt 2)
+ * around the grain (inside a dense packing, reach 4 D50 is ample); a grain
+ * whose cell does not (on a free surface, beside a void) gets the
+ * neighbours whose cell edges lie in the square, and is counted in
+ * *open_cells (optional). neighbours[p] (optional) = grain p's count. On
+ * an error nothing is written. */
 GKDEF gk_result gk_hybrid_cundall_delaunay(int n, const double *const X[2], const double *const x[2],
                                            const double period[2], double reach, double *eps, int *neighbours,
                                            int *open_cells, const gk_allocator *alloc, gk_err *err);
@@ -1467,7 +1469,6 @@ static gk_result gk__hy_cundall(int n, const double *const X[2], const double *c
     gk_allocator al;
     memset(&al, 0, sizeof al);
     if (alloc) al = *alloc;
-    if (open_cells) *open_cells = 0;
     if (n < 1) return gk_err_set(err, GK_ERR_ARG, "%d grains", n);
     if (!(radius > 0.0) || !isfinite(radius))
         return gk_err_set(err, GK_ERR_ARG, "neighbour %s %g (must be > 0)", delaunay ? "reach" : "cutoff",

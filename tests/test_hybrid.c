@@ -731,8 +731,15 @@ TEST(cundall_delaunay_neighbours) {
         CHECK_NEAR(eps[4 * p + 1], -0.02, 1e-12);
         CHECK_NEAR(eps[4 * p + 2], 0.1, 1e-12);
     }
+    /* refused, nothing written */
+    open = -7;
+    nnb[0] = -7;
+    eps[0] = -7.0;
     CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 0.0, eps, nnb, &open, NULL, &e) == GK_ERR_ARG);
     CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 6.0 * s, eps, nnb, &open, NULL, &e) == GK_ERR_ARG);
+    x0[3] = NAN;
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 4.0 * s, eps, nnb, &open, NULL, &e) == GK_ERR_NAN);
+    CHECK(open == -7 && nnb[0] == -7 && eps[0] == -7.0);
 }
 
 /* ================================================================ band thickness
