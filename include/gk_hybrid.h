@@ -1495,34 +1495,27 @@ static gk_result gk__hy_cundall(int n, const double *const X[2], const double *c
     nbin = nb[0] * nb[1];
     head = (int32_t *)gk_alloc(&al, (size_t)nbin * sizeof(int32_t));
     next = (int32_t *)gk_alloc(&al, (size_t)n * sizeof(int32_t));
-    if (head) {
+    if (head && next) {
+        int most = 0;
         for (k = 0; k < nbin; ++k) head[k] = -1;
-        if (next) {
-            int32_t *fill = (int32_t *)gk_alloc(&al, (size_t)nbin * sizeof(int32_t));
-            /* insert in descending order so each bin lists ascending indices */
-            for (p = n - 1; p >= 0; --p) {
-                int b = gk__hy_bin(lo, hi, nb, period, 0, X[0][p]) +
-                        nb[0] * gk__hy_bin(lo, hi, nb, period, 1, X[1][p]);
-                next[p] = head[b];
-                head[b] = p;
-            }
-            if (fill) { /* the largest bin bounds a grain's candidates: nine bins */
-                int most = 0;
-                for (k = 0; k < nbin; ++k) fill[k] = 0;
-                for (p = 0; p < n; ++p) {
-                    int b = gk__hy_bin(lo, hi, nb, period, 0, X[0][p]) +
-                            nb[0] * gk__hy_bin(lo, hi, nb, period, 1, X[1][p]);
-                    if (++fill[b] > most) most = fill[b];
-                }
-                gk_free(&al, fill);
-                cap = 9 * most;
-                cand = (double *)gk_alloc(&al, 4 * (size_t)cap * sizeof(double));
-                use = (unsigned char *)gk_alloc(&al, (size_t)cap);
-                if (delaunay) {
-                    poly = (double *)gk_alloc(&al, 4 * ((size_t)cap + 5) * sizeof(double));
-                    lab = (int *)gk_alloc(&al, 2 * ((size_t)cap + 5) * sizeof(int));
-                }
-            }
+        /* insert in descending order so each bin lists ascending indices */
+        for (p = n - 1; p >= 0; --p) {
+            int b = gk__hy_bin(lo, hi, nb, period, 0, X[0][p]) +
+                    nb[0] * gk__hy_bin(lo, hi, nb, period, 1, X[1][p]);
+            next[p] = head[b];
+            head[b] = p;
+        }
+        for (k = 0; k < nbin; ++k) { /* the largest bin bounds a grain's candidates: nine bins */
+            int cnt = 0, q;
+            for (q = head[k]; q >= 0; q = next[q]) ++cnt;
+            if (cnt > most) most = cnt;
+        }
+        cap = 9 * most;
+        cand = (double *)gk_alloc(&al, 4 * (size_t)cap * sizeof(double));
+        use = (unsigned char *)gk_alloc(&al, (size_t)cap);
+        if (delaunay) {
+            poly = (double *)gk_alloc(&al, 4 * ((size_t)cap + 5) * sizeof(double));
+            lab = (int *)gk_alloc(&al, 2 * ((size_t)cap + 5) * sizeof(int));
         }
     }
     if (!head || !next || !cand || !use || (delaunay && (!poly || !lab))) {
