@@ -87,6 +87,7 @@ typedef struct opts {
     int ppd, threads, oracle_every, quiet, keep_strays;
     int weigh_overlap; /* --weigh-overlap: overlap grains carry w of their contact forces */
     int delaunay;      /* --delaunay: Cundall strain over Delaunay neighbours (else within 1.6 D50) */
+    int interior;      /* --interior: the band leaves out grains with an open cell (implies --delaunay) */
     int band_grains;   /* > 0: band grains are the band_grains largest values (not --percentile) */
     long grains;
     unsigned long seed;
@@ -199,6 +200,9 @@ static void usage(FILE *fp) {
         "  --percentile Q       band grains: value above the Q-th percentile (default %g)\n"
         "  --delaunay           band grains: Cundall strain over each grain's Delaunay neighbours,\n"
         "                       as App. A (by default over the grains within 1.6 D50)\n"
+        "  --interior           band grains: --delaunay, leaving out the grains whose cell is open\n"
+        "                       (the free sides, the edge of the measured set: one-sided fits;\n"
+        "                       drawn grey in band.svg)\n"
         "  --band-grains N      band grains: the N largest values instead (a hybrid measures only\n"
         "                       its discrete zone's grains and prints its count: give it to a dem\n"
         "                       run to compare bands measured on as many grains)\n"
@@ -281,6 +285,7 @@ static int parse(int argc, char **argv, opts *o) {
             {"--keep-strays", CLI_FLAG, &o->keep_strays, 0, 0, NULL, NULL, 0},
             {"--weigh-overlap", CLI_FLAG, &o->weigh_overlap, 0, 0, NULL, NULL, 0},
             {"--delaunay", CLI_FLAG, &o->delaunay, 0, 0, NULL, NULL, 0},
+            {"--interior", CLI_FLAG, &o->interior, 0, 0, NULL, NULL, 0},
             {"--paper", CLI_FLAG, &paper, 0, 0, NULL, NULL, 0}, /* applied above */
             {"--width", CLI_REAL, &o->width, 0.005, 10.0, "a width in [0.005, 10] m", NULL, 0},
             {"--height", CLI_REAL, &o->height, 0.005, 10.0, "a height in [0.005, 10] m", NULL, 0},
@@ -401,8 +406,10 @@ static int parse(int argc, char **argv, opts *o) {
         return fprintf(stderr, "error: --keep-strays is an option of the planar hybrid run\n"), 1;
     if (o->weigh_overlap && o->mode != M_HYBRID)
         return fprintf(stderr, "error: --weigh-overlap is an option of the hybrid run (--mode hybrid)\n"), 1;
+    if (o->interior) o->delaunay = 1;
     if (o->delaunay && o->mode == M_CONT)
-        return fprintf(stderr, "error: --delaunay measures grains: the continuum's band is of its points\n"),
+        return fprintf(stderr, "error: --%s measures grains: the continuum's band is of its points\n",
+                       o->interior ? "interior" : "delaunay"),
                1;
     if (o->test != T_PLANAR && o->train < 1.0)
         return fprintf(stderr,

@@ -13,7 +13,8 @@
  * volume.svg (not for indent), band.svg (the incremental shear strain
  * over the band window --window S0 S1 (strain), grains by Cundall's best
  * fit over the grains within 1.6 D50, or over Delaunay neighbours with
- * --delaunay, points by F),
+ * --delaunay, grey where not measured, e.g. the open cells --interior
+ * leaves out; points by F),
  * packing.txt, and on stdout a line
  *   RESULT mode=M peak_tau=Pa band_thickness_D50=X strain_at_enrichment=S
  *          seconds=T speedup_vs_dem=R packing_tau=Pa band_count=N
@@ -175,7 +176,8 @@ static int take_window(run *R) {
 static int band_measure(run *R, double *thick_D50, int *count) {
     gk_err e;
     gk_hybrid_band_result b;
-    int n, p, q = 0, bad = 0, open = 0;
+    int n, p, q = 0, bad = 0, nopen = 0;
+    unsigned char *open = NULL;
     double *xy, *val, *X[2] = {NULL, NULL}, *x[2] = {NULL, NULL}, *eps = NULL, *half = NULL,
                       period[2] = {0.0, 0.0}, *px, *py, reach;
     char path[1200];
@@ -194,9 +196,10 @@ static int band_measure(run *R, double *thick_D50, int *count) {
         x[0] = (double *)malloc((size_t)n * sizeof(double));
         x[1] = (double *)malloc((size_t)n * sizeof(double));
         eps = (double *)malloc(4 * (size_t)n * sizeof(double));
+        open = (unsigned char *)malloc((size_t)n);
     }
     if (!xy || !val || !px || !py ||
-        (R->band_on_grains && (!half || !X[0] || !X[1] || !x[0] || !x[1] || !eps))) {
+        (R->band_on_grains && (!half || !X[0] || !X[1] || !x[0] || !x[1] || !eps || !open))) {
         bad = fprintf(stderr, "error: out of memory\n");
         goto done;
     }
@@ -218,18 +221,21 @@ static int band_measure(run *R, double *thick_D50, int *count) {
            specimen allows a third of its width */
         reach = period[0] > 0.0 && period[0] < 12.0 * DIAM ? period[0] / 3.0 : 4.0 * DIAM;
         if (R->o.delaunay ? gk_hybrid_cundall_delaunay(q, (const double *const *)X, (const double *const *)x,
-                                                       period, reach, eps, NULL, &open, NULL, &e)
+                                                       period, reach, eps, NULL, open, NULL, &e)
                           : gk_hybrid_cundall(q, (const double *const *)X, (const double *const *)x, period,
                                               1.6 * DIAM, eps, NULL, &e)) {
             bad = fprintf(stderr, "error: Cundall strain: %s\n", e.msg);
             goto done;
         }
-        if (R->o.delaunay && !R->o.quiet)
-            printf("Cundall strain over Delaunay neighbours: %d of %d grains at the edge of the measured set "
-                   "(open cells)\n",
-                   open, q);
+        if (R->o.delaunay) {
+            for (p = 0; p < q; ++p) nopen += open[p];
+            if (!R->o.quiet)
+                printf("Cundall strain over Delaunay neighbours: %d of %d grains at the edge of the measured "
+                       "set (open cells)%s\n",
+                       nopen, q, R->o.interior ? ", left out" : "");
+        }
         for (p = 0; p < q; ++p) {
-            val[p] = eps[4 * p + 3];
+            val[p] = R->o.interior && open[p] ? NAN : eps[4 * p + 3];
             px[p] = x[0][p];
             py[p] = x[1][p];
         }
@@ -324,6 +330,7 @@ done:
     free(x[0]);
     free(x[1]);
     free(eps);
+    free(open);
     return bad != 0;
 }
 

@@ -409,12 +409,13 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
  * the cell closes inside the square of half-width reach / (2 sqrt 2)
  * around the grain (inside a dense packing, reach 4 D50 is ample); a grain
  * whose cell does not (on a free surface, beside a void) gets the
- * neighbours whose cell edges lie in the square, and is counted in
- * *open_cells (optional). neighbours[p] (optional) = grain p's count. On
- * an error nothing is written. */
+ * neighbours whose cell edges lie in the square, and open[p] = 1 (else 0;
+ * optional, n entries: a caller may leave such one-sided fits out).
+ * neighbours[p] (optional) = grain p's count. On an error nothing is
+ * written. */
 GKDEF gk_result gk_hybrid_cundall_delaunay(int n, const double *const X[2], const double *const x[2],
                                            const double period[2], double reach, double *eps, int *neighbours,
-                                           int *open_cells, const gk_allocator *alloc, gk_err *err);
+                                           unsigned char *open, const gk_allocator *alloc, gk_err *err);
 /* band thickness of the n positions (x, y) by value (see BAND THICKNESS);
  * values that are not finite are ignored */
 GKDEF gk_result gk_hybrid_band(int n, const double *x, const double *y, const double *value,
@@ -1460,10 +1461,10 @@ static int gk__hy_clip(const double *v, const int *lab, int m, const double d[2]
  * Delaunay neighbours among those (Voronoi cell edges) */
 static gk_result gk__hy_cundall(int n, const double *const X[2], const double *const x[2],
                                 const double period[2], double radius, int delaunay, double *eps, int *nnb,
-                                int *open_cells, const gk_allocator *alloc, gk_err *err) {
+                                unsigned char *open_out, const gk_allocator *alloc, gk_err *err) {
     double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL}, c2 = radius * radius,
            half = radius / (2.0 * sqrt(2.0)), *cand = NULL, *poly = NULL;
-    int nb[2], k, p, nbin, cap = 0, nopen = 0, *lab = NULL;
+    int nb[2], k, p, nbin, cap = 0, *lab = NULL;
     int32_t *head, *next;
     unsigned char *use = NULL;
     gk_allocator al;
@@ -1578,7 +1579,7 @@ static gk_result gk__hy_cundall(int n, const double *const X[2], const double *c
                 else
                     open = 1;
             }
-            nopen += open;
+            if (open_out) open_out[p] = (unsigned char)open;
         }
         for (c = 0; c < nc; ++c) {
             const double *dX = cand + 4 * c, *du = dX + 2;
@@ -1610,7 +1611,6 @@ static gk_result gk__hy_cundall(int n, const double *const X[2], const double *c
             eps[4 * p + 3] = sqrt(2.0 * (d0 * d0 + d1 * d1 + 2.0 * exy * exy));
         }
     }
-    if (open_cells) *open_cells = nopen;
     gk_free(&al, head);
     gk_free(&al, next);
     gk_free(&al, cand);
@@ -1628,8 +1628,8 @@ GKDEF gk_result gk_hybrid_cundall(int n, const double *const X[2], const double 
 
 GKDEF gk_result gk_hybrid_cundall_delaunay(int n, const double *const X[2], const double *const x[2],
                                            const double period[2], double reach, double *eps, int *neighbours,
-                                           int *open_cells, const gk_allocator *alloc, gk_err *err) {
-    return gk__hy_cundall(n, X, x, period, reach, 1, eps, neighbours, open_cells, alloc, err);
+                                           unsigned char *open, const gk_allocator *alloc, gk_err *err) {
+    return gk__hy_cundall(n, X, x, period, reach, 1, eps, neighbours, open, alloc, err);
 }
 
 /* ---------------------------------------------------------- band thickness */

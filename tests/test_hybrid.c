@@ -669,16 +669,37 @@ static int delaunay_edge(int n, const double *x, const double *y, int i, int j) 
     return 0;
 }
 
+static int cmp_double(const void *a, const void *b) {
+    double u = *(const double *)a, v = *(const double *)b;
+    return (u > v) - (u < v);
+}
+
+/* grain i is a vertex of the convex hull of the n points: the directions to the others leave a gap
+   wider than pi */
+static int hull_vertex(int n, const double *x, const double *y, int i) {
+    double a[256], gap;
+    int k, m = 0;
+    for (k = 0; k < n && m < 256; ++k)
+        if (k != i) a[m++] = atan2(y[k] - y[i], x[k] - x[i]);
+    qsort(a, (size_t)m, sizeof a[0], cmp_double);
+    gap = a[0] + 2.0 * GK_PI - a[m - 1];
+    for (k = 1; k < m; ++k)
+        if (a[k] - a[k - 1] > gap) gap = a[k] - a[k - 1];
+    return gap > GK_PI;
+}
+
 /* App. A's neighbours: gk_hybrid_cundall_delaunay against the brute-force
  * triangulation of a jittered grid (every grain at least two spacings
  * inside: the same neighbour count, and the least-squares grad u of eq
  * A.1 over exactly those neighbours), exact for affine motion, open cells
- * only on the free surface, none across a periodic seam. */
+ * on every hull grain and only in the outer ring, none across a periodic
+ * seam. */
 TEST(cundall_delaunay_neighbours) {
     enum { NX = 16, NY = 12, N = NX * NY };
     double X0[N], X1[N], x0[N], x1[N], eps[4 * N], s = 1e-3, period[2] = {NX * 1e-3, 0.0};
     const double *X[2] = {X0, X1}, *x[2] = {x0, x1};
-    int nnb[N], p, q, open = -1, inner = 0;
+    int nnb[N], p, q, nopen = 0, inner = 0;
+    unsigned char open[N];
     gk_rng rng;
     gk_err e;
     gk_rng_seed(&rng, 5);
@@ -688,8 +709,15 @@ TEST(cundall_delaunay_neighbours) {
         x0[p] = X0[p] + 1e-5 * gk_rng_normal(&rng); /* a non-affine motion */
         x1[p] = X1[p] + 1e-5 * gk_rng_normal(&rng);
     }
-    CHECK(gk_hybrid_cundall_delaunay(N, X, x, NULL, 4.0 * s, eps, nnb, &open, NULL, &e) == GK_OK);
-    CHECK(open > 0 && open <= 2 * (NX + NY)); /* the outer ring's cells stay open, no inner one */
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, NULL, 4.0 * s, eps, nnb, open, NULL, &e) == GK_OK);
+    for (p = 0; p < N; ++p) { /* a hull grain's cell is unbounded; an inner one's closes within a spacing */
+        int i = p % NX, j = p / NX, ring = i == 0 || j == 0 || i == NX - 1 || j == NY - 1;
+        CHECK(open[p] <= 1);
+        if (hull_vertex(N, X0, X1, p)) CHECK(open[p] == 1);
+        if (!ring) CHECK(open[p] == 0);
+        nopen += open[p];
+    }
+    CHECK(nopen >= 4);
     for (p = 0; p < N; ++p) {
         int i = p % NX, j = p / NX, cnt = 0;
         double A[3] = {0.0, 0.0, 0.0}, B[4] = {0.0, 0.0, 0.0, 0.0}, det, g[4];
@@ -723,23 +751,26 @@ TEST(cundall_delaunay_neighbours) {
         x0[p] -= period[0] * floor(x0[p] / period[0]);
         x1[p] = X1[p] - 0.02 * X1[p];
     }
-    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 4.0 * s, eps, nnb, &open, NULL, &e) == GK_OK);
-    CHECK(open > 0 && open <= 2 * NX);
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 4.0 * s, eps, nnb, open, NULL, &e) == GK_OK);
+    nopen = 0;
     for (p = 0; p < N; ++p) {
+        if (p / NX != 0 && p / NX != NY - 1) CHECK(open[p] == 0);
+        nopen += open[p];
         CHECK(nnb[p] >= 3);
         CHECK_NEAR(eps[4 * p], 0.0, 1e-12);
         CHECK_NEAR(eps[4 * p + 1], -0.02, 1e-12);
         CHECK_NEAR(eps[4 * p + 2], 0.1, 1e-12);
     }
+    CHECK(nopen >= 2); /* the top and bottom rows' extremes at least */
     /* refused, nothing written */
-    open = -7;
+    open[0] = 7;
     nnb[0] = -7;
     eps[0] = -7.0;
-    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 0.0, eps, nnb, &open, NULL, &e) == GK_ERR_ARG);
-    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 6.0 * s, eps, nnb, &open, NULL, &e) == GK_ERR_ARG);
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 0.0, eps, nnb, open, NULL, &e) == GK_ERR_ARG);
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 6.0 * s, eps, nnb, open, NULL, &e) == GK_ERR_ARG);
     x0[3] = NAN;
-    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 4.0 * s, eps, nnb, &open, NULL, &e) == GK_ERR_NAN);
-    CHECK(open == -7 && nnb[0] == -7 && eps[0] == -7.0);
+    CHECK(gk_hybrid_cundall_delaunay(N, X, x, period, 4.0 * s, eps, nnb, open, NULL, &e) == GK_ERR_NAN);
+    CHECK(open[0] == 7 && nnb[0] == -7 && eps[0] == -7.0);
 }
 
 /* ================================================================ band thickness

@@ -256,14 +256,26 @@ TEST(hybrid_biaxial_dem_loads) {
     CHECK(gk_test_file_has(BUILD "/tests/t_hyB/grains_end.vtk", "POINTS"));
 }
 
+/* the open-cell count and the number of grains the band's percentile was taken over, from a run's
+ * output */
+static void band_counts(const char *path, int *open, int *total, int *ranked) {
+    FILE *fp = fopen(path, "r");
+    char line[1024];
+    *open = *total = *ranked = -1;
+    while (fp && fgets(line, sizeof line, fp)) {
+        const char *s = strstr(line, "percentile of ");
+        sscanf(line, "Cundall strain over Delaunay neighbours: %d of %d", open, total);
+        if (strncmp(line, "band (", 6) == 0 && s) sscanf(s, "percentile of %d", ranked);
+    }
+    if (fp) fclose(fp);
+}
+
 /* --delaunay (App. A's neighbours for Cundall's strain) changes the band measurement and nothing
  * else: the same CSV, a band, and the grains on the specimen's free sides are counted as open
- * cells (some, not all) */
+ * cells (some, not all); --interior ranks only the others */
 TEST(hybrid_delaunay_changes_only_the_band) {
-    FILE *fp;
-    char line[1024];
-    int open = -1, total = -1;
-    system("rm -rf " BUILD "/tests/t_hyD0 " BUILD "/tests/t_hyD1");
+    int open = -1, total = -1, ranked = -1, open2 = -1, total2 = -1, ranked2 = -1;
+    system("rm -rf " BUILD "/tests/t_hyD0 " BUILD "/tests/t_hyD1 " BUILD "/tests/t_hyD2");
     CHECK(system(BIAXIAL "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
                          "--out " BUILD "/tests/t_hyD0 > " BUILD "/tests/t_hyD0.out 2>&1") == 0);
     CHECK(system(BIAXIAL_SPEC "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
@@ -271,12 +283,20 @@ TEST(hybrid_delaunay_changes_only_the_band) {
                               "/tests/t_hyD1.out 2>&1") == 0);
     CHECK(same_but_seconds(BUILD "/tests/t_hyD0/hybrid.csv", BUILD "/tests/t_hyD1/hybrid.csv"));
     CHECK(gk_test_result(BUILD "/tests/t_hyD1.out", "band_thickness_D50") > 0.0);
-    fp = fopen(BUILD "/tests/t_hyD1.out", "r");
-    while (fp && fgets(line, sizeof line, fp))
-        sscanf(line, "Cundall strain over Delaunay neighbours: %d of %d", &open, &total);
-    if (fp) fclose(fp);
+    band_counts(BUILD "/tests/t_hyD1.out", &open, &total, &ranked);
     CHECK(open > 0 && total > 100 && open < total / 2);
+    CHECK_EQ_INT(ranked, total);
+    CHECK(system(BIAXIAL_SPEC "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
+                              "--interior --out " BUILD "/tests/t_hyD2 > " BUILD
+                              "/tests/t_hyD2.out 2>&1") == 0);
+    CHECK(same_but_seconds(BUILD "/tests/t_hyD0/hybrid.csv", BUILD "/tests/t_hyD2/hybrid.csv"));
+    CHECK(gk_test_result(BUILD "/tests/t_hyD2.out", "band_thickness_D50") > 0.0);
+    band_counts(BUILD "/tests/t_hyD2.out", &open2, &total2, &ranked2);
+    CHECK(open2 == open && total2 == total);
+    CHECK_EQ_INT(ranked2, total - open);
+    CHECK(gk_test_file_has(BUILD "/tests/t_hyD2.out", "(open cells), left out"));
     CHECK(refused("--test planar --mode continuum --delaunay", "--delaunay measures grains"));
+    CHECK(refused("--test planar --mode continuum --interior", "--interior measures grains"));
 }
 
 /* continuum mode, biaxial: MPM only, never enriched, starts at the confining pressure */
