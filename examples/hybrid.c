@@ -78,7 +78,10 @@
  *              Delaunay neighbours as the paper (--delaunay; the reduced
  *              bands move by up to 6.4 D50, in no consistent direction:
  *              examples/README.md), then the top --percentile (or the
- *              --band-grains N largest) in a minimum-area box.
+ *              --band-grains N largest) in a minimum-area box;
+ *              --interior ranks only grains whose Voronoi cell closes (not
+ *              the one-sided fits at the membranes, platens or the zone's
+ *              edge).
  *
  * THE CODE. This file holds the manual and main (set-up, the loop of
  * steps, the outputs). The rest is in five headers, each including the one
