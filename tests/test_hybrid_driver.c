@@ -274,26 +274,29 @@ static void band_counts(const char *path, int *open, int *total, int *ranked) {
  * else: the same CSV, a band, and the grains on the specimen's free sides are counted as open
  * cells (some, not all); --interior ranks only the others */
 TEST(hybrid_delaunay_changes_only_the_band) {
-    int open = -1, total = -1, ranked = -1, open2 = -1, total2 = -1, ranked2 = -1;
+    const char *flag[2] = {"--delaunay", "--interior"};
+    char cmd[512], out[64];
+    int k, open[2] = {-1, -1}, total[2] = {-1, -1}, ranked[2] = {-1, -1};
     system("rm -rf " BUILD "/tests/t_hyD0 " BUILD "/tests/t_hyD1 " BUILD "/tests/t_hyD2");
     CHECK(system(BIAXIAL "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
                          "--out " BUILD "/tests/t_hyD0 > " BUILD "/tests/t_hyD0.out 2>&1") == 0);
-    CHECK(system(BIAXIAL_SPEC "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
-                              "--delaunay --out " BUILD "/tests/t_hyD1 > " BUILD
-                              "/tests/t_hyD1.out 2>&1") == 0);
-    CHECK(same_but_seconds(BUILD "/tests/t_hyD0/hybrid.csv", BUILD "/tests/t_hyD1/hybrid.csv"));
-    CHECK(gk_test_result(BUILD "/tests/t_hyD1.out", "band_thickness_D50") > 0.0);
-    band_counts(BUILD "/tests/t_hyD1.out", &open, &total, &ranked);
-    CHECK(open > 0 && total > 100 && open < total / 2);
-    CHECK_EQ_INT(ranked, total);
-    CHECK(system(BIAXIAL_SPEC "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
-                              "--interior --out " BUILD "/tests/t_hyD2 > " BUILD
-                              "/tests/t_hyD2.out 2>&1") == 0);
-    CHECK(same_but_seconds(BUILD "/tests/t_hyD0/hybrid.csv", BUILD "/tests/t_hyD2/hybrid.csv"));
-    CHECK(gk_test_result(BUILD "/tests/t_hyD2.out", "band_thickness_D50") > 0.0);
-    band_counts(BUILD "/tests/t_hyD2.out", &open2, &total2, &ranked2);
-    CHECK(open2 == open && total2 == total);
-    CHECK_EQ_INT(ranked2, total - open);
+    for (k = 0; k < 2; ++k) {
+        snprintf(out, sizeof out, BUILD "/tests/t_hyD%d", k + 1);
+        snprintf(cmd, sizeof cmd,
+                 BIAXIAL_SPEC "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
+                              "%s --out %s > %s.out 2>&1",
+                 flag[k], out, out);
+        CHECK(system(cmd) == 0);
+        snprintf(cmd, sizeof cmd, "%s/hybrid.csv", out);
+        CHECK(same_but_seconds(BUILD "/tests/t_hyD0/hybrid.csv", cmd));
+        snprintf(cmd, sizeof cmd, "%s.out", out);
+        CHECK(gk_test_result(cmd, "band_thickness_D50") > 0.0);
+        band_counts(cmd, &open[k], &total[k], &ranked[k]);
+    }
+    CHECK(open[0] > 0 && total[0] > 100 && open[0] < total[0] / 2);
+    CHECK_EQ_INT(ranked[0], total[0]);
+    CHECK(open[1] == open[0] && total[1] == total[0]);
+    CHECK_EQ_INT(ranked[1], total[0] - open[0]);
     CHECK(gk_test_file_has(BUILD "/tests/t_hyD2.out", "(open cells), left out"));
     CHECK(refused("--test planar --mode continuum --delaunay", "--delaunay measures grains"));
     CHECK(refused("--test planar --mode continuum --interior", "--interior measures grains"));
