@@ -196,10 +196,11 @@ static int band_measure(run *R, double *thick_D50, int *count) {
         x[0] = (double *)malloc((size_t)n * sizeof(double));
         x[1] = (double *)malloc((size_t)n * sizeof(double));
         eps = (double *)malloc(4 * (size_t)n * sizeof(double));
-        open = (unsigned char *)malloc((size_t)n);
+        if (R->o.delaunay) open = (unsigned char *)malloc((size_t)n); /* the open-cell flags */
     }
     if (!xy || !val || !px || !py ||
-        (R->band_on_grains && (!half || !X[0] || !X[1] || !x[0] || !x[1] || !eps || !open))) {
+        (R->band_on_grains &&
+         (!half || !X[0] || !X[1] || !x[0] || !x[1] || !eps || (R->o.delaunay && !open)))) {
         bad = fprintf(stderr, "error: out of memory\n");
         goto done;
     }
