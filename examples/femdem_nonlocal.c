@@ -22,14 +22,13 @@
  *   20 steps (--dem-max); --paper takes the paper's 4096-sphere packing
  *   (12.8 mm cell) and the I_uf rule everywhere (--dem-max 4000). The cost
  *   of a coarse step is about (Gauss points) x (DEM steps per run) x
- *   (spheres) particle-steps at ~150 ns each (one core, measured as CPU
- *   time on the simple shear: 0.090 s per coarse step with the 20-step cap,
- *   4.2 s with --paper where the runs take 97-138 DEM steps to reach I_uf <
- *   0.01; these CPU times were taken on a loaded shared machine and are
- *   indicative). Measured: the default simple shear to 20 % (4000 steps)
- *   791 s on 2 threads, the 20-step cap to 10 % 188 s on one thread;
- *   with --paper to 20 % 5147 s on 2 threads and 8415 s of CPU, 2.1 s per
- *   coarse step (4.4e7 DEM steps; the runs' mean per coarse step 87-640,
+ *   (spheres) particle-steps at about 60 ns each (CPU time, AVX-512, no
+ *   other job running: 69 ns with the 20-step cap, 61 ns by default, 57 ns
+ *   with --paper). Measured alike: the default simple shear to 20 % (4000
+ *   steps) 732 s on 2 threads (4.7e7 DEM steps), the 20-step cap to 10 %
+ *   76 s on one thread (0.038 s per coarse step); with --paper to 20 %
+ *   5139 s on 2 threads (10182 s of CPU with the threads' waits, 2.5 s per
+ *   coarse step; 4.4e7 DEM steps; the runs' mean per coarse step 87-640,
  *   median 114, to 18 %, up to 1580 near 20 %, where the column rings; the
  *   paper reports 22 h CPU for its run). dem_steps_mean in the CSV gives
  *   the DEM steps per run.
@@ -71,7 +70,7 @@
  *     --xi 0.3) the shear element is 6.4 % off (peaks 1.061). 4-6 min each
  *     on one core.
  *   simple-shear (Figs 9-14, default: 512 spheres, 5x12x1, local, 4000
- *     steps to 20 %, eq 57's rule in every DEM run; 791 s on 2 threads,
+ *     steps to 20 %, eq 57's rule in every DEM run; 732 s on 2 threads,
  *     the runs' mean 90-500 DEM steps): shear stress, means over 2 %
  *     windows, 260 kPa at 1-3 %, 238 at 4-6 %, 214 at 6-8 %, 192 at 8-10
  *     %, 177 at 10-12 % and 174-182 from 12 to 20 % (the peak, RESULT's
@@ -100,9 +99,9 @@
  *     --steps 2000, 1091 s on 2 threads) soften a little later (1 % windows
  *     at 5-6 %: 241 kPa against 231) and put the band in the same row (52 %
  *     of the displacement at 10 %). The paper's 4096-sphere RVEs (--paper)
- *     keep the stress level from 1 to 6 % (265-270 kPa in 1 % windows,
+ *     keep the stress level from 1 to 6 % (264-270 kPa in 1 % windows,
  *     RESULT's peak 272 kPa at 3.4 %), soften it from 6 to 12 % (257 kPa at
- *     6-7 %, 233 at 8-9 %, 194 at 11-12 %) and hold 170-190 kPa to 20 %: the
+ *     6-7 %, 233 at 8-9 %, 194 at 11-12 %) and hold 167-190 kPa to 20 %: the
  *     paper's plateau, its drop spread over 6-12 %. They form two bands, one
  *     row each: 34 mm (0.53 at 12 %, RESULT's band, 37 % of the displacement)
  *     and 84 mm, the row below the imperfect one (0.31), which stays at 0.04;
