@@ -275,7 +275,7 @@ static void band_counts(const char *path, int *open, int *total, int *ranked) {
  * cells (some, not all); --interior ranks only the others */
 TEST(hybrid_delaunay_changes_only_the_band) {
     const char *flag[2] = {"--delaunay", "--interior"};
-    char cmd[512], out[64];
+    char cmd[512], out[64], path[80];
     int k, open[2] = {-1, -1}, total[2] = {-1, -1}, ranked[2] = {-1, -1};
     system("rm -rf " BUILD "/tests/t_hyD0 " BUILD "/tests/t_hyD1 " BUILD "/tests/t_hyD2");
     CHECK(system(BIAXIAL "--mode dem --strain 0.003 --out-every 0.001 --window 0.001 0.003 --threads 1 "
@@ -287,11 +287,11 @@ TEST(hybrid_delaunay_changes_only_the_band) {
                               "%s --out %s > %s.out 2>&1",
                  flag[k], out, out);
         CHECK(system(cmd) == 0);
-        snprintf(cmd, sizeof cmd, "%s/hybrid.csv", out);
-        CHECK(same_but_seconds(BUILD "/tests/t_hyD0/hybrid.csv", cmd));
-        snprintf(cmd, sizeof cmd, "%s.out", out);
-        CHECK(gk_test_result(cmd, "band_thickness_D50") > 0.0);
-        band_counts(cmd, &open[k], &total[k], &ranked[k]);
+        snprintf(path, sizeof path, "%s/hybrid.csv", out);
+        CHECK(same_but_seconds(BUILD "/tests/t_hyD0/hybrid.csv", path));
+        snprintf(path, sizeof path, "%s.out", out);
+        CHECK(gk_test_result(path, "band_thickness_D50") > 0.0);
+        band_counts(path, &open[k], &total[k], &ranked[k]);
     }
     CHECK(open[0] > 0 && total[0] > 100 && open[0] < total[0] / 2);
     CHECK_EQ_INT(ranked[0], total[0]);
